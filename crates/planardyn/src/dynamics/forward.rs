@@ -1,0 +1,98 @@
+//! Forward dynamics, the paper's eq. 29-31 in the workspace's chart z:
+//!   positions -> analogues U -> convective term c -> forces f -> A = U^T M U,
+//!   b = U^T (f - M c) -> zdd = A^-1 b -> xdd = U zdd + c, qdd.
+
+use super::forces::{applied_forces, Drives};
+use crate::kinematics::constraints::{coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_rate};
+use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
+use crate::linalg::{cholesky_in_place, cholesky_solve};
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::{Error, KinematicsError};
+
+/// Diagonal entry i of M = blockdiag(m, m, I).
+#[inline]
+fn mass_diag(mech: &Mechanism, i: usize) -> f64 {
+    let b = &mech.bodies[i / 3];
+    if i % 3 == 2 { b.inertia } else { b.mass }
+}
+
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`.
+pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
+    let n = ws.x.len();
+    let m = ws.b.len();
+    for j in 0..m {
+        for k in j..m {
+            let (uj, uk) = (&ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n]);
+            let s: f64 = (0..n).map(|i| mass_diag(mech, i) * uj[i] * uk[i]).sum();
+            ws.a[j * m + k] = s;
+            ws.a[k * m + j] = s;
+        }
+    }
+}
+
+/// b = U^T (f - M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
+pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
+    let n = ws.x.len();
+    for (j, bj) in ws.b.iter_mut().enumerate() {
+        let uj = &ws.u[j * n..(j + 1) * n];
+        *bj = (0..n).map(|i| uj[i] * (ws.f[i] - mass_diag(mech, i) * ws.c[i])).sum();
+    }
+}
+
+/// The user's coordinates, rates (and, with `xdd` filled, accelerations) from x, xd, xdd.
+fn user_coordinates(mech: &Mechanism, ws: &mut Workspace, with_accelerations: bool) {
+    coordinates(mech, &ws.x, &mut ws.q);
+    coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
+    if with_accelerations {
+        for (k, c) in mech.coordinates.iter().enumerate() {
+            let p = &mech.pairs[c.pair.0];
+            ws.qdd[k] = pair_coordinate_rate(p, &ws.x, &ws.xdd) + pair_coordinate_gamma(p, &ws.x, &ws.xd, &ws.xd);
+        }
+    }
+}
+
+/// Positions, analogues and the convective term at chart coordinates z, zd (`ws.x` is the
+/// Newton start), then the user's coordinates q and rates qd.
+pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    solve_position(mech, z, ws)?;
+    velocity_analogues(ws)?;
+    convective(mech, zd, ws);
+    user_coordinates(mech, ws, false);
+    Ok(())
+}
+
+/// One forward-dynamics evaluation at time t (s) and chart state (z, zd): fills every
+/// buffer of `ws`; the chart accelerations zdd are left in `ws.b`, the user's in `ws.qdd`.
+pub fn forward(mech: &Mechanism, t: f64, z: &[f64], zd: &[f64], drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
+    kinematic_stages(mech, z, zd, ws)?;
+    drives.efforts(t, &ws.q, &ws.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
+    if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Drive { t, message: format!("effort {bad} is {}", ws.tau[bad]) });
+    }
+    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    mass_matrix(mech, ws);
+    bias(mech, ws);
+    let m = ws.b.len();
+    if !cholesky_in_place(&mut ws.a, m) {
+        return Err(KinematicsError::Singular {
+            sigma_min: 0.0,
+            what: match ws.chart {
+                Chart::Inputs => "the mass matrix A is not positive definite (type II singularity)".into(),
+                Chart::Partition(_) => "the mass matrix A is not positive definite".into(),
+            },
+        }
+        .into());
+    }
+    cholesky_solve(&ws.a, m, &mut ws.b);
+    let n = ws.x.len();
+    ws.xdd.copy_from_slice(&ws.c);
+    for j in 0..m {
+        let zdd = ws.b[j];
+        for (a, u) in ws.xdd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
+            *a += u * zdd;
+        }
+    }
+    user_coordinates(mech, ws, true);
+    Ok(())
+}

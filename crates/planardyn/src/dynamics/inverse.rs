@@ -1,0 +1,28 @@
+//! Inverse dynamics: the drive efforts a motion needs, tau = A qdd - U^T (f - M c), with f
+//! the applied forces without drives (formulation.md). Defined only where the user's
+//! coordinates determine the mechanism (away from type II singularities).
+
+use super::forces::applied_forces;
+use super::forward::{bias, kinematic_stages, mass_matrix};
+use crate::kinematics::Chart;
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::KinematicsError;
+
+/// Drive efforts (N m or N) into `ws.tau` for user coordinates q, rates qd and accelerations
+/// qdd, starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
+/// distant q).
+pub fn inverse(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    ws.chart = Chart::Inputs;
+    kinematic_stages(mech, q, qd, ws)?;
+    ws.tau.fill(0.0);
+    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    mass_matrix(mech, ws);
+    bias(mech, ws);
+    let m = q.len();
+    for j in 0..m {
+        ws.tau[j] = (0..m).map(|k| ws.a[j * m + k] * qdd[k]).sum::<f64>() - ws.b[j];
+    }
+    ws.qdd.copy_from_slice(qdd);
+    Ok(())
+}

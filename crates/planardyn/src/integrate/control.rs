@@ -1,0 +1,341 @@
+//! Pieces shared by the integrators: the state common to all of them ([`Core`]),
+//! Hairer's error norm, the automatic initial step, the step-size controller and
+//! the step loop of the explicit embedded pairs (Dopri5, Dop853).
+//!
+//! Reference: E. Hairer, S. P. Nørsett, G. Wanner, *Solving ODE I*, 2nd ed.,
+//! II.4 ("Automatic step size control", "Starting step size"); scipy
+//! `integrate/_ivp/common.py` (`norm`, `select_initial_step`) and `rk.py`
+//! (`RungeKutta._step_impl`), whose constants are used here.
+
+use super::{OdeSystem, Options, StepError, Stats};
+
+/// Safety factor of the step-size controller.
+pub(crate) const SAFETY: f64 = 0.9;
+/// Smallest factor by which a rejected step is shrunk by the error control.
+pub(crate) const MIN_FACTOR: f64 = 0.2;
+/// Largest factor by which an accepted step may grow.
+pub(crate) const MAX_FACTOR: f64 = 10.0;
+/// Factor by which the step is shrunk after a failed `rhs` or a NaN/inf.
+pub(crate) const FAIL_FACTOR: f64 = 0.25;
+
+/// Why a trial step was rejected without an error estimate.
+pub(crate) enum Failure<E> {
+    /// `rhs` returned an error.
+    Rhs(E),
+    /// NaN or infinity in a stage or in the new state.
+    NonFinite,
+    /// Radau5: the simplified Newton iteration did not converge.
+    Newton,
+}
+
+impl<E> Failure<E> {
+    /// The error to return when the step cannot shrink any more.
+    pub(crate) fn into_error(self, t: f64, h: f64) -> StepError<E> {
+        match self {
+            Failure::Rhs(error) => StepError::Rhs { t, error },
+            Failure::NonFinite => StepError::NonFinite { t },
+            Failure::Newton => StepError::StepSizeUnderflow { t, h },
+        }
+    }
+}
+
+/// State that every stepper keeps: the current and previous point, the
+/// derivative at both, the proposed next step and the counters.
+pub(crate) struct Core {
+    pub(crate) opts: Options,
+    pub(crate) n: usize,
+    /// Current time (s) and the start of the last accepted step.
+    pub(crate) t: f64,
+    pub(crate) t_prev: f64,
+    /// State and derivative at `t` and at `t_prev` (length `n`).
+    pub(crate) y: Vec<f64>,
+    pub(crate) f: Vec<f64>,
+    pub(crate) y_prev: Vec<f64>,
+    pub(crate) f_prev: Vec<f64>,
+    /// Next trial step (s); 0 after `reset` (then chosen on the first step).
+    pub(crate) h_next: f64,
+    pub(crate) stats: Stats,
+    pub(crate) started: bool,
+}
+
+impl Core {
+    pub(crate) fn new(opts: &Options, n: usize) -> Self {
+        Core {
+            opts: opts.clone(),
+            n,
+            t: 0.0,
+            t_prev: 0.0,
+            y: vec![0.0; n],
+            f: vec![0.0; n],
+            y_prev: vec![0.0; n],
+            f_prev: vec![0.0; n],
+            h_next: 0.0,
+            stats: Stats::default(),
+            started: false,
+        }
+    }
+
+    /// Set the state to (t, y) and evaluate f(t, y).
+    pub(crate) fn reset<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), StepError<S::Error>> {
+        assert_eq!(y.len(), self.n, "Stepper::reset: y has the wrong length");
+        self.started = false;
+        if !t.is_finite() || !all_finite(y) {
+            return Err(StepError::NonFinite { t });
+        }
+        self.y.copy_from_slice(y);
+        self.stats.nfev += 1;
+        sys.rhs(t, &self.y, &mut self.f)
+            .map_err(|error| StepError::Rhs { t, error })?;
+        if !all_finite(&self.f) {
+            return Err(StepError::NonFinite { t });
+        }
+        self.t = t;
+        self.t_prev = t;
+        self.y_prev.copy_from_slice(&self.y);
+        self.f_prev.copy_from_slice(&self.f);
+        self.h_next = 0.0;
+        self.started = true;
+        Ok(())
+    }
+
+    /// Evaluate `rhs`, counting it, and map an error to a [`Failure`].
+    pub(crate) fn eval<S: OdeSystem>(
+        stats: &mut Stats,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        dy: &mut [f64],
+    ) -> Result<(), Failure<S::Error>> {
+        stats.nfev += 1;
+        sys.rhs(t, y, dy).map_err(Failure::Rhs)?;
+        if all_finite(dy) {
+            Ok(())
+        } else {
+            Err(Failure::NonFinite)
+        }
+    }
+
+    /// Smallest allowed trial step at the current time (s), see [`Options::h_min`].
+    pub(crate) fn h_min(&self) -> f64 {
+        let ulp = (self.t.abs() * f64::EPSILON).max(f64::MIN_POSITIVE);
+        (self.opts.h_min * self.t.abs().max(1.0)).max(10.0 * ulp)
+    }
+
+    /// Err when the attempt budget is used up.
+    pub(crate) fn check_budget<E>(&self) -> Result<(), StepError<E>> {
+        let steps = self.stats.naccept + self.stats.nreject;
+        if steps >= self.opts.max_steps {
+            Err(StepError::TooManySteps { t: self.t, steps })
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Clip a trial step `h` to `h_max` and to end exactly on `t_stop`; returns
+    /// `(h, t_new)`. A step within `stretch` (relative) of `t_stop` is stretched
+    /// to land on it, as in Hairer's codes (1 % for adaptive steps).
+    pub(crate) fn clip(&self, h: f64, t_stop: f64, stretch: f64) -> (f64, f64) {
+        let h = h.min(self.opts.h_max);
+        if self.t + h * (1.0 + stretch) >= t_stop {
+            (t_stop - self.t, t_stop)
+        } else {
+            (h, self.t + h)
+        }
+    }
+
+    /// Make (t_new, y_new, f_new) the current point; the old one becomes the
+    /// previous point. Buffers are swapped, not copied: `y_new`/`f_new` receive
+    /// the stale previous-point buffers.
+    pub(crate) fn accept(&mut self, t_new: f64, y_new: &mut Vec<f64>, f_new: &mut Vec<f64>) {
+        std::mem::swap(&mut self.y_prev, &mut self.y);
+        std::mem::swap(&mut self.y, y_new);
+        std::mem::swap(&mut self.f_prev, &mut self.f);
+        std::mem::swap(&mut self.f, f_new);
+        self.t_prev = self.t;
+        self.t = t_new;
+        self.stats.naccept += 1;
+    }
+
+    /// Panic with a clear message when `step` is called before `reset`.
+    pub(crate) fn assert_started(&self) {
+        assert!(
+            self.started,
+            "Stepper::step called before a successful Stepper::reset"
+        );
+    }
+}
+
+pub(crate) fn all_finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// Hairer's RMS norm of `err` scaled by `sc_i = atol + rtol * max(|y_i|, |ynew_i|)`.
+pub(crate) fn error_norm(err: &[f64], y: &[f64], y_new: &[f64], opts: &Options) -> f64 {
+    let n = err.len().max(1) as f64;
+    let sum: f64 = err
+        .iter()
+        .zip(y.iter().zip(y_new))
+        .map(|(e, (a, b))| {
+            let sc = opts.atol + opts.rtol * a.abs().max(b.abs());
+            (e / sc).powi(2)
+        })
+        .sum();
+    (sum / n).sqrt()
+}
+
+/// RMS norm of `v_i / (atol + rtol |y_i|)`.
+fn scaled_norm(v: &[f64], y: &[f64], opts: &Options) -> f64 {
+    error_norm(v, y, y, opts)
+}
+
+/// Hairer's automatic initial step (HNW I, II.4, p. 169; scipy `select_initial_step`)
+/// for a method whose error estimate is of order `order`, bounded by `t_stop - t`
+/// and `h_max`. Uses `y1`, `f1` as scratch and one `rhs` evaluation; if that
+/// evaluation fails, the first guess `h0` is returned.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn initial_step<S: OdeSystem>(
+    sys: &mut S,
+    core: &mut Core,
+    t_stop: f64,
+    order: usize,
+    y1: &mut [f64],
+    f1: &mut [f64],
+) -> f64 {
+    let (t, opts) = (core.t, &core.opts);
+    let interval = (t_stop - t).max(0.0);
+    if core.n == 0 {
+        return interval.min(opts.h_max);
+    }
+    let d0 = scaled_norm(&core.y, &core.y, opts);
+    let d1 = scaled_norm(&core.f, &core.y, opts);
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    let h0 = h0.min(interval).min(opts.h_max);
+    for i in 0..core.n {
+        y1[i] = core.y[i] + h0 * core.f[i];
+    }
+    core.stats.nfev += 1;
+    if sys.rhs(t + h0, y1, f1).is_err() || !all_finite(f1) {
+        return h0;
+    }
+    for i in 0..core.n {
+        f1[i] -= core.f[i];
+    }
+    let d2 = scaled_norm(f1, &core.y, opts) / h0;
+    let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
+    };
+    (100.0 * h0).min(h1).min(interval).min(opts.h_max)
+}
+
+/// Step factor after an accepted step with error norm `err <= 1` (scipy `rk.py`):
+/// `min(MAX_FACTOR, SAFETY * err^(-1/(q+1)))`, not above 1 right after a rejection.
+pub(crate) fn factor_accept(err: f64, error_order: usize, after_reject: bool) -> f64 {
+    let mut factor = if err == 0.0 {
+        MAX_FACTOR
+    } else {
+        (SAFETY * err.powf(-1.0 / (error_order as f64 + 1.0))).min(MAX_FACTOR)
+    };
+    if after_reject {
+        factor = factor.min(1.0);
+    }
+    factor
+}
+
+/// Step factor after a rejected step with error norm `err > 1`.
+pub(crate) fn factor_reject(err: f64, error_order: usize) -> f64 {
+    (SAFETY * err.powf(-1.0 / (error_order as f64 + 1.0))).max(MIN_FACTOR)
+}
+
+/// An explicit embedded Runge-Kutta pair, driven by [`explicit_step`].
+pub(crate) trait ExplicitPair {
+    /// Order of the error estimate (the exponent is `-1/(ERROR_ORDER + 1)`).
+    const ERROR_ORDER: usize;
+    fn core(&mut self) -> &mut Core;
+    /// Scratch vectors of length `n` for the initial-step selection.
+    fn scratch(&mut self) -> (&mut Core, &mut [f64], &mut [f64]);
+    /// Try a step of size `h` from the current point: fill the new state and
+    /// derivative and return the error norm.
+    fn attempt<S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<f64, Failure<S::Error>>;
+    /// Accept the tried step, ending at `t_new` (dense output, then `Core::accept`).
+    fn accept<S: OdeSystem>(&mut self, sys: &mut S, t_new: f64);
+}
+
+/// One accepted step of an explicit pair: retry with smaller steps after an
+/// error estimate above 1 (factor from the controller), an `rhs` failure or a
+/// NaN ([`FAIL_FACTOR`]), until accepted or below `h_min`. With `Options::dt`
+/// the error estimate is ignored and the step is `dt`.
+pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
+    p: &mut P,
+    sys: &mut S,
+    t_stop: f64,
+) -> Result<(), StepError<S::Error>> {
+    let core = p.core();
+    core.assert_started();
+    if t_stop <= core.t {
+        return Ok(());
+    }
+    let fixed = core.opts.dt;
+    let mut h = match fixed {
+        Some(dt) => dt,
+        None if core.h_next > 0.0 => core.h_next,
+        None => match core.opts.h0 {
+            Some(h0) => h0,
+            None => {
+                let (core, y1, f1) = p.scratch();
+                initial_step(sys, core, t_stop, P::ERROR_ORDER, y1, f1)
+            }
+        },
+    };
+    let stretch = if fixed.is_some() { 1e-10 } else { 0.01 };
+    let mut rejected = false;
+    let mut last_failure: Option<Failure<S::Error>> = None;
+    loop {
+        let core = p.core();
+        core.check_budget()?;
+        let (h_try, t_new) = core.clip(h, t_stop, stretch);
+        if h_try < core.h_min() {
+            return Err(match last_failure {
+                Some(failure) => failure.into_error(core.t, h_try),
+                None => StepError::StepSizeUnderflow { t: core.t, h: h_try },
+            });
+        }
+        match p.attempt(sys, h_try) {
+            Ok(err) if fixed.is_some() || err <= 1.0 => {
+                p.accept(sys, t_new);
+                let core = p.core();
+                core.h_next = match fixed {
+                    Some(dt) => dt,
+                    None => h_try * factor_accept(err, P::ERROR_ORDER, rejected),
+                };
+                return Ok(());
+            }
+            Ok(err) => {
+                // NaN error norm counts as non-finite.
+                h = if err.is_finite() {
+                    last_failure = None;
+                    h_try * factor_reject(err, P::ERROR_ORDER)
+                } else {
+                    last_failure = Some(Failure::NonFinite);
+                    h_try * FAIL_FACTOR
+                };
+            }
+            Err(failure) => {
+                last_failure = Some(failure);
+                h = h_try * FAIL_FACTOR;
+            }
+        }
+        rejected = true;
+        p.core().stats.nreject += 1;
+    }
+}

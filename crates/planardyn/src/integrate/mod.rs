@@ -1,0 +1,418 @@
+//! ODE integrators for the equations of motion `y' = f(t, y)`, with `y = (q, qd)`.
+//!
+//! Four one-step methods, one file each:
+//!
+//! | [`Method`] | file | order | step | dense output |
+//! |---|---|---|---|---|
+//! | `Rk4` | [`rk4`] | 4 | fixed `dt` | cubic Hermite (order 3) |
+//! | `Dopri5` | [`dopri5`] | 5(4) | adaptive | quartic (order 4) |
+//! | `Dop853` | [`dop853`] | 8(5,3) | adaptive | degree 7 (order 7) |
+//! | `Radau5` | [`radau5`] | 5, implicit, stiff | adaptive | collocation cubic (order 3) |
+//!
+//! The shared pieces (error norm, initial step, step-size controller, the
+//! explicit-pair step loop) live in `control`; the small LU used by Radau5 in `lu`.
+//!
+//! # Why hand-written
+//!
+//! The crates on crates.io (`ode_solvers`, ...) do not fit a closed-chain simulator:
+//!
+//! 1. The right-hand side can **fail**: evaluating `f` needs the position analysis
+//!    of the closed chain (a Newton solve), which may not converge for a large
+//!    trial step. Here [`OdeSystem::rhs`] returns a `Result`, and an `Err` rejects
+//!    the trial step, which is retried with a smaller one (see [`StepError::Rhs`]).
+//! 2. The driver **switches coordinate charts** between steps (near a singular
+//!    configuration it changes the independent coordinates) and restarts the
+//!    integrator from the new state: [`Stepper::reset`], while the caller keeps
+//!    control of the loop, one [`Stepper::step`] at a time.
+//! 3. **No heap allocation per step**: every buffer is sized in [`Stepper::new`];
+//!    `reset`, `step` and `interpolate` only reuse them (checked by a counting
+//!    allocator in `tests/integrators.rs`).
+//!
+//! # Conventions
+//!
+//! Time `t` in seconds, `y` in the units of the system (rad, m, rad/s, m/s for
+//! mechanisms). Integration runs forward in time only (`t_stop > t`).
+//! Error control uses Hairer's RMS norm, with the scale
+//! `sc_i = atol + rtol * max(|y_i|, |ynew_i|)`; a step is accepted when the
+//! norm of the scaled local error estimate is `<= 1`.
+//!
+//! References: E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential
+//! Equations I* (2nd ed., Springer 1993), II.4-II.6; E. Hairer, G. Wanner,
+//! *Solving Ordinary Differential Equations II* (2nd ed., Springer 1996), IV.8;
+//! scipy's `scipy/integrate/_ivp` (`rk.py`, `radau.py`, `common.py`), whose
+//! structure these implementations follow.
+
+mod control;
+pub mod dop853;
+pub mod dopri5;
+mod lu;
+pub mod radau5;
+pub mod rk4;
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A first-order system y' = f(t, y) whose evaluation may fail.
+pub trait OdeSystem {
+    /// The error of a failed evaluation (for a mechanism: the position analysis
+    /// did not converge). Carried by [`StepError::Rhs`].
+    type Error: Clone + std::fmt::Debug;
+    /// Number of state components (length of `y` and `dy`).
+    fn dim(&self) -> usize;
+    /// Write f(t, y) into dy. An Err makes the integrator reject the step and retry with a smaller one.
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Self::Error>;
+}
+
+/// The integration method, chosen at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Classic fixed-step Runge-Kutta of order 4 (needs [`Options::dt`]).
+    Rk4,
+    /// Dormand-Prince 5(4), adaptive, FSAL.
+    Dopri5,
+    /// Dormand-Prince 8(5,3), adaptive, for tight tolerances.
+    Dop853,
+    /// Radau IIA of order 5, implicit, for stiff systems (stiff springs, dampers).
+    Radau5,
+}
+
+impl Method {
+    /// All methods, in declaration order.
+    pub const ALL: [Method; 4] = [Method::Rk4, Method::Dopri5, Method::Dop853, Method::Radau5];
+
+    /// Classical order of the propagated solution (global error `O(h^order)`).
+    pub fn order(self) -> usize {
+        match self {
+            Method::Rk4 => 4,
+            Method::Dopri5 => 5,
+            Method::Dop853 => 8,
+            Method::Radau5 => 5,
+        }
+    }
+
+    /// Order of the dense output: its local error is `O(h^(dense_order + 1))`.
+    pub fn dense_order(self) -> usize {
+        match self {
+            Method::Rk4 => 3,
+            Method::Dopri5 => 4,
+            Method::Dop853 => 7,
+            Method::Radau5 => 3,
+        }
+    }
+
+    /// True for the methods with local error control (all but `Rk4`).
+    pub fn is_adaptive(self) -> bool {
+        !matches!(self, Method::Rk4)
+    }
+
+    /// True for the implicit (stiffly accurate) methods.
+    pub fn is_implicit(self) -> bool {
+        matches!(self, Method::Radau5)
+    }
+
+    /// The canonical lower-case name, as accepted by `FromStr`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Rk4 => "rk4",
+            Method::Dopri5 => "dopri5",
+            Method::Dop853 => "dop853",
+            Method::Radau5 => "radau5",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = String;
+
+    /// Case-insensitive: "rk4", "dopri5" (or "rk45"), "dop853", "radau5" (or "radau").
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "rk4" => Ok(Method::Rk4),
+            "dopri5" | "rk45" => Ok(Method::Dopri5),
+            "dop853" => Ok(Method::Dop853),
+            "radau5" | "radau" => Ok(Method::Radau5),
+            _ => Err(format!(
+                "unknown integration method {s:?}: use one of \"rk4\", \"dopri5\" (\"rk45\"), \
+                 \"dop853\", \"radau5\" (\"radau\")"
+            )),
+        }
+    }
+}
+
+/// Integrator options. Times in seconds.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Relative tolerance (dimensionless), `> 0`. Default `1e-8`.
+    pub rtol: f64,
+    /// Absolute tolerance (units of `y`), `>= 0`. Default `1e-10`.
+    pub atol: f64,
+    /// First trial step (s). `None`: chosen automatically by Hairer's algorithm
+    /// (HNW I, II.4, as scipy's `select_initial_step`). Default `None`.
+    pub h0: Option<f64>,
+    /// Largest step (s). Default `f64::INFINITY`.
+    pub h_max: f64,
+    /// Smallest step, relative to the time scale: a trial step below
+    /// `h_min * max(|t|, 1 s)` (and never below 10 ulp of `t`) ends the step with
+    /// an error ([`StepError::StepSizeUnderflow`], `Rhs` or `NonFinite`). Default `1e-14`.
+    pub h_min: f64,
+    /// Fixed step (s). Required by `Rk4`. For the adaptive methods, `Some(dt)`
+    /// switches the error control off and steps with `dt` (used to measure the
+    /// order of convergence); a failing `rhs` still halves the trial step.
+    /// Default `None`.
+    pub dt: Option<f64>,
+    /// Largest number of step attempts (accepted plus rejected) since
+    /// [`Stepper::new`]; past it [`StepError::TooManySteps`]. Default `10_000_000`.
+    pub max_steps: usize,
+    /// Compute the full-order dense output at each accepted step. Only `Dop853`
+    /// pays for it (3 extra `rhs` evaluations per step); when `false` its
+    /// [`Stepper::interpolate`] falls back to cubic Hermite. Default `true`.
+    pub dense_output: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            rtol: 1e-8,
+            atol: 1e-10,
+            h0: None,
+            h_max: f64::INFINITY,
+            h_min: 1e-14,
+            dt: None,
+            max_steps: 10_000_000,
+            dense_output: true,
+        }
+    }
+}
+
+impl Options {
+    /// Default options with tolerances `rtol`, `atol`.
+    pub fn tol(rtol: f64, atol: f64) -> Self {
+        Options { rtol, atol, ..Options::default() }
+    }
+
+    /// Default options with a fixed step `dt` (s): no error control, for any method.
+    pub fn fixed(dt: f64) -> Self {
+        Options { dt: Some(dt), ..Options::default() }
+    }
+
+    /// Check the options for `method`; the message says what to change.
+    pub fn validate(&self, method: Method) -> Result<(), String> {
+        let eps = f64::EPSILON;
+        if !(self.rtol.is_finite() && self.rtol > 0.0) {
+            return Err(format!("rtol = {} must be finite and > 0 (try 1e-8)", self.rtol));
+        }
+        if self.rtol < 100.0 * eps {
+            return Err(format!(
+                "rtol = {:e} is below 100 machine epsilons and cannot be met: use rtol >= 2.3e-14",
+                self.rtol
+            ));
+        }
+        if !(self.atol.is_finite() && self.atol >= 0.0) {
+            return Err(format!("atol = {} must be finite and >= 0 (try 1e-10)", self.atol));
+        }
+        if let Some(h0) = self.h0 {
+            if !(h0.is_finite() && h0 > 0.0) {
+                return Err(format!("h0 = {h0} must be finite and > 0, or None for automatic"));
+            }
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return Err(format!("h_max = {} must be > 0 (use infinity for no limit)", self.h_max));
+        }
+        if !(self.h_min.is_finite() && self.h_min >= 0.0) {
+            return Err(format!("h_min = {} must be finite and >= 0 (default 1e-14)", self.h_min));
+        }
+        if let Some(dt) = self.dt {
+            if !(dt.is_finite() && dt > 0.0) {
+                return Err(format!("dt = {dt} must be finite and > 0"));
+            }
+        } else if method == Method::Rk4 {
+            return Err("rk4 is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
+                        or choose an adaptive method such as dopri5"
+                .to_string());
+        }
+        if self.max_steps == 0 {
+            return Err("max_steps must be >= 1".to_string());
+        }
+        Ok(())
+    }
+}
+
+/// Why a step could not be completed. The stepper state stays at the last
+/// accepted point (`t()`, `y()`, `dy()`, `interpolate` are unchanged).
+#[derive(Clone, Debug)]
+pub enum StepError<E> {
+    /// The error control (or Newton convergence, for Radau5) drove the step below `h_min`.
+    StepSizeUnderflow { t: f64, h: f64 },
+    /// `rhs` kept failing until the step underflowed; `error` is the last failure.
+    Rhs { t: f64, error: E },
+    /// NaN or infinity in the solution, persisting down to `h_min`.
+    NonFinite { t: f64 },
+    /// [`Options::max_steps`] attempts were used.
+    TooManySteps { t: f64, steps: usize },
+}
+
+impl<E: fmt::Debug> fmt::Display for StepError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StepError::StepSizeUnderflow { t, h } => write!(
+                f,
+                "step size underflow at t = {t} s (h = {h:e} s): the problem may be stiff \
+                 (try radau5) or singular there, or loosen rtol/atol"
+            ),
+            StepError::Rhs { t, error } => write!(
+                f,
+                "right-hand side failed at t = {t} s even for the smallest step: {error:?}"
+            ),
+            StepError::NonFinite { t } => {
+                write!(f, "NaN or infinity in the solution near t = {t} s")
+            }
+            StepError::TooManySteps { t, steps } => write!(
+                f,
+                "{steps} steps used before t_stop (stopped at t = {t} s): raise max_steps, \
+                 loosen the tolerances, or try radau5 if the problem is stiff"
+            ),
+        }
+    }
+}
+
+impl<E: fmt::Debug> std::error::Error for StepError<E> {}
+
+/// Work counters, cumulative since [`Stepper::new`] (a `reset` does not clear them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Evaluations of `rhs`, failed ones included.
+    pub nfev: usize,
+    /// Accepted steps.
+    pub naccept: usize,
+    /// Rejected trial steps (error too large, `rhs` failure, non-finite values, Newton failure).
+    pub nreject: usize,
+    /// Jacobian evaluations (Radau5, by finite differences: `dim` `rhs` calls each).
+    pub njev: usize,
+    /// LU decompositions (Radau5: the real and the complex matrix count one each).
+    pub nlu: usize,
+}
+
+/// One integrator, chosen at run time (enum dispatch, so generic `step<S>` works without trait objects).
+pub enum Stepper {
+    Rk4(rk4::Rk4),
+    Dopri5(dopri5::Dopri5),
+    Dop853(dop853::Dop853),
+    Radau5(radau5::Radau5),
+}
+
+impl fmt::Debug for Stepper {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Stepper")
+            .field("method", &self.method())
+            .field("t", &self.t())
+            .field("t_prev", &self.t_prev())
+            .field("h_next", &self.h_next())
+            .field("stats", &self.stats())
+            .finish_non_exhaustive()
+    }
+}
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $body:expr) => {
+        match $self {
+            Stepper::Rk4($s) => $body,
+            Stepper::Dopri5($s) => $body,
+            Stepper::Dop853($s) => $body,
+            Stepper::Radau5($s) => $body,
+        }
+    };
+}
+
+impl Stepper {
+    /// A stepper for systems of dimension `dim`, all buffers allocated here.
+    /// Err for invalid options, with the fix in the message.
+    pub fn new(method: Method, opts: &Options, dim: usize) -> Result<Self, String> {
+        opts.validate(method)?;
+        Ok(match method {
+            Method::Rk4 => Stepper::Rk4(rk4::Rk4::new(opts, dim)),
+            Method::Dopri5 => Stepper::Dopri5(dopri5::Dopri5::new(opts, dim)),
+            Method::Dop853 => Stepper::Dop853(dop853::Dop853::new(opts, dim)),
+            Method::Radau5 => Stepper::Radau5(radau5::Radau5::new(opts, dim)),
+        })
+    }
+
+    /// Start, or restart after a discontinuity / change of coordinates, at (t, y). Evaluates f(t, y).
+    ///
+    /// Forgets the step-size history (the next step starts from `h0` or the
+    /// automatic initial step) and, for Radau5, the Jacobian. Panics if
+    /// `y.len()` differs from the `dim` given to `new` (a driver bug).
+    pub fn reset<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), StepError<S::Error>> {
+        dispatch!(self, s => s.reset(sys, t, y))
+    }
+
+    /// Advance by one accepted step, never past t_stop (t_stop > t). Rejected tries are retried inside.
+    ///
+    /// The last step before `t_stop` ends exactly on it. With `t_stop <= t` nothing
+    /// is done. Panics if called before `reset` (a driver bug).
+    pub fn step<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t_stop: f64,
+    ) -> Result<(), StepError<S::Error>> {
+        dispatch!(self, s => s.step(sys, t_stop))
+    }
+
+    /// Current time (s).
+    pub fn t(&self) -> f64 {
+        dispatch!(self, s => s.core.t)
+    }
+
+    /// Start of the last accepted step (s); equals `t()` right after `reset`.
+    pub fn t_prev(&self) -> f64 {
+        dispatch!(self, s => s.core.t_prev)
+    }
+
+    /// Current state.
+    pub fn y(&self) -> &[f64] {
+        dispatch!(self, s => &s.core.y)
+    }
+
+    /// The derivative f(t, y) at the current point (available for all methods after reset/step).
+    pub fn dy(&self) -> &[f64] {
+        dispatch!(self, s => &s.core.f)
+    }
+
+    /// Dense output: the solution at any t in [t_prev, t] of the last accepted step, written to out.
+    ///
+    /// Outside that interval the polynomial is extrapolated (less accurate).
+    /// Right after `reset`, returns `y()`.
+    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
+        dispatch!(self, s => s.interpolate(t, out))
+    }
+
+    /// Work counters since `new`.
+    pub fn stats(&self) -> Stats {
+        dispatch!(self, s => s.core.stats)
+    }
+
+    /// The method of this stepper.
+    pub fn method(&self) -> Method {
+        match self {
+            Stepper::Rk4(_) => Method::Rk4,
+            Stepper::Dopri5(_) => Method::Dopri5,
+            Stepper::Dop853(_) => Method::Dop853,
+            Stepper::Radau5(_) => Method::Radau5,
+        }
+    }
+
+    /// The step size the next `step` will try first (s), 0 before the first step after a reset.
+    pub fn h_next(&self) -> f64 {
+        dispatch!(self, s => s.core.h_next)
+    }
+}

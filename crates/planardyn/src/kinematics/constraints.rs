@@ -1,0 +1,320 @@
+//! The position equations F(x) = [Phi(x); D(x) - z] = 0 and their derivatives.
+//!
+//! Rows 0..2p are the pair constraints Phi (two per pair); rows 2p..2p+m fix the chart's
+//! coordinates z: the user's generalized coordinates D(x) (relative angles and displacements
+//! of the input pairs), or m chosen components of x (generalized coordinate partitioning).
+//! Per row we need the value, the gradient (a row of J) and the second derivative as a
+//! bilinear form gamma(a, b) = sum_ij d2F/dx_i dx_j a_i b_j, which gives the convective term
+//! (gamma(xd, xd)) and the acceleration analogues (gamma(u_j, u_k)).
+
+use crate::model::{Link, Mechanism, Pair, PairKind};
+
+/// Which m functions of x are the independent coordinates.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Chart {
+    /// The user's generalized coordinates q.
+    Inputs,
+    /// Components of x (indices into the 3n body coordinates), chosen near a singularity
+    /// of the actuated mechanism.
+    Partition(Vec<usize>),
+}
+
+/// Pose of a link in x: centre (m), angle (rad) and its first column in x (None for ground).
+#[derive(Clone, Copy)]
+struct LinkState {
+    r: [f64; 2],
+    phi: f64,
+    col: Option<usize>,
+}
+
+fn link_state(link: Link, x: &[f64]) -> LinkState {
+    match link {
+        Link::Ground => LinkState { r: [0.0; 2], phi: 0.0, col: None },
+        Link::Body(b) => {
+            let c = 3 * b.0;
+            LinkState { r: [x[c], x[c + 1]], phi: x[c + 2], col: Some(c) }
+        }
+    }
+}
+
+/// R(phi) s.
+#[inline]
+pub fn rotate(phi: f64, s: [f64; 2]) -> [f64; 2] {
+    let (sn, cs) = phi.sin_cos();
+    [cs * s[0] - sn * s[1], sn * s[0] + cs * s[1]]
+}
+
+/// E v: v turned by +90 degrees.
+#[inline]
+pub fn perp(v: [f64; 2]) -> [f64; 2] {
+    [-v[1], v[0]]
+}
+
+#[inline]
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// Components (dr_x, dr_y, dphi) of a direction vector for a link (zeros for ground).
+#[inline]
+fn part(link: &LinkState, v: &[f64]) -> ([f64; 2], f64) {
+    match link.col {
+        Some(c) => ([v[c], v[c + 1]], v[c + 2]),
+        None => ([0.0; 2], 0.0),
+    }
+}
+
+/// Add `g = [d/dr_x, d/dr_y, d/dphi]` of a link to row `row` of the row-major matrix `j`.
+#[inline]
+fn add_grad(j: &mut [f64], ncols: usize, row: usize, link: &LinkState, g: [f64; 3]) {
+    if let Some(c) = link.col {
+        let o = row * ncols + c;
+        j[o] += g[0];
+        j[o + 1] += g[1];
+        j[o + 2] += g[2];
+    }
+}
+
+/// A projection row g = (R_a d0) . (p_b - p_a) with d0 a unit vector fixed in body a: the
+/// normal row of a prismatic pair (d0 = normal) and its displacement (d0 = axis).
+struct Projection {
+    a: LinkState,
+    b: LinkState,
+    /// d = R_a d0 (global).
+    d: [f64; 2],
+    /// w = r_b + R_b s_b - r_a.
+    w: [f64; 2],
+    /// R_b s_b.
+    rbsb: [f64; 2],
+    /// d0 . s_a, so that g = d . w - offset.
+    offset: f64,
+}
+
+impl Projection {
+    fn new(pair: &Pair, d0: [f64; 2], x: &[f64]) -> Self {
+        let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+        let rbsb = rotate(b.phi, pair.sb);
+        let w = [b.r[0] + rbsb[0] - a.r[0], b.r[1] + rbsb[1] - a.r[1]];
+        Projection { a, b, d: rotate(a.phi, d0), w, rbsb, offset: dot(d0, pair.sa) }
+    }
+    fn value(&self) -> f64 {
+        dot(self.d, self.w) - self.offset
+    }
+    fn grad(&self, j: &mut [f64], ncols: usize, row: usize) {
+        let ed = perp(self.d);
+        add_grad(j, ncols, row, &self.a, [-self.d[0], -self.d[1], dot(ed, self.w)]);
+        add_grad(j, ncols, row, &self.b, [self.d[0], self.d[1], dot(self.d, perp(self.rbsb))]);
+    }
+    /// Bilinear second derivative (see the module doc), from the Hessian entries
+    /// d2/dphi_a2 = -d.w, d2/dphi_a dr_b = E d = -d2/dphi_a dr_a,
+    /// d2/dphi_a dphi_b = d.R_b s_b = -d2/dphi_b2.
+    fn gamma(&self, u: &[f64], v: &[f64]) -> f64 {
+        let (ura, upa) = part(&self.a, u);
+        let (urb, upb) = part(&self.b, u);
+        let (vra, vpa) = part(&self.a, v);
+        let (vrb, vpb) = part(&self.b, v);
+        let ed = perp(self.d);
+        let h = dot(self.d, self.rbsb);
+        -dot(self.d, self.w) * upa * vpa
+            + dot(ed, [vrb[0] - vra[0], vrb[1] - vra[1]]) * upa
+            + dot(ed, [urb[0] - ura[0], urb[1] - ura[1]]) * vpa
+            + h * (upa * vpb + upb * vpa - upb * vpb)
+    }
+}
+
+/// Residual of the two rows of a pair.
+fn pair_residual(pair: &Pair, x: &[f64]) -> [f64; 2] {
+    match pair.kind {
+        PairKind::Revolute => {
+            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+            let (pa, pb) = (rotate(a.phi, pair.sa), rotate(b.phi, pair.sb));
+            [a.r[0] + pa[0] - b.r[0] - pb[0], a.r[1] + pa[1] - b.r[1] - pb[1]]
+        }
+        PairKind::Prismatic { axis } => {
+            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+            [b.phi - a.phi - pair.rel_angle0, Projection::new(pair, perp(axis), x).value()]
+        }
+    }
+}
+
+fn pair_jacobian(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize, row: usize) {
+    let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+    match pair.kind {
+        PairKind::Revolute => {
+            let (ta, tb) = (perp(rotate(a.phi, pair.sa)), perp(rotate(b.phi, pair.sb)));
+            add_grad(j, ncols, row, &a, [1.0, 0.0, ta[0]]);
+            add_grad(j, ncols, row + 1, &a, [0.0, 1.0, ta[1]]);
+            add_grad(j, ncols, row, &b, [-1.0, 0.0, -tb[0]]);
+            add_grad(j, ncols, row + 1, &b, [0.0, -1.0, -tb[1]]);
+        }
+        PairKind::Prismatic { axis } => {
+            add_grad(j, ncols, row, &a, [0.0, 0.0, -1.0]);
+            add_grad(j, ncols, row, &b, [0.0, 0.0, 1.0]);
+            Projection::new(pair, perp(axis), x).grad(j, ncols, row + 1);
+        }
+    }
+}
+
+fn pair_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> [f64; 2] {
+    match pair.kind {
+        PairKind::Revolute => {
+            // d2(R(phi) s)/dphi2 = -R(phi) s; only the angle-angle entries are non-zero.
+            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+            let (pa, pb) = (rotate(a.phi, pair.sa), rotate(b.phi, pair.sb));
+            let (ka, kb) = (part(&a, u).1 * part(&a, v).1, part(&b, u).1 * part(&b, v).1);
+            [-pa[0] * ka + pb[0] * kb, -pa[1] * ka + pb[1] * kb]
+        }
+        PairKind::Prismatic { axis } => [0.0, Projection::new(pair, perp(axis), x).gamma(u, v)],
+    }
+}
+
+/// Relative coordinate of a pair from the drawing: angle (rad) or displacement (m).
+pub fn pair_coordinate(pair: &Pair, x: &[f64]) -> f64 {
+    match pair.kind {
+        PairKind::Revolute => {
+            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+            b.phi - a.phi - pair.rel_angle0
+        }
+        PairKind::Prismatic { axis } => Projection::new(pair, axis, x).value(),
+    }
+}
+
+/// Gradient of [`pair_coordinate`], added into row `row` of `j`.
+pub fn pair_coordinate_grad(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize, row: usize) {
+    match pair.kind {
+        PairKind::Revolute => {
+            add_grad(j, ncols, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
+            add_grad(j, ncols, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
+        }
+        PairKind::Prismatic { axis } => Projection::new(pair, axis, x).grad(j, ncols, row),
+    }
+}
+
+/// Second derivative of [`pair_coordinate`] as a bilinear form.
+pub fn pair_coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    match pair.kind {
+        PairKind::Revolute => 0.0,
+        PairKind::Prismatic { axis } => Projection::new(pair, axis, x).gamma(u, v),
+    }
+}
+
+/// Rate of a pair's relative coordinate: its gradient times xd.
+pub fn pair_coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+    match pair.kind {
+        PairKind::Revolute => {
+            part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1
+        }
+        PairKind::Prismatic { axis } => {
+            let p = Projection::new(pair, axis, x);
+            let (ra, pa) = part(&p.a, xd);
+            let (rb, pb) = part(&p.b, xd);
+            dot(p.d, [rb[0] - ra[0], rb[1] - ra[1]]) + dot(perp(p.d), p.w) * pa + dot(p.d, perp(p.rbsb)) * pb
+        }
+    }
+}
+
+/// The user's generalized coordinates q = D(x).
+pub fn coordinates(mech: &Mechanism, x: &[f64], q: &mut [f64]) {
+    for (qk, c) in q.iter_mut().zip(&mech.coordinates) {
+        *qk = pair_coordinate(&mech.pairs[c.pair.0], x) + c.value;
+    }
+}
+
+/// Rates qd = D_x xd.
+pub fn coordinate_rates(mech: &Mechanism, x: &[f64], xd: &[f64], qd: &mut [f64]) {
+    for (qk, c) in qd.iter_mut().zip(&mech.coordinates) {
+        *qk = pair_coordinate_rate(&mech.pairs[c.pair.0], x, xd);
+    }
+}
+
+/// F(x) for a chart with target values z.
+pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], z: &[f64], out: &mut [f64]) {
+    let nc = 2 * mech.pairs.len();
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        let r = pair_residual(pair, x);
+        out[2 * k] = r[0];
+        out[2 * k + 1] = r[1];
+    }
+    match chart {
+        Chart::Inputs => coordinates(mech, x, &mut out[nc..]),
+        Chart::Partition(idx) => {
+            for (o, &i) in out[nc..].iter_mut().zip(idx) {
+                *o = x[i];
+            }
+        }
+    }
+    for (o, zk) in out[nc..].iter_mut().zip(z) {
+        *o -= zk;
+    }
+}
+
+/// J = dF/dx for a chart, written (overwritten) into the row-major 3n x 3n buffer `j`.
+pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], j: &mut [f64]) {
+    let ncols = x.len();
+    constraint_jacobian(mech, x, j);
+    let nc = 2 * mech.pairs.len();
+    match chart {
+        Chart::Inputs => {
+            for (k, c) in mech.coordinates.iter().enumerate() {
+                pair_coordinate_grad(&mech.pairs[c.pair.0], x, j, ncols, nc + k);
+            }
+        }
+        Chart::Partition(idx) => {
+            for (k, &i) in idx.iter().enumerate() {
+                j[(nc + k) * ncols + i] = 1.0;
+            }
+        }
+    }
+}
+
+/// The pair-constraint rows Phi_x (2p x 3n, row-major); the rest of `j` is zeroed.
+pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], j: &mut [f64]) {
+    let ncols = x.len();
+    j.fill(0.0);
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        pair_jacobian(pair, x, j, ncols, 2 * k);
+    }
+}
+
+/// gamma(u, v) = d2F/dx2 [u, v] for every row (the chart rows of a partition are linear).
+pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], u: &[f64], v: &[f64], out: &mut [f64]) {
+    let nc = 2 * mech.pairs.len();
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        let g = pair_gamma(pair, x, u, v);
+        out[2 * k] = g[0];
+        out[2 * k + 1] = g[1];
+    }
+    for (k, o) in out[nc..].iter_mut().enumerate() {
+        *o = match chart {
+            Chart::Inputs => {
+                pair_coordinate_gamma(&mech.pairs[mech.coordinates[k].pair.0], x, u, v)
+            }
+            Chart::Partition(_) => 0.0,
+        };
+    }
+}
+
+/// World position of a point of a link.
+pub fn world_point(link: Link, s: [f64; 2], x: &[f64]) -> [f64; 2] {
+    let l = link_state(link, x);
+    let p = rotate(l.phi, s);
+    [l.r[0] + p[0], l.r[1] + p[1]]
+}
+
+/// Velocity of a point of a link for body rates xd.
+pub fn point_velocity(link: Link, s: [f64; 2], x: &[f64], xd: &[f64]) -> [f64; 2] {
+    let l = link_state(link, x);
+    let (v, w) = part(&l, xd);
+    let t = perp(rotate(l.phi, s));
+    [v[0] + w * t[0], v[1] + w * t[1]]
+}
+
+/// Acceleration of a point of a link for body rates xd and accelerations xdd.
+pub fn point_acceleration(link: Link, s: [f64; 2], x: &[f64], xd: &[f64], xdd: &[f64]) -> [f64; 2] {
+    let l = link_state(link, x);
+    let (_, w) = part(&l, xd);
+    let (a, al) = part(&l, xdd);
+    let p = rotate(l.phi, s);
+    let t = perp(p);
+    [a[0] + al * t[0] - w * w * p[0], a[1] + al * t[1] - w * w * p[1]]
+}

@@ -1,0 +1,14 @@
+//! Kinematics: position analysis, velocity and acceleration analogues, points, singularities.
+//! One algorithm a file; all of them work on the body coordinates x (3n values).
+
+pub mod analogues;
+pub mod constraints;
+pub mod position;
+pub mod singularity;
+pub mod system;
+
+pub use analogues::{acceleration_analogues, convective, velocity_analogues};
+pub use constraints::{coordinate_rates, coordinates, Chart};
+pub use position::{assemble, assemble_into, continue_to, solve_position, POSITION_TOL};
+pub use singularity::{constraint_rank, passive_sigma_min, select_partition, sigma_min};
+pub use system::System;

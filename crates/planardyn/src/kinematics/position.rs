@@ -1,0 +1,139 @@
+//! Position analysis: Newton's method on F(x) = 0 from the last solution, and continuation
+//! in the coordinates for larger moves (it stays on the branch the mechanism is drawn in).
+
+use super::analogues::velocity_analogues;
+use super::constraints::{residual, Chart};
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::KinematicsError;
+
+/// Convergence test of Newton's method: the largest residual, lengths divided by the
+/// characteristic length L and angles in radians, below 1e-12 (about 1e4 ulp of O(1) values).
+pub const POSITION_TOL: f64 = 1e-12;
+/// Newton iterations before giving up; from a first-order predictor it takes 1 to 3.
+pub const MAX_NEWTON: usize = 30;
+
+fn scaled_norm(ws: &Workspace) -> f64 {
+    ws.tmp.iter().zip(&ws.sys.row_scale).fold(0.0, |m: f64, (r, s)| m.max((r * s).abs()))
+}
+
+/// Solve F(x; z) = 0 for x from the start guess in `ws.x`, in the chart `ws.chart`. On
+/// success `ws.x` is the solution, `ws.sys` holds J(x) factorised, `ws.residual` the scaled
+/// residual. Fails if J is singular on the way or Newton does not converge.
+pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    let tol = POSITION_TOL * (1.0 + ws.x.iter().zip(&ws.sys.col_scale).fold(0.0, |m: f64, (v, s)| m.max((v / s).abs())));
+    let mut first = f64::INFINITY;
+    for it in 0..=MAX_NEWTON {
+        residual(mech, &ws.chart, &ws.x, z, &mut ws.tmp);
+        // Row scales depend on the chart only; they are set by the factorisation below,
+        // and by the previous one on the first pass.
+        if it == 0 {
+            super::system::set_row_scale(mech, &ws.chart, &mut ws.sys.row_scale);
+        }
+        let norm = scaled_norm(ws);
+        if !norm.is_finite() || norm > 1e6 * first.max(1.0) {
+            break;
+        }
+        first = first.min(norm);
+        factor(mech, ws)?;
+        ws.iterations = it;
+        if norm <= tol {
+            ws.residual = norm;
+            return Ok(());
+        }
+        ws.sys.solve(&mut ws.tmp);
+        for (xi, dx) in ws.x.iter_mut().zip(&ws.tmp) {
+            *xi -= dx;
+        }
+    }
+    residual(mech, &ws.chart, &ws.x, z, &mut ws.tmp);
+    Err(KinematicsError::AssemblyFailed { residual: scaled_norm(ws), iterations: MAX_NEWTON })
+}
+
+fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+    ws.sys.factor(mech, &ws.chart, &ws.x).map_err(|_| KinematicsError::Singular {
+        sigma_min: 0.0,
+        what: match ws.chart {
+            Chart::Inputs => "the generalized coordinates do not determine the mechanism's position \
+                              (a type II, parallel singularity of the actuated mechanism)"
+                .to_string(),
+            Chart::Partition(_) => "the pair constraints lose rank (a singularity of the passive mechanism)".to_string(),
+        },
+    })
+}
+
+/// Smallest continuation step, as a fraction of the whole move, before giving up.
+const MIN_CONTINUATION_STEP: f64 = 1e-6;
+
+/// Move the solution in `ws` (converged at `z_from` in the input chart) to the user
+/// coordinates `q` by continuation: a first-order predictor along the velocity analogues,
+/// a Newton corrector, and the step cut by 4 when Newton fails.
+pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    ws.chart = Chart::Inputs;
+    let (m, n) = (q.len(), ws.x.len());
+    // U is unavailable at a singular start: plain Newton from x then.
+    let mut u_ok = velocity_analogues(ws).ok().map(|_| ws.u.clone());
+    let mut x_ok = ws.x.clone();
+    let (mut s, mut h) = (0.0_f64, 1.0_f64);
+    let mut z = vec![0.0; m];
+    while s < 1.0 {
+        let s_new = (s + h).min(1.0);
+        ws.x.copy_from_slice(&x_ok);
+        for k in 0..m {
+            let dq = q[k] - z_from[k];
+            z[k] = z_from[k] + s_new * dq;
+            if let Some(u) = &u_ok {
+                for (p, uk) in ws.x.iter_mut().zip(&u[k * n..(k + 1) * n]) {
+                    *p += uk * (s_new - s) * dq;
+                }
+            }
+        }
+        match solve_position(mech, &z, ws) {
+            Ok(()) => {
+                s = s_new;
+                x_ok.copy_from_slice(&ws.x);
+                u_ok = velocity_analogues(ws).ok().map(|_| ws.u.clone());
+                h = (2.0 * h).min(1.0);
+            }
+            Err(e) => {
+                h /= 4.0;
+                if h < MIN_CONTINUATION_STEP {
+                    ws.x.copy_from_slice(&x_ok);
+                    return Err(e);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Body coordinates x at user coordinates q, by continuation from the drawing.
+pub fn assemble(mech: &Mechanism, q: &[f64]) -> Result<Vec<f64>, KinematicsError> {
+    let mut ws = Workspace::new(mech);
+    assemble_into(mech, q, &mut ws)?;
+    Ok(ws.x)
+}
+
+/// As [`assemble`], leaving the solution (and J factorised, if regular) in `ws`.
+pub fn assemble_into(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    if q.len() != mech.dof() || q.iter().any(|v| !v.is_finite()) {
+        return Err(KinematicsError::BadArgument(format!(
+            "expected {} finite coordinate values ({}), got {:?}",
+            mech.dof(),
+            mech.coordinate_names().join(", "),
+            q
+        )));
+    }
+    ws.chart = Chart::Inputs;
+    ws.x.copy_from_slice(&mech.x0);
+    let drawn = mech.drawn_q();
+    if drawn == q {
+        // The drawing closes by construction; J may still be singular there.
+        return match solve_position(mech, q, ws) {
+            Err(KinematicsError::Singular { .. }) => Ok(()),
+            other => other,
+        };
+    }
+    solve_position(mech, &drawn, ws)?;
+    continue_to(mech, &drawn, q, ws)
+}

@@ -1,0 +1,107 @@
+//! The factorised, scaled Jacobian J = dF/dx of the position equations.
+//!
+//! J is factorised in scaled variables so that its pivots and singular values are
+//! dimensionless: translations are measured in units of the mechanism's characteristic
+//! length L (column scale L) and length-valued rows are divided by L (angle rows are kept).
+//! All solves take and return unscaled vectors.
+
+use super::constraints::{jacobian, Chart};
+use crate::linalg::Lu;
+use crate::model::{CoordinateKind, Mechanism, PairKind};
+
+/// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
+/// 1e4 times the rounding error of an O(1) elimination.
+pub const SINGULAR_PIVOT: f64 = 1e-12;
+
+/// J(x) for one chart, scaled and LU-factorised.
+#[derive(Debug, Clone)]
+pub struct System {
+    lu: Lu,
+    /// Row scale: 1/L for rows in metres, 1 for rows in radians.
+    pub row_scale: Vec<f64>,
+    /// Column scale: L for translations, 1 for angles (x = col_scale * x_scaled).
+    pub col_scale: Vec<f64>,
+    tmp: Vec<f64>,
+    /// Whether the last factorisation succeeded.
+    factored: bool,
+}
+
+impl System {
+    pub fn new(mech: &Mechanism) -> Self {
+        let n = mech.n_x();
+        let col_scale = (0..n).map(|i| if i % 3 == 2 { 1.0 } else { mech.scale }).collect();
+        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, tmp: vec![0.0; n], factored: false }
+    }
+
+    /// Fill `j` (row-major, n x n) with the scaled Jacobian and set the row scales.
+    pub fn scaled_jacobian(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], j: &mut [f64]) {
+        fill_scaled(mech, chart, x, &mut self.row_scale, &self.col_scale, j);
+    }
+
+    /// Evaluate and factorise J(x). Err carries the elimination column that had no pivot.
+    pub fn factor(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64]) -> Result<(), usize> {
+        fill_scaled(mech, chart, x, &mut self.row_scale, &self.col_scale, self.lu.matrix_mut());
+        let out = self.lu.factor(SINGULAR_PIVOT).map_err(|e| e.column);
+        self.factored = out.is_ok();
+        out
+    }
+
+    /// Whether J is factorised (the last [`System::factor`] succeeded).
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
+    /// Solve J y = b in place (b and y unscaled).
+    pub fn solve(&mut self, b: &mut [f64]) {
+        for (v, s) in b.iter_mut().zip(&self.row_scale) {
+            *v *= s;
+        }
+        self.lu.solve(b, &mut self.tmp);
+        for (v, s) in b.iter_mut().zip(&self.col_scale) {
+            *v *= s;
+        }
+    }
+
+    /// Solve J^T y = b in place (b and y unscaled).
+    pub fn solve_transpose(&mut self, b: &mut [f64]) {
+        for (v, s) in b.iter_mut().zip(&self.col_scale) {
+            *v *= s;
+        }
+        self.lu.solve_transpose(b, &mut self.tmp);
+        for (v, s) in b.iter_mut().zip(&self.row_scale) {
+            *v *= s;
+        }
+    }
+}
+
+fn fill_scaled(mech: &Mechanism, chart: &Chart, x: &[f64], rs: &mut [f64], cs: &[f64], j: &mut [f64]) {
+    let n = x.len();
+    set_row_scale(mech, chart, rs);
+    jacobian(mech, chart, x, j);
+    for r in 0..n {
+        for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(cs) {
+            *v *= rs[r] * c;
+        }
+    }
+}
+
+/// 1/L for rows measured in metres, 1 for rows measured in radians.
+pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
+    let inv = 1.0 / mech.scale;
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        let first = match pair.kind {
+            PairKind::Revolute => inv,
+            PairKind::Prismatic { .. } => 1.0,
+        };
+        rs[2 * k] = first;
+        rs[2 * k + 1] = inv;
+    }
+    let nc = 2 * mech.pairs.len();
+    for (k, r) in rs[nc..].iter_mut().enumerate() {
+        let angle = match chart {
+            Chart::Inputs => mech.coordinates[k].kind == CoordinateKind::Angle,
+            Chart::Partition(idx) => idx[k] % 3 == 2,
+        };
+        *r = if angle { 1.0 } else { inv };
+    }
+}

@@ -1,0 +1,265 @@
+//! The mechanism model: immutable once built and validated from a [`MechanismSpec`].
+//!
+//! Bodies carry their points in a local frame with origin at the centre of mass, rotated by
+//! the body's drawn angle, so that a world point is `r + R(phi) s` with `x_i = [X, Y, phi]`.
+//! The ground is not part of `x`; its local frame is the global frame.
+
+mod build;
+mod io;
+pub mod spec;
+
+pub use io::{load, loads, Format};
+pub use spec::MechanismSpec;
+
+/// Index of a mobile body (its coordinates are `x[3i..3i+3]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BodyId(pub usize);
+/// Index of a kinematic pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PairId(pub usize);
+/// Index of a named point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PointId(pub usize);
+
+/// A body taking part in a pair or a load: the fixed ground or a mobile body.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Link {
+    Ground,
+    Body(BodyId),
+}
+
+/// A mobile rigid body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    pub name: String,
+    /// Mass (kg), > 0.
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass (kg m^2), > 0.
+    pub inertia: f64,
+    /// Centre of mass in the drawing (m).
+    pub com0: [f64; 2],
+    /// Body angle in the drawing (rad): the angle of the line from its first to its second point.
+    pub angle0: f64,
+    /// The points it carries, with their coordinates in the body frame (m).
+    pub points: Vec<(PointId, [f64; 2])>,
+}
+
+/// The kind of a kinematic pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PairKind {
+    /// Hinge: the two copies of the pair point coincide.
+    Revolute,
+    /// Slider: no relative rotation, b's copy of the point stays on a line fixed to a.
+    Prismatic {
+        /// Unit direction of the guide in a's frame.
+        axis: [f64; 2],
+    },
+}
+
+/// A kinematic pair between links `a` and `b` at a point both carry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pair {
+    pub name: String,
+    pub kind: PairKind,
+    pub a: Link,
+    pub b: Link,
+    pub point: PointId,
+    /// The pair point in a's and b's frames (m).
+    pub sa: [f64; 2],
+    pub sb: [f64; 2],
+    /// Drawn relative angle phi_b - phi_a (rad).
+    pub rel_angle0: f64,
+}
+
+/// What a generalized coordinate measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CoordinateKind {
+    /// Relative angle of a revolute pair (rad).
+    Angle,
+    /// Displacement along a prismatic pair (m).
+    Displacement,
+}
+
+/// A generalized coordinate `q_k`: the relative motion of an input pair, offset to equal
+/// `value` in the drawing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coordinate {
+    pub name: String,
+    pub pair: PairId,
+    pub kind: CoordinateKind,
+    /// Value in the drawing (rad or m).
+    pub value: f64,
+    /// Start value (rad or m); the drawing's value unless the file gives `q0`.
+    pub q0: f64,
+    /// Initial rate (rad/s or m/s).
+    pub qd0: f64,
+}
+
+/// A drive effort law on one coordinate (N m for an angle, N for a displacement).
+#[derive(Debug, Clone, PartialEq)]
+pub enum DriveLaw {
+    Constant(f64),
+    /// Linear interpolation in time, held constant outside `t[0]..t[last]`.
+    Table { t: Vec<f64>, effort: Vec<f64> },
+}
+
+impl DriveLaw {
+    /// The effort at time `t` (s).
+    pub fn effort(&self, t: f64) -> f64 {
+        match self {
+            DriveLaw::Constant(value) => *value,
+            DriveLaw::Table { t: times, effort } => {
+                let last = times.len() - 1;
+                if t <= times[0] {
+                    return effort[0];
+                }
+                if t >= times[last] {
+                    return effort[last];
+                }
+                let k = times.partition_point(|&ti| ti <= t).min(last);
+                let s = (t - times[k - 1]) / (times[k] - times[k - 1]);
+                effort[k - 1] + s * (effort[k] - effort[k - 1])
+            }
+        }
+    }
+}
+
+/// A point of a link: the link and the point's coordinates in the link frame (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Attachment {
+    pub link: Link,
+    pub s: [f64; 2],
+}
+
+/// An external load or force element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Load {
+    /// Constant global force (N) at a point of a body.
+    Force { at: Attachment, value: [f64; 2] },
+    /// Constant torque (N m) on a body.
+    Torque { body: BodyId, value: f64 },
+    /// Linear spring-damper between two points: tension k (L - rest_length) + c L'.
+    Spring {
+        ends: [Attachment; 2],
+        stiffness: f64,
+        damping: f64,
+        rest_length: f64,
+    },
+    /// Spring-damper on the relative motion of a pair (angle or displacement from the
+    /// drawing): generalized effort -k (theta - rest) - c theta'. Viscous friction has k = 0.
+    PairSpring {
+        pair: PairId,
+        stiffness: f64,
+        damping: f64,
+        rest: f64,
+    },
+}
+
+/// Default simulation settings read from the model file.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimulateDefaults {
+    pub t_end: Option<f64>,
+    pub method: Option<String>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub dt: Option<f64>,
+    pub output_dt: Option<f64>,
+}
+
+/// An immutable, validated planar mechanism.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mechanism {
+    pub name: String,
+    /// Where it was loaded from (a path or `<string>`), used in messages.
+    pub source: String,
+    /// The specification it was built from, kept so results can record their model.
+    pub spec: MechanismSpec,
+    /// Gravity (m/s^2).
+    pub gravity: [f64; 2],
+    /// Point names and drawn coordinates (m).
+    pub points: Vec<(String, [f64; 2])>,
+    /// Points the ground carries.
+    pub ground_points: Vec<PointId>,
+    pub bodies: Vec<Body>,
+    pub pairs: Vec<Pair>,
+    pub coordinates: Vec<Coordinate>,
+    /// One drive law per coordinate (`None`: no drive).
+    pub drives: Vec<Option<DriveLaw>>,
+    pub loads: Vec<Load>,
+    pub simulate: SimulateDefaults,
+    /// Body coordinates in the drawing, 3n values [X, Y, phi] per body.
+    pub x0: Vec<f64>,
+    /// Characteristic length (m): the largest distance between two points; it scales
+    /// tolerances and makes the singularity measure dimensionless.
+    pub scale: f64,
+}
+
+impl Mechanism {
+    /// Validate a specification and build the mechanism; `source` names it in messages.
+    pub fn new(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
+        build::build(spec, source)
+    }
+    /// Number of degrees of freedom m (= number of generalized coordinates).
+    pub fn dof(&self) -> usize {
+        self.coordinates.len()
+    }
+    /// Number of mobile bodies n.
+    pub fn n_bodies(&self) -> usize {
+        self.bodies.len()
+    }
+    /// Number of body coordinates, 3n.
+    pub fn n_x(&self) -> usize {
+        3 * self.bodies.len()
+    }
+    pub fn coordinate_names(&self) -> Vec<&str> {
+        self.coordinates.iter().map(|c| c.name.as_str()).collect()
+    }
+    pub fn body_names(&self) -> Vec<&str> {
+        self.bodies.iter().map(|b| b.name.as_str()).collect()
+    }
+    pub fn pair_names(&self) -> Vec<&str> {
+        self.pairs.iter().map(|p| p.name.as_str()).collect()
+    }
+    pub fn point_names(&self) -> Vec<&str> {
+        self.points.iter().map(|p| p.0.as_str()).collect()
+    }
+    /// Start coordinates q0 and rates qd0.
+    pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let q0 = self.coordinates.iter().map(|c| c.q0).collect();
+        let qd0 = self.coordinates.iter().map(|c| c.qd0).collect();
+        (q0, qd0)
+    }
+    /// Coordinate values in the drawing.
+    pub fn drawn_q(&self) -> Vec<f64> {
+        self.coordinates.iter().map(|c| c.value).collect()
+    }
+    /// Look a point up by name.
+    pub fn point_id(&self, name: &str) -> Option<PointId> {
+        self.points.iter().position(|p| p.0 == name).map(PointId)
+    }
+    /// Look a body up by name.
+    pub fn body_id(&self, name: &str) -> Option<BodyId> {
+        self.bodies.iter().position(|b| b.name == name).map(BodyId)
+    }
+    /// Where a link carries a point (the point's coordinates in the link frame), if it does.
+    pub fn attachment(&self, link: Link, point: PointId) -> Option<Attachment> {
+        match link {
+            Link::Ground => self
+                .ground_points
+                .contains(&point)
+                .then(|| Attachment { link, s: self.points[point.0].1 }),
+            Link::Body(b) => self.bodies[b.0]
+                .points
+                .iter()
+                .find(|(p, _)| *p == point)
+                .map(|&(_, s)| Attachment { link, s }),
+        }
+    }
+    /// Link name (`ground` or the body's).
+    pub fn link_name(&self, link: Link) -> &str {
+        match link {
+            Link::Ground => "ground",
+            Link::Body(b) => &self.bodies[b.0].name,
+        }
+    }
+}

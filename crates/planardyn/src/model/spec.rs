@@ -1,0 +1,265 @@
+//! The model file: a mechanism described as it is drawn (YAML or JSON, one schema).
+//!
+//! These plain structs are what a file deserialises to and what a Rust user fills in to
+//! describe a mechanism in code; [`crate::Mechanism::new`] validates them. The schema is
+//! documented field by field in `docs/model-format.md` and `schema/planardyn-model.schema.json`.
+//! Units are SI throughout: m, kg, kg m^2, s, rad, N, N m.
+
+use indexmap::IndexMap;
+use serde::de::{Deserializer, MapAccess, Visitor};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::marker::PhantomData;
+
+/// A whole mechanism.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MechanismSpec {
+    /// A human-readable name.
+    pub name: String,
+    /// Free text: where the data come from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<String>,
+    /// Only "SI" is accepted (m, kg, s, rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<String>,
+    /// Gravity vector [g_x, g_y] in m/s^2 (default none).
+    #[serde(default)]
+    pub gravity: [f64; 2],
+    /// Named points and their global coordinates [x, y] (m) in the drawn configuration.
+    #[serde(alias = "points_at_t0")]
+    pub points: NamedMap<[f64; 2]>,
+    /// The points carried by the fixed body `ground`.
+    #[serde(default, alias = "fixed_points")]
+    pub ground: Vec<String>,
+    /// The mobile bodies, by name, in the order their coordinates are stored.
+    pub bodies: NamedMap<BodySpec>,
+    /// Kinematic pairs (joints).
+    pub pairs: Vec<PairSpec>,
+    /// Generalized coordinates: the input pairs, one per degree of freedom.
+    pub coordinates: Vec<CoordinateSpec>,
+    /// Drive efforts on the coordinates (torque for an angle, force for a displacement).
+    #[serde(default)]
+    pub drives: Vec<DriveSpec>,
+    /// External loads and force elements.
+    #[serde(default)]
+    pub loads: Vec<LoadSpec>,
+    /// Default simulation settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulate: Option<SimulateSpec>,
+}
+
+/// A mobile body. Its inertia is given either directly (`mass`, `inertia`, `com`), as a
+/// uniform bar or a point mass, or as a list of `parts` that are summed.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// The points this body carries. The body's angle is that of the line from its first to
+    /// its second point (0 for a body with a single point).
+    pub points: Vec<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<f64>,
+    /// Moment of inertia about the centre of mass (kg m^2).
+    #[serde(default, alias = "inertia_about_com", skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub com: Option<Location>,
+    /// Mass spread uniformly along the segment between two points: centre of mass at the
+    /// midpoint, inertia m L^2 / 12.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uniform_bar: Option<[String; 2]>,
+    /// All the mass concentrated at a point.
+    #[serde(default, alias = "point_mass_at", skip_serializing_if = "Option::is_none")]
+    pub point_mass: Option<String>,
+    /// Parts summed with the parallel-axis theorem.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parts: Option<Vec<PartSpec>>,
+    /// Free text.
+    #[serde(default, alias = "role", skip_serializing_if = "Option::is_none")]
+    pub about: Option<String>,
+}
+
+/// One part of a body: a general rigid part, a uniform bar or a point mass.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PartSpec {
+    pub mass: f64,
+    #[serde(default, alias = "inertia_about_com", skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub com: Option<Location>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uniform_bar: Option<[String; 2]>,
+    #[serde(default, alias = "point_mass_at", skip_serializing_if = "Option::is_none")]
+    pub point_mass: Option<String>,
+}
+
+/// A location in the drawing: coordinates [x, y] (m) or the name of a point.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Location {
+    Coords([f64; 2]),
+    Point(String),
+}
+
+/// A kinematic pair between two bodies (`ground` is the fixed body).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PairSpec {
+    /// Revolute pair (hinge) at a point both bodies carry.
+    Revolute {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        at: String,
+        bodies: [String; 2],
+    },
+    /// Prismatic pair (slider): the second body translates along a guide fixed to the first,
+    /// through a point both carry, without relative rotation. The guide direction is `axis`
+    /// [d_x, d_y] in the drawing, or the line `along` [from, to] between two points.
+    Prismatic {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        at: String,
+        bodies: [String; 2],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        axis: Option<[f64; 2]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        along: Option<[String; 2]>,
+    },
+}
+
+/// A generalized coordinate: the relative angle (rad) of a revolute pair or the displacement
+/// (m) of a prismatic pair, of the second body relative to the first.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CoordinateSpec {
+    pub name: String,
+    /// The name of the input pair.
+    pub pair: String,
+    /// The coordinate's value in the drawing (e.g. the absolute angle of a crank line).
+    pub value: f64,
+    /// Start the simulation here instead of at the drawing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub q0: Option<f64>,
+    /// Initial rate (rad/s or m/s), default 0.
+    #[serde(default)]
+    pub qd0: f64,
+    /// Free text.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<String>,
+}
+
+/// A drive effort on one coordinate: a constant, or a time table interpolated linearly
+/// (held at its end values outside the table).
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSpec {
+    pub coordinate: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effort: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table: Option<TableSpec>,
+}
+
+/// A time table: times (s, increasing) and efforts (N m or N), of equal length.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TableSpec {
+    pub t: Vec<f64>,
+    pub effort: Vec<f64>,
+}
+
+/// An external load or a force element.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LoadSpec {
+    /// A constant force [F_x, F_y] (N, global frame) at a point of a body.
+    Force {
+        body: String,
+        at: String,
+        value: [f64; 2],
+    },
+    /// A constant torque (N m) on a body.
+    Torque { body: String, value: f64 },
+    /// A linear spring-damper between two body points, each given as [body, point]:
+    /// tension k (L - rest_length) + c dL/dt. `rest_length` defaults to the drawn length.
+    Spring {
+        between: [[String; 2]; 2],
+        stiffness: f64,
+        #[serde(default)]
+        damping: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rest_length: Option<f64>,
+    },
+    /// A torsional spring-damper at a revolute pair (or a linear one along a prismatic pair),
+    /// acting on the pair's relative motion from the drawing: torque -k (theta - rest) - c theta'.
+    TorsionalSpring {
+        pair: String,
+        stiffness: f64,
+        #[serde(default)]
+        damping: f64,
+        /// Relative rotation (rad) or displacement (m) from the drawing at which it is unloaded.
+        #[serde(default)]
+        rest: f64,
+    },
+    /// Viscous friction at a pair: -c times the relative rate (N m s/rad or N s/m).
+    Friction { pair: String, viscous: f64 },
+}
+
+/// Default settings for `simulate`.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SimulateSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t_end: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
+    /// Step of the fixed-step method (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dt: Option<f64>,
+    /// Spacing of the output times (s); default: every accepted step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_dt: Option<f64>,
+}
+
+/// An ordered map from names to values that rejects a name given twice
+/// (serde's maps silently keep the last one).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct NamedMap<T>(pub IndexMap<String, T>);
+
+impl<T> Default for NamedMap<T> {
+    fn default() -> Self {
+        NamedMap(IndexMap::new())
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for NamedMap<T> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct MapVisitor<T>(PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for MapVisitor<T> {
+            type Value = NamedMap<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a map from names to entries")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+                let mut out = IndexMap::new();
+                while let Some(key) = map.next_key::<String>()? {
+                    if out.contains_key(&key) {
+                        return Err(serde::de::Error::custom(format!(
+                            "duplicate name '{key}': every name must be unique"
+                        )));
+                    }
+                    let value = map.next_value()?;
+                    out.insert(key, value);
+                }
+                Ok(NamedMap(out))
+            }
+        }
+        deserializer.deserialize_map(MapVisitor(PhantomData))
+    }
+}

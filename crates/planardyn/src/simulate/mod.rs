@@ -1,0 +1,215 @@
+//! Forward simulation: the whole loop in Rust. Integrates y = [z, zd, W] in the best chart,
+//! writes outputs in the user's coordinates, and on any failure returns the trajectory
+//! computed so far with a status saying why it stopped.
+
+pub mod charts;
+pub mod ode;
+pub mod trajectory;
+
+pub use trajectory::{SimStats, Status, Trajectory};
+
+use crate::dynamics::Drives;
+use crate::integrate::{Method, Options, StepError, Stepper};
+use crate::kinematics::{assemble_into, velocity_analogues, Chart};
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::{Error, KinematicsError};
+use charts::{measure, next_chart, state_in, PASSIVE_SINGULAR};
+use ode::MechanismOde;
+
+/// What to simulate and how. Times in s.
+#[derive(Debug, Clone)]
+pub struct Settings {
+    pub t0: f64,
+    pub t_end: f64,
+    pub method: Method,
+    /// Integrator options (tolerances, fixed step `dt`, step limits).
+    pub options: Options,
+    /// Output times, increasing, within [t0, t_end]; `None`: t0 and every accepted step.
+    pub t_eval: Option<Vec<f64>>,
+    /// Start coordinates and rates; `None`: the model's.
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+}
+
+impl Settings {
+    /// Defaults for a mechanism: its file's `simulate` section, else DOP853 with
+    /// rtol 1e-9, atol 1e-12 over 1 s.
+    pub fn for_model(mech: &Mechanism) -> Result<Settings, Error> {
+        let d = &mech.simulate;
+        let method = match &d.method {
+            Some(name) => name.parse().map_err(Error::Options)?,
+            None => Method::Dop853,
+        };
+        let options = Options { rtol: d.rtol.unwrap_or(1e-9), atol: d.atol.unwrap_or(1e-12), dt: d.dt, ..Options::default() };
+        let t_end = d.t_end.unwrap_or(1.0);
+        let t_eval = d.output_dt.map(|h| grid(0.0, t_end, h));
+        Ok(Settings { t0: 0.0, t_end, method, options, t_eval, q0: None, qd0: None })
+    }
+}
+
+/// Times t0, t0 + h, ... up to t_end included.
+pub fn grid(t0: f64, t_end: f64, h: f64) -> Vec<f64> {
+    let n = ((t_end - t0) / h * (1.0 + 1e-12)).floor() as usize;
+    let mut t: Vec<f64> = (0..=n).map(|k| t0 + k as f64 * h).collect();
+    if t_end - t[n] > 1e-9 * h {
+        t.push(t_end);
+    }
+    t
+}
+
+fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::Options(m));
+    if !(settings.t_end > settings.t0) || !settings.t_end.is_finite() || !settings.t0.is_finite() {
+        return bad(format!("t_end = {} must be finite and after t0 = {}", settings.t_end, settings.t0));
+    }
+    settings.options.validate(settings.method).map_err(Error::Options)?;
+    for (name, v) in [("q0", &settings.q0), ("qd0", &settings.qd0)] {
+        if let Some(v) = v {
+            if v.len() != mech.dof() || v.iter().any(|x| !x.is_finite()) {
+                return bad(format!("{name} needs {} finite values ({}), got {v:?}", mech.dof(), mech.coordinate_names().join(", ")));
+            }
+        }
+    }
+    if let Some(te) = &settings.t_eval {
+        if te.windows(2).any(|w| !(w[1] > w[0])) || te.first().is_some_and(|&t| t < settings.t0) || te.last().is_some_and(|&t| t > settings.t_end) {
+            return bad(format!("t_eval must increase strictly within [t0, t_end] = [{}, {}]", settings.t0, settings.t_end));
+        }
+    }
+    Ok(())
+}
+
+/// The start: assembled at q0, in the user's chart unless it is near-singular there.
+fn start<'a>(mech: &'a Mechanism, s: &Settings, drives: &'a mut dyn Drives) -> Result<(MechanismOde<'a>, Vec<f64>), Error> {
+    let (q0m, qd0m) = mech.initial_state();
+    let q0 = s.q0.clone().unwrap_or(q0m);
+    let qd0 = s.qd0.clone().unwrap_or(qd0m);
+    let mut ws = Workspace::new(mech);
+    assemble_into(mech, &q0, &mut ws)?;
+    // Body velocities from qd0 need U in the user's chart, i.e. a regular start; at rest a
+    // singular start is fine (xd = 0).
+    ws.xd.fill(0.0);
+    if qd0.iter().any(|&v| v != 0.0) {
+        velocity_analogues(&mut ws).map_err(|_| KinematicsError::Singular {
+            sigma_min: 0.0,
+            what: "the start is a type II singularity, where the rates qd0 do not determine the body velocities; start at rest or elsewhere".into(),
+        })?;
+        for (j, r) in qd0.iter().enumerate() {
+            let n = ws.x.len();
+            for i in 0..n {
+                ws.xd[i] += ws.u[j * n + i] * r;
+            }
+        }
+    }
+    ws.q.copy_from_slice(&q0);
+    ws.qd.copy_from_slice(&qd0);
+    let mut ode = MechanismOde::new(mech, ws, drives);
+    let m0 = measure(&ode);
+    if m0.passive < PASSIVE_SINGULAR {
+        return Err(KinematicsError::Singular { sigma_min: m0.passive, what: "the passive mechanism is singular at the start (its pair constraints lose rank); start elsewhere".into() }.into());
+    }
+    let chart = next_chart(&ode, &m0).unwrap_or(Chart::Inputs);
+    let m = mech.dof();
+    let mut y = vec![0.0; 2 * m + 1];
+    state_in(&ode, &chart, 0.0, &mut y);
+    ode.set_chart(chart, s.t0, &y)?;
+    Ok((ode, y))
+}
+
+/// Status and message for a failed step.
+fn failure(e: &StepError<Error>) -> (Status, String) {
+    let status = match e {
+        StepError::StepSizeUnderflow { .. } => Status::StepSizeUnderflow,
+        StepError::NonFinite { .. } => Status::NonFinite,
+        StepError::TooManySteps { .. } => Status::TooManySteps,
+        StepError::Rhs { error: Error::Drive { .. }, .. } => Status::DriveFailed,
+        StepError::Rhs { .. } => Status::AssemblyFailed,
+    };
+    (status, e.to_string())
+}
+
+/// Simulate from the model's (or the given) initial state. `progress(t)` is called after
+/// each accepted step and may return false to stop. Errors in the settings or at the
+/// start return Err; anything after the start returns the partial trajectory with a status.
+pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, mut progress: Option<&mut dyn FnMut(f64) -> bool>) -> Result<Trajectory, Error> {
+    check(settings, mech)?;
+    let (mut ode, y0) = start(mech, settings, drives)?;
+    let m = mech.dof();
+    let mut traj = Trajectory::new(m, mech.n_x());
+    let mut stepper = Stepper::new(settings.method, &settings.options, 2 * m + 1).map_err(Error::Options)?;
+    let mut y = y0;
+    if let Err(e) = stepper.reset(&mut ode, settings.t0, &y) {
+        let (status, message) = failure(&e);
+        return Err(Error::Options(format!("cannot start the integrator ({}): {message}", status.name())));
+    }
+    let t_eval = settings.t_eval.as_deref();
+    let mut next_out = 0;
+    if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
+        ode.accept(settings.t0, &y)?;
+        traj.record(&ode, settings.t0, y[2 * m]);
+        next_out = 1;
+    }
+    let mut yi = vec![0.0; 2 * m + 1];
+    let (mut status, mut message) = (Status::Success, String::new());
+    while stepper.t() < settings.t_end {
+        if let Err(e) = stepper.step(&mut ode, settings.t_end) {
+            (status, message) = failure(&e);
+            break;
+        }
+        let t = stepper.t();
+        y.copy_from_slice(stepper.y());
+        if ode.ws.chart != Chart::Inputs {
+            traj.stats.partition_steps += 1;
+        }
+        if let Some(te) = t_eval {
+            while next_out < te.len() && te[next_out] <= t {
+                stepper.interpolate(te[next_out], &mut yi);
+                if let Err(e) = ode.evaluate(te[next_out], &yi) {
+                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[next_out]));
+                    break;
+                }
+                traj.record(&ode, te[next_out], yi[2 * m]);
+                next_out += 1;
+            }
+            if status != Status::Success {
+                break;
+            }
+        }
+        if let Err(e) = ode.accept(t, &y) {
+            (status, message) = (Status::AssemblyFailed, format!("at t = {t}: {e}"));
+            break;
+        }
+        if t_eval.is_none() {
+            traj.record(&ode, t, y[2 * m]);
+        }
+        let meas = measure(&ode);
+        traj.stats.min_sigma = traj.stats.min_sigma.min(meas.sigma);
+        traj.stats.min_passive_sigma = traj.stats.min_passive_sigma.min(meas.passive);
+        if meas.passive < PASSIVE_SINGULAR {
+            (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
+            break;
+        }
+        if let Some(chart) = next_chart(&ode, &meas) {
+            state_in(&ode, &chart, y[2 * m], &mut y);
+            traj.stats.chart_switches += 1;
+            let switched = ode.set_chart(chart, t, &y).map_err(|e| e.to_string());
+            if let Err(e) = switched.and_then(|_| stepper.reset(&mut ode, t, &y).map_err(|e| e.to_string())) {
+                (status, message) = (Status::AssemblyFailed, format!("changing coordinates at t = {t} s: {e}"));
+                break;
+            }
+        }
+        if let Some(cb) = progress.as_mut() {
+            if !cb(t) {
+                (status, message) = (Status::Cancelled, format!("stopped by the progress callback at t = {t} s"));
+                break;
+            }
+        }
+    }
+    traj.stats.integrator = stepper.stats();
+    if status == Status::Success {
+        message = format!("reached t_end = {} s", settings.t_end);
+    }
+    traj.status = status;
+    traj.message = message;
+    Ok(traj)
+}

@@ -1,0 +1,102 @@
+//! The equations of motion as a first-order system for the integrators, in a chart z:
+//! y = [z, zd, W] with y' = [zd, zdd, P], where W is the work done by the non-conservative
+//! forces and P its power, so that T + V - W is constant along any exact trajectory.
+
+use crate::dynamics::{forward, Drives};
+use crate::integrate::OdeSystem;
+use crate::kinematics::Chart;
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::Error;
+
+/// A mechanism in one chart, with the state the Newton predictor starts from.
+pub struct MechanismOde<'a> {
+    pub mech: &'a Mechanism,
+    pub ws: Workspace,
+    pub drives: &'a mut dyn Drives,
+    /// The last accepted point: body coordinates, analogues U (3n x m) and chart values z.
+    anchor_x: Vec<f64>,
+    anchor_u: Vec<f64>,
+    anchor_z: Vec<f64>,
+    /// The (t, y) of the evaluation whose results `ws` holds, to reuse it at acceptance.
+    last_t: f64,
+    last_y: Vec<f64>,
+}
+
+impl<'a> MechanismOde<'a> {
+    /// A system whose workspace `ws` holds a converged, analysed point of chart `ws.chart`.
+    pub fn new(mech: &'a Mechanism, ws: Workspace, drives: &'a mut dyn Drives) -> Self {
+        let m = mech.dof();
+        MechanismOde {
+            anchor_x: ws.x.clone(),
+            anchor_u: ws.u.clone(),
+            anchor_z: vec![0.0; m],
+            last_t: f64::NAN,
+            last_y: vec![f64::NAN; 2 * m + 1],
+            mech,
+            ws,
+            drives,
+        }
+    }
+
+    pub fn m(&self) -> usize {
+        self.mech.dof()
+    }
+
+    /// Make (t, y) the Newton predictor's anchor, evaluating there unless `ws` already holds
+    /// that point (the FSAL stage of an explicit pair usually does).
+    pub fn accept(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        if t != self.last_t || y != self.last_y.as_slice() {
+            self.evaluate(t, y)?;
+        }
+        self.anchor_x.copy_from_slice(&self.ws.x);
+        self.anchor_u.copy_from_slice(&self.ws.u);
+        let m = self.m();
+        self.anchor_z.copy_from_slice(&y[..m]);
+        Ok(())
+    }
+
+    /// Change to `chart`, in which the point held by `ws` has state `y`; then evaluates
+    /// there and anchors the predictor to it.
+    pub fn set_chart(&mut self, chart: Chart, t: f64, y: &[f64]) -> Result<(), Error> {
+        self.ws.chart = chart;
+        self.anchor_x.copy_from_slice(&self.ws.x);
+        let m = self.m();
+        self.anchor_z.copy_from_slice(&y[..m]);
+        self.last_t = f64::NAN;
+        self.accept(t, y)
+    }
+
+    /// Forward dynamics at (t, y) from the anchor's first-order prediction.
+    pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let m = self.m();
+        let n = self.ws.x.len();
+        self.ws.x.copy_from_slice(&self.anchor_x);
+        for j in 0..m {
+            let dz = y[j] - self.anchor_z[j];
+            for (x, u) in self.ws.x.iter_mut().zip(&self.anchor_u[j * n..(j + 1) * n]) {
+                *x += u * dz;
+            }
+        }
+        self.last_t = f64::NAN;
+        forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws)?;
+        self.last_t = t;
+        self.last_y.copy_from_slice(y);
+        Ok(())
+    }
+}
+
+impl OdeSystem for MechanismOde<'_> {
+    type Error = Error;
+    fn dim(&self) -> usize {
+        2 * self.m() + 1
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
+        self.evaluate(t, y)?;
+        let m = self.m();
+        dy[..m].copy_from_slice(&y[m..2 * m]);
+        dy[m..2 * m].copy_from_slice(&self.ws.b);
+        dy[2 * m] = self.ws.power;
+        Ok(())
+    }
+}

@@ -1,0 +1,136 @@
+//! A simulation result: the trajectory computed (all of it, even when the run stopped early),
+//! why it ended, and the figures that say how far to trust it.
+
+use super::ode::MechanismOde;
+use crate::dynamics::{kinetic_energy, potential_energy};
+use crate::integrate::Stats;
+use crate::kinematics::{sigma_min, Chart};
+
+/// How a simulation ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Reached t_end.
+    Success,
+    /// Position analysis failed even for the smallest step (the mechanism cannot move on).
+    AssemblyFailed,
+    /// The passive mechanism became singular (its constraints lost rank).
+    PassiveSingularity,
+    /// The step size underflowed (stiffness, or a discontinuity).
+    StepSizeUnderflow,
+    /// NaN or infinity appeared.
+    NonFinite,
+    /// A drive function failed or returned a non-finite effort.
+    DriveFailed,
+    /// The step budget was used up.
+    TooManySteps,
+    /// The progress callback asked to stop.
+    Cancelled,
+}
+
+impl Status {
+    /// Short machine-readable name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Success => "success",
+            Status::AssemblyFailed => "assembly_failed",
+            Status::PassiveSingularity => "passive_singularity",
+            Status::StepSizeUnderflow => "step_size_underflow",
+            Status::NonFinite => "non_finite",
+            Status::DriveFailed => "drive_failed",
+            Status::TooManySteps => "too_many_steps",
+            Status::Cancelled => "cancelled",
+        }
+    }
+}
+
+/// Counters and accuracy figures of a run.
+#[derive(Debug, Clone, Default)]
+pub struct SimStats {
+    /// Integrator counters (evaluations, accepted and rejected steps, Jacobians, LUs).
+    pub integrator: Stats,
+    /// Changes between the user's coordinates and a partition, and between partitions.
+    pub chart_switches: usize,
+    /// Steps integrated in a partition chart (near type II singularities).
+    pub partition_steps: usize,
+    /// Largest scaled loop-closure residual at the output points (lengths / L, angles in rad).
+    pub max_residual: f64,
+    /// Smallest type II measure seen at accepted steps (scaled singular value).
+    pub min_sigma: f64,
+    /// Smallest passive measure seen (see `charts::Measures::passive`).
+    pub min_passive_sigma: f64,
+    /// Largest |E(t) - E(0)| at the outputs with E = T + V - W (J): energy balance error.
+    pub energy_drift: f64,
+}
+
+/// Output arrays, time-major: row k belongs to `t[k]`.
+#[derive(Debug, Clone, Default)]
+pub struct Trajectory {
+    /// Number of coordinates m and of body coordinates 3n (row lengths).
+    pub m: usize,
+    pub nx: usize,
+    /// Times (s).
+    pub t: Vec<f64>,
+    /// (N x m) coordinates (rad or m), rates and accelerations.
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    /// (N x m) drive efforts applied (N m or N).
+    pub tau: Vec<f64>,
+    /// (N x 3n) body poses [X, Y, phi] of each centre of mass (m, rad) and their rates.
+    pub x: Vec<f64>,
+    pub xd: Vec<f64>,
+    /// (N) kinetic and potential energy, work of non-conservative forces (J).
+    pub kinetic: Vec<f64>,
+    pub potential: Vec<f64>,
+    pub work: Vec<f64>,
+    /// (N) type II singularity measure and loop-closure residual at each output.
+    pub sigma: Vec<f64>,
+    pub residual: Vec<f64>,
+    /// (N) whether the point was integrated in a partition chart.
+    pub partitioned: Vec<bool>,
+    pub status: Status,
+    pub message: String,
+    pub stats: SimStats,
+}
+
+impl Default for Status {
+    fn default() -> Self {
+        Status::Success
+    }
+}
+
+impl Trajectory {
+    pub fn new(m: usize, nx: usize) -> Self {
+        Trajectory { m, nx, stats: SimStats { min_sigma: f64::INFINITY, min_passive_sigma: f64::INFINITY, ..Default::default() }, ..Default::default() }
+    }
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+    pub fn success(&self) -> bool {
+        self.status == Status::Success
+    }
+    /// Record the point analysed in `ode.ws` at time t with work W.
+    pub fn record(&mut self, ode: &MechanismOde, t: f64, work: f64) {
+        let ws = &ode.ws;
+        self.t.push(t);
+        self.q.extend_from_slice(&ws.q);
+        self.qd.extend_from_slice(&ws.qd);
+        self.qdd.extend_from_slice(&ws.qdd);
+        self.tau.extend_from_slice(&ws.tau);
+        self.x.extend_from_slice(&ws.x);
+        self.xd.extend_from_slice(&ws.xd);
+        let (kin, pot) = (kinetic_energy(ode.mech, &ws.xd), potential_energy(ode.mech, &ws.x));
+        self.kinetic.push(kin);
+        self.potential.push(pot);
+        self.work.push(work);
+        self.sigma.push(sigma_min(ode.mech, &Chart::Inputs, &ws.x));
+        self.residual.push(ws.residual);
+        self.partitioned.push(ws.chart != Chart::Inputs);
+        let e0 = self.kinetic[0] + self.potential[0] - self.work[0];
+        self.stats.energy_drift = self.stats.energy_drift.max((kin + pot - work - e0).abs());
+        self.stats.max_residual = self.stats.max_residual.max(ws.residual);
+    }
+}
