@@ -37,8 +37,6 @@ EXPECTED_COUNTS = {
 # Geometry written by hand in the drawings is checked to this (m, rad): the numbers are
 # pasted at full double precision, so only the last-digit rounding of the generator remains.
 GEOMETRY_TOL = 1e-14
-# Reference energies (J) quoted in the benchmarks' `checks_without_reference` (PROVENANCE.md).
-G_TOL_REL = 1e-12
 
 
 # --------------------------------------------------------------------------- loading
@@ -161,7 +159,9 @@ def reference_errors(model: dict) -> list[str]:
             pair_names[pr["name"]] = pr
         point(f"{path}.at", pr["at"])
         for k, b in enumerate(pr["bodies"]):
-            if body(f"{path}.bodies[{k}]", b):
+            # a prismatic pair's guide body (a, k = 0) need not carry `at`: the guide passes
+            # through its drawn position
+            if body(f"{path}.bodies[{k}]", b) and (k == 1 or pr["type"] == "revolute"):
                 carries(f"{path}.at", b, pr["at"])
         for k, p in enumerate(pr.get("along", [])):
             point(f"{path}.along[{k}]", p)
@@ -383,6 +383,8 @@ def _mutations():
     def point_mass_alone(m): m["bodies"]["crank"] = {"points": ["O", "A"], "point_mass": "A", "mass": 1.0}
     def body_named_ground(m): m["bodies"]["ground"] = m["bodies"].pop("crank")
     def units_mm(m): m["units"] = "mm"
+    def point_named_ground(m): m["points"]["ground"] = [0.0, 0.0]
+    def force_on_ground(m): m["loads"] = [{"type": "force", "body": "ground", "at": "O", "value": [1.0, 0.0]}]
     def gravity_3d(m): m["gravity"] = [0.0, -9.81, 0.0]
     def point_1d(m): m["points"]["O"] = [0.0]
     def revolute_with_axis(m): m["pairs"][0]["axis"] = [1.0, 0.0]
@@ -541,14 +543,15 @@ def test_five_bar_free_fall_distal_left_parts():
     assert inertia == pytest.approx(0.25 * 0.25**2 / 12 + 0.25 * d_bar**2 + 0.1 * d_pm**2, rel=1e-14)
 
 
-# Energies of the drawings quoted by the sources (PROVENANCE.md): (figure J, relative tolerance).
+# Energies of the drawings quoted by the sources (PROVENANCE.md), checked to half a unit in the
+# last decimal they quote: that is all the figure carries.
 DRAWN_ENERGY = {
     # "Total energy (kinetic + m g y of each centre of mass) stays at 13.770736975732 J"
-    "four-bar-gravity": ("13.770736975732", 1e-12),
+    "four-bar-gravity": "13.770736975732",
     # "Total energy stays at 1.874338473780 J"
-    "five-bar-free-fall": ("1.874338473780", 1e-12),
-    # "T + V_spring - mom*(beta - beta0) ... (about 1.43580 J)": quoted to 6 figures
-    "andrews-squeezer": ("1.43580", 5e-6),
+    "five-bar-free-fall": "1.874338473780",
+    # "T + V_spring - mom*(beta - beta0) stays equal to its value at t = 0 (about 1.43580 J)"
+    "andrews-squeezer": "1.43580",
 }
 
 
@@ -556,11 +559,12 @@ DRAWN_ENERGY = {
 def test_drawn_energy_matches_checks_without_reference(stem):
     """At rest in the drawing the total energy is the potential one: the model file's masses,
     centres of mass (uniform bars, point masses) and spring give the source's figure."""
-    figure, rel = DRAWN_ENERGY[stem]
+    figure = DRAWN_ENERGY[stem]
     assert figure in load_benchmark(stem)["checks_without_reference"]
+    half_unit = 0.5 * 10.0 ** -len(figure.split(".")[1])
     model = load_model(f"{stem}.yaml")
     assert all(c.get("qd0", 0.0) == 0.0 for c in model["coordinates"])
-    assert drawn_potential_energy(model) == pytest.approx(float(figure), rel=rel)
+    assert drawn_potential_energy(model) == pytest.approx(float(figure), rel=0, abs=half_unit)
 
 
 def test_benchmark_inertias_are_uniform_bars_where_the_source_says_so():
@@ -608,8 +612,8 @@ def test_five_bar_drawing():
     assert p[1] > max(c1[1], c2[1])  # upper working mode
     # the drives: a constant and a table
     drives = {d["coordinate"]: d for d in model["drives"]}
-    assert drives["theta1"]["effort"] == -2.4
-    assert drives["theta2"]["table"] == {"t": [0.0, 0.2, 0.6, 0.8], "effort": [2.6, 3.2, 3.2, 2.6]}
+    assert drives["theta1"]["effort"] == -2.41
+    assert drives["theta2"]["table"] == {"t": [0.0, 0.2, 0.6, 0.8], "effort": [2.61, 3.2, 3.2, 2.61]}
 
 
 def test_slider_crank_drawing():

@@ -1,1 +1,58 @@
-//! PyO3 glue.
+//! PyO3 glue for planardyn: the native module `planardyn._core`. Conversions live in
+//! `convert.rs`, the mapping of errors to Python exceptions in `errors.rs` (the only place),
+//! the `Mechanism` class in `mechanism.rs` and the simulation entry point in `simulate.rs`.
+//! The typed Python face is the package `python/planardyn`; its stub `_core.pyi` mirrors
+//! this module.
+
+mod convert;
+mod errors;
+mod mechanism;
+mod simulate;
+
+use errors::{model_error, PlanardynError};
+use mechanism::PyMechanism;
+use planardyn::Format;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+fn built(py: Python<'_>, result: std::thread::Result<Result<planardyn::Mechanism, planardyn::ModelError>>) -> PyResult<PyMechanism> {
+    match result {
+        Ok(Ok(m)) => Ok(PyMechanism::new(m)),
+        Ok(Err(e)) => Err(model_error(py, &e)),
+        Err(_) => Err(PlanardynError::new_err(
+            "internal error in planardyn while building the model (a bug: please report it with the model file)",
+        )),
+    }
+}
+
+/// Load a model file (.yaml, .yml or .json; anything else is read as YAML).
+#[pyfunction]
+fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<PyMechanism> {
+    let r = py.detach(|| catch_unwind(AssertUnwindSafe(|| planardyn::load(&path))));
+    built(py, r)
+}
+
+/// Build a mechanism from model text; `format` is "yaml" or "json", `source` names it in messages.
+#[pyfunction]
+#[pyo3(signature = (text, format="yaml", source="<string>"))]
+fn loads(py: Python<'_>, text: &str, format: &str, source: &str) -> PyResult<PyMechanism> {
+    let format = match format.to_ascii_lowercase().as_str() {
+        "yaml" | "yml" => Format::Yaml,
+        "json" => Format::Json,
+        other => return Err(PyValueError::new_err(format!("format must be 'yaml' or 'json', got {other:?}"))),
+    };
+    let (text, source) = (text.to_owned(), source.to_owned());
+    let r = py.detach(|| catch_unwind(AssertUnwindSafe(|| planardyn::loads(&text, format, &source))));
+    built(py, r)
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<PyMechanism>()?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(loads, m)?)?;
+    errors::register(m)?;
+    Ok(())
+}

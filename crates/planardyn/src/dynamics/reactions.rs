@@ -8,7 +8,8 @@ use crate::workspace::Workspace;
 
 /// For each pair, [F_x, F_y, M]: the force (N, global) and the couple (N m) that body a
 /// exerts on body b (the pair's first and second body), after a forward evaluation in `ws`.
-/// A revolute pair transmits no couple; a prismatic pair's force is normal to its guide.
+/// The force acts at b's copy of the pair point (where a slider touches its guide); a
+/// revolute pair transmits no couple; a prismatic pair's force is normal to its guide.
 pub fn reactions(mech: &Mechanism, ws: &mut Workspace) -> Vec<[f64; 3]> {
     let mut lambda: Vec<f64> = (0..ws.x.len())
         .map(|i| {

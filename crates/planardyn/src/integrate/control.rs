@@ -7,7 +7,7 @@
 //! `integrate/_ivp/common.py` (`norm`, `select_initial_step`) and `rk.py`
 //! (`RungeKutta._step_impl`), whose constants are used here.
 
-use super::{OdeSystem, Options, StepError, Stats};
+use super::{OdeSystem, Options, Stats, StepError};
 
 /// Safety factor of the step-size controller.
 pub(crate) const SAFETY: f64 = 0.9;
@@ -137,14 +137,52 @@ impl Core {
     }
 
     /// Clip a trial step `h` to `h_max` and to end exactly on `t_stop`; returns
-    /// `(h, t_new)`. A step within `stretch` (relative) of `t_stop` is stretched
-    /// to land on it, as in Hairer's codes (1 % for adaptive steps).
+    /// `(h, t_new)`. A step within `stretch` (relative) of `t_stop`, or leaving
+    /// less than `h_min` before it, is stretched to land on it, as in Hairer's
+    /// codes (1 % for adaptive steps).
     pub(crate) fn clip(&self, h: f64, t_stop: f64, stretch: f64) -> (f64, f64) {
         let h = h.min(self.opts.h_max);
-        if self.t + h * (1.0 + stretch) >= t_stop {
-            (t_stop - self.t, t_stop)
+        let t = self.t;
+        if t + h * (1.0 + stretch) >= t_stop || t_stop - (t + h) < self.h_min() {
+            (t_stop - t, t_stop)
         } else {
-            (h, self.t + h)
+            (h, t + h)
+        }
+    }
+
+    /// The next trial: checks the attempt budget, clips `h` (see [`Core::clip`])
+    /// and, after a rejection, ends with an error when the step fell below
+    /// `h_min` (reporting the last failure). A first try that is tiny only
+    /// because `t_stop` is close is allowed.
+    pub(crate) fn next_try<E>(
+        &self,
+        h: f64,
+        t_stop: f64,
+        stretch: f64,
+        rejected: bool,
+        last_failure: &mut Option<Failure<E>>,
+    ) -> Result<(f64, f64), StepError<E>> {
+        self.check_budget()?;
+        let (h_try, t_new) = self.clip(h, t_stop, stretch);
+        if rejected && h_try < self.h_min() {
+            let t = self.t;
+            return Err(match last_failure.take() {
+                Some(failure) => failure.into_error(t, h_try),
+                None => StepError::StepSizeUnderflow { t, h: h_try },
+            });
+        }
+        Ok((h_try, t_new))
+    }
+
+    /// Proposal for the step after an accepted step `h_try` grown by `factor`.
+    /// A step cut short to land on `t_stop` does not shrink the step `h_planned`
+    /// it was cut from, so that stopping at many close `t_stop` stays cheap.
+    pub(crate) fn propose(&self, h_try: f64, factor: f64, h_planned: f64, t_stop: f64) -> f64 {
+        let h = h_try * factor;
+        if self.t == t_stop {
+            h.max(h_planned.min(self.opts.h_max))
+        } else {
+            h
         }
     }
 
@@ -282,7 +320,7 @@ pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
 ) -> Result<(), StepError<S::Error>> {
     let core = p.core();
     core.assert_started();
-    if t_stop <= core.t {
+    if t_stop.is_nan() || t_stop <= core.t {
         return Ok(());
     }
     let fixed = core.opts.dt;
@@ -301,22 +339,19 @@ pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
     let mut rejected = false;
     let mut last_failure: Option<Failure<S::Error>> = None;
     loop {
-        let core = p.core();
-        core.check_budget()?;
-        let (h_try, t_new) = core.clip(h, t_stop, stretch);
-        if h_try < core.h_min() {
-            return Err(match last_failure {
-                Some(failure) => failure.into_error(core.t, h_try),
-                None => StepError::StepSizeUnderflow { t: core.t, h: h_try },
-            });
-        }
+        let (h_try, t_new) = p
+            .core()
+            .next_try(h, t_stop, stretch, rejected, &mut last_failure)?;
         match p.attempt(sys, h_try) {
             Ok(err) if fixed.is_some() || err <= 1.0 => {
                 p.accept(sys, t_new);
                 let core = p.core();
                 core.h_next = match fixed {
                     Some(dt) => dt,
-                    None => h_try * factor_accept(err, P::ERROR_ORDER, rejected),
+                    None => {
+                        let factor = factor_accept(err, P::ERROR_ORDER, rejected);
+                        core.propose(h_try, factor, h, t_stop)
+                    }
                 };
                 return Ok(());
             }

@@ -22,6 +22,10 @@
 //! interpolant then degrades to the cubic Hermite polynomial (order 3). If one
 //! of the extra stages fails, that step's dense output is cubic Hermite too.
 
+// The coefficients keep the 30 digits of the published table, so that they can be
+// compared with it digit by digit; the compiler rounds them to f64.
+#![allow(clippy::excessive_precision)]
+
 use super::control::{all_finite, explicit_step, Core, ExplicitPair, Failure};
 use super::{OdeSystem, Options, StepError};
 
@@ -299,7 +303,12 @@ impl Dop853 {
     }
 
     /// Evaluate stage `s` from the stages before it: `K_s = f(t + C_s h, y + h sum_j A_sj K_j)`.
-    fn stage<S: OdeSystem>(&mut self, sys: &mut S, s: usize, h: f64) -> Result<(), Failure<S::Error>> {
+    fn stage<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        s: usize,
+        h: f64,
+    ) -> Result<(), Failure<S::Error>> {
         let Dop853 { core, k, ytmp, .. } = self;
         let n = core.n;
         for i in 0..n {
@@ -308,7 +317,13 @@ impl Dop853 {
         }
         let (done, rest) = k.split_at_mut(s * n);
         let _ = done;
-        Core::eval(&mut core.stats, sys, core.t + C[s] * h, ytmp, &mut rest[..n])
+        Core::eval(
+            &mut core.stats,
+            sys,
+            core.t + C[s] * h,
+            ytmp,
+            &mut rest[..n],
+        )
     }
 }
 
@@ -330,7 +345,13 @@ impl ExplicitPair for Dop853 {
         for s in 1..N_STAGES {
             self.stage(sys, s, h)?;
         }
-        let Dop853 { core, k, y_new, f_new, .. } = self;
+        let Dop853 {
+            core,
+            k,
+            y_new,
+            f_new,
+            ..
+        } = self;
         for i in 0..n {
             let incr: f64 = (0..N_STAGES).map(|j| B[j] * k[j * n + i]).sum();
             y_new[i] = core.y[i] + h * incr;
@@ -370,7 +391,14 @@ impl ExplicitPair for Dop853 {
                 }
             }
         }
-        let Dop853 { core, k, fd, y_new, f_new, .. } = self;
+        let Dop853 {
+            core,
+            k,
+            fd,
+            y_new,
+            f_new,
+            ..
+        } = self;
         for i in 0..n {
             let dy = y_new[i] - core.y[i];
             fd[i] = dy;
@@ -402,12 +430,20 @@ mod tests {
         }
         for q in 0..8 {
             let sum: f64 = (0..N_STAGES).map(|j| B[j] * C[j].powi(q)).sum();
-            assert!((sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-14, "q = {q}: {sum}");
+            assert!(
+                (sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-14,
+                "q = {q}: {sum}"
+            );
         }
         // The 5th-order embedded solution (B - E5) also integrates c^q exactly, q < 5.
         for q in 0..5 {
-            let sum: f64 = (0..=N_STAGES).map(|j| (B.get(j).unwrap_or(&0.0) - E5[j]) * C[j].powi(q)).sum();
-            assert!((sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-13, "E5, q = {q}: {sum}");
+            let sum: f64 = (0..=N_STAGES)
+                .map(|j| (B.get(j).unwrap_or(&0.0) - E5[j]) * C[j].powi(q))
+                .sum();
+            assert!(
+                (sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-13,
+                "E5, q = {q}: {sum}"
+            );
         }
         assert!(E3.iter().sum::<f64>().abs() < 1e-14);
         assert!(E5.iter().sum::<f64>().abs() < 1e-14);

@@ -12,12 +12,7 @@ use std::ops::{Div, Mul, MulAssign, Sub, SubAssign};
 
 /// The scalars the LU works with.
 pub(crate) trait Scalar:
-    Copy
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Sub<Output = Self>
-    + SubAssign
-    + MulAssign
+    Copy + Mul<Output = Self> + Div<Output = Self> + Sub<Output = Self> + SubAssign + MulAssign
 {
     /// Magnitude used to choose the pivot (the modulus for complex numbers).
     fn magnitude(self) -> f64;

@@ -42,6 +42,9 @@
 //! scipy's `scipy/integrate/_ivp` (`rk.py`, `radau.py`, `common.py`), whose
 //! structure these implementations follow.
 
+// Index loops over stages and components read like the formulas of the references.
+#![allow(clippy::needless_range_loop)]
+
 mod control;
 pub mod dop853;
 pub mod dopri5;
@@ -157,13 +160,16 @@ pub struct Options {
     pub h0: Option<f64>,
     /// Largest step (s). Default `f64::INFINITY`.
     pub h_max: f64,
-    /// Smallest step, relative to the time scale: a trial step below
-    /// `h_min * max(|t|, 1 s)` (and never below 10 ulp of `t`) ends the step with
-    /// an error ([`StepError::StepSizeUnderflow`], `Rhs` or `NonFinite`). Default `1e-14`.
+    /// Smallest step, relative to the time scale: when rejections shrink the
+    /// trial step below `h_min * max(|t|, 1 s)` (and never below 10 ulp of `t`),
+    /// the step ends with an error ([`StepError::StepSizeUnderflow`], `Rhs` or
+    /// `NonFinite`, after the last cause of rejection). A step that lands on a
+    /// `t_stop` closer than this is still taken. Default `1e-14`.
     pub h_min: f64,
     /// Fixed step (s). Required by `Rk4`. For the adaptive methods, `Some(dt)`
     /// switches the error control off and steps with `dt` (used to measure the
-    /// order of convergence); a failing `rhs` still halves the trial step.
+    /// order of convergence); a failing `rhs` still shrinks the trial step
+    /// (by 0.25, see [`StepError::Rhs`]).
     /// Default `None`.
     pub dt: Option<f64>,
     /// Largest number of step attempts (accepted plus rejected) since
@@ -193,19 +199,29 @@ impl Default for Options {
 impl Options {
     /// Default options with tolerances `rtol`, `atol`.
     pub fn tol(rtol: f64, atol: f64) -> Self {
-        Options { rtol, atol, ..Options::default() }
+        Options {
+            rtol,
+            atol,
+            ..Options::default()
+        }
     }
 
     /// Default options with a fixed step `dt` (s): no error control, for any method.
     pub fn fixed(dt: f64) -> Self {
-        Options { dt: Some(dt), ..Options::default() }
+        Options {
+            dt: Some(dt),
+            ..Options::default()
+        }
     }
 
     /// Check the options for `method`; the message says what to change.
     pub fn validate(&self, method: Method) -> Result<(), String> {
         let eps = f64::EPSILON;
         if !(self.rtol.is_finite() && self.rtol > 0.0) {
-            return Err(format!("rtol = {} must be finite and > 0 (try 1e-8)", self.rtol));
+            return Err(format!(
+                "rtol = {} must be finite and > 0 (try 1e-8)",
+                self.rtol
+            ));
         }
         if self.rtol < 100.0 * eps {
             return Err(format!(
@@ -214,27 +230,40 @@ impl Options {
             ));
         }
         if !(self.atol.is_finite() && self.atol >= 0.0) {
-            return Err(format!("atol = {} must be finite and >= 0 (try 1e-10)", self.atol));
+            return Err(format!(
+                "atol = {} must be finite and >= 0 (try 1e-10)",
+                self.atol
+            ));
         }
         if let Some(h0) = self.h0 {
             if !(h0.is_finite() && h0 > 0.0) {
-                return Err(format!("h0 = {h0} must be finite and > 0, or None for automatic"));
+                return Err(format!(
+                    "h0 = {h0} must be finite and > 0, or None for automatic"
+                ));
             }
         }
         if self.h_max.is_nan() || self.h_max <= 0.0 {
-            return Err(format!("h_max = {} must be > 0 (use infinity for no limit)", self.h_max));
+            return Err(format!(
+                "h_max = {} must be > 0 (use infinity for no limit)",
+                self.h_max
+            ));
         }
         if !(self.h_min.is_finite() && self.h_min >= 0.0) {
-            return Err(format!("h_min = {} must be finite and >= 0 (default 1e-14)", self.h_min));
+            return Err(format!(
+                "h_min = {} must be finite and >= 0 (default 1e-14)",
+                self.h_min
+            ));
         }
         if let Some(dt) = self.dt {
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(format!("dt = {dt} must be finite and > 0"));
             }
         } else if method == Method::Rk4 {
-            return Err("rk4 is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
+            return Err(
+                "rk4 is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
                         or choose an adaptive method such as dopri5"
-                .to_string());
+                    .to_string(),
+            );
         }
         if self.max_steps == 0 {
             return Err("max_steps must be >= 1".to_string());
@@ -299,6 +328,9 @@ pub struct Stats {
 }
 
 /// One integrator, chosen at run time (enum dispatch, so generic `step<S>` works without trait objects).
+///
+/// Created once per simulation, so the variants' different sizes do not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum Stepper {
     Rk4(rk4::Rk4),
     Dopri5(dopri5::Dopri5),

@@ -20,10 +20,9 @@
 //!
 //! **On `rhs` failure** (or a NaN) the step cannot rely on error control, so it
 //! falls back to the adaptive behaviour of the other methods: the trial step is
-//! shrunk by [`FAIL_FACTOR`](super::control::FAIL_FACTOR) (counted as a
-//! rejection) and retried, down to `h_min`, where
-//! [`StepError::Rhs`](super::StepError::Rhs) is returned. The step after a
-//! shortened one is `dt` again.
+//! shrunk by a factor 0.25 (counted as a rejection) and retried, down to
+//! `h_min`, where [`StepError::Rhs`](super::StepError) is returned. The step
+//! after a shortened one is `dt` again.
 
 use super::control::{explicit_step, Core, ExplicitPair, Failure};
 use super::{OdeSystem, Options, StepError};
@@ -105,7 +104,13 @@ impl ExplicitPair for Rk4 {
 
     /// One RK4 step; returns an error norm of 0 (no estimate).
     fn attempt<S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<f64, Failure<S::Error>> {
-        let Rk4 { core, k, ytmp, y_new, f_new } = self;
+        let Rk4 {
+            core,
+            k,
+            ytmp,
+            y_new,
+            f_new,
+        } = self;
         let (t, n) = (core.t, core.n);
         let [k2, k3, k4] = k;
         for i in 0..n {

@@ -262,7 +262,13 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
             ctx.err(format!("{path}.at"), format!("'{}' does not carry point '{at}' ({}: {fix})", bodies[i], bodies[i]))
         })
     };
-    let (sa, sb) = (carried(a, 0)?.s, carried(b, 1)?.s);
+    // A slider's guide passes through the pair point in the drawing: the guide body need not
+    // list it (its copy is placed where the drawing puts it).
+    let sa = match p {
+        PairSpec::Prismatic { .. } => mech.attachment(a, point).map_or_else(|| local_coords(mech, a, mech.points[point.0].1), |at| at.s),
+        PairSpec::Revolute { .. } => carried(a, 0)?.s,
+    };
+    let sb = carried(b, 1)?.s;
     let angle = |l: Link| match l {
         Link::Ground => 0.0,
         Link::Body(id) => mech.bodies[id.0].angle0,
@@ -289,6 +295,19 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
     };
     let name = name.clone().unwrap_or_else(|| format!("{}-{}@{at}", bodies[0], bodies[1]));
     Ok(Pair { name, kind, a, b, point, sa, sb, rel_angle0: angle(b) - angle(a) })
+}
+
+/// Coordinates in a link's frame of a drawn point.
+fn local_coords(mech: &Mechanism, link: Link, p: [f64; 2]) -> [f64; 2] {
+    match link {
+        Link::Ground => p,
+        Link::Body(b) => {
+            let body = &mech.bodies[b.0];
+            let (c, s) = (body.angle0.cos(), body.angle0.sin());
+            let (dx, dy) = (p[0] - body.com0[0], p[1] - body.com0[1]);
+            [c * dx + s * dy, -s * dx + c * dy]
+        }
+    }
 }
 
 fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {

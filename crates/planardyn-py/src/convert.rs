@@ -1,0 +1,95 @@
+//! Conversions between numpy arrays (float64, C order, time-major) and the core's slices,
+//! with shape checks whose messages name the argument, the expected shape and its meaning.
+
+use numpy::ndarray::{Array1, Array2, Array3, ArrayD, IxDyn};
+use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// An argument read as float64 values in C order, with its shape.
+pub struct Values {
+    pub data: Vec<f64>,
+    pub shape: Vec<usize>,
+}
+
+impl Values {
+    pub fn read(a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>) -> Values {
+        Values { shape: a.shape().to_vec(), data: a.as_array().iter().copied().collect() }
+    }
+    /// Number of rows: 1 for a vector, N for an (N, k) array.
+    pub fn rows(&self) -> usize {
+        if self.shape.len() == 2 { self.shape[0] } else { 1 }
+    }
+    pub fn row(&self, k: usize, len: usize) -> &[f64] {
+        &self.data[k * len..(k + 1) * len]
+    }
+}
+
+fn shape_str(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!("({})", shape.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", ")),
+    }
+}
+
+/// Check a 1-D argument of length `len`; `what` says what its entries are.
+pub fn vector(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize, what: &str) -> PyResult<Vec<f64>> {
+    let v = Values::read(a);
+    if v.shape != [len] {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape ({len},) ({what}), got shape {}",
+            shape_str(&v.shape)
+        )));
+    }
+    finite(name, &v.data)?;
+    Ok(v.data)
+}
+
+/// Check a (len,) or (N, len) argument.
+pub fn rows(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize, what: &str) -> PyResult<Values> {
+    let v = Values::read(a);
+    let ok = match v.shape.as_slice() {
+        [n] => *n == len,
+        [_, n] => *n == len,
+        _ => false,
+    };
+    if !ok {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape ({len},) or (N, {len}) ({what}), got shape {}",
+            shape_str(&v.shape)
+        )));
+    }
+    finite(name, &v.data)?;
+    Ok(v)
+}
+
+pub fn finite(name: &str, data: &[f64]) -> PyResult<()> {
+    match data.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(PyValueError::new_err(format!("{name}[{i}] = {} is not a finite number", data[i]))),
+        None => Ok(()),
+    }
+}
+
+pub fn arr1<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
+    Array1::from_vec(v).into_pyarray(py).into_any()
+}
+
+/// An (rows, cols) array from row-major data.
+pub fn arr2<'py>(py: Python<'py>, rows: usize, cols: usize, v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
+    let a = Array2::from_shape_vec((rows, cols), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any())
+}
+
+pub fn arr3<'py>(py: Python<'py>, shape: (usize, usize, usize), v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
+    let a = Array3::from_shape_vec(shape, v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any())
+}
+
+pub fn arr_dyn<'py>(py: Python<'py>, shape: &[usize], v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
+    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any())
+}
+
+pub fn bool1<'py>(py: Python<'py>, v: Vec<bool>) -> Bound<'py, PyAny> {
+    Array1::from_vec(v).into_pyarray(py).into_any()
+}

@@ -1,0 +1,181 @@
+//! The one place where Rust errors become Python exceptions.
+//!
+//! Tree (all importable from `planardyn`):
+//!
+//! ```text
+//! PlanardynError(Exception)
+//! ├── ModelError(PlanardynError, ValueError)   a model file or dict that is not a mechanism
+//! ├── AssemblyError                            KinematicsError::AssemblyFailed
+//! ├── SingularityError                         KinematicsError::Singular
+//! └── SimulationError                          Error::Options, Error::Drive
+//! ```
+//!
+//! Shape and value errors in the arguments are plain `ValueError`s. A Rust panic never
+//! reaches Python as `PanicException`: [`run`] catches it and raises `PlanardynError` asking
+//! for a bug report.
+
+use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple, PyType};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+create_exception!(planardyn, PlanardynError, PyException, "Base class of every error planardyn raises.");
+create_exception!(
+    planardyn,
+    AssemblyError,
+    PlanardynError,
+    "The position analysis did not converge: the mechanism cannot be assembled at these \
+     coordinates (attributes `residual`, `iterations`)."
+);
+create_exception!(
+    planardyn,
+    SingularityError,
+    PlanardynError,
+    "The mechanism is singular at this configuration (attribute `sigma_min`)."
+);
+create_exception!(
+    planardyn,
+    SimulationError,
+    PlanardynError,
+    "Invalid simulation options, or a run that could not start."
+);
+
+/// `ModelError(PlanardynError, ValueError)`: two bases, so it is made with `type(...)`
+/// (`create_exception!` takes one base). Attributes `source` and `path`.
+static MODEL_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+pub fn model_error_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
+    MODEL_ERROR
+        .get_or_try_init(py, || {
+            let bases = PyTuple::new(py, [py.get_type::<PlanardynError>(), py.get_type::<PyValueError>()])?;
+            let ns = PyDict::new(py);
+            ns.set_item("__module__", "planardyn")?;
+            ns.set_item(
+                "__doc__",
+                "A model that cannot be built: malformed YAML/JSON, a wrong field, or a drawing \
+                 that is not a mechanism. The message names the source and the field path; \
+                 attributes `source` (file or '<string>') and `path` (e.g. 'bodies.crank.mass').",
+            )?;
+            let ty = py.get_type::<PyType>().call1(("ModelError", bases, ns))?;
+            Ok::<_, PyErr>(ty.cast_into::<PyType>()?.unbind())
+        })
+        .map(|t| t.bind(py))
+}
+
+/// Register the exception classes in the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("PlanardynError", py.get_type::<PlanardynError>())?;
+    m.add("ModelError", model_error_type(py)?)?;
+    m.add("AssemblyError", py.get_type::<AssemblyError>())?;
+    m.add("SingularityError", py.get_type::<SingularityError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    Ok(())
+}
+
+fn with_attrs(py: Python<'_>, err: PyErr, attrs: &[(&str, Py<PyAny>)]) -> PyErr {
+    let value = err.value(py);
+    for (name, v) in attrs {
+        // An attribute that cannot be set only loses detail: the message has it all.
+        let _ = value.setattr(*name, v.bind(py));
+    }
+    err
+}
+
+/// A core model error as `ModelError` with `.source` and `.path`.
+pub fn model_error(py: Python<'_>, e: &CoreModelError) -> PyErr {
+    let (source, path) = match e {
+        CoreModelError::Parse { source_name, path, .. } | CoreModelError::Invalid { source_name, path, .. } => {
+            (source_name.clone(), path.clone())
+        }
+    };
+    let ty = match model_error_type(py) {
+        Ok(t) => t.clone(),
+        Err(err) => return err,
+    };
+    let err = PyErr::from_type(ty, e.to_string());
+    let Ok(source) = source.into_pyobject(py);
+    let Ok(path) = path.into_pyobject(py);
+    with_attrs(py, err, &[("source", source.into_any().unbind()), ("path", path.into_any().unbind())])
+}
+
+/// A kinematics error as the matching exception.
+pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
+    match e {
+        KinematicsError::AssemblyFailed { residual, iterations } => {
+            let Ok(r) = residual.into_pyobject(py);
+            let Ok(i) = iterations.into_pyobject(py);
+            let attrs = [("residual", r.into_any().unbind()), ("iterations", i.into_any().unbind())];
+            with_attrs(py, AssemblyError::new_err(e.to_string()), &attrs)
+        }
+        KinematicsError::Singular { sigma_min, .. } => {
+            let Ok(s) = sigma_min.into_pyobject(py);
+            with_attrs(py, SingularityError::new_err(e.to_string()), &[("sigma_min", s.into_any().unbind())])
+        }
+        KinematicsError::BadArgument(msg) => PyValueError::new_err(msg.clone()),
+    }
+}
+
+/// Any core error as a Python exception.
+pub fn to_pyerr(py: Python<'_>, e: &Error) -> PyErr {
+    match e {
+        Error::Model(m) => model_error(py, m),
+        Error::Kinematics(k) => kinematics_error(py, k),
+        Error::Options(_) | Error::Drive { .. } => SimulationError::new_err(e.to_string()),
+    }
+}
+
+/// What a computation run by [`run`] can fail with.
+pub enum Failure {
+    Core(Error),
+    /// Already a Python exception (a bad argument found inside, an exception from a callback).
+    Py(PyErr),
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Self {
+        Failure::Core(e)
+    }
+}
+impl From<KinematicsError> for Failure {
+    fn from(e: KinematicsError) -> Self {
+        Failure::Core(e.into())
+    }
+}
+impl From<CoreModelError> for Failure {
+    fn from(e: CoreModelError) -> Self {
+        Failure::Core(e.into())
+    }
+}
+impl From<PyErr> for Failure {
+    fn from(e: PyErr) -> Self {
+        Failure::Py(e)
+    }
+}
+
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_string())
+}
+
+/// Run a core computation with the GIL released (callbacks re-attach), turning its errors
+/// into Python exceptions and a panic into `PlanardynError` (a bug to report).
+pub fn run<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, Failure> + Send) -> PyResult<T> {
+    let outcome = py.detach(|| catch_unwind(AssertUnwindSafe(f)));
+    match outcome {
+        Ok(Ok(v)) => Ok(v),
+        Ok(Err(Failure::Core(e))) => Err(to_pyerr(py, &e)),
+        Ok(Err(Failure::Py(e))) => Err(e),
+        Err(payload) => Err(PlanardynError::new_err(format!(
+            "internal error in planardyn (a bug: please report it with the model and the call \
+             that caused it): {}",
+            panic_message(payload.as_ref())
+        ))),
+    }
+}

@@ -1,0 +1,500 @@
+//! `planardyn._core.Mechanism`: an immutable, validated mechanism (an `Arc` of the core's)
+//! and its kinematics and dynamics at given coordinates. Every call makes its own
+//! `Workspace` (buffers sized once per call, no shared mutable state), so calls are
+//! reproducible (positions come by continuation from the drawing) and thread-safe; the
+//! GIL is released while the core computes.
+
+use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
+use crate::errors::{run, Failure};
+use numpy::{AllowTypeChange, PyArrayLikeDyn};
+use planardyn::dynamics::{self, Drives, ModelDrives};
+use planardyn::kinematics::constraints::{point_velocity, world_point};
+use planardyn::kinematics::{self as kin, Chart};
+use planardyn::model::{CoordinateKind, Link, PairKind};
+use planardyn::{Mechanism, Workspace};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::Arc;
+
+type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+/// A validated planar mechanism (immutable). Made by `load`/`loads`.
+#[pyclass(frozen, module = "planardyn._core", name = "Mechanism")]
+pub struct PyMechanism {
+    pub inner: Arc<Mechanism>,
+    /// For each named point, the link that carries it first (ground before bodies) and its
+    /// coordinates in that link's frame (m); `None` for a point no link carries.
+    carriers: Vec<Option<(Link, [f64; 2])>>,
+}
+
+/// Fixed efforts (N m or N) on the coordinates.
+pub struct FixedDrives(pub Vec<f64>);
+
+impl Drives for FixedDrives {
+    fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
+        tau.copy_from_slice(&self.0);
+        Ok(())
+    }
+}
+
+impl PyMechanism {
+    pub fn new(mech: Mechanism) -> Self {
+        let carriers = (0..mech.points.len())
+            .map(|p| {
+                let id = planardyn::model::PointId(p);
+                std::iter::once(Link::Ground)
+                    .chain((0..mech.n_bodies()).map(|b| Link::Body(planardyn::model::BodyId(b))))
+                    .find_map(|link| mech.attachment(link, id).map(|a| (link, a.s)))
+            })
+            .collect();
+        PyMechanism { inner: Arc::new(mech), carriers }
+    }
+
+    fn m(&self) -> usize {
+        self.inner.dof()
+    }
+
+    fn coords_what(&self) -> String {
+        format!("one value per coordinate: {}", self.inner.coordinate_names().join(", "))
+    }
+
+    fn q_arg(&self, name: &str, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
+        vector(name, a, self.m(), &self.coords_what())
+    }
+
+    /// World positions (P x 2, row-major) of every named point for body coordinates x.
+    fn points_at(&self, x: &[f64], out: &mut Vec<f64>) {
+        for c in &self.carriers {
+            match c {
+                Some((link, s)) => out.extend_from_slice(&world_point(*link, *s, x)),
+                None => out.extend_from_slice(&[f64::NAN, f64::NAN]),
+            }
+        }
+    }
+
+    fn point_velocities(&self, x: &[f64], xd: &[f64]) -> Vec<f64> {
+        let mut out = Vec::with_capacity(2 * self.carriers.len());
+        for c in &self.carriers {
+            match c {
+                Some((link, s)) => out.extend_from_slice(&point_velocity(*link, *s, x, xd)),
+                None => out.extend_from_slice(&[f64::NAN, f64::NAN]),
+            }
+        }
+        out
+    }
+
+    /// Drive efforts: the given tau, or the model's drives.
+    fn drives_for(&self, tau: Option<Vec<f64>>) -> Box<dyn Drives + Send + '_> {
+        match tau {
+            Some(t) => Box::new(FixedDrives(t)),
+            None => Box::new(ModelDrives(&self.inner)),
+        }
+    }
+
+    /// Assembled and analysed (positions, U) at q: a workspace in the input chart.
+    fn analysed(mech: &Mechanism, q: &[f64]) -> Result<Workspace, Failure> {
+        let mut ws = Workspace::new(mech);
+        kin::assemble_into(mech, q, &mut ws)?;
+        kin::velocity_analogues(&mut ws)?;
+        Ok(ws)
+    }
+
+    fn forward_ws(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Workspace, Failure> {
+        let mech = &*self.inner;
+        let mut ws = Workspace::new(mech);
+        kin::assemble_into(mech, q, &mut ws)?;
+        let mut drives = self.drives_for(tau);
+        dynamics::forward(mech, t, q, qd, drives.as_mut(), &mut ws)?;
+        Ok(ws)
+    }
+}
+
+#[pymethods]
+impl PyMechanism {
+    /// The model's name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.inner.name
+    }
+    /// Where it was loaded from (a path or '<string>').
+    #[getter]
+    fn source(&self) -> &str {
+        &self.inner.source
+    }
+    /// Degrees of freedom m (= number of generalized coordinates).
+    #[getter]
+    fn dof(&self) -> usize {
+        self.m()
+    }
+    /// Number of mobile bodies n.
+    #[getter]
+    fn n_bodies(&self) -> usize {
+        self.inner.n_bodies()
+    }
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.inner.coordinates.iter().map(|c| c.name.clone()).collect()
+    }
+    /// 'angle' (rad) or 'displacement' (m) for each coordinate.
+    #[getter]
+    fn coordinate_kinds(&self) -> Vec<&'static str> {
+        self.inner
+            .coordinates
+            .iter()
+            .map(|c| match c.kind {
+                CoordinateKind::Angle => "angle",
+                CoordinateKind::Displacement => "displacement",
+            })
+            .collect()
+    }
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.inner.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+    #[getter]
+    fn pair_names(&self) -> Vec<String> {
+        self.inner.pairs.iter().map(|p| p.name.clone()).collect()
+    }
+    #[getter]
+    fn point_names(&self) -> Vec<String> {
+        self.inner.points.iter().map(|p| p.0.clone()).collect()
+    }
+    /// Names of the points the ground carries.
+    #[getter]
+    fn ground_points(&self) -> Vec<String> {
+        self.inner.ground_points.iter().map(|p| self.inner.points[p.0].0.clone()).collect()
+    }
+    /// (m,) start coordinates (rad or m).
+    #[getter]
+    fn q0<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.initial_state().0)
+    }
+    /// (m,) start rates (rad/s or m/s).
+    #[getter]
+    fn qd0<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.initial_state().1)
+    }
+    /// (m,) coordinates in the drawing (rad or m).
+    #[getter]
+    fn drawn_q<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.drawn_q())
+    }
+    /// (3n,) body coordinates [X, Y, phi] per body in the drawing (m, rad).
+    #[getter]
+    fn x0<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.x0.clone())
+    }
+    /// (n,) body masses (kg).
+    #[getter]
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.bodies.iter().map(|b| b.mass).collect())
+    }
+    /// (n,) moments of inertia about the centres of mass (kg m^2).
+    #[getter]
+    fn inertias<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.bodies.iter().map(|b| b.inertia).collect())
+    }
+    /// Characteristic length L (m): the largest distance between two drawn points.
+    #[getter]
+    fn scale(&self) -> f64 {
+        self.inner.scale
+    }
+    /// (2,) gravity [g_x, g_y] (m/s^2).
+    #[getter]
+    fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arr1(py, self.inner.gravity.to_vec())
+    }
+    /// For each body, its points as (name, (s_x, s_y)) in the body frame (m): origin at the
+    /// centre of mass, rotated by the body angle phi.
+    #[getter]
+    fn body_points(&self) -> Vec<Vec<(String, (f64, f64))>> {
+        let mech = &self.inner;
+        mech.bodies
+            .iter()
+            .map(|b| b.points.iter().map(|(p, s)| (mech.points[p.0].0.clone(), (s[0], s[1]))).collect())
+            .collect()
+    }
+    /// The pairs as dicts: name, kind ('revolute' | 'prismatic'), bodies (a, b) by name
+    /// ('ground' for the fixed body), point (name), axis (guide direction in a's frame or None).
+    #[getter]
+    fn pairs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mech = &self.inner;
+        mech.pairs
+            .iter()
+            .map(|p| {
+                let d = PyDict::new(py);
+                d.set_item("name", &p.name)?;
+                let (kind, axis) = match p.kind {
+                    PairKind::Revolute => ("revolute", None),
+                    PairKind::Prismatic { axis } => ("prismatic", Some((axis[0], axis[1]))),
+                };
+                d.set_item("kind", kind)?;
+                d.set_item("bodies", (mech.link_name(p.a), mech.link_name(p.b)))?;
+                d.set_item("point", &mech.points[p.point.0].0)?;
+                d.set_item("axis", axis)?;
+                Ok(d)
+            })
+            .collect()
+    }
+    /// The model file's `simulate` defaults (None where not given).
+    #[getter]
+    fn simulate_defaults<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.inner.simulate;
+        let d = PyDict::new(py);
+        d.set_item("t_end", s.t_end)?;
+        d.set_item("method", s.method.clone())?;
+        d.set_item("rtol", s.rtol)?;
+        d.set_item("atol", s.atol)?;
+        d.set_item("dt", s.dt)?;
+        d.set_item("output_dt", s.output_dt)?;
+        Ok(d)
+    }
+
+    /// The specification the mechanism was built from, as JSON text (`loads(..., 'json')`
+    /// gives the same mechanism back).
+    fn spec_json(&self) -> PyResult<String> {
+        planardyn_spec_json(&self.inner)
+    }
+
+    /// Body coordinates x (3n,) at coordinates q (m,), by continuation from the drawing
+    /// (the assembly branch drawn).
+    fn assemble<'py>(&self, py: Python<'py>, q: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let q = self.q_arg("q", &q)?;
+        let mech = self.inner.clone();
+        let x = run(py, move || Ok(kin::assemble(&mech, &q)?))?;
+        Ok(arr1(py, x))
+    }
+
+    /// World positions of every named point: (P, 2) for x of shape (3n,), (N, P, 2) for (N, 3n).
+    fn point_positions<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let nx = self.inner.n_x();
+        let v = rows("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
+        let p = self.carriers.len();
+        let mut out = Vec::with_capacity(v.rows() * p * 2);
+        for k in 0..v.rows() {
+            self.points_at(v.row(k, nx), &mut out);
+        }
+        if v.shape.len() == 1 {
+            arr2(py, p, 2, out)
+        } else {
+            arr3(py, (v.rows(), p, 2), out)
+        }
+    }
+
+    /// Positions and analogues at q (and velocities with qd); see the Python docstring.
+    #[pyo3(signature = (q, qd=None))]
+    fn kinematics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyDict>> {
+        let q = self.q_arg("q", &q)?;
+        let qd = qd.map(|a| self.q_arg("qd", &a)).transpose()?;
+        let mech = self.inner.clone();
+        let (n, m) = (mech.n_bodies(), mech.dof());
+        let nx = 3 * n;
+        let (ws, w, sigma, passive) = run(py, {
+            let qd = qd.clone();
+            move || {
+                let mut ws = Self::analysed(&mech, &q)?;
+                let w = kin::acceleration_analogues(&mech, &mut ws);
+                if let Some(qd) = &qd {
+                    kin::convective(&mech, qd, &mut ws);
+                }
+                let sigma = kin::sigma_min(&mech, &Chart::Inputs, &ws.x);
+                let passive = kin::passive_sigma_min(&mech, &ws.x);
+                Ok((ws, w, sigma, passive))
+            }
+        })?;
+        // u: (n, 3, m) from columns u_j; w: (n, 3, m, m).
+        let mut u = vec![0.0; nx * m];
+        for j in 0..m {
+            for i in 0..nx {
+                u[i * m + j] = ws.u[j * nx + i];
+            }
+        }
+        let mut wo = vec![0.0; nx * m * m];
+        for j in 0..m {
+            for k in 0..m {
+                for i in 0..nx {
+                    wo[(i * m + j) * m + k] = w[(j * m + k) * nx + i];
+                }
+            }
+        }
+        let d = PyDict::new(py);
+        d.set_item("x", arr1(py, ws.x.clone()))?;
+        d.set_item("poses", arr2(py, n, 3, ws.x.clone())?)?;
+        d.set_item("u", arr_dyn(py, &[n, 3, m], u)?)?;
+        d.set_item("w", arr_dyn(py, &[n, 3, m, m], wo)?)?;
+        let mut pts = Vec::new();
+        self.points_at(&ws.x, &mut pts);
+        let p = self.carriers.len();
+        d.set_item("points", arr2(py, p, 2, pts)?)?;
+        if qd.is_some() {
+            d.set_item("xd", arr1(py, ws.xd.clone()))?;
+            d.set_item("c", arr1(py, ws.c.clone()))?;
+            d.set_item("point_velocities", arr2(py, p, 2, self.point_velocities(&ws.x, &ws.xd))?)?;
+        }
+        d.set_item("sigma_min", sigma)?;
+        d.set_item("sigma_passive", passive)?;
+        d.set_item("residual", ws.residual)?;
+        Ok(d)
+    }
+
+    /// Mass matrix A = U^T M U (m, m) at q.
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let q = self.q_arg("q", &q)?;
+        let mech = self.inner.clone();
+        let m = mech.dof();
+        let a = run(py, move || {
+            let mut ws = Self::analysed(&mech, &q)?;
+            dynamics::mass_matrix(&mech, &mut ws);
+            Ok(ws.a)
+        })?;
+        arr2(py, m, m, a)
+    }
+
+    /// Accelerations qdd (m,) at (q, qd), time t (s), efforts tau (m,) or the model's drives.
+    #[pyo3(signature = (q, qd, t=0.0, tau=None))]
+    fn forward_dynamics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: ArrayArg<'py>, t: f64, tau: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
+        check_time(t)?;
+        let ws = run(py, || self.forward_ws(&q, &qd, t, tau))?;
+        Ok(arr1(py, ws.qdd))
+    }
+
+    /// Efforts tau for (q, qd, qdd), each (m,) or (N, m); rows by continuation.
+    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: ArrayArg<'py>, qdd: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.m();
+        let what = self.coords_what();
+        let (q, qd, qdd) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("qdd", &qdd, m, &what)?);
+        if qd.shape != q.shape || qdd.shape != q.shape {
+            return Err(PyValueError::new_err(format!(
+                "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
+                q.shape, qd.shape, qdd.shape
+            )));
+        }
+        let mech = self.inner.clone();
+        let shape = q.shape.clone();
+        let tau = run(py, move || inverse_rows(&mech, &q, &qd, &qdd))?;
+        arr_dyn(py, &shape, tau)
+    }
+
+    /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
+    #[pyo3(signature = (q, qd, t=0.0, tau=None))]
+    fn reactions<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: ArrayArg<'py>, t: f64, tau: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
+        check_time(t)?;
+        let mech = self.inner.clone();
+        let r = run(py, || {
+            let mut ws = self.forward_ws(&q, &qd, t, tau)?;
+            Ok(dynamics::reactions(&mech, &mut ws))
+        })?;
+        let p = r.len();
+        arr2(py, p, 3, r.into_iter().flatten().collect())
+    }
+
+    /// Kinetic and potential energy (J) at (q, qd).
+    fn energy(&self, py: Python<'_>, q: ArrayArg<'_>, qd: ArrayArg<'_>) -> PyResult<(f64, f64)> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let mech = self.inner.clone();
+        run(py, move || {
+            let mut ws = Workspace::new(&mech);
+            kin::assemble_into(&mech, &q, &mut ws)?;
+            if qd.iter().any(|&v| v != 0.0) {
+                kin::velocity_analogues(&mut ws)?;
+                kin::convective(&mech, &qd, &mut ws);
+            } else {
+                ws.xd.fill(0.0);
+            }
+            Ok((dynamics::kinetic_energy(&mech, &ws.xd), dynamics::potential_energy(&mech, &ws.x)))
+        })
+    }
+
+    /// Simulate; see `planardyn.Mechanism.simulate` for the arguments.
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        t_end: Option<f64>,
+        method: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        dt: Option<f64>,
+        t_eval: Option<ArrayArg<'py>>,
+        output_dt: Option<f64>,
+        q0: Option<ArrayArg<'py>>,
+        qd0: Option<ArrayArg<'py>>,
+        drives: Option<Py<PyAny>>,
+        progress: Option<Py<PyAny>>,
+        max_steps: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t_eval = t_eval
+            .map(|a| {
+                let v = Values::read(&a);
+                if v.shape.len() != 1 {
+                    return Err(PyValueError::new_err(format!("t_eval must be 1-D (output times in s), got shape {:?}", v.shape)));
+                }
+                crate::convert::finite("t_eval", &v.data)?;
+                Ok(v.data)
+            })
+            .transpose()?;
+        let args = crate::simulate::Args {
+            t_end,
+            method,
+            rtol,
+            atol,
+            dt,
+            t_eval,
+            output_dt,
+            q0: q0.map(|a| self.q_arg("q0", &a)).transpose()?,
+            qd0: qd0.map(|a| self.q_arg("qd0", &a)).transpose()?,
+            max_steps,
+        };
+        crate::simulate::simulate(py, &self.inner, args, drives, progress)
+    }
+
+    fn __repr__(&self) -> String {
+        let m = &self.inner;
+        format!(
+            "<planardyn.Mechanism {:?}: {} bodies, {} pairs, {} dof ({}) from {}>",
+            m.name,
+            m.n_bodies(),
+            m.pairs.len(),
+            m.dof(),
+            m.coordinate_names().join(", "),
+            m.source
+        )
+    }
+}
+
+fn check_time(t: f64) -> PyResult<()> {
+    if t.is_finite() {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!("t = {t} must be a finite time (s)")))
+    }
+}
+
+fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
+    serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
+}
+
+/// Inverse dynamics row by row: the first assembled from the drawing, each next one by
+/// continuation from the previous solution (same branch, few Newton iterations).
+fn inverse_rows(mech: &Mechanism, q: &Values, qd: &Values, qdd: &Values) -> Result<Vec<f64>, Failure> {
+    let m = mech.dof();
+    let mut ws = Workspace::new(mech);
+    let mut tau = Vec::with_capacity(q.data.len());
+    for k in 0..q.rows() {
+        let qk = q.row(k, m);
+        if k == 0 {
+            kin::assemble_into(mech, qk, &mut ws)?;
+        } else {
+            kin::continue_to(mech, q.row(k - 1, m), qk, &mut ws)?;
+        }
+        dynamics::inverse(mech, qk, qd.row(k, m), qdd.row(k, m), &mut ws)?;
+        tau.extend_from_slice(&ws.tau);
+    }
+    Ok(tau)
+}

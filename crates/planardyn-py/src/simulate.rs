@@ -1,0 +1,212 @@
+//! `Mechanism.simulate`: settings from the model file's defaults and the caller's
+//! overrides, Python callables as drives and progress callback, and the trajectory as a
+//! dict of time-major numpy arrays. The whole loop runs in Rust with the GIL released;
+//! callbacks re-attach to the interpreter for the duration of each call.
+
+use crate::convert::{arr1, arr2, bool1, Values};
+use crate::errors::{run, Failure};
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
+use planardyn::dynamics::{Drives, ModelDrives};
+use planardyn::integrate::Method;
+use planardyn::simulate::{grid, Settings, Trajectory};
+use planardyn::{Error, Mechanism};
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Most output times a run may ask for through `output_dt` (a guard against a typo such as
+/// output_dt = 1e-12 filling the memory).
+const MAX_OUTPUTS: f64 = 1e8;
+/// The progress callback (and the check for Ctrl-C) runs each time t has advanced by this
+/// fraction of the run: at most about 100 times.
+const PROGRESS_FRACTION: f64 = 0.01;
+
+/// The caller's overrides of the model's `simulate` defaults (None: the model's).
+pub struct Args {
+    pub t_end: Option<f64>,
+    pub method: Option<String>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub dt: Option<f64>,
+    pub t_eval: Option<Vec<f64>>,
+    pub output_dt: Option<f64>,
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+    pub max_steps: Option<usize>,
+}
+
+fn settings(mech: &Mechanism, a: Args) -> Result<Settings, Failure> {
+    let mut s = Settings::for_model(mech)?;
+    if let Some(t_end) = a.t_end {
+        if !(t_end.is_finite() && t_end > s.t0) {
+            return Err(PyValueError::new_err(format!("t_end = {t_end} must be a finite time after t0 = {} s", s.t0)).into());
+        }
+        s.t_end = t_end;
+    }
+    if let Some(name) = &a.method {
+        s.method = name.parse::<Method>().map_err(Error::Options)?;
+        // The file's `dt` belongs to its fixed-step method: an adaptive method chosen here
+        // keeps its error control unless a step is given with it.
+        if s.method.is_adaptive() && a.dt.is_none() {
+            s.options.dt = None;
+        }
+    }
+    if let Some(v) = a.rtol {
+        s.options.rtol = v;
+    }
+    if let Some(v) = a.atol {
+        s.options.atol = v;
+    }
+    if a.dt.is_some() {
+        s.options.dt = a.dt;
+    }
+    if let Some(n) = a.max_steps {
+        s.options.max_steps = n;
+    }
+    s.t_eval = match (a.t_eval, a.output_dt.or(mech.simulate.output_dt)) {
+        (Some(te), _) => Some(te),
+        (None, Some(h)) => {
+            if !(h.is_finite() && h > 0.0) || (s.t_end - s.t0) / h > MAX_OUTPUTS {
+                return Err(PyValueError::new_err(format!(
+                    "output_dt = {h} must be > 0 s and give at most {MAX_OUTPUTS:e} outputs over [{}, {}] s",
+                    s.t0, s.t_end
+                ))
+                .into());
+            }
+            // `grid` can overshoot t_end by an ulp (0.3 = 3 * 0.1 + 4e-17): clamp, and drop
+            // a duplicate end point, so that the times pass the core's range check.
+            let mut t = grid(s.t0, s.t_end, h);
+            t.iter_mut().for_each(|v| *v = v.min(s.t_end));
+            t.dedup();
+            Some(t)
+        }
+        (None, None) => None,
+    };
+    s.q0 = a.q0;
+    s.qd0 = a.qd0;
+    Ok(s)
+}
+
+/// A Python callable `f(t, q, qd) -> (m,)` as drive efforts.
+struct PyDrives {
+    f: Py<PyAny>,
+    m: usize,
+    /// A BaseException that is not an Exception (KeyboardInterrupt, SystemExit): the run
+    /// stops at once and it is raised again at the end.
+    fatal: Option<PyErr>,
+}
+
+impl Drives for PyDrives {
+    fn efforts(&mut self, t: f64, q: &[f64], qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
+        if self.fatal.is_some() {
+            return Err("interrupted".to_string());
+        }
+        Python::attach(|py| {
+            let args = (t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd));
+            let out = self.f.bind(py).call1(args).and_then(|r| {
+                let a: PyArrayLikeDyn<'_, f64, AllowTypeChange> = r.extract()?;
+                Ok(Values::read(&a))
+            });
+            match out {
+                Ok(v) if v.data.len() == self.m && v.shape.len() <= 1 => {
+                    tau.copy_from_slice(&v.data);
+                    Ok(())
+                }
+                Ok(v) => Err(format!("the drive function returned shape {:?}; expected ({},), one effort per coordinate", v.shape, self.m)),
+                Err(e) => {
+                    let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
+                    if !e.is_instance_of::<PyException>(py) {
+                        self.fatal = Some(e);
+                    }
+                    Err(format!("the drive function raised {text}"))
+                }
+            }
+        })
+    }
+}
+
+/// Run a simulation and return its trajectory as a dict (see `planardyn.SimulationResult`).
+pub fn simulate<'py>(py: Python<'py>, mech: &Mechanism, args: Args, drives: Option<Py<PyAny>>, progress: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
+    let m = mech.dof();
+    let mut py_drives = drives.map(|f| PyDrives { f, m, fatal: None });
+    let mut fatal: Option<PyErr> = None;
+    let mut cancel_reason: Option<String> = None;
+    let traj = run(py, || {
+        let s = settings(mech, args)?;
+        let step = PROGRESS_FRACTION * (s.t_end - s.t0);
+        let mut next = s.t0 + step;
+        let mut on_step = |t: f64| -> bool {
+            if t < next {
+                return true;
+            }
+            next = t + step;
+            Python::attach(|py| {
+                if let Err(e) = py.check_signals() {
+                    fatal = Some(e);
+                    return false;
+                }
+                let Some(cb) = &progress else { return true };
+                match cb.bind(py).call1((t,)) {
+                    Ok(r) => r.is_none() || r.is_truthy().unwrap_or(true),
+                    Err(e) => {
+                        let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
+                        cancel_reason = Some(format!("the progress callback raised {text} at t = {t} s"));
+                        if !e.is_instance_of::<PyException>(py) {
+                            fatal = Some(e);
+                        }
+                        false
+                    }
+                }
+            })
+        };
+        let mut model_drives = ModelDrives(mech);
+        let d: &mut dyn Drives = match py_drives.as_mut() {
+            Some(d) => d,
+            None => &mut model_drives,
+        };
+        Ok(planardyn::simulate::simulate(mech, &s, d, Some(&mut on_step))?)
+    })?;
+    if let Some(e) = fatal.or_else(|| py_drives.and_then(|d| d.fatal)) {
+        return Err(e);
+    }
+    to_dict(py, traj, cancel_reason)
+}
+
+fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<String>) -> PyResult<Bound<'_, PyDict>> {
+    let (n, m, nx) = (t.len(), t.m, t.nx);
+    let d = PyDict::new(py);
+    d.set_item("t", arr1(py, t.t))?;
+    d.set_item("q", arr2(py, n, m, t.q)?)?;
+    d.set_item("qd", arr2(py, n, m, t.qd)?)?;
+    d.set_item("qdd", arr2(py, n, m, t.qdd)?)?;
+    d.set_item("tau", arr2(py, n, m, t.tau)?)?;
+    d.set_item("x", arr2(py, n, nx, t.x)?)?;
+    d.set_item("xd", arr2(py, n, nx, t.xd)?)?;
+    d.set_item("kinetic", arr1(py, t.kinetic))?;
+    d.set_item("potential", arr1(py, t.potential))?;
+    d.set_item("work", arr1(py, t.work))?;
+    d.set_item("sigma", arr1(py, t.sigma))?;
+    d.set_item("residual", arr1(py, t.residual))?;
+    d.set_item("partitioned", bool1(py, t.partitioned))?;
+    d.set_item("status", t.status.name())?;
+    let message = match (t.status, cancel_reason) {
+        (planardyn::simulate::Status::Cancelled, Some(reason)) => reason,
+        _ => t.message,
+    };
+    d.set_item("message", message)?;
+    let st = &t.stats;
+    let stats = PyDict::new(py);
+    stats.set_item("nfev", st.integrator.nfev)?;
+    stats.set_item("naccept", st.integrator.naccept)?;
+    stats.set_item("nreject", st.integrator.nreject)?;
+    stats.set_item("njev", st.integrator.njev)?;
+    stats.set_item("nlu", st.integrator.nlu)?;
+    stats.set_item("chart_switches", st.chart_switches)?;
+    stats.set_item("partition_steps", st.partition_steps)?;
+    stats.set_item("max_residual", st.max_residual)?;
+    stats.set_item("min_sigma", st.min_sigma)?;
+    stats.set_item("min_passive_sigma", st.min_passive_sigma)?;
+    stats.set_item("energy_drift", st.energy_drift)?;
+    d.set_item("stats", stats)?;
+    Ok(d)
+}

@@ -1,0 +1,45 @@
+"""planardyn: exact minimal-coordinate dynamics of planar closed-chain mechanisms.
+
+A mechanism is described as it is drawn, in a model file (YAML or JSON, see
+``docs/model-format.md``), and validated once into an immutable :class:`Mechanism`::
+
+    import planardyn as pd
+
+    mech = pd.load("examples/models/five-bar.yaml")
+    res = mech.simulate(t_end=1.0)
+    res.q          # (N, m) coordinates, rad or m
+    res.to_csv("five-bar.csv")
+
+Units are SI throughout (m, kg, s, rad, N, N m); arrays are float64 and time-major.
+Errors raise subclasses of :class:`PlanardynError`: :class:`ModelError` (also a
+``ValueError``) for a model that cannot be built, :class:`AssemblyError`,
+:class:`SingularityError` and :class:`SimulationError`.
+"""
+
+from __future__ import annotations
+
+from ._core import (
+    AssemblyError,
+    ModelError,
+    PlanardynError,
+    SimulationError,
+    SingularityError,
+    __version__,
+)
+from .mechanism import Mechanism, from_dict, load, loads
+from .result import Energy, SimulationResult
+
+__all__ = [
+    "AssemblyError",
+    "Energy",
+    "Mechanism",
+    "ModelError",
+    "PlanardynError",
+    "SimulationError",
+    "SimulationResult",
+    "SingularityError",
+    "__version__",
+    "from_dict",
+    "load",
+    "loads",
+]

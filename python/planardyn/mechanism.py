@@ -1,0 +1,456 @@
+"""The typed Python face of a mechanism: loading, kinematics, dynamics, simulation.
+
+Notation (see ``docs/`` and the paper's symbols): m generalized coordinates ``q`` (rad for
+an angle, m for a displacement), n mobile bodies, ``x`` the 3n body coordinates
+[X, Y, phi] of each centre of mass (m, m, rad), P named points, p pairs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable, Mapping
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _core
+from .result import SimulationResult
+
+FloatArray = NDArray[np.float64]
+DriveFunction = Callable[[float, FloatArray, FloatArray], ArrayLike]
+ProgressFunction = Callable[[float], Any]
+
+
+class Mechanism:
+    """An immutable, validated planar mechanism.
+
+    Made by :func:`load`, :func:`loads` or :func:`from_dict`, never changed afterwards.
+    Every method computes from scratch at the configuration it is given: positions are
+    found by continuation from the drawing, so they stay on the branch (assembly mode)
+    the mechanism is drawn in. Methods release the GIL and may be called from threads.
+    """
+
+    __slots__ = ("_native",)
+
+    def __init__(self, native: _core.Mechanism) -> None:
+        if not isinstance(native, _core.Mechanism):
+            raise TypeError("use planardyn.load(), loads() or from_dict() to make a Mechanism")
+        self._native = native
+
+    # ------------------------------------------------------------------ description
+
+    @property
+    def name(self) -> str:
+        """The model's ``name``."""
+        return self._native.name
+
+    @property
+    def source(self) -> str:
+        """Where the model came from: a file path, ``'<string>'`` or ``'<dict>'``."""
+        return self._native.source
+
+    @property
+    def dof(self) -> int:
+        """Degrees of freedom m, the number of generalized coordinates."""
+        return self._native.dof
+
+    @property
+    def n_bodies(self) -> int:
+        """Number of mobile bodies n (the ground is not counted)."""
+        return self._native.n_bodies
+
+    @property
+    def coordinate_names(self) -> list[str]:
+        """Names of the m generalized coordinates, in the order of every q array."""
+        return self._native.coordinate_names
+
+    @property
+    def coordinate_kinds(self) -> list[str]:
+        """``'angle'`` (rad) or ``'displacement'`` (m) for each coordinate."""
+        return self._native.coordinate_kinds
+
+    @property
+    def coordinate_units(self) -> list[str]:
+        """``'rad'`` or ``'m'`` for each coordinate."""
+        return ["rad" if k == "angle" else "m" for k in self.coordinate_kinds]
+
+    @property
+    def effort_units(self) -> list[str]:
+        """``'N m'`` (torque on an angle) or ``'N'`` (force on a displacement) per coordinate."""
+        return ["N m" if k == "angle" else "N" for k in self.coordinate_kinds]
+
+    @property
+    def body_names(self) -> list[str]:
+        """Names of the n mobile bodies, in the order of x (3 values each)."""
+        return self._native.body_names
+
+    @property
+    def pair_names(self) -> list[str]:
+        """Names of the p kinematic pairs (rows of :meth:`reactions`)."""
+        return self._native.pair_names
+
+    @property
+    def point_names(self) -> list[str]:
+        """Names of the P named points (rows of :meth:`point_positions`)."""
+        return self._native.point_names
+
+    @property
+    def ground_points(self) -> list[str]:
+        """Names of the points the fixed ground carries."""
+        return self._native.ground_points
+
+    @property
+    def q0(self) -> FloatArray:
+        """(m,) start coordinates of a simulation (rad or m)."""
+        return self._native.q0
+
+    @property
+    def qd0(self) -> FloatArray:
+        """(m,) start rates of a simulation (rad/s or m/s)."""
+        return self._native.qd0
+
+    @property
+    def drawn_q(self) -> FloatArray:
+        """(m,) coordinates in the drawing (rad or m)."""
+        return self._native.drawn_q
+
+    @property
+    def x0(self) -> FloatArray:
+        """(3n,) body coordinates [X, Y, phi] per body in the drawing (m, m, rad)."""
+        return self._native.x0
+
+    @property
+    def masses(self) -> FloatArray:
+        """(n,) body masses (kg)."""
+        return self._native.masses
+
+    @property
+    def inertias(self) -> FloatArray:
+        """(n,) moments of inertia about the centres of mass (kg m^2)."""
+        return self._native.inertias
+
+    @property
+    def scale(self) -> float:
+        """Characteristic length L (m): the largest distance between two drawn points."""
+        return self._native.scale
+
+    @property
+    def gravity(self) -> FloatArray:
+        """(2,) gravity [g_x, g_y] (m/s^2)."""
+        return self._native.gravity
+
+    @property
+    def body_points(self) -> list[list[tuple[str, tuple[float, float]]]]:
+        """For each body, its points as ``(name, (s_x, s_y))`` in the body frame (m).
+
+        The body frame has its origin at the centre of mass and turns with the body angle
+        phi: the world position is ``[X, Y] + R(phi) s``.
+        """
+        return self._native.body_points
+
+    @property
+    def pairs(self) -> list[dict[str, Any]]:
+        """The pairs as dicts: ``name``, ``kind`` (``'revolute'`` | ``'prismatic'``),
+        ``bodies`` (a, b) by name (``'ground'`` for the fixed body), ``point`` (name) and
+        ``axis`` (unit guide direction in a's frame, or None)."""
+        return self._native.pairs
+
+    @property
+    def simulate_defaults(self) -> dict[str, Any]:
+        """The model file's ``simulate`` section (None for a setting not given)."""
+        return self._native.simulate_defaults
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model as a dict in the model-file schema; ``from_dict`` gives it back."""
+        return json.loads(self._native.spec_json())
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Mechanism):
+            return NotImplemented
+        return self._native.spec_json() == other._native.spec_json()
+
+    def __hash__(self) -> int:
+        return hash(self._native.spec_json())
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Pickled as its model (for multiprocessing): rebuilt and validated on load.
+        return (from_dict, (self.to_dict(), self.source))
+
+    # ------------------------------------------------------------------ kinematics
+
+    def assemble(self, q: ArrayLike) -> FloatArray:
+        """Body coordinates at given generalized coordinates (position analysis).
+
+        Parameters
+        ----------
+        q : (m,) array_like
+            Generalized coordinates (rad or m).
+
+        Returns
+        -------
+        x : (3n,) ndarray
+            [X, Y, phi] of each body's centre of mass (m, m, rad), on the drawn branch.
+
+        Raises
+        ------
+        AssemblyError
+            The mechanism cannot be assembled at q (or not on its drawn branch).
+        ValueError
+            q has the wrong shape or a non-finite value.
+        """
+        return self._native.assemble(q)
+
+    def point_positions(self, x: ArrayLike) -> FloatArray:
+        """World positions of every named point for given body coordinates.
+
+        Parameters
+        ----------
+        x : (3n,) or (N, 3n) array_like
+            Body coordinates [X, Y, phi] per body (m, m, rad), e.g. ``result.x``.
+
+        Returns
+        -------
+        (P, 2) or (N, P, 2) ndarray
+            Positions (m) in the order of :attr:`point_names`. A point carried by several
+            links has one position (taken from its first carrier, the ground first).
+        """
+        return self._native.point_positions(x)
+
+    def kinematics(self, q: ArrayLike, qd: ArrayLike | None = None) -> dict[str, Any]:
+        """Positions, velocity and acceleration analogues, singularity measures at q.
+
+        Parameters
+        ----------
+        q : (m,) array_like
+            Generalized coordinates (rad or m).
+        qd : (m,) array_like, optional
+            Generalized rates (rad/s or m/s); adds the velocity entries below.
+
+        Returns
+        -------
+        dict with
+            ``x`` (3n,): body coordinates (m, rad); ``poses`` (n, 3): the same per body;
+            ``u`` (n, 3, m): velocity analogues dx/dq_j (m/rad, m/m, rad/rad...);
+            ``w`` (n, 3, m, m): acceleration analogues d2x/dq_j dq_k (symmetric in j, k);
+            ``points`` (P, 2): world positions of the named points (m);
+            ``sigma_min``: type II singularity measure, the smallest singular value of the
+            scaled Jacobian with q fixed (dimensionless; 0 at a singularity);
+            ``sigma_passive``: the same for the pair constraints alone;
+            ``residual``: scaled loop-closure residual of the position solve.
+            With qd also ``xd`` (3n,): body velocities U qd (m/s, rad/s); ``c`` (3n,):
+            convective accelerations sum_jk qd_j qd_k w_jk (m/s^2, rad/s^2);
+            ``point_velocities`` (P, 2) (m/s).
+
+        Raises
+        ------
+        AssemblyError, SingularityError (the analogues are undefined where sigma_min = 0).
+        """
+        return self._native.kinematics(q, qd)
+
+    # ------------------------------------------------------------------ dynamics
+
+    def mass_matrix(self, q: ArrayLike) -> FloatArray:
+        """Generalized mass matrix A = U^T M U at q.
+
+        Parameters
+        ----------
+        q : (m,) array_like
+            Generalized coordinates (rad or m).
+
+        Returns
+        -------
+        A : (m, m) ndarray
+            Symmetric, positive definite away from singularities (kg m^2 for angles,
+            kg for displacements, mixed units off the diagonal).
+        """
+        return self._native.mass_matrix(q)
+
+    def forward_dynamics(
+        self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
+    ) -> FloatArray:
+        """Generalized accelerations from A qdd = b (forward dynamics).
+
+        Parameters
+        ----------
+        q, qd : (m,) array_like
+            Coordinates (rad or m) and rates (rad/s or m/s).
+        t : float
+            Time (s), for the model's drive tables.
+        tau : (m,) array_like, optional
+            Drive efforts (N m on angles, N on displacements); default: the model's drives at t.
+
+        Returns
+        -------
+        qdd : (m,) ndarray
+            Accelerations (rad/s^2 or m/s^2).
+        """
+        return self._native.forward_dynamics(q, qd, float(t), tau)
+
+    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> FloatArray:
+        """Drive efforts that produce a motion: tau = A qdd - U^T (f - M c).
+
+        Parameters
+        ----------
+        q, qd, qdd : (m,) or (N, m) array_like, all of the same shape
+            Coordinates (rad or m), rates and accelerations. For (N, m) the rows are a
+            trajectory: the first is assembled from the drawing, each next one by
+            continuation from the previous one (so they stay on one branch).
+
+        Returns
+        -------
+        tau : ndarray of the same shape
+            Efforts (N m on angles, N on displacements), the model's drives not included.
+        """
+        return self._native.inverse_dynamics(q, qd, qdd)
+
+    def reactions(
+        self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
+    ) -> FloatArray:
+        """Pair reactions during the motion from (q, qd) under drives tau.
+
+        Parameters
+        ----------
+        q, qd, t, tau
+            As for :meth:`forward_dynamics`.
+
+        Returns
+        -------
+        (p, 3) ndarray
+            Per pair (order of :attr:`pair_names`): [F_x, F_y, M], the force (N, global
+            frame) and couple (N m) that the pair's first body exerts on its second.
+        """
+        return self._native.reactions(q, qd, float(t), tau)
+
+    def energy(self, q: ArrayLike, qd: ArrayLike) -> tuple[float, float]:
+        """Kinetic and potential energy (J) at (q, qd): ``(T, V)``.
+
+        V counts gravity (zero at y = 0) and the elastic energy of springs.
+        """
+        return self._native.energy(q, qd)
+
+    # ------------------------------------------------------------------ simulation
+
+    def simulate(
+        self,
+        t_end: float | None = None,
+        *,
+        method: Literal["rk4", "dopri5", "rk45", "dop853", "radau5", "radau"] | None = None,
+        rtol: float | None = None,
+        atol: float | None = None,
+        dt: float | None = None,
+        t_eval: ArrayLike | None = None,
+        output_dt: float | None = None,
+        q0: ArrayLike | None = None,
+        qd0: ArrayLike | None = None,
+        drives: DriveFunction | None = None,
+        progress: ProgressFunction | None = None,
+        max_steps: int | None = None,
+    ) -> SimulationResult:
+        """Integrate the equations of motion from t = 0 (forward dynamics in time).
+
+        Every argument left at None takes the model file's ``simulate`` value, else the
+        default shown.
+
+        Parameters
+        ----------
+        t_end : float
+            End time (s); default 1.
+        method : str
+            ``'dop853'`` (default), ``'dopri5'``, ``'radau5'`` (stiff springs/dampers) or
+            ``'rk4'`` (fixed step, needs ``dt``).
+        rtol, atol : float
+            Relative and absolute tolerances of the adaptive methods (defaults 1e-9, 1e-12).
+        dt : float
+            Fixed step (s): required by rk4; for an adaptive method it turns error control off.
+        t_eval : (K,) array_like
+            Output times (s), increasing, within [0, t_end]. Default: every ``output_dt``,
+            else every accepted step.
+        output_dt : float
+            Spacing of the output times (s) when t_eval is not given.
+        q0, qd0 : (m,) array_like
+            Start coordinates (rad or m) and rates (rad/s or m/s); default the model's.
+        drives : callable ``f(t, q, qd) -> (m,)``, optional
+            Drive efforts (N m or N) instead of the model's ``drives``; t in s, q and qd
+            (m,) arrays. An exception inside it ends the run with status ``'drive_failed'``
+            and the trajectory computed so far.
+        progress : callable ``progress(t)``, optional
+            Called about 100 times in a run with the time reached (s); returning False
+            (not None) or raising stops the run with status ``'cancelled'``.
+        max_steps : int
+            Most step attempts (accepted and rejected); past it status ``'too_many_steps'``.
+
+        Returns
+        -------
+        SimulationResult
+            The trajectory (even when the run stopped early: check ``success``/``status``).
+
+        Raises
+        ------
+        SimulationError
+            Invalid options (unknown method, rtol <= 0, rk4 without dt...).
+        AssemblyError, SingularityError
+            The start state cannot be assembled, or is singular.
+        ValueError
+            An argument with the wrong shape or a non-finite value.
+        """
+        raw = self._native.simulate(
+            t_end=None if t_end is None else float(t_end),
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            dt=dt,
+            t_eval=t_eval,
+            output_dt=output_dt,
+            q0=q0,
+            qd0=qd0,
+            drives=drives,
+            progress=progress,
+            max_steps=max_steps,
+        )
+        return SimulationResult.from_raw(
+            raw,
+            coordinate_names=self.coordinate_names,
+            coordinate_kinds=self.coordinate_kinds,
+            body_names=self.body_names,
+        )
+
+
+def load(path: str | os.PathLike[str]) -> Mechanism:
+    """Load a model file (``.yaml``/``.yml``, or ``.json``; other names are read as YAML).
+
+    Raises
+    ------
+    ModelError
+        The file cannot be read or is not a valid mechanism; the message names the file and
+        the field (``bodies.crank.mass``), as do the attributes ``source`` and ``path``.
+    """
+    return Mechanism(_core.load(os.fspath(path)))
+
+
+def loads(text: str, format: Literal["yaml", "json"] = "yaml", source: str = "<string>") -> Mechanism:
+    """Build a mechanism from model text in YAML or JSON; ``source`` names it in messages."""
+    return Mechanism(_core.loads(text, format, source))
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    if isinstance(value, (tuple, set)):
+        return list(value)
+    raise TypeError(f"{type(value).__name__} is not a model value (use numbers, strings, lists and dicts)")
+
+
+def from_dict(model: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
+    """Build a mechanism from a dict in the model-file schema (as ``yaml.safe_load`` gives).
+
+    numpy numbers and arrays are accepted as values.
+    """
+    if not isinstance(model, Mapping):
+        raise TypeError(f"from_dict needs a mapping, got {type(model).__name__}")
+    return loads(json.dumps(model, default=_json_default, allow_nan=True), "json", source)
+

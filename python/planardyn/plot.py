@@ -1,0 +1,157 @@
+"""Matplotlib helpers. Each takes ``ax=`` (a new figure is made only when it is None) and
+returns the artists it drew. Nothing here changes rcParams or calls ``plt.show()``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+
+    from .mechanism import Mechanism
+    from .result import SimulationResult
+
+
+def _axes(ax: Axes | None) -> Axes:
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    _, ax = plt.subplots()
+    return ax
+
+
+def _unit(kinds: list[str], angle: str, displacement: str) -> str:
+    units = {angle if k == "angle" else displacement for k in kinds}
+    return units.pop() if len(units) == 1 else "mixed units"
+
+
+def plot_coordinates(
+    result: SimulationResult, ax: Axes | None = None, which: str = "q", **line_kw: Any
+) -> list[Artist]:
+    """Coordinates (``which='q'``), rates (``'qd'``) or accelerations (``'qdd'``) against time.
+
+    Returns the lines, one per coordinate.
+    """
+    ax = _axes(ax)
+    if which not in ("q", "qd", "qdd"):
+        raise ValueError(f"which must be 'q', 'qd' or 'qdd', got {which!r}")
+    data = getattr(result, which)
+    suffix = {"q": "", "qd": "/s", "qdd": "/s^2"}[which]
+    lines = []
+    for k, name in enumerate(result.coordinate_names):
+        label = name if which == "q" else f"{which}_{name}"
+        lines += ax.plot(result.t, data[:, k], label=label, **line_kw)
+    unit = _unit(result.coordinate_kinds, "rad", "m")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(f"{which} ({unit}{suffix if unit != 'mixed units' else ''})")
+    ax.legend(loc="best")
+    ax.grid(True, alpha=0.3)
+    return lines
+
+
+def plot_efforts(result: SimulationResult, ax: Axes | None = None, **line_kw: Any) -> list[Artist]:
+    """Drive efforts tau against time (N m on angles, N on displacements). Returns the lines."""
+    ax = _axes(ax)
+    lines = []
+    for k, name in enumerate(result.coordinate_names):
+        lines += ax.plot(result.t, result.tau[:, k], label=f"tau_{name}", **line_kw)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(f"drive effort ({_unit(result.coordinate_kinds, 'N m', 'N')})")
+    ax.legend(loc="best")
+    ax.grid(True, alpha=0.3)
+    return lines
+
+
+def plot_energy(result: SimulationResult, ax: Axes | None = None, balance: bool = True) -> list[Artist]:
+    """Kinetic T, potential V, total T + V and work W of the non-conservative forces (J).
+
+    With ``balance=True`` the energy balance T + V - W - E0 (the integration error) is drawn
+    on a second y axis. Returns the lines.
+    """
+    ax = _axes(ax)
+    e = result.energy
+    lines = []
+    lines += ax.plot(result.t, e.kinetic, label="kinetic T")
+    lines += ax.plot(result.t, e.potential, label="potential V")
+    lines += ax.plot(result.t, e.total, label="total T + V", linewidth=2)
+    lines += ax.plot(result.t, e.work, label="work W", linestyle="--")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("energy (J)")
+    ax.grid(True, alpha=0.3)
+    handles = list(lines)
+    if balance:
+        ax2 = ax.twinx()
+        bal = ax2.plot(result.t, e.balance, color="k", linewidth=0.8, label="balance T + V - W - E0")
+        ax2.set_ylabel("energy balance (J)")
+        lines += bal
+        handles += bal
+    ax.legend(handles=handles, loc="best", fontsize="small")
+    return lines
+
+
+def draw_mechanism(
+    mech: Mechanism,
+    x: ArrayLike | None = None,
+    ax: Axes | None = None,
+    *,
+    labels: bool = True,
+    color: Any = None,
+    alpha: float = 1.0,
+) -> list[Artist]:
+    """Draw the mechanism at body coordinates x (3n,) (default: the drawing ``mech.x0``).
+
+    Bodies with two points are bars, with more points filled polygons; ground points are
+    hatched triangles, pair points circles, prismatic guides dashed lines; points are
+    labelled with their names when ``labels``. Sets an equal aspect ratio. Returns the artists.
+    """
+    from matplotlib.patches import Polygon
+
+    ax = _axes(ax)
+    x = mech.x0 if x is None else np.asarray(x, dtype=float)
+    names = mech.point_names
+    pos = mech.point_positions(x)
+    where = {n: pos[i] for i, n in enumerate(names)}
+    artists: list[Artist] = []
+    colors = [f"C{i % 10}" for i in range(mech.n_bodies)] if color is None else [color] * mech.n_bodies
+    for b, pts in enumerate(mech.body_points):
+        xy = np.array([where[n] for n, _ in pts])
+        if len(xy) >= 3:
+            poly = Polygon(xy, closed=True, facecolor=colors[b], edgecolor=colors[b], alpha=0.35 * alpha, linewidth=2)
+            ax.add_patch(poly)
+            artists.append(poly)
+        artists += ax.plot(xy[:, 0], xy[:, 1], "-", color=colors[b], linewidth=3, alpha=alpha, solid_capstyle="round")
+    scale = mech.scale
+    for name in mech.ground_points:
+        px, py = where[name]
+        s = 0.04 * scale
+        tri = Polygon(
+            [[px, py], [px - s, py - 1.6 * s], [px + s, py - 1.6 * s]],
+            closed=True, facecolor="none", edgecolor="0.3", hatch="////", alpha=alpha,
+        )
+        ax.add_patch(tri)
+        artists.append(tri)
+    for pair in mech.pairs:
+        px, py = where[pair["point"]]
+        if pair["kind"] == "prismatic" and pair["axis"] is not None:
+            a = pair["bodies"][0]
+            phi = 0.0 if a == "ground" else x[3 * mech.body_names.index(a) + 2]
+            c, s_ = np.cos(phi), np.sin(phi)
+            d = np.array([c * pair["axis"][0] - s_ * pair["axis"][1], s_ * pair["axis"][0] + c * pair["axis"][1]])
+            L = 0.3 * scale
+            artists += ax.plot([px - L * d[0], px + L * d[0]], [py - L * d[1], py + L * d[1]], "--", color="0.4", alpha=alpha, linewidth=1)
+            artists += ax.plot([px], [py], "s", markersize=8, markerfacecolor="white", markeredgecolor="k", alpha=alpha)
+        else:
+            artists += ax.plot([px], [py], "o", markersize=7, markerfacecolor="white", markeredgecolor="k", alpha=alpha, zorder=3)
+    if labels:
+        for name in names:
+            px, py = where[name]
+            if np.isfinite(px):
+                artists.append(ax.annotate(name, (px, py), textcoords="offset points", xytext=(5, 5), fontsize=8, alpha=alpha))
+    ax.set_aspect("equal")
+    return artists

@@ -1,0 +1,164 @@
+"""The result of a simulation: time-major arrays, how the run ended, and its counters."""
+
+from __future__ import annotations
+
+import csv
+import os
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    import pandas
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, repr=False)
+class Energy:
+    """Energies along a trajectory, (N,) each, in J.
+
+    ``balance`` = total - work - (its value at the first output): zero along an exact
+    trajectory, so its size measures the integration error.
+    """
+
+    kinetic: FloatArray
+    potential: FloatArray
+    #: Work done by the non-conservative forces (drives, dampers, external loads) since t0.
+    work: FloatArray
+    total: FloatArray
+    balance: FloatArray
+
+    @classmethod
+    def from_arrays(cls, kinetic: FloatArray, potential: FloatArray, work: FloatArray) -> Energy:
+        total = kinetic + potential
+        raw = total - work
+        balance = raw - raw[0] if len(raw) else raw
+        return cls(kinetic, potential, work, total, balance)
+
+    @property
+    def drift(self) -> float:
+        """Largest |balance| (J), 0 for an empty trajectory."""
+        return float(np.max(np.abs(self.balance))) if len(self.balance) else 0.0
+
+    def __repr__(self) -> str:
+        return f"Energy(N={len(self.kinetic)}, drift={self.drift:.3g} J)"
+
+
+@dataclass(frozen=True, repr=False)
+class SimulationResult:
+    """A trajectory, kept whole even when the run stopped early (see ``status``).
+
+    Shapes: N outputs, m coordinates, n bodies. Units: s, rad or m (per coordinate), N m or N.
+    """
+
+    #: (N,) output times (s).
+    t: FloatArray
+    #: (N, m) coordinates (rad or m), rates, accelerations.
+    q: FloatArray
+    qd: FloatArray
+    qdd: FloatArray
+    #: (N, m) drive efforts applied (N m or N).
+    tau: FloatArray
+    #: (N, 3n) body coordinates [X, Y, phi] per body (m, m, rad) and their rates.
+    x: FloatArray
+    xd: FloatArray
+    #: (N, n, 3) the same as x, one row per body.
+    poses: FloatArray
+    energy: Energy
+    #: (N,) type II singularity measure (smallest scaled singular value, dimensionless).
+    sigma: FloatArray
+    #: (N,) scaled loop-closure residual of the position solve.
+    residual: FloatArray
+    #: (N,) True where the point was integrated in body coordinates near a singularity.
+    partitioned: NDArray[np.bool_]
+    #: True when the run reached t_end.
+    success: bool
+    #: 'success', 'assembly_failed', 'passive_singularity', 'step_size_underflow',
+    #: 'non_finite', 'drive_failed', 'too_many_steps' or 'cancelled'.
+    status: str
+    message: str
+    #: Counters: nfev, naccept, nreject, njev, nlu, chart_switches, partition_steps,
+    #: max_residual, min_sigma, min_passive_sigma, energy_drift (J).
+    stats: dict[str, Any] = field(default_factory=dict)
+    coordinate_names: list[str] = field(default_factory=list)
+    #: 'angle' or 'displacement' per coordinate.
+    coordinate_kinds: list[str] = field(default_factory=list)
+    body_names: list[str] = field(default_factory=list)
+
+    @classmethod
+    def from_raw(
+        cls,
+        raw: dict[str, Any],
+        *,
+        coordinate_names: list[str],
+        coordinate_kinds: list[str],
+        body_names: list[str],
+    ) -> SimulationResult:
+        """Wrap the dict returned by the native ``Mechanism.simulate``."""
+        x = raw["x"]
+        return cls(
+            t=raw["t"],
+            q=raw["q"],
+            qd=raw["qd"],
+            qdd=raw["qdd"],
+            tau=raw["tau"],
+            x=x,
+            xd=raw["xd"],
+            poses=x.reshape(x.shape[0], len(body_names), 3),
+            energy=Energy.from_arrays(raw["kinetic"], raw["potential"], raw["work"]),
+            sigma=raw["sigma"],
+            residual=raw["residual"],
+            partitioned=raw["partitioned"],
+            success=raw["status"] == "success",
+            status=raw["status"],
+            message=raw["message"],
+            stats=dict(raw["stats"]),
+            coordinate_names=list(coordinate_names),
+            coordinate_kinds=list(coordinate_kinds),
+            body_names=list(body_names),
+        )
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self) -> str:
+        span = f"t = {self.t[0]:.6g}..{self.t[-1]:.6g} s" if len(self.t) else "no output"
+        return (
+            f"SimulationResult(status={self.status!r}, N={len(self.t)}, {span}, "
+            f"coordinates=({', '.join(self.coordinate_names)}), "
+            f"steps={self.stats.get('naccept', 0)}, energy drift={self.energy.drift:.3g} J)"
+        )
+
+    def columns(self) -> dict[str, FloatArray]:
+        """The table of :meth:`to_dataframe` as a dict of (N,) arrays, in column order:
+        ``t``, the coordinate names, ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``,
+        ``kinetic``, ``potential``, ``work``, ``sigma``."""
+        cols: dict[str, FloatArray] = {"t": self.t}
+        for prefix, arr in (("", self.q), ("qd_", self.qd), ("qdd_", self.qdd), ("tau_", self.tau)):
+            for k, name in enumerate(self.coordinate_names):
+                cols[prefix + name] = arr[:, k]
+        cols["kinetic"] = self.energy.kinetic
+        cols["potential"] = self.energy.potential
+        cols["work"] = self.energy.work
+        cols["sigma"] = self.sigma
+        return cols
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """A pandas DataFrame with the columns of :meth:`columns` (needs pandas)."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+        return pd.DataFrame(self.columns())
+
+    def to_csv(self, path: str | os.PathLike[str]) -> None:
+        """Write the table of :meth:`columns` as CSV (full double precision; no pandas needed)."""
+        cols = self.columns()
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(cols)
+            for row in zip(*(c.tolist() for c in cols.values())):
+                w.writerow([repr(v) for v in row])
