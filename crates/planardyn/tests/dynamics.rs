@@ -118,3 +118,30 @@ fn reactions_balance_every_body() {
         }
     }
 }
+
+#[test]
+fn slider_crank_positions_and_mass_matrix_are_the_closed_form() {
+    // Offset slider-crank (r = 0.1, l = 0.35, offset e = 0.02 m): slider at
+    // x_B = r cos(phi) + sqrt(l^2 - (r sin(phi) - e)^2), rod angle rate
+    // beta' = -r cos(phi) / (l cos(beta)); with uniform bars of 0.3 and 0.6 kg and a 0.5 kg
+    // slider, A = m_c r^2/3 + m_r |v_G/phi'|^2 + (m_r l^2/12) beta'^2 + m_s x_B'^2.
+    let mech = yaml(SLIDER_CRANK);
+    let (r, l, e) = (0.1_f64, 0.35_f64, 0.02_f64);
+    let (mc, mr, ms) = (0.3, 0.6, 0.5);
+    let slider = 3 * mech.body_id("slider").unwrap().0;
+    let mut ws = Workspace::new(&mech);
+    for phi in [0.3, 1.5, 2.8, 4.0, 5.9] {
+        assemble_into(&mech, &[phi], &mut ws).unwrap();
+        let root = (l * l - (r * phi.sin() - e).powi(2)).sqrt();
+        let xb = r * phi.cos() + root;
+        assert!((ws.x[slider] - xb).abs() < 1e-13, "x_B({phi}) = {} vs {xb}", ws.x[slider]);
+        velocity_analogues(&mut ws).unwrap();
+        mass_matrix(&mech, &mut ws);
+        let dxb = -r * phi.sin() - (r * phi.sin() - e) * r * phi.cos() / root;
+        let cos_beta = root / l;
+        let dbeta = -r * phi.cos() / (l * cos_beta);
+        let vg = [(-r * phi.sin() + dxb) / 2.0, r * phi.cos() / 2.0];
+        let a = mc * r * r / 3.0 + mr * (vg[0].powi(2) + vg[1].powi(2)) + mr * l * l / 12.0 * dbeta.powi(2) + ms * dxb.powi(2);
+        assert!((ws.a[0] - a).abs() < 1e-13, "A({phi}) = {} vs {a}", ws.a[0]);
+    }
+}

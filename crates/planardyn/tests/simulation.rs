@@ -56,7 +56,8 @@ fn five_bar_free_fall_crosses_type_ii_singularities_with_its_energy() {
 
 /// Arithmetic-geometric mean, for the complete elliptic integral K(k) = pi / (2 agm(1, k')).
 fn agm(mut a: f64, mut b: f64) -> f64 {
-    while (a - b).abs() > 1e-16 * a {
+    // Quadratic convergence: 8 iterations reach round-off from any k' in (0, 1].
+    for _ in 0..8 {
         (a, b) = ((a + b) / 2.0, (a * b).sqrt());
     }
     a

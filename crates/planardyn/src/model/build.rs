@@ -131,6 +131,9 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
 /// Mass, inertia and centre of mass of one part.
 fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> {
     let mass = ctx.finite(&format!("{path}.mass"), p.mass)?;
+    if !(mass > 0.0) {
+        return Err(ctx.err(format!("{path}.mass"), format!("mass must be > 0 kg, got {mass}")));
+    }
     let kinds = [p.com.is_some(), p.uniform_bar.is_some(), p.point_mass.is_some()];
     if kinds.iter().filter(|&&k| k).count() != 1 {
         return Err(ctx.err(
@@ -155,7 +158,7 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     let inertia = p
         .inertia
         .ok_or_else(|| ctx.err(format!("{path}.inertia"), "missing: the moment of inertia about the centre of mass (kg m^2)"))?;
-    let inertia = ctx.finite(&format!("{path}.inertia"), inertia)?;
+    let inertia = ctx.non_negative(&format!("{path}.inertia"), inertia)?;
     let com = match p.com.as_ref().expect("checked above") {
         Location::Coords(c) => [ctx.finite(&format!("{path}.com"), c[0])?, ctx.finite(&format!("{path}.com"), c[1])?],
         Location::Point(name) => ctx.xy(&format!("{path}.com"), name)?,
@@ -176,11 +179,11 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         inertia: b.inertia,
         com: b.com.clone(),
         uniform_bar: b.uniform_bar.clone(),
-        point_mass: b.point_mass.clone(),
+        point_mass: None,
     };
     let parts: Vec<(f64, f64, [f64; 2])> = match &b.parts {
         Some(parts) => {
-            if b.mass.is_some() || b.inertia.is_some() || b.com.is_some() || b.uniform_bar.is_some() || b.point_mass.is_some() {
+            if b.mass.is_some() || b.inertia.is_some() || b.com.is_some() || b.uniform_bar.is_some() {
                 return Err(ctx.err(&path, "give either `parts` or the body's own mass properties, not both"));
             }
             if parts.is_empty() {
@@ -210,7 +213,7 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
     if !(inertia > 0.0) {
         return Err(ctx.err(
             format!("{path}.inertia"),
-            format!("the moment of inertia about the centre of mass must be > 0 kg m^2, got {inertia} (a body that is only a point mass needs an inertia too)"),
+            format!("the moment of inertia about the centre of mass must be > 0 kg m^2, got {inertia}"),
         ));
     }
     let mut ids = Vec::new();

@@ -42,10 +42,11 @@ pub fn loads(text: &str, format: Format, source: &str) -> Result<Mechanism, Mode
 
 /// Parse model text into its specification without validating it.
 pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismSpec, ModelError> {
-    let parse_error = |path: String, message: String| ModelError::Parse {
-        source_name: source.to_string(),
-        path: if path == "." { String::new() } else { path },
-        message,
+    let parse_error = |path: String, message: String| {
+        let path = if path == "." { String::new() } else { path };
+        // The YAML parser already prefixes its messages with the path: keep it once.
+        let message = message.strip_prefix(&format!("{path}: ")).map(str::to_string).unwrap_or(message);
+        ModelError::Parse { source_name: source.to_string(), path, message }
     };
     match format {
         Format::Json => {

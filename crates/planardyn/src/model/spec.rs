@@ -50,7 +50,7 @@ pub struct MechanismSpec {
 }
 
 /// A mobile body. Its inertia is given either directly (`mass`, `inertia`, `com`), as a
-/// uniform bar or a point mass, or as a list of `parts` that are summed.
+/// uniform bar, or as a list of `parts` that are summed (a point mass is a part).
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
@@ -68,9 +68,6 @@ pub struct BodySpec {
     /// midpoint, inertia m L^2 / 12.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uniform_bar: Option<[String; 2]>,
-    /// All the mass concentrated at a point.
-    #[serde(default, alias = "point_mass_at", skip_serializing_if = "Option::is_none")]
-    pub point_mass: Option<String>,
     /// Parts summed with the parallel-axis theorem.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub parts: Option<Vec<PartSpec>>,
