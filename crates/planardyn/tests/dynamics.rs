@@ -134,7 +134,9 @@ fn slider_crank_positions_and_mass_matrix_are_the_closed_form() {
         assemble_into(&mech, &[phi], &mut ws).unwrap();
         let root = (l * l - (r * phi.sin() - e).powi(2)).sqrt();
         let xb = r * phi.cos() + root;
-        assert!((ws.x[slider] - xb).abs() < 1e-13, "x_B({phi}) = {} vs {xb}", ws.x[slider]);
+        // Newton stops at a scaled residual of POSITION_TOL = 1e-12 (times L = 0.44 m and the
+        // conditioning of J): 1e-11 m.
+        assert!((ws.x[slider] - xb).abs() < 1e-11, "x_B({phi}) = {} vs {xb}", ws.x[slider]);
         velocity_analogues(&mut ws).unwrap();
         mass_matrix(&mech, &mut ws);
         let dxb = -r * phi.sin() - (r * phi.sin() - e) * r * phi.cos() / root;
@@ -142,6 +144,6 @@ fn slider_crank_positions_and_mass_matrix_are_the_closed_form() {
         let dbeta = -r * phi.cos() / (l * cos_beta);
         let vg = [(-r * phi.sin() + dxb) / 2.0, r * phi.cos() / 2.0];
         let a = mc * r * r / 3.0 + mr * (vg[0].powi(2) + vg[1].powi(2)) + mr * l * l / 12.0 * dbeta.powi(2) + ms * dxb.powi(2);
-        assert!((ws.a[0] - a).abs() < 1e-13, "A({phi}) = {} vs {a}", ws.a[0]);
+        assert!((ws.a[0] - a).abs() < 1e-11, "A({phi}) = {} vs {a}", ws.a[0]);
     }
 }
