@@ -56,12 +56,16 @@ impl Lu {
                 self.perm.swap(k, piv);
             }
             let inv = 1.0 / a[k * n + k];
-            for i in k + 1..n {
-                let l = a[i * n + k] * inv;
-                a[i * n + k] = l;
+            // Row slices so that the update loop vectorises; J is sparse, so most
+            // multipliers are zero and skipped.
+            let (top, rest) = a.split_at_mut((k + 1) * n);
+            let pivot_row = &top[k * n + k + 1..(k + 1) * n];
+            for row in rest.chunks_exact_mut(n) {
+                let l = row[k] * inv;
+                row[k] = l;
                 if l != 0.0 {
-                    for j in k + 1..n {
-                        a[i * n + j] -= l * a[k * n + j];
+                    for (v, p) in row[k + 1..].iter_mut().zip(pivot_row) {
+                        *v -= l * p;
                     }
                 }
             }
@@ -76,17 +80,12 @@ impl Lu {
             tmp[i] = b[self.perm[i]];
         }
         for i in 0..n {
-            let mut s = tmp[i];
-            for j in 0..i {
-                s -= a[i * n + j] * tmp[j];
-            }
-            tmp[i] = s;
+            let row = &a[i * n..i * n + i];
+            tmp[i] -= row.iter().zip(&tmp[..i]).map(|(l, t)| l * t).sum::<f64>();
         }
         for i in (0..n).rev() {
-            let mut s = tmp[i];
-            for j in i + 1..n {
-                s -= a[i * n + j] * tmp[j];
-            }
+            let row = &a[i * n + i + 1..(i + 1) * n];
+            let s = tmp[i] - row.iter().zip(&tmp[i + 1..n]).map(|(u, t)| u * t).sum::<f64>();
             tmp[i] = s / a[i * n + i];
         }
         b[..n].copy_from_slice(&tmp[..n]);
