@@ -33,6 +33,7 @@ EXPECTED_COUNTS = {
     "five-bar.yaml": (4, 5, 2),
     "slider-crank.yaml": (3, 4, 1),
     "hydraulic-boom.yaml": (3, 4, 1),
+    "3-rrr.yaml": (7, 9, 3),
 }
 # Geometry written by hand in the drawings is checked to this (m, rad): the numbers are
 # pasted at full double precision, so only the last-digit rounding of the generator remains.

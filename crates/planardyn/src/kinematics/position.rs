@@ -3,7 +3,7 @@
 
 use super::analogues::velocity_analogues;
 use super::constraints::{residual, Chart};
-use crate::model::Mechanism;
+use crate::model::{CoordinateKind, Mechanism};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
@@ -64,36 +64,64 @@ fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
 
 /// Smallest continuation step, as a fraction of the whole move, before giving up.
 const MIN_CONTINUATION_STEP: f64 = 1e-6;
+/// Largest continuation step in any coordinate: 0.1 rad, or 0.1 L for a displacement. The
+/// Newton correction after a first-order predictor is then O(0.01) (scaled), far inside the
+/// basin of the branch being followed.
+const MAX_CONTINUATION_MOVE: f64 = 0.1;
+/// A Newton correction larger than this (scaled) means the solve left the branch: the step
+/// is refused and cut.
+const MAX_CORRECTION: f64 = 0.05;
+
+/// Largest scaled difference between two body-coordinate vectors.
+fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {
+    a.iter().zip(b).zip(col_scale).fold(0.0, |m: f64, ((x, y), s)| m.max((x - y).abs() / s))
+}
 
 /// Move the solution in `ws` (converged at `z_from` in the input chart) to the user
-/// coordinates `q` by continuation: a first-order predictor along the velocity analogues,
-/// a Newton corrector, and the step cut by 4 when Newton fails.
+/// coordinates `q` by continuation: steps of at most 0.1 rad (0.1 L), a first-order predictor
+/// along the velocity analogues, a Newton corrector whose correction must stay small (so the
+/// branch is kept), and the step cut by 4 when either fails.
 pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
     ws.chart = Chart::Inputs;
     let (m, n) = (q.len(), ws.x.len());
+    let move_scaled = mech.coordinates.iter().zip(q.iter().zip(z_from)).fold(0.0, |acc: f64, (c, (a, b))| {
+        let unit = if c.kind == CoordinateKind::Angle { 1.0 } else { mech.scale };
+        acc.max((a - b).abs() / unit)
+    });
+    let h_max = if move_scaled > 0.0 { (MAX_CONTINUATION_MOVE / move_scaled).min(1.0) } else { 1.0 };
     // U is unavailable at a singular start: plain Newton from x then.
     let mut u_ok = velocity_analogues(ws).ok().map(|_| ws.u.clone());
     let mut x_ok = ws.x.clone();
-    let (mut s, mut h) = (0.0_f64, 1.0_f64);
+    let mut predicted = ws.x.clone();
+    let (mut s, mut h) = (0.0_f64, h_max);
     let mut z = vec![0.0; m];
     while s < 1.0 {
         let s_new = (s + h).min(1.0);
-        ws.x.copy_from_slice(&x_ok);
+        predicted.copy_from_slice(&x_ok);
         for k in 0..m {
             let dq = q[k] - z_from[k];
             z[k] = z_from[k] + s_new * dq;
             if let Some(u) = &u_ok {
-                for (p, uk) in ws.x.iter_mut().zip(&u[k * n..(k + 1) * n]) {
+                for (p, uk) in predicted.iter_mut().zip(&u[k * n..(k + 1) * n]) {
                     *p += uk * (s_new - s) * dq;
                 }
             }
         }
-        match solve_position(mech, &z, ws) {
+        ws.x.copy_from_slice(&predicted);
+        let solved = solve_position(mech, &z, ws).and_then(|()| {
+            let correction = scaled_distance(&ws.x, &predicted, &ws.sys.col_scale);
+            if u_ok.is_some() && correction > MAX_CORRECTION {
+                Err(KinematicsError::AssemblyFailed { residual: correction, iterations: ws.iterations })
+            } else {
+                Ok(())
+            }
+        });
+        match solved {
             Ok(()) => {
                 s = s_new;
                 x_ok.copy_from_slice(&ws.x);
                 u_ok = velocity_analogues(ws).ok().map(|_| ws.u.clone());
-                h = (2.0 * h).min(1.0);
+                h = (2.0 * h).min(h_max);
             }
             Err(e) => {
                 h /= 4.0;

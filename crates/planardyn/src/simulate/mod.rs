@@ -48,13 +48,10 @@ impl Settings {
     }
 }
 
-/// Times t0, t0 + h, ... up to t_end included.
+/// Times t0, t0 + h, ... and t_end itself, never past t_end.
 pub fn grid(t0: f64, t_end: f64, h: f64) -> Vec<f64> {
-    let n = ((t_end - t0) / h * (1.0 + 1e-12)).floor() as usize;
-    let mut t: Vec<f64> = (0..=n).map(|k| t0 + k as f64 * h).collect();
-    if t_end - t[n] > 1e-9 * h {
-        t.push(t_end);
-    }
+    let mut t: Vec<f64> = (0..).map(|k| t0 + k as f64 * h).take_while(|&t| t < t_end - 1e-9 * h).collect();
+    t.push(t_end);
     t
 }
 
@@ -125,7 +122,11 @@ fn failure(e: &StepError<Error>) -> (Status, String) {
         StepError::Rhs { error: Error::Drive { .. }, .. } => Status::DriveFailed,
         StepError::Rhs { .. } => Status::AssemblyFailed,
     };
-    (status, e.to_string())
+    let message = match e {
+        StepError::Rhs { t, error } => format!("at t = {t} s, even with the smallest step: {error}"),
+        other => other.to_string(),
+    };
+    (status, message)
 }
 
 /// Simulate from the model's (or the given) initial state. `progress(t)` is called after
@@ -133,19 +134,26 @@ fn failure(e: &StepError<Error>) -> (Status, String) {
 /// start return Err; anything after the start returns the partial trajectory with a status.
 pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, mut progress: Option<&mut dyn FnMut(f64) -> bool>) -> Result<Trajectory, Error> {
     check(settings, mech)?;
-    let (mut ode, y0) = start(mech, settings, drives)?;
     let m = mech.dof();
     let mut traj = Trajectory::new(m, mech.n_x());
+    let (mut ode, y0) = match start(mech, settings, drives) {
+        Ok(started) => started,
+        // A drive that fails at once is a failed run, not bad input: say so in the status.
+        Err(e @ Error::Drive { .. }) => {
+            (traj.status, traj.message) = (Status::DriveFailed, e.to_string());
+            return Ok(traj);
+        }
+        Err(e) => return Err(e),
+    };
     let mut stepper = Stepper::new(settings.method, &settings.options, 2 * m + 1).map_err(Error::Options)?;
     let mut y = y0;
     if let Err(e) = stepper.reset(&mut ode, settings.t0, &y) {
-        let (status, message) = failure(&e);
-        return Err(Error::Options(format!("cannot start the integrator ({}): {message}", status.name())));
+        (traj.status, traj.message) = failure(&e);
+        return Ok(traj);
     }
     let t_eval = settings.t_eval.as_deref();
     let mut next_out = 0;
     if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
-        ode.accept(settings.t0, &y)?;
         traj.record(&ode, settings.t0, y[2 * m]);
         next_out = 1;
     }
