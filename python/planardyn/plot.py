@@ -155,3 +155,129 @@ def draw_mechanism(
                 artists.append(ax.annotate(name, (px, py), textcoords="offset points", xytext=(5, 5), fontsize=8, alpha=alpha))
     ax.set_aspect("equal")
     return artists
+
+
+def _nearest(t: np.ndarray, time: float) -> int:
+    """Index of the output nearest to ``time`` (s)."""
+    if len(t) == 0:
+        raise ValueError("the result has no output")
+    return int(np.argmin(np.abs(np.asarray(t) - time)))
+
+
+def default_trace_points(mech: Mechanism) -> list[str]:
+    """The points worth tracing: those not on the ground, carried by two or more bodies
+    (joints of the loop, the end effector of a parallel robot) or by a body with 3+ points
+    (coupler points); if none, every point not on the ground."""
+    ground = set(mech.ground_points)
+    carriers: dict[str, int] = {}
+    coupler: set[str] = set()
+    for pts in mech.body_points:
+        for name, _ in pts:
+            carriers[name] = carriers.get(name, 0) + 1
+            if len(pts) >= 3:
+                coupler.add(name)
+    # The points of the pairs of mobile bodies only (a point between two moving links).
+    mobile_joints = {p["point"] for p in mech.pairs if "ground" not in p["bodies"]}
+    chosen = [n for n in mech.point_names if n not in ground and (n in coupler or n in mobile_joints)]
+    # Prefer the points carried by the most bodies (an end effector) when there are many.
+    if len(chosen) > 3:
+        chosen = sorted(chosen, key=lambda n: -carriers.get(n, 0))[:3]
+        chosen = [n for n in mech.point_names if n in chosen]
+    return chosen or [n for n in mech.point_names if n not in ground]
+
+
+def plot_point_paths(
+    mech: Mechanism,
+    result: SimulationResult,
+    points: list[str] | None = None,
+    ax: Axes | None = None,
+    **line_kw: Any,
+) -> list[Artist]:
+    """Paths of named points over the whole result (coupler curves, end-effector path), in m.
+
+    ``points``: names (default :func:`default_trace_points`). Returns the lines, one a point.
+    """
+    ax = _axes(ax)
+    points = default_trace_points(mech) if points is None else list(points)
+    unknown = [p for p in points if p not in mech.point_names]
+    if unknown:
+        raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
+    pos = mech.point_positions(result.x)  # (N, P, 2)
+    lines = []
+    for name in points:
+        i = mech.point_names.index(name)
+        kw = {"linewidth": 1.2, "alpha": 0.8, **line_kw}
+        lines += ax.plot(pos[:, i, 0], pos[:, i, 1], label=f"path of {name}", **kw)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal")
+    return lines
+
+
+def draw_mechanism_at(
+    mech: Mechanism,
+    result: SimulationResult,
+    time: float,
+    ax: Axes | None = None,
+    *,
+    labels: bool = True,
+    paths: bool | list[str] = True,
+) -> list[Artist]:
+    """The mechanism at the output nearest to ``time`` (s), labelled, with the point paths
+    (``paths=True``: :func:`default_trace_points`, or a list of names) and a title giving the
+    time. Returns the artists."""
+    ax = _axes(ax)
+    k = _nearest(result.t, time)
+    artists: list[Artist] = []
+    if paths:
+        artists += plot_point_paths(mech, result, None if paths is True else paths, ax=ax, linestyle=":")
+    artists += draw_mechanism(mech, result.x[k], ax=ax, labels=labels)
+    artists.append(ax.set_title(f"{mech.name}, t = {result.t[k]:.4g} s"))
+    if paths:
+        ax.legend(loc="best", fontsize="small")
+    return artists
+
+
+def plot_torque_speed(result: SimulationResult, ax: Axes | None = None, **line_kw: Any) -> list[Artist]:
+    """Drive effort against speed of each coordinate (tau_k vs qd_k): the operating points a
+    motor must reach, start marked with a circle. Returns the lines."""
+    ax = _axes(ax)
+    lines = []
+    for k, name in enumerate(result.coordinate_names):
+        (line,) = ax.plot(result.qd[:, k], result.tau[:, k], label=f"{name}", **line_kw)
+        lines.append(line)
+        if len(result.t):
+            lines += ax.plot(result.qd[:1, k], result.tau[:1, k], "o", color=line.get_color())
+    ax.set_xlabel(f"speed ({_unit(result.coordinate_kinds, 'rad/s', 'm/s')})")
+    ax.set_ylabel(f"drive effort ({_unit(result.coordinate_kinds, 'N m', 'N')})")
+    ax.axhline(0, color="0.6", linewidth=0.6)
+    ax.axvline(0, color="0.6", linewidth=0.6)
+    ax.legend(loc="best")
+    ax.grid(True, alpha=0.3)
+    return lines
+
+
+def plot_results(result: SimulationResult, fig: Any = None) -> list[Artist]:
+    """The four time histories on one figure (2 x 2): coordinates, rates, drive efforts and
+    energy. ``fig``: a matplotlib Figure (default: a new one, 11 x 7 in). Returns the lines."""
+    if fig is None:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(11, 7))
+    axes = fig.subplots(2, 2, sharex=True)
+    artists: list[Artist] = []
+    artists += plot_coordinates(result, ax=axes[0, 0])
+    artists += plot_coordinates(result, ax=axes[0, 1], which="qd")
+    artists += plot_efforts(result, ax=axes[1, 0])
+    artists += plot_energy(result, ax=axes[1, 1])
+    axes[0, 0].set_title("coordinates")
+    axes[0, 1].set_title("rates")
+    axes[1, 0].set_title("drive efforts")
+    axes[1, 1].set_title(f"energy (balance drift {result.energy.drift:.2g} J)")
+    for ax in axes[0]:
+        ax.set_xlabel("")
+    name = (result.metadata.get("model") or {}).get("name")
+    kind = result.metadata.get("kind", "simulation")
+    fig.suptitle(f"{name or 'result'}: {kind}, {result.status}")
+    fig.tight_layout()
+    return artists

@@ -87,6 +87,11 @@ class SimulationResult:
     #: 'angle' or 'displacement' per coordinate.
     coordinate_kinds: list[str] = field(default_factory=list)
     body_names: list[str] = field(default_factory=list)
+    #: Where the result came from, for reproducing and re-plotting it: ``model`` (the model
+    #: as a dict, ``Mechanism.to_dict()``), ``settings`` (keyword arguments of
+    #: ``Mechanism.simulate``), ``planardyn_version``, ``kind`` ('simulation' or 'inverse').
+    #: Empty unless attached (:func:`planardyn.results_io.attach_metadata`) or read from a file.
+    metadata: dict[str, Any] = field(default_factory=dict)
 
     @classmethod
     def from_raw(
@@ -96,6 +101,7 @@ class SimulationResult:
         coordinate_names: list[str],
         coordinate_kinds: list[str],
         body_names: list[str],
+        metadata: dict[str, Any] | None = None,
     ) -> SimulationResult:
         """Wrap the dict returned by the native ``Mechanism.simulate``."""
         x = raw["x"]
@@ -119,6 +125,7 @@ class SimulationResult:
             coordinate_names=list(coordinate_names),
             coordinate_kinds=list(coordinate_kinds),
             body_names=list(body_names),
+            metadata=dict(metadata or {}),
         )
 
     def __len__(self) -> int:
@@ -162,3 +169,36 @@ class SimulationResult:
             w.writerow(cols)
             for row in zip(*(c.tolist() for c in cols.values())):
                 w.writerow([repr(v) for v in row])
+
+    # ------------------------------------------------------------------ files, models, notebooks
+
+    def save(
+        self,
+        path: str | os.PathLike[str],
+        *,
+        mechanism: Any = None,
+        settings: dict[str, Any] | None = None,
+    ) -> None:
+        """Write a results file: ``.csv``, ``.parquet`` or ``.npz`` by the name's extension.
+
+        The metadata (model, solver settings, planardyn version, status, counters) goes with
+        the arrays, so :func:`planardyn.read_results` gives back an equal result. Pass the
+        ``mechanism`` (and the ``settings`` of ``simulate``) unless the result carries them.
+        """
+        from .results_io import write_results
+
+        write_results(self, path, mechanism=mechanism, settings=settings)
+
+    def mechanism(self) -> Any:
+        """The :class:`~planardyn.Mechanism` rebuilt from ``metadata['model']`` (None without one)."""
+        model = self.metadata.get("model")
+        if not model:
+            return None
+        from .mechanism import from_dict
+
+        return from_dict(model, source=self.metadata.get("source") or "<results>")
+
+    def _repr_html_(self) -> str:
+        from .notebook import result_html
+
+        return result_html(self)

@@ -15,6 +15,8 @@ pub struct Workspace {
     /// (3n) body coordinates [X, Y, phi] per body; the Newton start before `position`,
     /// the solution after it.
     pub x: Vec<f64>,
+    /// (n) [cos, sin] of each body angle at `x` (position).
+    pub trig: Vec<[f64; 2]>,
     /// J(x) of the chart, scaled and factorised (position).
     pub sys: System,
     /// Largest scaled loop-closure residual left by the last position solve (position).
@@ -57,6 +59,7 @@ impl Workspace {
         Workspace {
             chart: Chart::Inputs,
             x: mech.x0.clone(),
+            trig: vec![[1.0, 0.0]; mech.n_bodies()],
             sys: System::new(mech),
             residual: 0.0,
             iterations: 0,

@@ -39,7 +39,7 @@ pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Workspace) {
             *v += u * r;
         }
     }
-    gamma(mech, &ws.chart, &ws.x, &ws.xd, &ws.xd, &mut ws.c);
+    gamma(mech, &ws.chart, &ws.x, &ws.trig, &ws.xd, &ws.xd, &mut ws.c);
     for v in ws.c.iter_mut() {
         *v = -*v;
     }
@@ -55,7 +55,7 @@ pub fn acceleration_analogues(mech: &Mechanism, ws: &mut Workspace) -> Vec<f64> 
     for j in 0..m {
         for k in j..m {
             let mut col = vec![0.0; n];
-            gamma(mech, &ws.chart, &ws.x, ws.u_col(j), ws.u_col(k), &mut col);
+            gamma(mech, &ws.chart, &ws.x, &ws.trig, ws.u_col(j), ws.u_col(k), &mut col);
             col.iter_mut().for_each(|v| *v = -*v);
             ws.sys.solve(&mut col);
             w[(j * m + k) * n..(j * m + k + 1) * n].copy_from_slice(&col);

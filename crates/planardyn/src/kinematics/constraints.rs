@@ -19,20 +19,57 @@ pub enum Chart {
     Partition(Vec<usize>),
 }
 
-/// Pose of a link in x: centre (m), angle (rad) and its first column in x (None for ground).
+/// [cos(phi), sin(phi)] of every body, computed once per configuration: the hot functions
+/// below (residual, Jacobian, second derivatives) take it instead of calling sin_cos per pair.
+pub fn body_trig(x: &[f64], trig: &mut [[f64; 2]]) {
+    for (t, xi) in trig.iter_mut().zip(x.chunks_exact(3)) {
+        let (s, c) = xi[2].sin_cos();
+        *t = [c, s];
+    }
+}
+
+/// Pose of a link in x: centre (m), [cos, sin] of its angle, and its first column in x
+/// (None for ground).
 #[derive(Clone, Copy)]
 struct LinkState {
     r: [f64; 2],
-    phi: f64,
+    cs: [f64; 2],
     col: Option<usize>,
 }
 
-fn link_state(link: Link, x: &[f64]) -> LinkState {
+impl LinkState {
+    /// R(phi) s.
+    #[inline]
+    fn rot(&self, s: [f64; 2]) -> [f64; 2] {
+        rot(self.cs, s)
+    }
+}
+
+#[inline]
+fn rot(cs: [f64; 2], s: [f64; 2]) -> [f64; 2] {
+    [cs[0] * s[0] - cs[1] * s[1], cs[1] * s[0] + cs[0] * s[1]]
+}
+
+/// Link pose with the angle's cos/sin taken from `trig`.
+#[inline]
+fn link_state_t(link: Link, x: &[f64], trig: &[[f64; 2]]) -> LinkState {
     match link {
-        Link::Ground => LinkState { r: [0.0; 2], phi: 0.0, col: None },
+        Link::Ground => LinkState { r: [0.0; 2], cs: [1.0, 0.0], col: None },
         Link::Body(b) => {
             let c = 3 * b.0;
-            LinkState { r: [x[c], x[c + 1]], phi: x[c + 2], col: Some(c) }
+            LinkState { r: [x[c], x[c + 1]], cs: trig[b.0], col: Some(c) }
+        }
+    }
+}
+
+/// Link pose computing the angle's cos/sin (for the occasional single evaluation).
+fn link_state(link: Link, x: &[f64]) -> LinkState {
+    match link {
+        Link::Ground => LinkState { r: [0.0; 2], cs: [1.0, 0.0], col: None },
+        Link::Body(b) => {
+            let c = 3 * b.0;
+            let (s, co) = x[c + 2].sin_cos();
+            LinkState { r: [x[c], x[c + 1]], cs: [co, s], col: Some(c) }
         }
     }
 }
@@ -41,7 +78,7 @@ fn link_state(link: Link, x: &[f64]) -> LinkState {
 #[inline]
 pub fn rotate(phi: f64, s: [f64; 2]) -> [f64; 2] {
     let (sn, cs) = phi.sin_cos();
-    [cs * s[0] - sn * s[1], sn * s[0] + cs * s[1]]
+    rot([cs, sn], s)
 }
 
 /// E v: v turned by +90 degrees.
@@ -91,11 +128,10 @@ struct Projection {
 }
 
 impl Projection {
-    fn new(pair: &Pair, d0: [f64; 2], x: &[f64]) -> Self {
-        let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
-        let rbsb = rotate(b.phi, pair.sb);
+    fn new(pair: &Pair, d0: [f64; 2], a: LinkState, b: LinkState) -> Self {
+        let rbsb = b.rot(pair.sb);
         let w = [b.r[0] + rbsb[0] - a.r[0], b.r[1] + rbsb[1] - a.r[1]];
-        Projection { a, b, d: rotate(a.phi, d0), w, rbsb, offset: dot(d0, pair.sa) }
+        Projection { a, b, d: a.rot(d0), w, rbsb, offset: dot(d0, pair.sa) }
     }
     fn value(&self) -> f64 {
         dot(self.d, self.w) - self.offset
@@ -123,25 +159,33 @@ impl Projection {
 }
 
 /// Residual of the two rows of a pair.
-fn pair_residual(pair: &Pair, x: &[f64]) -> [f64; 2] {
+fn pair_residual(pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> [f64; 2] {
+    let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
     match pair.kind {
         PairKind::Revolute => {
-            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
-            let (pa, pb) = (rotate(a.phi, pair.sa), rotate(b.phi, pair.sb));
+            let (pa, pb) = (a.rot(pair.sa), b.rot(pair.sb));
             [a.r[0] + pa[0] - b.r[0] - pb[0], a.r[1] + pa[1] - b.r[1] - pb[1]]
         }
         PairKind::Prismatic { axis } => {
-            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
-            [b.phi - a.phi - pair.rel_angle0, Projection::new(pair, perp(axis), x).value()]
+            [angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0, Projection::new(pair, perp(axis), a, b).value()]
         }
     }
 }
 
-fn pair_jacobian(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize, row: usize) {
-    let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+/// The angle of a link (0 for ground).
+#[inline]
+fn angle(link: Link, x: &[f64]) -> f64 {
+    match link {
+        Link::Ground => 0.0,
+        Link::Body(b) => x[3 * b.0 + 2],
+    }
+}
+
+fn pair_jacobian(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut [f64], ncols: usize, row: usize) {
+    let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
     match pair.kind {
         PairKind::Revolute => {
-            let (ta, tb) = (perp(rotate(a.phi, pair.sa)), perp(rotate(b.phi, pair.sb)));
+            let (ta, tb) = (perp(a.rot(pair.sa)), perp(b.rot(pair.sb)));
             add_grad(j, ncols, row, &a, [1.0, 0.0, ta[0]]);
             add_grad(j, ncols, row + 1, &a, [0.0, 1.0, ta[1]]);
             add_grad(j, ncols, row, &b, [-1.0, 0.0, -tb[0]]);
@@ -150,32 +194,34 @@ fn pair_jacobian(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize, row: usize
         PairKind::Prismatic { axis } => {
             add_grad(j, ncols, row, &a, [0.0, 0.0, -1.0]);
             add_grad(j, ncols, row, &b, [0.0, 0.0, 1.0]);
-            Projection::new(pair, perp(axis), x).grad(j, ncols, row + 1);
+            Projection::new(pair, perp(axis), a, b).grad(j, ncols, row + 1);
         }
     }
 }
 
-fn pair_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> [f64; 2] {
+fn pair_gamma(pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> [f64; 2] {
+    let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
     match pair.kind {
         PairKind::Revolute => {
             // d2(R(phi) s)/dphi2 = -R(phi) s; only the angle-angle entries are non-zero.
-            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
-            let (pa, pb) = (rotate(a.phi, pair.sa), rotate(b.phi, pair.sb));
+            let (pa, pb) = (a.rot(pair.sa), b.rot(pair.sb));
             let (ka, kb) = (part(&a, u).1 * part(&a, v).1, part(&b, u).1 * part(&b, v).1);
             [-pa[0] * ka + pb[0] * kb, -pa[1] * ka + pb[1] * kb]
         }
-        PairKind::Prismatic { axis } => [0.0, Projection::new(pair, perp(axis), x).gamma(u, v)],
+        PairKind::Prismatic { axis } => [0.0, Projection::new(pair, perp(axis), a, b).gamma(u, v)],
     }
+}
+
+/// The projection along `d0` (fixed in a) of a pair at x.
+fn projection(pair: &Pair, d0: [f64; 2], x: &[f64]) -> Projection {
+    Projection::new(pair, d0, link_state(pair.a, x), link_state(pair.b, x))
 }
 
 /// Relative coordinate of a pair from the drawing: angle (rad) or displacement (m).
 pub fn pair_coordinate(pair: &Pair, x: &[f64]) -> f64 {
     match pair.kind {
-        PairKind::Revolute => {
-            let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
-            b.phi - a.phi - pair.rel_angle0
-        }
-        PairKind::Prismatic { axis } => Projection::new(pair, axis, x).value(),
+        PairKind::Revolute => angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0,
+        PairKind::Prismatic { axis } => projection(pair, axis, x).value(),
     }
 }
 
@@ -186,7 +232,7 @@ pub fn pair_coordinate_grad(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize,
             add_grad(j, ncols, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
             add_grad(j, ncols, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
         }
-        PairKind::Prismatic { axis } => Projection::new(pair, axis, x).grad(j, ncols, row),
+        PairKind::Prismatic { axis } => projection(pair, axis, x).grad(j, ncols, row),
     }
 }
 
@@ -194,7 +240,7 @@ pub fn pair_coordinate_grad(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize,
 pub fn pair_coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
     match pair.kind {
         PairKind::Revolute => 0.0,
-        PairKind::Prismatic { axis } => Projection::new(pair, axis, x).gamma(u, v),
+        PairKind::Prismatic { axis } => projection(pair, axis, x).gamma(u, v),
     }
 }
 
@@ -205,7 +251,7 @@ pub fn pair_coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
             part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1
         }
         PairKind::Prismatic { axis } => {
-            let p = Projection::new(pair, axis, x);
+            let p = projection(pair, axis, x);
             let (ra, pa) = part(&p.a, xd);
             let (rb, pb) = part(&p.b, xd);
             dot(p.d, [rb[0] - ra[0], rb[1] - ra[1]]) + dot(perp(p.d), p.w) * pa + dot(p.d, perp(p.rbsb)) * pb
@@ -228,10 +274,10 @@ pub fn coordinate_rates(mech: &Mechanism, x: &[f64], xd: &[f64], qd: &mut [f64])
 }
 
 /// F(x) for a chart with target values z.
-pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], z: &[f64], out: &mut [f64]) {
+pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], z: &[f64], out: &mut [f64]) {
     let nc = 2 * mech.pairs.len();
     for (k, pair) in mech.pairs.iter().enumerate() {
-        let r = pair_residual(pair, x);
+        let r = pair_residual(pair, x, trig);
         out[2 * k] = r[0];
         out[2 * k + 1] = r[1];
     }
@@ -249,9 +295,9 @@ pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], z: &[f64], out: &mut
 }
 
 /// J = dF/dx for a chart, written (overwritten) into the row-major 3n x 3n buffer `j`.
-pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], j: &mut [f64]) {
+pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j: &mut [f64]) {
     let ncols = x.len();
-    constraint_jacobian(mech, x, j);
+    constraint_jacobian(mech, x, trig, j);
     let nc = 2 * mech.pairs.len();
     match chart {
         Chart::Inputs => {
@@ -268,19 +314,19 @@ pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], j: &mut [f64]) {
 }
 
 /// The pair-constraint rows Phi_x (2p x 3n, row-major); the rest of `j` is zeroed.
-pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], j: &mut [f64]) {
+pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], j: &mut [f64]) {
     let ncols = x.len();
     j.fill(0.0);
     for (k, pair) in mech.pairs.iter().enumerate() {
-        pair_jacobian(pair, x, j, ncols, 2 * k);
+        pair_jacobian(pair, x, trig, j, ncols, 2 * k);
     }
 }
 
 /// gamma(u, v) = d2F/dx2 [u, v] for every row (the chart rows of a partition are linear).
-pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], u: &[f64], v: &[f64], out: &mut [f64]) {
+pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], out: &mut [f64]) {
     let nc = 2 * mech.pairs.len();
     for (k, pair) in mech.pairs.iter().enumerate() {
-        let g = pair_gamma(pair, x, u, v);
+        let g = pair_gamma(pair, x, trig, u, v);
         out[2 * k] = g[0];
         out[2 * k + 1] = g[1];
     }
@@ -297,7 +343,7 @@ pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], u: &[f64], v: &[f64], o
 /// World position of a point of a link.
 pub fn world_point(link: Link, s: [f64; 2], x: &[f64]) -> [f64; 2] {
     let l = link_state(link, x);
-    let p = rotate(l.phi, s);
+    let p = l.rot(s);
     [l.r[0] + p[0], l.r[1] + p[1]]
 }
 
@@ -305,7 +351,7 @@ pub fn world_point(link: Link, s: [f64; 2], x: &[f64]) -> [f64; 2] {
 pub fn point_velocity(link: Link, s: [f64; 2], x: &[f64], xd: &[f64]) -> [f64; 2] {
     let l = link_state(link, x);
     let (v, w) = part(&l, xd);
-    let t = perp(rotate(l.phi, s));
+    let t = perp(l.rot(s));
     [v[0] + w * t[0], v[1] + w * t[1]]
 }
 
@@ -314,7 +360,7 @@ pub fn point_acceleration(link: Link, s: [f64; 2], x: &[f64], xd: &[f64], xdd: &
     let l = link_state(link, x);
     let (_, w) = part(&l, xd);
     let (a, al) = part(&l, xdd);
-    let p = rotate(l.phi, s);
+    let p = l.rot(s);
     let t = perp(p);
     [a[0] + al * t[0] - w * w * p[0], a[1] + al * t[1] - w * w * p[1]]
 }

@@ -2,7 +2,8 @@
 //! in the coordinates for larger moves (it stays on the branch the mechanism is drawn in).
 
 use super::analogues::velocity_analogues;
-use super::constraints::{residual, Chart};
+use super::constraints::{body_trig, residual, Chart};
+use super::system::set_row_scale;
 use crate::model::{CoordinateKind, Mechanism};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
@@ -13,45 +14,87 @@ pub const POSITION_TOL: f64 = 1e-12;
 /// Newton iterations before giving up; from a first-order predictor it takes 1 to 3.
 pub const MAX_NEWTON: usize = 30;
 
-fn scaled_norm(ws: &Workspace) -> f64 {
+/// Chord iterations (with the factorisation of the previous, nearby point) tried before
+/// full Newton: each costs a residual and a solve instead of a factorisation, and converges
+/// at a rate about the distance moved times the conditioning.
+const MAX_CHORD: usize = 6;
+/// A chord iteration must shrink the residual at least this much, else full Newton takes over.
+const CHORD_RATE: f64 = 0.25;
+
+/// F(x) into `ws.tmp` (with `ws.trig` refreshed for x); returns its scaled max-norm.
+fn residual_norm(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> f64 {
+    body_trig(&ws.x, &mut ws.trig);
+    residual(mech, &ws.chart, &ws.x, &ws.trig, z, &mut ws.tmp);
     ws.tmp.iter().zip(&ws.sys.row_scale).fold(0.0, |m: f64, (r, s)| m.max((r * s).abs()))
 }
 
+/// x -= J^-1 F with the factorisation held in `ws.sys`.
+fn newton_update(ws: &mut Workspace) {
+    ws.sys.solve(&mut ws.tmp);
+    for (xi, dx) in ws.x.iter_mut().zip(&ws.tmp) {
+        *xi -= dx;
+    }
+}
+
 /// Solve F(x; z) = 0 for x from the start guess in `ws.x`, in the chart `ws.chart`. On
-/// success `ws.x` is the solution, `ws.sys` holds J(x) factorised, `ws.residual` the scaled
-/// residual. Fails if J is singular on the way or Newton does not converge.
+/// success `ws.x` is the solution, `ws.trig` its angles' cos/sin, `ws.sys` holds J(x)
+/// factorised and `ws.residual` the scaled residual. Fails if J is singular on the way or
+/// Newton does not converge.
 pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
     let tol = POSITION_TOL * (1.0 + ws.x.iter().zip(&ws.sys.col_scale).fold(0.0, |m: f64, (v, s)| m.max((v / s).abs())));
+    set_row_scale(mech, &ws.chart, &mut ws.sys.row_scale);
+    if ws.sys.is_factored_for(&ws.chart) {
+        ws.rhs.copy_from_slice(&ws.x);
+        let (mut first, mut last) = (f64::NAN, f64::INFINITY);
+        for it in 0..MAX_CHORD {
+            let norm = residual_norm(mech, z, ws);
+            if norm <= tol {
+                return converged(mech, ws, norm, it);
+            }
+            if it == 0 {
+                first = norm;
+            }
+            if !(norm < CHORD_RATE * last) {
+                if !(norm < first) {
+                    ws.x.copy_from_slice(&ws.rhs); // went astray: restart Newton from the guess
+                }
+                break;
+            }
+            last = norm;
+            newton_update(ws);
+        }
+    }
     let mut first = f64::INFINITY;
     for it in 0..=MAX_NEWTON {
-        residual(mech, &ws.chart, &ws.x, z, &mut ws.tmp);
-        // Row scales depend on the chart only; they are set by the factorisation below,
-        // and by the previous one on the first pass.
-        if it == 0 {
-            super::system::set_row_scale(mech, &ws.chart, &mut ws.sys.row_scale);
-        }
-        let norm = scaled_norm(ws);
+        let norm = residual_norm(mech, z, ws);
         if !norm.is_finite() || norm > 1e6 * first.max(1.0) {
             break;
         }
         first = first.min(norm);
-        factor(mech, ws)?;
-        ws.iterations = it;
         if norm <= tol {
-            ws.residual = norm;
-            return Ok(());
+            return converged(mech, ws, norm, it);
         }
-        ws.sys.solve(&mut ws.tmp);
-        for (xi, dx) in ws.x.iter_mut().zip(&ws.tmp) {
-            *xi -= dx;
-        }
+        factor(mech, ws)?;
+        newton_update(ws);
     }
-    residual(mech, &ws.chart, &ws.x, z, &mut ws.tmp);
-    Err(KinematicsError::AssemblyFailed { residual: scaled_norm(ws), iterations: MAX_NEWTON })
+    let residual = residual_norm(mech, z, ws);
+    Err(KinematicsError::AssemblyFailed { residual, iterations: MAX_NEWTON })
+}
+
+/// Factorise J at the solution (the analogues need it), take one more Newton step with it
+/// (F(x) is still in `ws.tmp`): the residual drops from <= tol to ~tol^2, i.e. round-off,
+/// for one solve; J and the trig cache stay those of a point 1e-12 away, which is within
+/// the tolerance the analogues are computed to anyway. Then record the figures.
+fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize) -> Result<(), KinematicsError> {
+    factor(mech, ws)?;
+    newton_update(ws);
+    ws.residual = norm;
+    ws.iterations = iterations;
+    Ok(())
 }
 
 fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
-    ws.sys.factor(mech, &ws.chart, &ws.x).map_err(|_| KinematicsError::Singular {
+    ws.sys.factor(mech, &ws.chart, &ws.x, &ws.trig).map_err(|_| KinematicsError::Singular {
         sigma_min: 0.0,
         what: match ws.chart {
             Chart::Inputs => "the generalized coordinates do not determine the mechanism's position \

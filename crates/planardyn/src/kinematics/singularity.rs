@@ -10,7 +10,7 @@
 //! elimination with complete pivoting on Phi_x (Wehage & Haug 1982, generalized coordinate
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
-use super::constraints::Chart;
+use super::constraints::{body_trig, Chart};
 use super::system::System;
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
@@ -29,7 +29,9 @@ fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     let n = x.len();
     let mut sys = System::new(mech);
     let mut j = vec![0.0; n * n];
-    sys.scaled_jacobian(mech, chart, x, &mut j);
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    sys.scaled_jacobian(mech, chart, x, &trig, &mut j);
     j
 }
 

@@ -24,23 +24,26 @@ pub struct System {
     tmp: Vec<f64>,
     /// Whether the last factorisation succeeded.
     factored: bool,
+    /// The chart of the last factorisation.
+    chart: Chart,
 }
 
 impl System {
     pub fn new(mech: &Mechanism) -> Self {
         let n = mech.n_x();
         let col_scale = (0..n).map(|i| if i % 3 == 2 { 1.0 } else { mech.scale }).collect();
-        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, tmp: vec![0.0; n], factored: false }
+        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, tmp: vec![0.0; n], factored: false, chart: Chart::Inputs }
     }
 
     /// Fill `j` (row-major, n x n) with the scaled Jacobian and set the row scales.
-    pub fn scaled_jacobian(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], j: &mut [f64]) {
-        fill_scaled(mech, chart, x, &mut self.row_scale, &self.col_scale, j);
+    pub fn scaled_jacobian(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j: &mut [f64]) {
+        fill_scaled(mech, chart, x, trig, &mut self.row_scale, &self.col_scale, j);
     }
 
     /// Evaluate and factorise J(x). Err carries the elimination column that had no pivot.
-    pub fn factor(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64]) -> Result<(), usize> {
-        fill_scaled(mech, chart, x, &mut self.row_scale, &self.col_scale, self.lu.matrix_mut());
+    pub fn factor(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]]) -> Result<(), usize> {
+        fill_scaled(mech, chart, x, trig, &mut self.row_scale, &self.col_scale, self.lu.matrix_mut());
+        self.chart.clone_from(chart);
         let out = self.lu.factor(SINGULAR_PIVOT).map_err(|e| e.column);
         self.factored = out.is_ok();
         out
@@ -49,6 +52,11 @@ impl System {
     /// Whether J is factorised (the last [`System::factor`] succeeded).
     pub fn is_factored(&self) -> bool {
         self.factored
+    }
+
+    /// Whether J is factorised for `chart` (at some nearby x, for a chord iteration).
+    pub fn is_factored_for(&self, chart: &Chart) -> bool {
+        self.factored && self.chart == *chart
     }
 
     /// Solve J y = b in place (b and y unscaled).
@@ -74,10 +82,10 @@ impl System {
     }
 }
 
-fn fill_scaled(mech: &Mechanism, chart: &Chart, x: &[f64], rs: &mut [f64], cs: &[f64], j: &mut [f64]) {
+fn fill_scaled(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], rs: &mut [f64], cs: &[f64], j: &mut [f64]) {
     let n = x.len();
     set_row_scale(mech, chart, rs);
-    jacobian(mech, chart, x, j);
+    jacobian(mech, chart, x, trig, j);
     for r in 0..n {
         for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(cs) {
             *v *= rs[r] * c;
