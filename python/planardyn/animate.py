@@ -50,7 +50,7 @@ def frame_indices(
     if fps <= 0 or speed <= 0:
         raise ValueError(f"fps and speed must be positive, got fps={fps}, speed={speed}")
     span = t[-1] - t[0]
-    n = int(np.floor(span / speed * fps)) + 1
+    n = int(np.floor(span / speed * fps + 1e-9)) + 1  # 1e-9: 0.3 / 0.1 * 10 is 29.999...
     if n > max_frames:
         n = max_frames
     times = t[0] + np.linspace(0.0, span, max(n, 2) if len(t) > 1 else 1)

@@ -1,12 +1,16 @@
 """The ``planardyn`` command: a thin wrapper over the Python API.
 
+    planardyn check MODEL
     planardyn simulate MODEL [--t-end T] [--method M] [--rtol R] [--atol A] [--dt H]
-                             [--output-dt H] [--max-steps N] [-o results.csv] [--progress]
+                             [--output-dt H] [--max-steps N] [-o results.csv|.parquet|.npz]
+    planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
+    planardyn plot RESULTS [-o FILE.png] [--torque-speed]
+    planardyn animate MODEL RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn demo [--out DIR] [--model MODEL]
 
-Exit status: 0 success; 1 the computation failed (the simulation stopped before t_end:
-the CSV still holds the trajectory computed); 2 a usage, file or model error. Errors are
-one message on stderr, never a traceback.
+Exit status: 0 success; 1 the computation failed (the simulation stopped before t_end: the
+results file still holds the trajectory computed; the start could not be assembled); 2 a
+usage, file or model error. Errors are one message on stderr, never a traceback.
 """
 
 from __future__ import annotations
@@ -26,6 +30,11 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 #: The demo's model, in the source tree next to the package (an editable install).
 DEMO_MODEL = Path(__file__).resolve().parents[2] / "examples" / "models" / "five-bar.yaml"
+RESULT_EXTENSIONS = (".csv", ".parquet", ".npz")
+
+
+class UsageError(Exception):
+    """A command line that cannot be carried out as given (exit 2)."""
 
 
 class ProgressBar:
@@ -61,15 +70,64 @@ def summary(res: SimulationResult) -> str:
     )
 
 
+# ------------------------------------------------------------------ the parser
+
+EPILOG = "Exit status: 0 ok, 1 the computation failed, 2 usage or model error."
+
+
+def _sub(sub, name: str, help: str, description: str, examples: str) -> argparse.ArgumentParser:
+    return sub.add_parser(
+        name,
+        help=help,
+        description=description,
+        epilog="examples:\n" + examples.rstrip() + "\n\n" + EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
+def _results_path(value: str) -> Path:
+    p = Path(value)
+    if p.suffix.lower() not in RESULT_EXTENSIONS:
+        raise argparse.ArgumentTypeError(
+            f"{value}: results files end in {', '.join(RESULT_EXTENSIONS)}"
+        )
+    return p
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="planardyn",
-        description="Dynamics of planar closed-chain mechanisms from model files.",
-        epilog="Exit status: 0 ok, 1 the simulation stopped early, 2 usage or model error.",
+        description="Exact dynamics of planar closed-chain mechanisms, from model files.",
+        epilog=(
+            "examples:\n"
+            "  planardyn check examples/models/five-bar.yaml\n"
+            "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
+            "  planardyn plot five-bar.csv -o five-bar.png\n"
+            "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
+            "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
+            "  planardyn demo\n\n"
+            "Run 'planardyn COMMAND --help' for a command's options. " + EPILOG
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    s = sub.add_parser("simulate", help="simulate a model file and write the trajectory as CSV")
+    c = _sub(sub, "check", "describe a model: structure, mobility, coordinates, singularity measures",
+             "Load and validate a model file and describe it: bodies, pairs by kind, the coordinates\n"
+             "with their units and drawn values, the Grubler mobility 3n - 2p, and the singularity\n"
+             "measures at the start configuration.",
+             "  planardyn check examples/models/five-bar.yaml\n"
+             "  planardyn check my-linkage.json")
+    c.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+
+    s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
+             "Integrate the equations of motion from the model's start state. Options left out take\n"
+             "the model file's 'simulate' values, else the defaults shown. The results file holds\n"
+             "the model, the settings and the planardyn version, so it can be re-plotted and the\n"
+             "run reproduced.",
+             "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
+             "  planardyn simulate examples/models/slider-crank.yaml --t-end 2 --method radau5 -o run.npz\n"
+             "  planardyn simulate model.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
     s.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
     s.add_argument("--t-end", type=float, help="end time (s); default: the model's, else 1")
     s.add_argument("--method", help="dop853 (default), dopri5, radau5 or rk4 (needs --dt)")
@@ -78,40 +136,128 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--dt", type=float, help="fixed step (s): for rk4, or to switch error control off")
     s.add_argument("--output-dt", type=float, help="spacing of the output rows (s); default: the model's, else every step")
     s.add_argument("--max-steps", type=int, help="most step attempts before giving up")
-    s.add_argument("-o", "--output", type=Path, help="CSV file to write (columns t, q, qd_*, qdd_*, tau_*, energies, sigma)")
+    s.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
+                   help="results file to write: .csv, .parquet or .npz (by extension)")
     s.add_argument("--progress", action="store_true", help="show a progress bar on stderr even when it is not a terminal")
     s.add_argument("--no-progress", action="store_true", help="never show the progress bar")
 
-    d = sub.add_parser("demo", help="simulate the shipped five-bar robot and write PNG plots")
+    i = _sub(sub, "inverse", "drive efforts for a prescribed motion of the coordinates",
+             "Inverse dynamics: the drive efforts (N m on angles, N on displacements) that make the\n"
+             "mechanism follow a prescribed motion, with the model's loads (gravity, springs,\n"
+             "dampers) acting; the model's own drives are not counted. The motion is a CSV table\n"
+             "with a column t (s) and one per coordinate (rad or m); rates and accelerations come\n"
+             "from cubic splines of q unless columns qd_<name> and qdd_<name> give them. A\n"
+             "planardyn results file is also accepted (its q, qd, qdd are used).",
+             "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
+             "  planardyn inverse examples/models/five-bar.yaml --motion five-bar.npz -o check.npz\n"
+             "\n"
+             "motion.csv:\n"
+             "  t,theta1,theta2\n"
+             "  0.0,2.0071,1.0472\n"
+             "  0.01,2.0080,1.0460\n"
+             "  ...")
+    i.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    i.add_argument("--motion", type=Path, required=True, help="motion table (.csv) or results file")
+    i.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
+                   help="results file to write (.csv, .parquet or .npz) with tau_<name> columns")
+
+    pl = _sub(sub, "plot", "plot a results file: coordinates, rates, drive efforts, energy",
+              "Plot the time histories of a results file (coordinates, rates, drive efforts and\n"
+              "energy on one figure), or with --torque-speed each drive's effort against its speed.",
+              "  planardyn plot five-bar.csv                 # writes five-bar.png\n"
+              "  planardyn plot five-bar.npz -o histories.png\n"
+              "  planardyn plot five-bar.csv --torque-speed -o torque-speed.png")
+    pl.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz) written by planardyn")
+    pl.add_argument("-o", "--output", type=Path, help="image to write (.png, .pdf, .svg); default RESULTS with .png")
+    pl.add_argument("--torque-speed", action="store_true", help="plot drive effort against speed instead")
+    pl.add_argument("--dpi", type=float, default=120, help="resolution of raster images (default 120)")
+
+    a = _sub(sub, "animate", "animate a result: GIF, MP4 or an interactive HTML viewer",
+             "Animate the mechanism along a results file. .gif and .mp4 are videos (MP4 needs\n"
+             "imageio-ffmpeg); .html is a self-contained viewer (play, pause, speed, time slider,\n"
+             "point paths, linked plots) that works offline in any browser.",
+             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.gif\n"
+             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
+             "  planardyn animate examples/models/five-bar.yaml five-bar.npz -o five-bar.mp4 --fps 30 --speed 0.5")
+    a.add_argument("model", type=Path, help="model file the results were computed with")
+    a.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz)")
+    a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
+    a.add_argument("--fps", type=float, default=20.0, help="frames per second of playback (default 20)")
+    a.add_argument("--speed", type=float, help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
+    a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
+    a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
+
+    d = _sub(sub, "demo", "show what planardyn does: simulate the five-bar robot, write plots, GIF and viewer",
+             "Simulate the shipped five-bar robot and write, into one folder: the results (CSV),\n"
+             "plots of the coordinates, efforts, energy and the mechanism (PNG), an animation (GIF)\n"
+             "and the interactive viewer (HTML, open it in a browser).",
+             "  planardyn demo\n"
+             "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, default=DEMO_MODEL, help="model file (default: examples/models/five-bar.yaml)")
     return p
 
 
-def _simulate(args: argparse.Namespace) -> int:
+# ------------------------------------------------------------------ commands
+
+
+def _check(args: argparse.Namespace) -> int:
     mech = load(args.model)
-    t_end = args.t_end if args.t_end is not None else (mech.simulate_defaults.get("t_end") or 1.0)
+    n, pairs = mech.n_bodies, mech.pairs
+    print(f"model: {mech.name}  ({mech.source})")
+    print(f"bodies: {n}")
+    for b, mass, inertia in zip(mech.body_names, mech.masses, mech.inertias):
+        print(f"  {b}: mass {mass:.6g} kg, inertia {inertia:.6g} kg m^2")
+    kinds: dict[str, list[str]] = {}
+    for pr in pairs:
+        kinds.setdefault(pr["kind"], []).append(pr["name"])
+    print(f"pairs: {len(pairs)}  (" + ", ".join(f"{len(v)} {k}" for k, v in kinds.items()) + ")")
+    for k, names in kinds.items():
+        print(f"  {k}: {', '.join(names)}")
+    print(f"mobility (Grubler): 3n - 2p = 3*{n} - 2*{len(pairs)} = {3 * n - 2 * len(pairs)};"
+          f" coordinates: {mech.dof}")
+    print("coordinates:")
+    for name, unit, drawn, q0 in zip(mech.coordinate_names, mech.coordinate_units, mech.drawn_q, mech.q0):
+        start = "" if drawn == q0 else f", start {q0:.6g} {unit}"
+        print(f"  {name}: drawn {drawn:.6g} {unit}{start}")
+    try:
+        k = mech.kinematics(mech.q0)
+        print(f"singularity measures at the start (0 = singular): type II sigma_min {k['sigma_min']:.4g}, "
+              f"passive {k['sigma_passive']:.4g}")
+        print(f"loop-closure residual at the start: {k['residual']:.3g}")
+    except SingularityError as e:
+        print(f"singularity measures at the start: singular ({e})")
+    try:
+        from . import structure  # written elsewhere; optional
+    except ImportError:
+        structure = None
+    if structure is not None and hasattr(structure, "report"):
+        print(structure.report(mech))
+    return EXIT_OK
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    from .results_io import attach_metadata, simulate_settings, write_results
+
+    mech = load(args.model)
+    settings = simulate_settings(
+        mech, t_end=args.t_end, method=args.method, rtol=args.rtol, atol=args.atol, dt=args.dt,
+        output_dt=args.output_dt, max_steps=args.max_steps,
+    )
+    t_end = settings["t_end"] or 1.0
     show = not args.no_progress and (args.progress or sys.stderr.isatty())
     bar = ProgressBar(t_end) if show else None
     try:
-        res = mech.simulate(
-            t_end=args.t_end,
-            method=args.method,
-            rtol=args.rtol,
-            atol=args.atol,
-            dt=args.dt,
-            output_dt=args.output_dt,
-            max_steps=args.max_steps,
-            progress=bar,
-        )
+        res = mech.simulate(**settings, progress=bar)
         if bar is not None and res.success:
             bar(t_end)
     finally:
         if bar is not None:
             bar.close()
+    res = attach_metadata(res, mech, settings)
     if args.output is not None:
         args.output.parent.mkdir(parents=True, exist_ok=True)
-        res.to_csv(args.output)
+        write_results(res, args.output)
     line = summary(res) + (f" -> {args.output}" if args.output is not None else "")
     print(line)
     if not res.success:
@@ -120,49 +266,133 @@ def _simulate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _demo(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def _inverse(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from .plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy
+    from .results_io import inverse_from_file, write_results
+
+    mech = load(args.model)
+    res = inverse_from_file(mech, args.motion)
+    if args.output is not None:
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        write_results(res, args.output)
+    peaks = ", ".join(
+        f"|tau_{n}| <= {v:.4g} {u}" for n, v, u in zip(mech.coordinate_names, np.abs(res.tau).max(axis=0), mech.effort_units)
+    )
+    print(f"inverse dynamics: {len(res.t)} rows, t = {res.t[0]:.6g}..{res.t[-1]:.6g} s, {peaks}, "
+          f"min sigma {float(res.sigma.min()):.3g}" + (f" -> {args.output}" if args.output else ""))
+    return EXIT_OK
+
+
+def _plot(args: argparse.Namespace) -> int:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .plot import plot_results, plot_torque_speed
+    from .results_io import read_results
+
+    res = read_results(args.results)
+    out = args.output or args.results.with_suffix(".png")
+    if args.torque_speed:
+        fig = Figure(figsize=(7, 5))
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot()
+        plot_torque_speed(res, ax=ax)
+        name = (res.metadata.get("model") or {}).get("name") or args.results.name
+        ax.set_title(f"{name}: drive effort vs speed")
+        fig.tight_layout()
+    else:
+        fig = Figure(figsize=(11, 7))
+        FigureCanvasAgg(fig)
+        plot_results(res, fig=fig)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=args.dpi)
+    print(f"wrote {out}")
+    return EXIT_OK
+
+
+def _animate(args: argparse.Namespace) -> int:
+    from .animate import FORMATS, animate
+    from .results_io import read_results
+
+    if args.output.suffix.lower() not in FORMATS:
+        raise UsageError(f"{args.output}: an animation is .gif, .mp4 or .html")
+    mech = load(args.model)
+    res = read_results(args.results)
+    if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
+        raise UsageError(
+            f"{args.results} was not computed with {args.model}: its coordinates are "
+            f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})"
+        )
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
+    if args.channel and not kw:
+        raise UsageError("--channel is for the HTML viewer only")
+    start = time.monotonic()
+    animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    size = args.output.stat().st_size
+    print(f"wrote {args.output} ({size / 1024:.0f} KiB, {time.monotonic() - start:.1f} s)")
+    return EXIT_OK
+
+
+def _demo(args: argparse.Namespace) -> int:
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .animate import animate
+    from .plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy, plot_torque_speed
+    from .results_io import attach_metadata, simulate_settings, write_results
 
     if not args.model.is_file():
         raise FileNotFoundError(f"{args.model}: the demo model is not there (pass --model MODEL)")
     mech = load(args.model)
-    res = mech.simulate()
+    settings = simulate_settings(mech)
+    res = attach_metadata(mech.simulate(**settings), mech, settings)
     print(summary(res))
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     written = []
 
+    def figure(size):
+        fig = Figure(figsize=size)
+        FigureCanvasAgg(fig)
+        return fig
+
     def save(fig, name: str) -> None:
         fig.tight_layout()
         fig.savefig(out / name, dpi=120)
-        plt.close(fig)
         written.append(out / name)
 
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    fig = figure((8, 6))
+    axes = fig.subplots(2, 1, sharex=True)
     plot_coordinates(res, ax=axes[0])
     plot_coordinates(res, ax=axes[1], which="qd")
     axes[0].set_title(f"{mech.name}: coordinates")
     save(fig, "coordinates.png")
 
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig = figure((8, 4))
+    ax = fig.add_subplot()
     plot_efforts(res, ax=ax)
     ax.set_title("drive efforts")
     save(fig, "efforts.png")
 
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig = figure((6, 5))
+    ax = fig.add_subplot()
+    plot_torque_speed(res, ax=ax)
+    ax.set_title("drive effort vs speed")
+    save(fig, "torque-speed.png")
+
+    fig = figure((8, 4.5))
+    ax = fig.add_subplot()
     plot_energy(res, ax=ax)
     ax.set_title(f"energy (balance drift {res.energy.drift:.2g} J)")
     save(fig, "energy.png")
 
     n_snap = 4
     idx = np.linspace(0, len(res.t) - 1, n_snap).round().astype(int) if len(res.t) else []
-    fig, axes = plt.subplots(1, n_snap, figsize=(4 * n_snap, 4))
+    fig = figure((4 * n_snap, 4))
+    axes = fig.subplots(1, n_snap)
     pts = mech.point_positions(res.x)  # (N, P, 2): one frame for every snapshot
     lo, hi = np.nanmin(pts, axis=(0, 1)), np.nanmax(pts, axis=(0, 1))
     pad = 0.1 * mech.scale
@@ -173,23 +403,39 @@ def _demo(args: argparse.Namespace) -> int:
         ax.set_title(f"t = {res.t[k]:.3g} s")
     save(fig, "mechanism.png")
 
-    res.to_csv(out / "results.csv")
+    write_results(res, out / "results.csv")
     written.append(out / "results.csv")
+    animate(mech, res, out / "animation.gif")
+    written.append(out / "animation.gif")
+    animate(mech, res, out / "viewer.html")
+    written.append(out / "viewer.html")
     print("wrote " + ", ".join(str(p) for p in written))
+    print(f"open {out / 'viewer.html'} in a browser to play the motion")
     return EXIT_OK if res.success else EXIT_FAILED
+
+
+COMMANDS = {
+    "check": _check,
+    "simulate": _simulate,
+    "inverse": _inverse,
+    "plot": _plot,
+    "animate": _animate,
+    "demo": _demo,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        if args.command == "simulate":
-            return _simulate(args)
-        return _demo(args)
+        return COMMANDS[args.command](args)
     except (AssemblyError, SingularityError) as e:
-        # The start state could not be computed: the computation failed.
+        # The start state (or a row of a motion) could not be computed: the computation failed.
         print(f"planardyn: {e}", file=sys.stderr)
         return EXIT_FAILED
-    except (PlanardynError, ValueError, OSError) as e:
+    except (PlanardynError, UsageError, ValueError, OSError) as e:
+        print(f"planardyn: {e}", file=sys.stderr)
+        return EXIT_USAGE
+    except ImportError as e:
         print(f"planardyn: {e}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:

@@ -12,6 +12,9 @@ use crate::model::{CoordinateKind, Mechanism, PairKind};
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
 pub const SINGULAR_PIVOT: f64 = 1e-12;
+/// Inverse iterations of the singularity estimate: enough for 3 digits when the two
+/// smallest singular values differ by 30 %, and for many more near a singularity.
+const SIGMA_ITERATIONS: usize = 12;
 
 /// J(x) for one chart, scaled and LU-factorised.
 #[derive(Debug, Clone)]
@@ -26,13 +29,16 @@ pub struct System {
     factored: bool,
     /// The chart of the last factorisation.
     chart: Chart,
+    /// Inverse-iteration vectors of [`System::sigma_min_estimate`].
+    v: Vec<f64>,
+    w: Vec<f64>,
 }
 
 impl System {
     pub fn new(mech: &Mechanism) -> Self {
         let n = mech.n_x();
         let col_scale = (0..n).map(|i| if i % 3 == 2 { 1.0 } else { mech.scale }).collect();
-        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, tmp: vec![0.0; n], factored: false, chart: Chart::Inputs }
+        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, tmp: vec![0.0; n], factored: false, chart: Chart::Inputs, v: vec![0.0; n], w: vec![0.0; n] }
     }
 
     /// Fill `j` (row-major, n x n) with the scaled Jacobian and set the row scales.
@@ -57,6 +63,33 @@ impl System {
     /// Whether J is factorised for `chart` (at some nearby x, for a chord iteration).
     pub fn is_factored_for(&self, chart: &Chart) -> bool {
         self.factored && self.chart == *chart
+    }
+
+    /// The smallest singular value of the factorised scaled J, by inverse iteration on
+    /// (J^T J)^-1 with the LU factors (Golub & Van Loan 8.2.2): no new factorisation, 2n^2
+    /// flops per iteration. The estimate approaches sigma_min from above; the error falls as
+    /// (sigma_1 / sigma_2)^(2k) with the two smallest singular values, so it is sharpest
+    /// exactly where it matters, near a singularity. `None` if J is not factorised.
+    pub fn sigma_min_estimate(&mut self) -> Option<f64> {
+        if !self.factored {
+            return None;
+        }
+        // A fixed start with no special structure, so it is never orthogonal by design to
+        // the singular vector of a symmetric mechanism.
+        for (i, v) in self.v.iter_mut().enumerate() {
+            *v = 1.0 + 0.37 * ((i * 7 + 3) % 11) as f64;
+        }
+        let mut lambda = 0.0;
+        for _ in 0..SIGMA_ITERATIONS {
+            let norm = self.v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            self.v.iter_mut().for_each(|x| *x /= norm);
+            self.w.copy_from_slice(&self.v);
+            self.lu.solve(&mut self.w, &mut self.tmp);
+            self.lu.solve_transpose(&mut self.w, &mut self.tmp);
+            lambda = self.w.iter().zip(&self.v).map(|(a, b)| a * b).sum::<f64>();
+            std::mem::swap(&mut self.v, &mut self.w);
+        }
+        Some(if lambda > 0.0 { 1.0 / lambda.sqrt() } else { 0.0 })
     }
 
     /// Solve J y = b in place (b and y unscaled).

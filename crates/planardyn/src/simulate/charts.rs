@@ -24,10 +24,17 @@ pub struct Measures {
     pub passive: f64,
 }
 
-/// Measure the point held in `ode.ws`.
-pub fn measure(ode: &MechanismOde) -> Measures {
-    let sigma = sigma_min(ode.mech, &Chart::Inputs, &ode.ws.x);
-    let passive = if sigma < SWITCH_TO_INPUTS { passive_sigma_min(ode.mech, &ode.ws.x) } else { sigma };
+/// Measure the point analysed in `ode.ws`. In the user's chart the type II measure comes
+/// from the factorisation already in the workspace (inverse iteration, see
+/// `System::sigma_min_estimate`); near a singularity, where a partition is in use, both
+/// measures are exact singular values (an SVD, at a few steps only).
+pub fn measure(ode: &mut MechanismOde) -> Measures {
+    let estimate = match ode.ws.chart {
+        Chart::Inputs => ode.ws.sys.sigma_min_estimate(),
+        Chart::Partition(_) => None,
+    };
+    let sigma = estimate.unwrap_or_else(|| sigma_min(ode.mech, &Chart::Inputs, &ode.ws.x));
+    let passive = if sigma < SWITCH_TO_PARTITION { passive_sigma_min(ode.mech, &ode.ws.x) } else { sigma };
     Measures { sigma, passive }
 }
 

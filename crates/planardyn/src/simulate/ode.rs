@@ -4,6 +4,7 @@
 
 use crate::dynamics::{forward, Drives};
 use crate::integrate::OdeSystem;
+use crate::kinematics::constraints::gamma;
 use crate::kinematics::Chart;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
@@ -21,6 +22,8 @@ pub struct MechanismOde<'a> {
     /// The (t, y) of the evaluation whose results `ws` holds, to reuse it at acceptance.
     last_t: f64,
     last_y: Vec<f64>,
+    /// Whether `ws` holds a successful evaluation at `last_y` (in the current chart).
+    base_valid: bool,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -33,6 +36,7 @@ impl<'a> MechanismOde<'a> {
             anchor_z: vec![0.0; m],
             last_t: f64::NAN,
             last_y: vec![f64::NAN; 2 * m + 1],
+            base_valid: false,
             mech,
             ws,
             drives,
@@ -64,22 +68,50 @@ impl<'a> MechanismOde<'a> {
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
         self.last_t = f64::NAN;
+        self.base_valid = false;
         self.accept(t, y)
     }
 
-    /// Forward dynamics at (t, y) from the anchor's first-order prediction.
-    pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+    /// Newton's start for chart values z: a second-order prediction
+    /// x + U dz + 1/2 w(dz, dz) from the last evaluation when it succeeded (its x, U and
+    /// factorised J are still in `ws`; w(dz, dz) costs one solve), else a first-order one
+    /// from the last accepted point. Both start from converged points of the same branch.
+    fn predict(&mut self, z: &[f64]) {
         let m = self.m();
         let n = self.ws.x.len();
-        self.ws.x.copy_from_slice(&self.anchor_x);
-        for j in 0..m {
-            let dz = y[j] - self.anchor_z[j];
-            for (x, u) in self.ws.x.iter_mut().zip(&self.anchor_u[j * n..(j + 1) * n]) {
-                *x += u * dz;
+        let ws = &mut self.ws;
+        if self.base_valid {
+            ws.rhs.fill(0.0);
+            for j in 0..m {
+                let dz = z[j] - self.last_y[j];
+                for (d, u) in ws.rhs.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
+                    *d += u * dz;
+                }
+            }
+            gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
+            ws.sys.solve(&mut ws.tmp);
+            for ((x, d), w) in ws.x.iter_mut().zip(&ws.rhs).zip(&ws.tmp) {
+                *x += d - 0.5 * w;
+            }
+        } else {
+            ws.x.copy_from_slice(&self.anchor_x);
+            for j in 0..m {
+                let dz = z[j] - self.anchor_z[j];
+                for (x, u) in ws.x.iter_mut().zip(&self.anchor_u[j * n..(j + 1) * n]) {
+                    *x += u * dz;
+                }
             }
         }
+    }
+
+    /// Forward dynamics at (t, y).
+    pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let m = self.m();
+        self.predict(&y[..m]);
         self.last_t = f64::NAN;
+        self.base_valid = false;
         forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws)?;
+        self.base_valid = true;
         self.last_t = t;
         self.last_y.copy_from_slice(y);
         Ok(())

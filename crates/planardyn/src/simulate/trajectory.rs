@@ -4,7 +4,7 @@
 use super::ode::MechanismOde;
 use crate::dynamics::{kinetic_energy, potential_energy};
 use crate::integrate::Stats;
-use crate::kinematics::{sigma_min, Chart};
+use crate::kinematics::Chart;
 
 /// How a simulation ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,8 +112,8 @@ impl Trajectory {
     pub fn success(&self) -> bool {
         self.status == Status::Success
     }
-    /// Record the point analysed in `ode.ws` at time t with work W.
-    pub fn record(&mut self, ode: &MechanismOde, t: f64, work: f64) {
+    /// Record the point analysed in `ode.ws` at time t with work W and type II measure sigma.
+    pub fn record(&mut self, ode: &MechanismOde, t: f64, work: f64, sigma: f64) {
         let ws = &ode.ws;
         self.t.push(t);
         self.q.extend_from_slice(&ws.q);
@@ -126,7 +126,7 @@ impl Trajectory {
         self.kinetic.push(kin);
         self.potential.push(pot);
         self.work.push(work);
-        self.sigma.push(sigma_min(ode.mech, &Chart::Inputs, &ws.x));
+        self.sigma.push(sigma);
         self.residual.push(ws.residual);
         self.partitioned.push(ws.chart != Chart::Inputs);
         let e0 = self.kinetic[0] + self.potential[0] - self.work[0];

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# One command for the whole benchmark suite (issue 6):
+#
+#   benchmarks/run.sh [--quick] [--no-criterion]
+#
+# 1. ./dev setup: builds planardyn's extension from the current sources into python/.
+# 2. benchmarks/.venv-peers: a venv of its own with the other tools from PyPI (mujoco, pin,
+#    exudyn) plus numpy, matplotlib, pyyaml. A tool whose install fails is left out and
+#    reported by bench.py as not available, never hidden.
+# 3. benchmarks/rust-sim: the same simulate call from Rust, for the Python-overhead figure.
+# 4. bench.py: every measurement in one run; writes benchmarks/results/.
+set -euo pipefail
+
+HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+ROOT="$(dirname "$HERE")"
+VENV="$HERE/.venv-peers"
+PY="$VENV/bin/python"
+PEERS=(mujoco pin exudyn)
+BASE=(numpy matplotlib pyyaml)
+
+say() { printf '\033[1m==> %s\033[0m\n' "$*" >&2; }
+
+say "planardyn: ./dev setup"
+"$ROOT/dev" setup
+
+if [[ ! -x "$PY" ]]; then
+    say "creating $VENV"
+    python3 -m venv "$VENV"
+    "$PY" -m pip install --quiet --disable-pip-version-check --upgrade pip
+fi
+stamp="$VENV/.installed"
+want="${BASE[*]} ${PEERS[*]}"
+if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$want" ]]; then
+    say "installing ${BASE[*]} into $VENV"
+    "$PY" -m pip install --quiet --disable-pip-version-check "${BASE[@]}"
+    for pkg in "${PEERS[@]}"; do
+        say "installing $pkg"
+        # One at a time: one that will not install must not keep the others out.
+        "$PY" -m pip install --quiet --disable-pip-version-check "$pkg" \
+            || printf 'run.sh: pip could not install %s: bench.py reports it as not available\n' "$pkg" >&2
+    done
+    echo "$want" > "$stamp"
+fi
+
+say "building benchmarks/rust-sim (release)"
+# Start from the repository's lock file so that the core builds with the same dependency
+# versions as the Python extension.
+cp "$ROOT/Cargo.lock" "$HERE/rust-sim/Cargo.lock"
+CARGO_TARGET_DIR="$HERE/.target" cargo build --release --quiet --manifest-path "$HERE/rust-sim/Cargo.toml"
+
+say "running bench.py"
+cd "$ROOT"
+PYTHONPATH="$ROOT/python${PYTHONPATH:+:$PYTHONPATH}" "$PY" "$HERE/bench.py" "$@"

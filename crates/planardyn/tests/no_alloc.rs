@@ -1,0 +1,56 @@
+//! A forward-dynamics evaluation, as the integrator makes it, allocates nothing: every buffer
+//! is in the workspace (checked with a counting global allocator, this file only).
+
+mod common;
+use common::*;
+use planardyn::dynamics::ModelDrives;
+use planardyn::integrate::OdeSystem;
+use planardyn::kinematics::{assemble_into, velocity_analogues, Chart};
+use planardyn::simulate::ode::MechanismOde;
+use planardyn::Workspace;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn rhs_evaluation_does_not_allocate() {
+    for mech in all_models() {
+        let m = mech.dof();
+        let (q, qd) = test_state(&mech);
+        let mut ws = Workspace::new(&mech);
+        assemble_into(&mech, &q, &mut ws).unwrap();
+        velocity_analogues(&mut ws).unwrap();
+        let mut drives = ModelDrives(&mech);
+        let mut ode = MechanismOde::new(&mech, ws, &mut drives);
+        let mut y = vec![0.0; 2 * m + 1];
+        y[..m].copy_from_slice(&q);
+        y[m..2 * m].copy_from_slice(&qd);
+        ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
+        let mut dy = vec![0.0; 2 * m + 1];
+        for k in 0..m {
+            y[k] += 1e-3;
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for step in 0..10 {
+            y[0] += 1e-4 * step as f64;
+            ode.rhs(0.01 * step as f64, &y, &mut dy).unwrap();
+            ode.accept(0.01 * step as f64, &y).unwrap();
+        }
+        assert_eq!(ALLOCATIONS.load(Ordering::Relaxed) - before, 0, "{}: allocations in rhs/accept", mech.name);
+    }
+}

@@ -1,0 +1,202 @@
+"""A self-contained HTML viewer of a result: the mechanism animated on a canvas (play, pause,
+speed, a time slider, the point paths) and linked plots of chosen channels (a cursor follows
+the time; clicking a plot goes to that time).
+
+One file, no network: the page's JavaScript is hand-written and inline
+(``viewer_template.html`` next to this module) and the data is inline JSON. It works offline
+in any current browser. The page reports its state for tests and scripts: ``<body
+data-frame="K" data-drawn="N" data-ready="1">`` and ``document.title`` ending in
+``frame K/N-1``; an uncaught error sets ``data-error``. The address may set the start:
+``viewer.html#t=0.75&paused&speed=0.25``.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import os
+from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import _core
+from .animate import auto_speed
+from .plot import default_trace_points
+
+if TYPE_CHECKING:
+    from .mechanism import Mechanism
+    from .result import SimulationResult
+
+#: Frames kept in the page at most (longer results are subsampled uniformly).
+MAX_FRAMES = 1500
+#: Significant digits kept for positions (relative to the mechanism's size) and channels.
+DIGITS = 6
+
+
+def _round(a: np.ndarray, scale: float) -> list:
+    """Round to DIGITS significant digits of ``scale`` (keeps the page small); NaN -> None."""
+    scale = scale if scale > 0 and math.isfinite(scale) else 1.0
+    dec = max(0, DIGITS - 1 - int(math.floor(math.log10(scale))))
+    out = np.round(np.asarray(a, dtype=float), dec).tolist()
+    return _nan_to_none(out)
+
+
+def _nan_to_none(v: Any) -> Any:
+    if isinstance(v, list):
+        return [_nan_to_none(u) for u in v]
+    return None if isinstance(v, float) and not math.isfinite(v) else v
+
+
+def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | None) -> tuple[list, list]:
+    """(groups, channels): each channel a dict key, label, group, values, on."""
+    names, kinds = result.coordinate_names, result.coordinate_kinds
+    ang = lambda k, a, d: a if kinds[k] == "angle" else d  # noqa: E731
+    unit = lambda a, d: a if all(k == "angle" for k in kinds) else d if all(k != "angle" for k in kinds) else "mixed"  # noqa: E731
+    groups = [
+        {"key": "q", "label": "coordinates", "unit": unit("rad", "m")},
+        {"key": "qd", "label": "rates", "unit": unit("rad/s", "m/s")},
+        {"key": "qdd", "label": "accelerations", "unit": unit("rad/s²", "m/s²")},
+        {"key": "tau", "label": "drive efforts", "unit": unit("N m", "N")},
+        {"key": "energy", "label": "energy", "unit": "J"},
+        {"key": "sigma", "label": "singularity measure", "unit": "1"},
+    ]
+    chans: list[dict[str, Any]] = []
+    for g, arr, fmt in (("q", result.q, "{}"), ("qd", result.qd, "qd_{}"), ("qdd", result.qdd, "qdd_{}"),
+                        ("tau", result.tau, "tau_{}")):
+        for k, n in enumerate(names):
+            chans.append({"key": fmt.format(n), "label": fmt.format(n), "group": g, "values": arr[keep, k],
+                          "unit": ang(k, *{"q": ("rad", "m"), "qd": ("rad/s", "m/s"), "qdd": ("rad/s²", "m/s²"),
+                                             "tau": ("N m", "N")}[g])})
+    e = result.energy
+    for key, label, arr in (("kinetic", "T", e.kinetic), ("potential", "V", e.potential),
+                            ("total", "T + V", e.total), ("work", "W", e.work), ("balance", "balance", e.balance)):
+        chans.append({"key": key, "label": label, "group": "energy", "values": arr[keep], "unit": "J"})
+    chans.append({"key": "sigma", "label": "sigma", "group": "sigma", "values": result.sigma[keep], "unit": "1"})
+    default = {c["key"] for c in chans if c["group"] in ("q", "tau")}
+    chosen = default if selected is None else set(selected)
+    unknown = chosen - {c["key"] for c in chans}
+    if unknown:
+        raise ValueError(
+            f"unknown channel(s) {', '.join(sorted(unknown))}; the channels are "
+            f"{', '.join(c['key'] for c in chans)}"
+        )
+    for c in chans:
+        c["on"] = c["key"] in chosen
+        v = np.asarray(c["values"], dtype=float)
+        finite = v[np.isfinite(v)]
+        c["values"] = _round(v, float(np.max(np.abs(finite))) if finite.size else 1.0)
+    return groups, chans
+
+
+def viewer_data(
+    mech: Mechanism,
+    result: SimulationResult,
+    *,
+    channels: list[str] | None = None,
+    traces: list[str] | None = None,
+    max_frames: int = MAX_FRAMES,
+    title: str | None = None,
+) -> dict[str, Any]:
+    """The JSON-ready data of the page (see :func:`viewer_html` for the arguments)."""
+    n = len(result.t)
+    if n == 0:
+        raise ValueError("the result has no output to show")
+    keep = np.unique(np.linspace(0, n - 1, min(n, max_frames)).round().astype(int))
+    pos = mech.point_positions(result.x[keep])  # (K, P, 2)
+    finite = pos[np.all(np.isfinite(pos), axis=2)]
+    lo, hi = finite.min(axis=0), finite.max(axis=0)
+    L = mech.scale
+    pad = 0.12 * L
+    names = mech.point_names
+    traces = default_trace_points(mech) if traces is None else list(traces)
+    unknown = [p for p in traces if p not in names]
+    if unknown:
+        raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(names)}")
+    joints = []
+    for pair in mech.pairs:
+        jt: dict[str, Any] = {"i": names.index(pair["point"]), "kind": pair["kind"], "guide": None}
+        if pair["kind"] == "prismatic" and pair["axis"] is not None:
+            a = pair["bodies"][0]
+            phi = np.zeros(len(keep)) if a == "ground" else result.x[keep, 3 * mech.body_names.index(a) + 2]
+            ax, ay = pair["axis"]
+            d = np.column_stack([np.cos(phi) * ax - np.sin(phi) * ay, np.sin(phi) * ax + np.cos(phi) * ay])
+            jt["guide"] = _round(d, 1.0)
+        joints.append(jt)
+    groups, chans = _channels(result, keep, channels)
+    st = result.stats
+    info = (
+        f"{result.status}: {n} outputs, t = {result.t[0]:.4g}..{result.t[-1]:.4g} s; "
+        f"{mech.dof} coordinates ({', '.join(mech.coordinate_names)}), {mech.n_bodies} bodies; "
+        f"energy drift {result.energy.drift:.3g} J; min sigma {st.get('min_sigma', float(np.min(result.sigma))):.3g}"
+    )
+    t = result.t[keep]
+    return {
+        "title": title or mech.name,
+        "info": info,
+        "version": _core.__version__,
+        "t": _round(t, max(abs(t[0]), abs(t[-1]), 1e-3)),
+        "speed": auto_speed(result.t),
+        "scale": L,
+        "names": names,
+        "P": _round(pos.reshape(len(keep), -1), L),
+        "bodies": [{"name": b, "pts": [names.index(p) for p, _ in pts]}
+                   for b, pts in zip(mech.body_names, mech.body_points)],
+        "ground": [names.index(p) for p in mech.ground_points],
+        "joints": joints,
+        "traces": [names.index(p) for p in traces],
+        "bounds": [float(lo[0] - pad), float(hi[0] + pad), float(lo[1] - 2 * pad), float(hi[1] + pad)],
+        "groups": groups,
+        "channels": chans,
+    }
+
+
+def _template() -> str:
+    return resources.files("planardyn").joinpath("viewer_template.html").read_text(encoding="utf-8")
+
+
+def viewer_html(
+    mech: Mechanism,
+    result: SimulationResult,
+    *,
+    channels: list[str] | None = None,
+    traces: list[str] | None = None,
+    max_frames: int = MAX_FRAMES,
+    title: str | None = None,
+) -> str:
+    """The viewer page as one HTML string.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The model the result was computed with.
+    result : SimulationResult
+        The trajectory (``result.x`` gives the positions).
+    channels : list of str, optional
+        Channels plotted at first (the page has a checkbox for every one): coordinate names,
+        ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``, ``kinetic``, ``potential``, ``total``,
+        ``work``, ``balance``, ``sigma``. Default: the coordinates and the drive efforts.
+    traces : list of str, optional
+        Points whose paths are drawn (default :func:`planardyn.plot.default_trace_points`).
+    max_frames : int
+        Outputs kept at most (uniformly subsampled beyond).
+    title : str, optional
+        Page title (default the model's name).
+    """
+    data = viewer_data(mech, result, channels=channels, traces=traces, max_frames=max_frames, title=title)
+    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
+    # Inside <script>: no '<' or '&' may end the element early.
+    payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
+    page = _template()
+    page = page.replace("__TITLE__", html.escape(data["title"]))
+    page = page.replace("__VERSION__", html.escape(_core.__version__))
+    return page.replace("__DATA__", payload)
+
+
+def write_viewer(mech: Mechanism, result: SimulationResult, path: str | os.PathLike[str], **kw: Any) -> Path:
+    """Write :func:`viewer_html` to ``path`` (UTF-8). Returns the path."""
+    path = Path(path)
+    path.write_text(viewer_html(mech, result, **kw), encoding="utf-8")
+    return path
