@@ -10,8 +10,14 @@ import json
 import subprocess
 import sys
 
+import re
+
+import numpy as np
 import pytest
-from conftest import four_bar_dict
+from conftest import MODELS, four_bar_dict
+from PIL import Image
+
+from planardyn.results_io import read_results
 
 
 def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
@@ -27,17 +33,45 @@ def write_model(tmp_path, d: dict, name="model.json"):
     return path
 
 
+def csv_rows(path):
+    return list(csv.reader(line for line in path.open() if not line.startswith("#")))
+
+
 def test_simulate_writes_csv(tmp_path):
     model = write_model(tmp_path, four_bar_dict())
     out = tmp_path / "sub" / "results.csv"
     p = run("simulate", model, "--t-end", "0.2", "--output-dt", "0.01", "-o", out)
     assert p.returncode == 0, p.stderr
     assert p.stdout.startswith("success:") and "energy drift" in p.stdout and "min sigma" in p.stdout
-    rows = list(csv.reader(out.open()))
-    assert rows[0] == ["t", "theta", "qd_theta", "qdd_theta", "tau_theta", "kinetic", "potential", "work", "sigma"]
+    rows = csv_rows(out)
+    assert rows[0][:9] == ["t", "theta", "qd_theta", "qdd_theta", "tau_theta", "kinetic", "potential", "work", "sigma"]
+    assert rows[0][9:14] == ["residual", "partitioned", "X_crank", "Y_crank", "phi_crank"]
+    assert len(rows[0]) == 11 + 2 * 9  # then x and xd of the three bodies
     assert len(rows) == 1 + 21  # t = 0, 0.01, ..., 0.2
     assert float(rows[-1][0]) == pytest.approx(0.2)
     assert float(rows[1][1]) == pytest.approx(four_bar_dict()["coordinates"][0]["value"], abs=1e-12)
+    meta = json.loads("".join(line[2:] for line in out.open() if line.startswith("# ")))
+    assert meta["settings"]["t_end"] == 0.2 and meta["settings"]["output_dt"] == 0.01
+    assert meta["model"]["name"] == "crank-rocker four-bar"
+
+
+@pytest.mark.parametrize("ext", [".npz", ".parquet"])
+def test_simulate_writes_other_formats(tmp_path, ext):
+    model = write_model(tmp_path, four_bar_dict())
+    out = tmp_path / f"results{ext}"
+    p = run("simulate", model, "--t-end", "0.1", "--output-dt", "0.01", "-o", out)
+    assert p.returncode == 0, p.stderr
+    res = read_results(out)
+    assert len(res.t) == 11 and res.t[-1] == pytest.approx(0.1)
+    assert res.tau[0, 0] == 1.5  # the model's constant drive effort
+    assert res.metadata["settings"]["t_end"] == 0.1
+
+
+def test_simulate_unknown_extension_exit_2(tmp_path):
+    model = write_model(tmp_path, four_bar_dict())
+    p = run("simulate", model, "-o", tmp_path / "results.xlsx")
+    assert p.returncode == 2 and "results files end in .csv, .parquet, .npz" in p.stderr
+    assert "Traceback" not in p.stderr
 
 
 def test_simulate_with_method_and_progress(tmp_path):
@@ -83,7 +117,8 @@ def test_failed_simulation_exit_1_keeps_partial_csv(tmp_path):
     assert p.returncode == 1
     assert p.stdout.startswith("too_many_steps:")
     assert "stopped early" in p.stderr and "Traceback" not in p.stderr
-    assert len(out.read_text().splitlines()) >= 2
+    assert len(csv_rows(out)) >= 2
+    assert read_results(out).status == "too_many_steps"
 
 
 def test_bad_option_exit_2(tmp_path):
@@ -96,9 +131,114 @@ def test_bad_option_exit_2(tmp_path):
     assert p.returncode == 2
 
 
-def test_demo_writes_plots(tmp_path):
+def test_demo_writes_plots_animation_and_viewer(tmp_path):
     p = run("demo", "--out", tmp_path / "demo")
     assert p.returncode == 0, p.stderr
-    for name in ("coordinates.png", "efforts.png", "energy.png", "mechanism.png", "results.csv"):
+    for name in ("coordinates.png", "efforts.png", "torque-speed.png", "energy.png", "mechanism.png",
+                 "results.csv", "animation.gif", "viewer.html"):
         f = tmp_path / "demo" / name
         assert f.is_file() and f.stat().st_size > 1000, name
+    with Image.open(tmp_path / "demo" / "animation.gif") as im:
+        assert im.n_frames == 61  # 1.5 s shown in 3 s at 20 frames/s
+    assert "viewer.html in a browser" in p.stdout
+    assert read_results(tmp_path / "demo" / "results.csv").t[-1] == 1.5
+
+
+# ------------------------------------------------------------------ the other commands
+
+FIVE_BAR = MODELS / "five-bar.yaml"
+
+
+@pytest.mark.parametrize("command", ["check", "simulate", "inverse", "plot", "animate", "demo"])
+def test_every_command_has_help_with_examples(command):
+    p = run(command, "--help")
+    assert p.returncode == 0
+    assert "examples:" in p.stdout and f"planardyn {command}" in p.stdout.split("examples:")[1]
+    assert "Exit status" in p.stdout
+
+
+def test_check_describes_the_five_bar():
+    p = run("check", FIVE_BAR)
+    assert p.returncode == 0, p.stderr
+    out = p.stdout
+    assert "model: five-bar 5R robot, driven" in out
+    assert "bodies: 4" in out and "pairs: 5  (5 revolute)" in out
+    assert "mobility (Grubler): 3n - 2p = 3*4 - 2*5 = 2; coordinates: 2" in out
+    assert "theta1: drawn 2.00713 rad" in out and "theta2: drawn 1.0472 rad" in out
+    # The drawing is away from singularities (model file comment): sigma_min well above 0.
+    sigma = float(re.search(r"type II sigma_min ([\d.e-]+)", out).group(1))
+    assert 0.1 < sigma < 1.0
+    assert re.search(r"passive [\d.]+", out)
+
+
+def test_check_slider_crank_units_and_kinds():
+    p = run("check", MODELS / "slider-crank.yaml")
+    assert p.returncode == 0, p.stderr
+    assert "(3 revolute, 1 prismatic)" in p.stdout and "3*3 - 2*4 = 1" in p.stdout
+
+
+def test_check_bad_model_exit_2(tmp_path):
+    d = four_bar_dict()
+    d["bodies"]["crank"]["mass"] = -1.0
+    p = run("check", write_model(tmp_path, d, "bad.json"))
+    assert p.returncode == 2 and "bodies.crank.mass" in p.stderr and "Traceback" not in p.stderr
+
+
+def test_inverse_gives_the_torques_of_a_simulated_motion(tmp_path):
+    # Simulate the five-bar, keep only t and q as the prescribed motion: the inverse
+    # dynamics (spline derivatives) gives back the motor torques that drove it.
+    sim = tmp_path / "sim.npz"
+    assert run("simulate", FIVE_BAR, "--t-end", "0.5", "-o", sim).returncode == 0
+    res = read_results(sim)
+    motion = tmp_path / "motion.csv"
+    with motion.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["t", "theta1", "theta2"])
+        for t, q in zip(res.t.tolist(), res.q.tolist()):
+            w.writerow([repr(t), *map(repr, q)])
+    out = tmp_path / "torques.csv"
+    p = run("inverse", FIVE_BAR, "--motion", motion, "-o", out)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.startswith("inverse dynamics: 101 rows") and "|tau_theta1| <= 2.41 N m" in p.stdout
+    inv = read_results(out)
+    assert inv.metadata["kind"] == "inverse"
+    np.testing.assert_allclose(inv.tau, res.tau, rtol=0, atol=3e-3)  # see test_results_io
+
+
+def test_inverse_bad_motion_exit_2(tmp_path):
+    motion = tmp_path / "motion.csv"
+    motion.write_text("t,theta1\n0,2\n1,2\n")
+    p = run("inverse", FIVE_BAR, "--motion", motion)
+    assert p.returncode == 2 and "no column 'theta2'" in p.stderr and "Traceback" not in p.stderr
+    p = run("inverse", FIVE_BAR)
+    assert p.returncode == 2 and "--motion" in p.stderr
+
+
+def test_plot_and_animate(tmp_path):
+    sim = tmp_path / "run.csv"
+    assert run("simulate", FIVE_BAR, "--t-end", "0.3", "-o", sim).returncode == 0
+    p = run("plot", sim)
+    assert p.returncode == 0, p.stderr
+    with Image.open(tmp_path / "run.png") as im:
+        assert im.size == (1320, 840)  # 11 x 7 in at 120 dpi
+        assert np.asarray(im.convert("L")).std() > 10
+    p = run("plot", sim, "--torque-speed", "-o", tmp_path / "ts.png")
+    assert p.returncode == 0 and (tmp_path / "ts.png").stat().st_size > 5000
+    p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.gif", "--fps", "10", "--speed", "0.1")
+    assert p.returncode == 0, p.stderr
+    with Image.open(tmp_path / "a.gif") as im:
+        assert im.n_frames == 31
+    p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.html", "--channel", "tau_theta2")
+    assert p.returncode == 0, p.stderr
+    assert '"key":"tau_theta2"' in (tmp_path / "a.html").read_text()
+
+
+def test_plot_and_animate_errors(tmp_path):
+    p = run("plot", tmp_path / "none.csv")
+    assert p.returncode == 2 and "none.csv" in p.stderr and "Traceback" not in p.stderr
+    sim = tmp_path / "four.npz"
+    assert run("simulate", write_model(tmp_path, four_bar_dict()), "--t-end", "0.05", "-o", sim).returncode == 0
+    p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.gif")
+    assert p.returncode == 2 and "was not computed with" in p.stderr
+    p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.avi")
+    assert p.returncode == 2 and ".gif, .mp4 or .html" in p.stderr and "Traceback" not in p.stderr

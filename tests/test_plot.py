@@ -125,8 +125,8 @@ def test_mp4(slider_crank, tmp_path):
 
 
 def test_rendered_frame_shows_the_mechanism(slider_crank):
-    # The pixels where the crank pivot O is drawn (white circle, black ring) differ from the
-    # background between frames only where something moves: frame 0 and a later one differ.
+    # Frames are RGB arrays of the asked size with the coloured bars in them (pixels whose
+    # red and blue differ a lot: the blue crank, the orange rod), and the crank turns.
     mech, res = slider_crank
     frames = list(render_frames(mech, res, fps=5, speed=0.1, size=(320, 240)))
     assert len(frames) == 16 and frames[0].shape == (240, 320, 3) and frames[0].dtype == np.uint8

@@ -121,8 +121,7 @@ class Model:
 
 def run(fb: FourBar, setting: tuple, ref_grid: np.ndarray) -> Run:
     dt, w = setting
-    r = Run(TOOL, "RK4 + constraintDynamics" + (", Baumgarte" if w else ""),
-            f"dt={dt:g}" + (f", w={w:g}" if w else ""))
+    r = Run(TOOL, "RK4 + constraintDynamics" + (f", Baumgarte w={w:g}" if w else ""), f"dt={dt:g}")
     n = int(round(T_END / dt))
     m = Model(fb, w)
     with np.errstate(all="ignore"):

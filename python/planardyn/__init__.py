@@ -43,3 +43,8 @@ __all__ = [
     "load",
     "loads",
 ]
+
+# Results files (issue 4): planardyn.read_results(path) gives back a SimulationResult.
+from .results_io import read_results  # noqa: E402
+
+__all__ += ["read_results"]

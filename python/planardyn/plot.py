@@ -273,11 +273,14 @@ def plot_results(result: SimulationResult, fig: Any = None) -> list[Artist]:
     axes[0, 0].set_title("coordinates")
     axes[0, 1].set_title("rates")
     axes[1, 0].set_title("drive efforts")
-    axes[1, 1].set_title(f"energy (balance drift {result.energy.drift:.2g} J)")
+    kind = result.metadata.get("kind", "simulation")
+    if kind == "inverse":  # the balance then also holds what dampers dissipate
+        axes[1, 1].set_title("energy (W: work of the drive efforts only)")
+    else:
+        axes[1, 1].set_title(f"energy (balance drift {result.energy.drift:.2g} J)")
     for ax in axes[0]:
         ax.set_xlabel("")
     name = (result.metadata.get("model") or {}).get("name")
-    kind = result.metadata.get("kind", "simulation")
     fig.suptitle(f"{name or 'result'}: {kind}, {result.status}")
     fig.tight_layout()
     return artists

@@ -11,6 +11,9 @@ use crate::KinematicsError;
 /// Convergence test of Newton's method: the largest residual, lengths divided by the
 /// characteristic length L and angles in radians, below 1e-12 (about 1e4 ulp of O(1) values).
 pub const POSITION_TOL: f64 = 1e-12;
+/// Residuals above this (scaled) get a last Newton step after convergence, so positions
+/// are accurate to ~1e-14 whichever way the tolerance was met.
+const POLISH_BELOW: f64 = 1e-14;
 /// Newton iterations before giving up; from a first-order predictor it takes 1 to 3.
 pub const MAX_NEWTON: usize = 30;
 
@@ -81,13 +84,15 @@ pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result
     Err(KinematicsError::AssemblyFailed { residual, iterations: MAX_NEWTON })
 }
 
-/// Factorise J at the solution (the analogues need it), take one more Newton step with it
-/// (F(x) is still in `ws.tmp`): the residual drops from <= tol to ~tol^2, i.e. round-off,
-/// for one solve; J and the trig cache stay those of a point 1e-12 away, which is within
-/// the tolerance the analogues are computed to anyway. Then record the figures.
+/// Factorise J at the solution (the analogues need it); if the residual is only just below
+/// the tolerance, take one more Newton step with that J (F(x) is still in `ws.tmp`), which
+/// takes it to round-off for one solve. J and the trig cache then belong to a point within
+/// the tolerance, as accurate as the analogues are anyway. Then record the figures.
 fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize) -> Result<(), KinematicsError> {
     factor(mech, ws)?;
-    newton_update(ws);
+    if norm > POLISH_BELOW {
+        newton_update(ws);
+    }
     ws.residual = norm;
     ws.iterations = iterations;
     Ok(())

@@ -12,9 +12,9 @@ use crate::model::{CoordinateKind, Mechanism, PairKind};
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
 pub const SINGULAR_PIVOT: f64 = 1e-12;
-/// Inverse iterations of the singularity estimate: enough for 3 digits when the two
-/// smallest singular values differ by 30 %, and for many more near a singularity.
-const SIGMA_ITERATIONS: usize = 12;
+/// Inverse iterations of the singularity estimate: 2 digits when the two smallest singular
+/// values differ by 30 %, many more near a singularity (where they separate).
+const SIGMA_ITERATIONS: usize = 8;
 
 /// J(x) for one chart, scaled and LU-factorised.
 #[derive(Debug, Clone)]
