@@ -232,7 +232,10 @@ def _check(args: argparse.Namespace) -> int:
     except ImportError:
         structure = None
     if structure is not None and hasattr(structure, "report"):
-        print(structure.report(mech))
+        try:
+            print(structure.report(mech))
+        except Exception as e:  # the structural analysis is extra: never lose the rest
+            print(f"planardyn: structural analysis failed: {e}", file=sys.stderr)
     return EXIT_OK
 
 

@@ -10,7 +10,7 @@
 //! | `Radau5` | [`radau5`] | 5, implicit, stiff | adaptive | collocation cubic (order 3) |
 //!
 //! The shared pieces (error norm, initial step, step-size controller, the
-//! explicit-pair step loop) live in `control`; the small LU used by Radau5 in `lu`.
+//! explicit-pair step loop) live in `control`; Radau5's LU is `crate::linalg`'s.
 //!
 //! # Why hand-written
 //!
@@ -48,7 +48,6 @@
 mod control;
 pub mod dop853;
 pub mod dopri5;
-mod lu;
 pub mod radau5;
 pub mod rk4;
 

@@ -44,7 +44,7 @@
 use super::control::{
     all_finite, initial_step, Core, Failure, FAIL_FACTOR, MAX_FACTOR, MIN_FACTOR,
 };
-use super::lu;
+use crate::linalg::{lu_factor, lu_solve, LuError};
 use super::{OdeSystem, Options, StepError};
 use nalgebra::Complex;
 
@@ -252,7 +252,7 @@ impl Radau5 {
     }
 
     /// Factor `μ_r/h I - J` and `μ_c/h I - J`.
-    fn factorize(&mut self, h: f64) -> Result<(), lu::Singular> {
+    fn factorize(&mut self, h: f64) -> Result<(), LuError> {
         let n = self.core.n;
         let (mr, mc) = (self.tab.mu_real / h, self.tab.mu_complex / h);
         for i in 0..n {
@@ -264,8 +264,8 @@ impl Radau5 {
         }
         self.core.stats.nlu += 2;
         self.lu_h = 0.0;
-        lu::factor(&mut self.lu_real, n, &mut self.piv_real)?;
-        lu::factor(&mut self.lu_complex, n, &mut self.piv_complex)?;
+        lu_factor(&mut self.lu_real, n, &mut self.piv_real, 0.0)?;
+        lu_factor(&mut self.lu_complex, n, &mut self.piv_complex, 0.0)?;
         self.lu_h = h;
         Ok(())
     }
@@ -331,8 +331,8 @@ impl Radau5 {
                 self.b_real[i] = fr - mr * w(0);
                 self.b_complex[i] = C64::new(f1, f2) - mc * C64::new(w(1), w(2));
             }
-            lu::solve(&self.lu_real, n, &self.piv_real, &mut self.b_real);
-            lu::solve(&self.lu_complex, n, &self.piv_complex, &mut self.b_complex);
+            lu_solve(&self.lu_real, n, &self.piv_real, &mut self.b_real);
+            lu_solve(&self.lu_complex, n, &self.piv_complex, &mut self.b_complex);
             // dW = (b_real, Re b_complex, Im b_complex); its scaled RMS norm over 3n.
             let mut sum = 0.0;
             for i in 0..n {
@@ -387,7 +387,7 @@ impl Radau5 {
             self.fz[i] = ze;
             self.err[i] = self.core.f[i] + ze;
         }
-        lu::solve(&self.lu_real, n, &self.piv_real, &mut self.err);
+        lu_solve(&self.lu_real, n, &self.piv_real, &mut self.err);
         let mut norm =
             super::control::error_norm(&self.err, &self.core.y, &self.y_new, &self.core.opts);
         if stabilise && norm > 1.0 {
@@ -399,7 +399,7 @@ impl Radau5 {
                 for i in 0..n {
                     self.err[i] += self.fz[i];
                 }
-                lu::solve(&self.lu_real, n, &self.piv_real, &mut self.err);
+                lu_solve(&self.lu_real, n, &self.piv_real, &mut self.err);
                 norm = super::control::error_norm(
                     &self.err,
                     &self.core.y,

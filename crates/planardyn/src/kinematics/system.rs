@@ -24,7 +24,6 @@ pub struct System {
     pub row_scale: Vec<f64>,
     /// Column scale: L for translations, 1 for angles (x = col_scale * x_scaled).
     pub col_scale: Vec<f64>,
-    tmp: Vec<f64>,
     /// Whether the last factorisation succeeded.
     factored: bool,
     /// The chart of the last factorisation.
@@ -38,7 +37,7 @@ impl System {
     pub fn new(mech: &Mechanism) -> Self {
         let n = mech.n_x();
         let col_scale = (0..n).map(|i| if i % 3 == 2 { 1.0 } else { mech.scale }).collect();
-        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, tmp: vec![0.0; n], factored: false, chart: Chart::Inputs, v: vec![0.0; n], w: vec![0.0; n] }
+        System { lu: Lu::new(n), row_scale: vec![1.0; n], col_scale, factored: false, chart: Chart::Inputs, v: vec![0.0; n], w: vec![0.0; n] }
     }
 
     /// Fill `j` (row-major, n x n) with the scaled Jacobian and set the row scales.
@@ -84,8 +83,8 @@ impl System {
             let norm = self.v.iter().map(|x| x * x).sum::<f64>().sqrt();
             self.v.iter_mut().for_each(|x| *x /= norm);
             self.w.copy_from_slice(&self.v);
-            self.lu.solve(&mut self.w, &mut self.tmp);
-            self.lu.solve_transpose(&mut self.w, &mut self.tmp);
+            self.lu.solve(&mut self.w);
+            self.lu.solve_transpose(&mut self.w);
             lambda = self.w.iter().zip(&self.v).map(|(a, b)| a * b).sum::<f64>();
             std::mem::swap(&mut self.v, &mut self.w);
         }
@@ -97,7 +96,7 @@ impl System {
         for (v, s) in b.iter_mut().zip(&self.row_scale) {
             *v *= s;
         }
-        self.lu.solve(b, &mut self.tmp);
+        self.lu.solve(b);
         for (v, s) in b.iter_mut().zip(&self.col_scale) {
             *v *= s;
         }
@@ -108,7 +107,7 @@ impl System {
         for (v, s) in b.iter_mut().zip(&self.col_scale) {
             *v *= s;
         }
-        self.lu.solve_transpose(b, &mut self.tmp);
+        self.lu.solve_transpose(b);
         for (v, s) in b.iter_mut().zip(&self.row_scale) {
             *v *= s;
         }

@@ -1,25 +1,132 @@
-//! LU factorisation with partial pivoting, in place, row-major (Golub & Van Loan, alg. 3.4.1).
+//! LU factorisation with partial pivoting, in place, row-major (Golub & Van Loan,
+//! *Matrix Computations*, alg. 3.4.1), generic over `f64` and `Complex<f64>` so that the
+//! kinematics (real) and Radau5's Newton matrices (real and complex) share one code.
+//! The factors overwrite the matrix (unit lower L below the diagonal, U on and above it);
+//! `piv[k]` is the row swapped with row k at step k (LAPACK's convention).
 
-/// A zero pivot: the matrix is singular to working precision.
+use nalgebra::Complex;
+use std::ops::{Div, Mul, Sub, SubAssign};
+
+/// The scalars the LU works with.
+pub trait Scalar: Copy + PartialEq + Mul<Output = Self> + Div<Output = Self> + Sub<Output = Self> + SubAssign {
+    const ZERO: Self;
+    /// Magnitude used to choose the pivot (the modulus for complex numbers).
+    fn magnitude(self) -> f64;
+}
+
+impl Scalar for f64 {
+    const ZERO: f64 = 0.0;
+    fn magnitude(self) -> f64 {
+        self.abs()
+    }
+}
+
+impl Scalar for Complex<f64> {
+    const ZERO: Complex<f64> = Complex { re: 0.0, im: 0.0 };
+    fn magnitude(self) -> f64 {
+        self.re.hypot(self.im)
+    }
+}
+
+/// No pivot above the threshold: the matrix is singular to working precision.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LuError {
     /// Elimination step at which no usable pivot was found.
     pub column: usize,
 }
 
-/// The factors `P A = L U` of an n x n matrix, stored in one row-major buffer
-/// (unit lower L below the diagonal, U on and above it) with the row permutation.
+/// Factor the row-major n x n matrix `a` in place. A pivot of magnitude `<= tiny` (or not
+/// finite) makes the matrix singular.
+pub fn lu_factor<T: Scalar>(a: &mut [T], n: usize, piv: &mut [usize], tiny: f64) -> Result<(), LuError> {
+    for k in 0..n {
+        let (mut p, mut best) = (k, a[k * n + k].magnitude());
+        for i in k + 1..n {
+            let v = a[i * n + k].magnitude();
+            if v > best {
+                (p, best) = (i, v);
+            }
+        }
+        if !(best > tiny && best.is_finite()) {
+            return Err(LuError { column: k });
+        }
+        piv[k] = p;
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+        }
+        let pivot = a[k * n + k];
+        // Row slices so that the update loop vectorises; kinematic Jacobians are sparse, so
+        // most multipliers are zero and skipped.
+        let (top, rest) = a.split_at_mut((k + 1) * n);
+        let pivot_row = &top[k * n + k + 1..(k + 1) * n];
+        for row in rest.chunks_exact_mut(n) {
+            let l = row[k] / pivot;
+            row[k] = l;
+            if l != T::ZERO {
+                for (v, &u) in row[k + 1..].iter_mut().zip(pivot_row) {
+                    *v -= l * u;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solve A x = b in place (`b` becomes `x`) with the factors from [`lu_factor`].
+pub fn lu_solve<T: Scalar>(lu: &[T], n: usize, piv: &[usize], b: &mut [T]) {
+    for k in 0..n {
+        b.swap(k, piv[k]);
+    }
+    for i in 1..n {
+        let mut s = b[i];
+        for (l, &x) in lu[i * n..i * n + i].iter().zip(&b[..i]) {
+            s -= *l * x;
+        }
+        b[i] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for (u, &x) in lu[i * n + i + 1..(i + 1) * n].iter().zip(&b[i + 1..n]) {
+            s -= *u * x;
+        }
+        b[i] = s / lu[i * n + i];
+    }
+}
+
+/// Solve A^T x = b in place with the factors from [`lu_factor`] (real matrices).
+pub fn lu_solve_transpose(lu: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
+    // U^T y = b, then L^T z = y, then undo the row swaps in reverse order.
+    for i in 0..n {
+        let mut s = b[i];
+        for j in 0..i {
+            s -= lu[j * n + i] * b[j];
+        }
+        b[i] = s / lu[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for j in i + 1..n {
+            s -= lu[j * n + i] * b[j];
+        }
+        b[i] = s;
+    }
+    for k in (0..n).rev() {
+        b.swap(k, piv[k]);
+    }
+}
+
+/// A real n x n matrix and its factors, in buffers sized once.
 #[derive(Debug, Clone)]
 pub struct Lu {
     n: usize,
     lu: Vec<f64>,
-    perm: Vec<usize>,
+    piv: Vec<usize>,
 }
 
 impl Lu {
-    /// Buffers for n x n matrices.
     pub fn new(n: usize) -> Self {
-        Lu { n, lu: vec![0.0; n * n], perm: (0..n).collect() }
+        Lu { n, lu: vec![0.0; n * n], piv: vec![0; n] }
     }
     pub fn dim(&self) -> usize {
         self.n
@@ -28,90 +135,17 @@ impl Lu {
     pub fn matrix_mut(&mut self) -> &mut [f64] {
         &mut self.lu
     }
-    /// Factorise the matrix in the buffer in place. `tiny` is the absolute pivot size below
-    /// which the matrix counts as singular.
+    /// Factorise the matrix in the buffer in place (see [`lu_factor`]).
     pub fn factor(&mut self, tiny: f64) -> Result<(), LuError> {
-        let n = self.n;
-        let a = &mut self.lu;
-        for (i, p) in self.perm.iter_mut().enumerate() {
-            *p = i;
-        }
-        for k in 0..n {
-            let mut piv = k;
-            let mut best = a[k * n + k].abs();
-            for i in k + 1..n {
-                let v = a[i * n + k].abs();
-                if v > best {
-                    best = v;
-                    piv = i;
-                }
-            }
-            if !(best > tiny) {
-                return Err(LuError { column: k });
-            }
-            if piv != k {
-                for j in 0..n {
-                    a.swap(k * n + j, piv * n + j);
-                }
-                self.perm.swap(k, piv);
-            }
-            let inv = 1.0 / a[k * n + k];
-            // Row slices so that the update loop vectorises; J is sparse, so most
-            // multipliers are zero and skipped.
-            let (top, rest) = a.split_at_mut((k + 1) * n);
-            let pivot_row = &top[k * n + k + 1..(k + 1) * n];
-            for row in rest.chunks_exact_mut(n) {
-                let l = row[k] * inv;
-                row[k] = l;
-                if l != 0.0 {
-                    for (v, p) in row[k + 1..].iter_mut().zip(pivot_row) {
-                        *v -= l * p;
-                    }
-                }
-            }
-        }
-        Ok(())
+        lu_factor(&mut self.lu, self.n, &mut self.piv, tiny)
     }
-    /// Solve `A x = b` in place (`b` becomes `x`); `tmp` has length n.
-    pub fn solve(&self, b: &mut [f64], tmp: &mut [f64]) {
-        let n = self.n;
-        let a = &self.lu;
-        for i in 0..n {
-            tmp[i] = b[self.perm[i]];
-        }
-        for i in 0..n {
-            let row = &a[i * n..i * n + i];
-            tmp[i] -= row.iter().zip(&tmp[..i]).map(|(l, t)| l * t).sum::<f64>();
-        }
-        for i in (0..n).rev() {
-            let row = &a[i * n + i + 1..(i + 1) * n];
-            let s = tmp[i] - row.iter().zip(&tmp[i + 1..n]).map(|(u, t)| u * t).sum::<f64>();
-            tmp[i] = s / a[i * n + i];
-        }
-        b[..n].copy_from_slice(&tmp[..n]);
+    /// Solve A x = b in place.
+    pub fn solve(&self, b: &mut [f64]) {
+        lu_solve(&self.lu, self.n, &self.piv, b)
     }
-    /// Solve `A^T x = b` in place; `tmp` has length n.
-    pub fn solve_transpose(&self, b: &mut [f64], tmp: &mut [f64]) {
-        let n = self.n;
-        let a = &self.lu;
-        // U^T y = b, then L^T z = y, then x = P^T z.
-        for i in 0..n {
-            let mut s = b[i];
-            for j in 0..i {
-                s -= a[j * n + i] * tmp[j];
-            }
-            tmp[i] = s / a[i * n + i];
-        }
-        for i in (0..n).rev() {
-            let mut s = tmp[i];
-            for j in i + 1..n {
-                s -= a[j * n + i] * tmp[j];
-            }
-            tmp[i] = s;
-        }
-        for i in 0..n {
-            b[self.perm[i]] = tmp[i];
-        }
+    /// Solve A^T x = b in place.
+    pub fn solve_transpose(&self, b: &mut [f64]) {
+        lu_solve_transpose(&self.lu, self.n, &self.piv, b)
     }
 }
 
@@ -127,14 +161,29 @@ mod tests {
         let mut lu = Lu::new(3);
         lu.matrix_mut().copy_from_slice(&a);
         lu.factor(1e-300).unwrap();
-        let mut tmp = [0.0; 3];
         let mut b: Vec<f64> = (0..3).map(|i| (0..3).map(|j| a[i * 3 + j] * x[j]).sum()).collect();
-        lu.solve(&mut b, &mut tmp);
+        lu.solve(&mut b);
         let mut bt: Vec<f64> = (0..3).map(|i| (0..3).map(|j| a[j * 3 + i] * x[j]).sum()).collect();
-        lu.solve_transpose(&mut bt, &mut tmp);
+        lu.solve_transpose(&mut bt);
         for i in 0..3 {
             assert!((b[i] - x[i]).abs() < 1e-14, "solve: {b:?}");
             assert!((bt[i] - x[i]).abs() < 1e-14, "solve_transpose: {bt:?}");
+        }
+    }
+
+    #[test]
+    fn complex_solve_matches_known_solution() {
+        let c = |re, im| Complex::new(re, im);
+        // A = [[i, 1], [2, 1 - i]], x = (1 + i, -1) -> b = A x.
+        let a0 = [c(0.0, 1.0), c(1.0, 0.0), c(2.0, 0.0), c(1.0, -1.0)];
+        let x = [c(1.0, 1.0), c(-1.0, 0.0)];
+        let mut b = [a0[0] * x[0] + a0[1] * x[1], a0[2] * x[0] + a0[3] * x[1]];
+        let mut a = a0;
+        let mut piv = [0; 2];
+        lu_factor(&mut a, 2, &mut piv, 0.0).unwrap();
+        lu_solve(&a, 2, &piv, &mut b);
+        for i in 0..2 {
+            assert!((b[i] - x[i]).norm() < 1e-14);
         }
     }
 

@@ -11,4 +11,4 @@ mod cholesky;
 mod lu;
 
 pub use cholesky::{cholesky_in_place, cholesky_solve};
-pub use lu::{Lu, LuError};
+pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
