@@ -20,11 +20,9 @@ import argparse
 import dataclasses
 import importlib
 import json
-import math
 import os
 import platform
 import re
-import statistics
 import subprocess
 import sys
 import time
@@ -36,20 +34,18 @@ sys.path.insert(0, str(HERE))
 import numpy as np  # noqa: E402
 
 import common  # noqa: E402
+import overhead as overhead_mod  # noqa: E402
 import report  # noqa: E402
 from common import Run  # noqa: E402
 
 PEERS = ["planardyn_fourbar", "mujoco_fourbar", "pinocchio_fourbar", "exudyn_fourbar"]
 RESULTS = HERE / "results"
-RUST_SIM = Path(os.environ.get("RUST_SIM", HERE / ".target" / "release" / "planardyn-rust-sim"))
 
 #: Criterion targets of issue 6 for one forward-dynamics evaluation (s).
 FD_TARGETS = {"four-bar-gravity": 1e-6, "3-rrr": 2e-6, "andrews-squeezer": 3e-6}
 #: The error (rad) at which the tools are also compared: the crank angle within 1e-4 rad of
 #: the reference over the whole 10 s.
 ERROR_TARGET = 1e-4
-#: Python simulate may be at most this much slower than the same run from Rust.
-OVERHEAD_TARGET = 0.10
 
 
 def say(msg: str) -> None:
@@ -117,44 +113,13 @@ def criterion(quick: bool) -> dict:
     return {"ok": True, "command": " ".join(cmd), "seconds": time.perf_counter() - t0, "results": res}
 
 
-def python_overhead(setting: tuple, repeats: int) -> dict:
-    """Median wall time of one simulate from Python and of the same run from Rust
-    (benchmarks/rust-sim), alternated so that both see the same machine load."""
-    from peers import planardyn_fourbar as P
-
-    method, rtol, dt = setting
-    if not RUST_SIM.exists():
-        return {"ok": False, "why": f"{RUST_SIM} is not built (run.sh builds it with cargo)"}
-    mech = P.mechanism()
-    opts = P.options(method, rtol, dt)
-    out = {"ok": True, "setting": f"{method} {P.label(method, rtol, dt)}", "cases": {}}
-    for case, output_dt in (("0.1 s outputs", common.GRID_DT), ("every step", None)):
-        args = [str(RUST_SIM), str(common.MODEL), method, repr(rtol or 1e-8), repr(rtol or 1e-10),
-                "-" if dt is None else repr(dt), repr(common.T_END), "-" if output_dt is None else repr(output_dt)]
-        kw = dict(opts, output_dt=output_dt) if output_dt else opts
-        py, rs = [], []
-        for _ in range(repeats):
-            # Best of 3 on each side (the Rust binary does its 3 in one process), alternated.
-            best = math.inf
-            for _ in range(3):
-                t0 = time.perf_counter()
-                res = mech.simulate(common.T_END, **kw)
-                best = min(best, time.perf_counter() - t0)
-            py.append(best)
-            p = subprocess.run(args + ["3"], capture_output=True, text=True)
-            if p.returncode != 0:
-                return {"ok": False, "why": f"{' '.join(args)} failed: {p.stderr[-500:]}"}
-            rs.append(json.loads(p.stdout)["best_s"])
-        rust = json.loads(p.stdout)
-        same = rust["naccept"] == res.stats["naccept"] and rust["nfev"] == res.stats["nfev"]
-        py_med, rs_med = statistics.median(py), statistics.median(rs)
-        out["cases"][case] = {
-            "python_s": py_med, "rust_s": rs_med, "overhead": py_med / rs_med - 1.0,
-            "meets": py_med / rs_med - 1.0 <= OVERHEAD_TARGET, "same_steps": same,
-            "steps_python": int(res.stats["naccept"]), "steps_rust": rust["naccept"],
-            "outputs": len(res.t),
-        }
-    return out
+def python_overhead(setting: tuple) -> dict:
+    """overhead.py in a fresh Python process (only planardyn loaded: no peer's threads)."""
+    p = subprocess.run([sys.executable, str(HERE / "overhead.py"), json.dumps(list(setting))],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        return {"ok": False, "why": f"overhead.py failed: {p.stderr[-1000:]}"}
+    return json.loads(p.stdout)
 
 
 def main() -> int:
@@ -205,7 +170,7 @@ def main() -> int:
                                           for t in peers if by_error[t]}
 
     say("Python overhead: simulate from Python against the same run from Rust")
-    overhead = (python_overhead(tuple(pd_tight.extra["setting"]), 15) if pd_tight
+    overhead = (python_overhead(tuple(pd_tight.extra["setting"])) if pd_tight
                 else {"ok": False, "why": "no planardyn setting met 1e-6 J"})
     crit = {"ok": False, "error": "skipped (--no-criterion)"} if a.no_criterion else criterion(a.quick)
 
@@ -217,7 +182,7 @@ def main() -> int:
               "t_end_s": common.T_END, "targets": {"peer_drift_J": common.PEER_DRIFT_TARGET,
               "peer_gap_m": common.PEER_GAP_TARGET, "planardyn_drift_J": common.PLANARDYN_DRIFT_TARGET,
               "error_rad": ERROR_TARGET,
-              "forward_dynamics_s": FD_TARGETS, "python_overhead": OVERHEAD_TARGET},
+              "forward_dynamics_s": FD_TARGETS, "python_overhead": overhead_mod.OVERHEAD_TARGET},
               "reference_theta1_end": float(ref[-1]), "runs": [dataclasses.asdict(r) for r in runs],
               "summary": summary, "python_overhead": overhead, "criterion": crit,
               "bench_seconds": time.perf_counter() - t_start}

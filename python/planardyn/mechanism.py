@@ -412,12 +412,24 @@ class Mechanism:
             progress=progress,
             max_steps=max_steps,
         )
-        return SimulationResult.from_raw(
+        result = SimulationResult.from_raw(
             raw,
             coordinate_names=self.coordinate_names,
             coordinate_kinds=self.coordinate_kinds,
             body_names=self.body_names,
         )
+        # The result carries its model and settings, so it can be saved, re-plotted and rerun.
+        from .results_io import attach_metadata
+
+        settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
+                        t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
+                        drives="callable" if callable(drives) else drives)
+        return attach_metadata(result, self, settings)
+
+    def _repr_html_(self) -> str:
+        from .notebook import mechanism_html
+
+        return mechanism_html(self)
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:
