@@ -126,7 +126,7 @@ def plot(res: dict, path: Path) -> None:
             series.setdefault((r["tool"], r["method"]), []).append(r)
     marker_of: dict[str, int] = {}
     for (tool, method), rs in series.items():
-        rs = sorted(rs, key=lambda r: r["wall"])
+        # In sweep order (step or tolerance shrinking): timing noise shows as a kink, not a reordering.
         k = marker_of.setdefault(tool, 0)
         marker_of[tool] = k + 1
         style = dict(color=COLORS.get(tool, "gray"), marker=MARKERS[k % len(MARKERS)], ms=6,

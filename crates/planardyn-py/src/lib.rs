@@ -8,6 +8,7 @@ mod convert;
 mod errors;
 mod mechanism;
 mod simulate;
+mod structure;
 
 use errors::{model_error, PlanardynError};
 use mechanism::PyMechanism;
@@ -54,5 +55,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;
     errors::register(m)?;
+    structure::register(m)?;
     Ok(())
 }

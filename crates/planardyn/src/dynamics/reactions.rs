@@ -23,7 +23,9 @@ pub fn reactions(mech: &Mechanism, ws: &mut Workspace) -> Vec<[f64; 3]> {
         .iter()
         .enumerate()
         .map(|(k, pair)| {
-            let mu = [lambda[2 * k], lambda[2 * k + 1]];
+            // A redundant row left out of F carries no multiplier: the split of the load
+            // between redundant pairs is statically indeterminate.
+            let mu = [mech.row_slot[2 * k], mech.row_slot[2 * k + 1]].map(|s| s.map_or(0.0, |i| lambda[i]));
             match pair.kind {
                 // Phi = p_a - p_b: the multiplier is the force on a, so -mu acts on b.
                 PairKind::Revolute => [-mu[0], -mu[1], 0.0],

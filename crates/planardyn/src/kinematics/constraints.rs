@@ -181,20 +181,28 @@ fn angle(link: Link, x: &[f64]) -> f64 {
     }
 }
 
-fn pair_jacobian(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut [f64], ncols: usize, row: usize) {
+fn pair_jacobian(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut [f64], ncols: usize, rows: [Option<usize>; 2]) {
     let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
     match pair.kind {
         PairKind::Revolute => {
             let (ta, tb) = (perp(a.rot(pair.sa)), perp(b.rot(pair.sb)));
-            add_grad(j, ncols, row, &a, [1.0, 0.0, ta[0]]);
-            add_grad(j, ncols, row + 1, &a, [0.0, 1.0, ta[1]]);
-            add_grad(j, ncols, row, &b, [-1.0, 0.0, -tb[0]]);
-            add_grad(j, ncols, row + 1, &b, [0.0, -1.0, -tb[1]]);
+            if let Some(row) = rows[0] {
+                add_grad(j, ncols, row, &a, [1.0, 0.0, ta[0]]);
+                add_grad(j, ncols, row, &b, [-1.0, 0.0, -tb[0]]);
+            }
+            if let Some(row) = rows[1] {
+                add_grad(j, ncols, row, &a, [0.0, 1.0, ta[1]]);
+                add_grad(j, ncols, row, &b, [0.0, -1.0, -tb[1]]);
+            }
         }
         PairKind::Prismatic { axis } => {
-            add_grad(j, ncols, row, &a, [0.0, 0.0, -1.0]);
-            add_grad(j, ncols, row, &b, [0.0, 0.0, 1.0]);
-            Projection::new(pair, perp(axis), a, b).grad(j, ncols, row + 1);
+            if let Some(row) = rows[0] {
+                add_grad(j, ncols, row, &a, [0.0, 0.0, -1.0]);
+                add_grad(j, ncols, row, &b, [0.0, 0.0, 1.0]);
+            }
+            if let Some(row) = rows[1] {
+                Projection::new(pair, perp(axis), a, b).grad(j, ncols, row);
+            }
         }
     }
 }
@@ -273,13 +281,27 @@ pub fn coordinate_rates(mech: &Mechanism, x: &[f64], xd: &[f64], qd: &mut [f64])
     }
 }
 
-/// F(x) for a chart with target values z.
+/// Where the two rows of pair k go in F (None: a redundant row, left out).
+#[inline]
+fn slots(row_slot: &[Option<usize>], k: usize) -> [Option<usize>; 2] {
+    [row_slot[2 * k], row_slot[2 * k + 1]]
+}
+
+/// Write a pair's two row values to their slots.
+#[inline]
+fn put(out: &mut [f64], s: [Option<usize>; 2], v: [f64; 2]) {
+    for (slot, value) in s.into_iter().zip(v) {
+        if let Some(i) = slot {
+            out[i] = value;
+        }
+    }
+}
+
+/// F(x) for a chart with target values z: the independent pair rows, then the chart rows.
 pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], z: &[f64], out: &mut [f64]) {
-    let nc = 2 * mech.pairs.len();
+    let nc = mech.n_constraints;
     for (k, pair) in mech.pairs.iter().enumerate() {
-        let r = pair_residual(pair, x, trig);
-        out[2 * k] = r[0];
-        out[2 * k + 1] = r[1];
+        put(out, slots(&mech.row_slot, k), pair_residual(pair, x, trig));
     }
     match chart {
         Chart::Inputs => coordinates(mech, x, &mut out[nc..]),
@@ -297,8 +319,8 @@ pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], z
 /// J = dF/dx for a chart, written (overwritten) into the row-major 3n x 3n buffer `j`.
 pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j: &mut [f64]) {
     let ncols = x.len();
-    constraint_jacobian(mech, x, trig, j);
-    let nc = 2 * mech.pairs.len();
+    constraint_jacobian(mech, x, trig, &mech.row_slot, j);
+    let nc = mech.n_constraints;
     match chart {
         Chart::Inputs => {
             for (k, c) in mech.coordinates.iter().enumerate() {
@@ -313,22 +335,21 @@ pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j
     }
 }
 
-/// The pair-constraint rows Phi_x (2p x 3n, row-major); the rest of `j` is zeroed.
-pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], j: &mut [f64]) {
+/// The pair-constraint rows Phi_x (row-major, 3n columns) placed by `row_slot` (the
+/// mechanism's independent rows, or `0..2p` for all of them); the rest of `j` is zeroed.
+pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], row_slot: &[Option<usize>], j: &mut [f64]) {
     let ncols = x.len();
     j.fill(0.0);
     for (k, pair) in mech.pairs.iter().enumerate() {
-        pair_jacobian(pair, x, trig, j, ncols, 2 * k);
+        pair_jacobian(pair, x, trig, j, ncols, slots(row_slot, k));
     }
 }
 
 /// gamma(u, v) = d2F/dx2 [u, v] for every row (the chart rows of a partition are linear).
 pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], out: &mut [f64]) {
-    let nc = 2 * mech.pairs.len();
+    let nc = mech.n_constraints;
     for (k, pair) in mech.pairs.iter().enumerate() {
-        let g = pair_gamma(pair, x, trig, u, v);
-        out[2 * k] = g[0];
-        out[2 * k + 1] = g[1];
+        put(out, slots(&mech.row_slot, k), pair_gamma(pair, x, trig, u, v));
     }
     for (k, o) in out[nc..].iter_mut().enumerate() {
         *o = match chart {

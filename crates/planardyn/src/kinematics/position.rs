@@ -116,12 +116,13 @@ const MIN_CONTINUATION_STEP: f64 = 1e-6;
 /// Newton correction after a first-order predictor is then O(0.01) (scaled), far inside the
 /// basin of the branch being followed.
 const MAX_CONTINUATION_MOVE: f64 = 0.1;
-/// A Newton correction larger than this (scaled) means the solve left the branch: the step
-/// is refused and cut.
-const MAX_CORRECTION: f64 = 0.05;
+/// A Newton correction larger than this (scaled: lengths / L, angles in rad) means the solve
+/// may have left the branch it started on (another assembly mode is O(1) away): the step is
+/// refused and cut, by continuation here and by the integrator in a simulation.
+pub const MAX_CORRECTION: f64 = 0.1;
 
 /// Largest scaled difference between two body-coordinate vectors.
-fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {
+pub fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {
     a.iter().zip(b).zip(col_scale).fold(0.0, |m: f64, ((x, y), s)| m.max((x - y).abs() / s))
 }
 

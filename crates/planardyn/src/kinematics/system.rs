@@ -7,7 +7,7 @@
 
 use super::constraints::{jacobian, Chart};
 use crate::linalg::Lu;
-use crate::model::{CoordinateKind, Mechanism, PairKind};
+use crate::model::{CoordinateKind, Mechanism, Pair, PairKind};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
@@ -125,18 +125,25 @@ fn fill_scaled(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], rs
     }
 }
 
+/// Scales of a pair's two rows: 1/L (`inv`) for lengths, 1 for a prismatic pair's angle row.
+pub fn pair_row_scales(pair: &Pair, inv: f64) -> [f64; 2] {
+    match pair.kind {
+        PairKind::Revolute => [inv, inv],
+        PairKind::Prismatic { .. } => [1.0, inv],
+    }
+}
+
 /// 1/L for rows measured in metres, 1 for rows measured in radians.
 pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
     let inv = 1.0 / mech.scale;
     for (k, pair) in mech.pairs.iter().enumerate() {
-        let first = match pair.kind {
-            PairKind::Revolute => inv,
-            PairKind::Prismatic { .. } => 1.0,
-        };
-        rs[2 * k] = first;
-        rs[2 * k + 1] = inv;
+        for (slot, scale) in [mech.row_slot[2 * k], mech.row_slot[2 * k + 1]].into_iter().zip(pair_row_scales(pair, inv)) {
+            if let Some(i) = slot {
+                rs[i] = scale;
+            }
+        }
     }
-    let nc = 2 * mech.pairs.len();
+    let nc = mech.n_constraints;
     for (k, r) in rs[nc..].iter_mut().enumerate() {
         let angle = match chart {
             Chart::Inputs => mech.coordinates[k].kind == CoordinateKind::Angle,

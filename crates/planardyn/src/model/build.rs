@@ -104,6 +104,9 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         simulate: SimulateDefaults::default(),
         x0: Vec::new(),
         scale: 1.0,
+        row_slot: (0..2 * spec.pairs.len()).map(Some).collect(),
+        n_constraints: 2 * spec.pairs.len(),
+        warnings: Vec::new(),
     };
     mech.x0 = mech.bodies.iter().flat_map(|b| [b.com0[0], b.com0[1], b.angle0]).collect();
     mech.scale = characteristic_length(&mech.points);
@@ -123,7 +126,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         .map(|(k, l)| build_load(&ctx, &mech, k, l))
         .collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
-    check_mobility(&ctx, &mech)?;
+    check_mobility(&ctx, &mut mech)?;
     check_assembly(&ctx, &mech)?;
     Ok(mech)
 }
@@ -448,33 +451,49 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
     })
 }
 
-/// Chebyshev-Grubler count 3n - 2p against the number of coordinates, then the rank of the
-/// constraint Jacobian in the drawing (dependent constraints make the count misleading).
-fn check_mobility(ctx: &Ctx, mech: &Mechanism) -> R<()> {
+/// The mobility, 3n minus the rank of the pair constraints in the drawing, must equal the
+/// number of coordinates; the Chebyshev-Grubler count 3n - 2p explains a mismatch.
+/// Redundant constraints (rank < 2p with the right mobility, as in a parallelogram) are
+/// left out of the position equations and reported in `warnings`.
+fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     let (n, p, m) = (mech.n_bodies() as i64, mech.pairs.len() as i64, mech.dof() as i64);
     if m == 0 {
         return Err(ctx.err("coordinates", "no generalized coordinates: name at least one input pair"));
     }
-    let mobility = 3 * n - 2 * p;
+    let cr = constraint_rank(mech, &mech.x0);
+    let (grubler, mobility) = (3 * n - 2 * p, 3 * n - cr.rank as i64);
     if mobility != m {
-        return Err(ctx.err(
-            "coordinates",
+        let message = if mobility == grubler {
             format!(
                 "the mechanism has mobility 3n - 2p = 3*{n} - 2*{p} = {mobility} but {m} coordinate(s) are given; \
                  give exactly {mobility} coordinate(s), or check the pairs (each revolute or prismatic pair removes 2 freedoms)"
-            ),
-        ));
-    }
-    let (rank, rows) = constraint_rank(mech);
-    if rank < rows {
-        return Err(ctx.err(
-            "pairs",
+            )
+        } else {
             format!(
-                "the {rows} pair constraints have rank {rank} in the drawing: some constraints are redundant \
-                 (e.g. a parallelogram) or the drawing is at a singular (folded) configuration; \
-                 draw the mechanism away from singular positions"
-            ),
-        ));
+                "the {} pair constraints have rank {} in the drawing, so it has mobility 3n - rank = {mobility} \
+                 (Chebyshev-Grubler: 3n - 2p = {grubler}), but {m} coordinate(s) are given: the drawing is at a \
+                 singular (folded) configuration, or has redundant constraints; draw it away from singular positions",
+                2 * p,
+                cr.rank
+            )
+        };
+        return Err(ctx.err("coordinates", message));
+    }
+    if cr.rank < 2 * p as usize {
+        mech.row_slot = vec![None; 2 * p as usize];
+        for (slot, &row) in cr.independent.iter().enumerate() {
+            mech.row_slot[row] = Some(slot);
+        }
+        mech.n_constraints = cr.rank;
+        for pairs in &cr.dependencies {
+            let names: Vec<&str> = pairs.iter().map(|&k| mech.pairs[k].name.as_str()).collect();
+            mech.warnings.push(format!(
+                "redundant constraints among pairs {}: one of their constraint equations is implied by the others \
+                 and left out (Chebyshev-Grubler counts {grubler} degree(s) of freedom, the rank shows {mobility}); \
+                 the reactions shared by these pairs are statically indeterminate",
+                names.join(", ")
+            ));
+        }
     }
     Ok(())
 }

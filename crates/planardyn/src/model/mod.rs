@@ -192,6 +192,14 @@ pub struct Mechanism {
     /// Characteristic length (m): the largest distance between two points; it scales
     /// tolerances and makes the singularity measure dimensionless.
     pub scale: f64,
+    /// Where each of the 2p pair-constraint rows goes in the position equations F; `None`
+    /// for a redundant row (implied by the others, e.g. in a parallelogram), left out so
+    /// that J stays square.
+    pub row_slot: Vec<Option<usize>>,
+    /// Number of independent pair constraints kept: 3n - m.
+    pub n_constraints: usize,
+    /// Things a user should know about the model (redundant constraints...).
+    pub warnings: Vec<String>,
 }
 
 impl Mechanism {

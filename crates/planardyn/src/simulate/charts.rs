@@ -13,6 +13,8 @@ pub const SWITCH_TO_PARTITION: f64 = 0.05;
 pub const SWITCH_TO_INPUTS: f64 = 0.1;
 /// Below this scaled measure the passive mechanism is singular: the simulation stops.
 pub const PASSIVE_SINGULAR: f64 = 1e-8;
+/// A failed step this close to a passive singularity is reported as one.
+pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]

@@ -10,11 +10,11 @@ pub use trajectory::{SimStats, Status, Trajectory};
 
 use crate::dynamics::Drives;
 use crate::integrate::{Method, Options, StepError, Stepper};
-use crate::kinematics::{assemble_into, velocity_analogues, Chart};
+use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Chart};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
-use charts::{measure, next_chart, state_in, PASSIVE_SINGULAR};
+use charts::{measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
 use ode::MechanismOde;
 
 /// What to simulate and how. Times in s.
@@ -219,6 +219,18 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
         }
     }
     traj.stats.integrator = stepper.stats();
+    if matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
+        // Steps that shrink to nothing usually mean the passive mechanism is at a change
+        // point (a parallelogram folding flat): say so when it is.
+        let passive = passive_sigma_min(mech, ode.anchor_x());
+        if passive < NEAR_PASSIVE_SINGULAR {
+            status = Status::PassiveSingularity;
+            message = format!(
+                "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
+                 a change point where its motion is not determined"
+            );
+        }
+    }
     if status == Status::Success {
         message = format!("reached t_end = {} s", settings.t_end);
     }

@@ -5,10 +5,10 @@
 use crate::dynamics::{forward, Drives};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::Chart;
+use crate::kinematics::{scaled_distance, Chart, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
-use crate::Error;
+use crate::{Error, KinematicsError};
 
 /// A mechanism in one chart, with the state the Newton predictor starts from.
 pub struct MechanismOde<'a> {
@@ -24,6 +24,8 @@ pub struct MechanismOde<'a> {
     last_y: Vec<f64>,
     /// Whether `ws` holds a successful evaluation at `last_y` (in the current chart).
     base_valid: bool,
+    /// (3n) the Newton start of the current evaluation.
+    predicted: Vec<f64>,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -37,6 +39,7 @@ impl<'a> MechanismOde<'a> {
             last_t: f64::NAN,
             last_y: vec![f64::NAN; 2 * m + 1],
             base_valid: false,
+            predicted: vec![0.0; ws.x.len()],
             mech,
             ws,
             drives,
@@ -45,6 +48,11 @@ impl<'a> MechanismOde<'a> {
 
     pub fn m(&self) -> usize {
         self.mech.dof()
+    }
+
+    /// Body coordinates at the last accepted point.
+    pub fn anchor_x(&self) -> &[f64] {
+        &self.anchor_x
     }
 
     /// Make (t, y) the Newton predictor's anchor, evaluating there unless `ws` already holds
@@ -104,13 +112,20 @@ impl<'a> MechanismOde<'a> {
         }
     }
 
-    /// Forward dynamics at (t, y).
+    /// Forward dynamics at (t, y). A large Newton correction from the prediction fails the
+    /// evaluation (the integrator then takes a shorter step), so a long step cannot carry
+    /// the mechanism onto another assembly branch.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let m = self.m();
         self.predict(&y[..m]);
+        self.predicted.copy_from_slice(&self.ws.x);
         self.last_t = f64::NAN;
         self.base_valid = false;
         forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws)?;
+        let correction = scaled_distance(&self.ws.x, &self.predicted, &self.ws.sys.col_scale);
+        if correction > MAX_CORRECTION {
+            return Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
+        }
         self.base_valid = true;
         self.last_t = t;
         self.last_y.copy_from_slice(y);

@@ -1,0 +1,817 @@
+"""A library of planar linkages and parallel robots, each a parametrised constructor.
+
+Every mechanism comes as a pair of functions: ``<name>_model(...)`` builds the model dict
+(the model-file schema, docs/model-format.md) and ``<name>(...)`` validates it into a
+:class:`~planardyn.Mechanism` (``planardyn.from_dict``). The shipped files
+``examples/models/library/<name>.yaml`` are these dicts at their defaults, written by
+:func:`write_model` (regenerate them all with ``python -m planardyn.library``).
+
+Conventions shared by every constructor:
+
+- Units SI: lengths in m, angles in rad (counter-clockwise from the x axis), masses in kg.
+- Links are uniform slender bars of ``rho`` kg per metre (mass rho L, inertia m L^2 / 12)
+  unless said otherwise; a link with three or more pins (a ternary link, a platform) is
+  the triangle (polygon) of uniform bars along its sides, each of rho kg per metre.
+- The drawing is computed from the inputs (or, for the 3-DOF robots, from the platform
+  pose) by circle (or line-circle) intersections; where two solutions exist an argument
+  ``mode`` (+1 or -1) chooses one: +1 puts the new point on the **left** of the directed
+  line from the first known centre to the second (counter-clockwise side), -1 on the right.
+  Each constructor says which line that is. ``ValueError`` if the chosen geometry cannot be
+  assembled (the circles do not meet).
+- ``gravity`` (m/s^2), default [0, -9.81]: the mechanisms hang in a vertical plane.
+- Coordinates are the input pairs' relative angles (rad) or displacements (m), with the
+  drawn value of the physical quantity (a crank's absolute angle, a slider's position along
+  its rail from the rail's origin, a leg's pin-to-pin length) as ``value``.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import os
+import re
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from .mechanism import Mechanism, from_dict, load
+
+Vec = tuple[float, float]
+GRAVITY: Vec = (0.0, -9.81)
+#: Default mass per unit length of the bars (kg/m).
+RHO = 1.0
+
+__all__ = [
+    "LIBRARY",
+    "andrews_squeezer",
+    "biglide",
+    "biglide_model",
+    "circle_intersection",
+    "double_parallelogram",
+    "double_parallelogram_model",
+    "five_bar",
+    "five_bar_model",
+    "four_bar",
+    "four_bar_model",
+    "grashof",
+    "model_text",
+    "slider_crank",
+    "slider_crank_model",
+    "slider_crank_slider_driven",
+    "slider_crank_slider_driven_model",
+    "stephenson_six_bar",
+    "stephenson_six_bar_model",
+    "three_prr",
+    "three_prr_model",
+    "three_rpr",
+    "three_rpr_model",
+    "three_rrr",
+    "three_rrr_model",
+    "watt_six_bar",
+    "watt_six_bar_model",
+    "write_all",
+    "write_model",
+]
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+def _add(p: Vec, q: Vec) -> Vec:
+    return (p[0] + q[0], p[1] + q[1])
+
+
+def _sub(p: Vec, q: Vec) -> Vec:
+    return (p[0] - q[0], p[1] - q[1])
+
+
+def _polar(r: float, angle: float) -> Vec:
+    return (r * math.cos(angle), r * math.sin(angle))
+
+
+def _dist(p: Vec, q: Vec) -> float:
+    return math.hypot(q[0] - p[0], q[1] - p[1])
+
+
+def _angle(p: Vec, q: Vec) -> float:
+    return math.atan2(q[1] - p[1], q[0] - p[0])
+
+
+def _rotate(v: Vec, angle: float) -> Vec:
+    c, s = math.cos(angle), math.sin(angle)
+    return (c * v[0] - s * v[1], s * v[0] + c * v[1])
+
+
+def _unit(v: Vec) -> Vec:
+    n = math.hypot(*v)
+    if n == 0.0:
+        raise ValueError("a direction of zero length")
+    return (v[0] / n, v[1] / n)
+
+
+def circle_intersection(c1: Sequence[float], r1: float, c2: Sequence[float], r2: float, mode: int) -> Vec:
+    """The point at distance r1 from c1 and r2 from c2 (m), on the left of c1 -> c2 for
+    ``mode=+1``, on the right for ``mode=-1``. ``ValueError`` when the circles do not meet."""
+    _check_mode(mode)
+    c1, c2 = (float(c1[0]), float(c1[1])), (float(c2[0]), float(c2[1]))
+    d = _dist(c1, c2)
+    if d == 0.0 or d > r1 + r2 or d < abs(r1 - r2):
+        raise ValueError(
+            f"cannot assemble: circles of radii {r1:g} and {r2:g} m with centres {d:g} m apart do not "
+            f"meet (need |r1 - r2| <= d <= r1 + r2): change the lengths or the input values"
+        )
+    a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
+    h = math.sqrt(max(r1 * r1 - a * a, 0.0))
+    e = ((c2[0] - c1[0]) / d, (c2[1] - c1[1]) / d)
+    return (c1[0] + a * e[0] - mode * h * e[1], c1[1] + a * e[1] + mode * h * e[0])
+
+
+def _line_circle(origin: Vec, direction: Vec, centre: Vec, r: float, mode: int) -> float:
+    """Parameter s of the point origin + s d (d unit) at distance r from centre: the larger
+    root for mode=+1, the smaller for -1."""
+    _check_mode(mode)
+    d = _unit(direction)
+    w = _sub(origin, centre)
+    b = w[0] * d[0] + w[1] * d[1]
+    c = w[0] ** 2 + w[1] ** 2 - r * r
+    disc = b * b - c
+    if disc < 0.0:
+        raise ValueError(
+            f"cannot assemble: the rail through {origin} does not reach the circle of radius {r:g} m "
+            f"about {centre}: lengthen the link or move the rail"
+        )
+    return -b + mode * math.sqrt(disc)
+
+
+def _check_mode(mode: int) -> None:
+    if mode not in (1, -1):
+        raise ValueError(f"mode must be +1 or -1, got {mode!r}")
+
+
+def grashof(ground: float, crank: float, coupler: float, rocker: float) -> bool:
+    """Grashof's condition s + l <= p + q of a four-bar: some link turns fully."""
+    links = sorted([ground, crank, coupler, rocker])
+    return links[0] + links[3] <= links[1] + links[2]
+
+
+# ----------------------------------------------------------------------------- model builder
+
+
+class _Model:
+    """Collects points, bodies, pairs and coordinates into a model dict."""
+
+    def __init__(self, name: str, about: str, gravity: Sequence[float]) -> None:
+        self.d: dict[str, Any] = {
+            "name": name,
+            "about": about,
+            "gravity": [float(gravity[0]), float(gravity[1])],
+            "points": {},
+            "ground": [],
+            "bodies": {},
+            "pairs": [],
+            "coordinates": [],
+        }
+
+    def point(self, name: str, p: Vec) -> str:
+        self.d["points"][name] = [float(p[0]), float(p[1])]
+        return name
+
+    def xy(self, name: str) -> Vec:
+        p = self.d["points"][name]
+        return (p[0], p[1])
+
+    def ground(self, *names: str) -> None:
+        self.d["ground"] += list(names)
+
+    def bar(self, name: str, points: list[str], rho: float, about: str | None = None) -> None:
+        """A uniform bar between the first two points (rho kg/m)."""
+        p, q = points[0], points[1]
+        body: dict[str, Any] = {"points": points}
+        if about:
+            body["about"] = about
+        body["uniform_bar"] = [p, q]
+        body["mass"] = rho * _dist(self.xy(p), self.xy(q))
+        self.d["bodies"][name] = body
+
+    def polygon(self, name: str, points: list[str], outline: list[str], rho: float, about: str | None = None) -> None:
+        """A link made of uniform bars (rho kg/m) along the closed outline."""
+        parts = [
+            {"uniform_bar": [a, b], "mass": rho * _dist(self.xy(a), self.xy(b))}
+            for a, b in zip(outline, outline[1:] + outline[:1])
+        ]
+        body: dict[str, Any] = {"points": points}
+        if about:
+            body["about"] = about
+        body["parts"] = parts
+        self.d["bodies"][name] = body
+
+    def block(self, name: str, point: str, mass: float, inertia: float, about: str | None = None) -> None:
+        """A slider block: all its mass at one point, with its own inertia."""
+        body: dict[str, Any] = {"points": [point]}
+        if about:
+            body["about"] = about
+        body.update({"mass": float(mass), "inertia": float(inertia), "com": point})
+        self.d["bodies"][name] = body
+
+    def revolute(self, name: str, at: str, a: str, b: str) -> str:
+        self.d["pairs"].append({"type": "revolute", "name": name, "at": at, "bodies": [a, b]})
+        return name
+
+    def prismatic(self, name: str, at: str, a: str, b: str, axis: Vec) -> str:
+        u = _unit(axis)
+        self.d["pairs"].append({"type": "prismatic", "name": name, "at": at, "bodies": [a, b], "axis": [u[0], u[1]]})
+        return name
+
+    def coordinate(self, name: str, pair: str, value: float, about: str) -> None:
+        self.d["coordinates"].append({"name": name, "pair": pair, "value": float(value), "about": about})
+
+
+def _mechanism(model_fn: Callable[..., dict[str, Any]]) -> Callable[..., Mechanism]:
+    """``f(...)`` = ``from_dict(f_model(...))``, with the model function's signature and doc."""
+
+    @functools.wraps(model_fn)
+    def build(*args: Any, **kwargs: Any) -> Mechanism:
+        return from_dict(model_fn(*args, **kwargs), source=f"<planardyn.library.{build.__name__}>")
+
+    build.__name__ = build.__qualname__ = model_fn.__name__.removesuffix("_model")
+    build.__doc__ = (model_fn.__doc__ or "").replace("The model dict of", "A validated Mechanism:", 1)
+    return build
+
+
+# ----------------------------------------------------------------------------- single loops
+
+
+def four_bar_model(
+    ground: float = 1.0,
+    crank: float = 0.5,
+    coupler: float = 1.2,
+    rocker: float = 1.0,
+    theta: float = math.pi / 3,
+    mode: int = 1,
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of a four-bar: crank O-A, coupler A-B, rocker D-B, ground O-D.
+
+    O = (0, 0), D = (ground, 0); A = O + crank (cos theta, sin theta); B where the coupler
+    (from A) meets the rocker (from D), on the left of A -> D for ``mode=+1``. Input
+    ``theta1``: the crank's absolute angle (rad). Defaults: the crank-rocker of
+    ``four-bar-gravity.yaml``. Mobility 3*3 - 2*4 = 1.
+    """
+    m = _Model("four-bar", "Four-bar linkage O-A-B-D, uniform bars, crank angle input (planardyn.library.four_bar).", gravity)
+    O, D = m.point("O", (0.0, 0.0)), m.point("D", (ground, 0.0))
+    A = m.point("A", _polar(crank, theta))
+    m.point("B", circle_intersection(m.xy(A), coupler, m.xy(D), rocker, mode))
+    m.ground(O, D)
+    m.bar("crank", ["O", "A"], rho)
+    m.bar("coupler", ["A", "B"], rho)
+    m.bar("rocker", ["D", "B"], rho)
+    m.revolute("ground_crank", "O", "ground", "crank")
+    m.revolute("crank_coupler", "A", "crank", "coupler")
+    m.revolute("coupler_rocker", "B", "coupler", "rocker")
+    m.revolute("ground_rocker", "D", "ground", "rocker")
+    m.coordinate("theta1", "ground_crank", theta, "absolute angle of O->A (rad)")
+    return m.d
+
+
+def _slider_crank(
+    m: _Model, A: Vec, B: Vec, rho: float, slider_mass: float, slider_inertia: float
+) -> None:
+    m.point("O", (0.0, 0.0))
+    m.point("A", A)
+    m.point("B", B)
+    m.ground("O")
+    m.bar("crank", ["O", "A"], rho)
+    m.bar("rod", ["A", "B"], rho)
+    m.block("slider", "B", slider_mass, slider_inertia)
+    m.revolute("crank_pivot", "O", "ground", "crank")
+    m.revolute("crank_pin", "A", "crank", "rod")
+    m.revolute("wrist_pin", "B", "rod", "slider")
+    m.prismatic("guide", "B", "ground", "slider", (1.0, 0.0))
+
+
+def slider_crank_model(
+    crank: float = 0.1,
+    rod: float = 0.3,
+    offset: float = 0.0,
+    theta: float = math.pi / 3,
+    mode: int = 1,
+    rho: float = RHO,
+    slider_mass: float = 0.5,
+    slider_inertia: float = 1.0e-3,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of a slider-crank driven by its crank.
+
+    Crank O-A (O = (0, 0), A at angle theta), connecting rod A-B, slider block B on a
+    horizontal guide y = offset (mass ``slider_mass`` kg, inertia ``slider_inertia``
+    kg m^2). B is right of A for ``mode=+1``, left for -1. Input ``theta``: the crank's
+    absolute angle (rad). Mobility 3*3 - 2*4 = 1.
+    """
+    _check_mode(mode)
+    A = _polar(crank, theta)
+    dy = offset - A[1]
+    if abs(dy) > rod:
+        raise ValueError(f"cannot assemble: the rod ({rod:g} m) does not reach the guide {abs(dy):g} m from the crank pin")
+    B = (A[0] + mode * math.sqrt(rod * rod - dy * dy), float(offset))
+    m = _Model("slider-crank (crank input)", "Slider-crank with a horizontal guide, crank angle input (planardyn.library.slider_crank).", gravity)
+    _slider_crank(m, A, B, rho, slider_mass, slider_inertia)
+    m.coordinate("theta", "crank_pivot", theta, "absolute angle of O->A (rad)")
+    return m.d
+
+
+def slider_crank_slider_driven_model(
+    crank: float = 0.1,
+    rod: float = 0.3,
+    offset: float = 0.0,
+    s: float = 0.3,
+    mode: int = -1,
+    rho: float = RHO,
+    slider_mass: float = 0.5,
+    slider_inertia: float = 1.0e-3,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of a slider-crank driven by its slider (a piston engine's kinematics).
+
+    As :func:`slider_crank_model` with the slider at B = (s, offset) and the crank pin A
+    where the crank (from O) meets the rod (from B), on the left of O -> B for
+    ``mode=+1`` (above when B is right of O), right for -1 (the default: the crank hangs
+    below the guide, away from the dead centres). Input ``s``: the slider's x (m), through
+    the prismatic pair ``guide``. Mobility 3*3 - 2*4 = 1.
+    """
+    B = (float(s), float(offset))
+    A = circle_intersection((0.0, 0.0), crank, B, rod, mode)
+    m = _Model("slider-crank (slider input)", "Slider-crank with a horizontal guide, slider position input (planardyn.library.slider_crank_slider_driven).", gravity)
+    _slider_crank(m, A, B, rho, slider_mass, slider_inertia)
+    m.coordinate("s", "guide", s, "x of the slider pin B (m)")
+    return m.d
+
+
+def five_bar_model(
+    base: float = 0.2,
+    proximal: float = 0.2,
+    distal: float = 0.25,
+    theta1: float = 2 * math.pi / 3,
+    theta2: float = math.pi / 3,
+    mode: int = 1,
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of the five-bar 5R parallel robot.
+
+    Base pivots A1 = (-base/2, 0), A2 = (base/2, 0); proximal links A_i-B_i at absolute
+    angles theta_i; distal links B_i-P meeting at the end-effector P, on the left of
+    B1 -> B2 for ``mode=+1`` (above, with B1 left of B2). Inputs ``theta1``, ``theta2``
+    (rad). Mobility 3*4 - 2*5 = 2.
+    """
+    m = _Model("five-bar 5R", "Five-bar 5R parallel robot, uniform bars, two base angle inputs (planardyn.library.five_bar).", gravity)
+    A1, A2 = m.point("A1", (-base / 2, 0.0)), m.point("A2", (base / 2, 0.0))
+    m.point("B1", _add(m.xy(A1), _polar(proximal, theta1)))
+    m.point("B2", _add(m.xy(A2), _polar(proximal, theta2)))
+    m.point("P", circle_intersection(m.xy("B1"), distal, m.xy("B2"), distal, mode))
+    m.ground(A1, A2)
+    m.bar("proximal1", ["A1", "B1"], rho)
+    m.bar("distal1", ["B1", "P"], rho)
+    m.bar("proximal2", ["A2", "B2"], rho)
+    m.bar("distal2", ["B2", "P"], rho)
+    m.revolute("R1", "A1", "ground", "proximal1")
+    m.revolute("elbow1", "B1", "proximal1", "distal1")
+    m.revolute("tip", "P", "distal1", "distal2")
+    m.revolute("elbow2", "B2", "proximal2", "distal2")
+    m.revolute("R2", "A2", "ground", "proximal2")
+    m.coordinate("theta1", "R1", theta1, "absolute angle of A1->B1 (rad)")
+    m.coordinate("theta2", "R2", theta2, "absolute angle of A2->B2 (rad)")
+    return m.d
+
+
+def biglide_model(
+    length: float = 0.3,
+    s1: float = -0.2,
+    s2: float = 0.2,
+    mode: int = 1,
+    rho: float = RHO,
+    slider_mass: float = 0.5,
+    slider_inertia: float = 1.0e-3,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of the biglide (2-PRR): two sliders on the x axis, two bars of equal
+    ``length`` meeting at P.
+
+    Sliders B1 = (s1, 0), B2 = (s2, 0) (blocks of ``slider_mass`` kg); P on the left of
+    B1 -> B2 for ``mode=+1`` (above when s1 < s2). Inputs ``s1``, ``s2``: the sliders' x
+    (m). Mobility 3*4 - 2*5 = 2.
+    """
+    m = _Model("biglide 2-PRR", "Biglide: two sliders on one horizontal rail, two bars to the end-effector (planardyn.library.biglide).", gravity)
+    m.point("B1", (float(s1), 0.0))
+    m.point("B2", (float(s2), 0.0))
+    m.point("P", circle_intersection(m.xy("B1"), length, m.xy("B2"), length, mode))
+    for i in (1, 2):
+        m.block(f"slider{i}", f"B{i}", slider_mass, slider_inertia)
+        m.bar(f"bar{i}", [f"B{i}", "P"], rho)
+    m.prismatic("rail1", "B1", "ground", "slider1", (1.0, 0.0))
+    m.revolute("hinge1", "B1", "slider1", "bar1")
+    m.revolute("tip", "P", "bar1", "bar2")
+    m.revolute("hinge2", "B2", "slider2", "bar2")
+    m.prismatic("rail2", "B2", "ground", "slider2", (1.0, 0.0))
+    m.coordinate("s1", "rail1", s1, "x of slider 1 (m)")
+    m.coordinate("s2", "rail2", s2, "x of slider 2 (m)")
+    return m.d
+
+
+# ----------------------------------------------------------------------------- 3-DOF robots
+
+
+def _platform(m: _Model, base_radius: float, platform_radius: float, pose: Sequence[float], base_offset: float) -> None:
+    """Base points A_i on a circle (angles 90 + 120 i deg + base_offset), the platform's
+    centre P and its pins C_i at angles 90 + 120 i deg + pose[2] about P."""
+    x, y, phi = (float(v) for v in pose)
+    m.point("P", (x, y))
+    for i in (1, 2, 3):
+        a = math.pi / 2 + 2 * math.pi * (i - 1) / 3
+        m.point(f"A{i}", _polar(base_radius, a + base_offset))
+        m.point(f"C{i}", _add((x, y), _polar(platform_radius, a + phi)))
+
+
+def _platform_body(m: _Model, rho: float) -> None:
+    m.polygon("platform", ["P", "C1", "C2", "C3"], ["C1", "C2", "C3"], rho,
+              about="triangle C1 C2 C3 of uniform bars, end-effector point P at its centre")
+
+
+def three_rrr_model(
+    base_radius: float = 0.5,
+    platform_radius: float = 0.1,
+    proximal: float = 0.3,
+    distal: float = 0.3,
+    pose: Sequence[float] = (0.0, 0.0, 0.0),
+    modes: Sequence[int] = (1, 1, 1),
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of the symmetric 3-RRR planar parallel robot, drawn at a platform pose.
+
+    Base pivots A_i on a circle of ``base_radius`` (at 90, 210, 330 deg), platform pins C_i
+    on a circle of ``platform_radius`` about the platform centre P = (x, y), turned by phi
+    (``pose = (x, y, phi)``, m, m, rad). Elbow B_i: at ``proximal`` from A_i and ``distal``
+    from C_i, on the left of A_i -> C_i for ``modes[i] = +1`` (the working mode of leg i).
+    Inputs ``theta1..3``: absolute angles of A_i -> B_i (rad). Mobility 3*7 - 2*9 = 3.
+    """
+    m = _Model("3-RRR", "Symmetric 3-RRR planar parallel robot, uniform bars, three base angle inputs (planardyn.library.three_rrr).", gravity)
+    _platform(m, base_radius, platform_radius, pose, 0.0)
+    for i in (1, 2, 3):
+        m.point(f"B{i}", circle_intersection(m.xy(f"A{i}"), proximal, m.xy(f"C{i}"), distal, modes[i - 1]))
+    m.ground("A1", "A2", "A3")
+    for i in (1, 2, 3):
+        m.bar(f"proximal{i}", [f"A{i}", f"B{i}"], rho)
+        m.bar(f"distal{i}", [f"B{i}", f"C{i}"], rho)
+    _platform_body(m, rho)
+    for i in (1, 2, 3):
+        m.revolute(f"R{i}", f"A{i}", "ground", f"proximal{i}")
+        m.revolute(f"elbow{i}", f"B{i}", f"proximal{i}", f"distal{i}")
+        m.revolute(f"wrist{i}", f"C{i}", f"distal{i}", "platform")
+    for i in (1, 2, 3):
+        m.coordinate(f"theta{i}", f"R{i}", _angle(m.xy(f"A{i}"), m.xy(f"B{i}")), f"absolute angle of A{i}->B{i} (rad)")
+    return m.d
+
+
+def three_rpr_model(
+    base_radius: float = 0.5,
+    platform_radius: float = 0.1,
+    pose: Sequence[float] = (0.0, 0.0, 0.5),
+    barrel: float = 0.3,
+    rod: float = 0.3,
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of the 3-RPR planar parallel robot with actuated legs.
+
+    Base pivots A_i and platform pins C_i as in :func:`three_rrr_model` (no elbow: the
+    drawing is fixed by the pose). Each leg is two bodies: a cylinder barrel A_i-E_i
+    (``barrel`` m long, pivoted to ground at A_i) and a rod K_i-C_i (``rod`` m long, pinned
+    to the platform at C_i) sliding in it along A_i -> C_i: a relative prismatic pair at
+    the piston point K_i. Inputs ``L1..3``: the legs' pin-to-pin lengths |A_i C_i| (m).
+    The default pose turns the platform by 0.5 rad so that the legs are not concurrent
+    (a type II singularity). Mobility 3*7 - 2*9 = 3.
+    """
+    m = _Model("3-RPR", "3-RPR planar parallel robot, legs are cylinders (barrel + rod) with a relative prismatic input (planardyn.library.three_rpr).", gravity)
+    _platform(m, base_radius, platform_radius, pose, 0.0)
+    lengths = []
+    for i in (1, 2, 3):
+        A, C = m.xy(f"A{i}"), m.xy(f"C{i}")
+        L = _dist(A, C)
+        if not L - rod < barrel:
+            raise ValueError(f"leg {i}: length {L:g} m leaves the rod's end outside the barrel (rod + barrel = {rod + barrel:g} m)")
+        u = _unit(_sub(C, A))
+        m.point(f"E{i}", _add(A, (barrel * u[0], barrel * u[1])))
+        m.point(f"K{i}", _add(A, ((L - rod) * u[0], (L - rod) * u[1])))
+        lengths.append((L, u))
+    m.ground("A1", "A2", "A3")
+    for i in (1, 2, 3):
+        m.bar(f"barrel{i}", [f"A{i}", f"E{i}"], rho, about=f"cylinder barrel of leg {i}")
+        m.bar(f"rod{i}", [f"K{i}", f"C{i}"], rho, about=f"piston rod of leg {i}, piston at K{i}")
+    _platform_body(m, rho)
+    for i, (L, u) in zip((1, 2, 3), lengths):
+        m.revolute(f"base{i}", f"A{i}", "ground", f"barrel{i}")
+        m.prismatic(f"leg{i}", f"K{i}", f"barrel{i}", f"rod{i}", u)
+        m.revolute(f"wrist{i}", f"C{i}", f"rod{i}", "platform")
+    for i, (L, _u) in zip((1, 2, 3), lengths):
+        m.coordinate(f"L{i}", f"leg{i}", L, f"pin-to-pin length |A{i} C{i}| of leg {i} (m)")
+    return m.d
+
+
+def three_prr_model(
+    base_radius: float = 0.3,
+    platform_radius: float = 0.1,
+    distal: float = 0.3,
+    pose: Sequence[float] = (0.0, 0.0, 0.0),
+    modes: Sequence[int] = (1, 1, 1),
+    rho: float = RHO,
+    slider_mass: float = 0.5,
+    slider_inertia: float = 1.0e-3,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of the 3-PRR planar parallel robot: three sliders on fixed rails.
+
+    Rail i passes through A_i (on a circle of ``base_radius`` at 90, 210, 330 deg) along
+    the circle's tangent (the rails are the sides of an equilateral triangle), direction
+    t_i = (-sin, cos) of A_i's angle. Platform pins C_i as in :func:`three_rrr_model`. The
+    slider B_i is where the rail meets the circle of radius ``distal`` about C_i: the
+    larger s_i (further along t_i) for ``modes[i] = +1``. Inputs ``s1..3``: B_i's position
+    along its rail from A_i (m). Mobility 3*7 - 2*9 = 3.
+    """
+    m = _Model("3-PRR", "3-PRR planar parallel robot, sliders on three fixed rails (planardyn.library.three_prr).", gravity)
+    _platform(m, base_radius, platform_radius, pose, 0.0)
+    s, t = [], []
+    for i in (1, 2, 3):
+        a = math.pi / 2 + 2 * math.pi * (i - 1) / 3
+        ti = (-math.sin(a), math.cos(a))
+        si = _line_circle(m.xy(f"A{i}"), ti, m.xy(f"C{i}"), distal, modes[i - 1])
+        m.point(f"B{i}", _add(m.xy(f"A{i}"), (si * ti[0], si * ti[1])))
+        s.append(si)
+        t.append(ti)
+    m.ground("A1", "A2", "A3")
+    for i in (1, 2, 3):
+        m.block(f"slider{i}", f"B{i}", slider_mass, slider_inertia)
+        m.bar(f"distal{i}", [f"B{i}", f"C{i}"], rho)
+    _platform_body(m, rho)
+    for i in (1, 2, 3):
+        m.prismatic(f"rail{i}", f"B{i}", "ground", f"slider{i}", t[i - 1])
+        m.revolute(f"hinge{i}", f"B{i}", f"slider{i}", f"distal{i}")
+        m.revolute(f"wrist{i}", f"C{i}", f"distal{i}", "platform")
+    for i in (1, 2, 3):
+        m.coordinate(f"s{i}", f"rail{i}", s[i - 1], f"position of slider {i} along rail {i} from A{i} (m)")
+    return m.d
+
+
+# ----------------------------------------------------------------------------- six-bars
+
+
+def watt_six_bar_model(
+    crank: float = 0.3,
+    coupler1: float = 1.0,
+    rocker: float = 0.8,
+    rocker_arm: float = 0.5,
+    arm_angle: float = -math.pi / 2,
+    coupler2: float = 0.9,
+    output: float = 0.7,
+    o2: Sequence[float] = (1.0, 0.0),
+    o3: Sequence[float] = (1.8, 0.0),
+    theta: float = math.pi / 3,
+    modes: Sequence[int] = (1, 1),
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of a Watt six-bar (Watt II): two four-bars in series sharing the
+    ternary rocker.
+
+    Crank O1-A (O1 = (0, 0), angle theta), coupler A-B, ternary rocker O2-B-C (arm O2-C of
+    ``rocker_arm`` m at ``arm_angle`` rad from O2 -> B), second coupler C-E, output rocker
+    O3-E. B on the left of A -> O2 for ``modes[0] = +1``, E on the left of C -> O3 for
+    ``modes[1] = +1``. The ternary rocker is the triangle O2 B C of uniform bars. Input
+    ``theta1``: the crank's absolute angle (rad). The two ternary links (ground O1 O2 O3
+    and the rocker) are joined at O2: Watt's chain. Mobility 3*5 - 2*7 = 1.
+    """
+    m = _Model("Watt six-bar", "Watt six-bar (Watt II): four-bar O1-A-B-O2 driving four-bar O2-C-E-O3 through the ternary rocker O2-B-C (planardyn.library.watt_six_bar).", gravity)
+    O1, O2, O3 = m.point("O1", (0.0, 0.0)), m.point("O2", tuple(o2)), m.point("O3", tuple(o3))
+    m.point("A", _polar(crank, theta))
+    m.point("B", circle_intersection(m.xy("A"), coupler1, m.xy(O2), rocker, modes[0]))
+    m.point("C", _add(m.xy(O2), _polar(rocker_arm, _angle(m.xy(O2), m.xy("B")) + arm_angle)))
+    m.point("E", circle_intersection(m.xy("C"), coupler2, m.xy(O3), output, modes[1]))
+    m.ground(O1, O2, O3)
+    m.bar("crank", ["O1", "A"], rho)
+    m.bar("coupler1", ["A", "B"], rho)
+    m.polygon("rocker", ["O2", "B", "C"], ["O2", "B", "C"], rho, about="ternary rocker O2-B-C")
+    m.bar("coupler2", ["C", "E"], rho)
+    m.bar("output", ["O3", "E"], rho)
+    m.revolute("ground_crank", "O1", "ground", "crank")
+    m.revolute("crank_coupler1", "A", "crank", "coupler1")
+    m.revolute("coupler1_rocker", "B", "coupler1", "rocker")
+    m.revolute("ground_rocker", "O2", "ground", "rocker")
+    m.revolute("rocker_coupler2", "C", "rocker", "coupler2")
+    m.revolute("coupler2_output", "E", "coupler2", "output")
+    m.revolute("ground_output", "O3", "ground", "output")
+    m.coordinate("theta1", "ground_crank", theta, "absolute angle of O1->A (rad)")
+    return m.d
+
+
+def stephenson_six_bar_model(
+    o1: Sequence[float] = (0.0, 0.0),
+    o2: Sequence[float] = (0.6, 0.0),
+    o3: Sequence[float] = (1.2, 0.0),
+    crank: float = 0.25,
+    theta: float = -math.pi / 3,
+    triangle: Sequence[Sequence[float]] = ((-0.15, 0.0), (0.15, 0.0), (0.2, -0.15)),
+    pose: Sequence[float] = (0.3, -0.6, 0.0),
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of a Stephenson six-bar whose inputs leave a triad (class III group).
+
+    Stephenson's chain: the two ternary links (the ground, pivots O1 O2 O3, and the
+    floating triangle J1 J2 J3) are not joined to each other. Here the ground carries the
+    crank O3-D (input ``theta1``, its absolute angle), and the triangle hangs from O1 and
+    O2 by the binary links O1-J1 and O2-J2 and is driven by the link D-J3. With the crank
+    fixed, the triangle and its three binary links form one Assur triad: no circle
+    intersection gives the drawing, so it is given by the triangle's pose instead:
+    ``triangle`` the vertices J1 J2 J3 in its own frame (m), ``pose = (x, y, phi)`` where it
+    is drawn (m, m, rad); the binary links' lengths follow. Mobility 3*5 - 2*7 = 1.
+    """
+    m = _Model("Stephenson six-bar", "Stephenson six-bar: ground O1 O2 O3 and the triangle J1 J2 J3 are the ternary links; crank O3-D input; the triangle with links O1-J1, O2-J2, D-J3 is an Assur triad (planardyn.library.stephenson_six_bar).", gravity)
+    for name, p in (("O1", o1), ("O2", o2), ("O3", o3)):
+        m.point(name, (float(p[0]), float(p[1])))
+    m.point("D", _add(m.xy("O3"), _polar(crank, theta)))
+    x, y, phi = (float(v) for v in pose)
+    for k, v in enumerate(triangle, start=1):
+        m.point(f"J{k}", _add((x, y), _rotate((float(v[0]), float(v[1])), phi)))
+    m.ground("O1", "O2", "O3")
+    m.bar("crank", ["O3", "D"], rho)
+    m.bar("link1", ["O1", "J1"], rho)
+    m.bar("link2", ["O2", "J2"], rho)
+    m.bar("link3", ["D", "J3"], rho)
+    m.polygon("triangle", ["J1", "J2", "J3"], ["J1", "J2", "J3"], rho, about="floating ternary link")
+    m.revolute("ground_crank", "O3", "ground", "crank")
+    m.revolute("crank_link3", "D", "crank", "link3")
+    m.revolute("ground_link1", "O1", "ground", "link1")
+    m.revolute("ground_link2", "O2", "ground", "link2")
+    m.revolute("link1_triangle", "J1", "link1", "triangle")
+    m.revolute("link2_triangle", "J2", "link2", "triangle")
+    m.revolute("link3_triangle", "J3", "link3", "triangle")
+    m.coordinate("theta1", "ground_crank", theta, "absolute angle of O3->D (rad)")
+    return m.d
+
+
+def double_parallelogram_model(
+    crank: float = 0.3,
+    spacing: float = 0.4,
+    theta: float = math.pi / 3,
+    rho: float = RHO,
+    gravity: Sequence[float] = GRAVITY,
+) -> dict[str, Any]:
+    """The model dict of a double parallelogram: three equal parallel cranks O_i-A_i
+    (O_i = ((i - 1) spacing, 0), angle theta) carrying one coupler A1-A2-A3.
+
+    A mechanism with a redundant constraint: Grubler counts 3*4 - 2*6 = 0, yet it moves
+    with one degree of freedom (the third crank repeats the motion the first parallelogram
+    already imposes; the rank of the constraint Jacobian is 11, not 12). The loader
+    requires independent constraints and refuses it (see ``planardyn.structure`` for the
+    analysis). Input ``theta1``: the first crank's absolute angle (rad).
+    """
+    m = _Model("double parallelogram", "Double parallelogram: three parallel cranks and one coupler; one redundant constraint (planardyn.library.double_parallelogram).", gravity)
+    for i in (1, 2, 3):
+        m.point(f"O{i}", ((i - 1) * spacing, 0.0))
+        m.point(f"A{i}", _add(m.xy(f"O{i}"), _polar(crank, theta)))
+    m.ground("O1", "O2", "O3")
+    for i in (1, 2, 3):
+        m.bar(f"crank{i}", [f"O{i}", f"A{i}"], rho)
+    m.bar("coupler", ["A1", "A3", "A2"], rho)
+    for i in (1, 2, 3):
+        m.revolute(f"ground_crank{i}", f"O{i}", "ground", f"crank{i}")
+        m.revolute(f"crank{i}_coupler", f"A{i}", f"crank{i}", "coupler")
+    m.coordinate("theta1", "ground_crank1", theta, "absolute angle of O1->A1 (rad)")
+    return m.d
+
+
+four_bar = _mechanism(four_bar_model)
+slider_crank = _mechanism(slider_crank_model)
+slider_crank_slider_driven = _mechanism(slider_crank_slider_driven_model)
+five_bar = _mechanism(five_bar_model)
+biglide = _mechanism(biglide_model)
+three_rrr = _mechanism(three_rrr_model)
+three_rpr = _mechanism(three_rpr_model)
+three_prr = _mechanism(three_prr_model)
+watt_six_bar = _mechanism(watt_six_bar_model)
+stephenson_six_bar = _mechanism(stephenson_six_bar_model)
+double_parallelogram = _mechanism(double_parallelogram_model)
+
+#: Where the shipped model files are (examples/models/ of the repository).
+MODELS_DIR = Path(__file__).resolve().parents[2] / "examples" / "models"
+#: The library's own files, written from the constructors' defaults.
+LIBRARY_DIR = MODELS_DIR / "library"
+
+
+def andrews_squeezer() -> Mechanism:
+    """Andrews' squeezing mechanism: the shipped ``examples/models/andrews-squeezer.yaml``
+    (7 bodies, 10 revolute pairs, crank angle ``beta``; Hairer & Wanner's benchmark)."""
+    path = MODELS_DIR / "andrews-squeezer.yaml"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path} is not there: andrews_squeezer() needs the repository's examples/models")
+    return load(path)
+
+
+#: File stem -> model function (at its defaults), for every mechanism built here.
+LIBRARY: dict[str, Callable[..., dict[str, Any]]] = {
+    "four-bar": four_bar_model,
+    "slider-crank": slider_crank_model,
+    "slider-crank-slider-driven": slider_crank_slider_driven_model,
+    "five-bar-5r": five_bar_model,
+    "biglide": biglide_model,
+    "3-rrr": three_rrr_model,
+    "3-rpr": three_rpr_model,
+    "3-prr": three_prr_model,
+    "watt-six-bar": watt_six_bar_model,
+    "stephenson-six-bar": stephenson_six_bar_model,
+    "double-parallelogram": double_parallelogram_model,
+}
+
+
+# ----------------------------------------------------------------------------- writing files
+
+_PLAIN = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+_YAML_WORDS = {"y", "n", "yes", "no", "on", "off", "true", "false", "null", "~"}
+
+
+def _scalar(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            raise ValueError(f"a model value must be finite, got {v!r}")
+        text = repr(v)
+        # YAML 1.1 readers want a dot and a signed exponent: 1e-06 -> 1.0e-06.
+        if "e" in text and "." not in text:
+            mant, exp = text.split("e")
+            text = f"{mant}.0e{exp}"
+        return text
+    if isinstance(v, str):
+        return v if _PLAIN.match(v) and v.lower() not in _YAML_WORDS else json.dumps(v)
+    if v is None:
+        return "null"
+    raise TypeError(f"{type(v).__name__} is not a model value")
+
+
+def _flow(v: Any) -> str:
+    if isinstance(v, Mapping):
+        return "{" + ", ".join(f"{_scalar(k)}: {_flow(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_flow(x) for x in v) + "]"
+    return _scalar(v)
+
+
+def model_text(model: Mapping[str, Any], header: str | None = None) -> str:
+    """The model dict as YAML text: top-level sections in block style, one line per point,
+    body, pair, coordinate...; floats at full precision (``repr``). ``header`` (optional) is
+    written first as ``#`` comment lines. ``yaml.safe_load`` gives the dict back."""
+    lines = [f"# {h}".rstrip() for h in (header or "").splitlines()]
+    for key, value in model.items():
+        if isinstance(value, Mapping) and value:
+            lines.append(f"{key}:")
+            for k, v in value.items():
+                lines.append(f"  {_scalar(k)}: {_flow(v)}")
+        elif isinstance(value, list) and value and all(isinstance(x, Mapping) for x in value):
+            lines.append(f"{key}:")
+            lines += [f"  - {_flow(x)}" for x in value]
+        else:
+            lines.append(f"{key}: {_flow(value)}")
+    return "\n".join(lines) + "\n"
+
+
+def write_model(mech_or_model: Mechanism | Mapping[str, Any], path: str | os.PathLike[str], header: str | None = None) -> Path:
+    """Write a mechanism (its :meth:`~planardyn.Mechanism.to_dict`) or a model dict as a
+    YAML model file (:func:`model_text`); returns the path."""
+    model = mech_or_model.to_dict() if isinstance(mech_or_model, Mechanism) else mech_or_model
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(model_text(model, header))
+    return path
+
+
+def file_header(stem: str) -> str:
+    fn = LIBRARY[stem].__name__.removesuffix("_model")
+    return (
+        f"planardyn model file, generated by planardyn.library.{fn}() at its defaults.\n"
+        "Do not edit: regenerate with `python -m planardyn.library` (tests/test_library.py\n"
+        "checks that this file is what the constructor gives). Units SI; docs/library.md."
+    )
+
+
+def write_all(directory: str | os.PathLike[str] = LIBRARY_DIR) -> list[Path]:
+    """Write every library mechanism at its defaults to ``directory/<stem>.yaml``."""
+    return [write_model(fn(), Path(directory) / f"{stem}.yaml", file_header(stem)) for stem, fn in LIBRARY.items()]
+
+
+if __name__ == "__main__":
+    for p in write_all(sys.argv[1] if len(sys.argv) > 1 else LIBRARY_DIR):
+        print(p)

@@ -1,0 +1,211 @@
+"""Prescribed end-effector motions X(t) with exact derivatives: point-to-point and lines with a
+time profile, circles, and time tables (cubic splines).
+
+A path gives, at times t (N,) in [0, duration] (s), the task coordinates X (N, k) and their
+first and second time derivatives (m/s, m/s^2; rad/s, rad/s^2 for psi). k = 2 for a point
+(the orientation psi, when given, is appended for m = 3 robots; a path without one keeps
+psi = 0, the drawn orientation of the end-effector body).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+Profile = Literal["quintic", "trapezoid", "constant"]
+Sampler = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
+
+# Trapezoidal velocity profile: the fraction of the duration spent accelerating (and again
+# decelerating); 1/3 is the usual "thirds" move (accelerate, cruise, decelerate).
+TRAPEZOID_ACCEL_FRACTION = 1.0 / 3.0
+
+
+def time_law(kind: Profile, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Normalised time law s(tau), ds/dtau, d2s/dtau2 for tau in [0, 1], s from 0 to 1.
+
+    ``'quintic'``: 10 tau^3 - 15 tau^4 + 6 tau^5, at rest (zero speed and acceleration) at both
+    ends. ``'trapezoid'``: constant acceleration, cruise, constant deceleration (speed
+    continuous, acceleration steps). ``'constant'``: s = tau (constant speed).
+    """
+    tau = np.clip(np.asarray(tau, dtype=float), 0.0, 1.0)
+    if kind == "quintic":
+        s = tau**3 * (10 - 15 * tau + 6 * tau**2)
+        sd = 30 * tau**2 * (1 - tau) ** 2
+        sdd = 60 * tau * (1 - tau) * (1 - 2 * tau)
+    elif kind == "trapezoid":
+        a = TRAPEZOID_ACCEL_FRACTION
+        v = 1.0 / (1.0 - a)  # cruise speed so that s(1) = 1
+        acc = v / a
+        up, down = tau < a, tau > 1 - a
+        s = np.where(up, 0.5 * acc * tau**2, np.where(down, 1 - 0.5 * acc * (1 - tau) ** 2, v * (tau - a / 2)))
+        sd = np.where(up, acc * tau, np.where(down, acc * (1 - tau), v))
+        sdd = np.where(up, acc, np.where(down, -acc, 0.0))
+    elif kind == "constant":
+        s, sd, sdd = tau, np.ones_like(tau), np.zeros_like(tau)
+    else:
+        raise ValueError(f"profile must be 'quintic', 'trapezoid' or 'constant', got {kind!r}")
+    return s, sd, sdd
+
+
+@dataclass(frozen=True)
+class TaskPath:
+    """A prescribed end-effector motion over [0, duration] (s).
+
+    ``sample(t)`` gives X, Xd, Xdd, each (N, k). ``label`` describes it in reports.
+    """
+
+    duration: float
+    dim: int
+    label: str
+    _sample: Sampler
+
+    def sample(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return self._sample(t)
+
+    def with_dim(self, k: int) -> TaskPath:
+        """The same path with k task coordinates: psi = 0 (drawn orientation) appended for
+        k = 3 when it has none; k = 2 of a path with psi is an error."""
+        if k == self.dim:
+            return self
+        if k == 3 and self.dim == 2:
+            def sample3(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+                z = np.zeros((len(t), 1))
+                return tuple(np.hstack([a, z]) for a in self._sample(t))  # type: ignore[return-value]
+
+            return TaskPath(self.duration, 3, self.label, sample3)
+        raise ValueError(f"the path has {self.dim} task coordinates, the end effector {k}")
+
+
+def _check_duration(duration: float) -> float:
+    duration = float(duration)
+    if not np.isfinite(duration) or duration <= 0:
+        raise ValueError(f"duration must be > 0 s, got {duration}")
+    return duration
+
+
+def _angles(angle: float | tuple[float, float] | None) -> tuple[float, float] | None:
+    if angle is None:
+        return None
+    if np.ndim(angle) == 0:
+        return float(angle), float(angle)  # type: ignore[arg-type]
+    a0, a1 = angle  # type: ignore[misc]
+    return float(a0), float(a1)
+
+
+def _with_angle(
+    pos: tuple[FloatArray, FloatArray, FloatArray], angles: tuple[float, float] | None, s: tuple[FloatArray, ...]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    if angles is None:
+        return pos
+    a0, a1 = angles
+    d = a1 - a0
+    cols = (a0 + d * s[0], d * s[1], d * s[2])
+    return tuple(np.column_stack([p, c]) for p, c in zip(pos, cols))  # type: ignore[return-value]
+
+
+def line(
+    start: ArrayLike,
+    end: ArrayLike,
+    duration: float,
+    profile: Profile = "quintic",
+    angle: float | tuple[float, float] | None = None,
+) -> TaskPath:
+    """Straight line from ``start`` to ``end`` ((2,), m) in ``duration`` s with a time profile
+    (``'quintic'`` and ``'trapezoid'`` are rest-to-rest: a point-to-point move).
+
+    ``angle``: for a pose, psi (rad from the drawn orientation), constant or (psi0, psi1)
+    interpolated with the same profile.
+    """
+    T = _check_duration(duration)
+    p0, p1 = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    d = p1 - p0
+    angles = _angles(angle)
+
+    def sample(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        s, sd, sdd = time_law(profile, t / T)
+        s = (s, sd / T, sdd / T**2)
+        pos = (p0 + np.outer(s[0], d), np.outer(s[1], d), np.outer(s[2], d))
+        return _with_angle(pos, angles, s)
+
+    return TaskPath(T, 2 if angles is None else 3, f"line {p0.round(4).tolist()} -> {p1.round(4).tolist()} in {T:g} s ({profile})", sample)
+
+
+def point_to_point(
+    start: ArrayLike,
+    end: ArrayLike,
+    duration: float,
+    profile: Literal["quintic", "trapezoid"] = "quintic",
+    angle: float | tuple[float, float] | None = None,
+) -> TaskPath:
+    """Rest-to-rest move along a straight line (see :func:`line`)."""
+    if profile == "constant":
+        raise ValueError("a point-to-point move starts and ends at rest: use 'quintic' or 'trapezoid'")
+    return line(start, end, duration, profile, angle)
+
+
+def circle(
+    center: ArrayLike,
+    radius: float,
+    duration: float,
+    start_angle: float = -np.pi / 2,
+    turns: float = 1.0,
+    profile: Profile = "quintic",
+    angle: float | tuple[float, float] | None = None,
+) -> TaskPath:
+    """Circle of ``radius`` (m) about ``center`` ((2,), m), counter-clockwise for turns > 0,
+    starting at polar angle ``start_angle`` (rad, default the lowest point); the polar angle
+    follows the time profile (``'quintic'``: from rest to rest; ``'constant'``: uniform speed).
+    """
+    T = _check_duration(duration)
+    c = np.asarray(center, dtype=float)
+    r = float(radius)
+    if not r > 0:
+        raise ValueError(f"radius must be > 0 m, got {radius}")
+    sweep = 2 * np.pi * float(turns)
+    angles = _angles(angle)
+
+    def sample(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        s, sd, sdd = time_law(profile, t / T)
+        s = (s, sd / T, sdd / T**2)
+        th, thd, thdd = start_angle + sweep * s[0], sweep * s[1], sweep * s[2]
+        e_r = np.column_stack([np.cos(th), np.sin(th)])
+        e_t = np.column_stack([-np.sin(th), np.cos(th)])
+        pos = (c + r * e_r, r * thd[:, None] * e_t, r * (thdd[:, None] * e_t - (thd**2)[:, None] * e_r))
+        return _with_angle(pos, angles, s)
+
+    return TaskPath(T, 2 if angles is None else 3, f"circle r = {r:g} m about {c.round(4).tolist()} in {T:g} s ({profile})", sample)
+
+
+def table(t: ArrayLike, X: ArrayLike, bc_type: str = "clamped") -> TaskPath:
+    """A time table of task coordinates, interpolated by a cubic spline in t.
+
+    Parameters
+    ----------
+    t : (K,) array_like
+        Times (s), increasing, from 0.
+    X : (K, 2) or (K, 3) array_like
+        Positions (m), with psi (rad) as a third column for a pose.
+    bc_type : str
+        scipy's CubicSpline end conditions; ``'clamped'`` (default) starts and ends at rest.
+    """
+    from scipy.interpolate import CubicSpline
+
+    t = np.asarray(t, dtype=float)
+    X = np.asarray(X, dtype=float)
+    if t.ndim != 1 or X.ndim != 2 or X.shape[0] != t.shape[0] or X.shape[1] not in (2, 3):
+        raise ValueError(f"table needs t (K,) and X (K, 2 or 3); got {t.shape} and {X.shape}")
+    if t[0] != 0.0 or np.any(np.diff(t) <= 0):
+        raise ValueError("table times must start at 0 s and increase")
+    spline = CubicSpline(t, X, bc_type=bc_type)
+    d1, d2 = spline.derivative(1), spline.derivative(2)
+
+    def sample(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return spline(tt), d1(tt), d2(tt)
+
+    return TaskPath(float(t[-1]), X.shape[1], f"table of {len(t)} points over {t[-1]:g} s", sample)
