@@ -504,3 +504,38 @@ def test_keyboard_interrupt_in_a_drive_propagates(four_bar):
     with pytest.raises(KeyboardInterrupt):
         four_bar.simulate(t_end=1.0, drives=drive)
     assert sum(t > 0.1 for t in calls) == 1  # not retried with smaller steps
+
+
+def test_redundant_constraints_load_with_a_warning_and_simulate():
+    # A triple-crank parallelogram: Chebyshev-Grubler counts 3*4 - 2*6 = 0 freedoms, the
+    # rank of its constraints shows 1; the loader keeps the independent rows and says which
+    # pairs are redundant. Closed form: every crank turns alike, the coupler translates on a
+    # circle of r = 0.3 m, so A = 3 m_k r^2/3 + m_c r^2 (uniform 0.3 kg cranks, 1 kg coupler).
+    s = 0.2598076211353316
+    model = {
+        "name": "triple-crank parallelogram",
+        "gravity": [0, -9.81],
+        "points": {"O1": [0, 0], "O2": [0.5, 0], "O3": [1.0, 0], "A": [0.15, s], "B": [0.65, s], "C": [1.15, s]},
+        "ground": ["O1", "O2", "O3"],
+        "bodies": {
+            "crank1": {"points": ["O1", "A"], "uniform_bar": ["O1", "A"], "mass": 0.3},
+            "crank2": {"points": ["O2", "B"], "uniform_bar": ["O2", "B"], "mass": 0.3},
+            "crank3": {"points": ["O3", "C"], "uniform_bar": ["O3", "C"], "mass": 0.3},
+            "coupler": {"points": ["A", "C", "B"], "uniform_bar": ["A", "C"], "mass": 1.0},
+        },
+        "pairs": [
+            {"type": "revolute", "name": n, "at": n, "bodies": ["ground", c]}
+            for n, c in [("O1", "crank1"), ("O2", "crank2"), ("O3", "crank3")]
+        ] + [
+            {"type": "revolute", "name": n, "at": n, "bodies": [c, "coupler"]}
+            for n, c in [("A", "crank1"), ("B", "crank2"), ("C", "crank3")]
+        ],
+        "coordinates": [{"name": "theta", "pair": "O1", "value": 1.0471975511965976}],
+    }
+    with pytest.warns(pd.PlanardynWarning, match="redundant constraints among pairs"):
+        mech = pd.from_dict(model)
+    assert len(mech.warnings) == 1
+    A = mech.mass_matrix([0.4])
+    assert A[0, 0] == pytest.approx(3 * 0.3 * 0.09 / 3 + 1.0 * 0.09, rel=1e-12)
+    res = mech.simulate(t_end=0.3)
+    assert res.success and res.energy.drift < 1e-8

@@ -26,7 +26,7 @@ from ._core import (
     SingularityError,
     __version__,
 )
-from .mechanism import Mechanism, from_dict, load, loads
+from .mechanism import Mechanism, PlanardynWarning, from_dict, load, loads
 from .result import Energy, SimulationResult
 
 __all__ = [
@@ -35,6 +35,7 @@ __all__ = [
     "Mechanism",
     "ModelError",
     "PlanardynError",
+    "PlanardynWarning",
     "SimulationError",
     "SimulationResult",
     "SingularityError",

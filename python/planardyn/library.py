@@ -390,22 +390,25 @@ def biglide_model(
     length: float = 0.3,
     s1: float = -0.2,
     s2: float = 0.2,
+    rail_offset: float = 0.1,
     mode: int = 1,
     rho: float = RHO,
     slider_mass: float = 0.5,
     slider_inertia: float = 1.0e-3,
     gravity: Sequence[float] = GRAVITY,
 ) -> dict[str, Any]:
-    """The model dict of the biglide (2-PRR): two sliders on the x axis, two bars of equal
-    ``length`` meeting at P.
+    """The model dict of the biglide (2-PRR): two sliders on parallel horizontal rails, two
+    bars of equal ``length`` meeting at P.
 
-    Sliders B1 = (s1, 0), B2 = (s2, 0) (blocks of ``slider_mass`` kg); P on the left of
-    B1 -> B2 for ``mode=+1`` (above when s1 < s2). Inputs ``s1``, ``s2``: the sliders' x
-    (m). Mobility 3*4 - 2*5 = 2.
+    Sliders B1 = (s1, 0) and B2 = (s2, rail_offset) (blocks of ``slider_mass`` kg); P on
+    the left of B1 -> B2 for ``mode=+1`` (above when s1 < s2). Inputs ``s1``, ``s2``: the
+    sliders' x (m). With ``rail_offset=0`` the rails are one line and the sliders can meet
+    (B1 = B2: the bars then fold onto each other, a change point of the passive
+    mechanism); the default 0.1 m keeps them apart. Mobility 3*4 - 2*5 = 2.
     """
-    m = _Model("biglide 2-PRR", "Biglide: two sliders on one horizontal rail, two bars to the end-effector (planardyn.library.biglide).", gravity)
+    m = _Model("biglide 2-PRR", "Biglide: two sliders on parallel horizontal rails, two bars to the end-effector (planardyn.library.biglide).", gravity)
     m.point("B1", (float(s1), 0.0))
-    m.point("B2", (float(s2), 0.0))
+    m.point("B2", (float(s2), float(rail_offset)))
     m.point("P", circle_intersection(m.xy("B1"), length, m.xy("B2"), length, mode))
     for i in (1, 2):
         m.block(f"slider{i}", f"B{i}", slider_mass, slider_inertia)
@@ -664,7 +667,7 @@ def stephenson_six_bar_model(
 def double_parallelogram_model(
     crank: float = 0.3,
     spacing: float = 0.4,
-    theta: float = math.pi / 3,
+    theta: float = -math.pi / 3,
     rho: float = RHO,
     gravity: Sequence[float] = GRAVITY,
 ) -> dict[str, Any]:
@@ -675,7 +678,9 @@ def double_parallelogram_model(
     with one degree of freedom (the third crank repeats the motion the first parallelogram
     already imposes; the rank of the constraint Jacobian is 11, not 12). The loader
     requires independent constraints and refuses it (see ``planardyn.structure`` for the
-    analysis). Input ``theta1``: the first crank's absolute angle (rad).
+    analysis). Input ``theta1``: the first crank's absolute angle (rad); the default
+    hangs the cranks at -60 deg, so that the passive swing stays away from theta = 0 and pi
+    where the parallelograms fold (a change point).
     """
     m = _Model("double parallelogram", "Double parallelogram: three parallel cranks and one coupler; one redundant constraint (planardyn.library.double_parallelogram).", gravity)
     for i in (1, 2, 3):
@@ -812,6 +817,42 @@ def write_all(directory: str | os.PathLike[str] = LIBRARY_DIR) -> list[Path]:
     return [write_model(fn(), Path(directory) / f"{stem}.yaml", file_header(stem)) for stem, fn in LIBRARY.items()]
 
 
+def draw_all(directory: str | os.PathLike[str]) -> list[Path]:
+    """Draw every library mechanism (and Andrews' squeezer) at its defaults into
+    ``directory/library-<stem>.png`` with :func:`planardyn.plot.draw_mechanism` (the
+    pictures of docs/library.md)."""
+    import warnings
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .plot import draw_mechanism
+
+    out = []
+    items: list[tuple[str, Callable[[], Mechanism]]] = [
+        (stem, functools.partial(lambda f: from_dict(f(), source=stem), fn)) for stem, fn in LIBRARY.items()
+    ]
+    items.append(("andrews-squeezer", andrews_squeezer))
+    for stem, make in items:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the double parallelogram's redundancy warning
+            mech = make()
+        fig, ax = plt.subplots(figsize=(4.5, 4.0), dpi=100)
+        draw_mechanism(mech, ax=ax)
+        ax.set_title(mech.name)
+        path = Path(directory) / f"library-{stem}.png"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, bbox_inches="tight")
+        plt.close(fig)
+        out.append(path)
+    return out
+
+
 if __name__ == "__main__":
+    # python -m planardyn.library [MODEL_DIR [PICTURE_DIR]]
     for p in write_all(sys.argv[1] if len(sys.argv) > 1 else LIBRARY_DIR):
+        print(p)
+    for p in draw_all(sys.argv[2] if len(sys.argv) > 2 else MODELS_DIR.parents[1] / "docs" / "img"):
         print(p)

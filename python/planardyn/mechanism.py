@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any, Literal
 
@@ -17,6 +18,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from .result import SimulationResult
+
+
+class PlanardynWarning(UserWarning):
+    """Something a user should know about a model that still works (redundant constraints)."""
 
 FloatArray = NDArray[np.float64]
 DriveFunction = Callable[[float, FloatArray, FloatArray], ArrayLike]
@@ -38,8 +43,15 @@ class Mechanism:
         if not isinstance(native, _core.Mechanism):
             raise TypeError("use planardyn.load(), loads() or from_dict() to make a Mechanism")
         self._native = native
+        for message in native.warnings:
+            warnings.warn(f"{native.source}: {message}", PlanardynWarning, stacklevel=3)
 
     # ------------------------------------------------------------------ description
+
+    @property
+    def warnings(self) -> list[str]:
+        """What a user should know about the model (redundant constraints and which pairs)."""
+        return list(self._native.warnings)
 
     @property
     def name(self) -> str:

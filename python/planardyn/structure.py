@@ -41,6 +41,9 @@ RANK_TOL = 1e-9
 #: above this (the null vectors are exact to about RANK_TOL, so 1e-6 is well clear of it).
 SELF_STRESS_TOL = 1e-6
 
+#: The five types of class II dyads (outer, inner, outer pair).
+DYAD_TYPES = ("RRR", "RRP", "RPR", "PRP", "RPP")
+
 __all__ = ["AssurGroup", "Loop", "Structure", "analyse", "report"]
 
 
@@ -113,6 +116,8 @@ class Structure:
     groups: tuple[AssurGroup, ...]
     #: Links no zero-mobility group took (over- or under-constrained parts).
     left_over: tuple[str, ...]
+    #: 3k - 2p_k of those links with every pair that touches them (0 when none is left).
+    left_over_mobility: int
     #: Type II measure at the start (None when the core refused the model or is singular).
     sigma_min: float | None
     #: The loader's message when the model cannot be built (the analysis then uses the drawing).
@@ -253,8 +258,11 @@ def _assur(bodies: Sequence[str], pairs: Sequence[_Pair], input_pairs: Sequence[
         subset, inner, outer = found
         assigned |= set(subset)
         groups.append(_group([label[u] for u in subset], subset, inner, outer))
-    left_over = tuple(label[u] for u in free if u not in assigned)
-    return tuple(dict.fromkeys(input_links)), tuple(relative), tuple(groups), left_over
+    rest = {u for u in free if u not in assigned}
+    left_over = tuple(label[u] for u in free if u in rest)
+    # Grubler count of what is left: < 0 over-constrained (redundant), > 0 free to move.
+    rest_mobility = 3 * len(rest) - 2 * sum(1 for a, b, _ in edges if a in rest or b in rest)
+    return tuple(dict.fromkeys(input_links)), tuple(relative), tuple(groups), left_over, rest_mobility
 
 
 def _connected(units: set[str], inner: list) -> bool:
@@ -276,8 +284,8 @@ def _group(names: list[str], units: tuple[str, ...], inner: list, outer: list) -
         o1 = next(pr for a, b, pr in outer if u1 in (a, b))
         o2 = next(pr for a, b, pr in outer if u2 in (a, b))
         kind = letter[o1.kind] + letter[inner[0][2].kind] + letter[o2.kind]
-        # A dyad reads the same both ways: RRP and PRR are one type.
-        kind = min(kind, kind[::-1]) if kind[::-1] not in ("RRP", "RPP") else kind[::-1]
+        # A dyad reads the same both ways (PRR is RRP): name it by the five classical types.
+        kind = kind if kind in DYAD_TYPES else kind[::-1]
         cls = 2
     else:
         degree = {u: sum(u in (a, b) for a, b, _ in inner) for u in units}
@@ -423,7 +431,7 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
     rank, sv, null = _rank_and_null(J)
     input_pairs = tuple(c["pair"] for c in model["coordinates"])
     loops, connected = _loops(links, pairs)
-    input_links, relative, groups, left_over = _assur(bodies, pairs, input_pairs)
+    input_links, relative, groups, left_over, rest_mobility = _assur(bodies, pairs, input_pairs)
     kinds: dict[str, list[str]] = {}
     for pr in pairs:
         kinds.setdefault(pr.kind, []).append(pr.name)
@@ -455,6 +463,7 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
         relative_inputs=relative,
         groups=groups,
         left_over=left_over,
+        left_over_mobility=rest_mobility,
         sigma_min=sigma,
         load_error=load_error,
         notes=tuple(notes),
@@ -496,8 +505,10 @@ def report(mech: Mechanism | Mapping[str, Any]) -> str:
     for g in s.groups:
         out.append(f"    {g.description}; outer pairs {', '.join(g.outer_pairs)}")
     if s.left_over:
+        m = s.left_over_mobility
+        what = "over-constrained: redundant" if m < 0 else "under-constrained: free to move"
         out.append(f"    not in any zero-mobility group: {', '.join(s.left_over)} "
-                   "(over- or under-constrained: see the mobility above)")
+                   f"(3k - 2p = {m}: {what})")
     if s.sigma_min is not None:
         out.append(f"  type II singularity measure at the start: sigma_min = {s.sigma_min:.4g} (0 = singular)")
     out += [f"  {note}" for note in s.notes]

@@ -122,6 +122,12 @@ impl PyMechanism {
     fn source(&self) -> &str {
         &self.inner.source
     }
+
+    /// What a user should know about the model (redundant constraints...).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings.clone()
+    }
     /// Degrees of freedom m (= number of generalized coordinates).
     #[getter]
     fn dof(&self) -> usize {

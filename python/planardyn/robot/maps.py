@@ -20,6 +20,9 @@ from .motion import JUMP_TOL, SINGULAR_TOL
 
 FloatArray = NDArray[np.float64]
 
+# A quadrilateral (image of an input-box cell) this many times the median size joins two
+# branches of the position analysis: not filled.
+QUAD_JUMP = 20.0
 # Newton attempts at one cell (from different solved neighbours) before it is unreachable.
 MAX_ATTEMPTS = 4
 
@@ -172,26 +175,60 @@ class Workspace:
         return plot_workspace(self, ax)
 
 
-def _occupancy(points: FloatArray, cells: int, pad: float) -> tuple[FloatArray, FloatArray, NDArray[np.intp], NDArray[np.intp]]:
+def _grid_for(points: FloatArray, cells: int, pad: float) -> tuple[FloatArray, FloatArray]:
     lo, hi = points.min(axis=0) - pad, points.max(axis=0) + pad
     h = float(np.max(hi - lo)) / cells
-    nx, ny = (np.ceil((hi - lo) / h).astype(int) + 1)
-    x, y = lo[0] + h * np.arange(nx), lo[1] + h * np.arange(ny)
-    ix = np.clip(np.round((points[:, 0] - lo[0]) / h).astype(int), 0, nx - 1)
-    iy = np.clip(np.round((points[:, 1] - lo[1]) / h).astype(int), 0, ny - 1)
-    return x, y, ix, iy
+    nx, ny = np.ceil((hi - lo) / h).astype(int) + 1
+    return lo[0] + h * np.arange(nx), lo[1] + h * np.arange(ny)
 
 
-def workspace(ee: EndEffector, ranges: ArrayLike | None = None, n: int = 120, cells: int = 100,
+def _fill_quads(x: FloatArray, y: FloatArray, P: FloatArray, d: FloatArray) -> tuple[NDArray[np.bool_], FloatArray]:
+    """Occupancy and dexterity of the cells covered by the images of the input-box cells.
+
+    P (n1, n2, 2) positions at the box samples (NaN where unassemblable), d (n1, n2) their
+    dexterity. Each box cell whose four corners assemble maps to (about) the quadrilateral of
+    their images: its cells are occupied, with the corners' mean dexterity (the best of all
+    quadrilaterals covering a cell is kept). A quadrilateral much larger than the typical one
+    joins two branches of the core's position analysis and is skipped.
+    """
+    from matplotlib.path import Path
+
+    quads = np.stack([P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]], axis=2).reshape(-1, 4, 2)
+    dq = np.stack([d[:-1, :-1], d[1:, :-1], d[1:, 1:], d[:-1, 1:]], axis=2).reshape(-1, 4).mean(axis=1)
+    ok = np.all(np.isfinite(quads), axis=(1, 2))
+    quads, dq = quads[ok], dq[ok]
+    size = np.ptp(quads, axis=1).max(axis=1)
+    keep = size <= QUAD_JUMP * max(np.median(size), x[1] - x[0])
+    occ = np.zeros((len(y), len(x)), dtype=bool)
+    dex = np.full(occ.shape, np.nan)
+    h, x0, y0 = x[1] - x[0], x[0], y[0]
+    for quad, dv in zip(quads[keep], dq[keep]):
+        i0, j0 = np.floor((quad.min(axis=0) - [x0, y0]) / h).astype(int)
+        i1, j1 = np.ceil((quad.max(axis=0) - [x0, y0]) / h).astype(int) + 1
+        xs, ys = np.meshgrid(x[i0:i1], y[j0:j1])
+        inside = Path(quad).contains_points(np.column_stack([xs.ravel(), ys.ravel()]), radius=1e-9 * h)
+        inside = inside.reshape(xs.shape)
+        # The corners' own cells too (a quadrilateral thinner than a cell covers no centre).
+        occ[j0:j1, i0:i1] |= inside
+        sub = dex[j0:j1, i0:i1]
+        sub[inside] = np.fmax(sub[inside], dv)
+    ix = np.clip(np.round((quads[keep].reshape(-1, 2)[:, 0] - x0) / h).astype(int), 0, len(x) - 1)
+    iy = np.clip(np.round((quads[keep].reshape(-1, 2)[:, 1] - y0) / h).astype(int), 0, len(y) - 1)
+    occ[iy, ix] = True
+    np.fmax.at(dex, (iy, ix), np.repeat(dq[keep], 4))
+    return occ, dex
+
+
+def workspace(ee: EndEffector, ranges: ArrayLike | None = None, n: int = 80, cells: int = 120,
               psi: float = 0.0) -> Workspace:
     """The reachable workspace of the end-effector point for inputs within ``ranges``.
 
-    m = 2: the input box is sampled (n per input), each sample assembled (the core's position
-    analysis, from the drawing), unassemblable samples skipped; the positions fill an
-    occupancy grid of about ``cells`` cells per side, closed by one cell (binary closing) so
-    that the sampling does not leave holes. m = 3: the constant-orientation workspace (psi,
-    rad from the drawing) by continuation over a grid of ``cells`` per side (:func:`flood`),
-    keeping the cells whose inputs lie within ``ranges``.
+    m = 2: the input box is sampled (n per input) and each sample assembled (the core's
+    position analysis, from the drawing); each box cell whose corners assemble covers the
+    quadrilateral of their images on an occupancy grid of about ``cells`` cells per side (so
+    coarse sampling leaves no holes), whose area is the workspace's. m = 3: the
+    constant-orientation workspace (psi, rad from the drawing) by continuation over a grid of
+    ``cells`` per side (:func:`flood`), keeping the cells whose inputs lie within ``ranges``.
 
     Parameters
     ----------
@@ -209,29 +246,25 @@ def workspace(ee: EndEffector, ranges: ArrayLike | None = None, n: int = 120, ce
         raise ValueError(f"ranges must be (m, 2) = ({mech.dof}, 2) with low < high, got {ranges.tolist()}")
     if ee.dim == 3:
         return _workspace_pose(ee, ranges, cells, psi)
-    from scipy.ndimage import binary_closing
-
-    axes = [np.linspace(lo, hi, n) for lo, hi in ranges]
-    pts, inv_cond = [], []
-    for qq in np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, mech.dof):
-        try:
-            s = ee.state(qq)
-        except (AssemblyError, SingularityError):
-            continue
-        pts.append(s.X[:2])
-        inv_cond.append(1.0 / ee.condition(s.J))
-    if not pts:
+    a1, a2 = (np.linspace(lo, hi, n) for lo, hi in ranges)
+    P = np.full((n, n, 2), np.nan)
+    d = np.full((n, n), np.nan)
+    for i, qa in enumerate(a1):
+        for j, qb in enumerate(a2):
+            try:
+                s = ee.state([qa, qb])
+            except (AssemblyError, SingularityError):
+                continue
+            P[i, j], d[i, j] = s.X, 1.0 / ee.condition(s.J)
+    found = np.isfinite(P[..., 0])
+    if not found.any():
         raise AssemblyError("no sample of the input box can be assembled")
-    points = np.array(pts)
-    x, y, ix, iy = _occupancy(points, cells, pad=0.02 * mech.scale)
+    points = P[found]
+    x, y = _grid_for(points, cells, pad=0.02 * mech.scale)
+    occ, dex = _fill_quads(x, y, P, d)
     h = x[1] - x[0]
-    occ = np.zeros((len(y), len(x)), dtype=bool)
-    occ[iy, ix] = True
-    occ = binary_closing(np.pad(occ, 2), iterations=1)[2:-2, 2:-2]
-    dex = np.full(occ.shape, np.nan)
-    np.fmax.at(dex, (iy, ix), np.array(inv_cond))
     return Workspace(ee, points, x, y, occ, dex, float(occ.sum() * h * h),
-                     f"input box {mech.dof} x {n} samples, {len(points)} assembled")
+                     f"input box {n} x {n} samples, {len(points)} assembled")
 
 
 def _workspace_pose(ee: EndEffector, ranges: FloatArray, cells: int, psi: float) -> Workspace:
