@@ -24,10 +24,11 @@ fn main() {
             let wall = start.elapsed().as_secs_f64() / reps as f64;
             let tr = tr.expect("ran");
             println!(
-                "{method:7} rtol {rtol:.0e}: {:8.3} ms  steps {:5} (rejected {:4})  nfev {:6}  energy drift {:.2e} J  loop gap {:.1e}",
+                "{method:7} rtol {rtol:.0e}: {:8.3} ms  steps {:5} (rejected {:4}, failed evaluations {:3})  nfev {:6}  energy drift {:.2e} J  loop gap {:.1e}",
                 wall * 1e3,
                 tr.stats.integrator.naccept,
                 tr.stats.integrator.nreject,
+                tr.stats.failed_evaluations,
                 tr.stats.integrator.nfev,
                 tr.stats.energy_drift,
                 tr.stats.max_residual

@@ -16,6 +16,7 @@ from .effector import EffectorState, EndEffector
 from .maps import TaskGrid, Workspace, flood, singularity_map, workspace
 from .motion import SINGULAR_TOL, TaskMotion, singularity_message, solve_motion
 from .paths import TaskPath, circle, line, point_to_point, table, time_law
+from .cli import size_cli
 from .sizing import DriveSizing, SizingReport, envelope, size, with_payload
 
 __all__ = [
@@ -29,6 +30,7 @@ __all__ = [
     "singularity_map",
     "singularity_message",
     "size",
+    "size_cli",
     "with_payload",
     "workspace",
     "EffectorState",

@@ -219,6 +219,7 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
         }
     }
     traj.stats.integrator = stepper.stats();
+    traj.stats.failed_evaluations = ode.failed_evaluations;
     if matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
         // Steps that shrink to nothing usually mean the passive mechanism is at a change
         // point (a parallelogram folding flat): say so when it is.

@@ -26,6 +26,8 @@ pub struct MechanismOde<'a> {
     base_valid: bool,
     /// (3n) the Newton start of the current evaluation.
     predicted: Vec<f64>,
+    /// Evaluations that failed (Newton did not converge, or its correction was too large).
+    pub failed_evaluations: usize,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -40,6 +42,7 @@ impl<'a> MechanismOde<'a> {
             last_y: vec![f64::NAN; 2 * m + 1],
             base_valid: false,
             predicted: vec![0.0; ws.x.len()],
+            failed_evaluations: 0,
             mech,
             ws,
             drives,
@@ -121,11 +124,15 @@ impl<'a> MechanismOde<'a> {
         self.predicted.copy_from_slice(&self.ws.x);
         self.last_t = f64::NAN;
         self.base_valid = false;
-        forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws)?;
+        let mut outcome = forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws);
         let correction = scaled_distance(&self.ws.x, &self.predicted, &self.ws.sys.col_scale);
-        if correction > MAX_CORRECTION {
-            return Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
+        if outcome.is_ok() && correction > MAX_CORRECTION {
+            outcome = Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
         }
+        if outcome.is_err() {
+            self.failed_evaluations += 1;
+        }
+        outcome?;
         self.base_valid = true;
         self.last_t = t;
         self.last_y.copy_from_slice(y);

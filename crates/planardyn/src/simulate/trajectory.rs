@@ -52,6 +52,9 @@ pub struct SimStats {
     pub chart_switches: usize,
     /// Steps integrated in a partition chart (near type II singularities).
     pub partition_steps: usize,
+    /// Right-hand-side evaluations refused (Newton failed or would have changed branch); each
+    /// made the integrator retry a shorter step.
+    pub failed_evaluations: usize,
     /// Largest scaled loop-closure residual at the output points (lengths / L, angles in rad).
     pub max_residual: f64,
     /// Smallest type II measure seen at accepted steps (scaled singular value).
