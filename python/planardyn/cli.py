@@ -73,6 +73,7 @@ def summary(res: SimulationResult) -> str:
 # ------------------------------------------------------------------ the parser
 
 EPILOG = "Exit status: 0 ok, 1 the computation failed, 2 usage or model error."
+SIZE_NOTE = "Also: planardyn size MODEL ...: actuator sizing for an end-effector motion (see planardyn size --help)."
 
 
 def _sub(sub, name: str, help: str, description: str, examples: str) -> argparse.ArgumentParser:
@@ -106,7 +107,7 @@ def _parser() -> argparse.ArgumentParser:
             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
             "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
             "  planardyn demo\n\n"
-            "Run 'planardyn COMMAND --help' for a command's options. " + EPILOG
+            "Run 'planardyn COMMAND --help' for a command's options. " + SIZE_NOTE + "\n" + EPILOG
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -428,6 +429,12 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["size"]:
+        # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
+        from .robot import size_cli
+
+        return size_cli(argv[1:])
     args = _parser().parse_args(argv)
     try:
         return COMMANDS[args.command](args)
