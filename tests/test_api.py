@@ -539,3 +539,16 @@ def test_redundant_constraints_load_with_a_warning_and_simulate():
     assert A[0, 0] == pytest.approx(3 * 0.3 * 0.09 / 3 + 1.0 * 0.09, rel=1e-12)
     res = mech.simulate(t_end=0.3)
     assert res.success and res.energy.drift < 1e-8
+
+
+def test_assembly_continues_from_a_given_start_on_its_branch(four_bar):
+    # From a solution at theta = 2 (drawn branch), continuing to theta = 2.05 gives the
+    # same body coordinates as the whole continuation from the drawing (both converge to
+    # round-off on the same branch).
+    x_far = four_bar.assemble([2.0])
+    x_near = four_bar.assemble([2.05], x_start=x_far)
+    np.testing.assert_allclose(x_near, four_bar.assemble([2.05]), atol=1e-12)
+    kin = four_bar.kinematics([2.05], x_start=x_far)
+    np.testing.assert_allclose(kin["x"], x_near, atol=1e-12)
+    with pytest.raises(ValueError, match="x_start"):
+        four_bar.assemble([2.0], x_start=[0.0, 1.0])

@@ -195,13 +195,17 @@ class Mechanism:
 
     # ------------------------------------------------------------------ kinematics
 
-    def assemble(self, q: ArrayLike) -> FloatArray:
+    def assemble(self, q: ArrayLike, x_start: ArrayLike | None = None) -> FloatArray:
         """Body coordinates at given generalized coordinates (position analysis).
 
         Parameters
         ----------
         q : (m,) array_like
             Generalized coordinates (rad or m).
+        x_start : (3n,) array_like, optional
+            Body coordinates on the wanted branch (e.g. the previous point of a path):
+            continue from there instead of from the drawing, which is faster for nearby q
+            and keeps the branch where x_start is.
 
         Returns
         -------
@@ -215,7 +219,7 @@ class Mechanism:
         ValueError
             q has the wrong shape or a non-finite value.
         """
-        return self._native.assemble(q)
+        return self._native.assemble(q, x_start)
 
     def point_positions(self, x: ArrayLike) -> FloatArray:
         """World positions of every named point for given body coordinates.
@@ -233,7 +237,7 @@ class Mechanism:
         """
         return self._native.point_positions(x)
 
-    def kinematics(self, q: ArrayLike, qd: ArrayLike | None = None) -> dict[str, Any]:
+    def kinematics(self, q: ArrayLike, qd: ArrayLike | None = None, x_start: ArrayLike | None = None) -> dict[str, Any]:
         """Positions, velocity and acceleration analogues, singularity measures at q.
 
         Parameters
@@ -242,6 +246,10 @@ class Mechanism:
             Generalized coordinates (rad or m).
         qd : (m,) array_like, optional
             Generalized rates (rad/s or m/s); adds the velocity entries below.
+        x_start : (3n,) array_like, optional
+            Body coordinates on the wanted branch (e.g. the previous point of a path):
+            continue from there instead of from the drawing, which is faster for nearby q
+            and keeps the branch where x_start is.
 
         Returns
         -------
@@ -262,7 +270,7 @@ class Mechanism:
         ------
         AssemblyError, SingularityError (the analogues are undefined where sigma_min = 0).
         """
-        return self._native.kinematics(q, qd)
+        return self._native.kinematics(q, qd, x_start)
 
     # ------------------------------------------------------------------ dynamics
 

@@ -63,6 +63,11 @@ impl PyMechanism {
         vector(name, a, self.m(), &self.coords_what())
     }
 
+    /// Body coordinates (3n,) given as a continuation start.
+    fn x_arg(&self, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
+        vector("x_start", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")
+    }
+
     /// World positions (P x 2, row-major) of every named point for body coordinates x.
     fn points_at(&self, x: &[f64], out: &mut Vec<f64>) {
         for c in &self.carriers {
@@ -92,10 +97,14 @@ impl PyMechanism {
         }
     }
 
-    /// Assembled and analysed (positions, U) at q: a workspace in the input chart.
-    fn analysed(mech: &Mechanism, q: &[f64]) -> Result<Workspace, Failure> {
+    /// Assembled and analysed (positions, U) at q: a workspace in the input chart; by
+    /// continuation from `x_start` if given, else from the drawing.
+    fn analysed(mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, Failure> {
         let mut ws = Workspace::new(mech);
-        kin::assemble_into(mech, q, &mut ws)?;
+        match x_start {
+            Some(x) => kin::assemble_from(mech, x, q, &mut ws)?,
+            None => kin::assemble_into(mech, q, &mut ws)?,
+        }
         kin::velocity_analogues(&mut ws)?;
         Ok(ws)
     }
@@ -264,11 +273,20 @@ impl PyMechanism {
     }
 
     /// Body coordinates x (3n,) at coordinates q (m,), by continuation from the drawing
-    /// (the assembly branch drawn).
-    fn assemble<'py>(&self, py: Python<'py>, q: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+    /// (the assembly branch drawn), or from body coordinates `x_start` on the wanted branch.
+    #[pyo3(signature = (q, x_start=None))]
+    fn assemble<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, x_start: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyAny>> {
         let q = self.q_arg("q", &q)?;
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
-        let x = run(py, move || Ok(kin::assemble(&mech, &q)?))?;
+        let x = run(py, move || {
+            let mut ws = Workspace::new(&mech);
+            match &x_start {
+                Some(x) => kin::assemble_from(&mech, x, &q, &mut ws)?,
+                None => kin::assemble_into(&mech, &q, &mut ws)?,
+            }
+            Ok(ws.x)
+        })?;
         Ok(arr1(py, x))
     }
 
@@ -289,17 +307,18 @@ impl PyMechanism {
     }
 
     /// Positions and analogues at q (and velocities with qd); see the Python docstring.
-    #[pyo3(signature = (q, qd=None))]
-    fn kinematics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyDict>> {
+    #[pyo3(signature = (q, qd=None, x_start=None))]
+    fn kinematics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: Option<ArrayArg<'py>>, x_start: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyDict>> {
         let q = self.q_arg("q", &q)?;
         let qd = qd.map(|a| self.q_arg("qd", &a)).transpose()?;
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
         let (n, m) = (mech.n_bodies(), mech.dof());
         let nx = 3 * n;
         let (ws, w, sigma, passive) = run(py, {
             let qd = qd.clone();
             move || {
-                let mut ws = Self::analysed(&mech, &q)?;
+                let mut ws = Self::analysed(&mech, &q, x_start.as_deref())?;
                 let w = kin::acceleration_analogues(&mech, &mut ws);
                 if let Some(qd) = &qd {
                     kin::convective(&mech, qd, &mut ws);
@@ -350,7 +369,7 @@ impl PyMechanism {
         let mech = self.inner.clone();
         let m = mech.dof();
         let a = run(py, move || {
-            let mut ws = Self::analysed(&mech, &q)?;
+            let mut ws = Self::analysed(&mech, &q, None)?;
             dynamics::mass_matrix(&mech, &mut ws);
             Ok(ws.a)
         })?;

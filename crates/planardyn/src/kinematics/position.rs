@@ -184,6 +184,24 @@ pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Workspa
     Ok(())
 }
 
+/// As [`assemble_into`], but continuing from the body coordinates `x_start` (a solution on
+/// the wanted branch, e.g. the previous point of a path) instead of from the drawing.
+pub fn assemble_from(mech: &Mechanism, x_start: &[f64], q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
+        return Err(KinematicsError::BadArgument(format!(
+            "x_start needs {} finite body coordinates (X, Y, phi per body), got {}",
+            mech.n_x(),
+            x_start.len()
+        )));
+    }
+    ws.chart = Chart::Inputs;
+    ws.x.copy_from_slice(x_start);
+    let mut z = vec![0.0; mech.dof()];
+    super::constraints::coordinates(mech, x_start, &mut z);
+    solve_position(mech, &z, ws)?;
+    continue_to(mech, &z, q, ws)
+}
+
 /// Body coordinates x at user coordinates q, by continuation from the drawing.
 pub fn assemble(mech: &Mechanism, q: &[f64]) -> Result<Vec<f64>, KinematicsError> {
     let mut ws = Workspace::new(mech);
