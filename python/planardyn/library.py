@@ -51,6 +51,7 @@ __all__ = [
     "circle_intersection",
     "double_parallelogram",
     "double_parallelogram_model",
+    "draw_all",
     "five_bar",
     "five_bar_model",
     "four_bar",

@@ -4,6 +4,7 @@
 //! The typed Python face is the package `python/planardyn`; its stub `_core.pyi` mirrors
 //! this module.
 
+mod batch;
 mod convert;
 mod errors;
 mod mechanism;
@@ -56,5 +57,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loads, m)?)?;
     errors::register(m)?;
     structure::register(m)?;
+    batch::register(m)?;
     Ok(())
 }

@@ -10,6 +10,7 @@
 //! validated once into an immutable [`Mechanism`]; every computation runs in a
 //! [`Workspace`] of buffers sized once. SI units and radians throughout.
 
+pub mod batch;
 pub mod dynamics;
 pub mod error;
 pub mod integrate;

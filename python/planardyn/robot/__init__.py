@@ -44,3 +44,9 @@ __all__ = [
     "table",
     "time_law",
 ]
+
+from .capability import CapabilityMap, capability_at, capability_map, plot_capability
+from .modes import Mode, assembly_modes, plot_modes, working_modes
+
+__all__ += ["CapabilityMap", "Mode", "assembly_modes", "capability_at", "capability_map", "plot_capability",
+            "plot_modes", "working_modes"]

@@ -1,0 +1,137 @@
+"""Dynamic capability: the end-effector acceleration that the drives can give in every
+direction, at rest, within their effort limits |tau_k| <= tau_max_k.
+
+At rest (qd = 0) the convective term vanishes, so an end-effector acceleration a needs
+qdd = J^-1 a and
+
+    tau = A J^-1 a + g,        g = inverse_dynamics(q, 0, 0)
+
+(g: the efforts that hold the robot still against gravity and the model's springs). Along a
+direction d = (cos t, sin t), a = r d is feasible iff |(A J^-1 d)_k r + g_k| <= tau_max_k for
+every drive k; the largest feasible r is a minimum of ratios. The guaranteed acceleration
+is the minimum over ``N_DIRECTIONS`` directions (0 where g alone exceeds a limit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .effector import EndEffector
+from .maps import TaskGrid, flood
+
+FloatArray = NDArray[np.float64]
+
+N_DIRECTIONS = 72
+
+
+def max_acceleration(M: FloatArray, g: FloatArray, tau_max: FloatArray, d: FloatArray) -> float:
+    """Largest r >= 0 with |M d r + g| <= tau_max (all drives); 0 if g alone exceeds them."""
+    if np.any(np.abs(g) > tau_max):
+        return 0.0
+    v = M @ d
+    r = np.inf
+    for vk, gk, tk in zip(v, g, tau_max):
+        if vk > 0:
+            r = min(r, (tk - gk) / vk)
+        elif vk < 0:
+            r = min(r, (-tk - gk) / vk)
+    return float(r)
+
+
+def capability_at(ee: EndEffector, q: ArrayLike, tau_max: ArrayLike, n_dir: int = N_DIRECTIONS) -> tuple[float, float]:
+    """(guaranteed acceleration (m/s^2), its limiting direction t (rad)) at inputs q, at rest."""
+    mech = ee.mech
+    q = np.asarray(q, dtype=float)
+    tau_max = np.broadcast_to(np.asarray(tau_max, dtype=float), (mech.dof,))
+    J = ee.state(q).J[:2]
+    if ee.dim != 2:
+        raise ValueError("the capability map is for a point end effector (m = 2)")
+    M = mech.mass_matrix(q) @ np.linalg.inv(J)
+    g = mech.inverse_dynamics(q, np.zeros(mech.dof), np.zeros(mech.dof))
+    ts = np.linspace(0.0, 2 * np.pi, n_dir, endpoint=False)
+    r = [max_acceleration(M, g, tau_max, np.array([np.cos(t), np.sin(t)])) for t in ts]
+    k = int(np.argmin(r))
+    return float(r[k]), float(ts[k])
+
+
+@dataclass
+class CapabilityMap:
+    """Guaranteed end-effector acceleration at rest on a grid.
+
+    ``x`` (nx,), ``y`` (ny,) m; ``accel`` (ny, nx) m/s^2, the smallest over directions of the
+    largest feasible acceleration (0 where holding still already exceeds a limit, NaN where
+    unreachable); ``direction`` (ny, nx) rad, the limiting direction; ``holding`` (ny, nx, m)
+    efforts g that hold the robot at rest; ``tau_max`` (m,); ``grid`` the TaskGrid (q,
+    singularity measures) it was computed on.
+    """
+
+    effector: EndEffector
+    x: FloatArray
+    y: FloatArray
+    accel: FloatArray
+    direction: FloatArray
+    holding: FloatArray
+    tau_max: FloatArray
+    grid: TaskGrid
+
+    def plot(self, ax: Any = None) -> list[Any]:
+        return plot_capability(self, ax)
+
+
+def capability_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float, float],
+                   n: int | tuple[int, int], tau_max: ArrayLike, q_start: ArrayLike | None = None,
+                   n_dir: int = N_DIRECTIONS) -> CapabilityMap:
+    """Guaranteed acceleration of the end-effector point at rest over a grid of positions
+    (inverse kinematics by :func:`flood` on the working mode of ``q_start``, default the
+    drawing). ``tau_max``: (m,) or scalar effort limits (N m or N)."""
+    nx, ny = (n, n) if np.ndim(n) == 0 else n  # type: ignore[misc]
+    grid = flood(ee, np.linspace(*xlim, nx), np.linspace(*ylim, ny), 0.0, q_start)
+    m = ee.mech.dof
+    tmax = np.broadcast_to(np.asarray(tau_max, dtype=float), (m,)).copy()
+    acc = np.full((ny, nx), np.nan)
+    direc = np.full((ny, nx), np.nan)
+    hold = np.full((ny, nx, m), np.nan)
+    for j in range(ny):
+        for i in range(nx):
+            if not grid.reachable[j, i]:
+                continue
+            q = grid.q[j, i]
+            acc[j, i], direc[j, i] = capability_at(ee, q, tmax, n_dir)
+            hold[j, i] = ee.mech.inverse_dynamics(q, np.zeros(m), np.zeros(m))
+    return CapabilityMap(ee, grid.x, grid.y, acc, direc, hold, tmax, grid)
+
+
+def plot_capability(cmap: CapabilityMap, ax: Any = None) -> list[Any]:
+    """Guaranteed acceleration (colour), cells where holding still exceeds a limit hatched
+    grey, the robot in its drawing."""
+    from .plots import _draw_robot
+
+    if ax is None:
+        from matplotlib.figure import Figure
+
+        ax = Figure(figsize=(7, 6)).subplots()
+    out: list[Any] = []
+    z = np.ma.masked_invalid(np.where(cmap.accel > 0, cmap.accel, np.nan))
+    mesh = ax.pcolormesh(cmap.x, cmap.y, z, shading="nearest", cmap="viridis")
+    out.append(mesh)
+    ax.figure.colorbar(mesh, ax=ax, label="guaranteed acceleration at rest (m/s^2)")
+    zero = np.where(cmap.accel == 0, 1.0, np.nan)
+    if np.isfinite(zero).any():
+        out.append(ax.pcolormesh(cmap.x, cmap.y, np.ma.masked_invalid(zero), shading="nearest", cmap="Greys",
+                                 vmin=0, vmax=2))
+    out.append(ax.contour(cmap.x, cmap.y, cmap.grid.reachable.astype(float), levels=[0.5], colors="k",
+                          linewidths=0.8))
+    out += _draw_robot(ax, cmap.effector.mech)
+    lim = ", ".join(f"{t:g}" for t in cmap.tau_max)
+    ax.set(xlabel="x (m)", ylabel="y (m)",
+           title=f"{cmap.effector.mech.name}: acceleration of {cmap.effector.point} in every direction\n"
+                 f"at rest, |tau| <= [{lim}] (grey: holding still exceeds a limit)")
+    ax.set_aspect("equal")
+    return out
+
+
+__all__ = ["CapabilityMap", "capability_at", "capability_map", "max_acceleration", "plot_capability"]
