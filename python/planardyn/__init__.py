@@ -49,3 +49,4 @@ __all__ = [
 from .results_io import read_results  # noqa: E402
 
 __all__ += ["read_results"]
+from . import batch  # noqa: E402  (issue 6: planardyn.batch.simulate, sweep, monte_carlo)

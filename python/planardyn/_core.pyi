@@ -106,3 +106,7 @@ class Mechanism:
         progress: Callable[[float], Any] | None = None,
         max_steps: int | None = None,
     ) -> dict[str, Any]: ...
+
+def simulate_batch(
+    variants: list[tuple[Mechanism, dict[str, Any]]], threads: int | None = None
+) -> list[dict[str, Any] | tuple[str, str]]: ...

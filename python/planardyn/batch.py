@@ -1,0 +1,283 @@
+"""Batch runs: many variants of a mechanism simulated in one call.
+
+A *variant* is a model (a :class:`~planardyn.Mechanism` or a model dict) and, optionally, a
+dict of settings that override the call's (``q0``, ``qd0``, ``t_end``, ...). Parameter
+sweeps and Monte Carlo samples are model edits made by :func:`sweep` and
+:func:`monte_carlo`; a grid of start states is a list of ``(mech, {"q0": q})`` pairs.
+
+By default the whole list goes to Rust in one call and runs on a pool of native threads
+with the GIL released (all cores, or ``threads``). Given an ``executor`` (a
+``dask.distributed.Client`` or any ``concurrent.futures.Executor``), the list is cut into
+chunks and each chunk runs that same native batch on a worker. Either way the results come
+back in input order and equal, bit for bit, those of a loop of ``mech.simulate``. A variant
+that fails (a start that cannot be assembled, invalid settings, a model dict that is not a
+mechanism) gives a :class:`BatchError` in its place; the others are not affected.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _core
+from .mechanism import Mechanism, from_dict
+from .result import SimulationResult
+
+__all__ = ["BatchError", "monte_carlo", "simulate", "sweep"]
+
+#: A variant: a model, or a model with its own settings.
+VariantLike = Union[Mechanism, Mapping[str, Any], tuple[Union[Mechanism, Mapping[str, Any]], Mapping[str, Any]]]
+#: ``edit(model_dict, value) -> model_dict`` or a dotted path into the model dict.
+Edit = Union[str, Callable[[dict[str, Any], Any], dict[str, Any]]]
+
+_SETTINGS = ("t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps")
+_ARRAYS = ("t_eval", "q0", "qd0")
+
+
+@dataclass(frozen=True)
+class BatchError:
+    """The place of a variant that failed, and why.
+
+    ``type`` is the name of the exception ``Mechanism.simulate`` (or building the model)
+    would have raised: ``'AssemblyError'``, ``'SimulationError'``, ``'ModelError'``...
+    """
+
+    #: Position of the variant in the list given.
+    index: int
+    type: str
+    message: str
+    #: Always False, so that ``[r for r in results if r.success]`` works on a mixed list.
+    success: bool = False
+
+    def __str__(self) -> str:
+        return f"variant {self.index}: {self.type}: {self.message}"
+
+
+def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, Any]:
+    """The settings of one variant, arrays as lists of floats (exact for float64)."""
+    unknown = set(own) - set(_SETTINGS)
+    if unknown:
+        raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of {', '.join(_SETTINGS)}")
+    out = {k: v for k, v in {**common, **own}.items() if v is not None}
+    for k in _ARRAYS:
+        if k in out:
+            out[k] = np.asarray(out[k], dtype=np.float64).ravel().tolist()
+    if "t_end" in out:
+        out["t_end"] = float(out["t_end"])
+    return out
+
+
+def _run_chunk(items: list[tuple[Mechanism, dict[str, Any]]], threads: int | None) -> list[Any]:
+    """One native batch: a picklable call that runs on a worker (or here)."""
+    return _core.simulate_batch([(m._native, s) for m, s in items], threads)
+
+
+def _is_dask(executor: Any) -> bool:
+    return type(executor).__module__.split(".")[0] == "distributed"
+
+
+def simulate(
+    variants: Sequence[VariantLike],
+    t_end: float | None = None,
+    *,
+    method: str | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    dt: float | None = None,
+    t_eval: ArrayLike | None = None,
+    output_dt: float | None = None,
+    max_steps: int | None = None,
+    threads: int | None = None,
+    executor: Any = None,
+    chunk_size: int | None = None,
+    progress: Callable[[int, int], Any] | None = None,
+) -> list[SimulationResult | BatchError]:
+    """Simulate every variant with its model's drives; results in input order.
+
+    Parameters
+    ----------
+    variants : sequence
+        Each a :class:`Mechanism`, a model dict (as :meth:`Mechanism.to_dict` gives), or a
+        pair ``(model, settings)`` whose dict overrides the call's settings for that variant
+        (keys as the arguments of :meth:`Mechanism.simulate` without callables: ``q0``,
+        ``qd0`` (m,) in rad or m and rad/s or m/s, ``t_end``, ``method``...).
+    t_end, method, rtol, atol, dt, t_eval, output_dt, max_steps
+        As for :meth:`Mechanism.simulate` (None: the model file's value).
+    threads : int, optional
+        Native threads per batch (here, or on each worker); default one per core.
+    executor : dask.distributed.Client or concurrent.futures.Executor, optional
+        Spread chunks of the list over it; default: run here.
+    chunk_size : int, optional
+        Variants per chunk. Default with an executor: the list in about 16 chunks; without,
+        one chunk (or about 20 when ``progress`` is given).
+    progress : callable ``progress(done, total)``, optional
+        Called after each chunk with the number of variants finished.
+
+    Returns
+    -------
+    list of SimulationResult or BatchError
+        One entry per variant. A run that stopped early (check ``success``/``status``) is a
+        result, as from :meth:`Mechanism.simulate`; a run that could not start, or a model
+        that could not be built, is a :class:`BatchError`.
+    """
+    common = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, t_eval=t_eval,
+                  output_dt=output_dt, max_steps=max_steps)
+    out: list[SimulationResult | BatchError | None] = [None] * len(variants)
+    todo: list[int] = []
+    items: list[tuple[Mechanism, dict[str, Any]]] = []
+    for i, v in enumerate(variants):
+        model, own = (v if isinstance(v, tuple) else (v, {}))
+        try:
+            mech = model if isinstance(model, Mechanism) else from_dict(model)
+            items.append((mech, _settings(common, own)))
+            todo.append(i)
+        except Exception as e:  # noqa: BLE001 - reported in the variant's place
+            out[i] = BatchError(i, type(e).__name__, str(e))
+    n = len(items)
+    if chunk_size is None:
+        parts = 16 if executor is not None else (20 if progress is not None else 1)
+        chunk_size = max(1, math.ceil(n / parts))
+    if chunk_size < 1:
+        raise ValueError(f"chunk_size = {chunk_size} must be at least 1")
+    starts = range(0, n, chunk_size)
+    if executor is None:
+        pending = [lambda s=s: _run_chunk(items[s:s + chunk_size], threads) for s in starts]
+    else:
+        kw = {"pure": False} if _is_dask(executor) else {}
+        futures = [executor.submit(_run_chunk, items[s:s + chunk_size], threads, **kw) for s in starts]
+        pending = [f.result for f in futures]
+    done = 0
+    for s, get in zip(starts, pending):
+        chunk = items[s:s + chunk_size]
+        try:
+            raws = get()
+        except Exception as e:  # noqa: BLE001 - a lost chunk loses only its own variants
+            raws = [(type(e).__name__, f"the chunk with this variant failed: {e}")] * len(chunk)
+        for k, ((mech, settings), raw) in enumerate(zip(chunk, raws)):
+            i = todo[s + k]
+            out[i] = _result(raw, mech, settings) if isinstance(raw, dict) else BatchError(i, *raw)
+        done += len(chunk)
+        if progress is not None:
+            progress(done, n)
+    return out  # type: ignore[return-value]
+
+
+def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
+    from .results_io import attach_metadata
+
+    result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
+                                       coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names)
+    return attach_metadata(result, mech, settings)
+
+
+# ---------------------------------------------------------------------- making variants
+
+
+def _set(model: dict[str, Any], path: str, value: Any) -> dict[str, Any]:
+    """Set a dotted path (``bodies.crank.mass``, ``points.A.0``, ``coordinates.theta1.q0``)
+    in a copy of the model dict. A list is indexed by number or by its items' ``name``."""
+    model = copy.deepcopy(model)
+    *head, last = path.split(".")
+    node: Any = model
+    for key in [*head, last]:
+        parent, node = node, _child(node, key, path)
+    if isinstance(parent, list):
+        parent[_index(parent, last, path)] = _plain(value)
+    else:
+        parent[last] = _plain(value)
+    return model
+
+
+def _index(node: list[Any], key: str, path: str) -> int:
+    if key.lstrip("-").isdigit():
+        return int(key)
+    for k, item in enumerate(node):
+        if isinstance(item, Mapping) and item.get("name") == key:
+            return k
+    raise KeyError(f"{path}: no item named {key!r}")
+
+
+def _child(node: Any, key: str, path: str) -> Any:
+    if isinstance(node, list):
+        return node[_index(node, key, path)]
+    if isinstance(node, Mapping):
+        # A missing leaf (an optional field such as q0) is created by _set.
+        return node.get(key)
+    raise KeyError(f"{path}: {key!r} is inside a value, not a mapping or list")
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    return value
+
+
+def _edited(base: Mechanism | Mapping[str, Any], edit: Edit, value: Any) -> dict[str, Any]:
+    model = base.to_dict() if isinstance(base, Mechanism) else copy.deepcopy(dict(base))
+    return _set(model, edit, value) if isinstance(edit, str) else edit(model, value)
+
+
+def sweep(base: Mechanism | Mapping[str, Any], edit: Edit, values: Sequence[Any] | ArrayLike, *,
+          build: bool = True) -> list[Mechanism] | list[dict[str, Any]]:
+    """Variants of a model, one per value.
+
+    Parameters
+    ----------
+    base : Mechanism or model dict
+    edit : str or callable
+        A dotted path into the model dict, e.g. ``"bodies.crank.mass"`` (kg) or
+        ``"points.B.0"`` (m), lists indexed by number or item name
+        (``"coordinates.theta1.q0"``); or ``edit(model_dict, value) -> model_dict``, given
+        a fresh copy it may change.
+    values : sequence
+        The values (in the units of the field).
+    build : bool
+        True: validated Mechanisms (a value that makes no mechanism raises ``ModelError``).
+        False: the model dicts, which :func:`simulate` builds and reports on one by one.
+    """
+    models = [_edited(base, edit, v) for v in values]
+    return [from_dict(m) for m in models] if build else models
+
+
+def monte_carlo(base: Mechanism | Mapping[str, Any],
+                distributions: Mapping[str, tuple[float, float] | Callable[[np.random.Generator, int], ArrayLike]],
+                n: int, seed: int | None = None, *, build: bool = True,
+                ) -> tuple[list[Mechanism] | list[dict[str, Any]], dict[str, NDArray[np.float64]]]:
+    """n random variants of a model and the values drawn.
+
+    Parameters
+    ----------
+    distributions : mapping
+        For each dotted path (as in :func:`sweep`), ``(low, high)`` for a uniform draw, or
+        ``f(rng, n) -> (n,)`` values (e.g. ``lambda rng, n: rng.normal(1.2, 0.05, n)``).
+        Paths are drawn in the order given, each all n values at once, from
+        ``numpy.random.default_rng(seed)``: the same seed gives the same variants.
+    n : int
+        Number of variants.
+    build : bool
+        As for :func:`sweep`.
+
+    Returns
+    -------
+    (variants, values)
+        The n variants, and for each path the (n,) values used.
+    """
+    rng = np.random.default_rng(seed)
+    values: dict[str, NDArray[np.float64]] = {}
+    for path, dist in distributions.items():
+        drawn = rng.uniform(dist[0], dist[1], n) if isinstance(dist, tuple) else dist(rng, n)
+        values[path] = np.asarray(drawn, dtype=np.float64).reshape(n)
+    model = base.to_dict() if isinstance(base, Mechanism) else dict(base)
+    models = []
+    for k in range(n):
+        m = model
+        for path, vals in values.items():
+            m = _set(m, path, float(vals[k]))
+        models.append(m)
+    return ([from_dict(m) for m in models] if build else models), values
