@@ -7,7 +7,6 @@
 use crate::errors::{run, to_pyerr, Failure};
 use crate::mechanism::PyMechanism;
 use planardyn::batch::{simulate_many, Model, Overrides, Variant};
-use planardyn::simulate::Trajectory;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -55,7 +54,7 @@ fn simulate_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, 
     let out = run(py, || simulate_many(&vs, threads).map_err(Failure::from))?;
     out.into_iter()
         .map(|r| match r {
-            Ok(traj) => Ok(to_dict(py, traj)?.into_any()),
+            Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
             Err(e) => {
                 let err = to_pyerr(py, &e);
                 let name = err.get_type(py).name()?.to_string();
@@ -63,43 +62,6 @@ fn simulate_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, 
             }
         })
         .collect()
-}
-
-/// The trajectory as `Mechanism.simulate`'s dict (see `simulate.rs`, whose keys it mirrors).
-fn to_dict(py: Python<'_>, t: Trajectory) -> PyResult<Bound<'_, PyDict>> {
-    use crate::convert::{arr1, arr2, bool1};
-    let (n, m, nx) = (t.len(), t.m, t.nx);
-    let d = PyDict::new(py);
-    d.set_item("t", arr1(py, t.t))?;
-    d.set_item("q", arr2(py, n, m, t.q)?)?;
-    d.set_item("qd", arr2(py, n, m, t.qd)?)?;
-    d.set_item("qdd", arr2(py, n, m, t.qdd)?)?;
-    d.set_item("tau", arr2(py, n, m, t.tau)?)?;
-    d.set_item("x", arr2(py, n, nx, t.x)?)?;
-    d.set_item("xd", arr2(py, n, nx, t.xd)?)?;
-    d.set_item("kinetic", arr1(py, t.kinetic))?;
-    d.set_item("potential", arr1(py, t.potential))?;
-    d.set_item("work", arr1(py, t.work))?;
-    d.set_item("sigma", arr1(py, t.sigma))?;
-    d.set_item("residual", arr1(py, t.residual))?;
-    d.set_item("partitioned", bool1(py, t.partitioned))?;
-    d.set_item("status", t.status.name())?;
-    d.set_item("message", t.message)?;
-    let st = &t.stats;
-    let stats = PyDict::new(py);
-    stats.set_item("nfev", st.integrator.nfev)?;
-    stats.set_item("naccept", st.integrator.naccept)?;
-    stats.set_item("nreject", st.integrator.nreject)?;
-    stats.set_item("njev", st.integrator.njev)?;
-    stats.set_item("nlu", st.integrator.nlu)?;
-    stats.set_item("chart_switches", st.chart_switches)?;
-    stats.set_item("partition_steps", st.partition_steps)?;
-    stats.set_item("max_residual", st.max_residual)?;
-    stats.set_item("min_sigma", st.min_sigma)?;
-    stats.set_item("min_passive_sigma", st.min_passive_sigma)?;
-    stats.set_item("energy_drift", st.energy_drift)?;
-    d.set_item("stats", stats)?;
-    Ok(d)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -172,7 +172,9 @@ pub fn simulate<'py>(py: Python<'py>, mech: &Mechanism, args: Args, drives: Opti
     to_dict(py, traj, cancel_reason)
 }
 
-fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<String>) -> PyResult<Bound<'_, PyDict>> {
+/// The trajectory as the dict `Mechanism.simulate` returns (arrays time-major); a
+/// cancellation's reason, if given, replaces the message.
+pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<String>) -> PyResult<Bound<'_, PyDict>> {
     let (n, m, nx) = (t.len(), t.m, t.nx);
     let d = PyDict::new(py);
     d.set_item("t", arr1(py, t.t))?;
@@ -207,6 +209,7 @@ fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<String>) -> PyRe
     stats.set_item("min_sigma", st.min_sigma)?;
     stats.set_item("min_passive_sigma", st.min_passive_sigma)?;
     stats.set_item("energy_drift", st.energy_drift)?;
+    stats.set_item("failed_evaluations", st.failed_evaluations)?;
     d.set_item("stats", stats)?;
     Ok(d)
 }
