@@ -464,7 +464,7 @@ impl PyMechanism {
                 Ok(v.data)
             })
             .transpose()?;
-        let args = crate::simulate::Args {
+        let args = planardyn::simulate::Overrides {
             t_end,
             method,
             rtol,

@@ -7,84 +7,25 @@ use crate::convert::{arr1, arr2, bool1, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives};
-use planardyn::integrate::Method;
-use planardyn::simulate::{grid, Settings, Trajectory};
-use planardyn::{Error, Mechanism};
+use planardyn::simulate::{Overrides, Settings, Trajectory};
+use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// Most output times a run may ask for through `output_dt` (a guard against a typo such as
-/// output_dt = 1e-12 filling the memory).
-const MAX_OUTPUTS: f64 = 1e8;
 /// The progress callback (and the check for Ctrl-C) runs each time t has advanced by this
 /// fraction of the run: at most about 100 times.
 const PROGRESS_FRACTION: f64 = 0.01;
 
-/// The caller's overrides of the model's `simulate` defaults (None: the model's).
-pub struct Args {
-    pub t_end: Option<f64>,
-    pub method: Option<String>,
-    pub rtol: Option<f64>,
-    pub atol: Option<f64>,
-    pub dt: Option<f64>,
-    pub t_eval: Option<Vec<f64>>,
-    pub output_dt: Option<f64>,
-    pub q0: Option<Vec<f64>>,
-    pub qd0: Option<Vec<f64>>,
-    pub max_steps: Option<usize>,
-}
-
-fn settings(mech: &Mechanism, a: Args) -> Result<Settings, Failure> {
-    let mut s = Settings::for_model(mech)?;
+/// The model's simulation settings with the caller's overrides; a bad `t_end` is a
+/// ValueError (an argument), everything else the core's option error.
+fn settings(mech: &Mechanism, a: &Overrides) -> Result<Settings, Failure> {
     if let Some(t_end) = a.t_end {
-        if !(t_end.is_finite() && t_end > s.t0) {
-            return Err(PyValueError::new_err(format!("t_end = {t_end} must be a finite time after t0 = {} s", s.t0)).into());
-        }
-        s.t_end = t_end;
-    }
-    if let Some(name) = &a.method {
-        s.method = name.parse::<Method>().map_err(Error::Options)?;
-        // The file's `dt` belongs to its fixed-step method: an adaptive method chosen here
-        // keeps its error control unless a step is given with it.
-        if s.method.is_adaptive() && a.dt.is_none() {
-            s.options.dt = None;
+        if !(t_end.is_finite() && t_end > 0.0) {
+            return Err(PyValueError::new_err(format!("t_end = {t_end} must be a finite time after t0 = 0 s")).into());
         }
     }
-    if let Some(v) = a.rtol {
-        s.options.rtol = v;
-    }
-    if let Some(v) = a.atol {
-        s.options.atol = v;
-    }
-    if a.dt.is_some() {
-        s.options.dt = a.dt;
-    }
-    if let Some(n) = a.max_steps {
-        s.options.max_steps = n;
-    }
-    s.t_eval = match (a.t_eval, a.output_dt.or(mech.simulate.output_dt)) {
-        (Some(te), _) => Some(te),
-        (None, Some(h)) => {
-            if !(h.is_finite() && h > 0.0) || (s.t_end - s.t0) / h > MAX_OUTPUTS {
-                return Err(PyValueError::new_err(format!(
-                    "output_dt = {h} must be > 0 s and give at most {MAX_OUTPUTS:e} outputs over [{}, {}] s",
-                    s.t0, s.t_end
-                ))
-                .into());
-            }
-            // `grid` can overshoot t_end by an ulp (0.3 = 3 * 0.1 + 4e-17): clamp, and drop
-            // a duplicate end point, so that the times pass the core's range check.
-            let mut t = grid(s.t0, s.t_end, h);
-            t.iter_mut().for_each(|v| *v = v.min(s.t_end));
-            t.dedup();
-            Some(t)
-        }
-        (None, None) => None,
-    };
-    s.q0 = a.q0;
-    s.qd0 = a.qd0;
-    Ok(s)
+    Ok(a.settings(mech)?)
 }
 
 /// A Python callable `f(t, q, qd) -> (m,)` as drive efforts.
@@ -126,13 +67,13 @@ impl Drives for PyDrives {
 }
 
 /// Run a simulation and return its trajectory as a dict (see `planardyn.SimulationResult`).
-pub fn simulate<'py>(py: Python<'py>, mech: &Mechanism, args: Args, drives: Option<Py<PyAny>>, progress: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
+pub fn simulate<'py>(py: Python<'py>, mech: &Mechanism, args: Overrides, drives: Option<Py<PyAny>>, progress: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
     let m = mech.dof();
     let mut py_drives = drives.map(|f| PyDrives { f, m, fatal: None });
     let mut fatal: Option<PyErr> = None;
     let mut cancel_reason: Option<String> = None;
     let traj = run(py, || {
-        let s = settings(mech, args)?;
+        let s = settings(mech, &args)?;
         let step = PROGRESS_FRACTION * (s.t_end - s.t0);
         let mut next = s.t0 + step;
         let mut on_step = |t: f64| -> bool {

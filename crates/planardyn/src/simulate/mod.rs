@@ -4,8 +4,10 @@
 
 pub mod charts;
 pub mod ode;
+mod overrides;
 pub mod trajectory;
 
+pub use overrides::Overrides;
 pub use trajectory::{SimStats, Status, Trajectory};
 
 use crate::dynamics::Drives;

@@ -1,0 +1,71 @@
+//! A caller's changes to a model file's `simulate` defaults, applied the same way by the
+//! Python `Mechanism.simulate`, the batch runner and Rust users.
+
+use super::{grid, Settings};
+use crate::integrate::Method;
+use crate::model::Mechanism;
+use crate::Error;
+
+/// Most output times an `output_dt` may ask for (a guard against output_dt = 1e-12).
+const MAX_OUTPUTS: f64 = 1e8;
+
+/// Changes to the model file's `simulate` defaults (`None`: the model's value). Times in s,
+/// coordinates in rad or m, rates in rad/s or m/s.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Overrides {
+    pub t_end: Option<f64>,
+    pub method: Option<String>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    /// Fixed step (s); an adaptive `method` given without it drops the file's `dt`.
+    pub dt: Option<f64>,
+    pub t_eval: Option<Vec<f64>>,
+    pub output_dt: Option<f64>,
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+    pub max_steps: Option<usize>,
+}
+
+impl Overrides {
+    /// The settings of a run: the model's defaults ([`Settings::for_model`]) with these
+    /// changes, as `Mechanism.simulate` in Python makes them.
+    pub fn settings(&self, mech: &Mechanism) -> Result<Settings, Error> {
+        let mut s = Settings::for_model(mech)?;
+        if let Some(t_end) = self.t_end {
+            if !(t_end.is_finite() && t_end > s.t0) {
+                return Err(Error::Options(format!("t_end = {t_end} must be a finite time after t0 = {} s", s.t0)));
+            }
+            s.t_end = t_end;
+        }
+        if let Some(name) = &self.method {
+            s.method = name.parse::<Method>().map_err(Error::Options)?;
+            if s.method.is_adaptive() && self.dt.is_none() {
+                s.options.dt = None;
+            }
+        }
+        s.options.rtol = self.rtol.unwrap_or(s.options.rtol);
+        s.options.atol = self.atol.unwrap_or(s.options.atol);
+        s.options.dt = self.dt.or(s.options.dt);
+        s.options.max_steps = self.max_steps.unwrap_or(s.options.max_steps);
+        s.t_eval = match (&self.t_eval, self.output_dt.or(mech.simulate.output_dt)) {
+            (Some(te), _) => Some(te.clone()),
+            (None, Some(h)) => Some(output_grid(s.t0, s.t_end, h)?),
+            (None, None) => None,
+        };
+        s.q0 = self.q0.clone();
+        s.qd0 = self.qd0.clone();
+        Ok(s)
+    }
+}
+
+/// Output times every h (s) from t0 to t_end, clamped to t_end without a duplicate end.
+fn output_grid(t0: f64, t_end: f64, h: f64) -> Result<Vec<f64>, Error> {
+    if !(h.is_finite() && h > 0.0) || (t_end - t0) / h > MAX_OUTPUTS {
+        return Err(Error::Options(format!("output_dt = {h} must be > 0 s and give at most {MAX_OUTPUTS:e} outputs over [{t0}, {t_end}] s")));
+    }
+    let mut t = grid(t0, t_end, h);
+    t.iter_mut().for_each(|v| *v = v.min(t_end));
+    t.dedup();
+    Ok(t)
+}
+
