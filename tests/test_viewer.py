@@ -73,9 +73,10 @@ def test_viewer_plays_in_a_browser(five_bar, tmp_path):
     attrs = body_attrs(p.stdout)
     assert attrs["data-ready"] == "1" and "data-error" not in attrs
     frame, drawn = int(attrs["data-frame"]), int(attrs["data-drawn"])
-    # 1 s of (virtual) playback at 0.5x is 0.5 s of motion: frame 100 at most; the page
-    # loads within the budget, so at least 40.
-    assert 40 <= frame <= round(1.0 * AUTO_SPEED / DT) + 1, frame
+    # 1 s of (virtual) playback at 0.5x is 0.5 s of motion: frame 100 at most. How much of
+    # the budget the page load takes depends on the machine's load (seen: frame 99 idle,
+    # under 40 on a loaded CI machine), so the lower bound only says that it advanced.
+    assert 1 <= frame <= round(1.0 * AUTO_SPEED / DT) + 1, frame
     assert drawn >= 10
     assert re.search(rf"<title>{re.escape(mech.name)} \| frame {frame}/300</title>", p.stdout)
     assert elapsed < 60
