@@ -19,6 +19,10 @@ use nalgebra::DMatrix;
 pub const RANK_TOL: f64 = 1e-9;
 
 fn singular_values(rows: usize, cols: usize, data: &[f64]) -> Vec<f64> {
+    // The SVD iteration need not end on non-finite entries: such a matrix is singular.
+    if data[..rows * cols].iter().any(|v| !v.is_finite()) {
+        return vec![0.0; rows.min(cols)];
+    }
     let mat = DMatrix::from_row_slice(rows, cols, &data[..rows * cols]);
     let mut sv: Vec<f64> = mat.singular_values().iter().copied().collect();
     sv.sort_by(|a, b| a.total_cmp(b));

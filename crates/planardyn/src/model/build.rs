@@ -15,6 +15,13 @@ struct Ctx<'a> {
 
 type R<T> = Result<T, ModelError>;
 
+/// Largest drawn coordinate accepted (m): beyond it squared lengths overflow and the
+/// numbers cannot describe a machine.
+const MAX_COORDINATE: f64 = 1e9;
+/// Largest move from the drawing to `q0` (rad, or multiples of the drawing's size): the
+/// continuation takes steps of 0.1, so this bounds the loading time (~10^4 steps).
+const MAX_START_MOVE: f64 = 1e3;
+
 impl Ctx<'_> {
     fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
         ModelError::Invalid {
@@ -73,7 +80,11 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         if name == "ground" {
             return Err(ctx.err(path, "'ground' is the fixed body's name; rename the point"));
         }
-        points.push((name.clone(), [ctx.finite(&path, xy[0])?, ctx.finite(&path, xy[1])?]));
+        let p = [ctx.finite(&path, xy[0])?, ctx.finite(&path, xy[1])?];
+        if p[0].abs().max(p[1].abs()) > MAX_COORDINATE {
+            return Err(ctx.err(path, format!("{p:?} is more than {MAX_COORDINATE:e} m from the origin: check the units (SI: metres)")));
+        }
+        points.push((name.clone(), p));
     }
     let mut ground_points = Vec::new();
     for (k, name) in spec.ground.iter().enumerate() {
@@ -338,6 +349,10 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
         };
         let value = ctx.finite(&format!("{path}.value"), c.value)?;
         let q0 = ctx.finite(&format!("{path}.q0"), c.q0.unwrap_or(value))?;
+        let unit = if kind == CoordinateKind::Angle { 1.0 } else { mech.scale };
+        if (q0 - value).abs() > MAX_START_MOVE * unit {
+            return Err(ctx.err(format!("{path}.q0"), format!("q0 = {q0} is more than {MAX_START_MOVE:e} (rad, or lengths of the drawing) from the drawn value {value}: the assembly follows the drawing there step by step; draw the mechanism nearer its start")));
+        }
         let qd0 = ctx.finite(&format!("{path}.qd0"), c.qd0)?;
         mech.coordinates.push(Coordinate { name: c.name.clone(), pair, kind, value, q0, qd0 });
     }
