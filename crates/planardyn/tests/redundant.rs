@@ -76,12 +76,13 @@ fn redundant_parallelogram_conserves_energy_and_stops_at_its_change_point() {
     // Hanging 30 degrees off the vertical, it swings between -60 and -120 degrees.
     let hanging = PARALLELOGRAM.replace("0.2598076211353316", "-0.2598076211353316").replace("value: 1.0471975511965976", "value: -1.0471975511965976");
     let mech = yaml(&hanging);
-    let tr = run(&mech, "dop853", 2.0, 1e-11, None);
+    let tr = run(&mech, "dop853", 2.0, 1e-11, Some(planardyn::simulate::grid(0.0, 2.0, 1e-3)));
     assert!(tr.stats.energy_drift < 1e-9, "drift {}", tr.stats.energy_drift);
     let (lo, hi) = tr.q.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-    // The start is exact; the far turning point is only sampled by the accepted steps.
+    // The start is exact; the far turning point (-120 degrees, by symmetry of the swing) is
+    // sampled every 1 ms: qdd ~ 3 rad/s^2 there, so the sample misses it by < 1e-6 rad.
     assert!((hi + 1.0471975511965976).abs() < 1e-12, "start {hi}");
-    assert!((lo + 2.0943951023931953).abs() < 1e-3, "turning point {lo}");
+    assert!((lo + 2.0943951023931953).abs() < 1e-6, "turning point {lo}");
     // Released from +60 degrees it falls through 0, where all the pins line up with the
     // ground pivots: the constraints lose rank there (the coupler could also turn). The
     // integrator either steps across it on the parallelogram branch with the energy kept,

@@ -10,11 +10,14 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
 
-/// Diagonal entry i of M = blockdiag(m, m, I).
+/// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
 #[inline]
-fn mass_diag(mech: &Mechanism, i: usize) -> f64 {
-    let b = &mech.bodies[i / 3];
-    if i % 3 == 2 { b.inertia } else { b.mass }
+fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64]) -> f64 {
+    mech.bodies
+        .iter()
+        .zip(a.chunks_exact(3).zip(b.chunks_exact(3)))
+        .map(|(body, (a, b))| body.mass * (a[0] * b[0] + a[1] * b[1]) + body.inertia * a[2] * b[2])
+        .sum()
 }
 
 /// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`.
@@ -23,20 +26,19 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     let m = ws.b.len();
     for j in 0..m {
         for k in j..m {
-            let (uj, uk) = (&ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n]);
-            let s: f64 = (0..n).map(|i| mass_diag(mech, i) * uj[i] * uk[i]).sum();
+            let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n]);
             ws.a[j * m + k] = s;
             ws.a[k * m + j] = s;
         }
     }
 }
 
-/// b = U^T (f - M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
+/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
 pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     for (j, bj) in ws.b.iter_mut().enumerate() {
         let uj = &ws.u[j * n..(j + 1) * n];
-        *bj = (0..n).map(|i| uj[i] * (ws.f[i] - mass_diag(mech, i) * ws.c[i])).sum();
+        *bj = uj.iter().zip(&ws.f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c);
     }
 }
 

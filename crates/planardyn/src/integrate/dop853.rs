@@ -15,12 +15,12 @@
 //! for large steps, behaving like order 8 asymptotically); the controller uses
 //! exponent `-1/8`.
 //!
-//! Dense output: 3 more stages (`C = 0.1, 0.2, 7/9`) at each accepted step,
-//! i.e. 15 instead of 12 `rhs` calls per step (+25 %), computed eagerly because
-//! [`interpolate`](Dop853::interpolate) takes `&self` and has no access to the
-//! system. Set [`Options::dense_output`] to `false` to skip them: the
-//! interpolant then degrades to the cubic Hermite polynomial (order 3). If one
-//! of the extra stages fails, that step's dense output is cubic Hermite too.
+//! Dense output: 3 more stages (`C = 0.1, 0.2, 7/9`), evaluated lazily by the
+//! first [`interpolate`](Dop853::interpolate) within an accepted step, so a step
+//! with no output time in it costs 12 `rhs` calls and one with outputs 15. Set
+//! [`Options::dense_output`] to `false` to skip them: the interpolant then
+//! degrades to the cubic Hermite polynomial (order 3). If one of the extra
+//! stages fails, that step's dense output is cubic Hermite too.
 
 // The coefficients keep the 30 digits of the published table, so that they can be
 // compared with it digit by digit; the compiler rounds them to f64.
@@ -251,6 +251,9 @@ pub struct Dop853 {
     f_new: Vec<f64>,
     /// Step size of the last attempt (s).
     h: f64,
+    /// Whether `fd` holds the 7th-order coefficients of the last accepted step (else only
+    /// its cubic Hermite rows, until the next `interpolate` evaluates the extra stages).
+    dense_ready: bool,
 }
 
 impl Dop853 {
@@ -263,6 +266,7 @@ impl Dop853 {
             y_new: vec![0.0; n],
             f_new: vec![0.0; n],
             h: 0.0,
+            dense_ready: true,
         }
     }
 
@@ -273,6 +277,7 @@ impl Dop853 {
         y: &[f64],
     ) -> Result<(), StepError<S::Error>> {
         self.fd.fill(0.0);
+        self.dense_ready = true;
         self.core.reset(sys, t, y)
     }
 
@@ -287,7 +292,11 @@ impl Dop853 {
     /// 7th-order dense output on the last accepted step (HNW I, II.6; scipy
     /// `Dop853DenseOutput`): with `s = (t - t_prev)/h`,
     /// `y = y_prev + s (F0 + (1-s) (F1 + s (F2 + (1-s) (F3 + s (F4 + (1-s) (F5 + s F6))))))`.
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
+    /// The first call within a step evaluates its 3 extra stages with `sys`.
+    pub fn interpolate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
+        if !self.dense_ready {
+            self.dense_coefficients(sys);
+        }
         let c = &self.core;
         let n = c.n;
         let h = c.t - c.t_prev;
@@ -302,28 +311,46 @@ impl Dop853 {
         }
     }
 
-    /// Evaluate stage `s` from the stages before it: `K_s = f(t + C_s h, y + h sum_j A_sj K_j)`.
+    /// Rows 3..6 of the dense output of the last accepted step, from its stages and the 3
+    /// extra ones (evaluated from its start point, now `y_prev`); zero (cubic Hermite) if
+    /// dense output is off or an extra stage fails.
+    fn dense_coefficients<S: OdeSystem>(&mut self, sys: &mut S) {
+        self.dense_ready = true;
+        let (n, h) = (self.core.n, self.h);
+        let mut extra_ok = self.core.opts.dense_output;
+        if extra_ok {
+            for s in N_STAGES + 1..N_EXT {
+                if self.stage(sys, s, h, true).is_err() {
+                    extra_ok = false;
+                    break;
+                }
+            }
+        }
+        let Dop853 { k, fd, .. } = self;
+        for i in 0..n {
+            for r in 0..4 {
+                fd[(3 + r) * n + i] = if extra_ok { h * (0..N_EXT).map(|j| D[r][j] * k[j * n + i]).sum::<f64>() } else { 0.0 };
+            }
+        }
+    }
+
+    /// Evaluate stage `s` from the stages before it: `K_s = f(t + C_s h, y + h sum_j A_sj K_j)`,
+    /// from the current point, or (`accepted`) from the start of the last accepted step.
     fn stage<S: OdeSystem>(
         &mut self,
         sys: &mut S,
         s: usize,
         h: f64,
+        accepted: bool,
     ) -> Result<(), Failure<S::Error>> {
         let Dop853 { core, k, ytmp, .. } = self;
         let n = core.n;
+        let (t0, y0) = if accepted { (core.t_prev, &core.y_prev) } else { (core.t, &core.y) };
         for i in 0..n {
             let incr: f64 = (0..s).map(|j| A[s][j] * k[j * n + i]).sum();
-            ytmp[i] = core.y[i] + h * incr;
+            ytmp[i] = y0[i] + h * incr;
         }
-        let (done, rest) = k.split_at_mut(s * n);
-        let _ = done;
-        Core::eval(
-            &mut core.stats,
-            sys,
-            core.t + C[s] * h,
-            ytmp,
-            &mut rest[..n],
-        )
+        Core::eval(&mut core.stats, sys, t0 + C[s] * h, ytmp, &mut k[s * n..(s + 1) * n])
     }
 }
 
@@ -339,11 +366,17 @@ impl ExplicitPair for Dop853 {
     }
 
     fn attempt<S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<f64, Failure<S::Error>> {
-        self.h = h;
         let n = self.core.n;
+        if !self.dense_ready {
+            // The stages of the last accepted step are about to be overwritten: its dense
+            // output, if ever asked for, falls back to cubic Hermite.
+            self.fd[3 * n..].fill(0.0);
+            self.dense_ready = true;
+        }
+        self.h = h;
         self.k[..n].copy_from_slice(&self.core.f);
         for s in 1..N_STAGES {
-            self.stage(sys, s, h)?;
+            self.stage(sys, s, h, false)?;
         }
         let Dop853 {
             core,
@@ -380,39 +413,18 @@ impl ExplicitPair for Dop853 {
         Ok(h.abs() * e5sq / (denom * n as f64).sqrt())
     }
 
-    fn accept<S: OdeSystem>(&mut self, sys: &mut S, t_new: f64) {
+    /// The cubic Hermite rows of the dense output now; rows 3..6 when first interpolated.
+    fn accept<S: OdeSystem>(&mut self, _sys: &mut S, t_new: f64) {
         let (n, h) = (self.core.n, self.h);
-        let mut extra_ok = self.core.opts.dense_output;
-        if extra_ok {
-            for s in N_STAGES + 1..N_EXT {
-                if self.stage(sys, s, h).is_err() {
-                    extra_ok = false;
-                    break;
-                }
-            }
-        }
-        let Dop853 {
-            core,
-            k,
-            fd,
-            y_new,
-            f_new,
-            ..
-        } = self;
+        let Dop853 { core, fd, y_new, f_new, .. } = self;
         for i in 0..n {
             let dy = y_new[i] - core.y[i];
             fd[i] = dy;
             fd[n + i] = h * core.f[i] - dy;
             fd[2 * n + i] = 2.0 * dy - h * (f_new[i] + core.f[i]);
-            for r in 0..4 {
-                fd[(3 + r) * n + i] = if extra_ok {
-                    h * (0..N_EXT).map(|j| D[r][j] * k[j * n + i]).sum::<f64>()
-                } else {
-                    0.0
-                };
-            }
         }
-        core.accept(t_new, y_new, f_new);
+        self.dense_ready = false;
+        self.core.accept(t_new, &mut self.y_new, &mut self.f_new);
     }
 }
 

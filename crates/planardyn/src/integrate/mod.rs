@@ -174,9 +174,9 @@ pub struct Options {
     /// Largest number of step attempts (accepted plus rejected) since
     /// [`Stepper::new`]; past it [`StepError::TooManySteps`]. Default `10_000_000`.
     pub max_steps: usize,
-    /// Compute the full-order dense output at each accepted step. Only `Dop853`
-    /// pays for it (3 extra `rhs` evaluations per step); when `false` its
-    /// [`Stepper::interpolate`] falls back to cubic Hermite. Default `true`.
+    /// Full-order dense output. Only `Dop853` pays for it: 3 extra `rhs` evaluations in
+    /// each step where [`Stepper::interpolate`] is called; when `false` its interpolant
+    /// is cubic Hermite. Default `true`.
     pub dense_output: bool,
 }
 
@@ -422,9 +422,16 @@ impl Stepper {
     /// Dense output: the solution at any t in [t_prev, t] of the last accepted step, written to out.
     ///
     /// Outside that interval the polynomial is extrapolated (less accurate).
-    /// Right after `reset`, returns `y()`.
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        dispatch!(self, s => s.interpolate(t, out))
+    /// Right after `reset`, returns `y()`. `sys` is the system being integrated: Dop853
+    /// evaluates its 3 dense-output stages on the first call within a step (so steps with no
+    /// output time in them do not pay for them); call it before the next `step`.
+    pub fn interpolate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
+        match self {
+            Stepper::Dop853(s) => s.interpolate(sys, t, out),
+            Stepper::Rk4(s) => s.interpolate(t, out),
+            Stepper::Dopri5(s) => s.interpolate(t, out),
+            Stepper::Radau5(s) => s.interpolate(t, out),
+        }
     }
 
     /// Work counters since `new`.

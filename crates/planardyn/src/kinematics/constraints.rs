@@ -345,6 +345,41 @@ pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], row_s
     }
 }
 
+/// The columns where each row of J may be non-zero, for its block-triangular analysis: a
+/// pair's rows use both its bodies' three columns, a revolute pair's coordinate row only
+/// their angles, a partition row its one component.
+pub fn jacobian_pattern(mech: &Mechanism, chart: &Chart) -> Vec<Vec<usize>> {
+    let columns = |links: [Link; 2], angles_only: bool| -> Vec<usize> {
+        let mut cols: Vec<usize> = links
+            .iter()
+            .filter_map(|l| match l {
+                Link::Ground => None,
+                Link::Body(b) => Some(b.0),
+            })
+            .flat_map(|b| if angles_only { 3 * b + 2..3 * b + 3 } else { 3 * b..3 * b + 3 })
+            .collect();
+        cols.sort_unstable();
+        cols
+    };
+    let nc = mech.n_constraints;
+    let mut pattern = vec![Vec::new(); mech.n_x()];
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        for slot in slots(&mech.row_slot, k).into_iter().flatten() {
+            pattern[slot] = columns([pair.a, pair.b], false);
+        }
+    }
+    for (k, row) in pattern[nc..].iter_mut().enumerate() {
+        *row = match chart {
+            Chart::Inputs => {
+                let pair = &mech.pairs[mech.coordinates[k].pair.0];
+                columns([pair.a, pair.b], pair.kind == PairKind::Revolute)
+            }
+            Chart::Partition(idx) => vec![idx[k]],
+        };
+    }
+    pattern
+}
+
 /// gamma(u, v) = d2F/dx2 [u, v] for every row (the chart rows of a partition are linear).
 pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], out: &mut [f64]) {
     let nc = mech.n_constraints;

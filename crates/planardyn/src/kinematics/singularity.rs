@@ -11,7 +11,7 @@
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
 use super::constraints::{body_trig, constraint_jacobian, Chart};
-use super::system::{pair_row_scales, System};
+use super::system::{col_scales, pair_row_scales, scaled_jacobian};
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
 
@@ -31,11 +31,10 @@ fn singular_values(rows: usize, cols: usize, data: &[f64]) -> Vec<f64> {
 
 fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     let n = x.len();
-    let mut sys = System::new(mech);
     let mut j = vec![0.0; n * n];
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
-    sys.scaled_jacobian(mech, chart, x, &trig, &mut j);
+    scaled_jacobian(mech, chart, x, &trig, &mut vec![1.0; n], &col_scales(mech), &mut j);
     j
 }
 

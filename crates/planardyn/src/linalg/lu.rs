@@ -116,39 +116,6 @@ pub fn lu_solve_transpose(lu: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
     }
 }
 
-/// A real n x n matrix and its factors, in buffers sized once.
-#[derive(Debug, Clone)]
-pub struct Lu {
-    n: usize,
-    lu: Vec<f64>,
-    piv: Vec<usize>,
-}
-
-impl Lu {
-    pub fn new(n: usize) -> Self {
-        Lu { n, lu: vec![0.0; n * n], piv: vec![0; n] }
-    }
-    pub fn dim(&self) -> usize {
-        self.n
-    }
-    /// The matrix buffer (row-major, n x n) to fill before [`Lu::factor`].
-    pub fn matrix_mut(&mut self) -> &mut [f64] {
-        &mut self.lu
-    }
-    /// Factorise the matrix in the buffer in place (see [`lu_factor`]).
-    pub fn factor(&mut self, tiny: f64) -> Result<(), LuError> {
-        lu_factor(&mut self.lu, self.n, &mut self.piv, tiny)
-    }
-    /// Solve A x = b in place.
-    pub fn solve(&self, b: &mut [f64]) {
-        lu_solve(&self.lu, self.n, &self.piv, b)
-    }
-    /// Solve A^T x = b in place.
-    pub fn solve_transpose(&self, b: &mut [f64]) {
-        lu_solve_transpose(&self.lu, self.n, &self.piv, b)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -158,13 +125,12 @@ mod tests {
         // A needs a row swap at the first step (zero leading entry).
         let a = [0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 1.0];
         let x = [1.0, -2.0, 0.5];
-        let mut lu = Lu::new(3);
-        lu.matrix_mut().copy_from_slice(&a);
-        lu.factor(1e-300).unwrap();
+        let (mut lu, mut piv) = (a, [0; 3]);
+        lu_factor(&mut lu, 3, &mut piv, 1e-300).unwrap();
         let mut b: Vec<f64> = (0..3).map(|i| (0..3).map(|j| a[i * 3 + j] * x[j]).sum()).collect();
-        lu.solve(&mut b);
+        lu_solve(&lu, 3, &piv, &mut b);
         let mut bt: Vec<f64> = (0..3).map(|i| (0..3).map(|j| a[j * 3 + i] * x[j]).sum()).collect();
-        lu.solve_transpose(&mut bt);
+        lu_solve_transpose(&lu, 3, &piv, &mut bt);
         for i in 0..3 {
             assert!((b[i] - x[i]).abs() < 1e-14, "solve: {b:?}");
             assert!((bt[i] - x[i]).abs() < 1e-14, "solve_transpose: {bt:?}");
@@ -189,8 +155,7 @@ mod tests {
 
     #[test]
     fn reports_a_singular_matrix() {
-        let mut lu = Lu::new(2);
-        lu.matrix_mut().copy_from_slice(&[1.0, 2.0, 2.0, 4.0]);
-        assert_eq!(lu.factor(1e-12), Err(LuError { column: 1 }));
+        let (mut a, mut piv) = ([1.0, 2.0, 2.0, 4.0], [0; 2]);
+        assert_eq!(lu_factor(&mut a, 2, &mut piv, 1e-12), Err(LuError { column: 1 }));
     }
 }

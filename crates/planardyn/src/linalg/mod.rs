@@ -7,8 +7,10 @@
 //! well under a microsecond for a four-bar. nalgebra is still used where allocation does not
 //! matter (singular values for the singularity measures).
 
+mod block_lu;
 mod cholesky;
 mod lu;
 
+pub use block_lu::BlockLu;
 pub use cholesky::{cholesky_in_place, cholesky_solve};
-pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
+pub use lu::{lu_factor, lu_solve, lu_solve_transpose, LuError, Scalar};

@@ -148,7 +148,7 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
         Err(e) => return Err(e),
     };
     // Dense output is only needed to interpolate at requested times (DOP853 pays 3 extra
-    // evaluations per step for it).
+    // evaluations in each step that holds one).
     let options = Options { dense_output: settings.t_eval.is_some(), ..settings.options.clone() };
     let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
     let mut y = y0;
@@ -177,7 +177,7 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
         }
         if let Some(te) = t_eval {
             while next_out < te.len() && te[next_out] <= t {
-                stepper.interpolate(te[next_out], &mut yi);
+                stepper.interpolate(&mut ode, te[next_out], &mut yi);
                 if let Err(e) = ode.evaluate(te[next_out], &yi) {
                     (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[next_out]));
                     break;
