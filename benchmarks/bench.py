@@ -171,7 +171,7 @@ def bench_mechanism(bm, found: dict, quick: bool) -> dict:
         i, value, source = bm.published_end
         reference["published"] = {"coordinate": i, "value": value, "source": source,
                                   "difference": float(ref[-1, i] - value)}
-        say(f"  reference at t_end {ref[-1, i]!r} against {value!r} ({source}): {ref[-1, i] - value:+.2e}")
+        say(f"  reference at t_end {float(ref[-1, i])!r} against {value!r} ({source}): {ref[-1, i] - value:+.2e}")
     runs: list[Run] = []
     for tool, (mod, _) in found.items():
         runs += sweep(mod, bm, d, ref, quick)

@@ -81,7 +81,7 @@ FIVE_BAR = Benchmark(
 )
 THREE_RRR = Benchmark(
     "3-rrr", "3-RRR parallel robot, constant torque on one input", MODELS / "3-rrr.yaml",
-    t_end=0.8, grid_dt=0.01, drift_target=1e-5, gap_target=1e-6, error_target=1e-4,
+    t_end=0.8, grid_dt=0.04, drift_target=1e-5, gap_target=1e-6, error_target=1e-4,
     scenario="the file's constant 0.2 N m drive on th1, th2 and th3 free (the file's time-table "
              "drive on th2 left out), no gravity (as in the file), from rest, 0.8 s: th1 turns "
              "1.2 rad inside the workspace, away from singularities",

@@ -29,8 +29,8 @@ def _sweep(dts: tuple, ws: tuple) -> list[tuple]:
 SWEEPS = {
     "four-bar": _sweep((0.01, 0.005, 0.004, 0.0025, 0.002, 0.001), (0.0, 10.0, 30.0)),
     "five-bar": _sweep((0.005, 0.002, 0.001, 0.0005, 0.0002), (0.0, 30.0, 100.0)),
-    "3-rrr": _sweep((0.01, 0.005, 0.002, 0.001), (0.0, 30.0, 100.0)),
-    "andrews": _sweep((1e-4, 5e-5, 2e-5, 1e-5, 5e-6), (0.0, 1e3, 1e4)),
+    "3-rrr": _sweep((0.04, 0.02, 0.01, 0.005, 0.002), (0.0, 30.0, 100.0)),
+    "andrews": _sweep((3e-4, 1.5e-4, 1e-4, 5e-5, 2e-5), (0.0, 1e3, 1e4)),
 }
 
 #: Proximal solver settings: absolute and relative accuracy, mu, iterations.
