@@ -23,10 +23,14 @@ def ms(v: float | None) -> str:
     return f"{v * 1e3:.3g}" if v < 0.01 else f"{v * 1e3:.1f}"
 
 
+def _energy(m: dict) -> str:
+    return "balance" if m["driven"] else "drift"
+
+
 def _targets(m: dict, kind: str) -> str:
     t = m["targets"]
     if kind == "accuracy":
-        return f"drift < {t['drift_J']:g} J, gap < {t['gap_m']:g} m"
+        return f"{_energy(m)} < {t['drift_J']:g} J, gap < {t['gap_m']:g} m"
     return f"error < {t['error_rad']:g} rad, gap < {t['gap_m']:g} m"
 
 
@@ -44,9 +48,20 @@ def mechanism_text(m: dict) -> list[str]:
         for tool, x in s[f"ratio_at_{kind}"].items():
             lines.append(f"  {tool} / planardyn wall time = {x:.2f}")
     if "start_energy_max_deviation" in s:
-        lines.append(f"start energy {s['start_energy']['planardyn']:.12f} J; largest deviation of any tool's "
-                     f"{s['start_energy_max_deviation']:.1e} J")
+        lines.append(start_energy(s))
     return lines
+
+
+def start_energy(s: dict) -> str:
+    dev = s["start_energy_max_deviation"]
+    return (f"Start energy {s['start_energy']['planardyn']:.12f} J, from every tool's own start state "
+            + ("bit for bit" if dev == 0 else f"to within {dev:.0e} J"))
+
+
+def published(ref: dict) -> str:
+    p = ref["published"]
+    return (f"Reference at t_end {ref['q_end'][p['coordinate']]:.12f} rad; {p['source']}: {p['value']!r} "
+            f"(difference {p['difference']:+.1e})")
 
 
 def summary_text(res: dict) -> str:
@@ -119,7 +134,7 @@ def best_table(m: dict) -> str:
     """Per tool: the cheapest setting at the stated accuracy and at the stated error, with
     the ratio of its wall time to planardyn's."""
     s = m["summary"]
-    rows = [f"| tool | cheapest at {_targets(m, 'accuracy')} | wall (ms) | drift (J) | × planardyn "
+    rows = [f"| tool | cheapest at {_targets(m, 'accuracy')} | wall (ms) | {_energy(m)} (J) | × planardyn "
             f"| cheapest at {_targets(m, 'error')} | wall (ms) | × planardyn |",
             "|---|---|---:|---:|---:|---|---:|---:|"]
     for tool in s["best_at_accuracy"]:
@@ -175,8 +190,7 @@ def write(res: dict, out: Path, docs: Path | None) -> None:
                f"Measured {measured_line(m['measured'])}.", "",
                f"Model `{m['model']}`: {m['scenario']}. Reference q({m['t_end_s']:g} s) = "
                + ", ".join(f"{c} {v:.12f}" for c, v in zip(m["coordinates"], ref["q_end"])) + " rad"
-               + (f" ({ref['published']['source']}: {ref['published']['value']!r}, difference "
-                  f"{ref['published']['difference']:+.1e})" if "published" in ref else "") + ".", "",
+               + (f" ({published(ref)})" if "published" in ref else "") + ".", "",
                best_table(m), "", f"![work-precision diagram, {m['key']}](work_precision_{m['key']}.png)", "",
                runs_table(m), ""]
         plot(m, out / f"work_precision_{m['key']}.png")
@@ -194,8 +208,8 @@ def docs_section(res: dict) -> str:
     for m in res["mechanisms"].values():
         s = m["summary"]
         parts += [f"### {m['title']}", "", f"`{m['model']}`: {m['scenario']}. Measured {measured_line(m['measured'])}."
-                  + (f" Start energy {s['start_energy']['planardyn']:.9f} J in planardyn; every tool's within "
-                     f"{s['start_energy_max_deviation']:.0e} J." if "start_energy_max_deviation" in s else ""), "",
+                  + (f" {start_energy(s)}." if "start_energy_max_deviation" in s else "")
+                  + (f" {published(m['reference'])}." if "published" in m["reference"] else ""), "",
                   best_table(m), "",
                   f"![work-precision diagram, {m['key']}](../benchmarks/results/work_precision_{m['key']}.png)", ""]
     parts += ["### The targets of issue 6", "", targets_table(res), ""]
