@@ -162,6 +162,7 @@ def python_overhead(setting: list) -> dict:
 def bench_mechanism(bm, found: dict, quick: bool) -> dict:
     say(f"== {bm.key}: {bm.title} ({bm.model_rel})")
     load_start = os.getloadavg()  # other work on the machine skews every wall time
+    date = time.strftime("%Y-%m-%d %H:%M:%S %Z")
     d = common.load_drawing(bm.spec)
     pd_mod = found["planardyn"][0]
     say("reference: planardyn DOP853 rtol = atol = 1e-13")
@@ -175,7 +176,7 @@ def bench_mechanism(bm, found: dict, quick: bool) -> dict:
     runs: list[Run] = []
     for tool, (mod, _) in found.items():
         runs += sweep(mod, bm, d, ref, quick)
-    measured = {"date": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "quick": quick,
+    measured = {"date": date, "quick": quick,
                 "load_average_at_start": load_start, "load_average_at_end": os.getloadavg()}
     return {"key": bm.key, "title": bm.title, "measured": measured,
             "driven": any(c.effort for c in d.coordinates), "model": bm.model_rel, "scenario": bm.scenario,
