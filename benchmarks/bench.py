@@ -70,7 +70,9 @@ def tools() -> tuple[dict, dict]:
 
 
 def sweep(mod, bm, d, ref, quick: bool) -> list[Run]:
-    settings = mod.SWEEPS[bm.key]
+    settings = mod.SWEEPS.get(bm.key)
+    if not settings:
+        return [Run(mod.TOOL, "—", "—", bm.key).fail(f"{bm.key} is not modelled for {mod.TOOL} (no sweep)")]
     runs = []
     for s in settings[::2] if quick else settings:
         try:
@@ -233,6 +235,7 @@ def main() -> int:
         say("Python overhead: simulate from Python against the same run from Rust")
         overhead = (python_overhead(four_bar["planardyn"]["extra"]["setting"]) if four_bar["planardyn"]
                     else {"ok": False, "why": f"no planardyn setting met {PLANARDYN_DRIFT_TARGET:g} J"})
+        overhead["date"] = four_bar["date"] = m["measured"]["date"]
     for m in mechs.values():
         del m["_runs"]
     crit = {"ok": False, "error": "skipped (--no-criterion)"} if a.no_criterion else criterion(a.quick)

@@ -72,6 +72,23 @@ def test_energy_and_gap_on_a_planardyn_trajectory(bm):
 
 
 @BENCHES
+def test_mujoco_model_accelerates_as_planardyn(bm):
+    """At rest in the drawing MuJoCo's acceleration is the constrained one, up to the soft
+    constraint's regularisation (solimp d = 0.9999: about 1e-4 relative)."""
+    mujoco = pytest.importorskip("mujoco")
+    from peers import mujoco_peer as M
+
+    d, mech = common.load_drawing(bm.spec), P.mechanism(bm)
+    model = mujoco.MjModel.from_xml_string(M.mjcf(d, "RK4", 1e-4, True))
+    data = mujoco.MjData(model)
+    data.ctrl[:] = [c.effort for c in d.coordinates if c.effort]
+    mujoco.mj_forward(model, data)
+    idx = [model.jnt_dofadr[model.joint(c.pair.name).id] for c in d.coordinates]
+    expected = mech.forward_dynamics(mech.q0, np.zeros(mech.dof), t=0.0)
+    np.testing.assert_allclose(data.qacc[idx], expected, rtol=1e-3, atol=1e-3 * np.max(np.abs(expected)))
+
+
+@BENCHES
 def test_pinocchio_model_accelerates_as_planardyn(bm):
     pytest.importorskip("pinocchio")
     from peers import pinocchio_peer as Q
