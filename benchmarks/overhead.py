@@ -22,8 +22,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-import common  # noqa: E402
-from peers import planardyn_fourbar as P  # noqa: E402
+from mechanisms import FOUR_BAR  # noqa: E402
+from peers import planardyn_peer as P  # noqa: E402
 
 RUST_SIM = Path(os.environ.get("RUST_SIM", HERE / ".target" / "release" / "planardyn-rust-sim"))
 #: Python simulate may be at most this much slower than the same run from Rust (issue 6).
@@ -37,12 +37,12 @@ def measure(setting: tuple, repeats: int = REPEATS) -> dict:
     method, rtol, dt = setting
     if not RUST_SIM.exists():
         return {"ok": False, "why": f"{RUST_SIM} is not built (run.sh builds it with cargo)"}
-    mech = P.mechanism()
+    mech = P.mechanism(FOUR_BAR)
     opts = P.options(method, rtol, dt)
     out = {"ok": True, "setting": f"{method} {P.label(method, rtol, dt)}", "cases": {}}
-    for case, output_dt in (("0.1 s outputs", common.GRID_DT), ("every step", None)):
-        args = [str(RUST_SIM), str(common.MODEL), method, repr(rtol or 1e-8), repr(rtol or 1e-10),
-                "-" if dt is None else repr(dt), repr(common.T_END), "-" if output_dt is None else repr(output_dt)]
+    for case, output_dt in (("0.1 s outputs", FOUR_BAR.grid_dt), ("every step", None)):
+        args = [str(RUST_SIM), str(FOUR_BAR.model), method, repr(rtol or 1e-8), repr(rtol or 1e-10),
+                "-" if dt is None else repr(dt), repr(FOUR_BAR.t_end), "-" if output_dt is None else repr(output_dt)]
         kw = dict(opts, output_dt=output_dt) if output_dt else opts
         py, rs = [], []
         for _ in range(repeats):
@@ -50,7 +50,7 @@ def measure(setting: tuple, repeats: int = REPEATS) -> dict:
             best = math.inf
             for _ in range(3):
                 t0 = time.perf_counter()
-                res = mech.simulate(common.T_END, **kw)
+                res = mech.simulate(FOUR_BAR.t_end, **kw)
                 best = min(best, time.perf_counter() - t0)
             py.append(best)
             p = subprocess.run(args + ["3"], capture_output=True, text=True)

@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
 # One command for the whole benchmark suite (issue 6):
 #
-#   benchmarks/run.sh [--quick] [--no-criterion]
+#   benchmarks/run.sh [--quick] [--only four-bar five-bar 3-rrr andrews] [--no-criterion]
+#
+# --only runs some mechanisms and keeps the others' results (each with its own date) in
+# results.json, results.md and docs/benchmarks.md; --quick takes every other setting.
 #
 # 1. ./dev setup: builds planardyn's extension from the current sources into python/.
 # 2. benchmarks/.venv-peers: a venv of its own with the other tools from PyPI (mujoco, pin,
-#    exudyn) plus numpy, matplotlib, pyyaml. A tool whose install fails is left out and
-#    reported by bench.py as not available, never hidden.
+#    exudyn) plus numpy, matplotlib, pyyaml, pytest (for benchmarks/test_common.py). A tool
+#    whose install fails is left out and reported by bench.py as not available, never hidden.
 # 3. benchmarks/rust-sim: the same simulate call from Rust, for the Python-overhead figure.
-# 4. bench.py: every measurement in one run; writes benchmarks/results/.
+# 4. bench.py: every measurement in one run; writes benchmarks/results/ and the generated
+#    section of docs/benchmarks.md.
 set -euo pipefail
 
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -16,7 +20,7 @@ ROOT="$(dirname "$HERE")"
 VENV="$HERE/.venv-peers"
 PY="$VENV/bin/python"
 PEERS=(mujoco pin exudyn)
-BASE=(numpy matplotlib pyyaml)
+BASE=(numpy matplotlib pyyaml pytest)
 
 say() { printf '\033[1m==> %s\033[0m\n' "$*" >&2; }
 

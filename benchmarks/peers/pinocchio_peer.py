@@ -1,0 +1,173 @@
+"""Pinocchio (PyPI ``pin``): a mechanism as a kinematic tree of RZ joints
+(``Drawing.tree``) with each loop closed by a ``RigidConstraintModel`` (CONTACT_3D between
+the closing pair's two bodies), forward dynamics by ``pin.constraintDynamics`` (index-1 KKT
+with the proximal solver, which copes with each constraint's redundant z row), Baumgarte
+stabilisation with Kp = w^2, Kd = 2 w (critical), and classic RK4 written in Python over q, v.
+Drive torques enter as joint torques; a spring's force enters as J^T f through the frame
+Jacobians of its two ends (the way a Pinocchio user adds a force element).
+
+Timed: the RK4 loop, storing q and v at every step. Energy, loop gap and coordinates are
+computed afterwards from the stored states (untimed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from common import Drawing, Run, best_time, coordinates, energy, loop_gap
+from mechanisms import Benchmark
+
+TOOL = "Pinocchio"
+PACKAGE = "pin"
+
+
+def _sweep(dts: tuple, ws: tuple) -> list[tuple]:
+    """(dt in s, Baumgarte w in 1/s): w = 0 is no stabilisation."""
+    return [(dt, w) for w in ws for dt in dts]
+
+
+SWEEPS = {
+    "four-bar": _sweep((0.01, 0.005, 0.004, 0.0025, 0.002, 0.001), (0.0, 10.0, 30.0)),
+    "five-bar": _sweep((0.005, 0.002, 0.001, 0.0005, 0.0002), (0.0, 30.0, 100.0)),
+    "3-rrr": _sweep((0.04, 0.02, 0.01, 0.005, 0.002), (0.0, 30.0, 100.0)),
+    "andrews": _sweep((3e-4, 1.5e-4, 1e-4, 5e-5, 2e-5), (0.0, 1e3, 1e4)),
+}
+
+#: Proximal solver settings: absolute and relative accuracy, mu, iterations.
+PROX = (1e-12, 1e-12, 1e-8, 20)
+
+
+def version() -> str:
+    import pinocchio
+
+    return pinocchio.__version__
+
+
+def v3(p) -> np.ndarray:
+    return np.array([p[0], p[1], 0.0])
+
+
+class Model:
+    """The tree, its data, the loop constraints and the force elements. Joint frames are
+    world-aligned in the drawing, so q = 0 there and each q is a relative angle (RZ joints,
+    not wrapped)."""
+
+    def __init__(self, d: Drawing, w: float):
+        import pinocchio as pin
+
+        self.pin, self.d = pin, d
+        tree, closing = d.tree()
+        model = pin.Model()
+        model.gravity = pin.Motion(np.array([d.gravity[0], d.gravity[1], 0.0, 0.0, 0.0, 0.0]))
+        self.origin = {"ground": np.zeros(2)} | {p.b: d.points[p.point] for p in tree}
+        self.jid = {"ground": 0}
+        for p in tree:
+            pos = v3(self.origin[p.b] - self.origin[p.a])
+            j = model.addJoint(self.jid[p.a], pin.JointModelRZ(), pin.SE3(np.eye(3), pos), p.name)
+            b = d.bodies[p.b]
+            inertia = pin.Inertia(b.mass, v3(b.com - self.origin[p.b]), np.diag([b.inertia] * 3))
+            model.appendBodyToJoint(j, inertia, pin.SE3.Identity())
+            self.jid[p.b] = j
+        self.springs = [(s, self._frame(model, s.a, s.point_a), self._frame(model, s.b, s.point_b)) for s in d.springs]
+        self.model, self.data = model, model.createData()
+        self.cmodels = pin.StdVec_RigidConstraintModel()
+        self.cdatas = pin.StdVec_RigidConstraintData()
+        for p in closing:
+            cm = pin.RigidConstraintModel(
+                pin.ContactType.CONTACT_3D, model,
+                self.jid[p.a], self._at(p.a, p.point), self.jid[p.b], self._at(p.b, p.point),
+                pin.ReferenceFrame.LOCAL,
+            )
+            # The list holds a copy: set the corrector before appending.
+            cm.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(w * w, 2.0 * w))
+            self.cmodels.append(cm)
+            self.cdatas.append(cm.createData())
+        pin.initConstraintDynamics(model, self.data, self.cmodels, self.cdatas)
+        self.prox = pin.ProximalSettings(*PROX)
+        self.tau = np.zeros(model.nv)
+        for c in d.coordinates:
+            self.tau[model.joints[self.jid[c.pair.b]].idx_v] = c.effort
+
+    def _at(self, body: str, point: str):
+        return self.pin.SE3(np.eye(3), v3(self.d.points[point] - self.origin[body]))
+
+    def _frame(self, model, body: str, point: str) -> int:
+        pin = self.pin
+        return model.addFrame(pin.Frame(f"{point}@{body}", self.jid[body], 0, self._at(body, point), pin.FrameType.OP_FRAME))
+
+    def spring_tau(self, q: np.ndarray) -> np.ndarray:
+        """Joint torques of the springs at q: J_a^T f - J_b^T f, f the force on a's end."""
+        pin, model, data = self.pin, self.model, self.data
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        tau = self.tau.copy()
+        for s, fa, fb in self.springs:
+            delta = data.oMf[fa].translation - data.oMf[fb].translation
+            length = np.linalg.norm(delta)
+            f = -s.stiffness * (length - s.rest_length) * delta / length
+            for fid, sign in ((fa, 1.0), (fb, -1.0)):
+                J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+                tau += sign * (J[:3].T @ f)
+        return tau
+
+    def simulate(self, dt: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Classic RK4 over (q, v), n steps of dt; (n+1, nq) q and v."""
+        pin, model, data = self.pin, self.model, self.data
+        cm, cd, prox = self.cmodels, self.cdatas, self.prox
+        torques = self.spring_tau if self.springs else (lambda q: self.tau)
+
+        def f(q, v):
+            return pin.constraintDynamics(model, data, q, v, torques(q), cm, cd, prox)
+
+        q = np.zeros(model.nq)
+        v = np.zeros(model.nv)
+        Q = np.empty((n + 1, model.nq))
+        V = np.empty((n + 1, model.nv))
+        Q[0], V[0] = q, v
+        h2, h6 = 0.5 * dt, dt / 6.0
+        for i in range(n):
+            a1 = f(q, v)
+            v2 = v + h2 * a1
+            a2 = f(q + h2 * v, v2)
+            v3_ = v + h2 * a2
+            a3 = f(q + h2 * v2, v3_)
+            v4 = v + dt * a3
+            a4 = f(q + dt * v3_, v4)
+            q = q + h6 * (v + 2.0 * v2 + 2.0 * v3_ + v4)
+            v = v + h6 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+            Q[i + 1], V[i + 1] = q, v
+        return Q, V
+
+    def body_states(self, Q: np.ndarray, V: np.ndarray) -> tuple[dict, dict]:
+        """Per-body (N, 3) CoM poses (phi from the drawing) and rates, from Pinocchio's
+        forward kinematics."""
+        pin, model, data = self.pin, self.model, self.data
+        bodies = self.d.bodies
+        poses = {k: np.empty((len(Q), 3)) for k in bodies}
+        rates = {k: np.empty((len(Q), 3)) for k in bodies}
+        for i in range(len(Q)):
+            pin.forwardKinematics(model, data, Q[i], V[i])
+            for name in bodies:
+                j = self.jid[name]
+                M, vel = data.oMi[j], data.v[j]  # vel: joint frame, local coordinates
+                c = v3(bodies[name].com - self.origin[name])
+                R = M.rotation
+                poses[name][i, :2] = (M.translation + R @ c)[:2]
+                poses[name][i, 2] = np.arctan2(R[1, 0], R[0, 0])
+                rates[name][i, :2] = (R @ (vel.linear + np.cross(vel.angular, c)))[:2]
+                rates[name][i, 2] = vel.angular[2]
+        for p in poses.values():
+            p[:, 2] = np.unwrap(p[:, 2])
+        return poses, rates
+
+
+def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
+    dt, w = setting
+    r = Run(TOOL, "RK4 + constraintDynamics" + (f", Baumgarte w={w:g}" if w else ""), f"dt={dt:g}")
+    n = r.steps = bm.steps(dt)
+    m = Model(d, w)
+    with np.errstate(all="ignore"):
+        r.wall, (Q, V) = best_time(lambda: m.simulate(dt, n))
+        poses, rates = m.body_states(Q, V)
+        q = coordinates(d, poses)[bm.grid_indices(dt)]
+        return r.finish(energy(d, poses, rates), loop_gap(d, poses), q, ref_grid)
