@@ -269,12 +269,14 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
     for i in 0..n {
         let target = row(&path.x, i);
         let st = if i == 0 {
-            tr.inverse(&target, &q_start)
+            tr.inverse(&target, &q_start).map_err(|e| at_sample(e, path.t[i], &target, true))?
         } else {
             let (q, qd, qdd) = (row(&out.q, i - 1), row(&out.qd, i - 1), row(&out.qdd, i - 1));
-            tr.step(&target, &q, &qd, &qdd, path.t[i] - path.t[i - 1])
-        }
-        .map_err(|e| at_sample(e, path.t[i], &target, i == 0))?;
+            match tr.step(&target, &q, &qd, &qdd, path.t[i] - path.t[i - 1]) {
+                Ok(st) => st,
+                Err(e) => return Err(fail_between(&mut tr, path, &out, i, e)),
+            }
+        };
         let (qd, qdd) = tr.rates(&row(&path.xd, i), &row(&path.xdd, i));
         out.sigma_ii[i] = sigma_min(mech, &Chart::Inputs, &tr.ws.x);
         (out.sigma_i[i], out.condition[i]) = (st.sigma_i, st.condition);
@@ -292,11 +294,54 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
 }
 
 fn at_sample(e: TaskError, t: f64, x: &[f64], first: bool) -> TaskError {
-    match e {
-        TaskError::OutOfReach(why) if first => TaskError::OutOfReach(format!("the path's first point {} cannot be reached from the start: {why}", fmt_vec(x))),
-        TaskError::OutOfReach(why) => TaskError::OutOfReach(format!("the path leaves the reach of the working mode at t = {t:.4} s, end effector at {}: {why}", fmt_vec(x))),
-        other => other,
+    let why = match e {
+        TaskError::Core(Error::Kinematics(k)) => k.to_string(),
+        TaskError::OutOfReach(why) => why,
+        other => return other,
+    };
+    TaskError::OutOfReach(if first {
+        format!("the path's first point {} cannot be reached from the start: {why}", fmt_vec(x))
+    } else {
+        format!("the path leaves the reach of the working mode at t = {t:.4} s, end effector at {}: {why}", fmt_vec(x))
+    })
+}
+
+/// Sample i could not be solved: find by bisection how far past t_i-1 the path can be
+/// followed; at that edge one of the measures is near zero (the singularity that stops it),
+/// or the target is simply out of reach (motion.py `_fail_between`).
+fn fail_between(tr: &mut Tracker<'_>, path: &TaskPath, out: &TaskSolution, i: usize, e: TaskError) -> TaskError {
+    let m = tr.k();
+    let rows = |a: &[f64]| a[(i - 1) * m..i * m].to_vec();
+    let (q, qd, qdd) = (rows(&out.q), rows(&out.qd), rows(&out.qdd));
+    let at = |tt: f64| -> Vec<f64> {
+        if i >= 2 {
+            local_path(path, i - 1, m, tt)
+        } else {
+            let a = (tt - path.t[0]) / (path.t[1] - path.t[0]);
+            (0..m).map(|k| path.x[k] + a * (path.x[m + k] - path.x[k])).collect()
+        }
+    };
+    let (mut lo, mut hi, mut best) = (path.t[i - 1], path.t[i], None);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        match tr.step(&at(mid), &q, &qd, &qdd, mid - path.t[i - 1]) {
+            Ok(st) => {
+                best = Some((mid, sigma_min(tr.mech, &Chart::Inputs, &tr.ws.x), st));
+                lo = mid;
+            }
+            Err(_) => hi = mid,
+        }
     }
+    if let Some((tm, s_ii, st)) = best {
+        let sigma = st.sigma_i.min(s_ii);
+        if sigma < REFINE_LEVEL {
+            let tol = if sigma < path.singular_tol { path.singular_tol } else { REFINE_LEVEL };
+            if let Err(singular) = check(st.sigma_i, s_ii, tol, tm, &st) {
+                return singular;
+            }
+        }
+    }
+    at_sample(e, path.t[i], &path.x[i * m..(i + 1) * m], false)
 }
 
 fn check(s_i: f64, s_ii: f64, tol: f64, t: f64, st: &Sample) -> Result<(), TaskError> {
@@ -318,7 +363,7 @@ fn refine(tr: &mut Tracker<'_>, path: &TaskPath, out: &TaskSolution, j: usize) -
     let rows = |a: &[f64]| a[j * m..(j + 1) * m].to_vec();
     let (q, qd, qdd) = (rows(&out.q), rows(&out.qd), rows(&out.qdd));
     let ts = [path.t[j - 1], path.t[j], path.t[j + 1]];
-    let quad = |tt: f64| -> Vec<f64> { (0..m).map(|k| lagrange(ts, [-1, 0, 1].map(|d| path.x[(j as isize + d) as usize * m + k]), tt)).collect() };
+    let quad = |tt: f64| local_path(path, j, m, tt);
     for (type_i, s) in [(true, &out.sigma_i), (false, &out.sigma_ii)] {
         if !(s[j] < REFINE_LEVEL && s[j] <= s[j - 1] && s[j] <= s[j + 1]) {
             continue;
@@ -368,14 +413,20 @@ fn rows_at(out: &TaskSolution, i: usize, m: usize) -> Vec<f64> {
     out.q[i * m..(i + 1) * m].to_vec()
 }
 
-/// The quadratic through (ts, ys) at t (Lagrange form).
-fn lagrange(ts: [f64; 3], ys: [f64; 3], t: f64) -> f64 {
-    (0..3)
-        .map(|i| {
-            let (a, b) = ((i + 1) % 3, (i + 2) % 3);
-            ys[i] * (t - ts[a]) * (t - ts[b]) / ((ts[i] - ts[a]) * (ts[i] - ts[b]))
+/// X(t) near sample j: the quadratic through samples j-1, j, j+1 (Lagrange form); exact
+/// enough to locate a singularity, the refused motion is not integrated from it.
+fn local_path(path: &TaskPath, j: usize, m: usize, t: f64) -> Vec<f64> {
+    let ts = &path.t[j - 1..j + 2];
+    (0..m)
+        .map(|k| {
+            (0..3)
+                .map(|i| {
+                    let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+                    path.x[(j - 1 + i) * m + k] * (t - ts[a]) * (t - ts[b]) / ((ts[i] - ts[a]) * (ts[i] - ts[b]))
+                })
+                .sum()
         })
-        .sum()
+        .collect()
 }
 
 fn fmt_vec(v: &[f64]) -> String {
