@@ -108,11 +108,22 @@ def _model(design: Design, names: list[str], values: FloatArray) -> Mechanism | 
     return model
 
 
-def steps(values: ArrayLike, rel_step: float = DEFAULT_REL_STEP, typical: ArrayLike | float = 1.0) -> FloatArray:
-    """The steps h_i = rel_step max(|v_i|, typical_i), rounded so that (v + h) - v == h."""
+def steps(values: ArrayLike, rel_step: float = DEFAULT_REL_STEP, typical: ArrayLike | float = 0.0,
+          names: Sequence[str] | None = None) -> FloatArray:
+    """The steps h_i = rel_step max(|v_i|, typical_i), rounded so that (v + h) - v == h.
+
+    ``typical`` (scalar or (p,), in each parameter's units) is a floor for parameters whose
+    value is 0 or near it (a point on an axis): their step is then relative to it.
+    """
     v = np.asarray(values, dtype=float)
     h = rel_step * np.maximum(np.abs(v), np.broadcast_to(np.asarray(typical, dtype=float), v.shape))
-    return (v + h) - v
+    h = (v + h) - v
+    bad = np.flatnonzero(~(h > 0) | ~np.isfinite(h))
+    if len(bad):
+        which = names[bad[0]] if names is not None else f"parameter {bad[0]}"
+        raise ValueError(f"{which} = {v[bad[0]]:g}: no step can be made from it; give typical= (a typical "
+                         f"magnitude in its units, e.g. the mechanism's size for a coordinate that is 0)")
+    return h
 
 
 def _differences(design: Design, params: Mapping[str, float] | Sequence[str],
@@ -120,7 +131,7 @@ def _differences(design: Design, params: Mapping[str, float] | Sequence[str],
                  rel_step: float, typical: ArrayLike | float) -> Sensitivity:
     """Evaluate the nominal design and v +- h e_i, v +- 2h e_i for every i in one batch."""
     names, v = _nominal(design, params)
-    h = steps(v, rel_step, typical)
+    h = steps(v, rel_step, typical, names)
     shifts = [np.zeros_like(v)] + [s * h[i] * np.eye(len(v))[i] for i in range(len(v)) for s in (1, -1, 2, -2)]
     results = run([_model(design, names, v + d) for d in shifts])
     for k, r in enumerate(results):
@@ -141,7 +152,7 @@ def _differences(design: Design, params: Mapping[str, float] | Sequence[str],
 
 def trajectory(design: Design, params: Mapping[str, float] | Sequence[str], t_eval: ArrayLike, *,
                quantity: Callable[[Any], ArrayLike] | None = None, rel_step: float = DEFAULT_REL_STEP,
-               typical: ArrayLike | float = 1.0, threads: int | None = None, executor: Any = None,
+               typical: ArrayLike | float = 0.0, threads: int | None = None, executor: Any = None,
                **settings: Any) -> Sensitivity:
     """d q(t) / dp of a simulation with the model's drives, at the times ``t_eval`` (s).
 
@@ -165,8 +176,11 @@ def trajectory(design: Design, params: Mapping[str, float] | Sequence[str], t_ev
     """
     t_eval = np.asarray(t_eval, dtype=float)
 
+    own = {k: settings.pop(k) for k in ("q0", "qd0") if k in settings}
+
     def run(models: list[Any]) -> list[Any]:
-        out = batch.simulate(models, float(t_eval[-1]), t_eval=t_eval, threads=threads, executor=executor, **settings)
+        out = batch.simulate([(m, own) for m in models], float(t_eval[-1]), t_eval=t_eval, threads=threads,
+                             executor=executor, **settings)
         return [r if isinstance(r, batch.BatchError) or r.success else
                 batch.BatchError(k, "SimulationError", f"the run stopped at t = {r.t[-1]:.4g} s: {r.message}")
                 for k, r in enumerate(out)]
@@ -176,7 +190,7 @@ def trajectory(design: Design, params: Mapping[str, float] | Sequence[str], t_ev
 
 def objective(design: Design, params: Mapping[str, float] | Sequence[str], path: Any,
               quantity: Callable[[Any], ArrayLike], *, rel_step: float = DEFAULT_REL_STEP,
-              typical: ArrayLike | float = 1.0, threads: int | None = None, executor: Any = None,
+              typical: ArrayLike | float = 0.0, threads: int | None = None, executor: Any = None,
               **motion: Any) -> Sensitivity:
     """d f / dp of ``quantity(motion)`` for the end-effector ``path`` solved on every design.
 
