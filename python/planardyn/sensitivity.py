@@ -133,12 +133,20 @@ def _differences(design: Design, params: Mapping[str, float] | Sequence[str],
     names, v = _nominal(design, params)
     h = steps(v, rel_step, typical, names)
     shifts = [np.zeros_like(v)] + [s * h[i] * np.eye(len(v))[i] for i in range(len(v)) for s in (1, -1, 2, -2)]
-    results = run([_model(design, names, v + d) for d in shifts])
+    def where(k: int) -> str:
+        return "the nominal design" if k == 0 else f"{names[(k - 1) // 4]} = {(v + shifts[k])[(k - 1) // 4]:.9g}"
+
+    models = []
+    for k, d in enumerate(shifts):
+        try:
+            models.append(_model(design, names, v + d))
+        except Exception as e:
+            raise type(e)(f"sensitivity: {where(k)}: {e}") from e
+    results = run(models)
     for k, r in enumerate(results):
         if isinstance(r, batch.BatchError):
-            where = "the nominal design" if k == 0 else f"{names[(k - 1) // 4]} = {(v + shifts[k])[(k - 1) // 4]:.9g}"
             exc = getattr(_core, r.type, None) or getattr(builtins, r.type, _core.PlanardynError)
-            raise exc(f"sensitivity: {where}: {r.message}")
+            raise exc(f"sensitivity: {where(k)}: {r.message}")
     f = np.array([np.asarray(quantity(r), dtype=float) for r in results])
     plus, minus, plus2, minus2 = (f[1 + j::4] for j in range(4))
     shape = (len(v),) + (1,) * (f.ndim - 1)
