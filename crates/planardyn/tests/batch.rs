@@ -155,19 +155,24 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
     let task = |model: Model, path: &TaskPath| InverseVariant { model, motion: Motion::Task(path.clone()) };
     let mut wrong_point = circle.clone();
     wrong_point.point = "Q".into();
+    let mut far = circle.clone();
+    far.x.iter_mut().skip(1).step_by(2).for_each(|y| *y += 1.0);
     let vs = vec![
         task(Model::Built(mech.clone()), &circle),
         // Straight down through the type II singularity (distal links aligned near y = 0.15 m).
         task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 0.1])),
-        // Out of reach: 1 m above the base.
+        // Up to 1 m above the base: it stops at the edge of the workspace, a type I singularity.
         task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 1.0])),
         task(Model::Built(mech.clone()), &wrong_point),
         task(Model::Spec(heavy), &circle),
+        // The circle 1 m higher: its first point is out of reach.
+        task(Model::Built(mech.clone()), &far),
     ];
     let out = inverse_many(&vs, Some(2)).unwrap();
     assert_eq!(out, inverse_many(&vs, Some(1)).unwrap());
     assert!(matches!(&out[1], Err(TaskError::Singular(m)) if m.contains("type II")), "{:?}", out[1]);
-    assert!(matches!(&out[2], Err(TaskError::OutOfReach(m)) if m.contains("leaves the reach")), "{:?}", out[2]);
+    assert!(matches!(&out[2], Err(TaskError::Singular(m)) if m.contains("type I ") && m.contains("0.577")), "{:?}", out[2]);
+    assert!(matches!(&out[5], Err(TaskError::OutOfReach(m)) if m.contains("first point")), "{:?}", out[5]);
     assert!(matches!(&out[3], Err(TaskError::Core(Error::Kinematics(KinematicsError::BadArgument(m)))) if m.contains("\"Q\"")));
     let (Ok(Efforts::Task(sol)), Ok(Efforts::Task(heavier))) = (&out[0], &out[4]) else { panic!("{:?}", out[0]) };
     for i in (0..circle.t.len()).step_by(50) {
