@@ -12,7 +12,7 @@ use crate::convert::{arr1, arr2};
 use crate::errors::{run, to_pyerr, AssemblyError, Failure, SingularityError};
 use crate::mechanism::PyMechanism;
 use planardyn::batch::task::{TaskError, TaskPath, TaskSolution};
-use planardyn::batch::{inverse_many, simulate_many, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::batch::{map_many, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -61,22 +61,31 @@ fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
     })
 }
 
+/// The native variants (`make` from each pair), solved by `solve` on the batch pool with
+/// the GIL released; each outcome turned into a Python object by `out`, in input order.
+fn run_batch<'py, V: Sync, R: Send>(
+    py: Python<'py>,
+    variants: &[(Bound<'py, PyMechanism>, Bound<'py, PyDict>)],
+    threads: Option<usize>,
+    make: impl Fn(&Bound<'py, PyMechanism>, &Bound<'py, PyDict>) -> PyResult<V>,
+    solve: impl Fn(&V) -> R + Sync + Send,
+    out: impl Fn(R, &Bound<'py, PyMechanism>) -> PyResult<Bound<'py, PyAny>>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let vs = variants.iter().map(|(m, d)| make(m, d)).collect::<PyResult<Vec<_>>>()?;
+    let done = run(py, || map_many(&vs, threads, solve).map_err(Failure::from))?;
+    done.into_iter().zip(variants).map(|(r, (m, _))| out(r, m)).collect()
+}
+
 /// Simulate `(mechanism, overrides)` pairs on `threads` threads (None: all cores); results
 /// in input order.
 #[pyfunction]
 #[pyo3(signature = (variants, threads=None))]
 fn simulate_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>, threads: Option<usize>) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let vs = variants
-        .iter()
-        .map(|(m, d)| Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? }))
-        .collect::<PyResult<Vec<_>>>()?;
-    let out = run(py, || simulate_many(&vs, threads).map_err(Failure::from))?;
-    out.into_iter()
-        .map(|r| match r {
-            Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
-            Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
-        })
-        .collect()
+    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? });
+    run_batch(py, &variants, threads, make, Variant::simulate, |r, _| match r {
+        Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
+        Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
+    })
 }
 
 /// A motion dict: `q`, `qd`, `qdd` (flat rows), or `t`, `X`, `Xd`, `Xdd` (flat rows) with
@@ -136,18 +145,11 @@ fn error_pair<'py>(py: Python<'py>, err: PyErr, message: String) -> PyResult<Bou
 #[pyfunction]
 #[pyo3(signature = (variants, threads=None))]
 fn inverse_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>, threads: Option<usize>) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let vs = variants
-        .iter()
-        .map(|(m, d)| Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? }))
-        .collect::<PyResult<Vec<_>>>()?;
-    let out = run(py, || inverse_many(&vs, threads).map_err(Failure::from))?;
-    out.into_iter()
-        .zip(&variants)
-        .map(|(r, (mech, _))| match r {
-            Ok(e) => efforts_dict(py, e, mech.get().inner.dof()),
-            Err(e) => failure(py, &e),
-        })
-        .collect()
+    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? });
+    run_batch(py, &variants, threads, make, InverseVariant::solve, |r, m| match r {
+        Ok(e) => efforts_dict(py, e, m.get().inner.dof()),
+        Err(e) => failure(py, &e),
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
