@@ -1,7 +1,7 @@
 """Batch runs (planardyn.batch): native threads and a local Dask cluster of worker processes
-both give, bit for bit, what a serial loop of Mechanism.simulate gives; a failing variant
-is reported in its place without losing the others; sweep and monte_carlo make the variants
-they say."""
+both give, bit for bit, what a serial loop of Mechanism.simulate (or of the inverse dynamics)
+gives; a failing variant is reported in its place without losing the others; sweep and
+monte_carlo make the variants they say."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ import pytest
 from conftest import MODELS
 
 import planardyn as pd
-from planardyn.batch import BatchError, monte_carlo, simulate, sweep
+from planardyn import robot
+from planardyn.batch import BatchError, inverse_dynamics, monte_carlo, simulate, sweep
 
 T_END = 0.1  # s: short runs, the test is about bookkeeping, not dynamics
 # Proximal links straight out: C1 C2 = 0.8 m > 2 x 0.35 m, the distal links cannot meet.
@@ -82,17 +83,117 @@ def test_any_concurrent_futures_executor(variants):
         assert_same(a, b)
 
 
-def test_dask_cluster_of_processes_equals_serial(variants, five_bar):
+def test_dask_cluster_of_processes_equals_serial(variants, five_bar, designs, circle):
     distributed = pytest.importorskip("distributed")
     mixed = [*variants[:3], (five_bar, {"q0": IMPOSSIBLE_Q0}), *variants[3:]]
     with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
                                   dashboard_address=None, silence_logs=40) as cluster, \
             distributed.Client(cluster) as client:
         got = simulate(mixed, T_END, executor=client, chunk_size=2, threads=1)
+        efforts = inverse_dynamics(designs, circle, dt=ID_DT, executor=client, chunk_size=2, threads=1)
     expected = serial(variants)
     assert isinstance(got[3], BatchError) and got[3].type == "AssemblyError" and got[3].index == 3
     for a, b in zip(got[:3] + got[4:], expected):
         assert_same(a, b)
+    assert_same_efforts(efforts, serial_inverse(designs, circle))
+
+
+# ---------------------------------------------------------------------- inverse dynamics
+
+ID_DT = 0.004  # s: 251 samples of a 1 s circle
+
+
+@pytest.fixture(scope="module")
+def circle(five_bar):
+    home = robot.EndEffector(five_bar, "P").home()
+    return robot.circle(home + [0.0, 0.05], 0.05, duration=1.0)
+
+
+@pytest.fixture(scope="module")
+def designs(five_bar):
+    """Design variants of the five-bar on one circle: a heavier distal link, longer proximal
+    links (the points C1, C2 moved out along them), and a right proximal link so short
+    that the circle meets a singularity of that design."""
+    heavy = sweep(five_bar, "bodies.distal_right.mass", [1.4])
+    model = five_bar.to_dict()
+    longer = []
+    for scale in (1.02, 0.6):
+        m = five_bar.to_dict()
+        for a, c in (("A1", "C1"), ("A2", "C2")):
+            A, C = np.array(model["points"][a]), np.array(model["points"][c])
+            m["points"][c] = (A + scale * (C - A)).tolist()
+        longer.append(m)
+    return [five_bar, *heavy, *longer]
+
+
+def serial_inverse(designs, path):
+    """One call per design (no pool shared between them)."""
+    return [inverse_dynamics([d], path, dt=ID_DT, threads=1)[0] for d in designs]
+
+
+def assert_same_efforts(got, expected):
+    assert len(got) == len(expected)
+    for a, b in zip(got, expected):
+        if isinstance(b, BatchError):
+            assert (a.type, a.message) == (b.type, b.message)
+            continue
+        for name in ("t", "X", "q", "qd", "qdd", "tau", "sigma_I", "sigma_II", "condition"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def test_inverse_dynamics_of_designs_on_a_path_equal_serial_and_solve_motion(designs, circle):
+    got = inverse_dynamics(designs, circle, dt=ID_DT, threads=2)
+    expected = serial_inverse(designs, circle)
+    assert_same_efforts(got, expected)
+    # The shortened proximal links cannot follow the circle: reported in place.
+    assert isinstance(got[3], BatchError) and got[3].index == 3, got[3]
+    assert got[3].type in ("SingularityError", "AssemblyError")
+    # The Rust stages are those of robot.solve_motion (which reassembles each sample from
+    # the drawing, and uses LAPACK): equal to round-off.
+    for k in range(3):
+        mech = got[k].mech
+        ref = robot.solve_motion(robot.EndEffector(mech, "P"), circle, dt=ID_DT)
+        assert np.allclose(got[k].q, ref.q, rtol=0, atol=1e-11)
+        scale = np.abs(ref.tau).max()
+        assert np.abs(got[k].tau - ref.tau).max() < 1e-9 * scale
+        assert np.allclose(got[k].sigma_II, ref.sigma_II, rtol=0, atol=1e-12)
+    # Same kinematics, heavier link: same inputs, more effort.
+    assert np.array_equal(got[0].q, got[1].q) and not np.array_equal(got[0].tau, got[1].tau)
+
+
+def test_inverse_dynamics_of_coordinate_rows_equals_mechanism_inverse_dynamics(five_bar):
+    res = five_bar.simulate(0.2, output_dt=0.01)
+    variants = [(m, {"q": res.q, "qd": res.qd, "qdd": res.qdd}) for m in sweep(five_bar, "bodies.distal_left.parts.1.mass", [0.3, 0.5])]
+    variants.append((five_bar, {"q": [[math.pi, 0.0]], "qd": [[0.0, 0.0]], "qdd": [[0.0, 0.0]]}))
+    got = inverse_dynamics(variants, threads=2)
+    for (mech, own), tau in zip(variants[:2], got):
+        assert np.array_equal(tau, mech.inverse_dynamics(res.q, res.qd, res.qdd))
+    # Forward then inverse: the model's own drive efforts back (0.3 kg: the simulated model).
+    assert np.abs(got[0] - res.tau).max() < 1e-8
+    assert isinstance(got[2], BatchError) and got[2].type == "AssemblyError"
+
+
+def test_inverse_dynamics_failures_in_place(five_bar, designs, circle):
+    bad = five_bar.to_dict()
+    bad["bodies"]["proximal_left"]["mass"] = -1.0
+    home = robot.EndEffector(five_bar, "P").home()
+    through_singularity = robot.point_to_point(home, (home[0], 0.1), duration=1.0)
+    mixed = [designs[0], bad, (five_bar, {"path": through_singularity}), (five_bar, {"point": "Q"}), five_bar]
+    got = inverse_dynamics(mixed, circle, dt=ID_DT)
+    assert isinstance(got[1], BatchError) and got[1].type == "ModelError" and "mass" in got[1].message
+    assert got[2].type == "SingularityError" and "type II" in got[2].message and got[2].index == 2
+    assert got[3].type == "ValueError" and 'no point "Q"' in got[3].message
+    with pytest.raises(pd.SingularityError):
+        robot.solve_motion(robot.EndEffector(five_bar, "P"), through_singularity)
+    assert_same_efforts([got[0], got[4]], serial_inverse([designs[0], five_bar], circle))
+    (no_motion,) = inverse_dynamics([five_bar])
+    assert no_motion.type == "ValueError" and "needs a path" in no_motion.message
+
+
+def test_inverse_dynamics_on_a_thread_pool_executor(designs, circle):
+    with ThreadPoolExecutor(2) as ex:
+        got = inverse_dynamics(designs, circle, dt=ID_DT, executor=ex, chunk_size=1, threads=1)
+    assert_same_efforts(got, serial_inverse(designs, circle))
 
 
 def test_sweep_edits_the_path(five_bar):

@@ -110,3 +110,6 @@ class Mechanism:
 def simulate_batch(
     variants: list[tuple[Mechanism, dict[str, Any]]], threads: int | None = None
 ) -> list[dict[str, Any] | tuple[str, str]]: ...
+def inverse_batch(
+    variants: list[tuple[Mechanism, dict[str, Any]]], threads: int | None = None
+) -> list[dict[str, Any] | tuple[str, str]]: ...

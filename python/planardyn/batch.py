@@ -12,6 +12,11 @@ chunks and each chunk runs that same native batch on a worker. Either way the re
 back in input order and equal, bit for bit, those of a loop of ``mech.simulate``. A variant
 that fails (a start that cannot be assembled, invalid settings, a model dict that is not a
 mechanism) gives a :class:`BatchError` in its place; the others are not affected.
+
+:func:`inverse_dynamics` does the same for the drive efforts of a motion: a motion in the
+coordinates (``q``, ``qd``, ``qdd`` rows), or an end-effector path solved for the inputs on
+each variant first (as :func:`planardyn.robot.solve_motion`, but in Rust), e.g. many
+designs of a robot on one task or many tasks of one robot.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ import copy
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -29,7 +34,10 @@ from . import _core
 from .mechanism import Mechanism, from_dict
 from .result import SimulationResult
 
-__all__ = ["BatchError", "monte_carlo", "simulate", "sweep"]
+if TYPE_CHECKING:
+    from .robot import TaskMotion, TaskPath
+
+__all__ = ["BatchError", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
 
 #: A variant: a model, or a model with its own settings.
 VariantLike = Union[Mechanism, Mapping[str, Any], tuple[Union[Mechanism, Mapping[str, Any]], Mapping[str, Any]]]
@@ -38,6 +46,7 @@ Edit = Union[str, Callable[[dict[str, Any], Any], dict[str, Any]]]
 
 _SETTINGS = ("t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps")
 _ARRAYS = ("t_eval", "q0", "qd0")
+_MOTION = ("path", "q", "qd", "qdd", "point", "body", "n", "dt", "q_start", "singular_tol")
 
 
 @dataclass(frozen=True)
@@ -73,13 +82,68 @@ def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, An
     return out
 
 
-def _run_chunk(items: list[tuple[Mechanism, dict[str, Any]]], threads: int | None) -> list[Any]:
-    """One native batch: a picklable call that runs on a worker (or here)."""
-    return _core.simulate_batch([(m._native, s) for m, s in items], threads)
+def _run_chunk(kind: str, items: list[tuple[Mechanism, dict[str, Any]]], threads: int | None) -> list[Any]:
+    """One native batch (``kind`` 'simulate' or 'inverse'): a picklable call that runs on a
+    worker (or here)."""
+    native = _core.simulate_batch if kind == "simulate" else _core.inverse_batch
+    # Keys with a leading underscore stay in Python (the path's label, for the result).
+    return native([(m._native, {k: v for k, v in s.items() if not k.startswith("_")}) for m, s in items], threads)
 
 
 def _is_dask(executor: Any) -> bool:
     return type(executor).__module__.split(".")[0] == "distributed"
+
+
+def _prepare(variants: Sequence[VariantLike], own_args: Callable[[Mechanism, Mapping[str, Any]], dict[str, Any]],
+             ) -> tuple[list[Any], list[int], list[tuple[Mechanism, dict[str, Any]]]]:
+    """Build every variant's model and native arguments; a failure is a BatchError in its place."""
+    out: list[Any] = [None] * len(variants)
+    todo: list[int] = []
+    items: list[tuple[Mechanism, dict[str, Any]]] = []
+    for i, v in enumerate(variants):
+        model, own = (v if isinstance(v, tuple) else (v, {}))
+        try:
+            mech = model if isinstance(model, Mechanism) else from_dict(model)
+            items.append((mech, own_args(mech, own)))
+            todo.append(i)
+        except Exception as e:  # noqa: BLE001 - reported in the variant's place
+            out[i] = BatchError(i, type(e).__name__, str(e))
+    return out, todo, items
+
+
+def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechanism, Mapping[str, Any]], dict[str, Any]],
+         finish: Callable[[Any, Mechanism, dict[str, Any]], Any], threads: int | None, executor: Any,
+         chunk_size: int | None, progress: Callable[[int, int], Any] | None) -> list[Any]:
+    """Cut the prepared variants into chunks, run them here or on the executor, and put each
+    raw result (``finish``-ed) or BatchError in its variant's place."""
+    out, todo, items = _prepare(variants, own_args)
+    n = len(items)
+    if chunk_size is None:
+        parts = 16 if executor is not None else (20 if progress is not None else 1)
+        chunk_size = max(1, math.ceil(n / parts))
+    if chunk_size < 1:
+        raise ValueError(f"chunk_size = {chunk_size} must be at least 1")
+    starts = range(0, n, chunk_size)
+    if executor is None:
+        pending = [lambda s=s: _run_chunk(kind, items[s:s + chunk_size], threads) for s in starts]
+    else:
+        kw = {"pure": False} if _is_dask(executor) else {}
+        futures = [executor.submit(_run_chunk, kind, items[s:s + chunk_size], threads, **kw) for s in starts]
+        pending = [f.result for f in futures]
+    done = 0
+    for s, get in zip(starts, pending):
+        chunk = items[s:s + chunk_size]
+        try:
+            raws = get()
+        except Exception as e:  # noqa: BLE001 - a lost chunk loses only its own variants
+            raws = [(type(e).__name__, f"the chunk with this variant failed: {e}")] * len(chunk)
+        for k, ((mech, args), raw) in enumerate(zip(chunk, raws)):
+            i = todo[s + k]
+            out[i] = finish(raw, mech, args) if isinstance(raw, dict) else BatchError(i, *raw)
+        done += len(chunk)
+        if progress is not None:
+            progress(done, n)
+    return out
 
 
 def simulate(
@@ -128,44 +192,8 @@ def simulate(
     """
     common = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, t_eval=t_eval,
                   output_dt=output_dt, max_steps=max_steps)
-    out: list[SimulationResult | BatchError | None] = [None] * len(variants)
-    todo: list[int] = []
-    items: list[tuple[Mechanism, dict[str, Any]]] = []
-    for i, v in enumerate(variants):
-        model, own = (v if isinstance(v, tuple) else (v, {}))
-        try:
-            mech = model if isinstance(model, Mechanism) else from_dict(model)
-            items.append((mech, _settings(common, own)))
-            todo.append(i)
-        except Exception as e:  # noqa: BLE001 - reported in the variant's place
-            out[i] = BatchError(i, type(e).__name__, str(e))
-    n = len(items)
-    if chunk_size is None:
-        parts = 16 if executor is not None else (20 if progress is not None else 1)
-        chunk_size = max(1, math.ceil(n / parts))
-    if chunk_size < 1:
-        raise ValueError(f"chunk_size = {chunk_size} must be at least 1")
-    starts = range(0, n, chunk_size)
-    if executor is None:
-        pending = [lambda s=s: _run_chunk(items[s:s + chunk_size], threads) for s in starts]
-    else:
-        kw = {"pure": False} if _is_dask(executor) else {}
-        futures = [executor.submit(_run_chunk, items[s:s + chunk_size], threads, **kw) for s in starts]
-        pending = [f.result for f in futures]
-    done = 0
-    for s, get in zip(starts, pending):
-        chunk = items[s:s + chunk_size]
-        try:
-            raws = get()
-        except Exception as e:  # noqa: BLE001 - a lost chunk loses only its own variants
-            raws = [(type(e).__name__, f"the chunk with this variant failed: {e}")] * len(chunk)
-        for k, ((mech, settings), raw) in enumerate(zip(chunk, raws)):
-            i = todo[s + k]
-            out[i] = _result(raw, mech, settings) if isinstance(raw, dict) else BatchError(i, *raw)
-        done += len(chunk)
-        if progress is not None:
-            progress(done, n)
-    return out  # type: ignore[return-value]
+    return _run("simulate", variants, lambda mech, own: _settings(common, own), _result,
+                threads, executor, chunk_size, progress)
 
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
@@ -174,6 +202,98 @@ def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> S
     result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
                                        coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names)
     return attach_metadata(result, mech, settings)
+
+
+def inverse_dynamics(
+    variants: Sequence[VariantLike],
+    path: TaskPath | None = None,
+    *,
+    q: ArrayLike | None = None,
+    qd: ArrayLike | None = None,
+    qdd: ArrayLike | None = None,
+    point: str = "P",
+    body: str | None = None,
+    n: int | None = None,
+    dt: float | None = None,
+    q_start: ArrayLike | None = None,
+    singular_tol: float | None = None,
+    threads: int | None = None,
+    executor: Any = None,
+    chunk_size: int | None = None,
+    progress: Callable[[int, int], Any] | None = None,
+) -> list[TaskMotion | NDArray[np.float64] | BatchError]:
+    """Drive efforts of a motion for every variant; results in input order.
+
+    Parameters
+    ----------
+    variants : sequence
+        As for :func:`simulate`; a pair's dict overrides this call's motion arguments for
+        that variant (keys ``path``, ``q``, ``qd``, ``qdd``, ``point``, ``body``, ``n``,
+        ``dt``, ``q_start``, ``singular_tol``).
+    path : planardyn.robot.TaskPath, optional
+        An end-effector motion: on each variant it is sampled (``n`` samples or spacing
+        ``dt`` s, default 1 ms), solved for the inputs from ``q_start`` (rad or m; default
+        the drawing) on that working mode, then for the efforts, as
+        :func:`planardyn.robot.solve_motion` does.
+    q, qd, qdd : (N, m) array_like, optional
+        Instead of a path, a motion in the coordinates (rad or m, per s, per s^2); the
+        efforts as :meth:`Mechanism.inverse_dynamics` gives them, bit for bit.
+    point, body : str
+        The end-effector point (and its body, for a pose of an m = 3 robot).
+    singular_tol : float
+        Refuse a path where sigma_I or sigma_II falls below this (dimensionless; default
+        :data:`planardyn.robot.SINGULAR_TOL`).
+    threads, executor, chunk_size, progress
+        As for :func:`simulate`.
+
+    Returns
+    -------
+    list of TaskMotion, ndarray or BatchError
+        Per variant: a :class:`~planardyn.robot.TaskMotion` for a path (its ``tau``, ``q``,
+        ``sigma_I``...), the (N, m) efforts (N m or N) for coordinate rows, or a
+        :class:`BatchError`: ``SingularityError`` where the path meets a singularity of that
+        design, ``AssemblyError`` where it leaves its reach, ``ModelError``...
+    """
+    common = dict(path=path, q=q, qd=qd, qdd=qdd, point=point, body=body, n=n, dt=dt, q_start=q_start,
+                  singular_tol=singular_tol)
+    return _run("inverse", variants, lambda mech, own: _motion(mech, common, own), _efforts,
+                threads, executor, chunk_size, progress)
+
+
+def _motion(mech: Mechanism, common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, Any]:
+    """The native motion dict of one variant: coordinate rows, or the path sampled."""
+    from .robot.motion import SINGULAR_TOL, _sample_times
+
+    unknown = set(own) - set(_MOTION)
+    if unknown:
+        raise ValueError(f"unknown motion arguments {sorted(unknown)}; expected some of {', '.join(_MOTION)}")
+    a = {k: v for k, v in {**common, **own}.items() if v is not None}
+    flat = lambda x: np.asarray(x, dtype=np.float64).ravel().tolist()  # noqa: E731 - exact for float64
+    if "path" not in a:
+        if not {"q", "qd", "qdd"} <= set(a):
+            raise ValueError("inverse_dynamics needs a path, or q, qd and qdd (N, m) rows")
+        return {k: flat(a[k]) for k in ("q", "qd", "qdd")}
+    path = a["path"].with_dim(mech.dof)
+    t = _sample_times(path.duration, a.get("n"), a.get("dt"))
+    X, Xd, Xdd = path.sample(t)
+    motion = {"t": t.tolist(), "X": flat(X), "Xd": flat(Xd), "Xdd": flat(Xdd), "point": a["point"],
+              "body": a.get("body"), "singular_tol": float(a.get("singular_tol", SINGULAR_TOL)),
+              "_label": path.label}
+    if "q_start" in a:
+        motion["q_start"] = flat(a["q_start"])
+    return motion
+
+
+def _efforts(raw: dict[str, Any], mech: Mechanism, motion: dict[str, Any]) -> TaskMotion | NDArray[np.float64]:
+    if "t" not in motion:
+        return raw["tau"]
+    from .robot import EndEffector, TaskMotion
+
+    ee = EndEffector(mech, motion["point"], motion["body"])
+    k = mech.dof
+    X, Xd, Xdd = (np.asarray(motion[key]).reshape(-1, k) for key in ("X", "Xd", "Xdd"))
+    return TaskMotion(ee, motion["_label"], np.asarray(motion["t"]), X, Xd, Xdd, raw["q"], raw["qd"], raw["qdd"],
+                      raw["tau"], raw["sigma_I"], raw["sigma_II"], raw["condition"])
 
 
 # ---------------------------------------------------------------------- making variants

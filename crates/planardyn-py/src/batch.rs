@@ -3,10 +3,16 @@
 //! `Mechanism` and a dict of overrides; each result is a trajectory dict (as
 //! `Mechanism.simulate` returns) or, for a variant that failed, the pair
 //! (exception type name, message) that `Mechanism.simulate` would have raised.
+//!
+//! `planardyn._core.inverse_batch` does the same for inverse dynamics: each variant a
+//! native `Mechanism` and a motion dict, either coordinate rows (`q`, `qd`, `qdd`) or a
+//! sampled end-effector path (`t`, `X`, `Xd`, `Xdd`, `point`, ...), on the same pool.
 
-use crate::errors::{run, to_pyerr, Failure};
+use crate::convert::{arr1, arr2};
+use crate::errors::{run, to_pyerr, AssemblyError, Failure, SingularityError};
 use crate::mechanism::PyMechanism;
-use planardyn::batch::{simulate_many, Model, Overrides, Variant};
+use planardyn::batch::task::{TaskError, TaskPath, TaskSolution};
+use planardyn::batch::{map_many, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -15,19 +21,32 @@ use pyo3::types::{PyDict, PyTuple};
 /// that need no Python callback).
 const KEYS: [&str; 10] = ["t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps"];
 
-fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
+/// Keys of an inverse-dynamics motion dict: coordinate rows, or a sampled task path.
+const MOTION_KEYS: [&str; 11] = ["q", "qd", "qdd", "t", "X", "Xd", "Xdd", "point", "body", "q_start", "singular_tol"];
+
+fn get<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<Option<T>> {
+    match d.get_item(k)? {
+        Some(v) if !v.is_none() => Ok(Some(v.extract::<T>().map_err(|e| PyValueError::new_err(format!("{k}: {}", Into::<PyErr>::into(e))))?)),
+        _ => Ok(None),
+    }
+}
+
+fn require<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<T> {
+    get(d, k)?.ok_or_else(|| PyValueError::new_err(format!("the motion needs {k:?}")))
+}
+
+fn check_keys(d: &Bound<'_, PyDict>, keys: &[&str], what: &str) -> PyResult<()> {
     for k in d.keys() {
         let k: String = k.extract()?;
-        if !KEYS.contains(&k.as_str()) {
-            return Err(PyValueError::new_err(format!("unknown simulation setting {k:?}; expected one of {}", KEYS.join(", "))));
+        if !keys.contains(&k.as_str()) {
+            return Err(PyValueError::new_err(format!("unknown {what} {k:?}; expected one of {}", keys.join(", "))));
         }
     }
-    fn get<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<Option<T>> {
-        match d.get_item(k)? {
-            Some(v) if !v.is_none() => Ok(Some(v.extract::<T>().map_err(|e| PyValueError::new_err(format!("{k}: {}", Into::<PyErr>::into(e))))?)),
-            _ => Ok(None),
-        }
-    }
+    Ok(())
+}
+
+fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
+    check_keys(d, &KEYS, "simulation setting")?;
     Ok(Overrides {
         t_end: get(d, "t_end")?,
         method: get(d, "method")?,
@@ -42,28 +61,98 @@ fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
     })
 }
 
+/// The native variants (`make` from each pair), solved by `solve` on the batch pool with
+/// the GIL released; each outcome turned into a Python object by `out`, in input order.
+fn run_batch<'py, V: Sync, R: Send>(
+    py: Python<'py>,
+    variants: &[(Bound<'py, PyMechanism>, Bound<'py, PyDict>)],
+    threads: Option<usize>,
+    make: impl Fn(&Bound<'py, PyMechanism>, &Bound<'py, PyDict>) -> PyResult<V>,
+    solve: impl Fn(&V) -> R + Sync + Send,
+    out: impl Fn(R, &Bound<'py, PyMechanism>) -> PyResult<Bound<'py, PyAny>>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let vs = variants.iter().map(|(m, d)| make(m, d)).collect::<PyResult<Vec<_>>>()?;
+    let done = run(py, || map_many(&vs, threads, solve).map_err(Failure::from))?;
+    done.into_iter().zip(variants).map(|(r, (m, _))| out(r, m)).collect()
+}
+
 /// Simulate `(mechanism, overrides)` pairs on `threads` threads (None: all cores); results
 /// in input order.
 #[pyfunction]
 #[pyo3(signature = (variants, threads=None))]
 fn simulate_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>, threads: Option<usize>) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let vs = variants
-        .iter()
-        .map(|(m, d)| Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? }))
-        .collect::<PyResult<Vec<_>>>()?;
-    let out = run(py, || simulate_many(&vs, threads).map_err(Failure::from))?;
-    out.into_iter()
-        .map(|r| match r {
-            Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
-            Err(e) => {
-                let err = to_pyerr(py, &e);
-                let name = err.get_type(py).name()?.to_string();
-                Ok(PyTuple::new(py, [name, e.to_string()])?.into_any())
+    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? });
+    run_batch(py, &variants, threads, make, Variant::simulate, |r, _| match r {
+        Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
+        Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
+    })
+}
+
+/// A motion dict: `q`, `qd`, `qdd` (flat rows), or `t`, `X`, `Xd`, `Xdd` (flat rows) with
+/// `point` and optionally `body`, `q_start`, `singular_tol`.
+fn motion(d: &Bound<'_, PyDict>) -> PyResult<Motion> {
+    check_keys(d, &MOTION_KEYS, "motion key")?;
+    if d.contains("t")? {
+        return Ok(Motion::Task(TaskPath {
+            t: require(d, "t")?,
+            x: require(d, "X")?,
+            xd: require(d, "Xd")?,
+            xdd: require(d, "Xdd")?,
+            point: require(d, "point")?,
+            body: get(d, "body")?,
+            q_start: get(d, "q_start")?,
+            singular_tol: require(d, "singular_tol")?,
+        }));
+    }
+    Ok(Motion::Coordinates { q: require(d, "q")?, qd: require(d, "qd")?, qdd: require(d, "qdd")? })
+}
+
+fn efforts_dict<'py>(py: Python<'py>, e: Efforts, m: usize) -> PyResult<Bound<'py, PyAny>> {
+    let d = PyDict::new(py);
+    let rows = |v: Vec<f64>| arr2(py, v.len() / m.max(1), m, v);
+    match e {
+        Efforts::Coordinates(tau) => d.set_item("tau", rows(tau)?)?,
+        Efforts::Task(TaskSolution { q, qd, qdd, tau, sigma_i, sigma_ii, condition }) => {
+            for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)] {
+                d.set_item(k, rows(v)?)?;
             }
-        })
-        .collect()
+            for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
+                d.set_item(k, arr1(py, v))?;
+            }
+        }
+    }
+    Ok(d.into_any())
+}
+
+/// (exception type name, message) of a failed variant, as the serial call would raise.
+fn failure<'py>(py: Python<'py>, e: &TaskError) -> PyResult<Bound<'py, PyAny>> {
+    let err = match e {
+        TaskError::Core(core) => to_pyerr(py, core),
+        TaskError::Singular(msg) => SingularityError::new_err(msg.clone()),
+        TaskError::OutOfReach(msg) => AssemblyError::new_err(msg.clone()),
+    };
+    error_pair(py, err, e.to_string())
+}
+
+/// The pair (exception type name, message) that reports a failed variant.
+fn error_pair<'py>(py: Python<'py>, err: PyErr, message: String) -> PyResult<Bound<'py, PyAny>> {
+    let name = err.get_type(py).name()?.to_string();
+    Ok(PyTuple::new(py, [name, message])?.into_any())
+}
+
+/// Inverse dynamics of `(mechanism, motion)` pairs on `threads` threads (None: all cores);
+/// results (dicts of arrays) in input order.
+#[pyfunction]
+#[pyo3(signature = (variants, threads=None))]
+fn inverse_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>, threads: Option<usize>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? });
+    run_batch(py, &variants, threads, make, InverseVariant::solve, |r, m| match r {
+        Ok(e) => efforts_dict(py, e, m.get().inner.dof()),
+        Err(e) => failure(py, &e),
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(simulate_batch, m)?)
+    m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse_batch, m)?)
 }

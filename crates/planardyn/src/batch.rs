@@ -8,11 +8,20 @@
 //! settings, a spec that is not a mechanism) leaves the others untouched. The outputs are in
 //! the order of the inputs and equal, bit for bit, those of a serial loop: a run does not
 //! depend on which thread it lands on.
+//!
+//! Inverse dynamics runs the same way ([`inverse_many`]): each variant a model and a motion,
+//! either in the coordinates (q, qd, qdd rows) or of an end effector along a sampled path
+//! ([`task`], the stages of `planardyn.robot.solve_motion`), e.g. many designs of a robot
+//! on one task, or many tasks of one robot.
 
-use crate::dynamics::ModelDrives;
+pub mod task;
+
+use crate::dynamics::{self, ModelDrives};
+use crate::kinematics::{assemble_into, continue_to};
 pub use crate::simulate::Overrides;
 use crate::simulate::{simulate, Trajectory};
-use crate::{Error, Mechanism, MechanismSpec};
+use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
+use task::{TaskError, TaskPath, TaskSolution};
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -32,20 +41,85 @@ pub struct Variant {
     pub overrides: Overrides,
 }
 
+impl Model {
+    /// Run `f` on the built mechanism (building a specification first, in this thread).
+    fn with<R, E: From<Error>>(&self, f: impl FnOnce(&Mechanism) -> Result<R, E>) -> Result<R, E> {
+        match self {
+            Model::Built(m) => f(m),
+            Model::Spec(spec) => f(&Mechanism::new(spec.clone(), "<variant>").map_err(Error::from)?),
+        }
+    }
+}
+
 impl Variant {
     /// Build (if needed), set up and simulate with the model's drives, in the caller's thread.
     pub fn simulate(&self) -> Result<Trajectory, Error> {
-        let built;
-        let mech: &Mechanism = match &self.model {
-            Model::Built(m) => m,
-            Model::Spec(spec) => {
-                built = Mechanism::new(spec.clone(), "<variant>")?;
-                &built
-            }
-        };
-        let settings = self.overrides.settings(mech)?;
-        simulate(mech, &settings, &mut ModelDrives(mech), None)
+        self.model.with(|mech| {
+            let settings = self.overrides.settings(mech)?;
+            simulate(mech, &settings, &mut ModelDrives(mech), None)
+        })
     }
+}
+
+/// The motion whose drive efforts a variant asks for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Motion {
+    /// Time-major rows (N x m) of coordinates (rad or m), rates and accelerations.
+    Coordinates { q: Vec<f64>, qd: Vec<f64>, qdd: Vec<f64> },
+    /// An end-effector path, solved for the inputs first.
+    Task(TaskPath),
+}
+
+/// Drive efforts of a [`Motion::Coordinates`] (tau rows, N x m) or the solved task motion.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Efforts {
+    Coordinates(Vec<f64>),
+    Task(TaskSolution),
+}
+
+/// One inverse-dynamics variant: its model and its motion.
+#[derive(Debug, Clone)]
+pub struct InverseVariant {
+    pub model: Model,
+    pub motion: Motion,
+}
+
+impl InverseVariant {
+    /// Build (if needed) and solve, in the caller's thread.
+    pub fn solve(&self) -> Result<Efforts, TaskError> {
+        self.model.with(|mech| match &self.motion {
+            Motion::Coordinates { q, qd, qdd } => Ok(Efforts::Coordinates(inverse_rows(mech, q, qd, qdd)?)),
+            Motion::Task(path) => Ok(Efforts::Task(task::solve(mech, path)?)),
+        })
+    }
+}
+
+/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each), the positions
+/// found by continuation from row to row (so the rows stay on one branch).
+pub fn inverse_rows(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>, Error> {
+    let m = mech.dof();
+    if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
+        return Err(KinematicsError::BadArgument(format!(
+            "q, qd and qdd need the same number of rows of {m} values, got {}, {} and {} values",
+            q.len(),
+            qd.len(),
+            qdd.len()
+        ))
+        .into());
+    }
+    let mut ws = Workspace::new(mech);
+    let mut tau = Vec::with_capacity(q.len());
+    for k in 0..q.len() / m {
+        let row = k * m..(k + 1) * m;
+        if k == 0 {
+            assemble_into(mech, &q[row.clone()], &mut ws)?;
+        } else {
+            continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?;
+        }
+        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], &mut ws)?;
+        tau.extend_from_slice(&ws.tau);
+    }
+    Ok(tau)
 }
 
 /// Apply `f` to every item on a pool of `threads` threads (`None` or 0: one per core), the
@@ -65,4 +139,10 @@ pub fn map_many<T: Sync, R: Send>(items: &[T], threads: Option<usize>, f: impl F
 /// `Err` only when no thread pool can be made; one `Result` per variant otherwise.
 pub fn simulate_many(variants: &[Variant], threads: Option<usize>) -> Result<Vec<Result<Trajectory, Error>>, Error> {
     map_many(variants, threads, Variant::simulate)
+}
+
+/// Solve every inverse-dynamics variant in parallel on `threads` threads (`None`: all
+/// cores), on the same pool as [`simulate_many`]; one `Result` per variant, in input order.
+pub fn inverse_many(variants: &[InverseVariant], threads: Option<usize>) -> Result<Vec<Result<Efforts, TaskError>>, Error> {
+    map_many(variants, threads, InverseVariant::solve)
 }

@@ -79,3 +79,117 @@ fn spec_variants_are_built_in_the_task() {
     // The heavier coupler changes the motion.
     assert_ne!(out[0].as_ref().unwrap().q.last(), out[1].as_ref().unwrap().q.last());
 }
+
+// ------------------------------------------------------------------ inverse dynamics
+
+use planardyn::batch::task::{TaskError, TaskPath};
+use planardyn::batch::{inverse_many, inverse_rows, Efforts, InverseVariant, Motion};
+
+/// Forward dynamics at (q, qd) under given efforts: the consistency check of an inverse.
+struct Given(Vec<f64>);
+impl planardyn::dynamics::Drives for Given {
+    fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
+        tau.copy_from_slice(&self.0);
+        Ok(())
+    }
+}
+
+fn qdd_under(mech: &planardyn::Mechanism, q: &[f64], qd: &[f64], tau: &[f64]) -> Vec<f64> {
+    let mut ws = planardyn::Workspace::new(mech);
+    planardyn::kinematics::assemble_into(mech, q, &mut ws).unwrap();
+    planardyn::dynamics::forward(mech, 0.0, q, qd, &mut Given(tau.to_vec()), &mut ws).unwrap();
+    ws.qdd.clone()
+}
+
+/// The five-bar's end effector P on a circle of radius r (m) through its drawn position,
+/// once around in 1 s at constant angular speed, sampled every 2 ms; or on the straight
+/// segment from the drawing to `to` (m) at constant speed.
+fn five_bar_path(mech: &planardyn::Mechanism, circle: Option<f64>, to: [f64; 2]) -> TaskPath {
+    let p0 = mech.points.iter().find(|(n, _)| n == "P").unwrap().1;
+    let w = 2.0 * std::f64::consts::PI;
+    let t: Vec<f64> = (0..=500).map(|i| i as f64 * 0.002).collect();
+    let (mut x, mut xd, mut xdd) = (vec![], vec![], vec![]);
+    for &ti in &t {
+        let (c, s) = ((w * ti).cos(), (w * ti).sin());
+        let (p, v, a) = match circle {
+            Some(r) => ([p0[0] + r * (c - 1.0), p0[1] + r * s], [-r * w * s, r * w * c], [-r * w * w * c, -r * w * w * s]),
+            None => ([p0[0] + ti * (to[0] - p0[0]), p0[1] + ti * (to[1] - p0[1])], [to[0] - p0[0], to[1] - p0[1]], [0.0, 0.0]),
+        };
+        x.extend(p);
+        xd.extend(v);
+        xdd.extend(a);
+    }
+    TaskPath { t, x, xd, xdd, point: "P".into(), body: None, q_start: None, singular_tol: 1e-3 }
+}
+
+#[test]
+fn coordinate_motions_in_a_batch_equal_the_serial_rows_and_invert_the_forward_dynamics() {
+    let mech = Arc::new(shipped("five-bar.yaml"));
+    let runs: Vec<Trajectory> = variants(&Arc::new(yaml(FOUR_BAR)), 1).iter().map(|v| v.simulate().unwrap()).collect();
+    let tr = run(&mech, "dop853", 0.3, 1e-10, Some((0..=30).map(|i| i as f64 * 0.01).collect()));
+    let four = Arc::new(yaml(FOUR_BAR));
+    let vs = vec![
+        InverseVariant { model: Model::Built(mech.clone()), motion: Motion::Coordinates { q: tr.q.clone(), qd: tr.qd.clone(), qdd: tr.qdd.clone() } },
+        InverseVariant { model: Model::Built(four.clone()), motion: Motion::Coordinates { q: runs[0].q.clone(), qd: runs[0].qd.clone(), qdd: runs[0].qdd.clone() } },
+        // Rows of the wrong length: reported for this variant only.
+        InverseVariant { model: Model::Built(mech.clone()), motion: Motion::Coordinates { q: vec![1.0; 3], qd: vec![0.0; 3], qdd: vec![0.0; 3] } },
+    ];
+    let out = inverse_many(&vs, Some(2)).unwrap();
+    let Ok(Efforts::Coordinates(tau)) = &out[0] else { panic!("{:?}", out[0]) };
+    assert_eq!(tau, &inverse_rows(&mech, &tr.q, &tr.qd, &tr.qdd).unwrap());
+    assert_eq!(out, inverse_many(&vs, Some(1)).unwrap());
+    // Forward then inverse returns the model's drive efforts (a constant and a table).
+    let err = tau.iter().zip(&tr.tau).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(err < 1e-8, "inverse of the simulated motion differs from its drives by {err} N m");
+    let Ok(Efforts::Coordinates(tau4)) = &out[1] else { panic!("{:?}", out[1]) };
+    assert!(tau4.iter().zip(&runs[0].tau).all(|(a, b)| (a - b).abs() < 1e-8), "the passive four-bar needs no effort");
+    assert!(matches!(out[2], Err(TaskError::Core(Error::Kinematics(KinematicsError::BadArgument(_))))));
+}
+
+#[test]
+fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
+    let mech = Arc::new(shipped("five-bar.yaml"));
+    let circle = five_bar_path(&mech, Some(0.05), [0.0; 2]);
+    let mut heavy = mech.spec.clone();
+    heavy.bodies.0.get_mut("distal_right").unwrap().mass = Some(1.4);
+    let task = |model: Model, path: &TaskPath| InverseVariant { model, motion: Motion::Task(path.clone()) };
+    let mut wrong_point = circle.clone();
+    wrong_point.point = "Q".into();
+    let mut far = circle.clone();
+    far.x.iter_mut().skip(1).step_by(2).for_each(|y| *y += 1.0);
+    let vs = vec![
+        task(Model::Built(mech.clone()), &circle),
+        // Straight down through the type II singularity (distal links aligned near y = 0.15 m).
+        task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 0.1])),
+        // Up to 1 m above the base: it stops at the edge of the workspace, a type I singularity.
+        task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 1.0])),
+        task(Model::Built(mech.clone()), &wrong_point),
+        task(Model::Spec(heavy), &circle),
+        // The circle 1 m higher: its first point is out of reach.
+        task(Model::Built(mech.clone()), &far),
+    ];
+    let out = inverse_many(&vs, Some(2)).unwrap();
+    assert_eq!(out, inverse_many(&vs, Some(1)).unwrap());
+    assert!(matches!(&out[1], Err(TaskError::Singular(m)) if m.contains("type II")), "{:?}", out[1]);
+    assert!(matches!(&out[2], Err(TaskError::Singular(m)) if m.contains("type I ") && m.contains("0.577")), "{:?}", out[2]);
+    assert!(matches!(&out[5], Err(TaskError::OutOfReach(m)) if m.contains("first point")), "{:?}", out[5]);
+    assert!(matches!(&out[3], Err(TaskError::Core(Error::Kinematics(KinematicsError::BadArgument(m)))) if m.contains("\"Q\"")));
+    let (Ok(Efforts::Task(sol)), Ok(Efforts::Task(heavier))) = (&out[0], &out[4]) else { panic!("{:?}", out[0]) };
+    for i in (0..circle.t.len()).step_by(50) {
+        let row = i * 2..i * 2 + 2;
+        // The point is on the path: P at the solved q, from the positions alone.
+        let x = planardyn::kinematics::assemble(&mech, &sol.q[row.clone()]).unwrap();
+        let body = mech.body_id("distal_left").unwrap().0;
+        let s = mech.bodies[body].points.iter().find(|(p, _)| *p == mech.point_id("P").unwrap()).unwrap().1;
+        let (c, sn) = (x[3 * body + 2].cos(), x[3 * body + 2].sin());
+        let p = [x[3 * body] + c * s[0] - sn * s[1], x[3 * body + 1] + sn * s[0] + c * s[1]];
+        assert!((p[0] - circle.x[2 * i]).abs() < 1e-12 && (p[1] - circle.x[2 * i + 1]).abs() < 1e-12, "sample {i}: {p:?}");
+        // The efforts produce the accelerations.
+        let qdd = qdd_under(&mech, &sol.q[row.clone()], &sol.qd[row.clone()], &sol.tau[row.clone()]);
+        assert!(qdd.iter().zip(&sol.qdd[row.clone()]).all(|(a, b)| (a - b).abs() < 1e-8 * (1.0 + b.abs())), "sample {i}");
+        // Same kinematics, heavier right distal link: the same q, other efforts.
+        assert_eq!(heavier.q[row.clone()], sol.q[row.clone()]);
+        assert!(sol.sigma_i[i] > 1e-3 && sol.sigma_ii[i] > 1e-3 && sol.condition[i] >= 1.0);
+    }
+    assert_ne!(heavier.tau, sol.tau);
+}
