@@ -116,6 +116,32 @@ pub fn lu_solve_transpose(lu: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
     }
 }
 
+/// A real n x n matrix and its factors, in buffers sized once.
+#[derive(Debug, Clone)]
+pub struct Lu {
+    n: usize,
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+}
+
+impl Lu {
+    pub fn new(n: usize) -> Self {
+        Lu { n, lu: vec![0.0; n * n], piv: vec![0; n] }
+    }
+    /// The matrix buffer (row-major, n x n) to fill before [`Lu::factor`].
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.lu
+    }
+    /// Factorise the matrix in the buffer in place (see [`lu_factor`]).
+    pub fn factor(&mut self, tiny: f64) -> Result<(), LuError> {
+        lu_factor(&mut self.lu, self.n, &mut self.piv, tiny)
+    }
+    /// Solve A x = b in place.
+    pub fn solve(&self, b: &mut [f64]) {
+        lu_solve(&self.lu, self.n, &self.piv, b)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,4 +13,4 @@ mod lu;
 
 pub use block_lu::BlockLu;
 pub use cholesky::{cholesky_in_place, cholesky_solve};
-pub use lu::{lu_factor, lu_solve, lu_solve_transpose, LuError, Scalar};
+pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
