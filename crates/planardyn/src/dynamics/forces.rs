@@ -2,7 +2,7 @@
 //! gravity, point forces, torques, springs and dampers, and the drive efforts mapped
 //! through the coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
-use crate::kinematics::constraints::{pair_coordinate, pair_coordinate_grad, pair_coordinate_rate, point_velocity, rotate, world_point};
+use crate::kinematics::constraints::{pair_coordinate, pair_coordinate_grad, Dense, pair_coordinate_rate, point_velocity, rotate, world_point};
 use crate::model::{Attachment, Link, Load, Mechanism};
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).
@@ -43,7 +43,7 @@ fn add_point_force(at: &Attachment, force: [f64; 2], x: &[f64], xd: &[f64], f: &
 /// Add `effort` acting on a pair's relative coordinate (f += effort * grad); `grad` is scratch.
 fn add_pair_effort(mech: &Mechanism, pair: usize, effort: f64, x: &[f64], f: &mut [f64], grad: &mut [f64]) {
     grad.fill(0.0);
-    pair_coordinate_grad(&mech.pairs[pair], x, grad, x.len(), 0);
+    pair_coordinate_grad(&mech.pairs[pair], x, &mut Dense { j: grad, ncols: x.len() }, 0);
     for (fi, g) in f.iter_mut().zip(grad.iter()) {
         *fi += effort * g;
     }

@@ -7,6 +7,7 @@
 //! bilinear form gamma(a, b) = sum_ij d2F/dx_i dx_j a_i b_j, which gives the convective term
 //! (gamma(xd, xd)) and the acceleration analogues (gamma(u_j, u_k)).
 
+pub use crate::linalg::{Dense, Sink};
 use crate::model::{Link, Mechanism, Pair, PairKind};
 
 /// Which m functions of x are the independent coordinates.
@@ -101,14 +102,16 @@ fn part(link: &LinkState, v: &[f64]) -> ([f64; 2], f64) {
     }
 }
 
-/// Add `g = [d/dr_x, d/dr_y, d/dphi]` of a link to row `row` of the row-major matrix `j`.
+/// Add `g = [d/dr_x, d/dr_y, d/dphi]` of a link to row `row` of `j`; a zero entry is left
+/// out (the patterns of `jacobian_pattern` need not include it).
 #[inline]
-fn add_grad(j: &mut [f64], ncols: usize, row: usize, link: &LinkState, g: [f64; 3]) {
+fn add_grad<S: Sink>(j: &mut S, row: usize, link: &LinkState, g: [f64; 3]) {
     if let Some(c) = link.col {
-        let o = row * ncols + c;
-        j[o] += g[0];
-        j[o + 1] += g[1];
-        j[o + 2] += g[2];
+        for (k, v) in g.into_iter().enumerate() {
+            if v != 0.0 {
+                j.add(row, c + k, v);
+            }
+        }
     }
 }
 
@@ -136,10 +139,10 @@ impl Projection {
     fn value(&self) -> f64 {
         dot(self.d, self.w) - self.offset
     }
-    fn grad(&self, j: &mut [f64], ncols: usize, row: usize) {
+    fn grad<S: Sink>(&self, j: &mut S, row: usize) {
         let ed = perp(self.d);
-        add_grad(j, ncols, row, &self.a, [-self.d[0], -self.d[1], dot(ed, self.w)]);
-        add_grad(j, ncols, row, &self.b, [self.d[0], self.d[1], dot(self.d, perp(self.rbsb))]);
+        add_grad(j, row, &self.a, [-self.d[0], -self.d[1], dot(ed, self.w)]);
+        add_grad(j, row, &self.b, [self.d[0], self.d[1], dot(self.d, perp(self.rbsb))]);
     }
     /// Bilinear second derivative (see the module doc), from the Hessian entries
     /// d2/dphi_a2 = -d.w, d2/dphi_a dr_b = E d = -d2/dphi_a dr_a,
@@ -181,27 +184,27 @@ fn angle(link: Link, x: &[f64]) -> f64 {
     }
 }
 
-fn pair_jacobian(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut [f64], ncols: usize, rows: [Option<usize>; 2]) {
+fn pair_jacobian<S: Sink>(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
     let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
     match pair.kind {
         PairKind::Revolute => {
             let (ta, tb) = (perp(a.rot(pair.sa)), perp(b.rot(pair.sb)));
             if let Some(row) = rows[0] {
-                add_grad(j, ncols, row, &a, [1.0, 0.0, ta[0]]);
-                add_grad(j, ncols, row, &b, [-1.0, 0.0, -tb[0]]);
+                add_grad(j, row, &a, [1.0, 0.0, ta[0]]);
+                add_grad(j, row, &b, [-1.0, 0.0, -tb[0]]);
             }
             if let Some(row) = rows[1] {
-                add_grad(j, ncols, row, &a, [0.0, 1.0, ta[1]]);
-                add_grad(j, ncols, row, &b, [0.0, -1.0, -tb[1]]);
+                add_grad(j, row, &a, [0.0, 1.0, ta[1]]);
+                add_grad(j, row, &b, [0.0, -1.0, -tb[1]]);
             }
         }
         PairKind::Prismatic { axis } => {
             if let Some(row) = rows[0] {
-                add_grad(j, ncols, row, &a, [0.0, 0.0, -1.0]);
-                add_grad(j, ncols, row, &b, [0.0, 0.0, 1.0]);
+                add_grad(j, row, &a, [0.0, 0.0, -1.0]);
+                add_grad(j, row, &b, [0.0, 0.0, 1.0]);
             }
             if let Some(row) = rows[1] {
-                Projection::new(pair, perp(axis), a, b).grad(j, ncols, row);
+                Projection::new(pair, perp(axis), a, b).grad(j, row);
             }
         }
     }
@@ -234,13 +237,13 @@ pub fn pair_coordinate(pair: &Pair, x: &[f64]) -> f64 {
 }
 
 /// Gradient of [`pair_coordinate`], added into row `row` of `j`.
-pub fn pair_coordinate_grad(pair: &Pair, x: &[f64], j: &mut [f64], ncols: usize, row: usize) {
+pub fn pair_coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
     match pair.kind {
         PairKind::Revolute => {
-            add_grad(j, ncols, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
-            add_grad(j, ncols, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
+            add_grad(j, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
+            add_grad(j, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
         }
-        PairKind::Prismatic { axis } => projection(pair, axis, x).grad(j, ncols, row),
+        PairKind::Prismatic { axis } => projection(pair, axis, x).grad(j, row),
     }
 }
 
@@ -318,18 +321,25 @@ pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], z
 
 /// J = dF/dx for a chart, written (overwritten) into the row-major 3n x 3n buffer `j`.
 pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j: &mut [f64]) {
-    let ncols = x.len();
-    constraint_jacobian(mech, x, trig, &mech.row_slot, j);
+    j.fill(0.0);
+    jacobian_into(mech, chart, x, trig, &mut Dense { j, ncols: x.len() });
+}
+
+/// The entries of J = dF/dx for a chart, added into `sink` (which starts at zero).
+pub fn jacobian_into<S: Sink>(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], sink: &mut S) {
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        pair_jacobian(pair, x, trig, sink, slots(&mech.row_slot, k));
+    }
     let nc = mech.n_constraints;
     match chart {
         Chart::Inputs => {
             for (k, c) in mech.coordinates.iter().enumerate() {
-                pair_coordinate_grad(&mech.pairs[c.pair.0], x, j, ncols, nc + k);
+                pair_coordinate_grad(&mech.pairs[c.pair.0], x, sink, nc + k);
             }
         }
         Chart::Partition(idx) => {
             for (k, &i) in idx.iter().enumerate() {
-                j[(nc + k) * ncols + i] = 1.0;
+                sink.add(nc + k, i, 1.0);
             }
         }
     }
@@ -338,10 +348,10 @@ pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j
 /// The pair-constraint rows Phi_x (row-major, 3n columns) placed by `row_slot` (the
 /// mechanism's independent rows, or `0..2p` for all of them); the rest of `j` is zeroed.
 pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], row_slot: &[Option<usize>], j: &mut [f64]) {
-    let ncols = x.len();
     j.fill(0.0);
+    let mut dense = Dense { j, ncols: x.len() };
     for (k, pair) in mech.pairs.iter().enumerate() {
-        pair_jacobian(pair, x, trig, j, ncols, slots(row_slot, k));
+        pair_jacobian(pair, x, trig, &mut dense, slots(row_slot, k));
     }
 }
 

@@ -7,7 +7,7 @@
 //! (`linalg::BlockLu`): input links and Assur groups are eliminated one after another, with
 //! the blocks found once per chart from the pattern of J.
 
-use super::constraints::{jacobian, jacobian_pattern, Chart};
+use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
 use crate::linalg::BlockLu;
 use crate::model::{CoordinateKind, Mechanism, Pair, PairKind};
 
@@ -24,8 +24,6 @@ const SIGMA_RTOL: f64 = 2e-3;
 /// J(x) for one chart, scaled and LU-factorised.
 #[derive(Debug, Clone)]
 pub struct System {
-    /// J (row-major, 3n x 3n), input of the factorisation (which scales it).
-    j: Vec<f64>,
     lu: BlockLu,
     /// The chart whose pattern `lu` was analysed for.
     pattern_chart: Chart,
@@ -53,7 +51,6 @@ impl System {
     pub fn new(mech: &Mechanism) -> Self {
         let n = mech.n_x();
         System {
-            j: vec![0.0; n * n],
             lu: BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs)),
             pattern_chart: Chart::Inputs,
             row_scale: vec![1.0; n],
@@ -74,9 +71,9 @@ impl System {
             self.pattern_chart.clone_from(chart);
         }
         set_row_scale(mech, chart, &mut self.row_scale);
-        jacobian(mech, chart, x, trig, &mut self.j);
+        jacobian_into(mech, chart, x, trig, &mut self.lu.sink(&self.row_scale, &self.col_scale));
         self.chart.clone_from(chart);
-        let out = self.lu.factor(&self.j, &self.row_scale, &self.col_scale, SINGULAR_PIVOT).map_err(|e| e.column);
+        let out = self.lu.factor(SINGULAR_PIVOT).map_err(|e| e.column);
         self.factored = out.is_ok();
         out
     }

@@ -16,6 +16,7 @@
 //! the graph algorithms come from petgraph.
 
 use super::lu::{lu_factor, LuError};
+use super::sink::Sink;
 use petgraph::algo::{maximum_matching, tarjan_scc};
 use petgraph::graph::{DiGraph, NodeIndex, UnGraph};
 
@@ -28,22 +29,25 @@ pub struct BlockLu {
     col: Vec<usize>,
     /// Block k spans the permuted positions `start[k]..start[k + 1]`.
     start: Vec<usize>,
-    /// Dense factors of the diagonal blocks, block k row-major from `lu_at[k]`: unit lower L
-    /// below the diagonal, U on and above it, of the block's rows in pivoted order.
-    lu: Vec<f64>,
+    /// The diagonal blocks, block k row-major from `lu_at[k]`, then the entries left of
+    /// them (`off_val`, from `off_base`). Filled through [`BlockLu::sink`]; the blocks are then
+    /// factorised in place: unit lower L below the diagonal, U on and above it, of the
+    /// block's rows in pivoted order.
+    store: Vec<f64>,
     lu_at: Vec<usize>,
+    off_base: usize,
+    /// Slot in `store` of entry (r, c) of the matrix at `r * n + c` (`NONE` outside the pattern).
+    dest: Vec<u32>,
     /// Row pivots of the last factorisation, per permuted position, local to its block.
     piv: Vec<usize>,
     /// The permuted position whose row the factor row at each position is (the block's row
     /// pivots composed into one gather index).
     src: Vec<usize>,
     /// Entries of the row at permuted position p left of its diagonal block:
-    /// `off_at[p]..off_at[p + 1]` index `off_col` (permuted column), `off_rc` (original row
-    /// and column) and `off_val` (the scaled value).
+    /// `off_at[p]..off_at[p + 1]` index `off_col` (permuted column) and the values
+    /// `store[off_base..]`.
     off_at: Vec<usize>,
     off_col: Vec<usize>,
-    off_rc: Vec<(usize, usize)>,
-    off_val: Vec<f64>,
     /// The solve as sparse rows, rebuilt by each factorisation (the pivots move rows): forward
     /// row i takes the right-hand side of original row `rhs_row[i]` and subtracts
     /// `fwd_val * y[fwd_idx]` over `fwd_at[i]..fwd_at[i + 1]` (entries of the blocks already
@@ -60,8 +64,33 @@ pub struct BlockLu {
     work: Vec<f64>,
 }
 
-/// Row and column scales applied on the way in and out of a solve (see [`BlockLu::factor`]).
+/// Row and column scales applied on the way in and out of a solve (see [`BlockLu::sink`]).
 type Scales<'a> = Option<(&'a [f64], &'a [f64])>;
+
+/// `dest` of an entry outside the pattern.
+const NONE: u32 = u32::MAX;
+
+/// The entries of the matrix to factorise, scaled and written into the blocks as they come.
+pub struct BlockSink<'a> {
+    n: usize,
+    store: &'a mut [f64],
+    dest: &'a [u32],
+    rs: &'a [f64],
+    cs: &'a [f64],
+}
+
+impl Sink for BlockSink<'_> {
+    /// Add `v` (of the unscaled matrix) to entry (row, col). An entry outside the pattern
+    /// is a bug in the pattern: it panics in debug builds and is dropped in release ones.
+    #[inline]
+    fn add(&mut self, row: usize, col: usize, v: f64) {
+        let d = self.dest[row * self.n + col];
+        debug_assert!(d != NONE, "entry ({row}, {col}) is outside the pattern");
+        if d != NONE {
+            self.store[d as usize] += v * self.rs[row] * self.cs[col];
+        }
+    }
+}
 
 impl BlockLu {
     /// Analyse the pattern: `pattern[i]` lists the columns where row i may be non-zero (a
@@ -83,18 +112,25 @@ impl BlockLu {
         for (j, &c) in col.iter().enumerate() {
             position[c] = j;
         }
-        let (mut off_at, mut off_col, mut off_rc) = (vec![0], Vec::new(), Vec::new());
+        let mut dest = vec![NONE; n * n];
+        let (mut off_at, mut off_col) = (vec![0], Vec::new());
         let (mut bwd_at, mut bwd_idx) = (vec![0], Vec::new());
         for k in 0..blocks.len() {
-            for (i, &r) in row[start[k]..start[k + 1]].iter().enumerate() {
+            let (s0, s1) = (start[k], start[k + 1]);
+            for (i, &r) in row[s0..s1].iter().enumerate() {
                 for &c in &pattern[r] {
-                    if position[c] < start[k] {
-                        off_col.push(position[c]);
-                        off_rc.push((r, c));
-                    }
+                    let j = position[c];
+                    dest[r * n + c] = if j < s0 {
+                        off_col.push(j);
+                        (size + off_col.len() - 1) as u32
+                    } else if j < s1 {
+                        (lu_at[k] + i * (s1 - s0) + j - s0) as u32
+                    } else {
+                        unreachable!("the block-triangular form has no entry right of a block")
+                    };
                 }
                 off_at.push(off_col.len());
-                bwd_idx.extend(start[k] + i + 1..start[k + 1]);
+                bwd_idx.extend(s0 + i + 1..s1);
                 bwd_at.push(bwd_idx.len());
             }
         }
@@ -102,16 +138,16 @@ impl BlockLu {
         BlockLu {
             n,
             start,
-            lu: vec![0.0; size],
+            store: vec![0.0; size + off_col.len()],
             lu_at,
+            off_base: size,
+            dest,
             piv: vec![0; n],
             src: (0..n).collect(),
             off_at,
-            off_val: vec![0.0; off_col.len()],
             fwd_idx: vec![0; off_col.len() + l_entries],
             fwd_val: vec![0.0; off_col.len() + l_entries],
             off_col,
-            off_rc,
             rhs_row: row.clone(),
             fwd_at: vec![0; n + 1],
             bwd_val: vec![0.0; bwd_idx.len()],
@@ -129,25 +165,22 @@ impl BlockLu {
         self.start.windows(2).map(|w| w[1] - w[0])
     }
 
-    /// Factorise B = diag(rs) A diag(cs) for the row-major n x n matrix `a` (zero outside the
-    /// pattern) and row and column scales `rs`, `cs` (the scaling is applied to the entries
-    /// of the pattern only, as they are gathered). A pivot of B of magnitude `<= tiny` (or
-    /// not finite) makes it singular; the error names the original column being eliminated.
-    pub fn factor(&mut self, a: &[f64], rs: &[f64], cs: &[f64], tiny: f64) -> Result<(), LuError> {
-        let n = self.n;
-        for (v, &(r, c)) in self.off_val.iter_mut().zip(&self.off_rc) {
-            *v = a[r * n + c] * rs[r] * cs[c];
-        }
+    /// Start filling the matrix B = diag(rs) A diag(cs) to factorise: every entry is zeroed,
+    /// and the sink scales the entries of A it is given. Then [`BlockLu::factor`].
+    pub fn sink<'a>(&'a mut self, rs: &'a [f64], cs: &'a [f64]) -> BlockSink<'a> {
+        self.store.fill(0.0);
+        BlockSink { n: self.n, store: &mut self.store, dest: &self.dest, rs, cs }
+    }
+
+    /// Factorise the filled matrix B block by block. A pivot of magnitude `<= tiny` (or not
+    /// finite) makes it singular; the error names the original column being eliminated.
+    pub fn factor(&mut self, tiny: f64) -> Result<(), LuError> {
         let mut fwd = 0;
         for k in 0..self.start.len() - 1 {
             let (s0, s1, base) = (self.start[k], self.start[k + 1], self.lu_at[k]);
             let s = s1 - s0;
-            let block = &mut self.lu[base..base + s * s];
-            for (i, &r) in self.row[s0..s1].iter().enumerate() {
-                for (j, &c) in self.col[s0..s1].iter().enumerate() {
-                    block[i * s + j] = a[r * n + c] * rs[r] * cs[c];
-                }
-            }
+            let (blocks, off_val) = self.store.split_at_mut(self.off_base);
+            let block = &mut blocks[base..base + s * s];
             lu_factor(block, s, &mut self.piv[s0..s1], tiny).map_err(|e| LuError { column: self.col[s0 + e.column] })?;
             let src = &mut self.src[s0..s1];
             for (i, p) in src.iter_mut().enumerate() {
@@ -161,7 +194,7 @@ impl BlockLu {
                 let p = self.src[s0 + i];
                 self.rhs_row[s0 + i] = self.row[p];
                 for e in self.off_at[p]..self.off_at[p + 1] {
-                    (self.fwd_idx[fwd], self.fwd_val[fwd]) = (self.off_col[e], self.off_val[e]);
+                    (self.fwd_idx[fwd], self.fwd_val[fwd]) = (self.off_col[e], off_val[e]);
                     fwd += 1;
                 }
                 for j in 0..i {
@@ -240,7 +273,7 @@ impl BlockLu {
         for k in (0..self.start.len() - 1).rev() {
             let (s0, s1) = (self.start[k], self.start[k + 1]);
             let s = s1 - s0;
-            let lu = &self.lu[self.lu_at[k]..self.lu_at[k] + s * s];
+            let lu = &self.store[self.lu_at[k]..self.lu_at[k] + s * s];
             let t = &mut y[s0..s1];
             for i in 0..s {
                 let v = t[i] - (0..i).map(|j| lu[j * s + i] * t[j]).sum::<f64>();
@@ -256,7 +289,7 @@ impl BlockLu {
             for p in s0..s1 {
                 let v = b[self.row[p]];
                 for e in self.off_at[p]..self.off_at[p + 1] {
-                    y[self.off_col[e]] -= self.off_val[e] * v;
+                    y[self.off_col[e]] -= self.store[self.off_base + e] * v;
                 }
             }
         }
@@ -314,6 +347,15 @@ fn blocks(pattern: &[Vec<usize>]) -> Option<Vec<(Vec<usize>, Vec<usize>)>> {
 mod tests {
     use super::*;
 
+    /// Fill with the non-zeros of the row-major n x n `a`, unscaled.
+    fn fill(lu: &mut BlockLu, a: &[f64], n: usize) {
+        let ones = vec![1.0; n];
+        let mut sink = lu.sink(&ones, &ones);
+        for (i, &v) in a.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+            sink.add(i / n, i % n, v);
+        }
+    }
+
     /// A 5 x 5 matrix whose block-triangular form has blocks of 1, 2 and 2, given scrambled.
     fn example() -> (Vec<f64>, Vec<Vec<usize>>) {
         // Unknowns: a (col 3) alone; b, c (cols 0, 4) coupled, using a; d, e (cols 1, 2) coupled, using b.
@@ -339,7 +381,8 @@ mod tests {
         let (a, pattern) = example();
         let mut lu = BlockLu::new(&pattern);
         assert_eq!(lu.block_sizes().collect::<Vec<_>>(), vec![1, 2, 2]);
-        lu.factor(&a, &[1.0; 5], &[1.0; 5], 1e-300).unwrap();
+        fill(&mut lu, &a, 5);
+        lu.factor(1e-300).unwrap();
         let x = [1.0, -2.0, 0.5, 3.0, -0.25];
         let mut b: Vec<f64> = (0..5).map(|i| (0..5).map(|j| a[i * 5 + j] * x[j]).sum()).collect();
         lu.solve(&mut b);
@@ -364,7 +407,8 @@ mod tests {
         let mut lu = BlockLu::new(&pattern);
         // Block {rows 1, 2; cols 1, 2} = [[1, 2], [2, 4]] is singular.
         let a = [1.0, 0.0, 0.0, 5.0, 1.0, 2.0, 0.0, 2.0, 4.0];
-        let err = lu.factor(&a, &[1.0; 3], &[1.0; 3], 1e-12).unwrap_err();
+        fill(&mut lu, &a, 3);
+        let err = lu.factor(1e-12).unwrap_err();
         assert!(err.column == 1 || err.column == 2, "{err:?}");
     }
 }

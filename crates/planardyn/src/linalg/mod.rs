@@ -10,7 +10,9 @@
 mod block_lu;
 mod cholesky;
 mod lu;
+mod sink;
 
-pub use block_lu::BlockLu;
+pub use block_lu::{BlockLu, BlockSink};
 pub use cholesky::{cholesky_in_place, cholesky_solve};
+pub use sink::{Dense, Sink};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
