@@ -17,7 +17,7 @@ from mechanisms import Benchmark
 TOOL = "planardyn"
 PACKAGE = "planardyn (this repository)"
 
-_RTOLS_DOP853 = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
+_RTOLS_DOP853 = (1e-5, 1e-6, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 1e-10, 1e-11)
 _RTOLS_DOPRI5 = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)
 
 
