@@ -43,7 +43,17 @@ pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
 }
 
 /// The user's coordinates, rates (and, with `xdd` filled, accelerations) from x, xd, xdd.
-fn user_coordinates(mech: &Mechanism, ws: &mut Workspace, with_accelerations: bool) {
+/// In the input chart they are the chart's own z, zd (and zdd, in `ws.b`): D(x) = z to the
+/// Newton tolerance and D_x U = I, so they are copied rather than recomputed.
+fn user_coordinates(mech: &Mechanism, ws: &mut Workspace, z: &[f64], zd: &[f64], with_accelerations: bool) {
+    if ws.chart == Chart::Inputs {
+        ws.q.copy_from_slice(z);
+        ws.qd.copy_from_slice(zd);
+        if with_accelerations {
+            ws.qdd.copy_from_slice(&ws.b);
+        }
+        return;
+    }
     coordinates(mech, &ws.x, &mut ws.q);
     coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
     if with_accelerations {
@@ -60,7 +70,7 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Worksp
     solve_position(mech, z, ws)?;
     velocity_analogues(ws)?;
     convective(mech, zd, ws);
-    user_coordinates(mech, ws, false);
+    user_coordinates(mech, ws, z, zd, false);
     Ok(())
 }
 
@@ -95,6 +105,6 @@ pub fn forward(mech: &Mechanism, t: f64, z: &[f64], zd: &[f64], drives: &mut dyn
             *a += u * zdd;
         }
     }
-    user_coordinates(mech, ws, true);
+    user_coordinates(mech, ws, z, zd, true);
     Ok(())
 }

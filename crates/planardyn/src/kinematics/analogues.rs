@@ -21,12 +21,11 @@ pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
     }
     let n = ws.x.len();
     let m = ws.u.len() / n.max(1);
+    ws.u.fill(0.0);
     for j in 0..m {
-        let col = &mut ws.u[j * n..(j + 1) * n];
-        col.fill(0.0);
-        col[n - m + j] = 1.0;
-        ws.sys.solve(col);
+        ws.u[j * n + n - m + j] = 1.0;
     }
+    ws.sys.solve_many(&mut ws.u);
     Ok(())
 }
 

@@ -137,6 +137,11 @@ impl System {
         self.lu.solve_scaled(b, &self.row_scale, &self.col_scale);
     }
 
+    /// Solve J Y = B in place for the columns of `b` (3n values each, one after the other).
+    pub fn solve_many(&mut self, b: &mut [f64]) {
+        self.lu.solve_many_scaled(b, &self.row_scale, &self.col_scale);
+    }
+
     /// Solve J^T y = b in place (b and y unscaled).
     pub fn solve_transpose(&mut self, b: &mut [f64]) {
         for (v, s) in b.iter_mut().zip(&self.col_scale) {

@@ -48,24 +48,18 @@ pub struct BlockLu {
     /// `store[off_base..]`.
     off_at: Vec<usize>,
     off_col: Vec<usize>,
-    /// The solve as sparse rows, rebuilt by each factorisation (the pivots move rows): forward
-    /// row i takes the right-hand side of original row `rhs_row[i]` and subtracts
-    /// `fwd_val * y[fwd_idx]` over `fwd_at[i]..fwd_at[i + 1]` (entries of the blocks already
-    /// solved, then L); backward row i subtracts the U entries `bwd_*` and scales by `inv_diag`.
-    rhs_row: Vec<usize>,
-    fwd_at: Vec<usize>,
-    fwd_idx: Vec<usize>,
-    fwd_val: Vec<f64>,
-    bwd_at: Vec<usize>,
-    bwd_idx: Vec<usize>,
-    bwd_val: Vec<f64>,
+    /// 1 / U_ii, per permuted position.
     inv_diag: Vec<f64>,
-    /// The solution in permuted column order while a solve runs.
+    /// The solution in permuted column order while a solve runs, up to [`MAX_COLUMNS`]
+    /// right-hand sides interleaved (`work[i * R + r]`).
     work: Vec<f64>,
 }
 
 /// Row and column scales applied on the way in and out of a solve (see [`BlockLu::sink`]).
 type Scales<'a> = Option<(&'a [f64], &'a [f64])>;
+
+/// Right-hand sides solved in one sweep (the velocity analogues of a 3-DOF robot).
+pub const MAX_COLUMNS: usize = 3;
 
 /// `dest` of an entry outside the pattern.
 const NONE: u32 = u32::MAX;
@@ -114,7 +108,6 @@ impl BlockLu {
         }
         let mut dest = vec![NONE; n * n];
         let (mut off_at, mut off_col) = (vec![0], Vec::new());
-        let (mut bwd_at, mut bwd_idx) = (vec![0], Vec::new());
         for k in 0..blocks.len() {
             let (s0, s1) = (start[k], start[k + 1]);
             for (i, &r) in row[s0..s1].iter().enumerate() {
@@ -130,11 +123,8 @@ impl BlockLu {
                     };
                 }
                 off_at.push(off_col.len());
-                bwd_idx.extend(s0 + i + 1..s1);
-                bwd_at.push(bwd_idx.len());
             }
         }
-        let l_entries: usize = blocks.iter().map(|(r, _)| r.len() * (r.len() - 1) / 2).sum();
         BlockLu {
             n,
             start,
@@ -145,16 +135,9 @@ impl BlockLu {
             piv: vec![0; n],
             src: (0..n).collect(),
             off_at,
-            fwd_idx: vec![0; off_col.len() + l_entries],
-            fwd_val: vec![0.0; off_col.len() + l_entries],
             off_col,
-            rhs_row: row.clone(),
-            fwd_at: vec![0; n + 1],
-            bwd_val: vec![0.0; bwd_idx.len()],
-            bwd_at,
-            bwd_idx,
             inv_diag: vec![0.0; n],
-            work: vec![0.0; n],
+            work: vec![0.0; n * MAX_COLUMNS],
             row,
             col,
         }
@@ -175,12 +158,10 @@ impl BlockLu {
     /// Factorise the filled matrix B block by block. A pivot of magnitude `<= tiny` (or not
     /// finite) makes it singular; the error names the original column being eliminated.
     pub fn factor(&mut self, tiny: f64) -> Result<(), LuError> {
-        let mut fwd = 0;
         for k in 0..self.start.len() - 1 {
             let (s0, s1, base) = (self.start[k], self.start[k + 1], self.lu_at[k]);
             let s = s1 - s0;
-            let (blocks, off_val) = self.store.split_at_mut(self.off_base);
-            let block = &mut blocks[base..base + s * s];
+            let block = &mut self.store[base..base + s * s];
             lu_factor(block, s, &mut self.piv[s0..s1], tiny).map_err(|e| LuError { column: self.col[s0 + e.column] })?;
             let src = &mut self.src[s0..s1];
             for (i, p) in src.iter_mut().enumerate() {
@@ -189,22 +170,8 @@ impl BlockLu {
             for (i, &p) in self.piv[s0..s1].iter().enumerate() {
                 src.swap(i, p);
             }
-            // The solve's rows for this block, in pivoted order.
-            for i in 0..s {
-                let p = self.src[s0 + i];
-                self.rhs_row[s0 + i] = self.row[p];
-                for e in self.off_at[p]..self.off_at[p + 1] {
-                    (self.fwd_idx[fwd], self.fwd_val[fwd]) = (self.off_col[e], off_val[e]);
-                    fwd += 1;
-                }
-                for j in 0..i {
-                    (self.fwd_idx[fwd], self.fwd_val[fwd]) = (s0 + j, block[i * s + j]);
-                    fwd += 1;
-                }
-                self.fwd_at[s0 + i + 1] = fwd;
-                let b0 = self.bwd_at[s0 + i];
-                self.bwd_val[b0..b0 + s - i - 1].copy_from_slice(&block[i * s + i + 1..(i + 1) * s]);
-                self.inv_diag[s0 + i] = 1.0 / block[i * s + i];
+            for (i, d) in self.inv_diag[s0..s1].iter_mut().enumerate() {
+                *d = 1.0 / block[i * s + i];
             }
         }
         Ok(())
@@ -212,53 +179,96 @@ impl BlockLu {
 
     /// Solve B y = b in place for the factorised (scaled) B.
     pub fn solve(&mut self, b: &mut [f64]) {
-        self.solve_with(b, None)
+        self.solve_columns::<1>(b, None)
     }
 
     /// Solve A x = b in place for the unscaled A: x = diag(cs) B^-1 diag(rs) b, the scalings
     /// folded into the gather and the scatter.
     pub fn solve_scaled(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64]) {
-        self.solve_with(b, Some((rs, cs)))
+        self.solve_columns::<1>(b, Some((rs, cs)))
     }
 
-    /// Block after block: forward rows (the right-hand side less the entries of the blocks
-    /// already solved, and L), then backward rows (U).
-    fn solve_with(&mut self, b: &mut [f64], scales: Scales) {
-        assert!(b.len() == self.n && scales.is_none_or(|(rs, cs)| rs.len() == self.n && cs.len() == self.n));
+    /// As [`BlockLu::solve_scaled`] for the columns of `b` (n values each, one after the
+    /// other), up to [`MAX_COLUMNS`] in one sweep: each factor entry is read once for all.
+    pub fn solve_many_scaled(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64]) {
+        let n = self.n.max(1);
+        for chunk in b.chunks_mut(MAX_COLUMNS * n) {
+            match chunk.len() / n {
+                3 => self.solve_columns::<3>(chunk, Some((rs, cs))),
+                2 => self.solve_columns::<2>(chunk, Some((rs, cs))),
+                _ => self.solve_columns::<1>(chunk, Some((rs, cs))),
+            }
+        }
+    }
+
+    /// Block after block: forward rows (the right-hand side in pivoted order less the
+    /// entries of the blocks already solved, then L), then backward rows (U), for R
+    /// right-hand sides at once.
+    fn solve_columns<const R: usize>(&mut self, b: &mut [f64], scales: Scales) {
+        let n = self.n;
+        assert!(b.len() == R * n && R <= MAX_COLUMNS && scales.is_none_or(|(rs, cs)| rs.len() == n && cs.len() == n));
         let y = &mut self.work;
-        // SAFETY: every index read below was built in `new` and `factor` from the n x n
-        // pattern: `rhs_row` and `col` hold 0..n, `fwd_idx` and `bwd_idx` < n, the `*_at`
-        // ranges lie inside their arrays, and b, rs, cs have length n (asserted above).
-        // Unchecked because the blocks have 1 to ~12 rows: bounds checks cost more than the
-        // arithmetic there (the solve is a third of a forward-dynamics evaluation).
+        // SAFETY: every index read below was built in `new` from the n x n pattern: `row`,
+        // `col` and `src` hold 0..n, `off_col` < n, `off_at` and `start` index inside their
+        // arrays, a block's L and U entries lie in its s x s slice of `store`; b has R columns
+        // of n and rs, cs have n values (asserted), `work` has n * MAX_COLUMNS. Unchecked
+        // because the blocks have 1 to ~12 rows: bounds checks cost more than the arithmetic
+        // there, and the solves are a third of a forward-dynamics evaluation.
         unsafe {
             let at = |v: &[f64], i: usize| *v.get_unchecked(i);
             let ix = |v: &[usize], i: usize| *v.get_unchecked(i);
             for k in 0..self.start.len() - 1 {
-                let (s0, s1) = (ix(&self.start, k), ix(&self.start, k + 1));
+                let (s0, s1, base) = (ix(&self.start, k), ix(&self.start, k + 1), ix(&self.lu_at, k));
+                let s = s1 - s0;
                 for i in s0..s1 {
-                    let r = ix(&self.rhs_row, i);
-                    let mut v = match scales {
-                        Some((rs, _)) => at(b, r) * at(rs, r),
-                        None => at(b, r),
-                    };
-                    for e in ix(&self.fwd_at, i)..ix(&self.fwd_at, i + 1) {
-                        v -= at(&self.fwd_val, e) * at(y, ix(&self.fwd_idx, e));
+                    let p = ix(&self.src, i);
+                    let r0 = ix(&self.row, p);
+                    let scale = scales.map_or(1.0, |(rs, _)| at(rs, r0));
+                    let mut v = [0.0; R];
+                    for (r, v) in v.iter_mut().enumerate() {
+                        *v = at(b, r * n + r0) * scale;
                     }
-                    *y.get_unchecked_mut(i) = v;
+                    for e in ix(&self.off_at, p)..ix(&self.off_at, p + 1) {
+                        let (a, c) = (at(&self.store, self.off_base + e), ix(&self.off_col, e));
+                        for (r, v) in v.iter_mut().enumerate() {
+                            *v -= a * at(y, c * R + r);
+                        }
+                    }
+                    let l = base + (i - s0) * s - s0;
+                    for j in s0..i {
+                        let a = at(&self.store, l + j);
+                        for (r, v) in v.iter_mut().enumerate() {
+                            *v -= a * at(y, j * R + r);
+                        }
+                    }
+                    for (r, v) in v.into_iter().enumerate() {
+                        *y.get_unchecked_mut(i * R + r) = v;
+                    }
                 }
                 for i in (s0..s1).rev() {
-                    let mut v = at(y, i);
-                    for e in ix(&self.bwd_at, i)..ix(&self.bwd_at, i + 1) {
-                        v -= at(&self.bwd_val, e) * at(y, ix(&self.bwd_idx, e));
+                    let u = base + (i - s0) * s - s0;
+                    let mut v = [0.0; R];
+                    for (r, v) in v.iter_mut().enumerate() {
+                        *v = at(y, i * R + r);
                     }
-                    *y.get_unchecked_mut(i) = v * at(&self.inv_diag, i);
+                    for j in i + 1..s1 {
+                        let a = at(&self.store, u + j);
+                        for (r, v) in v.iter_mut().enumerate() {
+                            *v -= a * at(y, j * R + r);
+                        }
+                    }
+                    let d = at(&self.inv_diag, i);
+                    for (r, v) in v.into_iter().enumerate() {
+                        *y.get_unchecked_mut(i * R + r) = v * d;
+                    }
                 }
             }
         }
-        match scales {
-            Some((_, cs)) => self.col.iter().zip(y.iter()).for_each(|(&c, &v)| b[c] = v * cs[c]),
-            None => self.col.iter().zip(y.iter()).for_each(|(&c, &v)| b[c] = v),
+        for (j, &c) in self.col.iter().enumerate() {
+            let scale = scales.map_or(1.0, |(_, cs)| cs[c]);
+            for r in 0..R {
+                b[r * n + c] = y[j * R + r] * scale;
+            }
         }
     }
 
@@ -391,6 +401,25 @@ mod tests {
         for i in 0..5 {
             assert!((b[i] - x[i]).abs() < 1e-14, "solve: {b:?}");
             assert!((bt[i] - x[i]).abs() < 1e-14, "solve_transpose: {bt:?}");
+        }
+    }
+
+    #[test]
+    fn solves_many_scaled_columns_in_sweeps_of_three() {
+        // B = diag(rs) A diag(cs) is factorised; A x = b is solved for 5 columns (3 + 2).
+        let (a, pattern) = example();
+        let (rs, cs) = ([2.0, 0.5, 1.0, 4.0, 0.25], [1.0, 3.0, 0.5, 2.0, 1.0]);
+        let mut lu = BlockLu::new(&pattern);
+        let mut sink = lu.sink(&rs, &cs);
+        for (i, &v) in a.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+            sink.add(i / 5, i % 5, v);
+        }
+        lu.factor(1e-300).unwrap();
+        let xs: Vec<f64> = (0..25).map(|k| ((k * 7 % 11) as f64 - 5.0) / 3.0).collect();
+        let mut b: Vec<f64> = xs.chunks(5).flat_map(|x| (0..5).map(|i| (0..5).map(|j| a[i * 5 + j] * x[j]).sum::<f64>()).collect::<Vec<_>>()).collect();
+        lu.solve_many_scaled(&mut b, &rs, &cs);
+        for (k, (got, want)) in b.iter().zip(&xs).enumerate() {
+            assert!((got - want).abs() < 1e-13, "entry {k}: {got} vs {want}");
         }
     }
 

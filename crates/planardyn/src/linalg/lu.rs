@@ -38,34 +38,38 @@ pub struct LuError {
 /// Factor the row-major n x n matrix `a` in place. A pivot of magnitude `<= tiny` (or not
 /// finite) makes the matrix singular.
 pub fn lu_factor<T: Scalar>(a: &mut [T], n: usize, piv: &mut [usize], tiny: f64) -> Result<(), LuError> {
-    for k in 0..n {
-        let (mut p, mut best) = (k, a[k * n + k].magnitude());
-        for i in k + 1..n {
-            let v = a[i * n + k].magnitude();
-            if v > best {
-                (p, best) = (i, v);
+    assert!(a.len() >= n * n && piv.len() >= n, "lu_factor: buffers smaller than n = {n}");
+    // SAFETY: every index below is < n * n into `a` or < n into `piv` (asserted above).
+    // Unchecked because the matrices are small (1 to ~40, mostly under 12), where bounds
+    // checks and slice set-up per row cost more than the elimination itself.
+    unsafe {
+        let at = |a: &[T], i: usize| *a.get_unchecked(i);
+        for k in 0..n {
+            let (mut p, mut best) = (k, at(a, k * n + k).magnitude());
+            for i in k + 1..n {
+                let v = at(a, i * n + k).magnitude();
+                if v > best {
+                    (p, best) = (i, v);
+                }
             }
-        }
-        if !(best > tiny && best.is_finite()) {
-            return Err(LuError { column: k });
-        }
-        piv[k] = p;
-        if p != k {
-            for j in 0..n {
-                a.swap(k * n + j, p * n + j);
+            if !(best > tiny && best.is_finite()) {
+                return Err(LuError { column: k });
             }
-        }
-        let pivot = a[k * n + k];
-        // Row slices so that the update loop vectorises; kinematic Jacobians are sparse, so
-        // most multipliers are zero and skipped.
-        let (top, rest) = a.split_at_mut((k + 1) * n);
-        let pivot_row = &top[k * n + k + 1..(k + 1) * n];
-        for row in rest.chunks_exact_mut(n) {
-            let l = row[k] / pivot;
-            row[k] = l;
-            if l != T::ZERO {
-                for (v, &u) in row[k + 1..].iter_mut().zip(pivot_row) {
-                    *v -= l * u;
+            *piv.get_unchecked_mut(k) = p;
+            if p != k {
+                let (top, bottom) = a.split_at_mut(p * n);
+                top[k * n..(k + 1) * n].swap_with_slice(&mut bottom[..n]);
+            }
+            let pivot = at(a, k * n + k);
+            // Kinematic Jacobians are sparse: most multipliers are zero and skipped.
+            for i in k + 1..n {
+                let l = at(a, i * n + k) / pivot;
+                *a.get_unchecked_mut(i * n + k) = l;
+                if l != T::ZERO {
+                    for j in k + 1..n {
+                        let u = at(a, k * n + j);
+                        *a.get_unchecked_mut(i * n + j) -= l * u;
+                    }
                 }
             }
         }
