@@ -24,7 +24,7 @@ import numpy as np
 
 from . import _core
 from .animate import auto_speed
-from .plot import default_trace_points
+from .plot import _unit, default_trace_points
 
 if TYPE_CHECKING:
     from .mechanism import Mechanism
@@ -60,13 +60,8 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
         ("qdd", result.qdd, "qdd_{}", "accelerations", ("rad/s²", "m/s²")),
         ("tau", result.tau, "tau_{}", "drive efforts", ("N m", "N")),
     ]
-
-    def group_unit(angle: str, displacement: str) -> str:
-        if all(k == "angle" for k in kinds):
-            return angle
-        return displacement if all(k != "angle" for k in kinds) else "mixed"
-
-    groups = [{"key": g, "label": label, "unit": group_unit(*units)} for g, _, _, label, units in per_coordinate]
+    groups = [{"key": g, "label": label, "unit": _unit(kinds, *units, mixed="mixed")}
+              for g, _, _, label, units in per_coordinate]
     groups += [
         {"key": "energy", "label": "energy", "unit": "J"},
         {"key": "sigma", "label": "singularity measure", "unit": "1"},
