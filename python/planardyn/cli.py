@@ -375,23 +375,16 @@ def _demo(args: argparse.Namespace) -> int:
     axes[0].set_title(f"{mech.name}: coordinates")
     save(fig, "coordinates.png")
 
-    fig = figure((8, 4))
-    ax = fig.add_subplot()
-    plot_efforts(res, ax=ax)
-    ax.set_title("drive efforts")
-    save(fig, "efforts.png")
-
-    fig = figure((6, 5))
-    ax = fig.add_subplot()
-    plot_torque_speed(res, ax=ax)
-    ax.set_title("drive effort vs speed")
-    save(fig, "torque-speed.png")
-
-    fig = figure((8, 4.5))
-    ax = fig.add_subplot()
-    plot_energy(res, ax=ax)
-    ax.set_title(f"energy (balance drift {res.energy.drift:.2g} J)")
-    save(fig, "energy.png")
+    for size, plotter, title, name in [
+        ((8, 4), plot_efforts, "drive efforts", "efforts.png"),
+        ((6, 5), plot_torque_speed, "drive effort vs speed", "torque-speed.png"),
+        ((8, 4.5), plot_energy, f"energy (balance drift {res.energy.drift:.2g} J)", "energy.png"),
+    ]:
+        fig = figure(size)
+        ax = fig.add_subplot()
+        plotter(res, ax=ax)
+        ax.set_title(title)
+        save(fig, name)
 
     n_snap = 4
     idx = np.linspace(0, len(res.t) - 1, n_snap).round().astype(int) if len(res.t) else []

@@ -11,7 +11,7 @@ import json
 import os
 import warnings
 from collections.abc import Callable, Mapping
-from typing import Any, Literal
+from typing import Any, Generic, Literal, TypeVar, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,6 +26,31 @@ class PlanardynWarning(UserWarning):
 FloatArray = NDArray[np.float64]
 DriveFunction = Callable[[float, FloatArray, FloatArray], ArrayLike]
 ProgressFunction = Callable[[float], Any]
+
+
+T = TypeVar("T")
+
+
+class _Native(Generic[T]):
+    """A read-only attribute of :class:`Mechanism` read from its native mechanism under the
+    same name: one typed, documented line in place of a property per attribute."""
+
+    def __init__(self, doc: str) -> None:
+        self.__doc__ = doc
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, obj: None, owner: type | None = None) -> _Native[T]: ...
+    @overload
+    def __get__(self, obj: Mechanism, owner: type | None = None) -> T: ...
+    def __get__(self, obj: Mechanism | None, owner: type | None = None) -> T | _Native[T]:
+        return self if obj is None else getattr(obj._native, self.name)
+
+    def __set__(self, obj: Mechanism, value: Any) -> None:
+        # A data descriptor (like a property without a setter): a Mechanism is immutable.
+        raise AttributeError(f"Mechanism.{self.name} is read-only: a Mechanism is immutable")
 
 
 class Mechanism:
@@ -53,35 +78,36 @@ class Mechanism:
         """What a user should know about the model (redundant constraints and which pairs)."""
         return list(self._native.warnings)
 
-    @property
-    def name(self) -> str:
-        """The model's ``name``."""
-        return self._native.name
-
-    @property
-    def source(self) -> str:
-        """Where the model came from: a file path, ``'<string>'`` or ``'<dict>'``."""
-        return self._native.source
-
-    @property
-    def dof(self) -> int:
-        """Degrees of freedom m, the number of generalized coordinates."""
-        return self._native.dof
-
-    @property
-    def n_bodies(self) -> int:
-        """Number of mobile bodies n (the ground is not counted)."""
-        return self._native.n_bodies
-
-    @property
-    def coordinate_names(self) -> list[str]:
-        """Names of the m generalized coordinates, in the order of every q array."""
-        return self._native.coordinate_names
-
-    @property
-    def coordinate_kinds(self) -> list[str]:
-        """``'angle'`` (rad) or ``'displacement'`` (m) for each coordinate."""
-        return self._native.coordinate_kinds
+    # Read straight from the native mechanism (read-only; each docstring is the attribute's).
+    name: _Native[str] = _Native("The model's ``name``.")
+    source: _Native[str] = _Native("Where the model came from: a file path, ``'<string>'`` or ``'<dict>'``.")
+    dof: _Native[int] = _Native("Degrees of freedom m, the number of generalized coordinates.")
+    n_bodies: _Native[int] = _Native("Number of mobile bodies n (the ground is not counted).")
+    coordinate_names: _Native[list[str]] = _Native("Names of the m generalized coordinates, in the order of every q array.")
+    coordinate_kinds: _Native[list[str]] = _Native("``'angle'`` (rad) or ``'displacement'`` (m) for each coordinate.")
+    body_names: _Native[list[str]] = _Native("Names of the n mobile bodies, in the order of x (3 values each).")
+    pair_names: _Native[list[str]] = _Native("Names of the p kinematic pairs (rows of :meth:`reactions`).")
+    point_names: _Native[list[str]] = _Native("Names of the P named points (rows of :meth:`point_positions`).")
+    ground_points: _Native[list[str]] = _Native("Names of the points the fixed ground carries.")
+    q0: _Native[FloatArray] = _Native("(m,) start coordinates of a simulation (rad or m).")
+    qd0: _Native[FloatArray] = _Native("(m,) start rates of a simulation (rad/s or m/s).")
+    drawn_q: _Native[FloatArray] = _Native("(m,) coordinates in the drawing (rad or m).")
+    x0: _Native[FloatArray] = _Native("(3n,) body coordinates [X, Y, phi] per body in the drawing (m, m, rad).")
+    masses: _Native[FloatArray] = _Native("(n,) body masses (kg).")
+    inertias: _Native[FloatArray] = _Native("(n,) moments of inertia about the centres of mass (kg m^2).")
+    scale: _Native[float] = _Native("Characteristic length L (m): the largest distance between two drawn points.")
+    gravity: _Native[FloatArray] = _Native("(2,) gravity [g_x, g_y] (m/s^2).")
+    body_points: _Native[list[list[tuple[str, tuple[float, float]]]]] = _Native(
+        "For each body, its points as ``(name, (s_x, s_y))`` in the body frame (m).\n\n"
+        "The body frame has its origin at the centre of mass and turns with the body angle\n"
+        "phi: the world position is ``[X, Y] + R(phi) s``."
+    )
+    pairs: _Native[list[dict[str, Any]]] = _Native(
+        "The pairs as dicts: ``name``, ``kind`` (``'revolute'`` | ``'prismatic'``),\n"
+        "``bodies`` (a, b) by name (``'ground'`` for the fixed body), ``point`` (name) and\n"
+        "``axis`` (unit guide direction in a's frame, or None)."
+    )
+    simulate_defaults: _Native[dict[str, Any]] = _Native("The model file's ``simulate`` section (None for a setting not given).")
 
     @property
     def coordinate_units(self) -> list[str]:
@@ -92,87 +118,6 @@ class Mechanism:
     def effort_units(self) -> list[str]:
         """``'N m'`` (torque on an angle) or ``'N'`` (force on a displacement) per coordinate."""
         return ["N m" if k == "angle" else "N" for k in self.coordinate_kinds]
-
-    @property
-    def body_names(self) -> list[str]:
-        """Names of the n mobile bodies, in the order of x (3 values each)."""
-        return self._native.body_names
-
-    @property
-    def pair_names(self) -> list[str]:
-        """Names of the p kinematic pairs (rows of :meth:`reactions`)."""
-        return self._native.pair_names
-
-    @property
-    def point_names(self) -> list[str]:
-        """Names of the P named points (rows of :meth:`point_positions`)."""
-        return self._native.point_names
-
-    @property
-    def ground_points(self) -> list[str]:
-        """Names of the points the fixed ground carries."""
-        return self._native.ground_points
-
-    @property
-    def q0(self) -> FloatArray:
-        """(m,) start coordinates of a simulation (rad or m)."""
-        return self._native.q0
-
-    @property
-    def qd0(self) -> FloatArray:
-        """(m,) start rates of a simulation (rad/s or m/s)."""
-        return self._native.qd0
-
-    @property
-    def drawn_q(self) -> FloatArray:
-        """(m,) coordinates in the drawing (rad or m)."""
-        return self._native.drawn_q
-
-    @property
-    def x0(self) -> FloatArray:
-        """(3n,) body coordinates [X, Y, phi] per body in the drawing (m, m, rad)."""
-        return self._native.x0
-
-    @property
-    def masses(self) -> FloatArray:
-        """(n,) body masses (kg)."""
-        return self._native.masses
-
-    @property
-    def inertias(self) -> FloatArray:
-        """(n,) moments of inertia about the centres of mass (kg m^2)."""
-        return self._native.inertias
-
-    @property
-    def scale(self) -> float:
-        """Characteristic length L (m): the largest distance between two drawn points."""
-        return self._native.scale
-
-    @property
-    def gravity(self) -> FloatArray:
-        """(2,) gravity [g_x, g_y] (m/s^2)."""
-        return self._native.gravity
-
-    @property
-    def body_points(self) -> list[list[tuple[str, tuple[float, float]]]]:
-        """For each body, its points as ``(name, (s_x, s_y))`` in the body frame (m).
-
-        The body frame has its origin at the centre of mass and turns with the body angle
-        phi: the world position is ``[X, Y] + R(phi) s``.
-        """
-        return self._native.body_points
-
-    @property
-    def pairs(self) -> list[dict[str, Any]]:
-        """The pairs as dicts: ``name``, ``kind`` (``'revolute'`` | ``'prismatic'``),
-        ``bodies`` (a, b) by name (``'ground'`` for the fixed body), ``point`` (name) and
-        ``axis`` (unit guide direction in a's frame, or None)."""
-        return self._native.pairs
-
-    @property
-    def simulate_defaults(self) -> dict[str, Any]:
-        """The model file's ``simulate`` section (None for a setting not given)."""
-        return self._native.simulate_defaults
 
     def to_dict(self) -> dict[str, Any]:
         """The model as a dict in the model-file schema; ``from_dict`` gives it back."""

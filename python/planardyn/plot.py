@@ -26,9 +26,10 @@ def _axes(ax: Axes | None) -> Axes:
     return ax
 
 
-def _unit(kinds: list[str], angle: str, displacement: str) -> str:
+def _unit(kinds: list[str], angle: str, displacement: str, mixed: str = "mixed units") -> str:
+    """The unit of a group of coordinates of these kinds ('angle' or 'displacement')."""
     units = {angle if k == "angle" else displacement for k in kinds}
-    return units.pop() if len(units) == 1 else "mixed units"
+    return units.pop() if len(units) == 1 else mixed
 
 
 def plot_coordinates(

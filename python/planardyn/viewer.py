@@ -24,7 +24,7 @@ import numpy as np
 
 from . import _core
 from .animate import auto_speed
-from .plot import default_trace_points
+from .plot import _unit, default_trace_points
 
 if TYPE_CHECKING:
     from .mechanism import Mechanism
@@ -53,23 +53,24 @@ def _nan_to_none(v: Any) -> Any:
 def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | None) -> tuple[list, list]:
     """(groups, channels): each channel a dict key, label, group, values, on."""
     names, kinds = result.coordinate_names, result.coordinate_kinds
-    ang = lambda k, a, d: a if kinds[k] == "angle" else d  # noqa: E731
-    unit = lambda a, d: a if all(k == "angle" for k in kinds) else d if all(k != "angle" for k in kinds) else "mixed"  # noqa: E731
-    groups = [
-        {"key": "q", "label": "coordinates", "unit": unit("rad", "m")},
-        {"key": "qd", "label": "rates", "unit": unit("rad/s", "m/s")},
-        {"key": "qdd", "label": "accelerations", "unit": unit("rad/s²", "m/s²")},
-        {"key": "tau", "label": "drive efforts", "unit": unit("N m", "N")},
+    # Per coordinate group: key, values, channel names, label, unit (on an angle, on a displacement).
+    per_coordinate = [
+        ("q", result.q, "{}", "coordinates", ("rad", "m")),
+        ("qd", result.qd, "qd_{}", "rates", ("rad/s", "m/s")),
+        ("qdd", result.qdd, "qdd_{}", "accelerations", ("rad/s²", "m/s²")),
+        ("tau", result.tau, "tau_{}", "drive efforts", ("N m", "N")),
+    ]
+    groups = [{"key": g, "label": label, "unit": _unit(kinds, *units, mixed="mixed")}
+              for g, _, _, label, units in per_coordinate]
+    groups += [
         {"key": "energy", "label": "energy", "unit": "J"},
         {"key": "sigma", "label": "singularity measure", "unit": "1"},
     ]
     chans: list[dict[str, Any]] = []
-    for g, arr, fmt in (("q", result.q, "{}"), ("qd", result.qd, "qd_{}"), ("qdd", result.qdd, "qdd_{}"),
-                        ("tau", result.tau, "tau_{}")):
+    for g, arr, fmt, _, (angle, displacement) in per_coordinate:
         for k, n in enumerate(names):
             chans.append({"key": fmt.format(n), "label": fmt.format(n), "group": g, "values": arr[keep, k],
-                          "unit": ang(k, *{"q": ("rad", "m"), "qd": ("rad/s", "m/s"), "qdd": ("rad/s²", "m/s²"),
-                                             "tau": ("N m", "N")}[g])})
+                          "unit": angle if kinds[k] == "angle" else displacement})
     e = result.energy
     for key, label, arr in (("kinetic", "T", e.kinetic), ("potential", "V", e.potential),
                             ("total", "T + V", e.total), ("work", "W", e.work), ("balance", "balance", e.balance)):

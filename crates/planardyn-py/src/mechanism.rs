@@ -7,6 +7,7 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
+use planardyn::batch::inverse_rows;
 use planardyn::dynamics::{self, Drives, ModelDrives};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::{self as kin, Chart};
@@ -68,24 +69,22 @@ impl PyMechanism {
         vector("x_start", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")
     }
 
+    /// `f(link, s)` of every named point, appended to `out` (P x 2, row-major); NaN for a
+    /// point no link carries.
+    fn per_point(&self, out: &mut Vec<f64>, f: impl Fn(Link, [f64; 2]) -> [f64; 2]) {
+        for c in &self.carriers {
+            out.extend_from_slice(&c.map_or([f64::NAN; 2], |(link, s)| f(link, s)));
+        }
+    }
+
     /// World positions (P x 2, row-major) of every named point for body coordinates x.
     fn points_at(&self, x: &[f64], out: &mut Vec<f64>) {
-        for c in &self.carriers {
-            match c {
-                Some((link, s)) => out.extend_from_slice(&world_point(*link, *s, x)),
-                None => out.extend_from_slice(&[f64::NAN, f64::NAN]),
-            }
-        }
+        self.per_point(out, |link, s| world_point(link, s, x));
     }
 
     fn point_velocities(&self, x: &[f64], xd: &[f64]) -> Vec<f64> {
         let mut out = Vec::with_capacity(2 * self.carriers.len());
-        for c in &self.carriers {
-            match c {
-                Some((link, s)) => out.extend_from_slice(&point_velocity(*link, *s, x, xd)),
-                None => out.extend_from_slice(&[f64::NAN, f64::NAN]),
-            }
-        }
+        self.per_point(&mut out, |link, s| point_velocity(link, s, x, xd));
         out
     }
 
@@ -97,14 +96,20 @@ impl PyMechanism {
         }
     }
 
-    /// Assembled and analysed (positions, U) at q: a workspace in the input chart; by
-    /// continuation from `x_start` if given, else from the drawing.
-    fn analysed(mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, Failure> {
+    /// Assembled at q: a workspace in the input chart, by continuation from `x_start` if
+    /// given, else from the drawing.
+    fn assembled(mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, Failure> {
         let mut ws = Workspace::new(mech);
         match x_start {
             Some(x) => kin::assemble_from(mech, x, q, &mut ws)?,
             None => kin::assemble_into(mech, q, &mut ws)?,
         }
+        Ok(ws)
+    }
+
+    /// Assembled and analysed (positions, U) at q; see [`Self::assembled`].
+    fn analysed(mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, Failure> {
+        let mut ws = Self::assembled(mech, q, x_start)?;
         kin::velocity_analogues(&mut ws)?;
         Ok(ws)
     }
@@ -279,14 +284,7 @@ impl PyMechanism {
         let q = self.q_arg("q", &q)?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
-        let x = run(py, move || {
-            let mut ws = Workspace::new(&mech);
-            match &x_start {
-                Some(x) => kin::assemble_from(&mech, x, &q, &mut ws)?,
-                None => kin::assemble_into(&mech, &q, &mut ws)?,
-            }
-            Ok(ws.x)
-        })?;
+        let x = run(py, move || Ok(Self::assembled(&mech, &q, x_start.as_deref())?.x))?;
         Ok(arr1(py, x))
     }
 
@@ -399,7 +397,7 @@ impl PyMechanism {
         }
         let mech = self.inner.clone();
         let shape = q.shape.clone();
-        let tau = run(py, move || inverse_rows(&mech, &q, &qd, &qdd))?;
+        let tau = run(py, move || Ok(inverse_rows(&mech, &q.data, &qd.data, &qdd.data)?))?;
         arr_dyn(py, &shape, tau)
     }
 
@@ -503,23 +501,4 @@ fn check_time(t: f64) -> PyResult<()> {
 
 fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
     serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
-}
-
-/// Inverse dynamics row by row: the first assembled from the drawing, each next one by
-/// continuation from the previous solution (same branch, few Newton iterations).
-fn inverse_rows(mech: &Mechanism, q: &Values, qd: &Values, qdd: &Values) -> Result<Vec<f64>, Failure> {
-    let m = mech.dof();
-    let mut ws = Workspace::new(mech);
-    let mut tau = Vec::with_capacity(q.data.len());
-    for k in 0..q.rows() {
-        let qk = q.row(k, m);
-        if k == 0 {
-            kin::assemble_into(mech, qk, &mut ws)?;
-        } else {
-            kin::continue_to(mech, q.row(k - 1, m), qk, &mut ws)?;
-        }
-        dynamics::inverse(mech, qk, qd.row(k, m), qdd.row(k, m), &mut ws)?;
-        tau.extend_from_slice(&ws.tau);
-    }
-    Ok(tau)
 }
