@@ -1,5 +1,11 @@
-//! One forward-dynamics evaluation as the integrator makes it: Newton from the first-order
-//! prediction of a nearby accepted point, analogues, convective term, A, b, solve.
+//! One forward-dynamics evaluation as the integrator makes it. Two cases per model:
+//! - `NAME`: evaluated again and again at one stage point (1 mrad from the accepted point
+//!   the first time): the position is then already converged, so this is the cost of the
+//!   stages after it (J factorised, analogues U, convective term, A, b, solve) plus one
+//!   residual check. The figure the targets are read against.
+//! - `NAME+1mrad`: alternating between two stage points 1 mrad apart in every coordinate,
+//!   so that each evaluation also runs Newton from the second-order prediction, as between
+//!   the stages of an integration step.
 //! Run: `cargo bench -p planardyn --bench forward_dynamics`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -30,8 +36,18 @@ fn bench(c: &mut Criterion) {
         let mut y = y0.clone();
         y[..m].iter_mut().for_each(|v| *v += 1e-3);
         let mut dy = vec![0.0; 2 * m + 1];
-        group.bench_function(file.trim_end_matches(".yaml"), |b| {
+        let name = file.trim_end_matches(".yaml");
+        group.bench_function(name, |b| {
             b.iter(|| ode.rhs(0.0, black_box(&y), &mut dy).unwrap());
+        });
+        let mut y2 = y.clone();
+        y2[..m].iter_mut().for_each(|v| *v += 1e-3);
+        let mut second = false;
+        group.bench_function(format!("{name}+1mrad"), |b| {
+            b.iter(|| {
+                second = !second;
+                ode.rhs(0.0, black_box(if second { &y2 } else { &y }), &mut dy).unwrap()
+            });
         });
     }
     group.finish();
