@@ -40,16 +40,26 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
     Measures { sigma, passive }
 }
 
+/// Smallest scaled singular value of the current chart's J at the point in `ode.ws`, given
+/// the type II measure `sigma` there (which it is in the user's chart; a partition costs an
+/// SVD, taken at the few steps integrated in one).
+pub fn chart_sigma(ode: &MechanismOde, sigma: f64) -> f64 {
+    match &ode.ws.chart {
+        Chart::Inputs => sigma,
+        Chart::Partition(_) => sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x),
+    }
+}
+
 /// The chart to integrate in next, if it should change, from the measures at the current
-/// point: partition when q is near-singular, back to q when clear of it, and a fresh
-/// partition when the current one degrades.
-pub fn next_chart(ode: &MechanismOde, m: &Measures) -> Option<Chart> {
+/// point and the current chart's own measure `own` ([`chart_sigma`]): partition when q is
+/// near-singular, back to q when clear of it, and a fresh partition when the current one
+/// degrades.
+pub fn next_chart(ode: &MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
     match &ode.ws.chart {
         Chart::Inputs if m.sigma < SWITCH_TO_PARTITION => Some(Chart::Partition(select_partition(ode.mech, &ode.ws.x))),
         Chart::Inputs => None,
         Chart::Partition(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
         Chart::Partition(idx) => {
-            let own = sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x);
             let best = select_partition(ode.mech, &ode.ws.x);
             (own < SWITCH_TO_PARTITION && &best != idx).then_some(Chart::Partition(best))
         }

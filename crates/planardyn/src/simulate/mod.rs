@@ -16,7 +16,7 @@ use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Ch
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
-use charts::{measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
+use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
 use ode::MechanismOde;
 
 /// What to simulate and how. Times in s.
@@ -107,11 +107,13 @@ fn start<'a>(mech: &'a Mechanism, s: &Settings, drives: &'a mut dyn Drives) -> R
     if m0.passive < PASSIVE_SINGULAR {
         return Err(KinematicsError::Singular { sigma_min: m0.passive, what: "the passive mechanism is singular at the start (its pair constraints lose rank); start elsewhere".into() }.into());
     }
-    let chart = next_chart(&ode, &m0).unwrap_or(Chart::Inputs);
+    let chart = next_chart(&ode, &m0, m0.sigma).unwrap_or(Chart::Inputs);
     let m = mech.dof();
     let mut y = vec![0.0; 2 * m + 1];
     state_in(&ode, &chart, 0.0, &mut y);
     ode.set_chart(chart, s.t0, &y)?;
+    let own = chart_sigma(&ode, m0.sigma);
+    ode.limit_correction(own);
     Ok((ode, y))
 }
 
@@ -129,6 +131,29 @@ fn failure(e: &StepError<Error>) -> (Status, String) {
         other => other.to_string(),
     };
     (status, message)
+}
+
+/// Evaluate the dense output at `t_out` of the step just taken from `t_prev` into `yi` (at
+/// the step's end it is the step's own state). If
+/// the position solve refuses it from the last evaluation (a stage on the far side of the
+/// output, possibly across a near-singular stretch), follow the interpolant from the step's
+/// start (the anchor, on the branch) in shorter and shorter pieces, as the stages did.
+fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_prev: f64, t_out: f64, yi: &mut [f64]) -> Result<(), Error> {
+    stepper.interpolate(ode, t_out, yi);
+    let Err(mut error) = ode.evaluate(t_out, yi) else { return Ok(()) };
+    for pieces in [4, 16, 64] {
+        ode.restart_from_anchor();
+        let walked = (1..=pieces).try_for_each(|k| {
+            let t = if k == pieces { t_out } else { t_prev + (t_out - t_prev) * k as f64 / pieces as f64 };
+            stepper.interpolate(ode, t, yi);
+            ode.evaluate(t, yi)
+        });
+        match walked {
+            Ok(()) => return Ok(()),
+            Err(e) => error = e,
+        }
+    }
+    Err(error)
 }
 
 /// Simulate from the model's (or the given) initial state. `progress(t)` is called after
@@ -166,6 +191,7 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
     let mut yi = vec![0.0; 2 * m + 1];
     let (mut status, mut message) = (Status::Success, String::new());
     while stepper.t() < settings.t_end {
+        let t_prev = stepper.t();
         if let Err(e) = stepper.step(&mut ode, settings.t_end) {
             (status, message) = failure(&e);
             break;
@@ -177,8 +203,7 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
         }
         if let Some(te) = t_eval {
             while next_out < te.len() && te[next_out] <= t {
-                stepper.interpolate(&mut ode, te[next_out], &mut yi);
-                if let Err(e) = ode.evaluate(te[next_out], &yi) {
+                if let Err(e) = evaluate_output(&mut ode, &mut stepper, t_prev, te[next_out], &mut yi) {
                     (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[next_out]));
                     break;
                 }
@@ -190,7 +215,9 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
                 break;
             }
         }
-        if let Err(e) = ode.accept(t, &y) {
+        // Outputs moved the evaluation away from the step's end: come back the same way.
+        let back = if t_eval.is_some() { evaluate_output(&mut ode, &mut stepper, t_prev, t, &mut yi) } else { Ok(()) };
+        if let Err(e) = back.and_then(|_| ode.accept(t, &y)) {
             (status, message) = (Status::AssemblyFailed, format!("at t = {t}: {e}"));
             break;
         }
@@ -204,7 +231,8 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
             (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
             break;
         }
-        if let Some(chart) = next_chart(&ode, &meas) {
+        let mut own = chart_sigma(&ode, meas.sigma);
+        if let Some(chart) = next_chart(&ode, &meas, own) {
             state_in(&ode, &chart, y[2 * m], &mut y);
             traj.stats.chart_switches += 1;
             let switched = ode.set_chart(chart, t, &y).map_err(|e| e.to_string());
@@ -212,7 +240,9 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
                 (status, message) = (Status::AssemblyFailed, format!("changing coordinates at t = {t} s: {e}"));
                 break;
             }
+            own = chart_sigma(&ode, meas.sigma);
         }
+        ode.limit_correction(own);
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
                 (status, message) = (Status::Cancelled, format!("stopped by the progress callback at t = {t} s"));
