@@ -215,9 +215,16 @@ pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, 
                 break;
             }
         }
-        // Outputs moved the evaluation away from the step's end: come back the same way.
-        let back = if t_eval.is_some() { evaluate_output(&mut ode, &mut stepper, t_prev, t, &mut yi) } else { Ok(()) };
-        if let Err(e) = back.and_then(|_| ode.accept(t, &y)) {
+        // Outputs moved the evaluation away from the step's end; if going straight back is
+        // refused, come back along the interpolant as the outputs did.
+        let accepted = ode.accept(t, &y).or_else(|e| {
+            if t_eval.is_none() {
+                return Err(e);
+            }
+            evaluate_output(&mut ode, &mut stepper, t_prev, t, &mut yi)?;
+            ode.accept(t, &y)
+        });
+        if let Err(e) = accepted {
             (status, message) = (Status::AssemblyFailed, format!("at t = {t}: {e}"));
             break;
         }
