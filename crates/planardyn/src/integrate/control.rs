@@ -116,12 +116,13 @@ impl Core {
         dy: &mut [f64],
     ) -> Result<(), Failure<S::Error>> {
         stats.nfev += 1;
-        sys.rhs(t, y, dy).map_err(Failure::Rhs)?;
-        if all_finite(dy) {
-            Ok(())
-        } else {
-            Err(Failure::NonFinite)
-        }
+        finite(sys.rhs(t, y, dy), dy)
+    }
+
+    /// As [`Core::eval`], through [`OdeSystem::rhs_dense`].
+    pub(crate) fn eval_dense<S: OdeSystem>(stats: &mut Stats, sys: &mut S, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Failure<S::Error>> {
+        stats.nfev += 1;
+        finite(sys.rhs_dense(t, y, dy), dy)
     }
 
     /// Smallest allowed trial step at the current time (s), see [`Options::h_min`].
@@ -209,6 +210,16 @@ impl Core {
             self.started,
             "Stepper::step called before a successful Stepper::reset"
         );
+    }
+}
+
+/// An evaluation's outcome, NaN or infinity in `dy` counting as a failure.
+fn finite<E>(outcome: Result<(), E>, dy: &[f64]) -> Result<(), Failure<E>> {
+    outcome.map_err(Failure::Rhs)?;
+    if all_finite(dy) {
+        Ok(())
+    } else {
+        Err(Failure::NonFinite)
     }
 }
 

@@ -350,7 +350,12 @@ impl Dop853 {
             let incr: f64 = (0..s).map(|j| A[s][j] * k[j * n + i]).sum();
             ytmp[i] = y0[i] + h * incr;
         }
-        Core::eval(&mut core.stats, sys, t0 + C[s] * h, ytmp, &mut k[s * n..(s + 1) * n])
+        let ks = &mut k[s * n..(s + 1) * n];
+        if accepted {
+            Core::eval_dense(&mut core.stats, sys, t0 + C[s] * h, ytmp, ks)
+        } else {
+            Core::eval(&mut core.stats, sys, t0 + C[s] * h, ytmp, ks)
+        }
     }
 }
 

@@ -63,6 +63,12 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Write f(t, y) into dy. An Err makes the integrator reject the step and retry with a smaller one.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Self::Error>;
+    /// f(t, y) at a point that must be evaluated rather than avoided by a shorter step: the
+    /// dense-output stages of a step already accepted. The default is [`OdeSystem::rhs`]; a
+    /// system that refuses evaluations far from its last one may try harder here.
+    fn rhs_dense(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Self::Error> {
+        self.rhs(t, y, dy)
+    }
 }
 
 /// The integration method, chosen at run time.

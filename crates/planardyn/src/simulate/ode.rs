@@ -38,6 +38,8 @@ pub struct MechanismOde<'a> {
     /// (3n) the Newton start of the current evaluation, and the converged point it was
     /// predicted from.
     predicted: Vec<f64>,
+    /// (2m + 1) the intermediate states of [`MechanismOde::evaluate_walking`].
+    walk_y: Vec<f64>,
     base: Vec<f64>,
     /// Largest scaled Newton correction accepted from the predictor (see `limit_correction`).
     max_correction: f64,
@@ -58,6 +60,7 @@ impl<'a> MechanismOde<'a> {
             last_y: vec![f64::NAN; 2 * m + 1],
             base_valid: false,
             predicted: vec![0.0; ws.x.len()],
+            walk_y: vec![0.0; 2 * m + 1],
             base: vec![0.0; ws.x.len()],
             max_correction: MAX_CORRECTION,
             max_move: f64::INFINITY,
@@ -182,6 +185,51 @@ impl<'a> MechanismOde<'a> {
     }
 }
 
+impl MechanismOde<'_> {
+    /// As [`MechanismOde::evaluate`], for a point that must be evaluated (an output, a dense
+    /// output stage) rather than avoided by a shorter step: when refused, walk to it from the
+    /// last accepted point in straight pieces of the chart coordinates (4, then 16, then 64),
+    /// each a short move on the branch, as continuation does.
+    pub fn evaluate_walking(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let Err(mut error) = self.evaluate(t, y) else { return Ok(()) };
+        let m = self.m();
+        let mut walk = std::mem::take(&mut self.walk_y);
+        walk.copy_from_slice(y);
+        for pieces in [4, 16, 64] {
+            self.restart_from_anchor();
+            let walked = (1..=pieces).try_for_each(|k| {
+                let f = k as f64 / pieces as f64;
+                for j in 0..m {
+                    walk[j] = self.anchor_z[j] + (y[j] - self.anchor_z[j]) * f;
+                }
+                self.evaluate(t, &walk)
+            });
+            match walked {
+                Ok(()) => {
+                    error = match self.evaluate(t, y) {
+                        Ok(()) => {
+                            self.walk_y = walk;
+                            return Ok(());
+                        }
+                        Err(e) => e,
+                    }
+                }
+                Err(e) => error = e,
+            }
+        }
+        self.walk_y = walk;
+        Err(error)
+    }
+
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` at state y.
+    fn derivative(&self, y: &[f64], dy: &mut [f64]) {
+        let m = self.m();
+        dy[..m].copy_from_slice(&y[m..2 * m]);
+        dy[m..2 * m].copy_from_slice(&self.ws.b);
+        dy[2 * m] = self.ws.power;
+    }
+}
+
 impl OdeSystem for MechanismOde<'_> {
     type Error = Error;
     fn dim(&self) -> usize {
@@ -189,10 +237,12 @@ impl OdeSystem for MechanismOde<'_> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.evaluate(t, y)?;
-        let m = self.m();
-        dy[..m].copy_from_slice(&y[m..2 * m]);
-        dy[m..2 * m].copy_from_slice(&self.ws.b);
-        dy[2 * m] = self.ws.power;
+        self.derivative(y, dy);
+        Ok(())
+    }
+    fn rhs_dense(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
+        self.evaluate_walking(t, y)?;
+        self.derivative(y, dy);
         Ok(())
     }
 }
