@@ -33,7 +33,7 @@ impl Ctx<'_> {
     fn point(&self, path: &str, name: &str) -> R<PointId> {
         self.spec.points.0.get_index_of(name).map(PointId).ok_or_else(|| {
             let known: Vec<&str> = self.spec.points.0.keys().map(String::as_str).collect();
-            self.err(path, format!("unknown point '{name}'; points are: {}", known.join(", ")))
+            self.err(path, format!("unknown point '{name}'; points are: {} (use one of them, or add it to `points`)", known.join(", ")))
         })
     }
     fn xy(&self, path: &str, name: &str) -> R<[f64; 2]> {
@@ -47,7 +47,7 @@ impl Ctx<'_> {
             let known: Vec<&str> = self.spec.bodies.0.keys().map(String::as_str).collect();
             self.err(
                 path,
-                format!("unknown body '{name}'; bodies are: ground, {}", known.join(", ")),
+                format!("unknown body '{name}'; bodies are: ground, {} (use one of them, or add it to `bodies`)", known.join(", ")),
             )
         })
     }
@@ -55,7 +55,7 @@ impl Ctx<'_> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(self.err(path, format!("{v} is not a finite number")))
+            Err(self.err(path, format!("{v} is not a finite number; give a finite one")))
         }
     }
     fn non_negative(&self, path: &str, v: f64) -> R<f64> {
@@ -90,7 +90,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     for (k, name) in spec.ground.iter().enumerate() {
         let p = ctx.point(&format!("ground[{k}]"), name)?;
         if ground_points.contains(&p) {
-            return Err(ctx.err(format!("ground[{k}]"), format!("point '{name}' is listed twice")));
+            return Err(ctx.err(format!("ground[{k}]"), format!("point '{name}' is listed twice; list it once")));
         }
         ground_points.push(p);
     }
@@ -124,7 +124,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     for (k, p) in spec.pairs.iter().enumerate() {
         let pair = build_pair(&ctx, &mech, k, p)?;
         if mech.pairs.iter().any(|q| q.name == pair.name) {
-            return Err(ctx.err(format!("pairs[{k}].name"), format!("duplicate pair name '{}'", pair.name)));
+            return Err(ctx.err(format!("pairs[{k}].name"), format!("duplicate pair name '{}'; rename one of the two", pair.name)));
         }
         mech.pairs.push(pair);
     }
@@ -171,7 +171,7 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     }
     let inertia = p
         .inertia
-        .ok_or_else(|| ctx.err(format!("{path}.inertia"), "missing: the moment of inertia about the centre of mass (kg m^2)"))?;
+        .ok_or_else(|| ctx.err(format!("{path}.inertia"), "missing: add the moment of inertia about the centre of mass (kg m^2)"))?;
     let inertia = ctx.non_negative(&format!("{path}.inertia"), inertia)?;
     let com = match p.com.as_ref().expect("checked above") {
         Location::Coords(c) => [ctx.finite(&format!("{path}.com"), c[0])?, ctx.finite(&format!("{path}.com"), c[1])?],
@@ -201,13 +201,13 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
                 return Err(ctx.err(&path, "give either `parts` or the body's own mass properties, not both"));
             }
             if parts.is_empty() {
-                return Err(ctx.err(format!("{path}.parts"), "empty list of parts"));
+                return Err(ctx.err(format!("{path}.parts"), "empty list of parts; add a part, or remove `parts` and give the body's own mass"));
             }
             parts.iter().enumerate().map(|(k, p)| part_inertia(ctx, &format!("{path}.parts[{k}]"), p)).collect::<R<_>>()?
         }
         None => {
             if b.mass.is_none() {
-                return Err(ctx.err(format!("{path}.mass"), "missing: the body's mass (kg), or `parts`"));
+                return Err(ctx.err(format!("{path}.mass"), "missing: add the body's mass (kg), or `parts`"));
             }
             vec![part_inertia(ctx, &path, &own)?]
         }
@@ -234,7 +234,7 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
     for (k, p) in b.points.iter().enumerate() {
         let id = ctx.point(&format!("{path}.points[{k}]"), p)?;
         if ids.contains(&id) {
-            return Err(ctx.err(format!("{path}.points[{k}]"), format!("point '{p}' is listed twice")));
+            return Err(ctx.err(format!("{path}.points[{k}]"), format!("point '{p}' is listed twice; list it once")));
         }
         ids.push(id);
     }
@@ -270,7 +270,7 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
     let a = ctx.link(&format!("{path}.bodies[0]"), &bodies[0])?;
     let b = ctx.link(&format!("{path}.bodies[1]"), &bodies[1])?;
     if a == b {
-        return Err(ctx.err(format!("{path}.bodies"), "a pair joins two different bodies"));
+        return Err(ctx.err(format!("{path}.bodies"), "a pair must join two different bodies; name two"));
     }
     let point = ctx.point(&format!("{path}.at"), at)?;
     let carried = |link: Link, i: usize| {
@@ -299,11 +299,11 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
                     let (pf, pt) = (ctx.xy(&format!("{path}.along[0]"), from)?, ctx.xy(&format!("{path}.along[1]"), to)?);
                     [pt[0] - pf[0], pt[1] - pf[1]]
                 }
-                _ => return Err(ctx.err(&path, "a prismatic pair needs exactly one of `axis: [dx, dy]` or `along: [P, Q]`")),
+                _ => return Err(ctx.err(&path, "give a prismatic pair exactly one of `axis: [dx, dy]` or `along: [P, Q]`")),
             };
             let len = d[0].hypot(d[1]);
             if !(len > 0.0 && len.is_finite()) {
-                return Err(ctx.err(&path, "the guide direction has zero length"));
+                return Err(ctx.err(&path, "the guide direction has zero length; give a non-zero `axis`, or two distinct `along` points"));
             }
             let (c, s) = (angle(a).cos(), angle(a).sin());
             let (ux, uy) = (d[0] / len, d[1] / len);
@@ -337,11 +337,11 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     for (k, c) in ctx.spec.coordinates.iter().enumerate() {
         let path = format!("coordinates[{k}]");
         if mech.coordinates.iter().any(|d| d.name == c.name) || c.name.is_empty() {
-            return Err(ctx.err(format!("{path}.name"), format!("coordinate name '{}' is empty or used twice", c.name)));
+            return Err(ctx.err(format!("{path}.name"), format!("coordinate name '{}' is empty or used twice; give each coordinate its own name", c.name)));
         }
         let pair = pair_id(ctx, mech, &format!("{path}.pair"), &c.pair)?;
         if mech.coordinates.iter().any(|d| d.pair == pair) {
-            return Err(ctx.err(format!("{path}.pair"), format!("pair '{}' already has a coordinate", c.pair)));
+            return Err(ctx.err(format!("{path}.pair"), format!("pair '{}' already has a coordinate; remove one of the two", c.pair)));
         }
         let kind = match mech.pairs[pair.0].kind {
             PairKind::Revolute => CoordinateKind::Angle,
@@ -361,7 +361,7 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
 
 fn coordinate_index(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<usize> {
     mech.coordinates.iter().position(|c| c.name == name).ok_or_else(|| {
-        ctx.err(path, format!("unknown coordinate '{name}'; coordinates are: {}", mech.coordinate_names().join(", ")))
+        ctx.err(path, format!("unknown coordinate '{name}'; coordinates are: {} (use one of them)", mech.coordinate_names().join(", ")))
     })
 }
 
@@ -371,7 +371,7 @@ fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<Vec<Opti
         let path = format!("drives[{k}]");
         let i = coordinate_index(ctx, mech, &format!("{path}.coordinate"), &d.coordinate)?;
         if out[i].is_some() {
-            return Err(ctx.err(format!("{path}.coordinate"), format!("coordinate '{}' already has a drive", d.coordinate)));
+            return Err(ctx.err(format!("{path}.coordinate"), format!("coordinate '{}' already has a drive; remove one of the two", d.coordinate)));
         }
         out[i] = Some(match (&d.effort, &d.table) {
             (Some(e), None) => DriveLaw::Constant(ctx.finite(&format!("{path}.effort"), *e)?),
