@@ -37,7 +37,7 @@ fn runner() -> TestRunner {
     bytes[..8].copy_from_slice(&seed.to_le_bytes());
     // Failures are kept by hand in tests/fuzz_corpus/ (with what the loader must say), not
     // in proptest's regression files.
-    let config = Config { cases: cases(), failure_persistence: None, max_shrink_iters: 2000, ..Config::default() };
+    let config = Config { cases: cases(), max_global_rejects: cases(), failure_persistence: None, max_shrink_iters: 2000, ..Config::default() };
     TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
 }
 
@@ -389,6 +389,30 @@ fn mutated_models(bases: Vec<(String, String)>) -> impl Strategy<Value = (String
         })
 }
 
+/// A shipped file with 1 to 3 of its numbers changed (extreme, NaN, inf, scaled): the
+/// structure stays, so most of these load and go on to assembly and dynamics.
+fn numeric_mutations(bases: Vec<(String, String)>) -> impl Strategy<Value = (String, String)> {
+    let models: Vec<(String, Value)> = bases.into_iter().map(|(n, t)| (n, serde_yaml_ng::from_str(&t).unwrap())).collect();
+    let change = prop_oneof![extreme().prop_map(Err), prop::sample::select(vec![1e9, 1e6, 1e3, -1.0, 0.0, 1e-6, 1e-300]).prop_map(Ok)];
+    (prop::sample::select(models), prop::collection::vec((any::<usize>(), change), 1..4)).prop_filter_map(
+        "not writable as text",
+        |((name, mut model), changes)| {
+            for (target, change) in changes {
+                let mut all = Vec::new();
+                node_paths(&model, &mut Vec::new(), &mut all);
+                all.retain(|p| node_mut(&mut model, p).is_some_and(|v| v.is_number()));
+                let node = node_mut(&mut model, &all[target % all.len()]).unwrap();
+                let x = node.as_f64().unwrap();
+                *node = Value::from(match change {
+                    Ok(factor) => x * factor,
+                    Err(value) => value,
+                });
+            }
+            Some((name, serde_yaml_ng::to_string(&model).ok()?))
+        },
+    )
+}
+
 // ----------------------------------------------------------------------------- text mutations
 
 /// Pieces of YAML: the schema's keys, brackets, anchors, tags, special floats, tabs.
@@ -466,6 +490,11 @@ fn structurally_mutated_models_load_or_are_refused_with_a_located_fix() {
     campaign("structural mutations", mutated_models(bases()), |(name, text, format)| {
         run(&text, format, &format!("{name}~"))
     });
+}
+
+#[test]
+fn models_with_extreme_numbers_load_and_evaluate_or_are_refused() {
+    campaign("numeric mutations", numeric_mutations(bases()), |(name, text)| run(&text, Format::Yaml, &format!("{name}~")));
 }
 
 #[test]

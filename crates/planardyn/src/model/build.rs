@@ -21,6 +21,12 @@ const MAX_COORDINATE: f64 = 1e9;
 /// Largest move from the drawing to `q0` (rad, or multiples of the drawing's size): the
 /// continuation takes steps of 0.1, so this bounds the loading time (~10^4 steps).
 const MAX_START_MOVE: f64 = 1e3;
+/// Largest magnitude of any other number (SI): products of a few model numbers (m u^2,
+/// qd^2 L, tau / A) then stay far from overflowing a double (1.8e308).
+const MAX_MAGNITUDE: f64 = 1e30;
+/// Smallest total mass (kg) and inertia (kg m^2) of a body: with efforts up to
+/// MAX_MAGNITUDE the accelerations stay finite (the fuzz found NaN with 1e308 kg).
+const MIN_MASS: f64 = 1e-30;
 
 impl Ctx<'_> {
     fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
@@ -51,12 +57,15 @@ impl Ctx<'_> {
             )
         })
     }
+    /// A finite number of magnitude at most MAX_MAGNITUDE.
     fn finite(&self, path: &str, v: f64) -> R<f64> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err(path, format!("{v} is not a finite number; give a finite one")))
+        if !v.is_finite() {
+            return Err(self.err(path, format!("{v} is not a finite number; give a finite one")));
         }
+        if v.abs() > MAX_MAGNITUDE {
+            return Err(self.err(path, format!("{v:e} is beyond the largest magnitude accepted, {MAX_MAGNITUDE:e}: check the units (SI)")));
+        }
+        Ok(v)
     }
     fn non_negative(&self, path: &str, v: f64) -> R<f64> {
         if self.finite(path, v)? < 0.0 {
@@ -213,8 +222,8 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         }
     };
     let mass: f64 = parts.iter().map(|p| p.0).sum();
-    if !(mass > 0.0) {
-        return Err(ctx.err(format!("{path}.mass"), format!("mass must be > 0 kg, got {mass}")));
+    if !(mass >= MIN_MASS) {
+        return Err(ctx.err(format!("{path}.mass"), format!("mass must be > 0 kg (at least {MIN_MASS:e}), got {mass}")));
     }
     let com = [
         parts.iter().map(|p| p.0 * p.2[0]).sum::<f64>() / mass,
@@ -224,10 +233,10 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         .iter()
         .map(|(m, i, c)| i + m * ((c[0] - com[0]).powi(2) + (c[1] - com[1]).powi(2)))
         .sum();
-    if !(inertia > 0.0) {
+    if !(inertia >= MIN_MASS) {
         return Err(ctx.err(
             format!("{path}.inertia"),
-            format!("the moment of inertia about the centre of mass must be > 0 kg m^2, got {inertia}"),
+            format!("the moment of inertia about the centre of mass must be > 0 kg m^2 (at least {MIN_MASS:e}), got {inertia}"),
         ));
     }
     let mut ids = Vec::new();

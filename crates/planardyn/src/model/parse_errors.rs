@@ -184,7 +184,13 @@ fn plain(message: &str) -> String {
         ("f64", "a number"),
         ("field identifier", "a field name"),
     ];
-    WORDS.iter().fold(message.to_string(), |m, (rust, words)| m.replace(rust, words))
+    let mut out = WORDS.iter().fold(message.to_string(), |m, (rust, words)| m.replace(rust, words));
+    // A pair or load written as a list: "expected struct variant PairSpec::Revolute with 3 elements".
+    while let Some(i) = out.find("struct variant ") {
+        let end = out[i..].find(" elements").map_or(out.len(), |j| i + j + " elements".len());
+        out.replace_range(i..end, "a mapping with the fields of its `type`");
+    }
+    out
 }
 
 #[cfg(test)]
@@ -203,5 +209,9 @@ mod tests {
     fn rust_names_become_plain_words() {
         assert_eq!(plain("invalid type: string \"a\", expected f64"), "invalid type: string \"a\", expected a number");
         assert_eq!(plain("invalid length 3, expected an array of length 2"), "invalid length 3, expected a list of 2 items");
+        assert_eq!(
+            plain("invalid length 1, expected struct variant PairSpec::Revolute with 3 elements"),
+            "invalid length 1, expected a mapping with the fields of its `type`"
+        );
     }
 }
