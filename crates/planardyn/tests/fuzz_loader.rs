@@ -87,7 +87,7 @@ fn check_error(e: &ModelError, source: &str) -> Result<(), String> {
     let message = text
         .strip_prefix(&format!("{source}: {path}: "))
         .ok_or_else(|| format!("not '<source>: <path>: <message>': {text}"))?;
-    if path.is_empty() || path == "." || path.split('.').any(|s| s == "?") {
+    if path.is_empty() || path == "." {
         return Err(format!("no location: {text}"));
     }
     if message.trim().is_empty() {

@@ -34,12 +34,10 @@ impl Input<'_> {
     /// A parse error at `path`, with the parser's `message` and its location `at`.
     pub(super) fn error(&self, path: &Path, message: &str, at: LineColumn) -> ModelError {
         let message = strip_marks(message);
-        // The YAML parser prefixes its own path to data errors: keep the message from the phrase on.
-        let message = DATA_ERRORS
-            .iter()
-            .filter_map(|p| message.find(p))
-            .min()
-            .map_or(message.as_str(), |i| &message[i..]);
+        // The YAML parser prefixes its own path to data errors (written like `path`'s, or
+        // not quite, e.g. around aliases): keep the message from serde's phrase on.
+        let message = message.strip_prefix(&format!("{path}: ")).unwrap_or(&message);
+        let message = DATA_ERRORS.iter().filter_map(|p| message.find(p)).min().map_or(message, |i| &message[i..]);
         let mut field = field_path(path);
         let (message, fix) = self.explain(message, &mut field);
         let (path, message) = match (field.is_empty(), at) {
@@ -53,11 +51,12 @@ impl Input<'_> {
     /// The message in plain words and its fix; a missing field goes onto the path.
     fn explain(&self, message: &str, field: &mut String) -> (String, String) {
         let docs = "see docs/model-format.md";
-        if let Some(name) = between(message, "missing field `", "`") {
+        if let Some(name) = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
             push_field(field, name);
             return (format!("missing field `{name}`"), format!("add it ({docs})"));
         }
-        if let Some(name) = message.strip_prefix("unknown field `").and_then(|m| m.split('`').next()) {
+        // The name may hold a backtick itself: it ends at "`, expected" / "`, there are no fields".
+        if let Some(name) = message.strip_prefix("unknown field `").and_then(|m| m.find("`, ").map(|i| &m[..i])) {
             // Inside a pair or a load (tagged by `type`) serde stops at the entry: name the field.
             if field.rsplit(['.', ']']).next() != Some(name) {
                 push_field(field, name);
