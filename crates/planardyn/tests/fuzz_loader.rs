@@ -94,7 +94,9 @@ fn check_error(e: &ModelError, source: &str) -> Result<(), String> {
     if message.trim().is_empty() {
         return Err(format!("no message: {text}"));
     }
-    if let Some(w) = JARGON.iter().find(|w| message.contains(*w)) {
+    // The user's own text is quoted ("...", `...`) in messages: only the rest is ours.
+    let ours: String = message.split(['"', '`']).step_by(2).collect();
+    if let Some(w) = JARGON.iter().find(|w| ours.contains(*w)) {
         return Err(format!("Rust jargon '{w}' in: {text}"));
     }
     let lower = message.to_lowercase();
