@@ -196,6 +196,11 @@ class _Model:
         body["mass"] = rho * _dist(self.xy(p), self.xy(q))
         self.d["bodies"][name] = body
 
+    def bars(self, rho: float, **links: Sequence[str]) -> None:
+        """Uniform bars (rho kg/m), each named by its keyword and carrying the points given."""
+        for name, points in links.items():
+            self.bar(name, list(points), rho)
+
     def polygon(self, name: str, points: list[str], outline: list[str], rho: float, about: str | None = None) -> None:
         """A link made of uniform bars (rho kg/m) along the closed outline."""
         parts = [
@@ -219,6 +224,11 @@ class _Model:
     def revolute(self, name: str, at: str, a: str, b: str) -> str:
         self.d["pairs"].append({"type": "revolute", "name": name, "at": at, "bodies": [a, b]})
         return name
+
+    def hinges(self, *joints: tuple[str, str, str]) -> None:
+        """Revolute pairs given as (at, a, b), each named ``a_b`` after the bodies it joins."""
+        for at, a, b in joints:
+            self.revolute(f"{a}_{b}", at, a, b)
 
     def prismatic(self, name: str, at: str, a: str, b: str, axis: Vec) -> str:
         u = _unit(axis)
@@ -266,13 +276,8 @@ def four_bar_model(
     A = m.point("A", _polar(crank, theta))
     m.point("B", circle_intersection(m.xy(A), coupler, m.xy(D), rocker, mode))
     m.ground(O, D)
-    m.bar("crank", ["O", "A"], rho)
-    m.bar("coupler", ["A", "B"], rho)
-    m.bar("rocker", ["D", "B"], rho)
-    m.revolute("ground_crank", "O", "ground", "crank")
-    m.revolute("crank_coupler", "A", "crank", "coupler")
-    m.revolute("coupler_rocker", "B", "coupler", "rocker")
-    m.revolute("ground_rocker", "D", "ground", "rocker")
+    m.bars(rho, crank=("O", "A"), coupler=("A", "B"), rocker=("D", "B"))
+    m.hinges(("O", "ground", "crank"), ("A", "crank", "coupler"), ("B", "coupler", "rocker"), ("D", "ground", "rocker"))
     m.coordinate("theta1", "ground_crank", theta, "absolute angle of O->A (rad)")
     return m.d
 
@@ -284,8 +289,7 @@ def _slider_crank(
     m.point("A", A)
     m.point("B", B)
     m.ground("O")
-    m.bar("crank", ["O", "A"], rho)
-    m.bar("rod", ["A", "B"], rho)
+    m.bars(rho, crank=("O", "A"), rod=("A", "B"))
     m.block("slider", "B", slider_mass, slider_inertia)
     m.revolute("crank_pivot", "O", "ground", "crank")
     m.revolute("crank_pin", "A", "crank", "rod")
@@ -373,10 +377,7 @@ def five_bar_model(
     m.point("B2", _add(m.xy(A2), _polar(proximal, theta2)))
     m.point("P", circle_intersection(m.xy("B1"), distal, m.xy("B2"), distal, mode))
     m.ground(A1, A2)
-    m.bar("proximal1", ["A1", "B1"], rho)
-    m.bar("distal1", ["B1", "P"], rho)
-    m.bar("proximal2", ["A2", "B2"], rho)
-    m.bar("distal2", ["B2", "P"], rho)
+    m.bars(rho, proximal1=("A1", "B1"), distal1=("B1", "P"), proximal2=("A2", "B2"), distal2=("B2", "P"))
     m.revolute("R1", "A1", "ground", "proximal1")
     m.revolute("elbow1", "B1", "proximal1", "distal1")
     m.revolute("tip", "P", "distal1", "distal2")
@@ -603,18 +604,12 @@ def watt_six_bar_model(
     m.point("C", _add(m.xy(O2), _polar(rocker_arm, _angle(m.xy(O2), m.xy("B")) + arm_angle)))
     m.point("E", circle_intersection(m.xy("C"), coupler2, m.xy(O3), output, modes[1]))
     m.ground(O1, O2, O3)
-    m.bar("crank", ["O1", "A"], rho)
-    m.bar("coupler1", ["A", "B"], rho)
+    m.bars(rho, crank=("O1", "A"), coupler1=("A", "B"))
     m.polygon("rocker", ["O2", "B", "C"], ["O2", "B", "C"], rho, about="ternary rocker O2-B-C")
-    m.bar("coupler2", ["C", "E"], rho)
-    m.bar("output", ["O3", "E"], rho)
-    m.revolute("ground_crank", "O1", "ground", "crank")
-    m.revolute("crank_coupler1", "A", "crank", "coupler1")
-    m.revolute("coupler1_rocker", "B", "coupler1", "rocker")
-    m.revolute("ground_rocker", "O2", "ground", "rocker")
-    m.revolute("rocker_coupler2", "C", "rocker", "coupler2")
-    m.revolute("coupler2_output", "E", "coupler2", "output")
-    m.revolute("ground_output", "O3", "ground", "output")
+    m.bars(rho, coupler2=("C", "E"), output=("O3", "E"))
+    m.hinges(("O1", "ground", "crank"), ("A", "crank", "coupler1"), ("B", "coupler1", "rocker"),
+             ("O2", "ground", "rocker"), ("C", "rocker", "coupler2"), ("E", "coupler2", "output"),
+             ("O3", "ground", "output"))
     m.coordinate("theta1", "ground_crank", theta, "absolute angle of O1->A (rad)")
     return m.d
 
@@ -649,18 +644,10 @@ def stephenson_six_bar_model(
     for k, v in enumerate(triangle, start=1):
         m.point(f"J{k}", _add((x, y), _rotate((float(v[0]), float(v[1])), phi)))
     m.ground("O1", "O2", "O3")
-    m.bar("crank", ["O3", "D"], rho)
-    m.bar("link1", ["O1", "J1"], rho)
-    m.bar("link2", ["O2", "J2"], rho)
-    m.bar("link3", ["D", "J3"], rho)
+    m.bars(rho, crank=("O3", "D"), link1=("O1", "J1"), link2=("O2", "J2"), link3=("D", "J3"))
     m.polygon("triangle", ["J1", "J2", "J3"], ["J1", "J2", "J3"], rho, about="floating ternary link")
-    m.revolute("ground_crank", "O3", "ground", "crank")
-    m.revolute("crank_link3", "D", "crank", "link3")
-    m.revolute("ground_link1", "O1", "ground", "link1")
-    m.revolute("ground_link2", "O2", "ground", "link2")
-    m.revolute("link1_triangle", "J1", "link1", "triangle")
-    m.revolute("link2_triangle", "J2", "link2", "triangle")
-    m.revolute("link3_triangle", "J3", "link3", "triangle")
+    m.hinges(("O3", "ground", "crank"), ("D", "crank", "link3"), ("O1", "ground", "link1"), ("O2", "ground", "link2"),
+             ("J1", "link1", "triangle"), ("J2", "link2", "triangle"), ("J3", "link3", "triangle"))
     m.coordinate("theta1", "ground_crank", theta, "absolute angle of O3->D (rad)")
     return m.d
 
@@ -692,8 +679,7 @@ def double_parallelogram_model(
         m.bar(f"crank{i}", [f"O{i}", f"A{i}"], rho)
     m.bar("coupler", ["A1", "A3", "A2"], rho)
     for i in (1, 2, 3):
-        m.revolute(f"ground_crank{i}", f"O{i}", "ground", f"crank{i}")
-        m.revolute(f"crank{i}_coupler", f"A{i}", f"crank{i}", "coupler")
+        m.hinges((f"O{i}", "ground", f"crank{i}"), (f"A{i}", f"crank{i}", "coupler"))
     m.coordinate("theta1", "ground_crank1", theta, "absolute angle of O1->A1 (rad)")
     return m.d
 

@@ -57,7 +57,8 @@ pub fn model_error_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
                 "__doc__",
                 "A model that cannot be built: malformed YAML/JSON, a wrong field, or a drawing \
                  that is not a mechanism. The message names the source and the field path; \
-                 attributes `source` (file or '<string>') and `path` (e.g. 'bodies.crank.mass').",
+                 attributes `source` (file or '<string>') and `path` (e.g. 'bodies.crank.mass', or \
+                 'line 3 column 5' where no field can be named).",
             )?;
             let ty = py.get_type::<PyType>().call1(("ModelError", bases, ns))?;
             Ok::<_, PyErr>(ty.cast_into::<PyType>()?.unbind())

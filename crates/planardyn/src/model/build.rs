@@ -21,6 +21,12 @@ const MAX_COORDINATE: f64 = 1e9;
 /// Largest move from the drawing to `q0` (rad, or multiples of the drawing's size): the
 /// continuation takes steps of 0.1, so this bounds the loading time (~10^4 steps).
 const MAX_START_MOVE: f64 = 1e3;
+/// Largest magnitude of any other number (SI): products of a few model numbers (m u^2,
+/// qd^2 L, tau / A) then stay far from overflowing a double (1.8e308).
+const MAX_MAGNITUDE: f64 = 1e30;
+/// Smallest total mass (kg) and inertia (kg m^2) of a body: with efforts up to
+/// MAX_MAGNITUDE the accelerations stay finite (the fuzz found NaN with 1e308 kg).
+const MIN_MASS: f64 = 1e-30;
 
 impl Ctx<'_> {
     fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
@@ -33,7 +39,7 @@ impl Ctx<'_> {
     fn point(&self, path: &str, name: &str) -> R<PointId> {
         self.spec.points.0.get_index_of(name).map(PointId).ok_or_else(|| {
             let known: Vec<&str> = self.spec.points.0.keys().map(String::as_str).collect();
-            self.err(path, format!("unknown point '{name}'; points are: {}", known.join(", ")))
+            self.err(path, format!("unknown point '{name}'; points are: {} (use one of them, or add it to `points`)", known.join(", ")))
         })
     }
     fn xy(&self, path: &str, name: &str) -> R<[f64; 2]> {
@@ -47,16 +53,19 @@ impl Ctx<'_> {
             let known: Vec<&str> = self.spec.bodies.0.keys().map(String::as_str).collect();
             self.err(
                 path,
-                format!("unknown body '{name}'; bodies are: ground, {}", known.join(", ")),
+                format!("unknown body '{name}'; bodies are: ground, {} (use one of them, or add it to `bodies`)", known.join(", ")),
             )
         })
     }
+    /// A finite number of magnitude at most MAX_MAGNITUDE.
     fn finite(&self, path: &str, v: f64) -> R<f64> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err(path, format!("{v} is not a finite number")))
+        if !v.is_finite() {
+            return Err(self.err(path, format!("{v} is not a finite number; give a finite one")));
         }
+        if v.abs() > MAX_MAGNITUDE {
+            return Err(self.err(path, format!("{v:e} is beyond the largest magnitude accepted, {MAX_MAGNITUDE:e}: check the units (SI)")));
+        }
+        Ok(v)
     }
     fn non_negative(&self, path: &str, v: f64) -> R<f64> {
         if self.finite(path, v)? < 0.0 {
@@ -90,7 +99,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     for (k, name) in spec.ground.iter().enumerate() {
         let p = ctx.point(&format!("ground[{k}]"), name)?;
         if ground_points.contains(&p) {
-            return Err(ctx.err(format!("ground[{k}]"), format!("point '{name}' is listed twice")));
+            return Err(ctx.err(format!("ground[{k}]"), format!("point '{name}' is listed twice; list it once")));
         }
         ground_points.push(p);
     }
@@ -124,7 +133,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     for (k, p) in spec.pairs.iter().enumerate() {
         let pair = build_pair(&ctx, &mech, k, p)?;
         if mech.pairs.iter().any(|q| q.name == pair.name) {
-            return Err(ctx.err(format!("pairs[{k}].name"), format!("duplicate pair name '{}'", pair.name)));
+            return Err(ctx.err(format!("pairs[{k}].name"), format!("duplicate pair name '{}'; rename one of the two", pair.name)));
         }
         mech.pairs.push(pair);
     }
@@ -171,7 +180,7 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     }
     let inertia = p
         .inertia
-        .ok_or_else(|| ctx.err(format!("{path}.inertia"), "missing: the moment of inertia about the centre of mass (kg m^2)"))?;
+        .ok_or_else(|| ctx.err(format!("{path}.inertia"), "missing: add the moment of inertia about the centre of mass (kg m^2)"))?;
     let inertia = ctx.non_negative(&format!("{path}.inertia"), inertia)?;
     let com = match p.com.as_ref().expect("checked above") {
         Location::Coords(c) => [ctx.finite(&format!("{path}.com"), c[0])?, ctx.finite(&format!("{path}.com"), c[1])?],
@@ -201,20 +210,20 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
                 return Err(ctx.err(&path, "give either `parts` or the body's own mass properties, not both"));
             }
             if parts.is_empty() {
-                return Err(ctx.err(format!("{path}.parts"), "empty list of parts"));
+                return Err(ctx.err(format!("{path}.parts"), "empty list of parts; add a part, or remove `parts` and give the body's own mass"));
             }
             parts.iter().enumerate().map(|(k, p)| part_inertia(ctx, &format!("{path}.parts[{k}]"), p)).collect::<R<_>>()?
         }
         None => {
             if b.mass.is_none() {
-                return Err(ctx.err(format!("{path}.mass"), "missing: the body's mass (kg), or `parts`"));
+                return Err(ctx.err(format!("{path}.mass"), "missing: add the body's mass (kg), or `parts`"));
             }
             vec![part_inertia(ctx, &path, &own)?]
         }
     };
     let mass: f64 = parts.iter().map(|p| p.0).sum();
-    if !(mass > 0.0) {
-        return Err(ctx.err(format!("{path}.mass"), format!("mass must be > 0 kg, got {mass}")));
+    if !(mass >= MIN_MASS) {
+        return Err(ctx.err(format!("{path}.mass"), format!("mass must be > 0 kg (at least {MIN_MASS:e}), got {mass}")));
     }
     let com = [
         parts.iter().map(|p| p.0 * p.2[0]).sum::<f64>() / mass,
@@ -224,17 +233,17 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         .iter()
         .map(|(m, i, c)| i + m * ((c[0] - com[0]).powi(2) + (c[1] - com[1]).powi(2)))
         .sum();
-    if !(inertia > 0.0) {
+    if !(inertia >= MIN_MASS) {
         return Err(ctx.err(
             format!("{path}.inertia"),
-            format!("the moment of inertia about the centre of mass must be > 0 kg m^2, got {inertia}"),
+            format!("the moment of inertia about the centre of mass must be > 0 kg m^2 (at least {MIN_MASS:e}), got {inertia}"),
         ));
     }
     let mut ids = Vec::new();
     for (k, p) in b.points.iter().enumerate() {
         let id = ctx.point(&format!("{path}.points[{k}]"), p)?;
         if ids.contains(&id) {
-            return Err(ctx.err(format!("{path}.points[{k}]"), format!("point '{p}' is listed twice")));
+            return Err(ctx.err(format!("{path}.points[{k}]"), format!("point '{p}' is listed twice; list it once")));
         }
         ids.push(id);
     }
@@ -270,7 +279,7 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
     let a = ctx.link(&format!("{path}.bodies[0]"), &bodies[0])?;
     let b = ctx.link(&format!("{path}.bodies[1]"), &bodies[1])?;
     if a == b {
-        return Err(ctx.err(format!("{path}.bodies"), "a pair joins two different bodies"));
+        return Err(ctx.err(format!("{path}.bodies"), "a pair must join two different bodies; name two"));
     }
     let point = ctx.point(&format!("{path}.at"), at)?;
     let carried = |link: Link, i: usize| {
@@ -299,11 +308,11 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
                     let (pf, pt) = (ctx.xy(&format!("{path}.along[0]"), from)?, ctx.xy(&format!("{path}.along[1]"), to)?);
                     [pt[0] - pf[0], pt[1] - pf[1]]
                 }
-                _ => return Err(ctx.err(&path, "a prismatic pair needs exactly one of `axis: [dx, dy]` or `along: [P, Q]`")),
+                _ => return Err(ctx.err(&path, "give a prismatic pair exactly one of `axis: [dx, dy]` or `along: [P, Q]`")),
             };
             let len = d[0].hypot(d[1]);
             if !(len > 0.0 && len.is_finite()) {
-                return Err(ctx.err(&path, "the guide direction has zero length"));
+                return Err(ctx.err(&path, "the guide direction has zero length; give a non-zero `axis`, or two distinct `along` points"));
             }
             let (c, s) = (angle(a).cos(), angle(a).sin());
             let (ux, uy) = (d[0] / len, d[1] / len);
@@ -337,11 +346,11 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     for (k, c) in ctx.spec.coordinates.iter().enumerate() {
         let path = format!("coordinates[{k}]");
         if mech.coordinates.iter().any(|d| d.name == c.name) || c.name.is_empty() {
-            return Err(ctx.err(format!("{path}.name"), format!("coordinate name '{}' is empty or used twice", c.name)));
+            return Err(ctx.err(format!("{path}.name"), format!("coordinate name '{}' is empty or used twice; give each coordinate its own name", c.name)));
         }
         let pair = pair_id(ctx, mech, &format!("{path}.pair"), &c.pair)?;
         if mech.coordinates.iter().any(|d| d.pair == pair) {
-            return Err(ctx.err(format!("{path}.pair"), format!("pair '{}' already has a coordinate", c.pair)));
+            return Err(ctx.err(format!("{path}.pair"), format!("pair '{}' already has a coordinate; remove one of the two", c.pair)));
         }
         let kind = match mech.pairs[pair.0].kind {
             PairKind::Revolute => CoordinateKind::Angle,
@@ -361,7 +370,7 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
 
 fn coordinate_index(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<usize> {
     mech.coordinates.iter().position(|c| c.name == name).ok_or_else(|| {
-        ctx.err(path, format!("unknown coordinate '{name}'; coordinates are: {}", mech.coordinate_names().join(", ")))
+        ctx.err(path, format!("unknown coordinate '{name}'; coordinates are: {} (use one of them)", mech.coordinate_names().join(", ")))
     })
 }
 
@@ -371,7 +380,7 @@ fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<Vec<Opti
         let path = format!("drives[{k}]");
         let i = coordinate_index(ctx, mech, &format!("{path}.coordinate"), &d.coordinate)?;
         if out[i].is_some() {
-            return Err(ctx.err(format!("{path}.coordinate"), format!("coordinate '{}' already has a drive", d.coordinate)));
+            return Err(ctx.err(format!("{path}.coordinate"), format!("coordinate '{}' already has a drive; remove one of the two", d.coordinate)));
         }
         out[i] = Some(match (&d.effort, &d.table) {
             (Some(e), None) => DriveLaw::Constant(ctx.finite(&format!("{path}.effort"), *e)?),

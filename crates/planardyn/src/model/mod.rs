@@ -6,6 +6,7 @@
 
 mod build;
 mod io;
+mod parse_errors;
 pub mod spec;
 
 pub use io::{load, loads, Format};

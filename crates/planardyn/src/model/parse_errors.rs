@@ -1,0 +1,216 @@
+//! Parse errors in plain words. serde and the YAML/JSON parsers say what went wrong in
+//! their own terms (`expected struct BodySpec`, an empty path at the top of the document,
+//! no line for an error at the first character); this turns each into a [`ModelError`] with
+//! a location (the field path, or `line L column C` where no field is known) and a fix.
+
+use super::Format;
+use crate::ModelError;
+use serde_path_to_error::{Path, Segment};
+
+/// Where a parser stopped: 1-based line and column, if it said.
+pub(super) type LineColumn = Option<(usize, usize)>;
+
+/// The text of the model, its format and name, for locating errors.
+pub(super) struct Input<'a> {
+    pub text: &'a str,
+    pub format: Format,
+    pub source: &'a str,
+}
+
+/// The phrases serde starts its data errors with (anything else is a syntax error).
+const DATA_ERRORS: &[&str] = &[
+    "invalid type",
+    "invalid value",
+    "invalid length",
+    "missing field",
+    "unknown field",
+    "unknown variant",
+    "duplicate field",
+    "duplicate name",
+    "data did not match",
+];
+
+impl Input<'_> {
+    /// A parse error at `path`, with the parser's `message` and its location `at`.
+    pub(super) fn error(&self, path: &Path, message: &str, at: LineColumn) -> ModelError {
+        let message = strip_marks(message);
+        // The YAML parser prefixes its own path to data errors (written like `path`'s, or
+        // not quite, e.g. around aliases): keep the message from serde's phrase on.
+        let message = message.strip_prefix(&format!("{path}: ")).unwrap_or(&message);
+        let message = DATA_ERRORS.iter().filter_map(|p| message.find(p)).min().map_or(message, |i| &message[i..]);
+        let mut field = field_path(path);
+        let (message, fix) = self.explain(message, &mut field);
+        let (path, message) = match (field.is_empty(), at) {
+            (true, _) => (self.line_column(&message, at), message),
+            (false, Some((line, column))) => (field, format!("{message} (line {line} column {column})")),
+            (false, None) => (field, message),
+        };
+        ModelError::Parse { source_name: self.source.to_string(), path, message: format!("{message}; {fix}") }
+    }
+
+    /// The message in plain words and its fix; a missing field goes onto the path.
+    fn explain(&self, message: &str, field: &mut String) -> (String, String) {
+        let docs = "see docs/model-format.md";
+        if let Some(name) = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
+            push_field(field, name);
+            return (format!("missing field `{name}`"), format!("add it ({docs})"));
+        }
+        // The name may hold a backtick itself: it ends at "`, expected" / "`, there are no fields".
+        if let Some(name) = message.strip_prefix("unknown field `").and_then(|m| m.find("`, ").map(|i| &m[..i])) {
+            // Inside a pair or a load (tagged by `type`) serde stops at the entry: name the field.
+            if field.rsplit(['.', ']']).next() != Some(name) {
+                push_field(field, name);
+            }
+            return (plain(message), "remove it or correct its spelling".into());
+        }
+        if message.starts_with("unknown variant") {
+            return (plain(message), "use one of those".into());
+        }
+        if message.starts_with("duplicate field") {
+            return (message.into(), "give it once".into());
+        }
+        if message.starts_with("duplicate name") {
+            return (message.into(), "rename one of the two".into());
+        }
+        if message.starts_with("data did not match any variant of untagged enum Location") {
+            return ("expected a point name or coordinates [x, y] (m)".into(), "give one of those".into());
+        }
+        if message.starts_with("invalid") {
+            if field.is_empty() && message.ends_with("expected struct MechanismSpec") {
+                let found = between(message, "invalid type: ", ", expected").unwrap_or("something else");
+                return (
+                    format!("the model is {found}, not a mapping"),
+                    format!("a model file must be a mapping with the keys name, points, ground, bodies, pairs and coordinates: {docs}"),
+                );
+            }
+            return (plain(message), format!("give the form the field takes: {docs}"));
+        }
+        let syntax = match self.format {
+            Format::Yaml => "the text is not valid YAML: check the indentation, brackets, quotes and colons there",
+            Format::Json => "the text is not valid JSON: check the brackets, quotes, commas and colons there (JSON has no NaN or Infinity)",
+        };
+        let fix = match message {
+            "unknown anchor" => "an alias `*name` needs an anchor `&name` before it: add the anchor or write the value out".into(),
+            "recursion limit exceeded" => "the text nests too deeply: check the brackets".into(),
+            "repetition limit exceeded" => "aliases `*name` expand to too much: write the values out".into(),
+            "EOF while parsing a value" => format!("the text is empty: write a model ({docs})"),
+            m if m.starts_with("deserializing from YAML containing more than one document") => {
+                "remove the `---` separators: a model file holds one document".into()
+            }
+            _ => syntax.into(),
+        };
+        (message.into(), fix)
+    }
+
+    /// `line L column C` for an error no field can name: where the parser stopped, or the
+    /// second document of a multi-document YAML text, or the start.
+    fn line_column(&self, message: &str, at: LineColumn) -> String {
+        let (line, column) = at.unwrap_or_else(|| {
+            let second_document = message.contains("more than one document").then(|| {
+                let starts = self.text.lines().enumerate().filter(|(_, l)| l.starts_with("---") || l.starts_with("..."));
+                let content = self.text.lines().position(|l| !l.trim().is_empty() && !l.starts_with('#')).unwrap_or(0);
+                starts.map(|(i, _)| i).find(|&i| i > content)
+            });
+            (second_document.flatten().map_or(1, |i| i + 1), 1)
+        });
+        format!("line {line} column {}", column.max(1))
+    }
+}
+
+/// The field path, `bodies.crank.mass`, `pairs[2].at`; up to an unknown segment (a key
+/// that is not a string), empty at the top of the document.
+fn field_path(path: &Path) -> String {
+    let mut out = String::new();
+    for segment in path {
+        match segment {
+            Segment::Seq { index } => out.push_str(&format!("[{index}]")),
+            Segment::Map { key } | Segment::Enum { variant: key } => push_field(&mut out, key),
+            Segment::Unknown => break,
+        }
+    }
+    out
+}
+
+fn push_field(path: &mut String, name: &str) {
+    if !path.is_empty() {
+        path.push('.');
+    }
+    path.push_str(name);
+}
+
+/// The text between `start` and the next `end` after it.
+fn between<'a>(s: &'a str, start: &str, end: &str) -> Option<&'a str> {
+    let rest = &s[s.find(start)? + start.len()..];
+    Some(&rest[..rest.find(end)?])
+}
+
+/// The message without the parsers' " at line L column C" / " at position N" marks (the
+/// location is given once, in the path or after the message).
+fn strip_marks(message: &str) -> String {
+    let mut out = message.to_string();
+    for mark in [" at line ", " at position "] {
+        while let Some(i) = out.find(mark) {
+            let rest = &out[i + mark.len()..];
+            let digits = |s: &str| s.len() - s.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+            let mut n = digits(rest);
+            if n == 0 {
+                break;
+            }
+            if let Some(col) = rest[n..].strip_prefix(" column ") {
+                n += " column ".len() + digits(col);
+            }
+            out.replace_range(i..i + mark.len() + n, "");
+        }
+    }
+    out
+}
+
+/// serde's Rust type names in what a user writes.
+fn plain(message: &str) -> String {
+    const WORDS: &[(&str, &str)] = &[
+        ("struct MechanismSpec", "a model (a mapping: name, points, ground, bodies, pairs, coordinates)"),
+        ("struct BodySpec", "a body (a mapping: points, mass...)"),
+        ("struct PartSpec", "a part (a mapping: mass, and com, uniform_bar or point_mass)"),
+        ("struct CoordinateSpec", "a coordinate (a mapping: name, pair, value)"),
+        ("struct DriveSpec", "a drive (a mapping: coordinate, and effort or table)"),
+        ("struct TableSpec", "a table (a mapping: t, effort)"),
+        ("struct SimulateSpec", "simulation settings (a mapping: t_end, method...)"),
+        ("internally tagged enum PairSpec", "a pair (a mapping with type: revolute or prismatic)"),
+        ("internally tagged enum LoadSpec", "a load (a mapping with type: force, torque, spring, torsional_spring or friction)"),
+        ("a map from names to entries", "a mapping from names to entries"),
+        ("sequence", "list"),
+        ("an array of length 2", "a list of 2 items"),
+        ("f64", "a number"),
+        ("field identifier", "a field name"),
+    ];
+    let mut out = WORDS.iter().fold(message.to_string(), |m, (rust, words)| m.replace(rust, words));
+    // A pair or load written as a list: "expected struct variant PairSpec::Revolute with 3 elements".
+    while let Some(i) = out.find("struct variant ") {
+        let end = out[i..].find(" elements").map_or(out.len(), |j| i + j + " elements".len());
+        out.replace_range(i..end, "a mapping with the fields of its `type`");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marks_are_stripped_wherever_they_are() {
+        assert_eq!(strip_marks("did not find expected key at line 3 column 5, while parsing a block mapping at line 1 column 1"), "did not find expected key, while parsing a block mapping");
+        assert_eq!(strip_marks("found unexpected end of stream at position 12"), "found unexpected end of stream");
+        assert_eq!(strip_marks("expected value at line 1 column 0"), "expected value");
+        assert_eq!(strip_marks("the line at line x"), "the line at line x");
+    }
+
+    #[test]
+    fn rust_names_become_plain_words() {
+        assert_eq!(plain("invalid type: string \"a\", expected f64"), "invalid type: string \"a\", expected a number");
+        assert_eq!(plain("invalid length 3, expected an array of length 2"), "invalid length 3, expected a list of 2 items");
+        assert_eq!(
+            plain("invalid length 1, expected struct variant PairSpec::Revolute with 3 elements"),
+            "invalid length 1, expected a mapping with the fields of its `type`"
+        );
+    }
+}

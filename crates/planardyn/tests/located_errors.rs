@@ -1,0 +1,115 @@
+//! Every parse error is located: a field path, or the line and column where the text stops
+//! being YAML/JSON (the document's top level has no field to name), and says what to do.
+//! The exact messages a user reads, for the cases the parsers alone leave unlocated or in
+//! Rust terms.
+
+mod common;
+use common::*;
+use planardyn::{load, loads, Format, ModelError};
+
+/// The whole message (`<source>: <path>: <message>`) and the path of a refused text.
+fn refused(text: &str, format: Format) -> (String, String) {
+    match loads(text, format, "m.yaml") {
+        Err(e) => (e.to_string(), e.path().to_string()),
+        Ok(_) => panic!("accepted:\n{text}"),
+    }
+}
+
+const MAPPING_FIX: &str =
+    "a model file must be a mapping with the keys name, points, ground, bodies, pairs and coordinates: see docs/model-format.md";
+
+#[test]
+fn a_document_that_is_not_a_mapping_says_what_a_model_is() {
+    let (msg, path) = refused("# a comment\n;\n", Format::Yaml);
+    assert_eq!(path, "line 2 column 1");
+    assert_eq!(msg, format!("m.yaml: line 2 column 1: the model is string \";\", not a mapping; {MAPPING_FIX}"));
+    let (msg, _) = refused("[1, 2]", Format::Yaml);
+    assert_eq!(msg, format!("m.yaml: line 1 column 1: the model is sequence, not a mapping; {MAPPING_FIX}"));
+    let (msg, _) = refused("3", Format::Json);
+    assert_eq!(msg, format!("m.yaml: line 1 column 1: the model is integer `3`, not a mapping; {MAPPING_FIX}"));
+}
+
+#[test]
+fn a_missing_top_level_field_is_the_path() {
+    let (msg, path) = refused(&FOUR_BAR.replace("name: four-bar under gravity\n", ""), Format::Yaml);
+    assert_eq!(path, "name");
+    assert_eq!(msg, "m.yaml: name: missing field `name` (line 2 column 1); add it (see docs/model-format.md)");
+    // Nested: the missing field's own path, not its parent's.
+    let (_, path) = refused(&FOUR_BAR.replace(", value: 1.0471975511965976}", "}"), Format::Yaml);
+    assert_eq!(path, "coordinates[0].value");
+}
+
+#[test]
+fn yaml_syntax_errors_give_line_and_column_even_at_the_first_character() {
+    // libyaml's mark at line 1 column 1 is printed as nothing: the path still says where.
+    let (msg, path) = refused(",./;[]", Format::Yaml);
+    assert_eq!(path, "line 1 column 1");
+    assert_eq!(
+        msg,
+        "m.yaml: line 1 column 1: did not find expected node content, while parsing a block node; \
+         the text is not valid YAML: check the indentation, brackets, quotes and colons there"
+    );
+    let (msg, path) = refused("*a", Format::Yaml);
+    assert_eq!(path, "line 1 column 1");
+    assert!(msg.ends_with("unknown anchor; an alias `*name` needs an anchor `&name` before it: add the anchor or write the value out"), "{msg}");
+    let (_, path) = refused("name: x\n!!float ~}~~\n", Format::Yaml);
+    assert_eq!(path, "line 3 column 1");
+    let (msg, path) = refused("", Format::Json);
+    assert_eq!(path, "line 1 column 1");
+    assert_eq!(msg, "m.yaml: line 1 column 1: EOF while parsing a value; the text is empty: write a model (see docs/model-format.md)");
+}
+
+#[test]
+fn a_second_yaml_document_is_located_at_its_separator() {
+    let text = format!("{FOUR_BAR}---\n{FOUR_BAR}");
+    let separator = text.lines().position(|l| l == "---").unwrap() + 1;
+    let (msg, path) = refused(&text, Format::Yaml);
+    assert_eq!(path, format!("line {separator} column 1"));
+    assert!(msg.ends_with("remove the `---` separators: a model file holds one document"), "{msg}");
+}
+
+#[test]
+fn errors_inside_a_field_keep_its_path_and_add_the_line() {
+    let (msg, path) = refused(&FOUR_BAR.replace("mass: 0.5,", "mass: heavy,"), Format::Yaml);
+    assert_eq!(path, "bodies.crank.mass");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: invalid type: string \"heavy\", expected a number (line 11 column 33); \
+         give the form the field takes: see docs/model-format.md"
+    );
+    // An unknown field inside a pair (an entry tagged by `type`): the field itself.
+    let (msg, path) = refused(&FOUR_BAR.replace("{type: revolute, name: O,", "{type: revolute, axis: [1, 0], name: O,"), Format::Yaml);
+    assert_eq!(path, "pairs[0].axis");
+    assert!(msg.contains("unknown field `axis`, expected one of `name`, `at`, `bodies`") && msg.ends_with("; remove it or correct its spelling"), "{msg}");
+    // A pair written as a list: no Rust type names.
+    let (msg, path) = refused(&FOUR_BAR.replace("{type: revolute, name: O, at: O, bodies: [ground, crank]}", "[revolute]"), Format::Yaml);
+    assert_eq!(path, "pairs[0]");
+    assert!(msg.contains("expected a mapping with the fields of its `type`"), "{msg}");
+}
+
+#[test]
+fn json_errors_are_located_in_the_field_being_read() {
+    let (msg, path) = refused(r#"{"name": "x", "points": {"O": [0, NaN]}}"#, Format::Json);
+    assert_eq!(path, "points.O[1]");
+    assert_eq!(
+        msg,
+        "m.yaml: points.O[1]: expected value (line 1 column 35); \
+         the text is not valid JSON: check the brackets, quotes, commas and colons there (JSON has no NaN or Infinity)"
+    );
+}
+
+#[test]
+fn a_file_that_cannot_be_read_says_which_and_where() {
+    let e = load("/nonexistent/model.yaml").unwrap_err();
+    assert_eq!(e.path(), "<file>");
+    assert!(e.to_string().starts_with("/nonexistent/model.yaml: <file>: cannot read the file: "), "{e}");
+    let dir = std::env::temp_dir().join(format!("planardyn-latin1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("m.yaml");
+    std::fs::write(&file, b"name: x\npoints: {\xe9: [0, 0]}\n").unwrap();
+    let e = load(&file).unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(matches!(e, ModelError::Parse { .. }));
+    assert_eq!(e.path(), "line 2 column 10");
+    assert!(e.to_string().ends_with("the file is not UTF-8 text; save it as UTF-8"), "{e}");
+}
