@@ -39,3 +39,23 @@ fn output_grid_ends_exactly_at_t_end() {
     assert_eq!(t.len(), 4);
     assert_eq!(*t.last().unwrap(), 0.3);
 }
+
+/// The block-triangular form of J that the position solves use has exactly the mechanism's
+/// structure as its diagonal blocks: each input link (its angle row alone, then its two pin
+/// rows) and each Assur group, in an order they can be solved in. A class-II dyad is 2 bodies
+/// (6 coordinates), the 3-RRR's class-III triad 4 bodies (12), Andrews' squeezer three dyads.
+#[test]
+fn block_triangular_form_is_the_assur_decomposition() {
+    use planardyn::kinematics::{constraints::jacobian_pattern, Chart};
+    use planardyn::linalg::BlockLu;
+    for (file, blocks) in [
+        ("four-bar-gravity.yaml", vec![1, 2, 6]),
+        ("five-bar.yaml", vec![1, 2, 1, 2, 6]),
+        ("3-rrr.yaml", vec![1, 2, 1, 2, 1, 2, 12]),
+        ("andrews-squeezer.yaml", vec![1, 2, 6, 6, 6]),
+    ] {
+        let mech = shipped(file);
+        let lu = BlockLu::new(&jacobian_pattern(&mech, &Chart::Inputs));
+        assert_eq!(lu.block_sizes().collect::<Vec<_>>(), blocks, "{file}");
+    }
+}

@@ -78,12 +78,6 @@ impl System {
         out
     }
 
-    /// Sizes of the diagonal blocks of the factorisation (input links and Assur groups of
-    /// the chart last factorised), in solve order.
-    pub fn block_sizes(&self) -> Vec<usize> {
-        self.lu.block_sizes().collect()
-    }
-
     /// Whether J is factorised (the last [`System::factor`] succeeded).
     pub fn is_factored(&self) -> bool {
         self.factored
