@@ -30,7 +30,7 @@ pub struct BlockLu {
     /// Block k spans the permuted positions `start[k]..start[k + 1]`.
     start: Vec<usize>,
     /// The diagonal blocks, block k row-major from `lu_at[k]`, then the entries left of
-    /// them (`off_val`, from `off_base`). Filled through [`BlockLu::sink`]; the blocks are then
+    /// them (from `off_base`, in `off_col` order). Filled through [`BlockLu::sink`]; the blocks are then
     /// factorised in place: unit lower L below the diagonal, U on and above it, of the
     /// block's rows in pivoted order.
     store: Vec<f64>,
