@@ -15,7 +15,7 @@
 //! that cost more than the whole factorisation at these sizes (n = 9 to ~60, microseconds);
 //! the graph algorithms come from petgraph.
 
-use super::lu::{lu_factor, LuError};
+use super::lu::{lu_factor, lu_solve_transpose, LuError};
 use super::sink::Sink;
 use petgraph::algo::{maximum_matching, tarjan_scc};
 use petgraph::graph::{DiGraph, NodeIndex, UnGraph};
@@ -273,8 +273,8 @@ impl BlockLu {
     }
 
     /// Solve B^T y = b in place for the factorised (scaled) B: the blocks in reverse order,
-    /// U^T then L^T and the pivots undone, each block's transposed off-diagonal entries then
-    /// taken from the earlier blocks' right-hand sides. Used by the singularity monitor only.
+    /// each by the dense transposed solve of its factors, its transposed off-diagonal entries
+    /// then taken from the earlier blocks' right-hand sides. Used by the singularity monitor.
     pub fn solve_transpose(&mut self, b: &mut [f64]) {
         let y = &mut self.work;
         for (w, &c) in y.iter_mut().zip(&self.col) {
@@ -284,20 +284,11 @@ impl BlockLu {
             let (s0, s1) = (self.start[k], self.start[k + 1]);
             let s = s1 - s0;
             let lu = &self.store[self.lu_at[k]..self.lu_at[k] + s * s];
-            let t = &mut y[s0..s1];
-            for i in 0..s {
-                let v = t[i] - (0..i).map(|j| lu[j * s + i] * t[j]).sum::<f64>();
-                t[i] = v * self.inv_diag[s0 + i];
-            }
-            for i in (0..s).rev() {
-                t[i] -= (i + 1..s).map(|j| lu[j * s + i] * t[j]).sum::<f64>();
-            }
-            // t holds the solution in pivoted order: back to the block's row order.
-            for i in s0..s1 {
-                b[self.row[self.src[i]]] = y[i];
-            }
+            // The block's transposed solve, pivots undone: the solution in its row order.
+            lu_solve_transpose(lu, s, &self.piv[s0..s1], &mut y[s0..s1]);
             for p in s0..s1 {
-                let v = b[self.row[p]];
+                let v = y[p];
+                b[self.row[p]] = v;
                 for e in self.off_at[p]..self.off_at[p + 1] {
                     y[self.off_col[e]] -= self.store[self.off_base + e] * v;
                 }

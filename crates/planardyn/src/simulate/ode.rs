@@ -197,22 +197,18 @@ impl MechanismOde<'_> {
         walk.copy_from_slice(y);
         for pieces in [4, 16, 64] {
             self.restart_from_anchor();
-            let walked = (1..=pieces).try_for_each(|k| {
+            // The pieces before the last; the last is y itself, exactly.
+            let walked = (1..pieces).try_for_each(|k| {
                 let f = k as f64 / pieces as f64;
                 for j in 0..m {
                     walk[j] = self.anchor_z[j] + (y[j] - self.anchor_z[j]) * f;
                 }
                 self.evaluate(t, &walk)
             });
-            match walked {
+            match walked.and_then(|()| self.evaluate(t, y)) {
                 Ok(()) => {
-                    error = match self.evaluate(t, y) {
-                        Ok(()) => {
-                            self.walk_y = walk;
-                            return Ok(());
-                        }
-                        Err(e) => e,
-                    }
+                    self.walk_y = walk;
+                    return Ok(());
                 }
                 Err(e) => error = e,
             }
