@@ -12,7 +12,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 import planardyn as pd
 from planardyn.batch import simulate
 

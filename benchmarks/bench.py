@@ -33,10 +33,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-import numpy as np  # noqa: E402
-
 import common  # noqa: E402
 import mechanisms  # noqa: E402
+import numpy as np  # noqa: E402
 import overhead as overhead_mod  # noqa: E402
 import report  # noqa: E402
 from common import Run  # noqa: E402

@@ -12,7 +12,6 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-
 import planardyn as pd
 from planardyn.plot import draw_mechanism, plot_coordinates, plot_efforts
 

@@ -21,9 +21,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import numpy as np
-from matplotlib.figure import Figure
-
 import planardyn as pd
+from matplotlib.figure import Figure
 from planardyn import robot
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -23,10 +23,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
-
 import planardyn as pd
 from planardyn import robot
+from scipy.interpolate import CubicHermiteSpline
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "out"

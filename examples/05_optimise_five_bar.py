@@ -26,13 +26,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 import numpy as np
-from matplotlib.figure import Figure
-from scipy.optimize import minimize
-
 import planardyn as pd
+from matplotlib.figure import Figure
 from planardyn import batch, library, robot
 from planardyn import sensitivity as sens
 from planardyn.plot import draw_mechanism
+from scipy.optimize import minimize
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "out"

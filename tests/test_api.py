@@ -10,16 +10,17 @@ import copy
 import math
 
 import numpy as np
+import planardyn as pd
 import pytest
 import yaml
 from conftest import (
     FOUR_BAR_A,
     FOUR_BAR_THETA0,
-    G,
     MODELS,
     PENDULUM_I,
     PENDULUM_L,
     PENDULUM_M,
+    G,
     four_bar_B,
     four_bar_dict,
     pendulum_dict,
@@ -27,8 +28,6 @@ from conftest import (
 )
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-import planardyn as pd
 
 # Round-off level for closed forms evaluated in a few dozen flops on O(1) numbers.
 CLOSED_FORM_RTOL = 1e-12
@@ -447,7 +446,6 @@ def test_plot_helpers(four_bar):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
     from planardyn.plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy
 
     res = four_bar.simulate(t_end=0.2)

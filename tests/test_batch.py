@@ -9,10 +9,9 @@ import math
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import MODELS
-
-import planardyn as pd
 from planardyn import robot
 from planardyn.batch import BatchError, inverse_dynamics, monte_carlo, simulate, sweep
 

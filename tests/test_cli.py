@@ -7,16 +7,14 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import subprocess
 import sys
-
-import re
 
 import numpy as np
 import pytest
 from conftest import MODELS, four_bar_dict
 from PIL import Image
-
 from planardyn.results_io import read_results
 
 

@@ -8,7 +8,6 @@ The site builds with `mkdocs build --strict` when mkdocs is installed.
 from __future__ import annotations
 
 import re
-import shlex
 import subprocess
 import sys
 import textwrap

@@ -25,12 +25,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import planardyn as pd
 import pytest
 import yaml
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
-
-import planardyn as pd
 from planardyn import library as lib
 
 ROOT = Path(__file__).resolve().parents[1]

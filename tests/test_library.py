@@ -12,10 +12,9 @@ import math
 import warnings
 
 import numpy as np
+import planardyn as pd
 import pytest
 import yaml
-
-import planardyn as pd
 from planardyn import library as lib
 from planardyn.cli import main as cli_main
 
@@ -67,7 +66,7 @@ def test_shipped_file_is_the_constructor_output(stem):
     path = lib.LIBRARY_DIR / f"{stem}.yaml"
     model = lib.LIBRARY[stem]()
     text = path.read_text()
-    assert text == lib.model_text(model, lib.file_header(stem)), f"regenerate: python -m planardyn.library"
+    assert text == lib.model_text(model, lib.file_header(stem)), "regenerate: python -m planardyn.library"
     assert yaml.safe_load(text) == model  # the writer round-trips through a YAML 1.1 reader
     if stem != "double-parallelogram" or redundant_models_load():
         with warnings.catch_warnings():

@@ -11,12 +11,11 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import MODELS
 from matplotlib.figure import Figure
 from PIL import Image
-
-import planardyn as pd
 from planardyn.animate import frame_indices, render_frames
 from planardyn.plot import (
     default_trace_points,
@@ -130,7 +129,7 @@ def test_rendered_frame_shows_the_mechanism(slider_crank):
     mech, res = slider_crank
     frames = list(render_frames(mech, res, fps=5, speed=0.1, size=(320, 240)))
     assert len(frames) == 16 and frames[0].shape == (240, 320, 3) and frames[0].dtype == np.uint8
-    colored = lambda f: np.sum((np.abs(f[:, :, 0].astype(int) - f[:, :, 2].astype(int)) > 80))  # noqa: E731
+    colored = lambda f: np.sum(np.abs(f[:, :, 0].astype(int) - f[:, :, 2].astype(int)) > 80)  # noqa: E731
     assert colored(frames[0]) > 100  # the coloured bars are there
     assert np.any(frames[0] != frames[-1])
 

@@ -12,10 +12,9 @@ import csv
 import json
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import MODELS, four_bar_dict
-
-import planardyn as pd
 from planardyn.results_io import (
     attach_metadata,
     inverse_from_file,

@@ -7,10 +7,9 @@ import math
 import runpy
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import MODELS, ROOT
-
-import planardyn as pd
 from planardyn import robot
 
 # Central differences with h = 1e-6 on positions solved to ~1e-12 L: error ~ 1e-12/1e-6.

@@ -4,10 +4,9 @@
 from __future__ import annotations
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import MODELS
-
-import planardyn as pd
 from planardyn import robot
 from planardyn.robot.capability import max_acceleration
 

@@ -9,10 +9,9 @@ import math
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-import pytest
-from conftest import G, MODELS, PENDULUM_I, PENDULUM_L, PENDULUM_M, pendulum_dict
-
 import planardyn as pd
+import pytest
+from conftest import MODELS, PENDULUM_I, PENDULUM_L, PENDULUM_M, G, pendulum_dict
 from planardyn import batch, library, robot
 from planardyn import sensitivity as sens
 

@@ -8,10 +8,10 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-import pytest
-
 import planardyn as pd
-from planardyn import _core, library as lib, structure
+import pytest
+from planardyn import _core, structure
+from planardyn import library as lib
 from planardyn.structure import _assur, _drawn_jacobian, _Pair, _pairs_of, _rank_and_null, _self_stresses
 
 

@@ -17,11 +17,10 @@ import subprocess
 import time
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import MODELS
 from PIL import Image
-
-import planardyn as pd
 from planardyn.notebook import mechanism_html, mechanism_svg, result_html, viewer
 from planardyn.results_io import attach_metadata
 from planardyn.viewer import viewer_data, viewer_html, write_viewer

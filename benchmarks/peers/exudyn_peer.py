@@ -19,7 +19,6 @@ import io
 from contextlib import redirect_stdout
 
 import numpy as np
-
 from common import Drawing, Run, best_time, coordinates, energy, loop_gap
 from mechanisms import Benchmark
 
@@ -51,8 +50,17 @@ def build(d: Drawing):
     """The system and, per body, its sensors (position, angle, velocity, angular velocity)."""
     import exudyn as exu
     from exudyn.itemInterface import (
-        Gravity, LoadTorqueVector, MarkerBodyMass, MarkerBodyPosition, MarkerBodyRigid, NodeRigidBody2D,
-        ObjectConnectorSpringDamper, ObjectGround, ObjectRigidBody2D, RevoluteJoint2D, SensorNode,
+        Gravity,
+        LoadTorqueVector,
+        MarkerBodyMass,
+        MarkerBodyPosition,
+        MarkerBodyRigid,
+        NodeRigidBody2D,
+        ObjectConnectorSpringDamper,
+        ObjectGround,
+        ObjectRigidBody2D,
+        RevoluteJoint2D,
+        SensorNode,
     )
 
     sc = exu.SystemContainer()

@@ -13,7 +13,6 @@ computed afterwards from the stored states (untimed).
 from __future__ import annotations
 
 import numpy as np
-
 from common import Drawing, Run, best_time, coordinates, energy, loop_gap
 from mechanisms import Benchmark
 

@@ -10,7 +10,6 @@ as for the peers.
 from __future__ import annotations
 
 import numpy as np
-
 from common import Drawing, Run, best_time, energy, loop_gap
 from mechanisms import Benchmark
 

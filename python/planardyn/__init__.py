@@ -49,5 +49,7 @@ __all__ = [
 from .results_io import read_results  # noqa: E402
 
 __all__ += ["read_results"]
-from . import batch  # noqa: E402  (issue 6: planardyn.batch.simulate, inverse_dynamics, sweep, monte_carlo)
-from . import sensitivity  # noqa: E402  (issue 6: derivatives to design parameters, as one batch)
+from . import (
+    batch,  # noqa: E402  (issue 6: planardyn.batch.simulate, inverse_dynamics, sweep, monte_carlo)
+    sensitivity,  # noqa: E402  (issue 6: derivatives to design parameters, as one batch)
+)

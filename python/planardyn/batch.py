@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 __all__ = ["BatchError", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
 
 #: A variant: a model, or a model with its own settings.
-VariantLike = Union[Mechanism, Mapping[str, Any], tuple[Union[Mechanism, Mapping[str, Any]], Mapping[str, Any]]]
+VariantLike = Union[Mechanism, Mapping[str, Any], tuple[Mechanism | Mapping[str, Any], Mapping[str, Any]]]
 #: ``edit(model_dict, value) -> model_dict`` or a dotted path into the model dict.
 Edit = Union[str, Callable[[dict[str, Any], Any], dict[str, Any]]]
 

@@ -40,7 +40,7 @@ __all__ = ["Sensitivity", "efforts", "objective", "peak_effort", "rms_effort", "
 
 FloatArray = NDArray[np.float64]
 #: A model with dotted-path parameters, or a constructor ``make(**params)`` of a model.
-Design = Union[Mechanism, Mapping[str, Any], Callable[..., Union[Mechanism, Mapping[str, Any]]]]
+Design = Union[Mechanism, Mapping[str, Any], Callable[..., Mechanism | Mapping[str, Any]]]
 
 #: eps^(1/3): the relative step that balances truncation (h^2) and rounding (eps / h) errors.
 DEFAULT_REL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))

@@ -26,7 +26,9 @@ const MOTION_KEYS: [&str; 11] = ["q", "qd", "qdd", "t", "X", "Xd", "Xdd", "point
 
 fn get<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<Option<T>> {
     match d.get_item(k)? {
-        Some(v) if !v.is_none() => Ok(Some(v.extract::<T>().map_err(|e| PyValueError::new_err(format!("{k}: {}", Into::<PyErr>::into(e))))?)),
+        Some(v) if !v.is_none() => {
+            Ok(Some(v.extract::<T>().map_err(|e| PyValueError::new_err(format!("{k}: {}", Into::<PyErr>::into(e))))?))
+        }
         _ => Ok(None),
     }
 }
@@ -80,8 +82,14 @@ fn run_batch<'py, V: Sync, R: Send>(
 /// in input order.
 #[pyfunction]
 #[pyo3(signature = (variants, threads=None))]
-fn simulate_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>, threads: Option<usize>) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? });
+fn simulate_batch<'py>(
+    py: Python<'py>,
+    variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>,
+    threads: Option<usize>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
+        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? })
+    };
     run_batch(py, &variants, threads, make, Variant::simulate, |r, _| match r {
         Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
         Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
@@ -144,8 +152,14 @@ fn error_pair<'py>(py: Python<'py>, err: PyErr, message: String) -> PyResult<Bou
 /// results (dicts of arrays) in input order.
 #[pyfunction]
 #[pyo3(signature = (variants, threads=None))]
-fn inverse_batch<'py>(py: Python<'py>, variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>, threads: Option<usize>) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? });
+fn inverse_batch<'py>(
+    py: Python<'py>,
+    variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>,
+    threads: Option<usize>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
+        Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? })
+    };
     run_batch(py, &variants, threads, make, InverseVariant::solve, |r, m| match r {
         Ok(e) => efforts_dict(py, e, m.get().inner.dof()),
         Err(e) => failure(py, &e),

@@ -18,7 +18,11 @@ impl Values {
     }
     /// Number of rows: 1 for a vector, N for an (N, k) array.
     pub fn rows(&self) -> usize {
-        if self.shape.len() == 2 { self.shape[0] } else { 1 }
+        if self.shape.len() == 2 {
+            self.shape[0]
+        } else {
+            1
+        }
     }
     pub fn row(&self, k: usize, len: usize) -> &[f64] {
         &self.data[k * len..(k + 1) * len]

@@ -18,7 +18,10 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-fn built(py: Python<'_>, result: std::thread::Result<Result<planardyn::Mechanism, planardyn::ModelError>>) -> PyResult<PyMechanism> {
+fn built(
+    py: Python<'_>,
+    result: std::thread::Result<Result<planardyn::Mechanism, planardyn::ModelError>>,
+) -> PyResult<PyMechanism> {
     match result {
         Ok(Ok(m)) => Ok(PyMechanism::new(m)),
         Ok(Err(e)) => Err(model_error(py, &e)),

@@ -280,7 +280,12 @@ impl PyMechanism {
     /// Body coordinates x (3n,) at coordinates q (m,), by continuation from the drawing
     /// (the assembly branch drawn), or from body coordinates `x_start` on the wanted branch.
     #[pyo3(signature = (q, x_start=None))]
-    fn assemble<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, x_start: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyAny>> {
+    fn assemble<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let q = self.q_arg("q", &q)?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
@@ -306,7 +311,13 @@ impl PyMechanism {
 
     /// Positions and analogues at q (and velocities with qd); see the Python docstring.
     #[pyo3(signature = (q, qd=None, x_start=None))]
-    fn kinematics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: Option<ArrayArg<'py>>, x_start: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyDict>> {
+    fn kinematics<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: Option<ArrayArg<'py>>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let q = self.q_arg("q", &q)?;
         let qd = qd.map(|a| self.q_arg("qd", &a)).transpose()?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
@@ -376,7 +387,14 @@ impl PyMechanism {
 
     /// Accelerations qdd (m,) at (q, qd), time t (s), efforts tau (m,) or the model's drives.
     #[pyo3(signature = (q, qd, t=0.0, tau=None))]
-    fn forward_dynamics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: ArrayArg<'py>, t: f64, tau: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyAny>> {
+    fn forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        t: f64,
+        tau: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
@@ -385,7 +403,13 @@ impl PyMechanism {
     }
 
     /// Efforts tau for (q, qd, qdd), each (m,) or (N, m); rows by continuation.
-    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: ArrayArg<'py>, qdd: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let m = self.m();
         let what = self.coords_what();
         let (q, qd, qdd) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("qdd", &qdd, m, &what)?);
@@ -403,7 +427,14 @@ impl PyMechanism {
 
     /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
     #[pyo3(signature = (q, qd, t=0.0, tau=None))]
-    fn reactions<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, qd: ArrayArg<'py>, t: f64, tau: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyAny>> {
+    fn reactions<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        t: f64,
+        tau: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
@@ -456,7 +487,10 @@ impl PyMechanism {
             .map(|a| {
                 let v = Values::read(&a);
                 if v.shape.len() != 1 {
-                    return Err(PyValueError::new_err(format!("t_eval must be 1-D (output times in s), got shape {:?}", v.shape)));
+                    return Err(PyValueError::new_err(format!(
+                        "t_eval must be 1-D (output times in s), got shape {:?}",
+                        v.shape
+                    )));
                 }
                 crate::convert::finite("t_eval", &v.data)?;
                 Ok(v.data)

@@ -53,7 +53,10 @@ impl Drives for PyDrives {
                     tau.copy_from_slice(&v.data);
                     Ok(())
                 }
-                Ok(v) => Err(format!("the drive function returned shape {:?}; expected ({},), one effort per coordinate", v.shape, self.m)),
+                Ok(v) => Err(format!(
+                    "the drive function returned shape {:?}; expected ({},), one effort per coordinate",
+                    v.shape, self.m
+                )),
                 Err(e) => {
                     let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
                     if !e.is_instance_of::<PyException>(py) {
@@ -67,7 +70,13 @@ impl Drives for PyDrives {
 }
 
 /// Run a simulation and return its trajectory as a dict (see `planardyn.SimulationResult`).
-pub fn simulate<'py>(py: Python<'py>, mech: &Mechanism, args: Overrides, drives: Option<Py<PyAny>>, progress: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
+pub fn simulate<'py>(
+    py: Python<'py>,
+    mech: &Mechanism,
+    args: Overrides,
+    drives: Option<Py<PyAny>>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
     let m = mech.dof();
     let mut py_drives = drives.map(|f| PyDrives { f, m, fatal: None });
     let mut fatal: Option<PyErr> = None;

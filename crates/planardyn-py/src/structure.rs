@@ -53,9 +53,8 @@ fn singular_values(rows: usize, cols: usize, a: &[f64]) -> Vec<f64> {
         let mut rotated = false;
         for i in 0..rows {
             for k in i + 1..rows {
-                let (alpha, beta, gamma) = v[i].iter().zip(&v[k]).fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| {
-                    (a + x * x, b + y * y, g + x * y)
-                });
+                let (alpha, beta, gamma) =
+                    v[i].iter().zip(&v[k]).fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| (a + x * x, b + y * y, g + x * y));
                 if gamma.abs() <= 1e-15 * (alpha * beta).sqrt() || gamma == 0.0 {
                     continue;
                 }
@@ -93,7 +92,12 @@ fn singular_values(rows: usize, cols: usize, a: &[f64]) -> Vec<f64> {
 /// core's rank test and singularity measures use.
 #[pyfunction]
 #[pyo3(signature = (mech, x, scaled=false))]
-pub fn constraint_jacobian<'py>(py: Python<'py>, mech: &PyMechanism, x: ArrayArg<'py>, scaled: bool) -> PyResult<Bound<'py, PyAny>> {
+pub fn constraint_jacobian<'py>(
+    py: Python<'py>,
+    mech: &PyMechanism,
+    x: ArrayArg<'py>,
+    scaled: bool,
+) -> PyResult<Bound<'py, PyAny>> {
     let m = &*mech.inner;
     let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
     arr2(py, 2 * m.pairs.len(), m.n_x(), jacobian(m, &x, scaled))
@@ -101,7 +105,11 @@ pub fn constraint_jacobian<'py>(py: Python<'py>, mech: &PyMechanism, x: ArrayArg
 
 /// Singular values of the scaled Phi_x at x, ascending: min(2p, 3n) of them.
 #[pyfunction]
-pub fn constraint_singular_values<'py>(py: Python<'py>, mech: &PyMechanism, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn constraint_singular_values<'py>(
+    py: Python<'py>,
+    mech: &PyMechanism,
+    x: ArrayArg<'py>,
+) -> PyResult<Bound<'py, PyAny>> {
     let m = &*mech.inner;
     let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
     let (rows, cols) = (2 * m.pairs.len(), m.n_x());

@@ -21,10 +21,9 @@ use crate::kinematics::{assemble_into, continue_to};
 pub use crate::simulate::Overrides;
 use crate::simulate::{simulate, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
-use task::{TaskError, TaskPath, TaskSolution};
 use rayon::prelude::*;
 use std::sync::Arc;
-
+use task::{TaskError, TaskPath, TaskSolution};
 
 /// The model of a variant: a built mechanism (shared, not copied) or a specification that
 /// is validated inside the task, so that building many edited models runs in parallel too.
@@ -124,7 +123,11 @@ pub fn inverse_rows(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64]) -> Res
 
 /// Apply `f` to every item on a pool of `threads` threads (`None` or 0: one per core), the
 /// results in input order. Fails only if the operating system refuses the threads.
-pub fn map_many<T: Sync, R: Send>(items: &[T], threads: Option<usize>, f: impl Fn(&T) -> R + Sync + Send) -> Result<Vec<R>, Error> {
+pub fn map_many<T: Sync, R: Send>(
+    items: &[T],
+    threads: Option<usize>,
+    f: impl Fn(&T) -> R + Sync + Send,
+) -> Result<Vec<R>, Error> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .thread_name(|i| format!("planardyn-batch-{i}"))
@@ -143,6 +146,9 @@ pub fn simulate_many(variants: &[Variant], threads: Option<usize>) -> Result<Vec
 
 /// Solve every inverse-dynamics variant in parallel on `threads` threads (`None`: all
 /// cores), on the same pool as [`simulate_many`]; one `Result` per variant, in input order.
-pub fn inverse_many(variants: &[InverseVariant], threads: Option<usize>) -> Result<Vec<Result<Efforts, TaskError>>, Error> {
+pub fn inverse_many(
+    variants: &[InverseVariant],
+    threads: Option<usize>,
+) -> Result<Vec<Result<Efforts, TaskError>>, Error> {
     map_many(variants, threads, InverseVariant::solve)
 }

@@ -8,18 +8,10 @@ use thiserror::Error;
 pub enum ModelError {
     /// The text is not valid YAML/JSON, or a field has the wrong type or an unknown name.
     #[error("{source_name}: {path}: {message}")]
-    Parse {
-        source_name: String,
-        path: String,
-        message: String,
-    },
+    Parse { source_name: String, path: String, message: String },
     /// A field has a value that is well-formed but not allowed (unknown name, non-positive mass...).
     #[error("{source_name}: {path}: {message}")]
-    Invalid {
-        source_name: String,
-        path: String,
-        message: String,
-    },
+    Invalid { source_name: String, path: String, message: String },
 }
 
 impl ModelError {

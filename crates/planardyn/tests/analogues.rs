@@ -32,7 +32,12 @@ fn velocity_analogues_match_finite_differences() {
             let (xp, xm) = (analysed(&mech, &qp).x, analysed(&mech, &qm).x);
             for i in 0..mech.n_x() {
                 let fd = (xp[i] - xm[i]) / (2.0 * H);
-                assert!((fd - ws.u_col(j)[i]).abs() < FD_TOL_U, "{}: u[{i}][{j}] = {} vs FD {fd}", mech.name, ws.u_col(j)[i]);
+                assert!(
+                    (fd - ws.u_col(j)[i]).abs() < FD_TOL_U,
+                    "{}: u[{i}][{j}] = {} vs FD {fd}",
+                    mech.name,
+                    ws.u_col(j)[i]
+                );
             }
         }
     }
@@ -71,9 +76,17 @@ fn convective_term_is_the_contraction_of_w_with_the_rates() {
         convective(&mech, &qd, &mut ws);
         let (n, m) = (mech.n_x(), mech.dof());
         for i in 0..n {
-            let expected: f64 = (0..m).flat_map(|j| (0..m).map(move |l| (j, l))).map(|(j, l)| qd[j] * qd[l] * w[(j * m + l) * n + i]).sum();
+            let expected: f64 = (0..m)
+                .flat_map(|j| (0..m).map(move |l| (j, l)))
+                .map(|(j, l)| qd[j] * qd[l] * w[(j * m + l) * n + i])
+                .sum();
             // Both come from the same factorisation: agreement to round-off.
-            assert!((ws.c[i] - expected).abs() < 1e-10 * (1.0 + expected.abs()), "{}: c[{i}] = {} vs {expected}", mech.name, ws.c[i]);
+            assert!(
+                (ws.c[i] - expected).abs() < 1e-10 * (1.0 + expected.abs()),
+                "{}: c[{i}] = {} vs {expected}",
+                mech.name,
+                ws.c[i]
+            );
         }
     }
 }

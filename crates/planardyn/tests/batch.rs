@@ -54,7 +54,11 @@ fn a_failing_variant_does_not_stop_the_others() {
     vs[2].overrides.q0 = Some(vec![std::f64::consts::PI, 0.0]);
     vs[3].overrides.method = Some("euler".into());
     let out = simulate_many(&vs, None).unwrap();
-    assert!(matches!(out[2], Err(Error::Kinematics(KinematicsError::AssemblyFailed { .. }))), "{:?}", out[2].as_ref().err());
+    assert!(
+        matches!(out[2], Err(Error::Kinematics(KinematicsError::AssemblyFailed { .. }))),
+        "{:?}",
+        out[2].as_ref().err()
+    );
     assert!(matches!(out[3], Err(Error::Options(_))));
     for k in [0, 1, 4] {
         assert!(out[k].as_ref().unwrap().success());
@@ -74,7 +78,10 @@ fn spec_variants_are_built_in_the_task() {
         .map(|spec| Variant { model: Model::Spec(spec), overrides: over.clone() })
         .collect();
     let out = simulate_many(&vs, Some(2)).unwrap();
-    same(out[0].as_ref().unwrap(), &Variant { model: Model::Built(Arc::new(base)), overrides: over.clone() }.simulate().unwrap());
+    same(
+        out[0].as_ref().unwrap(),
+        &Variant { model: Model::Built(Arc::new(base)), overrides: over.clone() }.simulate().unwrap(),
+    );
     assert!(matches!(out[2], Err(Error::Model(_))));
     // The heavier coupler changes the motion.
     assert_ne!(out[0].as_ref().unwrap().q.last(), out[1].as_ref().unwrap().q.last());
@@ -112,8 +119,14 @@ fn five_bar_path(mech: &planardyn::Mechanism, circle: Option<f64>, to: [f64; 2])
     for &ti in &t {
         let (c, s) = ((w * ti).cos(), (w * ti).sin());
         let (p, v, a) = match circle {
-            Some(r) => ([p0[0] + r * (c - 1.0), p0[1] + r * s], [-r * w * s, r * w * c], [-r * w * w * c, -r * w * w * s]),
-            None => ([p0[0] + ti * (to[0] - p0[0]), p0[1] + ti * (to[1] - p0[1])], [to[0] - p0[0], to[1] - p0[1]], [0.0, 0.0]),
+            Some(r) => {
+                ([p0[0] + r * (c - 1.0), p0[1] + r * s], [-r * w * s, r * w * c], [-r * w * w * c, -r * w * w * s])
+            }
+            None => (
+                [p0[0] + ti * (to[0] - p0[0]), p0[1] + ti * (to[1] - p0[1])],
+                [to[0] - p0[0], to[1] - p0[1]],
+                [0.0, 0.0],
+            ),
         };
         x.extend(p);
         xd.extend(v);
@@ -129,10 +142,19 @@ fn coordinate_motions_in_a_batch_equal_the_serial_rows_and_invert_the_forward_dy
     let tr = run(&mech, "dop853", 0.3, 1e-10, Some((0..=30).map(|i| i as f64 * 0.01).collect()));
     let four = Arc::new(yaml(FOUR_BAR));
     let vs = vec![
-        InverseVariant { model: Model::Built(mech.clone()), motion: Motion::Coordinates { q: tr.q.clone(), qd: tr.qd.clone(), qdd: tr.qdd.clone() } },
-        InverseVariant { model: Model::Built(four.clone()), motion: Motion::Coordinates { q: runs[0].q.clone(), qd: runs[0].qd.clone(), qdd: runs[0].qdd.clone() } },
+        InverseVariant {
+            model: Model::Built(mech.clone()),
+            motion: Motion::Coordinates { q: tr.q.clone(), qd: tr.qd.clone(), qdd: tr.qdd.clone() },
+        },
+        InverseVariant {
+            model: Model::Built(four.clone()),
+            motion: Motion::Coordinates { q: runs[0].q.clone(), qd: runs[0].qd.clone(), qdd: runs[0].qdd.clone() },
+        },
         // Rows of the wrong length: reported for this variant only.
-        InverseVariant { model: Model::Built(mech.clone()), motion: Motion::Coordinates { q: vec![1.0; 3], qd: vec![0.0; 3], qdd: vec![0.0; 3] } },
+        InverseVariant {
+            model: Model::Built(mech.clone()),
+            motion: Motion::Coordinates { q: vec![1.0; 3], qd: vec![0.0; 3], qdd: vec![0.0; 3] },
+        },
     ];
     let out = inverse_many(&vs, Some(2)).unwrap();
     let Ok(Efforts::Coordinates(tau)) = &out[0] else { panic!("{:?}", out[0]) };
@@ -171,9 +193,15 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
     let out = inverse_many(&vs, Some(2)).unwrap();
     assert_eq!(out, inverse_many(&vs, Some(1)).unwrap());
     assert!(matches!(&out[1], Err(TaskError::Singular(m)) if m.contains("type II")), "{:?}", out[1]);
-    assert!(matches!(&out[2], Err(TaskError::Singular(m)) if m.contains("type I ") && m.contains("0.577")), "{:?}", out[2]);
+    assert!(
+        matches!(&out[2], Err(TaskError::Singular(m)) if m.contains("type I ") && m.contains("0.577")),
+        "{:?}",
+        out[2]
+    );
     assert!(matches!(&out[5], Err(TaskError::OutOfReach(m)) if m.contains("first point")), "{:?}", out[5]);
-    assert!(matches!(&out[3], Err(TaskError::Core(Error::Kinematics(KinematicsError::BadArgument(m)))) if m.contains("\"Q\"")));
+    assert!(
+        matches!(&out[3], Err(TaskError::Core(Error::Kinematics(KinematicsError::BadArgument(m)))) if m.contains("\"Q\""))
+    );
     let (Ok(Efforts::Task(sol)), Ok(Efforts::Task(heavier))) = (&out[0], &out[4]) else { panic!("{:?}", out[0]) };
     for i in (0..circle.t.len()).step_by(50) {
         let row = i * 2..i * 2 + 2;
@@ -183,10 +211,16 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
         let s = mech.bodies[body].points.iter().find(|(p, _)| *p == mech.point_id("P").unwrap()).unwrap().1;
         let (c, sn) = (x[3 * body + 2].cos(), x[3 * body + 2].sin());
         let p = [x[3 * body] + c * s[0] - sn * s[1], x[3 * body + 1] + sn * s[0] + c * s[1]];
-        assert!((p[0] - circle.x[2 * i]).abs() < 1e-12 && (p[1] - circle.x[2 * i + 1]).abs() < 1e-12, "sample {i}: {p:?}");
+        assert!(
+            (p[0] - circle.x[2 * i]).abs() < 1e-12 && (p[1] - circle.x[2 * i + 1]).abs() < 1e-12,
+            "sample {i}: {p:?}"
+        );
         // The efforts produce the accelerations.
         let qdd = qdd_under(&mech, &sol.q[row.clone()], &sol.qd[row.clone()], &sol.tau[row.clone()]);
-        assert!(qdd.iter().zip(&sol.qdd[row.clone()]).all(|(a, b)| (a - b).abs() < 1e-8 * (1.0 + b.abs())), "sample {i}");
+        assert!(
+            qdd.iter().zip(&sol.qdd[row.clone()]).all(|(a, b)| (a - b).abs() < 1e-8 * (1.0 + b.abs())),
+            "sample {i}"
+        );
         // Same kinematics, heavier right distal link: the same q, other efforts.
         assert_eq!(heavier.q[row.clone()], sol.q[row.clone()]);
         assert!(sol.sigma_i[i] > 1e-3 && sol.sigma_ii[i] > 1e-3 && sol.condition[i] >= 1.0);

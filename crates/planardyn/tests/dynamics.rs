@@ -63,7 +63,12 @@ fn forward_then_inverse_dynamics_returns_the_applied_efforts() {
         inverse(&mech, &q, &qd, &qdd, &mut ws).unwrap();
         for k in 0..m {
             // 1e-9 relative: the brief's requirement; both sides are exact to round-off.
-            assert!((ws.tau[k] - tau[k]).abs() < 1e-9 * (1.0 + tau[k].abs()), "{}: tau {:?} vs {tau:?}", mech.name, ws.tau);
+            assert!(
+                (ws.tau[k] - tau[k]).abs() < 1e-9 * (1.0 + tau[k].abs()),
+                "{}: tau {:?} vs {tau:?}",
+                mech.name,
+                ws.tau
+            );
         }
     }
 }
@@ -113,7 +118,13 @@ fn reactions_balance_every_body() {
             for k in 0..3 {
                 let inertial = mass[k] * ws.xdd[3 * i + k];
                 let scale = 1.0 + inertial.abs() + ws.f[3 * i + k].abs();
-                assert!((net[3 * i + k] - inertial).abs() < 1e-9 * scale, "{} body {}: {k}: {} vs {inertial}", mech.name, body.name, net[3 * i + k]);
+                assert!(
+                    (net[3 * i + k] - inertial).abs() < 1e-9 * scale,
+                    "{} body {}: {k}: {} vs {inertial}",
+                    mech.name,
+                    body.name,
+                    net[3 * i + k]
+                );
             }
         }
     }
@@ -143,7 +154,10 @@ fn slider_crank_positions_and_mass_matrix_are_the_closed_form() {
         let cos_beta = root / l;
         let dbeta = -r * phi.cos() / (l * cos_beta);
         let vg = [(-r * phi.sin() + dxb) / 2.0, r * phi.cos() / 2.0];
-        let a = mc * r * r / 3.0 + mr * (vg[0].powi(2) + vg[1].powi(2)) + mr * l * l / 12.0 * dbeta.powi(2) + ms * dxb.powi(2);
+        let a = mc * r * r / 3.0
+            + mr * (vg[0].powi(2) + vg[1].powi(2))
+            + mr * l * l / 12.0 * dbeta.powi(2)
+            + ms * dxb.powi(2);
         assert!((ws.a[0] - a).abs() < 1e-11, "A({phi}) = {} vs {a}", ws.a[0]);
     }
 }

@@ -23,7 +23,12 @@ fn expect(from: &str, to: &str, path: &str, words: &str) {
 
 #[test]
 fn unknown_names_are_named_with_the_known_ones() {
-    expect("bodies: [crank, coupler]", "bodies: [crank, couple]", "pairs[1].bodies[1]", "unknown body 'couple'; bodies are: ground, crank, coupler, rocker");
+    expect(
+        "bodies: [crank, coupler]",
+        "bodies: [crank, couple]",
+        "pairs[1].bodies[1]",
+        "unknown body 'couple'; bodies are: ground, crank, coupler, rocker",
+    );
     expect("at: A, bodies", "at: Q, bodies", "pairs[1].at", "unknown point 'Q'");
     expect("pair: O, value", "pair: X, value", "coordinates[0].pair", "unknown pair 'X'");
 }
@@ -31,7 +36,12 @@ fn unknown_names_are_named_with_the_known_ones() {
 #[test]
 fn duplicate_names_are_refused() {
     expect("  D: [1.0, 0.0]\n", "  D: [1.0, 0.0]\n  D: [2.0, 0.0]\n", "points", "duplicate name 'D'");
-    expect("{name: theta1, pair: O", "{name: theta1, pair: O, value: 1}\n  - {name: theta1, pair: O", "coordinates[1].name", "used twice");
+    expect(
+        "{name: theta1, pair: O",
+        "{name: theta1, pair: O, value: 1}\n  - {name: theta1, pair: O",
+        "coordinates[1].name",
+        "used twice",
+    );
 }
 
 #[test]
@@ -41,7 +51,12 @@ fn a_pair_on_a_point_a_body_does_not_carry_says_where_to_add_it() {
 
 #[test]
 fn wrong_mobility_explains_the_count() {
-    let e = model_error(&FOUR_BAR.replace("coordinates:\n", "coordinates:\n  - {name: extra, pair: D, value: 0}\n").replace("at: D, bodies", "name: D, at: D, bodies"), Format::Yaml);
+    let e = model_error(
+        &FOUR_BAR
+            .replace("coordinates:\n", "coordinates:\n  - {name: extra, pair: D, value: 0}\n")
+            .replace("at: D, bodies", "name: D, at: D, bodies"),
+        Format::Yaml,
+    );
     assert_eq!(e.path(), "coordinates");
     assert!(e.to_string().contains("mobility 3n - 2p = 3*3 - 2*4 = 1 but 2 coordinate(s)"), "{e}");
 }
@@ -69,7 +84,9 @@ fn malformed_text_gets_a_parse_error_with_its_location() {
 fn a_start_that_cannot_be_assembled_is_refused() {
     // With the rocker pair as input, turning the rocker 1.25 rad clockwise from the drawing
     // puts B about 2.0 m from O, beyond the reach of crank + coupler (0.5 + 1.2 m).
-    let text = FOUR_BAR.replace("{type: revolute, at: D", "{type: revolute, name: D, at: D").replace("pair: O, value: 1.0471975511965976", "pair: D, value: 0.0, q0: -1.25");
+    let text = FOUR_BAR
+        .replace("{type: revolute, at: D", "{type: revolute, name: D, at: D")
+        .replace("pair: O, value: 1.0471975511965976", "pair: D, value: 0.0, q0: -1.25");
     let e = model_error(&text, Format::Yaml);
     assert_eq!(e.path(), "coordinates", "{e}");
     assert!(e.to_string().contains("cannot start at q0"), "{e}");

@@ -38,7 +38,13 @@ fn runner() -> TestRunner {
     bytes[..8].copy_from_slice(&seed.to_le_bytes());
     // Failures are kept by hand in tests/fuzz_corpus/ (with what the loader must say), not
     // in proptest's regression files.
-    let config = Config { cases: cases(), max_global_rejects: cases(), failure_persistence: None, max_shrink_iters: 2000, ..Config::default() };
+    let config = Config {
+        cases: cases(),
+        max_global_rejects: cases(),
+        failure_persistence: None,
+        max_shrink_iters: 2000,
+        ..Config::default()
+    };
     TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
 }
 
@@ -75,8 +81,24 @@ enum Outcome {
 
 /// Words a fix is phrased with (an imperative, or the rule the value must follow).
 const FIX_WORDS: &[&str] = &[
-    "add", "remove", "use ", "give", "write", "check", "rename", "draw", "must", "list ", "name ", "quote", "close",
-    "indent", "bring", "convert", "join", "see docs/",
+    "add",
+    "remove",
+    "use ",
+    "give",
+    "write",
+    "check",
+    "rename",
+    "draw",
+    "must",
+    "list ",
+    "name ",
+    "quote",
+    "close",
+    "indent",
+    "bring",
+    "convert",
+    "join",
+    "see docs/",
 ];
 /// Rust names that must not reach a user.
 const JARGON: &[&str] = &["Spec", "f64", "usize", "struct ", "enum "];
@@ -113,7 +135,9 @@ fn check_mechanism(mech: &Mechanism) -> Result<(), String> {
     if !finite(&mech.x0) || !mech.scale.is_finite() {
         return Err(format!("non-finite drawing: x0 {:?}, scale {}", mech.x0, mech.scale));
     }
-    if let Some(b) = mech.bodies.iter().find(|b| !(b.mass > 0.0 && b.inertia > 0.0 && b.mass.is_finite() && b.inertia.is_finite())) {
+    if let Some(b) =
+        mech.bodies.iter().find(|b| !(b.mass > 0.0 && b.inertia > 0.0 && b.mass.is_finite() && b.inertia.is_finite()))
+    {
         return Err(format!("body '{}' has mass {} and inertia {}", b.name, b.mass, b.inertia));
     }
     let (q0, qd0) = mech.initial_state();
@@ -126,7 +150,9 @@ fn check_mechanism(mech: &Mechanism) -> Result<(), String> {
     match forward(mech, 0.0, &q0, &qd0, &mut ModelDrives(mech), &mut ws) {
         Ok(()) if finite(&ws.qdd) => Ok(()),
         Ok(()) => Err(format!("forward dynamics gave qdd = {:?}", ws.qdd)),
-        Err(e) if e.to_string().trim().is_empty() || e.to_string().contains("NaN") => Err(format!("forward dynamics: '{e}'")),
+        Err(e) if e.to_string().trim().is_empty() || e.to_string().contains("NaN") => {
+            Err(format!("forward dynamics: '{e}'"))
+        }
         Err(_) => Ok(()),
     }
 }
@@ -145,7 +171,8 @@ fn run(text: &str, format: Format, source: &str) -> Result<Outcome, String> {
     let result = match rx.recv_timeout(TIME_LIMIT) {
         Ok(Ok(checked)) => checked,
         Ok(Err(panic)) => {
-            let what = panic.downcast_ref::<String>().cloned().or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()));
+            let what =
+                panic.downcast_ref::<String>().cloned().or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()));
             Err(format!("panicked: {}", what.unwrap_or_default()))
         }
         Err(_) => Err(format!("no answer within {TIME_LIMIT:?} (a hang)")),
@@ -304,7 +331,8 @@ fn apply(model: &mut Value, (target, shallow, edit): &(usize, bool, Edit)) {
         (Edit::RenameKey(n), Value::Mapping(m), Step::Key(k)) => {
             let name = Value::String(names[n % names.len()].clone());
             // A key renamed to one already there replaces that entry (a YAML map has no duplicates).
-            *m = std::mem::take(m).into_iter().map(|(key, v)| (if &key == k { name.clone() } else { key }, v)).collect();
+            *m =
+                std::mem::take(m).into_iter().map(|(key, v)| (if &key == k { name.clone() } else { key }, v)).collect();
         }
         (edit, parent, last) => {
             let node = match (parent, last) {
@@ -337,8 +365,25 @@ fn extreme() -> impl Strategy<Value = f64> {
     prop_oneof![
         any::<f64>(),
         prop::sample::select(vec![
-            0.0, -0.0, -1.0, 1e-300, -1e-300, 5e-324, 1e-9, 1e9, 1.1e9, 1e15, 1e20, 1e300, -1e300, 1e308, f64::MAX,
-            f64::MIN, f64::NAN, f64::INFINITY, f64::NEG_INFINITY,
+            0.0,
+            -0.0,
+            -1.0,
+            1e-300,
+            -1e-300,
+            5e-324,
+            1e-9,
+            1e9,
+            1.1e9,
+            1e15,
+            1e20,
+            1e300,
+            -1e300,
+            1e308,
+            f64::MAX,
+            f64::MIN,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
         ]),
     ]
 }
@@ -351,8 +396,21 @@ fn values() -> impl Strategy<Value = Value> {
         any::<bool>().prop_map(Value::Bool),
         Just(Value::Null),
         "\\PC{0,12}".prop_map(Value::String),
-        prop::sample::select(vec!["", "ground", "revolute", "prismatic", "force", "spring", "SI", "rk4", "O", "A", "yes", "~"])
-            .prop_map(|s| Value::String(s.into())),
+        prop::sample::select(vec![
+            "",
+            "ground",
+            "revolute",
+            "prismatic",
+            "force",
+            "spring",
+            "SI",
+            "rk4",
+            "O",
+            "A",
+            "yes",
+            "~"
+        ])
+        .prop_map(|s| Value::String(s.into())),
     ];
     leaf.prop_recursive(2, 8, 3, |inner| {
         prop_oneof![
@@ -379,7 +437,8 @@ fn edit() -> impl Strategy<Value = Edit> {
 
 /// A model text: a shipped file with 1 to 4 structural edits, written as YAML or JSON.
 fn mutated_models(bases: Vec<(String, String)>) -> impl Strategy<Value = (String, String, Format)> {
-    let models: Vec<(String, Value)> = bases.into_iter().map(|(n, t)| (n, serde_yaml_ng::from_str(&t).unwrap())).collect();
+    let models: Vec<(String, Value)> =
+        bases.into_iter().map(|(n, t)| (n, serde_yaml_ng::from_str(&t).unwrap())).collect();
     (prop::sample::select(models), prop::collection::vec((any::<usize>(), any::<bool>(), edit()), 1..5), any::<bool>())
         .prop_filter_map("not writable as text", |((name, mut model), edits, json)| {
             for e in &edits {
@@ -387,7 +446,11 @@ fn mutated_models(bases: Vec<(String, String)>) -> impl Strategy<Value = (String
             }
             // JSON cannot write NaN or inf (serde_json makes them null): YAML then.
             let json = json && serde_json::to_string(&model).is_ok_and(|t| !t.contains("null"));
-            let text = if json { serde_json::to_string_pretty(&model).ok()? } else { serde_yaml_ng::to_string(&model).ok()? };
+            let text = if json {
+                serde_json::to_string_pretty(&model).ok()?
+            } else {
+                serde_yaml_ng::to_string(&model).ok()?
+            };
             Some((name, text, if json { Format::Json } else { Format::Yaml }))
         })
 }
@@ -395,8 +458,12 @@ fn mutated_models(bases: Vec<(String, String)>) -> impl Strategy<Value = (String
 /// A shipped file with 1 to 3 of its numbers changed (extreme, NaN, inf, scaled): the
 /// structure stays, so most of these load and go on to assembly and dynamics.
 fn numeric_mutations(bases: Vec<(String, String)>) -> impl Strategy<Value = (String, String)> {
-    let models: Vec<(String, Value)> = bases.into_iter().map(|(n, t)| (n, serde_yaml_ng::from_str(&t).unwrap())).collect();
-    let change = prop_oneof![extreme().prop_map(Err), prop::sample::select(vec![1e9, 1e6, 1e3, -1.0, 0.0, 1e-6, 1e-300]).prop_map(Ok)];
+    let models: Vec<(String, Value)> =
+        bases.into_iter().map(|(n, t)| (n, serde_yaml_ng::from_str(&t).unwrap())).collect();
+    let change = prop_oneof![
+        extreme().prop_map(Err),
+        prop::sample::select(vec![1e9, 1e6, 1e3, -1.0, 0.0, 1e-6, 1e-300]).prop_map(Ok)
+    ];
     (prop::sample::select(models), prop::collection::vec((any::<usize>(), change), 1..4)).prop_filter_map(
         "not writable as text",
         |((name, mut model), changes)| {
@@ -420,10 +487,49 @@ fn numeric_mutations(bases: Vec<(String, String)>) -> impl Strategy<Value = (Str
 
 /// Pieces of YAML: the schema's keys, brackets, anchors, tags, special floats, tabs.
 const TOKENS: &[&str] = &[
-    "\n", "\t", "  ", ": ", "- ", "[", "]", "{", "}", ",", "'", "\"", "#", "&a ", "*a", "<<: *a", "!!float ", "!!str ",
-    "!!binary ", "~", ".nan", "-.inf", "1e999", "0x10", "---\n", "...\n", "? ", "|\n", ">\n", "%YAML 1.2\n", "name: x\n",
-    "points:\n", "  O: [0, 0]\n", "ground: [O]\n", "bodies:\n", "pairs:\n", "coordinates:\n", "type: prismatic",
-    "{type: revolute, at: O, bodies: [ground, b]}", "\u{0}", "\u{feff}", "\u{1b}", "é",
+    "\n",
+    "\t",
+    "  ",
+    ": ",
+    "- ",
+    "[",
+    "]",
+    "{",
+    "}",
+    ",",
+    "'",
+    "\"",
+    "#",
+    "&a ",
+    "*a",
+    "<<: *a",
+    "!!float ",
+    "!!str ",
+    "!!binary ",
+    "~",
+    ".nan",
+    "-.inf",
+    "1e999",
+    "0x10",
+    "---\n",
+    "...\n",
+    "? ",
+    "|\n",
+    ">\n",
+    "%YAML 1.2\n",
+    "name: x\n",
+    "points:\n",
+    "  O: [0, 0]\n",
+    "ground: [O]\n",
+    "bodies:\n",
+    "pairs:\n",
+    "coordinates:\n",
+    "type: prismatic",
+    "{type: revolute, at: O, bodies: [ground, b]}",
+    "\u{0}",
+    "\u{feff}",
+    "\u{1b}",
+    "é",
 ];
 
 #[derive(Debug, Clone)]
@@ -497,7 +603,9 @@ fn structurally_mutated_models_load_or_are_refused_with_a_located_fix() {
 
 #[test]
 fn models_with_extreme_numbers_load_and_evaluate_or_are_refused() {
-    campaign("numeric mutations", numeric_mutations(bases()), |(name, text)| run(&text, Format::Yaml, &format!("{name}~")));
+    campaign("numeric mutations", numeric_mutations(bases()), |(name, text)| {
+        run(&text, Format::Yaml, &format!("{name}~"))
+    });
 }
 
 #[test]

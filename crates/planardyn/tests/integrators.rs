@@ -121,10 +121,7 @@ impl OdeSystem for VanDerPol {
 // Helpers.
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
 
 /// Integrate from (t0, y0) to t_end, one `step` at a time.
@@ -168,11 +165,7 @@ fn loglog_slope(h: &[f64], err: &[f64]) -> f64 {
 /// tolerance (max(10 eps/rtol, min(0.03, sqrt(rtol))) in units of rtol |y|),
 /// which must be far below the discretisation error being measured.
 fn fixed(dt: f64) -> Options {
-    Options {
-        rtol: 1e-13,
-        atol: 1e-13,
-        ..Options::fixed(dt)
-    }
+    Options { rtol: 1e-13, atol: 1e-13, ..Options::fixed(dt) }
 }
 
 // ---------------------------------------------------------------------------
@@ -185,14 +178,7 @@ const SLOPE_TOL: f64 = 0.3;
 
 /// Fixed-step run of `method` on `sys` from (0, y0) to t_end with `n` steps;
 /// returns the max-norm error at t_end.
-fn fixed_run<S: OdeSystem>(
-    method: Method,
-    sys: &mut S,
-    y0: &[f64],
-    t_end: f64,
-    n: usize,
-    exact: &[f64],
-) -> f64 {
+fn fixed_run<S: OdeSystem>(method: Method, sys: &mut S, y0: &[f64], t_end: f64, n: usize, exact: &[f64]) -> f64 {
     let h = t_end / n as f64;
     let st = solve(method, &fixed(h), sys, 0.0, y0, t_end).unwrap();
     assert_eq!(st.t(), t_end, "{method}: the last step ends on t_stop");
@@ -203,14 +189,8 @@ fn fixed_run<S: OdeSystem>(
 fn assert_order(label: &str, method: Method, ns: &[usize], errs: &[f64], expected: f64) {
     let hs: Vec<f64> = ns.iter().map(|&n| 1.0 / n as f64).collect();
     let slope = loglog_slope(&hs, errs);
-    eprintln!(
-        "{label} {method}: n = {ns:?}, errors {}, slope {slope:.2} (expected {expected})",
-        sci(errs)
-    );
-    assert!(
-        (slope - expected).abs() < SLOPE_TOL,
-        "{label} {method}: slope {slope:.3}, expected {expected}"
-    );
+    eprintln!("{label} {method}: n = {ns:?}, errors {}, slope {slope:.2} (expected {expected})", sci(errs));
+    assert!((slope - expected).abs() < SLOPE_TOL, "{label} {method}: slope {slope:.3}, expected {expected}");
 }
 
 /// Kepler, one period, fixed steps: the slope of the end-point error against h
@@ -227,10 +207,7 @@ fn measured_order_kepler() {
             Method::Radau5 => &[104, 148, 211, 300],
         };
         let y0 = kepler_exact(0.0);
-        let errs: Vec<f64> = ns
-            .iter()
-            .map(|&n| fixed_run(method, &mut Kepler, &y0, 2.0 * PI, n, &y0))
-            .collect();
+        let errs: Vec<f64> = ns.iter().map(|&n| fixed_run(method, &mut Kepler, &y0, 2.0 * PI, n, &y0)).collect();
         assert_order("kepler", method, ns, &errs, method.order() as f64);
     }
 }
@@ -245,16 +222,7 @@ fn measured_order_oscillator() {
         };
         let errs: Vec<f64> = ns
             .iter()
-            .map(|&n| {
-                fixed_run(
-                    method,
-                    &mut Oscillator,
-                    &[1.0, 0.0],
-                    10.0,
-                    n,
-                    &oscillator_exact(10.0),
-                )
-            })
+            .map(|&n| fixed_run(method, &mut Oscillator, &[1.0, 0.0], 10.0, n, &oscillator_exact(10.0)))
             .collect();
         assert_order("oscillator", method, ns, &errs, method.order() as f64);
     }
@@ -284,10 +252,7 @@ fn dense_output_order_kepler() {
                 st.step(&mut Kepler, 2.0 * PI).unwrap();
                 // The ends of the step are reproduced exactly.
                 st.interpolate(&mut Kepler, st.t(), &mut out);
-                assert!(
-                    max_abs_diff(&out, st.y()) < 1e-13,
-                    "{method}: interpolate(t) = y"
-                );
+                assert!(max_abs_diff(&out, st.y()) < 1e-13, "{method}: interpolate(t) = y");
                 let tm = 0.5 * (st.t_prev() + st.t());
                 st.interpolate(&mut Kepler, tm, &mut out);
                 err = err.max(max_abs_diff(&out, &kepler_exact(tm)));
@@ -297,11 +262,11 @@ fn dense_output_order_kepler() {
         let expected = method.order().min(method.dense_order() + 1) as f64;
         let hs: Vec<f64> = ns.iter().map(|&n| 1.0 / n as f64).collect();
         let slope = loglog_slope(&hs, &errs);
-        eprintln!("dense {method}: n = {ns:?}, midpoint errors {}, slope {slope:.2} (expected >= {expected})", sci(&errs));
-        assert!(
-            slope > expected - SLOPE_TOL,
-            "{method}: dense slope {slope:.3} < {expected}"
+        eprintln!(
+            "dense {method}: n = {ns:?}, midpoint errors {}, slope {slope:.2} (expected >= {expected})",
+            sci(&errs)
         );
+        assert!(slope > expected - SLOPE_TOL, "{method}: dense slope {slope:.3} < {expected}");
     }
 }
 
@@ -309,19 +274,12 @@ fn dense_output_order_kepler() {
 #[test]
 fn dense_output_matches_step_start() {
     for method in Method::ALL {
-        let opts = Options {
-            dt: Some(0.1),
-            ..Options::default()
-        };
+        let opts = Options { dt: Some(0.1), ..Options::default() };
         let mut st = Stepper::new(method, &opts, 2).unwrap();
         st.reset(&mut Oscillator, 0.0, &[1.0, 0.0]).unwrap();
         let mut out = [0.0; 2];
         st.interpolate(&mut Oscillator, 0.0, &mut out);
-        assert_eq!(
-            out,
-            [1.0, 0.0],
-            "{method}: before any step, interpolate gives y"
-        );
+        assert_eq!(out, [1.0, 0.0], "{method}: before any step, interpolate gives y");
         st.step(&mut Oscillator, 1.0).unwrap();
         let y1 = st.y().to_vec();
         st.step(&mut Oscillator, 1.0).unwrap();
@@ -349,10 +307,7 @@ fn adaptive_accuracy_oscillator() {
         let st = solve(method, &opts, &mut Oscillator, 0.0, &[1.0, 0.0], t_end).unwrap();
         assert_eq!(st.t(), t_end);
         let err = max_abs_diff(st.y(), &oscillator_exact(t_end));
-        eprintln!(
-            "adaptive {method}: global error {err:.2e}, {:?}",
-            st.stats()
-        );
+        eprintln!("adaptive {method}: global error {err:.2e}, {:?}", st.stats());
         assert!(err < ADAPTIVE_GLOBAL_TOL, "{method}: error {err:e}");
     }
 }
@@ -377,10 +332,7 @@ fn adaptive_accuracy_kepler_dense() {
             }
         }
         assert_eq!(k, 101);
-        eprintln!(
-            "kepler dense {method}: max error {err:.2e}, {:?}",
-            st.stats()
-        );
+        eprintln!("kepler dense {method}: max error {err:.2e}, {:?}", st.stats());
         // 1e-6: a thousand times rtol, the usual global/local ratio on one orbit.
         assert!(err < 1e-6, "{method}: error {err:e}");
     }
@@ -403,17 +355,11 @@ fn stiff_van_der_pol_radau5() {
     let st = solve(Method::Radau5, &opts, &mut sys, 0.0, &[2.0, 0.0], 2.0).unwrap();
     let s = st.stats();
     let err = max_abs_diff(st.y(), &VDPOL_REF);
-    eprintln!(
-        "vdpol radau5 rtol 1e-6: y = {:?}, error {err:.2e}, {s:?}",
-        st.y()
-    );
+    eprintln!("vdpol radau5 rtol 1e-6: y = {:?}, error {err:.2e}, {s:?}", st.y());
     // Measured: ~900 accepted steps (the solution has two fast transients on [0, 2]).
     assert!(s.naccept < 1500, "{s:?}");
     assert!(err < 1e-6, "error {err:e}");
-    assert!(
-        s.njev < s.naccept,
-        "the Jacobian is reused across steps: {s:?}"
-    );
+    assert!(s.njev < s.naccept, "the Jacobian is reused across steps: {s:?}");
 
     // Tight tolerance: agreement with the published reference to ~1e-10.
     let opts = Options::tol(1e-10, 1e-10);
@@ -429,10 +375,7 @@ fn stiff_van_der_pol_explicit_runs_out_of_steps() {
     // reach t = 2. With a budget of 1e5 attempts it stops early, keeping the
     // state of its last accepted step.
     let mut sys = VanDerPol { eps: 1e-6 };
-    let opts = Options {
-        max_steps: 100_000,
-        ..Options::tol(1e-6, 1e-6)
-    };
+    let opts = Options { max_steps: 100_000, ..Options::tol(1e-6, 1e-6) };
     let (st, e) = solve(Method::Dopri5, &opts, &mut sys, 0.0, &[2.0, 0.0], 2.0).unwrap_err();
     match e {
         StepError::TooManySteps { t, steps } => {
@@ -485,11 +428,7 @@ fn rhs_failure_rejects_and_recovers() {
             Method::Rk4 => Options::fixed(0.2),
             _ => Options::tol(1e-8, 1e-10),
         };
-        let mut sys = WarmStarted {
-            anchor: [1.0, 0.0],
-            max_jump: 0.02,
-            failures: 0,
-        };
+        let mut sys = WarmStarted { anchor: [1.0, 0.0], max_jump: 0.02, failures: 0 };
         let mut st = Stepper::new(method, &opts, 2).unwrap();
         st.reset(&mut sys, 0.0, &[1.0, 0.0]).unwrap();
         while st.t() < 10.0 {
@@ -498,14 +437,8 @@ fn rhs_failure_rejects_and_recovers() {
         }
         let err = max_abs_diff(st.y(), &oscillator_exact(10.0));
         let s = st.stats();
-        eprintln!(
-            "warm-started {method}: {} rhs failures, error {err:.2e}, {s:?}",
-            sys.failures
-        );
-        assert!(
-            sys.failures > 0 && s.nreject > 0,
-            "{method}: the test must exercise failures"
-        );
+        eprintln!("warm-started {method}: {} rhs failures, error {err:.2e}, {s:?}", sys.failures);
+        assert!(sys.failures > 0 && s.nreject > 0, "{method}: the test must exercise failures");
         // RK4 runs with the failure-shortened steps (h <= 0.2 / 4): error ~1e-6.
         let tol = if method == Method::Rk4 { 1e-5 } else { 1e-6 };
         assert!(err < tol, "{method}: error {err:e}");
@@ -550,10 +483,7 @@ fn rhs_always_failing_returns_error_at_last_accepted_point() {
             match (&e, nan) {
                 (StepError::Rhs { t: te, error }, false) => {
                     assert_eq!(*te, t);
-                    assert!(
-                        error.t > 1.0,
-                        "{method}: carries the last failure {error:?}"
-                    );
+                    assert!(error.t > 1.0, "{method}: carries the last failure {error:?}");
                 }
                 (StepError::NonFinite { t: te }, true) => assert_eq!(*te, t),
                 _ => panic!("{method}: unexpected error {e:?}"),
@@ -564,10 +494,7 @@ fn rhs_always_failing_returns_error_at_last_accepted_point() {
             assert!(err < 1e-6, "{method}: error {err:e}");
             let mut out = [0.0; 2];
             st.interpolate(&mut sys, t, &mut out);
-            assert!(
-                max_abs_diff(&out, st.y()) < 1e-12,
-                "{method}: dense output intact"
-            );
+            assert!(max_abs_diff(&out, st.y()) < 1e-12, "{method}: dense output intact");
             eprintln!("wall (nan = {nan}) {method}: {e} ; {:?}", st.stats());
         }
     }
@@ -576,20 +503,9 @@ fn rhs_always_failing_returns_error_at_last_accepted_point() {
 #[test]
 fn reset_at_failing_point_reports_rhs_error() {
     let mut st = Stepper::new(Method::Dopri5, &Options::default(), 2).unwrap();
-    let e = st
-        .reset(
-            &mut Wall {
-                t_wall: 1.0,
-                nan: false,
-            },
-            1.5,
-            &[1.0, 0.0],
-        )
-        .unwrap_err();
+    let e = st.reset(&mut Wall { t_wall: 1.0, nan: false }, 1.5, &[1.0, 0.0]).unwrap_err();
     assert!(matches!(e, StepError::Rhs { t, .. } if t == 1.5));
-    let e = st
-        .reset(&mut Oscillator, 0.0, &[f64::NAN, 0.0])
-        .unwrap_err();
+    let e = st.reset(&mut Oscillator, 0.0, &[f64::NAN, 0.0]).unwrap_err();
     assert!(matches!(e, StepError::NonFinite { .. }));
 }
 
@@ -643,10 +559,7 @@ fn steps_do_not_allocate() {
         };
         let mut st = Stepper::new(method, &opts, 2).unwrap();
         // The oscillator until the wall at t = 3π + 0.1, where every evaluation fails.
-        let mut sys = Wall {
-            t_wall: 3.0 * PI + 0.1,
-            nan: false,
-        };
+        let mut sys = Wall { t_wall: 3.0 * PI + 0.1, nan: false };
         let mut out = [0.0; 2];
         let before = allocations();
         st.reset(&mut sys, 0.0, &[1.0, 0.0]).unwrap();
@@ -664,10 +577,7 @@ fn steps_do_not_allocate() {
         };
         let n_alloc = allocations() - before;
         assert!(matches!(r, StepError::Rhs { .. }), "{method}: {r:?}");
-        assert_eq!(
-            n_alloc, 0,
-            "{method}: {n_alloc} allocations in reset/step/interpolate"
-        );
+        assert_eq!(n_alloc, 0, "{method}: {n_alloc} allocations in reset/step/interpolate");
     }
 }
 
@@ -692,10 +602,7 @@ fn method_names_and_properties() {
     let e = "euler".parse::<Method>().unwrap_err();
     assert!(e.contains("dopri5"), "{e}");
     assert_eq!(Method::ALL.map(Method::order), [4, 5, 8, 5]);
-    assert_eq!(
-        Method::ALL.map(Method::is_adaptive),
-        [false, true, true, true]
-    );
+    assert_eq!(Method::ALL.map(Method::is_adaptive), [false, true, true, true]);
 }
 
 #[test]
@@ -706,30 +613,16 @@ fn invalid_options_are_rejected_with_a_fix() {
     assert!(e.contains("rtol"), "{e}");
     let e = Stepper::new(Method::Dopri5, &Options::tol(1e-8, -1.0), 2).unwrap_err();
     assert!(e.contains("atol"), "{e}");
-    let bad_h0 = Options {
-        h0: Some(-1.0),
-        ..Options::default()
-    };
+    let bad_h0 = Options { h0: Some(-1.0), ..Options::default() };
     assert!(Stepper::new(Method::Radau5, &bad_h0, 2).is_err());
-    let bad_dt = Options {
-        dt: Some(f64::NAN),
-        ..Options::default()
-    };
+    let bad_dt = Options { dt: Some(f64::NAN), ..Options::default() };
     assert!(Stepper::new(Method::Rk4, &bad_dt, 2).is_err());
     assert!(Stepper::new(Method::Dop853, &Options::default(), 2).is_ok());
 }
 
 #[test]
 fn fixed_rk4_costs_four_evaluations_per_step() {
-    let st = solve(
-        Method::Rk4,
-        &Options::fixed(0.1),
-        &mut Oscillator,
-        0.0,
-        &[1.0, 0.0],
-        1.0,
-    )
-    .unwrap();
+    let st = solve(Method::Rk4, &Options::fixed(0.1), &mut Oscillator, 0.0, &[1.0, 0.0], 1.0).unwrap();
     let s = st.stats();
     assert_eq!(s.naccept, 10);
     assert_eq!(s.nfev, 1 + 4 * 10);
@@ -769,8 +662,7 @@ fn lands_on_close_and_frequent_stops() {
         };
         // A t_stop closer than h_min is reached in one step.
         let mut st = Stepper::new(method, &opts, 2).unwrap();
-        st.reset(&mut Oscillator, 1.0, &oscillator_exact(1.0))
-            .unwrap();
+        st.reset(&mut Oscillator, 1.0, &oscillator_exact(1.0)).unwrap();
         st.step(&mut Oscillator, 1.0 + 1e-15).unwrap();
         assert_eq!(st.t(), 1.0 + 1e-15, "{method}");
         // Stopping at 100 output times (as a driver with events would) keeps the accuracy.

@@ -51,7 +51,12 @@ fn yaml_syntax_errors_give_line_and_column_even_at_the_first_character() {
     );
     let (msg, path) = refused("*a", Format::Yaml);
     assert_eq!(path, "line 1 column 1");
-    assert!(msg.ends_with("unknown anchor; an alias `*name` needs an anchor `&name` before it: add the anchor or write the value out"), "{msg}");
+    assert!(
+        msg.ends_with(
+            "unknown anchor; an alias `*name` needs an anchor `&name` before it: add the anchor or write the value out"
+        ),
+        "{msg}"
+    );
     let (_, path) = refused("name: x\n!!float ~}~~\n", Format::Yaml);
     assert_eq!(path, "line 3 column 1");
     let (msg, path) = refused("", Format::Json);
@@ -78,11 +83,21 @@ fn errors_inside_a_field_keep_its_path_and_add_the_line() {
          give the form the field takes: see docs/model-format.md"
     );
     // An unknown field inside a pair (an entry tagged by `type`): the field itself.
-    let (msg, path) = refused(&FOUR_BAR.replace("{type: revolute, name: O,", "{type: revolute, axis: [1, 0], name: O,"), Format::Yaml);
+    let (msg, path) = refused(
+        &FOUR_BAR.replace("{type: revolute, name: O,", "{type: revolute, axis: [1, 0], name: O,"),
+        Format::Yaml,
+    );
     assert_eq!(path, "pairs[0].axis");
-    assert!(msg.contains("unknown field `axis`, expected one of `name`, `at`, `bodies`") && msg.ends_with("; remove it or correct its spelling"), "{msg}");
+    assert!(
+        msg.contains("unknown field `axis`, expected one of `name`, `at`, `bodies`")
+            && msg.ends_with("; remove it or correct its spelling"),
+        "{msg}"
+    );
     // A pair written as a list: no Rust type names.
-    let (msg, path) = refused(&FOUR_BAR.replace("{type: revolute, name: O, at: O, bodies: [ground, crank]}", "[revolute]"), Format::Yaml);
+    let (msg, path) = refused(
+        &FOUR_BAR.replace("{type: revolute, name: O, at: O, bodies: [ground, crank]}", "[revolute]"),
+        Format::Yaml,
+    );
     assert_eq!(path, "pairs[0]");
     assert!(msg.contains("expected a mapping with the fields of its `type`"), "{msg}");
 }

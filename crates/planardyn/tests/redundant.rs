@@ -74,7 +74,9 @@ fn redundant_parallelogram_has_the_closed_form_dynamics() {
 #[test]
 fn redundant_parallelogram_conserves_energy_and_stops_at_its_change_point() {
     // Hanging 30 degrees off the vertical, it swings between -60 and -120 degrees.
-    let hanging = PARALLELOGRAM.replace("0.2598076211353316", "-0.2598076211353316").replace("value: 1.0471975511965976", "value: -1.0471975511965976");
+    let hanging = PARALLELOGRAM
+        .replace("0.2598076211353316", "-0.2598076211353316")
+        .replace("value: 1.0471975511965976", "value: -1.0471975511965976");
     let mech = yaml(&hanging);
     let tr = run(&mech, "dop853", 2.0, 1e-11, Some(planardyn::simulate::grid(0.0, 2.0, 1e-3)));
     assert!(tr.stats.energy_drift < 1e-9, "drift {}", tr.stats.energy_drift);

@@ -67,7 +67,8 @@ fn agm(mut a: f64, mut b: f64) -> f64 {
 fn pendulum_period_at_large_amplitude_is_exact() {
     // Physical pendulum released from rest at 1 rad from the vertical: period
     // 4 sqrt(I_O / (m g l)) K(sin(theta0/2)) (exact, Landau & Lifshitz sec. 11).
-    let text = PENDULUM.replace("{name: theta, pair: O, value: 0.0}", "{name: theta, pair: O, value: 0.0, q0: -0.5707963267948966}");
+    let text = PENDULUM
+        .replace("{name: theta, pair: O, value: 0.0}", "{name: theta, pair: O, value: 0.0, q0: -0.5707963267948966}");
     let mech = yaml(&text);
     let (m, l, g) = (2.0_f64, 0.8_f64, 9.81_f64);
     let omega = (m * g * (l / 2.0) / (m * l * l / 3.0)).sqrt();

@@ -12,11 +12,11 @@ maps and workspaces. See ``docs/robot.md``.
 
 from __future__ import annotations
 
+from .cli import size_cli
 from .effector import EffectorState, EndEffector
 from .maps import TaskGrid, Workspace, flood, singularity_map, workspace
 from .motion import SINGULAR_TOL, TaskMotion, singularity_message, solve_motion
 from .paths import TaskPath, circle, line, point_to_point, table, time_law
-from .cli import size_cli
 from .sizing import DriveSizing, SizingReport, envelope, size, with_payload
 
 __all__ = [

@@ -106,21 +106,45 @@ impl<'a> Tracker<'a> {
         let m = mech.dof();
         let bad = |msg: String| TaskError::Core(KinematicsError::BadArgument(msg).into());
         if m != 2 && m != 3 {
-            return Err(bad(format!("task-space motions need m = 2 (a point) or m = 3 (a pose) coordinates; {:?} has m = {m}", mech.name)));
+            return Err(bad(format!(
+                "task-space motions need m = 2 (a point) or m = 3 (a pose) coordinates; {:?} has m = {m}",
+                mech.name
+            )));
         }
-        let pid = mech.point_id(point).ok_or_else(|| bad(format!("no point {point:?}; the points are {}", mech.point_names().join(", "))))?;
-        let carriers: Vec<usize> = (0..mech.n_bodies()).filter(|&i| mech.bodies[i].points.iter().any(|(p, _)| *p == pid)).collect();
+        let pid = mech
+            .point_id(point)
+            .ok_or_else(|| bad(format!("no point {point:?}; the points are {}", mech.point_names().join(", "))))?;
+        let carriers: Vec<usize> =
+            (0..mech.n_bodies()).filter(|&i| mech.bodies[i].points.iter().any(|(p, _)| *p == pid)).collect();
         let i = match body {
             Some(name) => mech.body_id(name).map(|b| b.0).filter(|b| carriers.contains(b)),
-            None if m == 3 && carriers.len() > 1 => return Err(bad(format!("point {point:?} is on several bodies: say which body's pose"))),
+            None if m == 3 && carriers.len() > 1 => {
+                return Err(bad(format!("point {point:?} is on several bodies: say which body's pose")))
+            }
             None => carriers.first().copied(),
         }
-        .ok_or_else(|| bad(format!("no mobile body{} carries point {point:?}", body.map(|b| format!(" named {b:?}")).unwrap_or_default())))?;
+        .ok_or_else(|| {
+            bad(format!(
+                "no mobile body{} carries point {point:?}",
+                body.map(|b| format!(" named {b:?}")).unwrap_or_default()
+            ))
+        })?;
         let s = mech.bodies[i].points.iter().find(|(p, _)| *p == pid).map(|(_, s)| *s).unwrap_or([0.0; 2]);
         let l = mech.scale;
-        let input_scale = mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.0 } else { l }).collect();
+        let input_scale =
+            mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.0 } else { l }).collect();
         let ws = Workspace::new(mech);
-        Ok(Tracker { mech, ws, at: None, body: i, s, phi0: mech.x0[3 * i + 2], task_scale: [l, l, 1.0], input_scale, lu: Lu::new(m) })
+        Ok(Tracker {
+            mech,
+            ws,
+            at: None,
+            body: i,
+            s,
+            phi0: mech.x0[3 * i + 2],
+            task_scale: [l, l, 1.0],
+            input_scale,
+            lu: Lu::new(m),
+        })
     }
 
     fn k(&self) -> usize {
@@ -229,7 +253,9 @@ impl<'a> Tracker<'a> {
         let st = self.solve(target, &pred)?;
         let jump = (0..q.len()).fold(0.0, |m: f64, j| m.max((st.q[j] - pred[j]).abs() / self.input_scale[j]));
         if jump > JUMP_TOL {
-            return Err(TaskError::OutOfReach(format!("the inputs jumped by {jump:.3} from the predictor: another working mode")));
+            return Err(TaskError::OutOfReach(format!(
+                "the inputs jumped by {jump:.3} from the predictor: another working mode"
+            )));
         }
         Ok(st)
     }
@@ -255,7 +281,11 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
     let mut tr = Tracker::new(mech, &path.point, path.body.as_deref())?;
     let (m, n) = (mech.dof(), path.t.len());
     let finite = [&path.t, &path.x, &path.xd, &path.xdd].iter().all(|a| a.iter().all(|v| v.is_finite()));
-    if n < 2 || [&path.x, &path.xd, &path.xdd].iter().any(|a| a.len() != n * m) || !finite || path.t.windows(2).any(|w| w[1] <= w[0]) {
+    if n < 2
+        || [&path.x, &path.xd, &path.xdd].iter().any(|a| a.len() != n * m)
+        || !finite
+        || path.t.windows(2).any(|w| w[1] <= w[0])
+    {
         return Err(TaskError::Core(Error::Options(format!(
             "a task path needs N >= 2 increasing times t (s) and N x {m} finite values of X, Xd, Xdd; got N = {n}"
         ))));
@@ -264,7 +294,15 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
         return Err(TaskError::Core(Error::Options(format!("singular_tol must be >= 0, got {}", path.singular_tol))));
     }
     let q_start = path.q_start.clone().unwrap_or_else(|| mech.drawn_q());
-    let mut out = TaskSolution { q: vec![0.0; n * m], qd: vec![0.0; n * m], qdd: vec![0.0; n * m], tau: vec![0.0; n * m], sigma_i: vec![0.0; n], sigma_ii: vec![0.0; n], condition: vec![0.0; n] };
+    let mut out = TaskSolution {
+        q: vec![0.0; n * m],
+        qd: vec![0.0; n * m],
+        qdd: vec![0.0; n * m],
+        tau: vec![0.0; n * m],
+        sigma_i: vec![0.0; n],
+        sigma_ii: vec![0.0; n],
+        condition: vec![0.0; n],
+    };
     let row = |a: &Vec<f64>, i: usize| a[i * m..(i + 1) * m].to_vec();
     for i in 0..n {
         let target = row(&path.x, i);
@@ -349,8 +387,16 @@ fn check(s_i: f64, s_ii: f64, tol: f64, t: f64, st: &Sample) -> Result<(), TaskE
         return Ok(());
     }
     let (kind, text) = if s_i <= s_ii { ("I", KIND_I) } else { ("II", KIND_II) };
-    let mut msg = format!("the prescribed motion reaches a {text}; at t = {t:.4} s, end effector at {}, q = {}: ", fmt_vec(&st.x[..st.q.len()]), fmt_vec(&st.q));
-    let _ = write!(msg, "sigma_{kind} = {:.2e} < {tol}. Keep the path away from it (robot.singularity_map shows where they are)", s_i.min(s_ii));
+    let mut msg = format!(
+        "the prescribed motion reaches a {text}; at t = {t:.4} s, end effector at {}, q = {}: ",
+        fmt_vec(&st.x[..st.q.len()]),
+        fmt_vec(&st.q)
+    );
+    let _ = write!(
+        msg,
+        "sigma_{kind} = {:.2e} < {tol}. Keep the path away from it (robot.singularity_map shows where they are)",
+        s_i.min(s_ii)
+    );
     Err(TaskError::Singular(msg))
 }
 

@@ -16,7 +16,8 @@ pub fn kinetic_energy(mech: &Mechanism, xd: &[f64]) -> f64 {
 /// V = -sum_i m_i g . r_i + sum 1/2 k (L - L0)^2 over springs and pair springs.
 pub fn potential_energy(mech: &Mechanism, x: &[f64]) -> f64 {
     let g = mech.gravity;
-    let gravity: f64 = mech.bodies.iter().enumerate().map(|(i, b)| -b.mass * (g[0] * x[3 * i] + g[1] * x[3 * i + 1])).sum();
+    let gravity: f64 =
+        mech.bodies.iter().enumerate().map(|(i, b)| -b.mass * (g[0] * x[3 * i] + g[1] * x[3 * i + 1])).sum();
     let elastic: f64 = mech
         .loads
         .iter()
@@ -25,7 +26,9 @@ pub fn potential_energy(mech: &Mechanism, x: &[f64]) -> f64 {
                 let (p0, p1) = (world_point(ends[0].link, ends[0].s, x), world_point(ends[1].link, ends[1].s, x));
                 0.5 * stiffness * ((p1[0] - p0[0]).hypot(p1[1] - p0[1]) - rest_length).powi(2)
             }
-            Load::PairSpring { pair, stiffness, rest, .. } => 0.5 * stiffness * (pair_coordinate(&mech.pairs[pair.0], x) - rest).powi(2),
+            Load::PairSpring { pair, stiffness, rest, .. } => {
+                0.5 * stiffness * (pair_coordinate(&mech.pairs[pair.0], x) - rest).powi(2)
+            }
             Load::Force { .. } | Load::Torque { .. } => 0.0,
         })
         .sum();

@@ -2,7 +2,9 @@
 //! gravity, point forces, torques, springs and dampers, and the drive efforts mapped
 //! through the coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
-use crate::kinematics::constraints::{pair_coordinate, pair_coordinate_grad, Dense, pair_coordinate_rate, point_velocity, rotate, world_point};
+use crate::kinematics::constraints::{
+    pair_coordinate, pair_coordinate_grad, pair_coordinate_rate, point_velocity, rotate, world_point, Dense,
+};
 use crate::model::{Attachment, Link, Load, Mechanism};
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).
@@ -75,7 +77,8 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
                     continue; // direction undefined; a spring of zero length exerts no force
                 }
                 let e = [d[0] / len, d[1] / len];
-                let (v0, v1) = (point_velocity(ends[0].link, ends[0].s, x, xd), point_velocity(ends[1].link, ends[1].s, x, xd));
+                let (v0, v1) =
+                    (point_velocity(ends[0].link, ends[0].s, x, xd), point_velocity(ends[1].link, ends[1].s, x, xd));
                 let rate = e[0] * (v1[0] - v0[0]) + e[1] * (v1[1] - v0[1]);
                 let tension = stiffness * (len - rest_length) + damping * rate;
                 add_point_force(&ends[0], [tension * e[0], tension * e[1]], x, xd, f);

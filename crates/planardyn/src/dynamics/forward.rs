@@ -76,7 +76,14 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Worksp
 
 /// One forward-dynamics evaluation at time t (s) and chart state (z, zd): fills every
 /// buffer of `ws`; the chart accelerations zdd are left in `ws.b`, the user's in `ws.qdd`.
-pub fn forward(mech: &Mechanism, t: f64, z: &[f64], zd: &[f64], drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
+pub fn forward(
+    mech: &Mechanism,
+    t: f64,
+    z: &[f64],
+    zd: &[f64],
+    drives: &mut dyn Drives,
+    ws: &mut Workspace,
+) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
     drives.efforts(t, &ws.q, &ws.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
     if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {

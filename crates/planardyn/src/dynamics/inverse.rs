@@ -12,7 +12,13 @@ use crate::KinematicsError;
 /// Drive efforts (N m or N) into `ws.tau` for user coordinates q, rates qd and accelerations
 /// qdd, starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
 /// distant q).
-pub fn inverse(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+pub fn inverse(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    ws: &mut Workspace,
+) -> Result<(), KinematicsError> {
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
     ws.tau.fill(0.0);

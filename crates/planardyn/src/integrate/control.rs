@@ -79,12 +79,7 @@ impl Core {
     }
 
     /// Set the state to (t, y) and evaluate f(t, y).
-    pub(crate) fn reset<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t: f64,
-        y: &[f64],
-    ) -> Result<(), StepError<S::Error>> {
+    pub(crate) fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         assert_eq!(y.len(), self.n, "Stepper::reset: y has the wrong length");
         self.started = false;
         if !t.is_finite() || !all_finite(y) {
@@ -92,8 +87,7 @@ impl Core {
         }
         self.y.copy_from_slice(y);
         self.stats.nfev += 1;
-        sys.rhs(t, &self.y, &mut self.f)
-            .map_err(|error| StepError::Rhs { t, error })?;
+        sys.rhs(t, &self.y, &mut self.f).map_err(|error| StepError::Rhs { t, error })?;
         if !all_finite(&self.f) {
             return Err(StepError::NonFinite { t });
         }
@@ -120,7 +114,13 @@ impl Core {
     }
 
     /// As [`Core::eval`], through [`OdeSystem::rhs_dense`].
-    pub(crate) fn eval_dense<S: OdeSystem>(stats: &mut Stats, sys: &mut S, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Failure<S::Error>> {
+    pub(crate) fn eval_dense<S: OdeSystem>(
+        stats: &mut Stats,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        dy: &mut [f64],
+    ) -> Result<(), Failure<S::Error>> {
         stats.nfev += 1;
         finite(sys.rhs_dense(t, y, dy), dy)
     }
@@ -206,10 +206,7 @@ impl Core {
 
     /// Panic with a clear message when `step` is called before `reset`.
     pub(crate) fn assert_started(&self) {
-        assert!(
-            self.started,
-            "Stepper::step called before a successful Stepper::reset"
-        );
+        assert!(self.started, "Stepper::step called before a successful Stepper::reset");
     }
 }
 
@@ -266,11 +263,7 @@ pub(crate) fn initial_step<S: OdeSystem>(
     }
     let d0 = scaled_norm(&core.y, &core.y, opts);
     let d1 = scaled_norm(&core.f, &core.y, opts);
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6
-    } else {
-        0.01 * d0 / d1
-    };
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
     let h0 = h0.min(interval).min(opts.h_max);
     for i in 0..core.n {
         y1[i] = core.y[i] + h0 * core.f[i];
@@ -363,9 +356,7 @@ pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
     let mut rejected = false;
     let mut last_failure: Option<Failure<S::Error>> = None;
     loop {
-        let (h_try, t_new) = p
-            .core()
-            .next_try(h, t_stop, stretch, rejected, &mut last_failure)?;
+        let (h_try, t_new) = p.core().next_try(h, t_stop, stretch, rejected, &mut last_failure)?;
         match p.attempt(sys, h_try) {
             Ok(err) if fixed.is_some() || err <= 1.0 => {
                 p.accept(sys, t_new);

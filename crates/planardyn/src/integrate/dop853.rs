@@ -270,22 +270,13 @@ impl Dop853 {
         }
     }
 
-    pub fn reset<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t: f64,
-        y: &[f64],
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         self.fd.fill(0.0);
         self.dense_ready = true;
         self.core.reset(sys, t, y)
     }
 
-    pub fn step<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t_stop: f64,
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
         explicit_step(self, sys, t_stop)
     }
 
@@ -329,20 +320,15 @@ impl Dop853 {
         let Dop853 { k, fd, .. } = self;
         for i in 0..n {
             for r in 0..4 {
-                fd[(3 + r) * n + i] = if extra_ok { h * (0..N_EXT).map(|j| D[r][j] * k[j * n + i]).sum::<f64>() } else { 0.0 };
+                fd[(3 + r) * n + i] =
+                    if extra_ok { h * (0..N_EXT).map(|j| D[r][j] * k[j * n + i]).sum::<f64>() } else { 0.0 };
             }
         }
     }
 
     /// Evaluate stage `s` from the stages before it: `K_s = f(t + C_s h, y + h sum_j A_sj K_j)`,
     /// from the current point, or (`accepted`) from the start of the last accepted step.
-    fn stage<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        s: usize,
-        h: f64,
-        accepted: bool,
-    ) -> Result<(), Failure<S::Error>> {
+    fn stage<S: OdeSystem>(&mut self, sys: &mut S, s: usize, h: f64, accepted: bool) -> Result<(), Failure<S::Error>> {
         let Dop853 { core, k, ytmp, .. } = self;
         let n = core.n;
         let (t0, y0) = if accepted { (core.t_prev, &core.y_prev) } else { (core.t, &core.y) };
@@ -383,13 +369,7 @@ impl ExplicitPair for Dop853 {
         for s in 1..N_STAGES {
             self.stage(sys, s, h, false)?;
         }
-        let Dop853 {
-            core,
-            k,
-            y_new,
-            f_new,
-            ..
-        } = self;
+        let Dop853 { core, k, y_new, f_new, .. } = self;
         for i in 0..n {
             let incr: f64 = (0..N_STAGES).map(|j| B[j] * k[j * n + i]).sum();
             y_new[i] = core.y[i] + h * incr;
@@ -447,20 +427,12 @@ mod tests {
         }
         for q in 0..8 {
             let sum: f64 = (0..N_STAGES).map(|j| B[j] * C[j].powi(q)).sum();
-            assert!(
-                (sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-14,
-                "q = {q}: {sum}"
-            );
+            assert!((sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-14, "q = {q}: {sum}");
         }
         // The 5th-order embedded solution (B - E5) also integrates c^q exactly, q < 5.
         for q in 0..5 {
-            let sum: f64 = (0..=N_STAGES)
-                .map(|j| (B.get(j).unwrap_or(&0.0) - E5[j]) * C[j].powi(q))
-                .sum();
-            assert!(
-                (sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-13,
-                "E5, q = {q}: {sum}"
-            );
+            let sum: f64 = (0..=N_STAGES).map(|j| (B.get(j).unwrap_or(&0.0) - E5[j]) * C[j].powi(q)).sum();
+            assert!((sum - 1.0 / (q as f64 + 1.0)).abs() < 1e-13, "E5, q = {q}: {sum}");
         }
         assert!(E3.iter().sum::<f64>().abs() < 1e-14);
         assert!(E5.iter().sum::<f64>().abs() < 1e-14);

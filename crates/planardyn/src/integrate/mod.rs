@@ -204,29 +204,19 @@ impl Default for Options {
 impl Options {
     /// Default options with tolerances `rtol`, `atol`.
     pub fn tol(rtol: f64, atol: f64) -> Self {
-        Options {
-            rtol,
-            atol,
-            ..Options::default()
-        }
+        Options { rtol, atol, ..Options::default() }
     }
 
     /// Default options with a fixed step `dt` (s): no error control, for any method.
     pub fn fixed(dt: f64) -> Self {
-        Options {
-            dt: Some(dt),
-            ..Options::default()
-        }
+        Options { dt: Some(dt), ..Options::default() }
     }
 
     /// Check the options for `method`; the message says what to change.
     pub fn validate(&self, method: Method) -> Result<(), String> {
         let eps = f64::EPSILON;
         if !(self.rtol.is_finite() && self.rtol > 0.0) {
-            return Err(format!(
-                "rtol = {} must be finite and > 0 (try 1e-8)",
-                self.rtol
-            ));
+            return Err(format!("rtol = {} must be finite and > 0 (try 1e-8)", self.rtol));
         }
         if self.rtol < 100.0 * eps {
             return Err(format!(
@@ -235,40 +225,27 @@ impl Options {
             ));
         }
         if !(self.atol.is_finite() && self.atol >= 0.0) {
-            return Err(format!(
-                "atol = {} must be finite and >= 0 (try 1e-10)",
-                self.atol
-            ));
+            return Err(format!("atol = {} must be finite and >= 0 (try 1e-10)", self.atol));
         }
         if let Some(h0) = self.h0 {
             if !(h0.is_finite() && h0 > 0.0) {
-                return Err(format!(
-                    "h0 = {h0} must be finite and > 0, or None for automatic"
-                ));
+                return Err(format!("h0 = {h0} must be finite and > 0, or None for automatic"));
             }
         }
         if self.h_max.is_nan() || self.h_max <= 0.0 {
-            return Err(format!(
-                "h_max = {} must be > 0 (use infinity for no limit)",
-                self.h_max
-            ));
+            return Err(format!("h_max = {} must be > 0 (use infinity for no limit)", self.h_max));
         }
         if !(self.h_min.is_finite() && self.h_min >= 0.0) {
-            return Err(format!(
-                "h_min = {} must be finite and >= 0 (default 1e-14)",
-                self.h_min
-            ));
+            return Err(format!("h_min = {} must be finite and >= 0 (default 1e-14)", self.h_min));
         }
         if let Some(dt) = self.dt {
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(format!("dt = {dt} must be finite and > 0"));
             }
         } else if method == Method::Rk4 {
-            return Err(
-                "rk4 is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
+            return Err("rk4 is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
                         or choose an adaptive method such as dopri5"
-                    .to_string(),
-            );
+                .to_string());
         }
         if self.max_steps == 0 {
             return Err("max_steps must be >= 1".to_string());
@@ -299,10 +276,9 @@ impl<E: fmt::Debug> fmt::Display for StepError<E> {
                 "step size underflow at t = {t} s (h = {h:e} s): the problem may be stiff \
                  (try radau5) or singular there, or loosen rtol/atol"
             ),
-            StepError::Rhs { t, error } => write!(
-                f,
-                "right-hand side failed at t = {t} s even for the smallest step: {error:?}"
-            ),
+            StepError::Rhs { t, error } => {
+                write!(f, "right-hand side failed at t = {t} s even for the smallest step: {error:?}")
+            }
             StepError::NonFinite { t } => {
                 write!(f, "NaN or infinity in the solution near t = {t} s")
             }
@@ -384,12 +360,7 @@ impl Stepper {
     /// Forgets the step-size history (the next step starts from `h0` or the
     /// automatic initial step) and, for Radau5, the Jacobian. Panics if
     /// `y.len()` differs from the `dim` given to `new` (a driver bug).
-    pub fn reset<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t: f64,
-        y: &[f64],
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         dispatch!(self, s => s.reset(sys, t, y))
     }
 
@@ -397,11 +368,7 @@ impl Stepper {
     ///
     /// The last step before `t_stop` ends exactly on it. With `t_stop <= t` nothing
     /// is done. Panics if called before `reset` (a driver bug).
-    pub fn step<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t_stop: f64,
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
         dispatch!(self, s => s.step(sys, t_stop))
     }
 

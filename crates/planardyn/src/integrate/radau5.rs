@@ -41,11 +41,9 @@
 // T and TI keep the 17 digits of scipy's table.
 #![allow(clippy::excessive_precision)]
 
-use super::control::{
-    all_finite, initial_step, Core, Failure, FAIL_FACTOR, MAX_FACTOR, MIN_FACTOR,
-};
-use crate::linalg::{lu_factor, lu_solve, LuError};
+use super::control::{all_finite, initial_step, Core, Failure, FAIL_FACTOR, MAX_FACTOR, MIN_FACTOR};
 use super::{OdeSystem, Options, StepError};
+use crate::linalg::{lu_factor, lu_solve, LuError};
 use nalgebra::Complex;
 
 type C64 = Complex<f64>;
@@ -70,57 +68,25 @@ impl Tableau {
         let cbrt3 = 3f64.cbrt();
         Tableau {
             c: [(4.0 - s6) / 10.0, (4.0 + s6) / 10.0, 1.0],
-            e: [
-                (-13.0 - 7.0 * s6) / 3.0,
-                (-13.0 + 7.0 * s6) / 3.0,
-                -1.0 / 3.0,
-            ],
+            e: [(-13.0 - 7.0 * s6) / 3.0, (-13.0 + 7.0 * s6) / 3.0, -1.0 / 3.0],
             mu_real: 3.0 + cbrt3 * cbrt3 - cbrt3,
             mu_complex: Complex::new(
                 3.0 + 0.5 * (cbrt3 - cbrt3 * cbrt3),
                 -0.5 * (3f64.powf(5.0 / 6.0) + 3f64.powf(7.0 / 6.0)),
             ),
             t: [
-                [
-                    0.09443876248897524,
-                    -0.14125529502095421,
-                    0.03002919410514742,
-                ],
-                [
-                    0.25021312296533332,
-                    0.20412935229379994,
-                    -0.38294211275726192,
-                ],
+                [0.09443876248897524, -0.14125529502095421, 0.03002919410514742],
+                [0.25021312296533332, 0.20412935229379994, -0.38294211275726192],
                 [1.0, 1.0, 0.0],
             ],
             ti: [
-                [
-                    4.17871859155190428,
-                    0.32768282076106237,
-                    0.52337644549944951,
-                ],
-                [
-                    -4.17871859155190428,
-                    -0.32768282076106237,
-                    0.47662355450055044,
-                ],
-                [
-                    0.50287263494578682,
-                    -2.57192694985560522,
-                    0.59603920482822492,
-                ],
+                [4.17871859155190428, 0.32768282076106237, 0.52337644549944951],
+                [-4.17871859155190428, -0.32768282076106237, 0.47662355450055044],
+                [0.50287263494578682, -2.57192694985560522, 0.59603920482822492],
             ],
             p: [
-                [
-                    13.0 / 3.0 + 7.0 * s6 / 3.0,
-                    -23.0 / 3.0 - 22.0 * s6 / 3.0,
-                    10.0 / 3.0 + 5.0 * s6,
-                ],
-                [
-                    13.0 / 3.0 - 7.0 * s6 / 3.0,
-                    -23.0 / 3.0 + 22.0 * s6 / 3.0,
-                    10.0 / 3.0 - 5.0 * s6,
-                ],
+                [13.0 / 3.0 + 7.0 * s6 / 3.0, -23.0 / 3.0 - 22.0 * s6 / 3.0, 10.0 / 3.0 + 5.0 * s6],
+                [13.0 / 3.0 - 7.0 * s6 / 3.0, -23.0 / 3.0 + 22.0 * s6 / 3.0, 10.0 / 3.0 - 5.0 * s6],
                 [1.0 / 3.0, -8.0 / 3.0, 10.0 / 3.0],
             ],
         }
@@ -198,12 +164,7 @@ impl Radau5 {
         }
     }
 
-    pub fn reset<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t: f64,
-        y: &[f64],
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         self.jac_valid = false;
         self.jac_current = false;
         self.lu_h = 0.0;
@@ -292,11 +253,7 @@ impl Radau5 {
 
     /// Simplified Newton iteration for the collocation system (scipy
     /// `solve_collocation_system`). `Ok(None)`: did not converge.
-    fn newton<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        h: f64,
-    ) -> Result<Option<Newton>, Failure<S::Error>> {
+    fn newton<S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<Option<Newton>, Failure<S::Error>> {
         let n = self.core.n;
         let tab = &self.tab;
         let (mr, mc) = (tab.mu_real / h, tab.mu_complex / h);
@@ -314,13 +271,7 @@ impl Radau5 {
                     self.ytmp[i] = self.core.y[i] + self.z[k * n + i];
                 }
                 let fk = &mut self.fz[k * n..(k + 1) * n];
-                Core::eval(
-                    &mut self.core.stats,
-                    sys,
-                    self.core.t + tab.c[k] * h,
-                    &self.ytmp,
-                    fk,
-                )?;
+                Core::eval(&mut self.core.stats, sys, self.core.t + tab.c[k] * h, &self.ytmp, fk)?;
             }
             for i in 0..n {
                 let f = |k: usize| self.fz[k * n + i];
@@ -361,13 +312,10 @@ impl Radau5 {
                     self.z[k * n + i] = (0..3).map(|m| tab.t[k][m] * self.w[m * n + i]).sum();
                 }
             }
-            let converged = dw_norm == 0.0
-                || (dw_norm_old.is_some() && rate / (1.0 - rate) * dw_norm < self.newton_tol);
+            let converged =
+                dw_norm == 0.0 || (dw_norm_old.is_some() && rate / (1.0 - rate) * dw_norm < self.newton_tol);
             if converged {
-                return Ok(Some(Newton {
-                    iterations: iter + 1,
-                    rate,
-                }));
+                return Ok(Some(Newton { iterations: iter + 1, rate }));
             }
             dw_norm_old = Some(dw_norm);
         }
@@ -380,16 +328,12 @@ impl Radau5 {
         let n = self.core.n;
         // ZE = Z^T E / h, kept in fz[0..n] (the stage derivatives are no longer needed).
         for i in 0..n {
-            let ze: f64 = (0..3)
-                .map(|k| self.tab.e[k] * self.z[k * n + i])
-                .sum::<f64>()
-                / h;
+            let ze: f64 = (0..3).map(|k| self.tab.e[k] * self.z[k * n + i]).sum::<f64>() / h;
             self.fz[i] = ze;
             self.err[i] = self.core.f[i] + ze;
         }
         lu_solve(&self.lu_real, n, &self.piv_real, &mut self.err);
-        let mut norm =
-            super::control::error_norm(&self.err, &self.core.y, &self.y_new, &self.core.opts);
+        let mut norm = super::control::error_norm(&self.err, &self.core.y, &self.y_new, &self.core.opts);
         if stabilise && norm > 1.0 {
             for i in 0..n {
                 self.ytmp[i] = self.core.y[i] + self.err[i];
@@ -400,46 +344,27 @@ impl Radau5 {
                     self.err[i] += self.fz[i];
                 }
                 lu_solve(&self.lu_real, n, &self.piv_real, &mut self.err);
-                norm = super::control::error_norm(
-                    &self.err,
-                    &self.core.y,
-                    &self.y_new,
-                    &self.core.opts,
-                );
+                norm = super::control::error_norm(&self.err, &self.core.y, &self.y_new, &self.core.opts);
             }
         }
         norm
     }
 
     /// One accepted step; see the module doc for the logic.
-    pub fn step<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t_stop: f64,
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
         self.core.assert_started();
         if t_stop.is_nan() || t_stop <= self.core.t {
             return Ok(());
         }
         if !self.jac_valid {
-            self.compute_jacobian(sys).map_err(|error| StepError::Rhs {
-                t: self.core.t,
-                error,
-            })?;
+            self.compute_jacobian(sys).map_err(|error| StepError::Rhs { t: self.core.t, error })?;
         }
         let fixed = self.core.opts.dt;
         let mut h = match (fixed, self.core.opts.h0) {
             (Some(dt), _) => dt,
             _ if self.core.h_next > 0.0 => self.core.h_next,
             (None, Some(h0)) => h0,
-            (None, None) => initial_step(
-                sys,
-                &mut self.core,
-                t_stop,
-                3,
-                &mut self.ytmp,
-                &mut self.f_new,
-            ),
+            (None, None) => initial_step(sys, &mut self.core, t_stop, 3, &mut self.ytmp, &mut self.f_new),
         };
         let h_start = h;
         let (mut h_old, mut err_old) = (self.h_old, self.err_old);
@@ -450,32 +375,21 @@ impl Radau5 {
         let mut rejected = false;
         let mut last_failure: Option<Failure<S::Error>> = None;
         let (newton, err_norm, h_planned, h, t_new) = loop {
-            let (h_try, t_new) =
-                self.core
-                    .next_try(h, t_stop, stretch, rejected, &mut last_failure)?;
+            let (h_try, t_new) = self.core.next_try(h, t_stop, stretch, rejected, &mut last_failure)?;
             match self.attempt(sys, h_try) {
                 Ok(newton) => {
-                    let err = if fixed.is_some() {
-                        0.0
-                    } else {
-                        self.error_estimate(sys, h_try, rejected)
-                    };
+                    let err = if fixed.is_some() { 0.0 } else { self.error_estimate(sys, h_try, rejected) };
                     if err <= 1.0 {
                         break (newton, err, h, h_try, t_new);
                     }
-                    let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64
-                        / (2 * NEWTON_MAXITER + newton.iterations) as f64;
+                    let safety =
+                        0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + newton.iterations) as f64;
                     let factor = predict_factor(h_try, h_old, err, err_old);
                     h = h_try * (safety * factor).max(MIN_FACTOR);
                     last_failure = None;
                 }
                 Err(f) => {
-                    h = h_try
-                        * if matches!(f, Failure::Newton) {
-                            0.5
-                        } else {
-                            FAIL_FACTOR
-                        };
+                    h = h_try * if matches!(f, Failure::Newton) { 0.5 } else { FAIL_FACTOR };
                     last_failure = Some(f);
                 }
             }
@@ -485,8 +399,7 @@ impl Radau5 {
         };
         // Accepted: choose the next step and whether to refresh J (scipy's rules).
         let recompute_jac = newton.iterations > 2 && newton.rate > 1e-3;
-        let safety =
-            0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + newton.iterations) as f64;
+        let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + newton.iterations) as f64;
         let mut factor = (safety * predict_factor(h, h_old, err_norm, err_old)).min(MAX_FACTOR);
         if !recompute_jac && factor < 1.2 {
             factor = 1.0;
@@ -532,13 +445,7 @@ impl Radau5 {
             return Err(Failure::NonFinite);
         }
         let t_new = self.core.t + h;
-        Core::eval(
-            &mut self.core.stats,
-            sys,
-            t_new,
-            &self.y_new,
-            &mut self.f_new,
-        )?;
+        Core::eval(&mut self.core.stats, sys, t_new, &self.y_new, &mut self.f_new)?;
         Ok(newton)
     }
 

@@ -48,20 +48,11 @@ impl Rk4 {
         }
     }
 
-    pub fn reset<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t: f64,
-        y: &[f64],
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         self.core.reset(sys, t, y)
     }
 
-    pub fn step<S: OdeSystem>(
-        &mut self,
-        sys: &mut S,
-        t_stop: f64,
-    ) -> Result<(), StepError<S::Error>> {
+    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
         explicit_step(self, sys, t_stop)
     }
 
@@ -104,13 +95,7 @@ impl ExplicitPair for Rk4 {
 
     /// One RK4 step; returns an error norm of 0 (no estimate).
     fn attempt<S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<f64, Failure<S::Error>> {
-        let Rk4 {
-            core,
-            k,
-            ytmp,
-            y_new,
-            f_new,
-        } = self;
+        let Rk4 { core, k, ytmp, y_new, f_new } = self;
         let (t, n) = (core.t, core.n);
         let [k2, k3, k4] = k;
         for i in 0..n {

@@ -258,9 +258,7 @@ pub fn pair_coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f6
 /// Rate of a pair's relative coordinate: its gradient times xd.
 pub fn pair_coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
     match pair.kind {
-        PairKind::Revolute => {
-            part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1
-        }
+        PairKind::Revolute => part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1,
         PairKind::Prismatic { axis } => {
             let p = projection(pair, axis, x);
             let (ra, pa) = part(&p.a, xd);
@@ -398,9 +396,7 @@ pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &
     }
     for (k, o) in out[nc..].iter_mut().enumerate() {
         *o = match chart {
-            Chart::Inputs => {
-                pair_coordinate_gamma(&mech.pairs[mech.coordinates[k].pair.0], x, u, v)
-            }
+            Chart::Inputs => pair_coordinate_gamma(&mech.pairs[mech.coordinates[k].pair.0], x, u, v),
             Chart::Partition(_) => 0.0,
         };
     }

@@ -9,6 +9,8 @@ pub mod system;
 
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
 pub use constraints::{coordinate_rates, coordinates, Chart};
-pub use position::{assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL};
+pub use position::{
+    assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL,
+};
 pub use singularity::{constraint_rank, passive_sigma_min, select_partition, sigma_min};
 pub use system::System;

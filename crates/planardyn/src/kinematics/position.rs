@@ -49,7 +49,8 @@ fn newton_update(ws: &mut Workspace) {
 /// factorised and `ws.residual` the scaled residual. Fails if J is singular on the way or
 /// Newton does not converge.
 pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
-    let tol = POSITION_TOL * (1.0 + ws.x.iter().zip(&ws.sys.col_scale).fold(0.0, |m: f64, (v, s)| m.max((v / s).abs())));
+    let tol =
+        POSITION_TOL * (1.0 + ws.x.iter().zip(&ws.sys.col_scale).fold(0.0, |m: f64, (v, s)| m.max((v / s).abs())));
     set_row_scale(mech, &ws.chart, &mut ws.sys.row_scale);
     if ws.sys.is_factored_for(&ws.chart) {
         ws.rhs.copy_from_slice(&ws.x);
@@ -111,7 +112,9 @@ fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
             Chart::Inputs => "the generalized coordinates do not determine the mechanism's position \
                               (a type II, parallel singularity of the actuated mechanism)"
                 .to_string(),
-            Chart::Partition(_) => "the pair constraints lose rank (a singularity of the passive mechanism)".to_string(),
+            Chart::Partition(_) => {
+                "the pair constraints lose rank (a singularity of the passive mechanism)".to_string()
+            }
         },
     })
 }

@@ -150,7 +150,15 @@ impl System {
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
 /// scales, given the column scales `cs`.
-pub fn scaled_jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], rs: &mut [f64], cs: &[f64], j: &mut [f64]) {
+pub fn scaled_jacobian(
+    mech: &Mechanism,
+    chart: &Chart,
+    x: &[f64],
+    trig: &[[f64; 2]],
+    rs: &mut [f64],
+    cs: &[f64],
+    j: &mut [f64],
+) {
     let n = x.len();
     set_row_scale(mech, chart, rs);
     jacobian(mech, chart, x, trig, j);
@@ -173,7 +181,9 @@ pub fn pair_row_scales(pair: &Pair, inv: f64) -> [f64; 2] {
 pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
     let inv = 1.0 / mech.scale;
     for (k, pair) in mech.pairs.iter().enumerate() {
-        for (slot, scale) in [mech.row_slot[2 * k], mech.row_slot[2 * k + 1]].into_iter().zip(pair_row_scales(pair, inv)) {
+        for (slot, scale) in
+            [mech.row_slot[2 * k], mech.row_slot[2 * k + 1]].into_iter().zip(pair_row_scales(pair, inv))
+        {
             if let Some(i) = slot {
                 rs[i] = scale;
             }

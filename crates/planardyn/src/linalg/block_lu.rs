@@ -93,7 +93,8 @@ impl BlockLu {
     pub fn new(pattern: &[Vec<usize>]) -> Self {
         let n = pattern.len();
         let blocks = blocks(pattern).unwrap_or_else(|| vec![((0..n).collect(), (0..n).collect())]);
-        let (mut row, mut col, mut start, mut lu_at) = (Vec::with_capacity(n), Vec::with_capacity(n), vec![0], Vec::new());
+        let (mut row, mut col, mut start, mut lu_at) =
+            (Vec::with_capacity(n), Vec::with_capacity(n), vec![0], Vec::new());
         let mut size = 0;
         for (rows, cols) in &blocks {
             lu_at.push(size);
@@ -162,7 +163,8 @@ impl BlockLu {
             let (s0, s1, base) = (self.start[k], self.start[k + 1], self.lu_at[k]);
             let s = s1 - s0;
             let block = &mut self.store[base..base + s * s];
-            lu_factor(block, s, &mut self.piv[s0..s1], tiny).map_err(|e| LuError { column: self.col[s0 + e.column] })?;
+            lu_factor(block, s, &mut self.piv[s0..s1], tiny)
+                .map_err(|e| LuError { column: self.col[s0 + e.column] })?;
             let src = &mut self.src[s0..s1];
             for (i, p) in src.iter_mut().enumerate() {
                 *p = s0 + i;
@@ -407,7 +409,10 @@ mod tests {
         }
         lu.factor(1e-300).unwrap();
         let xs: Vec<f64> = (0..25).map(|k| ((k * 7 % 11) as f64 - 5.0) / 3.0).collect();
-        let mut b: Vec<f64> = xs.chunks(5).flat_map(|x| (0..5).map(|i| (0..5).map(|j| a[i * 5 + j] * x[j]).sum::<f64>()).collect::<Vec<_>>()).collect();
+        let mut b: Vec<f64> = xs
+            .chunks(5)
+            .flat_map(|x| (0..5).map(|i| (0..5).map(|j| a[i * 5 + j] * x[j]).sum::<f64>()).collect::<Vec<_>>())
+            .collect();
         lu.solve_many_scaled(&mut b, &rs, &cs);
         for (k, (got, want)) in b.iter().zip(&xs).enumerate() {
             assert!((got - want).abs() < 1e-13, "entry {k}: {got} vs {want}");

@@ -14,5 +14,5 @@ mod sink;
 
 pub use block_lu::{BlockLu, BlockSink};
 pub use cholesky::{cholesky_in_place, cholesky_solve};
-pub use sink::{Dense, Sink};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
+pub use sink::{Dense, Sink};

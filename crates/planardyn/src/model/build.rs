@@ -30,16 +30,18 @@ const MIN_MASS: f64 = 1e-30;
 
 impl Ctx<'_> {
     fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
-        ModelError::Invalid {
-            source_name: self.source.to_string(),
-            path: path.into(),
-            message: message.into(),
-        }
+        ModelError::Invalid { source_name: self.source.to_string(), path: path.into(), message: message.into() }
     }
     fn point(&self, path: &str, name: &str) -> R<PointId> {
         self.spec.points.0.get_index_of(name).map(PointId).ok_or_else(|| {
             let known: Vec<&str> = self.spec.points.0.keys().map(String::as_str).collect();
-            self.err(path, format!("unknown point '{name}'; points are: {} (use one of them, or add it to `points`)", known.join(", ")))
+            self.err(
+                path,
+                format!(
+                    "unknown point '{name}'; points are: {} (use one of them, or add it to `points`)",
+                    known.join(", ")
+                ),
+            )
         })
     }
     fn xy(&self, path: &str, name: &str) -> R<[f64; 2]> {
@@ -53,7 +55,10 @@ impl Ctx<'_> {
             let known: Vec<&str> = self.spec.bodies.0.keys().map(String::as_str).collect();
             self.err(
                 path,
-                format!("unknown body '{name}'; bodies are: ground, {} (use one of them, or add it to `bodies`)", known.join(", ")),
+                format!(
+                    "unknown body '{name}'; bodies are: ground, {} (use one of them, or add it to `bodies`)",
+                    known.join(", ")
+                ),
             )
         })
     }
@@ -63,7 +68,10 @@ impl Ctx<'_> {
             return Err(self.err(path, format!("{v} is not a finite number; give a finite one")));
         }
         if v.abs() > MAX_MAGNITUDE {
-            return Err(self.err(path, format!("{v:e} is beyond the largest magnitude accepted, {MAX_MAGNITUDE:e}: check the units (SI)")));
+            return Err(self.err(
+                path,
+                format!("{v:e} is beyond the largest magnitude accepted, {MAX_MAGNITUDE:e}: check the units (SI)"),
+            ));
         }
         Ok(v)
     }
@@ -91,7 +99,10 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         }
         let p = [ctx.finite(&path, xy[0])?, ctx.finite(&path, xy[1])?];
         if p[0].abs().max(p[1].abs()) > MAX_COORDINATE {
-            return Err(ctx.err(path, format!("{p:?} is more than {MAX_COORDINATE:e} m from the origin: check the units (SI: metres)")));
+            return Err(ctx.err(
+                path,
+                format!("{p:?} is more than {MAX_COORDINATE:e} m from the origin: check the units (SI: metres)"),
+            ));
         }
         points.push((name.clone(), p));
     }
@@ -103,12 +114,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         }
         ground_points.push(p);
     }
-    let bodies = spec
-        .bodies
-        .0
-        .iter()
-        .map(|(name, b)| build_body(&ctx, name, b))
-        .collect::<R<Vec<_>>>()?;
+    let bodies = spec.bodies.0.iter().map(|(name, b)| build_body(&ctx, name, b)).collect::<R<Vec<_>>>()?;
     let mut mech = Mechanism {
         name: spec.name.clone(),
         source: source.to_string(),
@@ -133,18 +139,16 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     for (k, p) in spec.pairs.iter().enumerate() {
         let pair = build_pair(&ctx, &mech, k, p)?;
         if mech.pairs.iter().any(|q| q.name == pair.name) {
-            return Err(ctx.err(format!("pairs[{k}].name"), format!("duplicate pair name '{}'; rename one of the two", pair.name)));
+            return Err(ctx.err(
+                format!("pairs[{k}].name"),
+                format!("duplicate pair name '{}'; rename one of the two", pair.name),
+            ));
         }
         mech.pairs.push(pair);
     }
     build_coordinates(&ctx, &mut mech)?;
     mech.drives = build_drives(&ctx, &mech, &spec.drives)?;
-    mech.loads = spec
-        .loads
-        .iter()
-        .enumerate()
-        .map(|(k, l)| build_load(&ctx, &mech, k, l))
-        .collect::<R<_>>()?;
+    mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     check_mobility(&ctx, &mut mech)?;
     check_assembly(&ctx, &mech)?;
@@ -159,10 +163,9 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     }
     let kinds = [p.com.is_some(), p.uniform_bar.is_some(), p.point_mass.is_some()];
     if kinds.iter().filter(|&&k| k).count() != 1 {
-        return Err(ctx.err(
-            path,
-            "give exactly one of `com` (with `inertia`), `uniform_bar: [P, Q]` or `point_mass: P`",
-        ));
+        return Err(
+            ctx.err(path, "give exactly one of `com` (with `inertia`), `uniform_bar: [P, Q]` or `point_mass: P`")
+        );
     }
     if let Some([a, b]) = &p.uniform_bar {
         if p.inertia.is_some() {
@@ -174,13 +177,15 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     }
     if let Some(pt) = &p.point_mass {
         if p.inertia.is_some() {
-            return Err(ctx.err(format!("{path}.inertia"), "a point mass has no inertia; remove `inertia` or use `com`"));
+            return Err(
+                ctx.err(format!("{path}.inertia"), "a point mass has no inertia; remove `inertia` or use `com`")
+            );
         }
         return Ok((mass, 0.0, ctx.xy(&format!("{path}.point_mass"), pt)?));
     }
-    let inertia = p
-        .inertia
-        .ok_or_else(|| ctx.err(format!("{path}.inertia"), "missing: add the moment of inertia about the centre of mass (kg m^2)"))?;
+    let inertia = p.inertia.ok_or_else(|| {
+        ctx.err(format!("{path}.inertia"), "missing: add the moment of inertia about the centre of mass (kg m^2)")
+    })?;
     let inertia = ctx.non_negative(&format!("{path}.inertia"), inertia)?;
     let com = match p.com.as_ref().expect("checked above") {
         Location::Coords(c) => [ctx.finite(&format!("{path}.com"), c[0])?, ctx.finite(&format!("{path}.com"), c[1])?],
@@ -210,9 +215,16 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
                 return Err(ctx.err(&path, "give either `parts` or the body's own mass properties, not both"));
             }
             if parts.is_empty() {
-                return Err(ctx.err(format!("{path}.parts"), "empty list of parts; add a part, or remove `parts` and give the body's own mass"));
+                return Err(ctx.err(
+                    format!("{path}.parts"),
+                    "empty list of parts; add a part, or remove `parts` and give the body's own mass",
+                ));
             }
-            parts.iter().enumerate().map(|(k, p)| part_inertia(ctx, &format!("{path}.parts[{k}]"), p)).collect::<R<_>>()?
+            parts
+                .iter()
+                .enumerate()
+                .map(|(k, p)| part_inertia(ctx, &format!("{path}.parts[{k}]"), p))
+                .collect::<R<_>>()?
         }
         None => {
             if b.mass.is_none() {
@@ -229,10 +241,7 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         parts.iter().map(|p| p.0 * p.2[0]).sum::<f64>() / mass,
         parts.iter().map(|p| p.0 * p.2[1]).sum::<f64>() / mass,
     ];
-    let inertia: f64 = parts
-        .iter()
-        .map(|(m, i, c)| i + m * ((c[0] - com[0]).powi(2) + (c[1] - com[1]).powi(2)))
-        .sum();
+    let inertia: f64 = parts.iter().map(|(m, i, c)| i + m * ((c[0] - com[0]).powi(2) + (c[1] - com[1]).powi(2))).sum();
     if !(inertia >= MIN_MASS) {
         return Err(ctx.err(
             format!("{path}.inertia"),
@@ -253,7 +262,10 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
             let (a, b) = (xy(*p0), xy(*p1));
             let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
             if dx.hypot(dy) == 0.0 {
-                return Err(ctx.err(format!("{path}.points"), "the first two points coincide, so they do not define the body's angle; list another point second"));
+                return Err(ctx.err(
+                    format!("{path}.points"),
+                    "the first two points coincide, so they do not define the body's angle; list another point second",
+                ));
             }
             dy.atan2(dx)
         }
@@ -284,14 +296,20 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
     let point = ctx.point(&format!("{path}.at"), at)?;
     let carried = |link: Link, i: usize| {
         mech.attachment(link, point).ok_or_else(|| {
-            let fix = if link == Link::Ground { "add it to the top-level `ground` list" } else { "add it to that body's `points`" };
+            let fix = if link == Link::Ground {
+                "add it to the top-level `ground` list"
+            } else {
+                "add it to that body's `points`"
+            };
             ctx.err(format!("{path}.at"), format!("'{}' does not carry point '{at}' ({}: {fix})", bodies[i], bodies[i]))
         })
     };
     // A slider's guide passes through the pair point in the drawing: the guide body need not
     // list it (its copy is placed where the drawing puts it).
     let sa = match p {
-        PairSpec::Prismatic { .. } => mech.attachment(a, point).map_or_else(|| local_coords(mech, a, mech.points[point.0].1), |at| at.s),
+        PairSpec::Prismatic { .. } => {
+            mech.attachment(a, point).map_or_else(|| local_coords(mech, a, mech.points[point.0].1), |at| at.s)
+        }
         PairSpec::Revolute { .. } => carried(a, 0)?.s,
     };
     let sb = carried(b, 1)?.s;
@@ -305,14 +323,22 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
             let d = match (axis, along) {
                 (Some(d), None) => *d,
                 (None, Some([from, to])) => {
-                    let (pf, pt) = (ctx.xy(&format!("{path}.along[0]"), from)?, ctx.xy(&format!("{path}.along[1]"), to)?);
+                    let (pf, pt) =
+                        (ctx.xy(&format!("{path}.along[0]"), from)?, ctx.xy(&format!("{path}.along[1]"), to)?);
                     [pt[0] - pf[0], pt[1] - pf[1]]
                 }
-                _ => return Err(ctx.err(&path, "give a prismatic pair exactly one of `axis: [dx, dy]` or `along: [P, Q]`")),
+                _ => {
+                    return Err(
+                        ctx.err(&path, "give a prismatic pair exactly one of `axis: [dx, dy]` or `along: [P, Q]`")
+                    )
+                }
             };
             let len = d[0].hypot(d[1]);
             if !(len > 0.0 && len.is_finite()) {
-                return Err(ctx.err(&path, "the guide direction has zero length; give a non-zero `axis`, or two distinct `along` points"));
+                return Err(ctx.err(
+                    &path,
+                    "the guide direction has zero length; give a non-zero `axis`, or two distinct `along` points",
+                ));
             }
             let (c, s) = (angle(a).cos(), angle(a).sin());
             let (ux, uy) = (d[0] / len, d[1] / len);
@@ -338,7 +364,10 @@ fn local_coords(mech: &Mechanism, link: Link, p: [f64; 2]) -> [f64; 2] {
 
 fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
     mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
-        ctx.err(path, format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")))
+        ctx.err(
+            path,
+            format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")),
+        )
     })
 }
 
@@ -346,11 +375,17 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     for (k, c) in ctx.spec.coordinates.iter().enumerate() {
         let path = format!("coordinates[{k}]");
         if mech.coordinates.iter().any(|d| d.name == c.name) || c.name.is_empty() {
-            return Err(ctx.err(format!("{path}.name"), format!("coordinate name '{}' is empty or used twice; give each coordinate its own name", c.name)));
+            return Err(ctx.err(
+                format!("{path}.name"),
+                format!("coordinate name '{}' is empty or used twice; give each coordinate its own name", c.name),
+            ));
         }
         let pair = pair_id(ctx, mech, &format!("{path}.pair"), &c.pair)?;
         if mech.coordinates.iter().any(|d| d.pair == pair) {
-            return Err(ctx.err(format!("{path}.pair"), format!("pair '{}' already has a coordinate; remove one of the two", c.pair)));
+            return Err(ctx.err(
+                format!("{path}.pair"),
+                format!("pair '{}' already has a coordinate; remove one of the two", c.pair),
+            ));
         }
         let kind = match mech.pairs[pair.0].kind {
             PairKind::Revolute => CoordinateKind::Angle,
@@ -370,7 +405,13 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
 
 fn coordinate_index(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<usize> {
     mech.coordinates.iter().position(|c| c.name == name).ok_or_else(|| {
-        ctx.err(path, format!("unknown coordinate '{name}'; coordinates are: {} (use one of them)", mech.coordinate_names().join(", ")))
+        ctx.err(
+            path,
+            format!(
+                "unknown coordinate '{name}'; coordinates are: {} (use one of them)",
+                mech.coordinate_names().join(", ")
+            ),
+        )
     })
 }
 
@@ -380,14 +421,19 @@ fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<Vec<Opti
         let path = format!("drives[{k}]");
         let i = coordinate_index(ctx, mech, &format!("{path}.coordinate"), &d.coordinate)?;
         if out[i].is_some() {
-            return Err(ctx.err(format!("{path}.coordinate"), format!("coordinate '{}' already has a drive; remove one of the two", d.coordinate)));
+            return Err(ctx.err(
+                format!("{path}.coordinate"),
+                format!("coordinate '{}' already has a drive; remove one of the two", d.coordinate),
+            ));
         }
         out[i] = Some(match (&d.effort, &d.table) {
             (Some(e), None) => DriveLaw::Constant(ctx.finite(&format!("{path}.effort"), *e)?),
             (None, Some(table)) => {
                 let n = table.t.len();
                 if n == 0 || n != table.effort.len() {
-                    return Err(ctx.err(format!("{path}.table"), "`t` and `effort` must be non-empty and of equal length"));
+                    return Err(
+                        ctx.err(format!("{path}.table"), "`t` and `effort` must be non-empty and of equal length")
+                    );
                 }
                 for (j, (&t, &e)) in table.t.iter().zip(&table.effort).enumerate() {
                     ctx.finite(&format!("{path}.table.t[{j}]"), t)?;
@@ -407,9 +453,8 @@ fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<Vec<Opti
 fn body_point(ctx: &Ctx, mech: &Mechanism, path: &str, body: &str, point: &str) -> R<Attachment> {
     let link = ctx.link(&format!("{path}.body"), body)?;
     let id = ctx.point(&format!("{path}.at"), point)?;
-    mech.attachment(link, id).ok_or_else(|| {
-        ctx.err(path, format!("body '{body}' does not carry point '{point}'; add it to its points"))
-    })
+    mech.attachment(link, id)
+        .ok_or_else(|| ctx.err(path, format!("body '{body}' does not carry point '{point}'; add it to its points")))
 }
 
 fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
@@ -423,10 +468,15 @@ fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
             mobile(body)?;
             Load::Force {
                 at: body_point(ctx, mech, &path, body, at)?,
-                value: [ctx.finite(&format!("{path}.value"), value[0])?, ctx.finite(&format!("{path}.value"), value[1])?],
+                value: [
+                    ctx.finite(&format!("{path}.value"), value[0])?,
+                    ctx.finite(&format!("{path}.value"), value[1])?,
+                ],
             }
         }
-        LoadSpec::Torque { body, value } => Load::Torque { body: mobile(body)?, value: ctx.finite(&format!("{path}.value"), *value)? },
+        LoadSpec::Torque { body, value } => {
+            Load::Torque { body: mobile(body)?, value: ctx.finite(&format!("{path}.value"), *value)? }
+        }
         LoadSpec::Spring { between, stiffness, damping, rest_length } => {
             let e0 = body_point(ctx, mech, &format!("{path}.between[0]"), &between[0][0], &between[0][1])?;
             let e1 = body_point(ctx, mech, &format!("{path}.between[1]"), &between[1][0], &between[1][1])?;
@@ -458,7 +508,9 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
     let Some(s) = s else { return Ok(SimulateDefaults::default()) };
     let positive = |field: &str, v: Option<f64>| -> R<Option<f64>> {
         match v {
-            Some(x) if !(x > 0.0 && x.is_finite()) => Err(ctx.err(format!("simulate.{field}"), format!("{x} must be a positive number"))),
+            Some(x) if !(x > 0.0 && x.is_finite()) => {
+                Err(ctx.err(format!("simulate.{field}"), format!("{x} must be a positive number")))
+            }
             _ => Ok(v),
         }
     };
@@ -535,5 +587,9 @@ fn characteristic_length(points: &[(String, [f64; 2])]) -> f64 {
             l = l.max((a[0] - b[0]).hypot(a[1] - b[1]));
         }
     }
-    if l > 0.0 { l } else { 1.0 }
+    if l > 0.0 {
+        l
+    } else {
+        1.0
+    }
 }

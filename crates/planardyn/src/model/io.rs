@@ -34,7 +34,10 @@ pub fn load(path: impl AsRef<Path>) -> Result<Mechanism, ModelError> {
     let text = String::from_utf8(bytes).map_err(|e| {
         let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line_start = valid.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-        let (line, column) = (valid.iter().filter(|&&b| b == b'\n').count() + 1, String::from_utf8_lossy(&valid[line_start..]).chars().count() + 1);
+        let (line, column) = (
+            valid.iter().filter(|&&b| b == b'\n').count() + 1,
+            String::from_utf8_lossy(&valid[line_start..]).chars().count() + 1,
+        );
         error(format!("line {line} column {column}"), "the file is not UTF-8 text; save it as UTF-8".into())
     })?;
     loads(&text, Format::from_path(path), &source)

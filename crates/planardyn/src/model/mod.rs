@@ -101,7 +101,10 @@ pub struct Coordinate {
 pub enum DriveLaw {
     Constant(f64),
     /// Linear interpolation in time, held constant outside `t[0]..t[last]`.
-    Table { t: Vec<f64>, effort: Vec<f64> },
+    Table {
+        t: Vec<f64>,
+        effort: Vec<f64>,
+    },
 }
 
 impl DriveLaw {
@@ -140,20 +143,10 @@ pub enum Load {
     /// Constant torque (N m) on a body.
     Torque { body: BodyId, value: f64 },
     /// Linear spring-damper between two points: tension k (L - rest_length) + c L'.
-    Spring {
-        ends: [Attachment; 2],
-        stiffness: f64,
-        damping: f64,
-        rest_length: f64,
-    },
+    Spring { ends: [Attachment; 2], stiffness: f64, damping: f64, rest_length: f64 },
     /// Spring-damper on the relative motion of a pair (angle or displacement from the
     /// drawing): generalized effort -k (theta - rest) - c theta'. Viscous friction has k = 0.
-    PairSpring {
-        pair: PairId,
-        stiffness: f64,
-        damping: f64,
-        rest: f64,
-    },
+    PairSpring { pair: PairId, stiffness: f64, damping: f64, rest: f64 },
 }
 
 /// Default simulation settings read from the model file.
@@ -253,15 +246,10 @@ impl Mechanism {
     /// Where a link carries a point (the point's coordinates in the link frame), if it does.
     pub fn attachment(&self, link: Link, point: PointId) -> Option<Attachment> {
         match link {
-            Link::Ground => self
-                .ground_points
-                .contains(&point)
-                .then(|| Attachment { link, s: self.points[point.0].1 }),
-            Link::Body(b) => self.bodies[b.0]
-                .points
-                .iter()
-                .find(|(p, _)| *p == point)
-                .map(|&(_, s)| Attachment { link, s }),
+            Link::Ground => self.ground_points.contains(&point).then(|| Attachment { link, s: self.points[point.0].1 }),
+            Link::Body(b) => {
+                self.bodies[b.0].points.iter().find(|(p, _)| *p == point).map(|&(_, s)| Attachment { link, s })
+            }
         }
     }
     /// Link name (`ground` or the body's).

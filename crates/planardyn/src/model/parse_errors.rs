@@ -90,7 +90,9 @@ impl Input<'_> {
             Format::Json => "the text is not valid JSON: check the brackets, quotes, commas and colons there (JSON has no NaN or Infinity)",
         };
         let fix = match message {
-            "unknown anchor" => "an alias `*name` needs an anchor `&name` before it: add the anchor or write the value out".into(),
+            "unknown anchor" => {
+                "an alias `*name` needs an anchor `&name` before it: add the anchor or write the value out".into()
+            }
             "recursion limit exceeded" => "the text nests too deeply: check the brackets".into(),
             "repetition limit exceeded" => "aliases `*name` expand to too much: write the values out".into(),
             "EOF while parsing a value" => format!("the text is empty: write a model ({docs})"),
@@ -107,7 +109,8 @@ impl Input<'_> {
     fn line_column(&self, message: &str, at: LineColumn) -> String {
         let (line, column) = at.unwrap_or_else(|| {
             let second_document = message.contains("more than one document").then(|| {
-                let starts = self.text.lines().enumerate().filter(|(_, l)| l.starts_with("---") || l.starts_with("..."));
+                let starts =
+                    self.text.lines().enumerate().filter(|(_, l)| l.starts_with("---") || l.starts_with("..."));
                 let content = self.text.lines().position(|l| !l.trim().is_empty() && !l.starts_with('#')).unwrap_or(0);
                 starts.map(|(i, _)| i).find(|&i| i > content)
             });
@@ -176,7 +179,10 @@ fn plain(message: &str) -> String {
         ("struct TableSpec", "a table (a mapping: t, effort)"),
         ("struct SimulateSpec", "simulation settings (a mapping: t_end, method...)"),
         ("internally tagged enum PairSpec", "a pair (a mapping with type: revolute or prismatic)"),
-        ("internally tagged enum LoadSpec", "a load (a mapping with type: force, torque, spring, torsional_spring or friction)"),
+        (
+            "internally tagged enum LoadSpec",
+            "a load (a mapping with type: force, torque, spring, torsional_spring or friction)",
+        ),
         ("a map from names to entries", "a mapping from names to entries"),
         ("sequence", "list"),
         ("an array of length 2", "a list of 2 items"),
@@ -198,7 +204,12 @@ mod tests {
 
     #[test]
     fn marks_are_stripped_wherever_they_are() {
-        assert_eq!(strip_marks("did not find expected key at line 3 column 5, while parsing a block mapping at line 1 column 1"), "did not find expected key, while parsing a block mapping");
+        assert_eq!(
+            strip_marks(
+                "did not find expected key at line 3 column 5, while parsing a block mapping at line 1 column 1"
+            ),
+            "did not find expected key, while parsing a block mapping"
+        );
         assert_eq!(strip_marks("found unexpected end of stream at position 12"), "found unexpected end of stream");
         assert_eq!(strip_marks("expected value at line 1 column 0"), "expected value");
         assert_eq!(strip_marks("the line at line x"), "the line at line x");
@@ -207,7 +218,10 @@ mod tests {
     #[test]
     fn rust_names_become_plain_words() {
         assert_eq!(plain("invalid type: string \"a\", expected f64"), "invalid type: string \"a\", expected a number");
-        assert_eq!(plain("invalid length 3, expected an array of length 2"), "invalid length 3, expected a list of 2 items");
+        assert_eq!(
+            plain("invalid length 3, expected an array of length 2"),
+            "invalid length 3, expected a list of 2 items"
+        );
         assert_eq!(
             plain("invalid length 1, expected struct variant PairSpec::Revolute with 3 elements"),
             "invalid length 1, expected a mapping with the fields of its `type`"

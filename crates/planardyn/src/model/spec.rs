@@ -171,11 +171,7 @@ pub struct TableSpec {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadSpec {
     /// A constant force [F_x, F_y] (N, global frame) at a point of a body.
-    Force {
-        body: String,
-        at: String,
-        value: [f64; 2],
-    },
+    Force { body: String, at: String, value: [f64; 2] },
     /// A constant torque (N m) on a body.
     Torque { body: String, value: f64 },
     /// A linear spring-damper between two body points, each given as [body, point]:

@@ -43,7 +43,8 @@ impl Settings {
             Some(name) => name.parse().map_err(Error::Options)?,
             None => Method::Dop853,
         };
-        let options = Options { rtol: d.rtol.unwrap_or(1e-9), atol: d.atol.unwrap_or(1e-12), dt: d.dt, ..Options::default() };
+        let options =
+            Options { rtol: d.rtol.unwrap_or(1e-9), atol: d.atol.unwrap_or(1e-12), dt: d.dt, ..Options::default() };
         let t_end = d.t_end.unwrap_or(1.0);
         let t_eval = d.output_dt.map(|h| grid(0.0, t_end, h));
         Ok(Settings { t0: 0.0, t_end, method, options, t_eval, q0: None, qd0: None })
@@ -66,20 +67,34 @@ fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
     for (name, v) in [("q0", &settings.q0), ("qd0", &settings.qd0)] {
         if let Some(v) = v {
             if v.len() != mech.dof() || v.iter().any(|x| !x.is_finite()) {
-                return bad(format!("{name} needs {} finite values ({}), got {v:?}", mech.dof(), mech.coordinate_names().join(", ")));
+                return bad(format!(
+                    "{name} needs {} finite values ({}), got {v:?}",
+                    mech.dof(),
+                    mech.coordinate_names().join(", ")
+                ));
             }
         }
     }
     if let Some(te) = &settings.t_eval {
-        if te.windows(2).any(|w| !(w[1] > w[0])) || te.first().is_some_and(|&t| t < settings.t0) || te.last().is_some_and(|&t| t > settings.t_end) {
-            return bad(format!("t_eval must increase strictly within [t0, t_end] = [{}, {}]", settings.t0, settings.t_end));
+        if te.windows(2).any(|w| !(w[1] > w[0]))
+            || te.first().is_some_and(|&t| t < settings.t0)
+            || te.last().is_some_and(|&t| t > settings.t_end)
+        {
+            return bad(format!(
+                "t_eval must increase strictly within [t0, t_end] = [{}, {}]",
+                settings.t0, settings.t_end
+            ));
         }
     }
     Ok(())
 }
 
 /// The start: assembled at q0, in the user's chart unless it is near-singular there.
-fn start<'a>(mech: &'a Mechanism, s: &Settings, drives: &'a mut dyn Drives) -> Result<(MechanismOde<'a>, Vec<f64>), Error> {
+fn start<'a>(
+    mech: &'a Mechanism,
+    s: &Settings,
+    drives: &'a mut dyn Drives,
+) -> Result<(MechanismOde<'a>, Vec<f64>), Error> {
     let (q0m, qd0m) = mech.initial_state();
     let q0 = s.q0.clone().unwrap_or(q0m);
     let qd0 = s.qd0.clone().unwrap_or(qd0m);
@@ -105,7 +120,12 @@ fn start<'a>(mech: &'a Mechanism, s: &Settings, drives: &'a mut dyn Drives) -> R
     let mut ode = MechanismOde::new(mech, ws, drives);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
-        return Err(KinematicsError::Singular { sigma_min: m0.passive, what: "the passive mechanism is singular at the start (its pair constraints lose rank); start elsewhere".into() }.into());
+        return Err(KinematicsError::Singular {
+            sigma_min: m0.passive,
+            what: "the passive mechanism is singular at the start (its pair constraints lose rank); start elsewhere"
+                .into(),
+        }
+        .into());
     }
     let chart = next_chart(&ode, &m0, m0.sigma).unwrap_or(Chart::Inputs);
     let m = mech.dof();
@@ -143,7 +163,12 @@ fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi
 /// Simulate from the model's (or the given) initial state. `progress(t)` is called after
 /// each accepted step and may return false to stop. Errors in the settings or at the
 /// start return Err; anything after the start returns the partial trajectory with a status.
-pub fn simulate(mech: &Mechanism, settings: &Settings, drives: &mut dyn Drives, mut progress: Option<&mut dyn FnMut(f64) -> bool>) -> Result<Trajectory, Error> {
+pub fn simulate(
+    mech: &Mechanism,
+    settings: &Settings,
+    drives: &mut dyn Drives,
+    mut progress: Option<&mut dyn FnMut(f64) -> bool>,
+) -> Result<Trajectory, Error> {
     check(settings, mech)?;
     let m = mech.dof();
     let mut traj = Trajectory::new(m, mech.n_x());

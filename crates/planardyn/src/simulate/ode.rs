@@ -172,7 +172,8 @@ impl<'a> MechanismOde<'a> {
             outcome = Err(KinematicsError::AssemblyFailed { residual: moved, iterations: self.ws.iterations }.into());
         }
         if outcome.is_ok() && correction > self.max_correction {
-            outcome = Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
+            outcome =
+                Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
         }
         if outcome.is_err() {
             self.failed_evaluations += 1;

@@ -61,11 +61,12 @@ impl Overrides {
 /// Output times every h (s) from t0 to t_end, clamped to t_end without a duplicate end.
 fn output_grid(t0: f64, t_end: f64, h: f64) -> Result<Vec<f64>, Error> {
     if !(h.is_finite() && h > 0.0) || (t_end - t0) / h > MAX_OUTPUTS {
-        return Err(Error::Options(format!("output_dt = {h} must be > 0 s and give at most {MAX_OUTPUTS:e} outputs over [{t0}, {t_end}] s")));
+        return Err(Error::Options(format!(
+            "output_dt = {h} must be > 0 s and give at most {MAX_OUTPUTS:e} outputs over [{t0}, {t_end}] s"
+        )));
     }
     let mut t = grid(t0, t_end, h);
     t.iter_mut().for_each(|v| *v = v.min(t_end));
     t.dedup();
     Ok(t)
 }
-

@@ -104,7 +104,12 @@ impl Default for Status {
 
 impl Trajectory {
     pub fn new(m: usize, nx: usize) -> Self {
-        Trajectory { m, nx, stats: SimStats { min_sigma: f64::INFINITY, min_passive_sigma: f64::INFINITY, ..Default::default() }, ..Default::default() }
+        Trajectory {
+            m,
+            nx,
+            stats: SimStats { min_sigma: f64::INFINITY, min_passive_sigma: f64::INFINITY, ..Default::default() },
+            ..Default::default()
+        }
     }
     pub fn len(&self) -> usize {
         self.t.len()

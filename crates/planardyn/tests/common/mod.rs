@@ -197,7 +197,13 @@ pub fn shipped(name: &str) -> Mechanism {
 }
 
 /// Simulate with the model's drives, tight tolerances, and optional output times.
-pub fn run(mech: &Mechanism, method: &str, t_end: f64, rtol: f64, t_eval: Option<Vec<f64>>) -> planardyn::simulate::Trajectory {
+pub fn run(
+    mech: &Mechanism,
+    method: &str,
+    t_end: f64,
+    rtol: f64,
+    t_eval: Option<Vec<f64>>,
+) -> planardyn::simulate::Trajectory {
     let mut s = planardyn::simulate::Settings::for_model(mech).unwrap();
     s.method = method.parse().unwrap();
     s.t_end = t_end;
