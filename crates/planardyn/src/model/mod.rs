@@ -213,6 +213,18 @@ impl Mechanism {
     pub fn n_x(&self) -> usize {
         3 * self.bodies.len()
     }
+    /// Number of pair-constraint rows of all pairs, redundant ones included.
+    pub fn n_pair_rows(&self) -> usize {
+        self.row_slot.len()
+    }
+    /// The rows of pair `k` among all pair-constraint rows (`0..n_pair_rows()`).
+    pub fn pair_rows(&self, k: PairId) -> std::ops::Range<usize> {
+        2 * k.0..2 * k.0 + 2
+    }
+    /// The pair a pair-constraint row belongs to.
+    pub fn row_pair(&self, row: usize) -> PairId {
+        PairId(row / 2)
+    }
     pub fn coordinate_names(&self) -> Vec<&str> {
         self.coordinates.iter().map(|c| c.name.as_str()).collect()
     }
