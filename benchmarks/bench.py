@@ -175,7 +175,7 @@ def bench_mechanism(bm, found: dict, quick: bool) -> dict:
                                   "difference": float(ref[-1, i] - value)}
         say(f"  reference at t_end {float(ref[-1, i])!r} against {value!r} ({source}): {ref[-1, i] - value:+.2e}")
     runs: list[Run] = []
-    for tool, (mod, _) in found.items():
+    for mod, _ in found.values():
         runs += sweep(mod, bm, d, ref, quick)
     measured = {"date": date, "quick": quick,
                 "load_average_at_start": load_start, "load_average_at_end": os.getloadavg()}

@@ -30,7 +30,7 @@ tau = mech.inverse_dynamics(res.q, res.qd, res.qdd)
 print(f"inverse dynamics vs applied motor torques: largest difference {np.abs(tau - res.tau).max():.2e} N m")
 
 R = mech.reactions(res.q[-1], res.qd[-1], t=res.t[-1])
-for name, (fx, fy, mz) in zip(mech.pair_names, R):
+for name, (fx, fy, _) in zip(mech.pair_names, R):
     print(f"  reaction at {name:>9}: F = ({fx:8.3f}, {fy:8.3f}) N")
 print(f"smallest singularity measure along the run: {res.sigma.min():.3f} (0 = singular)")
 

@@ -165,7 +165,7 @@ def test_inverse_dynamics_of_coordinate_rows_equals_mechanism_inverse_dynamics(f
     variants = [(m, {"q": res.q, "qd": res.qd, "qdd": res.qdd}) for m in sweep(five_bar, "bodies.distal_left.parts.1.mass", [0.3, 0.5])]
     variants.append((five_bar, {"q": [[math.pi, 0.0]], "qd": [[0.0, 0.0]], "qdd": [[0.0, 0.0]]}))
     got = inverse_dynamics(variants, threads=2)
-    for (mech, own), tau in zip(variants[:2], got):
+    for (mech, _), tau in zip(variants[:2], got):
         assert np.array_equal(tau, mech.inverse_dynamics(res.q, res.qd, res.qdd))
     # Forward then inverse: the model's own drive efforts back (0.3 kg: the simulated model).
     assert np.abs(got[0] - res.tau).max() < 1e-8

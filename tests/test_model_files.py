@@ -604,7 +604,8 @@ def test_five_bar_drawing():
 
     # away from singularities: no two of (proximal, distal) collinear, distal links not collinear
     def sin_between(u0, u1, v0, v1):
-        u = (u1[0] - u0[0], u1[1] - u0[1]); v = (v1[0] - v0[0], v1[1] - v0[1])
+        u = (u1[0] - u0[0], u1[1] - u0[1])
+        v = (v1[0] - v0[0], v1[1] - v0[1])
         return abs(u[0] * v[1] - u[1] * v[0]) / (math.hypot(*u) * math.hypot(*v))
 
     assert sin_between(a1, c1, c1, p) > 0.9

@@ -9,6 +9,7 @@ efforts that drove it (consistency, see test_api's forward-then-inverse test).
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 
 import numpy as np
@@ -68,7 +69,7 @@ def test_round_trip_every_array_equal(five_bar_run, tmp_path, ext):
     assert meta["kind"] == "simulation"
     assert meta["settings"] == settings and settings["method"] == "dopri5" and settings["t_end"] == 0.5
     assert meta["model"] == mech.to_dict()
-    assert back.mechanism() == mech
+    assert pd.from_result(back) == mech
     df = back.to_dataframe()
     assert list(df.columns[:3]) == ["t", "theta1", "theta2"]
     np.testing.assert_array_equal(df["tau_theta2"].to_numpy(), res.tau[:, 1])
@@ -78,7 +79,7 @@ def test_results_file_reproduces_the_run(five_bar_run, tmp_path):
     # The model and settings in the file are enough to compute the same trajectory again.
     _, _, res = five_bar_run
     back = read_results(write_results(res, tmp_path / "run.npz"))
-    again = back.mechanism().simulate(**back.metadata["settings"])
+    again = pd.from_result(back).simulate(**back.metadata["settings"])
     np.testing.assert_array_equal(again.q, res.q)
     np.testing.assert_array_equal(again.tau, res.tau)
 
@@ -102,13 +103,21 @@ def test_csv_layout_metadata_in_comments(five_bar_run, tmp_path):
     assert float(v) == res.q[4, 0]
 
 
-def test_result_save_method_and_failed_run_round_trip(four_bar, tmp_path):
+def test_failed_run_round_trip(four_bar, tmp_path):
     res = four_bar.simulate(max_steps=5)
     assert res.status == "too_many_steps" and not res.success
-    res.save(tmp_path / "partial.npz", mechanism=four_bar, settings={"max_steps": 5})
+    write_results(res, tmp_path / "partial.npz", mechanism=four_bar, settings={"max_steps": 5})
     back = read_results(tmp_path / "partial.npz")
     assert_same(res, back)
     assert back.metadata["settings"] == {"max_steps": 5}
+
+
+def test_from_result_needs_the_model(four_bar):
+    res = four_bar.simulate(t_end=0.01)
+    assert pd.from_result(res) == four_bar  # simulate attaches the model
+    bare = dataclasses.replace(res, metadata={})
+    with pytest.raises(ValueError, match="does not carry its model"):
+        pd.from_result(bare)
 
 
 def test_read_errors(tmp_path):

@@ -160,9 +160,10 @@ def test_plots_draw(five, tmp_path):
     from matplotlib.figure import Figure
 
     motion = robot.solve_motion(five, robot.point_to_point(five.home(), five.home() + [0.03, 0], 0.2), dt=5e-3)
-    for obj in (motion, robot.size(motion), robot.singularity_map(five, (-0.2, 0.2), (0.3, 0.6), n=8)):
+    for plot, obj in ((robot.plot_motion, motion), (robot.plot_sizing, robot.size(motion)),
+                      (robot.plot_singularity_map, robot.singularity_map(five, (-0.2, 0.2), (0.3, 0.6), n=8))):
         fig = Figure()
-        assert obj.plot(fig)
+        assert plot(obj, fig)
         fig.savefig(tmp_path / "x.png")
 
 

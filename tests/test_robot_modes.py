@@ -103,4 +103,4 @@ def test_plots_draw(ee):
     modes = robot.working_modes(ee, ee.home())
     assert robot.plot_modes(modes, Figure().subplots())
     cmap = robot.capability_map(ee, (-0.1, 0.1), (0.4, 0.5), 4, 20.0)
-    assert cmap.plot(Figure().subplots())
+    assert robot.plot_capability(cmap, Figure().subplots())

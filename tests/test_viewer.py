@@ -15,13 +15,14 @@ import re
 import shutil
 import subprocess
 import time
+import types
 
 import numpy as np
 import planardyn as pd
 import pytest
 from conftest import MODELS
 from PIL import Image
-from planardyn.notebook import mechanism_html, mechanism_svg, result_html, viewer
+from planardyn.notebook import mechanism_html, mechanism_svg, register_display, result_html, viewer
 from planardyn.results_io import attach_metadata
 from planardyn.viewer import viewer_data, viewer_html, write_viewer
 
@@ -171,8 +172,26 @@ def test_result_html(five_bar):
     assert "success" in plain and "301" in plain and "<svg" not in plain
     assert "tau 2.41 .. 2.41" not in plain and "tau -2.41 .. -2.41 N m" in plain
     with_model = attach_metadata(res, mech, {})
-    rich = with_model._repr_html_()
+    rich = result_html(with_model)
     assert "<svg" in rich and rich.count("<polyline") == mech.n_bodies + 3  # bars and 3 paths
     v = viewer(None, with_model)
     frame = v._repr_html_()
     assert frame.startswith("<iframe srcdoc=") and "&lt;canvas" in frame
+    with pytest.raises(ValueError, match="does not carry its model"):
+        viewer(None, dataclasses.replace(res, metadata={}))
+
+
+def test_register_display_hands_both_views_to_ipython(five_bar):
+    # A stand-in for IPython's shell: display_formatter.formatters["text/html"].for_type(cls, f).
+    mech, res = five_bar
+    printers = {}
+
+    class Formatter:
+        def for_type(self, cls, printer):
+            printers[cls] = printer
+
+    shell = types.SimpleNamespace(display_formatter=types.SimpleNamespace(formatters={"text/html": Formatter()}))
+    assert register_display(shell)
+    assert printers == {pd.Mechanism: mechanism_html, pd.SimulationResult: result_html}
+    assert printers[type(mech)](mech).startswith('<div style="display:flex')
+    assert register_display() is False  # no running IPython shell under pytest: nothing to do

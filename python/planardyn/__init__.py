@@ -18,6 +18,7 @@ Errors raise subclasses of :class:`PlanardynError`: :class:`ModelError` (also a
 
 from __future__ import annotations
 
+from . import batch, notebook, sensitivity
 from ._core import (
     AssemblyError,
     ModelError,
@@ -26,8 +27,9 @@ from ._core import (
     SingularityError,
     __version__,
 )
-from .mechanism import Mechanism, PlanardynWarning, from_dict, load, loads
+from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, loads
 from .result import Energy, SimulationResult
+from .results_io import read_results
 
 __all__ = [
     "AssemblyError",
@@ -40,16 +42,14 @@ __all__ = [
     "SimulationResult",
     "SingularityError",
     "__version__",
+    "batch",
     "from_dict",
+    "from_result",
     "load",
     "loads",
+    "read_results",
+    "sensitivity",
 ]
 
-# Results files (issue 4): planardyn.read_results(path) gives back a SimulationResult.
-from .results_io import read_results  # noqa: E402
-
-__all__ += ["read_results"]
-from . import (
-    batch,  # noqa: E402  (issue 6: planardyn.batch.simulate, inverse_dynamics, sweep, monte_carlo)
-    sensitivity,  # noqa: E402  (issue 6: derivatives to design parameters, as one batch)
-)
+# Inside IPython or Jupyter, mechanisms and results show themselves as HTML.
+notebook.register_display()

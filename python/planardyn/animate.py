@@ -14,7 +14,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .playback import auto_speed
 from .plot import default_trace_points, draw_mechanism
+from .viewer import write_viewer
 
 if TYPE_CHECKING:
     from .mechanism import Mechanism
@@ -23,25 +25,14 @@ if TYPE_CHECKING:
 #: Frames drawn at most (longer runs are played faster than real time instead).
 MAX_FRAMES = 400
 FORMATS = (".gif", ".mp4", ".html", ".htm")
-#: Shortest and longest playback (s) of the default speed.
-MIN_PLAYBACK, MAX_PLAYBACK = 3.0, 10.0
 DEFAULT_FPS = 20.0
-
-
-def auto_speed(t: np.ndarray) -> float:
-    """Playback speed (simulated s per s) that shows the run in 3 to 10 s: real time when
-    it lasts that long, slow motion for a shorter run, faster for a longer one."""
-    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
-    if span <= 0:
-        return 1.0
-    return span / min(max(span, MIN_PLAYBACK), MAX_PLAYBACK)
 
 
 def frame_indices(
     t: np.ndarray, fps: float, speed: float | None = None, max_frames: int = MAX_FRAMES
 ) -> np.ndarray:
     """Indices of the outputs shown at ``fps`` frames per second of playback, ``speed``
-    seconds of simulated time per second of playback (default :func:`auto_speed`; the output
+    seconds of simulated time per second of playback (default :func:`~planardyn.playback.auto_speed`; the output
     at or before each frame's time). At most ``max_frames`` (then uniformly spaced), at least the first and last output."""
     t = np.asarray(t, dtype=float)
     if len(t) == 0:
@@ -165,7 +156,7 @@ def animate(
         Frames per second of playback.
     speed : float
         Simulated seconds per second of playback (0.5: slow motion); default
-        :func:`auto_speed` (the run lasts 3 to 10 s).
+        :func:`planardyn.playback.auto_speed` (the run lasts 3 to 10 s).
     size : (int, int)
         Width and height in pixels (multiples of 16 for MP4).
     traces : list of str
@@ -182,8 +173,6 @@ def animate(
         if unknown:
             raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
     if ext in (".html", ".htm"):
-        from .viewer import write_viewer
-
         return write_viewer(mech, result, path, traces=traces, **viewer_kw)
     if ext == ".mp4" and (size[0] % 16 or size[1] % 16):
         raise ValueError(f"MP4 frame size must be multiples of 16 pixels, got {size[0]} x {size[1]}")

@@ -25,13 +25,13 @@ import copy
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
-from .mechanism import Mechanism, from_dict
+from ._core import inverse_batch, simulate_batch
+from .mechanism import Mechanism, attach_metadata, from_dict
 from .result import SimulationResult
 
 if TYPE_CHECKING:
@@ -40,9 +40,9 @@ if TYPE_CHECKING:
 __all__ = ["BatchError", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
 
 #: A variant: a model, or a model with its own settings.
-VariantLike = Union[Mechanism, Mapping[str, Any], tuple[Mechanism | Mapping[str, Any], Mapping[str, Any]]]
+VariantLike = Mechanism | Mapping[str, Any] | tuple[Mechanism | Mapping[str, Any], Mapping[str, Any]]
 #: ``edit(model_dict, value) -> model_dict`` or a dotted path into the model dict.
-Edit = Union[str, Callable[[dict[str, Any], Any], dict[str, Any]]]
+Edit = str | Callable[[dict[str, Any], Any], dict[str, Any]]
 
 _SETTINGS = ("t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps")
 _ARRAYS = ("t_eval", "q0", "qd0")
@@ -85,7 +85,7 @@ def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, An
 def _run_chunk(kind: str, items: list[tuple[Mechanism, dict[str, Any]]], threads: int | None) -> list[Any]:
     """One native batch (``kind`` 'simulate' or 'inverse'): a picklable call that runs on a
     worker (or here)."""
-    native = _core.simulate_batch if kind == "simulate" else _core.inverse_batch
+    native = simulate_batch if kind == "simulate" else inverse_batch
     # Keys with a leading underscore stay in Python (the path's label, for the result).
     return native([(m._native, {k: v for k, v in s.items() if not k.startswith("_")}) for m, s in items], threads)
 
@@ -197,8 +197,6 @@ def simulate(
 
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
-    from .results_io import attach_metadata
-
     result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
                                        coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names)
     return attach_metadata(result, mech, settings)
@@ -262,7 +260,8 @@ def inverse_dynamics(
 
 def _motion(mech: Mechanism, common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, Any]:
     """The native motion dict of one variant: coordinate rows, or the path sampled."""
-    from .robot.motion import SINGULAR_TOL, _sample_times
+    from .robot.motion import _sample_times
+    from .robot.tolerances import SINGULAR_TOL
 
     unknown = set(own) - set(_MOTION)
     if unknown:

@@ -516,7 +516,7 @@ def three_rpr_model(
         m.bar(f"barrel{i}", [f"A{i}", f"E{i}"], rho, about=f"cylinder barrel of leg {i}")
         m.bar(f"rod{i}", [f"K{i}", f"C{i}"], rho, about=f"piston rod of leg {i}, piston at K{i}")
     _platform_body(m, rho)
-    for i, (L, u) in zip((1, 2, 3), lengths):
+    for i, (_, u) in zip((1, 2, 3), lengths):
         m.revolute(f"base{i}", f"A{i}", "ground", f"barrel{i}")
         m.prismatic(f"leg{i}", f"K{i}", f"barrel{i}", f"rod{i}", u)
         m.revolute(f"wrist{i}", f"C{i}", f"rod{i}", "platform")
@@ -819,7 +819,7 @@ def draw_all(directory: str | os.PathLike[str]) -> list[Path]:
 
     out = []
     items: list[tuple[str, Callable[[], Mechanism]]] = [
-        (stem, functools.partial(lambda f: from_dict(f(), source=stem), fn)) for stem, fn in LIBRARY.items()
+        (stem, functools.partial(lambda f, source: from_dict(f(), source=source), fn, stem)) for stem, fn in LIBRARY.items()
     ]
     items.append(("andrews-squeezer", andrews_squeezer))
     for stem, make in items:

@@ -7,6 +7,7 @@ an angle, m for a displacement), n mobile bodies, ``x`` the 3n body coordinates
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import warnings
@@ -16,7 +17,10 @@ from typing import Any, Generic, Literal, TypeVar, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from ._core import Mechanism as NativeMechanism
+from ._core import __version__
+from ._core import load as native_load
+from ._core import loads as native_loads
 from .result import SimulationResult
 
 
@@ -64,8 +68,8 @@ class Mechanism:
 
     __slots__ = ("_native",)
 
-    def __init__(self, native: _core.Mechanism) -> None:
-        if not isinstance(native, _core.Mechanism):
+    def __init__(self, native: NativeMechanism) -> None:
+        if not isinstance(native, NativeMechanism):
             raise TypeError("use planardyn.load(), loads() or from_dict() to make a Mechanism")
         self._native = native
         for message in native.warnings:
@@ -384,17 +388,10 @@ class Mechanism:
             body_names=self.body_names,
         )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
-        from .results_io import attach_metadata
-
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
                         drives="callable" if callable(drives) else drives)
         return attach_metadata(result, self, settings)
-
-    def _repr_html_(self) -> str:
-        from .notebook import mechanism_html
-
-        return mechanism_html(self)
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:
@@ -406,12 +403,12 @@ def load(path: str | os.PathLike[str]) -> Mechanism:
         The file cannot be read or is not a valid mechanism; the message names the file and
         the field (``bodies.crank.mass``), as do the attributes ``source`` and ``path``.
     """
-    return Mechanism(_core.load(os.fspath(path)))
+    return Mechanism(native_load(os.fspath(path)))
 
 
 def loads(text: str, format: Literal["yaml", "json"] = "yaml", source: str = "<string>") -> Mechanism:
     """Build a mechanism from model text in YAML or JSON; ``source`` names it in messages."""
-    return Mechanism(_core.loads(text, format, source))
+    return Mechanism(native_loads(text, format, source))
 
 
 def _json_default(value: Any) -> Any:
@@ -431,3 +428,47 @@ def from_dict(model: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
         raise TypeError(f"from_dict needs a mapping, got {type(model).__name__}")
     return loads(json.dumps(model, default=_json_default, allow_nan=True), "json", source)
 
+
+def from_result(result: SimulationResult) -> Mechanism:
+    """The mechanism a result was computed with, rebuilt from ``result.metadata['model']``
+    (a results file, or a result of :meth:`Mechanism.simulate`, carries it).
+
+    Raises
+    ------
+    ValueError
+        The result does not carry its model (attach it with :func:`attach_metadata`).
+    """
+    model = result.metadata.get("model")
+    if not model:
+        raise ValueError("the result does not carry its model (metadata['model']): "
+                         "pass the mechanism, or attach it with planardyn.results_io.attach_metadata")
+    return from_dict(model, source=result.metadata.get("source") or "<results>")
+
+
+def attach_metadata(
+    result: SimulationResult,
+    mechanism: Mechanism | None = None,
+    settings: dict[str, Any] | None = None,
+    **extra: Any,
+) -> SimulationResult:
+    """A copy of ``result`` whose ``metadata`` records the model, settings and version.
+
+    Values already in ``result.metadata`` are kept unless given again here.
+    """
+    meta = dict(result.metadata)
+    meta.setdefault("kind", "simulation")
+    meta["planardyn_version"] = meta.get("planardyn_version") or __version__
+    if mechanism is not None:
+        meta["model"] = mechanism.to_dict()
+        meta["source"] = mechanism.source
+    if settings is not None:
+        meta["settings"] = {k: plain(v) for k, v in settings.items()}
+    meta.update(extra)
+    return dataclasses.replace(result, metadata=meta)
+
+
+def plain(v: Any) -> Any:
+    """``v`` as JSON takes it: numpy arrays and numbers as lists and Python numbers."""
+    if isinstance(v, (np.ndarray, np.generic)):
+        return v.tolist()
+    return v

@@ -2,21 +2,25 @@
 a result as a summary table (with a drawing of its last configuration when it knows its
 model), and :func:`viewer` embeds the interactive HTML viewer.
 
-Everything here returns HTML strings; nothing needs IPython.
+Everything here returns HTML strings; nothing needs IPython. :func:`register_display` hands
+:func:`mechanism_html` and :func:`result_html` to IPython's HTML formatter (``import
+planardyn`` does it inside IPython), so the model classes need not know about notebooks.
 """
 
 from __future__ import annotations
 
 import html
 import math
-from typing import TYPE_CHECKING, Any
+import sys
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-if TYPE_CHECKING:
-    from .mechanism import Mechanism
-    from .result import SimulationResult
+from .mechanism import Mechanism, from_result
+from .plot import default_trace_points
+from .result import SimulationResult
+from .viewer import viewer_html
 
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
 
@@ -160,9 +164,7 @@ def result_html(result: SimulationResult) -> str:
     drawing = ""
     if n and result.metadata.get("model"):
         try:
-            from .plot import default_trace_points
-
-            mech = result.mechanism()
+            mech = from_result(result)
             idx = [mech.point_names.index(p) for p in default_trace_points(mech)]
             keep = np.unique(np.linspace(0, n - 1, min(n, 300)).round().astype(int))
             paths = mech.point_positions(result.x[keep])[:, idx, :]
@@ -197,10 +199,21 @@ def viewer(mech: Mechanism | None, result: SimulationResult, height: int = 640, 
     """The HTML viewer for a notebook cell: ``planardyn.notebook.viewer(mech, res)`` as the
     cell's last line. ``mech`` None: the result's own model. ``kw`` go to
     :func:`planardyn.viewer.viewer_html`."""
-    from .viewer import viewer_html
-
     if mech is None:
-        mech = result.mechanism()
-        if mech is None:
-            raise ValueError("the result does not carry its model: pass the mechanism")
+        mech = from_result(result)
     return Viewer(viewer_html(mech, result, **kw), height)
+
+
+def register_display(shell: Any = None) -> bool:
+    """Show every :class:`~planardyn.Mechanism` and :class:`~planardyn.SimulationResult` as
+    HTML (:func:`mechanism_html`, :func:`result_html`) in an IPython shell (default: the
+    running one, if any). Returns whether there was a shell to register with."""
+    if shell is None:
+        ipython = sys.modules.get("IPython")  # not imported here: only a running shell matters
+        shell = ipython.get_ipython() if ipython is not None else None
+    if shell is None:
+        return False
+    formatter = shell.display_formatter.formatters["text/html"]
+    formatter.for_type(Mechanism, mechanism_html)
+    formatter.for_type(SimulationResult, result_html)
+    return True

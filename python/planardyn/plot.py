@@ -9,6 +9,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .units import group_unit
+
 if TYPE_CHECKING:
     from matplotlib.artist import Artist
     from matplotlib.axes import Axes
@@ -24,12 +26,6 @@ def _axes(ax: Axes | None) -> Axes:
 
     _, ax = plt.subplots()
     return ax
-
-
-def _unit(kinds: list[str], angle: str, displacement: str, mixed: str = "mixed units") -> str:
-    """The unit of a group of coordinates of these kinds ('angle' or 'displacement')."""
-    units = {angle if k == "angle" else displacement for k in kinds}
-    return units.pop() if len(units) == 1 else mixed
 
 
 def plot_coordinates(
@@ -48,7 +44,7 @@ def plot_coordinates(
     for k, name in enumerate(result.coordinate_names):
         label = name if which == "q" else f"{which}_{name}"
         lines += ax.plot(result.t, data[:, k], label=label, **line_kw)
-    unit = _unit(result.coordinate_kinds, "rad", "m")
+    unit = group_unit(result.coordinate_kinds, "rad", "m")
     ax.set_xlabel("t (s)")
     ax.set_ylabel(f"{which} ({unit}{suffix if unit != 'mixed units' else ''})")
     ax.legend(loc="best")
@@ -63,7 +59,7 @@ def plot_efforts(result: SimulationResult, ax: Axes | None = None, **line_kw: An
     for k, name in enumerate(result.coordinate_names):
         lines += ax.plot(result.t, result.tau[:, k], label=f"tau_{name}", **line_kw)
     ax.set_xlabel("t (s)")
-    ax.set_ylabel(f"drive effort ({_unit(result.coordinate_kinds, 'N m', 'N')})")
+    ax.set_ylabel(f"drive effort ({group_unit(result.coordinate_kinds, 'N m', 'N')})")
     ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
     return lines
@@ -249,8 +245,8 @@ def plot_torque_speed(result: SimulationResult, ax: Axes | None = None, **line_k
         lines.append(line)
         if len(result.t):
             lines += ax.plot(result.qd[:1, k], result.tau[:1, k], "o", color=line.get_color())
-    ax.set_xlabel(f"speed ({_unit(result.coordinate_kinds, 'rad/s', 'm/s')})")
-    ax.set_ylabel(f"drive effort ({_unit(result.coordinate_kinds, 'N m', 'N')})")
+    ax.set_xlabel(f"speed ({group_unit(result.coordinate_kinds, 'rad/s', 'm/s')})")
+    ax.set_ylabel(f"drive effort ({group_unit(result.coordinate_kinds, 'N m', 'N')})")
     ax.axhline(0, color="0.6", linewidth=0.6)
     ax.axvline(0, color="0.6", linewidth=0.6)
     ax.legend(loc="best")

@@ -169,36 +169,3 @@ class SimulationResult:
             w.writerow(cols)
             for row in zip(*(c.tolist() for c in cols.values())):
                 w.writerow([repr(v) for v in row])
-
-    # ------------------------------------------------------------------ files, models, notebooks
-
-    def save(
-        self,
-        path: str | os.PathLike[str],
-        *,
-        mechanism: Any = None,
-        settings: dict[str, Any] | None = None,
-    ) -> None:
-        """Write a results file: ``.csv``, ``.parquet`` or ``.npz`` by the name's extension.
-
-        The metadata (model, solver settings, planardyn version, status, counters) goes with
-        the arrays, so :func:`planardyn.read_results` gives back an equal result. Pass the
-        ``mechanism`` (and the ``settings`` of ``simulate``) unless the result carries them.
-        """
-        from .results_io import write_results
-
-        write_results(self, path, mechanism=mechanism, settings=settings)
-
-    def mechanism(self) -> Any:
-        """The :class:`~planardyn.Mechanism` rebuilt from ``metadata['model']`` (None without one)."""
-        model = self.metadata.get("model")
-        if not model:
-            return None
-        from .mechanism import from_dict
-
-        return from_dict(model, source=self.metadata.get("source") or "<results>")
-
-    def _repr_html_(self) -> str:
-        from .notebook import result_html
-
-        return result_html(self)

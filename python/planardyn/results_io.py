@@ -25,21 +25,18 @@ the metadata), so a coordinate may be named like another column.
 from __future__ import annotations
 
 import csv
-import dataclasses
 import io
 import json
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from ._core import __version__
+from .mechanism import Mechanism, attach_metadata, plain
 from .result import Energy, SimulationResult
-
-if TYPE_CHECKING:
-    from .mechanism import Mechanism
 
 FloatArray = NDArray[np.float64]
 
@@ -64,34 +61,6 @@ def simulate_settings(mech: Mechanism, **given: Any) -> dict[str, Any]:
         raise TypeError(f"unknown simulate settings: {', '.join(sorted(unknown))}")
     model = mech.simulate_defaults
     return {k: given[k] if given.get(k) is not None else model.get(k) for k in SETTING_NAMES}
-
-
-def attach_metadata(
-    result: SimulationResult,
-    mechanism: Mechanism | None = None,
-    settings: dict[str, Any] | None = None,
-    **extra: Any,
-) -> SimulationResult:
-    """A copy of ``result`` whose ``metadata`` records the model, settings and version.
-
-    Values already in ``result.metadata`` are kept unless given again here.
-    """
-    meta = dict(result.metadata)
-    meta.setdefault("kind", "simulation")
-    meta["planardyn_version"] = meta.get("planardyn_version") or _core.__version__
-    if mechanism is not None:
-        meta["model"] = mechanism.to_dict()
-        meta["source"] = mechanism.source
-    if settings is not None:
-        meta["settings"] = {k: _plain(v) for k, v in settings.items()}
-    meta.update(extra)
-    return dataclasses.replace(result, metadata=meta)
-
-
-def _plain(v: Any) -> Any:
-    if isinstance(v, (np.ndarray, np.generic)):
-        return v.tolist()
-    return v
 
 
 def _layout(res: SimulationResult) -> list[tuple[str, list[str]]]:
@@ -130,7 +99,7 @@ def _metadata(res: SimulationResult) -> dict[str, Any]:
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
         "kind": "simulation",
-        "planardyn_version": _core.__version__,
+        "planardyn_version": __version__,
         "model": None,
         "settings": None,
     }
@@ -139,7 +108,7 @@ def _metadata(res: SimulationResult) -> dict[str, Any]:
         status=res.status,
         success=res.success,
         message=res.message,
-        stats={k: _plain(v) for k, v in res.stats.items()},
+        stats={k: plain(v) for k, v in res.stats.items()},
         coordinate_names=res.coordinate_names,
         coordinate_kinds=res.coordinate_kinds,
         body_names=res.body_names,
@@ -262,7 +231,7 @@ def read_results(path: str | os.PathLike[str]) -> SimulationResult:
     """Read a results file written by planardyn (``.csv``, ``.parquet`` or ``.npz``).
 
     Gives back the result that was written, every array equal, with ``metadata`` (model,
-    settings, version; ``result.mechanism()`` rebuilds the model).
+    settings, version; :func:`planardyn.from_result` rebuilds the model).
 
     Raises
     ------

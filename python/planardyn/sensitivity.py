@@ -28,19 +28,23 @@ import builtins
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, batch
+from . import batch
+from ._core import AssemblyError, ModelError, PlanardynError, SimulationError, SingularityError
 from .mechanism import Mechanism
 
 __all__ = ["Sensitivity", "efforts", "objective", "peak_effort", "rms_effort", "trajectory", "DEFAULT_REL_STEP"]
 
+#: The exceptions a failed variant re-raises, by the name its BatchError records.
+_ERRORS = {e.__name__: e for e in (AssemblyError, ModelError, PlanardynError, SimulationError, SingularityError)}
+
 FloatArray = NDArray[np.float64]
 #: A model with dotted-path parameters, or a constructor ``make(**params)`` of a model.
-Design = Union[Mechanism, Mapping[str, Any], Callable[..., Mechanism | Mapping[str, Any]]]
+Design = Mechanism | Mapping[str, Any] | Callable[..., Mechanism | Mapping[str, Any]]
 
 #: eps^(1/3): the relative step that balances truncation (h^2) and rounding (eps / h) errors.
 DEFAULT_REL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
@@ -145,7 +149,7 @@ def _differences(design: Design, params: Mapping[str, float] | Sequence[str],
     results = run(models)
     for k, r in enumerate(results):
         if isinstance(r, batch.BatchError):
-            exc = getattr(_core, r.type, None) or getattr(builtins, r.type, _core.PlanardynError)
+            exc = _ERRORS.get(r.type) or getattr(builtins, r.type, PlanardynError)
             raise exc(f"sensitivity: {where(k)}: {r.message}")
     f = np.array([np.asarray(quantity(r), dtype=float) for r in results])
     plus, minus, plus2, minus2 = (f[1 + j::4] for j in range(4))

@@ -30,8 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
-from ._core import ModelError, PlanardynError
+from ._core import ModelError, PlanardynError, constraint_jacobian
 from .mechanism import Mechanism, from_dict
 
 #: Relative singular value below which a constraint counts as dependent: the core's
@@ -421,7 +420,7 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
     if native is not None:
         # The core's names (it names unnamed pairs) and its Jacobian at the drawing.
         pairs = [_Pair(n, p.kind, p.a, p.b, p.at, p.axis) for n, p in zip(native.pair_names, pairs)]
-        J = np.asarray(_core.constraint_jacobian(native._native, native.x0, True))
+        J = np.asarray(constraint_jacobian(native._native, native.x0, True))
         bodies = tuple(native.body_names)
     else:
         J = _drawn_jacobian(model, pairs)

@@ -22,9 +22,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _core
-from .animate import auto_speed
-from .plot import _unit, default_trace_points
+from ._core import __version__
+from .playback import auto_speed
+from .plot import default_trace_points
+from .units import group_unit
 
 if TYPE_CHECKING:
     from .mechanism import Mechanism
@@ -60,7 +61,7 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
         ("qdd", result.qdd, "qdd_{}", "accelerations", ("rad/s²", "m/s²")),
         ("tau", result.tau, "tau_{}", "drive efforts", ("N m", "N")),
     ]
-    groups = [{"key": g, "label": label, "unit": _unit(kinds, *units, mixed="mixed")}
+    groups = [{"key": g, "label": label, "unit": group_unit(kinds, *units, mixed="mixed")}
               for g, _, _, label, units in per_coordinate]
     groups += [
         {"key": "energy", "label": "energy", "unit": "J"},
@@ -137,7 +138,7 @@ def viewer_data(
     return {
         "title": title or mech.name,
         "info": info,
-        "version": _core.__version__,
+        "version": __version__,
         "t": _round(t, max(abs(t[0]), abs(t[-1]), 1e-3)),
         "speed": auto_speed(result.t),
         "scale": L,
@@ -192,7 +193,7 @@ def viewer_html(
     payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
     page = _template()
     page = page.replace("__TITLE__", html.escape(data["title"]))
-    page = page.replace("__VERSION__", html.escape(_core.__version__))
+    page = page.replace("__VERSION__", html.escape(__version__))
     return page.replace("__DATA__", payload)
 
 

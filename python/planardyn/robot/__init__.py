@@ -7,17 +7,21 @@ maps and workspaces. See ``docs/robot.md``.
     ee = robot.EndEffector(mech, "P")            # a point (m = 2) or a pose (m = 3)
     motion = robot.solve_motion(ee, robot.circle((0.0, 0.4), 0.05, duration=1.0))
     motion.tau                                   # (N, m) drive efforts
-    robot.size(motion).plot()                    # peak/RMS effort, speed, power per drive
+    robot.plot_sizing(robot.size(motion))        # peak/RMS effort, speed, power per drive
 """
 
 from __future__ import annotations
 
+from .capability import CapabilityMap, capability_at, capability_map
 from .cli import size_cli
 from .effector import EffectorState, EndEffector
 from .maps import TaskGrid, Workspace, flood, singularity_map, workspace
-from .motion import SINGULAR_TOL, TaskMotion, singularity_message, solve_motion
+from .modes import Mode, assembly_modes, working_modes
+from .motion import TaskMotion, singularity_message, solve_motion
 from .paths import TaskPath, circle, line, point_to_point, table, time_law
+from .plots import plot_capability, plot_modes, plot_motion, plot_singularity_map, plot_sizing, plot_workspace
 from .sizing import DriveSizing, SizingReport, envelope, size, with_payload
+from .tolerances import SINGULAR_TOL
 
 __all__ = [
     "SINGULAR_TOL",
@@ -43,10 +47,16 @@ __all__ = [
     "solve_motion",
     "table",
     "time_law",
+    "CapabilityMap",
+    "Mode",
+    "assembly_modes",
+    "capability_at",
+    "capability_map",
+    "plot_capability",
+    "plot_modes",
+    "plot_motion",
+    "plot_singularity_map",
+    "plot_sizing",
+    "plot_workspace",
+    "working_modes",
 ]
-
-from .capability import CapabilityMap, capability_at, capability_map, plot_capability
-from .modes import Mode, assembly_modes, plot_modes, working_modes
-
-__all__ += ["CapabilityMap", "Mode", "assembly_modes", "capability_at", "capability_map", "plot_capability",
-            "plot_modes", "working_modes"]

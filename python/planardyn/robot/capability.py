@@ -15,7 +15,6 @@ is the minimum over ``N_DIRECTIONS`` directions (0 where g alone exceeds a limit
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -78,9 +77,6 @@ class CapabilityMap:
     tau_max: FloatArray
     grid: TaskGrid
 
-    def plot(self, ax: Any = None) -> list[Any]:
-        return plot_capability(self, ax)
-
 
 def capability_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float, float],
                    n: int | tuple[int, int], tau_max: ArrayLike, q_start: ArrayLike | None = None,
@@ -105,33 +101,4 @@ def capability_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float
     return CapabilityMap(ee, grid.x, grid.y, acc, direc, hold, tmax, grid)
 
 
-def plot_capability(cmap: CapabilityMap, ax: Any = None) -> list[Any]:
-    """Guaranteed acceleration (colour), cells where holding still exceeds a limit hatched
-    grey, the robot in its drawing."""
-    from .plots import _draw_robot
-
-    if ax is None:
-        from matplotlib.figure import Figure
-
-        ax = Figure(figsize=(7, 6)).subplots()
-    out: list[Any] = []
-    z = np.ma.masked_invalid(np.where(cmap.accel > 0, cmap.accel, np.nan))
-    mesh = ax.pcolormesh(cmap.x, cmap.y, z, shading="nearest", cmap="viridis")
-    out.append(mesh)
-    ax.figure.colorbar(mesh, ax=ax, label="guaranteed acceleration at rest (m/s^2)")
-    zero = np.where(cmap.accel == 0, 1.0, np.nan)
-    if np.isfinite(zero).any():
-        out.append(ax.pcolormesh(cmap.x, cmap.y, np.ma.masked_invalid(zero), shading="nearest", cmap="Greys",
-                                 vmin=0, vmax=2))
-    out.append(ax.contour(cmap.x, cmap.y, cmap.grid.reachable.astype(float), levels=[0.5], colors="k",
-                          linewidths=0.8))
-    out += _draw_robot(ax, cmap.effector.mech)
-    lim = ", ".join(f"{t:g}" for t in cmap.tau_max)
-    ax.set(xlabel="x (m)", ylabel="y (m)",
-           title=f"{cmap.effector.mech.name}: acceleration of {cmap.effector.point} in every direction\n"
-                 f"at rest, |tau| <= [{lim}] (grey: holding still exceeds a limit)")
-    ax.set_aspect("equal")
-    return out
-
-
-__all__ = ["CapabilityMap", "capability_at", "capability_map", "max_acceleration", "plot_capability"]
+__all__ = ["CapabilityMap", "capability_at", "capability_map", "max_acceleration"]

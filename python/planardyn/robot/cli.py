@@ -14,6 +14,11 @@ import json
 import sys
 
 from .._core import AssemblyError, ModelError, SingularityError
+from ..mechanism import load
+from .effector import EndEffector
+from .paths import circle, line
+from .plots import plot_sizing
+from .sizing import size
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -35,11 +40,6 @@ def _parser() -> argparse.ArgumentParser:
 
 def size_cli(argv: list[str] | None = None) -> int:
     """Run ``planardyn size`` with ``argv`` (without the program and command names)."""
-    from .. import load
-    from .effector import EndEffector
-    from .paths import circle, line
-    from .sizing import size
-
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:
@@ -65,6 +65,6 @@ def size_cli(argv: list[str] | None = None) -> int:
         from matplotlib.figure import Figure
 
         fig = Figure(figsize=(11, 7))
-        report.plot(fig)
+        plot_sizing(report, fig)
         fig.savefig(args.plot, dpi=100)
     return 0

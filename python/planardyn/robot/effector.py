@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from .tolerances import IK_TOL
 
 if TYPE_CHECKING:
     from ..mechanism import Mechanism
@@ -32,10 +33,7 @@ FloatArray = NDArray[np.float64]
 
 E = np.array([[0.0, -1.0], [1.0, 0.0]])  # rotation by +90 deg: d/dphi R(phi) = E R(phi)
 
-# Newton on the task coordinates: converged when the scaled residual |X* - X| / L (position
-# rows; psi rows in rad) is below this. The core's own position tolerance is ~1e-12 L, so this
-# is as tight as the positions it is computed from allow.
-IK_TOL = 1e-11
+# Newton steps to reach IK_TOL from a predictor or continuation step.
 IK_MAX_ITER = 30
 # Largest Newton step (rad for an angle input, L for a displacement): keeps a poor guess from
 # jumping to another working mode.

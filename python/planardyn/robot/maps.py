@@ -9,20 +9,16 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
 from .effector import EffectorState, EndEffector
-from .motion import JUMP_TOL, SINGULAR_TOL
+from .tolerances import EDGE_TOL, JUMP_TOL, QUAD_JUMP, SINGULAR_TOL
 
 FloatArray = NDArray[np.float64]
 
-# A quadrilateral (image of an input-box cell) this many times the median size joins two
-# branches of the position analysis: not filled.
-QUAD_JUMP = 20.0
 # Newton attempts at one cell (from different solved neighbours) before it is unreachable.
 MAX_ATTEMPTS = 4
 
@@ -52,13 +48,6 @@ class TaskGrid:
     def area(self) -> float:
         """Area (m^2) of the reachable cells."""
         return float(self.reachable.sum() * np.diff(self.x).mean() * np.diff(self.y).mean())
-
-    def plot(self, fig: Any = None, levels: tuple[float, ...] = (0.02, 0.05)) -> list[Any]:
-        """Two panels, sigma_I and sigma_II, with the singularity loci as contours at
-        ``levels`` and the robot in its drawing. Returns the artists."""
-        from .plots import plot_singularity_map
-
-        return plot_singularity_map(self, fig, levels)
 
 
 def _neighbours(j: int, i: int, ny: int, nx: int) -> list[tuple[int, int]]:
@@ -168,12 +157,6 @@ class Workspace:
         ys = np.concatenate([[self.y[0] - dy], self.y, [self.y[-1] + dy]])
         return list(contourpy.contour_generator(xs, ys, z).lines(0.5))
 
-    def plot(self, ax: Any = None) -> list[Any]:
-        """Dexterity map inside the boundary, with the robot in its drawing. Returns the artists."""
-        from .plots import plot_workspace
-
-        return plot_workspace(self, ax)
-
 
 def _grid_for(points: FloatArray, cells: int, pad: float) -> tuple[FloatArray, FloatArray]:
     lo, hi = points.min(axis=0) - pad, points.max(axis=0) + pad
@@ -206,7 +189,7 @@ def _fill_quads(x: FloatArray, y: FloatArray, P: FloatArray, d: FloatArray) -> t
         i0, j0 = np.floor((quad.min(axis=0) - [x0, y0]) / h).astype(int)
         i1, j1 = np.ceil((quad.max(axis=0) - [x0, y0]) / h).astype(int) + 1
         xs, ys = np.meshgrid(x[i0:i1], y[j0:j1])
-        inside = Path(quad).contains_points(np.column_stack([xs.ravel(), ys.ravel()]), radius=1e-9 * h)
+        inside = Path(quad).contains_points(np.column_stack([xs.ravel(), ys.ravel()]), radius=EDGE_TOL * h)
         inside = inside.reshape(xs.shape)
         # The corners' own cells too (a quadrilateral thinner than a cell covers no centre).
         occ[j0:j1, i0:i1] |= inside

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from .tolerances import DEDUP_TOL, WORKING_TOL
 
 if TYPE_CHECKING:
     from ..mechanism import Mechanism
@@ -35,12 +36,8 @@ if TYPE_CHECKING:
 
 FloatArray = NDArray[np.float64]
 
-# Two solutions are the same when no named point differs by more than this (m).
-DEDUP_TOL = 1e-9
 # At most this many dyads are mirrored in every combination (2^6 variants).
 MAX_MIRRORED_DYADS = 6
-# A working mode must reproduce X to this (m) to count.
-WORKING_TOL = 1e-9
 
 
 def _rot(a: float) -> FloatArray:
@@ -183,7 +180,7 @@ def _mirror(model: dict[str, Any], mech: Mechanism, dyad: tuple[str, str, str]) 
     foot = e1 + t * ((p - e1) @ t)
     p_new = 2 * foot - p
     pts[P] = p_new.tolist()
-    for bname, body in model.get("bodies", {}).items():
+    for body in model.get("bodies", {}).values():
         plist = body.get("points", [])
         if P not in plist or len(plist) != 2:
             continue
@@ -433,34 +430,4 @@ def working_modes(ee: EndEffector, X: ArrayLike, starts: int = 64, seed: int = 0
     return modes
 
 
-def plot_modes(modes: list[Mode], ax: Any = None, title: str | None = None) -> list[Any]:
-    """Every mode's configuration on one axes (one colour each, named in the legend)."""
-    if ax is None:
-        from matplotlib.figure import Figure
-
-        ax = Figure(figsize=(6, 5)).subplots()
-    out: list[Any] = []
-    colors = ["C0", "C1", "C2", "C3", "C4", "C5", "C6", "C7"]
-    for k, mode in enumerate(modes):
-        src = mode._source
-        c = colors[k % len(colors)]
-        first = True
-        for bp in src.body_points:
-            names = [n for n, _ in bp]
-            idx = [src.point_names.index(n) for n in names]
-            p = mode.points[idx]
-            if len(p) > 2:
-                p = np.vstack([p, p[:1]])
-            out += ax.plot(p[:, 0], p[:, 1], "-o", color=c, linewidth=2, markersize=4, alpha=0.8,
-                           label=f"{mode.name} (sigma_II {mode.sigma_min:.2f})" if first else None)
-            first = False
-    ax.set(xlabel="x (m)", ylabel="y (m)")
-    if title:
-        ax.set_title(title)
-    ax.set_aspect("equal")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="small")
-    return out
-
-
-__all__ = ["Mode", "assembly_modes", "dyads", "plot_modes", "redraw", "working_modes"]
+__all__ = ["Mode", "assembly_modes", "dyads", "redraw", "working_modes"]

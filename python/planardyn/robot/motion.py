@@ -13,6 +13,7 @@ and at the end tau = mech.inverse_dynamics(q, qd, qdd) for all rows at once.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -22,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._core import AssemblyError, SingularityError
 from .effector import EffectorState, EndEffector
 from .paths import TaskPath
+from .tolerances import JUMP_TOL, REFINE_LEVEL, SINGULAR_TOL
 
 if TYPE_CHECKING:
     from ..mechanism import DriveFunction
@@ -29,19 +31,10 @@ if TYPE_CHECKING:
 
 FloatArray = NDArray[np.float64]
 
-# A motion is refused where either singularity measure (dimensionless, 0 at the singularity)
-# falls below this: there the input rates (type I) or the drive efforts (type II) grow as
-# 1/sigma, i.e. about 1000 times their values in a well-conditioned pose.
-SINGULAR_TOL = 1e-3
 # Default spacing of the samples of a path (s).
 DEFAULT_DT = 1e-3
-# Between samples, a local minimum of a measure below this level is refined (golden section
-# in t), so that a singularity crossed between two samples is not missed.
-REFINE_LEVEL = 0.05
+# Golden-section steps refining a dip of a measure between samples (REFINE_LEVEL).
 REFINE_ITER = 40
-# Largest departure (rad for angles, L for displacements) of a solved q from the second-order
-# predictor: beyond it the solution has jumped to another working mode.
-JUMP_TOL = 0.05
 
 KIND_TEXT = {
     "I": "type I (serial) singularity: the end effector cannot move in some direction there "
@@ -105,13 +98,6 @@ class TaskMotion:
     def task_of(self, q: ArrayLike) -> FloatArray:
         """(N, k) task coordinates along coordinates q (N, m), e.g. a simulation's ``res.q``."""
         return np.array([self.effector.state(qi).X for qi in np.atleast_2d(q)])
-
-    def plot(self, fig: Any = None) -> list[Any]:
-        """Path (with the robot at the start), inputs, efforts and singularity measures on one
-        figure (2 x 2). Returns the artists."""
-        from .plots import plot_motion
-
-        return plot_motion(self, fig)
 
     def _head(self, n: int) -> TaskMotion:
         cut = {k: getattr(self, k)[:n] for k in ("t", "X", "Xd", "Xdd", "q", "qd", "qdd", "tau",
@@ -246,7 +232,7 @@ def _refine(ee: EndEffector, solver: _Solver, t: FloatArray, X: FloatArray, q: F
         a, b = t[j - 1], t[j + 1]
         g = (np.sqrt(5) - 1) / 2
 
-        def measure(tt: float) -> tuple[float, EffectorState]:
+        def measure(tt: float, path_X: Callable[[float], FloatArray] = path_X, kind: str = kind) -> tuple[float, EffectorState]:
             st = solver.step(path_X(tt), q[j], qd[j], qdd[j], tt - t[j])
             return (st.sigma_I if kind == "I" else st.sigma_II), st
 

@@ -1,5 +1,9 @@
-"""Figures of the robot tools. Each takes ``fig=`` or ``ax=`` (new ones only when None) and
-returns the artists; nothing changes rcParams or calls ``plt.show()``.
+"""Figures of the robot tools, one function per object: :func:`plot_motion` (a
+:class:`TaskMotion`), :func:`plot_sizing` (a :class:`SizingReport`),
+:func:`plot_singularity_map` (a :class:`TaskGrid`), :func:`plot_workspace` (a
+:class:`Workspace`), :func:`plot_capability` (a :class:`CapabilityMap`) and
+:func:`plot_modes` (a list of :class:`Mode`). Each takes ``fig=`` or ``ax=`` (new ones only
+when None) and returns the artists; nothing changes rcParams or calls ``plt.show()``.
 """
 
 from __future__ import annotations
@@ -9,9 +13,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..plot import draw_mechanism
+from .tolerances import SINGULAR_TOL
 
 if TYPE_CHECKING:
+    from .capability import CapabilityMap
     from .maps import TaskGrid, Workspace
+    from .modes import Mode
     from .motion import TaskMotion
     from .sizing import SizingReport
 
@@ -40,9 +47,8 @@ def _sigma_axes(ax: Any, t: Any, s_I: Any, s_II: Any, tol: float) -> list[Any]:
 
 
 def plot_motion(motion: TaskMotion, fig: Any = None) -> list[Any]:
-    """Path with the robot at its start, inputs q(t), efforts tau(t), singularity measures."""
-    from .motion import SINGULAR_TOL
-
+    """Path with the robot at its start, inputs q(t), efforts tau(t), singularity measures,
+    on one figure (2 x 2)."""
     fig = _figure(fig, (11, 7))
     ax = fig.subplots(2, 2)
     mech = motion.mech
@@ -68,9 +74,7 @@ def plot_motion(motion: TaskMotion, fig: Any = None) -> list[Any]:
 
 def plot_sizing(report: SizingReport, fig: Any = None) -> list[Any]:
     """Efforts against time; operating points (speed, effort) with the envelope; power;
-    singularity measures."""
-    from .motion import SINGULAR_TOL
-
+    singularity measures, on one figure (2 x 2)."""
     fig = _figure(fig, (11, 7))
     ax = fig.subplots(2, 2)
     m = report.motion
@@ -143,4 +147,63 @@ def plot_workspace(ws: Workspace, ax: Any = None) -> list[Any]:
            title=f"{ws.effector.mech.name}: workspace of {ws.effector.point}, area {ws.area * 1e4:.1f} cm^2\n({ws.method})")
     ax.set_aspect("equal")
     ax.legend(loc="upper right", fontsize="small")
+    return out
+
+
+def plot_capability(cmap: CapabilityMap, ax: Any = None) -> list[Any]:
+    """Guaranteed acceleration (colour), cells where holding still exceeds a limit hatched
+    grey, the robot in its drawing."""
+    if ax is None:
+        from matplotlib.figure import Figure
+
+        ax = Figure(figsize=(7, 6)).subplots()
+    out: list[Any] = []
+    z = np.ma.masked_invalid(np.where(cmap.accel > 0, cmap.accel, np.nan))
+    mesh = ax.pcolormesh(cmap.x, cmap.y, z, shading="nearest", cmap="viridis")
+    out.append(mesh)
+    ax.figure.colorbar(mesh, ax=ax, label="guaranteed acceleration at rest (m/s^2)")
+    zero = np.where(cmap.accel == 0, 1.0, np.nan)
+    if np.isfinite(zero).any():
+        out.append(ax.pcolormesh(cmap.x, cmap.y, np.ma.masked_invalid(zero), shading="nearest", cmap="Greys",
+                                 vmin=0, vmax=2))
+    out.append(ax.contour(cmap.x, cmap.y, cmap.grid.reachable.astype(float), levels=[0.5], colors="k",
+                          linewidths=0.8))
+    out += _draw_robot(ax, cmap.effector.mech)
+    lim = ", ".join(f"{t:g}" for t in cmap.tau_max)
+    ax.set(xlabel="x (m)", ylabel="y (m)",
+           title=f"{cmap.effector.mech.name}: acceleration of {cmap.effector.point} in every direction\n"
+                 f"at rest, |tau| <= [{lim}] (grey: holding still exceeds a limit)")
+    ax.set_aspect("equal")
+    return out
+
+
+
+
+def plot_modes(modes: list[Mode], ax: Any = None, title: str | None = None) -> list[Any]:
+    """Every mode's configuration on one axes (one colour each, named in the legend)."""
+    if ax is None:
+        from matplotlib.figure import Figure
+
+        ax = Figure(figsize=(6, 5)).subplots()
+    out: list[Any] = []
+    colors = ["C0", "C1", "C2", "C3", "C4", "C5", "C6", "C7"]
+    for k, mode in enumerate(modes):
+        src = mode._source
+        c = colors[k % len(colors)]
+        first = True
+        for bp in src.body_points:
+            names = [n for n, _ in bp]
+            idx = [src.point_names.index(n) for n in names]
+            p = mode.points[idx]
+            if len(p) > 2:
+                p = np.vstack([p, p[:1]])
+            out += ax.plot(p[:, 0], p[:, 1], "-o", color=c, linewidth=2, markersize=4, alpha=0.8,
+                           label=f"{mode.name} (sigma_II {mode.sigma_min:.2f})" if first else None)
+            first = False
+    ax.set(xlabel="x (m)", ylabel="y (m)")
+    if title:
+        ax.set_title(title)
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
     return out

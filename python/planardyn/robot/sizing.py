@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..mechanism import Mechanism, from_dict
 from .effector import EndEffector
 from .motion import TaskMotion, solve_motion
 
 if TYPE_CHECKING:
-    from ..mechanism import Mechanism
     from .paths import TaskPath
 
 FloatArray = NDArray[np.float64]
@@ -27,8 +27,6 @@ _MASS_FIELDS = ("mass", "inertia", "inertia_about_com", "com", "uniform_bar", "p
 def with_payload(mech: Mechanism, point: str, mass: float, inertia: float = 0.0, body: str | None = None) -> Mechanism:
     """The mechanism with a payload (mass kg, inertia kg m^2 about its centre) at ``point``,
     added as a part of the body carrying it (``body``: which, when several do)."""
-    from ..mechanism import from_dict
-
     if not mass > 0:
         raise ValueError(f"payload mass must be > 0 kg, got {mass}")
     model = copy.deepcopy(mech.to_dict())
@@ -104,13 +102,6 @@ class SizingReport:
             "min_sigma_I": {"value": self.min_sigma_I[0], "t": self.min_sigma_I[1], "X": self.min_sigma_I[2].tolist()},
             "min_sigma_II": {"value": self.min_sigma_II[0], "t": self.min_sigma_II[1], "X": self.min_sigma_II[2].tolist()},
         }
-
-    def plot(self, fig: Any = None) -> list[Any]:
-        """Efforts, torque-speed operating points with their envelope, power, and the two
-        singularity measures, on one figure (2 x 2). Returns the artists."""
-        from .plots import plot_sizing
-
-        return plot_sizing(self, fig)
 
 
 def envelope(speed: FloatArray, effort: FloatArray) -> tuple[FloatArray, FloatArray]:
