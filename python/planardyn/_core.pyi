@@ -11,6 +11,22 @@ from typing import Any, final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+__all__ = [
+    "__version__",
+    "Mechanism",
+    "load",
+    "loads",
+    "PlanardynError",
+    "ModelError",
+    "AssemblyError",
+    "SingularityError",
+    "SimulationError",
+    "constraint_jacobian",
+    "constraint_singular_values",
+    "simulate_batch",
+    "inverse_batch",
+]
+
 __version__: str
 
 class PlanardynError(Exception): ...

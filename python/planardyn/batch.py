@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -342,7 +342,7 @@ def _edited(base: Mechanism | Mapping[str, Any], edit: Edit, value: Any) -> dict
     return _set(model, edit, value) if isinstance(edit, str) else edit(model, value)
 
 
-def sweep(base: Mechanism | Mapping[str, Any], edit: Edit, values: Sequence[Any] | ArrayLike, *,
+def sweep(base: Mechanism | Mapping[str, Any], edit: Edit, values: Iterable[Any], *,
           build: bool = True) -> list[Mechanism] | list[dict[str, Any]]:
     """Variants of a model, one per value.
 

@@ -19,11 +19,11 @@ import argparse
 import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
-from . import AssemblyError, PlanardynError, SingularityError, load
+from . import AssemblyError, PlanardynError, SingularityError, load, structure
 from .result import SimulationResult
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -222,21 +222,16 @@ def _check(args: argparse.Namespace) -> int:
         start = "" if drawn == q0 else f", start {q0:.6g} {unit}"
         print(f"  {name}: drawn {drawn:.6g} {unit}{start}")
     try:
-        k = mech.kinematics(mech.q0)
-        print(f"singularity measures at the start (0 = singular): type II sigma_min {k['sigma_min']:.4g}, "
-              f"passive {k['sigma_passive']:.4g}")
-        print(f"loop-closure residual at the start: {k['residual']:.3g}")
+        kin = mech.kinematics(mech.q0)
+        print(f"singularity measures at the start (0 = singular): type II sigma_min {kin['sigma_min']:.4g}, "
+              f"passive {kin['sigma_passive']:.4g}")
+        print(f"loop-closure residual at the start: {kin['residual']:.3g}")
     except SingularityError as e:
         print(f"singularity measures at the start: singular ({e})")
     try:
-        from . import structure  # written elsewhere; optional
-    except ImportError:
-        structure = None
-    if structure is not None and hasattr(structure, "report"):
-        try:
-            print(structure.report(mech))
-        except Exception as e:  # the structural analysis is extra: never lose the rest
-            print(f"planardyn: structural analysis failed: {e}", file=sys.stderr)
+        print(structure.report(mech))
+    except Exception as e:  # the structural analysis is extra: never lose the rest
+        print(f"planardyn: structural analysis failed: {e}", file=sys.stderr)
     return EXIT_OK
 
 
@@ -375,11 +370,12 @@ def _demo(args: argparse.Namespace) -> int:
     axes[0].set_title(f"{mech.name}: coordinates")
     save(fig, "coordinates.png")
 
-    for size, plotter, title, name in [
+    plotters: list[tuple[tuple[float, float], Callable[..., Any], str, str]] = [
         ((8, 4), plot_efforts, "drive efforts", "efforts.png"),
         ((6, 5), plot_torque_speed, "drive effort vs speed", "torque-speed.png"),
         ((8, 4.5), plot_energy, f"energy (balance drift {res.energy.drift:.2g} J)", "energy.png"),
-    ]:
+    ]
+    for size, plotter, title, name in plotters:
         fig = figure(size)
         ax = fig.add_subplot()
         plotter(res, ax=ax)

@@ -598,7 +598,7 @@ def watt_six_bar_model(
     and the rocker) are joined at O2: Watt's chain. Mobility 3*5 - 2*7 = 1.
     """
     m = _Model("Watt six-bar", "Watt six-bar (Watt II): four-bar O1-A-B-O2 driving four-bar O2-C-E-O3 through the ternary rocker O2-B-C (planardyn.library.watt_six_bar).", gravity)
-    O1, O2, O3 = m.point("O1", (0.0, 0.0)), m.point("O2", tuple(o2)), m.point("O3", tuple(o3))
+    O1, O2, O3 = m.point("O1", (0.0, 0.0)), m.point("O2", (o2[0], o2[1])), m.point("O3", (o3[0], o3[1]))
     m.point("A", _polar(crank, theta))
     m.point("B", circle_intersection(m.xy("A"), coupler1, m.xy(O2), rocker, modes[0]))
     m.point("C", _add(m.xy(O2), _polar(rocker_arm, _angle(m.xy(O2), m.xy("B")) + arm_angle)))

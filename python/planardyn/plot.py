@@ -40,7 +40,7 @@ def plot_coordinates(
         raise ValueError(f"which must be 'q', 'qd' or 'qdd', got {which!r}")
     data = getattr(result, which)
     suffix = {"q": "", "qd": "/s", "qdd": "/s^2"}[which]
-    lines = []
+    lines: list[Artist] = []
     for k, name in enumerate(result.coordinate_names):
         label = name if which == "q" else f"{which}_{name}"
         lines += ax.plot(result.t, data[:, k], label=label, **line_kw)
@@ -55,7 +55,7 @@ def plot_coordinates(
 def plot_efforts(result: SimulationResult, ax: Axes | None = None, **line_kw: Any) -> list[Artist]:
     """Drive efforts tau against time (N m on angles, N on displacements). Returns the lines."""
     ax = _axes(ax)
-    lines = []
+    lines: list[Artist] = []
     for k, name in enumerate(result.coordinate_names):
         lines += ax.plot(result.t, result.tau[:, k], label=f"tau_{name}", **line_kw)
     ax.set_xlabel("t (s)")
@@ -73,7 +73,7 @@ def plot_energy(result: SimulationResult, ax: Axes | None = None, balance: bool 
     """
     ax = _axes(ax)
     e = result.energy
-    lines = []
+    lines: list[Artist] = []
     lines += ax.plot(result.t, e.kinetic, label="kinetic T")
     lines += ax.plot(result.t, e.potential, label="potential V")
     lines += ax.plot(result.t, e.total, label="total T + V", linewidth=2)
@@ -200,7 +200,7 @@ def plot_point_paths(
     if unknown:
         raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
     pos = mech.point_positions(result.x)  # (N, P, 2)
-    lines = []
+    lines: list[Artist] = []
     for name in points:
         i = mech.point_names.index(name)
         kw = {"linewidth": 1.2, "alpha": 0.8, **line_kw}
@@ -239,7 +239,7 @@ def plot_torque_speed(result: SimulationResult, ax: Axes | None = None, **line_k
     """Drive effort against speed of each coordinate (tau_k vs qd_k): the operating points a
     motor must reach, start marked with a circle. Returns the lines."""
     ax = _axes(ax)
-    lines = []
+    lines: list[Artist] = []
     for k, name in enumerate(result.coordinate_names):
         (line,) = ax.plot(result.qd[:, k], result.tau[:, k], label=f"{name}", **line_kw)
         lines.append(line)

@@ -199,7 +199,8 @@ def write_results(
     groups = _group_arrays(result)
     n_t = len(result.t)
     if ext == ".npz":
-        arrays = {g: np.asarray(a) for g, a in groups.items()}
+        # Any: numpy's signature would also take a group for its allow_pickle flag.
+        arrays: dict[str, Any] = {g: np.asarray(a) for g, a in groups.items()}
         with open(path, "wb") as f:
             np.savez_compressed(f, metadata=np.array(json.dumps(meta)), **arrays)
         return path
@@ -211,8 +212,8 @@ def write_results(
     ]
     if ext == ".parquet":
         pa, pq = _pyarrow()
-        arrays = [pa.array(c.astype(bool) if n == "partitioned" else c) for n, c in zip(names, columns)]
-        table = pa.Table.from_arrays(arrays, names=names).replace_schema_metadata(
+        pa_columns = [pa.array(c.astype(bool) if n == "partitioned" else c) for n, c in zip(names, columns)]
+        table = pa.Table.from_arrays(pa_columns, names=names).replace_schema_metadata(
             {"planardyn": json.dumps(meta)}
         )
         pq.write_table(table, path)
@@ -260,8 +261,8 @@ def read_results(path: str | os.PathLike[str]) -> SimulationResult:
         data = np.column_stack(cols) if cols else np.empty((0, 0))
         return _result(meta, _split(meta, data.reshape(table.num_rows, len(cols)), path), path)
     if ext == ".csv":
-        meta, _, rows = _read_csv(path)
-        meta = _check_meta(meta, path)
+        found, _, rows = _read_csv(path)
+        meta = _check_meta(found, path)
         width = sum(k for _, k in meta["layout"])
         try:
             data = np.array([[float(v) for v in r] for r in rows], dtype=np.float64).reshape(len(rows), width)
@@ -350,13 +351,13 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 raise ValueError(f"{path}: row {i + 1} of the data has no number in column {h!r}") from None
         if not all(np.isfinite(data[i, col[h]]) for h in used):
             raise ValueError(f"{path}: row {i + 1} of the data has a non-finite value")
-    get = lambda h: data[:, col[h]] if h in col else None  # noqa: E731
-    t = get("t")
+    get = lambda h: data[:, col[h]] if h in col else None  # noqa: E731 - an optional column
+    t = data[:, col["t"]]
     if len(t) < 2:
         raise ValueError(f"{path}: a motion needs at least 2 rows, found {len(t)}")
     if np.any(np.diff(t) <= 0):
         raise ValueError(f"{path}: column t must increase strictly")
-    q = np.column_stack([get(n) for n in coordinate_names])
+    q = np.column_stack([data[:, col[n]] for n in coordinate_names])
     qd_cols = [get(f"qd_{n}") for n in coordinate_names]
     qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
     both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731

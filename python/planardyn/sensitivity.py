@@ -149,7 +149,7 @@ def _differences(design: Design, params: Mapping[str, float] | Sequence[str],
     results = run(models)
     for k, r in enumerate(results):
         if isinstance(r, batch.BatchError):
-            exc = _ERRORS.get(r.type) or getattr(builtins, r.type, PlanardynError)
+            exc: type[Exception] = _ERRORS[r.type] if r.type in _ERRORS else getattr(builtins, r.type, PlanardynError)
             raise exc(f"sensitivity: {where(k)}: {r.message}")
     f = np.array([np.asarray(quantity(r), dtype=float) for r in results])
     plus, minus, plus2, minus2 = (f[1 + j::4] for j in range(4))
@@ -188,7 +188,7 @@ def trajectory(design: Design, params: Mapping[str, float] | Sequence[str], t_ev
     """
     t_eval = np.asarray(t_eval, dtype=float)
 
-    own = {k: settings.pop(k) for k in ("q0", "qd0") if k in settings}
+    own: dict[str, Any] = {k: settings.pop(k) for k in ("q0", "qd0") if k in settings}
 
     def run(models: list[Any]) -> list[Any]:
         out = batch.simulate([(m, own) for m in models], float(t_eval[-1]), t_eval=t_eval, threads=threads,

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .effector import EndEffector
-from .maps import TaskGrid, flood
+from .maps import TaskGrid, flood, grid_size
 
 FloatArray = NDArray[np.float64]
 
@@ -84,7 +84,7 @@ def capability_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float
     """Guaranteed acceleration of the end-effector point at rest over a grid of positions
     (inverse kinematics by :func:`flood` on the working mode of ``q_start``, default the
     drawing). ``tau_max``: (m,) or scalar effort limits (N m or N)."""
-    nx, ny = (n, n) if np.ndim(n) == 0 else n  # type: ignore[misc]
+    nx, ny = grid_size(n)
     grid = flood(ee, np.linspace(*xlim, nx), np.linspace(*ylim, ny), 0.0, q_start)
     m = ee.mech.dof
     tmax = np.broadcast_to(np.asarray(tau_max, dtype=float), (m,)).copy()

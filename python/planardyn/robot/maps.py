@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,6 +49,12 @@ class TaskGrid:
     def area(self) -> float:
         """Area (m^2) of the reachable cells."""
         return float(self.reachable.sum() * np.diff(self.x).mean() * np.diff(self.y).mean())
+
+
+def grid_size(n: int | tuple[int, int]) -> tuple[int, int]:
+    """(nx, ny): ``n`` points per side, or the (nx, ny) given."""
+    nx, ny = np.broadcast_to(np.asarray(n, dtype=int), (2,))
+    return int(nx), int(ny)
 
 
 def _neighbours(j: int, i: int, ny: int, nx: int) -> list[tuple[int, int]]:
@@ -124,7 +131,7 @@ def singularity_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[floa
     q_start : (m,), optional
         A configuration on the working mode to map (default the drawing).
     """
-    nx, ny = (n, n) if np.ndim(n) == 0 else n  # type: ignore[misc]
+    nx, ny = grid_size(n)
     return flood(ee, np.linspace(*xlim, nx), np.linspace(*ylim, ny), psi, q_start)
 
 
@@ -155,7 +162,9 @@ class Workspace:
         dx, dy = self.x[1] - self.x[0], self.y[1] - self.y[0]
         xs = np.concatenate([[self.x[0] - dx], self.x, [self.x[-1] + dx]])
         ys = np.concatenate([[self.y[0] - dy], self.y, [self.y[-1] + dy]])
-        return list(contourpy.contour_generator(xs, ys, z).lines(0.5))
+        # LineType.Separate: one (K, 2) array per polyline.
+        lines = contourpy.contour_generator(xs, ys, z, line_type=contourpy.LineType.Separate).lines(0.5)
+        return cast(list[FloatArray], lines)
 
 
 def _grid_for(points: FloatArray, cells: int, pad: float) -> tuple[FloatArray, FloatArray]:

@@ -105,6 +105,24 @@ class TaskMotion:
         return replace(self, **cut)
 
 
+class MotionSingularityError(SingularityError):
+    """The path meets a singularity: its ``kind`` (``'I'``/``'II'``), where (``t`` s, ``X``),
+    its measure ``sigma``, and the motion up to there (``partial``)."""
+
+    kind: str
+    t: float
+    X: FloatArray
+    sigma: float
+    partial: TaskMotion
+
+
+class MotionAssemblyError(AssemblyError):
+    """A point of the path is out of reach on the working mode; the motion up to there is
+    ``partial``."""
+
+    partial: TaskMotion
+
+
 def _sample_times(duration: float, n: int | None, dt: float | None) -> FloatArray:
     if n is None:
         n = int(np.ceil(duration / (dt or DEFAULT_DT))) + 1
@@ -134,8 +152,8 @@ class _Solver:
         self.ee, self.tol = ee, tol
 
     def rates(self, st: EffectorState, Xd: FloatArray, Xdd: FloatArray) -> tuple[FloatArray, FloatArray]:
-        qd = np.linalg.solve(st.J, Xd)
-        qdd = np.linalg.solve(st.J, Xdd - self.ee.convective(st.kin, qd))
+        qd = np.asarray(np.linalg.solve(st.J, Xd), dtype=np.float64)
+        qdd = np.asarray(np.linalg.solve(st.J, Xdd - self.ee.convective(st.kin, qd)), dtype=np.float64)
         return qd, qdd
 
     def step(self, X: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray, h: float) -> EffectorState:
@@ -216,7 +234,7 @@ def _below(s_I: float, s_II: float, tol: float) -> str | None:
 
 def _raise(ee: EndEffector, kind: str, t: float, X: FloatArray, q: FloatArray, sigma: float, tol: float,
            partial: TaskMotion) -> None:
-    exc = SingularityError(singularity_message(ee, kind, t, X, q, sigma, tol))
+    exc = MotionSingularityError(singularity_message(ee, kind, t, X, q, sigma, tol))
     exc.kind, exc.t, exc.X, exc.sigma, exc.partial = kind, t, X, sigma, partial
     raise exc
 
@@ -274,7 +292,7 @@ def _fail_between(ee: EndEffector, solver: _Solver, t: FloatArray, X: FloatArray
     followed; at that edge one of the measures is near zero (the singularity that stops it),
     or the target is simply out of reach."""
     if i == 0:
-        err = AssemblyError(f"the path's first point {_where(ee, X[0])} cannot be reached from the drawing: {exc}")
+        err = MotionAssemblyError(f"the path's first point {_where(ee, X[0])} cannot be reached from the drawing: {exc}")
         err.partial = partial(0)
         raise err from exc
     lo, hi, best = t[i - 1], t[i], None
@@ -292,7 +310,7 @@ def _fail_between(ee: EndEffector, solver: _Solver, t: FloatArray, X: FloatArray
         sigma = min(st.sigma_I, st.sigma_II)
         if sigma < REFINE_LEVEL:
             _raise(ee, kind, tm, st.X, st.q, sigma, tol if sigma < tol else REFINE_LEVEL, partial(i))
-    err = AssemblyError(f"the path leaves the reach of the working mode at t = {t[i]:.4f} s, end effector at "
+    err = MotionAssemblyError(f"the path leaves the reach of the working mode at t = {t[i]:.4f} s, end effector at "
                         f"{_where(ee, X[i])}: {exc}; the motion up to there is the error's .partial")
     err.partial = partial(i)
     raise err from exc

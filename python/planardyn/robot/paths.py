@@ -92,9 +92,7 @@ def _check_duration(duration: float) -> float:
 def _angles(angle: float | tuple[float, float] | None) -> tuple[float, float] | None:
     if angle is None:
         return None
-    if np.ndim(angle) == 0:
-        return float(angle), float(angle)  # type: ignore[arg-type]
-    a0, a1 = angle  # type: ignore[misc]
+    a0, a1 = np.broadcast_to(np.asarray(angle, dtype=float), (2,))  # psi, or (psi0, psi1)
     return float(a0), float(a1)
 
 
@@ -106,7 +104,8 @@ def _with_angle(
     a0, a1 = angles
     d = a1 - a0
     cols = (a0 + d * s[0], d * s[1], d * s[2])
-    return tuple(np.column_stack([p, c]) for p, c in zip(pos, cols))  # type: ignore[return-value]
+    X, Xd, Xdd = (np.column_stack([p, c]) for p, c in zip(pos, cols))
+    return X, Xd, Xdd
 
 
 def line(
@@ -129,9 +128,9 @@ def line(
 
     def sample(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         s, sd, sdd = time_law(profile, t / T)
-        s = (s, sd / T, sdd / T**2)
-        pos = (p0 + np.outer(s[0], d), np.outer(s[1], d), np.outer(s[2], d))
-        return _with_angle(pos, angles, s)
+        law = (s, sd / T, sdd / T**2)
+        pos = (p0 + np.outer(law[0], d), np.outer(law[1], d), np.outer(law[2], d))
+        return _with_angle(pos, angles, law)
 
     return TaskPath(T, 2 if angles is None else 3, f"line {p0.round(4).tolist()} -> {p1.round(4).tolist()} in {T:g} s ({profile})", sample)
 
@@ -144,8 +143,8 @@ def point_to_point(
     angle: float | tuple[float, float] | None = None,
 ) -> TaskPath:
     """Rest-to-rest move along a straight line (see :func:`line`)."""
-    if profile == "constant":
-        raise ValueError("a point-to-point move starts and ends at rest: use 'quintic' or 'trapezoid'")
+    if profile not in ("quintic", "trapezoid"):
+        raise ValueError(f"a point-to-point move starts and ends at rest: use 'quintic' or 'trapezoid', got {profile!r}")
     return line(start, end, duration, profile, angle)
 
 
@@ -172,12 +171,12 @@ def circle(
 
     def sample(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         s, sd, sdd = time_law(profile, t / T)
-        s = (s, sd / T, sdd / T**2)
-        th, thd, thdd = start_angle + sweep * s[0], sweep * s[1], sweep * s[2]
+        law = (s, sd / T, sdd / T**2)
+        th, thd, thdd = start_angle + sweep * law[0], sweep * law[1], sweep * law[2]
         e_r = np.column_stack([np.cos(th), np.sin(th)])
         e_t = np.column_stack([-np.sin(th), np.cos(th)])
         pos = (c + r * e_r, r * thd[:, None] * e_t, r * (thdd[:, None] * e_t - (thd**2)[:, None] * e_r))
-        return _with_angle(pos, angles, s)
+        return _with_angle(pos, angles, law)
 
     return TaskPath(T, 2 if angles is None else 3, f"circle r = {r:g} m about {c.round(4).tolist()} in {T:g} s ({profile})", sample)
 
