@@ -11,14 +11,16 @@ from __future__ import annotations
 #: values in a well-conditioned pose.
 SINGULAR_TOL = 1e-3
 
-#: Between the samples of a path, a local minimum of a measure below this level is refined
-#: (golden section in t): a singularity crossed between two samples shows there only as a dip
-#: of the sampled measure, which at the usual spacing stays above this.
+#: Between the samples of a path, a local minimum of a measure below this level (50 times
+#: SINGULAR_TOL) is refined by golden section in t: a singularity crossed between two samples
+#: shows at the samples only as such a minimum, and one above this level could hide a crossing
+#: only if the measure changed by more than 0.05 within half a sample spacing.
 REFINE_LEVEL = 0.05
 
-#: Largest departure (rad for angles, L for displacements) of a solved q from the second-order
-#: predictor q + qd h + qdd h^2 / 2: its error is O(h^3), orders of magnitude below this at
-#: any usable spacing, so a larger departure means the solution jumped to another working mode.
+#: Largest departure (rad for angles, L for displacements) of a solved q from its predictor
+#: (along a path q + qd h + qdd h^2 / 2, error O(h^3); on a map q + J^-1 dX from a neighbouring
+#: cell, error O(dX^2)): both are far smaller at the default spacings, so a larger departure
+#: means the solve jumped to another working mode.
 JUMP_TOL = 0.05
 
 #: Newton on the task coordinates converges when the scaled residual |X* - X| / L (position
