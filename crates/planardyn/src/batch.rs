@@ -30,7 +30,7 @@ use task::{TaskError, TaskPath, TaskSolution};
 #[derive(Debug, Clone)]
 pub enum Model {
     Built(Arc<Mechanism>),
-    Spec(MechanismSpec),
+    Spec(Box<MechanismSpec>),
 }
 
 /// One variant: its model and its settings.
@@ -45,7 +45,7 @@ impl Model {
     fn with<R, E: From<Error>>(&self, f: impl FnOnce(&Mechanism) -> Result<R, E>) -> Result<R, E> {
         match self {
             Model::Built(m) => f(m),
-            Model::Spec(spec) => f(&Mechanism::new(spec.clone(), "<variant>").map_err(Error::from)?),
+            Model::Spec(spec) => f(&Mechanism::new((**spec).clone(), "<variant>").map_err(Error::from)?),
         }
     }
 }

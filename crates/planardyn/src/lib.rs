@@ -10,6 +10,9 @@
 //! validated once into an immutable [`Mechanism`]; every computation runs in a
 //! [`Workspace`] of buffers sized once. SI units and radians throughout.
 
+// `!(x > 0.0)` is how the validators reject NaN along with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod batch;
 pub mod dynamics;
 pub mod error;

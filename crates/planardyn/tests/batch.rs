@@ -75,7 +75,7 @@ fn spec_variants_are_built_in_the_task() {
     let over = Overrides { t_end: Some(0.2), ..Overrides::default() };
     let vs: Vec<Variant> = [base.spec.clone(), heavy.clone(), broken]
         .into_iter()
-        .map(|spec| Variant { model: Model::Spec(spec), overrides: over.clone() })
+        .map(|spec| Variant { model: Model::Spec(Box::new(spec)), overrides: over.clone() })
         .collect();
     let out = simulate_many(&vs, Some(2)).unwrap();
     same(
@@ -186,7 +186,7 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
         // Up to 1 m above the base: it stops at the edge of the workspace, a type I singularity.
         task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 1.0])),
         task(Model::Built(mech.clone()), &wrong_point),
-        task(Model::Spec(heavy), &circle),
+        task(Model::Spec(Box::new(heavy)), &circle),
         // The circle 1 m higher: its first point is out of reach.
         task(Model::Built(mech.clone()), &far),
     ];

@@ -42,8 +42,8 @@ fn rhs_evaluation_does_not_allocate() {
         y[m..2 * m].copy_from_slice(&qd);
         ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
         let mut dy = vec![0.0; 2 * m + 1];
-        for k in 0..m {
-            y[k] += 1e-3;
+        for yk in &mut y[..m] {
+            *yk += 1e-3;
         }
         let before = ALLOCATIONS.load(Ordering::Relaxed);
         for step in 0..10 {

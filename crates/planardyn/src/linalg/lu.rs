@@ -79,8 +79,8 @@ pub fn lu_factor<T: Scalar>(a: &mut [T], n: usize, piv: &mut [usize], tiny: f64)
 
 /// Solve A x = b in place (`b` becomes `x`) with the factors from [`lu_factor`].
 pub fn lu_solve<T: Scalar>(lu: &[T], n: usize, piv: &[usize], b: &mut [T]) {
-    for k in 0..n {
-        b.swap(k, piv[k]);
+    for (k, &p) in piv[..n].iter().enumerate() {
+        b.swap(k, p);
     }
     for i in 1..n {
         let mut s = b[i];

@@ -133,8 +133,8 @@ impl<'a> MechanismOde<'a> {
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);
-            for j in 0..m {
-                let dz = z[j] - self.last_y[j];
+            for (j, (zj, last)) in z[..m].iter().zip(&self.last_y).enumerate() {
+                let dz = zj - last;
                 for (d, u) in ws.rhs.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
                     *d += u * dz;
                 }
@@ -146,8 +146,8 @@ impl<'a> MechanismOde<'a> {
             }
         } else {
             ws.x.copy_from_slice(&self.anchor_x);
-            for j in 0..m {
-                let dz = z[j] - self.anchor_z[j];
+            for (j, (zj, anchor)) in z[..m].iter().zip(&self.anchor_z).enumerate() {
+                let dz = zj - anchor;
                 for (x, u) in ws.x.iter_mut().zip(&self.anchor_u[j * n..(j + 1) * n]) {
                     *x += u * dz;
                 }

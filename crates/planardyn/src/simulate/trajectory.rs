@@ -7,9 +7,10 @@ use crate::integrate::Stats;
 use crate::kinematics::Chart;
 
 /// How a simulation ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Status {
     /// Reached t_end.
+    #[default]
     Success,
     /// Position analysis failed even for the smallest step (the mechanism cannot move on).
     AssemblyFailed,
@@ -94,12 +95,6 @@ pub struct Trajectory {
     pub status: Status,
     pub message: String,
     pub stats: SimStats,
-}
-
-impl Default for Status {
-    fn default() -> Self {
-        Status::Success
-    }
 }
 
 impl Trajectory {
