@@ -581,12 +581,8 @@ fn check_assembly(ctx: &Ctx, mech: &Mechanism) -> R<()> {
 }
 
 fn characteristic_length(points: &[(String, [f64; 2])]) -> f64 {
-    let mut l: f64 = 0.0;
-    for (i, (_, a)) in points.iter().enumerate() {
-        for (_, b) in &points[i + 1..] {
-            l = l.max((a[0] - b[0]).hypot(a[1] - b[1]));
-        }
-    }
+    let xy: Vec<[f64; 2]> = points.iter().map(|p| p.1).collect();
+    let l = super::diameter::diameter(&xy);
     if l > 0.0 {
         l
     } else {

@@ -2,6 +2,7 @@
 //! name the file and the field path (`bodies.crank.mass`) thanks to `serde_path_to_error`,
 //! put in plain words by [`super::parse_errors`].
 
+use super::nesting;
 use super::parse_errors::Input;
 use super::{Mechanism, MechanismSpec};
 use crate::ModelError;
@@ -61,6 +62,17 @@ pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismS
             })
         }
         Format::Yaml => {
+            if let Some((line, column)) = nesting::too_deep(text) {
+                return Err(ModelError::Parse {
+                    source_name: source.to_string(),
+                    path: format!("line {line} column {column}"),
+                    message: format!(
+                        "the text nests deeper than {} levels, where a model file needs about 6; \
+                         check the brackets and the indentation there",
+                        nesting::MAX_NESTING
+                    ),
+                });
+            }
             let de = serde_yaml_ng::Deserializer::from_str(text);
             serde_path_to_error::deserialize(de).map_err(|e| {
                 let at = e.inner().location().map(|l| (l.line(), l.column()));

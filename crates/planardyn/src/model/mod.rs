@@ -5,7 +5,9 @@
 //! The ground is not part of `x`; its local frame is the global frame.
 
 mod build;
+mod diameter;
 mod io;
+mod nesting;
 mod parse_errors;
 pub mod spec;
 
