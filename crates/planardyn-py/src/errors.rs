@@ -24,6 +24,7 @@ use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
+use pyo3::IntoPyObjectExt;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -127,7 +128,7 @@ pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
 }
 
 fn attr<'py, T: IntoPyObject<'py>>(py: Python<'py>, v: T) -> Option<Py<PyAny>> {
-    v.into_pyobject(py).ok().map(|o| o.into_any().unbind())
+    v.into_py_any(py).ok()
 }
 
 fn set_attrs(py: Python<'_>, err: PyErr, attrs: Vec<(&str, Option<Py<PyAny>>)>) -> PyErr {
