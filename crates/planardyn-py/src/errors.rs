@@ -24,9 +24,9 @@ use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
-use pyo3::IntoPyObjectExt;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
+use pyo3::IntoPyObjectExt;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 create_exception!(planardyn, PlanardynError, PyException, "Base class of every error planardyn raises.");

@@ -159,11 +159,11 @@ pub enum TaskError {
         q: Vec<f64>,
         sigma: f64,
         tol: f64,
-        partial: TaskSolution,
+        partial: Box<TaskSolution>,
     },
     /// A point of the path is out of reach on the working mode (sample `t`, s).
     #[error("{message}")]
-    OutOfReach { t: f64, message: String, partial: TaskSolution },
+    OutOfReach { t: f64, message: String, partial: Box<TaskSolution> },
 }
 
 /// "(x, y) m" or "(x, y) m, psi = ... rad".
@@ -247,7 +247,7 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
                         "the path's first point {} cannot be reached from the start: {why}",
                         fmt_pose(&target)
                     ),
-                    partial: TaskSolution::default(),
+                    partial: Box::default(),
                 }
             })?
         } else {
@@ -323,7 +323,8 @@ fn singular(
     tol: f64,
     partial: TaskSolution,
 ) -> TaskError {
-    TaskError::Singular { kind, t, point: ee.point.clone(), x: st.pose.clone(), q: st.q.clone(), sigma, tol, partial }
+    let (point, x, q, partial) = (ee.point.clone(), st.pose.clone(), st.q.clone(), Box::new(partial));
+    TaskError::Singular { kind, t, point, x, q, sigma, tol, partial }
 }
 
 /// Sample i could not be solved: find by bisection how far past t_i-1 the path can be
@@ -376,7 +377,7 @@ fn fail_between(tr: &mut Tracker<'_>, path: &TaskPath, out: &TaskSolution, i: us
             path.t[i],
             fmt_pose(&path.x[i * m..(i + 1) * m])
         ),
-        partial,
+        partial: Box::new(partial),
     }
 }
 
