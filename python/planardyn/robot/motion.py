@@ -185,10 +185,10 @@ def solve_motion(
     try:
         rows = ee._core.motion(t, X, Xd, Xdd, q_start, singular_tol)
     except (AssemblyError, SingularityError) as exc:
-        rows = getattr(exc, "partial_rows", None)
-        if rows is not None:
-            exc.partial = motion(rows)  # type: ignore[attr-defined]
+        part = getattr(exc, "partial_rows", None)
+        if part is not None:
+            setattr(exc, "partial", motion(part))  # noqa: B010 - set on the native exception
         if hasattr(exc, "X"):
-            exc.X = np.asarray(exc.X)  # type: ignore[attr-defined]
+            setattr(exc, "X", np.asarray(getattr(exc, "X")))  # noqa: B010, B009
         raise
     return motion(rows)
