@@ -113,7 +113,7 @@ class Mechanism:
 
 @final
 class Effector:
-    def __init__(self, mech: Mechanism, point: str, body: str | None = None) -> None: ...
+    def __new__(cls, mech: Mechanism, point: str, body: str | None = None) -> Effector: ...
     @property
     def body(self) -> str: ...
     @property
@@ -134,7 +134,7 @@ class Effector:
         xd: ArrayLike,
         xdd: ArrayLike,
         q_start: ArrayLike | None = None,
-        singular_tol: float = 1e-3,
+        singular_tol: float = ...,
     ) -> dict[str, Any]: ...
 
 def simulate_batch(
