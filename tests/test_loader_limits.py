@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import math
 
+import planardyn as pd
 import pytest
 import yaml
-
-import planardyn as pd
 from planardyn import ModelError
 
 MODELS = "examples/models"

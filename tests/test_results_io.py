@@ -194,3 +194,28 @@ def test_motion_table_errors(tmp_path):
     bad.write_text("t,theta1,theta2\n0,1,x\n1,2,2\n")
     with pytest.raises(ValueError, match="row 1 .* column 'theta2'"):
         read_motion(bad, names)
+
+
+def test_inverse_of_a_results_file_stays_on_its_branch(tmp_path):
+    # The five-bar simulated on its other assembly mode (P mirrored below the elbows C1 C2,
+    # the same links and masses), saved, then inverted with the model drawn in the upper
+    # mode: every row continues on the file's branch from its body coordinates, so the
+    # efforts are the run's drive torques (exact: the file has qd and qdd) and x is the run's.
+    upper = pd.load(MODELS / "five-bar.yaml")
+    model = upper.to_dict()
+    c1, c2, p = (np.array(model["points"][k]) for k in ("C1", "C2", "P"))
+    e = (c2 - c1) / np.linalg.norm(c2 - c1)
+    model["points"]["P"] = (2 * (c1 + e * np.dot(p - c1, e)) - p).tolist()  # reflection in C1 C2
+    lower = pd.from_dict(model)
+    res = lower.simulate(0.3, output_dt=0.01)
+    assert res.success, res.message
+    path = tmp_path / "lower.npz"
+    write_results(res, path)
+    inv = inverse_from_file(upper, path)
+    np.testing.assert_allclose(inv.tau, res.tau, rtol=0, atol=EXACT_TAU_ATOL)
+    np.testing.assert_allclose(inv.x, res.x, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(inv.energy.potential, res.energy.potential, rtol=1e-10)
+    # From the drawing instead, the same coordinates put P on the upper mode: other efforts.
+    drawn = inverse_result(upper, res.t, res.q, res.qd, res.qdd)
+    assert np.abs(drawn.tau - res.tau).max() > 0.1
+    assert np.abs(drawn.x - res.x).max() > 0.1

@@ -260,22 +260,27 @@ class Mechanism:
         """
         return self._native.forward_dynamics(q, qd, float(t), tau)
 
-    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> FloatArray:
+    def inverse_dynamics(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x_start: ArrayLike | None = None
+    ) -> FloatArray:
         """Drive efforts that produce a motion: tau = A qdd - U^T (f - M c).
 
         Parameters
         ----------
         q, qd, qdd : (m,) or (N, m) array_like, all of the same shape
             Coordinates (rad or m), rates and accelerations. For (N, m) the rows are a
-            trajectory: the first is assembled from the drawing, each next one by
-            continuation from the previous one (so they stay on one branch).
+            trajectory: the first is reached from ``x_start`` (else the drawing), each next
+            one by continuation from the previous one (so they stay on one branch).
+        x_start : (3n,) array_like, optional
+            Body coordinates on the wanted branch at (or near) the first row, e.g. a result's
+            ``x[0]``.
 
         Returns
         -------
         tau : ndarray of the same shape
             Efforts (N m on angles, N on displacements), the model's drives not included.
         """
-        return self._native.inverse_dynamics(q, qd, qdd)
+        return self._native.inverse_dynamics(q, qd, qdd, x_start)
 
     def reactions(
         self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
@@ -295,12 +300,14 @@ class Mechanism:
         """
         return self._native.reactions(q, qd, float(t), tau)
 
-    def energy(self, q: ArrayLike, qd: ArrayLike) -> tuple[float, float]:
-        """Kinetic and potential energy (J) at (q, qd): ``(T, V)``.
+    def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
+        """Kinetic and potential energy (J) at (q, qd): ``(T, V)``, the position reached from
+        the body coordinates ``x_start`` (3n,) on the wanted branch when given, else from the
+        drawing.
 
         V counts gravity (zero at y = 0) and the elastic energy of springs.
         """
-        return self._native.energy(q, qd)
+        return self._native.energy(q, qd, x_start)
 
     # ------------------------------------------------------------------ simulation
 

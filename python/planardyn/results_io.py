@@ -314,8 +314,9 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     Returns
     -------
     dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``: (N, m) arrays where every
-    coordinate had such a column (a results file has both), else None; and per-coordinate
-    lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
+    coordinate had such a column (a results file has both), else None; ``x`` (N, 3n) the
+    body coordinates of a results file (the branch it is on), None for a table; and
+    per-coordinate lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
     """
     path = Path(path)
     if path.suffix.lower() in (".npz", ".parquet") or (
@@ -328,7 +329,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 f"{path}: the results' coordinates ({', '.join(res.coordinate_names)}) are not "
                 f"the model's ({', '.join(coordinate_names)})"
             )
-        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd,
+        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "x": res.x,
                 "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
@@ -361,7 +362,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     qd_cols = [get(f"qd_{n}") for n in coordinate_names]
     qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
     both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731
-    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols),
+    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "x": None,
             "qd_columns": qd_cols, "qdd_columns": qdd_cols}
 
 
@@ -402,8 +403,12 @@ def inverse_result(
     q: ArrayLike,
     qd: ArrayLike | None = None,
     qdd: ArrayLike | None = None,
+    x_start: ArrayLike | None = None,
 ) -> SimulationResult:
     """Drive efforts for a prescribed motion, as a result (``metadata['kind'] = 'inverse'``).
+
+    The rows follow one branch: the first is reached from ``x_start`` (else the drawing),
+    every next one by continuation from the previous row's body coordinates.
 
     Parameters
     ----------
@@ -414,6 +419,9 @@ def inverse_result(
     qd, qdd : (N, m) array_like, optional
         Rates and accelerations; those not given come from cubic splines
         (:func:`motion_derivatives`).
+    x_start : (3n,) array_like, optional
+        Body coordinates (m, m, rad per body) on the wanted branch at the first row, e.g. a
+        results file's ``x[0]``.
 
     Returns
     -------
@@ -433,15 +441,15 @@ def inverse_result(
         qdd = sdd if qdd is None else qdd
     qd = np.ascontiguousarray(qd, dtype=np.float64).reshape(q.shape)
     qdd = np.ascontiguousarray(qdd, dtype=np.float64).reshape(q.shape)
-    tau = np.asarray(mech.inverse_dynamics(q, qd, qdd), dtype=np.float64).reshape(q.shape)
+    tau = np.asarray(mech.inverse_dynamics(q, qd, qdd, x_start), dtype=np.float64).reshape(q.shape)
     n_t, n_b = len(t), mech.n_bodies
     x, xd = np.empty((n_t, 3 * n_b)), np.empty((n_t, 3 * n_b))
     sigma, residual, kinetic, potential = (np.empty(n_t) for _ in range(4))
     for i in range(n_t):
-        k = mech.kinematics(q[i], qd[i])
+        k = mech.kinematics(q[i], qd[i], x_start=x_start if i == 0 else x[i - 1])
         x[i], xd[i] = k["x"], k["xd"]
         sigma[i], residual[i] = k["sigma_min"], k["residual"]
-        kinetic[i], potential[i] = mech.energy(q[i], qd[i])
+        kinetic[i], potential[i] = mech.energy(q[i], qd[i], x_start=x[i])
     power = np.sum(tau * qd, axis=1)
     work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
     res = SimulationResult(
@@ -462,6 +470,7 @@ def inverse_from_file(mech: Mechanism, path: str | os.PathLike[str]) -> Simulati
     """:func:`inverse_result` of the motion in a file (see :func:`read_motion`)."""
     m = read_motion(path, mech.coordinate_names)
     qd, qdd = motion_derivatives(m["t"], m["q"], m["qd_columns"], m["qdd_columns"])
-    res = inverse_result(mech, m["t"], m["q"], qd, qdd)
+    x = m["x"]
+    res = inverse_result(mech, m["t"], m["q"], qd, qdd, x_start=None if x is None else x[0])
     return attach_metadata(res, None, None, motion=str(path))
 

@@ -8,10 +8,11 @@
 //! native `Mechanism` and a motion dict, either coordinate rows (`q`, `qd`, `qdd`) or a
 //! sampled end-effector path (`t`, `X`, `Xd`, `Xdd`, `point`, ...), on the same pool.
 
-use crate::convert::{arr1, arr2};
-use crate::errors::{run, to_pyerr, AssemblyError, Failure, SingularityError};
+use crate::convert::arr2;
+use crate::effector::solution_dict;
+use crate::errors::{run, task_error, to_pyerr, Failure};
 use crate::mechanism::PyMechanism;
-use planardyn::batch::task::{TaskError, TaskPath, TaskSolution};
+use planardyn::batch::task::{TaskError, TaskPath};
 use planardyn::batch::{map_many, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -120,26 +121,14 @@ fn efforts_dict<'py>(py: Python<'py>, e: Efforts, m: usize) -> PyResult<Bound<'p
     let rows = |v: Vec<f64>| arr2(py, v.len() / m.max(1), m, v);
     match e {
         Efforts::Coordinates(tau) => d.set_item("tau", rows(tau)?)?,
-        Efforts::Task(TaskSolution { q, qd, qdd, tau, sigma_i, sigma_ii, condition }) => {
-            for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)] {
-                d.set_item(k, rows(v)?)?;
-            }
-            for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
-                d.set_item(k, arr1(py, v))?;
-            }
-        }
+        Efforts::Task(s) => return Ok(solution_dict(py, s, m)?.into_any()),
     }
     Ok(d.into_any())
 }
 
 /// (exception type name, message) of a failed variant, as the serial call would raise.
 fn failure<'py>(py: Python<'py>, e: &TaskError) -> PyResult<Bound<'py, PyAny>> {
-    let err = match e {
-        TaskError::Core(core) => to_pyerr(py, core),
-        TaskError::Singular(msg) => SingularityError::new_err(msg.clone()),
-        TaskError::OutOfReach(msg) => AssemblyError::new_err(msg.clone()),
-    };
-    error_pair(py, err, e.to_string())
+    error_pair(py, task_error(py, e), e.to_string())
 }
 
 /// The pair (exception type name, message) that reports a failed variant.

@@ -10,16 +10,23 @@
 //! └── SimulationError                          Error::Options, Error::Drive
 //! ```
 //!
+//! A task motion's failures (`TaskError`) are `SingularityError` and `AssemblyError` too, with
+//! the data of where the motion stopped as attributes.
+//!
 //! Shape and value errors in the arguments are plain `ValueError`s. A Rust panic never
 //! reaches Python as `PanicException`: [`run`] catches it and raises `PlanardynError` asking
 //! for a bug report.
 
+use crate::effector::solution_dict;
+use planardyn::dynamics::task::{TaskError, TaskSolution};
+use planardyn::kinematics::EffectorError;
 use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
+use pyo3::IntoPyObjectExt;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 create_exception!(planardyn, PlanardynError, PyException, "Base class of every error planardyn raises.");
@@ -117,6 +124,60 @@ pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
             with_attrs(py, SingularityError::new_err(e.to_string()), &[("sigma_min", s.into_any().unbind())])
         }
         KinematicsError::BadArgument(msg) => PyValueError::new_err(msg.clone()),
+    }
+}
+
+fn attr<'py, T: IntoPyObject<'py>>(py: Python<'py>, v: T) -> Option<Py<PyAny>> {
+    v.into_py_any(py).ok()
+}
+
+fn set_attrs(py: Python<'_>, err: PyErr, attrs: Vec<(&str, Option<Py<PyAny>>)>) -> PyErr {
+    let attrs: Vec<(&str, Py<PyAny>)> = attrs.into_iter().filter_map(|(k, v)| v.map(|v| (k, v))).collect();
+    with_attrs(py, err, &attrs)
+}
+
+/// An inverse-kinematics failure: `AssemblyError` (attributes `X` the target, `residual`,
+/// `iterations`) when Newton does not converge, else as its kinematics error.
+pub fn effector_error(py: Python<'_>, e: &EffectorError) -> PyErr {
+    match e {
+        EffectorError::Kinematics(k) => kinematics_error(py, k),
+        EffectorError::OutOfReach { target, residual, iterations } => {
+            let attrs = vec![
+                ("X", attr(py, target.clone())),
+                ("residual", attr(py, *residual)),
+                ("iterations", attr(py, *iterations)),
+            ];
+            set_attrs(py, AssemblyError::new_err(e.to_string()), attrs)
+        }
+        _ => PlanardynError::new_err(e.to_string()),
+    }
+}
+
+/// A task motion that failed: `SingularityError` (attributes `kind` 'I' or 'II', `t` (s), `X`
+/// (k,), `q` (m,), `sigma`, `tol`) or `AssemblyError` (attribute `t`), both with `partial_rows`,
+/// the dict of the motion solved before the failure (see `effector::solution_dict`).
+pub fn task_error(py: Python<'_>, e: &TaskError) -> PyErr {
+    let partial = |p: &TaskSolution, m: usize| solution_dict(py, p.clone(), m).ok().map(|d| d.into_any().unbind());
+    match e {
+        TaskError::Core(core) => to_pyerr(py, core),
+        TaskError::Singular { kind, t, x, q, sigma, tol, partial: p, .. } => {
+            let attrs = vec![
+                ("kind", attr(py, kind.label())),
+                ("t", attr(py, *t)),
+                ("X", attr(py, x.clone())),
+                ("q", attr(py, q.clone())),
+                ("sigma", attr(py, *sigma)),
+                ("tol", attr(py, *tol)),
+                ("partial_rows", partial(p, q.len())),
+            ];
+            set_attrs(py, SingularityError::new_err(e.to_string()), attrs)
+        }
+        TaskError::OutOfReach { t, partial: p, .. } => {
+            let m = p.q.len().checked_div(p.len()).unwrap_or(0);
+            let attrs = vec![("t", attr(py, *t)), ("partial_rows", partial(p, m))];
+            set_attrs(py, AssemblyError::new_err(e.to_string()), attrs)
+        }
+        _ => PlanardynError::new_err(e.to_string()),
     }
 }
 

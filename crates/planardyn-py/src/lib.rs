@@ -1,11 +1,13 @@
 //! PyO3 glue for planardyn: the native module `planardyn._core`. Conversions live in
 //! `convert.rs`, the mapping of errors to Python exceptions in `errors.rs` (the only place),
-//! the `Mechanism` class in `mechanism.rs` and the simulation entry point in `simulate.rs`.
+//! the `Mechanism` class in `mechanism.rs`, the end effector and task-space motions in
+//! `effector.rs`, and the simulation entry point in `simulate.rs`.
 //! The typed Python face is the package `python/planardyn`; its stub `_core.pyi` mirrors
 //! this module.
 
 mod batch;
 mod convert;
+mod effector;
 mod errors;
 mod mechanism;
 mod simulate;
@@ -61,5 +63,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     structure::register(m)?;
     batch::register(m)?;
+    effector::register(m)?;
     Ok(())
 }

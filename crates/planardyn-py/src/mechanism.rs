@@ -7,7 +7,7 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::inverse_rows;
+use planardyn::batch::inverse_rows_from;
 use planardyn::dynamics::{self, Drives, ModelDrives};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::{self as kin, Chart};
@@ -402,14 +402,18 @@ impl PyMechanism {
         Ok(arr1(py, ws.qdd))
     }
 
-    /// Efforts tau for (q, qd, qdd), each (m,) or (N, m); rows by continuation.
+    /// Efforts tau for (q, qd, qdd), each (m,) or (N, m); the first row from `x_start` (else
+    /// the drawing), the next ones by continuation from row to row.
+    #[pyo3(signature = (q, qd, qdd, x_start=None))]
     fn inverse_dynamics<'py>(
         &self,
         py: Python<'py>,
         q: ArrayArg<'py>,
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
+        x_start: Option<ArrayArg<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let m = self.m();
         let what = self.coords_what();
         let (q, qd, qdd) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("qdd", &qdd, m, &what)?);
@@ -421,7 +425,7 @@ impl PyMechanism {
         }
         let mech = self.inner.clone();
         let shape = q.shape.clone();
-        let tau = run(py, move || Ok(inverse_rows(&mech, &q.data, &qd.data, &qdd.data)?))?;
+        let tau = run(py, move || Ok(inverse_rows_from(&mech, x_start.as_deref(), &q.data, &qd.data, &qdd.data)?))?;
         arr_dyn(py, &shape, tau)
     }
 
@@ -447,13 +451,20 @@ impl PyMechanism {
         arr2(py, p, 3, r.into_iter().flatten().collect())
     }
 
-    /// Kinetic and potential energy (J) at (q, qd).
-    fn energy(&self, py: Python<'_>, q: ArrayArg<'_>, qd: ArrayArg<'_>) -> PyResult<(f64, f64)> {
+    /// Kinetic and potential energy (J) at (q, qd), reached from `x_start` (else the drawing).
+    #[pyo3(signature = (q, qd, x_start=None))]
+    fn energy(
+        &self,
+        py: Python<'_>,
+        q: ArrayArg<'_>,
+        qd: ArrayArg<'_>,
+        x_start: Option<ArrayArg<'_>>,
+    ) -> PyResult<(f64, f64)> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
         run(py, move || {
-            let mut ws = Workspace::new(&mech);
-            kin::assemble_into(&mech, &q, &mut ws)?;
+            let mut ws = Self::assembled(&mech, &q, x_start.as_deref())?;
             if qd.iter().any(|&v| v != 0.0) {
                 kin::velocity_analogues(&mut ws)?;
                 kin::convective(&mech, &qd, &mut ws);

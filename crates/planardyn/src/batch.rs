@@ -11,13 +11,13 @@
 //!
 //! Inverse dynamics runs the same way ([`inverse_many`]): each variant a model and a motion,
 //! either in the coordinates (q, qd, qdd rows) or of an end effector along a sampled path
-//! ([`task`], the stages of `planardyn.robot.solve_motion`), e.g. many designs of a robot
-//! on one task, or many tasks of one robot.
+//! ([`crate::dynamics::task`], also behind `planardyn.robot.solve_motion`), e.g. many designs
+//! of a robot on one task, or many tasks of one robot.
 
 pub mod task;
 
 use crate::dynamics::{self, ModelDrives};
-use crate::kinematics::{assemble_into, continue_to};
+use crate::kinematics::{assemble_from, assemble_into, continue_to};
 pub use crate::simulate::Overrides;
 use crate::simulate::{simulate, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
@@ -93,9 +93,23 @@ impl InverseVariant {
     }
 }
 
-/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each), the positions
-/// found by continuation from row to row (so the rows stay on one branch).
+/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each), the first row
+/// assembled from the drawing; see [`inverse_rows_from`].
 pub fn inverse_rows(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>, Error> {
+    inverse_rows_from(mech, None, q, qd, qdd)
+}
+
+/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each). The first row is
+/// reached by continuation from the body coordinates `x_start` (3n; e.g. those a results file
+/// carries for it), else from the drawing; every next row by continuation from the previous
+/// row's body coordinates, so the rows stay on one branch.
+pub fn inverse_rows_from(
+    mech: &Mechanism,
+    x_start: Option<&[f64]>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+) -> Result<Vec<f64>, Error> {
     let m = mech.dof();
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
         return Err(KinematicsError::BadArgument(format!(
@@ -111,7 +125,10 @@ pub fn inverse_rows(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64]) -> Res
     for k in 0..q.len() / m {
         let row = k * m..(k + 1) * m;
         if k == 0 {
-            assemble_into(mech, &q[row.clone()], &mut ws)?;
+            match x_start {
+                Some(x) => assemble_from(mech, x, &q[row.clone()], &mut ws)?,
+                None => assemble_into(mech, &q[row.clone()], &mut ws)?,
+            }
         } else {
             continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?;
         }

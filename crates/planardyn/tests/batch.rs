@@ -89,8 +89,9 @@ fn spec_variants_are_built_in_the_task() {
 
 // ------------------------------------------------------------------ inverse dynamics
 
-use planardyn::batch::task::{TaskError, TaskPath};
+use planardyn::batch::task::{SingularityKind, TaskError, TaskPath};
 use planardyn::batch::{inverse_many, inverse_rows, Efforts, InverseVariant, Motion};
+use planardyn::kinematics::Effector;
 
 /// Forward dynamics at (q, qd) under given efforts: the consistency check of an inverse.
 struct Given(Vec<f64>);
@@ -192,13 +193,22 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
     ];
     let out = inverse_many(&vs, Some(2)).unwrap();
     assert_eq!(out, inverse_many(&vs, Some(1)).unwrap());
-    assert!(matches!(&out[1], Err(TaskError::Singular(m)) if m.contains("type II")), "{:?}", out[1]);
     assert!(
-        matches!(&out[2], Err(TaskError::Singular(m)) if m.contains("type I ") && m.contains("0.577")),
+        matches!(&out[1], Err(e @ TaskError::Singular { kind: SingularityKind::TypeII, .. }) if e.to_string().contains("type II")),
+        "{:?}",
+        out[1]
+    );
+    // The type I singularity: P stretched out of reach, (x, y) = (0.014, 0.577) m.
+    assert!(
+        matches!(&out[2], Err(TaskError::Singular { kind: SingularityKind::TypeI, x, .. }) if (x[1] - 0.577).abs() < 2e-3),
         "{:?}",
         out[2]
     );
-    assert!(matches!(&out[5], Err(TaskError::OutOfReach(m)) if m.contains("first point")), "{:?}", out[5]);
+    assert!(
+        matches!(&out[5], Err(TaskError::OutOfReach { message, .. }) if message.contains("first point")),
+        "{:?}",
+        out[5]
+    );
     assert!(
         matches!(&out[3], Err(TaskError::Core(Error::Kinematics(KinematicsError::BadArgument(m)))) if m.contains("\"Q\""))
     );
@@ -207,10 +217,7 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
         let row = i * 2..i * 2 + 2;
         // The point is on the path: P at the solved q, from the positions alone.
         let x = planardyn::kinematics::assemble(&mech, &sol.q[row.clone()]).unwrap();
-        let body = mech.body_id("distal_left").unwrap().0;
-        let s = mech.bodies[body].points.iter().find(|(p, _)| *p == mech.point_id("P").unwrap()).unwrap().1;
-        let (c, sn) = (x[3 * body + 2].cos(), x[3 * body + 2].sin());
-        let p = [x[3 * body] + c * s[0] - sn * s[1], x[3 * body + 1] + sn * s[0] + c * s[1]];
+        let p = Effector::new(&mech, "P", None).unwrap().pose(&x);
         assert!(
             (p[0] - circle.x[2 * i]).abs() < 1e-12 && (p[1] - circle.x[2 * i + 1]).abs() < 1e-12,
             "sample {i}: {p:?}"

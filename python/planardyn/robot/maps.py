@@ -82,7 +82,7 @@ def flood(ee: EndEffector, x: FloatArray, y: FloatArray, psi: float = 0.0, q_sta
     st0 = ee.state(ee.mech.drawn_q if q_start is None else q_start)
     j0, i0 = int(np.argmin(np.abs(y - st0.X[1]))), int(np.argmin(np.abs(x - st0.X[0])))
     try:
-        st = ee.inverse(target(j0, i0), st0.q)
+        st = ee.inverse(target(j0, i0), st0.q, x_start=st0.kin["x"])
     except (AssemblyError, SingularityError) as exc:
         raise AssemblyError(f"the grid cell nearest the start, {target(j0, i0)}, cannot be reached: {exc}") from exc
     states: dict[tuple[int, int], EffectorState] = {}
@@ -106,7 +106,7 @@ def flood(ee: EndEffector, x: FloatArray, y: FloatArray, psi: float = 0.0, q_sta
             X = target(a, b)
             pred = s.q + np.linalg.solve(s.J, X - s.X)
             try:
-                new = ee.solve(X, pred)
+                new = ee.solve(X, pred, x_start=s.kin["x"])
             except (AssemblyError, SingularityError, np.linalg.LinAlgError):
                 continue
             if np.max(np.abs(new.q - pred) / ee._input_scale) > JUMP_TOL or not _in_ranges(new.q, ranges):

@@ -1,19 +1,18 @@
 """Task-space motion: inverse kinematics along a prescribed end-effector path, input rates and
 accelerations from the analogues (not by differencing), then the inverse dynamics.
 
-Stages per sample i of the path (t_i, X_i, Xd_i, Xdd_i):
+Stages per sample i of the path (t_i, X_i, Xd_i, Xdd_i), computed by the core
+(``planardyn::dynamics::task``) on one branch, each sample continuing from the last:
 
     q_i    Newton on X(q) = X_i from the predictor q + qd h + qdd h^2 / 2 (same working mode)
     qd_i   J qd = Xd_i
     qdd_i  J qdd = Xdd_i - d2X/dq2 [qd_i, qd_i]      (the acceleration analogues)
     sigma  type I (J) and type II (kinematics) measures; refused below ``singular_tol``
-
-and at the end tau = mech.inverse_dynamics(q, qd, qdd) for all rows at once.
+    tau_i  inverse dynamics at (q_i, qd_i, qdd_i)
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -21,9 +20,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
-from .effector import EffectorState, EndEffector
+from .effector import EndEffector
 from .paths import TaskPath
-from .tolerances import JUMP_TOL, REFINE_LEVEL, SINGULAR_TOL
+from .tolerances import SINGULAR_TOL
 
 if TYPE_CHECKING:
     from ..mechanism import DriveFunction
@@ -33,8 +32,6 @@ FloatArray = NDArray[np.float64]
 
 # Default spacing of the samples of a path (s).
 DEFAULT_DT = 1e-3
-# Golden-section steps refining a dip of a measure between samples (REFINE_LEVEL).
-REFINE_ITER = 40
 
 KIND_TEXT = {
     "I": "type I (serial) singularity: the end effector cannot move in some direction there "
@@ -105,24 +102,6 @@ class TaskMotion:
         return replace(self, **cut)
 
 
-class MotionSingularityError(SingularityError):
-    """The path meets a singularity: its ``kind`` (``'I'``/``'II'``), where (``t`` s, ``X``),
-    its measure ``sigma``, and the motion up to there (``partial``)."""
-
-    kind: str
-    t: float
-    X: FloatArray
-    sigma: float
-    partial: TaskMotion
-
-
-class MotionAssemblyError(AssemblyError):
-    """A point of the path is out of reach on the working mode; the motion up to there is
-    ``partial``."""
-
-    partial: TaskMotion
-
-
 def _sample_times(duration: float, n: int | None, dt: float | None) -> FloatArray:
     if n is None:
         n = int(np.ceil(duration / (dt or DEFAULT_DT))) + 1
@@ -143,27 +122,6 @@ def singularity_message(ee: EndEffector, kind: str, t: float, X: FloatArray, q: 
             f"{ee.point} at {_where(ee, X)}, q = {np.array2string(q, precision=4)}: sigma_{kind} = "
             f"{sigma:.2e} < {tol:g}. Keep the path away from it (robot.singularity_map shows where "
             f"they are); the motion up to there is the error's .partial")
-
-
-class _Solver:
-    """Solves one sample after another, keeping the last state as the warm start."""
-
-    def __init__(self, ee: EndEffector, tol: float) -> None:
-        self.ee, self.tol = ee, tol
-
-    def rates(self, st: EffectorState, Xd: FloatArray, Xdd: FloatArray) -> tuple[FloatArray, FloatArray]:
-        qd = np.asarray(np.linalg.solve(st.J, Xd), dtype=np.float64)
-        qdd = np.asarray(np.linalg.solve(st.J, Xdd - self.ee.convective(st.kin, qd)), dtype=np.float64)
-        return qd, qdd
-
-    def step(self, X: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray, h: float) -> EffectorState:
-        """Solve X from the state (q, qd, qdd) h seconds before; AssemblyError on a jump."""
-        pred = q + qd * h + 0.5 * qdd * h * h
-        st = self.ee.solve(X, pred)
-        jump = np.max(np.abs(st.q - pred) / self.ee._input_scale)
-        if jump > JUMP_TOL:
-            raise AssemblyError(f"the inputs jumped by {jump:.3g} from the predictor: another working mode")
-        return st
 
 
 def solve_motion(
@@ -204,121 +162,19 @@ def solve_motion(
     path = path.with_dim(ee.dim)
     t = _sample_times(path.duration, n, dt)
     X, Xd, Xdd = path.sample(t)
-    N, m = len(t), ee.mech.dof
-    q, qd, qdd = (np.zeros((N, m)) for _ in range(3))
-    sI, sII, cond = (np.zeros(N) for _ in range(3))
-    solver = _Solver(ee, singular_tol)
-    partial = lambda i: _finish(ee, path, t, X, Xd, Xdd, q, qd, qdd, sI, sII, cond, i)  # noqa: E731
 
-    for i in range(N):
-        try:
-            st = ee.inverse(X[0], q_start) if i == 0 else solver.step(X[i], q[i - 1], qd[i - 1], qdd[i - 1], t[i] - t[i - 1])
-        except (AssemblyError, SingularityError) as exc:
-            _fail_between(ee, solver, t, X, Xd, Xdd, q, qd, qdd, i, singular_tol, exc, partial)
-        q[i] = st.q
-        qd[i], qdd[i] = solver.rates(st, Xd[i], Xdd[i])
-        sI[i], sII[i], cond[i] = st.sigma_I, st.sigma_II, ee.condition(st.J)
-        kind = _below(sI[i], sII[i], singular_tol)
-        if kind:
-            _raise(ee, kind, t[i], X[i], q[i], min(sI[i], sII[i]), singular_tol, partial(i))
-        if i >= 2:
-            _refine(ee, solver, t, X, q, qd, qdd, (sI, sII), i - 1, singular_tol, partial)
-    return partial(N)
+    def motion(rows: dict[str, FloatArray]) -> TaskMotion:
+        k = len(rows["sigma_I"])
+        return TaskMotion(ee, path.label, t[:k].copy(), X[:k].copy(), Xd[:k].copy(), Xdd[:k].copy(), rows["q"],
+                          rows["qd"], rows["qdd"], rows["tau"], rows["sigma_I"], rows["sigma_II"], rows["condition"])
 
-
-def _below(s_I: float, s_II: float, tol: float) -> str | None:
-    if min(s_I, s_II) >= tol:
-        return None
-    return "I" if s_I <= s_II else "II"
-
-
-def _raise(ee: EndEffector, kind: str, t: float, X: FloatArray, q: FloatArray, sigma: float, tol: float,
-           partial: TaskMotion) -> None:
-    exc = MotionSingularityError(singularity_message(ee, kind, t, X, q, sigma, tol))
-    exc.kind, exc.t, exc.X, exc.sigma, exc.partial = kind, t, X, sigma, partial
-    raise exc
-
-
-def _refine(ee: EndEffector, solver: _Solver, t: FloatArray, X: FloatArray, q: FloatArray, qd: FloatArray,
-            qdd: FloatArray, sigmas: tuple[FloatArray, FloatArray], j: int, tol: float, partial: Any) -> None:
-    """If a measure has a local minimum at sample j below REFINE_LEVEL, find the minimum in
-    (t_j-1, t_j+1) by golden section and refuse the motion if it is below tol there."""
-    for kind, s in zip(("I", "II"), sigmas):
-        if not (s[j] < REFINE_LEVEL and s[j] <= s[j - 1] and s[j] <= s[j + 1]):
-            continue
-        path_X = _interp_path(t, X, j)
-        a, b = t[j - 1], t[j + 1]
-        g = (np.sqrt(5) - 1) / 2
-
-        def measure(tt: float, path_X: Callable[[float], FloatArray] = path_X, kind: str = kind) -> tuple[float, EffectorState]:
-            st = solver.step(path_X(tt), q[j], qd[j], qdd[j], tt - t[j])
-            return (st.sigma_I if kind == "I" else st.sigma_II), st
-
-        try:
-            c, d = b - g * (b - a), a + g * (b - a)
-            fc, fd = measure(c)[0], measure(d)[0]
-            for _ in range(REFINE_ITER):
-                if fc < fd:
-                    b, d, fd = d, c, fc
-                    c = b - g * (b - a)
-                    fc = measure(c)[0]
-                else:
-                    a, c, fc = c, d, fd
-                    d = a + g * (b - a)
-                    fd = measure(d)[0]
-                if min(fc, fd) < tol:
-                    break
-            tm = c if fc < fd else d
-            sigma, st = measure(tm)
-        except (AssemblyError, SingularityError):
-            sigma, tm, st = 0.0, t[j], None
-        if sigma < tol:
-            qm = q[j] if st is None else st.q
-            _raise(ee, kind, tm, path_X(tm), qm, sigma, tol, partial(j if tm > t[j] else j - 1))
-
-
-def _interp_path(t: FloatArray, X: FloatArray, j: int):  # noqa: ANN202
-    """X(t) near sample j: the quadratic through samples j-1, j, j+1 (exact enough for the
-    location of a singularity; the refused motion is not integrated from it)."""
-    ts, Xs = t[j - 1 : j + 2], X[j - 1 : j + 2]
-    coef = np.polyfit(ts - t[j], Xs, 2)
-    return lambda tt: np.array([np.polyval(coef[:, k], tt - t[j]) for k in range(X.shape[1])])
-
-
-def _fail_between(ee: EndEffector, solver: _Solver, t: FloatArray, X: FloatArray, Xd: FloatArray,
-                  Xdd: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray, i: int, tol: float,
-                  exc: Exception, partial: Any) -> None:
-    """Sample i could not be solved: find by bisection how far past t_i-1 the path can be
-    followed; at that edge one of the measures is near zero (the singularity that stops it),
-    or the target is simply out of reach."""
-    if i == 0:
-        err = MotionAssemblyError(f"the path's first point {_where(ee, X[0])} cannot be reached from the drawing: {exc}")
-        err.partial = partial(0)
-        raise err from exc
-    lo, hi, best = t[i - 1], t[i], None
-    path_X = _interp_path(t, X, i - 1) if i >= 2 else (lambda tt: X[i - 1] + (tt - t[i - 1]) / (t[i] - t[i - 1]) * (X[i] - X[i - 1]))
-    for _ in range(30):
-        mid = 0.5 * (lo + hi)
-        try:
-            best = (mid, solver.step(path_X(mid), q[i - 1], qd[i - 1], qdd[i - 1], mid - t[i - 1]))
-            lo = mid
-        except (AssemblyError, SingularityError):
-            hi = mid
-    if best is not None:
-        tm, st = best
-        kind = "I" if st.sigma_I <= st.sigma_II else "II"
-        sigma = min(st.sigma_I, st.sigma_II)
-        if sigma < REFINE_LEVEL:
-            _raise(ee, kind, tm, st.X, st.q, sigma, tol if sigma < tol else REFINE_LEVEL, partial(i))
-    err = MotionAssemblyError(f"the path leaves the reach of the working mode at t = {t[i]:.4f} s, end effector at "
-                        f"{_where(ee, X[i])}: {exc}; the motion up to there is the error's .partial")
-    err.partial = partial(i)
-    raise err from exc
-
-
-def _finish(ee: EndEffector, path: TaskPath, t: FloatArray, X: FloatArray, Xd: FloatArray, Xdd: FloatArray,
-            q: FloatArray, qd: FloatArray, qdd: FloatArray, sI: FloatArray, sII: FloatArray, cond: FloatArray,
-            n: int) -> TaskMotion:
-    tau = ee.mech.inverse_dynamics(q[:n], qd[:n], qdd[:n]) if n else np.zeros((0, q.shape[1]))
-    return TaskMotion(ee, path.label, t[:n].copy(), X[:n].copy(), Xd[:n].copy(), Xdd[:n].copy(), q[:n].copy(),
-                      qd[:n].copy(), qdd[:n].copy(), tau, sI[:n].copy(), sII[:n].copy(), cond[:n].copy())
+    try:
+        rows = ee._core.motion(t, X, Xd, Xdd, q_start, singular_tol)
+    except (AssemblyError, SingularityError) as exc:
+        part = getattr(exc, "partial_rows", None)
+        if part is not None:
+            setattr(exc, "partial", motion(part))  # noqa: B010 - set on the native exception
+        if hasattr(exc, "X"):
+            setattr(exc, "X", np.asarray(getattr(exc, "X")))  # noqa: B010, B009
+        raise
+    return motion(rows)

@@ -1,14 +1,17 @@
-//! Kinematics: position analysis, velocity and acceleration analogues, points, singularities.
+//! Kinematics: position analysis, velocity and acceleration analogues, points, singularities,
+//! the end effector and its inverse kinematics.
 //! One algorithm a file; all of them work on the body coordinates x (3n values).
 
 pub mod analogues;
 pub mod constraints;
+pub mod effector;
 pub mod position;
 pub mod singularity;
 pub mod system;
 
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
 pub use constraints::{coordinate_rates, coordinates, Chart};
+pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
 pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL,
 };

@@ -1,0 +1,254 @@
+//! `planardyn._core.Effector`: the core's end effector (`kinematics::effector`) and its
+//! task-space inverse dynamics (`dynamics::task`) on a native `Mechanism`. Every call makes
+//! its own `Workspace`, started at the body coordinates `x_start` when given, else at the
+//! drawing.
+
+use crate::convert::{arr1, arr2, finite, rows, vector, Values};
+use crate::errors::{effector_error, run, task_error, Failure};
+use crate::mechanism::PyMechanism;
+use numpy::{AllowTypeChange, PyArrayLikeDyn};
+use planardyn::dynamics::task::{self, TaskPath, TaskSolution};
+use planardyn::kinematics::constraints::coordinates;
+use planardyn::kinematics::effector::{Effector, EffectorState};
+use planardyn::kinematics::{self as kin};
+use planardyn::{Mechanism, Workspace};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::Arc;
+
+type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+/// A point of a body (k = 2) or its body's pose (k = 3) as task coordinates.
+#[pyclass(frozen, module = "planardyn._core", name = "Effector")]
+pub struct PyEffector {
+    mech: Arc<Mechanism>,
+    ee: Effector,
+}
+
+/// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
+/// `q`, `qd`, `qdd`, `tau` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
+pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let TaskSolution { q, qd, qdd, tau, sigma_i, sigma_ii, condition } = s;
+    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)] {
+        d.set_item(k, arr2(py, v.len() / m.max(1), m, v)?)?;
+    }
+    for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
+        d.set_item(k, arr1(py, v))?;
+    }
+    Ok(d)
+}
+
+impl PyEffector {
+    fn m(&self) -> usize {
+        self.mech.dof()
+    }
+
+    fn q_arg(&self, name: &str, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
+        vector(name, a, self.m(), "one value per coordinate")
+    }
+
+    fn task_arg(&self, name: &str, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
+        vector(name, a, self.ee.dim, "the task coordinates x, y[, psi] (m, m[, rad])")
+    }
+
+    fn x_arg(&self, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
+        vector("x", a, self.mech.n_x(), "body coordinates [X, Y, phi] per body")
+    }
+
+    /// A workspace at the body coordinates `x` (a closed configuration), or at the drawing.
+    fn workspace(&self, x: Option<&[f64]>) -> Workspace {
+        let mut ws = Workspace::new(&self.mech);
+        if let Some(x) = x {
+            ws.x.copy_from_slice(x);
+        }
+        ws
+    }
+
+    /// A workspace analysed at the body coordinates `x`, and the end effector there.
+    fn at(&self, x: &[f64]) -> Result<(Workspace, EffectorState), Failure> {
+        let mut ws = self.workspace(Some(x));
+        let mut q = vec![0.0; self.m()];
+        coordinates(&self.mech, x, &mut q);
+        let st = self.ee.state(&self.mech, &q, &mut ws)?;
+        Ok((ws, st))
+    }
+
+    fn state_dict<'py>(&self, py: Python<'py>, st: EffectorState, x: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let (k, m) = (self.ee.dim, self.m());
+        let d = PyDict::new(py);
+        d.set_item("q", arr1(py, st.q))?;
+        d.set_item("X", arr1(py, st.pose))?;
+        d.set_item("J", arr2(py, k, m, st.jt)?)?;
+        d.set_item("sigma_I", st.sigma_i)?;
+        d.set_item("condition", st.condition)?;
+        d.set_item("x", arr1(py, x))?;
+        Ok(d)
+    }
+}
+
+#[pymethods]
+impl PyEffector {
+    #[new]
+    #[pyo3(signature = (mech, point, body=None))]
+    fn new(mech: &Bound<'_, PyMechanism>, point: &str, body: Option<&str>) -> PyResult<Self> {
+        let mech = mech.get().inner.clone();
+        let ee = Effector::new(&mech, point, body).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(PyEffector { mech, ee })
+    }
+
+    /// The body carrying the point.
+    #[getter]
+    fn body(&self) -> String {
+        self.mech.bodies[self.ee.body.0].name.clone()
+    }
+
+    /// k: 2 (a point) or 3 (a pose).
+    #[getter]
+    fn dim(&self) -> usize {
+        self.ee.dim
+    }
+
+    /// The end effector at inputs q, reached by continuation from `x_start` (else the drawing).
+    #[pyo3(signature = (q, x_start=None))]
+    fn state<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let q = self.q_arg("q", &q)?;
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
+        let (st, x) = run(py, || {
+            let mut ws = self.workspace(x_start.as_deref());
+            let st = self.ee.state(&self.mech, &q, &mut ws)?;
+            Ok((st, ws.x))
+        })?;
+        self.state_dict(py, st, x)
+    }
+
+    /// Task coordinates (k,) at body coordinates x (3n,).
+    fn pose<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(arr1(py, self.ee.pose(&self.x_arg(&x)?)))
+    }
+
+    /// J_t (k, m) at body coordinates x (3n,).
+    fn jacobian<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let x = self.x_arg(&x)?;
+        let st = run(py, || Ok(self.at(&x)?.1))?;
+        arr2(py, self.ee.dim, self.m(), st.jt)
+    }
+
+    /// J_t' qd (k,) at body coordinates x (3n,) and rates qd (m,).
+    fn convective<'py>(&self, py: Python<'py>, x: ArrayArg<'py>, qd: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let (x, qd) = (self.x_arg(&x)?, self.q_arg("qd", &qd)?);
+        let c = run(py, || {
+            let (mut ws, _) = self.at(&x)?;
+            kin::convective(&self.mech, &qd, &mut ws);
+            Ok(self.ee.convective(&ws))
+        })?;
+        Ok(arr1(py, c))
+    }
+
+    /// (sigma_I, condition number) of a task Jacobian J (k, m), scaled dimensionless.
+    fn measures(&self, jt: ArrayArg<'_>) -> PyResult<(f64, f64)> {
+        let v = Values::read(&jt);
+        if v.shape != [self.ee.dim, self.m()] {
+            return Err(PyValueError::new_err(format!(
+                "J must have shape ({}, {}), got {:?}",
+                self.ee.dim,
+                self.m(),
+                v.shape
+            )));
+        }
+        Ok(self.ee.measures(&v.data))
+    }
+
+    /// Inverse kinematics by Newton from `q_guess`, on the branch of `x_start` (else the drawing).
+    #[pyo3(signature = (target, q_guess, x_start=None))]
+    fn solve<'py>(
+        &self,
+        py: Python<'py>,
+        target: ArrayArg<'py>,
+        q_guess: ArrayArg<'py>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (target, guess) = (self.task_arg("X", &target)?, self.q_arg("q_guess", &q_guess)?);
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
+        let r = run(py, || {
+            let mut ws = self.workspace(x_start.as_deref());
+            Ok(self.ee.solve(&self.mech, &target, &guess, &mut ws).map(|st| (st, ws.x)))
+        })?;
+        let (st, x) = r.map_err(|e| effector_error(py, &e))?;
+        self.state_dict(py, st, x)
+    }
+
+    /// Inverse kinematics by continuation in task space from the end effector at `q_start`
+    /// (default the drawing; reached from `x_start` when given).
+    #[pyo3(signature = (target, q_start=None, x_start=None))]
+    fn reach<'py>(
+        &self,
+        py: Python<'py>,
+        target: ArrayArg<'py>,
+        q_start: Option<ArrayArg<'py>>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let target = self.task_arg("X", &target)?;
+        let q_start = match q_start {
+            Some(a) => self.q_arg("q_start", &a)?,
+            None => self.mech.drawn_q(),
+        };
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
+        let r = run(py, || {
+            let mut ws = self.workspace(x_start.as_deref());
+            Ok(self.ee.reach(&self.mech, &target, &q_start, &mut ws).map(|st| (st, ws.x)))
+        })?;
+        let (st, x) = r.map_err(|e| effector_error(py, &e))?;
+        self.state_dict(py, st, x)
+    }
+
+    /// Inputs and drive efforts along a sampled path: t (N,) s, X, Xd, Xdd (N, k).
+    #[pyo3(signature = (t, x, xd, xdd, q_start=None, singular_tol=kin::SINGULAR_TOL))]
+    #[allow(clippy::too_many_arguments)]
+    fn motion<'py>(
+        &self,
+        py: Python<'py>,
+        t: ArrayArg<'py>,
+        x: ArrayArg<'py>,
+        xd: ArrayArg<'py>,
+        xdd: ArrayArg<'py>,
+        q_start: Option<ArrayArg<'py>>,
+        singular_tol: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let k = self.ee.dim;
+        let what = "task coordinates per sample";
+        let t = Values::read(&t).data;
+        finite("t", &t)?;
+        let (x, xd, xdd) = (rows("X", &x, k, what)?, rows("Xd", &xd, k, what)?, rows("Xdd", &xdd, k, what)?);
+        let path = TaskPath {
+            t,
+            x: x.data,
+            xd: xd.data,
+            xdd: xdd.data,
+            point: self.ee.point.clone(),
+            body: Some(self.body()),
+            q_start: q_start.map(|a| self.q_arg("q_start", &a)).transpose()?,
+            singular_tol,
+        };
+        let r = run(py, || Ok(task::solve(&self.mech, &path)))?;
+        let sol = r.map_err(|e| task_error(py, &e))?;
+        solution_dict(py, sol, self.m())
+    }
+
+    fn __repr__(&self) -> String {
+        let what = if self.ee.dim == 2 { "position" } else { "pose" };
+        format!("Effector({what} of point {:?} on {:?})", self.ee.point, self.body())
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("SINGULAR_TOL", kin::SINGULAR_TOL)?;
+    m.add("JUMP_TOL", task::JUMP_TOL)?;
+    m.add_class::<PyEffector>()
+}
