@@ -3,12 +3,13 @@
 Pure data tests (no planardyn import): they check `examples/models/*.yaml` against
 `schema/planardyn-model.schema.json`, resolve every name the way the loader does, check the
 mobility 3n - 2p, and check that the three validation benchmarks are reproduced number for
-number from `../shared/benchmarks/*.json` (provenance: `tests/data/PROVENANCE.md`).
+number from `tests/data/benchmarks/*.json` (provenance: `tests/data/PROVENANCE.md`).
 """
 
 from __future__ import annotations
 
 import copy
+import hashlib
 import json
 import math
 import re
@@ -22,7 +23,8 @@ ROOT = Path(__file__).parents[1]
 MODELS = ROOT / "examples" / "models"
 SCHEMA_PATH = ROOT / "schema" / "planardyn-model.schema.json"
 DOC_PATH = ROOT / "docs" / "model-format.md"
-BENCHMARKS = Path(__file__).parents[1].parent / "shared" / "benchmarks"
+BENCHMARKS = ROOT / "tests" / "data" / "benchmarks"
+PROVENANCE = ROOT / "tests" / "data" / "PROVENANCE.md"
 
 BENCHMARK_STEMS = ["four-bar-gravity", "andrews-squeezer", "five-bar-free-fall"]
 # file -> (mobile bodies n, pairs p, coordinates m), counted by hand from each drawing.
@@ -78,7 +80,6 @@ def load_model(name: str) -> dict:
 
 def load_benchmark(stem: str) -> dict:
     path = BENCHMARKS / f"{stem}.json"
-    assert path.is_file(), f"benchmark source {path} is missing: the tests need ../shared/benchmarks"
     return json.loads(path.read_text())
 
 
@@ -438,6 +439,13 @@ def test_schema_accepts_every_pair_and_load_kind(validator):
 
 
 @pytest.mark.parametrize("stem", BENCHMARK_STEMS)
+def test_benchmark_copy_is_the_one_provenance_names(stem):
+    """The copy in tests/data/benchmarks is byte for byte the file whose sha256 PROVENANCE.md records."""
+    digest = hashlib.sha256((BENCHMARKS / f"{stem}.json").read_bytes()).hexdigest()
+    assert f"| `{stem}.json` | `{digest}` |" in PROVENANCE.read_text()
+
+
+@pytest.mark.parametrize("stem", BENCHMARK_STEMS)
 def test_benchmark_reproduced_exactly(stem):
     src = load_benchmark(stem)
     model = canonical(load_model(f"{stem}.yaml"))
@@ -604,7 +612,8 @@ def test_five_bar_drawing():
 
     # away from singularities: no two of (proximal, distal) collinear, distal links not collinear
     def sin_between(u0, u1, v0, v1):
-        u = (u1[0] - u0[0], u1[1] - u0[1]); v = (v1[0] - v0[0], v1[1] - v0[1])
+        u = (u1[0] - u0[0], u1[1] - u0[1])
+        v = (v1[0] - v0[0], v1[1] - v0[1])
         return abs(u[0] * v[1] - u[1] * v[0]) / (math.hypot(*u) * math.hypot(*v))
 
     assert sin_between(a1, c1, c1, p) > 0.9

@@ -5,7 +5,7 @@ A mechanism is described as it is drawn, in a model file (YAML or JSON, see
 
     import planardyn as pd
 
-    mech = pd.load("examples/models/five-bar.yaml")
+    mech = pd.load("examples/models/five-bar.yaml")   # or pd.load_example("five-bar")
     res = mech.simulate(t_end=1.0)
     res.q          # (N, m) coordinates, rad or m
     res.to_csv("five-bar.csv")
@@ -18,6 +18,7 @@ Errors raise subclasses of :class:`PlanardynError`: :class:`ModelError` (also a
 
 from __future__ import annotations
 
+from . import models
 from ._core import (
     AssemblyError,
     ModelError,
@@ -26,7 +27,7 @@ from ._core import (
     SingularityError,
     __version__,
 )
-from .mechanism import Mechanism, PlanardynWarning, from_dict, load, loads
+from .mechanism import Mechanism, PlanardynWarning, from_dict, load, load_example, loads
 from .result import Energy, SimulationResult
 
 __all__ = [
@@ -42,14 +43,15 @@ __all__ = [
     "__version__",
     "from_dict",
     "load",
+    "load_example",
     "loads",
+    "models",
 ]
 
-# Results files (issue 4): planardyn.read_results(path) gives back a SimulationResult.
+# Modules built on the names above: planardyn.read_results(path) gives back a SimulationResult;
+# planardyn.batch (simulate, inverse_dynamics, sweep, monte_carlo); planardyn.sensitivity
+# (derivatives to design parameters, as one batch).
+from . import batch, sensitivity  # noqa: E402
 from .results_io import read_results  # noqa: E402
 
-__all__ += ["read_results"]
-from . import (
-    batch,  # noqa: E402  (issue 6: planardyn.batch.simulate, inverse_dynamics, sweep, monte_carlo)
-    sensitivity,  # noqa: E402  (issue 6: derivatives to design parameters, as one batch)
-)
+__all__ += ["batch", "read_results", "sensitivity"]

@@ -36,7 +36,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .mechanism import Mechanism, from_dict, load
+from . import models
+from .mechanism import Mechanism, from_dict, load_example
 
 Vec = tuple[float, float]
 GRAVITY: Vec = (0.0, -9.81)
@@ -516,7 +517,7 @@ def three_rpr_model(
         m.bar(f"barrel{i}", [f"A{i}", f"E{i}"], rho, about=f"cylinder barrel of leg {i}")
         m.bar(f"rod{i}", [f"K{i}", f"C{i}"], rho, about=f"piston rod of leg {i}, piston at K{i}")
     _platform_body(m, rho)
-    for i, (L, u) in zip((1, 2, 3), lengths):
+    for i, (_, u) in zip((1, 2, 3), lengths):
         m.revolute(f"base{i}", f"A{i}", "ground", f"barrel{i}")
         m.prismatic(f"leg{i}", f"K{i}", f"barrel{i}", f"rod{i}", u)
         m.revolute(f"wrist{i}", f"C{i}", f"rod{i}", "platform")
@@ -696,19 +697,16 @@ watt_six_bar = _mechanism(watt_six_bar_model)
 stephenson_six_bar = _mechanism(stephenson_six_bar_model)
 double_parallelogram = _mechanism(double_parallelogram_model)
 
-#: Where the shipped model files are (examples/models/ of the repository).
-MODELS_DIR = Path(__file__).resolve().parents[2] / "examples" / "models"
+#: Where the shipped model files are (package data, ``planardyn.models``).
+MODELS_DIR = models.directory()
 #: The library's own files, written from the constructors' defaults.
-LIBRARY_DIR = MODELS_DIR / "library"
+LIBRARY_DIR = MODELS_DIR / models.LIBRARY
 
 
 def andrews_squeezer() -> Mechanism:
-    """Andrews' squeezing mechanism: the shipped ``examples/models/andrews-squeezer.yaml``
+    """Andrews' squeezing mechanism: the shipped model ``andrews-squeezer``
     (7 bodies, 10 revolute pairs, crank angle ``beta``; Hairer & Wanner's benchmark)."""
-    path = MODELS_DIR / "andrews-squeezer.yaml"
-    if not path.is_file():
-        raise FileNotFoundError(f"{path} is not there: andrews_squeezer() needs the repository's examples/models")
-    return load(path)
+    return load_example("andrews-squeezer")
 
 
 #: File stem -> model function (at its defaults), for every mechanism built here.
@@ -819,7 +817,7 @@ def draw_all(directory: str | os.PathLike[str]) -> list[Path]:
 
     out = []
     items: list[tuple[str, Callable[[], Mechanism]]] = [
-        (stem, functools.partial(lambda f: from_dict(f(), source=stem), fn)) for stem, fn in LIBRARY.items()
+        (stem, functools.partial(lambda f, s: from_dict(f(), source=s), fn, stem)) for stem, fn in LIBRARY.items()
     ]
     items.append(("andrews-squeezer", andrews_squeezer))
     for stem, make in items:
@@ -838,8 +836,8 @@ def draw_all(directory: str | os.PathLike[str]) -> list[Path]:
 
 
 if __name__ == "__main__":
-    # python -m planardyn.library [MODEL_DIR [PICTURE_DIR]]
+    # python -m planardyn.library [MODEL_DIR [PICTURE_DIR]], run from the repository's root
     for p in write_all(sys.argv[1] if len(sys.argv) > 1 else LIBRARY_DIR):
         print(p)
-    for p in draw_all(sys.argv[2] if len(sys.argv) > 2 else MODELS_DIR.parents[1] / "docs" / "img"):
+    for p in draw_all(sys.argv[2] if len(sys.argv) > 2 else Path("docs") / "img"):
         print(p)

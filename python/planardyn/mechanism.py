@@ -16,7 +16,7 @@ from typing import Any, Generic, Literal, TypeVar, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, models
 from .result import SimulationResult
 
 
@@ -407,6 +407,17 @@ def load(path: str | os.PathLike[str]) -> Mechanism:
         the field (``bodies.crank.mass``), as do the attributes ``source`` and ``path``.
     """
     return Mechanism(_core.load(os.fspath(path)))
+
+
+def load_example(name: str) -> Mechanism:
+    """Load a model file shipped with planardyn by name (``"five-bar"``; see ``planardyn.models.names()``).
+
+    Raises
+    ------
+    planardyn.models.UnknownModelError
+        (a ``KeyError``) No shipped model has that name; the message lists the names there are.
+    """
+    return load(models.path(name))
 
 
 def loads(text: str, format: Literal["yaml", "json"] = "yaml", source: str = "<string>") -> Mechanism:
