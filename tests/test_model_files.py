@@ -40,6 +40,9 @@ EXPECTED_COUNTS = {
 # Geometry written by hand in the drawings is checked to this (m, rad): the numbers are
 # pasted at full double precision, so only the last-digit rounding of the generator remains.
 GEOMETRY_TOL = 1e-14
+# A drawn coordinate value is a number pasted at full precision from math.radians of a whole
+# degree: equal to it to the last bit or so (1 ulp of 2 rad is 4.4e-16).
+PASTED_ANGLE_TOL = 1e-15
 
 
 # --------------------------------------------------------------------------- loading
@@ -527,7 +530,7 @@ def test_benchmark_reproduced_exactly(stem):
 
 
 def test_andrews_specifics():
-    """The two numbers the brief names: drive 0.033 N m on beta, spring [b3, D] - [ground, C]."""
+    """The two numbers the source names: drive 0.033 N m on beta, spring [b3, D] - [ground, C]."""
     model = load_model("andrews-squeezer.yaml")
     assert model["drives"] == [{"coordinate": "beta", "effort": 0.033}]
     spring = model["loads"][0]
@@ -605,8 +608,8 @@ def test_five_bar_drawing():
     assert math.dist(c1, p) == pytest.approx(0.35, abs=GEOMETRY_TOL)
     assert math.dist(c2, p) == pytest.approx(0.35, abs=GEOMETRY_TOL)
     theta = {c["name"]: c["value"] for c in model["coordinates"]}
-    assert theta == {"theta1": pytest.approx(math.radians(115.0), abs=1e-15),
-                     "theta2": pytest.approx(math.radians(60.0), abs=1e-15)}
+    assert theta == {"theta1": pytest.approx(math.radians(115.0), abs=PASTED_ANGLE_TOL),
+                     "theta2": pytest.approx(math.radians(60.0), abs=PASTED_ANGLE_TOL)}
     assert drawn_angle(model, "proximal_left") == pytest.approx(theta["theta1"], abs=GEOMETRY_TOL)
     assert drawn_angle(model, "proximal_right") == pytest.approx(theta["theta2"], abs=GEOMETRY_TOL)
 
@@ -636,7 +639,7 @@ def test_slider_crank_drawing():
     assert guide["bodies"] == ["ground", "slider"] and guide["axis"] == [1.0, 0.0] and guide["at"] == "B"
     (coord,) = model["coordinates"]
     assert coord["pair"] == "crank_pivot"
-    assert coord["value"] == pytest.approx(math.radians(60.0), abs=1e-15)
+    assert coord["value"] == pytest.approx(math.radians(60.0), abs=PASTED_ANGLE_TOL)
     assert drawn_angle(model, "crank") == pytest.approx(coord["value"], abs=GEOMETRY_TOL)
     assert drawn_angle(model, "slider") == 0.0  # one point
     assert {ld["type"] for ld in model["loads"]} == {"spring", "friction"}

@@ -1,6 +1,6 @@
 """The typed Python face of a mechanism: loading, kinematics, dynamics, simulation.
 
-Notation (see ``docs/`` and the paper's symbols): m generalized coordinates ``q`` (rad for
+Notation (the paper's symbols, see ``docs/formulation.md``): m generalized coordinates ``q`` (rad for
 an angle, m for a displacement), n mobile bodies, ``x`` the 3n body coordinates
 [X, Y, phi] of each centre of mass (m, m, rad), P named points, p pairs.
 """

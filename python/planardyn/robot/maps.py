@@ -25,6 +25,9 @@ FloatArray = NDArray[np.float64]
 QUAD_JUMP = 20.0
 # Newton attempts at one cell (from different solved neighbours) before it is unreachable.
 MAX_ATTEMPTS = 4
+# Grid points this close to a quadrilateral's edge (a fraction of the cell size h) count as
+# inside: a point on an edge shared by two cells must not fall between them by round-off.
+EDGE_SLACK = 1e-9
 
 
 @dataclass
@@ -206,7 +209,7 @@ def _fill_quads(x: FloatArray, y: FloatArray, P: FloatArray, d: FloatArray) -> t
         i0, j0 = np.floor((quad.min(axis=0) - [x0, y0]) / h).astype(int)
         i1, j1 = np.ceil((quad.max(axis=0) - [x0, y0]) / h).astype(int) + 1
         xs, ys = np.meshgrid(x[i0:i1], y[j0:j1])
-        inside = Path(quad).contains_points(np.column_stack([xs.ravel(), ys.ravel()]), radius=1e-9 * h)
+        inside = Path(quad).contains_points(np.column_stack([xs.ravel(), ys.ravel()]), radius=EDGE_SLACK * h)
         inside = inside.reshape(xs.shape)
         # The corners' own cells too (a quadrilateral thinner than a cell covers no centre).
         occ[j0:j1, i0:i1] |= inside

@@ -104,30 +104,35 @@ struct Sample {
 impl<'a> Tracker<'a> {
     fn new(mech: &'a Mechanism, point: &str, body: Option<&str>) -> Result<Self, TaskError> {
         let m = mech.dof();
-        let bad = |msg: String| TaskError::Core(KinematicsError::BadArgument(msg).into());
+        let bad = |name, expected: String, got: String| {
+            TaskError::Core(KinematicsError::bad_argument(name, expected, got).into())
+        };
         if m != 2 && m != 3 {
-            return Err(bad(format!(
-                "task-space motions need m = 2 (a point) or m = 3 (a pose) coordinates; {:?} has m = {m}",
-                mech.name
-            )));
+            return Err(bad(
+                "mechanism",
+                "m = 2 (a point) or m = 3 (a pose) coordinates for a task-space motion".into(),
+                format!("{:?} with m = {m}", mech.name),
+            ));
         }
-        let pid = mech
-            .point_id(point)
-            .ok_or_else(|| bad(format!("no point {point:?}; the points are {}", mech.point_names().join(", "))))?;
+        let pid = mech.point_id(point).ok_or_else(|| {
+            bad("point", format!("one of the points {}", mech.point_names().join(", ")), format!("{point:?}"))
+        })?;
         let carriers: Vec<usize> =
             (0..mech.n_bodies()).filter(|&i| mech.bodies[i].points.iter().any(|(p, _)| *p == pid)).collect();
         let i = match body {
             Some(name) => mech.body_id(name).map(|b| b.0).filter(|b| carriers.contains(b)),
             None if m == 3 && carriers.len() > 1 => {
-                return Err(bad(format!("point {point:?} is on several bodies: say which body's pose")))
+                return Err(bad(
+                    "body",
+                    format!("the body whose pose to follow (point {point:?} is on several)"),
+                    "none".into(),
+                ))
             }
             None => carriers.first().copied(),
         }
-        .ok_or_else(|| {
-            bad(format!(
-                "no mobile body{} carries point {point:?}",
-                body.map(|b| format!(" named {b:?}")).unwrap_or_default()
-            ))
+        .ok_or_else(|| match body {
+            Some(b) => bad("body", format!("a mobile body carrying point {point:?}"), format!("{b:?}")),
+            None => bad("point", "a point carried by a mobile body".into(), format!("{point:?} (on the ground only)")),
         })?;
         let s = mech.bodies[i].points.iter().find(|(p, _)| *p == pid).map(|(_, s)| *s).unwrap_or([0.0; 2]);
         let l = mech.scale;

@@ -1,4 +1,4 @@
-//! Dynamics (formulation.md): applied forces, A and b, forward and inverse dynamics,
+//! Dynamics (docs/formulation.md): applied forces, A and b, forward and inverse dynamics,
 //! pair reactions, energies. Stages run in a [`crate::Workspace`].
 
 pub mod energy;
