@@ -14,7 +14,7 @@ from pathlib import Path
 
 import planardyn as pd
 import pytest
-from planardyn import models
+from planardyn import cli, models
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -81,3 +81,8 @@ def test_models_imports_nothing_of_the_package():
     imported += [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import)
                  for alias in node.names if alias.name.startswith("planardyn")]
     assert imported == []
+
+
+def test_demo_runs_a_shipped_model():
+    """`planardyn demo` finds its model in the package, not relative to a source tree."""
+    assert cli.DEMO_MODEL in models.names()
