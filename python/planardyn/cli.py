@@ -228,15 +228,12 @@ def _check(args: argparse.Namespace) -> int:
         print(f"loop-closure residual at the start: {k['residual']:.3g}")
     except SingularityError as e:
         print(f"singularity measures at the start: singular ({e})")
+    from .structure import report
+
     try:
-        from . import structure  # written elsewhere; optional
-    except ImportError:
-        structure = None
-    if structure is not None and hasattr(structure, "report"):
-        try:
-            print(structure.report(mech))
-        except Exception as e:  # the structural analysis is extra: never lose the rest
-            print(f"planardyn: structural analysis failed: {e}", file=sys.stderr)
+        print(report(mech))
+    except Exception as e:  # the structural analysis is extra: never lose the rest
+        print(f"planardyn: structural analysis failed: {e}", file=sys.stderr)
     return EXIT_OK
 
 
