@@ -38,6 +38,9 @@ DEFAULT_DT = 1e-3
 # Between samples, a local minimum of a measure below this level is refined (golden section
 # in t), so that a singularity crossed between two samples is not missed.
 REFINE_LEVEL = 0.05
+# Tolerances of the open-loop check run (Motion.simulate): its integration error must stay far
+# below the 1e-6 m to which the efforts are required to reproduce the path.
+CHECK_RTOL, CHECK_ATOL = 1e-10, 1e-12
 REFINE_ITER = 40
 # Largest departure (rad for angles, L for displacements) of a solved q from the second-order
 # predictor: beyond it the solution has jumped to another working mode.
@@ -97,7 +100,7 @@ class TaskMotion:
         """Forward dynamics under :meth:`drives` from the motion's first state, output at
         ``t`` (open loop: the check that the efforts produce the motion). ``options`` go to
         :meth:`Mechanism.simulate` (default dop853, rtol 1e-10, atol 1e-12)."""
-        kw = dict(method="dop853", rtol=1e-10, atol=1e-12, t_eval=self.t, q0=self.q[0], qd0=self.qd[0],
+        kw = dict(method="dop853", rtol=CHECK_RTOL, atol=CHECK_ATOL, t_eval=self.t, q0=self.q[0], qd0=self.qd[0],
                   drives=self.drives())
         kw.update(options)
         return self.mech.simulate(self.t[-1], **kw)
