@@ -1,4 +1,4 @@
-"""planardyn against the tools users would pick instead, measured in one run (issue 6).
+"""planardyn against the tools users would pick instead, measured in one run.
 
 Run through ``benchmarks/run.sh`` (which makes the environment); by hand, from the
 repository root with the peers' venv::
@@ -8,8 +8,8 @@ repository root with the peers' venv::
 For each mechanism of ``mechanisms.py`` (four-bar, five-bar, 3-RRR, Andrews' squeezer):
 each tool's wall time and accuracy (energy drift or balance, loop gap, error against a
 tight planardyn reference) over a sweep of its step size or tolerance, and the cheapest
-setting of each that meets the mechanism's stated accuracy. On the four-bar also the issue's
-targets: planardyn's cheapest for drift < 1e-6 J against the fastest peer at 1e-3 J, and
+setting of each that meets the mechanism's stated accuracy. On the four-bar also the
+performance targets: planardyn's cheapest for drift < 1e-6 J against the fastest peer at 1e-3 J, and
 ``simulate`` from Python against the same run from Rust. Also runs the Rust criterion bench
 of one forward-dynamics evaluation. Writes ``benchmarks/results/`` (results.json,
 results.md, one work-precision plot per mechanism) and the generated part of
@@ -44,9 +44,9 @@ PEERS = ["planardyn_peer", "mujoco_peer", "pinocchio_peer", "exudyn_peer"]
 RESULTS = HERE / "results"
 DOCS_PAGE = mechanisms.ROOT / "docs" / "benchmarks.md"
 
-#: Criterion targets of issue 6 for one forward-dynamics evaluation (s).
+#: Criterion targets for one forward-dynamics evaluation (s).
 FD_TARGETS = {"four-bar-gravity": 1e-6, "3-rrr": 2e-6, "andrews-squeezer": 3e-6}
-#: Issue 6 on the four-bar: planardyn at this drift (J) in at most 1/RATIO_TARGET of the
+#: Target on the four-bar: planardyn at this drift (J) in at most 1/RATIO_TARGET of the
 #: wall time of the fastest peer meeting the four-bar's drift and gap targets.
 PLANARDYN_DRIFT_TARGET = 1e-6
 RATIO_TARGET = 20.0
@@ -113,7 +113,7 @@ def summarise(bm, runs: list[Run], tools: list[str]) -> dict:
 
 
 def four_bar_target(runs: list[Run], summary: dict) -> dict:
-    """Issue 6: planardyn at drift < 1e-6 J against the fastest peer meeting the four-bar's
+    """The four-bar target: planardyn at drift < 1e-6 J against the fastest peer meeting the four-bar's
     stated accuracy (drift < 1e-3 J, gap < 1e-6 m)."""
     bm = mechanisms.FOUR_BAR
     tight = cheapest([r for r in runs if r.tool == "planardyn"], drift=PLANARDYN_DRIFT_TARGET, gap=bm.gap_target)

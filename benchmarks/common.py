@@ -1,7 +1,7 @@
 """What every peer module shares: a mechanism as drawn, the accuracy measures, the timer.
 
 A benchmark mechanism is read from its planardyn model file (``examples/models/*.yaml``,
-the shared benchmarks reproduced exactly) by ``load_drawing``, independently of planardyn,
+the validation benchmarks of tests/data/benchmarks reproduced exactly) by ``load_drawing``, independently of planardyn,
 so that every tool models the same numbers: points, bodies (mass, inertia about the centre
 of mass, centre of mass, in any of the file's inertia forms), revolute pairs, the
 generalized coordinates, constant drive efforts, linear springs and gravity. Each tool's

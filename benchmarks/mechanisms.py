@@ -1,6 +1,6 @@
 """The benchmark mechanisms: which model file, which scenario, how long, which accuracy.
 
-Each is a planardyn model file of ``examples/models/`` (the shared benchmarks reproduced
+Each is a planardyn model file of ``examples/models/`` (the validation benchmarks of tests/data/benchmarks reproduced
 exactly), optionally with top-level fields replaced (``overrides``, computed from the file) to make a scenario every
 tool can run; planardyn runs the same dict (``planardyn.from_dict``).
 """

@@ -26,7 +26,7 @@ from mechanisms import FOUR_BAR  # noqa: E402
 from peers import planardyn_peer as P  # noqa: E402
 
 RUST_SIM = Path(os.environ.get("RUST_SIM", HERE / ".target" / "release" / "planardyn-rust-sim"))
-#: Python simulate may be at most this much slower than the same run from Rust (issue 6).
+#: Python simulate may be at most this much slower than the same run from Rust (a performance target).
 OVERHEAD_TARGET = 0.10
 REPEATS = 15
 

@@ -71,7 +71,7 @@ def summary_text(res: dict) -> str:
     lines = ["", "== summary =="]
     for m in res["mechanisms"].values():
         lines += mechanism_text(m)
-    lines.append("-- targets of issue 6 --")
+    lines.append("-- performance targets --")
     f = res.get("four_bar_target")
     if f and f["planardyn"]:
         p = f["planardyn"]
@@ -159,7 +159,7 @@ def best_table(m: dict) -> str:
 def targets_table(res: dict) -> str:
     dates = {k: (res.get(k) or {}).get("date", "?") for k in ("four_bar_target", "criterion", "python_overhead")}
     rows = [f"Measured {dates['four_bar_target']} (criterion {dates['criterion']}).", "",
-            "| target of issue 6 | measured | verdict |", "|---|---|---|"]
+            "| performance target | measured | verdict |", "|---|---|---|"]
     f = res.get("four_bar_target")
     if f and "ratio" in f:
         p, fp = f["planardyn"], f["fastest_peer"]
@@ -217,7 +217,7 @@ def docs_section(res: dict) -> str:
                   + (f" {published(m['reference'])}." if "published" in m["reference"] else ""), "",
                   best_table(m), "",
                   f"![work-precision diagram, {m['key']}](../benchmarks/results/work_precision_{m['key']}.png)", ""]
-    parts += ["### The targets of issue 6", "", targets_table(res), ""]
+    parts += ["### The performance targets", "", targets_table(res), ""]
     return "\n".join(parts)
 
 

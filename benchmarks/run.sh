@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One command for the whole benchmark suite (issue 6):
+# One command for the whole benchmark suite (docs/benchmarks.md):
 #
 #   benchmarks/run.sh [--quick] [--only four-bar five-bar 3-rrr andrews] [--no-criterion]
 #

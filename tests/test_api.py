@@ -32,7 +32,7 @@ from hypothesis import strategies as st
 # Round-off level for closed forms evaluated in a few dozen flops on O(1) numbers.
 CLOSED_FORM_RTOL = 1e-12
 # Forward then inverse dynamics solve the same linear system twice (Cholesky of A, condition
-# number O(10) here): the brief's 1e-9 leaves three orders of magnitude of margin.
+# number O(10) here): the required 1e-9 leaves three orders of magnitude of margin.
 ROUND_TRIP_RTOL = 1e-9
 # Positions: Newton stops at a scaled residual of 1e-12 (kinematics/position.rs POSITION_TOL).
 POSITION_ATOL = 1e-11
@@ -550,3 +550,18 @@ def test_assembly_continues_from_a_given_start_on_its_branch(four_bar):
     np.testing.assert_allclose(kin["x"], x_near, atol=1e-12)
     with pytest.raises(ValueError, match="x_start"):
         four_bar.assemble([2.0], x_start=[0.0, 1.0])
+
+
+def test_singularity_error_carries_its_kind_and_no_made_up_sigma():
+    """The five-bar drawn with its distal links in line (P on C1-C2) is a type II singularity:
+    it loads (the pair constraints keep full rank), but inverse dynamics is undefined there.
+    The factorisation that fails measures no singular value, so ``sigma_min`` is None."""
+    text = pd.models.path("five-bar-free-fall").read_text()
+    assert "P: [0.0, 0.32320508075688775]" in text
+    mech = pd.loads(text.replace("P: [0.0, 0.32320508075688775]", "P: [0.0, 0.17320508075688773]"))
+    q = np.array([[2.0943951023931953, 1.0471975511965976]])
+    with pytest.raises(pd.SingularityError, match="type II") as info:
+        mech.inverse_dynamics(q, np.zeros_like(q), np.zeros_like(q))
+    assert info.value.kind == "type_ii"
+    assert info.value.sigma_min is None
+    assert "singular value" not in str(info.value)

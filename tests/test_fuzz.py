@@ -162,8 +162,8 @@ def dump(model: dict) -> str:
 @settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 @given(mutated_models())
 def test_fuzz_mutated_models(model):
-    # Far starts (q0 1e300 from the drawing) and huge points (1e308 m) once hung the loader;
-    # it now refuses them (tests/fuzz_corpus/far-q0.yaml, hang-huge-point-prismatic.yaml).
+    # Far starts (q0 1e300 from the drawing) and huge points (1e308 m) must be refused, not
+    # hang the loader (tests/fuzz_corpus/far-q0.yaml, hang-huge-point-prismatic.yaml).
     check_outcome(lambda: pd.from_dict(model))
     # The same through YAML text (PyYAML's emitter; NaN and inf become .nan and .inf).
     check_outcome(lambda: pd.loads(yaml.safe_dump(model), "yaml", "<fuzz>"))

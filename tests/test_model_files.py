@@ -3,12 +3,13 @@
 Pure data tests (no planardyn import): they check `examples/models/*.yaml` against
 `schema/planardyn-model.schema.json`, resolve every name the way the loader does, check the
 mobility 3n - 2p, and check that the three validation benchmarks are reproduced number for
-number from `../shared/benchmarks/*.json` (provenance: `tests/data/PROVENANCE.md`).
+number from `tests/data/benchmarks/*.json` (provenance: `tests/data/PROVENANCE.md`).
 """
 
 from __future__ import annotations
 
 import copy
+import hashlib
 import json
 import math
 import re
@@ -22,7 +23,8 @@ ROOT = Path(__file__).parents[1]
 MODELS = ROOT / "examples" / "models"
 SCHEMA_PATH = ROOT / "schema" / "planardyn-model.schema.json"
 DOC_PATH = ROOT / "docs" / "model-format.md"
-BENCHMARKS = Path(__file__).parents[1].parent / "shared" / "benchmarks"
+BENCHMARKS = ROOT / "tests" / "data" / "benchmarks"
+PROVENANCE = ROOT / "tests" / "data" / "PROVENANCE.md"
 
 BENCHMARK_STEMS = ["four-bar-gravity", "andrews-squeezer", "five-bar-free-fall"]
 # file -> (mobile bodies n, pairs p, coordinates m), counted by hand from each drawing.
@@ -38,6 +40,9 @@ EXPECTED_COUNTS = {
 # Geometry written by hand in the drawings is checked to this (m, rad): the numbers are
 # pasted at full double precision, so only the last-digit rounding of the generator remains.
 GEOMETRY_TOL = 1e-14
+# A drawn coordinate value is a number pasted at full precision from math.radians of a whole
+# degree: equal to it to the last bit or so (1 ulp of 2 rad is 4.4e-16).
+PASTED_ANGLE_TOL = 1e-15
 
 
 # --------------------------------------------------------------------------- loading
@@ -78,7 +83,6 @@ def load_model(name: str) -> dict:
 
 def load_benchmark(stem: str) -> dict:
     path = BENCHMARKS / f"{stem}.json"
-    assert path.is_file(), f"benchmark source {path} is missing: the tests need ../shared/benchmarks"
     return json.loads(path.read_text())
 
 
@@ -438,6 +442,13 @@ def test_schema_accepts_every_pair_and_load_kind(validator):
 
 
 @pytest.mark.parametrize("stem", BENCHMARK_STEMS)
+def test_benchmark_copy_is_the_one_provenance_names(stem):
+    """The copy in tests/data/benchmarks is byte for byte the file whose sha256 PROVENANCE.md records."""
+    digest = hashlib.sha256((BENCHMARKS / f"{stem}.json").read_bytes()).hexdigest()
+    assert f"| `{stem}.json` | `{digest}` |" in PROVENANCE.read_text()
+
+
+@pytest.mark.parametrize("stem", BENCHMARK_STEMS)
 def test_benchmark_reproduced_exactly(stem):
     src = load_benchmark(stem)
     model = canonical(load_model(f"{stem}.yaml"))
@@ -519,7 +530,7 @@ def test_benchmark_reproduced_exactly(stem):
 
 
 def test_andrews_specifics():
-    """The two numbers the brief names: drive 0.033 N m on beta, spring [b3, D] - [ground, C]."""
+    """The two numbers the source names: drive 0.033 N m on beta, spring [b3, D] - [ground, C]."""
     model = load_model("andrews-squeezer.yaml")
     assert model["drives"] == [{"coordinate": "beta", "effort": 0.033}]
     spring = model["loads"][0]
@@ -597,8 +608,8 @@ def test_five_bar_drawing():
     assert math.dist(c1, p) == pytest.approx(0.35, abs=GEOMETRY_TOL)
     assert math.dist(c2, p) == pytest.approx(0.35, abs=GEOMETRY_TOL)
     theta = {c["name"]: c["value"] for c in model["coordinates"]}
-    assert theta == {"theta1": pytest.approx(math.radians(115.0), abs=1e-15),
-                     "theta2": pytest.approx(math.radians(60.0), abs=1e-15)}
+    assert theta == {"theta1": pytest.approx(math.radians(115.0), abs=PASTED_ANGLE_TOL),
+                     "theta2": pytest.approx(math.radians(60.0), abs=PASTED_ANGLE_TOL)}
     assert drawn_angle(model, "proximal_left") == pytest.approx(theta["theta1"], abs=GEOMETRY_TOL)
     assert drawn_angle(model, "proximal_right") == pytest.approx(theta["theta2"], abs=GEOMETRY_TOL)
 
@@ -628,7 +639,7 @@ def test_slider_crank_drawing():
     assert guide["bodies"] == ["ground", "slider"] and guide["axis"] == [1.0, 0.0] and guide["at"] == "B"
     (coord,) = model["coordinates"]
     assert coord["pair"] == "crank_pivot"
-    assert coord["value"] == pytest.approx(math.radians(60.0), abs=1e-15)
+    assert coord["value"] == pytest.approx(math.radians(60.0), abs=PASTED_ANGLE_TOL)
     assert drawn_angle(model, "crank") == pytest.approx(coord["value"], abs=GEOMETRY_TOL)
     assert drawn_angle(model, "slider") == 0.0  # one point
     assert {ld["type"] for ld in model["loads"]} == {"spring", "friction"}

@@ -16,7 +16,7 @@ from planardyn import robot
 FD_TOL = 1e-7
 # Second differences with h = 1e-4: truncation ~ h^2 |X''''| ~ 1e-8, round-off 1e-12/h^2.
 FD2_TOL = 1e-6
-# The issue's requirement: the drive torques reproduce the circle in open-loop forward
+# Required: the drive torques reproduce the circle in open-loop forward
 # dynamics to 1e-6 m (measured: ~3e-10 m five-bar, ~2e-10 m 3-RRR).
 RECOVER_TOL = 1e-6
 

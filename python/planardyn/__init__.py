@@ -5,7 +5,7 @@ A mechanism is described as it is drawn, in a model file (YAML or JSON, see
 
     import planardyn as pd
 
-    mech = pd.load("examples/models/five-bar.yaml")
+    mech = pd.load("examples/models/five-bar.yaml")   # or pd.load_example("five-bar")
     res = mech.simulate(t_end=1.0)
     res.q          # (N, m) coordinates, rad or m
     res.to_csv("five-bar.csv")
@@ -18,7 +18,7 @@ Errors raise subclasses of :class:`PlanardynError`: :class:`ModelError` (also a
 
 from __future__ import annotations
 
-from . import batch, notebook, sensitivity
+from . import batch, models, notebook, sensitivity
 from ._core import (
     AssemblyError,
     ModelError,
@@ -27,7 +27,7 @@ from ._core import (
     SingularityError,
     __version__,
 )
-from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, loads
+from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
 from .result import Energy, SimulationResult
 from .results_io import read_results
 
@@ -46,7 +46,9 @@ __all__ = [
     "from_dict",
     "from_result",
     "load",
+    "load_example",
     "loads",
+    "models",
     "read_results",
     "sensitivity",
 ]

@@ -42,7 +42,8 @@ class AssemblyError(PlanardynError):
     iterations: int
 
 class SingularityError(PlanardynError):
-    sigma_min: float
+    kind: str
+    sigma_min: float | None
 
 class SimulationError(PlanardynError): ...
 

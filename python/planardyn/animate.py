@@ -26,6 +26,12 @@ if TYPE_CHECKING:
 MAX_FRAMES = 400
 FORMATS = (".gif", ".mp4", ".html", ".htm")
 DEFAULT_FPS = 20.0
+#: Added to the frame count before flooring: a whole count computed in floating point
+#: (0.3 / 0.1 * 10 is 29.999...) must not lose its last frame.
+FRAME_COUNT_SLACK = 1e-9
+#: Frame times are nudged forward by this fraction of the span before the output search, so
+#: a frame on an output time picks that output despite round-off in the linspace.
+FRAME_TIME_SLACK = 1e-12
 
 
 def frame_indices(
@@ -41,11 +47,11 @@ def frame_indices(
     if fps <= 0 or speed <= 0:
         raise ValueError(f"fps and speed must be positive, got fps={fps}, speed={speed}")
     span = t[-1] - t[0]
-    n = int(np.floor(span / speed * fps + 1e-9)) + 1  # 1e-9: 0.3 / 0.1 * 10 is 29.999...
+    n = int(np.floor(span / speed * fps + FRAME_COUNT_SLACK)) + 1
     if n > max_frames:
         n = max_frames
     times = t[0] + np.linspace(0.0, span, max(n, 2) if len(t) > 1 else 1)
-    idx = np.searchsorted(t, times + 1e-12 * max(1.0, abs(span)), side="right") - 1
+    idx = np.searchsorted(t, times + FRAME_TIME_SLACK * max(1.0, abs(span)), side="right") - 1
     return np.clip(idx, 0, len(t) - 1)
 
 

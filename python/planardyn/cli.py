@@ -23,13 +23,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from . import AssemblyError, PlanardynError, SingularityError, load, structure
+from . import AssemblyError, PlanardynError, SingularityError, load, models, structure
 from .result import SimulationResult
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
-#: The demo's model, in the source tree next to the package (an editable install).
-DEMO_MODEL = Path(__file__).resolve().parents[2] / "examples" / "models" / "five-bar.yaml"
+#: The demo's model: a shipped model (package data, ``planardyn.models``).
+DEMO_MODEL = "five-bar"
 RESULT_EXTENSIONS = (".csv", ".parquet", ".npz")
 
 
@@ -195,7 +195,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    d.add_argument("--model", type=Path, default=DEMO_MODEL, help="model file (default: examples/models/five-bar.yaml)")
+    d.add_argument("--model", type=Path, help=f"model file (default: the shipped model {DEMO_MODEL!r})")
     return p
 
 
@@ -228,6 +228,7 @@ def _check(args: argparse.Namespace) -> int:
         print(f"loop-closure residual at the start: {kin['residual']:.3g}")
     except SingularityError as e:
         print(f"singularity measures at the start: singular ({e})")
+
     try:
         print(structure.report(mech))
     except Exception as e:  # the structural analysis is extra: never lose the rest
@@ -343,9 +344,7 @@ def _demo(args: argparse.Namespace) -> int:
     from .plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy, plot_torque_speed
     from .results_io import attach_metadata, simulate_settings, write_results
 
-    if not args.model.is_file():
-        raise FileNotFoundError(f"{args.model}: the demo model is not there (pass --model MODEL)")
-    mech = load(args.model)
+    mech = load(models.path(DEMO_MODEL) if args.model is None else args.model)
     settings = simulate_settings(mech)
     res = attach_metadata(mech.simulate(**settings), mech, settings)
     print(summary(res))

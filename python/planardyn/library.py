@@ -36,7 +36,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .mechanism import Mechanism, from_dict, load
+from . import models
+from .mechanism import Mechanism, from_dict, load_example
 
 Vec = tuple[float, float]
 GRAVITY: Vec = (0.0, -9.81)
@@ -696,19 +697,16 @@ watt_six_bar = _mechanism(watt_six_bar_model)
 stephenson_six_bar = _mechanism(stephenson_six_bar_model)
 double_parallelogram = _mechanism(double_parallelogram_model)
 
-#: Where the shipped model files are (examples/models/ of the repository).
-MODELS_DIR = Path(__file__).resolve().parents[2] / "examples" / "models"
+#: Where the shipped model files are (package data, ``planardyn.models``).
+MODELS_DIR = models.directory()
 #: The library's own files, written from the constructors' defaults.
-LIBRARY_DIR = MODELS_DIR / "library"
+LIBRARY_DIR = MODELS_DIR / models.LIBRARY
 
 
 def andrews_squeezer() -> Mechanism:
-    """Andrews' squeezing mechanism: the shipped ``examples/models/andrews-squeezer.yaml``
+    """Andrews' squeezing mechanism: the shipped model ``andrews-squeezer``
     (7 bodies, 10 revolute pairs, crank angle ``beta``; Hairer & Wanner's benchmark)."""
-    path = MODELS_DIR / "andrews-squeezer.yaml"
-    if not path.is_file():
-        raise FileNotFoundError(f"{path} is not there: andrews_squeezer() needs the repository's examples/models")
-    return load(path)
+    return load_example("andrews-squeezer")
 
 
 #: File stem -> model function (at its defaults), for every mechanism built here.
@@ -838,8 +836,8 @@ def draw_all(directory: str | os.PathLike[str]) -> list[Path]:
 
 
 if __name__ == "__main__":
-    # python -m planardyn.library [MODEL_DIR [PICTURE_DIR]]
+    # python -m planardyn.library [MODEL_DIR [PICTURE_DIR]], run from the repository's root
     for p in write_all(sys.argv[1] if len(sys.argv) > 1 else LIBRARY_DIR):
         print(p)
-    for p in draw_all(sys.argv[2] if len(sys.argv) > 2 else MODELS_DIR.parents[1] / "docs" / "img"):
+    for p in draw_all(sys.argv[2] if len(sys.argv) > 2 else Path("docs") / "img"):
         print(p)

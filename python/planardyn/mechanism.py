@@ -1,6 +1,6 @@
 """The typed Python face of a mechanism: loading, kinematics, dynamics, simulation.
 
-Notation (see ``docs/`` and the paper's symbols): m generalized coordinates ``q`` (rad for
+Notation (the paper's symbols, see ``docs/formulation.md``): m generalized coordinates ``q`` (rad for
 an angle, m for a displacement), n mobile bodies, ``x`` the 3n body coordinates
 [X, Y, phi] of each centre of mass (m, m, rad), P named points, p pairs.
 """
@@ -21,6 +21,7 @@ from ._core import Mechanism as NativeMechanism
 from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
+from .models import path as model_path
 from .result import SimulationResult
 
 
@@ -411,6 +412,17 @@ def load(path: str | os.PathLike[str]) -> Mechanism:
         the field (``bodies.crank.mass``), as do the attributes ``source`` and ``path``.
     """
     return Mechanism(native_load(os.fspath(path)))
+
+
+def load_example(name: str) -> Mechanism:
+    """Load a model file shipped with planardyn by name (``"five-bar"``; see ``planardyn.models.names()``).
+
+    Raises
+    ------
+    planardyn.models.UnknownModelError
+        (a ``KeyError``) No shipped model has that name; the message lists the names there are.
+    """
+    return load(model_path(name))
 
 
 def loads(text: str, format: Literal["yaml", "json"] = "yaml", source: str = "<string>") -> Mechanism:

@@ -35,6 +35,9 @@ if TYPE_CHECKING:
 MAX_FRAMES = 1500
 #: Significant digits kept for positions (relative to the mechanism's size) and channels.
 DIGITS = 6
+#: Smallest time scale (s) the rounding of output times is relative to: a run near t = 0
+#: keeps its times to DIGITS digits of a millisecond, not of zero.
+MIN_TIME_SCALE = 1e-3
 
 
 def _round(a: np.ndarray, scale: float) -> list:
@@ -139,7 +142,7 @@ def viewer_data(
         "title": title or mech.name,
         "info": info,
         "version": __version__,
-        "t": _round(t, max(abs(t[0]), abs(t[-1]), 1e-3)),
+        "t": _round(t, max(abs(t[0]), abs(t[-1]), MIN_TIME_SCALE)),
         "speed": auto_speed(result.t),
         "scale": L,
         "names": names,

@@ -13,7 +13,8 @@
 //! A task motion's failures (`TaskError`) are `SingularityError` and `AssemblyError` too, with
 //! the data of where the motion stopped as attributes.
 //!
-//! Shape and value errors in the arguments are plain `ValueError`s. A Rust panic never
+//! Shape and value errors in the arguments are plain `ValueError`s (attribute `argument`
+//! where the core names it). A core error of a kind added later is a `PlanardynError`. A Rust panic never
 //! reaches Python as `PanicException`: [`run`] catches it and raises `PlanardynError` asking
 //! for a bug report.
 
@@ -41,7 +42,9 @@ create_exception!(
     planardyn,
     SingularityError,
     PlanardynError,
-    "The mechanism is singular at this configuration (attribute `sigma_min`)."
+    "The mechanism is singular at this configuration (attributes `kind`: which matrix lost rank, \
+     e.g. 'type_ii' or 'passive'; `sigma_min`: the smallest scaled singular value, None where \
+     a failed factorisation measured none)."
 );
 create_exception!(
     planardyn,
@@ -99,6 +102,7 @@ pub fn model_error(py: Python<'_>, e: &CoreModelError) -> PyErr {
         CoreModelError::Parse { source_name, path, .. } | CoreModelError::Invalid { source_name, path, .. } => {
             (source_name.clone(), path.clone())
         }
+        _ => (String::new(), e.path().to_string()),
     };
     let ty = match model_error_type(py) {
         Ok(t) => t.clone(),
@@ -119,11 +123,17 @@ pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
             let attrs = [("residual", r.into_any().unbind()), ("iterations", i.into_any().unbind())];
             with_attrs(py, AssemblyError::new_err(e.to_string()), &attrs)
         }
-        KinematicsError::Singular { sigma_min, .. } => {
+        KinematicsError::Singular { kind, sigma_min } => {
             let Ok(s) = sigma_min.into_pyobject(py);
-            with_attrs(py, SingularityError::new_err(e.to_string()), &[("sigma_min", s.into_any().unbind())])
+            let Ok(k) = kind.name().into_pyobject(py);
+            let attrs = [("kind", k.into_any().unbind()), ("sigma_min", s.into_any().unbind())];
+            with_attrs(py, SingularityError::new_err(e.to_string()), &attrs)
         }
-        KinematicsError::BadArgument(msg) => PyValueError::new_err(msg.clone()),
+        KinematicsError::BadArgument { name, .. } => {
+            let Ok(n) = name.into_pyobject(py);
+            with_attrs(py, PyValueError::new_err(e.to_string()), &[("argument", n.into_any().unbind())])
+        }
+        _ => PlanardynError::new_err(e.to_string()),
     }
 }
 
@@ -187,6 +197,7 @@ pub fn to_pyerr(py: Python<'_>, e: &Error) -> PyErr {
         Error::Model(m) => model_error(py, m),
         Error::Kinematics(k) => kinematics_error(py, k),
         Error::Options(_) | Error::Drive { .. } => SimulationError::new_err(e.to_string()),
+        _ => PlanardynError::new_err(e.to_string()),
     }
 }
 

@@ -2,7 +2,7 @@
 //! - `NAME`: evaluated again and again at one stage point (1 mrad from the accepted point
 //!   the first time): the position is then already converged, so this is the cost of the
 //!   stages after it (J factorised, analogues U, convective term, A, b, solve) plus one
-//!   residual check. The figure the speed targets are read against.
+//!   residual check. The figure the performance targets (docs/benchmarks.md) are read against.
 //! - `NAME+1mrad`: alternating between two stage points 1 mrad apart in every coordinate,
 //!   so that each evaluation also runs Newton from the second-order prediction, as between
 //!   the stages of an integration step.

@@ -112,12 +112,11 @@ pub fn inverse_rows_from(
 ) -> Result<Vec<f64>, Error> {
     let m = mech.dof();
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
-        return Err(KinematicsError::BadArgument(format!(
-            "q, qd and qdd need the same number of rows of {m} values, got {}, {} and {} values",
-            q.len(),
-            qd.len(),
-            qdd.len()
-        ))
+        return Err(KinematicsError::bad_argument(
+            "q, qd, qdd",
+            format!("the same number of rows of {m} values each"),
+            format!("{}, {} and {} values", q.len(), qd.len(), qdd.len()),
+        )
         .into());
     }
     let mut ws = Workspace::new(mech);

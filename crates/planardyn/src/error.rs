@@ -5,6 +5,7 @@ use thiserror::Error;
 
 /// A model that cannot be built: a malformed file, or a drawing that is not a mechanism.
 #[derive(Debug, Clone, Error, PartialEq)]
+#[non_exhaustive]
 pub enum ModelError {
     /// The text is not valid YAML/JSON, or a field has the wrong type or an unknown name.
     #[error("{source_name}: {path}: {message}")]
@@ -23,8 +24,65 @@ impl ModelError {
     }
 }
 
+/// Which matrix lost rank where a computation needs it regular, and so what to change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SingularityKind {
+    /// Type II (parallel): J with the generalized coordinates fixed is singular, so q does not
+    /// determine the position (the actuated mechanism gains an uncontrolled motion).
+    TypeII,
+    /// The pair constraints Phi_x lose rank: a singularity of the passive mechanism, whatever
+    /// the coordinates.
+    Passive,
+    /// The start is a type II singularity and the rates qd0 are not all zero: they do not
+    /// determine the body velocities there.
+    TypeIIStartInMotion,
+    /// The passive mechanism is singular at the start of a simulation.
+    PassiveAtStart,
+    /// The mass matrix A = U^T M U is not positive definite (`type_ii`: in the chart of the
+    /// generalized coordinates, i.e. at a type II singularity).
+    MassMatrix { type_ii: bool },
+}
+
+impl SingularityKind {
+    /// A stable identifier (`"type_ii"`, `"passive"`...), for bindings and logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            SingularityKind::TypeII => "type_ii",
+            SingularityKind::Passive => "passive",
+            SingularityKind::TypeIIStartInMotion => "type_ii_start_in_motion",
+            SingularityKind::PassiveAtStart => "passive_at_start",
+            SingularityKind::MassMatrix { .. } => "mass_matrix",
+        }
+    }
+}
+
+impl std::fmt::Display for SingularityKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SingularityKind::TypeII => {
+                "the generalized coordinates do not determine the mechanism's position \
+                 (a type II, parallel singularity of the actuated mechanism)"
+            }
+            SingularityKind::Passive => "the pair constraints lose rank (a singularity of the passive mechanism)",
+            SingularityKind::TypeIIStartInMotion => {
+                "the start is a type II singularity, where the rates qd0 do not determine the body \
+                 velocities; start at rest or elsewhere"
+            }
+            SingularityKind::PassiveAtStart => {
+                "the passive mechanism is singular at the start (its pair constraints lose rank); start elsewhere"
+            }
+            SingularityKind::MassMatrix { type_ii: true } => {
+                "the mass matrix A = U^T M U is not positive definite (type II singularity)"
+            }
+            SingularityKind::MassMatrix { type_ii: false } => "the mass matrix A = U^T M U is not positive definite",
+        })
+    }
+}
+
 /// A kinematic computation that failed at a given configuration.
 #[derive(Debug, Clone, Error, PartialEq)]
+#[non_exhaustive]
 pub enum KinematicsError {
     /// Newton's method on the loop-closure equations did not converge.
     #[error(
@@ -33,19 +91,34 @@ pub enum KinematicsError {
          try values closer to the drawing or a smaller step"
     )]
     AssemblyFailed { residual: f64, iterations: usize },
-    /// The Jacobian of the constraints with the given coordinates fixed is singular.
-    #[error(
-        "the mechanism is singular here (smallest scaled singular value {sigma_min:.3e}): \
-         {what}"
-    )]
-    Singular { sigma_min: f64, what: String },
+    /// A matrix the computation needs regular is singular. `sigma_min`: the smallest scaled
+    /// singular value, where it was measured (a failed factorisation measures nothing).
+    #[error("the mechanism is singular here{}: {kind}", sigma_note(.sigma_min))]
+    Singular { kind: SingularityKind, sigma_min: Option<f64> },
     /// An argument with the wrong length or a non-finite value.
-    #[error("{0}")]
-    BadArgument(String),
+    #[error("{name}: expected {expected}, got {got}")]
+    BadArgument { name: &'static str, expected: String, got: String },
+}
+
+fn sigma_note(sigma_min: &Option<f64>) -> String {
+    sigma_min.map(|s| format!(" (smallest scaled singular value {s:.3e})")).unwrap_or_default()
+}
+
+impl KinematicsError {
+    /// A singularity found by a factorisation, which measures no singular value.
+    pub fn singular(kind: SingularityKind) -> Self {
+        KinematicsError::Singular { kind, sigma_min: None }
+    }
+
+    /// An argument `name` that is not what was `expected`; `got` says what it is.
+    pub fn bad_argument(name: &'static str, expected: impl Into<String>, got: impl Into<String>) -> Self {
+        KinematicsError::BadArgument { name, expected: expected.into(), got: got.into() }
+    }
 }
 
 /// Errors returned by the dynamics and simulation entry points.
 #[derive(Debug, Clone, Error, PartialEq)]
+#[non_exhaustive]
 pub enum Error {
     #[error(transparent)]
     Model(#[from] ModelError),

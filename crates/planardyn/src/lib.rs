@@ -4,7 +4,8 @@
 //! robots, after Baigunchekov & Baigunchekov, "Differential equations of motion of planar
 //! executive mechanisms of parallel manipulating robots": per body M_i = diag(m, m, I),
 //! velocity analogues u_j and acceleration analogues w_jk of the centres of mass,
-//! A = U^T M U, b = U^T f - U^T M sum_jl qd_j qd_l w_jl, qdd = A^-1 b.
+//! A = U^T M U, b = U^T f - U^T M sum_jl qd_j qd_l w_jl, qdd = A^-1 b. The equations, by
+//! the paper's numbers, its misprints and the conventions used here: `docs/formulation.md`.
 //!
 //! A mechanism is described as it is drawn (a model file, see `docs/model-format.md`),
 //! validated once into an immutable [`Mechanism`]; every computation runs in a
@@ -23,6 +24,6 @@ pub mod model;
 pub mod simulate;
 pub mod workspace;
 
-pub use error::{Error, KinematicsError, ModelError, Result};
+pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};
 pub use model::{load, loads, Format, Mechanism, MechanismSpec};
 pub use workspace::Workspace;

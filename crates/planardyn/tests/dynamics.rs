@@ -62,7 +62,7 @@ fn forward_then_inverse_dynamics_returns_the_applied_efforts() {
         let qdd = ws.qdd.clone();
         inverse(&mech, &q, &qd, &qdd, &mut ws).unwrap();
         for k in 0..m {
-            // 1e-9 relative: the brief's requirement; both sides are exact to round-off.
+            // 1e-9 relative: the required accuracy; both sides are exact to round-off.
             assert!(
                 (ws.tau[k] - tau[k]).abs() < 1e-9 * (1.0 + tau[k].abs()),
                 "{}: tau {:?} vs {tau:?}",

@@ -2,7 +2,7 @@
 
 mod common;
 use common::*;
-use planardyn::{loads, Format, KinematicsError, ModelError};
+use planardyn::{loads, Format, KinematicsError, ModelError, SingularityKind};
 
 fn model_error(text: &str, format: Format) -> ModelError {
     match loads(text, format, "bad.yaml") {
@@ -102,6 +102,31 @@ fn inverse_dynamics_at_a_type_ii_singularity_says_so() {
     ws.x.copy_from_slice(&mech.x0);
     let q = mech.drawn_q();
     let err = planardyn::dynamics::inverse(&mech, &q, &[0.0, 0.0], &[0.0, 0.0], &mut ws).unwrap_err();
-    assert!(matches!(err, KinematicsError::Singular { .. }), "{err:?}");
+    assert_eq!(err, KinematicsError::Singular { kind: SingularityKind::TypeII, sigma_min: None });
     assert!(err.to_string().contains("type II"), "{err}");
+}
+
+#[test]
+fn a_bad_argument_names_it_with_what_was_expected_and_what_came() {
+    let mech = yaml(FIVE_BAR_FALL);
+    let err = planardyn::kinematics::assemble(&mech, &[1.0]).unwrap_err();
+    let KinematicsError::BadArgument { name, expected, got } = &err else { panic!("{err:?}") };
+    assert_eq!((*name, expected.as_str(), got.as_str()), ("q", "2 finite coordinate values (theta1, theta2)", "[1.0]"));
+    assert_eq!(err.to_string(), "q: expected 2 finite coordinate values (theta1, theta2), got [1.0]");
+    let mut ws = planardyn::Workspace::new(&mech);
+    let x = vec![f64::NAN; mech.n_x()];
+    let err = planardyn::kinematics::assemble_from(&mech, &x, &mech.drawn_q(), &mut ws).unwrap_err();
+    assert!(
+        matches!(&err, KinematicsError::BadArgument { name: "x_start", got, .. } if got == "NaN at index 0 of 12 values")
+    );
+}
+
+#[test]
+fn an_unmeasured_singularity_has_no_sigma_and_says_nothing_of_one() {
+    let err = KinematicsError::singular(SingularityKind::TypeII);
+    assert_eq!(err, KinematicsError::Singular { kind: SingularityKind::TypeII, sigma_min: None });
+    assert!(!err.to_string().contains("singular value"), "{err}");
+    let measured = KinematicsError::Singular { kind: SingularityKind::PassiveAtStart, sigma_min: Some(1.5e-9) };
+    assert!(measured.to_string().contains("(smallest scaled singular value 1.500e-9)"), "{measured}");
+    assert_eq!(SingularityKind::MassMatrix { type_ii: true }.name(), "mass_matrix");
 }

@@ -1,5 +1,5 @@
 //! Whole simulations checked without outside software: energy balance of the benchmark
-//! mechanisms (figures from ../shared/benchmarks, see tests/data/PROVENANCE.md), a published
+//! mechanisms (figures from tests/data/benchmarks, see tests/data/PROVENANCE.md), a published
 //! reference solution (Andrews' squeezer), the exact pendulum period, and invariance to the
 //! frame of the drawing.
 

@@ -32,6 +32,9 @@ FloatArray = NDArray[np.float64]
 
 # Default spacing of the samples of a path (s).
 DEFAULT_DT = 1e-3
+# Tolerances of the open-loop check run (TaskMotion.simulate): its integration error must stay
+# far below the 1e-6 m to which the efforts are required to reproduce the path.
+CHECK_RTOL, CHECK_ATOL = 1e-10, 1e-12
 
 KIND_TEXT = {
     "I": "type I (serial) singularity: the end effector cannot move in some direction there "
@@ -87,7 +90,7 @@ class TaskMotion:
         """Forward dynamics under :meth:`drives` from the motion's first state, output at
         ``t`` (open loop: the check that the efforts produce the motion). ``options`` go to
         :meth:`Mechanism.simulate` (default dop853, rtol 1e-10, atol 1e-12)."""
-        kw = dict(method="dop853", rtol=1e-10, atol=1e-12, t_eval=self.t, q0=self.q[0], qd0=self.qd[0],
+        kw = dict(method="dop853", rtol=CHECK_RTOL, atol=CHECK_ATOL, t_eval=self.t, q0=self.q[0], qd0=self.qd[0],
                   drives=self.drives())
         kw.update(options)
         return self.mech.simulate(self.t[-1], **kw)

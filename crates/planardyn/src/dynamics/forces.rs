@@ -1,4 +1,5 @@
-//! Applied forces reduced to the centres of mass, f = [F_x, F_y, M] per body (eq. 26):
+//! Applied forces reduced to the centres of mass, f = [F_x, F_y, M] per body
+//! (docs/formulation.md, eq. 26):
 //! gravity, point forces, torques, springs and dampers, and the drive efforts mapped
 //! through the coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 

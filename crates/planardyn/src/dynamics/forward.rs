@@ -1,4 +1,4 @@
-//! Forward dynamics, the paper's eq. 29-31 in the workspace's chart z:
+//! Forward dynamics, docs/formulation.md eqs. 29-31 in the workspace's chart z:
 //!   positions -> analogues U -> convective term c -> forces f -> A = U^T M U,
 //!   b = U^T (f - M c) -> zdd = A^-1 b -> xdd = U zdd + c, qdd.
 
@@ -8,7 +8,7 @@ use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
 use crate::linalg::{cholesky_in_place, cholesky_solve};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
-use crate::{Error, KinematicsError};
+use crate::{Error, KinematicsError, SingularityKind};
 
 /// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
 #[inline]
@@ -94,14 +94,8 @@ pub fn forward(
     bias(mech, ws);
     let m = ws.b.len();
     if !cholesky_in_place(&mut ws.a, m) {
-        return Err(KinematicsError::Singular {
-            sigma_min: 0.0,
-            what: match ws.chart {
-                Chart::Inputs => "the mass matrix A is not positive definite (type II singularity)".into(),
-                Chart::Partition(_) => "the mass matrix A is not positive definite".into(),
-            },
-        }
-        .into());
+        let type_ii = matches!(ws.chart, Chart::Inputs);
+        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }).into());
     }
     cholesky_solve(&ws.a, m, &mut ws.b);
     let n = ws.x.len();

@@ -1,5 +1,5 @@
 //! Inverse dynamics: the drive efforts a motion needs, tau = A qdd - U^T (f - M c), with f
-//! the applied forces without drives (formulation.md). Defined only where the user's
+//! the applied forces without drives (docs/formulation.md, *Inverse dynamics*). Defined only where the user's
 //! coordinates determine the mechanism (away from type II singularities).
 
 use super::forces::applied_forces;

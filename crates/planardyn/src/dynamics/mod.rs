@@ -1,5 +1,6 @@
-//! Dynamics (formulation.md): applied forces, A and b, forward and inverse dynamics,
-//! pair reactions, energies, task-space inverse dynamics along an end-effector path. Stages run in a [`crate::Workspace`].
+//! Dynamics (docs/formulation.md): applied forces, A and b, forward and inverse dynamics,
+//! pair reactions, energies, task-space inverse dynamics along an end-effector path. Stages
+//! run in a [`crate::Workspace`].
 
 pub mod energy;
 pub mod forces;

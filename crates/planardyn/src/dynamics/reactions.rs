@@ -1,6 +1,6 @@
 //! Pair reactions from the Lagrange multipliers: with the accelerations known,
 //! M xdd = f + Phi_x^T mu, solved as J^T lambda = M xdd - f in the current chart (the chart
-//! rows carry no force, so their multipliers vanish up to round-off).
+//! rows carry no force, so their multipliers vanish up to round-off; docs/formulation.md).
 
 use crate::kinematics::constraints::rotate;
 use crate::model::{Link, Mechanism, PairKind};

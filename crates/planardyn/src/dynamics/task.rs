@@ -238,7 +238,9 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
         let st = if i == 0 {
             tr.ee.reach(mech, &target, &q_start, &mut tr.ws).map_err(|e| {
                 let why = match e {
-                    EffectorError::Kinematics(KinematicsError::BadArgument(_)) => return TaskError::Core(e_core(e)),
+                    EffectorError::Kinematics(KinematicsError::BadArgument { .. }) => {
+                        return TaskError::Core(e_core(e))
+                    }
                     other => other.to_string(),
                 };
                 TaskError::OutOfReach {

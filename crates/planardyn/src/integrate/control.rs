@@ -18,6 +18,32 @@ pub(crate) const MAX_FACTOR: f64 = 10.0;
 /// Factor by which the step is shrunk after a failed `rhs` or a NaN/inf.
 pub(crate) const FAIL_FACTOR: f64 = 0.25;
 
+/// How far past `t_stop` an adaptive step may reach, as a fraction of h, and still be cut
+/// to land on it: stretching by 1 % is cheaper than a sliver of a last step.
+const ADAPTIVE_STRETCH: f64 = 0.01;
+/// The same for a fixed step: only the round-off of summing dt (steps of 1e-10 dt or less
+/// would be noise).
+const FIXED_STRETCH: f64 = 1e-10;
+
+/// The stretch allowed to land on `t_stop` with the fixed step `dt` (None: adaptive).
+pub(crate) fn stretch(dt: Option<f64>) -> f64 {
+    if dt.is_some() {
+        FIXED_STRETCH
+    } else {
+        ADAPTIVE_STRETCH
+    }
+}
+
+// The starting-step rule of HNW I, II.4 (scipy's `select_initial_step`), with its constants.
+/// Scaled norms of y or f below this count as zero: no scale to take h0 from.
+const START_NORM_FLOOR: f64 = 1e-5;
+/// The first guess h0 when y or f is (nearly) zero.
+const START_H_FALLBACK: f64 = 1e-6;
+/// Scaled derivative norms below this count as zero: the second guess is not from them.
+const START_DERIVATIVE_FLOOR: f64 = 1e-15;
+/// The second guess from h0 when both derivatives are (nearly) zero: h0 * 1e-3, at least 1e-6.
+const START_H_SHRINK: f64 = 1e-3;
+
 /// Why a trial step was rejected without an error estimate.
 pub(crate) enum Failure<E> {
     /// `rhs` returned an error.
@@ -263,7 +289,7 @@ pub(crate) fn initial_step<S: OdeSystem>(
     }
     let d0 = scaled_norm(&core.y, &core.y, opts);
     let d1 = scaled_norm(&core.f, &core.y, opts);
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+    let h0 = if d0 < START_NORM_FLOOR || d1 < START_NORM_FLOOR { START_H_FALLBACK } else { 0.01 * d0 / d1 };
     let h0 = h0.min(interval).min(opts.h_max);
     for i in 0..core.n {
         y1[i] = core.y[i] + h0 * core.f[i];
@@ -276,8 +302,8 @@ pub(crate) fn initial_step<S: OdeSystem>(
         f1[i] -= core.f[i];
     }
     let d2 = scaled_norm(f1, &core.y, opts) / h0;
-    let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
-        (h0 * 1e-3).max(1e-6)
+    let h1 = if d1 <= START_DERIVATIVE_FLOOR && d2 <= START_DERIVATIVE_FLOOR {
+        (h0 * START_H_SHRINK).max(START_H_FALLBACK)
     } else {
         (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
     };
@@ -352,7 +378,7 @@ pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
             }
         },
     };
-    let stretch = if fixed.is_some() { 1e-10 } else { 0.01 };
+    let stretch = stretch(fixed);
     let mut rejected = false;
     let mut last_failure: Option<Failure<S::Error>> = None;
     loop {

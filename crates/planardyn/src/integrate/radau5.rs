@@ -41,7 +41,7 @@
 // T and TI keep the 17 digits of scipy's table.
 #![allow(clippy::excessive_precision)]
 
-use super::control::{all_finite, initial_step, Core, Failure, FAIL_FACTOR, MAX_FACTOR, MIN_FACTOR};
+use super::control::{all_finite, initial_step, stretch, Core, Failure, FAIL_FACTOR, MAX_FACTOR, MIN_FACTOR};
 use super::{OdeSystem, Options, StepError};
 use crate::linalg::{lu_factor, lu_solve, LuError};
 use nalgebra::Complex;
@@ -50,6 +50,12 @@ type C64 = Complex<f64>;
 
 /// Newton iterations allowed per step.
 const NEWTON_MAXITER: usize = 6;
+/// Floor of |y_j| in the finite-difference increment sqrt(eps * max(|y_j|, floor)) (RADAU5's
+/// DELT): a component near 0 still gets an increment well above round-off.
+const FD_SCALE_FLOOR: f64 = 1e-5;
+/// Newton contraction rate above which the Jacobian is refreshed after an accepted step
+/// (RADAU5's THET; scipy's rule): a slower Newton means a stale J.
+const JAC_REUSE_RATE: f64 = 1e-3;
 
 /// The transformed tableau: scipy's `radau.py` constants.
 struct Tableau {
@@ -191,7 +197,7 @@ impl Radau5 {
         self.ytmp.copy_from_slice(&self.core.y);
         for j in 0..n {
             let yj = self.core.y[j];
-            let mut delta = (f64::EPSILON * yj.abs().max(1e-5)).sqrt();
+            let mut delta = (f64::EPSILON * yj.abs().max(FD_SCALE_FLOOR)).sqrt();
             self.ytmp[j] = yj + delta;
             self.core.stats.nfev += 1;
             if sys.rhs(t, &self.ytmp, &mut self.f_new).is_err() || !all_finite(&self.f_new) {
@@ -371,7 +377,7 @@ impl Radau5 {
         if h > self.core.opts.h_max {
             (h_old, err_old) = (None, None);
         }
-        let stretch = if fixed.is_some() { 1e-10 } else { 0.01 };
+        let stretch = stretch(fixed);
         let mut rejected = false;
         let mut last_failure: Option<Failure<S::Error>> = None;
         let (newton, err_norm, h_planned, h, t_new) = loop {
@@ -398,7 +404,7 @@ impl Radau5 {
             self.core.stats.nreject += 1;
         };
         // Accepted: choose the next step and whether to refresh J (scipy's rules).
-        let recompute_jac = newton.iterations > 2 && newton.rate > 1e-3;
+        let recompute_jac = newton.iterations > 2 && newton.rate > JAC_REUSE_RATE;
         let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + newton.iterations) as f64;
         let mut factor = (safety * predict_factor(h, h_old, err_norm, err_old)).min(MAX_FACTOR);
         if !recompute_jac && factor < 1.2 {

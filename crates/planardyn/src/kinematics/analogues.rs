@@ -1,23 +1,19 @@
 //! Velocity analogues U = dx/dz, acceleration analogues w_jk = d2x/dz_j dz_k and the
-//! convective term c = sum_jl zd_j zd_l w_jl, from the factorised J (formulation.md):
+//! convective term c = sum_jl zd_j zd_l w_jl, from the factorised J
+//! (docs/formulation.md, eqs. 6-9, 13-14 and 24):
 //!   J U = [0; I_m],   J w_jk = -gamma(u_j, u_k),   J c = -gamma(xd, xd) with xd = U zd.
 
 use super::constraints::gamma;
+use super::position::chart_singularity;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
-fn not_factored() -> KinematicsError {
-    KinematicsError::Singular {
-        sigma_min: 0.0,
-        what: "the velocity analogues are undefined where J is singular".to_string(),
-    }
-}
-
 /// Fill `ws.u` (column j = u_j) from J factorised at `ws.x`.
 pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
     if !ws.sys.is_factored() {
-        return Err(not_factored());
+        // The analogues are undefined where J is singular (no factorisation of it).
+        return Err(KinematicsError::singular(chart_singularity(&ws.chart)));
     }
     let n = ws.x.len();
     let m = ws.u.len() / n.max(1);

@@ -92,29 +92,46 @@ impl Effector {
     /// named when several carry the point, since their angles differ).
     pub fn new(mech: &Mechanism, point: &str, body: Option<&str>) -> Result<Self, KinematicsError> {
         let m = mech.dof();
-        let bad = KinematicsError::BadArgument;
         if m != 2 && m != 3 {
-            return Err(bad(format!(
-                "task-space motions need m = 2 (a point) or m = 3 (a pose) coordinates; {:?} has m = {m}",
-                mech.name
-            )));
+            return Err(KinematicsError::bad_argument(
+                "mechanism",
+                "m = 2 (a point) or m = 3 (a pose) coordinates for a task-space motion",
+                format!("{:?} with m = {m}", mech.name),
+            ));
         }
-        let pid = mech
-            .point_id(point)
-            .ok_or_else(|| bad(format!("no point {point:?}; the points are {}", mech.point_names().join(", "))))?;
+        let pid = mech.point_id(point).ok_or_else(|| {
+            KinematicsError::bad_argument(
+                "point",
+                format!("one of the points {}", mech.point_names().join(", ")),
+                format!("{point:?}"),
+            )
+        })?;
         let carriers: Vec<usize> =
             (0..mech.n_bodies()).filter(|&i| mech.bodies[i].points.iter().any(|(p, _)| *p == pid)).collect();
         let names = || carriers.iter().map(|&i| mech.bodies[i].name.as_str()).collect::<Vec<_>>().join(", ");
-        let i =
-            match body {
-                Some(name) => mech.body_id(name).map(|b| b.0).filter(|b| carriers.contains(b)).ok_or_else(|| {
-                    bad(format!("body {name:?} does not carry point {point:?} (carried by {})", names()))
-                })?,
-                None if m == 3 && carriers.len() > 1 => {
-                    return Err(bad(format!("point {point:?} is on {}: say which body's pose", names())))
-                }
-                None => *carriers.first().ok_or_else(|| bad(format!("no mobile body carries point {point:?}")))?,
-            };
+        let i = match body {
+            Some(name) => mech.body_id(name).map(|b| b.0).filter(|b| carriers.contains(b)).ok_or_else(|| {
+                KinematicsError::bad_argument(
+                    "body",
+                    format!("a body carrying point {point:?} ({})", names()),
+                    format!("{name:?}"),
+                )
+            })?,
+            None if m == 3 && carriers.len() > 1 => {
+                return Err(KinematicsError::bad_argument(
+                    "body",
+                    format!("the body whose pose to follow: point {point:?} is on {}", names()),
+                    "none",
+                ))
+            }
+            None => *carriers.first().ok_or_else(|| {
+                KinematicsError::bad_argument(
+                    "point",
+                    "a point carried by a mobile body",
+                    format!("{point:?} (on the ground only)"),
+                )
+            })?,
+        };
         let s = mech.bodies[i].points.iter().find(|(p, _)| *p == pid).map_or([0.0; 2], |(_, s)| *s);
         let l = mech.scale;
         Ok(Effector {
@@ -188,11 +205,11 @@ impl Effector {
     /// analogues and the end effector there.
     pub fn state(&self, mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<EffectorState, KinematicsError> {
         if q.len() != mech.dof() || q.iter().any(|v| !v.is_finite()) {
-            return Err(KinematicsError::BadArgument(format!(
-                "expected {} finite coordinate values ({}), got {q:?}",
-                mech.dof(),
-                mech.coordinate_names().join(", ")
-            )));
+            return Err(KinematicsError::bad_argument(
+                "q",
+                format!("{} finite coordinate values ({})", mech.dof(), mech.coordinate_names().join(", ")),
+                format!("{q:?}"),
+            ));
         }
         let mut z = vec![0.0; q.len()];
         coordinates(mech, &ws.x, &mut z);

@@ -6,7 +6,7 @@ use super::constraints::{body_trig, residual, Chart};
 use super::system::set_row_scale;
 use crate::model::{CoordinateKind, Mechanism};
 use crate::workspace::Workspace;
-use crate::KinematicsError;
+use crate::{KinematicsError, SingularityKind};
 
 /// Convergence test of Newton's method: the largest residual, lengths divided by the
 /// characteristic length L and angles in radians, below 1e-14 (about 50 ulp of O(1) values).
@@ -106,17 +106,17 @@ fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize)
 }
 
 fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
-    ws.sys.factor(mech, &ws.chart, &ws.x, &ws.trig).map_err(|_| KinematicsError::Singular {
-        sigma_min: 0.0,
-        what: match ws.chart {
-            Chart::Inputs => "the generalized coordinates do not determine the mechanism's position \
-                              (a type II, parallel singularity of the actuated mechanism)"
-                .to_string(),
-            Chart::Partition(_) => {
-                "the pair constraints lose rank (a singularity of the passive mechanism)".to_string()
-            }
-        },
-    })
+    let chart = &ws.chart;
+    ws.sys.factor(mech, chart, &ws.x, &ws.trig).map_err(|_| KinematicsError::singular(chart_singularity(chart)))
+}
+
+/// What a singular J means in `chart`: a type II singularity in the generalized coordinates,
+/// a rank loss of the pair constraints in a partition chart.
+pub(crate) fn chart_singularity(chart: &Chart) -> SingularityKind {
+    match chart {
+        Chart::Inputs => SingularityKind::TypeII,
+        Chart::Partition(_) => SingularityKind::Passive,
+    }
 }
 
 /// Smallest continuation step, as a fraction of the whole move, before giving up.
@@ -193,15 +193,24 @@ pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Workspa
     Ok(())
 }
 
+/// What a slice given for finite values holds, when it is not that: its length, or where a
+/// non-finite value sits.
+fn finite_values(v: &[f64]) -> String {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => format!("{} at index {i} of {} values", v[i], v.len()),
+        None => format!("{} values", v.len()),
+    }
+}
+
 /// As [`assemble_into`], but continuing from the body coordinates `x_start` (a solution on
 /// the wanted branch, e.g. the previous point of a path) instead of from the drawing.
 pub fn assemble_from(mech: &Mechanism, x_start: &[f64], q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
     if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
-        return Err(KinematicsError::BadArgument(format!(
-            "x_start needs {} finite body coordinates (X, Y, phi per body), got {}",
-            mech.n_x(),
-            x_start.len()
-        )));
+        return Err(KinematicsError::bad_argument(
+            "x_start",
+            format!("{} finite body coordinates (X, Y, phi per body)", mech.n_x()),
+            finite_values(x_start),
+        ));
     }
     ws.chart = Chart::Inputs;
     ws.x.copy_from_slice(x_start);
@@ -221,12 +230,11 @@ pub fn assemble(mech: &Mechanism, q: &[f64]) -> Result<Vec<f64>, KinematicsError
 /// As [`assemble`], leaving the solution (and J factorised, if regular) in `ws`.
 pub fn assemble_into(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
     if q.len() != mech.dof() || q.iter().any(|v| !v.is_finite()) {
-        return Err(KinematicsError::BadArgument(format!(
-            "expected {} finite coordinate values ({}), got {:?}",
-            mech.dof(),
-            mech.coordinate_names().join(", "),
-            q
-        )));
+        return Err(KinematicsError::bad_argument(
+            "q",
+            format!("{} finite coordinate values ({})", mech.dof(), mech.coordinate_names().join(", ")),
+            format!("{q:?}"),
+        ));
     }
     ws.chart = Chart::Inputs;
     ws.x.copy_from_slice(&mech.x0);

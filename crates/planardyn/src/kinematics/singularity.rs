@@ -1,4 +1,5 @@
-//! Singularity measures and the choice of independent coordinates near them.
+//! Singularity measures and the choice of independent coordinates near them
+//! (docs/formulation.md, *Singularities* and *Charts*).
 //!
 //! Both measures are singular values of the scaled (dimensionless, see `system.rs`) Jacobian:
 //! - type II (parallel): the smallest singular value of J = [Phi_x; D_x] with the inputs
@@ -17,6 +18,10 @@ use nalgebra::DMatrix;
 
 /// Relative singular value below which the constraints count as dependent (rank test).
 pub const RANK_TOL: f64 = 1e-9;
+/// A pair row takes part in a self-stress (a dependency of the unit left singular vector)
+/// when its weight there exceeds this: well above the round-off of the SVD (~1e-15), well
+/// below the 1/sqrt(rows) weights of a genuine dependency.
+pub const SELF_STRESS_TOL: f64 = 1e-6;
 
 fn singular_values(rows: usize, cols: usize, data: &[f64]) -> Vec<f64> {
     // The SVD iteration need not end on non-finite entries: such a matrix is singular.
@@ -96,7 +101,8 @@ pub fn constraint_rank(mech: &Mechanism, x: &[f64]) -> ConstraintRank {
         .chain(svd.singular_values.len()..rows)
         .filter(|&i| i < u.ncols())
         .map(|i| {
-            let mut pairs: Vec<usize> = (0..rows).filter(|&r| u[(r, i)].abs() > 1e-6).map(|r| r / 2).collect();
+            let mut pairs: Vec<usize> =
+                (0..rows).filter(|&r| u[(r, i)].abs() > SELF_STRESS_TOL).map(|r| r / 2).collect();
             pairs.dedup();
             pairs
         })

@@ -1,4 +1,5 @@
-//! The factorised, scaled Jacobian J = dF/dx of the position equations.
+//! The factorised, scaled Jacobian J = dF/dx of the position equations (docs/formulation.md,
+//! *Scaling by the characteristic length*).
 //!
 //! J is factorised in scaled variables so that its pivots and singular values are
 //! dimensionless: translations are measured in units of the mechanism's characteristic

@@ -15,9 +15,19 @@ use crate::integrate::{Method, Options, StepError, Stepper};
 use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Chart};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
-use crate::{Error, KinematicsError};
+use crate::{Error, KinematicsError, SingularityKind};
 use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
 use ode::MechanismOde;
+
+/// Relative tolerance of a model's run when its file gives none (docs/model-format.md,
+/// `simulate`): tighter than [`Options::default`], as the run's energy balance is read as a
+/// check of the model, in the 1e-9 J class on the validation benchmarks.
+pub const MODEL_RTOL: f64 = 1e-9;
+/// Absolute tolerance to go with [`MODEL_RTOL`] (units of q and qd).
+pub const MODEL_ATOL: f64 = 1e-12;
+/// A grid time within this fraction of h before t_end is dropped for t_end itself: the
+/// round-off of t0 + k h must not leave a sliver of an output interval.
+const GRID_END_SLACK: f64 = 1e-9;
 
 /// What to simulate and how. Times in s.
 #[derive(Debug, Clone)]
@@ -43,8 +53,12 @@ impl Settings {
             Some(name) => name.parse().map_err(Error::Options)?,
             None => Method::Dop853,
         };
-        let options =
-            Options { rtol: d.rtol.unwrap_or(1e-9), atol: d.atol.unwrap_or(1e-12), dt: d.dt, ..Options::default() };
+        let options = Options {
+            rtol: d.rtol.unwrap_or(MODEL_RTOL),
+            atol: d.atol.unwrap_or(MODEL_ATOL),
+            dt: d.dt,
+            ..Options::default()
+        };
         let t_end = d.t_end.unwrap_or(1.0);
         let t_eval = d.output_dt.map(|h| grid(0.0, t_end, h));
         Ok(Settings { t0: 0.0, t_end, method, options, t_eval, q0: None, qd0: None })
@@ -53,7 +67,7 @@ impl Settings {
 
 /// Times t0, t0 + h, ... and t_end itself, never past t_end.
 pub fn grid(t0: f64, t_end: f64, h: f64) -> Vec<f64> {
-    let mut t: Vec<f64> = (0..).map(|k| t0 + k as f64 * h).take_while(|&t| t < t_end - 1e-9 * h).collect();
+    let mut t: Vec<f64> = (0..).map(|k| t0 + k as f64 * h).take_while(|&t| t < t_end - GRID_END_SLACK * h).collect();
     t.push(t_end);
     t
 }
@@ -104,10 +118,7 @@ fn start<'a>(
     // singular start is fine (xd = 0).
     ws.xd.fill(0.0);
     if qd0.iter().any(|&v| v != 0.0) {
-        velocity_analogues(&mut ws).map_err(|_| KinematicsError::Singular {
-            sigma_min: 0.0,
-            what: "the start is a type II singularity, where the rates qd0 do not determine the body velocities; start at rest or elsewhere".into(),
-        })?;
+        velocity_analogues(&mut ws).map_err(|_| KinematicsError::singular(SingularityKind::TypeIIStartInMotion))?;
         for (j, r) in qd0.iter().enumerate() {
             let n = ws.x.len();
             for i in 0..n {
@@ -120,12 +131,9 @@ fn start<'a>(
     let mut ode = MechanismOde::new(mech, ws, drives);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
-        return Err(KinematicsError::Singular {
-            sigma_min: m0.passive,
-            what: "the passive mechanism is singular at the start (its pair constraints lose rank); start elsewhere"
-                .into(),
-        }
-        .into());
+        return Err(
+            KinematicsError::Singular { kind: SingularityKind::PassiveAtStart, sigma_min: Some(m0.passive) }.into()
+        );
     }
     let chart = next_chart(&ode, &m0, m0.sigma).unwrap_or(Chart::Inputs);
     let m = mech.dof();

@@ -22,7 +22,7 @@ coordinates:
   - {name: theta, pair: O, value: 0.0}
 "#;
 
-/// The four-bar of ../shared/benchmarks/four-bar-gravity.json.
+/// The four-bar of tests/data/benchmarks/four-bar-gravity.json.
 pub const FOUR_BAR: &str = r#"
 name: four-bar under gravity
 gravity: [0.0, -9.81]
@@ -146,7 +146,7 @@ drives:
   - {coordinate: th2, table: {t: [0, 0.5, 1], effort: [0, -0.3, 0.1]}}
 "#;
 
-/// The 5R of ../shared/benchmarks/five-bar-free-fall.json.
+/// The 5R of tests/data/benchmarks/five-bar-free-fall.json.
 pub const FIVE_BAR_FALL: &str = r#"
 name: five-bar free fall
 gravity: [0.0, -9.81]
