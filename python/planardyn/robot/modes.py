@@ -182,7 +182,7 @@ def _mirror(model: dict[str, Any], mech: Mechanism, dyad: tuple[str, str, str]) 
     foot = e1 + t * ((p - e1) @ t)
     p_new = 2 * foot - p
     pts[P] = p_new.tolist()
-    for bname, body in model.get("bodies", {}).items():
+    for body in model.get("bodies", {}).values():
         plist = body.get("points", [])
         if P not in plist or len(plist) != 2:
             continue
