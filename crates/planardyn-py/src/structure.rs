@@ -9,7 +9,6 @@ use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x
 use planardyn::model::{parse_spec, Link};
 use planardyn::structure::{analyse, analyse_spec, scaled_constraint_jacobian, Structure};
 use planardyn::Format;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -56,22 +55,12 @@ pub fn structure<'py>(py: Python<'py>, mech: &PyMechanism, x: Option<ArrayArg<'p
     to_dict(py, &s)
 }
 
-/// The structural analysis of model text at its drawing, also of a model whose mobility
-/// differs from its coordinates (`planardyn::structure::analyse_spec`).
+/// The structural analysis of a model (JSON text) at its drawing, also of a model whose
+/// mobility differs from its coordinates (`planardyn::structure::analyse_spec`).
 #[pyfunction]
-#[pyo3(signature = (text, format="json", source="<dict>"))]
-pub fn structure_of_model<'py>(
-    py: Python<'py>,
-    text: &str,
-    format: &str,
-    source: &str,
-) -> PyResult<Bound<'py, PyDict>> {
-    let format = match format.to_ascii_lowercase().as_str() {
-        "yaml" | "yml" => Format::Yaml,
-        "json" => Format::Json,
-        other => return Err(PyValueError::new_err(format!("format must be 'yaml' or 'json', got {other:?}"))),
-    };
-    let s = parse_spec(text, format, source)
+#[pyo3(signature = (text, source="<dict>"))]
+pub fn structure_of_model<'py>(py: Python<'py>, text: &str, source: &str) -> PyResult<Bound<'py, PyDict>> {
+    let s = parse_spec(text, Format::Json, source)
         .and_then(|spec| analyse_spec(spec, source))
         .map_err(|e| model_error(py, &e))?;
     to_dict(py, &s)

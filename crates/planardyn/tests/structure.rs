@@ -224,6 +224,21 @@ fn a_model_the_loader_refuses_is_analysed_from_its_drawing() {
 }
 
 #[test]
+fn links_a_missing_coordinate_leaves_free_are_left_over() {
+    // The 3-RRR with two coordinates: the third proximal link, the distal links and the
+    // platform are free to move with the pairs that touch them: 3*5 - 2*7 = 1.
+    let text = RRR3.replace("  - {name: th3, pair: R3, value: 1.7769252074235635}\n", "");
+    let spec = planardyn::model::parse_spec(&text, Format::Yaml, "<test>").unwrap();
+    let s = analyse_spec(spec, "<test>").unwrap();
+    assert_eq!(counts(&s), (3, 3, 18, 2));
+    assert_eq!(names(&s, &s.input_links), ["prox1", "prox2"]);
+    assert!(s.groups.is_empty());
+    let left: Vec<String> = s.left_over.iter().map(|l| s.link_name(l)).collect();
+    assert_eq!(left, ["dist1", "dist2", "prox3", "dist3", "platform"]);
+    assert_eq!(s.left_over_mobility, 1);
+}
+
+#[test]
 fn bad_coordinates_are_an_error_not_a_panic() {
     let mech = yaml(FOUR_BAR);
     let mut x = mech.x0.clone();

@@ -242,8 +242,7 @@ pub(super) fn assur(mech: &Mechanism) -> Assur {
     while order.len() < live.len() {
         let ready = live.iter().copied().filter(|s| !order.contains(s) && preds[*s].iter().all(|t| order.contains(t)));
         let next = ready.map(|s| (key(&mut units, s), s)).min().map(|(_, s)| s);
-        // A cycle left among sets cannot happen after the merge above; take the rest as they come.
-        order.push(next.unwrap_or_else(|| *live.iter().find(|s| !order.contains(s)).expect("one left")));
+        order.push(next.expect("with their cycles merged the sets form a DAG: one is always ready"));
     }
 
     let mut placed = vec![false; n + 1];
@@ -265,8 +264,8 @@ pub(super) fn assur(mech: &Mechanism) -> Assur {
                     outer.push(PairId(k));
                 }
             }
-            let rows: usize = inner.iter().chain(&outer).map(|&k| mech.pair_rows(k).len()).sum();
-            if s != under && 3 * links.len() == rows {
+            let constraints: usize = inner.iter().chain(&outer).map(|&k| mech.pair_rows(k).len()).sum();
+            if s != under && 3 * links.len() == constraints {
                 groups.push(group(mech, links, inner, outer));
             } else {
                 left_over.extend(links);
@@ -276,11 +275,11 @@ pub(super) fn assur(mech: &Mechanism) -> Assur {
     }
     left_over.sort_by_key(|l| l[0].0);
     let rest = |l: Link| body(l).is_some_and(|b| left_over.iter().flatten().any(|&c| c == b));
-    let rows: usize = (0..mech.pairs.len())
+    let constraints: usize = (0..mech.pairs.len())
         .filter(|&k| !input[k] && (rest(mech.pairs[k].a) || rest(mech.pairs[k].b)))
         .map(|k| mech.pair_rows(PairId(k)).len())
         .sum();
-    let left_over_mobility = 3 * left_over.len() as i64 - rows as i64;
+    let left_over_mobility = 3 * left_over.len() as i64 - constraints as i64;
     Assur { input_links, relative_inputs, groups, left_over, left_over_mobility }
 }
 

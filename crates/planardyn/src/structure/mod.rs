@@ -11,7 +11,8 @@
 //!   Phi_x^T lambda = 0: reactions in equilibrium without any load, so not unique).
 //! - **Loops**: the independent cycles of the body-pair graph, p - (n + 1) + 1 for a
 //!   connected mechanism.
-//! - **Assur groups**: see [`assur`](self::AssurGroup).
+//! - **Assur groups**: the blocks of the block-triangular form of the position Jacobian with
+//!   the inputs locked, see [`AssurGroup`].
 
 mod assur;
 mod loops;
