@@ -1,10 +1,13 @@
 """Structural analysis (planardyn.structure) of every library mechanism, with the expected
 answer derived by hand in a comment; the constraint Jacobian from Rust against the
-velocity analogues and against an independent Python computation from the drawing.
+velocity analogues, and its rank and self-stresses against an independent computation from
+the drawing in this file.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
 import warnings
 
 import numpy as np
@@ -12,7 +15,6 @@ import planardyn as pd
 import pytest
 from planardyn import _core, structure
 from planardyn import library as lib
-from planardyn.structure import _assur, _drawn_jacobian, _Pair, _pairs_of, _rank_and_null, _self_stresses
 
 
 def build(stem: str) -> pd.Mechanism:
@@ -109,12 +111,21 @@ def test_loops_close():
 def test_class_iv_group_from_topology():
     """Stephenson's chain with a binary link as ground: T1-b1-T2-b2 is a closed four-link
     contour joined to the fixed links at two pairs: class IV, order 2 (Artobolevsky)."""
-    P = lambda n, a, b: _Pair(n, "revolute", a, b, n, None)  # noqa: E731
-    pairs = [P("J5", "ground", "T1"), P("J6", "ground", "b4"), P("J7", "b4", "T2"), P("J1", "T1", "b1"),
-             P("J2", "b1", "T2"), P("J3", "T1", "b2"), P("J4", "b2", "T2")]
-    inputs, relative, groups, left, _ = _assur(["b4", "T1", "T2", "b1", "b2"], pairs, ["J6"])
-    assert inputs == ("b4",) and left == ()
-    (g,) = groups
+    xy = {"J5": [0.0, 0.0], "J6": [2.0, 0.0], "J7": [2.3, 1.1], "J1": [0.2, 1.0], "J3": [0.9, 0.4],
+          "J2": [1.1, 1.9], "J4": [1.8, 1.3]}
+    links = {"T1": ["J5", "J1", "J3"], "T2": ["J7", "J2", "J4"], "b1": ["J1", "J2"], "b2": ["J3", "J4"],
+             "b4": ["J6", "J7"]}
+    joints = [("J5", "ground", "T1"), ("J6", "ground", "b4"), ("J7", "b4", "T2"), ("J1", "T1", "b1"),
+              ("J2", "b1", "T2"), ("J3", "T1", "b2"), ("J4", "b2", "T2")]
+    model = {
+        "name": "Stephenson chain on a binary link", "points": xy, "ground": ["J5", "J6"],
+        "bodies": {b: {"points": p, "uniform_bar": p[:2], "mass": 1.0} for b, p in links.items()},
+        "pairs": [{"type": "revolute", "name": n, "at": n, "bodies": [a, b]} for n, a, b in joints],
+        "coordinates": [{"name": "q", "pair": "J6", "value": 0.0}],
+    }
+    s = structure.analyse(model)
+    assert s.load_error is None and s.input_links == ("b4",) and s.left_over == ()
+    (g,) = s.groups
     assert (g.group_class, g.order, sorted(g.links), sorted(g.outer_pairs)) == (4, 2, ["T1", "T2", "b1", "b2"], ["J5", "J7"])
 
 
@@ -131,20 +142,63 @@ def test_constraint_jacobian_annihilates_the_velocity_analogues(stem):
     np.testing.assert_allclose(J @ U, 0.0, atol=1e-10 * np.abs(J).max() * np.abs(U).max())
 
 
+def drawn_jacobian(model) -> np.ndarray:
+    """Scaled Phi_x at the drawing from the model dict alone, each body's reference point its
+    first point (any reference gives the same rank and the same null space of Phi_x^T: a
+    change of reference is an invertible column change). Revolute rows: d(P_b - P_a);
+    prismatic rows: d(phi_b - phi_a) and n . d(P_b - P_a), n the guide's normal. Metre rows
+    / L, translation columns * L."""
+    pts = {k: (float(v[0]), float(v[1])) for k, v in model["points"].items()}
+    bodies = list(model["bodies"])
+    col = {b: 3 * i for i, b in enumerate(bodies)}
+    ref = {b: pts[model["bodies"][b]["points"][0]] for b in bodies}
+    L = max((math.dist(p, q) for p, q in itertools.combinations(pts.values(), 2)), default=1.0) or 1.0
+    J = np.zeros((2 * len(model["pairs"]), 3 * len(bodies)))
+
+    def point_rows(link, P, sign):
+        g = np.zeros((2, 3 * len(bodies)))
+        if link != "ground":
+            c, r = col[link], ref[link]
+            g[:, c : c + 2] = sign * np.eye(2) * L
+            g[:, c + 2] = sign * np.array([-(P[1] - r[1]), P[0] - r[0]])
+        return g
+
+    for k, pr in enumerate(model["pairs"]):
+        a, b = pr["bodies"]
+        P = pts[pr["at"]]
+        d = point_rows(b, P, 1.0) + point_rows(a, P, -1.0)
+        if pr["type"] == "revolute":
+            J[2 * k : 2 * k + 2] = d / L
+        else:
+            axis = pr.get("axis") or np.subtract(pts[pr["along"][1]], pts[pr["along"][0]])
+            t = np.asarray(axis, dtype=float) / np.hypot(*axis)
+            for link, sign in ((b, 1.0), (a, -1.0)):
+                if link != "ground":
+                    J[2 * k, col[link] + 2] = sign
+            J[2 * k + 1] = np.array([-t[1], t[0]]) @ d / L
+    return J
+
+
+def stressed_pairs(J: np.ndarray, names) -> set[str]:
+    """The pairs with a share of the left null space of J (numpy's SVD, the core's 1e-9)."""
+    U, s, _ = np.linalg.svd(J)
+    rank = int(np.sum(s > 1e-9 * max(s.max(), 1.0)))
+    null = U[:, rank:]
+    share = np.hypot(np.linalg.norm(null[0::2], axis=1), np.linalg.norm(null[1::2], axis=1))
+    return {n for n, w in zip(names, share) if w > 1e-6}
+
+
 @pytest.mark.parametrize("stem", list(EXPECTED))
-def test_singular_values_and_the_python_jacobian_agree(stem):
+def test_singular_values_and_an_independent_jacobian_agree(stem):
     mech = build(stem)
     Js = _core.constraint_jacobian(mech._native, mech.x0, True)
-    sv = _core.constraint_singular_values(mech._native, mech.x0)
-    np.testing.assert_allclose(sv, np.sort(np.linalg.svd(Js, compute_uv=False)), atol=1e-12)
+    s = structure.analyse(mech)
+    np.testing.assert_allclose(s.singular_values, np.sort(np.linalg.svd(Js, compute_uv=False)), atol=1e-12)
     # Independent computation from the drawing (other body reference points): same rank
-    # and the same pairs in each self-stress.
-    model = lib.LIBRARY[stem]()
-    pairs = _pairs_of(model)
-    r1, _, n1 = _rank_and_null(Js)
-    r2, _, n2 = _rank_and_null(_drawn_jacobian(model, pairs))
-    assert r1 == r2
-    assert _self_stresses(n1, pairs) == _self_stresses(n2, pairs)
+    # and the same pairs in the self-stresses.
+    J2 = drawn_jacobian(lib.LIBRARY[stem]())
+    assert s.rank == np.linalg.matrix_rank(J2, tol=1e-9 * max(np.linalg.norm(J2, 2), 1.0))
+    assert {p for st in s.redundant_pairs for p in st} == stressed_pairs(J2, mech.pair_names)
 
 
 def test_analyse_a_model_the_loader_refuses():

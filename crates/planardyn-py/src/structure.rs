@@ -1,95 +1,23 @@
-//! Structural analysis support (`planardyn.structure`): the pair-constraint Jacobian Phi_x
-//! at given body coordinates and its singular values. The Python side finds the mobility
-//! from its rank and the redundant pairs from the null space of Phi_x^T.
+//! Structural analysis (`planardyn.structure`): the core's `planardyn::structure` results as
+//! Python dicts of names and numbers, and the pair-constraint Jacobian Phi_x.
 
 use crate::convert::{arr1, arr2, vector};
+use crate::errors::{kinematics_error, model_error};
 use crate::mechanism::PyMechanism;
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x};
-use planardyn::model::PairKind;
-use planardyn::Mechanism;
+use planardyn::model::{parse_spec, Link};
+use planardyn::structure::{analyse, analyse_spec, scaled_constraint_jacobian, Structure};
+use planardyn::Format;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
-/// Phi_x (2p x 3n, row-major) at x; `scaled`: rows in metres divided by the mechanism's
-/// length L and translation columns multiplied by L, so that entries are dimensionless
-/// (the scaling of the core's singularity measures, `kinematics::system`).
-fn jacobian(mech: &Mechanism, x: &[f64], scaled: bool) -> Vec<f64> {
-    let (rows, cols) = (2 * mech.pairs.len(), mech.n_x());
-    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
-    body_trig(x, &mut trig);
-    // Every pair row, in pair order (rows 2k, 2k+1 for pair k), also the ones the core
-    // drops as redundant.
-    let all_rows: Vec<Option<usize>> = (0..rows).map(Some).collect();
-    let mut j = vec![0.0; rows * cols];
-    phi_x(mech, x, &trig, &all_rows, &mut j);
-    if scaled {
-        let inv = 1.0 / mech.scale;
-        let rs: Vec<f64> = mech
-            .pairs
-            .iter()
-            .flat_map(|p| match p.kind {
-                PairKind::Revolute => [inv, inv],
-                PairKind::Prismatic { .. } => [1.0, inv],
-            })
-            .collect();
-        for r in 0..rows {
-            for c in 0..cols {
-                j[r * cols + c] *= rs[r] * if c % 3 == 2 { 1.0 } else { mech.scale };
-            }
-        }
-    }
-    j
-}
-
-/// Singular values of a (rows x cols) row-major matrix, ascending, by one-sided Jacobi
-/// rotations (Hestenes 1958) on the columns of A^T (rows <= a few dozen here, so O(n^3) is fine).
-fn singular_values(rows: usize, cols: usize, a: &[f64]) -> Vec<f64> {
-    // Work on the rows of A as vectors: orthogonalise them pairwise; their norms are the
-    // singular values (min(rows, cols) of them are meaningful, the rest are zero).
-    let mut v: Vec<Vec<f64>> = (0..rows).map(|r| a[r * cols..(r + 1) * cols].to_vec()).collect();
-    for _sweep in 0..60 {
-        let mut rotated = false;
-        for i in 0..rows {
-            for k in i + 1..rows {
-                let (alpha, beta, gamma) =
-                    v[i].iter().zip(&v[k]).fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| (a + x * x, b + y * y, g + x * y));
-                if gamma.abs() <= 1e-15 * (alpha * beta).sqrt() || gamma == 0.0 {
-                    continue;
-                }
-                rotated = true;
-                let zeta = (beta - alpha) / (2.0 * gamma);
-                let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
-                let t = if zeta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (1.0 + t * t).sqrt();
-                let s = c * t;
-                let (lo, hi) = v.split_at_mut(k);
-                for (x, y) in lo[i].iter_mut().zip(hi[0].iter_mut()) {
-                    let (xi, yk) = (*x, *y);
-                    *x = c * xi - s * yk;
-                    *y = s * xi + c * yk;
-                }
-            }
-        }
-        if !rotated {
-            break;
-        }
-    }
-    let mut sv: Vec<f64> = v.iter().map(|r| r.iter().map(|x| x * x).sum::<f64>().sqrt()).collect();
-    sv.sort_by(|a, b| b.total_cmp(a));
-    sv.truncate(rows.min(cols));
-    sv.reverse();
-    sv
-}
-
-/// The pair-constraint Jacobian Phi_x = dPhi/dx at body coordinates x: shape (2p, 3n),
-/// two rows per pair in the order of `pair_names` (a revolute pair: the x and y
-/// components of the gap between its two copies of the point, m; a prismatic pair: the
-/// relative angle, rad, then the normal offset from the guide, m), three columns per body
-/// (X, Y in m, phi in rad). `scaled=True` makes it dimensionless (metre rows / L,
-/// translation columns * L, L = `Mechanism.scale`), the form whose singular values the
-/// core's rank test and singularity measures use.
+/// The pair-constraint Jacobian Phi_x = dPhi/dx at body coordinates x: shape
+/// (`n_pair_rows`, 3n), every pair's rows in pair order, also the ones the core leaves out
+/// as redundant; three columns per body (X, Y in m, phi in rad). `scaled=True` makes it
+/// dimensionless as the core's rank test does (`planardyn::structure::scaled_constraint_jacobian`).
 #[pyfunction]
 #[pyo3(signature = (mech, x, scaled=false))]
 pub fn constraint_jacobian<'py>(
@@ -100,25 +28,117 @@ pub fn constraint_jacobian<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = &*mech.inner;
     let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
-    arr2(py, 2 * m.pairs.len(), m.n_x(), jacobian(m, &x, scaled))
+    let (rows, cols) = (m.n_pair_rows(), m.n_x());
+    let j = if scaled {
+        scaled_constraint_jacobian(m, &x)
+    } else {
+        let mut trig = vec![[0.0; 2]; m.n_bodies()];
+        body_trig(&x, &mut trig);
+        let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
+        let mut j = vec![0.0; rows * cols];
+        phi_x(m, &x, &trig, &all, &mut j);
+        j
+    };
+    arr2(py, rows, cols, j)
 }
 
-/// Singular values of the scaled Phi_x at x, ascending: min(2p, 3n) of them.
+/// The structural analysis of a mechanism at body coordinates x (default: the drawing).
 #[pyfunction]
-pub fn constraint_singular_values<'py>(
-    py: Python<'py>,
-    mech: &PyMechanism,
-    x: ArrayArg<'py>,
-) -> PyResult<Bound<'py, PyAny>> {
+#[pyo3(signature = (mech, x=None))]
+pub fn structure<'py>(py: Python<'py>, mech: &PyMechanism, x: Option<ArrayArg<'py>>) -> PyResult<Bound<'py, PyDict>> {
     let m = &*mech.inner;
-    let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
-    let (rows, cols) = (2 * m.pairs.len(), m.n_x());
-    let j = jacobian(m, &x, true);
-    Ok(arr1(py, singular_values(rows, cols, &j)))
+    let x = match x {
+        Some(x) => vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?,
+        None => m.x0.clone(),
+    };
+    let s = analyse(m, &x).map_err(|e| kinematics_error(py, &e))?;
+    to_dict(py, &s)
+}
+
+/// The structural analysis of a model (JSON text) at its drawing, also of a model whose
+/// mobility differs from its coordinates (`planardyn::structure::analyse_spec`).
+#[pyfunction]
+#[pyo3(signature = (text, source="<dict>"))]
+pub fn structure_of_model<'py>(py: Python<'py>, text: &str, source: &str) -> PyResult<Bound<'py, PyDict>> {
+    let s = parse_spec(text, Format::Json, source)
+        .and_then(|spec| analyse_spec(spec, source))
+        .map_err(|e| model_error(py, &e))?;
+    to_dict(py, &s)
+}
+
+fn to_dict<'py>(py: Python<'py>, s: &Structure) -> PyResult<Bound<'py, PyDict>> {
+    let pair = |k: &planardyn::model::PairId| s.pairs[k.0].clone();
+    let pairs = |ks: &[planardyn::model::PairId]| ks.iter().map(pair).collect::<Vec<_>>();
+    let link = |l: &Link| match l {
+        Link::Ground => "ground".to_string(),
+        Link::Body(b) => s.bodies[b.0].clone(),
+    };
+    let d = PyDict::new(py);
+    d.set_item("bodies", &s.bodies)?;
+    d.set_item("pairs", &s.pairs)?;
+    d.set_item("n_pair_rows", s.n_pair_rows)?;
+    d.set_item("grubler", s.grubler)?;
+    d.set_item("rank", s.rank)?;
+    d.set_item("singular_values", arr1(py, s.singular_values.clone()))?;
+    d.set_item("independent_rows", &s.independent_rows)?;
+    d.set_item("mobility", s.mobility)?;
+    d.set_item("redundant", s.redundant)?;
+    let stresses = s
+        .self_stresses
+        .iter()
+        .map(|st| {
+            let e = PyDict::new(py);
+            e.set_item("pairs", pairs(&st.pairs))?;
+            e.set_item("lambda", arr1(py, st.lambda.clone()))?;
+            Ok(e)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("self_stresses", stresses)?;
+    d.set_item("actuation", s.actuation)?;
+    let loops = s
+        .loops
+        .iter()
+        .map(|lp| {
+            let mut path = Vec::new();
+            for (l, k) in lp.links.iter().zip(&lp.pairs) {
+                path.push(link(l));
+                path.push(pair(k));
+            }
+            path.push(link(&lp.links[0]));
+            let e = PyDict::new(py);
+            e.set_item("closing_pair", pair(&lp.closing_pair))?;
+            e.set_item("path", path)?;
+            Ok(e)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("loops", loops)?;
+    d.set_item("connected", s.connected)?;
+    d.set_item("input_links", s.input_links.iter().map(|b| s.bodies[b.0].clone()).collect::<Vec<_>>())?;
+    d.set_item("relative_inputs", pairs(&s.relative_inputs))?;
+    let groups = s
+        .groups
+        .iter()
+        .map(|g| {
+            let e = PyDict::new(py);
+            e.set_item("links", g.links.iter().map(|l| s.link_name(l)).collect::<Vec<_>>())?;
+            e.set_item("inner_pairs", pairs(&g.inner_pairs))?;
+            e.set_item("outer_pairs", pairs(&g.outer_pairs))?;
+            e.set_item("class", g.class)?;
+            e.set_item("order", g.order)?;
+            e.set_item("kind", &g.kind)?;
+            e.set_item("description", &g.description)?;
+            Ok(e)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("groups", groups)?;
+    d.set_item("left_over", s.left_over.iter().map(|l| s.link_name(l)).collect::<Vec<_>>())?;
+    d.set_item("left_over_mobility", s.left_over_mobility)?;
+    Ok(d)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constraint_jacobian, m)?)?;
-    m.add_function(wrap_pyfunction!(constraint_singular_values, m)?)?;
+    m.add_function(wrap_pyfunction!(structure, m)?)?;
+    m.add_function(wrap_pyfunction!(structure_of_model, m)?)?;
     Ok(())
 }

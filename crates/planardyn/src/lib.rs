@@ -22,8 +22,10 @@ pub mod kinematics;
 pub mod linalg;
 pub mod model;
 pub mod simulate;
+pub mod structure;
 pub mod workspace;
 
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};
 pub use model::{load, loads, Format, Mechanism, MechanismSpec};
+pub use structure::{analyse, Structure};
 pub use workspace::Workspace;

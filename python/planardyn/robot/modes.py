@@ -5,10 +5,10 @@ a re-drawn :class:`~planardyn.Mechanism` to simulate in.
 The core's position analysis continues from the drawing, so it only ever finds the drawn
 branch. Other branches are reached by changing the drawing:
 
-- **dyad mirrors**: a dyad is two binary links b1 = (E1, P), b2 = (E2, P) joined by a
-  revolute pair at the elbow P, neither link driven by a coordinate. Reflecting P across the
-  line E1-E2 keeps both link lengths and gives the other closure of that dyad; every subset of
-  the dyads is mirrored (at most 2^6 variants).
+- **dyad mirrors**: a dyad is an RRR Assur group of two binary links b1 = (E1, P),
+  b2 = (E2, P) joined by a revolute pair at the elbow P (the core's structural analysis finds
+  them). Reflecting P across the line E1-E2 keeps both link lengths and gives the other
+  closure of that dyad; every subset of the dyads is mirrored (at most 2^6 variants).
 - **random re-draws** (any mechanism): the drawing (or a mirror) is assembled at random inputs
   and re-drawn there; continuation from that drawing to q can end on another branch.
 
@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from .._core import structure as native_structure
 from .tolerances import DEDUP_TOL, WORKING_TOL
 
 if TYPE_CHECKING:
@@ -147,21 +148,19 @@ def redraw(mech: Mechanism, q: ArrayLike, x: ArrayLike) -> dict[str, Any]:
 
 
 def dyads(mech: Mechanism) -> list[tuple[str, str, str]]:
-    """The mirrorable dyads as (E1, P, E2) point names: binary links (E1, P) and (E2, P)
-    joined by a revolute pair at P, neither driven by a coordinate pair."""
-    d = mech.to_dict()
-    coord_pairs = {c.get("pair") for c in d.get("coordinates", [])}
-    driven = {b for p in d.get("pairs", []) if p.get("name") in coord_pairs for b in p["bodies"]}
-    bodies = d.get("bodies", {})
+    """The mirrorable dyads as (E1, P, E2) point names: the core's class II RRR groups
+    (``planardyn::structure``) of two binary links (E1, P) and (E2, P), P the point of
+    their inner pair."""
+    at = {p["name"]: p["point"] for p in mech.pairs}
+    points = {b: [n for n, _ in bp] for b, bp in zip(mech.body_names, mech.body_points)}
     out = []
-    for p in d.get("pairs", []):
-        a, b = p["bodies"]
-        if p.get("type") != "revolute" or "ground" in (a, b) or a in driven or b in driven:
+    for g in native_structure(mech._native)["groups"]:
+        if g["class"] != 2 or g["kind"] != "RRR":
             continue
-        P = p["at"]
+        P = at[g["inner_pairs"][0]]
         ends = []
-        for body in (a, b):
-            pts = list(bodies[body].get("points", []))
+        for link in g["links"]:  # a link of two locked bodies ('a+b') is no binary link
+            pts = points.get(link, [])
             if len(pts) != 2 or P not in pts:
                 break
             ends.append(pts[0] if pts[1] == P else pts[1])

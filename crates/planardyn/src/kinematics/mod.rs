@@ -15,5 +15,5 @@ pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
 pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL,
 };
-pub use singularity::{constraint_rank, passive_sigma_min, select_partition, sigma_min};
+pub use singularity::{passive_sigma_min, select_partition, sigma_min};
 pub use system::System;

@@ -11,17 +11,11 @@
 //! elimination with complete pivoting on Phi_x (Wehage & Haug 1982, generalized coordinate
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
-use super::constraints::{body_trig, constraint_jacobian, Chart};
-use super::system::{col_scales, pair_row_scales, scaled_jacobian};
+use super::constraints::{body_trig, Chart};
+use super::system::{col_scales, scaled_jacobian};
+use crate::linalg::pivot_columns;
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
-
-/// Relative singular value below which the constraints count as dependent (rank test).
-pub const RANK_TOL: f64 = 1e-9;
-/// A pair row takes part in a self-stress (a dependency of the unit left singular vector)
-/// when its weight there exceeds this: well above the round-off of the SVD (~1e-15), well
-/// below the 1/sqrt(rows) weights of a genuine dependency.
-pub const SELF_STRESS_TOL: f64 = 1e-6;
 
 fn singular_values(rows: usize, cols: usize, data: &[f64]) -> Vec<f64> {
     // The SVD iteration need not end on non-finite entries: such a matrix is singular.
@@ -60,96 +54,6 @@ pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
         return f64::INFINITY;
     }
     singular_values(rows, n, &scaled(mech, &Chart::Inputs, x))[0]
-}
-
-/// The rank structure of all 2p pair constraints at x.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ConstraintRank {
-    /// Numerical rank of Phi_x (relative tolerance [`RANK_TOL`]).
-    pub rank: usize,
-    /// A maximal set of independent rows (indices into 0..2p), ascending.
-    pub independent: Vec<usize>,
-    /// The pairs taking part in each dependency among the rows (from the left null space).
-    pub dependencies: Vec<Vec<usize>>,
-}
-
-/// Rank, independent rows and dependencies of all 2p pair-constraint rows at x.
-pub fn constraint_rank(mech: &Mechanism, x: &[f64]) -> ConstraintRank {
-    let (n, rows) = (x.len(), 2 * mech.pairs.len());
-    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
-    body_trig(x, &mut trig);
-    let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
-    let mut j = vec![0.0; rows * n];
-    constraint_jacobian(mech, x, &trig, &all, &mut j);
-    if rows == 0 {
-        return ConstraintRank { rank: 0, independent: vec![], dependencies: vec![] };
-    }
-    // Scaled as the solver's J: length rows by 1/L, translation columns by L.
-    let rs: Vec<f64> = mech.pairs.iter().flat_map(|p| pair_row_scales(p, 1.0 / mech.scale)).collect();
-    for r in 0..rows {
-        for c in 0..n {
-            j[r * n + c] *= rs[r] * if c % 3 == 2 { 1.0 } else { mech.scale };
-        }
-    }
-    let svd = DMatrix::from_row_slice(rows, n, &j).svd(true, false);
-    let top = svd.singular_values.max();
-    let tol = RANK_TOL * top.max(1.0);
-    let rank = svd.singular_values.iter().filter(|&&s| s > tol).count();
-    let u = svd.u.expect("requested");
-    let dependencies = (0..svd.singular_values.len())
-        .filter(|&i| svd.singular_values[i] <= tol)
-        .chain(svd.singular_values.len()..rows)
-        .filter(|&i| i < u.ncols())
-        .map(|i| {
-            let mut pairs: Vec<usize> =
-                (0..rows).filter(|&r| u[(r, i)].abs() > SELF_STRESS_TOL).map(|r| r / 2).collect();
-            pairs.dedup();
-            pairs
-        })
-        .collect();
-    // Independent rows: the pivot columns of Phi_x^T under complete pivoting.
-    let mut t = vec![0.0; n * rows];
-    for r in 0..rows {
-        for c in 0..n {
-            t[c * rows + r] = j[r * n + c];
-        }
-    }
-    let mut independent = pivot_columns(&mut t, n, rows, rank);
-    independent.sort_unstable();
-    ConstraintRank { rank, independent, dependencies }
-}
-
-/// Gaussian elimination with complete pivoting on the row-major `rows x cols` matrix `a`
-/// (destroyed); returns the first `count` pivot columns in pivot order.
-fn pivot_columns(a: &mut [f64], rows: usize, cols: usize, count: usize) -> Vec<usize> {
-    let mut free: Vec<usize> = (0..cols).collect();
-    let mut pivots = Vec::new();
-    for k in 0..rows.min(count) {
-        let (mut pr, mut pc, mut best) = (k, 0, 0.0);
-        for r in k..rows {
-            for (ci, &c) in free.iter().enumerate() {
-                let v = a[r * cols + c].abs();
-                if v > best {
-                    (pr, pc, best) = (r, ci, v);
-                }
-            }
-        }
-        if best == 0.0 {
-            break;
-        }
-        let col = free.remove(pc);
-        pivots.push(col);
-        for j in 0..cols {
-            a.swap(k * cols + j, pr * cols + j);
-        }
-        for r in k + 1..rows {
-            let l = a[r * cols + col] / a[k * cols + col];
-            for j in 0..cols {
-                a[r * cols + j] -= l * a[k * cols + j];
-            }
-        }
-    }
-    pivots
 }
 
 /// The m best independent components of x at x: the columns of the scaled Phi_x (its

@@ -149,6 +149,18 @@ impl BlockLu {
         self.start.windows(2).map(|w| w[1] - w[0])
     }
 
+    /// The diagonal blocks in solve order: each block's rows and its columns (original
+    /// indices, ascending). For the position Jacobian they are the input links and the Assur
+    /// groups (see `structure`).
+    pub fn blocks(&self) -> impl Iterator<Item = (Vec<usize>, Vec<usize>)> + '_ {
+        self.start.windows(2).map(|w| {
+            let (mut rows, mut cols) = (self.row[w[0]..w[1]].to_vec(), self.col[w[0]..w[1]].to_vec());
+            rows.sort_unstable();
+            cols.sort_unstable();
+            (rows, cols)
+        })
+    }
+
     /// Start filling the matrix B = diag(rs) A diag(cs) to factorise: every entry is zeroed,
     /// and the sink scales the entries of A it is given. Then [`BlockLu::factor`].
     pub fn sink<'a>(&'a mut self, rs: &'a [f64], cs: &'a [f64]) -> BlockSink<'a> {

@@ -5,14 +5,16 @@
 //! every call for dynamic sizes and faer is tuned for large matrices, while an in-place
 //! factorisation into the workspace keeps a forward-dynamics evaluation allocation-free and
 //! well under a microsecond for a four-bar. nalgebra is still used where allocation does not
-//! matter (singular values for the singularity measures).
+//! matter (singular values for the singularity measures and the structural analysis).
 
 mod block_lu;
 mod cholesky;
 mod lu;
+mod pivot;
 mod sink;
 
 pub use block_lu::{BlockLu, BlockSink};
 pub use cholesky::{cholesky_in_place, cholesky_solve};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
+pub use pivot::pivot_columns;
 pub use sink::{Dense, Sink};

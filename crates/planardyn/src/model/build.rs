@@ -4,7 +4,8 @@
 
 use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, PairSpec, PartSpec, SimulateSpec};
 use super::*;
-use crate::kinematics::{assemble, constraint_rank};
+use crate::kinematics::assemble;
+use crate::structure::constraint_rank;
 use crate::ModelError;
 
 /// Collects the context for error messages: the source name.
@@ -84,6 +85,17 @@ impl Ctx<'_> {
 }
 
 pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
+    let mut mech = drawing(spec, source)?;
+    let spec = mech.spec.clone();
+    let ctx = Ctx { source, spec: &spec };
+    check_mobility(&ctx, &mut mech)?;
+    check_assembly(&ctx, &mech)?;
+    Ok(mech)
+}
+
+/// Every check but the mobility and the assembly: the mechanism as drawn, all its pair rows
+/// kept, which the structural analysis of a model the loader refuses reads.
+pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     let ctx = Ctx { source, spec: &spec };
     if let Some(units) = &spec.units {
         if units != "SI" {
@@ -150,8 +162,6 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.drives = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
-    check_mobility(&ctx, &mut mech)?;
-    check_assembly(&ctx, &mech)?;
     Ok(mech)
 }
 
@@ -557,12 +567,12 @@ fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     }
     if cr.rank < 2 * p as usize {
         mech.row_slot = vec![None; 2 * p as usize];
-        for (slot, &row) in cr.independent.iter().enumerate() {
+        for (slot, &row) in cr.independent_rows.iter().enumerate() {
             mech.row_slot[row] = Some(slot);
         }
         mech.n_constraints = cr.rank;
-        for pairs in &cr.dependencies {
-            let names: Vec<&str> = pairs.iter().map(|&k| mech.pairs[k].name.as_str()).collect();
+        for stress in &cr.self_stresses {
+            let names: Vec<&str> = stress.pairs.iter().map(|&k| mech.pairs[k.0].name.as_str()).collect();
             mech.warnings.push(format!(
                 "redundant constraints among pairs {}: one of their constraint equations is implied by the others \
                  and left out (Chebyshev-Grubler counts {grubler} degree(s) of freedom, the rank shows {mobility}); \

@@ -11,7 +11,7 @@ mod nesting;
 mod parse_errors;
 pub mod spec;
 
-pub use io::{load, loads, Format};
+pub use io::{load, loads, parse_spec, Format};
 pub use spec::MechanismSpec;
 
 /// Index of a mobile body (its coordinates are `x[3i..3i+3]`).
@@ -202,6 +202,11 @@ impl Mechanism {
     /// Validate a specification and build the mechanism; `source` names it in messages.
     pub fn new(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
         build::build(spec, source)
+    }
+    /// The mechanism as drawn without the mobility and assembly checks (for the structural
+    /// analysis of a model the loader refuses; not for kinematics).
+    pub(crate) fn drawing(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
+        build::drawing(spec, source)
     }
     /// Number of degrees of freedom m (= number of generalized coordinates).
     pub fn dof(&self) -> usize {

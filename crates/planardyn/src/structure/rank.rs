@@ -1,0 +1,143 @@
+//! The scaled pair-constraint Jacobian Phi_x and what its singular value decomposition
+//! tells: numerical rank, a maximal set of independent rows, and the self-stresses.
+
+use crate::kinematics::constraints::{body_trig, constraint_jacobian};
+use crate::kinematics::system::{col_scales, pair_row_scales};
+use crate::linalg::pivot_columns;
+use crate::model::{Mechanism, PairId};
+use nalgebra::DMatrix;
+
+/// Relative singular value of the scaled Phi_x below which its rows count as dependent:
+/// sigma <= RANK_TOL * max(sigma_max, 1). The scaled entries are O(1) whatever the size of
+/// the mechanism, so the threshold needs no factor of the matrix size. It sits far above the
+/// SVD's rounding (~1e-15 sigma_max) and below the perturbation that coordinates typed to 9
+/// or more significant digits put into the entries, so that a drawn parallelogram is still
+/// recognised as redundant, while no drawing is meant to be within 1e-9 of a singular one.
+pub const RANK_TOL: f64 = 1e-9;
+
+/// A pair takes part in a self-stress when its rows' share (Euclidean norm) of the unit
+/// self-stress vector exceeds this: the null vectors are exact to about RANK_TOL, so 1e-6
+/// is well clear of their rounding and far below any real participation.
+pub const SELF_STRESS_TOL: f64 = 1e-6;
+
+/// A self-stress: pair reactions in equilibrium without any load (lambda != 0 with
+/// Phi_x^T lambda = 0), so the reactions of its pairs are not unique.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelfStress {
+    /// The pairs with a share above [`SELF_STRESS_TOL`], ascending.
+    pub pairs: Vec<PairId>,
+    /// lambda, one value per pair-constraint row of the scaled Phi_x, unit norm.
+    pub lambda: Vec<f64>,
+}
+
+/// The rank structure of all pair-constraint rows at x.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rank {
+    /// Numerical rank of the scaled Phi_x (tolerance [`RANK_TOL`]).
+    pub rank: usize,
+    /// Its min(rows, 3n) singular values, ascending (dimensionless).
+    pub singular_values: Vec<f64>,
+    /// A maximal set of independent rows (indices into `0..n_pair_rows()`), ascending: the
+    /// pivot columns of Phi_x^T under complete pivoting, the best-conditioned choice.
+    pub independent_rows: Vec<usize>,
+    /// A basis of the self-stresses (rows - rank of them), each reduced to involve as few
+    /// pairs as the structure allows.
+    pub self_stresses: Vec<SelfStress>,
+}
+
+/// Phi_x at body coordinates x (3n values): all `n_pair_rows()` rows, redundant ones
+/// included, by 3n columns, row-major, scaled as the solver's J (`kinematics::system`):
+/// rows in metres divided by the characteristic length L, translation columns multiplied by
+/// L, so that the entries are dimensionless.
+pub fn scaled_constraint_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
+    let (rows, n) = (mech.n_pair_rows(), mech.n_x());
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
+    let mut j = vec![0.0; rows * n];
+    constraint_jacobian(mech, x, &trig, &all, &mut j);
+    let mut rs = vec![1.0; rows];
+    for (k, pair) in mech.pairs.iter().enumerate() {
+        for (r, s) in mech.pair_rows(PairId(k)).zip(pair_row_scales(pair, 1.0 / mech.scale)) {
+            rs[r] = s;
+        }
+    }
+    let cs = col_scales(mech);
+    for (row, s) in j.chunks_exact_mut(n.max(1)).zip(&rs) {
+        for (v, c) in row.iter_mut().zip(&cs) {
+            *v *= s * c;
+        }
+    }
+    j
+}
+
+/// Rank, singular values, independent rows and self-stresses of all pair-constraint rows at
+/// x, which must be finite (the SVD iteration need not end otherwise).
+pub(crate) fn constraint_rank(mech: &Mechanism, x: &[f64]) -> Rank {
+    let (rows, n) = (mech.n_pair_rows(), mech.n_x());
+    if rows == 0 {
+        return Rank { rank: 0, singular_values: vec![], independent_rows: vec![], self_stresses: vec![] };
+    }
+    let j = scaled_constraint_jacobian(mech, x);
+    // Zero columns up to a square matrix give the full U (rows x rows), so that the whole
+    // left null space is there also when there are more rows than body coordinates.
+    let width = n.max(rows);
+    let padded = DMatrix::from_fn(rows, width, |r, c| if c < n { j[r * n + c] } else { 0.0 });
+    let svd = padded.svd(true, false);
+    let tol = RANK_TOL * svd.singular_values.max().max(1.0);
+    let rank = svd.singular_values.iter().filter(|&&s| s > tol).count();
+    let mut singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
+    singular_values.sort_by(|a, b| b.total_cmp(a));
+    singular_values.truncate(rows.min(n));
+    singular_values.reverse();
+    let u = svd.u.expect("requested");
+    let null: Vec<Vec<f64>> =
+        (0..rows).filter(|&i| svd.singular_values[i] <= tol).map(|i| u.column(i).iter().copied().collect()).collect();
+    let mut t = vec![0.0; n * rows];
+    for r in 0..rows {
+        for c in 0..n {
+            t[c * rows + r] = j[r * n + c];
+        }
+    }
+    let mut independent_rows = pivot_columns(&mut t, n, rows, rank);
+    independent_rows.sort_unstable();
+    Rank { rank, singular_values, independent_rows, self_stresses: self_stresses(mech, null) }
+}
+
+/// Reduce a basis of the left null space (column echelon form: each vector gets a pivot row
+/// the others lack, so each involves as few pairs as possible) and name its pairs.
+fn self_stresses(mech: &Mechanism, mut q: Vec<Vec<f64>>) -> Vec<SelfStress> {
+    let rows = mech.n_pair_rows();
+    let mut pivot_rows: Vec<usize> = Vec::new();
+    for j in 0..q.len() {
+        let (mut best, mut at) = (-1.0, (0, j));
+        for i in (0..rows).filter(|i| !pivot_rows.contains(i)) {
+            for (c, v) in q.iter().enumerate().skip(j) {
+                if v[i].abs() > best {
+                    (best, at) = (v[i].abs(), (i, c));
+                }
+            }
+        }
+        let (i, c) = at;
+        q.swap(j, c);
+        let p = q[j][i];
+        q[j].iter_mut().for_each(|v| *v /= p);
+        let pivot = q[j].clone();
+        for v in q.iter_mut().enumerate().filter(|(c, _)| *c != j).map(|(_, v)| v) {
+            let f = v[i];
+            v.iter_mut().zip(&pivot).for_each(|(a, b)| *a -= f * b);
+        }
+        pivot_rows.push(i);
+    }
+    q.into_iter()
+        .map(|mut lambda| {
+            let norm = lambda.iter().map(|v| v * v).sum::<f64>().sqrt();
+            lambda.iter_mut().for_each(|v| *v /= norm);
+            let pairs = (0..mech.pairs.len())
+                .map(PairId)
+                .filter(|&k| mech.pair_rows(k).map(|r| lambda[r] * lambda[r]).sum::<f64>().sqrt() > SELF_STRESS_TOL)
+                .collect();
+            SelfStress { pairs, lambda }
+        })
+        .collect()
+}
