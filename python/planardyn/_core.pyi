@@ -24,6 +24,9 @@ __all__ = [
     "constraint_jacobian",
     "structure",
     "structure_of_model",
+    "Effector",
+    "SINGULAR_TOL",
+    "JUMP_TOL",
     "simulate_batch",
     "inverse_batch",
 ]
