@@ -6,34 +6,28 @@ use crate::convert::{arr1, arr2, vector};
 use crate::mechanism::PyMechanism;
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x};
-use planardyn::model::PairKind;
+use planardyn::kinematics::pairs::{n_rows, row_scales};
 use planardyn::Mechanism;
 use pyo3::prelude::*;
 
 type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
-/// Phi_x (2p x 3n, row-major) at x; `scaled`: rows in metres divided by the mechanism's
+/// Phi_x (all pair rows x 3n, row-major) at x; `scaled`: rows in metres divided by the mechanism's
 /// length L and translation columns multiplied by L, so that entries are dimensionless
 /// (the scaling of the core's singularity measures, `kinematics::system`).
 fn jacobian(mech: &Mechanism, x: &[f64], scaled: bool) -> Vec<f64> {
-    let (rows, cols) = (2 * mech.pairs.len(), mech.n_x());
+    let (rows, cols) = (mech.n_pair_rows(), mech.n_x());
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
-    // Every pair row, in pair order (rows 2k, 2k+1 for pair k), also the ones the core
-    // drops as redundant.
+    // Every pair row, in pair order (`Mechanism::pair_rows`), also the ones the core drops
+    // as redundant.
     let all_rows: Vec<Option<usize>> = (0..rows).map(Some).collect();
     let mut j = vec![0.0; rows * cols];
     phi_x(mech, x, &trig, &all_rows, &mut j);
     if scaled {
         let inv = 1.0 / mech.scale;
-        let rs: Vec<f64> = mech
-            .pairs
-            .iter()
-            .flat_map(|p| match p.kind {
-                PairKind::Revolute => [inv, inv],
-                PairKind::Prismatic { .. } => [1.0, inv],
-            })
-            .collect();
+        let rs: Vec<f64> =
+            mech.pairs.iter().flat_map(|p| row_scales(p, inv).into_iter().take(n_rows(&p.kind))).collect();
         for r in 0..rows {
             for c in 0..cols {
                 j[r * cols + c] *= rs[r] * if c % 3 == 2 { 1.0 } else { mech.scale };
@@ -83,10 +77,11 @@ fn singular_values(rows: usize, cols: usize, a: &[f64]) -> Vec<f64> {
     sv
 }
 
-/// The pair-constraint Jacobian Phi_x = dPhi/dx at body coordinates x: shape (2p, 3n),
-/// two rows per pair in the order of `pair_names` (a revolute pair: the x and y
-/// components of the gap between its two copies of the point, m; a prismatic pair: the
-/// relative angle, rad, then the normal offset from the guide, m), three columns per body
+/// The pair-constraint Jacobian Phi_x = dPhi/dx at body coordinates x: shape (rows, 3n),
+/// the pairs' rows in the order of `pair_names`, pair k's at `Mechanism.pairs[k]['rows']`
+/// (a revolute pair: the x and y components of the gap between its two copies of the point,
+/// m; a prismatic pair: the relative angle, rad, then the normal offset from the guide, m;
+/// a gear pair: the rolling condition, m; a slot pair: the pin's offset from the slot, m), three columns per body
 /// (X, Y in m, phi in rad). `scaled=True` makes it dimensionless (metre rows / L,
 /// translation columns * L, L = `Mechanism.scale`), the form whose singular values the
 /// core's rank test and singularity measures use.
@@ -100,10 +95,10 @@ pub fn constraint_jacobian<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = &*mech.inner;
     let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
-    arr2(py, 2 * m.pairs.len(), m.n_x(), jacobian(m, &x, scaled))
+    arr2(py, m.n_pair_rows(), m.n_x(), jacobian(m, &x, scaled))
 }
 
-/// Singular values of the scaled Phi_x at x, ascending: min(2p, 3n) of them.
+/// Singular values of the scaled Phi_x at x, ascending: min(rows, 3n) of them.
 #[pyfunction]
 pub fn constraint_singular_values<'py>(
     py: Python<'py>,
@@ -112,7 +107,7 @@ pub fn constraint_singular_values<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = &*mech.inner;
     let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
-    let (rows, cols) = (2 * m.pairs.len(), m.n_x());
+    let (rows, cols) = (m.n_pair_rows(), m.n_x());
     let j = jacobian(m, &x, true);
     Ok(arr1(py, singular_values(rows, cols, &j)))
 }

@@ -3,7 +3,7 @@
 //! Both measures are singular values of the scaled (dimensionless, see `system.rs`) Jacobian:
 //! - type II (parallel): the smallest singular value of J = [Phi_x; D_x] with the inputs
 //!   fixed. It is 0 where the actuated mechanism gains an uncontrolled motion.
-//! - passive: the smallest singular value of Phi_x alone (2p x 3n). It is 0 where the
+//! - passive: the smallest singular value of Phi_x alone (its independent rows x 3n). It is 0 where the
 //!   mechanism without its drives changes mobility (a folded four-bar, a change point).
 //!
 //! Near a type II singularity the integrator changes to m components of x chosen by Gaussian
@@ -11,7 +11,8 @@
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
 use super::constraints::{body_trig, constraint_jacobian, Chart};
-use super::system::{col_scales, pair_row_scales, scaled_jacobian};
+use super::pairs;
+use super::system::{col_scales, scaled_jacobian};
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
 
@@ -57,20 +58,20 @@ pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
     singular_values(rows, n, &scaled(mech, &Chart::Inputs, x))[0]
 }
 
-/// The rank structure of all 2p pair constraints at x.
+/// The rank structure of all pair constraints at x.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConstraintRank {
     /// Numerical rank of Phi_x (relative tolerance [`RANK_TOL`]).
     pub rank: usize,
-    /// A maximal set of independent rows (indices into 0..2p), ascending.
+    /// A maximal set of independent rows (indices into 0..n_pair_rows()), ascending.
     pub independent: Vec<usize>,
     /// The pairs taking part in each dependency among the rows (from the left null space).
     pub dependencies: Vec<Vec<usize>>,
 }
 
-/// Rank, independent rows and dependencies of all 2p pair-constraint rows at x.
+/// Rank, independent rows and dependencies of all pair-constraint rows at x.
 pub fn constraint_rank(mech: &Mechanism, x: &[f64]) -> ConstraintRank {
-    let (n, rows) = (x.len(), 2 * mech.pairs.len());
+    let (n, rows) = (x.len(), mech.n_pair_rows());
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
     let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
@@ -80,7 +81,11 @@ pub fn constraint_rank(mech: &Mechanism, x: &[f64]) -> ConstraintRank {
         return ConstraintRank { rank: 0, independent: vec![], dependencies: vec![] };
     }
     // Scaled as the solver's J: length rows by 1/L, translation columns by L.
-    let rs: Vec<f64> = mech.pairs.iter().flat_map(|p| pair_row_scales(p, 1.0 / mech.scale)).collect();
+    let rs: Vec<f64> = mech
+        .pairs
+        .iter()
+        .flat_map(|p| pairs::row_scales(p, 1.0 / mech.scale).into_iter().take(pairs::n_rows(&p.kind)))
+        .collect();
     for r in 0..rows {
         for c in 0..n {
             j[r * n + c] *= rs[r] * if c % 3 == 2 { 1.0 } else { mech.scale };
@@ -96,7 +101,8 @@ pub fn constraint_rank(mech: &Mechanism, x: &[f64]) -> ConstraintRank {
         .chain(svd.singular_values.len()..rows)
         .filter(|&i| i < u.ncols())
         .map(|i| {
-            let mut pairs: Vec<usize> = (0..rows).filter(|&r| u[(r, i)].abs() > 1e-6).map(|r| r / 2).collect();
+            let mut pairs: Vec<usize> =
+                (0..rows).filter(|&r| u[(r, i)].abs() > 1e-6).map(|r| mech.row_pair(r).0).collect();
             pairs.dedup();
             pairs
         })
