@@ -152,6 +152,11 @@ fn geared_five_bar_swings_with_its_energy() {
     let mech = shipped("geared-five-bar.yaml");
     assert_eq!(mech.dof(), 1);
     let tr = run(&mech, "dop853", 1.0, 1e-11, None);
+    // Released from rest: E = V = g (sum of m y_com) in the drawing, from the file's points.
+    let y = |p: &str| mech.points[mech.point_id(p).unwrap().0].1[1];
+    let (c1, c2, p) = (y("C1"), y("C2"), y("P"));
+    let v0 = 9.81 * (0.5 * c1 / 2.0 + 0.5 * c2 / 2.0 + 0.7 * (c1 + p) / 2.0 + 0.3 * p + 0.7 * (c2 + p) / 2.0);
+    assert!((energy(&tr, 0) - v0).abs() < 1e-12, "E0 {} vs {v0}", energy(&tr, 0));
     assert!(tr.stats.energy_drift < 1e-9, "energy drift {} J", tr.stats.energy_drift);
     // The gear row holds along the run: theta2 - theta2_0 = -(r1/r2)(theta1 - theta1_0).
     let nx = mech.n_x();

@@ -433,7 +433,7 @@ fn build_gear(
         ));
     }
     for (i, &r) in radii.iter().enumerate() {
-        if !(ctx.finite(&format!("{path}.radii[{i}]"), r)? > 0.0) {
+        if ctx.finite(&format!("{path}.radii[{i}]"), r)? <= 0.0 {
             return Err(ctx.err(format!("{path}.radii[{i}]"), format!("pitch radius {r} must be > 0 m")));
         }
     }
@@ -478,7 +478,7 @@ fn build_gear(
             let end = carried(ctx, mech, &format!("{path}.rack[1]"), b, &bodies[1], qid)?;
             let (pp, pq) = (mech.points[pid.0].1, mech.points[qid.0].1);
             let len = (pq[0] - pp[0]).hypot(pq[1] - pp[1]);
-            if !(len > 0.0) {
+            if len == 0.0 {
                 return Err(ctx.err(
                     format!("{path}.rack"),
                     "the rack's two points coincide; give two distinct points of its pitch line",
