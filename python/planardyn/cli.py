@@ -215,8 +215,9 @@ def _check(args: argparse.Namespace) -> int:
     print(f"pairs: {len(pairs)}  (" + ", ".join(f"{len(v)} {k}" for k, v in kinds.items()) + ")")
     for k, names in kinds.items():
         print(f"  {k}: {', '.join(names)}")
-    print(f"mobility (Grubler): 3n - 2p = 3*{n} - 2*{len(pairs)} = {3 * n - 2 * len(pairs)};"
-          f" coordinates: {mech.dof}")
+    rows = sum(stop - start for start, stop in (pr["rows"] for pr in pairs))
+    count = f"3n - 2p = 3*{n} - 2*{len(pairs)}" if rows == 2 * len(pairs) else f"3n - rows = 3*{n} - {rows}"
+    print(f"mobility (Grubler): {count} = {3 * n - rows}; coordinates: {mech.dof}")
     print("coordinates:")
     for name, unit, drawn, q0 in zip(mech.coordinate_names, mech.coordinate_units, mech.drawn_q, mech.q0):
         start = "" if drawn == q0 else f", start {q0:.6g} {unit}"

@@ -277,7 +277,7 @@ def _connected(units: set[str], inner: list) -> bool:
 
 
 def _group(names: list[str], units: tuple[str, ...], inner: list, outer: list) -> AssurGroup:
-    letter = {"revolute": "R", "prismatic": "P"}
+    letter = {"revolute": "R", "prismatic": "P", "gear": "G", "slot": "S"}
     k = len(units)
     if k == 2:
         u1, u2 = units
@@ -350,6 +350,9 @@ def _drawn_jacobian(model: Mapping[str, Any], pairs: Sequence[_Pair]) -> np.ndar
         return g
 
     for k, pr in enumerate(pairs):
+        if pr.kind not in ("revolute", "prismatic"):
+            raise ValueError(f"pair {pr.name!r}: the analysis from the drawing (for a model the loader refuses) "
+                             f"knows revolute and prismatic pairs only; fix the model so that it loads")
         P = pts[pr.at]
         d = point_rows(pr.b, P, 1.0) + point_rows(pr.a, P, -1.0)
         if pr.kind == "revolute":
@@ -376,7 +379,9 @@ def _rank_and_null(J: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
     return rank, np.sort(s), U[:, rank:]
 
 
-def _self_stresses(null: np.ndarray, pairs: Sequence[_Pair]) -> tuple[tuple[str, ...], ...]:
+def _self_stresses(
+    null: np.ndarray, pairs: Sequence[_Pair], rows: Sequence[tuple[int, int]]
+) -> tuple[tuple[str, ...], ...]:
     """The pairs each independent self-stress involves. A basis of the null space of
     Phi_x^T is reduced (column echelon form) so that each vector involves as few pairs as
     the structure allows; each is reported with its pairs."""
@@ -397,7 +402,7 @@ def _self_stresses(null: np.ndarray, pairs: Sequence[_Pair]) -> tuple[tuple[str,
     out = []
     for j in range(Q.shape[1]):
         v = Q[:, j] / np.linalg.norm(Q[:, j])
-        share = np.hypot(v[0::2], v[1::2])
+        share = [np.linalg.norm(v[start:stop]) for start, stop in rows]
         out.append(tuple(pr.name for pr, w in zip(pairs, share) if w > SELF_STRESS_TOL))
     return tuple(out)
 
@@ -418,16 +423,19 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
         except (ModelError, PlanardynError) as e:
             native, load_error = None, str(e)
     pairs = _pairs_of(model)
+    # Each pair's rows of Phi_x (two for a drawing the loader refused: revolute, prismatic).
+    rows = [(2 * k, 2 * k + 2) for k in range(len(pairs))]
     if native is not None:
-        # The core's names (it names unnamed pairs) and its Jacobian at the drawing.
+        # The core's names (it names unnamed pairs), row layout and Jacobian at the drawing.
         pairs = [_Pair(n, p.kind, p.a, p.b, p.at, p.axis) for n, p in zip(native.pair_names, pairs)]
+        rows = [pr["rows"] for pr in native.pairs]
         J = np.asarray(_core.constraint_jacobian(native._native, native.x0, True))
         bodies = tuple(native.body_names)
     else:
         J = _drawn_jacobian(model, pairs)
         bodies = tuple(model["bodies"])
     links = ("ground", *bodies)
-    n, p = len(bodies), len(pairs)
+    n, p, n_rows = len(bodies), len(pairs), J.shape[0]
     rank, sv, null = _rank_and_null(J)
     input_pairs = tuple(c["pair"] for c in model["coordinates"])
     loops, connected = _loops(links, pairs)
@@ -450,12 +458,12 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
         n_pairs=p,
         coordinates=tuple(c["name"] for c in model["coordinates"]),
         input_pairs=input_pairs,
-        grubler=3 * n - 2 * p,
+        grubler=3 * n - n_rows,
         rank=rank,
         singular_values=sv,
         mobility=3 * n - rank,
-        redundant=2 * p - rank,
-        redundant_pairs=_self_stresses(null, pairs),
+        redundant=n_rows - rank,
+        redundant_pairs=_self_stresses(null, pairs, rows),
         n_loops=p - len(links) + 1 if connected else len(loops),
         loops=tuple(loops),
         connected=connected,
