@@ -143,7 +143,8 @@ def _pairs_of(model: Mapping[str, Any]) -> list[_Pair]:
     out = []
     for pr in model["pairs"]:
         a, b = pr["bodies"]
-        name = pr.get("name") or f"{a}-{b}@{pr['at']}"
+        at = pr["at"] if "at" in pr else pr["centers"][0]  # a gear pair names its centres
+        name = pr.get("name") or f"{a}-{b}@{at}"
         axis = None
         if pr["type"] == "prismatic":
             if "axis" in pr:
@@ -151,7 +152,7 @@ def _pairs_of(model: Mapping[str, Any]) -> list[_Pair]:
             else:
                 p, q = pr["along"]
                 axis = (pts[q][0] - pts[p][0], pts[q][1] - pts[p][1])
-        out.append(_Pair(name, pr["type"], a, b, pr["at"], axis))
+        out.append(_Pair(name, pr["type"], a, b, at, axis))
     return out
 
 
