@@ -381,7 +381,7 @@ def _rank_and_null(J: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
 
 
 def _self_stresses(
-    null: np.ndarray, pairs: Sequence[_Pair], rows: Sequence[tuple[int, int]]
+    null: np.ndarray, pairs: Sequence[_Pair], pair_rows: Sequence[tuple[int, int]] | None = None
 ) -> tuple[tuple[str, ...], ...]:
     """The pairs each independent self-stress involves. A basis of the null space of
     Phi_x^T is reduced (column echelon form) so that each vector involves as few pairs as
@@ -403,7 +403,8 @@ def _self_stresses(
     out = []
     for j in range(Q.shape[1]):
         v = Q[:, j] / np.linalg.norm(Q[:, j])
-        share = [np.linalg.norm(v[start:stop]) for start, stop in rows]
+        layout = pair_rows or [(2 * k, 2 * k + 2) for k in range(len(pairs))]
+        share = [np.linalg.norm(v[start:stop]) for start, stop in layout]
         out.append(tuple(pr.name for pr, w in zip(pairs, share) if w > SELF_STRESS_TOL))
     return tuple(out)
 
@@ -425,11 +426,11 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
             native, load_error = None, str(e)
     pairs = _pairs_of(model)
     # Each pair's rows of Phi_x (two for a drawing the loader refused: revolute, prismatic).
-    rows = [(2 * k, 2 * k + 2) for k in range(len(pairs))]
+    pair_rows = [(2 * k, 2 * k + 2) for k in range(len(pairs))]
     if native is not None:
         # The core's names (it names unnamed pairs), row layout and Jacobian at the drawing.
         pairs = [_Pair(n, p.kind, p.a, p.b, p.at, p.axis) for n, p in zip(native.pair_names, pairs)]
-        rows = [pr["rows"] for pr in native.pairs]
+        pair_rows = [pr["rows"] for pr in native.pairs]
         J = np.asarray(_core.constraint_jacobian(native._native, native.x0, True))
         bodies = tuple(native.body_names)
     else:
@@ -464,7 +465,7 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
         singular_values=sv,
         mobility=3 * n - rank,
         redundant=n_rows - rank,
-        redundant_pairs=_self_stresses(null, pairs, rows),
+        redundant_pairs=_self_stresses(null, pairs, pair_rows),
         n_loops=p - len(links) + 1 if connected else len(loops),
         loops=tuple(loops),
         connected=connected,
