@@ -3,7 +3,7 @@
 //! rows carry no force, so their multipliers vanish up to round-off).
 
 use crate::kinematics::pairs;
-use crate::model::{Mechanism, PairId};
+use crate::model::Mechanism;
 use crate::workspace::Workspace;
 
 /// For each pair, [F_x, F_y, M]: the force (N, global) and the couple (N m) that body a
@@ -22,15 +22,11 @@ pub fn reactions(mech: &Mechanism, ws: &mut Workspace) -> Vec<[f64; 3]> {
     ws.sys.solve_transpose(&mut lambda);
     mech.pairs
         .iter()
-        .enumerate()
-        .map(|(k, pair)| {
+        .zip(&mech.pair_slots)
+        .map(|(pair, slots)| {
             // A redundant row left out of F carries no multiplier: the split of the load
             // between redundant pairs is statically indeterminate.
-            let mut mu = [0.0; 2];
-            for (m, slot) in mu.iter_mut().zip(&mech.row_slot[mech.pair_rows(PairId(k))]) {
-                *m = slot.map_or(0.0, |i| lambda[i]);
-            }
-            pairs::reaction(pair, &ws.x, mu)
+            pairs::reaction(pair, &ws.x, slots.map(|s| s.map_or(0.0, |i| lambda[i])))
         })
         .collect()
 }

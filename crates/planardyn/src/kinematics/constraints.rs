@@ -15,7 +15,7 @@ pub use super::pairs::{
     coordinate_rate as pair_coordinate_rate,
 };
 pub use crate::linalg::{Dense, Sink};
-use crate::model::{Link, Mechanism, PairId};
+use crate::model::{Link, Mechanism};
 
 /// Which m functions of x are the independent coordinates.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -50,17 +50,11 @@ pub fn coordinate_rates(mech: &Mechanism, x: &[f64], xd: &[f64], qd: &mut [f64])
     }
 }
 
-/// Where the rows of pair k go in F (None: a redundant row, left out).
-#[inline]
-fn slots<'a>(mech: &Mechanism, row_slot: &'a [Option<usize>], k: usize) -> &'a [Option<usize>] {
-    &row_slot[mech.pair_rows(PairId(k))]
-}
-
 /// Write a pair's row values to their slots.
 #[inline]
-fn put(out: &mut [f64], s: &[Option<usize>], v: pairs::Rows) {
-    for (slot, value) in s.iter().zip(v) {
-        if let Some(i) = *slot {
+fn put(out: &mut [f64], s: [Option<usize>; 2], v: pairs::Rows) {
+    for (slot, value) in s.into_iter().zip(v) {
+        if let Some(i) = slot {
             out[i] = value;
         }
     }
@@ -69,8 +63,8 @@ fn put(out: &mut [f64], s: &[Option<usize>], v: pairs::Rows) {
 /// F(x) for a chart with target values z: the independent pair rows, then the chart rows.
 pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], z: &[f64], out: &mut [f64]) {
     let nc = mech.n_constraints;
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        put(out, slots(mech, &mech.row_slot, k), pairs::residual(pair, x, trig));
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        put(out, *slots, pairs::residual(pair, x, trig));
     }
     match chart {
         Chart::Inputs => coordinates(mech, x, &mut out[nc..]),
@@ -93,8 +87,8 @@ pub fn jacobian(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], j
 
 /// The entries of J = dF/dx for a chart, added into `sink` (which starts at zero).
 pub fn jacobian_into<S: Sink>(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], sink: &mut S) {
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        pairs::jacobian(pair, x, trig, sink, slots(mech, &mech.row_slot, k));
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        pairs::jacobian(pair, x, trig, sink, *slots);
     }
     let nc = mech.n_constraints;
     match chart {
@@ -116,8 +110,8 @@ pub fn jacobian_into<S: Sink>(mech: &Mechanism, chart: &Chart, x: &[f64], trig: 
 pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], row_slot: &[Option<usize>], j: &mut [f64]) {
     j.fill(0.0);
     let mut dense = Dense { j, ncols: x.len() };
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        pairs::jacobian(pair, x, trig, &mut dense, slots(mech, row_slot, k));
+    for (pair, slots) in mech.pairs.iter().zip(&mech.slots_by_pair(row_slot)) {
+        pairs::jacobian(pair, x, trig, &mut dense, *slots);
     }
 }
 
@@ -127,8 +121,8 @@ pub fn constraint_jacobian(mech: &Mechanism, x: &[f64], trig: &[[f64; 2]], row_s
 pub fn jacobian_pattern(mech: &Mechanism, chart: &Chart) -> Vec<Vec<usize>> {
     let nc = mech.n_constraints;
     let mut pattern = vec![Vec::new(); mech.n_x()];
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        for (row, slot) in slots(mech, &mech.row_slot, k).iter().enumerate() {
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        for (row, slot) in slots.iter().enumerate() {
             if let Some(i) = *slot {
                 pattern[i] = pairs::pattern(pair, row);
             }
@@ -146,8 +140,8 @@ pub fn jacobian_pattern(mech: &Mechanism, chart: &Chart) -> Vec<Vec<usize>> {
 /// gamma(u, v) = d2F/dx2 [u, v] for every row (the chart rows of a partition are linear).
 pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], out: &mut [f64]) {
     let nc = mech.n_constraints;
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        put(out, slots(mech, &mech.row_slot, k), pairs::gamma(pair, x, trig, u, v));
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        put(out, *slots, pairs::gamma(pair, x, trig, u, v));
     }
     for (k, o) in out[nc..].iter_mut().enumerate() {
         *o = match chart {

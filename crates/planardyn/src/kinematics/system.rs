@@ -10,7 +10,7 @@
 use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
 use super::pairs;
 use crate::linalg::BlockLu;
-use crate::model::{CoordinateKind, Mechanism, PairId};
+use crate::model::{CoordinateKind, Mechanism};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
@@ -173,8 +173,8 @@ pub fn scaled_jacobian(
 /// 1/L for rows measured in metres, 1 for rows measured in radians.
 pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
     let inv = 1.0 / mech.scale;
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        for (slot, scale) in mech.row_slot[mech.pair_rows(PairId(k))].iter().zip(pairs::row_scales(pair, inv)) {
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        for (slot, scale) in slots.iter().zip(pairs::row_scales(pair, inv)) {
             if let Some(i) = *slot {
                 rs[i] = scale;
             }

@@ -134,6 +134,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         scale: 1.0,
         pair_row_start: vec![0],
         row_slot: Vec::new(),
+        pair_slots: Vec::new(),
         n_constraints: 0,
         warnings: Vec::new(),
     };
@@ -153,6 +154,7 @@ pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     }
     mech.n_constraints = mech.n_pair_rows();
     mech.row_slot = (0..mech.n_constraints).map(Some).collect();
+    mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
     build_coordinates(&ctx, &mut mech)?;
     mech.drives = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
@@ -741,6 +743,7 @@ fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
             mech.row_slot[row] = Some(slot);
         }
         mech.n_constraints = cr.rank;
+        mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
         for pairs in &cr.dependencies {
             let names: Vec<&str> = pairs.iter().map(|&k| mech.pairs[k].name.as_str()).collect();
             mech.warnings.push(format!(

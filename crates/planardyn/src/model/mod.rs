@@ -198,6 +198,9 @@ pub struct Mechanism {
     /// for a redundant row (implied by the others, e.g. in a parallelogram), left out so
     /// that J stays square.
     pub row_slot: Vec<Option<usize>>,
+    /// `row_slot` by pair: where each pair's rows go in F (unused entries None), for the
+    /// assembler's hot loops.
+    pub pair_slots: Vec<[Option<usize>; 2]>,
     /// Number of independent pair constraints kept: 3n - m.
     pub n_constraints: usize,
     /// Things a user should know about the model (redundant constraints...).
@@ -229,6 +232,19 @@ impl Mechanism {
     #[inline]
     pub fn pair_rows(&self, k: PairId) -> std::ops::Range<usize> {
         self.pair_row_start[k.0]..self.pair_row_start[k.0 + 1]
+    }
+    /// A row placement (`row_slot`, or all rows) gathered by pair: entry k holds where pair
+    /// k's rows go (None past its row count).
+    pub fn slots_by_pair(&self, row_slot: &[Option<usize>]) -> Vec<[Option<usize>; 2]> {
+        (0..self.pairs.len())
+            .map(|k| {
+                let mut slots = [None; 2];
+                for (s, r) in slots.iter_mut().zip(&row_slot[self.pair_rows(PairId(k))]) {
+                    *s = *r;
+                }
+                slots
+            })
+            .collect()
     }
     /// The pair a pair-constraint row belongs to.
     pub fn row_pair(&self, row: usize) -> PairId {

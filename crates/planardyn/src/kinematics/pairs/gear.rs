@@ -80,7 +80,7 @@ impl PairType for Gear {
     }
 
     #[inline]
-    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: &[Option<usize>]) {
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
         let Some(row) = rows[0] else { return };
         let [ka, kb] = self.coefficients();
         add_grad(j, row, &link_state_t(pair.a, x, trig), [0.0, 0.0, ka]);
@@ -113,6 +113,7 @@ impl PairType for Gear {
         cols
     }
 
+    #[inline]
     fn relative(&self) -> Option<Relative> {
         None
     }

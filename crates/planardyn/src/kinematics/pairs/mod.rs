@@ -1,6 +1,6 @@
 //! Pair kinds: what each kind of kinematic pair contributes to the position equations,
 //! one file a kind. The assembler (`constraints`, `system`, `dynamics::reactions`) walks the
-//! pairs and asks them through the functions below; only this file's [`dispatch`] looks at
+//! pairs and asks them through the functions below; only this file's `dispatch!` looks at
 //! the kind, and it calls the kind's module statically (no dynamic dispatch in the hot loop).
 //!
 //! A kind has 1 or 2 constraint rows ([`PairType::ROWS`]); the rows of all pairs are laid
@@ -8,7 +8,7 @@
 //! of which the first `ROWS` entries are meaningful.
 //!
 //! Adding a kind: a file here implementing [`PairType`], a variant of `model::PairKind`
-//! with an arm in [`dispatch`], its `PairSpec` variant and validation in `model`, the schema
+//! with an arm in `dispatch!`, its `PairSpec` variant and validation in `model`, the schema
 //! and `docs/model-format.md`.
 
 pub mod frames;
@@ -66,7 +66,7 @@ pub trait PairType {
     /// Residual of the rows.
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows;
     /// Gradients of the rows, added into `j`.
-    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: &[Option<usize>]);
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]);
     /// Second derivatives of the rows as bilinear forms gamma(u, v).
     fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows;
     /// Row scales: `inv_l` (1/L) for rows in metres, 1 for rows in radians.
@@ -80,6 +80,25 @@ pub trait PairType {
     fn reaction(&self, pair: &Pair, x: &[f64], mu: Rows) -> [f64; 3];
     /// What the drawings show, with `scale` the mechanism's characteristic length.
     fn geometry(&self, pair: &Pair, x: &[f64], scale: f64) -> PairGeometry;
+
+    // The relative coordinate's value, gradient, second derivative and rate, from
+    // `relative` (a constant of the kind, so each folds to one case).
+    #[inline]
+    fn coordinate(&self, pair: &Pair, x: &[f64]) -> f64 {
+        relative_value(self.relative(), pair, x)
+    }
+    #[inline]
+    fn coordinate_grad<S: Sink>(&self, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+        relative_grad(self.relative(), pair, x, j, row)
+    }
+    #[inline]
+    fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+        relative_gamma(self.relative(), pair, x, u, v)
+    }
+    #[inline]
+    fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+        relative_rate(self.relative(), pair, x, xd)
+    }
 }
 
 /// Call `$body` with `$t` bound to the pair kind's [`PairType`] value.
@@ -129,7 +148,7 @@ pub fn residual(pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
 }
 
 #[inline]
-pub fn jacobian<S: Sink>(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: &[Option<usize>]) {
+pub fn jacobian<S: Sink>(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
     dispatch!(&pair.kind, t => t.jacobian(pair, x, trig, j, rows))
 }
 
@@ -188,21 +207,45 @@ fn along(pair: &Pair, axis: [f64; 2], x: &[f64]) -> Projection {
     Projection::new(pair.sa, pair.sb, axis, link_state(pair.a, x), link_state(pair.b, x))
 }
 
-// A pair without a relative coordinate never reaches the four functions below: the model
+// A pair without a relative coordinate never reaches the functions below: the model
 // refuses a coordinate or a pair spring on it; they return 0 for it.
 
 /// Relative coordinate of a pair from the drawing: angle (rad) or displacement (m).
+#[inline]
 pub fn coordinate(pair: &Pair, x: &[f64]) -> f64 {
-    match relative(pair) {
+    dispatch!(&pair.kind, t => t.coordinate(pair, x))
+}
+
+/// Gradient of [`coordinate`], added into row `row` of `j`.
+#[inline]
+pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+    dispatch!(&pair.kind, t => t.coordinate_grad(pair, x, j, row))
+}
+
+/// Second derivative of [`coordinate`] as a bilinear form.
+#[inline]
+pub fn coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    dispatch!(&pair.kind, t => t.coordinate_gamma(pair, x, u, v))
+}
+
+/// Rate of [`coordinate`]: its gradient times xd.
+#[inline]
+pub fn coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+    dispatch!(&pair.kind, t => t.coordinate_rate(pair, x, xd))
+}
+
+#[inline(always)]
+fn relative_value(r: Option<Relative>, pair: &Pair, x: &[f64]) -> f64 {
+    match r {
         Some(Relative::Angle) => angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0,
         Some(Relative::Along { axis }) => along(pair, axis, x).value(),
         None => 0.0,
     }
 }
 
-/// Gradient of [`coordinate`], added into row `row` of `j`.
-pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
-    match relative(pair) {
+#[inline(always)]
+fn relative_grad<S: Sink>(r: Option<Relative>, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+    match r {
         Some(Relative::Angle) => {
             add_grad(j, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
             add_grad(j, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
@@ -212,17 +255,17 @@ pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
     }
 }
 
-/// Second derivative of [`coordinate`] as a bilinear form.
-pub fn coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
-    match relative(pair) {
+#[inline(always)]
+fn relative_gamma(r: Option<Relative>, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    match r {
         Some(Relative::Along { axis }) => along(pair, axis, x).gamma(u, v),
         Some(Relative::Angle) | None => 0.0,
     }
 }
 
-/// Rate of [`coordinate`]: its gradient times xd.
-pub fn coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
-    match relative(pair) {
+#[inline(always)]
+fn relative_rate(r: Option<Relative>, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+    match r {
         Some(Relative::Angle) => part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1,
         Some(Relative::Along { axis }) => along(pair, axis, x).rate(xd),
         None => 0.0,

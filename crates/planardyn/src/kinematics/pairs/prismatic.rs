@@ -31,7 +31,7 @@ impl PairType for Prismatic {
     }
 
     #[inline]
-    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: &[Option<usize>]) {
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
         if let Some(row) = rows[0] {
             add_grad(j, row, &link_state_t(pair.a, x, trig), [0.0, 0.0, -1.0]);
             add_grad(j, row, &link_state_t(pair.b, x, trig), [0.0, 0.0, 1.0]);
@@ -54,6 +54,7 @@ impl PairType for Prismatic {
         both_links(pair)
     }
 
+    #[inline]
     fn relative(&self) -> Option<Relative> {
         Some(Relative::Along { axis: self.axis })
     }

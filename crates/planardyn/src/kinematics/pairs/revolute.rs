@@ -20,7 +20,7 @@ impl PairType for Revolute {
     }
 
     #[inline]
-    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: &[Option<usize>]) {
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
         let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
         let (ta, tb) = (perp(a.rot(pair.sa)), perp(b.rot(pair.sb)));
         if let Some(row) = rows[0] {
@@ -50,6 +50,7 @@ impl PairType for Revolute {
         both_links(pair)
     }
 
+    #[inline]
     fn relative(&self) -> Option<Relative> {
         Some(Relative::Angle)
     }

@@ -35,7 +35,7 @@ impl PairType for Slot {
     }
 
     #[inline]
-    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: &[Option<usize>]) {
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
         if let Some(row) = rows[0] {
             self.normal(pair, x, trig).grad(j, row, 1.0);
         }
@@ -54,6 +54,7 @@ impl PairType for Slot {
         both_links(pair)
     }
 
+    #[inline]
     fn relative(&self) -> Option<Relative> {
         Some(Relative::Along { axis: self.axis })
     }
