@@ -104,7 +104,8 @@ def test_description(four_bar):
     np.testing.assert_allclose(m.inertias, [0.3 * 0.09 / 12, 1.0 / 12, 0.8 * 0.64 / 12], rtol=CLOSED_FORM_RTOL)
     np.testing.assert_array_equal(m.gravity, [0.0, -G])
     assert m.q0[0] == FOUR_BAR_THETA0 and m.qd0[0] == 0.0
-    assert m.pairs[1] == {"name": "elbow", "kind": "revolute", "bodies": ("crank", "coupler"), "point": "A", "axis": None}
+    assert m.pairs[1] == {"name": "elbow", "kind": "revolute", "bodies": ("crank", "coupler"), "point": "A", "axis": None,
+                          "rows": (2, 4)}
     assert [p for p, _ in m.body_points[2]] == ["D", "B"]
     assert "crank-rocker" in repr(m) and "1 dof" in repr(m)
 

@@ -146,8 +146,14 @@ def test_prismatic_guide_in_data():
     res = mech.simulate(t_end=0.1, output_dt=0.01)
     data = viewer_data(mech, res)
     guides = [j for j in data["joints"] if j["kind"] == "prismatic"]
-    assert len(guides) == 1 and len(guides[0]["guide"]) == 11
-    np.testing.assert_allclose(np.linalg.norm(guides[0]["guide"], axis=1), 1.0, atol=1e-6)
+    assert len(guides) == 1 and len(guides[0]["lines"]) == 11
+    # The guide is drawn +-0.3 L about the block, along the horizontal axis of the model;
+    # positions are rounded to 6 digits of L (1e-6 L).
+    lines, blocks = np.array(guides[0]["lines"]), np.array(guides[0]["blocks"])
+    L = data["scale"]
+    np.testing.assert_allclose(np.hypot(lines[:, 2] - lines[:, 0], lines[:, 3] - lines[:, 1]) / L, 0.6, atol=3e-6)
+    np.testing.assert_allclose(lines[:, 1], lines[:, 3], atol=1e-6 * L)
+    np.testing.assert_allclose((lines[:, :2] + lines[:, 2:]) / 2, blocks, atol=1e-6 * L)
 
 
 # ------------------------------------------------------------------ notebook

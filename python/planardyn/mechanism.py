@@ -108,9 +108,10 @@ class Mechanism:
         "phi: the world position is ``[X, Y] + R(phi) s``."
     )
     pairs: _Native[list[dict[str, Any]]] = _Native(
-        "The pairs as dicts: ``name``, ``kind`` (``'revolute'`` | ``'prismatic'``),\n"
-        "``bodies`` (a, b) by name (``'ground'`` for the fixed body), ``point`` (name) and\n"
-        "``axis`` (unit guide direction in a's frame, or None)."
+        "The pairs as dicts: ``name``, ``kind`` (``'revolute'`` | ``'prismatic'`` | ``'gear'``\n"
+        "| ``'slot'``), ``bodies`` (a, b) by name (``'ground'`` for the fixed body), ``point``\n"
+        "(name; a gear pair's first centre), ``axis`` (unit guide or slot direction in a's frame,\n"
+        "or None) and ``rows`` (start, stop): the pair's rows among the pair-constraint rows."
     )
     simulate_defaults: _Native[dict[str, Any]] = _Native("The model file's ``simulate`` section (None for a setting not given).")
 
@@ -170,6 +171,14 @@ class Mechanism:
             q has the wrong shape or a non-finite value.
         """
         return self._native.assemble(q, x_start)
+
+    def pair_geometry(self, x: ArrayLike) -> list[dict[str, Any]]:
+        """What the drawings show of each pair at body coordinates x (3n,), in world
+        coordinates (m), from the core: a dict per pair with ``name``, ``kind``, ``pins``
+        [(x, y)] (pin joints), ``blocks`` [(x, y)] (sliding blocks), ``lines``
+        [((x, y), (x, y))] (guides, slots, rack pitch lines) and ``circles`` [((x, y), r)]
+        (pitch circles)."""
+        return self._native.pair_geometry(np.asarray(x, dtype=float))
 
     def point_positions(self, x: ArrayLike) -> FloatArray:
         """World positions of every named point for given body coordinates.

@@ -35,9 +35,9 @@ def mechanism_svg(
 ) -> str:
     """An SVG drawing of the mechanism at body coordinates x (3n,) (default the drawing).
 
-    Bars and plates in the bodies' colours, pairs as circles (revolute) or squares on a
-    dashed guide (prismatic), ground marks, point names when ``labels``. ``paths``:
-    optional (N, k, 2) point paths (m) drawn as thin lines. ``width`` in pixels; the height
+    Bars and plates in the bodies' colours, pairs as the core's ``pair_geometry`` gives them
+    (pins circles, blocks squares, dashed guides and slots, dash-dotted pitch circles), ground
+    marks, point names when ``labels``. ``paths``: optional (N, k, 2) point paths (m) drawn as thin lines. ``width`` in pixels; the height
     follows the drawing's aspect ratio.
     """
     x = mech.x0 if x is None else np.asarray(x, dtype=float)
@@ -81,21 +81,17 @@ def mechanism_svg(
         else:
             out.append(f'<polyline points="{d}" fill="none" stroke="{col}" stroke-width="4" stroke-linecap="round">'
                        f'<title>{html.escape(mech.body_names[b])}</title></polyline>')
-    for pair in mech.pairs:
-        px, py = where[pair["point"]]
-        tip = f"<title>{html.escape(pair['name'])} ({pair['kind']})</title>"
-        if pair["kind"] == "prismatic" and pair["axis"] is not None:
-            a = pair["bodies"][0]
-            phi = 0.0 if a == "ground" else x[3 * mech.body_names.index(a) + 2]
-            c, sn = math.cos(phi), math.sin(phi)
-            ax, ay = pair["axis"]
-            dx, dy = c * ax - sn * ay, sn * ax + c * ay
-            g = 0.3 * L
-            out.append(f'<line x1="{X(px - g * dx)}" y1="{Y(py - g * dy)}" x2="{X(px + g * dx)}" y2="{Y(py + g * dy)}" '
-                       f'stroke="#666" stroke-dasharray="5 4"/>')
+    for g in mech.pair_geometry(x):
+        tip = f"<title>{html.escape(g['name'])} ({g['kind']})</title>"
+        for (ax, ay), (bx, by) in g["lines"]:
+            out.append(f'<line x1="{X(ax)}" y1="{Y(ay)}" x2="{X(bx)}" y2="{Y(by)}" stroke="#666" stroke-dasharray="5 4"/>')
+        for (cx, cy), r in g["circles"]:
+            out.append(f'<circle cx="{X(cx)}" cy="{Y(cy)}" r="{r * s:.2f}" fill="none" stroke="#555" '
+                       f'stroke-dasharray="6 3 1 3">{tip}</circle>')
+        for px, py in g["blocks"]:
             out.append(f'<rect x="{(px - x0) * s - 5:.2f}" y="{(y1 - py) * s - 5:.2f}" width="10" height="10" '
                        f'fill="#fff" stroke="#000">{tip}</rect>')
-        else:
+        for px, py in g["pins"]:
             out.append(f'<circle cx="{X(px)}" cy="{Y(py)}" r="4.5" fill="#fff" stroke="#000" stroke-width="1.3">{tip}</circle>')
     if labels:
         for name in names:
@@ -115,6 +111,13 @@ def _table(rows: list[tuple[str, str]]) -> str:
     return f'<table style="border-collapse:collapse;font-size:13px">{cells}</table>'
 
 
+def _grubler(mech: Mechanism) -> str:
+    """The Chebyshev-Grubler count: 3n minus the pairs' constraint rows."""
+    rows = sum(stop - start for start, stop in (p["rows"] for p in mech.pairs))
+    form = "3n - 2p" if rows == 2 * len(mech.pairs) else "3n - rows"
+    return f"{form} = {3 * mech.n_bodies - rows}"
+
+
 def mechanism_html(mech: Mechanism) -> str:
     """The mechanism's notebook view: the drawing (SVG) beside a summary table."""
     coords = ", ".join(
@@ -128,7 +131,7 @@ def mechanism_html(mech: Mechanism) -> str:
         ("source", html.escape(mech.source)),
         ("bodies", f"{mech.n_bodies}: {html.escape(', '.join(mech.body_names))}"),
         ("pairs", ", ".join(f"{v} {k}" for k, v in kinds.items())),
-        ("mobility", f"{mech.dof} (3n - 2p = {3 * mech.n_bodies - 2 * len(mech.pairs)})"),
+        ("mobility", f"{mech.dof} ({_grubler(mech)})"),
         ("coordinates (drawn)", coords),
         ("mass", f"{float(np.sum(mech.masses)):.4g} kg"),
         ("gravity", f"({mech.gravity[0]:.4g}, {mech.gravity[1]:.4g}) m/s²"),

@@ -104,10 +104,12 @@ def draw_mechanism(
     """Draw the mechanism at body coordinates x (3n,) (default: the drawing ``mech.x0``).
 
     Bodies with two points are bars, with more points filled polygons; ground points are
-    hatched triangles, pair points circles, prismatic guides dashed lines; points are
+    hatched triangles; the pairs as the core's :meth:`Mechanism.pair_geometry` gives them: pins
+    circles, sliding blocks squares, guides, slots and racks dashed lines, gears' pitch
+    circles dash-dotted; points are
     labelled with their names when ``labels``. Sets an equal aspect ratio. Returns the artists.
     """
-    from matplotlib.patches import Polygon
+    from matplotlib.patches import Circle, Polygon
 
     ax = _axes(ax)
     x = mech.x0 if x is None else np.asarray(x, dtype=float)
@@ -133,17 +135,16 @@ def draw_mechanism(
         )
         ax.add_patch(tri)
         artists.append(tri)
-    for pair in mech.pairs:
-        px, py = where[pair["point"]]
-        if pair["kind"] == "prismatic" and pair["axis"] is not None:
-            a = pair["bodies"][0]
-            phi = 0.0 if a == "ground" else x[3 * mech.body_names.index(a) + 2]
-            c, s_ = np.cos(phi), np.sin(phi)
-            d = np.array([c * pair["axis"][0] - s_ * pair["axis"][1], s_ * pair["axis"][0] + c * pair["axis"][1]])
-            L = 0.3 * scale
-            artists += ax.plot([px - L * d[0], px + L * d[0]], [py - L * d[1], py + L * d[1]], "--", color="0.4", alpha=alpha, linewidth=1)
+    for g in mech.pair_geometry(x):
+        for (x0, y0), (x1, y1) in g["lines"]:
+            artists += ax.plot([x0, x1], [y0, y1], "--", color="0.4", alpha=alpha, linewidth=1)
+        for (cx, cy), r in g["circles"]:
+            circle = Circle((cx, cy), r, fill=False, edgecolor="0.3", linestyle="-.", linewidth=1, alpha=alpha)
+            ax.add_patch(circle)
+            artists.append(circle)
+        for px, py in g["blocks"]:
             artists += ax.plot([px], [py], "s", markersize=8, markerfacecolor="white", markeredgecolor="k", alpha=alpha)
-        else:
+        for px, py in g["pins"]:
             artists += ax.plot([px], [py], "o", markersize=7, markerfacecolor="white", markeredgecolor="k", alpha=alpha, zorder=3)
     if labels:
         for name in names:

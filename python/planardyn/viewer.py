@@ -48,6 +48,13 @@ def _round(a: np.ndarray, scale: float) -> list:
     return _nan_to_none(out)
 
 
+def _flatten(v: Any) -> list[float]:
+    """The numbers of nested tuples and lists, in order."""
+    if isinstance(v, (list, tuple)):
+        return [x for u in v for x in _flatten(u)]
+    return [float(v)]
+
+
 def _nan_to_none(v: Any) -> Any:
     if isinstance(v, list):
         return [_nan_to_none(u) for u in v]
@@ -120,16 +127,15 @@ def viewer_data(
     unknown = [p for p in traces if p not in names]
     if unknown:
         raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(names)}")
-    joints = []
-    for pair in mech.pairs:
-        jt: dict[str, Any] = {"i": names.index(pair["point"]), "kind": pair["kind"], "guide": None}
-        if pair["kind"] == "prismatic" and pair["axis"] is not None:
-            a = pair["bodies"][0]
-            phi = np.zeros(len(keep)) if a == "ground" else result.x[keep, 3 * mech.body_names.index(a) + 2]
-            ax, ay = pair["axis"]
-            d = np.column_stack([np.cos(phi) * ax - np.sin(phi) * ay, np.sin(phi) * ax + np.cos(phi) * ay])
-            jt["guide"] = _round(d, 1.0)
-        joints.append(jt)
+    # Each pair's drawing per frame from the core: flat lists of pins [x, y], blocks [x, y],
+    # lines [x0, y0, x1, y1] and circles [x, y, r].
+    frames = [mech.pair_geometry(xk) for xk in result.x[keep]]
+    parts = ("pins", "blocks", "lines", "circles")
+    joints = [
+        {"name": pair["name"], "kind": pair["kind"]}
+        | {part: [_round(np.array(_flatten(f[j][part])), L) for f in frames] for part in parts}
+        for j, pair in enumerate(mech.pairs)
+    ]
     groups, chans = _channels(result, keep, channels)
     st = result.stats
     info = (

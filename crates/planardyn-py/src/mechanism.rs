@@ -10,8 +10,9 @@ use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::batch::inverse_rows_from;
 use planardyn::dynamics::{self, Drives, ModelDrives};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
+use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
-use planardyn::model::{CoordinateKind, Link, PairKind};
+use planardyn::model::{CoordinateKind, Link, PairId};
 use planardyn::{Mechanism, Workspace};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -235,24 +236,52 @@ impl PyMechanism {
             .map(|b| b.points.iter().map(|(p, s)| (mech.points[p.0].0.clone(), (s[0], s[1]))).collect())
             .collect()
     }
-    /// The pairs as dicts: name, kind ('revolute' | 'prismatic'), bodies (a, b) by name
-    /// ('ground' for the fixed body), point (name), axis (guide direction in a's frame or None).
+    /// The pairs as dicts: name, kind ('revolute' | 'prismatic' | 'gear' | 'slot'), bodies
+    /// (a, b) by name ('ground' for the fixed body), point (name; a gear's first centre),
+    /// axis (the guide or slot direction in a's frame, or None), rows (start, stop): the
+    /// pair's rows among the pair-constraint rows (`structure.constraint_jacobian`).
     #[getter]
     fn pairs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mech = &self.inner;
         mech.pairs
             .iter()
-            .map(|p| {
+            .enumerate()
+            .map(|(k, p)| {
                 let d = PyDict::new(py);
                 d.set_item("name", &p.name)?;
-                let (kind, axis) = match p.kind {
-                    PairKind::Revolute => ("revolute", None),
-                    PairKind::Prismatic { axis } => ("prismatic", Some((axis[0], axis[1]))),
+                let axis = match pairs::relative(p) {
+                    Some(Relative::Along { axis }) => Some((axis[0], axis[1])),
+                    _ => None,
                 };
-                d.set_item("kind", kind)?;
+                d.set_item("kind", pairs::kind_name(p))?;
                 d.set_item("bodies", (mech.link_name(p.a), mech.link_name(p.b)))?;
                 d.set_item("point", &mech.points[p.point.0].0)?;
                 d.set_item("axis", axis)?;
+                let rows = mech.pair_rows(PairId(k));
+                d.set_item("rows", (rows.start, rows.end))?;
+                Ok(d)
+            })
+            .collect()
+    }
+    /// What the drawings show of each pair at body coordinates x (3n,), in world
+    /// coordinates (m): a dict per pair with name, kind, pins [(x, y)] (pin joints),
+    /// blocks [(x, y)] (sliding blocks), lines [((x, y), (x, y))] (guides, slots, rack pitch
+    /// lines) and circles [((x, y), r)] (pitch circles).
+    fn pair_geometry<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let x = self.x_arg(&x)?;
+        let pt = |p: [f64; 2]| (p[0], p[1]);
+        self.inner
+            .pairs
+            .iter()
+            .zip(pair_geometry(&self.inner, &x))
+            .map(|(p, g)| {
+                let d = PyDict::new(py);
+                d.set_item("name", &p.name)?;
+                d.set_item("kind", g.kind)?;
+                d.set_item("pins", g.pins.iter().map(|&p| pt(p)).collect::<Vec<_>>())?;
+                d.set_item("blocks", g.blocks.iter().map(|&p| pt(p)).collect::<Vec<_>>())?;
+                d.set_item("lines", g.lines.iter().map(|l| (pt(l[0]), pt(l[1]))).collect::<Vec<_>>())?;
+                d.set_item("circles", g.circles.iter().map(|&(c, r)| (pt(c), r)).collect::<Vec<_>>())?;
                 Ok(d)
             })
             .collect()

@@ -5,6 +5,7 @@
 pub mod analogues;
 pub mod constraints;
 pub mod effector;
+pub mod pairs;
 pub mod position;
 pub mod singularity;
 pub mod system;
@@ -12,6 +13,7 @@ pub mod system;
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
+pub use pairs::{pair_geometry, PairGeometry};
 pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL,
 };

@@ -4,7 +4,7 @@
 //! Both measures are singular values of the scaled (dimensionless, see `system.rs`) Jacobian:
 //! - type II (parallel): the smallest singular value of J = [Phi_x; D_x] with the inputs
 //!   fixed. It is 0 where the actuated mechanism gains an uncontrolled motion.
-//! - passive: the smallest singular value of Phi_x alone (2p x 3n). It is 0 where the
+//! - passive: the smallest singular value of Phi_x alone (its independent rows x 3n). It is 0 where the
 //!   mechanism without its drives changes mobility (a folded four-bar, a change point).
 //!
 //! Near a type II singularity the integrator changes to m components of x chosen by Gaussian

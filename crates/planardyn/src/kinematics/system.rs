@@ -9,8 +9,9 @@
 //! the blocks found once per chart from the pattern of J.
 
 use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
+use super::pairs;
 use crate::linalg::BlockLu;
-use crate::model::{CoordinateKind, Mechanism, Pair, PairKind};
+use crate::model::{CoordinateKind, Mechanism};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
@@ -170,22 +171,12 @@ pub fn scaled_jacobian(
     }
 }
 
-/// Scales of a pair's two rows: 1/L (`inv`) for lengths, 1 for a prismatic pair's angle row.
-pub fn pair_row_scales(pair: &Pair, inv: f64) -> [f64; 2] {
-    match pair.kind {
-        PairKind::Revolute => [inv, inv],
-        PairKind::Prismatic { .. } => [1.0, inv],
-    }
-}
-
 /// 1/L for rows measured in metres, 1 for rows measured in radians.
 pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
     let inv = 1.0 / mech.scale;
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        for (slot, scale) in
-            [mech.row_slot[2 * k], mech.row_slot[2 * k + 1]].into_iter().zip(pair_row_scales(pair, inv))
-        {
-            if let Some(i) = slot {
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        for (slot, scale) in slots.iter().zip(pairs::row_scales(pair, inv)) {
+            if let Some(i) = *slot {
                 rs[i] = scale;
             }
         }

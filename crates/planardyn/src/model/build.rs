@@ -5,6 +5,8 @@
 use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, PairSpec, PartSpec, SimulateSpec};
 use super::*;
 use crate::kinematics::assemble;
+use crate::kinematics::constraints::rotate;
+use crate::kinematics::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
 use crate::structure::constraint_rank;
 use crate::ModelError;
 
@@ -142,8 +144,10 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         simulate: SimulateDefaults::default(),
         x0: Vec::new(),
         scale: 1.0,
-        row_slot: (0..2 * spec.pairs.len()).map(Some).collect(),
-        n_constraints: 2 * spec.pairs.len(),
+        pair_row_start: vec![0],
+        row_slot: Vec::new(),
+        pair_slots: Vec::new(),
+        n_constraints: 0,
         warnings: Vec::new(),
     };
     mech.x0 = mech.bodies.iter().flat_map(|b| [b.com0[0], b.com0[1], b.angle0]).collect();
@@ -156,8 +160,13 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
                 format!("duplicate pair name '{}'; rename one of the two", pair.name),
             ));
         }
+        let start = mech.n_pair_rows();
+        mech.pair_row_start.push(start + pairs::n_rows(&pair.kind));
         mech.pairs.push(pair);
     }
+    mech.n_constraints = mech.n_pair_rows();
+    mech.row_slot = (0..mech.n_constraints).map(Some).collect();
+    mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
     build_coordinates(&ctx, &mut mech)?;
     mech.drives = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
@@ -296,7 +305,15 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
 fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
     let path = format!("pairs[{k}]");
     let (name, at, bodies) = match p {
-        PairSpec::Revolute { name, at, bodies } | PairSpec::Prismatic { name, at, bodies, .. } => (name, at, bodies),
+        PairSpec::Revolute { name, at, bodies }
+        | PairSpec::Prismatic { name, at, bodies, .. }
+        | PairSpec::Slot { name, at, bodies, .. } => (name, at.as_str(), bodies),
+        PairSpec::Gear { name, bodies, centers, .. } => {
+            let at = centers.first().ok_or_else(|| {
+                ctx.err(format!("{path}.centers"), "empty: give the gear centres [A, B] (a rack and pinion: [A])")
+            })?;
+            (name, at.as_str(), bodies)
+        }
     };
     let a = ctx.link(&format!("{path}.bodies[0]"), &bodies[0])?;
     let b = ctx.link(&format!("{path}.bodies[1]"), &bodies[1])?;
@@ -304,59 +321,197 @@ fn build_pair(ctx: &Ctx, mech: &Mechanism, k: usize, p: &PairSpec) -> R<Pair> {
         return Err(ctx.err(format!("{path}.bodies"), "a pair must join two different bodies; name two"));
     }
     let point = ctx.point(&format!("{path}.at"), at)?;
-    let carried = |link: Link, i: usize| {
-        mech.attachment(link, point).ok_or_else(|| {
-            let fix = if link == Link::Ground {
-                "add it to the top-level `ground` list"
-            } else {
-                "add it to that body's `points`"
-            };
-            ctx.err(format!("{path}.at"), format!("'{}' does not carry point '{at}' ({}: {fix})", bodies[i], bodies[i]))
-        })
-    };
-    // A slider's guide passes through the pair point in the drawing: the guide body need not
-    // list it (its copy is placed where the drawing puts it).
-    let sa = match p {
-        PairSpec::Prismatic { .. } => {
-            mech.attachment(a, point).map_or_else(|| local_coords(mech, a, mech.points[point.0].1), |at| at.s)
-        }
-        PairSpec::Revolute { .. } => carried(a, 0)?.s,
-    };
-    let sb = carried(b, 1)?.s;
     let angle = |l: Link| match l {
         Link::Ground => 0.0,
         Link::Body(id) => mech.bodies[id.0].angle0,
     };
-    let kind = match p {
-        PairSpec::Revolute { .. } => PairKind::Revolute,
+    // A slider's guide and a slot pass through the pair point in the drawing: the guide
+    // body need not list it (its copy is placed where the drawing puts it).
+    let guided = |point: PointId| {
+        mech.attachment(a, point).map_or_else(|| local_coords(mech, a, mech.points[point.0].1), |at| at.s)
+    };
+    let carried_b = |point: PointId| carried(ctx, mech, &format!("{path}.at"), b, &bodies[1], point);
+    let (kind, sa, sb) = match p {
+        PairSpec::Revolute { .. } => {
+            (PairKind::Revolute, carried(ctx, mech, &format!("{path}.at"), a, &bodies[0], point)?, carried_b(point)?)
+        }
         PairSpec::Prismatic { axis, along, .. } => {
-            let d = match (axis, along) {
-                (Some(d), None) => *d,
-                (None, Some([from, to])) => {
-                    let (pf, pt) =
-                        (ctx.xy(&format!("{path}.along[0]"), from)?, ctx.xy(&format!("{path}.along[1]"), to)?);
-                    [pt[0] - pf[0], pt[1] - pf[1]]
-                }
-                _ => {
-                    return Err(
-                        ctx.err(&path, "give a prismatic pair exactly one of `axis: [dx, dy]` or `along: [P, Q]`")
-                    )
+            let axis = guide_axis(ctx, &path, axis.as_ref(), along.as_ref(), angle(a))?;
+            (PairKind::Prismatic { axis }, guided(point), carried_b(point)?)
+        }
+        PairSpec::Slot { axis, along, .. } => {
+            let axis_a = guide_axis(ctx, &path, axis.as_ref(), along.as_ref(), angle(a))?;
+            let ends = match along {
+                Some(ends) => [ctx.xy(&path, &ends[0])?, ctx.xy(&path, &ends[1])?],
+                None => {
+                    // Drawn +-0.3 L about the pin.
+                    let (p, d) = (mech.points[point.0].1, rotate(angle(a), axis_a));
+                    let h = 0.3 * mech.scale;
+                    [[p[0] - h * d[0], p[1] - h * d[1]], [p[0] + h * d[0], p[1] + h * d[1]]]
                 }
             };
-            let len = d[0].hypot(d[1]);
-            if !(len > 0.0 && len.is_finite()) {
-                return Err(ctx.err(
-                    &path,
-                    "the guide direction has zero length; give a non-zero `axis`, or two distinct `along` points",
-                ));
-            }
-            let (c, s) = (angle(a).cos(), angle(a).sin());
-            let (ux, uy) = (d[0] / len, d[1] / len);
-            PairKind::Prismatic { axis: [c * ux + s * uy, -s * ux + c * uy] }
+            let slot = Slot { axis: axis_a, ends: ends.map(|e| local_coords(mech, a, e)) };
+            (PairKind::Slot(slot), guided(point), carried_b(point)?)
+        }
+        PairSpec::Gear { centers, radii, internal, carrier, rack, .. } => {
+            let gear =
+                GearSpec { centers, radii, internal: *internal, carrier: carrier.as_deref(), rack: rack.as_ref() };
+            build_gear(ctx, mech, &path, [a, b], bodies, gear)?
         }
     };
     let name = name.clone().unwrap_or_else(|| format!("{}-{}@{at}", bodies[0], bodies[1]));
     Ok(Pair { name, kind, a, b, point, sa, sb, rel_angle0: angle(b) - angle(a) })
+}
+
+/// Where `link` (named `link_name`) carries `point`, or an error at `path` saying how to fix it.
+fn carried(ctx: &Ctx, mech: &Mechanism, path: &str, link: Link, link_name: &str, point: PointId) -> R<[f64; 2]> {
+    mech.attachment(link, point).map(|at| at.s).ok_or_else(|| {
+        let fix = if link == Link::Ground {
+            "add it to the top-level `ground` list"
+        } else {
+            "add it to that body's `points`"
+        };
+        let name = &mech.points[point.0].0;
+        ctx.err(path, format!("'{link_name}' does not carry point '{name}' ({link_name}: {fix})"))
+    })
+}
+
+/// The unit guide direction of a prismatic or slot pair in a's frame (a drawn at angle
+/// `angle_a`), from exactly one of `axis` or `along`.
+fn guide_axis(
+    ctx: &Ctx,
+    path: &str,
+    axis: Option<&[f64; 2]>,
+    along: Option<&[String; 2]>,
+    angle_a: f64,
+) -> R<[f64; 2]> {
+    let d = match (axis, along) {
+        (Some(d), None) => [ctx.finite(&format!("{path}.axis"), d[0])?, ctx.finite(&format!("{path}.axis"), d[1])?],
+        (None, Some([from, to])) => {
+            let (pf, pt) = (ctx.xy(&format!("{path}.along[0]"), from)?, ctx.xy(&format!("{path}.along[1]"), to)?);
+            [pt[0] - pf[0], pt[1] - pf[1]]
+        }
+        _ => return Err(ctx.err(path, "give exactly one of `axis: [dx, dy]` or `along: [P, Q]` for the guide")),
+    };
+    let len = d[0].hypot(d[1]);
+    if !(len > 0.0 && len.is_finite()) {
+        return Err(ctx
+            .err(path, "the guide direction has zero length; give a non-zero `axis`, or two distinct `along` points"));
+    }
+    Ok(rotate(-angle_a, [d[0] / len, d[1] / len]))
+}
+
+/// Largest mismatch (relative to the centre distance) between a gear pair's drawn centres
+/// and its pitch radii: the drawing's digits, not a tolerance of the solver.
+const GEAR_FIT: f64 = 1e-6;
+
+/// The fields of a gear pair's `PairSpec`.
+struct GearSpec<'a> {
+    centers: &'a [String],
+    radii: &'a [f64],
+    internal: bool,
+    carrier: Option<&'a str>,
+    rack: Option<&'a [String; 2]>,
+}
+
+/// A gear pair's kind and its two pair points (the centres; for a rack, the pitch line's
+/// first point on b).
+fn build_gear(
+    ctx: &Ctx,
+    mech: &Mechanism,
+    path: &str,
+    [a, b]: [Link; 2],
+    bodies: &[String; 2],
+    spec: GearSpec,
+) -> R<(PairKind, [f64; 2], [f64; 2])> {
+    let GearSpec { centers, radii, internal, carrier, rack } = spec;
+    let carrier_name = carrier.unwrap_or("ground");
+    let c = ctx.link(&format!("{path}.carrier"), carrier_name)?;
+    if c == a || c == b {
+        return Err(ctx.err(
+            format!("{path}.carrier"),
+            format!("the carrier '{carrier_name}' is one of the two gears; name the link holding both gear centres (default: ground)"),
+        ));
+    }
+    let n = if rack.is_some() { 1 } else { 2 };
+    let what = if rack.is_some() { "a rack and pinion takes the pinion's: [A]" } else { "two gears take [A, B]" };
+    if centers.len() != n {
+        return Err(ctx.err(format!("{path}.centers"), format!("{} centre(s) given; {what}", centers.len())));
+    }
+    if radii.len() != n {
+        return Err(ctx.err(
+            format!("{path}.radii"),
+            format!("{} radius(es) given; give one pitch radius per centre ({what})", radii.len()),
+        ));
+    }
+    for (i, &r) in radii.iter().enumerate() {
+        if ctx.finite(&format!("{path}.radii[{i}]"), r)? <= 0.0 {
+            return Err(ctx.err(format!("{path}.radii[{i}]"), format!("pitch radius {r} must be > 0 m")));
+        }
+    }
+    let angle = |l: Link| match l {
+        Link::Ground => 0.0,
+        Link::Body(id) => mech.bodies[id.0].angle0,
+    };
+    let centre = |i: usize, link: Link, name: &str| -> R<(PointId, [f64; 2])> {
+        let at = format!("{path}.centers[{i}]");
+        let id = ctx.point(&at, &centers[i])?;
+        carried(ctx, mech, &at, c, carrier_name, id).map_err(|_| {
+            ctx.err(&at, format!("the carrier '{carrier_name}' does not carry centre '{}': a gear's centre is fixed in the carrier (pin the gear to it); add the point to the carrier, or name the right `carrier`", centers[i]))
+        })?;
+        Ok((id, carried(ctx, mech, &at, link, name, id)?))
+    };
+    let (pa_id, sa) = centre(0, a, &bodies[0])?;
+    let pa = mech.points[pa_id.0].1;
+    let ra = radii[0];
+    let turn_a = angle(a) - angle(c);
+    let (mesh, sb, offset) = match rack {
+        None => {
+            let (pb_id, sb) = centre(1, b, &bodies[1])?;
+            let pb = mech.points[pb_id.0].1;
+            let rb = if internal { -radii[1] } else { radii[1] };
+            let d = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+            let (fit, how) =
+                if internal { ((ra + rb).abs(), "|r_a - r_b| (internal)") } else { (ra + rb, "r_a + r_b") };
+            if !(fit > 0.0 && (d - fit).abs() <= GEAR_FIT * d) {
+                return Err(ctx.err(
+                    format!("{path}.radii"),
+                    format!("the pitch circles do not touch in the drawing: the centres are {d} m apart but {how} = {fit} m; change `radii` (or the centre points{})", if internal { "; internal gears need different radii" } else { "; for a ring gear add `internal: true`" }),
+                ));
+            }
+            (Mesh::Gear { rb }, sb, ra * turn_a + rb * (angle(b) - angle(c)))
+        }
+        Some([p, q]) => {
+            if internal {
+                return Err(ctx.err(format!("{path}.internal"), "a rack has no internal mesh; remove `internal`"));
+            }
+            let (pid, qid) = (ctx.point(&format!("{path}.rack[0]"), p)?, ctx.point(&format!("{path}.rack[1]"), q)?);
+            let sb = carried(ctx, mech, &format!("{path}.rack[0]"), b, &bodies[1], pid)?;
+            let end = carried(ctx, mech, &format!("{path}.rack[1]"), b, &bodies[1], qid)?;
+            let (pp, pq) = (mech.points[pid.0].1, mech.points[qid.0].1);
+            let len = (pq[0] - pp[0]).hypot(pq[1] - pp[1]);
+            if len == 0.0 {
+                return Err(ctx.err(
+                    format!("{path}.rack"),
+                    "the rack's two points coincide; give two distinct points of its pitch line",
+                ));
+            }
+            let t = [(pq[0] - pp[0]) / len, (pq[1] - pp[1]) / len];
+            // The pinion's centre is r_a from the pitch line; n points from it to the line.
+            let h = (pp[0] - pa[0]) * t[1] - (pp[1] - pa[1]) * t[0];
+            if ((h.abs() - ra).abs()) > GEAR_FIT * ra.max(h.abs()) {
+                return Err(ctx.err(
+                    format!("{path}.radii"),
+                    format!("the pinion's pitch circle does not touch the rack's pitch line in the drawing: its centre is {} m from the line but r_a = {ra} m; change `radii[0]` or the points", h.abs()),
+                ));
+            }
+            // n = -sign(h) E t, so sigma = n x t = sign(h).
+            let sign = if h > 0.0 { 1.0 } else { -1.0 };
+            let mesh = Mesh::Rack { sign, axis: rotate(-angle(c), t), sc: local_coords(mech, c, pp), end };
+            (mesh, sb, sign * ra * turn_a)
+        }
+    };
+    Ok((PairKind::Gear(Gear { carrier: c, ra, mesh, offset }), sa, sb))
 }
 
 /// Coordinates in a link's frame of a drawn point.
@@ -381,6 +536,21 @@ fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
     })
 }
 
+/// A pair with a relative motion of its own (for a pair spring or friction).
+fn relative_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
+    let id = pair_id(ctx, mech, path, name)?;
+    match pairs::relative(&mech.pairs[id.0]) {
+        Some(_) => Ok(id),
+        None => Err(ctx.err(
+            path,
+            format!(
+                "'{name}' is a {} pair, which has no relative motion of its own; put the spring or friction on the revolute pair of one of its gears",
+                pairs::kind_name(&mech.pairs[id.0])
+            ),
+        )),
+    }
+}
+
 fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     for (k, c) in ctx.spec.coordinates.iter().enumerate() {
         let path = format!("coordinates[{k}]");
@@ -397,10 +567,16 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
                 format!("pair '{}' already has a coordinate; remove one of the two", c.pair),
             ));
         }
-        let kind = match mech.pairs[pair.0].kind {
-            PairKind::Revolute => CoordinateKind::Angle,
-            PairKind::Prismatic { .. } => CoordinateKind::Displacement,
-        };
+        let kind = pairs::coordinate_kind(&mech.pairs[pair.0]).ok_or_else(|| {
+            ctx.err(
+                format!("{path}.pair"),
+                format!(
+                    "'{}' is a {} pair, which has no relative coordinate of its own; make the coordinate the revolute pair of one of its gears",
+                    c.pair,
+                    pairs::kind_name(&mech.pairs[pair.0])
+                ),
+            )
+        })?;
         let value = ctx.finite(&format!("{path}.value"), c.value)?;
         let q0 = ctx.finite(&format!("{path}.q0"), c.q0.unwrap_or(value))?;
         let unit = if kind == CoordinateKind::Angle { 1.0 } else { mech.scale };
@@ -500,13 +676,13 @@ fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
             }
         }
         LoadSpec::TorsionalSpring { pair, stiffness, damping, rest } => Load::PairSpring {
-            pair: pair_id(ctx, mech, &format!("{path}.pair"), pair)?,
+            pair: relative_pair(ctx, mech, &format!("{path}.pair"), pair)?,
             stiffness: ctx.non_negative(&format!("{path}.stiffness"), *stiffness)?,
             damping: ctx.non_negative(&format!("{path}.damping"), *damping)?,
             rest: ctx.finite(&format!("{path}.rest"), *rest)?,
         },
         LoadSpec::Friction { pair, viscous } => Load::PairSpring {
-            pair: pair_id(ctx, mech, &format!("{path}.pair"), pair)?,
+            pair: relative_pair(ctx, mech, &format!("{path}.pair"), pair)?,
             stiffness: 0.0,
             damping: ctx.non_negative(&format!("{path}.viscous"), *viscous)?,
             rest: 0.0,
@@ -538,39 +714,46 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
 }
 
 /// The mobility, 3n minus the rank of the pair constraints in the drawing, must equal the
-/// number of coordinates; the Chebyshev-Grubler count 3n - 2p explains a mismatch.
-/// Redundant constraints (rank < 2p with the right mobility, as in a parallelogram) are
-/// left out of the position equations and reported in `warnings`.
+/// number of coordinates; the Chebyshev-Grubler count 3n - (sum of the pairs' rows)
+/// explains a mismatch. Redundant constraints (rank below the row count with the right
+/// mobility, as in a parallelogram) are left out of the position equations and reported
+/// in `warnings`.
 fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
-    let (n, p, m) = (mech.n_bodies() as i64, mech.pairs.len() as i64, mech.dof() as i64);
+    let (n, rows, m) = (mech.n_bodies() as i64, mech.n_pair_rows(), mech.dof() as i64);
     if m == 0 {
         return Err(ctx.err("coordinates", "no generalized coordinates: name at least one input pair"));
     }
     let cr = constraint_rank(mech, &mech.x0);
-    let (grubler, mobility) = (3 * n - 2 * p, 3 * n - cr.rank as i64);
+    let (grubler, mobility) = (3 * n - rows as i64, 3 * n - cr.rank as i64);
+    // The count written out: 2 rows for each revolute and prismatic pair, 1 for each gear or slot.
+    let p1 = mech.pairs.iter().filter(|p| pairs::n_rows(&p.kind) == 1).count();
+    let p2 = mech.pairs.len() - p1;
+    let count =
+        if p1 == 0 { format!("3n - 2p = 3*{n} - 2*{p2}") } else { format!("3n - 2p - p1 = 3*{n} - 2*{p2} - {p1}") };
     if mobility != m {
         let message = if mobility == grubler {
             format!(
-                "the mechanism has mobility 3n - 2p = 3*{n} - 2*{p} = {mobility} but {m} coordinate(s) are given; \
-                 give exactly {mobility} coordinate(s), or check the pairs (each revolute or prismatic pair removes 2 freedoms)"
+                "the mechanism has mobility {count} = {mobility} but {m} coordinate(s) are given; \
+                 give exactly {mobility} coordinate(s), or check the pairs (a revolute or prismatic pair removes 2 freedoms, \
+                 a gear or slot pair 1)"
             )
         } else {
             format!(
-                "the {} pair constraints have rank {} in the drawing, so it has mobility 3n - rank = {mobility} \
-                 (Chebyshev-Grubler: 3n - 2p = {grubler}), but {m} coordinate(s) are given: the drawing is at a \
+                "the {rows} pair constraints have rank {} in the drawing, so it has mobility 3n - rank = {mobility} \
+                 (Chebyshev-Grubler: {count} = {grubler}), but {m} coordinate(s) are given: the drawing is at a \
                  singular (folded) configuration, or has redundant constraints; draw it away from singular positions",
-                2 * p,
                 cr.rank
             )
         };
         return Err(ctx.err("coordinates", message));
     }
-    if cr.rank < 2 * p as usize {
-        mech.row_slot = vec![None; 2 * p as usize];
+    if cr.rank < rows {
+        mech.row_slot = vec![None; rows];
         for (slot, &row) in cr.independent_rows.iter().enumerate() {
             mech.row_slot[row] = Some(slot);
         }
         mech.n_constraints = cr.rank;
+        mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
         for stress in &cr.self_stresses {
             let names: Vec<&str> = stress.pairs.iter().map(|&k| mech.pairs[k.0].name.as_str()).collect();
             mech.warnings.push(format!(

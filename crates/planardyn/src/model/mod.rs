@@ -57,9 +57,14 @@ pub enum PairKind {
         /// Unit direction of the guide in a's frame.
         axis: [f64; 2],
     },
+    /// Gears (or a pinion and a rack) rolling without slip: `kinematics::pairs::gear`.
+    Gear(crate::kinematics::pairs::gear::Gear),
+    /// A pin of b in a slot of a: `kinematics::pairs::slot`.
+    Slot(crate::kinematics::pairs::slot::Slot),
 }
 
-/// A kinematic pair between links `a` and `b` at a point both carry.
+/// A kinematic pair between links `a` and `b` at a point both carry (a gear pair: at the
+/// two gear centres, `sa` and `sb`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pair {
     pub name: String,
@@ -188,10 +193,16 @@ pub struct Mechanism {
     /// Characteristic length (m): the largest distance between two points; it scales
     /// tolerances and makes the singularity measure dimensionless.
     pub scale: f64,
-    /// Where each of the 2p pair-constraint rows goes in the position equations F; `None`
+    /// Where pair k's constraint rows start among all pair rows (`pair_rows`): p + 1
+    /// offsets, the last one the number of pair rows.
+    pub pair_row_start: Vec<usize>,
+    /// Where each pair-constraint row goes in the position equations F; `None`
     /// for a redundant row (implied by the others, e.g. in a parallelogram), left out so
     /// that J stays square.
     pub row_slot: Vec<Option<usize>>,
+    /// `row_slot` by pair: where each pair's rows go in F (unused entries None), for the
+    /// assembler's hot loops.
+    pub pair_slots: Vec<[Option<usize>; 2]>,
     /// Number of independent pair constraints kept: 3n - m.
     pub n_constraints: usize,
     /// Things a user should know about the model (redundant constraints...).
@@ -222,15 +233,29 @@ impl Mechanism {
     }
     /// Number of pair-constraint rows of all pairs, redundant ones included.
     pub fn n_pair_rows(&self) -> usize {
-        self.row_slot.len()
+        self.pair_row_start.last().copied().unwrap_or(0)
     }
     /// The rows of pair `k` among all pair-constraint rows (`0..n_pair_rows()`).
+    #[inline]
     pub fn pair_rows(&self, k: PairId) -> std::ops::Range<usize> {
-        2 * k.0..2 * k.0 + 2
+        self.pair_row_start[k.0]..self.pair_row_start[k.0 + 1]
+    }
+    /// A row placement (`row_slot`, or all rows) gathered by pair: entry k holds where pair
+    /// k's rows go (None past its row count).
+    pub fn slots_by_pair(&self, row_slot: &[Option<usize>]) -> Vec<[Option<usize>; 2]> {
+        (0..self.pairs.len())
+            .map(|k| {
+                let mut slots = [None; 2];
+                for (s, r) in slots.iter_mut().zip(&row_slot[self.pair_rows(PairId(k))]) {
+                    *s = *r;
+                }
+                slots
+            })
+            .collect()
     }
     /// The pair a pair-constraint row belongs to.
     pub fn row_pair(&self, row: usize) -> PairId {
-        PairId(row / 2)
+        PairId(self.pair_row_start.partition_point(|&s| s <= row) - 1)
     }
     pub fn coordinate_names(&self) -> Vec<&str> {
         self.coordinates.iter().map(|c| c.name.as_str()).collect()

@@ -123,10 +123,43 @@ pub enum PairSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         along: Option<[String; 2]>,
     },
+    /// Gear pair: the pitch circles of a's and b's gears roll on each other without slip
+    /// (one constraint row). The gears are centred at `centers` [A, B], points fixed in the
+    /// `carrier` (default `ground`), with pitch radii `radii` [r_a, r_b]; `internal: true`
+    /// for a pinion meshing inside a ring gear. A rack and pinion: `rack: [P, Q]`, b's pitch
+    /// line through two of its points, with `centers: [A]` and `radii: [r_a]`.
+    Gear {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        bodies: [String; 2],
+        centers: Vec<String>,
+        radii: Vec<f64>,
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        internal: bool,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        carrier: Option<String>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rack: Option<[String; 2]>,
+    },
+    /// Pin-in-slot pair: the second body's pin `at` slides along a slot fixed to the first
+    /// and turns freely (one constraint row). The slot's direction is `axis` [d_x, d_y] in
+    /// the drawing, or the line `along` [from, to] between two points (then also its drawn
+    /// extent).
+    Slot {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        at: String,
+        bodies: [String; 2],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        axis: Option<[f64; 2]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        along: Option<[String; 2]>,
+    },
 }
 
 /// A generalized coordinate: the relative angle (rad) of a revolute pair or the displacement
-/// (m) of a prismatic pair, of the second body relative to the first.
+/// (m) of a prismatic or slot pair, of the second body relative to the first (a gear pair
+/// has none).
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CoordinateSpec {

@@ -12,8 +12,9 @@
 //! inner pairs, or (without a contour) the largest number of inner pairs on one of its links,
 //! 2 for a dyad; its order is its number of outer pairs (Artobolevsky).
 
+use crate::kinematics::pairs::letter;
 use crate::linalg::BlockLu;
-use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
+use crate::model::{BodyId, Link, Mechanism, PairId};
 use petgraph::algo::tarjan_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
 
@@ -78,14 +79,6 @@ fn body(link: Link) -> Option<BodyId> {
     match link {
         Link::Ground => None,
         Link::Body(b) => Some(b),
-    }
-}
-
-/// The letter of a pair kind in a group's type.
-fn letter(kind: &PairKind) -> char {
-    match kind {
-        PairKind::Revolute => 'R',
-        PairKind::Prismatic { .. } => 'P',
     }
 }
 

@@ -2,7 +2,8 @@
 //! tells: numerical rank, a maximal set of independent rows, and the self-stresses.
 
 use crate::kinematics::constraints::{body_trig, constraint_jacobian};
-use crate::kinematics::system::{col_scales, pair_row_scales};
+use crate::kinematics::pairs::row_scales;
+use crate::kinematics::system::col_scales;
 use crate::linalg::pivot_columns;
 use crate::model::{Mechanism, PairId};
 use nalgebra::DMatrix;
@@ -58,7 +59,7 @@ pub fn scaled_constraint_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
     constraint_jacobian(mech, x, &trig, &all, &mut j);
     let mut rs = vec![1.0; rows];
     for (k, pair) in mech.pairs.iter().enumerate() {
-        for (r, s) in mech.pair_rows(PairId(k)).zip(pair_row_scales(pair, 1.0 / mech.scale)) {
+        for (r, s) in mech.pair_rows(PairId(k)).zip(row_scales(pair, 1.0 / mech.scale)) {
             rs[r] = s;
         }
     }

@@ -1,0 +1,295 @@
+//! Pair kinds: what each kind of kinematic pair contributes to the position equations,
+//! one file a kind. The assembler (`constraints`, `system`, `dynamics::reactions`) walks the
+//! pairs and asks them through the functions below; only this file's `dispatch!` looks at
+//! the kind, and it calls the kind's module statically (no dynamic dispatch in the hot loop).
+//!
+//! A kind has 1 or 2 constraint rows ([`PairType::ROWS`]); the rows of all pairs are laid
+//! out one pair after the other (`Mechanism::pair_rows`). Row values are passed as [`Rows`],
+//! of which the first `ROWS` entries are meaningful.
+//!
+//! Adding a kind: a file here implementing [`PairType`], a variant of `model::PairKind`
+//! with an arm in `dispatch!`, its `PairSpec` variant and validation in `model`, the schema
+//! and `docs/model-format.md`.
+
+pub mod frames;
+pub mod gear;
+pub mod prismatic;
+pub mod revolute;
+pub mod slot;
+
+use crate::linalg::Sink;
+use crate::model::{CoordinateKind, Mechanism, Pair, PairKind};
+use frames::{add_grad, angle, link_columns, link_state, part, Projection};
+
+/// Values of a pair's rows (the first `ROWS` entries).
+pub type Rows = [f64; 2];
+
+/// The relative coordinate a pair offers as an input (or to a pair spring).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Relative {
+    /// phi_b - phi_a - (drawn value) (rad).
+    Angle,
+    /// Displacement of b's pair point along the unit direction `axis` fixed in a (m),
+    /// measured from a's copy of the point.
+    Along { axis: [f64; 2] },
+}
+
+/// How a pair is drawn at a configuration, in world coordinates (m).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairGeometry {
+    /// `revolute`, `prismatic`, `gear`, `slot`.
+    pub kind: &'static str,
+    /// Pin joints (circles).
+    pub pins: Vec<[f64; 2]>,
+    /// Sliding blocks (squares).
+    pub blocks: Vec<[f64; 2]>,
+    /// Guides, slots and rack pitch lines: segments [from, to].
+    pub lines: Vec<[[f64; 2]; 2]>,
+    /// Pitch circles: centre and radius.
+    pub circles: Vec<([f64; 2], f64)>,
+}
+
+impl PairGeometry {
+    fn new(kind: &'static str) -> Self {
+        PairGeometry { kind, pins: vec![], blocks: vec![], lines: vec![], circles: vec![] }
+    }
+}
+
+/// What a pair kind provides. `x` holds the body coordinates, `trig` their [cos, sin]
+/// (`constraints::body_trig`), `rows` where each of the kind's rows goes in F (None: a
+/// redundant row, left out).
+pub trait PairType {
+    /// Name in the model file (`type:`).
+    const NAME: &'static str;
+    /// Number of constraint rows: 1 or 2.
+    const ROWS: usize;
+    /// Its letter in the type of an Assur group (`RRP`...): R and P for the lower pairs, G
+    /// (gear) and S (pin-in-slot) for the one-row higher pairs.
+    const LETTER: char;
+    /// Residual of the rows.
+    fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows;
+    /// Gradients of the rows, added into `j`.
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]);
+    /// Second derivatives of the rows as bilinear forms gamma(u, v).
+    fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows;
+    /// Row scales: `inv_l` (1/L) for rows in metres, 1 for rows in radians.
+    fn row_scales(&self, inv_l: f64) -> Rows;
+    /// The columns of x each row may touch (its sparsity pattern), ascending.
+    fn pattern(&self, pair: &Pair, row: usize) -> Vec<usize>;
+    /// The relative coordinate, if the pair can be an input (None: it cannot).
+    fn relative(&self) -> Option<Relative>;
+    /// [F_x, F_y, M]: the force (N) and couple (N m) a exerts on b, reduced to b's pair
+    /// point, from the rows' multipliers `mu` (the force on the bodies is Phi_x^T mu).
+    fn reaction(&self, pair: &Pair, x: &[f64], mu: Rows) -> [f64; 3];
+    /// What the drawings show, with `scale` the mechanism's characteristic length.
+    fn geometry(&self, pair: &Pair, x: &[f64], scale: f64) -> PairGeometry;
+
+    // The relative coordinate's value, gradient, second derivative and rate, from
+    // `relative` (a constant of the kind, so each folds to one case).
+    #[inline]
+    fn coordinate(&self, pair: &Pair, x: &[f64]) -> f64 {
+        relative_value(self.relative(), pair, x)
+    }
+    #[inline]
+    fn coordinate_grad<S: Sink>(&self, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+        relative_grad(self.relative(), pair, x, j, row)
+    }
+    #[inline]
+    fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+        relative_gamma(self.relative(), pair, x, u, v)
+    }
+    #[inline]
+    fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+        relative_rate(self.relative(), pair, x, xd)
+    }
+}
+
+/// Call `$body` with `$t` bound to the pair kind's [`PairType`] value.
+macro_rules! dispatch {
+    ($kind:expr, $t:ident => $body:expr) => {
+        match $kind {
+            PairKind::Revolute => {
+                let $t = revolute::Revolute;
+                $body
+            }
+            PairKind::Prismatic { axis } => {
+                let $t = prismatic::Prismatic { axis: *axis };
+                $body
+            }
+            PairKind::Gear(g) => {
+                let $t = *g;
+                $body
+            }
+            PairKind::Slot(s) => {
+                let $t = *s;
+                $body
+            }
+        }
+    };
+}
+
+/// Type name of a pair's kind (as in the model file).
+pub fn kind_name(pair: &Pair) -> &'static str {
+    fn name<T: PairType>(_: &T) -> &'static str {
+        T::NAME
+    }
+    dispatch!(&pair.kind, t => name(&t))
+}
+
+/// Letter of a pair kind in an Assur group's type.
+pub fn letter(kind: &PairKind) -> char {
+    fn letter<T: PairType>(_: &T) -> char {
+        T::LETTER
+    }
+    dispatch!(kind, t => letter(&t))
+}
+
+/// Number of constraint rows of a pair.
+#[inline]
+pub fn n_rows(kind: &PairKind) -> usize {
+    fn rows<T: PairType>(_: &T) -> usize {
+        T::ROWS
+    }
+    dispatch!(kind, t => rows(&t))
+}
+
+#[inline]
+pub fn residual(pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
+    dispatch!(&pair.kind, t => t.residual(pair, x, trig))
+}
+
+#[inline]
+pub fn jacobian<S: Sink>(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
+    dispatch!(&pair.kind, t => t.jacobian(pair, x, trig, j, rows))
+}
+
+#[inline]
+pub fn gamma(pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
+    dispatch!(&pair.kind, t => t.gamma(pair, x, trig, u, v))
+}
+
+#[inline]
+pub fn row_scales(pair: &Pair, inv_l: f64) -> Rows {
+    dispatch!(&pair.kind, t => t.row_scales(inv_l))
+}
+
+pub fn pattern(pair: &Pair, row: usize) -> Vec<usize> {
+    dispatch!(&pair.kind, t => t.pattern(pair, row))
+}
+
+#[inline]
+pub fn relative(pair: &Pair) -> Option<Relative> {
+    dispatch!(&pair.kind, t => t.relative())
+}
+
+pub fn reaction(pair: &Pair, x: &[f64], mu: Rows) -> [f64; 3] {
+    dispatch!(&pair.kind, t => t.reaction(pair, x, mu))
+}
+
+/// What the drawings show of a pair at body coordinates x.
+pub fn geometry(pair: &Pair, x: &[f64], scale: f64) -> PairGeometry {
+    dispatch!(&pair.kind, t => t.geometry(pair, x, scale))
+}
+
+/// What the drawings show of every pair of a mechanism at body coordinates x (3n).
+pub fn pair_geometry(mech: &Mechanism, x: &[f64]) -> Vec<PairGeometry> {
+    mech.pairs.iter().map(|p| geometry(p, x, mech.scale)).collect()
+}
+
+/// The kind of generalized coordinate a pair's relative coordinate is, if it has one.
+pub fn coordinate_kind(pair: &Pair) -> Option<CoordinateKind> {
+    relative(pair).map(|r| match r {
+        Relative::Angle => CoordinateKind::Angle,
+        Relative::Along { .. } => CoordinateKind::Displacement,
+    })
+}
+
+/// The columns the relative coordinate's gradient may touch: both links' angles for an
+/// angle, all their columns for a displacement.
+pub fn coordinate_pattern(pair: &Pair) -> Vec<usize> {
+    let angle_only = relative(pair) == Some(Relative::Angle);
+    let mut cols: Vec<usize> = link_columns(pair.a, angle_only).chain(link_columns(pair.b, angle_only)).collect();
+    cols.sort_unstable();
+    cols
+}
+
+/// The projection along `axis` (fixed in a) of b's pair point.
+fn along(pair: &Pair, axis: [f64; 2], x: &[f64]) -> Projection {
+    Projection::new(pair.sa, pair.sb, axis, link_state(pair.a, x), link_state(pair.b, x))
+}
+
+// A pair without a relative coordinate never reaches the functions below: the model
+// refuses a coordinate or a pair spring on it; they return 0 for it.
+
+/// Relative coordinate of a pair from the drawing: angle (rad) or displacement (m).
+#[inline]
+pub fn coordinate(pair: &Pair, x: &[f64]) -> f64 {
+    dispatch!(&pair.kind, t => t.coordinate(pair, x))
+}
+
+/// Gradient of [`coordinate`], added into row `row` of `j`.
+#[inline]
+pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+    dispatch!(&pair.kind, t => t.coordinate_grad(pair, x, j, row))
+}
+
+/// Second derivative of [`coordinate`] as a bilinear form.
+#[inline]
+pub fn coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    dispatch!(&pair.kind, t => t.coordinate_gamma(pair, x, u, v))
+}
+
+/// Rate of [`coordinate`]: its gradient times xd.
+#[inline]
+pub fn coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+    dispatch!(&pair.kind, t => t.coordinate_rate(pair, x, xd))
+}
+
+#[inline(always)]
+fn relative_value(r: Option<Relative>, pair: &Pair, x: &[f64]) -> f64 {
+    match r {
+        Some(Relative::Angle) => angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0,
+        Some(Relative::Along { axis }) => along(pair, axis, x).value(),
+        None => 0.0,
+    }
+}
+
+#[inline(always)]
+fn relative_grad<S: Sink>(r: Option<Relative>, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+    match r {
+        Some(Relative::Angle) => {
+            add_grad(j, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
+            add_grad(j, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
+        }
+        Some(Relative::Along { axis }) => along(pair, axis, x).grad(j, row, 1.0),
+        None => {}
+    }
+}
+
+#[inline(always)]
+fn relative_gamma(r: Option<Relative>, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    match r {
+        Some(Relative::Along { axis }) => along(pair, axis, x).gamma(u, v),
+        Some(Relative::Angle) | None => 0.0,
+    }
+}
+
+#[inline(always)]
+fn relative_rate(r: Option<Relative>, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+    match r {
+        Some(Relative::Angle) => part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1,
+        Some(Relative::Along { axis }) => along(pair, axis, x).rate(xd),
+        None => 0.0,
+    }
+}
+
+/// The block drawn on a guide of direction `axis` (in a's frame) through b's pair point:
+/// the guide +-0.3 L about it.
+fn guide(pair: &Pair, axis: [f64; 2], x: &[f64], scale: f64, g: &mut PairGeometry) {
+    let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+    let p = b.point(pair.sb);
+    let d = a.rot(axis);
+    let h = 0.3 * scale;
+    g.blocks.push(p);
+    g.lines.push([[p[0] - h * d[0], p[1] - h * d[1]], [p[0] + h * d[0], p[1] + h * d[1]]]);
+}

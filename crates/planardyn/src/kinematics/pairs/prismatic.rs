@@ -1,0 +1,75 @@
+//! Prismatic pair (slider): no relative rotation, and b's copy of the pair point stays on a
+//! line fixed in a. Two rows: phi_b - phi_a - (drawn) in radians, then the normal offset
+//! from the guide in metres; relative coordinate: the displacement along the guide.
+
+use super::frames::{add_grad, angle, link_state, link_state_t, perp, Projection};
+use super::revolute::both_links;
+use super::{guide, PairGeometry, PairType, Relative, Rows};
+use crate::linalg::Sink;
+use crate::model::Pair;
+
+pub struct Prismatic {
+    /// Unit direction of the guide in a's frame.
+    pub axis: [f64; 2],
+}
+
+impl Prismatic {
+    #[inline]
+    fn normal(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Projection {
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        Projection::new(pair.sa, pair.sb, perp(self.axis), a, b)
+    }
+}
+
+impl PairType for Prismatic {
+    const NAME: &'static str = "prismatic";
+    const ROWS: usize = 2;
+    const LETTER: char = 'P';
+
+    #[inline]
+    fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
+        [angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0, self.normal(pair, x, trig).value()]
+    }
+
+    #[inline]
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
+        if let Some(row) = rows[0] {
+            add_grad(j, row, &link_state_t(pair.a, x, trig), [0.0, 0.0, -1.0]);
+            add_grad(j, row, &link_state_t(pair.b, x, trig), [0.0, 0.0, 1.0]);
+        }
+        if let Some(row) = rows[1] {
+            self.normal(pair, x, trig).grad(j, row, 1.0);
+        }
+    }
+
+    #[inline]
+    fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
+        [0.0, self.normal(pair, x, trig).gamma(u, v)]
+    }
+
+    fn row_scales(&self, inv_l: f64) -> Rows {
+        [1.0, inv_l]
+    }
+
+    fn pattern(&self, pair: &Pair, _row: usize) -> Vec<usize> {
+        both_links(pair)
+    }
+
+    #[inline]
+    fn relative(&self) -> Option<Relative> {
+        Some(Relative::Along { axis: self.axis })
+    }
+
+    /// The normal row's multiplier is the force on b along the guide's normal (its
+    /// gradient in r_b is the normal); the angle row's is the couple on b.
+    fn reaction(&self, pair: &Pair, x: &[f64], mu: Rows) -> [f64; 3] {
+        let n = link_state(pair.a, x).rot(perp(self.axis));
+        [mu[1] * n[0], mu[1] * n[1], mu[0]]
+    }
+
+    fn geometry(&self, pair: &Pair, x: &[f64], scale: f64) -> PairGeometry {
+        let mut g = PairGeometry::new(Self::NAME);
+        guide(pair, self.axis, x, scale, &mut g);
+        g
+    }
+}

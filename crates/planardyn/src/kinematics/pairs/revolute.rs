@@ -1,0 +1,76 @@
+//! Revolute pair (hinge): the two copies of the pair point coincide. Two rows in metres,
+//! Phi = p_a - p_b; relative coordinate: the angle phi_b - phi_a.
+
+use super::frames::{add_grad, link_columns, link_state, link_state_t, part, perp};
+use super::{PairGeometry, PairType, Relative, Rows};
+use crate::linalg::Sink;
+use crate::model::Pair;
+
+pub struct Revolute;
+
+impl PairType for Revolute {
+    const NAME: &'static str = "revolute";
+    const ROWS: usize = 2;
+    const LETTER: char = 'R';
+
+    #[inline]
+    fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        let (pa, pb) = (a.point(pair.sa), b.point(pair.sb));
+        [pa[0] - pb[0], pa[1] - pb[1]]
+    }
+
+    #[inline]
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        let (ta, tb) = (perp(a.rot(pair.sa)), perp(b.rot(pair.sb)));
+        if let Some(row) = rows[0] {
+            add_grad(j, row, &a, [1.0, 0.0, ta[0]]);
+            add_grad(j, row, &b, [-1.0, 0.0, -tb[0]]);
+        }
+        if let Some(row) = rows[1] {
+            add_grad(j, row, &a, [0.0, 1.0, ta[1]]);
+            add_grad(j, row, &b, [0.0, -1.0, -tb[1]]);
+        }
+    }
+
+    #[inline]
+    fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
+        // d2(R(phi) s)/dphi2 = -R(phi) s; only the angle-angle entries are non-zero.
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        let (pa, pb) = (a.rot(pair.sa), b.rot(pair.sb));
+        let (ka, kb) = (part(&a, u).1 * part(&a, v).1, part(&b, u).1 * part(&b, v).1);
+        [-pa[0] * ka + pb[0] * kb, -pa[1] * ka + pb[1] * kb]
+    }
+
+    fn row_scales(&self, inv_l: f64) -> Rows {
+        [inv_l, inv_l]
+    }
+
+    fn pattern(&self, pair: &Pair, _row: usize) -> Vec<usize> {
+        both_links(pair)
+    }
+
+    #[inline]
+    fn relative(&self) -> Option<Relative> {
+        Some(Relative::Angle)
+    }
+
+    /// The multiplier of Phi = p_a - p_b is the force on a, so -mu acts on b; no couple.
+    fn reaction(&self, _pair: &Pair, _x: &[f64], mu: Rows) -> [f64; 3] {
+        [-mu[0], -mu[1], 0.0]
+    }
+
+    fn geometry(&self, pair: &Pair, x: &[f64], _scale: f64) -> PairGeometry {
+        let mut g = PairGeometry::new(Self::NAME);
+        g.pins.push(link_state(pair.a, x).point(pair.sa));
+        g
+    }
+}
+
+/// All three columns of both links of a pair, ascending.
+pub(super) fn both_links(pair: &Pair) -> Vec<usize> {
+    let mut cols: Vec<usize> = link_columns(pair.a, false).chain(link_columns(pair.b, false)).collect();
+    cols.sort_unstable();
+    cols
+}

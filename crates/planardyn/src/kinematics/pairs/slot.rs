@@ -1,0 +1,76 @@
+//! Pin-in-slot pair: b's pin (the pair point) slides along a line fixed in a, and b turns
+//! freely. One row in metres: the pin's normal offset from the slot's centre line, 0.
+//! Relative coordinate: the pin's displacement along the slot (as a prismatic pair's).
+//! Reaction: the normal force at the pin (no friction, no couple).
+
+use super::frames::{link_state, link_state_t, perp, Projection};
+use super::revolute::both_links;
+use super::{PairGeometry, PairType, Relative, Rows};
+use crate::linalg::Sink;
+use crate::model::Pair;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slot {
+    /// Unit direction of the slot in a's frame.
+    pub axis: [f64; 2],
+    /// The slot's drawn ends in a's frame (m), for the drawings.
+    pub ends: [[f64; 2]; 2],
+}
+
+impl Slot {
+    #[inline]
+    fn normal(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Projection {
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        Projection::new(pair.sa, pair.sb, perp(self.axis), a, b)
+    }
+}
+
+impl PairType for Slot {
+    const NAME: &'static str = "slot";
+    const ROWS: usize = 1;
+    const LETTER: char = 'S';
+
+    #[inline]
+    fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
+        [self.normal(pair, x, trig).value(), 0.0]
+    }
+
+    #[inline]
+    fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
+        if let Some(row) = rows[0] {
+            self.normal(pair, x, trig).grad(j, row, 1.0);
+        }
+    }
+
+    #[inline]
+    fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
+        [self.normal(pair, x, trig).gamma(u, v), 0.0]
+    }
+
+    fn row_scales(&self, inv_l: f64) -> Rows {
+        [inv_l, 0.0]
+    }
+
+    fn pattern(&self, pair: &Pair, _row: usize) -> Vec<usize> {
+        both_links(pair)
+    }
+
+    #[inline]
+    fn relative(&self) -> Option<Relative> {
+        Some(Relative::Along { axis: self.axis })
+    }
+
+    /// The row's gradient in r_b is the slot's normal n, so mu n is the force on b.
+    fn reaction(&self, pair: &Pair, x: &[f64], mu: Rows) -> [f64; 3] {
+        let n = link_state(pair.a, x).rot(perp(self.axis));
+        [mu[0] * n[0], mu[0] * n[1], 0.0]
+    }
+
+    fn geometry(&self, pair: &Pair, x: &[f64], _scale: f64) -> PairGeometry {
+        let (a, b) = (link_state(pair.a, x), link_state(pair.b, x));
+        let mut g = PairGeometry::new(Self::NAME);
+        g.pins.push(b.point(pair.sb));
+        g.lines.push(self.ends.map(|e| a.point(e)));
+        g
+    }
+}
