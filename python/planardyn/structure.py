@@ -75,10 +75,10 @@ class Structure:
     #: Mobile bodies (n) and every link including the ground.
     bodies: tuple[str, ...]
     links: tuple[str, ...]
-    #: Pair names by kind ('revolute', 'prismatic').
+    #: Pair names by kind ('revolute', 'prismatic', 'gear', 'slot').
     pairs_by_kind: dict[str, tuple[str, ...]]
     n_pairs: int
-    #: Pair-constraint rows in all (two per revolute or prismatic pair).
+    #: Pair-constraint rows in all (two per revolute or prismatic pair, one per gear or slot).
     n_pair_rows: int
     #: Generalized coordinates and their input pairs.
     coordinates: tuple[str, ...]
