@@ -214,3 +214,31 @@ pub fn run(
     assert!(tr.success(), "{}: {:?} {}", mech.name, tr.status, tr.message);
     tr
 }
+
+/// Three parallel cranks on one coupler: one redundant constraint (a self-stress).
+pub const PARALLELOGRAM: &str = r#"
+name: triple-crank parallelogram
+gravity: [0, -9.81]
+points:
+  O1: [0, 0]
+  O2: [0.5, 0]
+  O3: [1.0, 0]
+  A: [0.15, 0.2598076211353316]
+  B: [0.65, 0.2598076211353316]
+  C: [1.15, 0.2598076211353316]
+ground: [O1, O2, O3]
+bodies:
+  crank1: {points: [O1, A], uniform_bar: [O1, A], mass: 0.3}
+  crank2: {points: [O2, B], uniform_bar: [O2, B], mass: 0.3}
+  crank3: {points: [O3, C], uniform_bar: [O3, C], mass: 0.3}
+  coupler: {points: [A, C, B], uniform_bar: [A, C], mass: 1.0}
+pairs:
+  - {type: revolute, name: O1, at: O1, bodies: [ground, crank1]}
+  - {type: revolute, name: O2, at: O2, bodies: [ground, crank2]}
+  - {type: revolute, name: O3, at: O3, bodies: [ground, crank3]}
+  - {type: revolute, name: A, at: A, bodies: [crank1, coupler]}
+  - {type: revolute, name: B, at: B, bodies: [crank2, coupler]}
+  - {type: revolute, name: C, at: C, bodies: [crank3, coupler]}
+coordinates:
+  - {name: theta, pair: O1, value: 1.0471975511965976}
+"#;

@@ -2,7 +2,7 @@
 //! projection row, and how a link's gradient goes into a row of J.
 
 use crate::linalg::Sink;
-use crate::model::Link;
+use crate::model::{Link, Pair};
 
 /// Pose of a link in x: centre (m), [cos, sin] of its angle, and its first column in x
 /// (None for ground).
@@ -136,6 +136,13 @@ pub struct Projection {
 }
 
 impl Projection {
+    /// The offset of b's copy of the pair point from the line through a's copy along
+    /// `axis` (fixed in a): the normal row of a prismatic or a slot pair.
+    #[inline]
+    pub fn normal(pair: &Pair, axis: [f64; 2], x: &[f64], trig: &[[f64; 2]]) -> Self {
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        Projection::new(pair.sa, pair.sb, perp(axis), a, b)
+    }
     #[inline]
     pub fn new(sa: [f64; 2], sb: [f64; 2], d0: [f64; 2], a: LinkState, b: LinkState) -> Self {
         let rbsb = b.rot(sb);

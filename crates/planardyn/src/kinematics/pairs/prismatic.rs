@@ -13,14 +13,6 @@ pub struct Prismatic {
     pub axis: [f64; 2],
 }
 
-impl Prismatic {
-    #[inline]
-    fn normal(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Projection {
-        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
-        Projection::new(pair.sa, pair.sb, perp(self.axis), a, b)
-    }
-}
-
 impl PairType for Prismatic {
     const NAME: &'static str = "prismatic";
     const ROWS: usize = 2;
@@ -28,7 +20,7 @@ impl PairType for Prismatic {
 
     #[inline]
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
-        [angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0, self.normal(pair, x, trig).value()]
+        [angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0, Projection::normal(pair, self.axis, x, trig).value()]
     }
 
     #[inline]
@@ -38,13 +30,13 @@ impl PairType for Prismatic {
             add_grad(j, row, &link_state_t(pair.b, x, trig), [0.0, 0.0, 1.0]);
         }
         if let Some(row) = rows[1] {
-            self.normal(pair, x, trig).grad(j, row, 1.0);
+            Projection::normal(pair, self.axis, x, trig).grad(j, row, 1.0);
         }
     }
 
     #[inline]
     fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
-        [0.0, self.normal(pair, x, trig).gamma(u, v)]
+        [0.0, Projection::normal(pair, self.axis, x, trig).gamma(u, v)]
     }
 
     fn row_scales(&self, inv_l: f64) -> Rows {

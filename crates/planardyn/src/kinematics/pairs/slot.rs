@@ -3,7 +3,7 @@
 //! Relative coordinate: the pin's displacement along the slot (as a prismatic pair's).
 //! Reaction: the normal force at the pin (no friction, no couple).
 
-use super::frames::{link_state, link_state_t, perp, Projection};
+use super::frames::{link_state, perp, Projection};
 use super::revolute::both_links;
 use super::{PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
@@ -17,14 +17,6 @@ pub struct Slot {
     pub ends: [[f64; 2]; 2],
 }
 
-impl Slot {
-    #[inline]
-    fn normal(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Projection {
-        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
-        Projection::new(pair.sa, pair.sb, perp(self.axis), a, b)
-    }
-}
-
 impl PairType for Slot {
     const NAME: &'static str = "slot";
     const ROWS: usize = 1;
@@ -32,19 +24,19 @@ impl PairType for Slot {
 
     #[inline]
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
-        [self.normal(pair, x, trig).value(), 0.0]
+        [Projection::normal(pair, self.axis, x, trig).value(), 0.0]
     }
 
     #[inline]
     fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]) {
         if let Some(row) = rows[0] {
-            self.normal(pair, x, trig).grad(j, row, 1.0);
+            Projection::normal(pair, self.axis, x, trig).grad(j, row, 1.0);
         }
     }
 
     #[inline]
     fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
-        [self.normal(pair, x, trig).gamma(u, v), 0.0]
+        [Projection::normal(pair, self.axis, x, trig).gamma(u, v), 0.0]
     }
 
     fn row_scales(&self, inv_l: f64) -> Rows {
