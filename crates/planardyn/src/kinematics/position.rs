@@ -129,6 +129,11 @@ const MAX_CONTINUATION_MOVE: f64 = 0.1;
 /// may have left the branch it started on (another assembly mode is O(1) away): the step is
 /// refused and cut, by continuation here and by the integrator in a simulation.
 pub const MAX_CORRECTION: f64 = 0.1;
+/// Largest move one continuation may make (rad, or lengths L for a displacement), for the
+/// loader's `q0` and every API call alike: with steps of [`MAX_CONTINUATION_MOVE`] it bounds
+/// a call to ~10^4 position solves (well under a second), where an unbounded target such as
+/// 1e15 rad would never return. A longer way is a sequence of calls, each from the last.
+pub const MAX_CONTINUATION_DISTANCE: f64 = 1e3;
 
 /// Largest scaled difference between two body-coordinate vectors.
 pub fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {
@@ -146,6 +151,16 @@ pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Workspa
         let unit = if c.kind == CoordinateKind::Angle { 1.0 } else { mech.scale };
         acc.max((a - b).abs() / unit)
     });
+    if !(move_scaled <= MAX_CONTINUATION_DISTANCE) {
+        return Err(KinematicsError::bad_argument(
+            "q",
+            format!(
+                "coordinates within {MAX_CONTINUATION_DISTANCE:e} (rad, or lengths of the drawing) of the configuration \
+                 the position analysis continues from ({z_from:?}); go there in shorter moves, each from the last"
+            ),
+            format!("{q:?}"),
+        ));
+    }
     let h_max = if move_scaled > 0.0 { (MAX_CONTINUATION_MOVE / move_scaled).min(1.0) } else { 1.0 };
     // U is unavailable at a singular start: plain Newton from x then.
     let mut u_ok = velocity_analogues(ws).ok().map(|_| ws.u.clone());

@@ -7,6 +7,7 @@ use super::*;
 use crate::kinematics::assemble;
 use crate::kinematics::constraints::rotate;
 use crate::kinematics::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
+use crate::kinematics::position::MAX_CONTINUATION_DISTANCE;
 use crate::structure::constraint_rank;
 use crate::ModelError;
 
@@ -21,9 +22,6 @@ type R<T> = Result<T, ModelError>;
 /// Largest drawn coordinate accepted (m): beyond it squared lengths overflow and the
 /// numbers cannot describe a machine.
 const MAX_COORDINATE: f64 = 1e9;
-/// Largest move from the drawing to `q0` (rad, or multiples of the drawing's size): the
-/// continuation takes steps of 0.1, so this bounds the loading time (~10^4 steps).
-const MAX_START_MOVE: f64 = 1e3;
 /// Largest magnitude of any other number (SI): products of a few model numbers (m u^2,
 /// qd^2 L, tau / A) then stay far from overflowing a double (1.8e308).
 const MAX_MAGNITUDE: f64 = 1e30;
@@ -580,8 +578,8 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
         let value = ctx.finite(&format!("{path}.value"), c.value)?;
         let q0 = ctx.finite(&format!("{path}.q0"), c.q0.unwrap_or(value))?;
         let unit = if kind == CoordinateKind::Angle { 1.0 } else { mech.scale };
-        if (q0 - value).abs() > MAX_START_MOVE * unit {
-            return Err(ctx.err(format!("{path}.q0"), format!("q0 = {q0} is more than {MAX_START_MOVE:e} (rad, or lengths of the drawing) from the drawn value {value}: the assembly follows the drawing there step by step; draw the mechanism nearer its start")));
+        if (q0 - value).abs() > MAX_CONTINUATION_DISTANCE * unit {
+            return Err(ctx.err(format!("{path}.q0"), format!("q0 = {q0} is more than {MAX_CONTINUATION_DISTANCE:e} (rad, or lengths of the drawing) from the drawn value {value}: the assembly follows the drawing there step by step; draw the mechanism nearer its start")));
         }
         let qd0 = ctx.finite(&format!("{path}.qd0"), c.qd0)?;
         mech.coordinates.push(Coordinate { name: c.name.clone(), pair, kind, value, q0, qd0 });
