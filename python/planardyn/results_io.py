@@ -55,7 +55,7 @@ FORMAT_VERSION = 1
 EXTENSIONS = (".csv", ".parquet", ".npz")
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
-#: Rows a CSV writer formats at a time (bounds the memory of the text of a long run).
+#: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
 CSV_BLOCK = 4096
 
 
@@ -164,8 +164,12 @@ def _table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> F
 
 def _checksum(table: FloatArray) -> int:
     """CRC-32 of the table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
-    canonical = np.where(np.isnan(table), np.nan, table).astype("<f8")
-    return zlib.crc32(np.ascontiguousarray(canonical).tobytes())
+    crc = 0
+    for start in range(0, len(table), CSV_BLOCK):
+        block = table[start:start + CSV_BLOCK]
+        canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
+        crc = zlib.crc32(np.ascontiguousarray(canonical).tobytes(), crc)
+    return crc
 
 
 class _Damaged(Exception):
