@@ -162,9 +162,11 @@ def _table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> F
     return np.hstack(cols) if cols else np.empty((n_t, 0))
 
 
-def _checksum(table: FloatArray) -> int:
-    """CRC-32 of the table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
-    crc = 0
+def _checksum(meta: dict[str, Any], table: FloatArray) -> int:
+    """CRC-32 of the metadata (as sorted JSON, without the checksum) and of the table's
+    little-endian float64 bytes, row by row (every NaN as one NaN)."""
+    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")}, sort_keys=True)
+    crc = zlib.crc32(text.encode())
     for start in range(0, len(table), CSV_BLOCK):
         block = table[start:start + CSV_BLOCK]
         canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
@@ -233,8 +235,8 @@ def _check_table(meta: dict[str, Any], table: FloatArray) -> FloatArray:
     if rows is not None and len(table) != rows:
         raise _Damaged(f"truncated or damaged: {len(table)} rows where its metadata records {rows} "
                        "(an interrupted copy or write?)")
-    if meta.get("checksum") is not None and _checksum(table) != meta["checksum"]:
-        raise _Damaged("damaged: its numbers do not match the checksum its metadata records "
+    if meta.get("checksum") is not None and _checksum(meta, table) != meta["checksum"]:
+        raise _Damaged("damaged: its contents do not match the checksum its metadata records "
                        "(changed after it was written?)")
     return table
 
@@ -268,7 +270,8 @@ def write_results(
     columns = _layout(result)
     n_t = len(result.t)
     table = _table(_group_arrays(result), [(g, len(c)) for g, c in columns], n_t)
-    meta.update(rows=n_t, checksum=_checksum(table))
+    meta["rows"] = n_t
+    meta["checksum"] = _checksum(meta, table)
     names = [c for _, cols in columns for c in cols]
     with _replacing(path) as tmp:
         if ext == ".npz":
@@ -357,7 +360,7 @@ def _read_npz(path: Path) -> tuple[dict[str, Any], FloatArray]:
     with np.load(path, allow_pickle=False) as z:
         if "metadata" not in z.files:
             raise _Damaged("not a planardyn results file (no 'metadata' array)")
-        raw = z["metadata"]
+        raw = _member(z, "metadata")
         if raw.shape != () or raw.dtype.kind != "U":
             raise _Damaged(f"array 'metadata' is {raw.dtype} of shape {raw.shape}, not one JSON string")
         meta = _check_meta(_json(str(raw)))
@@ -365,7 +368,7 @@ def _read_npz(path: Path) -> tuple[dict[str, Any], FloatArray]:
         missing = [g for g, _ in layout if g not in z.files]
         if missing:
             raise _Damaged(f"no array {', '.join(repr(g) for g in missing)}")
-        groups = {g: z[g] for g, _ in layout}
+        groups = {g: _member(z, g) for g, _ in layout}
     n_t = groups["t"].size
     for g, k in layout:
         a = groups[g]
@@ -376,14 +379,23 @@ def _read_npz(path: Path) -> tuple[dict[str, Any], FloatArray]:
     return meta, _table(groups, layout, n_t)
 
 
+def _member(z: Any, name: str) -> np.ndarray:
+    """Array ``name`` of an open .npz; numpy's refusals as _Damaged."""
+    try:
+        return z[name]
+    except ValueError as e:
+        if "allow_pickle" in str(e):
+            raise _Damaged(f"array {name!r} holds Python objects, not numbers") from None
+        raise _Damaged(f"array {name!r} is damaged ({e})") from None
+
+
 def _read_parquet(path: Path) -> tuple[dict[str, Any], FloatArray]:
     pa, pq = _pyarrow()
     table = pq.read_table(path)
     raw = (table.schema.metadata or {}).get(b"planardyn")
     meta = _check_meta(_json(raw) if raw else None)
     width = sum(k for _, k in meta["layout"])
-    if table.num_columns != width:
-        raise _Damaged(f"{table.num_columns} columns where its metadata's layout has {width}")
+    _check_header(meta, table.column_names)
     cols = [table.column(i).to_numpy().astype(np.float64) for i in range(table.num_columns)]
     return meta, np.column_stack(cols).reshape(table.num_rows, width) if cols else np.empty((table.num_rows, 0))
 
@@ -391,9 +403,8 @@ def _read_parquet(path: Path) -> tuple[dict[str, Any], FloatArray]:
 def _read_csv_table(path: Path) -> tuple[dict[str, Any], FloatArray]:
     found, header, rows = _read_csv(path)
     meta = _check_meta(found)
-    width = sum(k for _, k in meta["layout"])
-    if len(header) != width:
-        raise _Damaged(f"header has {len(header)} columns where its metadata's layout has {width}")
+    _check_header(meta, header)
+    width = len(header)
     data = np.empty((len(rows), width))
     for i, r in enumerate(rows):
         try:
@@ -403,6 +414,15 @@ def _read_csv_table(path: Path) -> tuple[dict[str, Any], FloatArray]:
         except ValueError as e:
             raise _Damaged(f"data row {i + 1} is not {width} numbers ({e}): truncated or damaged") from None
     return meta, data
+
+
+def _check_header(meta: dict[str, Any], header: list[str]) -> None:
+    names = [c for _, cols in _columns(meta["coordinate_names"], meta["body_names"]) for c in cols]
+    if header != names:
+        wrong = next((k for k, (h, n) in enumerate(zip(header, names)) if h != n), min(len(header), len(names)))
+        raise _Damaged(f"{len(header)} columns where its metadata says {len(names)}: column {wrong + 1} is "
+                       f"{header[wrong] if wrong < len(header) else 'missing'!r}, expected "
+                       f"{names[wrong] if wrong < len(names) else 'none'!r}")
 
 
 def _json(text: Any) -> Any:

@@ -4,8 +4,9 @@ Times and tolerances (``t_end``, ``rtol``, ``atol``, ``dt``, ``output_dt``) are 
 > 0, the rule the model loader applies to a file's ``simulate`` values. ``atol = 0`` would
 pass the integrator's own check (its error scale is ``atol + rtol * |y_i|``), but a state
 component that passes through 0 (an angle, a rate at rest) then has a zero scale: the step
-size collapses and the run ends in "NaN or infinity" instead of an answer. ``max_steps`` is
-an integer in 1..=:data:`MAX_STEPS`.
+size collapses and the run ends in "NaN or infinity" instead of an answer. ``rtol`` is also
+at least :data:`MIN_RTOL` (below it the error test asks for more than double precision
+holds: the integrator's own rule). ``max_steps`` is an integer in 1..=:data:`MAX_STEPS`.
 
 A value that breaks its rule raises what ``Mechanism.simulate`` raises for it: ValueError
 for ``t_end`` (an argument), :class:`~planardyn.SimulationError` for a solver option,
@@ -16,12 +17,15 @@ from __future__ import annotations
 
 import math
 import operator
+import sys
 from typing import Any
 
 from ._core import SimulationError
 
 #: Settings that are finite numbers > 0 (s, or dimensionless for the tolerances).
 POSITIVE = ("t_end", "rtol", "atol", "dt", "output_dt")
+#: Smallest relative tolerance: 100 machine epsilons.
+MIN_RTOL = 100 * sys.float_info.epsilon
 #: Most step attempts a run may be given: days of computing at a microsecond a step.
 MAX_STEPS = 10**12
 #: Most native threads of a batch: far more than any machine's cores, far fewer than
@@ -68,6 +72,9 @@ def check_settings(**settings: Any) -> dict[str, Any]:
             continue
         if name in POSITIVE:
             out[name] = positive(name, value)
+            if name == "rtol" and out[name] < MIN_RTOL:
+                raise SimulationError(f"invalid option: rtol = {value!r} is below 100 machine epsilons and "
+                                      f"cannot be met: use rtol >= {MIN_RTOL:.3g}")
         elif name == "max_steps":
             try:
                 out[name] = count(name, value, MAX_STEPS)
