@@ -274,6 +274,8 @@ def _check(args: argparse.Namespace) -> int:
         print(f"singularity measures at the start: singular ({e})")
     try:
         print(structure.report(mech))
+    except BrokenPipeError:  # the reader stopped: main ends quietly
+        raise
     except Exception as e:  # the structural analysis is extra: never lose the rest
         print(f"planardyn: structural analysis failed: {e}", file=sys.stderr)
     return EXIT_OK
