@@ -55,6 +55,8 @@ FORMAT_VERSION = 1
 EXTENSIONS = (".csv", ".parquet", ".npz")
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
+#: Metadata a results file cannot be read without (the others may be absent or None).
+REQUIRED_FIELDS = ("coordinate_names", "coordinate_kinds", "body_names", "status", "success", "message", "layout")
 #: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
 CSV_BLOCK = 4096
 
@@ -163,9 +165,9 @@ def _table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> F
 
 
 def _checksum(meta: dict[str, Any], table: FloatArray) -> int:
-    """CRC-32 of the metadata (as sorted JSON, without the checksum) and of the table's
-    little-endian float64 bytes, row by row (every NaN as one NaN)."""
-    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")}, sort_keys=True)
+    """CRC-32 of the metadata (as JSON in its order, without the checksum) and of the
+    table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
+    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")})
     crc = zlib.crc32(text.encode())
     for start in range(0, len(table), CSV_BLOCK):
         block = table[start:start + CSV_BLOCK]
@@ -207,17 +209,15 @@ def _check_meta(meta: Any) -> dict[str, Any]:
          "a number of rows"),
         ("checksum", lambda v: v is None or isinstance(v, int) and not isinstance(v, bool), "a CRC-32"),
     ]
+    missing = [k for k in REQUIRED_FIELDS if k not in meta]
+    if missing:
+        raise _Damaged(f"metadata has no field{'s' * (len(missing) > 1)} {', '.join(repr(k) for k in missing)}")
     for name, ok, what in fields:
-        if name not in meta and name in ("coordinate_names", "coordinate_kinds", "body_names", "status",
-                                         "success", "message", "layout"):
-            raise _Damaged(f"metadata has no field {name!r}")
         if not ok(meta.get(name)):
             raise _Damaged(f"metadata field {name!r} is {_short(meta.get(name))}, not {what}")
     if len(meta["coordinate_kinds"]) != len(meta["coordinate_names"]):
         raise _Damaged("metadata fields 'coordinate_names' and 'coordinate_kinds' differ in length")
     layout = [[g, len(c)] for g, c in _columns(meta["coordinate_names"], meta["body_names"])]
-    if "layout" not in meta:
-        raise _Damaged("metadata has no field 'layout'")
     if meta["layout"] != layout:
         raise _Damaged(f"metadata field 'layout' is {_short(meta['layout'])}, not the layout of its "
                        f"coordinates and bodies {layout}")
