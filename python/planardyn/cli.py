@@ -116,7 +116,7 @@ def _setting(name: str) -> Callable[[str], float | int]:
     return parse
 
 
-def _within(low: float, high: float, unit: str = "") -> Callable[[str], float]:
+def _within(low: float, high: float) -> Callable[[str], float]:
     """An argparse type for a number in [low, high] (a finite one: nan and inf are refused)."""
 
     def parse(text: str) -> float:
@@ -125,7 +125,7 @@ def _within(low: float, high: float, unit: str = "") -> Callable[[str], float]:
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
         if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{text} must be from {low:g} to {high:g}{unit}")
+            raise argparse.ArgumentTypeError(f"{text} must be from {low:g} to {high:g}")
         return value
 
     return parse
