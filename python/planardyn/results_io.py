@@ -345,8 +345,11 @@ def read_results(path: str | os.PathLike[str]) -> SimulationResult:
 
 
 def _library_errors() -> tuple[type[BaseException], ...]:
-    """What numpy, zipfile, zlib, json and pyarrow raise on a damaged file."""
-    errors: tuple[type[BaseException], ...] = (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError)
+    """What numpy, zipfile, zlib, json and pyarrow raise on a damaged file (zipfile: a
+    NotImplementedError for flags or a compression it does not know, a RuntimeError for an
+    encrypted member)."""
+    errors: tuple[type[BaseException], ...] = (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError,
+                                               NotImplementedError, RuntimeError)
     try:
         import pyarrow as pa
     except ImportError:  # pragma: no cover - depends on the environment
