@@ -51,7 +51,8 @@ from .result import Energy, SimulationResult
 FloatArray = NDArray[np.float64]
 
 FORMAT = "planardyn-results"
-FORMAT_VERSION = 1
+#: 2: the metadata records ``rows`` and ``checksum`` (version 1 files, without them, are read).
+FORMAT_VERSION = 2
 EXTENSIONS = (".csv", ".parquet", ".npz")
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
@@ -209,7 +210,9 @@ def _check_meta(meta: Any) -> dict[str, Any]:
          "a number of rows"),
         ("checksum", lambda v: v is None or isinstance(v, int) and not isinstance(v, bool), "a CRC-32"),
     ]
-    missing = [k for k in REQUIRED_FIELDS if k not in meta]
+    # From version 2 the integrity fields are required: a damaged key must not switch the check off.
+    required = REQUIRED_FIELDS + (("rows", "checksum") if version >= 2 else ())
+    missing = [k for k in required if k not in meta]
     if missing:
         raise _Damaged(f"metadata has no field{'s' * (len(missing) > 1)} {', '.join(repr(k) for k in missing)}")
     for name, ok, what in fields:
