@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._core import inverse_batch, simulate_batch
 from .mechanism import Mechanism, attach_metadata, from_dict
 from .result import SimulationResult
+from .settings import MAX_THREADS, check_settings, count
 
 if TYPE_CHECKING:
     from .robot import TaskMotion, TaskPath
@@ -73,7 +74,7 @@ def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, An
     unknown = set(own) - set(_SETTINGS)
     if unknown:
         raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of {', '.join(_SETTINGS)}")
-    out = {k: v for k, v in {**common, **own}.items() if v is not None}
+    out = check_settings(**{k: v for k, v in {**common, **own}.items() if v is not None})
     for k in _ARRAYS:
         if k in out:
             out[k] = np.asarray(out[k], dtype=np.float64).ravel().tolist()
@@ -116,6 +117,8 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
          chunk_size: int | None, progress: Callable[[int, int], Any] | None) -> list[Any]:
     """Cut the prepared variants into chunks, run them here or on the executor, and put each
     raw result (``finish``-ed) or BatchError in its variant's place."""
+    if threads is not None:
+        threads = count("threads", threads, MAX_THREADS)
     out, todo, items = _prepare(variants, own_args)
     n = len(items)
     if chunk_size is None:
@@ -124,15 +127,20 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
     if chunk_size < 1:
         raise ValueError(f"chunk_size = {chunk_size} must be at least 1")
     starts = range(0, n, chunk_size)
+    futures: list[Any] = []
     if executor is None:
         pending = [lambda s=s: _run_chunk(kind, items[s:s + chunk_size], threads) for s in starts]
     else:
         kw = {"pure": False} if _is_dask(executor) else {}
         futures = [executor.submit(_run_chunk, kind, items[s:s + chunk_size], threads, **kw) for s in starts]
         pending = [f.result for f in futures]
-    done = 0
+    done, stopped = 0, None
     for s, get in zip(starts, pending):
         chunk = items[s:s + chunk_size]
+        if stopped is not None:
+            for k in range(len(chunk)):
+                out[todo[s + k]] = BatchError(todo[s + k], "Cancelled", stopped)
+            continue
         try:
             raws = get()
         except Exception as e:  # noqa: BLE001 - a lost chunk loses only its own variants
@@ -142,8 +150,24 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
             out[i] = finish(raw, mech, args) if isinstance(raw, dict) else BatchError(i, *raw)
         done += len(chunk)
         if progress is not None:
-            progress(done, n)
+            stopped = _progress_stop(progress, done, n)
+    if stopped is not None:
+        for f in futures:
+            f.cancel()
     return out
+
+
+def _progress_stop(progress: Callable[[int, int], Any], done: int, n: int) -> str | None:
+    """Why the batch stops after ``progress(done, n)`` (it returned False, or raised), else None.
+
+    The variants finished are kept; the rest become BatchErrors of type 'Cancelled'."""
+    try:
+        r = progress(done, n)
+    except Exception as e:  # noqa: BLE001 - the results so far are the caller's
+        return f"not run: the progress callback raised {e!r} after {done} of {n} variants"
+    if r is not None and not r:
+        return f"not run: the progress callback returned {r!r} after {done} of {n} variants"
+    return None
 
 
 def simulate(
@@ -174,14 +198,18 @@ def simulate(
     t_end, method, rtol, atol, dt, t_eval, output_dt, max_steps
         As for :meth:`Mechanism.simulate` (None: the model file's value).
     threads : int, optional
-        Native threads per batch (here, or on each worker); default one per core.
+        Native threads per batch (here, or on each worker), 1 to
+        :data:`planardyn.settings.MAX_THREADS` (256); default one per core. Another value is
+        a TypeError or ValueError for the call, not for each variant.
     executor : dask.distributed.Client or concurrent.futures.Executor, optional
         Spread chunks of the list over it; default: run here.
     chunk_size : int, optional
         Variants per chunk. Default with an executor: the list in about 16 chunks; without,
         one chunk (or about 20 when ``progress`` is given).
     progress : callable ``progress(done, total)``, optional
-        Called after each chunk with the number of variants finished.
+        Called after each chunk with the number of variants finished. Returning False (not
+        None) or raising stops the batch: the variants finished are kept, the others are
+        BatchErrors of type ``'Cancelled'`` whose message says why.
 
     Returns
     -------
@@ -192,6 +220,7 @@ def simulate(
     """
     common = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, t_eval=t_eval,
                   output_dt=output_dt, max_steps=max_steps)
+    check_settings(**common)
     return _run("simulate", variants, lambda mech, own: _settings(common, own), _result,
                 threads, executor, chunk_size, progress)
 

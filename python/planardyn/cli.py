@@ -16,15 +16,19 @@ usage, file or model error. Errors are one message on stderr, never a traceback.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
+import os
 import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from . import AssemblyError, PlanardynError, SingularityError, load, models, structure
+from . import AssemblyError, PlanardynError, SimulationError, SingularityError, load, models, structure
+from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
+from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -95,6 +99,44 @@ def _results_path(value: str) -> Path:
     return p
 
 
+def _setting(name: str) -> Callable[[str], float | int]:
+    """An argparse type for the simulation setting ``name``, by its rule in planardyn.settings."""
+
+    def parse(text: str) -> float | int:
+        try:
+            value: float | int = int(text) if name == "max_steps" else float(text)
+        except ValueError:
+            kind = "an integer" if name == "max_steps" else "a number"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
+        try:
+            return check_settings(**{name: value})[name]
+        except (ValueError, TypeError, SimulationError) as e:
+            raise argparse.ArgumentTypeError(str(e).removeprefix("invalid option: ")) from None
+
+    return parse
+
+
+def _within(low: float, high: float) -> Callable[[str], float]:
+    """An argparse type for a number in [low, high] (a finite one: nan and inf are refused)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text} must be from {low:g} to {high:g}")
+        return value
+
+    return parse
+
+
+#: A frame rate or a playback speed given as 0 < value <= this is taken; beyond, refused.
+MAX_FPS = 240.0
+#: Resolution of plot images (dots per inch): 600 makes an 11 x 7 in figure about 100 MB.
+DPI_RANGE = (10.0, 600.0)
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="planardyn",
@@ -130,13 +172,13 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn simulate examples/models/slider-crank.yaml --t-end 2 --method radau5 -o run.npz\n"
              "  planardyn simulate model.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
     s.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
-    s.add_argument("--t-end", type=float, help="end time (s); default: the model's, else 1")
+    s.add_argument("--t-end", type=_setting("t_end"), help="end time (s); default: the model's, else 1")
     s.add_argument("--method", help="dop853 (default), dopri5, radau5 or rk4 (needs --dt)")
-    s.add_argument("--rtol", type=float, help="relative tolerance (default 1e-9)")
-    s.add_argument("--atol", type=float, help="absolute tolerance (default 1e-12)")
-    s.add_argument("--dt", type=float, help="fixed step (s): for rk4, or to switch error control off")
-    s.add_argument("--output-dt", type=float, help="spacing of the output rows (s); default: the model's, else every step")
-    s.add_argument("--max-steps", type=int, help="most step attempts before giving up")
+    s.add_argument("--rtol", type=_setting("rtol"), help="relative tolerance (default 1e-9)")
+    s.add_argument("--atol", type=_setting("atol"), help="absolute tolerance, > 0 (default 1e-12)")
+    s.add_argument("--dt", type=_setting("dt"), help="fixed step (s): for rk4, or to switch error control off")
+    s.add_argument("--output-dt", type=_setting("output_dt"), help="spacing of the output rows (s); default: the model's, else every step")
+    s.add_argument("--max-steps", type=_setting("max_steps"), help="most step attempts before giving up")
     s.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write: .csv, .parquet or .npz (by extension)")
     s.add_argument("--progress", action="store_true", help="show a progress bar on stderr even when it is not a terminal")
@@ -171,7 +213,8 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz) written by planardyn")
     pl.add_argument("-o", "--output", type=Path, help="image to write (.png, .pdf, .svg); default RESULTS with .png")
     pl.add_argument("--torque-speed", action="store_true", help="plot drive effort against speed instead")
-    pl.add_argument("--dpi", type=float, default=120, help="resolution of raster images (default 120)")
+    pl.add_argument("--dpi", type=_within(*DPI_RANGE), default=120,
+                    help=f"resolution of raster images, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} (default 120)")
 
     a = _sub(sub, "animate", "animate a result: GIF, MP4 or an interactive HTML viewer",
              "Animate the mechanism along a results file. .gif and .mp4 are videos (MP4 needs\n"
@@ -183,8 +226,9 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("model", type=Path, help="model file the results were computed with")
     a.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz)")
     a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
-    a.add_argument("--fps", type=float, default=20.0, help="frames per second of playback (default 20)")
-    a.add_argument("--speed", type=float, help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
+    a.add_argument("--fps", type=_within(1e-3, MAX_FPS), default=20.0,
+                   help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
+    a.add_argument("--speed", type=_within(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
@@ -241,15 +285,22 @@ def _simulate(args: argparse.Namespace) -> int:
         output_dt=args.output_dt, max_steps=args.max_steps,
     )
     t_end = settings["t_end"] or 1.0
+    if settings["output_dt"] is not None:
+        refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
+        if refused:
+            raise UsageError(f"{args.model}: {refused}: give a larger --output-dt or a shorter --t-end")
     show = not args.no_progress and (args.progress or sys.stderr.isatty())
     bar = ProgressBar(t_end) if show else None
     try:
-        res = mech.simulate(**settings, progress=bar)
+        with RunGuard(bar) as guard:
+            res = mech.simulate(**settings, progress=guard)
         if bar is not None and res.success:
             bar(t_end)
     finally:
         if bar is not None:
             bar.close()
+    if guard.reason is not None and res.status == "cancelled":
+        res = dataclasses.replace(res, message=guard.reason)
     res = attach_metadata(res, mech, settings)
     if args.output is not None:
         args.output.parent.mkdir(parents=True, exist_ok=True)
@@ -302,7 +353,10 @@ def _plot(args: argparse.Namespace) -> int:
         FigureCanvasAgg(fig)
         plot_results(res, fig=fig)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=args.dpi)
+    try:
+        fig.savefig(out, dpi=args.dpi)
+    except ValueError as e:  # matplotlib: an image format it does not write
+        raise UsageError(f"{out}: {e}") from None
     print(f"wrote {out}")
     return EXIT_OK
 
@@ -414,27 +468,36 @@ COMMANDS = {
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    if argv[:1] == ["size"]:
-        # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
-        from .robot import size_cli
-
-        return size_cli(argv[1:])
-    args = _parser().parse_args(argv)
     try:
-        return COMMANDS[args.command](args)
+        if argv[:1] == ["size"]:
+            # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
+            from .robot import size_cli
+
+            return size_cli(argv[1:])
+        args = _parser().parse_args(argv)
+        code = COMMANDS[args.command](args)
+        sys.stdout.flush()
+        return code
+    except BrokenPipeError:
+        # The reader of stdout stopped (planardyn check ... | head -1): nothing left to say.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except (AssemblyError, SingularityError) as e:
         # The start state (or a row of a motion) could not be computed: the computation failed.
-        print(f"planardyn: {e}", file=sys.stderr)
-        return EXIT_FAILED
-    except (PlanardynError, UsageError, ValueError, OSError) as e:
-        print(f"planardyn: {e}", file=sys.stderr)
-        return EXIT_USAGE
-    except ImportError as e:
-        print(f"planardyn: {e}", file=sys.stderr)
-        return EXIT_USAGE
+        return _fail(str(e), EXIT_FAILED)
+    except (PlanardynError, UsageError, ValueError, OSError, ImportError) as e:
+        return _fail(str(e), EXIT_USAGE)
+    except MemoryError:
+        return _fail("out of memory: ask for fewer outputs (--output-dt, --t-end) or a smaller image", EXIT_FAILED)
     except KeyboardInterrupt:
-        print("planardyn: interrupted", file=sys.stderr)
-        return 130
+        return _fail("interrupted", 130)
+    except Exception as e:  # noqa: BLE001 - the last resort: a message, never a traceback
+        return _fail(f"unexpected {type(e).__name__}: {e} (please report this)", EXIT_FAILED)
+
+
+def _fail(message: str, code: int) -> int:
+    print(f"planardyn: {message}", file=sys.stderr)
+    return code
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -23,6 +23,7 @@ from ._core import load as native_load
 from ._core import loads as native_loads
 from .models import path as model_path
 from .result import SimulationResult
+from .settings import check_settings
 
 
 class PlanardynWarning(UserWarning):
@@ -350,7 +351,8 @@ class Mechanism:
             ``'dop853'`` (default), ``'dopri5'``, ``'radau5'`` (stiff springs/dampers) or
             ``'rk4'`` (fixed step, needs ``dt``).
         rtol, atol : float
-            Relative and absolute tolerances of the adaptive methods (defaults 1e-9, 1e-12).
+            Relative and absolute tolerances of the adaptive methods (defaults 1e-9, 1e-12),
+            each finite and > 0 (the rules of :mod:`planardyn.settings`).
         dt : float
             Fixed step (s): required by rk4; for an adaptive method it turns error control off.
         t_eval : (K,) array_like
@@ -378,25 +380,26 @@ class Mechanism:
         Raises
         ------
         SimulationError
-            Invalid options (unknown method, rtol <= 0, rk4 without dt...).
+            Invalid options (unknown method, rtol or atol <= 0, rk4 without dt...).
         AssemblyError, SingularityError
             The start state cannot be assembled, or is singular.
         ValueError
             An argument with the wrong shape or a non-finite value.
         """
+        checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
         raw = self._native.simulate(
-            t_end=None if t_end is None else float(t_end),
+            t_end=checked["t_end"],
             method=method,
-            rtol=rtol,
-            atol=atol,
-            dt=dt,
+            rtol=checked["rtol"],
+            atol=checked["atol"],
+            dt=checked["dt"],
             t_eval=t_eval,
-            output_dt=output_dt,
+            output_dt=checked["output_dt"],
             q0=q0,
             qd0=qd0,
             drives=drives,
             progress=progress,
-            max_steps=max_steps,
+            max_steps=checked["max_steps"],
         )
         result = SimulationResult.from_raw(
             raw,

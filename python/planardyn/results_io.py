@@ -15,6 +15,12 @@ the status and counters. The format is chosen by the file name's extension:
     One array per quantity (``t``, ``q``, ``x``, ...), the metadata as a 0-d string array
     ``metadata`` (read with ``allow_pickle=False``).
 
+A file is written whole or not at all (a temporary file renamed over the target). Its
+metadata records ``rows`` (the number of output times) and ``checksum`` (CRC-32 of the
+numbers): a truncated or changed file is refused on reading, with its name and what is
+wrong. Whether the run itself completed is its ``status`` (``'success'``, ``'cancelled'``
+for an interrupted run written as far as it got, ...).
+
 Columns, in order: ``t``; the coordinate names (q); ``qd_<name>``; ``qdd_<name>``;
 ``tau_<name>``; ``kinetic``, ``potential``, ``work`` (J); ``sigma``; ``residual``;
 ``partitioned`` (0/1); ``X_<body>``, ``Y_<body>``, ``phi_<body>`` (x) and ``Xd_<body>``,
@@ -24,10 +30,14 @@ the metadata), so a coordinate may be named like another column.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
 import os
+import zipfile
+import zlib
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -41,10 +51,15 @@ from .result import Energy, SimulationResult
 FloatArray = NDArray[np.float64]
 
 FORMAT = "planardyn-results"
-FORMAT_VERSION = 1
+#: 2: the metadata records ``rows`` and ``checksum`` (version 1 files, without them, are read).
+FORMAT_VERSION = 2
 EXTENSIONS = (".csv", ".parquet", ".npz")
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
+#: Metadata a results file cannot be read without (the others may be absent or None).
+REQUIRED_FIELDS = ("coordinate_names", "coordinate_kinds", "body_names", "status", "success", "message", "layout")
+#: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
+CSV_BLOCK = 4096
 
 
 # ------------------------------------------------------------------ metadata
@@ -65,7 +80,10 @@ def simulate_settings(mech: Mechanism, **given: Any) -> dict[str, Any]:
 
 def _layout(res: SimulationResult) -> list[tuple[str, list[str]]]:
     """(group, column names) in file order; groups are result fields or energy entries."""
-    names, bodies = res.coordinate_names, res.body_names
+    return _columns(res.coordinate_names, res.body_names)
+
+
+def _columns(names: list[str], bodies: list[str]) -> list[tuple[str, list[str]]]:
     body_cols = [f"{c}_{b}" for b in bodies for c in ("X", "Y", "phi")]
     return [
         ("t", ["t"]),
@@ -117,33 +135,22 @@ def _metadata(res: SimulationResult) -> dict[str, Any]:
     return meta
 
 
-def _result(meta: dict[str, Any], groups: dict[str, np.ndarray], path: Path) -> SimulationResult:
-    """Rebuild a result from its metadata and its arrays by group (2-D where the result has it)."""
-    n_b = len(meta["body_names"])
-    n_t = len(groups["t"])
-    as2 = lambda a, k: np.ascontiguousarray(np.asarray(a, dtype=np.float64).reshape(n_t, k))  # noqa: E731
-    m = len(meta["coordinate_names"])
-    x = as2(groups["x"], 3 * n_b)
+def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationResult:
+    """Rebuild a result from its checked metadata and its (rows, columns) table."""
+    groups, col = {}, 0
+    for g, k in meta["layout"]:
+        groups[g] = np.ascontiguousarray(table[:, col : col + k])
+        col += k
+    n_t, n_b = len(table), len(meta["body_names"])
+    flat = lambda g: np.ascontiguousarray(groups[g].reshape(n_t))  # noqa: E731
     own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
-           "coordinate_kinds", "body_names", "layout"}
+           "coordinate_kinds", "body_names", "layout", "rows", "checksum"}
     return SimulationResult(
-        t=np.ascontiguousarray(np.asarray(groups["t"], dtype=np.float64).reshape(n_t)),
-        q=as2(groups["q"], m),
-        qd=as2(groups["qd"], m),
-        qdd=as2(groups["qdd"], m),
-        tau=as2(groups["tau"], m),
-        x=x,
-        xd=as2(groups["xd"], 3 * n_b),
-        poses=x.reshape(n_t, n_b, 3),
-        energy=Energy.from_arrays(
-            *(np.asarray(groups[k], dtype=np.float64).reshape(n_t) for k in ("kinetic", "potential", "work"))
-        ),
-        sigma=np.asarray(groups["sigma"], dtype=np.float64).reshape(n_t),
-        residual=np.asarray(groups["residual"], dtype=np.float64).reshape(n_t),
-        partitioned=np.asarray(groups["partitioned"]).reshape(n_t).astype(bool),
-        success=bool(meta["success"]),
-        status=str(meta["status"]),
-        message=str(meta["message"]),
+        t=flat("t"), q=groups["q"], qd=groups["qd"], qdd=groups["qdd"], tau=groups["tau"],
+        x=groups["x"], xd=groups["xd"], poses=groups["x"].reshape(n_t, n_b, 3),
+        energy=Energy.from_arrays(flat("kinetic"), flat("potential"), flat("work")),
+        sigma=flat("sigma"), residual=flat("residual"), partitioned=flat("partitioned").astype(bool),
+        success=meta["success"], status=meta["status"], message=meta["message"],
         stats=dict(meta.get("stats") or {}),
         coordinate_names=list(meta["coordinate_names"]),
         coordinate_kinds=list(meta["coordinate_kinds"]),
@@ -152,25 +159,89 @@ def _result(meta: dict[str, Any], groups: dict[str, np.ndarray], path: Path) -> 
     )
 
 
-def _split(meta: dict[str, Any], table: np.ndarray, path: Path) -> dict[str, np.ndarray]:
-    groups, col = {}, 0
-    for g, k in meta["layout"]:
-        groups[g] = table[:, col : col + k]
-        col += k
-    if col != table.shape[1]:
-        raise ValueError(f"{path}: {table.shape[1]} columns, the metadata's layout says {col}")
-    return groups
+def _table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> FloatArray:
+    """The groups side by side in layout order: one row per output time, float64."""
+    cols = [np.asarray(groups[g], dtype=np.float64).reshape(n_t, k) for g, k in layout]
+    return np.hstack(cols) if cols else np.empty((n_t, 0))
 
 
-def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
+def _checksum(meta: dict[str, Any], table: FloatArray) -> int:
+    """CRC-32 of the metadata (as JSON in its order, without the checksum) and of the
+    table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
+    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")})
+    crc = zlib.crc32(text.encode())
+    for start in range(0, len(table), CSV_BLOCK):
+        block = table[start:start + CSV_BLOCK]
+        canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
+        crc = zlib.crc32(np.ascontiguousarray(canonical).tobytes(), crc)
+    return crc
+
+
+class _Damaged(Exception):
+    """What is wrong with a results file (the reader adds the file's name)."""
+
+
+def _is_str_list(v: Any) -> bool:
+    return isinstance(v, list) and all(isinstance(s, str) for s in v)
+
+
+def _check_meta(meta: Any) -> dict[str, Any]:
+    """The metadata if it is a planardyn results file's, field by field, else _Damaged."""
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
-        raise ValueError(f"{path}: not a planardyn results file (no '{FORMAT}' metadata)")
-    if meta.get("format_version", 0) > FORMAT_VERSION:
-        raise ValueError(
-            f"{path}: results format version {meta['format_version']} is newer than this "
-            f"planardyn reads ({FORMAT_VERSION}): upgrade planardyn"
-        )
+        raise _Damaged(f"not a planardyn results file (no '{FORMAT}' metadata)")
+    version = meta.get("format_version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise _Damaged(f"metadata field 'format_version' is {version!r}, not a version number")
+    if version > FORMAT_VERSION:
+        raise _Damaged(f"results format version {version} is newer than this planardyn reads "
+                       f"({FORMAT_VERSION}): upgrade planardyn")
+    fields: list[tuple[str, Callable[[Any], bool], str]] = [
+        ("coordinate_names", _is_str_list, "a list of names"),
+        ("coordinate_kinds", lambda v: isinstance(v, list) and all(k in ("angle", "displacement") for k in v),
+         "a list of 'angle'/'displacement'"),
+        ("body_names", _is_str_list, "a list of names"),
+        ("status", lambda v: isinstance(v, str), "a string"),
+        ("success", lambda v: isinstance(v, bool), "true or false"),
+        ("message", lambda v: isinstance(v, str), "a string"),
+        ("stats", lambda v: v is None or isinstance(v, dict), "a mapping"),
+        ("model", lambda v: v is None or isinstance(v, dict), "a model mapping"),
+        ("settings", lambda v: v is None or isinstance(v, dict), "a mapping"),
+        ("rows", lambda v: v is None or isinstance(v, int) and not isinstance(v, bool) and v >= 0,
+         "a number of rows"),
+        ("checksum", lambda v: v is None or isinstance(v, int) and not isinstance(v, bool), "a CRC-32"),
+    ]
+    # From version 2 the integrity fields are required: a damaged key must not switch the check off.
+    required = REQUIRED_FIELDS + (("rows", "checksum") if version >= 2 else ())
+    missing = [k for k in required if k not in meta]
+    if missing:
+        raise _Damaged(f"metadata has no field{'s' * (len(missing) > 1)} {', '.join(repr(k) for k in missing)}")
+    for name, ok, what in fields:
+        if not ok(meta.get(name)):
+            raise _Damaged(f"metadata field {name!r} is {_short(meta.get(name))}, not {what}")
+    if len(meta["coordinate_kinds"]) != len(meta["coordinate_names"]):
+        raise _Damaged("metadata fields 'coordinate_names' and 'coordinate_kinds' differ in length")
+    layout = [[g, len(c)] for g, c in _columns(meta["coordinate_names"], meta["body_names"])]
+    if meta["layout"] != layout:
+        raise _Damaged(f"metadata field 'layout' is {_short(meta['layout'])}, not the layout of its "
+                       f"coordinates and bodies {layout}")
     return meta
+
+
+def _short(v: Any) -> str:
+    text = repr(v)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _check_table(meta: dict[str, Any], table: FloatArray) -> FloatArray:
+    """The table if it has the rows and the checksum the metadata records, else _Damaged."""
+    rows = meta.get("rows")
+    if rows is not None and len(table) != rows:
+        raise _Damaged(f"truncated or damaged: {len(table)} rows where its metadata records {rows} "
+                       "(an interrupted copy or write?)")
+    if meta.get("checksum") is not None and _checksum(meta, table) != meta["checksum"]:
+        raise _Damaged("damaged: its contents do not match the checksum its metadata records "
+                       "(changed after it was written?)")
+    return table
 
 
 # ------------------------------------------------------------------ write / read
@@ -186,7 +257,10 @@ def write_results(
     """Write ``result`` to ``path`` (``.csv``, ``.parquet`` or ``.npz``) with its metadata.
 
     ``mechanism`` and ``settings`` are recorded when given (see :func:`attach_metadata`).
-    Parquet needs pyarrow. Returns the path.
+    The file is written whole or not at all: into a temporary file in the same folder,
+    renamed over ``path`` when complete. Its metadata records the number of rows and a
+    CRC-32 of the numbers, which :func:`read_results` checks. Parquet needs pyarrow.
+    Returns the path.
     """
     path = Path(path)
     ext = path.suffix.lower()
@@ -196,36 +270,48 @@ def write_results(
         result = attach_metadata(result, mechanism, settings)
     meta = _metadata(result)
     meta.pop("path", None)
-    groups = _group_arrays(result)
+    columns = _layout(result)
     n_t = len(result.t)
-    if ext == ".npz":
-        # Any: numpy's signature would also take a group for its allow_pickle flag.
-        arrays: dict[str, Any] = {g: np.asarray(a) for g, a in groups.items()}
-        with open(path, "wb") as f:
-            np.savez_compressed(f, metadata=np.array(json.dumps(meta)), **arrays)
-        return path
-    names = [c for _, cols in _layout(result) for c in cols]
-    columns = [
-        np.asarray(groups[g], dtype=np.float64).reshape(n_t, len(cols))[:, k]
-        for g, cols in _layout(result)
-        for k in range(len(cols))
-    ]
-    if ext == ".parquet":
-        pa, pq = _pyarrow()
-        pa_columns = [pa.array(c.astype(bool) if n == "partitioned" else c) for n, c in zip(names, columns)]
-        table = pa.Table.from_arrays(pa_columns, names=names).replace_schema_metadata(
-            {"planardyn": json.dumps(meta)}
-        )
-        pq.write_table(table, path)
-        return path
-    with open(path, "w", newline="") as f:
-        for line in json.dumps(meta, indent=1).splitlines():
-            f.write(f"# {line}\n")
-        w = csv.writer(f)
-        w.writerow(names)
-        for row in zip(*(c.tolist() for c in columns)):
-            w.writerow([repr(v) for v in row])
+    table = _table(_group_arrays(result), [(g, len(c)) for g, c in columns], n_t)
+    meta["rows"] = n_t
+    meta["checksum"] = _checksum(meta, table)
+    names = [c for _, cols in columns for c in cols]
+    with _replacing(path) as tmp:
+        if ext == ".npz":
+            # Any: numpy's signature would also take a group for its allow_pickle flag.
+            arrays: dict[str, Any] = {g: np.asarray(a) for g, a in _group_arrays(result).items()}
+            with open(tmp, "wb") as f:
+                np.savez_compressed(f, metadata=np.array(json.dumps(meta)), **arrays)
+        elif ext == ".parquet":
+            pa, pq = _pyarrow()
+            pa_columns = [pa.array(table[:, k].astype(bool) if n == "partitioned" else table[:, k])
+                          for k, n in enumerate(names)]
+            pq.write_table(pa.Table.from_arrays(pa_columns, names=names).replace_schema_metadata(
+                {"planardyn": json.dumps(meta)}), tmp)
+        else:
+            with open(tmp, "w", newline="") as f:
+                for line in json.dumps(meta, indent=1).splitlines():
+                    f.write(f"# {line}\n")
+                w = csv.writer(f)
+                w.writerow(names)
+                for start in range(0, n_t, CSV_BLOCK):
+                    w.writerows([repr(v) for v in row] for row in table[start:start + CSV_BLOCK].tolist())
     return path
+
+
+@contextlib.contextmanager
+def _replacing(path: Path) -> Iterator[Path]:
+    """A temporary file next to ``path`` that replaces it (one rename) when the block ends
+    without an error, and is removed when it fails: ``path`` is never half written."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
+    try:
+        yield tmp
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def read_results(path: str | os.PathLike[str]) -> SimulationResult:
@@ -239,42 +325,126 @@ def read_results(path: str | os.PathLike[str]) -> SimulationResult:
     FileNotFoundError
         No such file.
     ValueError
-        Not a planardyn results file, or a damaged one.
+        Not a planardyn results file, or a damaged one: truncated (fewer rows than its
+        metadata records), changed (its checksum), metadata missing or of the wrong type,
+        a file its format's library cannot read. The message starts with the file's name.
     """
     path = Path(path)
     ext = path.suffix.lower()
+    if ext not in EXTENSIONS:
+        raise ValueError(f"{path}: unknown results format {ext!r} (use {', '.join(EXTENSIONS)})")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such results file")
-    if ext == ".npz":
-        with np.load(path, allow_pickle=False) as z:
-            if "metadata" not in z.files:
-                raise ValueError(f"{path}: not a planardyn results file (no 'metadata' array)")
-            meta = _check_meta(json.loads(str(z["metadata"])), path)
-            groups = {g: z[g] for g, _ in meta["layout"]}
-        return _result(meta, groups, path)
-    if ext == ".parquet":
-        pa, pq = _pyarrow()
-        table = pq.read_table(path)
-        raw = (table.schema.metadata or {}).get(b"planardyn")
-        meta = _check_meta(json.loads(raw) if raw else None, path)
-        cols = [table.column(i).to_numpy().astype(np.float64) for i in range(table.num_columns)]
-        data = np.column_stack(cols) if cols else np.empty((0, 0))
-        return _result(meta, _split(meta, data.reshape(table.num_rows, len(cols)), path), path)
-    if ext == ".csv":
-        found, _, rows = _read_csv(path)
-        meta = _check_meta(found, path)
-        width = sum(k for _, k in meta["layout"])
+    readers = {".npz": _read_npz, ".parquet": _read_parquet, ".csv": _read_csv_table}
+    try:
+        meta, table = readers[ext](path)
+        return _result(meta, _check_table(meta, table), path)
+    except _Damaged as e:
+        raise ValueError(f"{path}: {e}") from None
+    except MemoryError:
+        raise ValueError(f"{path}: damaged: it declares arrays larger than memory") from None
+    except _library_errors() as e:
+        raise ValueError(f"{path}: damaged or not a {ext} results file ({type(e).__name__}: {e})") from None
+
+
+def _library_errors() -> tuple[type[BaseException], ...]:
+    """What numpy, zipfile, zlib, json and pyarrow raise on a damaged file (zipfile: a
+    NotImplementedError for flags or a compression it does not know, a RuntimeError for an
+    encrypted member)."""
+    errors: tuple[type[BaseException], ...] = (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError,
+                                               NotImplementedError, RuntimeError)
+    try:
+        import pyarrow as pa
+    except ImportError:  # pragma: no cover - depends on the environment
+        return errors
+    return (*errors, pa.lib.ArrowException)
+
+
+def _read_npz(path: Path) -> tuple[dict[str, Any], FloatArray]:
+    if not zipfile.is_zipfile(path):
+        raise _Damaged("not an .npz archive (damaged, or another kind of file)")
+    with np.load(path, allow_pickle=False) as z:
+        if "metadata" not in z.files:
+            raise _Damaged("not a planardyn results file (no 'metadata' array)")
+        raw = _member(z, "metadata")
+        if raw.shape != () or raw.dtype.kind != "U":
+            raise _Damaged(f"array 'metadata' is {raw.dtype} of shape {raw.shape}, not one JSON string")
+        meta = _check_meta(_json(str(raw)))
+        layout = [(g, k) for g, k in meta["layout"]]
+        missing = [g for g, _ in layout if g not in z.files]
+        if missing:
+            raise _Damaged(f"no array {', '.join(repr(g) for g in missing)}")
+        groups = {g: _member(z, g) for g, _ in layout}
+    n_t = groups["t"].size
+    for g, k in layout:
+        a = groups[g]
+        if a.dtype.kind not in "fiub":
+            raise _Damaged(f"array {g!r} holds {a.dtype}, not numbers")
+        if a.size != n_t * k:
+            raise _Damaged(f"array {g!r} has {a.size} values where {n_t} rows of {k} need {n_t * k}")
+    return meta, _table(groups, layout, n_t)
+
+
+def _member(z: Any, name: str) -> np.ndarray:
+    """Array ``name`` of an open .npz; numpy's refusals as _Damaged."""
+    try:
+        return z[name]
+    except ValueError as e:
+        if "allow_pickle" in str(e):
+            raise _Damaged(f"array {name!r} holds Python objects, not numbers") from None
+        raise _Damaged(f"array {name!r} is damaged ({e})") from None
+
+
+def _read_parquet(path: Path) -> tuple[dict[str, Any], FloatArray]:
+    pa, pq = _pyarrow()
+    table = pq.read_table(path)
+    raw = (table.schema.metadata or {}).get(b"planardyn")
+    meta = _check_meta(_json(raw) if raw else None)
+    width = sum(k for _, k in meta["layout"])
+    _check_header(meta, table.column_names)
+    cols = [table.column(i).to_numpy().astype(np.float64) for i in range(table.num_columns)]
+    return meta, np.column_stack(cols).reshape(table.num_rows, width) if cols else np.empty((table.num_rows, 0))
+
+
+def _read_csv_table(path: Path) -> tuple[dict[str, Any], FloatArray]:
+    found, header, rows = _read_csv(path)
+    meta = _check_meta(found)
+    _check_header(meta, header)
+    width = len(header)
+    data = np.empty((len(rows), width))
+    for i, r in enumerate(rows):
         try:
-            data = np.array([[float(v) for v in r] for r in rows], dtype=np.float64).reshape(len(rows), width)
+            if len(r) != width:
+                raise ValueError(f"{len(r)} fields")
+            data[i] = [float(v) for v in r]
         except ValueError as e:
-            raise ValueError(f"{path}: a row is not {width} numbers ({e})") from None
-        return _result(meta, _split(meta, data, path), path)
-    raise ValueError(f"{path}: unknown results format {ext!r} (use {', '.join(EXTENSIONS)})")
+            raise _Damaged(f"data row {i + 1} is not {width} numbers ({e}): truncated or damaged") from None
+    return meta, data
+
+
+def _check_header(meta: dict[str, Any], header: list[str]) -> None:
+    names = [c for _, cols in _columns(meta["coordinate_names"], meta["body_names"]) for c in cols]
+    if header != names:
+        wrong = next((k for k, (h, n) in enumerate(zip(header, names)) if h != n), min(len(header), len(names)))
+        raise _Damaged(f"{len(header)} columns where its metadata says {len(names)}: column {wrong + 1} is "
+                       f"{header[wrong] if wrong < len(header) else 'missing'!r}, expected "
+                       f"{names[wrong] if wrong < len(names) else 'none'!r}")
+
+
+def _json(text: Any) -> Any:
+    try:
+        return json.loads(text)
+    except (ValueError, TypeError) as e:
+        raise _Damaged(f"metadata is not JSON ({e})") from None
 
 
 def _read_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[list[str]]]:
-    """The JSON of the leading '# ' lines (None if there are none), the header, the data rows."""
-    text = path.read_text()
+    """The JSON of the leading '# ' lines (None if there are none or it is not JSON), the
+    header, the data rows."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise _Damaged(f"not text: byte {e.start} is not UTF-8 (damaged, or not a CSV file)") from None
     comment: list[str] = []
     lines = text.splitlines(keepends=True)
     k = 0
@@ -282,7 +452,10 @@ def _read_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[list[s
         comment.append(lines[k][2:] if lines[k].startswith("# ") else lines[k][1:])
         k += 1
     body = lines[k:]
-    rows = [r for r in csv.reader(io.StringIO("".join(body))) if r]
+    try:
+        rows = [r for r in csv.reader(io.StringIO("".join(body))) if r]
+    except csv.Error as e:
+        raise _Damaged(f"not a CSV table ({e})") from None
     meta = None
     if comment:
         try:
@@ -290,6 +463,14 @@ def _read_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[list[s
         except json.JSONDecodeError:
             meta = None
     return meta, [h.strip() for h in rows[0]] if rows else [], rows[1:]
+
+
+def _read_named_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[list[str]]]:
+    """:func:`_read_csv`, its errors as ValueErrors that name the file."""
+    try:
+        return _read_csv(path)
+    except _Damaged as e:
+        raise ValueError(f"{path}: {e}") from None
 
 
 def _pyarrow() -> tuple[Any, Any]:
@@ -320,8 +501,8 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     """
     path = Path(path)
     if path.suffix.lower() in (".npz", ".parquet") or (
-        path.suffix.lower() == ".csv" and path.is_file() and path.read_text()[:1] == "#"
-        and ((_read_csv(path)[0] or {}).get("format") == FORMAT)
+        path.suffix.lower() == ".csv" and path.is_file() and path.open("rb").read(1) == b"#"
+        and ((_read_named_csv(path)[0] or {}).get("format") == FORMAT)
     ):
         res = read_results(path)
         if res.coordinate_names != list(coordinate_names):
@@ -333,7 +514,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
-    _, header, rows = _read_csv(path)
+    _, header, rows = _read_named_csv(path)
     need = ["t", *coordinate_names]
     missing = [c for c in need if c not in header]
     if missing:

@@ -1,0 +1,273 @@
+"""Fuzzing the command line: damaged results files and random option values.
+
+Each input is a command (``plot``, ``animate`` to HTML, ``inverse``, ``simulate``) on a
+results file damaged at random (truncated at a random offset, bytes flipped, an array, a
+column or a metadata key dropped, metadata of another type, random bytes, another .npz) or
+with random option values (negative, zero, nan, inf, huge, not a number). Every outcome
+must be an exit status 0, 1 or 2 with at most a one-line message: no exception escapes
+``cli.main``, none reaches its last-resort handler ("unexpected ..."), and a refused file
+is named in the message.
+
+The campaign is seeded: ``PLANARDYN_CLI_FUZZ_N=20000 PLANARDYN_CLI_FUZZ_SEED=7 pytest
+tests/test_cli_fuzz.py`` runs a longer one (default 150 inputs, seed 11).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import zipfile
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import planardyn as pd
+import pytest
+from conftest import MODELS
+from planardyn.cli import main
+
+N_INPUTS = int(os.environ.get("PLANARDYN_CLI_FUZZ_N", "150"))
+SEED = int(os.environ.get("PLANARDYN_CLI_FUZZ_SEED", "11"))
+MODEL = MODELS / "five-bar.yaml"
+FORMATS = (".csv", ".npz", ".parquet")
+
+#: Option values: valid, out of range, not finite, not numbers, overflowing.
+WORDS = ["0", "-1", "-0", "1", "2", "nan", "inf", "-inf", "1e400", "1e-400", "x", "", "0x10", "9" * 400,
+         "1e308", "5e-324", "1e12", "1e13", "20000", "100000", "-1e-9", "3.5", " 2 ", "1_000"]
+
+
+def run(argv: list[str]) -> tuple[int, str]:
+    """Exit status and stderr of ``planardyn ARGV`` run here; an exception escaping main fails
+    the test with its traceback."""
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            code = main(argv)
+        except SystemExit as e:  # argparse's usage errors
+            code = e.code if isinstance(e.code, int) else 2
+    return code, err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def originals(tmp_path_factory) -> dict[str, bytes]:
+    """A short five-bar run (6 rows) in every results format, as bytes."""
+    d = tmp_path_factory.mktemp("valid")
+    mech = pd.load(MODEL)
+    res = mech.simulate(0.05, output_dt=0.01)
+    out = {}
+    for ext in FORMATS:
+        p = pd.results_io.write_results(res, d / f"run{ext}", mechanism=mech)
+        out[ext] = p.read_bytes()
+    return out
+
+
+def random_value(rng: np.random.Generator) -> Any:
+    kinds = [None, True, -1, 0, 1.5, "x", [], {}, [1, "a"], {"a": 1}, 10**30, float("nan")]
+    return kinds[rng.integers(len(kinds))]
+
+
+def damage_meta(meta: dict[str, Any], rng: np.random.Generator) -> dict[str, Any]:
+    """Drop a key or give it a value of another type."""
+    meta = dict(meta)
+    key = sorted(meta)[rng.integers(len(meta))]
+    if rng.random() < 0.4:
+        del meta[key]
+    else:
+        meta[key] = random_value(rng)
+    return meta
+
+
+def damage(ext: str, data: bytes, rng: np.random.Generator, where: Path) -> tuple[bytes, str]:
+    """Damaged bytes of a results file and how they were damaged."""
+    how = rng.choice(["truncate", "flip", "meta", "drop", "empty", "noise", "other"])
+    if how == "truncate":
+        return data[: rng.integers(0, len(data))], how
+    if how == "flip":
+        b = bytearray(data)
+        for _ in range(rng.integers(1, 4)):
+            b[rng.integers(len(b))] ^= int(rng.integers(1, 256))
+        return bytes(b), how
+    if how == "empty":
+        return b"", how
+    if how == "noise":
+        return rng.bytes(int(rng.integers(1, 2000))), how
+    if how == "other":
+        # Another program's .npz (or an object array, which numpy reads only with allow_pickle).
+        buf = io.BytesIO()
+        if rng.random() < 0.5:
+            np.savez(buf, a=rng.random(5), metadata=np.array([1, 2]))
+        else:
+            np.save(buf, np.array([{"a": 1}], dtype=object), allow_pickle=True)
+        return buf.getvalue(), how
+    src = where / f"src{ext}"
+    src.write_bytes(data)
+    if ext == ".npz":
+        with np.load(src, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+        meta = json.loads(str(arrays["metadata"]))
+        if how == "meta":
+            arrays["metadata"] = np.array(json.dumps(damage_meta(meta, rng)))
+        else:
+            name = sorted(arrays)[rng.integers(len(arrays))]
+            if rng.random() < 0.5:
+                del arrays[name]
+            else:
+                arrays[name] = np.array(["x"] * 3) if rng.random() < 0.5 else arrays[name].ravel()[:-1]
+        buf = io.BytesIO()
+        np.savez(buf, **arrays)
+        return buf.getvalue(), how
+    if ext == ".parquet":
+        import pyarrow.parquet as pq
+
+        table = pq.read_table(src)
+        meta = json.loads(table.schema.metadata[b"planardyn"])
+        if how == "meta":
+            table = table.replace_schema_metadata({"planardyn": json.dumps(damage_meta(meta, rng))})
+        else:
+            table = table.remove_column(int(rng.integers(table.num_columns))).replace_schema_metadata(
+                table.schema.metadata)
+        buf = io.BytesIO()
+        pq.write_table(table, buf)
+        return buf.getvalue(), how
+    lines = data.decode().splitlines(keepends=True)
+    comment = [ln for ln in lines if ln.startswith("#")]
+    body = lines[len(comment):]
+    if how == "meta":
+        meta = json.loads("".join(ln[2:] for ln in comment))
+        comment = [f"# {ln}\n" for ln in json.dumps(damage_meta(meta, rng), indent=1).splitlines()]
+    elif rng.random() < 0.5:
+        del body[rng.integers(len(body))]
+    else:
+        col = int(rng.integers(len(body[0].split(","))))
+        body = [",".join(v for k, v in enumerate(ln.rstrip("\n").split(",")) if k != col) + "\n" for ln in body]
+    return "".join(comment + body).encode(), how
+
+
+def option(rng: np.random.Generator) -> str:
+    if rng.random() < 0.5:
+        return WORDS[rng.integers(len(WORDS))]
+    return repr(float(rng.choice([-1, 1]) * 10 ** rng.uniform(-320, 308)))
+
+
+def command(rng: np.random.Generator, path: Path, out: Path) -> list[str]:
+    """A random command on ``path``; its options random, kept cheap to run."""
+    kind = rng.choice(["plot", "animate", "inverse", "simulate"])
+    if kind == "plot":
+        argv = ["plot", str(path), "-o", str(out / "fig.png")]
+        if rng.random() < 0.5:
+            argv += ["--dpi", option(rng) if rng.random() < 0.9 else "20"]
+        if rng.random() < 0.3:
+            argv.append("--torque-speed")
+        return argv
+    if kind == "animate":
+        argv = ["animate", str(MODEL), str(path), "-o", str(out / "view.html")]
+        for name in ("--fps", "--speed"):
+            if rng.random() < 0.5:
+                argv += [name, option(rng)]
+        return argv
+    if kind == "inverse":
+        return ["inverse", str(MODEL), "--motion", str(path)] + (["-o", str(out / "inv.npz")] if rng.random() < 0.5 else [])
+    argv = ["simulate", str(MODEL), "--no-progress", "-o", str(out / "sim.npz")]
+    for name in ("--t-end", "--rtol", "--atol", "--dt", "--output-dt"):
+        if rng.random() < 0.4:
+            argv += [name, option(rng)]
+    if rng.random() < 0.2:
+        argv += ["--method", str(rng.choice(["rk4", "dopri5", "radau5", "dop853", "euler", ""]))]
+    # Bounded work: a random --max-steps replaces the cap only where the run is short.
+    steps = option(rng) if rng.random() < 0.2 else str(rng.integers(1, 300))
+    if steps.lstrip("-").isdigit() and abs(int(steps)) > 300:
+        argv += ["--t-end", "0.01"]
+    return argv + ["--max-steps", steps]
+
+
+def same_as_written(path: Path, original: pd.SimulationResult) -> bool:
+    """The file reads back as the result that was written (damage that changed nothing read)."""
+    back = pd.read_results(path)
+    fields = ("t", "q", "qd", "qdd", "tau", "x", "xd", "sigma", "residual", "partitioned")
+    return all(np.array_equal(getattr(back, f), getattr(original, f), equal_nan=True) for f in fields) and (
+        {k: v for k, v in back.metadata.items() if k != "path"}
+        == {k: v for k, v in original.metadata.items() if k != "path"}
+        and (back.status, back.message, back.stats) == (original.status, original.message, original.stats))
+
+
+def motion_table(argv: list[str], path: Path) -> bool:
+    """``inverse`` takes a CSV that is no longer a results file (its metadata's 'format'
+    changed) as what it then is: a motion table with a t column and one per coordinate."""
+    try:
+        pd.read_results(path)
+    except ValueError as e:
+        return argv[0] == "inverse" and path.suffix == ".csv" and "not a planardyn results file" in str(e)
+    return False
+
+
+def check(argv: list[str], path: Path, damaged: bool, harmless: bool, original: pd.SimulationResult) -> int:
+    code, err = run(argv)
+    where = f"planardyn {' '.join(argv)}"
+    assert code in (0, 1, 2), f"{where}: exit {code}\n{err}"
+    assert "Traceback" not in err and "planardyn: unexpected " not in err, f"{where}:\n{err}"
+    lines = [ln for ln in err.splitlines() if ln.startswith("planardyn:")]
+    assert len(lines) <= 2, f"{where}: several messages\n{err}"
+    reads = argv[0] != "simulate"
+    if reads and damaged and code == 2 and "error: argument" not in err and str(MODEL) not in err:
+        assert str(path) in err, f"{where}: the message does not name the file\n{err}"
+    if reads and damaged and not harmless:
+        assert code != 0 or motion_table(argv, path) or same_as_written(path, original), (
+            f"{where}: a damaged file misread as a success")
+    return code
+
+
+def test_cli_fuzz(originals, tmp_path):
+    """Damaged results files and random options: exit 0, 1 or 2, a message, no traceback."""
+    rng = np.random.default_rng(SEED)
+    failures: list[str] = []
+    written = {}
+    for ext in FORMATS:
+        (tmp_path / f"written{ext}").write_bytes(originals[ext])
+        written[ext] = pd.read_results(tmp_path / f"written{ext}")
+    outcomes: Counter[tuple[str, int]] = Counter()
+    for k in range(N_INPUTS):
+        ext = FORMATS[k % 3]
+        path = tmp_path / f"input{ext}"
+        damaged = rng.random() < 0.8
+        if damaged:
+            data, how = damage(ext, originals[ext], rng, tmp_path)
+        else:
+            data, how = originals[ext], "intact"
+        path.write_bytes(data)
+        argv = command(rng, path, tmp_path)
+        # Harmless: the final newline cut off, or the metadata's checksum itself dropped.
+        harmless = data.rstrip() == originals[ext].rstrip() or (how == "meta" and b'"checksum"' not in data)
+        try:
+            outcomes[(f"{argv[0]} {how}", check(argv, path, damaged, harmless, written[ext]))] += 1
+        except AssertionError as e:  # the whole campaign runs; every failure is listed at the end
+            failures.append(str(e).splitlines()[0] + " | " + " ".join(str(e).splitlines()[1:2]))
+    print(f"\n{N_INPUTS} inputs, seed {SEED}: {len(failures)} failures")
+    assert not failures, "\n".join(failures[:10])
+    # Every kind of damage was tried.
+    assert {h.split()[1] for h, _ in outcomes} >= {"truncate", "flip", "meta", "drop"} or N_INPUTS < 100
+    print(f"\n{N_INPUTS} inputs, seed {SEED}: " + ", ".join(f"{h} exit {c}: {n}" for (h, c), n in sorted(outcomes.items())))
+
+
+def test_broken_pipe_ends_quietly():
+    """``planardyn check MODEL | head -1``: no BrokenPipeError traceback, exit 0."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    cmd = f"{sys.executable} -m planardyn check {MODEL} | head -c 10; exit ${{PIPESTATUS[0]}}"
+    p = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout == "model: fiv" and p.stderr == "", p.stderr
+
+
+def test_npz_needing_pickle_is_refused_with_its_name(tmp_path):
+    """A .npz of object arrays was read on numpy's advice to pass allow_pickle; now refused."""
+    p = tmp_path / "other.npz"
+    np.savez(p, metadata=np.array([{"format": "planardyn-results"}], dtype=object))
+    code, err = run(["plot", str(p)])
+    assert code == 2 and str(p) in err and "allow_pickle" not in err, err
+    with zipfile.ZipFile(p) as z:
+        assert z.namelist() == ["metadata.npy"]

@@ -1,0 +1,109 @@
+"""One rule per simulation setting, the same for the model loader, the API, the batch runner
+and the CLI (planardyn.settings); batch threads bounded; a batch keeps what it has done."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+
+import numpy as np
+import planardyn as pd
+import pytest
+import yaml
+from conftest import MODELS
+from planardyn import batch, cli
+from planardyn.settings import MAX_THREADS, MIN_RTOL
+
+FIVE_BAR = MODELS / "five-bar.yaml"
+
+
+def cli_run(*argv: str) -> tuple[int, str]:
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            code = cli.main([str(a) for a in argv])
+        except SystemExit as e:
+            code = e.code
+    return code, err.getvalue()
+
+
+def model_with(**simulate) -> str:
+    d = yaml.safe_load(FIVE_BAR.read_text())
+    d["simulate"] = {**(d.get("simulate") or {}), **simulate}
+    return yaml.safe_dump(d)
+
+
+@pytest.mark.parametrize("name", ["atol", "rtol", "dt", "output_dt", "t_end"])
+@pytest.mark.parametrize("value", [0.0, -1e-9, math.nan, math.inf])
+def test_loader_api_and_cli_refuse_the_same_values(name, value):
+    """Before: atol = 0 was refused by the loader but taken by the API and the CLI, where
+    the run then failed as "NaN or infinity in the solution"."""
+    with pytest.raises(pd.ModelError, match=f"simulate.{name}"):
+        pd.loads(model_with(**{name: value}))
+    mech = pd.load(FIVE_BAR)
+    error = ValueError if name == "t_end" else pd.SimulationError
+    with pytest.raises(error, match=f"{name} = .* must be a finite number > 0"):
+        mech.simulate(**{name: value})
+    code, err = cli_run("simulate", FIVE_BAR, f"--{name.replace('_', '-')}={value!r}")
+    assert code == 2 and f"argument --{name.replace('_', '-')}: {name} = " in err, err
+
+
+def test_positive_tolerances_are_taken():
+    # The smallest values the rules allow run: atol just above 0, rtol at 100 epsilons.
+    res = pd.load(FIVE_BAR).simulate(0.01, atol=1e-300, rtol=MIN_RTOL, max_steps=50)
+    assert res.status in ("success", "too_many_steps")
+    assert MIN_RTOL == pytest.approx(2.22e-14, rel=1e-3)  # 100 * 2.220446e-16
+    with pytest.raises(pd.SimulationError, match="below 100 machine epsilons"):
+        pd.load(FIVE_BAR).simulate(0.01, rtol=MIN_RTOL / 2)
+
+
+@pytest.mark.parametrize("value, error", [(-1, pd.SimulationError), (0, pd.SimulationError),
+                                          (10**13, pd.SimulationError), (True, TypeError), (2.5, TypeError)])
+def test_max_steps_rule(value, error):
+    """Before: max_steps = -1 was an OverflowError from the conversion to an unsigned integer."""
+    with pytest.raises(error, match="max_steps"):
+        pd.load(FIVE_BAR).simulate(0.01, max_steps=value)
+
+
+@pytest.mark.parametrize("threads, error", [(-1, ValueError), (0, ValueError), (MAX_THREADS + 1, ValueError),
+                                            (20000, ValueError), ("x", TypeError), (2.0, TypeError)])
+def test_batch_threads_bounded(threads, error):
+    """Before: -1 or "x" became a BatchError in every variant's place, and 20000 spawned
+    20000 threads (over 300 s)."""
+    mech = pd.load(FIVE_BAR)
+    with pytest.raises(error, match="threads"):
+        batch.simulate([mech, mech], 0.01, threads=threads)
+
+
+def test_batch_settings_checked_once_and_per_variant():
+    mech = pd.load(FIVE_BAR)
+    with pytest.raises(pd.SimulationError, match="atol = 0"):
+        batch.simulate([mech], 0.01, atol=0)
+    got = batch.simulate([mech, (mech, {"atol": 0.0})], 0.01)
+    assert got[0].success and isinstance(got[1], batch.BatchError) and got[1].type == "SimulationError"
+
+
+def test_batch_progress_raising_keeps_the_variants_done():
+    """Before: a progress callback that raised lost every result of the batch."""
+    mech = pd.load(FIVE_BAR)
+    variants = [(mech, {"t_end": 0.01 * (k + 1)}) for k in range(5)]
+    calls = []
+
+    def progress(done, total):
+        calls.append(done)
+        if done == 2:
+            raise RuntimeError("stop here")
+
+    got = batch.simulate(variants, chunk_size=1, progress=progress, threads=1)
+    assert calls == [1, 2]
+    # The two finished variants are the runs a direct call gives, bit for bit.
+    for k in (0, 1):
+        direct = mech.simulate(0.01 * (k + 1))
+        assert np.array_equal(got[k].q, direct.q) and np.array_equal(got[k].t, direct.t)
+    for k in (2, 3, 4):
+        assert isinstance(got[k], batch.BatchError) and got[k].type == "Cancelled"
+        assert "progress callback raised RuntimeError('stop here') after 2 of 5" in got[k].message
+    # Returning False stops it the same way; None goes on.
+    got = batch.simulate(variants, chunk_size=2, progress=lambda d, n: d < 2, threads=1)
+    assert [getattr(r, "type", "ok") for r in got] == ["ok", "ok", "Cancelled", "Cancelled", "Cancelled"]
