@@ -112,7 +112,7 @@ class Mechanism:
         self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
     ) -> NDArray[np.float64]: ...
     def inverse_dynamics(
-        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x_start: ArrayLike | None = None
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None
     ) -> NDArray[np.float64]: ...
     def reactions(
         self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None

@@ -272,7 +272,7 @@ class Mechanism:
         return self._native.forward_dynamics(q, qd, float(t), tau)
 
     def inverse_dynamics(
-        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x_start: ArrayLike | None = None
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None
     ) -> FloatArray:
         """Drive efforts that produce a motion: tau = A qdd - U^T (f - M c).
 
@@ -280,18 +280,22 @@ class Mechanism:
         ----------
         q, qd, qdd : (m,) or (N, m) array_like, all of the same shape
             Coordinates (rad or m), rates and accelerations. For (N, m) the rows are a
-            trajectory: the first is reached from ``x_start`` (else the drawing), each next
-            one by continuation from the previous one (so they stay on one branch).
-        x_start : (3n,) array_like, optional
-            Body coordinates on the wanted branch at (or near) the first row, e.g. a result's
-            ``x[0]``.
+            trajectory.
+        x : (3n,) or (N, 3n) array_like, optional
+            The branch: body coordinates at every row (a result's ``x``: exact whatever
+            branches the motion went through), or at the first row only. Without them, or
+            with the first row only, each row continues from the previous one, and rows that
+            go on past one where that branch comes within ``planardyn::batch::BRANCH_SIGMA``
+            (0.05) of a type II singularity raise ``SingularityError`` (attributes ``row``,
+            ``sigma_min``): there the motion may have left on the other branch, which q
+            alone cannot tell.
 
         Returns
         -------
         tau : ndarray of the same shape
             Efforts (N m on angles, N on displacements), the model's drives not included.
         """
-        return self._native.inverse_dynamics(q, qd, qdd, x_start)
+        return self._native.inverse_dynamics(q, qd, qdd, x)
 
     def reactions(
         self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None

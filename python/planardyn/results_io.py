@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._core import __version__
+from ._core import SingularityError, __version__
 from .mechanism import Mechanism, attach_metadata, plain
 from .result import Energy, SimulationResult
 
@@ -584,12 +584,13 @@ def inverse_result(
     q: ArrayLike,
     qd: ArrayLike | None = None,
     qdd: ArrayLike | None = None,
-    x_start: ArrayLike | None = None,
+    x: ArrayLike | None = None,
 ) -> SimulationResult:
     """Drive efforts for a prescribed motion, as a result (``metadata['kind'] = 'inverse'``).
 
-    The rows follow one branch: the first is reached from ``x_start`` (else the drawing),
-    every next one by continuation from the previous row's body coordinates.
+    The rows follow the branch of ``x`` as :meth:`Mechanism.inverse_dynamics` does: every
+    row's own body coordinates when ``x`` is (N, 3n), else continuation from row to row,
+    refused (``SingularityError`` with ``row`` and ``t``) where q alone cannot tell the branch.
 
     Parameters
     ----------
@@ -600,9 +601,9 @@ def inverse_result(
     qd, qdd : (N, m) array_like, optional
         Rates and accelerations; those not given come from cubic splines
         (:func:`motion_derivatives`).
-    x_start : (3n,) array_like, optional
-        Body coordinates (m, m, rad per body) on the wanted branch at the first row, e.g. a
-        results file's ``x[0]``.
+    x : (3n,) or (N, 3n) array_like, optional
+        Body coordinates (m, m, rad per body) at the first row, or at every row (a results
+        file's ``x``).
 
     Returns
     -------
@@ -622,12 +623,25 @@ def inverse_result(
         qdd = sdd if qdd is None else qdd
     qd = np.ascontiguousarray(qd, dtype=np.float64).reshape(q.shape)
     qdd = np.ascontiguousarray(qdd, dtype=np.float64).reshape(q.shape)
-    tau = np.asarray(mech.inverse_dynamics(q, qd, qdd, x_start), dtype=np.float64).reshape(q.shape)
+    given = None if x is None else np.asarray(x, dtype=np.float64)
+    try:
+        tau = np.asarray(mech.inverse_dynamics(q, qd, qdd, given), dtype=np.float64).reshape(q.shape)
+    except SingularityError as e:
+        row = getattr(e, "row", None)
+        if row is not None:
+            e.t = float(t[row])  # type: ignore[attr-defined]
+            e.args = (f"at t = {t[row]:.6g} s: {e}",)
+        raise
     n_t, n_b = len(t), mech.n_bodies
     x, xd = np.empty((n_t, 3 * n_b)), np.empty((n_t, 3 * n_b))
     sigma, residual, kinetic, potential = (np.empty(n_t) for _ in range(4))
     for i in range(n_t):
-        k = mech.kinematics(q[i], qd[i], x_start=x_start if i == 0 else x[i - 1])
+        # Each row from its own body coordinates when given, else from the row before.
+        if given is not None and given.ndim == 2:
+            start = given[i]
+        else:
+            start = given if i == 0 else x[i - 1]
+        k = mech.kinematics(q[i], qd[i], x_start=start)
         x[i], xd[i] = k["x"], k["xd"]
         sigma[i], residual[i] = k["sigma_min"], k["residual"]
         kinetic[i], potential[i] = mech.energy(q[i], qd[i], x_start=x[i])
@@ -651,7 +665,6 @@ def inverse_from_file(mech: Mechanism, path: str | os.PathLike[str]) -> Simulati
     """:func:`inverse_result` of the motion in a file (see :func:`read_motion`)."""
     m = read_motion(path, mech.coordinate_names)
     qd, qdd = motion_derivatives(m["t"], m["q"], m["qd_columns"], m["qdd_columns"])
-    x = m["x"]
-    res = inverse_result(mech, m["t"], m["q"], qd, qdd, x_start=None if x is None else x[0])
+    res = inverse_result(mech, m["t"], m["q"], qd, qdd, x=m["x"])
     return attach_metadata(res, None, None, motion=str(path))
 

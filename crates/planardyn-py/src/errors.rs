@@ -6,7 +6,7 @@
 //! PlanardynError(Exception)
 //! ├── ModelError(PlanardynError, ValueError)   a model file or dict that is not a mechanism
 //! ├── AssemblyError                            KinematicsError::AssemblyFailed
-//! ├── SingularityError                         KinematicsError::Singular
+//! ├── SingularityError                         KinematicsError::Singular, Error::BranchUndecided
 //! └── SimulationError                          Error::Options, Error::Drive
 //! ```
 //!
@@ -197,6 +197,10 @@ pub fn to_pyerr(py: Python<'_>, e: &Error) -> PyErr {
         Error::Model(m) => model_error(py, m),
         Error::Kinematics(k) => kinematics_error(py, k),
         Error::Options(_) | Error::Drive { .. } => SimulationError::new_err(e.to_string()),
+        Error::BranchUndecided { row, sigma_min, .. } => {
+            let attrs = vec![("kind", attr(py, "II")), ("row", attr(py, *row)), ("sigma_min", attr(py, *sigma_min))];
+            set_attrs(py, SingularityError::new_err(e.to_string()), attrs)
+        }
         _ => PlanardynError::new_err(e.to_string()),
     }
 }

@@ -7,7 +7,7 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::inverse_rows_from;
+use planardyn::batch::{inverse_rows_on, Branch};
 use planardyn::dynamics::{self, Drives, ModelDrives};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
@@ -431,18 +431,19 @@ impl PyMechanism {
         Ok(arr1(py, ws.qdd))
     }
 
-    /// Efforts tau for (q, qd, qdd), each (m,) or (N, m); the first row from `x_start` (else
-    /// the drawing), the next ones by continuation from row to row.
-    #[pyo3(signature = (q, qd, qdd, x_start=None))]
+    /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
+    /// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
+    /// (`planardyn::batch::Branch`).
+    #[pyo3(signature = (q, qd, qdd, x=None))]
     fn inverse_dynamics<'py>(
         &self,
         py: Python<'py>,
         q: ArrayArg<'py>,
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
-        x_start: Option<ArrayArg<'py>>,
+        x: Option<ArrayArg<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
+        let x = x.map(|a| rows("x", &a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
         let m = self.m();
         let what = self.coords_what();
         let (q, qd, qdd) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("qdd", &qdd, m, &what)?);
@@ -454,7 +455,14 @@ impl PyMechanism {
         }
         let mech = self.inner.clone();
         let shape = q.shape.clone();
-        let tau = run(py, move || Ok(inverse_rows_from(&mech, x_start.as_deref(), &q.data, &qd.data, &qdd.data)?))?;
+        let tau = run(py, move || {
+            let branch = match &x {
+                None => Branch::Drawing,
+                Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
+                Some(x) => Branch::Rows(&x.data),
+            };
+            Ok(inverse_rows_on(&mech, branch, &q.data, &qd.data, &qdd.data)?)
+        })?;
         arr_dyn(py, &shape, tau)
     }
 

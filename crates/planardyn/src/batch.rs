@@ -18,6 +18,7 @@ pub mod task;
 
 use crate::dynamics::{self, ModelDrives};
 use crate::kinematics::{assemble_from, assemble_into, continue_to};
+use crate::simulate::charts::SWITCH_TO_PARTITION;
 pub use crate::simulate::Overrides;
 use crate::simulate::{simulate, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
@@ -93,24 +94,44 @@ impl InverseVariant {
     }
 }
 
-/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each), the first row
-/// assembled from the drawing; see [`inverse_rows_from`].
-pub fn inverse_rows(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>, Error> {
-    inverse_rows_from(mech, None, q, qd, qdd)
+/// Which branch of the position analysis the rows of a motion are on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Branch<'a> {
+    /// The drawn one: the first row by continuation from the drawing, each next row from
+    /// the previous one.
+    Drawing,
+    /// The one through these body coordinates (3n, e.g. a result's first row), then row to row.
+    From(&'a [f64]),
+    /// Each row's own body coordinates (N x 3n, as a simulation records them): exact whatever
+    /// branches the motion went through.
+    Rows(&'a [f64]),
 }
 
-/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each). The first row is
-/// reached by continuation from the body coordinates `x_start` (3n; e.g. those a results file
-/// carries for it), else from the drawing; every next row by continuation from the previous
-/// row's body coordinates, so the rows stay on one branch.
-pub fn inverse_rows_from(
+/// A motion given by q alone whose continuation passes below this type II measure is
+/// refused ([`Error::BranchUndecided`]): there the two branches meet, and a motion through
+/// the singularity may leave on either (the free-falling five-bar does). The integrator's own
+/// threshold for leaving the input chart (`simulate::charts::SWITCH_TO_PARTITION`).
+pub const BRANCH_SIGMA: f64 = SWITCH_TO_PARTITION;
+
+/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each) on the drawn branch;
+/// see [`inverse_rows_on`].
+pub fn inverse_rows(mech: &Mechanism, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>, Error> {
+    inverse_rows_on(mech, Branch::Drawing, q, qd, qdd)
+}
+
+/// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each) on `branch`. With
+/// q alone (`Drawing`, `From`) each row continues from the previous one, and a motion that
+/// goes on past a row where the branch followed is within [`BRANCH_SIGMA`] of a type II
+/// singularity is refused ([`Error::BranchUndecided`]) rather than guessed; with `Rows` each row is solved from its
+/// own body coordinates.
+pub fn inverse_rows_on(
     mech: &Mechanism,
-    x_start: Option<&[f64]>,
+    branch: Branch<'_>,
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
 ) -> Result<Vec<f64>, Error> {
-    let m = mech.dof();
+    let (m, nx) = (mech.dof(), mech.n_x());
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
         return Err(KinematicsError::bad_argument(
             "q, qd, qdd",
@@ -119,19 +140,31 @@ pub fn inverse_rows_from(
         )
         .into());
     }
+    let n = q.len() / m;
+    if let Branch::Rows(x) = branch {
+        if x.len() != n * nx {
+            let expected = format!("{n} rows of {nx} body coordinates, one per row of q");
+            return Err(KinematicsError::bad_argument("x", expected, format!("{} values", x.len())).into());
+        }
+    }
     let mut ws = Workspace::new(mech);
     let mut tau = Vec::with_capacity(q.len());
-    for k in 0..q.len() / m {
+    for k in 0..n {
         let row = k * m..(k + 1) * m;
-        if k == 0 {
-            match x_start {
-                Some(x) => assemble_from(mech, x, &q[row.clone()], &mut ws)?,
-                None => assemble_into(mech, &q[row.clone()], &mut ws)?,
-            }
-        } else {
-            continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?;
+        match (branch, k) {
+            (Branch::Rows(x), _) => assemble_from(mech, &x[k * nx..(k + 1) * nx], &q[row.clone()], &mut ws)?,
+            (Branch::From(x), 0) => assemble_from(mech, x, &q[row.clone()], &mut ws)?,
+            (Branch::Drawing, 0) => assemble_into(mech, &q[row.clone()], &mut ws)?,
+            _ => continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?,
         }
         dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], &mut ws)?;
+        // Only the rows after a near-singular one are in doubt.
+        if !matches!(branch, Branch::Rows(_)) && k + 1 < n {
+            let sigma_min = ws.sys.sigma_min_estimate().unwrap_or(0.0);
+            if sigma_min < BRANCH_SIGMA {
+                return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
+            }
+        }
         tau.extend_from_slice(&ws.tau);
     }
     Ok(tau)

@@ -130,6 +130,14 @@ pub enum Error {
     /// A user-supplied drive function failed (its message is kept).
     #[error("drive function failed at t = {t}: {message}")]
     Drive { t: f64, message: String },
+    /// Rows of a motion given by q alone pass so near a type II singularity that the branch
+    /// after it cannot be told from q: the motion may have changed assembly mode there.
+    #[error(
+        "row {row} of the motion is at a type II singularity of the branch followed (smallest scaled singular \
+         value {sigma_min:.3e} < {tol}): from q alone the branch the motion took after that row cannot be decided; \
+         give the body coordinates of every row (x=, which a simulation result and a results file carry)"
+    )]
+    BranchUndecided { row: usize, sigma_min: f64, tol: f64 },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
