@@ -12,9 +12,8 @@ the drawn branch (they were off by up to 2.28e3 N m).
 from __future__ import annotations
 
 import numpy as np
-import pytest
-
 import planardyn as pd
+import pytest
 from planardyn.results_io import inverse_from_file, write_results
 
 TIGHT = dict(method="dop853", rtol=1e-10, atol=1e-12)
