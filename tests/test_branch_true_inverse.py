@@ -41,6 +41,7 @@ def test_free_fall_efforts_are_zero_from_its_results_file(free_fall, tmp_path):
     write_results(res, path)
     inv = inverse_from_file(mech, path)
     assert np.abs(inv.tau).max() < 1e-8
+    assert inv.metadata["branch"] == "each row's body coordinates"
     assert np.allclose(inv.x, res.x, atol=1e-9)
 
 

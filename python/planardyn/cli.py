@@ -327,7 +327,8 @@ def _inverse(args: argparse.Namespace) -> int:
         f"|tau_{n}| <= {v:.4g} {u}" for n, v, u in zip(mech.coordinate_names, np.abs(res.tau).max(axis=0), mech.effort_units)
     )
     print(f"inverse dynamics: {len(res.t)} rows, t = {res.t[0]:.6g}..{res.t[-1]:.6g} s, {peaks}, "
-          f"min sigma {float(res.sigma.min()):.3g}" + (f" -> {args.output}" if args.output else ""))
+          f"min sigma {float(res.sigma.min()):.3g}; branch: {res.metadata['branch']}"
+          + (f" -> {args.output}" if args.output else ""))
     return EXIT_OK
 
 

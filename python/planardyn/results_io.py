@@ -611,7 +611,8 @@ def inverse_result(
         ``tau`` (N, m): the drive efforts (N m or N) that produce the motion together with
         the model's loads (springs, dampers, gravity; the model's own drives are not
         counted); ``x``, ``xd``, ``sigma``, ``residual`` from the kinematics at each row;
-        kinetic and potential energy; ``work`` the work of tau (J, trapezoidal rule).
+        kinetic and potential energy; ``work`` the work of tau (J, trapezoidal rule);
+        ``metadata["branch"]`` says which branch the rows were computed on.
     """
     t = np.ascontiguousarray(t, dtype=np.float64)
     q = np.ascontiguousarray(q, dtype=np.float64)
@@ -658,13 +659,23 @@ def inverse_result(
         coordinate_kinds=list(mech.coordinate_kinds),
         body_names=list(mech.body_names),
     )
-    return attach_metadata(res, mech, None, kind="inverse")
+    if given is not None and given.ndim == 2:
+        branch = "each row's body coordinates"
+    elif given is not None:
+        branch = "continued from the first row's body coordinates"
+    else:
+        branch = "the drawn branch, continued row to row"
+    return attach_metadata(res, mech, None, kind="inverse", branch=branch)
 
 
 def inverse_from_file(mech: Mechanism, path: str | os.PathLike[str]) -> SimulationResult:
     """:func:`inverse_result` of the motion in a file (see :func:`read_motion`)."""
     m = read_motion(path, mech.coordinate_names)
     qd, qdd = motion_derivatives(m["t"], m["q"], m["qd_columns"], m["qdd_columns"])
-    res = inverse_result(mech, m["t"], m["q"], qd, qdd, x=m["x"])
+    try:
+        res = inverse_result(mech, m["t"], m["q"], qd, qdd, x=m["x"])
+    except SingularityError as e:
+        e.args = (f"{path}: {e}",)
+        raise
     return attach_metadata(res, None, None, motion=str(path))
 
