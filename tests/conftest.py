@@ -7,6 +7,8 @@ are derived from them in closed form (see each test's comment).
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 import os
 from pathlib import Path
@@ -122,3 +124,17 @@ def _headless_matplotlib():
 
 def shipped_models() -> list[Path]:
     return sorted(MODELS.glob("*.yaml")) + sorted(MODELS.glob("*.json"))
+
+
+def cli_run(*argv: object) -> tuple[int, str]:
+    """Exit status and stderr of ``planardyn ARGV`` run in this process (stdout dropped); an
+    exception escaping ``cli.main`` fails the test with its traceback."""
+    from planardyn.cli import main
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            code = main([str(a) for a in argv])
+        except SystemExit as e:  # argparse's usage errors
+            code = e.code if isinstance(e.code, int) else 2
+    return code, err.getvalue()

@@ -14,7 +14,6 @@ tests/test_cli_fuzz.py`` runs a longer one (default 150 inputs, seed 11).
 
 from __future__ import annotations
 
-import contextlib
 import io
 import json
 import os
@@ -26,8 +25,7 @@ from typing import Any
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import MODELS
-from planardyn.cli import main
+from conftest import MODELS, cli_run
 
 N_INPUTS = int(os.environ.get("PLANARDYN_CLI_FUZZ_N", "150"))
 SEED = int(os.environ.get("PLANARDYN_CLI_FUZZ_SEED", "11"))
@@ -38,17 +36,6 @@ FORMATS = (".csv", ".npz", ".parquet")
 WORDS = ["0", "-1", "-0", "1", "2", "nan", "inf", "-inf", "1e400", "1e-400", "x", "", "0x10", "9" * 400,
          "1e308", "5e-324", "1e12", "1e13", "20000", "100000", "-1e-9", "3.5", " 2 ", "1_000"]
 
-
-def run(argv: list[str]) -> tuple[int, str]:
-    """Exit status and stderr of ``planardyn ARGV`` run here; an exception escaping main fails
-    the test with its traceback."""
-    err = io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-        try:
-            code = main(argv)
-        except SystemExit as e:  # argparse's usage errors
-            code = e.code if isinstance(e.code, int) else 2
-    return code, err.getvalue()
 
 
 @pytest.fixture(scope="module")
@@ -204,7 +191,7 @@ def motion_table(argv: list[str], path: Path) -> bool:
 
 
 def check(argv: list[str], path: Path, damaged: bool, harmless: bool, original: pd.SimulationResult) -> int:
-    code, err = run(argv)
+    code, err = cli_run(*argv)
     where = f"planardyn {' '.join(argv)}"
     assert code in (0, 1, 2), f"{where}: exit {code}\n{err}"
     assert "Traceback" not in err and "planardyn: unexpected " not in err, f"{where}:\n{err}"
@@ -267,7 +254,7 @@ def test_npz_needing_pickle_is_refused_with_its_name(tmp_path):
     """A .npz of object arrays was read on numpy's advice to pass allow_pickle; now refused."""
     p = tmp_path / "other.npz"
     np.savez(p, metadata=np.array([{"format": "planardyn-results"}], dtype=object))
-    code, err = run(["plot", str(p)])
+    code, err = cli_run(*["plot", str(p)])
     assert code == 2 and str(p) in err and "allow_pickle" not in err, err
     with zipfile.ZipFile(p) as z:
         assert z.namelist() == ["metadata.npy"]

@@ -6,8 +6,6 @@ Each test states the failure it reproduces (what happened before) and checks the
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import os
 import signal
@@ -16,22 +14,12 @@ import zipfile
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import MODELS
+from conftest import MODELS, cli_run
 from planardyn import cli, guard, results_io
 from planardyn.results_io import read_results, write_results
 
 FIVE_BAR = MODELS / "five-bar.yaml"
 
-
-def run(*argv: str) -> tuple[int, str]:
-    """``planardyn ARGV`` run here: exit status and stderr (an escaping exception fails the test)."""
-    err = io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-        try:
-            code = cli.main([str(a) for a in argv])
-        except SystemExit as e:
-            code = e.code
-    return code, err.getvalue()
 
 
 @pytest.fixture(scope="module")
@@ -119,7 +107,7 @@ def test_ctrl_c_keeps_the_run_as_a_cancelled_file(tmp_path, monkeypatch):
             os.kill(os.getpid(), signal.SIGINT)
 
     monkeypatch.setattr(cli.ProgressBar, "__call__", press_ctrl_c)
-    code, err = run("simulate", FIVE_BAR, "--t-end", "5000", "--output-dt", "0.5", "--progress", "-o", out)
+    code, err = cli_run("simulate", FIVE_BAR, "--t-end", "5000", "--output-dt", "0.5", "--progress", "-o", out)
     assert code == 1 and "interrupted (Ctrl-C)" in err, err
     back = read_results(out)
     assert back.status == "cancelled" and not back.success and "Ctrl-C" in back.message
@@ -136,7 +124,7 @@ def test_run_that_cannot_fit_is_refused_up_front(monkeypatch):
     # 10001 rows of the five-bar (m = 2, 4 bodies): 8 * (1 + 8 + 5 + 24) + 1 = 305 B a row,
     # times PEAK_FACTOR 4: 12.2 MB > 10 MiB.
     assert guard.row_bytes(2, 4) == 305
-    code, err = run("simulate", FIVE_BAR, "--t-end", "10", "--output-dt", "0.001")
+    code, err = cli_run("simulate", FIVE_BAR, "--t-end", "10", "--output-dt", "0.001")
     assert code == 2 and "--output-dt" in err and "--t-end" in err and "five-bar.yaml" in err, err
 
 
@@ -190,7 +178,7 @@ def test_damaged_npz_gives_exit_2_naming_file_and_field(run_5bar, tmp_path, dama
         np.savez(path, metadata=np.array([{"format": "planardyn-results"}], dtype=object))
     for argv in (["plot", path], ["animate", FIVE_BAR, path, "-o", tmp_path / "v.html"],
                  ["inverse", FIVE_BAR, "--motion", path]):
-        code, err = run(*argv)
+        code, err = cli_run(*argv)
         assert code == 2 and str(path) in err and "Traceback" not in err, err
         assert len(err.strip().splitlines()) == 1 and "allow_pickle" not in err
         assert __import__("re").search(expect, err), err
@@ -207,7 +195,7 @@ def test_damaged_npz_gives_exit_2_naming_file_and_field(run_5bar, tmp_path, dama
     (["animate", FIVE_BAR, "r.csv", "-o", "v.gif", "--fps", "inf"], "--fps"),
 ])
 def test_out_of_range_options_exit_2_naming_the_option(argv, option):
-    code, err = run(*argv)
+    code, err = cli_run(*argv)
     assert code == 2 and f"argument {option}" in err and "Traceback" not in err, err
 
 
@@ -216,7 +204,7 @@ def test_unexpected_error_is_one_line_exit_1(monkeypatch):
         raise RuntimeError("boom")
 
     monkeypatch.setitem(cli.COMMANDS, "check", broken)
-    code, err = run("check", FIVE_BAR)
+    code, err = cli_run("check", FIVE_BAR)
     assert (code, err) == (1, "planardyn: unexpected RuntimeError: boom (please report this)\n")
 
 

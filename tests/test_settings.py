@@ -3,29 +3,18 @@ and the CLI (planardyn.settings); batch threads bounded; a batch keeps what it h
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
 
 import numpy as np
 import planardyn as pd
 import pytest
 import yaml
-from conftest import MODELS
-from planardyn import batch, cli
+from conftest import MODELS, cli_run
+from planardyn import batch
 from planardyn.settings import MAX_THREADS, MIN_RTOL
 
 FIVE_BAR = MODELS / "five-bar.yaml"
 
-
-def cli_run(*argv: str) -> tuple[int, str]:
-    err = io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-        try:
-            code = cli.main([str(a) for a in argv])
-        except SystemExit as e:
-            code = e.code
-    return code, err.getvalue()
 
 
 def model_with(**simulate) -> str:
