@@ -128,3 +128,30 @@ fn a_file_that_cannot_be_read_says_which_and_where() {
     assert_eq!(e.path(), "line 2 column 10");
     assert!(e.to_string().ends_with("the file is not UTF-8 text; save it as UTF-8"), "{e}");
 }
+
+/// A triangle of two bars pinned to the ground at O and A and to each other at B: 3*2 - 2*3 = 0.
+const TRIANGLE: &str = "name: s\npoints: {O: [0, 0], A: [1, 0], B: [0, 1]}\nground: [O, A]\nbodies:\n  \
+    b1: {points: [O, B], mass: 1, inertia: 1, com: [0, 0.5]}\n  b2: {points: [A, B], mass: 1, inertia: 1, com: [0.5, 0.5]}\n\
+    pairs:\n  - {type: revolute, name: O, at: O, bodies: [ground, b1]}\n  - {type: revolute, name: A, at: A, bodies: [ground, b2]}\n  \
+    - {type: revolute, name: B, at: B, bodies: [b1, b2]}\n";
+
+#[test]
+fn a_structure_is_told_it_cannot_move_whatever_its_coordinates() {
+    let expected = "m.yaml: coordinates: the drawing is a structure (mobility 0): its 6 pair constraints have rank 6 = 3n \
+        in the drawing (Chebyshev-Grubler: 3n - 2p = 3*2 - 2*3 = 0), so nothing can move, and planardyn moves mechanisms \
+        only; remove a pair or a body (or add a body) until the mobility is at least 1, or check the drawing, then give \
+        one coordinate per degree of freedom";
+    for coordinates in ["coordinates: []\n", "coordinates:\n  - {name: q, pair: O, value: 1.5707963267948966}\n"] {
+        let (msg, path) = refused(&format!("{TRIANGLE}{coordinates}"), Format::Yaml);
+        assert_eq!(path, "coordinates");
+        assert_eq!(msg, expected);
+    }
+    // A mechanism with no coordinate is told how many to give.
+    let (msg, _) =
+        refused(&FOUR_BAR.replace("  - {name: theta1, pair: O, value: 1.0471975511965976}\n", ""), Format::Yaml);
+    assert_eq!(
+        msg,
+        "m.yaml: coordinates: no generalized coordinates, but the mechanism has mobility 3n - rank = 1; \
+         name 1 input pair(s) under `coordinates`"
+    );
+}

@@ -718,9 +718,6 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
 /// in `warnings`.
 fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     let (n, rows, m) = (mech.n_bodies() as i64, mech.n_pair_rows(), mech.dof() as i64);
-    if m == 0 {
-        return Err(ctx.err("coordinates", "no generalized coordinates: name at least one input pair"));
-    }
     let cr = constraint_rank(mech, &mech.x0);
     let (grubler, mobility) = (3 * n - rows as i64, 3 * n - cr.rank as i64);
     // The count written out: 2 rows for each revolute and prismatic pair, 1 for each gear or slot.
@@ -728,6 +725,34 @@ fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     let p2 = mech.pairs.len() - p1;
     let count =
         if p1 == 0 { format!("3n - 2p = 3*{n} - 2*{p2}") } else { format!("3n - 2p - p1 = 3*{n} - 2*{p2} - {p1}") };
+    // Whatever the coordinates, a drawing whose constraints have full rank cannot move.
+    if mobility == 0 {
+        let why = if n == 0 {
+            "the model has no mobile body".to_string()
+        } else {
+            format!(
+                "its {rows} pair constraints have rank {} = 3n in the drawing (Chebyshev-Grubler: {count} = {grubler})",
+                cr.rank
+            )
+        };
+        return Err(ctx.err(
+            "coordinates",
+            format!(
+                "the drawing is a structure (mobility 0): {why}, so nothing can move, and planardyn moves \
+                 mechanisms only; remove a pair or a body (or add a body) until the mobility is at least 1, \
+                 or check the drawing, then give one coordinate per degree of freedom"
+            ),
+        ));
+    }
+    if m == 0 {
+        return Err(ctx.err(
+            "coordinates",
+            format!(
+                "no generalized coordinates, but the mechanism has mobility 3n - rank = {mobility}; \
+                 name {mobility} input pair(s) under `coordinates`"
+            ),
+        ));
+    }
     if mobility != m {
         let message = if mobility == grubler {
             format!(
