@@ -155,3 +155,26 @@ fn a_structure_is_told_it_cannot_move_whatever_its_coordinates() {
          name 1 input pair(s) under `coordinates`"
     );
 }
+
+#[test]
+fn a_number_in_another_radix_or_beyond_a_double_is_named_for_what_it_is() {
+    // YAML reads 0x10 as the integer 16, and the number field refuses it: not "expected a number".
+    let (msg, path) = refused(&FOUR_BAR.replace("mass: 0.5,", "mass: 0x10,"), Format::Yaml);
+    assert_eq!(path, "bodies.crank.mass");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: the integer 16 is written in hexadecimal, octal or binary (0x, 0o or 0b), \
+         which the model does not accept (line 11 column 33); write the decimal number 16"
+    );
+    // 400 digits overflow a double (YAML then reads them as text): not "a string".
+    let (msg, _) = refused(&FOUR_BAR.replace("mass: 0.5,", &format!("mass: {},", "1".repeat(400))), Format::Yaml);
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: the number 11111111111111111111... (400 characters) is beyond the largest \
+         magnitude a number can have (about 1.8e308) (line 11 column 33); check the units (SI) and the digits, \
+         and write it with at most 17 significant digits, in exponent form if large (e.g. 1.5e12)"
+    );
+    // A long number within range is read (to the nearest double).
+    let long = format!("0.5{}", "0".repeat(400));
+    yaml(&FOUR_BAR.replace("mass: 0.5,", &format!("mass: {long},")));
+}
