@@ -178,3 +178,23 @@ fn a_number_in_another_radix_or_beyond_a_double_is_named_for_what_it_is() {
     let long = format!("0.5{}", "0".repeat(400));
     yaml(&FOUR_BAR.replace("mass: 0.5,", &format!("mass: {long},")));
 }
+
+#[test]
+fn a_centre_of_mass_far_outside_the_drawing_is_named() {
+    let text = FOUR_BAR.replace("com: [0.125, 0.21650635094610965]", "com: [1e9, 0.2]");
+    let (msg, path) = refused(&text, Format::Yaml);
+    assert_eq!(path, "bodies.crank.com");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.com: the centre of mass [1000000000, 0.2] is 1.000e9 m from the nearest point of body \
+         'crank', more than 1e6 times the size of the drawing (1.6351920284924188 m): it is far outside the drawing; \
+         check its coordinates and units (SI: metres), and give it in the same frame as `points`"
+    );
+    // A part's centre of mass is named as the part's.
+    let parts = FOUR_BAR.replace(
+        "crank: {points: [O, A], mass: 0.5, inertia: 0.010416666666666666, com: [0.125, 0.21650635094610965]}",
+        "crank: {points: [O, A], parts: [{point_mass: A, mass: 0.5}, {mass: 1e-3, inertia: 0, com: [0, -1e7]}]}",
+    );
+    let (_, path) = refused(&parts, Format::Yaml);
+    assert_eq!(path, "bodies.crank.parts[1].com");
+}

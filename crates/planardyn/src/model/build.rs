@@ -126,7 +126,8 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         }
         ground_points.push(p);
     }
-    let bodies = spec.bodies.0.iter().map(|(name, b)| build_body(&ctx, name, b)).collect::<R<Vec<_>>>()?;
+    let scale = characteristic_length(&points);
+    let bodies = spec.bodies.0.iter().map(|(name, b)| build_body(&ctx, name, b, scale)).collect::<R<Vec<_>>>()?;
     let mut mech = Mechanism {
         name: spec.name.clone(),
         source: source.to_string(),
@@ -149,7 +150,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         warnings: Vec::new(),
     };
     mech.x0 = mech.bodies.iter().flat_map(|b| [b.com0[0], b.com0[1], b.angle0]).collect();
-    mech.scale = characteristic_length(&mech.points);
+    mech.scale = scale;
     for (k, p) in spec.pairs.iter().enumerate() {
         let pair = build_pair(&ctx, &mech, k, p)?;
         if mech.pairs.iter().any(|q| q.name == pair.name) {
@@ -170,6 +171,43 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
+}
+
+/// Largest distance from a centre of mass to the nearest point of its body, in lengths of
+/// the drawing: the body's points are stored relative to it, and 1e6 L keeps them to about
+/// 1e-10 L, well within what the rank test of the drawing resolves (1e9 L defeats it).
+const MAX_COM_OFFSET: f64 = 1e6;
+
+/// Every centre of mass given as coordinates lies near its body: far outside the drawing it
+/// is a typing or units error (and ruins the precision of the body's points).
+fn check_com_near(
+    ctx: &Ctx,
+    name: &str,
+    b: &BodySpec,
+    parts: &[(f64, f64, [f64; 2])],
+    points: impl Iterator<Item = [f64; 2]> + Clone,
+    scale: f64,
+) -> R<()> {
+    let far = |c: [f64; 2]| {
+        let d = points.clone().map(|p| (p[0] - c[0]).hypot(p[1] - c[1])).fold(f64::INFINITY, f64::min);
+        (d > MAX_COM_OFFSET * scale).then_some(d)
+    };
+    for (k, part) in parts.iter().enumerate() {
+        if let Some(d) = far(part.2) {
+            let field =
+                if b.parts.is_some() { format!("bodies.{name}.parts[{k}].com") } else { format!("bodies.{name}.com") };
+            return Err(ctx.err(
+                field,
+                format!(
+                    "the centre of mass [{}, {}] is {d:.3e} m from the nearest point of body '{name}', more than \
+                     {MAX_COM_OFFSET:e} times the size of the drawing ({scale} m): it is far outside the drawing; \
+                     check its coordinates and units (SI: metres), and give it in the same frame as `points`",
+                    part.2[0], part.2[1],
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Mass, inertia and centre of mass of one part.
@@ -211,7 +249,7 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     Ok((mass, inertia, com))
 }
 
-fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
+fn build_body(ctx: &Ctx, name: &str, b: &BodySpec, scale: f64) -> R<Body> {
     let path = format!("bodies.{name}");
     if name == "ground" {
         return Err(ctx.err(&path, "'ground' is the fixed body; list its points under the top-level `ground`"));
@@ -274,6 +312,7 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         ids.push(id);
     }
     let xy = |id: PointId| ctx.spec.points.0[id.0];
+    check_com_near(ctx, name, b, &parts, ids.iter().map(|&id| xy(id)), scale)?;
     let angle0 = match ids.as_slice() {
         [p0, p1, ..] => {
             let (a, b) = (xy(*p0), xy(*p1));
