@@ -198,3 +198,15 @@ fn a_centre_of_mass_far_outside_the_drawing_is_named() {
     let (_, path) = refused(&parts, Format::Yaml);
     assert_eq!(path, "bodies.crank.parts[1].com");
 }
+
+#[test]
+fn an_unnamed_pair_is_not_referenced_by_its_made_up_name() {
+    let text = FOUR_BAR.replace("{name: theta1, pair: O,", "{name: theta1, pair: crank-coupler@A,");
+    let (msg, path) = refused(&text, Format::Yaml);
+    assert_eq!(path, "coordinates[0].pair");
+    assert_eq!(
+        msg,
+        "m.yaml: coordinates[0].pair: 'crank-coupler@A' is the name made up for the unnamed pairs[1], which a model \
+         may not refer to; give that pair a `name:` and refer to it by that name"
+    );
+}

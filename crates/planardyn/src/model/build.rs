@@ -564,13 +564,35 @@ fn local_coords(mech: &Mechanism, link: Link, p: [f64; 2]) -> [f64; 2] {
     }
 }
 
+/// A pair referenced by the `name` it was given: the name made up for an unnamed pair
+/// (`a-b@at`) is for messages and results only, and changes when the file is edited.
 fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
-    mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
+    let id = mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
         ctx.err(
             path,
             format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")),
         )
-    })
+    })?;
+    if pair_name(&ctx.spec.pairs[id.0]).is_none() {
+        return Err(ctx.err(
+            path,
+            format!(
+                "'{name}' is the name made up for the unnamed pairs[{}], which a model may not refer to; \
+                 give that pair a `name:` and refer to it by that name",
+                id.0
+            ),
+        ));
+    }
+    Ok(id)
+}
+
+fn pair_name(p: &PairSpec) -> &Option<String> {
+    match p {
+        PairSpec::Revolute { name, .. }
+        | PairSpec::Prismatic { name, .. }
+        | PairSpec::Slot { name, .. }
+        | PairSpec::Gear { name, .. } => name,
+    }
 }
 
 /// A pair with a relative motion of its own (for a pair spring or friction).
