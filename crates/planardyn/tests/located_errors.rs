@@ -210,3 +210,19 @@ fn an_unnamed_pair_is_not_referenced_by_its_made_up_name() {
          may not refer to; give that pair a `name:` and refer to it by that name"
     );
 }
+
+#[test]
+fn a_yaml_tag_is_refused_where_it_is() {
+    let (msg, path) = refused(&FOUR_BAR.replace("mass: 0.5,", "mass: !foo 3,"), Format::Yaml);
+    assert_eq!(path, "bodies.crank.mass");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: the YAML tag `!foo` is not part of the model format (line 11 column 33); \
+         remove it and write the value alone (see docs/model-format.md)"
+    );
+    let (msg, path) = refused(&format!("!model\n{FOUR_BAR}"), Format::Yaml);
+    assert_eq!(path, "line 1 column 1");
+    assert!(msg.starts_with("m.yaml: line 1 column 1: the YAML tag `!model` is not part"), "{msg}");
+    // The core tags are YAML's own types, and `!` inside a plain string is text.
+    yaml(&FOUR_BAR.replace("mass: 0.5,", "mass: !!float 0.5,").replace("under gravity", "under gravity !x"));
+}

@@ -126,7 +126,7 @@ impl Input<'_> {
 
 /// The field path, `bodies.crank.mass`, `pairs[2].at`; up to an unknown segment (a key
 /// that is not a string), empty at the top of the document.
-fn field_path(path: &Path) -> String {
+pub(super) fn field_path(path: &Path) -> String {
     let mut out = String::new();
     for segment in path {
         match segment {
