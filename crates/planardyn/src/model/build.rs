@@ -175,7 +175,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
 
 /// Largest distance from a centre of mass to the nearest point of its body, in lengths of
 /// the drawing: the body's points are stored relative to it, and 1e6 L keeps them to about
-/// 1e-10 L, well within what the rank test of the drawing resolves (1e9 L defeats it).
+/// 2e-10 L, well within what the rank test of the drawing resolves (1e9 L defeats it).
 const MAX_COM_OFFSET: f64 = 1e6;
 
 /// Every centre of mass given as coordinates lies near its body: far outside the drawing it
