@@ -153,6 +153,31 @@ def test_malformed_yaml():
     assert "broken.yaml" in str(info.value)
 
 
+def _yaml_error(text: str) -> pd.ModelError:
+    with pytest.raises(pd.ModelError) as info:
+        pd.loads(text, source="m.yaml")
+    return info.value
+
+
+def test_a_hexadecimal_mass_is_named_as_such():
+    # YAML reads 0x10 as the integer 16; a number field takes decimal numbers only.
+    d = four_bar_dict()
+    d["bodies"]["crank"]["mass"] = "MASS"
+    e = _yaml_error(yaml.safe_dump(d, sort_keys=False).replace("MASS", "0x10"))
+    assert e.path == "bodies.crank.mass"
+    assert "the integer 16 is written in hexadecimal, octal or binary (0x, 0o or 0b)" in str(e)
+    assert str(e).endswith("; write the decimal number 16")
+
+
+def test_a_yaml_tag_is_refused_with_its_line_and_column():
+    e = _yaml_error("!model\n" + yaml.safe_dump(four_bar_dict(), sort_keys=False))
+    assert e.path == "line 1 column 1"
+    assert str(e) == (
+        "m.yaml: line 1 column 1: the YAML tag `!model` is not part of the model format; "
+        "remove it and write the value alone (see docs/model-format.md)"
+    )
+
+
 def test_wrong_type_names_the_field():
     d = four_bar_dict()
     d["bodies"]["crank"]["mass"] = "heavy"

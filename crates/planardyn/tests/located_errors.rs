@@ -128,3 +128,101 @@ fn a_file_that_cannot_be_read_says_which_and_where() {
     assert_eq!(e.path(), "line 2 column 10");
     assert!(e.to_string().ends_with("the file is not UTF-8 text; save it as UTF-8"), "{e}");
 }
+
+/// A triangle of two bars pinned to the ground at O and A and to each other at B: 3*2 - 2*3 = 0.
+const TRIANGLE: &str = "name: s\npoints: {O: [0, 0], A: [1, 0], B: [0, 1]}\nground: [O, A]\nbodies:\n  \
+    b1: {points: [O, B], mass: 1, inertia: 1, com: [0, 0.5]}\n  b2: {points: [A, B], mass: 1, inertia: 1, com: [0.5, 0.5]}\n\
+    pairs:\n  - {type: revolute, name: O, at: O, bodies: [ground, b1]}\n  - {type: revolute, name: A, at: A, bodies: [ground, b2]}\n  \
+    - {type: revolute, name: B, at: B, bodies: [b1, b2]}\n";
+
+#[test]
+fn a_structure_is_told_it_cannot_move_whatever_its_coordinates() {
+    let expected = "m.yaml: coordinates: the drawing is a structure (mobility 0): its 6 pair constraints have rank 6 = 3n \
+        in the drawing (Chebyshev-Grubler: 3n - 2p = 3*2 - 2*3 = 0), so nothing can move, and planardyn moves mechanisms \
+        only; remove a pair or a body (or add a body) until the mobility is at least 1, or check the drawing, then give \
+        one coordinate per degree of freedom";
+    for coordinates in ["coordinates: []\n", "coordinates:\n  - {name: q, pair: O, value: 1.5707963267948966}\n"] {
+        let (msg, path) = refused(&format!("{TRIANGLE}{coordinates}"), Format::Yaml);
+        assert_eq!(path, "coordinates");
+        assert_eq!(msg, expected);
+    }
+    // A mechanism with no coordinate is told how many to give.
+    let (msg, _) =
+        refused(&FOUR_BAR.replace("  - {name: theta1, pair: O, value: 1.0471975511965976}\n", ""), Format::Yaml);
+    assert_eq!(
+        msg,
+        "m.yaml: coordinates: no generalized coordinates, but the mechanism has mobility 3n - rank = 1; \
+         name 1 input pair(s) under `coordinates`"
+    );
+}
+
+#[test]
+fn a_number_in_another_radix_or_beyond_a_double_is_named_for_what_it_is() {
+    // YAML reads 0x10 as the integer 16, and the number field refuses it: not "expected a number".
+    let (msg, path) = refused(&FOUR_BAR.replace("mass: 0.5,", "mass: 0x10,"), Format::Yaml);
+    assert_eq!(path, "bodies.crank.mass");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: the integer 16 is written in hexadecimal, octal or binary (0x, 0o or 0b), \
+         which the model does not accept (line 11 column 33); write the decimal number 16"
+    );
+    // 400 digits overflow a double (YAML then reads them as text): not "a string".
+    let (msg, _) = refused(&FOUR_BAR.replace("mass: 0.5,", &format!("mass: {},", "1".repeat(400))), Format::Yaml);
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: the number 11111111111111111111... (400 characters) is beyond the largest \
+         magnitude a number can have (about 1.8e308) (line 11 column 33); check the units (SI) and the digits, \
+         and write it with at most 17 significant digits, in exponent form if large (e.g. 1.5e12)"
+    );
+    // A long number within range is read (to the nearest double).
+    let long = format!("0.5{}", "0".repeat(400));
+    yaml(&FOUR_BAR.replace("mass: 0.5,", &format!("mass: {long},")));
+}
+
+#[test]
+fn a_centre_of_mass_far_outside_the_drawing_is_named() {
+    let text = FOUR_BAR.replace("com: [0.125, 0.21650635094610965]", "com: [1e9, 0.2]");
+    let (msg, path) = refused(&text, Format::Yaml);
+    assert_eq!(path, "bodies.crank.com");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.com: the centre of mass [1000000000, 0.2] is 1.000e9 m from the nearest point of body \
+         'crank', more than 1e6 times the size of the drawing (1.6351920284924188 m): it is far outside the drawing; \
+         check its coordinates and units (SI: metres), and give it in the same frame as `points`"
+    );
+    // A part's centre of mass is named as the part's.
+    let parts = FOUR_BAR.replace(
+        "crank: {points: [O, A], mass: 0.5, inertia: 0.010416666666666666, com: [0.125, 0.21650635094610965]}",
+        "crank: {points: [O, A], parts: [{point_mass: A, mass: 0.5}, {mass: 1e-3, inertia: 0, com: [0, -1e7]}]}",
+    );
+    let (_, path) = refused(&parts, Format::Yaml);
+    assert_eq!(path, "bodies.crank.parts[1].com");
+}
+
+#[test]
+fn an_unnamed_pair_is_not_referenced_by_its_made_up_name() {
+    let text = FOUR_BAR.replace("{name: theta1, pair: O,", "{name: theta1, pair: crank-coupler@A,");
+    let (msg, path) = refused(&text, Format::Yaml);
+    assert_eq!(path, "coordinates[0].pair");
+    assert_eq!(
+        msg,
+        "m.yaml: coordinates[0].pair: 'crank-coupler@A' is the name made up for the unnamed pairs[1], which a model \
+         may not refer to; give that pair a `name:` and refer to it by that name"
+    );
+}
+
+#[test]
+fn a_yaml_tag_is_refused_where_it_is() {
+    let (msg, path) = refused(&FOUR_BAR.replace("mass: 0.5,", "mass: !foo 3,"), Format::Yaml);
+    assert_eq!(path, "bodies.crank.mass");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.mass: the YAML tag `!foo` is not part of the model format (line 11 column 33); \
+         remove it and write the value alone (see docs/model-format.md)"
+    );
+    let (msg, path) = refused(&format!("!model\n{FOUR_BAR}"), Format::Yaml);
+    assert_eq!(path, "line 1 column 1");
+    assert!(msg.starts_with("m.yaml: line 1 column 1: the YAML tag `!model` is not part"), "{msg}");
+    // The core tags are YAML's own types, and `!` inside a plain string is text.
+    yaml(&FOUR_BAR.replace("mass: 0.5,", "mass: !!float 0.5,").replace("under gravity", "under gravity !x"));
+}

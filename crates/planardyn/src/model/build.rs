@@ -126,7 +126,8 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         }
         ground_points.push(p);
     }
-    let bodies = spec.bodies.0.iter().map(|(name, b)| build_body(&ctx, name, b)).collect::<R<Vec<_>>>()?;
+    let scale = characteristic_length(&points);
+    let bodies = spec.bodies.0.iter().map(|(name, b)| build_body(&ctx, name, b, scale)).collect::<R<Vec<_>>>()?;
     let mut mech = Mechanism {
         name: spec.name.clone(),
         source: source.to_string(),
@@ -149,7 +150,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         warnings: Vec::new(),
     };
     mech.x0 = mech.bodies.iter().flat_map(|b| [b.com0[0], b.com0[1], b.angle0]).collect();
-    mech.scale = characteristic_length(&mech.points);
+    mech.scale = scale;
     for (k, p) in spec.pairs.iter().enumerate() {
         let pair = build_pair(&ctx, &mech, k, p)?;
         if mech.pairs.iter().any(|q| q.name == pair.name) {
@@ -170,6 +171,43 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
+}
+
+/// Largest distance from a centre of mass to the nearest point of its body, in lengths of
+/// the drawing: the body's points are stored relative to it, and 1e6 L keeps them to about
+/// 2e-10 L, well within what the rank test of the drawing resolves (1e9 L defeats it).
+const MAX_COM_OFFSET: f64 = 1e6;
+
+/// Every centre of mass given as coordinates lies near its body: far outside the drawing it
+/// is a typing or units error (and ruins the precision of the body's points).
+fn check_com_near(
+    ctx: &Ctx,
+    name: &str,
+    b: &BodySpec,
+    parts: &[(f64, f64, [f64; 2])],
+    points: impl Iterator<Item = [f64; 2]> + Clone,
+    scale: f64,
+) -> R<()> {
+    let far = |c: [f64; 2]| {
+        let d = points.clone().map(|p| (p[0] - c[0]).hypot(p[1] - c[1])).fold(f64::INFINITY, f64::min);
+        (d > MAX_COM_OFFSET * scale).then_some(d)
+    };
+    for (k, part) in parts.iter().enumerate() {
+        if let Some(d) = far(part.2) {
+            let field =
+                if b.parts.is_some() { format!("bodies.{name}.parts[{k}].com") } else { format!("bodies.{name}.com") };
+            return Err(ctx.err(
+                field,
+                format!(
+                    "the centre of mass [{}, {}] is {d:.3e} m from the nearest point of body '{name}', more than \
+                     {MAX_COM_OFFSET:e} times the size of the drawing ({scale} m): it is far outside the drawing; \
+                     check its coordinates and units (SI: metres), and give it in the same frame as `points`",
+                    part.2[0], part.2[1],
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Mass, inertia and centre of mass of one part.
@@ -211,7 +249,7 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
     Ok((mass, inertia, com))
 }
 
-fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
+fn build_body(ctx: &Ctx, name: &str, b: &BodySpec, scale: f64) -> R<Body> {
     let path = format!("bodies.{name}");
     if name == "ground" {
         return Err(ctx.err(&path, "'ground' is the fixed body; list its points under the top-level `ground`"));
@@ -274,6 +312,7 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec) -> R<Body> {
         ids.push(id);
     }
     let xy = |id: PointId| ctx.spec.points.0[id.0];
+    check_com_near(ctx, name, b, &parts, ids.iter().map(|&id| xy(id)), scale)?;
     let angle0 = match ids.as_slice() {
         [p0, p1, ..] => {
             let (a, b) = (xy(*p0), xy(*p1));
@@ -525,13 +564,35 @@ fn local_coords(mech: &Mechanism, link: Link, p: [f64; 2]) -> [f64; 2] {
     }
 }
 
+/// A pair referenced by the `name` it was given: the name made up for an unnamed pair
+/// (`a-b@at`) is for messages and results only, and changes when the file is edited.
 fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
-    mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
+    let id = mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
         ctx.err(
             path,
             format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")),
         )
-    })
+    })?;
+    if pair_name(&ctx.spec.pairs[id.0]).is_none() {
+        return Err(ctx.err(
+            path,
+            format!(
+                "'{name}' is the name made up for the unnamed pairs[{}], which a model may not refer to; \
+                 give that pair a `name:` and refer to it by that name",
+                id.0
+            ),
+        ));
+    }
+    Ok(id)
+}
+
+fn pair_name(p: &PairSpec) -> &Option<String> {
+    match p {
+        PairSpec::Revolute { name, .. }
+        | PairSpec::Prismatic { name, .. }
+        | PairSpec::Slot { name, .. }
+        | PairSpec::Gear { name, .. } => name,
+    }
 }
 
 /// A pair with a relative motion of its own (for a pair spring or friction).
@@ -718,9 +779,6 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
 /// in `warnings`.
 fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     let (n, rows, m) = (mech.n_bodies() as i64, mech.n_pair_rows(), mech.dof() as i64);
-    if m == 0 {
-        return Err(ctx.err("coordinates", "no generalized coordinates: name at least one input pair"));
-    }
     let cr = constraint_rank(mech, &mech.x0);
     let (grubler, mobility) = (3 * n - rows as i64, 3 * n - cr.rank as i64);
     // The count written out: 2 rows for each revolute and prismatic pair, 1 for each gear or slot.
@@ -728,6 +786,34 @@ fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     let p2 = mech.pairs.len() - p1;
     let count =
         if p1 == 0 { format!("3n - 2p = 3*{n} - 2*{p2}") } else { format!("3n - 2p - p1 = 3*{n} - 2*{p2} - {p1}") };
+    // Whatever the coordinates, a drawing whose constraints have full rank cannot move.
+    if mobility == 0 {
+        let why = if n == 0 {
+            "the model has no mobile body".to_string()
+        } else {
+            format!(
+                "its {rows} pair constraints have rank {} = 3n in the drawing (Chebyshev-Grubler: {count} = {grubler})",
+                cr.rank
+            )
+        };
+        return Err(ctx.err(
+            "coordinates",
+            format!(
+                "the drawing is a structure (mobility 0): {why}, so nothing can move, and planardyn moves \
+                 mechanisms only; remove a pair or a body (or add a body) until the mobility is at least 1, \
+                 or check the drawing, then give one coordinate per degree of freedom"
+            ),
+        ));
+    }
+    if m == 0 {
+        return Err(ctx.err(
+            "coordinates",
+            format!(
+                "no generalized coordinates, but the mechanism has mobility 3n - rank = {mobility}; \
+                 name {mobility} input pair(s) under `coordinates`"
+            ),
+        ));
+    }
     if mobility != m {
         let message = if mobility == grubler {
             format!(

@@ -2,8 +2,8 @@
 //! name the file and the field path (`bodies.crank.mass`) thanks to `serde_path_to_error`,
 //! put in plain words by [`super::parse_errors`].
 
-use super::nesting;
 use super::parse_errors::Input;
+use super::{nesting, tags};
 use super::{Mechanism, MechanismSpec};
 use crate::ModelError;
 use std::path::Path;
@@ -73,6 +73,7 @@ pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismS
                     ),
                 });
             }
+            tags::refuse(text, source)?;
             let de = serde_yaml_ng::Deserializer::from_str(text);
             serde_path_to_error::deserialize(de).map_err(|e| {
                 let at = e.inner().location().map(|l| (l.line(), l.column()));

@@ -10,6 +10,7 @@ mod io;
 mod nesting;
 mod parse_errors;
 pub mod spec;
+mod tags;
 
 pub use io::{load, loads, parse_spec, Format};
 pub use spec::MechanismSpec;

@@ -83,7 +83,11 @@ impl Input<'_> {
                     format!("a model file must be a mapping with the keys name, points, ground, bodies, pairs and coordinates: {docs}"),
                 );
             }
-            return (plain(message), format!("give the form the field takes: {docs}"));
+            let message = plain(message);
+            if let Some(explained) = number_literal(&message) {
+                return explained;
+            }
+            return (message, format!("give the form the field takes: {docs}"));
         }
         let syntax = match self.format {
             Format::Yaml => "the text is not valid YAML: check the indentation, brackets, quotes and colons there",
@@ -122,7 +126,7 @@ impl Input<'_> {
 
 /// The field path, `bodies.crank.mass`, `pairs[2].at`; up to an unknown segment (a key
 /// that is not a string), empty at the top of the document.
-fn field_path(path: &Path) -> String {
+pub(super) fn field_path(path: &Path) -> String {
     let mut out = String::new();
     for segment in path {
         match segment {
@@ -139,6 +143,31 @@ fn push_field(path: &mut String, name: &str) {
         path.push('.');
     }
     path.push_str(name);
+}
+
+/// A number field given a number the YAML parser reads but not as a number of the model: an
+/// integer in another radix (YAML reads `0x10` as the integer 16, but a field of the model
+/// takes decimal numbers only), or a number beyond the largest a double holds (read as text).
+fn number_literal(message: &str) -> Option<(String, String)> {
+    if let Some(n) = between(message, "invalid type: integer ", ", expected a number") {
+        let n = n.trim_matches('`');
+        return Some((
+            format!("the integer {n} is written in hexadecimal, octal or binary (0x, 0o or 0b), which the model does not accept"),
+            format!("write the decimal number {n}"),
+        ));
+    }
+    let text = between(message, "invalid type: string \"", "\", expected a number")?;
+    let huge = text.bytes().any(|b| b.is_ascii_digit()) && text.parse::<f64>().is_ok_and(f64::is_infinite);
+    huge.then(|| {
+        let shown = match text.char_indices().nth(20) {
+            Some((i, _)) => format!("{}... ({} characters)", &text[..i], text.len()),
+            None => text.to_string(),
+        };
+        (
+            format!("the number {shown} is beyond the largest magnitude a number can have (about 1.8e308)"),
+            "check the units (SI) and the digits, and write it with at most 17 significant digits, in exponent form if large (e.g. 1.5e12)".to_string(),
+        )
+    })
 }
 
 /// The text between `start` and the next `end` after it.
