@@ -107,15 +107,30 @@ class Mechanism:
     def pair_geometry(self, x: ArrayLike) -> list[dict[str, Any]]: ...
     def point_positions(self, x: ArrayLike) -> NDArray[np.float64]: ...
     def kinematics(self, q: ArrayLike, qd: ArrayLike | None = None, x_start: ArrayLike | None = None) -> dict[str, Any]: ...
-    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
+    def mass_matrix(self, q: ArrayLike, allow_singular: bool = False) -> NDArray[np.float64]: ...
     def forward_dynamics(
-        self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
     def inverse_dynamics(
-        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
     def reactions(
-        self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]: ...
     def simulate(

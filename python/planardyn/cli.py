@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import math
 import os
 import sys
 import time
@@ -66,11 +65,12 @@ def summary(res: SimulationResult) -> str:
     """One line: status, outputs, steps, energy balance drift, smallest singularity measure."""
     st = res.stats
     t_last = f"{res.t[-1]:.6g}" if len(res.t) else "-"
-    min_sigma = st.get("min_sigma", math.inf)
+    min_sigma = st.get("min_sigma")
+    sigma_text = "-" if min_sigma is None else f"{min_sigma:.3g}"
     return (
         f"{res.status}: {len(res.t)} outputs to t = {t_last} s, {st.get('naccept', 0)} steps "
         f"({st.get('nreject', 0)} rejected, {st.get('nfev', 0)} evaluations), "
-        f"energy drift {res.energy.drift:.3g} J, min sigma {min_sigma:.3g}"
+        f"energy drift {res.energy.drift:.3g} J, min sigma {sigma_text}"
     )
 
 

@@ -228,13 +228,14 @@ class Mechanism:
 
         Raises
         ------
-        AssemblyError, SingularityError (the analogues are undefined where sigma_min = 0).
+        AssemblyError, SingularityError (the analogues are undefined where sigma_min = 0);
+        ValueError (attribute ``quantity``) where rates so large make xd or c overflow.
         """
         return self._native.kinematics(q, qd, x_start)
 
     # ------------------------------------------------------------------ dynamics
 
-    def mass_matrix(self, q: ArrayLike) -> FloatArray:
+    def mass_matrix(self, q: ArrayLike, allow_singular: bool = False) -> FloatArray:
         """Generalized mass matrix A = U^T M U at q.
 
         Parameters
@@ -247,11 +248,24 @@ class Mechanism:
         A : (m, m) ndarray
             Symmetric, positive definite away from singularities (kg m^2 for angles,
             kg for displacements, mixed units off the diagonal).
+
+        Raises
+        ------
+        SingularityError
+            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
+            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
+            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
+            ``allow_singular=True`` the value is computed anyway.
         """
-        return self._native.mass_matrix(q)
+        return self._native.mass_matrix(q, allow_singular)
 
     def forward_dynamics(
-        self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> FloatArray:
         """Generalized accelerations from A qdd = b (forward dynamics).
 
@@ -268,11 +282,27 @@ class Mechanism:
         -------
         qdd : (m,) ndarray
             Accelerations (rad/s^2 or m/s^2).
+
+        Raises
+        ------
+        SingularityError
+            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
+            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
+            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
+            ``allow_singular=True`` the value is computed anyway.
+        ValueError
+            Finite arguments whose result overflows (attribute ``quantity``): try smaller
+            efforts or rates.
         """
-        return self._native.forward_dynamics(q, qd, float(t), tau)
+        return self._native.forward_dynamics(q, qd, float(t), tau, allow_singular)
 
     def inverse_dynamics(
-        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> FloatArray:
         """Drive efforts that produce a motion: tau = A qdd - U^T (f - M c).
 
@@ -294,17 +324,33 @@ class Mechanism:
         -------
         tau : ndarray of the same shape
             Efforts (N m on angles, N on displacements), the model's drives not included.
+
+        Raises
+        ------
+        SingularityError
+            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
+            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
+            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
+            ``allow_singular=True`` every row is computed anyway.
+        ValueError
+            Finite arguments whose result overflows (attribute ``quantity``): try smaller
+            efforts or rates.
         """
-        return self._native.inverse_dynamics(q, qd, qdd, x)
+        return self._native.inverse_dynamics(q, qd, qdd, x, allow_singular)
 
     def reactions(
-        self, q: ArrayLike, qd: ArrayLike, t: float = 0.0, tau: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> FloatArray:
         """Pair reactions during the motion from (q, qd) under drives tau.
 
         Parameters
         ----------
-        q, qd, t, tau
+        q, qd, t, tau, allow_singular
             As for :meth:`forward_dynamics`.
 
         Returns
@@ -312,15 +358,21 @@ class Mechanism:
         (p, 3) ndarray
             Per pair (order of :attr:`pair_names`): [F_x, F_y, M], the force (N, global
             frame) and couple (N m) that the pair's first body exerts on its second.
+
+        Raises
+        ------
+        SingularityError, ValueError
+            As for :meth:`forward_dynamics`.
         """
-        return self._native.reactions(q, qd, float(t), tau)
+        return self._native.reactions(q, qd, float(t), tau, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
         """Kinetic and potential energy (J) at (q, qd): ``(T, V)``, the position reached from
         the body coordinates ``x_start`` (3n,) on the wanted branch when given, else from the
         drawing.
 
-        V counts gravity (zero at y = 0) and the elastic energy of springs.
+        V counts gravity (zero at y = 0) and the elastic energy of springs. Rates so large that
+        T overflows raise ``ValueError`` (attribute ``quantity``).
         """
         return self._native.energy(q, qd, x_start)
 

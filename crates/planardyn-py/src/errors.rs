@@ -14,7 +14,8 @@
 //! the data of where the motion stopped as attributes.
 //!
 //! Shape and value errors in the arguments are plain `ValueError`s (attribute `argument`
-//! where the core names it). A core error of a kind added later is a `PlanardynError`. A Rust panic never
+//! where the core names it), and so are finite arguments whose results overflow
+//! (`KinematicsError::Overflow`, attribute `quantity`). A core error of a kind added later is a `PlanardynError`. A Rust panic never
 //! reaches Python as `PanicException`: [`run`] catches it and raises `PlanardynError` asking
 //! for a bug report.
 
@@ -128,6 +129,10 @@ pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
             let Ok(k) = kind.name().into_pyobject(py);
             let attrs = [("kind", k.into_any().unbind()), ("sigma_min", s.into_any().unbind())];
             with_attrs(py, SingularityError::new_err(e.to_string()), &attrs)
+        }
+        KinematicsError::Overflow { what } => {
+            let Ok(w) = what.into_pyobject(py);
+            with_attrs(py, PyValueError::new_err(e.to_string()), &[("quantity", w.into_any().unbind())])
         }
         KinematicsError::BadArgument { name, .. } => {
             let Ok(n) = name.into_pyobject(py);

@@ -7,7 +7,7 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::{inverse_rows_on, Branch};
+use planardyn::batch::{inverse_rows_checked, Branch};
 use planardyn::dynamics::{self, Drives, ModelDrives};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
@@ -115,12 +115,22 @@ impl PyMechanism {
         Ok(ws)
     }
 
-    fn forward_ws(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Workspace, Failure> {
+    /// Forward dynamics at (q, qd), refused near a type II singularity unless `allow_singular`.
+    fn forward_ws(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        t: f64,
+        tau: Option<Vec<f64>>,
+        allow_singular: bool,
+    ) -> Result<Workspace, Failure> {
         let mech = &*self.inner;
         let mut ws = Workspace::new(mech);
         kin::assemble_into(mech, q, &mut ws)?;
         let mut drives = self.drives_for(tau);
         dynamics::forward(mech, t, q, qd, drives.as_mut(), &mut ws)?;
+        dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
+        dynamics::finite("accelerations qdd", &ws.qdd)?;
         Ok(ws)
     }
 }
@@ -360,6 +370,8 @@ impl PyMechanism {
                 let w = kin::acceleration_analogues(&mech, &mut ws);
                 if let Some(qd) = &qd {
                     kin::convective(&mech, qd, &mut ws);
+                    dynamics::finite("body velocities xd", &ws.xd)?;
+                    dynamics::finite("convective accelerations c", &ws.c)?;
                 }
                 let sigma = kin::sigma_min(&mech, &Chart::Inputs, &ws.x);
                 let passive = kin::passive_sigma_min(&mech, &ws.x);
@@ -402,12 +414,14 @@ impl PyMechanism {
     }
 
     /// Mass matrix A = U^T M U (m, m) at q.
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+    #[pyo3(signature = (q, allow_singular=false))]
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, allow_singular: bool) -> PyResult<Bound<'py, PyAny>> {
         let q = self.q_arg("q", &q)?;
         let mech = self.inner.clone();
         let m = mech.dof();
         let a = run(py, move || {
             let mut ws = Self::analysed(&mech, &q, None)?;
+            dynamics::type_ii_measure(&mech, &mut ws, allow_singular)?;
             dynamics::mass_matrix(&mech, &mut ws);
             Ok(ws.a)
         })?;
@@ -415,7 +429,7 @@ impl PyMechanism {
     }
 
     /// Accelerations qdd (m,) at (q, qd), time t (s), efforts tau (m,) or the model's drives.
-    #[pyo3(signature = (q, qd, t=0.0, tau=None))]
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
     fn forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -423,18 +437,19 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         t: f64,
         tau: Option<ArrayArg<'py>>,
+        allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
-        let ws = run(py, || self.forward_ws(&q, &qd, t, tau))?;
+        let ws = run(py, || self.forward_ws(&q, &qd, t, tau, allow_singular))?;
         Ok(arr1(py, ws.qdd))
     }
 
     /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
     /// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
     /// (`planardyn::batch::Branch`).
-    #[pyo3(signature = (q, qd, qdd, x=None))]
+    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
     fn inverse_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -442,6 +457,7 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
         x: Option<ArrayArg<'py>>,
+        allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let x = x.map(|a| rows("x", &a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
         let m = self.m();
@@ -461,13 +477,13 @@ impl PyMechanism {
                 Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
                 Some(x) => Branch::Rows(&x.data),
             };
-            Ok(inverse_rows_on(&mech, branch, &q.data, &qd.data, &qdd.data)?)
+            Ok(inverse_rows_checked(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         arr_dyn(py, &shape, tau)
     }
 
     /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
-    #[pyo3(signature = (q, qd, t=0.0, tau=None))]
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
     fn reactions<'py>(
         &self,
         py: Python<'py>,
@@ -475,17 +491,18 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         t: f64,
         tau: Option<ArrayArg<'py>>,
+        allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
         let mech = self.inner.clone();
         let r = run(py, || {
-            let mut ws = self.forward_ws(&q, &qd, t, tau)?;
-            Ok(dynamics::reactions(&mech, &mut ws))
+            let mut ws = self.forward_ws(&q, &qd, t, tau, allow_singular)?;
+            let r = dynamics::reactions(&mech, &mut ws);
+            Ok(dynamics::finite("reactions", r.as_flattened())?.to_vec())
         })?;
-        let p = r.len();
-        arr2(py, p, 3, r.into_iter().flatten().collect())
+        arr2(py, r.len() / 3, 3, r)
     }
 
     /// Kinetic and potential energy (J) at (q, qd), reached from `x_start` (else the drawing).
@@ -508,7 +525,9 @@ impl PyMechanism {
             } else {
                 ws.xd.fill(0.0);
             }
-            Ok((dynamics::kinetic_energy(&mech, &ws.xd), dynamics::potential_energy(&mech, &ws.x)))
+            let energies = [dynamics::kinetic_energy(&mech, &ws.xd), dynamics::potential_energy(&mech, &ws.x)];
+            let [t, v] = dynamics::finite("energies", energies)?;
+            Ok((t, v))
         })
     }
 

@@ -156,8 +156,9 @@ pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<Strin
     stats.set_item("chart_switches", st.chart_switches)?;
     stats.set_item("partition_steps", st.partition_steps)?;
     stats.set_item("max_residual", st.max_residual)?;
-    stats.set_item("min_sigma", st.min_sigma)?;
-    stats.set_item("min_passive_sigma", st.min_passive_sigma)?;
+    // A run that failed before measuring anything has no least measure: None, not inf.
+    stats.set_item("min_sigma", Some(st.min_sigma).filter(|s| s.is_finite()))?;
+    stats.set_item("min_passive_sigma", Some(st.min_passive_sigma).filter(|s| s.is_finite()))?;
     stats.set_item("energy_drift", st.energy_drift)?;
     stats.set_item("failed_evaluations", st.failed_evaluations)?;
     d.set_item("stats", stats)?;

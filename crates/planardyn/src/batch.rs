@@ -131,6 +131,19 @@ pub fn inverse_rows_on(
     qd: &[f64],
     qdd: &[f64],
 ) -> Result<Vec<f64>, Error> {
+    inverse_rows_checked(mech, branch, q, qd, qdd, false)
+}
+
+/// [`inverse_rows_on`], refusing a row whose type II measure is below
+/// [`dynamics::SINGULAR_SIGMA`] (`KinematicsError::Singular` with it) unless `allow_singular`.
+pub fn inverse_rows_checked(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+) -> Result<Vec<f64>, Error> {
     let (m, nx) = (mech.dof(), mech.n_x());
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
         return Err(KinematicsError::bad_argument(
@@ -158,12 +171,10 @@ pub fn inverse_rows_on(
             _ => continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?,
         }
         dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], &mut ws)?;
+        let sigma_min = dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
         // Only the rows after a near-singular one are in doubt.
-        if !matches!(branch, Branch::Rows(_)) && k + 1 < n {
-            let sigma_min = ws.sys.sigma_min_estimate().unwrap_or(0.0);
-            if sigma_min < BRANCH_SIGMA {
-                return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
-            }
+        if !matches!(branch, Branch::Rows(_)) && k + 1 < n && sigma_min < BRANCH_SIGMA {
+            return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
         }
         tau.extend_from_slice(&ws.tau);
     }

@@ -95,6 +95,13 @@ pub enum KinematicsError {
     /// singular value, where it was measured (a failed factorisation measures nothing).
     #[error("the mechanism is singular here{}: {kind}", sigma_note(.sigma_min))]
     Singular { kind: SingularityKind, sigma_min: Option<f64> },
+    /// Finite inputs whose result overflows the floating-point range: `what` names the
+    /// quantity (e.g. "accelerations qdd").
+    #[error(
+        "the {what} overflow (not finite) for these finite inputs: the efforts or rates are too large \
+         for the mechanism; try smaller efforts (tau) or rates (qd)"
+    )]
+    Overflow { what: &'static str },
     /// An argument with the wrong length or a non-finite value.
     #[error("{name}: expected {expected}, got {got}")]
     BadArgument { name: &'static str, expected: String, got: String },

@@ -30,5 +30,6 @@ pub fn inverse(
         ws.tau[j] = (0..m).map(|k| ws.a[j * m + k] * qdd[k]).sum::<f64>() - ws.b[j];
     }
     ws.qdd.copy_from_slice(qdd);
+    super::finite("efforts tau", &ws.tau)?;
     Ok(())
 }

@@ -7,6 +7,7 @@ pub mod forces;
 pub mod forward;
 pub mod inverse;
 pub mod reactions;
+pub mod regular;
 pub mod task;
 
 pub use energy::{kinetic_energy, potential_energy};
@@ -14,4 +15,5 @@ pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};
 pub use inverse::inverse;
 pub use reactions::reactions;
+pub use regular::{finite, type_ii_measure, SINGULAR_SIGMA};
 pub use task::{SingularityKind, TaskError, TaskPath, TaskSolution};

@@ -200,9 +200,11 @@ pub fn simulate(
     }
     let t_eval = settings.t_eval.as_deref();
     let mut next_out = 0;
+    // The start counts in the least measures, so that a run of no step reports its start's.
+    let first = measure(&mut ode);
+    (traj.stats.min_sigma, traj.stats.min_passive_sigma) = (first.sigma, first.passive);
     if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
-        let sigma = measure(&mut ode).sigma;
-        traj.record(&ode, settings.t0, y[2 * m], sigma);
+        traj.record(&ode, settings.t0, y[2 * m], first.sigma);
         next_out = 1;
     }
     let mut yi = vec![0.0; 2 * m + 1];
