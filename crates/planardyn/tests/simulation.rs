@@ -177,15 +177,16 @@ fn hopeless_run_stops_early_and_keeps_its_last_state() {
     let st = tr.stats.integrator;
     let attempts = st.naccept + st.nreject;
     assert!((10_000..10_100).contains(&attempts), "{attempts} attempts");
-    // DOP853: 12 evaluations per attempt at most, dense output not reached.
-    assert!(st.nfev <= 12 * attempts + 2, "{} evaluations", st.nfev);
+    // The file's DOPRI5 (FSAL): 6 evaluations per attempt, 2 more at each (re)start.
+    let starts = 1 + tr.stats.chart_switches;
+    assert!(st.nfev <= 6 * attempts + 2 * starts, "{} evaluations", st.nfev);
     // The 0.01 s grid is not reached: the rows are t = 0 and the last accepted state.
     assert_eq!(tr.len(), 2);
     let (t, n) = (tr.t[1], tr.len() - 1);
     assert!(t > 0.0 && t < 1e-8 * attempts as f64, "last t = {t}");
     assert!(tr.q[2 * n..].iter().chain(&tr.qd[2 * n..]).all(|v| v.is_finite()));
-    // The energy balance of that row is the one reported; with rtol 1e-9 over 1e4 steps
-    // the global error allows 1e-5 of the work done (measured: 1.1e-6 of 6.8e13 J).
+    // The energy balance of that row is the one reported, a small fraction of the work done
+    // for the file's rtol 1e-8 over 1e4 steps (measured: 1.1e-6 of 6.8e13 J).
     let drift = (energy(&tr, n) - energy(&tr, 0)).abs();
     assert_eq!(tr.stats.energy_drift, drift);
     assert!(tr.work[n] > 1e12 && drift < 1e-5 * tr.work[n], "drift {drift} J, work {} J", tr.work[n]);
