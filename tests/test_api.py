@@ -415,6 +415,25 @@ def test_too_many_steps(four_bar):
     assert res.status == "too_many_steps" and len(res.t) >= 1
 
 
+def test_hopeless_run_stops_early_with_its_last_state():
+    # 1e12 N m on both motors of the five-bar: the steps shrink as 1/t, and the run used its
+    # 1e7 attempts (293 s) to reach t = 0.0035 s, returning the t = 0 row alone. It is judged
+    # after 10,000 attempts (mean step ~1e-9 s < t_end / (10 max_steps) = 1e-8 s).
+    mech = pd.load(MODELS / "five-bar.yaml")
+    res = mech.simulate(t_end=1.0, output_dt=0.01, drives=lambda t, q, qd: [1e12, 1e12])
+    assert res.status == "step_size_too_small" and not res.success
+    assert "efforts are too large" in res.message and "max_steps" in res.message
+    attempts = res.stats["naccept"] + res.stats["nreject"]
+    # The file's DOPRI5 (FSAL): 6 evaluations per attempt, 2 more at each (re)start.
+    starts = 1 + res.stats["chart_switches"]
+    assert 10_000 <= attempts < 10_100 and res.stats["nfev"] <= 6 * attempts + 2 * starts
+    # The t = 0 output and the last accepted state, with its real energy balance.
+    assert len(res.t) == 2 and 0 < res.t[-1] < 1e-8 * attempts
+    drift = abs(res.energy.balance[-1])
+    assert np.isfinite(res.q[-1]).all() and np.isfinite(drift)
+    assert res.stats["energy_drift"] == pytest.approx(drift, rel=1e-12)
+
+
 def test_simulation_option_errors(four_bar):
     with pytest.raises(pd.SimulationError, match="unknown integration method"):
         four_bar.simulate(method="euler")

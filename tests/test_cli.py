@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 import pytest
+import yaml
 from conftest import MODELS, four_bar_dict
 from PIL import Image
 from planardyn.results_io import read_results
@@ -117,6 +118,20 @@ def test_failed_simulation_exit_1_keeps_partial_csv(tmp_path):
     assert "stopped early" in p.stderr and "Traceback" not in p.stderr
     assert len(csv_rows(out)) >= 2
     assert read_results(out).status == "too_many_steps"
+
+
+def test_hopeless_model_stops_early_exit_1(tmp_path):
+    # Constant 1e12 N m on both motors in the file: stopped after ~10,000 attempts, the
+    # last accepted state written as the last row.
+    d = yaml.safe_load((MODELS / "five-bar.yaml").read_text())
+    d["drives"] = [{"coordinate": c, "effort": 1e12} for c in ("theta1", "theta2")]
+    out = tmp_path / "hopeless.csv"
+    p = run("simulate", write_model(tmp_path, d), "-o", out)
+    assert p.returncode == 1 and "Traceback" not in p.stderr
+    assert p.stdout.startswith("step_size_too_small:")
+    res = read_results(out)
+    assert res.status == "step_size_too_small" and "efforts are too large" in res.message
+    assert len(res.t) == 2 and res.t[-1] > 0 and np.isfinite(res.energy.balance[-1])
 
 
 def test_bad_option_exit_2(tmp_path):

@@ -427,6 +427,10 @@ class Mechanism:
             (not None) or raising stops the run with status ``'cancelled'``.
         max_steps : int
             Most step attempts (accepted and rejected); past it status ``'too_many_steps'``.
+            A run whose mean step, after 10,000 attempts, is below
+            ``t_end / (10 max_steps)`` cannot finish and stops early with status
+            ``'step_size_too_small'`` (efforts too large for the model, or tolerances too
+            tight), keeping its last accepted state as the last row.
 
         Returns
         -------

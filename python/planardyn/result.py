@@ -77,7 +77,9 @@ class SimulationResult:
     #: True when the run reached t_end.
     success: bool
     #: 'success', 'assembly_failed', 'passive_singularity', 'step_size_underflow',
-    #: 'non_finite', 'drive_failed', 'too_many_steps' or 'cancelled'.
+    #: 'non_finite', 'drive_failed', 'too_many_steps', 'step_size_too_small' (the steps are
+    #: too small to reach t_end within max_steps: stopped early) or 'cancelled'. A stopped
+    #: run's last row is its last accepted state, on the output grid or not.
     status: str
     message: str
     #: Counters: nfev, naccept, nreject, njev, nlu, chart_switches, partition_steps,

@@ -1,12 +1,11 @@
 """The rule of each simulation setting, in one place for the API, the batch runner and the CLI.
 
 Times and tolerances (``t_end``, ``rtol``, ``atol``, ``dt``, ``output_dt``) are finite numbers
-> 0, the rule the model loader applies to a file's ``simulate`` values. ``atol = 0`` would
-pass the integrator's own check (its error scale is ``atol + rtol * |y_i|``), but a state
-component that passes through 0 (an angle, a rate at rest) then has a zero scale: the step
-size collapses and the run ends in "NaN or infinity" instead of an answer. ``rtol`` is also
-at least :data:`MIN_RTOL` (below it the error test asks for more than double precision
-holds: the integrator's own rule). ``max_steps`` is an integer in 1..=:data:`MAX_STEPS`.
+> 0, the rule the model loader and the integrator's own check apply. ``atol = 0`` is refused
+because the error scale is ``atol + rtol * |y_i|``: a state component that passes through 0
+(an angle, a rate at rest) would have a zero scale, the step size would collapse and the run
+end in "NaN or infinity" instead of an answer. ``rtol`` is also at least :data:`MIN_RTOL`
+(below it the error test asks for more than double precision holds). ``max_steps`` is an integer in 1..=:data:`MAX_STEPS`.
 
 A value that breaks its rule raises what ``Mechanism.simulate`` raises for it: ValueError
 for ``t_end`` (an argument), :class:`~planardyn.SimulationError` for a solver option,

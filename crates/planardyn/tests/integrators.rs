@@ -620,6 +620,30 @@ fn invalid_options_are_rejected_with_a_fix() {
     assert!(Stepper::new(Method::Dop853, &Options::default(), 2).is_ok());
 }
 
+/// The loader's and the Python API's rule: atol > 0, rtol >= 100 eps, dt > 0, all finite,
+/// max_steps >= 1; each refusal names its option. The boundary values pass.
+#[test]
+fn options_follow_the_loaders_rule() {
+    let eps = f64::EPSILON;
+    let refused = |opts: Options, name: &str| {
+        let e = opts.validate(Method::Dopri5).unwrap_err();
+        assert!(e.starts_with(name), "{name}: {e}");
+    };
+    for atol in [0.0, -0.0, -1e-10, f64::NAN, f64::INFINITY] {
+        refused(Options::tol(1e-8, atol), "atol");
+    }
+    for rtol in [0.0, 99.0 * eps, f64::NAN, f64::INFINITY] {
+        refused(Options::tol(rtol, 1e-10), "rtol");
+    }
+    for dt in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        refused(Options::fixed(dt), "dt");
+    }
+    refused(Options { max_steps: 0, ..Options::default() }, "max_steps");
+    for opts in [Options::tol(100.0 * eps, f64::MIN_POSITIVE), Options { max_steps: 1, ..Options::fixed(1e-300) }] {
+        assert!(opts.validate(Method::Dopri5).is_ok(), "{opts:?}");
+    }
+}
+
 #[test]
 fn fixed_rk4_costs_four_evaluations_per_step() {
     let st = solve(Method::Rk4, &Options::fixed(0.1), &mut Oscillator, 0.0, &[1.0, 0.0], 1.0).unwrap();

@@ -151,3 +151,55 @@ fn five_bar_stays_on_its_branch_at_loose_tolerance() {
         assert!(tr.stats.energy_drift < 1e-2, "rtol {rtol} grid {grid}: energy drift {} J", tr.stats.energy_drift);
     }
 }
+
+/// Constant efforts on every coordinate, ignoring the model's drives.
+struct Constant(f64);
+
+impl planardyn::dynamics::Drives for Constant {
+    fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
+        tau.fill(self.0);
+        Ok(())
+    }
+}
+
+#[test]
+fn hopeless_run_stops_early_and_keeps_its_last_state() {
+    use planardyn::simulate::{grid, simulate, Settings, Status};
+    let mech = shipped("five-bar.yaml");
+    let mut s = Settings::for_model(&mech).unwrap();
+    s.t_end = 1.0;
+    s.t_eval = Some(grid(0.0, 1.0, 0.01));
+    let tr = simulate(&mech, &s, &mut Constant(1e12), None).unwrap();
+    assert_eq!(tr.status, Status::StepSizeTooSmall, "{}", tr.message);
+    assert!(tr.message.contains("efforts are too large"), "{}", tr.message);
+    // Judged at the first accepted step past 10,000 attempts (mean step ~1e-9 s, below
+    // 1 s / (10 * 1e7)), where it ran into the budget of 1e7 attempts (293 s) before.
+    let st = tr.stats.integrator;
+    let attempts = st.naccept + st.nreject;
+    assert!((10_000..10_100).contains(&attempts), "{attempts} attempts");
+    // The file's DOPRI5 (FSAL): 6 evaluations per attempt, 2 more at each (re)start.
+    let starts = 1 + tr.stats.chart_switches;
+    assert!(st.nfev <= 6 * attempts + 2 * starts, "{} evaluations", st.nfev);
+    // The 0.01 s grid is not reached: the rows are t = 0 and the last accepted state.
+    assert_eq!(tr.len(), 2);
+    let (t, n) = (tr.t[1], tr.len() - 1);
+    assert!(t > 0.0 && t < 1e-8 * attempts as f64, "last t = {t}");
+    assert!(tr.q[2 * n..].iter().chain(&tr.qd[2 * n..]).all(|v| v.is_finite()));
+    // The energy balance of that row is the one reported, a small fraction of the work done
+    // for the file's rtol 1e-8 over 1e4 steps (measured: 1.1e-6 of 6.8e13 J).
+    let drift = (energy(&tr, n) - energy(&tr, 0)).abs();
+    assert_eq!(tr.stats.energy_drift, drift);
+    assert!(tr.work[n] > 1e12 && drift < 1e-5 * tr.work[n], "drift {drift} J, work {} J", tr.work[n]);
+}
+
+/// atol = 0 gave "NaN or infinity in the solution" when the five-bar's W (or a rate at rest)
+/// passed through 0; it is refused up front, naming the option, as the loader refuses it.
+#[test]
+fn zero_atol_is_refused_before_the_run() {
+    let mech = shipped("five-bar.yaml");
+    let mut s = planardyn::simulate::Settings::for_model(&mech).unwrap();
+    s.options.atol = 0.0;
+    let e = planardyn::simulate::simulate(&mech, &s, &mut planardyn::dynamics::ModelDrives(&mech), None).unwrap_err();
+    assert!(matches!(e, planardyn::Error::Options(_)), "{e:?}");
+    assert!(e.to_string().contains("atol = 0 must be finite and > 0"), "{e}");
+}

@@ -156,9 +156,10 @@ impl FromStr for Method {
 /// Integrator options. Times in seconds.
 #[derive(Clone, Debug)]
 pub struct Options {
-    /// Relative tolerance (dimensionless), `> 0`. Default `1e-8`.
+    /// Relative tolerance (dimensionless), at least 100 machine epsilons. Default `1e-8`.
     pub rtol: f64,
-    /// Absolute tolerance (units of `y`), `>= 0`. Default `1e-10`.
+    /// Absolute tolerance (units of `y`), `> 0`: with 0, a component passing through 0
+    /// has a zero error scale and the step collapses there. Default `1e-10`.
     pub atol: f64,
     /// First trial step (s). `None`: chosen automatically by Hairer's algorithm
     /// (HNW I, II.4, as scipy's `select_initial_step`). Default `None`.
@@ -224,8 +225,12 @@ impl Options {
                 self.rtol
             ));
         }
-        if !(self.atol.is_finite() && self.atol >= 0.0) {
-            return Err(format!("atol = {} must be finite and >= 0 (try 1e-10)", self.atol));
+        if !(self.atol.is_finite() && self.atol > 0.0) {
+            return Err(format!(
+                "atol = {} must be finite and > 0 (try 1e-10): with 0, a component of the state passing \
+                 through 0 has no error scale and the step collapses",
+                self.atol
+            ));
         }
         if let Some(h0) = self.h0 {
             if !(h0.is_finite() && h0 > 0.0) {
@@ -248,7 +253,7 @@ impl Options {
                 .to_string());
         }
         if self.max_steps == 0 {
-            return Err("max_steps must be >= 1".to_string());
+            return Err("max_steps = 0 must be >= 1 (default 10000000)".to_string());
         }
         Ok(())
     }

@@ -28,6 +28,12 @@ pub const MODEL_ATOL: f64 = 1e-12;
 /// A grid time within this fraction of h before t_end is dropped for t_end itself: the
 /// round-off of t0 + k h must not leave a sliver of an output interval.
 const GRID_END_SLACK: f64 = 1e-9;
+/// Step attempts before a run's rate of progress is judged: an early transient of small
+/// steps (a stiff start, a chart switch) must not stop a run that would finish.
+const PROGRESS_MIN_STEPS: usize = 10_000;
+/// A run whose mean step so far would need this many times its step budget to reach t_end
+/// is stopped: it cannot finish, and waiting for the budget costs this many times more work.
+const PROGRESS_MARGIN: f64 = 10.0;
 
 /// What to simulate and how. Times in s.
 #[derive(Debug, Clone)]
@@ -161,6 +167,44 @@ fn failure(e: &StepError<Error>) -> (Status, String) {
     (status, message)
 }
 
+/// Status and message when the run cannot reach t_end at its present rate: after
+/// [`PROGRESS_MIN_STEPS`] attempts, its mean step is below `(t_end - t0) / (PROGRESS_MARGIN
+/// max_steps)`. The steps of such runs shrink as they go (efforts of 1e12 N m on the five-bar:
+/// 10 million steps for 0.35 % of 1 s), so waiting for `max_steps` only wastes the work.
+fn hopeless(settings: &Settings, stepper: &Stepper) -> Option<(Status, String)> {
+    let stats = stepper.stats();
+    let attempts = stats.naccept + stats.nreject;
+    let (t0, t, t_end) = (settings.t0, stepper.t(), settings.t_end);
+    let max_steps = settings.options.max_steps as f64;
+    let floor = (t_end - t0) / (PROGRESS_MARGIN * max_steps);
+    let mean = (t - t0) / attempts as f64;
+    if attempts < PROGRESS_MIN_STEPS || mean >= floor {
+        return None;
+    }
+    let message = format!(
+        "step size too small at t = {t:e} s: after {attempts} steps the mean step is {mean:.2e} s \
+         (last {:.2e} s), below (t_end - t0) / ({PROGRESS_MARGIN} max_steps) = {floor:.2e} s, so the run \
+         cannot make progress to t_end = {t_end} s within max_steps = {}. The efforts are too large for \
+         the model or the tolerances too tight: lower the efforts, loosen rtol/atol, shorten t_end, \
+         or raise max_steps",
+        t - stepper.t_prev(),
+        settings.options.max_steps
+    );
+    Some((Status::StepSizeTooSmall, message))
+}
+
+/// Record the stepper's last accepted state as the final row (a stopped run keeps it when
+/// the output grid did not reach it). Evaluated from its own anchor, so Newton starts at the
+/// answer; if even that fails, the rows already recorded stand.
+fn keep_last_state(ode: &mut MechanismOde, stepper: &Stepper, traj: &mut Trajectory) {
+    let (t, y) = (stepper.t(), stepper.y());
+    ode.restart_from_anchor();
+    if ode.accept(t, y).is_ok() {
+        let sigma = measure(ode).sigma;
+        traj.record(ode, t, y[y.len() - 1], sigma);
+    }
+}
+
 /// Evaluate the dense output of the step just taken at `t_out` into `yi` (walking there
 /// from the step's start if a direct evaluation is refused).
 fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi: &mut [f64]) -> Result<(), Error> {
@@ -209,9 +253,13 @@ pub fn simulate(
     }
     let mut yi = vec![0.0; 2 * m + 1];
     let (mut status, mut message) = (Status::Success, String::new());
+    // Whether a stop leaves the last accepted state in the stepper's chart, to be kept as
+    // the final row when the output grid did not reach it.
+    let mut keep_last = false;
     while stepper.t() < settings.t_end {
         if let Err(e) = stepper.step(&mut ode, settings.t_end) {
             (status, message) = failure(&e);
+            keep_last = true;
             break;
         }
         let t = stepper.t();
@@ -261,6 +309,11 @@ pub fn simulate(
             (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
             break;
         }
+        if let Some(stop) = hopeless(settings, &stepper) {
+            (status, message) = stop;
+            keep_last = true;
+            break;
+        }
         let mut own = chart_sigma(&ode, meas.sigma);
         if let Some(chart) = next_chart(&ode, &meas, own) {
             state_in(&ode, &chart, y[2 * m], &mut y);
@@ -276,9 +329,13 @@ pub fn simulate(
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
                 (status, message) = (Status::Cancelled, format!("stopped by the progress callback at t = {t} s"));
+                keep_last = true;
                 break;
             }
         }
+    }
+    if keep_last && traj.t.last().is_none_or(|&t| t < stepper.t()) {
+        keep_last_state(&mut ode, &stepper, &mut traj);
     }
     traj.stats.integrator = stepper.stats();
     traj.stats.failed_evaluations = ode.failed_evaluations;

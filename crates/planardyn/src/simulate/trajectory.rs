@@ -24,6 +24,9 @@ pub enum Status {
     DriveFailed,
     /// The step budget was used up.
     TooManySteps,
+    /// The steps became so small that the run could not reach t_end within its step budget
+    /// (efforts too large for the model, or tolerances too tight): stopped early.
+    StepSizeTooSmall,
     /// The progress callback asked to stop.
     Cancelled,
 }
@@ -39,6 +42,7 @@ impl Status {
             Status::NonFinite => "non_finite",
             Status::DriveFailed => "drive_failed",
             Status::TooManySteps => "too_many_steps",
+            Status::StepSizeTooSmall => "step_size_too_small",
             Status::Cancelled => "cancelled",
         }
     }
