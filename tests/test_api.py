@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import copy
 import math
+import os
+import signal
+import threading
 
 import numpy as np
 import planardyn as pd
@@ -544,9 +547,31 @@ def test_keyboard_interrupt_in_a_drive_propagates(four_bar):
             raise KeyboardInterrupt
         return [1.5]
 
-    with pytest.raises(KeyboardInterrupt):
-        four_bar.simulate(t_end=1.0, drives=drive)
+    with pytest.raises(pd.SimulationInterrupted) as caught:
+        four_bar.simulate(t_end=1.0, drives=drive, output_dt=0.01)
     assert sum(t > 0.1 for t in calls) == 1  # not retried with smaller steps
+    # Still a KeyboardInterrupt, with the rows up to the last accepted step kept.
+    res = caught.value.result
+    assert isinstance(caught.value, KeyboardInterrupt) and res.status == "cancelled"
+    assert 0.05 < res.t[-1] <= 0.1 and np.allclose(np.diff(res.t), 0.01, rtol=1e-9)
+    assert np.isfinite(res.q).all() and "KeyboardInterrupt" in res.message
+
+
+def test_ctrl_c_keeps_the_trajectory_so_far(four_bar):
+    # A real SIGINT 0.3 s into a run of 1e4 s (over 60 s of work): the binding checks for
+    # Ctrl-C every 0.1 s of wall time, well before the first 1 % of t_end (about 0.7 s), and
+    # the result so far comes with the interrupt.
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(pd.SimulationInterrupted) as caught:
+        four_bar.simulate(t_end=1e4, output_dt=0.01)
+    timer.join()
+    res = caught.value.result
+    assert res.status == "cancelled" and not res.success and 0 < res.t[-1] < 100
+    # The output grid up to the interrupt, then the last accepted state.
+    assert np.allclose(np.diff(res.t[:-1]), 0.01, rtol=1e-9) and 0 < res.t[-1] - res.t[-2] <= 0.01
+    assert np.isfinite(res.q).all()
+    assert res.metadata["settings"]["t_end"] == 1e4
 
 
 def test_redundant_constraints_load_with_a_warning_and_simulate():

@@ -28,7 +28,7 @@ from ._core import (
     __version__,
 )
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
-from .result import Energy, SimulationResult
+from .result import Energy, SimulationInterrupted, SimulationResult
 from .results_io import read_results
 
 __all__ = [
@@ -39,6 +39,7 @@ __all__ = [
     "PlanardynError",
     "PlanardynWarning",
     "SimulationError",
+    "SimulationInterrupted",
     "SimulationResult",
     "SingularityError",
     "__version__",

@@ -22,7 +22,7 @@ from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
 from .models import path as model_path
-from .result import SimulationResult
+from .result import SimulationInterrupted, SimulationResult
 from .settings import check_settings
 
 
@@ -441,6 +441,9 @@ class Mechanism:
         ------
         SimulationError
             Invalid options (unknown method, rtol or atol <= 0, rk4 without dt...).
+        SimulationInterrupted
+            Ctrl-C (a KeyboardInterrupt) during the run; its ``result`` is the trajectory so
+            far, status ``'cancelled'``.
         AssemblyError, SingularityError
             The start state cannot be assembled, or is singular.
         ValueError
@@ -471,7 +474,10 @@ class Mechanism:
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
                         drives="callable" if callable(drives) else drives)
-        return attach_metadata(result, self, settings)
+        result = attach_metadata(result, self, settings)
+        if "interrupt" in raw:
+            raise SimulationInterrupted(result) from raw["interrupt"]
+        return result
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:

@@ -47,6 +47,15 @@ class Energy:
         return f"Energy(N={len(self.kinetic)}, drift={self.drift:.3g} J)"
 
 
+class SimulationInterrupted(KeyboardInterrupt):
+    """Ctrl-C during ``Mechanism.simulate``: still a KeyboardInterrupt (loops stop), carrying
+    the trajectory computed so far as ``result`` (status ``'cancelled'``)."""
+
+    def __init__(self, result: SimulationResult) -> None:
+        super().__init__(result.message)
+        self.result = result
+
+
 @dataclass(frozen=True, repr=False)
 class SimulationResult:
     """A trajectory, kept whole even when the run stopped early (see ``status``).

@@ -9,13 +9,18 @@ use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives};
 use planardyn::simulate::{Overrides, Settings, Trajectory};
 use planardyn::Mechanism;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::time::{Duration, Instant};
 
-/// The progress callback (and the check for Ctrl-C) runs each time t has advanced by this
-/// fraction of the run: at most about 100 times.
+/// The progress callback runs each time t has advanced by this fraction of the run: at most
+/// about 100 times.
 const PROGRESS_FRACTION: f64 = 0.01;
+
+/// Ctrl-C is also checked at least this often in wall time, so a slow run answers it at once
+/// whatever its progress in t.
+const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
 
 /// The model's simulation settings with the caller's overrides; a bad `t_end` is a
 /// ValueError (an argument), everything else the core's option error.
@@ -85,16 +90,22 @@ pub fn simulate<'py>(
         let s = settings(mech, &args)?;
         let step = PROGRESS_FRACTION * (s.t_end - s.t0);
         let mut next = s.t0 + step;
+        let mut last_check = Instant::now();
         let mut on_step = |t: f64| -> bool {
-            if t < next {
+            let due = t >= next;
+            if !due && last_check.elapsed() < SIGNAL_INTERVAL {
                 return true;
             }
-            next = t + step;
+            last_check = Instant::now();
             Python::attach(|py| {
                 if let Err(e) = py.check_signals() {
                     fatal = Some(e);
                     return false;
                 }
+                if !due {
+                    return true;
+                }
+                next = t + step;
                 let Some(cb) = &progress else { return true };
                 match cb.bind(py).call1((t,)) {
                     Ok(r) => r.is_none() || r.is_truthy().unwrap_or(true),
@@ -116,10 +127,23 @@ pub fn simulate<'py>(
         };
         Ok(planardyn::simulate::simulate(mech, &s, d, Some(&mut on_step))?)
     })?;
-    if let Some(e) = fatal.or_else(|| py_drives.and_then(|d| d.fatal)) {
-        return Err(e);
+    let fatal = fatal.or_else(|| py_drives.and_then(|d| d.fatal));
+    match fatal {
+        // Ctrl-C keeps the trajectory so far: `Mechanism.simulate` raises the interrupt with
+        // it attached (`SimulationInterrupted.result`).
+        Some(e) if e.is_instance_of::<PyKeyboardInterrupt>(py) => {
+            let at = traj.t.last().copied().unwrap_or(0.0);
+            let reason = format!("interrupted (KeyboardInterrupt) at t = {at} s");
+            // Whether it came in the progress check or inside a drive callable, it is a cancel.
+            let d = to_dict(py, traj, None)?;
+            d.set_item("status", planardyn::simulate::Status::Cancelled.name())?;
+            d.set_item("message", reason)?;
+            d.set_item("interrupt", e.value(py))?;
+            Ok(d)
+        }
+        Some(e) => Err(e),
+        None => to_dict(py, traj, cancel_reason),
     }
-    to_dict(py, traj, cancel_reason)
 }
 
 /// The trajectory as the dict `Mechanism.simulate` returns (arrays time-major); a
