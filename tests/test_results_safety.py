@@ -112,9 +112,10 @@ def test_ctrl_c_keeps_the_run_as_a_cancelled_file(tmp_path, monkeypatch):
     back = read_results(out)
     assert back.status == "cancelled" and not back.success and "Ctrl-C" in back.message
     # Stopped at the first progress call (t = 1% of 5000 s, just past 50 s), far before
-    # 5000 s, with every output row up to there (one every 0.5 s from 0).
-    assert back.t[-1] == 50.0
-    assert np.allclose(back.t, 0.5 * np.arange(len(back.t)), rtol=0, atol=1e-9)
+    # 5000 s, with every output row up to there (one every 0.5 s from 0), then the last
+    # accepted state (the step that passed 50 s).
+    assert back.t[-2] == 50.0 and 50.0 < back.t[-1] < 50.5
+    assert np.allclose(back.t[:-1], 0.5 * np.arange(len(back.t) - 1), rtol=0, atol=1e-9)
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 

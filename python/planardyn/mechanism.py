@@ -286,10 +286,8 @@ class Mechanism:
         Raises
         ------
         SingularityError
-            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
-            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
-            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
-            ``allow_singular=True`` the value is computed anyway.
+            Below the type II threshold, as for :meth:`mass_matrix`, unless
+            ``allow_singular=True``.
         ValueError
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
@@ -328,10 +326,8 @@ class Mechanism:
         Raises
         ------
         SingularityError
-            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
-            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
-            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
-            ``allow_singular=True`` every row is computed anyway.
+            Below the type II threshold, as for :meth:`mass_matrix`, unless
+            ``allow_singular=True`` (then every row is computed).
         ValueError
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
