@@ -38,7 +38,7 @@ from .settings import MAX_THREADS, check_settings, count
 if TYPE_CHECKING:
     from .robot import TaskMotion, TaskPath
 
-__all__ = ["BatchError", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
+__all__ = ["BatchError", "BatchInterrupted", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
 
 #: A variant: a model, or a model with its own settings.
 VariantLike = Mechanism | Mapping[str, Any] | tuple[Mechanism | Mapping[str, Any], Mapping[str, Any]]
@@ -67,6 +67,18 @@ class BatchError:
 
     def __str__(self) -> str:
         return f"variant {self.index}: {self.type}: {self.message}"
+
+
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a batch: still a KeyboardInterrupt (loops stop), carrying ``results``,
+    one per variant as the call would return them: the finished ones, runs stopped on the
+    way (status ``'cancelled'``) and a :class:`BatchError` of type ``'Cancelled'`` for the
+    variants not run."""
+
+    def __init__(self, results: list[Any]) -> None:
+        done = sum(1 for r in results if not isinstance(r, BatchError) or r.type != "Cancelled")
+        super().__init__(f"batch interrupted (Ctrl-C): {done} of {len(results)} variants kept")
+        self.results = results
 
 
 def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, Any]:
@@ -135,6 +147,7 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
         futures = [executor.submit(_run_chunk, kind, items[s:s + chunk_size], threads, **kw) for s in starts]
         pending = [f.result for f in futures]
     done, stopped = 0, None
+    interrupted: KeyboardInterrupt | None = None
     for s, get in zip(starts, pending):
         chunk = items[s:s + chunk_size]
         if stopped is not None:
@@ -143,17 +156,22 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
             continue
         try:
             raws = get()
+        except KeyboardInterrupt as e:  # the native batch hands back what it has
+            interrupted, stopped = e, "not run: interrupted (Ctrl-C)"
+            raws = getattr(e, "partial", None) or [("Cancelled", stopped)] * len(chunk)
         except Exception as e:  # noqa: BLE001 - a lost chunk loses only its own variants
             raws = [(type(e).__name__, f"the chunk with this variant failed: {e}")] * len(chunk)
         for k, ((mech, args), raw) in enumerate(zip(chunk, raws)):
             i = todo[s + k]
             out[i] = finish(raw, mech, args) if isinstance(raw, dict) else BatchError(i, *raw)
         done += len(chunk)
-        if progress is not None:
+        if progress is not None and stopped is None:
             stopped = _progress_stop(progress, done, n)
     if stopped is not None:
         for f in futures:
             f.cancel()
+    if interrupted is not None:
+        raise BatchInterrupted(out) from interrupted
     return out
 
 

@@ -20,7 +20,7 @@ const PROGRESS_FRACTION: f64 = 0.01;
 
 /// Ctrl-C is also checked at least this often in wall time, so a slow run answers it at once
 /// whatever its progress in t.
-const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
+pub(crate) const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
 
 /// The model's simulation settings with the caller's overrides; a bad `t_end` is a
 /// ValueError (an argument), everything else the core's option error.

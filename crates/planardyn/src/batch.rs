@@ -23,6 +23,7 @@ pub use crate::simulate::Overrides;
 use crate::simulate::{simulate, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use task::{TaskError, TaskPath, TaskSolution};
 
@@ -54,9 +55,16 @@ impl Model {
 impl Variant {
     /// Build (if needed), set up and simulate with the model's drives, in the caller's thread.
     pub fn simulate(&self) -> Result<Trajectory, Error> {
+        self.simulate_until(&AtomicBool::new(false))
+    }
+
+    /// [`Variant::simulate`], stopping at the first step after `stop` is set (status
+    /// `Cancelled`, the trajectory so far kept).
+    pub fn simulate_until(&self, stop: &AtomicBool) -> Result<Trajectory, Error> {
         self.model.with(|mech| {
             let settings = self.overrides.settings(mech)?;
-            simulate(mech, &settings, &mut ModelDrives(mech), None)
+            let mut go_on = |_t: f64| !stop.load(Ordering::Relaxed);
+            simulate(mech, &settings, &mut ModelDrives(mech), Some(&mut go_on))
         })
     }
 }
@@ -181,21 +189,39 @@ pub fn inverse_rows_checked(
     Ok(tau)
 }
 
+/// A pool of `threads` threads (`None` or 0: one per core). Fails only if the operating
+/// system refuses the threads.
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .thread_name(|i| format!("planardyn-batch-{i}"))
+        .build()
+        .map_err(|e| Error::Options(format!("cannot start the batch thread pool: {e}")))
+}
+
 /// Apply `f` to every item on a pool of `threads` threads (`None` or 0: one per core), the
-/// results in input order. Fails only if the operating system refuses the threads.
+/// results in input order.
 pub fn map_many<T: Sync, R: Send>(
     items: &[T],
     threads: Option<usize>,
     f: impl Fn(&T) -> R + Sync + Send,
 ) -> Result<Vec<R>, Error> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .thread_name(|i| format!("planardyn-batch-{i}"))
-        .build()
-        .map_err(|e| Error::Options(format!("cannot start the batch thread pool: {e}")))?;
     // One item a task: runs take from milliseconds to seconds, so work stealing balances
     // them better than fixed chunks.
-    Ok(pool.install(|| items.par_iter().with_max_len(1).map(&f).collect()))
+    Ok(pool(threads)?.install(|| items.par_iter().with_max_len(1).map(&f).collect()))
+}
+
+/// [`map_many`] that another thread can stop (on Ctrl-C, a closed window...) by setting
+/// `stop`: the items not started by then are `None`; `f` gets the flag too, so a long item
+/// can stop early ([`Variant::simulate_until`]).
+pub fn map_many_until<T: Sync, R: Send>(
+    items: &[T],
+    threads: Option<usize>,
+    stop: &AtomicBool,
+    f: impl Fn(&T, &AtomicBool) -> R + Sync + Send,
+) -> Result<Vec<Option<R>>, Error> {
+    let one = |item: &T| (!stop.load(Ordering::Relaxed)).then(|| f(item, stop));
+    Ok(pool(threads)?.install(|| items.par_iter().with_max_len(1).map(one).collect()))
 }
 
 /// Simulate every variant in parallel on `threads` threads (`None`: all cores). The outer

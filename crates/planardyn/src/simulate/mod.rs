@@ -328,7 +328,8 @@ pub fn simulate(
         ode.limit_correction(own);
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
-                (status, message) = (Status::Cancelled, format!("stopped by the progress callback at t = {t} s"));
+                (status, message) =
+                    (Status::Cancelled, format!("cancelled at t = {t} s: the progress callback asked to stop"));
                 keep_last = true;
                 break;
             }
