@@ -469,7 +469,7 @@ def test_result_table(four_bar, tmp_path):
     assert len(res) == 4
     cols = ["t", "theta", "qd_theta", "qdd_theta", "tau_theta", "kinetic", "potential", "work", "sigma"]
     df = res.to_dataframe()
-    assert list(df.columns) == cols and len(df) == 4
+    assert df.index.name == "t" and list(df.columns) == [*cols[1:], "power_theta"] and len(df) == 4
     np.testing.assert_array_equal(df["theta"].to_numpy(), res.q[:, 0])
     path = tmp_path / "r.csv"
     res.to_csv(path)

@@ -132,6 +132,16 @@ class Mechanism:
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
+    def along(
+        self,
+        t: ArrayLike,
+        x: ArrayLike,
+        q: ArrayLike,
+        qd: ArrayLike,
+        tau: ArrayLike,
+        allow_singular: bool = False,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    def point_motion(self, x: ArrayLike, xd: ArrayLike, xdd: ArrayLike) -> dict[str, Any]: ...
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]: ...
     def simulate(
         self,

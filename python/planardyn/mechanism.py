@@ -22,7 +22,7 @@ from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
 from .models import path as model_path
-from .result import SimulationInterrupted, SimulationResult
+from .result import PointMotion, SimulationInterrupted, SimulationResult
 from .settings import check_settings
 
 
@@ -336,31 +336,60 @@ class Mechanism:
 
     def reactions(
         self,
-        q: ArrayLike,
-        qd: ArrayLike,
+        q: ArrayLike | SimulationResult,
+        qd: ArrayLike | None = None,
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> FloatArray:
-        """Pair reactions during the motion from (q, qd) under drives tau.
+        """Pair reactions during the motion from (q, qd) under drives tau, or along a whole
+        trajectory: ``mech.reactions(res)``.
 
         Parameters
         ----------
         q, qd, t, tau, allow_singular
             As for :meth:`forward_dynamics`.
+        q : SimulationResult
+            A run of this mechanism (qd, t, tau not given): every row on its own branch
+            (``res.x``) under the efforts the run applied (``res.tau``).
 
         Returns
         -------
-        (p, 3) ndarray
+        (p, 3) ndarray, or (N, p, 3) along a result
             Per pair (order of :attr:`pair_names`): [F_x, F_y, M], the force (N, global
             frame) and couple (N m) that the pair's first body exerts on its second.
 
         Raises
         ------
         SingularityError, ValueError
-            As for :meth:`forward_dynamics`.
+            As for :meth:`forward_dynamics`; along a result, with attributes ``row`` and
+            ``t`` of the row.
         """
+        if isinstance(q, SimulationResult):
+            if qd is not None or tau is not None:
+                raise TypeError("reactions(res) takes the result alone: its rows carry q, qd and tau")
+            return self._along(q, allow_singular)["reactions"]
+        if qd is None:
+            raise TypeError("reactions(q, qd, ...) needs qd (or give a SimulationResult alone)")
         return self._native.reactions(q, qd, float(t), tau, allow_singular)
+
+    def point_motion(self, res: SimulationResult, allow_singular: bool = False) -> PointMotion:
+        """Positions, velocities and accelerations of the named points (those a body or the
+        ground carries) along a run of this mechanism, each row on its own branch.
+
+        ``mech.point_motion(res)["P"]`` is the (N, 2) position, velocity and acceleration of
+        point P; ``.to_dataframe()`` a table indexed by t. Raises as :meth:`reactions`.
+        """
+        xdd = self._along(res, allow_singular)["xdd"]
+        raw = self._native.point_motion(res.x, res.xd, xdd)
+        return PointMotion(t=res.t, names=list(raw["names"]), position=raw["position"],
+                           velocity=raw["velocity"], acceleration=raw["acceleration"])
+
+    def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:
+        if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
+            raise ValueError("the result is not a run of this mechanism (its bodies differ); "
+                             "use pd.from_result(res) for the mechanism it was made with")
+        return self._native.along(res.t, res.x, res.q, res.qd, res.tau, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
         """Kinetic and potential energy (J) at (q, qd): ``(T, V)``, the position reached from

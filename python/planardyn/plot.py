@@ -236,6 +236,34 @@ def draw_mechanism_at(
     return artists
 
 
+def plot_reaction(mech: Mechanism, result: SimulationResult, pair: str, fig: Any = None) -> list[Artist]:
+    """The force of one pair along a run: its magnitude against time, and a polar diagram of
+    the force on the pair's second body in that body's frame (the load a pin or bearing
+    sees as the body turns; in the world frame when the second body is the ground).
+
+    ``fig`` is a matplotlib figure to draw in (a new one when None). Returns the artists.
+    """
+    if pair not in mech.pair_names:
+        raise ValueError(f"no pair {pair!r}; the pairs are {', '.join(mech.pair_names)}")
+    k = mech.pair_names.index(pair)
+    force = mech.reactions(result)[:, k, :2]
+    second = mech.pairs[k]["bodies"][1]
+    phi = result.poses[:, mech.body_names.index(second), 2] if second != "ground" else np.zeros(len(result.t))
+    magnitude = np.hypot(force[:, 0], force[:, 1])
+    if fig is None:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(10, 4))
+    left, right = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2, projection="polar")
+    artists: list[Artist] = left.plot(result.t, magnitude)
+    left.set_xlabel("t (s)")
+    left.set_ylabel(f"|F| at {pair} (N)")
+    left.grid(True, alpha=0.3)
+    artists += right.plot(np.arctan2(force[:, 1], force[:, 0]) - phi, magnitude)
+    right.set_title(f"force on {second} at {pair}, in its frame (N)", fontsize="medium")
+    return artists
+
+
 def plot_torque_speed(result: SimulationResult, ax: Axes | None = None, **line_kw: Any) -> list[Artist]:
     """Drive effort against speed of each coordinate (tau_k vs qd_k): the operating points a
     motor must reach, start marked with a circle. Returns the lines."""

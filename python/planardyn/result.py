@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -45,6 +46,44 @@ class Energy:
 
     def __repr__(self) -> str:
         return f"Energy(N={len(self.kinetic)}, drift={self.drift:.3g} J)"
+
+
+def _dataframe(cols: Mapping[str, FloatArray]) -> pandas.DataFrame:
+    """``cols`` as a DataFrame indexed by its ``t`` column (needs pandas)."""
+    try:
+        import pandas as pd
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+    return pd.DataFrame(cols).set_index("t")
+
+
+@dataclass(frozen=True)
+class PointMotion:
+    """Positions, velocities and accelerations of named points along a trajectory
+    (``Mechanism.point_motion``); each array (N, P, 2), points in the order of ``names``."""
+
+    t: FloatArray
+    names: list[str]
+    position: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+
+    def __getitem__(self, name: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Position (m), velocity (m/s) and acceleration (m/s^2) of one point, (N, 2) each."""
+        if name not in self.names:
+            raise KeyError(f"no point {name!r}; the points carried by a link are {', '.join(self.names)}")
+        k = self.names.index(name)
+        return self.position[:, k], self.velocity[:, k], self.acceleration[:, k]
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """Indexed by ``t``: per point ``<name>_x``, ``<name>_y``, ``<name>_vx``, ``<name>_vy``,
+        ``<name>_ax``, ``<name>_ay`` (m, m/s, m/s^2)."""
+        cols: dict[str, FloatArray] = {"t": self.t}
+        for k, name in enumerate(self.names):
+            for prefix, arr in (("", self.position), ("v", self.velocity), ("a", self.acceleration)):
+                cols[f"{name}_{prefix}x"] = arr[:, k, 0]
+                cols[f"{name}_{prefix}y"] = arr[:, k, 1]
+        return _dataframe(cols)
 
 
 class SimulationInterrupted(KeyboardInterrupt):
@@ -150,6 +189,11 @@ class SimulationResult:
             f"steps={self.stats.get('naccept', 0)}, energy drift={self.energy.drift:.3g} J)"
         )
 
+    @property
+    def power(self) -> FloatArray:
+        """(N, m) power of each drive, tau * qd (W): positive where the drive gives energy."""
+        return self.tau * self.qd
+
     def columns(self) -> dict[str, FloatArray]:
         """The table of :meth:`to_dataframe` as a dict of (N,) arrays, in column order:
         ``t``, the coordinate names, ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``,
@@ -165,12 +209,12 @@ class SimulationResult:
         return cols
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """A pandas DataFrame with the columns of :meth:`columns` (needs pandas)."""
-        try:
-            import pandas as pd
-        except ImportError as e:  # pragma: no cover - depends on the environment
-            raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
-        return pd.DataFrame(self.columns())
+        """A pandas DataFrame indexed by ``t`` (s) with the other columns of :meth:`columns`,
+        then ``power_<name>`` (W) per drive (needs pandas)."""
+        cols = self.columns()
+        for k, name in enumerate(self.coordinate_names):
+            cols["power_" + name] = self.power[:, k]
+        return _dataframe(cols)
 
     def to_csv(self, path: str | os.PathLike[str]) -> None:
         """Write the table of :meth:`columns` as CSV (full double precision; no pandas needed)."""

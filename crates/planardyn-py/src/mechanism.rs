@@ -8,7 +8,7 @@ use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::batch::{inverse_rows_checked, Branch};
-use planardyn::dynamics::{self, Drives, ModelDrives};
+use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
@@ -30,26 +30,10 @@ pub struct PyMechanism {
     carriers: Vec<Option<(Link, [f64; 2])>>,
 }
 
-/// Fixed efforts (N m or N) on the coordinates.
-pub struct FixedDrives(pub Vec<f64>);
-
-impl Drives for FixedDrives {
-    fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
-        tau.copy_from_slice(&self.0);
-        Ok(())
-    }
-}
-
 impl PyMechanism {
     pub fn new(mech: Mechanism) -> Self {
-        let carriers = (0..mech.points.len())
-            .map(|p| {
-                let id = planardyn::model::PointId(p);
-                std::iter::once(Link::Ground)
-                    .chain((0..mech.n_bodies()).map(|b| Link::Body(planardyn::model::BodyId(b))))
-                    .find_map(|link| mech.attachment(link, id).map(|a| (link, a.s)))
-            })
-            .collect();
+        let carriers =
+            (0..mech.points.len()).map(|p| mech.carrier(planardyn::model::PointId(p)).map(|a| (a.link, a.s))).collect();
         PyMechanism { inner: Arc::new(mech), carriers }
     }
 
@@ -503,6 +487,68 @@ impl PyMechanism {
             Ok(dynamics::finite("reactions", r.as_flattened())?.to_vec())
         })?;
         arr2(py, r.len() / 3, 3, r)
+    }
+
+    /// Body accelerations (N, 3n) and pair reactions (N, p, 3) along a trajectory's rows, each
+    /// on its own body coordinates x (`planardyn::dynamics::along`).
+    #[pyo3(signature = (t, x, q, qd, tau, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
+    fn along<'py>(
+        &self,
+        py: Python<'py>,
+        t: ArrayArg<'py>,
+        x: ArrayArg<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        tau: ArrayArg<'py>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (m, nx, p) = (self.m(), self.inner.n_x(), self.inner.pairs.len());
+        let what = self.coords_what();
+        let x = rows("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
+        let (q, qd, tau) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
+        let t = Values::read(&t);
+        let mech = self.inner.clone();
+        let out = run(py, || {
+            let r = Rows { t: &t.data, x: &x.data, q: &q.data, qd: &qd.data, tau: &tau.data };
+            Ok(dynamics::along(&mech, r, allow_singular)?)
+        })?;
+        let n = out.xdd.len() / nx;
+        let d = PyDict::new(py);
+        d.set_item("xdd", arr2(py, n, nx, out.xdd)?)?;
+        d.set_item("reactions", arr3(py, (n, p, 3), out.reactions)?)?;
+        Ok(d)
+    }
+
+    /// Positions, velocities and accelerations (N, P, 2) of the named points a link carries
+    /// (`names`), for rows of x, xd, xdd (N, 3n).
+    fn point_motion<'py>(
+        &self,
+        py: Python<'py>,
+        x: ArrayArg<'py>,
+        xd: ArrayArg<'py>,
+        xdd: ArrayArg<'py>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let nx = self.inner.n_x();
+        let what = "body coordinates [X, Y, phi] per body";
+        let (x, xd, xdd) = (rows("x", &x, nx, what)?, rows("xd", &xd, nx, what)?, rows("xdd", &xdd, nx, what)?);
+        if xd.data.len() != x.data.len() || xdd.data.len() != x.data.len() {
+            return Err(PyValueError::new_err(format!(
+                "x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}",
+                x.shape, xd.shape, xdd.shape
+            )));
+        }
+        let mech = &self.inner;
+        let names: Vec<&str> =
+            dynamics::carried_points(mech).iter().map(|(p, _)| mech.points[p.0].0.as_str()).collect();
+        let [pos, vel, acc] = dynamics::point_motion(mech, &x.data, &xd.data, &xdd.data);
+        let shape = (x.rows(), names.len(), 2);
+        let d = PyDict::new(py);
+        d.set_item("names", names)?;
+        d.set_item("position", arr3(py, shape, pos)?)?;
+        d.set_item("velocity", arr3(py, shape, vel)?)?;
+        d.set_item("acceleration", arr3(py, shape, acc)?)?;
+        Ok(d)
     }
 
     /// Kinetic and potential energy (J) at (q, qd), reached from `x_start` (else the drawing).

@@ -2,6 +2,7 @@
 //! pair reactions, energies, task-space inverse dynamics along an end-effector path. Stages
 //! run in a [`crate::Workspace`].
 
+pub mod along;
 pub mod energy;
 pub mod forces;
 pub mod forward;
@@ -10,6 +11,7 @@ pub mod reactions;
 pub mod regular;
 pub mod task;
 
+pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};

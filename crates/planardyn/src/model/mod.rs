@@ -284,6 +284,13 @@ impl Mechanism {
     pub fn point_id(&self, name: &str) -> Option<PointId> {
         self.points.iter().position(|p| p.0 == name).map(PointId)
     }
+    /// The link that carries a point (ground first, then the bodies in order) and where, or
+    /// None for a point no link carries (declared, unused).
+    pub fn carrier(&self, point: PointId) -> Option<Attachment> {
+        std::iter::once(Link::Ground)
+            .chain((0..self.n_bodies()).map(|b| Link::Body(BodyId(b))))
+            .find_map(|link| self.attachment(link, point))
+    }
     /// Look a body up by name.
     pub fn body_id(&self, name: &str) -> Option<BodyId> {
         self.bodies.iter().position(|b| b.name == name).map(BodyId)
