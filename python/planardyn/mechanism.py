@@ -23,6 +23,7 @@ from ._core import load as native_load
 from ._core import loads as native_loads
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
+from .results_format import plain
 from .settings import check_settings
 
 
@@ -587,10 +588,3 @@ def attach_metadata(
         meta["settings"] = {k: plain(v) for k, v in settings.items()}
     meta.update(extra)
     return dataclasses.replace(result, metadata=meta)
-
-
-def plain(v: Any) -> Any:
-    """``v`` as JSON takes it: numpy arrays and numbers as lists and Python numbers."""
-    if isinstance(v, (np.ndarray, np.generic)):
-        return v.tolist()
-    return v

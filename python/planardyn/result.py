@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
-import csv
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from . import results_format
+from ._core import __version__
 
 if TYPE_CHECKING:
     import pandas
@@ -216,11 +219,43 @@ class SimulationResult:
             cols["power_" + name] = self.power[:, k]
         return _dataframe(cols)
 
-    def to_csv(self, path: str | os.PathLike[str]) -> None:
-        """Write the table of :meth:`columns` as CSV (full double precision; no pandas needed)."""
-        cols = self.columns()
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(cols)
-            for row in zip(*(c.tolist() for c in cols.values())):
-                w.writerow([repr(v) for v in row])
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write a results file (``.csv``, ``.parquet`` or ``.npz``, by the name's extension;
+        format in :mod:`planardyn.results_io`): every array, exactly, and the metadata
+        (model, settings, version when attached), read back by :func:`planardyn.read_results`,
+        ``planardyn plot`` and ``planardyn animate``. Written whole or not at all. Returns
+        the path."""
+        return self._write(path, None)
+
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
+        """:meth:`save` in the CSV form whatever the name: the metadata on ``# `` lines, then
+        the columns of :meth:`columns` and the body coordinates, full double precision."""
+        return self._write(path, ".csv")
+
+    def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:
+        layout = results_format.columns(self.coordinate_names, self.body_names)
+        e = self.energy
+        groups = {
+            "t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau,
+            "kinetic": e.kinetic, "potential": e.potential, "work": e.work,
+            "sigma": self.sigma, "residual": self.residual, "partitioned": self.partitioned,
+            "x": self.x, "xd": self.xd,
+        }
+        meta = {
+            "format": results_format.FORMAT,
+            "format_version": results_format.FORMAT_VERSION,
+            "kind": "simulation",
+            "planardyn_version": __version__,
+            "model": None,
+            "settings": None,
+            **{k: v for k, v in self.metadata.items() if k != "path"},
+            "status": self.status,
+            "success": self.success,
+            "message": self.message,
+            "stats": {k: results_format.plain(v) for k, v in self.stats.items()},
+            "coordinate_names": self.coordinate_names,
+            "coordinate_kinds": self.coordinate_kinds,
+            "body_names": self.body_names,
+            "layout": [[g, len(cols)] for g, cols in layout],
+        }
+        return results_format.write(path, meta, groups, layout, ext)
