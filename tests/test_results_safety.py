@@ -226,3 +226,15 @@ def test_damaged_integrity_key_does_not_switch_the_check_off(run_5bar, tmp_path)
     head = "".join(f"# {ln}\n" for ln in json.dumps(meta, indent=1).splitlines())
     path.write_text(head + "".join(ln for ln in lines if not ln.startswith("#")))
     assert np.array_equal(read_results(path).q, res.q)
+
+
+def test_api_run_that_cannot_fit_is_refused_up_front(monkeypatch):
+    """The same rule in Mechanism.simulate: 10001 rows of 305 B, 4 times over, exceed 10 MiB;
+    10000 t_eval rows (12.2 MB) too; 1001 rows (1.2 MB) run."""
+    mech = pd.load(FIVE_BAR)
+    monkeypatch.setattr(pd.mechanism, "available_memory", lambda: 10 * 2**20)
+    with pytest.raises(ValueError, match="output rows need about 0.0114 GiB.*larger output_dt"):
+        mech.simulate(t_end=10.0, output_dt=0.001)
+    with pytest.raises(ValueError, match="fewer t_eval"):
+        mech.simulate(t_end=1.0, t_eval=np.linspace(0.0, 1.0, 10_000))
+    assert mech.simulate(t_end=0.01, output_dt=1e-5).success

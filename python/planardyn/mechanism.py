@@ -21,6 +21,7 @@ from ._core import Mechanism as NativeMechanism
 from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
+from .guard import available_memory, rows_message
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
 from .results_format import plain
@@ -476,6 +477,7 @@ class Mechanism:
             An argument with the wrong shape or a non-finite value.
         """
         checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
+        self._check_rows_fit(checked, t_eval)
         raw = self._native.simulate(
             t_end=checked["t_end"],
             method=method,
@@ -504,6 +506,21 @@ class Mechanism:
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
+
+    def _check_rows_fit(self, checked: dict[str, Any], t_eval: ArrayLike | None) -> None:
+        """Refuse up front a run whose output rows cannot fit in the memory available (a run
+        that outputs every step has no count known up front)."""
+        defaults = self.simulate_defaults
+        output_dt = checked.get("output_dt") or defaults.get("output_dt")
+        if t_eval is not None:
+            rows = float(np.size(t_eval))
+        elif output_dt is not None:
+            rows = (checked.get("t_end") or defaults.get("t_end") or 1.0) / output_dt + 1
+        else:
+            return
+        refused = rows_message(rows, self.dof, self.n_bodies, available_memory())
+        if refused:
+            raise ValueError(f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:
