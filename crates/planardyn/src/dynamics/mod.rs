@@ -8,6 +8,7 @@ pub mod forces;
 pub mod forward;
 pub mod inverse;
 pub mod reactions;
+pub mod regressor;
 pub mod regular;
 pub mod task;
 
