@@ -79,9 +79,9 @@ fn a_moved_centre_of_mass_is_other_numbers_in_pi() {
     // offset d in the model's coupler frame (origin at its centre of mass, x along A -> B),
     // gives the efforts of the model drawn with that centre of mass.
     let frames = yaml(FOUR_BAR);
-    let (ax, ay, bx, by) = (0.25, 0.4330127018922193, 1.336926485022576, 0.9415309573722639);
-    let len = (bx - ax) * (bx - ax) + (by - ay) * (by - ay);
-    let e = [(bx - ax) / len.sqrt(), (by - ay) / len.sqrt()];
+    let (ax, ay, bx, by): (f64, f64, f64, f64) = (0.25, 0.4330127018922193, 1.336926485022576, 0.9415309573722639);
+    let len = (bx - ax).hypot(by - ay);
+    let e = [(bx - ax) / len, (by - ay) / len];
     let d = [0.1, 0.05];
     let com = [0.793463242511288 + d[0] * e[0] - d[1] * e[1], 0.6872718296322415 + d[0] * e[1] + d[1] * e[0]];
     let (mass, inertia) = (1.5, 0.2);
