@@ -15,10 +15,9 @@ import subprocess
 import sys
 
 import numpy as np
+import planardyn as pd
 import pytest
 from conftest import PENDULUM_I, PENDULUM_L, PENDULUM_M, G, pendulum_dict
-
-import planardyn as pd
 from planardyn.results_io import read_results
 
 I_O = PENDULUM_I + PENDULUM_M * PENDULUM_L**2
