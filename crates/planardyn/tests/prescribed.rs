@@ -310,3 +310,25 @@ fn turning_crank_with_the_free_part_in_a_partition_chart() {
     assert!(tr.stats.partition_steps > 0, "never in a partition chart: min sigma {}", tr.stats.min_sigma);
     assert!(tr.stats.energy_drift < 5e-8, "energy balance {} J", tr.stats.energy_drift);
 }
+
+/// Both cranks of the five-bar turned into a type II singularity: the efforts the motion
+/// needs grow without bound there, and the run's message says so and what to change.
+#[test]
+fn motion_into_a_singularity_is_reported_as_such() {
+    let mech = shipped("five-bar.yaml");
+    let mut motion = Prescribed::from_model(&mech);
+    for (k, w) in [(0, 30f64.to_radians()), (1, -30f64.to_radians())] {
+        motion.set(k, Motion::Law(planardyn::model::MotionLaw::Speed(w)));
+    }
+    let mut s = Settings::for_model(&mech).unwrap();
+    s.t_end = 1.0;
+    s.t_eval = None;
+    let tr = simulate_prescribed(&mech, &s, &mut ModelDrives(&mech), &mut motion, None).unwrap();
+    assert!(!tr.success() && tr.t.last().is_some_and(|&t| t > 0.8), "{:?} at {:?}", tr.status, tr.t.last());
+    assert!(
+        tr.message.contains("the coordinates driven by motion are near a singularity of their own"),
+        "{}",
+        tr.message
+    );
+    assert!(tr.message.contains("Change the motion so that it avoids this configuration"), "{}", tr.message);
+}

@@ -18,7 +18,7 @@ pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};
 pub use inverse::inverse;
 pub use motion::{Motion, MotionFunction, Prescribed};
-pub use prescribed::forward_prescribed;
+pub use prescribed::{forward_prescribed, prescribed_sigma_min};
 pub use reactions::reactions;
 pub use regular::{finite, type_ii_measure, SINGULAR_SIGMA};
 pub use task::{SingularityKind, TaskError, TaskPath, TaskSolution};

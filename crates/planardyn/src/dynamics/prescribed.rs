@@ -12,12 +12,15 @@
 use super::forces::{applied_forces, Drives};
 use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::motion::Prescribed;
+use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
+use crate::kinematics::system::{col_scales, scaled_jacobian};
 use crate::kinematics::Chart;
 use crate::linalg::{cholesky_in_place, cholesky_solve};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
+use nalgebra::DMatrix;
 
 /// Buffers of [`forward_prescribed`] (held by [`Prescribed`]), sized for m coordinates, m_p of them prescribed, and
 /// 3n body coordinates.
@@ -124,4 +127,22 @@ pub fn forward_prescribed(
     }
     accelerations(mech, z, zd, ws);
     Ok(())
+}
+
+/// Smallest singular value of the scaled [Phi_x; D_p,x] at x: the pair constraints with the
+/// prescribed coordinates `p` fixed. It is 0 where they stop determining their part of the
+/// mechanism, and the efforts their motion needs grow without bound (with every coordinate
+/// prescribed, the type II measure).
+pub fn prescribed_sigma_min(mech: &Mechanism, p: &[usize], x: &[f64]) -> f64 {
+    let (n, nc) = (x.len(), mech.n_constraints);
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    let mut j = vec![0.0; n * n];
+    scaled_jacobian(mech, &Chart::Inputs, x, &trig, &mut vec![1.0; n], &col_scales(mech), &mut j);
+    let rows: Vec<usize> = (0..nc).chain(p.iter().map(|k| nc + k)).collect();
+    if rows.is_empty() || j.iter().any(|v| !v.is_finite()) {
+        return if rows.is_empty() { f64::INFINITY } else { 0.0 };
+    }
+    let a = DMatrix::from_fn(rows.len(), n, |r, c| j[rows[r] * n + c]);
+    a.singular_values().iter().copied().fold(f64::INFINITY, f64::min)
 }

@@ -10,7 +10,7 @@ pub mod trajectory;
 pub use overrides::Overrides;
 pub use trajectory::{SimStats, Status, Trajectory};
 
-use crate::dynamics::{Drives, Prescribed};
+use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
 use crate::integrate::{Method, Options, StepError, Stepper};
 use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Chart};
 use crate::model::Mechanism;
@@ -371,11 +371,18 @@ pub fn simulate_prescribed<'a>(
         // Steps that shrink to nothing usually mean the passive mechanism is at a change
         // point (a parallelogram folding flat): say so when it is.
         let passive = passive_sigma_min(mech, ode.anchor_x());
+        let driven = ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x()));
         if passive < NEAR_PASSIVE_SINGULAR {
             status = Status::PassiveSingularity;
             message = format!(
                 "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
                  a change point where its motion is not determined"
+            );
+        } else if driven < NEAR_PASSIVE_SINGULAR {
+            message = format!(
+                "{message}; the coordinates driven by motion are near a singularity of their own there (scaled \
+                 measure {driven:.2e}): they stop determining their part of the mechanism, and the efforts their \
+                 motion needs grow without bound. Change the motion so that it avoids this configuration"
             );
         }
     }
