@@ -196,13 +196,11 @@ pub fn simulate<'py>(
         };
         let mut prescribed = Prescribed::from_model(mech);
         for (k, entry) in motions.iter_mut() {
-            prescribed.set(
-                *k,
-                match entry {
-                    MotionEntry::Law(law) => Motion::Law(law.clone()),
-                    MotionEntry::Function(f) => Motion::Function(f),
-                },
-            );
+            let motion = match entry {
+                MotionEntry::Law(law) => Motion::Law(law.clone()),
+                MotionEntry::Function(f) => Motion::Function(f),
+            };
+            prescribed.set(*k, motion).map_err(PyValueError::new_err)?;
         }
         Ok(planardyn::simulate::simulate_prescribed(mech, &s, d, &mut prescribed, Some(&mut on_step))?)
     })?;

@@ -70,7 +70,7 @@ fn prescribed_rhs_evaluation_does_not_allocate() {
         let mut drives = ModelDrives(&mech);
         let law = Spline::new(&[0.0, 0.5, 1.0, 1.5], &[q[0], q[0] + 0.01, q[0] + 0.03, q[0] + 0.02]).unwrap();
         let mut motion = Prescribed::from_model(&mech);
-        motion.set(0, Motion::Law(MotionLaw::Table(law)));
+        motion.set(0, Motion::Law(MotionLaw::Table(law))).unwrap();
         motion.start(0.0, 1.0, &q).unwrap();
         let mut ode = MechanismOde::new(&mech, ws, &mut drives).with_motion(&mut motion);
         let mut y = vec![0.0; 2 * m + 1];

@@ -201,7 +201,7 @@ fn motion_function_matches_the_speed_law() {
     let s = settings(&mech, 1.0, 1e-10, t_eval);
     let mut turn = Turn(0.5235987755982988);
     let mut motion = Prescribed::from_model(&mech);
-    motion.set(0, Motion::Function(&mut turn));
+    motion.set(0, Motion::Function(&mut turn)).unwrap();
     let tr = simulate_prescribed(&mech, &s, &mut ModelDrives(&mech), &mut motion, None).unwrap();
     let reference = simulate(&mech_speed, &s, &mut ModelDrives(&mech_speed), None).unwrap();
     assert!(tr.success() && reference.success());
@@ -318,7 +318,7 @@ fn motion_into_a_singularity_is_reported_as_such() {
     let mech = shipped("five-bar.yaml");
     let mut motion = Prescribed::from_model(&mech);
     for (k, w) in [(0, 30f64.to_radians()), (1, -30f64.to_radians())] {
-        motion.set(k, Motion::Law(planardyn::model::MotionLaw::Speed(w)));
+        motion.set(k, Motion::Law(planardyn::model::MotionLaw::Speed(w))).unwrap();
     }
     let mut s = Settings::for_model(&mech).unwrap();
     s.t_end = 1.0;

@@ -57,14 +57,18 @@ impl<'a> Prescribed<'a> {
         };
         for (k, law) in mech.motions.iter().enumerate() {
             if let Some(law) = law {
-                set.set(k, Motion::Law(law.clone()));
+                // k < m: one law per coordinate.
+                let _ = set.set(k, Motion::Law(law.clone()));
             }
         }
         set
     }
 
-    /// Drive coordinate k by `motion`, replacing any motion it had.
-    pub fn set(&mut self, k: usize, motion: Motion<'a>) {
+    /// Drive coordinate k (0-based, < m) by `motion`, replacing any motion it had.
+    pub fn set(&mut self, k: usize, motion: Motion<'a>) -> Result<(), String> {
+        if k >= self.m {
+            return Err(format!("no coordinate {k}: the mechanism has {} ({})", self.m, self.names.join(", ")));
+        }
         match self.p.binary_search(&k) {
             Ok(i) => self.motions[i] = motion,
             Err(i) => {
@@ -77,6 +81,7 @@ impl<'a> Prescribed<'a> {
             v.resize(mp, 0.0);
         }
         self.scratch = Scratch::new(self.m, mp, self.nx);
+        Ok(())
     }
 
     /// Number of prescribed coordinates m_p.
@@ -85,11 +90,6 @@ impl<'a> Prescribed<'a> {
     }
     pub fn is_empty(&self) -> bool {
         self.p.is_empty()
-    }
-
-    /// Whether coordinate k is prescribed.
-    pub fn contains(&self, k: usize) -> bool {
-        self.p.binary_search(&k).is_ok()
     }
 
     /// Start the run at t0 (s) from coordinates q0 (m): the `Speed` laws count from there.
