@@ -105,6 +105,9 @@ def test_mixed_run_from_the_model_file_closes_its_energy_balance():
     # The crank torque is inverse dynamics' for the motion found, the rider needing none.
     tau = mech.inverse_dynamics(res.q[50], res.qd[50], res.qdd[50])
     np.testing.assert_allclose(tau, [res.tau[50, 0], 0.0], rtol=0, atol=1e-8)
+    # The model the result carries keeps its motion: the same run again, to the last bit.
+    again = pd.from_dict(res.metadata["model"]).simulate(2.0, output_dt=0.01, rtol=1e-10, atol=1e-13)
+    np.testing.assert_array_equal(again.tau, res.tau)
 
 
 def test_api_motion_replaces_the_model_files(pendulum):
@@ -136,6 +139,12 @@ def test_a_failing_motion_function_ends_the_run_with_its_error(pendulum):
     res = pendulum.simulate(1.0, motion={"theta": broken})
     assert res.status == "drive_failed" and "no data past 0.2 s" in res.message
     assert 0.0 < res.t[-1] <= 0.2
+
+
+def test_a_motion_function_of_the_wrong_shape_is_named(pendulum):
+    res = pendulum.simulate(1.0, motion={"theta": lambda t: (W * t, W)})
+    assert res.status == "drive_failed" and len(res.t) == 0
+    assert "the motion function of 'theta' must return (q, qd, qdd), three numbers" in res.message
 
 
 def test_model_file_motion_error_names_file_field_and_fix(tmp_path):
