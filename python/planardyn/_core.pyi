@@ -157,6 +157,7 @@ class Mechanism:
         drives: Callable[[float, NDArray[np.float64], NDArray[np.float64]], ArrayLike] | None = None,
         progress: Callable[[float], Any] | None = None,
         max_steps: int | None = None,
+        motion: list[tuple[int, float | tuple[list[float], list[float]] | Callable[[float], Any]]] | None = None,
     ) -> dict[str, Any]: ...
 
 @final

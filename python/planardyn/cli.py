@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from . import AssemblyError, PlanardynError, SimulationError, SingularityError, load, models, structure
+from . import AssemblyError, Mechanism, PlanardynError, SimulationError, SingularityError, load, models, structure
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
@@ -179,6 +179,10 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--dt", type=_setting("dt"), help="fixed step (s): for rk4, or to switch error control off")
     s.add_argument("--output-dt", type=_setting("output_dt"), help="spacing of the output rows (s); default: the model's, else every step")
     s.add_argument("--max-steps", type=_setting("max_steps"), help="most step attempts before giving up")
+    s.add_argument("--speed", action="append", metavar="NAME=RATE", default=[],
+                   help="drive coordinate NAME at a constant rate instead of its effort (its torque or force is "
+                        "computed): rad/s, rev/s, rpm, deg/s, or m/s, mm/s for a displacement, e.g. crank=1rev/s; "
+                        "repeatable")
     s.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write: .csv, .parquet or .npz (by extension)")
     s.add_argument("--progress", action="store_true", help="show a progress bar on stderr even when it is not a terminal")
@@ -284,6 +288,7 @@ def _simulate(args: argparse.Namespace) -> int:
         mech, t_end=args.t_end, method=args.method, rtol=args.rtol, atol=args.atol, dt=args.dt,
         output_dt=args.output_dt, max_steps=args.max_steps,
     )
+    motion = _speeds(args.speed, mech)
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
         refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
@@ -293,7 +298,7 @@ def _simulate(args: argparse.Namespace) -> int:
     bar = ProgressBar(t_end) if show else None
     try:
         with RunGuard(bar) as guard:
-            res = mech.simulate(**settings, progress=guard)
+            res = mech.simulate(**settings, progress=guard, motion=motion)
         if bar is not None and res.success:
             bar(t_end)
     finally:
@@ -301,7 +306,7 @@ def _simulate(args: argparse.Namespace) -> int:
             bar.close()
     if guard.reason is not None and res.status == "cancelled":
         res = dataclasses.replace(res, message=guard.reason)
-    res = attach_metadata(res, mech, settings)
+    res = attach_metadata(res, mech, dict(settings, motion=motion))
     if args.output is not None:
         args.output.parent.mkdir(parents=True, exist_ok=True)
         write_results(res, args.output)
@@ -311,6 +316,22 @@ def _simulate(args: argparse.Namespace) -> int:
         print(f"planardyn: simulation stopped early: {res.message}", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
+
+
+def _speeds(given: list[str], mech: Mechanism) -> dict[str, float] | None:
+    """``--speed NAME=RATE`` options as ``Mechanism.simulate``'s ``motion`` (rates in SI)."""
+    from .units import parse_rate
+
+    motion: dict[str, float] = {}
+    for text in given:
+        name, _, rate = text.partition("=")
+        if name not in mech.coordinate_names:
+            raise UsageError(f"--speed {text}: give NAME=RATE with NAME one of {', '.join(mech.coordinate_names)}")
+        try:
+            motion[name] = parse_rate(rate, mech.coordinate_kinds[mech.coordinate_names.index(name)])
+        except ValueError as e:
+            raise UsageError(f"--speed {text}: {e}") from None
+    return motion or None
 
 
 def _inverse(args: argparse.Namespace) -> int:

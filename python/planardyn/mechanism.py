@@ -34,6 +34,8 @@ class PlanardynWarning(UserWarning):
 FloatArray = NDArray[np.float64]
 DriveFunction = Callable[[float, FloatArray, FloatArray], ArrayLike]
 ProgressFunction = Callable[[float], Any]
+#: A coordinate's motion ``f(t) -> (q, qd, qdd)`` (rad, rad/s, rad/s^2 or m, m/s, m/s^2).
+MotionFunction = Callable[[float], tuple[float, float, float]]
 
 
 T = TypeVar("T")
@@ -420,6 +422,7 @@ class Mechanism:
         drives: DriveFunction | None = None,
         progress: ProgressFunction | None = None,
         max_steps: int | None = None,
+        motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None = None,
     ) -> SimulationResult:
         """Integrate the equations of motion from t = 0 (forward dynamics in time).
 
@@ -458,6 +461,15 @@ class Mechanism:
             ``t_end / (10 max_steps)`` cannot finish and stops early with status
             ``'step_size_too_small'`` (efforts too large for the model, or tolerances too
             tight), keeping its last accepted state as the last row.
+        motion : dict, optional
+            Coordinates driven by motion instead of effort, by name (with those of the model
+            file's ``drives: [{coordinate, motion}]``, which an entry here replaces): a number,
+            a constant speed (rad/s or m/s) from the start value; a table
+            ``{"t": times (s), "q": positions (rad or m)}`` covering [0, t_end], through which
+            a C2 cubic spline with not-a-knot ends runs; or a function ``f(t) -> (q, qd,
+            qdd)``. Their efforts are the ones the motion needs (in ``tau``; ``drives`` on them
+            are not applied), their work is part of ``work``, and the other coordinates move
+            freely under their drives.
 
         Returns
         -------
@@ -491,6 +503,7 @@ class Mechanism:
             drives=drives,
             progress=progress,
             max_steps=checked["max_steps"],
+            motion=_native_motion(motion, self.coordinate_names),
         )
         result = SimulationResult.from_raw(
             raw,
@@ -501,7 +514,9 @@ class Mechanism:
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
-                        drives="callable" if callable(drives) else drives)
+                        drives="callable" if callable(drives) else drives,
+                        motion=None if motion is None else
+                        {k: "callable" if callable(v) else v for k, v in motion.items()})
         result = attach_metadata(result, self, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
@@ -521,6 +536,37 @@ class Mechanism:
         refused = rows_message(rows, self.dof, self.n_bodies, available_memory())
         if refused:
             raise ValueError(f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
+
+
+def _native_motion(
+    motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None, names: list[str]
+) -> list[tuple[int, Any]] | None:
+    """``Mechanism.simulate``'s ``motion`` as the native call takes it: (coordinate index, a
+    speed, a (t, q) pair of lists or a callable)."""
+    if motion is None:
+        return None
+    if not isinstance(motion, Mapping):
+        raise TypeError(f"motion must be a dict from coordinate names to motions, got {type(motion).__name__}")
+    out: list[tuple[int, Any]] = []
+    for name, m in motion.items():
+        if name not in names:
+            raise ValueError(f"motion: unknown coordinate {name!r}; coordinates are: {', '.join(names)}")
+        k = names.index(name)
+        if isinstance(m, Mapping):
+            if set(m) != {"t", "q"}:
+                raise ValueError(f"motion of {name!r}: a table is {{'t': times, 'q': positions}}, got keys {sorted(m)}")
+            t, q = (np.asarray(m[key], dtype=float) for key in ("t", "q"))
+            if t.ndim != 1 or q.ndim != 1:
+                raise ValueError(f"motion table of {name!r}: t and q must be 1-D, got shapes {t.shape} and {q.shape}")
+            out.append((k, (t.tolist(), q.tolist())))
+        elif callable(m):
+            out.append((k, m))
+        elif isinstance(m, (int, float, np.integer, np.floating)) and not isinstance(m, bool):
+            out.append((k, float(m)))
+        else:
+            raise TypeError(f"motion of {name!r}: give a speed (a number, rad/s or m/s), a table "
+                            f"{{'t': ..., 'q': ...}} or a function f(t) -> (q, qd, qdd); got {type(m).__name__}")
+    return out
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:

@@ -578,7 +578,7 @@ impl PyMechanism {
     }
 
     /// Simulate; see `planardyn.Mechanism.simulate` for the arguments.
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None, motion=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -595,6 +595,7 @@ impl PyMechanism {
         drives: Option<Py<PyAny>>,
         progress: Option<Py<PyAny>>,
         max_steps: Option<usize>,
+        motion: Option<Vec<(usize, crate::simulate::MotionArg)>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let t_eval = t_eval
             .map(|a| {
@@ -621,7 +622,7 @@ impl PyMechanism {
             qd0: qd0.map(|a| self.q_arg("qd0", &a)).transpose()?,
             max_steps,
         };
-        crate::simulate::simulate(py, &self.inner, args, drives, progress)
+        crate::simulate::simulate(py, &self.inner, args, drives, motion.unwrap_or_default(), progress)
     }
 
     fn __repr__(&self) -> String {

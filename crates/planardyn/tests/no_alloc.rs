@@ -54,3 +54,37 @@ fn rhs_evaluation_does_not_allocate() {
         assert_eq!(ALLOCATIONS.load(Ordering::Relaxed) - before, 0, "{}: allocations in rhs/accept", mech.name);
     }
 }
+
+/// The same with the first coordinate driven by a table motion. (In the user's chart: an
+/// evaluation in a partition chart allocates once, with or without motion.)
+#[test]
+fn prescribed_rhs_evaluation_does_not_allocate() {
+    use planardyn::dynamics::{Motion, Prescribed};
+    use planardyn::model::{MotionLaw, Spline};
+    for mech in all_models() {
+        let m = mech.dof();
+        let (q, qd) = test_state(&mech);
+        let mut ws = Workspace::new(&mech);
+        assemble_into(&mech, &q, &mut ws).unwrap();
+        velocity_analogues(&mut ws).unwrap();
+        let mut drives = ModelDrives(&mech);
+        let law = Spline::new(&[0.0, 0.5, 1.0, 1.5], &[q[0], q[0] + 0.01, q[0] + 0.03, q[0] + 0.02]).unwrap();
+        let mut motion = Prescribed::from_model(&mech);
+        motion.set(0, Motion::Law(MotionLaw::Table(law))).unwrap();
+        motion.start(0.0, 1.0, &q).unwrap();
+        let mut ode = MechanismOde::new(&mech, ws, &mut drives).with_motion(&mut motion);
+        let mut y = vec![0.0; 2 * m + 1];
+        y[..m].copy_from_slice(&q);
+        y[m..2 * m].copy_from_slice(&qd);
+        ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
+        let mut dy = vec![0.0; 2 * m + 1];
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for step in 0..10 {
+            let t = 1e-3 * step as f64;
+            y[m..2 * m].iter_mut().for_each(|v| *v *= 1.0 + 1e-6);
+            ode.rhs(t, &y, &mut dy).unwrap();
+            ode.accept(t, &y).unwrap();
+        }
+        assert_eq!(ALLOCATIONS.load(Ordering::Relaxed) - before, 0, "{}: allocations in rhs/accept", mech.name);
+    }
+}

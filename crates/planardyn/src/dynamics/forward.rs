@@ -85,27 +85,44 @@ pub fn forward(
     ws: &mut Workspace,
 ) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
+    drive_efforts(t, drives, ws)?;
+    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    mass_matrix(mech, ws);
+    bias(mech, ws);
+    factor_mass_matrix(ws)?;
+    cholesky_solve(&ws.a, ws.b.len(), &mut ws.b);
+    accelerations(mech, z, zd, ws);
+    Ok(())
+}
+
+/// The drives' efforts at time t (s) and the point in `ws` into `ws.tau`, checked finite.
+pub(crate) fn drive_efforts(t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
     drives.efforts(t, &ws.q, &ws.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
     if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {
         return Err(Error::Drive { t, message: format!("effort {bad} is {}", ws.tau[bad]) });
     }
-    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
-    mass_matrix(mech, ws);
-    bias(mech, ws);
-    let m = ws.b.len();
-    if !cholesky_in_place(&mut ws.a, m) {
+    Ok(())
+}
+
+/// `ws.a` into its Cholesky factor, or the singularity that keeps A from being positive definite.
+pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsError> {
+    if !cholesky_in_place(&mut ws.a, ws.b.len()) {
         let type_ii = matches!(ws.chart, Chart::Inputs);
-        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }).into());
+        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }));
     }
-    cholesky_solve(&ws.a, m, &mut ws.b);
+    Ok(())
+}
+
+/// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd
+/// in `ws.b`, at chart state (z, zd).
+pub(crate) fn accelerations(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Workspace) {
     let n = ws.x.len();
     ws.xdd.copy_from_slice(&ws.c);
-    for j in 0..m {
+    for j in 0..ws.b.len() {
         let zdd = ws.b[j];
         for (a, u) in ws.xdd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
             *a += u * zdd;
         }
     }
     user_coordinates(mech, ws, z, zd, true);
-    Ok(())
 }

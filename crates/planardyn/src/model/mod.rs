@@ -7,12 +7,14 @@
 mod build;
 mod diameter;
 mod io;
+mod motion;
 mod nesting;
 mod parse_errors;
 pub mod spec;
 mod tags;
 
 pub use io::{load, loads, parse_spec, Format};
+pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
 
 /// Index of a mobile body (its coordinates are `x[3i..3i+3]`).
@@ -187,6 +189,8 @@ pub struct Mechanism {
     pub coordinates: Vec<Coordinate>,
     /// One drive law per coordinate (`None`: no drive).
     pub drives: Vec<Option<DriveLaw>>,
+    /// One motion law per coordinate (`None`: the coordinate moves freely under its effort).
+    pub motions: Vec<Option<MotionLaw>>,
     pub loads: Vec<Load>,
     pub simulate: SimulateDefaults,
     /// Body coordinates in the drawing, 3n values [X, Y, phi] per body.
