@@ -14,7 +14,7 @@ from pathlib import Path
 
 import planardyn as pd
 import pytest
-from planardyn import cli, models
+from planardyn import demo, models
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -83,6 +83,6 @@ def test_models_imports_nothing_of_the_package():
     assert imported == []
 
 
-def test_demo_runs_a_shipped_model():
-    """`planardyn demo` finds its model in the package, not relative to a source tree."""
-    assert cli.DEMO_MODEL in models.names()
+def test_demo_runs_shipped_models():
+    """`planardyn demo` finds its models in the package, not relative to a source tree."""
+    assert {demo.ROBOT_MODEL, demo.PASSIVE_MODEL} <= set(models.names())

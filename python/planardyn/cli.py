@@ -22,17 +22,15 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TextIO
 
-from . import AssemblyError, PlanardynError, SimulationError, SingularityError, load, models, structure
+from . import AssemblyError, PlanardynError, SimulationError, SingularityError, load, structure
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
-#: The demo's model: a shipped model (package data, ``planardyn.models``).
-DEMO_MODEL = "five-bar"
 RESULT_EXTENSIONS = (".csv", ".parquet", ".npz")
 
 
@@ -232,14 +230,15 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
-    d = _sub(sub, "demo", "show what planardyn does: simulate the five-bar robot, write plots, GIF and viewer",
-             "Simulate the shipped five-bar robot and write, into one folder: the results (CSV),\n"
-             "plots of the coordinates, efforts, energy and the mechanism (PNG), an animation (GIF)\n"
-             "and the interactive viewer (HTML, open it in a browser).",
+    d = _sub(sub, "demo", "show what planardyn does: a robot's path, torques, sizing, singularities; a mechanism moving",
+             "Write, into one folder and in seconds, from the shipped models: the 5R robot tracing a\n"
+             "circle with its drive torques, actuator sizing report and singularity map; a passive\n"
+             "mechanism (a four-bar under gravity) simulated, plotted and animated; and both in the\n"
+             "interactive viewer (HTML, open it in a browser). One line per file says what it is.",
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    d.add_argument("--model", type=Path, help=f"model file (default: the shipped model {DEMO_MODEL!r})")
+    d.add_argument("--model", type=Path, help="model file for the passive part (default: the shipped four-bar-gravity)")
     return p
 
 
@@ -387,74 +386,13 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
-    import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from .demo import run
 
-    from .animate import animate
-    from .plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy, plot_torque_speed
-    from .results_io import attach_metadata, simulate_settings, write_results
-
-    mech = load(models.path(DEMO_MODEL) if args.model is None else args.model)
-    settings = simulate_settings(mech)
-    res = attach_metadata(mech.simulate(**settings), mech, settings)
-    print(summary(res))
     out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-
-    def figure(size):
-        fig = Figure(figsize=size)
-        FigureCanvasAgg(fig)
-        return fig
-
-    def save(fig, name: str) -> None:
-        fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
-        written.append(out / name)
-
-    fig = figure((8, 6))
-    axes = fig.subplots(2, 1, sharex=True)
-    plot_coordinates(res, ax=axes[0])
-    plot_coordinates(res, ax=axes[1], which="qd")
-    axes[0].set_title(f"{mech.name}: coordinates")
-    save(fig, "coordinates.png")
-
-    plotters: list[tuple[tuple[float, float], Callable[..., Any], str, str]] = [
-        ((8, 4), plot_efforts, "drive efforts", "efforts.png"),
-        ((6, 5), plot_torque_speed, "drive effort vs speed", "torque-speed.png"),
-        ((8, 4.5), plot_energy, f"energy (balance drift {res.energy.drift:.2g} J)", "energy.png"),
-    ]
-    for size, plotter, title, name in plotters:
-        fig = figure(size)
-        ax = fig.add_subplot()
-        plotter(res, ax=ax)
-        ax.set_title(title)
-        save(fig, name)
-
-    n_snap = 4
-    idx = np.linspace(0, len(res.t) - 1, n_snap).round().astype(int) if len(res.t) else []
-    fig = figure((4 * n_snap, 4))
-    axes = fig.subplots(1, n_snap)
-    pts = mech.point_positions(res.x)  # (N, P, 2): one frame for every snapshot
-    lo, hi = np.nanmin(pts, axis=(0, 1)), np.nanmax(pts, axis=(0, 1))
-    pad = 0.1 * mech.scale
-    for ax, k in zip(np.atleast_1d(axes), idx):
-        draw_mechanism(mech, res.x[k], ax=ax, labels=True)
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - 2 * pad, hi[1] + pad)
-        ax.set_title(f"t = {res.t[k]:.3g} s")
-    save(fig, "mechanism.png")
-
-    write_results(res, out / "results.csv")
-    written.append(out / "results.csv")
-    animate(mech, res, out / "animation.gif")
-    written.append(out / "animation.gif")
-    animate(mech, res, out / "viewer.html")
-    written.append(out / "viewer.html")
-    print("wrote " + ", ".join(str(p) for p in written))
-    print(f"open {out / 'viewer.html'} in a browser to play the motion")
-    return EXIT_OK if res.success else EXIT_FAILED
+    print(f"planardyn demo: writing into {out}/")
+    demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
+    print(f"open {out / 'robot.html'} and {out / 'passive.html'} in a browser to play the motions")
+    return EXIT_OK if demo.success else EXIT_FAILED
 
 
 COMMANDS = {
