@@ -7,17 +7,16 @@ The site builds with `mkdocs build --strict` when mkdocs is installed.
 
 from __future__ import annotations
 
-import re
 import subprocess
 import sys
 import textwrap
 
 import pytest
 from conftest import ROOT
+from wheel_smoke import BLOCK
 
 DOCS = ROOT / "docs"
 PAGES = [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]
-BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.S | re.M)
 SKIPPED_COMMANDS = ("planardyn demo",)
 
 PRELUDE = textwrap.dedent(

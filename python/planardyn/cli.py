@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TextIO
 
-from . import AssemblyError, PlanardynError, SimulationError, SingularityError, load, structure
+from . import AssemblyError, PlanardynError, SimulationError, SingularityError, __version__, load, structure
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
@@ -151,6 +151,7 @@ def _parser() -> argparse.ArgumentParser:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    p.add_argument("--version", action="version", version=f"planardyn {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     c = _sub(sub, "check", "describe a model: structure, mobility, coordinates, singularity measures",
