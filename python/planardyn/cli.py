@@ -17,12 +17,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import importlib.util
 import os
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 from . import AssemblyError, PlanardynError, SimulationError, SingularityError, __version__, load, structure
 from .guard import RunGuard, available_memory, rows_message
@@ -38,20 +40,46 @@ class UsageError(Exception):
     """A command line that cannot be carried out as given (exit 2)."""
 
 
+#: What writing a file of this extension needs beyond the dependencies: (module, package, extra).
+OPTIONAL_WRITERS = {
+    ".parquet": ("pyarrow", "pyarrow", "parquet"),
+    ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg", "mp4"),
+}
+#: Integration methods without error control, whose step must be given (--dt).
+FIXED_STEP_METHODS = ("rk4",)
+
+
+def require_writer(path: Path | None) -> None:
+    """Refuse, before any computation, an output file whose optional package is missing."""
+    if path is None or path.suffix.lower() not in OPTIONAL_WRITERS:
+        return
+    module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
+    if importlib.util.find_spec(module) is None:
+        raise UsageError(f"{path}: writing {path.suffix} files needs {package}, which is not installed: "
+                         f"pip install {package} (or pip install 'planardyn[{extra}]')")
+
+
+def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
+    """warnings.showwarning for the command: one line, no source line or file position."""
+    print(f"planardyn: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 class ProgressBar:
-    """A one-line text bar on a stream, redrawn from the simulation's progress callback."""
+    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` with t
+    from 0 to ``t_end`` (simulated time, or frames done with ``unit="frame {:.0f} of N"``)."""
 
     WIDTH = 30
 
-    def __init__(self, t_end: float, stream: TextIO = sys.stderr) -> None:
-        self.t_end, self.stream, self.start = t_end, stream, time.monotonic()
+    def __init__(self, t_end: float, stream: TextIO | None = None, unit: str = "t = {:.4g} s") -> None:
+        self.t_end, self.unit, self.start = t_end, unit, time.monotonic()
+        self.stream = sys.stderr if stream is None else stream
 
     def __call__(self, t: float) -> None:
         frac = min(max(t / self.t_end, 0.0), 1.0) if self.t_end > 0 else 1.0
         filled = int(round(frac * self.WIDTH))
         bar = "#" * filled + "." * (self.WIDTH - filled)
         elapsed = time.monotonic() - self.start
-        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  t = {t:.4g} s  ({elapsed:.1f} s)")
+        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  {self.unit.format(t)}  ({elapsed:.1f} s)")
         self.stream.flush()
 
     def close(self) -> None:
@@ -284,6 +312,10 @@ def _simulate(args: argparse.Namespace) -> int:
         mech, t_end=args.t_end, method=args.method, rtol=args.rtol, atol=args.atol, dt=args.dt,
         output_dt=args.output_dt, max_steps=args.max_steps,
     )
+    if (settings["method"] or "").lower() in FIXED_STEP_METHODS and settings["dt"] is None:
+        raise UsageError(f"--method {settings['method']} takes fixed steps: give the step with --dt (e.g. --dt 1e-3; "
+                         "or dt in the model file's simulate section), or choose an adaptive method (--method dopri5)")
+    require_writer(args.output)
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
         refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
@@ -318,6 +350,7 @@ def _inverse(args: argparse.Namespace) -> int:
 
     from .results_io import inverse_from_file, write_results
 
+    require_writer(args.output)
     mech = load(args.model)
     res = inverse_from_file(mech, args.motion)
     if args.output is not None:
@@ -368,6 +401,7 @@ def _animate(args: argparse.Namespace) -> int:
 
     if args.output.suffix.lower() not in FORMATS:
         raise UsageError(f"{args.output}: an animation is .gif, .mp4 or .html")
+    require_writer(args.output)
     mech = load(args.model)
     res = read_results(args.results)
     if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
@@ -379,8 +413,15 @@ def _animate(args: argparse.Namespace) -> int:
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
+    bar = ProgressBar(1.0, unit="of the frames drawn") if not kw and sys.stderr.isatty() else None
+    if bar is not None:  # GIF and MP4 take seconds
+        kw["progress"] = lambda done, total, bar=bar: bar(done / total)
     start = time.monotonic()
-    animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    try:
+        animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    finally:
+        if bar is not None:
+            bar.close()
     size = args.output.stat().st_size
     print(f"wrote {args.output} ({size / 1024:.0f} KiB, {time.monotonic() - start:.1f} s)")
     return EXIT_OK
@@ -407,7 +448,12 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    with warnings.catch_warnings():  # restores showwarning for a caller in the same process
+        warnings.showwarning = _warning_line
+        return _main(list(sys.argv[1:] if argv is None else argv))
+
+
+def _main(argv: list[str]) -> int:
     try:
         if argv[:1] == ["size"]:
             # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
