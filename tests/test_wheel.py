@@ -9,22 +9,27 @@ from __future__ import annotations
 
 import pytest
 from conftest import ROOT
-from wheel_smoke import python_blocks
+from wheel_smoke import python_blocks, snippets
 
 README = (ROOT / "README.md").read_text()
 tomllib = pytest.importorskip("tomllib")  # Python 3.11+
 
 
-def test_python_blocks_are_found_in_order():
-    text = "a\n```python\nx = 1\n```\n```bash\nls\n```\n```python\ny = 2\n```\n"
+def test_snippets_are_found_in_page_order():
+    text = ("a\n```python\nx = 1\n```\n```bash\nls\nplanardyn check five-bar   # a comment\n"
+            "planardyn demo --out d\n```\n```python\ny = 2\n```\n")
+    assert snippets(text) == [("python", "x = 1\n"), ("planardyn", "planardyn check five-bar"), ("python", "y = 2\n")]
     assert python_blocks(text) == ["x = 1\n", "y = 2\n"]
 
 
-def test_readme_python_needs_no_repository_file():
+def test_readme_snippets_need_no_repository_file():
     # Run from an installed wheel in an empty folder: models by name, not by repository path.
-    blocks = python_blocks(README)
-    assert len(blocks) == 1
-    assert "examples/" not in blocks[0] and 'pd.load_example("five-bar")' in blocks[0]
+    code = snippets(README)
+    assert [kind for kind, _ in code] == ["python"] + ["planardyn"] * 7
+    for _, text in code:
+        assert "examples/" not in text, text
+    assert 'pd.load_example("five-bar")' in code[0][1]
+    assert code[1][1] == "planardyn check five-bar"
 
 
 def test_extras_and_licence():

@@ -5,25 +5,45 @@ wheel and its dependencies, from a folder outside the repository.
 
 Checks that planardyn is imported from the installed wheel, not a source tree; that the wheel
 holds the licence and every shipped model file, each of which loads; that `planardyn --version`
-prints the installed version; and that every ```python block of README.md runs, in order, in
-one namespace (as tests/test_docs.py runs them in the repository). Needs nothing but the wheel.
+prints the installed version; and that every snippet of README.md runs in page order, the
+```python blocks in one namespace, the `planardyn` lines of its ```bash blocks as commands (as
+tests/test_docs.py runs every page in the repository). Needs nothing but the wheel.
 """
 
 from __future__ import annotations
 
 import importlib.metadata
 import re
+import shlex
 import subprocess
 import sys
 import warnings
 from pathlib import Path
 
 BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.S | re.M)
+#: Commands the snippets leave out: the demo has its own run and test (it takes seconds).
+SKIPPED_COMMANDS = ("planardyn demo",)
 
 
 def python_blocks(markdown: str) -> list[str]:
     """The ```python blocks of a Markdown text, in order."""
-    return [body for lang, body in BLOCK.findall(markdown) if lang == "python"]
+    return [code for kind, code in snippets(markdown) if kind == "python"]
+
+
+def snippets(markdown: str) -> list[tuple[str, str]]:
+    """The code a page asks its reader to run, in page order: ("python", block) for each
+    ```python block, ("planardyn", line) for each `planardyn ...` line of a ```bash block
+    (its comment cut), the commands in SKIPPED_COMMANDS left out."""
+    out = []
+    for lang, body in BLOCK.findall(markdown):
+        if lang == "python":
+            out.append(("python", body))
+        elif lang == "bash":
+            for line in body.splitlines():
+                cmd = line.split("#")[0].strip()
+                if cmd.startswith("planardyn ") and not cmd.startswith(SKIPPED_COMMANDS):
+                    out.append(("planardyn", cmd))
+    return out
 
 
 def check_installed() -> None:
@@ -51,15 +71,22 @@ def check_version() -> None:
 
 
 def run_readme(readme: Path) -> None:
+    """Every snippet of the README, in order, in the current folder: the python blocks in one
+    namespace, the commands with this venv's `planardyn`."""
     import matplotlib
 
     matplotlib.use("Agg")
-    blocks = python_blocks(readme.read_text())
-    assert blocks, f"{readme} has no python block"
+    code = snippets(readme.read_text())
+    assert code, f"{readme} has no python block or planardyn command"
     namespace: dict[str, object] = {"__name__": "__main__"}
-    for k, body in enumerate(blocks, 1):
-        exec(compile(body, f"{readme.name}, python block {k}", "exec"), namespace)
-    print(f"wheel: the {len(blocks)} python block(s) of {readme.name} ran")
+    command = Path(sys.executable).parent / "planardyn"
+    for k, (kind, text) in enumerate(code, 1):
+        if kind == "python":
+            exec(compile(text, f"{readme.name}, snippet {k}", "exec"), namespace)
+        else:
+            p = subprocess.run([str(command), *shlex.split(text)[1:]], capture_output=True, text=True)
+            assert p.returncode == 0, f"{text!r} exited {p.returncode}: {p.stderr}"
+    print(f"wheel: the {len(code)} snippets of {readme.name} ran (python blocks and planardyn commands)")
 
 
 if __name__ == "__main__":

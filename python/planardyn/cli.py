@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from . import AssemblyError, PlanardynError, SimulationError, SingularityError, __version__, load, structure
+from . import AssemblyError, PlanardynError, SimulationError, SingularityError, __version__, load, models, structure
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
@@ -102,6 +102,7 @@ def summary(res: SimulationResult) -> str:
 
 # ------------------------------------------------------------------ the parser
 
+MODEL_HELP = "model file (.yaml, .yml or .json), or a shipped model by name (five-bar; see planardyn.models.names())"
 EPILOG = "Exit status: 0 ok, 1 the computation failed, 2 usage or model error."
 SIZE_NOTE = "Also: planardyn size MODEL ...: actuator sizing for an end-effector motion (see planardyn size --help)."
 
@@ -188,7 +189,7 @@ def _parser() -> argparse.ArgumentParser:
              "measures at the start configuration.",
              "  planardyn check examples/models/five-bar.yaml\n"
              "  planardyn check my-linkage.json")
-    c.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    c.add_argument("model", type=Path, help=MODEL_HELP)
 
     s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
              "Integrate the equations of motion from the model's start state. Options left out take\n"
@@ -198,7 +199,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
              "  planardyn simulate examples/models/slider-crank.yaml --t-end 2 --method radau5 -o run.npz\n"
              "  planardyn simulate model.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
-    s.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    s.add_argument("model", type=Path, help=MODEL_HELP)
     s.add_argument("--t-end", type=_setting("t_end"), help="end time (s); default: the model's, else 1")
     s.add_argument("--method", help="dop853 (default), dopri5, radau5 or rk4 (needs --dt)")
     s.add_argument("--rtol", type=_setting("rtol"), help="relative tolerance (default 1e-9)")
@@ -226,7 +227,7 @@ def _parser() -> argparse.ArgumentParser:
              "  0.0,2.0071,1.0472\n"
              "  0.01,2.0080,1.0460\n"
              "  ...")
-    i.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    i.add_argument("model", type=Path, help=MODEL_HELP)
     i.add_argument("--motion", type=Path, required=True, help="motion table (.csv) or results file")
     i.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write (.csv, .parquet or .npz) with tau_<name> columns")
@@ -461,6 +462,8 @@ def _main(argv: list[str]) -> int:
 
             return size_cli(argv[1:])
         args = _parser().parse_args(argv)
+        if getattr(args, "model", None) is not None:
+            args.model = models.resolve(args.model)
         code = COMMANDS[args.command](args)
         sys.stdout.flush()
         return code
@@ -471,7 +474,7 @@ def _main(argv: list[str]) -> int:
     except (AssemblyError, SingularityError) as e:
         # The start state (or a row of a motion) could not be computed: the computation failed.
         return _fail(str(e), EXIT_FAILED)
-    except (PlanardynError, UsageError, ValueError, OSError, ImportError) as e:
+    except (PlanardynError, UsageError, ValueError, OSError, ImportError, models.UnknownModelError) as e:
         return _fail(str(e), EXIT_USAGE)
     except MemoryError:
         return _fail("out of memory: ask for fewer outputs (--output-dt, --t-end) or a smaller image", EXIT_FAILED)
