@@ -73,13 +73,25 @@ def test_size_is_documented_with_a_command_that_runs(page):
     assert "planardyn size" in cli._parser().format_help()
 
 
+class Terminal(io.StringIO):
+    """A stderr that says it is a terminal, as an interactive shell's is."""
+
+    def isatty(self):
+        return True
+
+
+def test_a_simulation_in_a_terminal_shows_progress(tmp_path, monkeypatch):
+    stderr = Terminal()
+    monkeypatch.setattr(sys, "stderr", stderr)
+    assert cli.main(["simulate", str(FIVE_BAR), "--t-end", "0.5", "-o", str(tmp_path / "run.npz")]) == 0
+    updates = stderr.getvalue().split("\r")
+    assert len(updates) > 10  # the core reports about 100 times a run
+    assert "100.0%  t = 0.5 s" in updates[-1]
+
+
 def test_gif_writing_shows_progress(tmp_path, monkeypatch):
     res = pd.load(FIVE_BAR).simulate(t_end=0.3, output_dt=0.01)
     write_results(res, tmp_path / "run.npz")
-
-    class Terminal(io.StringIO):
-        def isatty(self):
-            return True
 
     stderr = Terminal()
     monkeypatch.setattr(sys, "stderr", stderr)

@@ -6,7 +6,11 @@
     planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
     planardyn animate MODEL RESULTS -o FILE.gif|FILE.mp4|FILE.html
+    planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
     planardyn demo [--out DIR] [--model MODEL]
+    planardyn --version
+
+MODEL is a model file, or a shipped model by name (``five-bar``: planardyn.models.resolve).
 
 Exit status: 0 success; 1 the computation failed (the simulation stopped before t_end: the
 results file still holds the trajectory computed; the start could not be assembled); 2 a
@@ -268,7 +272,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    d.add_argument("--model", type=Path, help="model file for the passive part (default: the shipped four-bar-gravity)")
+    d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
     return p
 
 
