@@ -69,8 +69,8 @@ def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__
 
 
 class ProgressBar:
-    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` with t
-    from 0 to ``t_end`` (simulated time, or frames done with ``unit="frame {:.0f} of N"``)."""
+    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` for t
+    from 0 to ``t_end``; ``unit`` formats t after the percentage (default: the simulated time)."""
 
     WIDTH = 30
 
