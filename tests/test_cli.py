@@ -144,19 +144,6 @@ def test_bad_option_exit_2(tmp_path):
     assert p.returncode == 2
 
 
-def test_demo_writes_plots_animation_and_viewer(tmp_path):
-    p = run("demo", "--out", tmp_path / "demo")
-    assert p.returncode == 0, p.stderr
-    for name in ("coordinates.png", "efforts.png", "torque-speed.png", "energy.png", "mechanism.png",
-                 "results.csv", "animation.gif", "viewer.html"):
-        f = tmp_path / "demo" / name
-        assert f.is_file() and f.stat().st_size > 1000, name
-    with Image.open(tmp_path / "demo" / "animation.gif") as im:
-        assert im.n_frames == 61  # 1.5 s shown in 3 s at 20 frames/s
-    assert "viewer.html in a browser" in p.stdout
-    assert read_results(tmp_path / "demo" / "results.csv").t[-1] == 1.5
-
-
 # ------------------------------------------------------------------ the other commands
 
 FIVE_BAR = MODELS / "five-bar.yaml"

@@ -6,7 +6,11 @@
     planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
     planardyn animate MODEL RESULTS -o FILE.gif|FILE.mp4|FILE.html
+    planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
     planardyn demo [--out DIR] [--model MODEL]
+    planardyn --version
+
+MODEL is a model file, or a shipped model by name (``five-bar``: planardyn.models.resolve).
 
 Exit status: 0 success; 1 the computation failed (the simulation stopped before t_end: the
 results file still holds the trajectory computed; the start could not be assembled); 2 a
@@ -17,22 +21,32 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import importlib.util
 import os
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from . import AssemblyError, Mechanism, PlanardynError, SimulationError, SingularityError, load, models, structure
+from . import (
+    AssemblyError,
+    Mechanism,
+    PlanardynError,
+    SimulationError,
+    SingularityError,
+    __version__,
+    load,
+    models,
+    structure,
+)
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
-#: The demo's model: a shipped model (package data, ``planardyn.models``).
-DEMO_MODEL = "five-bar"
 RESULT_EXTENSIONS = (".csv", ".parquet", ".npz")
 
 
@@ -40,20 +54,46 @@ class UsageError(Exception):
     """A command line that cannot be carried out as given (exit 2)."""
 
 
+#: What writing a file of this extension needs beyond the dependencies: (module, package, extra).
+OPTIONAL_WRITERS = {
+    ".parquet": ("pyarrow", "pyarrow", "parquet"),
+    ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg", "mp4"),
+}
+#: Integration methods without error control, whose step must be given (--dt).
+FIXED_STEP_METHODS = ("rk4",)
+
+
+def require_writer(path: Path | None) -> None:
+    """Refuse, before any computation, an output file whose optional package is missing."""
+    if path is None or path.suffix.lower() not in OPTIONAL_WRITERS:
+        return
+    module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
+    if importlib.util.find_spec(module) is None:
+        raise UsageError(f"{path}: writing {path.suffix} files needs {package}, which is not installed: "
+                         f"pip install {package} (or pip install 'planardyn[{extra}]')")
+
+
+def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
+    """warnings.showwarning for the command: one line, no source line or file position."""
+    print(f"planardyn: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 class ProgressBar:
-    """A one-line text bar on a stream, redrawn from the simulation's progress callback."""
+    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` for t
+    from 0 to ``t_end``; ``unit`` formats t after the percentage (default: the simulated time)."""
 
     WIDTH = 30
 
-    def __init__(self, t_end: float, stream: TextIO = sys.stderr) -> None:
-        self.t_end, self.stream, self.start = t_end, stream, time.monotonic()
+    def __init__(self, t_end: float, stream: TextIO | None = None, unit: str = "t = {:.4g} s") -> None:
+        self.t_end, self.unit, self.start = t_end, unit, time.monotonic()
+        self.stream = sys.stderr if stream is None else stream
 
     def __call__(self, t: float) -> None:
         frac = min(max(t / self.t_end, 0.0), 1.0) if self.t_end > 0 else 1.0
         filled = int(round(frac * self.WIDTH))
         bar = "#" * filled + "." * (self.WIDTH - filled)
         elapsed = time.monotonic() - self.start
-        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  t = {t:.4g} s  ({elapsed:.1f} s)")
+        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  {self.unit.format(t)}  ({elapsed:.1f} s)")
         self.stream.flush()
 
     def close(self) -> None:
@@ -76,6 +116,7 @@ def summary(res: SimulationResult) -> str:
 
 # ------------------------------------------------------------------ the parser
 
+MODEL_HELP = "model file (.yaml, .yml or .json), or a shipped model by name (five-bar; see planardyn.models.names())"
 EPILOG = "Exit status: 0 ok, 1 the computation failed, 2 usage or model error."
 SIZE_NOTE = "Also: planardyn size MODEL ...: actuator sizing for an end-effector motion (see planardyn size --help)."
 
@@ -153,6 +194,7 @@ def _parser() -> argparse.ArgumentParser:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    p.add_argument("--version", action="version", version=f"planardyn {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     c = _sub(sub, "check", "describe a model: structure, mobility, coordinates, singularity measures",
@@ -161,7 +203,7 @@ def _parser() -> argparse.ArgumentParser:
              "measures at the start configuration.",
              "  planardyn check examples/models/five-bar.yaml\n"
              "  planardyn check my-linkage.json")
-    c.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    c.add_argument("model", type=Path, help=MODEL_HELP)
 
     s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
              "Integrate the equations of motion from the model's start state. Options left out take\n"
@@ -171,7 +213,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
              "  planardyn simulate examples/models/slider-crank.yaml --t-end 2 --method radau5 -o run.npz\n"
              "  planardyn simulate model.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
-    s.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    s.add_argument("model", type=Path, help=MODEL_HELP)
     s.add_argument("--t-end", type=_setting("t_end"), help="end time (s); default: the model's, else 1")
     s.add_argument("--method", help="dop853 (default), dopri5, radau5 or rk4 (needs --dt)")
     s.add_argument("--rtol", type=_setting("rtol"), help="relative tolerance (default 1e-9)")
@@ -203,7 +245,7 @@ def _parser() -> argparse.ArgumentParser:
              "  0.0,2.0071,1.0472\n"
              "  0.01,2.0080,1.0460\n"
              "  ...")
-    i.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    i.add_argument("model", type=Path, help=MODEL_HELP)
     i.add_argument("--motion", type=Path, required=True, help="motion table (.csv) or results file")
     i.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write (.csv, .parquet or .npz) with tau_<name> columns")
@@ -236,14 +278,15 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
-    d = _sub(sub, "demo", "show what planardyn does: simulate the five-bar robot, write plots, GIF and viewer",
-             "Simulate the shipped five-bar robot and write, into one folder: the results (CSV),\n"
-             "plots of the coordinates, efforts, energy and the mechanism (PNG), an animation (GIF)\n"
-             "and the interactive viewer (HTML, open it in a browser).",
+    d = _sub(sub, "demo", "show what planardyn does: a robot's path, torques, sizing, singularities; a mechanism moving",
+             "Write, into one folder and in seconds, from the shipped models: the 5R robot tracing a\n"
+             "circle with its drive torques, actuator sizing report and singularity map; a passive\n"
+             "mechanism (a four-bar under gravity) simulated, plotted and animated; and both in the\n"
+             "interactive viewer (HTML, open it in a browser). One line per file says what it is.",
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    d.add_argument("--model", type=Path, help=f"model file (default: the shipped model {DEMO_MODEL!r})")
+    d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
     return p
 
 
@@ -288,6 +331,10 @@ def _simulate(args: argparse.Namespace) -> int:
         mech, t_end=args.t_end, method=args.method, rtol=args.rtol, atol=args.atol, dt=args.dt,
         output_dt=args.output_dt, max_steps=args.max_steps,
     )
+    if (settings["method"] or "").lower() in FIXED_STEP_METHODS and settings["dt"] is None:
+        raise UsageError(f"--method {settings['method']} takes fixed steps: give the step with --dt (e.g. --dt 1e-3; "
+                         "or dt in the model file's simulate section), or choose an adaptive method (--method dopri5)")
+    require_writer(args.output)
     motion = _speeds(args.speed, mech)
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
@@ -339,6 +386,7 @@ def _inverse(args: argparse.Namespace) -> int:
 
     from .results_io import inverse_from_file, write_results
 
+    require_writer(args.output)
     mech = load(args.model)
     res = inverse_from_file(mech, args.motion)
     if args.output is not None:
@@ -389,6 +437,7 @@ def _animate(args: argparse.Namespace) -> int:
 
     if args.output.suffix.lower() not in FORMATS:
         raise UsageError(f"{args.output}: an animation is .gif, .mp4 or .html")
+    require_writer(args.output)
     mech = load(args.model)
     res = read_results(args.results)
     if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
@@ -400,82 +449,28 @@ def _animate(args: argparse.Namespace) -> int:
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
+    bar = ProgressBar(1.0, unit="of the frames drawn") if not kw and sys.stderr.isatty() else None
+    if bar is not None:  # GIF and MP4 take seconds
+        kw["progress"] = lambda done, total, bar=bar: bar(done / total)
     start = time.monotonic()
-    animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    try:
+        animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    finally:
+        if bar is not None:
+            bar.close()
     size = args.output.stat().st_size
     print(f"wrote {args.output} ({size / 1024:.0f} KiB, {time.monotonic() - start:.1f} s)")
     return EXIT_OK
 
 
 def _demo(args: argparse.Namespace) -> int:
-    import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from .demo import run
 
-    from .animate import animate
-    from .plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy, plot_torque_speed
-    from .results_io import attach_metadata, simulate_settings, write_results
-
-    mech = load(models.path(DEMO_MODEL) if args.model is None else args.model)
-    settings = simulate_settings(mech)
-    res = attach_metadata(mech.simulate(**settings), mech, settings)
-    print(summary(res))
     out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-
-    def figure(size):
-        fig = Figure(figsize=size)
-        FigureCanvasAgg(fig)
-        return fig
-
-    def save(fig, name: str) -> None:
-        fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
-        written.append(out / name)
-
-    fig = figure((8, 6))
-    axes = fig.subplots(2, 1, sharex=True)
-    plot_coordinates(res, ax=axes[0])
-    plot_coordinates(res, ax=axes[1], which="qd")
-    axes[0].set_title(f"{mech.name}: coordinates")
-    save(fig, "coordinates.png")
-
-    plotters: list[tuple[tuple[float, float], Callable[..., Any], str, str]] = [
-        ((8, 4), plot_efforts, "drive efforts", "efforts.png"),
-        ((6, 5), plot_torque_speed, "drive effort vs speed", "torque-speed.png"),
-        ((8, 4.5), plot_energy, f"energy (balance drift {res.energy.drift:.2g} J)", "energy.png"),
-    ]
-    for size, plotter, title, name in plotters:
-        fig = figure(size)
-        ax = fig.add_subplot()
-        plotter(res, ax=ax)
-        ax.set_title(title)
-        save(fig, name)
-
-    n_snap = 4
-    idx = np.linspace(0, len(res.t) - 1, n_snap).round().astype(int) if len(res.t) else []
-    fig = figure((4 * n_snap, 4))
-    axes = fig.subplots(1, n_snap)
-    pts = mech.point_positions(res.x)  # (N, P, 2): one frame for every snapshot
-    lo, hi = np.nanmin(pts, axis=(0, 1)), np.nanmax(pts, axis=(0, 1))
-    pad = 0.1 * mech.scale
-    for ax, k in zip(np.atleast_1d(axes), idx):
-        draw_mechanism(mech, res.x[k], ax=ax, labels=True)
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - 2 * pad, hi[1] + pad)
-        ax.set_title(f"t = {res.t[k]:.3g} s")
-    save(fig, "mechanism.png")
-
-    write_results(res, out / "results.csv")
-    written.append(out / "results.csv")
-    animate(mech, res, out / "animation.gif")
-    written.append(out / "animation.gif")
-    animate(mech, res, out / "viewer.html")
-    written.append(out / "viewer.html")
-    print("wrote " + ", ".join(str(p) for p in written))
-    print(f"open {out / 'viewer.html'} in a browser to play the motion")
-    return EXIT_OK if res.success else EXIT_FAILED
+    print(f"planardyn demo: writing into {out}/")
+    demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
+    print(f"open {out / 'robot.html'} and {out / 'passive.html'} in a browser to play the motions")
+    return EXIT_OK if demo.success else EXIT_FAILED
 
 
 COMMANDS = {
@@ -489,7 +484,12 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    with warnings.catch_warnings():  # restores showwarning for a caller in the same process
+        warnings.showwarning = _warning_line
+        return _main(list(sys.argv[1:] if argv is None else argv))
+
+
+def _main(argv: list[str]) -> int:
     try:
         if argv[:1] == ["size"]:
             # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
@@ -497,6 +497,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             return size_cli(argv[1:])
         args = _parser().parse_args(argv)
+        if getattr(args, "model", None) is not None:
+            args.model = models.resolve(args.model)
         code = COMMANDS[args.command](args)
         sys.stdout.flush()
         return code
@@ -507,7 +509,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (AssemblyError, SingularityError) as e:
         # The start state (or a row of a motion) could not be computed: the computation failed.
         return _fail(str(e), EXIT_FAILED)
-    except (PlanardynError, UsageError, ValueError, OSError, ImportError) as e:
+    except (PlanardynError, UsageError, ValueError, OSError, ImportError, models.UnknownModelError) as e:
         return _fail(str(e), EXIT_USAGE)
     except MemoryError:
         return _fail("out of memory: ask for fewer outputs (--output-dt, --t-end) or a smaller image", EXIT_FAILED)

@@ -68,24 +68,32 @@ def plot_efforts(result: SimulationResult, ax: Axes | None = None, **line_kw: An
 def plot_energy(result: SimulationResult, ax: Axes | None = None, balance: bool = True) -> list[Artist]:
     """Kinetic T, potential V, total T + V and work W of the non-conservative forces (J).
 
-    With ``balance=True`` the energy balance T + V - W - E0 (the integration error) is drawn
-    on a second y axis. Returns the lines.
+    With ``balance=True`` a second y axis shows, for a simulation, the energy balance
+    T + V - W - E0 (the integration error); for inverse dynamics (``metadata["kind"] ==
+    "inverse"``, W the work of the drive efforts only), W - (T + V - E0): the energy the
+    model's dampers, friction and other non-conservative loads took. Returns the lines.
     """
     ax = _axes(ax)
     e = result.energy
+    inverse = result.metadata.get("kind") == "inverse"
     lines: list[Artist] = []
     lines += ax.plot(result.t, e.kinetic, label="kinetic T")
     lines += ax.plot(result.t, e.potential, label="potential V")
     lines += ax.plot(result.t, e.total, label="total T + V", linewidth=2)
-    lines += ax.plot(result.t, e.work, label="work W", linestyle="--")
+    lines += ax.plot(result.t, e.work, label="work W of the drives" if inverse else "work W", linestyle="--")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.grid(True, alpha=0.3)
     handles = list(lines)
     if balance:
         ax2 = ax.twinx()
-        bal = ax2.plot(result.t, e.balance, color="k", linewidth=0.8, label="balance T + V - W - E0")
-        ax2.set_ylabel("energy balance (J)")
+        if inverse:
+            bal = ax2.plot(result.t, -e.balance, color="k", linewidth=0.8,
+                           label="taken by dampers, friction, loads: W - (T + V - E0)")
+            ax2.set_ylabel("energy dissipated (J)")
+        else:
+            bal = ax2.plot(result.t, e.balance, color="k", linewidth=0.8, label="balance T + V - W - E0")
+            ax2.set_ylabel("energy balance (J)")
         lines += bal
         handles += bal
     ax.legend(handles=handles, loc="best", fontsize="small")
@@ -300,8 +308,8 @@ def plot_results(result: SimulationResult, fig: Any = None) -> list[Artist]:
     axes[0, 1].set_title("rates")
     axes[1, 0].set_title("drive efforts")
     kind = result.metadata.get("kind", "simulation")
-    if kind == "inverse":  # the balance then also holds what dampers dissipate
-        axes[1, 1].set_title("energy (W: work of the drive efforts only)")
+    if kind == "inverse":
+        axes[1, 1].set_title("energy: the drives' work W, and what the loads dissipate")
     else:
         axes[1, 1].set_title(f"energy (balance drift {result.energy.drift:.2g} J)")
     for ax in axes[0]:

@@ -168,6 +168,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.row_slot = (0..mech.n_constraints).map(Some).collect();
     mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
     build_coordinates(&ctx, &mut mech)?;
+    warn_degree_like_angles(&mut mech);
     (mech.drives, mech.motions) = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
@@ -647,6 +648,29 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
         mech.coordinates.push(Coordinate { name: c.name.clone(), pair, kind, value, q0, qd0 });
     }
     Ok(())
+}
+
+/// An angle beyond a full turn is legal (angles are unwrapped) but, in a drawing, more often
+/// degrees written where radians are meant (`value: 30`): say so, with the radian value.
+fn warn_degree_like_angles(mech: &mut Mechanism) {
+    let mut found = Vec::new();
+    for (k, c) in mech.coordinates.iter().enumerate() {
+        if c.kind != CoordinateKind::Angle {
+            continue;
+        }
+        let given_q0 = (c.q0 != c.value).then_some(("q0", c.q0));
+        for (field, v) in std::iter::once(("value", c.value)).chain(given_q0) {
+            if v.abs() > std::f64::consts::TAU {
+                found.push(format!(
+                    "coordinates[{k}].{field} of angle '{}' is {v} rad, more than a full turn (2 pi = 6.283 rad): \
+                     angles are in radians; if {v} is in degrees, write {:.6}",
+                    c.name,
+                    v.to_radians()
+                ));
+            }
+        }
+    }
+    mech.warnings.extend(found);
 }
 
 fn coordinate_index(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<usize> {
