@@ -132,6 +132,16 @@ class Mechanism:
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
+    def regressor(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    @property
+    def parameters(self) -> tuple[list[float], list[str]]: ...
     def along(
         self,
         t: ArrayLike,

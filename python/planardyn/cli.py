@@ -5,7 +5,7 @@
                              [--output-dt H] [--max-steps N] [-o results.csv|.parquet|.npz]
     planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
-    planardyn animate MODEL RESULTS -o FILE.gif|FILE.mp4|FILE.html
+    planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
     planardyn demo [--out DIR] [--model MODEL]
     planardyn --version
@@ -37,6 +37,7 @@ from . import (
     SimulationError,
     SingularityError,
     __version__,
+    from_result,
     load,
     models,
     structure,
@@ -187,7 +188,7 @@ def _parser() -> argparse.ArgumentParser:
             "  planardyn check examples/models/five-bar.yaml\n"
             "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
             "  planardyn plot five-bar.csv -o five-bar.png\n"
-            "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
+            "  planardyn animate five-bar.csv -o five-bar.html\n"
             "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
             "  planardyn demo\n\n"
             "Run 'planardyn COMMAND --help' for a command's options. " + SIZE_NOTE + "\n" + EPILOG
@@ -266,11 +267,12 @@ def _parser() -> argparse.ArgumentParser:
              "Animate the mechanism along a results file. .gif and .mp4 are videos (MP4 needs\n"
              "imageio-ffmpeg); .html is a self-contained viewer (play, pause, speed, time slider,\n"
              "point paths, linked plots) that works offline in any browser.",
-             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.gif\n"
-             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
-             "  planardyn animate examples/models/five-bar.yaml five-bar.npz -o five-bar.mp4 --fps 30 --speed 0.5")
-    a.add_argument("model", type=Path, help="model file the results were computed with")
-    a.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz)")
+             "  planardyn animate five-bar.csv -o five-bar.gif       # the model from the file\n"
+             "  planardyn animate five-bar five-bar.csv -o five-bar.html\n"
+             "  planardyn animate five-bar.npz -o five-bar.mp4 --fps 30 --speed 0.5")
+    a.add_argument("files", type=Path, nargs="+", metavar="[MODEL] RESULTS",
+                   help="results file (.csv, .parquet or .npz), after the model it was computed with when "
+                        "the file does not hold its model (files planardyn writes do)")
     a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
     a.add_argument("--fps", type=_within(1e-3, MAX_FPS), default=20.0,
                    help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
@@ -438,13 +440,22 @@ def _animate(args: argparse.Namespace) -> int:
     if args.output.suffix.lower() not in FORMATS:
         raise UsageError(f"{args.output}: an animation is .gif, .mp4 or .html")
     require_writer(args.output)
-    mech = load(args.model)
-    res = read_results(args.results)
-    if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
-        raise UsageError(
-            f"{args.results} was not computed with {args.model}: its coordinates are "
-            f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})"
-        )
+    if len(args.files) > 2:
+        raise UsageError(f"animate takes [MODEL] RESULTS, got {len(args.files)} files")
+    *model, results = args.files
+    res = read_results(results)
+    if model:
+        mech = load(models.resolve(model[0]))
+        if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
+            raise UsageError(
+                f"{results} was not computed with {model[0]}: its coordinates are "
+                f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})"
+            )
+    elif res.metadata.get("model") is None:
+        raise UsageError(f"{results} does not hold its model: give the model file first, "
+                         f"planardyn animate MODEL {results} -o {args.output}")
+    else:
+        mech = from_result(res)
     args.output.parent.mkdir(parents=True, exist_ok=True)
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:

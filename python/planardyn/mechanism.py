@@ -389,6 +389,34 @@ class Mechanism:
         return PointMotion(t=res.t, names=list(raw["names"]), position=raw["position"],
                            velocity=raw["velocity"], acceleration=raw["acceleration"])
 
+    @property
+    def inertial_parameters(self) -> dict[str, float]:
+        """The model's inertial parameters pi, by name: per body ``m_<body>`` (kg),
+        ``mcx_<body>``, ``mcy_<body>`` (kg m: the mass times the centre of mass in the body's
+        frame, whose origin is the drawn centre of mass, so 0 here) and ``I_<body>`` (kg m^2,
+        about that origin). The order is that of :meth:`regressor`'s columns."""
+        values, names = self._native.parameters
+        return dict(zip(names, values))
+
+    def regressor(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> tuple[FloatArray, FloatArray]:
+        """The dynamics in linear form: the efforts of :meth:`inverse_dynamics` are
+        ``Y @ pi + tau_o``, with pi the inertial parameters (:attr:`inertial_parameters`,
+        whatever their values: the kinematics do not depend on them) and tau_o the efforts of
+        the other loads (springs, dampers, external forces).
+
+        Parameters and branch as :meth:`inverse_dynamics`. Returns ``(Y, tau_o)``: (m, p)
+        and (m,), or (N, m, p) and (N, m) for rows, p = 4 per body.
+        """
+        out = self._native.regressor(q, qd, qdd, x, allow_singular)
+        return out["Y"], out["tau_o"]
+
     def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:
         if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
             raise ValueError("the result is not a run of this mechanism (its bodies differ); "

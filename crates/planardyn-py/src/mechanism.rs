@@ -7,7 +7,7 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::{inverse_rows_checked, Branch};
+use planardyn::batch::{inverse_rows_checked, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
@@ -71,6 +71,27 @@ impl PyMechanism {
         let mut out = Vec::with_capacity(2 * self.carriers.len());
         self.per_point(&mut out, |link, s| point_velocity(link, s, x, xd));
         out
+    }
+
+    /// q, qd, qdd of one shape, (m,) or (N, m), and the branch's body coordinates x, (3n,)
+    /// or (N, 3n), if given.
+    fn motion_rows(
+        &self,
+        q: &ArrayArg<'_>,
+        qd: &ArrayArg<'_>,
+        qdd: &ArrayArg<'_>,
+        x: Option<&ArrayArg<'_>>,
+    ) -> PyResult<(Values, Values, Values, Option<Values>)> {
+        let x = x.map(|a| rows("x", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
+        let (m, what) = (self.m(), self.coords_what());
+        let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
+        if qd.shape != q.shape || qdd.shape != q.shape {
+            return Err(PyValueError::new_err(format!(
+                "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
+                q.shape, qd.shape, qdd.shape
+            )));
+        }
+        Ok((q, qd, qdd, x))
     }
 
     /// Drive efforts: the given tau, or the model's drives.
@@ -443,27 +464,50 @@ impl PyMechanism {
         x: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let x = x.map(|a| rows("x", &a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
-        let m = self.m();
-        let what = self.coords_what();
-        let (q, qd, qdd) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("qdd", &qdd, m, &what)?);
-        if qd.shape != q.shape || qdd.shape != q.shape {
-            return Err(PyValueError::new_err(format!(
-                "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
-                q.shape, qd.shape, qdd.shape
-            )));
-        }
+        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
         let mech = self.inner.clone();
         let shape = q.shape.clone();
         let tau = run(py, move || {
-            let branch = match &x {
-                None => Branch::Drawing,
-                Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
-                Some(x) => Branch::Rows(&x.data),
-            };
-            Ok(inverse_rows_checked(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
+            Ok(inverse_rows_checked(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         arr_dyn(py, &shape, tau)
+    }
+
+    /// The regressor form along rows of a motion, on the branch of x as `inverse_dynamics`:
+    /// `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with efforts = Y pi + tau_o.
+    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    fn regressor<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        x: Option<ArrayArg<'py>>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let mech = self.inner.clone();
+        let (m, p) = (self.m(), planardyn::dynamics::regressor::BODY_PARAMETERS * mech.bodies.len());
+        let (y, tau_o) = run(py, || {
+            Ok(regressor_rows(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+        })?;
+        let n = q.rows();
+        let d = PyDict::new(py);
+        if q.shape.len() == 1 {
+            d.set_item("Y", arr2(py, m, p, y)?)?;
+            d.set_item("tau_o", arr1(py, tau_o))?;
+        } else {
+            d.set_item("Y", arr3(py, (n, m, p), y)?)?;
+            d.set_item("tau_o", arr2(py, n, m, tau_o)?)?;
+        }
+        Ok(d)
+    }
+
+    /// The model's inertial parameters pi (4 per body: m, m cx, m cy, I_O) and their names.
+    #[getter]
+    fn parameters(&self) -> (Vec<f64>, Vec<String>) {
+        use planardyn::dynamics::regressor::{parameter_names, parameters};
+        (parameters(&self.inner), parameter_names(&self.inner))
     }
 
     /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
@@ -649,4 +693,14 @@ fn check_time(t: f64) -> PyResult<()> {
 
 fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
     serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
+}
+
+/// The branch of a motion: the drawn one, from the first row's body coordinates (3n,), or
+/// every row's (N, 3n).
+fn branch_of(x: Option<&Values>) -> Branch<'_> {
+    match x {
+        None => Branch::Drawing,
+        Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
+        Some(x) => Branch::Rows(&x.data),
+    }
 }

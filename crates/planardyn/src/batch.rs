@@ -152,6 +152,51 @@ pub fn inverse_rows_checked(
     qdd: &[f64],
     allow_singular: bool,
 ) -> Result<Vec<f64>, Error> {
+    let mut tau = Vec::with_capacity(q.len());
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
+        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], ws)?;
+        tau.extend_from_slice(&ws.tau);
+        Ok(())
+    })?;
+    Ok(tau)
+}
+
+/// The regressor form along rows of a motion on `branch` (as [`inverse_rows_checked`]):
+/// Y (N x m x p, p = [`dynamics::regressor::BODY_PARAMETERS`] per body) and tau_o (N x m),
+/// so that every row's efforts are Y pi + tau_o.
+pub fn regressor_rows(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    let p = dynamics::regressor::BODY_PARAMETERS * mech.bodies.len();
+    let (mut y, mut tau_o) = (Vec::with_capacity(q.len() * p), Vec::with_capacity(q.len()));
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
+        dynamics::forward::kinematic_stages(mech, &q[row.clone()], &qd[row.clone()], ws)?;
+        let (y_row, tau_row) = dynamics::regressor::regressor(mech, ws, &qdd[row]);
+        y.extend(y_row);
+        tau_o.extend(tau_row);
+        Ok(())
+    })?;
+    Ok((y, tau_o))
+}
+
+/// Assemble every row of (q, qd, qdd) on `branch` in one workspace and call `each` with the
+/// row's index range (which computes into the workspace); then the type II measure: below
+/// [`dynamics::SINGULAR_SIGMA`] refused unless `allow_singular`, and with q alone (no `Rows`)
+/// a motion that goes on past a row within [`BRANCH_SIGMA`] refused as `BranchUndecided`.
+fn walk_rows(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+    mut each: impl FnMut(&mut Workspace, std::ops::Range<usize>) -> Result<(), Error>,
+) -> Result<(), Error> {
     let (m, nx) = (mech.dof(), mech.n_x());
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
         return Err(KinematicsError::bad_argument(
@@ -169,7 +214,6 @@ pub fn inverse_rows_checked(
         }
     }
     let mut ws = Workspace::new(mech);
-    let mut tau = Vec::with_capacity(q.len());
     for k in 0..n {
         let row = k * m..(k + 1) * m;
         match (branch, k) {
@@ -178,15 +222,14 @@ pub fn inverse_rows_checked(
             (Branch::Drawing, 0) => assemble_into(mech, &q[row.clone()], &mut ws)?,
             _ => continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?,
         }
-        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], &mut ws)?;
+        each(&mut ws, row)?;
         let sigma_min = dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
         // Only the rows after a near-singular one are in doubt.
         if !matches!(branch, Branch::Rows(_)) && k + 1 < n && sigma_min < BRANCH_SIGMA {
             return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
         }
-        tau.extend_from_slice(&ws.tau);
     }
-    Ok(tau)
+    Ok(())
 }
 
 /// A pool of `threads` threads (`None` or 0: one per core). Fails only if the operating
