@@ -21,18 +21,11 @@ def test_y_pi_plus_tau_o_is_the_inverse_dynamics_of_a_run(name):
     np.testing.assert_allclose(Y @ pi + tau_o, tau, rtol=0, atol=1e-12 * max(1.0, np.abs(tau).max()))
 
 
-def test_pendulum_has_three_base_parameters():
+def test_pendulum_has_three_base_parameters(pendulum):
     # A body on a ground pivot s (in the body frame, from the drawn centre of mass) moves by
     # one angle: tau = J qdd + g x (first moment about the pivot), with J = I_O + m |s|^2
     # - 2 s.(m c) and the first moment (m cx - m sx, m cy - m sy): 3 of the 4 parameters.
-    pend = pd.loads("""
-gravity: [0, -9.81]
-points: {O: [0, 0], A: [0, -1]}
-ground: [O]
-bodies: {bob: {points: [O, A], mass: 2.0, inertia: 0.05, com: [0.0, -0.6]}}
-pairs: [{type: revolute, name: pivot, at: O, bodies: [ground, bob]}]
-coordinates: [{name: theta, pair: pivot, value: 0.3}]
-""")
+    pend = pendulum
     base = base_parameters(pend, samples=50)
     assert base.rank == 3 and base.parameters == ["m_bob", "mcx_bob", "mcy_bob", "I_bob"]
     assert base.condition < 1e3
