@@ -82,7 +82,8 @@ def sample_states(mech: Mechanism, n: int = 200, seed: int = 0) -> tuple[FloatAr
     rng = np.random.default_rng(seed)
     scale = np.array([0.1 if k == "angle" else 0.1 * mech.scale for k in mech.coordinate_kinds])
     q, x = np.array(mech.q0, float), mech.assemble(mech.q0)
-    qs, xs = [], []
+    qs: list[FloatArray] = []
+    xs: list[FloatArray] = []
     for _ in range(20 * n):
         if len(qs) == n:
             break
@@ -117,7 +118,9 @@ def base_parameters(mech: Mechanism, samples: int = 200, seed: int = 0) -> BaseP
     cols = np.flatnonzero(live)[perm]
     independent, dependent = cols[:r], np.concatenate([cols[r:], np.flatnonzero(~live)])
     # W[:, dep] = W[:, ind] @ K (least squares, exact up to round-off for dependent columns).
-    K = np.linalg.lstsq(W[:, independent], W[:, dependent], rcond=None)[0] if len(dependent) else np.zeros((r, 0))
+    K = np.zeros((r, 0))
+    if len(dependent):
+        K = np.asarray(np.linalg.lstsq(W[:, independent], W[:, dependent], rcond=None)[0], dtype=np.float64)
     condition = float(np.linalg.cond(scaled[:, perm[:r]]))
     names = list(mech.inertial_parameters)
     return BaseParameters(names, independent.tolist(), dependent.tolist(), K, samples, condition)
