@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .mechanism import Mechanism
 
@@ -124,3 +124,116 @@ def base_parameters(mech: Mechanism, samples: int = 200, seed: int = 0) -> BaseP
     condition = float(np.linalg.cond(scaled[:, perm[:r]]))
     names = list(mech.inertial_parameters)
     return BaseParameters(names, independent.tolist(), dependent.tolist(), K, samples, condition)
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Base parameters estimated from a measured motion (:func:`identify`).
+
+    ``beta`` with ``std_error`` (one standard deviation, from the residuals' variance per
+    coordinate), ``prior`` the base parameters of the model identified against; ``pi`` a
+    full parameter vector with the estimated base parameters that is physically consistent
+    (positive masses, positive inertia about every centre of mass), nearest the model's.
+    """
+
+    base: BaseParameters
+    beta: FloatArray
+    std_error: FloatArray
+    prior: FloatArray
+    pi: dict[str, float]
+    #: RMS of the efforts' residual per coordinate (N m or N), and the samples used.
+    residual_rms: FloatArray
+    samples: int
+
+    def report(self) -> str:
+        """A table: each base parameter, identified ± standard error, and the prior."""
+        lines = [f"{'base parameter':<60} {'identified':>12} {'std error':>10} {'prior':>12}"]
+        for e, b, s, p in zip(self.base.expressions, self.beta, self.std_error, self.prior):
+            lines.append(f"{e[:60]:<60} {b:12.6g} {s:10.3g} {p:12.6g}")
+        rms = ", ".join(f"{v:.3g}" for v in self.residual_rms)
+        lines.append(f"{self.samples} samples; residual RMS per coordinate: {rms}")
+        return "\n".join(lines)
+
+
+def identify(
+    mech: Mechanism,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    tau: ArrayLike,
+    x: ArrayLike | None = None,
+    base: BaseParameters | None = None,
+) -> Identification:
+    """Estimate the base parameters from a motion's rows (q, qd, qdd, measured efforts tau;
+    (N, m) each; x the body coordinates of the branch, as for ``inverse_dynamics``).
+
+    Weighted least squares (two passes: ordinary least squares, then each coordinate's rows
+    weighted by the inverse of its residual's standard deviation), with standard errors from
+    the weighted residual's variance. Then the physically consistent full parameters nearest
+    the model's that have those base parameters (scipy's SLSQP: m > 0 and m I_O - (m cx)^2 -
+    (m cy)^2 > 0, i.e. a positive inertia about the centre of mass).
+
+    Rates and accelerations from measured positions: differentiate a low-pass filtered q,
+    e.g. :func:`differentiate`, and filter tau with the same filter.
+    """
+    base = base or base_parameters(mech)
+    Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+    Wb = Y[..., base.independent]  # (N, m, r)
+    rhs = np.asarray(tau, float) - tau_o
+    n, m, r = Wb.shape
+    if n * m <= r:
+        raise ValueError(f"{n} samples of {m} efforts cannot determine {r} base parameters: give more samples")
+    beta = np.linalg.lstsq(Wb.reshape(-1, r), rhs.reshape(-1), rcond=None)[0]
+    sigma = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0)) + 1e-300  # per coordinate
+    Ww, rw = (Wb / sigma[None, :, None]).reshape(-1, r), (rhs / sigma).reshape(-1)
+    beta, *_ = np.linalg.lstsq(Ww, rw, rcond=None)
+    dof = n * m - r
+    s2 = float(np.sum((rw - Ww @ beta) ** 2) / dof)
+    std = np.sqrt(s2 * np.diag(np.linalg.inv(Ww.T @ Ww)))
+    prior_pi = np.array(list(mech.inertial_parameters.values()))
+    resid = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0))
+    pi = _consistent(base, beta, prior_pi)
+    return Identification(base, beta, std, base.of(prior_pi), dict(zip(base.parameters, pi)), resid, n)
+
+
+def _consistent(base: BaseParameters, beta: FloatArray, prior: FloatArray) -> FloatArray:
+    """The full parameters nearest ``prior`` (scaled per parameter) with base parameters
+    ``beta`` and a physical body each: m > 0, m I_O > (m cx)^2 + (m cy)^2."""
+    from scipy.optimize import minimize
+
+    scale = np.maximum(np.abs(prior), 1e-6 * np.abs(prior).max())
+    nb = len(prior) // 4
+
+    def body_margins(z: FloatArray) -> FloatArray:
+        p = (z * scale).reshape(nb, 4)
+        return np.concatenate([p[:, 0], p[:, 0] * p[:, 3] - p[:, 1] ** 2 - p[:, 2] ** 2])
+
+    cons = [{"type": "eq", "fun": lambda z: base.of(z * scale) - beta},
+            {"type": "ineq", "fun": body_margins}]
+    out = minimize(lambda z: float(np.sum((z - 1.0) ** 2)), np.ones_like(prior), constraints=cons, method="SLSQP",
+                   options={"maxiter": 500, "ftol": 1e-14})
+    return np.asarray(out.x * scale, dtype=np.float64)
+
+
+def differentiate(t: ArrayLike, q: ArrayLike, cutoff: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """q filtered by a zero-phase 4th-order Butterworth low-pass at ``cutoff`` (Hz), and its
+    first two derivatives by a cubic spline through the filtered samples; t evenly spaced (s).
+    Filter the efforts with :func:`lowpass` at the same cutoff (the same delay-free filter on
+    both sides keeps the equations)."""
+    from scipy.interpolate import CubicSpline
+
+    qf = lowpass(t, q, cutoff)
+    spline = CubicSpline(np.asarray(t, float), qf, axis=0)
+    return qf, spline(t, 1), spline(t, 2)
+
+
+def lowpass(t: ArrayLike, v: ArrayLike, cutoff: float) -> FloatArray:
+    """Zero-phase 4th-order Butterworth low-pass of the columns of v at ``cutoff`` (Hz)."""
+    from scipy.signal import butter, filtfilt
+
+    t = np.asarray(t, float)
+    fs = 1.0 / float(np.mean(np.diff(t)))
+    if not 0.0 < cutoff < fs / 2:
+        raise ValueError(f"cutoff = {cutoff} Hz must be between 0 and half the sampling rate ({fs / 2:g} Hz)")
+    b, a = butter(4, cutoff / (fs / 2))
+    return np.asarray(filtfilt(b, a, np.asarray(v, float), axis=0), dtype=np.float64)
