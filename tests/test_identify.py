@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import planardyn as pd
 import pytest
@@ -148,3 +150,24 @@ def test_differentiate_a_quantised_encoder_signal():
     assert np.abs(qdd[inside, 0] + 0.3 * w * w * np.sin(w * t[inside])).max() < 0.25
     with pytest.raises(ValueError, match="half the sampling rate"):
         differentiate(t, q[:, None], cutoff=150.0)
+
+
+def test_optimised_excitation_is_better_conditioned_than_a_sine(experiment):
+    # From a sine on both motors (condition 7.7e6: every coordinate in phase) to a three-
+    # harmonic motion (measured 24), within 0.3 rad of the start; identification along it has
+    # standard errors 5e4 to 3e5 times smaller (median 1.6e5) for the same 1 % effort noise.
+    from planardyn.identify import excitation, identify
+
+    prior, _, base, truth = experiment
+    exc = excitation(prior, period=1.0, harmonics=3, amplitude=0.3, base=base)
+    assert exc.start_condition > 1e6 and exc.condition < 50
+    q, _, _ = exc.sample(np.linspace(0.0, 1.0, 100_001))
+    assert np.all(np.abs(q - prior.q0) <= 0.3 * (1 + 1e-5))
+    runs = {}
+    for name, e in (("optimised", exc), ("sine", dataclasses.replace(exc, a=exc.a * 0, b=exc.b * 0))):
+        if name == "sine":
+            e.a[:, 0] = 0.15
+        runs[name] = prior.simulate(t_end=2.0, output_dt=0.005, motion=e.motion(prior.coordinate_names))
+        assert runs[name].success, runs[name].message
+    std = {k: identify(prior, r.q, r.qd, r.qdd, noisy(r, 5), x=r.x, base=base).std_error for k, r in runs.items()}
+    assert np.median(std["sine"] / std["optimised"]) > 1e3

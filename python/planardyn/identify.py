@@ -12,6 +12,7 @@ linear combination of the physical ones.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -238,3 +239,85 @@ def lowpass(t: ArrayLike, v: ArrayLike, cutoff: float) -> FloatArray:
     # Second-order sections: the transfer-function form loses digits at low cutoffs.
     sos = butter(4, cutoff / (fs / 2), output="sos")
     return np.asarray(sosfiltfilt(sos, np.asarray(v, float), axis=0), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """A periodic motion of the coordinates for identification (:func:`excitation`):
+    q_k(t) = q0_k + sum_l a_kl (sin(l w t)) + b_kl (cos(l w t) - 1), w = 2 pi / period.
+
+    ``motion`` is the dict ``Mechanism.simulate(motion=...)`` takes; ``condition`` the
+    condition number of the scaled base columns of Y along it, ``start_condition`` that of
+    the simple sine it started from."""
+
+    q0: FloatArray
+    period: float
+    a: FloatArray
+    b: FloatArray
+    condition: float
+    start_condition: float
+
+    def sample(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """q, qd, qdd (N, m) at times t (N,)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        w = 2 * np.pi / self.period
+        ell = np.arange(1, self.a.shape[1] + 1)
+        s, c = np.sin(np.outer(t, ell * w)), np.cos(np.outer(t, ell * w))
+        q = self.q0 + s @ self.a.T + (c - 1.0) @ self.b.T
+        qd = (c * ell * w) @ self.a.T - (s * ell * w) @ self.b.T
+        qdd = -(s * (ell * w) ** 2) @ self.a.T - (c * (ell * w) ** 2) @ self.b.T
+        return q, qd, qdd
+
+    def motion(self, names: list[str]) -> dict[str, Any]:
+        """For ``Mechanism.simulate(motion=...)``: one function of t per coordinate."""
+        return {n: (lambda t, k=k: tuple(float(v[0, k]) for v in self.sample(t))) for k, n in enumerate(names)}
+
+
+def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitude: float = 0.3,
+               samples: int = 100, base: BaseParameters | None = None, max_evaluations: int = 2000) -> Excitation:
+    """A periodic motion that makes the base parameters well observable: the Fourier
+    coefficients (``harmonics`` per coordinate) minimising the condition number of the scaled
+    base columns of Y over ``samples`` points of a period, from a simple sine (amplitude / 2
+    at the first harmonic on every coordinate).
+
+    Every coordinate stays within ``amplitude`` (rad, or 0.1 of it times the drawing's size for
+    a displacement) of the model's start; a motion that cannot be assembled along the way, or
+    passes within the branch guard of a type II singularity, counts as infinitely bad.
+    Solved by scipy's Powell method (no derivatives: the objective is not smooth where the
+    extreme singular values cross).
+    """
+    from scipy.optimize import minimize
+
+    base = base or base_parameters(mech)
+    m = mech.dof
+    reach = np.array([amplitude if k == "angle" else 0.1 * amplitude * mech.scale for k in mech.coordinate_kinds])
+    t = np.linspace(0.0, period, samples, endpoint=False)
+    # The reach is checked on a grid fine enough that a trigonometric polynomial of this
+    # degree cannot exceed it between points by more than (pi h / period)^2 / 2 ~ 1e-5 of it.
+    fine = np.linspace(0.0, period, 1000 * harmonics)
+    q0 = np.array(mech.q0, float)
+
+    def make(z: FloatArray, start: float = np.inf) -> Excitation:
+        a, b = z[: m * harmonics].reshape(m, harmonics), z[m * harmonics:].reshape(m, harmonics)
+        return Excitation(q0, period, a * reach[:, None], b * reach[:, None], np.inf, start)
+
+    def cost(z: FloatArray) -> float:
+        exc = make(z)
+        if np.any(np.abs(exc.sample(fine)[0] - q0) > reach):
+            return 1e12
+        q, qd, qdd = exc.sample(t)
+        try:
+            Y, _ = mech.regressor(q, qd, qdd)
+        except Exception:  # noqa: BLE001 - not assembled, or too near a singularity
+            return 1e12
+        W = Y[..., base.independent].reshape(-1, base.rank)
+        W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
+        return float(np.linalg.cond(W))
+
+    z0 = np.zeros(2 * m * harmonics)
+    z0[::harmonics][:m] = 0.5
+    start = cost(z0)
+    out = minimize(cost, z0, method="Powell", options={"maxfev": max_evaluations, "xtol": 1e-3, "ftol": 1e-4})
+    best = out.x if out.fun < start else z0
+    exc = make(best, start)
+    return Excitation(exc.q0, period, exc.a, exc.b, min(float(out.fun), start), start)
