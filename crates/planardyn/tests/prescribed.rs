@@ -210,11 +210,9 @@ fn motion_function_matches_the_speed_law() {
     }
 }
 
-/// A crank held still (speed 0) while the rest of the five-bar falls: the free four-bar
-/// passes its own type II singularities, integrated in a partition chart there, and its
-/// energy stays that of the benchmark (the holding torque does no work).
-#[test]
-fn held_crank_lets_the_free_part_cross_its_singularities() {
+/// The falling five-bar (its benchmark file) for 1 s, every step output, with its first
+/// crank driven at `speed` (rad/s) from its start.
+fn falling_five_bar_with_crank_at(speed: f64) -> Trajectory {
     let text = std::fs::read_to_string(format!(
         "{}/../../examples/models/five-bar-free-fall.yaml",
         env!("CARGO_MANIFEST_DIR")
@@ -222,13 +220,21 @@ fn held_crank_lets_the_free_part_cross_its_singularities() {
     .unwrap()
     .replace(
         "  - {coordinate: theta1, effort: 0.0}   # N m, zero: the fall is passive",
-        "  - {coordinate: theta1, motion: {speed: 0.0}}",
+        &format!("  - {{coordinate: theta1, motion: {{speed: {speed}}}}}"),
     );
-    let mech = loads(&text, Format::Yaml, "<held five-bar>").unwrap();
+    let mech = loads(&text, Format::Yaml, "<five-bar, crank driven>").unwrap();
     let mut s = Settings::for_model(&mech).unwrap();
     s.t_end = 1.0;
     s.t_eval = None;
-    let tr = simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap();
+    simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap()
+}
+
+/// A crank held still (speed 0) while the rest of the five-bar falls: the free four-bar
+/// passes its own type II singularities, integrated in a partition chart there, and its
+/// energy stays that of the benchmark (the holding torque does no work).
+#[test]
+fn held_crank_lets_the_free_part_cross_its_singularities() {
+    let tr = falling_five_bar_with_crank_at(0.0);
     assert!(tr.success(), "{:?} {}", tr.status, tr.message);
     assert!(tr.stats.chart_switches > 0, "no chart switch: min sigma {}", tr.stats.min_sigma);
     assert!(tr.q.chunks(2).all(|q| (q[0] - 2.0943951023931953).abs() < 1e-7), "theta1 left its hold");
@@ -286,20 +292,7 @@ fn table_shorter_than_the_run_is_refused() {
 /// its motion and T + V - W, W its torque's work, still closes.
 #[test]
 fn turning_crank_with_the_free_part_in_a_partition_chart() {
-    let text = std::fs::read_to_string(format!(
-        "{}/../../examples/models/five-bar-free-fall.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
-    .replace(
-        "  - {coordinate: theta1, effort: 0.0}   # N m, zero: the fall is passive",
-        "  - {coordinate: theta1, motion: {speed: 0.5}}",
-    );
-    let mech = loads(&text, Format::Yaml, "<turning five-bar>").unwrap();
-    let mut s = Settings::for_model(&mech).unwrap();
-    s.t_end = 1.0;
-    s.t_eval = None;
-    let tr = simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap();
+    let tr = falling_five_bar_with_crank_at(0.5);
     assert!(tr.success(), "{:?} {}", tr.status, tr.message);
     let worst = (0..tr.len()).map(|k| (tr.q[2 * k] - (2.0943951023931953 + 0.5 * tr.t[k])).abs()).fold(0.0, f64::max);
     let work = tr.work.iter().fold(0.0_f64, |a, w| a.max(w.abs()));
