@@ -201,3 +201,19 @@ def test_register_display_hands_both_views_to_ipython(five_bar):
     assert printers == {pd.Mechanism: mechanism_html, pd.SimulationResult: result_html}
     assert printers[type(mech)](mech).startswith('<div style="display:flex')
     assert register_display() is False  # no running IPython shell under pytest: nothing to do
+
+
+def test_viewer_has_pair_forces_and_point_motion_channels(five_bar):
+    # Each pair's force magnitude and each traced point's speed and acceleration, computed
+    # along the frames kept (each on its own branch): the values are those of
+    # mech.reactions(res) and mech.point_motion(res), to the page's significant digits.
+    mech, res = five_bar
+    data = viewer_data(mech, res, channels=["F_elbow1", "v_P"])
+    chans = {c["key"]: c for c in data["channels"]}
+    assert {g["key"] for g in data["groups"]} >= {"reactions", "speeds", "point_accelerations"}
+    assert {f"F_{p}" for p in mech.pair_names} | {"v_P", "a_P"} <= set(chans)
+    assert chans["F_elbow1"]["on"] and chans["v_P"]["on"] and not chans["a_P"]["on"]
+    f = mech.reactions(res)[:, mech.pair_names.index("elbow1"), :2]
+    np.testing.assert_allclose(chans["F_elbow1"]["values"], np.hypot(*f.T), rtol=1e-5)
+    v = mech.point_motion(res)["P"][1]
+    np.testing.assert_allclose(chans["v_P"]["values"], np.hypot(*v.T), rtol=1e-5, atol=1e-6 * np.abs(v).max())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -9,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import results_format
 from ._core import __version__
@@ -191,6 +192,17 @@ class SimulationResult:
             f"coordinates=({', '.join(self.coordinate_names)}), "
             f"steps={self.stats.get('naccept', 0)}, energy drift={self.energy.drift:.3g} J)"
         )
+
+    def take(self, rows: ArrayLike) -> SimulationResult:
+        """The result at some of its rows: indices or a boolean mask, e.g. every tenth row
+        ``res.take(np.arange(0, len(res), 10))``. The energy balance keeps its reference
+        (the first output of the whole run)."""
+        k = np.arange(len(self.t))[np.asarray(rows)]
+        e = self.energy
+        arrays = dict(t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, x=self.x, xd=self.xd,
+                      poses=self.poses, sigma=self.sigma, residual=self.residual, partitioned=self.partitioned)
+        energy = Energy(e.kinetic[k], e.potential[k], e.work[k], e.total[k], e.balance[k])
+        return dataclasses.replace(self, **{n: a[k] for n, a in arrays.items()}, energy=energy)
 
     @property
     def power(self) -> FloatArray:
