@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import inverse_batch, simulate_batch
-from .mechanism import Mechanism, attach_metadata, from_dict
+from .mechanism import Mechanism, attach_metadata, from_dict, native_motion
 from .result import SimulationResult
 from .settings import MAX_THREADS, check_settings, count
 
@@ -81,12 +81,24 @@ class BatchInterrupted(KeyboardInterrupt):
         self.results = results
 
 
-def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, Any]:
-    """The settings of one variant, arrays as lists of floats (exact for float64)."""
-    unknown = set(own) - set(_SETTINGS)
+def _settings(common: Mapping[str, Any], own: Mapping[str, Any], mech: Mechanism) -> dict[str, Any]:
+    """The settings of one variant, arrays as lists of floats (exact for float64); its
+    motions by coordinate index for the native call (``motion``) and by name for the
+    result's metadata (``_motion``)."""
+    unknown = set(own) - set(_SETTINGS) - {"motion"}
     if unknown:
-        raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of {', '.join(_SETTINGS)}")
-    out = check_settings(**{k: v for k, v in {**common, **own}.items() if v is not None})
+        raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of "
+                         f"{', '.join(_SETTINGS)}, motion")
+    given = {k: v for k, v in {**common, **own}.items() if v is not None}
+    motion = given.pop("motion", None)
+    out = check_settings(**given)
+    if motion is not None:
+        if any(callable(m) for m in dict(motion).values()):
+            raise TypeError("a batch's motions are speeds or tables {'t': ..., 'q': ...}; "
+                            "a motion function runs only in Mechanism.simulate")
+        out["motion"] = native_motion(motion, mech.coordinate_names)
+        out["_motion"] = {k: v if np.isscalar(v) else {c: np.asarray(a, float).tolist() for c, a in v.items()}
+                          for k, v in motion.items()}
     for k in _ARRAYS:
         if k in out:
             out[k] = np.asarray(out[k], dtype=np.float64).ravel().tolist()
@@ -199,6 +211,7 @@ def simulate(
     t_eval: ArrayLike | None = None,
     output_dt: float | None = None,
     max_steps: int | None = None,
+    motion: Mapping[str, float | Mapping[str, ArrayLike]] | None = None,
     threads: int | None = None,
     executor: Any = None,
     chunk_size: int | None = None,
@@ -215,6 +228,10 @@ def simulate(
         ``qd0`` (m,) in rad or m and rad/s or m/s, ``t_end``, ``method``...).
     t_end, method, rtol, atol, dt, t_eval, output_dt, max_steps
         As for :meth:`Mechanism.simulate` (None: the model file's value).
+    motion : dict, optional
+        Coordinates driven by motion, as for :meth:`Mechanism.simulate`: a speed or a table
+        ``{"t": ..., "q": ...}`` by coordinate name (not a function: the batch runs without
+        Python). A variant's own ``motion`` replaces it.
     threads : int, optional
         Native threads per batch (here, or on each worker), 1 to
         :data:`planardyn.settings.MAX_THREADS` (256); default one per core. Another value is
@@ -236,17 +253,22 @@ def simulate(
         result, as from :meth:`Mechanism.simulate`; a run that could not start, or a model
         that could not be built, is a :class:`BatchError`.
     """
-    common = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, t_eval=t_eval,
-                  output_dt=output_dt, max_steps=max_steps)
+    common: dict[str, Any] = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt,
+                                  t_eval=t_eval, output_dt=output_dt, max_steps=max_steps)
     check_settings(**common)
-    return _run("simulate", variants, lambda mech, own: _settings(common, own), _result,
+    common["motion"] = motion
+    return _run("simulate", variants, lambda mech, own: _settings(common, own, mech), _result,
                 threads, executor, chunk_size, progress)
 
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
     result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
                                        coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names)
-    return attach_metadata(result, mech, settings)
+    # The metadata's settings rerun the variant: mech.simulate(**settings), motions by name.
+    rerun = {k: v for k, v in settings.items() if k not in ("motion", "_motion")}
+    if "_motion" in settings:
+        rerun["motion"] = settings["_motion"]
+    return attach_metadata(result, mech, rerun)
 
 
 def inverse_dynamics(

@@ -531,7 +531,7 @@ class Mechanism:
             drives=drives,
             progress=progress,
             max_steps=checked["max_steps"],
-            motion=_native_motion(motion, self.coordinate_names),
+            motion=native_motion(motion, self.coordinate_names),
         )
         result = SimulationResult.from_raw(
             raw,
@@ -566,7 +566,7 @@ class Mechanism:
             raise ValueError(f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
 
 
-def _native_motion(
+def native_motion(
     motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None, names: list[str]
 ) -> list[tuple[int, Any]] | None:
     """``Mechanism.simulate``'s ``motion`` as the native call takes it: (coordinate index, a

@@ -12,9 +12,10 @@ use crate::convert::arr2;
 use crate::effector::solution_dict;
 use crate::errors::{run, task_error, to_pyerr, Failure};
 use crate::mechanism::PyMechanism;
-use crate::simulate::SIGNAL_INTERVAL;
+use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};
 use planardyn::batch::{map_many_until, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::Mechanism;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -23,7 +24,8 @@ use std::sync::mpsc;
 
 /// Keys a variant's overrides dict may have (the keyword arguments of `Mechanism.simulate`
 /// that need no Python callback).
-const KEYS: [&str; 10] = ["t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps"];
+const KEYS: [&str; 11] =
+    ["t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps", "motion"];
 
 /// Keys of an inverse-dynamics motion dict: coordinate rows, or a sampled task path.
 const MOTION_KEYS: [&str; 11] = ["q", "qd", "qdd", "t", "X", "Xd", "Xdd", "point", "body", "q_start", "singular_tol"];
@@ -51,8 +53,18 @@ fn check_keys(d: &Bound<'_, PyDict>, keys: &[&str], what: &str) -> PyResult<()> 
     Ok(())
 }
 
-fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
+fn overrides(mech: &Mechanism, d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
     check_keys(d, &KEYS, "simulation setting")?;
+    // A batch runs without the GIL: its motions are laws (speeds, tables), not callables.
+    let motion = motion_entries(mech, get(d, "motion")?.unwrap_or_default())?
+        .into_iter()
+        .map(|(k, entry)| match entry {
+            MotionEntry::Law(law) => Ok((k, law)),
+            MotionEntry::Function(_) => Err(PyValueError::new_err(
+                "a batch's motions are speeds or tables; a Python function runs only in Mechanism.simulate",
+            )),
+        })
+        .collect::<PyResult<Vec<_>>>()?;
     Ok(Overrides {
         t_end: get(d, "t_end")?,
         method: get(d, "method")?,
@@ -64,6 +76,7 @@ fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
         q0: get(d, "q0")?,
         qd0: get(d, "qd0")?,
         max_steps: get(d, "max_steps")?,
+        motion,
     })
 }
 
@@ -148,7 +161,7 @@ fn simulate_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? })
+        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(&m.get().inner, d)? })
     };
     let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
     run_batch(py, &variants, threads, make, solve, |r, _| match r {

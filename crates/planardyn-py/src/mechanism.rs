@@ -665,6 +665,8 @@ impl PyMechanism {
             q0: q0.map(|a| self.q_arg("q0", &a)).transpose()?,
             qd0: qd0.map(|a| self.q_arg("qd0", &a)).transpose()?,
             max_steps,
+            // The caller's motions go to the run with its callables (`simulate::simulate`).
+            motion: Vec::new(),
         };
         crate::simulate::simulate(py, &self.inner, args, drives, motion.unwrap_or_default(), progress)
     }

@@ -85,7 +85,7 @@ pub enum MotionArg {
 }
 
 /// A Python callable `f(t) -> (q, qd, qdd)` as the motion of one coordinate.
-struct PyMotion {
+pub(crate) struct PyMotion {
     f: Py<PyAny>,
     name: String,
     /// As `PyDrives::fatal`.
@@ -114,13 +114,13 @@ impl MotionFunction for PyMotion {
 }
 
 /// A motion ready for the core: a law, or a Python function.
-enum MotionEntry {
+pub(crate) enum MotionEntry {
     Law(MotionLaw),
     Function(PyMotion),
 }
 
 /// The caller's motions by coordinate index, checked (a table's spline built).
-fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) -> PyResult<Vec<(usize, MotionEntry)>> {
+pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) -> PyResult<Vec<(usize, MotionEntry)>> {
     let names = mech.coordinate_names();
     motion
         .into_iter()

@@ -20,7 +20,7 @@ use crate::dynamics::{self, ModelDrives};
 use crate::kinematics::{assemble_from, assemble_into, continue_to};
 use crate::simulate::charts::SWITCH_TO_PARTITION;
 pub use crate::simulate::Overrides;
-use crate::simulate::{simulate, Trajectory};
+use crate::simulate::{simulate_prescribed, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -58,13 +58,15 @@ impl Variant {
         self.simulate_until(&AtomicBool::new(false))
     }
 
-    /// [`Variant::simulate`], stopping at the first step after `stop` is set (status
+    /// [`Variant::simulate`] (the coordinates of the overrides' and the model's motions
+    /// driven by them), stopping at the first step after `stop` is set (status
     /// `Cancelled`, the trajectory so far kept).
     pub fn simulate_until(&self, stop: &AtomicBool) -> Result<Trajectory, Error> {
         self.model.with(|mech| {
             let settings = self.overrides.settings(mech)?;
+            let mut motion = self.overrides.prescribed(mech)?;
             let mut go_on = |_t: f64| !stop.load(Ordering::Relaxed);
-            simulate(mech, &settings, &mut ModelDrives(mech), Some(&mut go_on))
+            simulate_prescribed(mech, &settings, &mut ModelDrives(mech), &mut motion, Some(&mut go_on))
         })
     }
 }
