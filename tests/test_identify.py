@@ -171,3 +171,49 @@ def test_optimised_excitation_is_better_conditioned_than_a_sine(experiment):
         assert runs[name].success, runs[name].message
     std = {k: identify(prior, r.q, r.qd, r.qdd, noisy(r, 5), x=r.x, base=base).std_error for k, r in runs.items()}
     assert np.median(std["sine"] / std["optimised"]) > 1e3
+
+
+def test_identify_command(experiment, tmp_path):
+    # Encoder readings (16-bit) and efforts with 1 % noise in a CSV table at 200 Hz: the
+    # command filters at 10 Hz (the motion's tones reach 3 Hz), differentiates, drops the
+    # filter's edge transients, identifies, and predicts another motion (a results file)
+    # far better than the model it started from: measured RMS 0.017 against 0.39 N m (at a
+    # 5 Hz cutoff the filter bends the 3 Hz tone and the estimate is no better than the model).
+    import contextlib
+    import csv
+    import io
+    import json
+    import re
+
+    from conftest import cli_run
+    from planardyn import cli
+
+    prior, runs, _, _ = experiment
+    res = runs[2.0]
+    quantum = 2 * np.pi / 65536
+    q = np.round(res.q / quantum) * quantum
+    tau = noisy(res, 3)
+    table = tmp_path / "measured.csv"
+    with open(table, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["t", "theta1", "theta2", "tau_theta1", "tau_theta2"])
+        w.writerows(np.column_stack([res.t, q, tau]).tolist())
+    check = runs["validation"].save(tmp_path / "other.npz")
+    out = tmp_path / "found.json"
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert cli.main(["identify", "five-bar", str(table), "--cutoff", "10", "--validate", str(check),
+                         "-o", str(out)]) == 0
+    errors = re.search(r"RMS effort error (\S+) identified, (\S+) with the model", printed.getvalue())
+    assert errors is not None and float(errors[1]) < 0.1 * float(errors[2]), printed.getvalue()
+    found = json.loads(out.read_text())
+    assert len(found["identified"]) == len(found["base_parameters"]) == len(found["std_error"]) == 11
+    # 2 s at 200 Hz less 0.2 s of filter transient at each end (EDGE_PERIODS / cutoff).
+    assert found["samples"] == 321 and all(v > 0 for k, v in found["parameters"].items() if k.startswith("m_"))
+    # Without rates the positions must be differentiated; without efforts nothing to fit.
+    code, err = cli_run("identify", "five-bar", table)
+    assert code == 2 and "--cutoff" in err
+    bare = tmp_path / "bare.csv"
+    bare.write_text("t,theta1,theta2\n0,2.0,1.0\n0.01,2.0,1.0\n")
+    code, err = cli_run("identify", "five-bar", bare, "--cutoff", "10")
+    assert code == 2 and "tau_theta1, tau_theta2" in err

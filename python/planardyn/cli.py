@@ -4,6 +4,7 @@
     planardyn simulate MODEL [--t-end T] [--method M] [--rtol R] [--atol A] [--dt H]
                              [--output-dt H] [--max-steps N] [-o results.csv|.parquet|.npz]
     planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
+    planardyn identify MODEL DATA [--cutoff HZ] [--validate DATA] [-o FILE.json]
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
@@ -22,6 +23,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import importlib.util
+import json
 import os
 import sys
 import time
@@ -251,6 +253,21 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write (.csv, .parquet or .npz) with tau_<name> columns")
 
+    idf = _sub(sub, "identify", "identify the inertial parameters from a measured motion",
+               "Estimate the model's base inertial parameters (the combinations the efforts can\n"
+               "tell apart) from a measured motion: a CSV table with t (s), one column per coordinate\n"
+               "(rad or m) and tau_<name> (N m or N), or a planardyn results file. Rates and\n"
+               "accelerations come from qd_<name>/qdd_<name> columns, else from the positions\n"
+               "low-pass filtered at --cutoff (the efforts filtered alike). Prints each base\n"
+               "parameter identified with its standard error, against the model's.",
+               "  planardyn identify five-bar measured.csv --cutoff 10\n"
+               "  planardyn identify five-bar run.npz --validate other.npz -o identified.json")
+    idf.add_argument("model", type=Path, help=MODEL_HELP)
+    idf.add_argument("data", type=Path, help="measured motion: CSV table or results file")
+    idf.add_argument("--cutoff", type=_within(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
+    idf.add_argument("--validate", type=Path, help="another measured motion: RMS effort error, identified vs model")
+    idf.add_argument("-o", "--output", type=Path, help="write the identification as JSON")
+
     pl = _sub(sub, "plot", "plot a results file: coordinates, rates, drive efforts, energy",
               "Plot the time histories of a results file (coordinates, rates, drive efforts and\n"
               "energy on one figure), or with --torque-speed each drive's effort against its speed.",
@@ -403,6 +420,53 @@ def _inverse(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
+    """q, qd, qdd, tau, x of a measured motion (rates from columns, or differentiated)."""
+    from .identify import differentiate, inside, lowpass
+    from .results_io import read_motion
+
+    m = read_motion(path, mech.coordinate_names)
+    if m["tau"] is None:
+        names = ", ".join(f"tau_{n}" for n in mech.coordinate_names)
+        raise UsageError(f"{path}: identification needs the measured efforts: columns {names}")
+    if m["qd"] is not None and m["qdd"] is not None:
+        return m["q"], m["qd"], m["qdd"], m["tau"], m["x"]
+    if cutoff is None:
+        raise UsageError(f"{path}: no qd_/qdd_ columns: give --cutoff (Hz) to differentiate the positions")
+    q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
+    keep = inside(m["t"], cutoff)
+    if not keep.any():
+        raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at --cutoff "
+                         f"{cutoff:g} Hz: record longer or raise --cutoff")
+    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], m["tau"], cutoff)[keep], None
+
+
+def _identify(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .identify import identify
+
+    mech = load(args.model)
+    found = identify(mech, *_measured(mech, args.data, args.cutoff))
+    print(found.report())
+    if args.validate is not None:
+        q, qd, qdd, tau, x = _measured(mech, args.validate, args.cutoff)
+        Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+        rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
+        ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
+        prior = rms(mech.inverse_dynamics(q, qd, qdd, x=x) - tau)
+        print(f"validation on {args.validate}: RMS effort error {ident:.4g} identified, {prior:.4g} with the model")
+    if args.output is not None:
+        out = {"base_parameters": found.base.expressions, "identified": found.beta.tolist(),
+               "std_error": found.std_error.tolist(), "model": found.prior.tolist(),
+               "parameters": {k: float(v) for k, v in found.pi.items()},
+               "residual_rms": found.residual_rms.tolist(), "samples": found.samples}
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        args.output.write_text(json.dumps(out, indent=1))
+        print(f"wrote {args.output}")
+    return EXIT_OK
+
+
 def _plot(args: argparse.Namespace) -> int:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -488,6 +552,7 @@ COMMANDS = {
     "check": _check,
     "simulate": _simulate,
     "inverse": _inverse,
+    "identify": _identify,
     "plot": _plot,
     "animate": _animate,
     "demo": _demo,

@@ -220,12 +220,26 @@ def differentiate(t: ArrayLike, q: ArrayLike, cutoff: float) -> tuple[FloatArray
     """q filtered by a zero-phase 4th-order Butterworth low-pass at ``cutoff`` (Hz), and its
     first two derivatives by a cubic spline through the filtered samples; t evenly spaced (s).
     Filter the efforts with :func:`lowpass` at the same cutoff (the same delay-free filter on
-    both sides keeps the equations)."""
+    both sides keeps the equations), and keep the rows :func:`inside` the record."""
     from scipy.interpolate import CubicSpline
 
     qf = lowpass(t, q, cutoff)
     spline = CubicSpline(np.asarray(t, float), qf, axis=0)
     return qf, spline(t, 1), spline(t, 2)
+
+
+#: The filter's edge transients spoil about this many periods of the cutoff at each end of
+#: a record (4th-order Butterworth run forwards and backwards: measured on an encoder
+#: signal, tests/test_identify.py).
+EDGE_PERIODS = 2.0
+
+
+def inside(t: ArrayLike, cutoff: float) -> NDArray[np.bool_]:
+    """The rows of a record filtered at ``cutoff`` (Hz) clear of its ends' transients
+    (:data:`EDGE_PERIODS` periods of the cutoff at each end)."""
+    t = np.asarray(t, float)
+    edge = EDGE_PERIODS / cutoff
+    return np.asarray((t >= t[0] + edge) & (t <= t[-1] - edge))
 
 
 def lowpass(t: ArrayLike, v: ArrayLike, cutoff: float) -> FloatArray:

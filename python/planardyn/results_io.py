@@ -352,13 +352,13 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     """Read a prescribed motion: a CSV table, or any planardyn results file.
 
     The CSV has a header row with ``t`` (s) and one column per coordinate name (rad or m),
-    and optionally ``qd_<name>`` and ``qdd_<name>`` columns; other columns are ignored, and
-    so are leading ``#`` comment lines.
+    and optionally ``qd_<name>``, ``qdd_<name>`` and ``tau_<name>`` (measured efforts, N m or
+    N) columns; other columns are ignored, and so are leading ``#`` comment lines.
 
     Returns
     -------
-    dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``: (N, m) arrays where every
-    coordinate had such a column (a results file has both), else None; ``x`` (N, 3n) the
+    dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``, ``tau``: (N, m) arrays where
+    every coordinate had such a column (a results file has all three), else None; ``x`` (N, 3n) the
     body coordinates of a results file (the branch it is on), None for a table; and
     per-coordinate lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
     """
@@ -373,7 +373,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 f"{path}: the results' coordinates ({', '.join(res.coordinate_names)}) are not "
                 f"the model's ({', '.join(coordinate_names)})"
             )
-        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "x": res.x,
+        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau, "x": res.x,
                 "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
@@ -386,7 +386,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
             f"(it needs t and the coordinates {', '.join(coordinate_names)}; found {', '.join(header)})"
         )
     col = {h: i for i, h in enumerate(header)}
-    used = need + [f"{p}_{n}" for p in ("qd", "qdd") for n in coordinate_names if f"{p}_{n}" in col]
+    used = need + [f"{p}_{n}" for p in ("qd", "qdd", "tau") for n in coordinate_names if f"{p}_{n}" in col]
     data = np.empty((len(rows), len(header)))
     for i, r in enumerate(rows):
         for h in used:
@@ -406,7 +406,8 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     qd_cols = [get(f"qd_{n}") for n in coordinate_names]
     qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
     both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731
-    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "x": None,
+    tau = both([get(f"tau_{n}") for n in coordinate_names])
+    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "x": None,
             "qd_columns": qd_cols, "qdd_columns": qdd_cols}
 
 
