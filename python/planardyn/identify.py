@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._core import PlanardynError
 from .mechanism import Mechanism
 
 FloatArray = NDArray[np.float64]
@@ -27,6 +28,9 @@ FloatArray = NDArray[np.float64]
 RANK_RTOL = 1e-9
 #: Coefficients of a combination smaller than this are round-off of an exact zero.
 COEFFICIENT_TOL = 1e-9
+#: The excitation's cost of a motion out of reach, unassembled or near a singularity: far
+#: above any condition number, and finite, which Powell's line searches need.
+INFEASIBLE = 1e12
 
 
 @dataclass(frozen=True)
@@ -91,7 +95,7 @@ def sample_states(mech: Mechanism, n: int = 200, seed: int = 0) -> tuple[FloatAr
         step = q + scale * rng.standard_normal(mech.dof)
         try:
             x = mech.assemble(step, x_start=x)
-        except Exception:  # noqa: BLE001 - outside the workspace: try another step
+        except (PlanardynError, ValueError):  # outside the workspace: try another step
             continue
         q = step
         qs.append(q)
@@ -318,12 +322,12 @@ def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitu
     def cost(z: FloatArray) -> float:
         exc = make(z)
         if np.any(np.abs(exc.sample(fine)[0] - q0) > reach):
-            return 1e12
+            return INFEASIBLE
         q, qd, qdd = exc.sample(t)
         try:
             Y, _ = mech.regressor(q, qd, qdd)
-        except Exception:  # noqa: BLE001 - not assembled, or too near a singularity
-            return 1e12
+        except (PlanardynError, ValueError):  # not assembled, or too near a singularity
+            return INFEASIBLE
         W = Y[..., base.independent].reshape(-1, base.rank)
         W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
         return float(np.linalg.cond(W))

@@ -198,11 +198,11 @@ class SimulationResult:
         ``res.take(np.arange(0, len(res), 10))``. The energy balance keeps its reference
         (the first output of the whole run)."""
         k = np.arange(len(self.t))[np.asarray(rows)]
-        e = self.energy
-        arrays = dict(t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, x=self.x, xd=self.xd,
-                      poses=self.poses, sigma=self.sigma, residual=self.residual, partitioned=self.partitioned)
-        energy = Energy(e.kinetic[k], e.potential[k], e.work[k], e.total[k], e.balance[k])
-        return dataclasses.replace(self, **{n: a[k] for n, a in arrays.items()}, energy=energy)
+
+        def rows_of(obj: Any) -> dict[str, Any]:  # every per-row array field, at rows k
+            return {f.name: v[k] for f in dataclasses.fields(obj) if isinstance(v := getattr(obj, f.name), np.ndarray)}
+
+        return dataclasses.replace(self, **rows_of(self), energy=Energy(**rows_of(self.energy)))
 
     @property
     def power(self) -> FloatArray:

@@ -175,12 +175,13 @@ pub fn regressor_rows(
     allow_singular: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), Error> {
     let p = dynamics::regressor::BODY_PARAMETERS * mech.bodies.len();
-    let (mut y, mut tau_o) = (Vec::with_capacity(q.len() * p), Vec::with_capacity(q.len()));
+    let m = mech.dof().max(1);
+    let (mut y, mut tau_o) = (vec![0.0; q.len() * p], vec![0.0; q.len()]);
     walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
         dynamics::forward::kinematic_stages(mech, &q[row.clone()], &qd[row.clone()], ws)?;
-        let (y_row, tau_row) = dynamics::regressor::regressor(mech, ws, &qdd[row]);
-        y.extend(y_row);
-        tau_o.extend(tau_row);
+        let k = row.start / m;
+        let (y_row, tau_row) = (&mut y[k * m * p..(k + 1) * m * p], &mut tau_o[row.clone()]);
+        dynamics::regressor::regressor(mech, ws, &qdd[row], y_row, tau_row);
         Ok(())
     })?;
     Ok((y, tau_o))

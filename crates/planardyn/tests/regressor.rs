@@ -23,8 +23,9 @@ fn both(
     let mut ws = Workspace::new(frames);
     assemble_into(frames, q, &mut ws).unwrap();
     kinematic_stages(frames, q, qd, &mut ws).unwrap();
-    let (y, tau_o) = regressor(frames, &mut ws, qdd);
     let p = pi.len();
+    let (mut y, mut tau_o) = (vec![0.0; m * p], vec![0.0; m]);
+    regressor(frames, &mut ws, qdd, &mut y, &mut tau_o);
     let linear: Vec<f64> = (0..m).map(|j| (0..p).map(|k| y[j * p + k] * pi[k]).sum::<f64>() + tau_o[j]).collect();
     // The size of the terms summed, for a relative tolerance that cancellation cannot fool.
     let scale =

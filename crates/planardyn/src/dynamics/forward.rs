@@ -116,13 +116,18 @@ pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsErr
 /// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd
 /// in `ws.b`, at chart state (z, zd).
 pub(crate) fn accelerations(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Workspace) {
-    let n = ws.x.len();
-    ws.xdd.copy_from_slice(&ws.c);
-    for j in 0..ws.b.len() {
-        let zdd = ws.b[j];
-        for (a, u) in ws.xdd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
-            *a += u * zdd;
+    body_accelerations(&ws.u, &ws.c, &ws.b, &mut ws.xdd);
+    user_coordinates(mech, ws, z, zd, true);
+}
+
+/// xdd = U zdd + c: the body accelerations of chart accelerations zdd (U column-major,
+/// one column of 3n a coordinate).
+pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], xdd: &mut [f64]) {
+    let n = c.len();
+    xdd.copy_from_slice(c);
+    for (u, &a) in u.chunks_exact(n).zip(zdd) {
+        for (x, u) in xdd.iter_mut().zip(u) {
+            *x += u * a;
         }
     }
-    user_coordinates(mech, ws, z, zd, true);
 }

@@ -14,6 +14,7 @@
 //! velocity analogues U of the origins).
 
 use super::forces::applied_forces;
+use super::forward::body_accelerations;
 use crate::kinematics::pairs::frames::rotate;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
@@ -31,18 +32,12 @@ pub fn parameters(mech: &Mechanism) -> Vec<f64> {
     mech.bodies.iter().flat_map(|b| [b.mass, 0.0, 0.0, b.inertia]).collect()
 }
 
-/// Y (m x 4n, row-major) and tau_o (m) at the state in `ws` (after the kinematic stages at
-/// q, qd: `ws.u`, `ws.xd`, `ws.c`) for accelerations qdd, so that the drive efforts of
-/// inverse dynamics are Y pi + tau_o.
-pub fn regressor(mech: &Mechanism, ws: &mut Workspace, qdd: &[f64]) -> (Vec<f64>, Vec<f64>) {
+/// Y (m x 4n, row-major) into `y` and tau_o (m) into `tau_o` at the state in `ws` (after
+/// the kinematic stages at q, qd: `ws.u`, `ws.xd`, `ws.c`) for accelerations qdd, so that
+/// the drive efforts of inverse dynamics are Y pi + tau_o.
+pub fn regressor(mech: &Mechanism, ws: &mut Workspace, qdd: &[f64], y: &mut [f64], tau_o: &mut [f64]) {
     let (n, m, nb) = (ws.x.len(), qdd.len(), mech.bodies.len());
-    // Body accelerations xdd = U qdd + c.
-    ws.xdd.copy_from_slice(&ws.c);
-    for (j, &a) in qdd.iter().enumerate() {
-        for (x, u) in ws.xdd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
-            *x += u * a;
-        }
-    }
+    body_accelerations(&ws.u, &ws.c, qdd, &mut ws.xdd);
     // The loads other than gravity, without drives.
     ws.tau.fill(0.0);
     applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
@@ -51,8 +46,7 @@ pub fn regressor(mech: &Mechanism, ws: &mut Workspace, qdd: &[f64]) -> (Vec<f64>
         f[0] -= body.mass * g[0];
         f[1] -= body.mass * g[1];
     }
-    let mut y = vec![0.0; m * BODY_PARAMETERS * nb];
-    let mut tau_o = vec![0.0; m];
+    tau_o.fill(0.0);
     for i in 0..nb {
         let (xd, xdd) = (&ws.xd[3 * i..3 * i + 3], &ws.xdd[3 * i..3 * i + 3]);
         let a = [xdd[0] - g[0], xdd[1] - g[1]];
@@ -76,5 +70,4 @@ pub fn regressor(mech: &Mechanism, ws: &mut Workspace, qdd: &[f64]) -> (Vec<f64>
             tau_o[j] -= u[0] * ws.f[3 * i] + u[1] * ws.f[3 * i + 1] + u[2] * ws.f[3 * i + 2];
         }
     }
-    (y, tau_o)
 }

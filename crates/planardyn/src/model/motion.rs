@@ -7,6 +7,8 @@
 //! and a clamped one needs end rates a table does not have (zero invents a stop), and either
 //! puts the end efforts of a motion that does not start at rest far off. Not-a-knot
 //! reproduces any cubic exactly, ends included. Two points give a line, three a parabola.
+//! Written here (a tridiagonal solve for the knot slopes, then Hermite pieces) because the
+//! Rust spline crates interpolate without not-a-knot ends or without the derivatives.
 
 /// A motion law of one coordinate; times in s, q in rad or m.
 #[derive(Debug, Clone, PartialEq)]
