@@ -39,14 +39,14 @@ fn assembled(mech: &Mechanism, q: &[f64]) -> Workspace {
     ws
 }
 
-/// Start `ode` at (q, qd) in the user's chart, then count the allocations of ten
+/// Start `ode` at (q, qd) in `chart`, then count the allocations of ten
 /// evaluations and acceptances at states that `vary` moves a little each step.
-fn allocations(ode: &mut MechanismOde, q: &[f64], qd: &[f64], vary: impl Fn(&mut [f64], usize)) -> usize {
+fn allocations(ode: &mut MechanismOde, chart: Chart, q: &[f64], qd: &[f64], vary: impl Fn(&mut [f64], usize)) -> usize {
     let m = q.len();
     let mut y = vec![0.0; 2 * m + 1];
     y[..m].copy_from_slice(q);
     y[m..2 * m].copy_from_slice(qd);
-    ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
+    ode.set_chart(chart, 0.0, &y).unwrap();
     let mut dy = vec![0.0; 2 * m + 1];
     let before = ALLOCATIONS.with(Cell::get);
     for step in 0..10 {
@@ -72,7 +72,7 @@ fn rhs_evaluation_does_not_allocate() {
             }
             y[0] += 1e-4 * step as f64;
         };
-        assert_eq!(allocations(&mut ode, &q, &qd, vary), 0, "{}: allocations in rhs/accept", mech.name);
+        assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "{}: allocations in rhs/accept", mech.name);
     }
 }
 
@@ -92,6 +92,25 @@ fn prescribed_rhs_evaluation_does_not_allocate() {
         motion.start(0.0, 1.0, &q).unwrap();
         let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives).with_motion(&mut motion);
         let vary = |y: &mut [f64], _: usize| y[m..2 * m].iter_mut().for_each(|v| *v *= 1.0 + 1e-6);
-        assert_eq!(allocations(&mut ode, &q, &qd, vary), 0, "{}: allocations in rhs/accept", mech.name);
+        assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "{}: allocations in rhs/accept", mech.name);
+    }
+}
+
+/// In a partition chart (components of x as coordinates, as near a type II singularity):
+/// the state is those components, their rates from the user's via U.
+#[test]
+fn partition_chart_evaluation_does_not_allocate() {
+    use planardyn::kinematics::select_partition;
+    for mech in all_models() {
+        let (q, qd) = test_state(&mech);
+        let ws = assembled(&mech, &q);
+        let idx = select_partition(&mech, &ws.x);
+        let z: Vec<f64> = idx.iter().map(|&i| ws.x[i]).collect();
+        let zd: Vec<f64> = idx.iter().map(|&i| (0..q.len()).map(|j| ws.u_col(j)[i] * qd[j]).sum()).collect();
+        let mut drives = ModelDrives(&mech);
+        let mut ode = MechanismOde::new(&mech, ws, &mut drives);
+        let vary = |y: &mut [f64], step: usize| y[0] += 1e-6 * step as f64;
+        let n = allocations(&mut ode, Chart::Partition(idx), &z, &zd, vary);
+        assert_eq!(n, 0, "{}: allocations in rhs/accept in a partition chart", mech.name);
     }
 }
