@@ -27,12 +27,14 @@ from ._core import (
     SingularityError,
     __version__,
 )
+from .events import Crossing
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
 from .result import Energy, PointMotion, SimulationInterrupted, SimulationResult
 from .results_io import read_results
 
 __all__ = [
     "AssemblyError",
+    "Crossing",
     "Energy",
     "Mechanism",
     "ModelError",

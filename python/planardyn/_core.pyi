@@ -25,6 +25,7 @@ __all__ = [
     "structure",
     "structure_of_model",
     "Effector",
+    "DenseOutput",
     "SINGULAR_TOL",
     "JUMP_TOL",
     "simulate_batch",
@@ -168,7 +169,19 @@ class Mechanism:
         progress: Callable[[float], Any] | None = None,
         max_steps: int | None = None,
         motion: list[tuple[int, float | tuple[list[float], list[float]] | Callable[[float], Any]]] | None = None,
+        events: list[tuple[Any, ...]] = ...,
+        dense_output: bool = False,
     ) -> dict[str, Any]: ...
+
+@final
+class DenseOutput:
+    def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+    @property
+    def t_min(self) -> float: ...
+    @property
+    def t_max(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
 
 @final
 class Effector:

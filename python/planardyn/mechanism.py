@@ -11,7 +11,7 @@ import dataclasses
 import json
 import os
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Generic, Literal, TypeVar, overload
 
 import numpy as np
@@ -21,6 +21,7 @@ from ._core import Mechanism as NativeMechanism
 from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
+from .events import Crossing, Event, native_events
 from .guard import available_memory, rows_message
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
@@ -451,6 +452,8 @@ class Mechanism:
         progress: ProgressFunction | None = None,
         max_steps: int | None = None,
         motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None = None,
+        events: Sequence[Event] | None = None,
+        dense_output: bool = False,
     ) -> SimulationResult:
         """Integrate the equations of motion from t = 0 (forward dynamics in time).
 
@@ -498,6 +501,19 @@ class Mechanism:
             qdd)``. Their efforts are the ones the motion needs (in ``tau``; ``drives`` on them
             are not applied), their work is part of ``work``, and the other coordinates move
             freely under their drives.
+        events : list, optional
+            Events as in scipy's ``solve_ivp`` (:mod:`planardyn.events`): functions
+            ``g(t, q, qd) -> float`` with optional attributes ``terminal`` and ``direction``,
+            or :class:`planardyn.Crossing` (a coordinate crossing a value). Zeros are found
+            where g changes sign between accepted steps and located on the step's own
+            interpolant to a few units in the last place of t (``EVENT_XTOL``); they are in
+            ``t_events``, ``q_events`` and ``qd_events``. A terminal event ends the run at its
+            first zero with status ``'event'`` (``success`` stays True), the last row at that
+            time and no output after it. A zero exactly at t = 0 is not an event. An exception
+            in g ends the run with status ``'event_failed'``.
+        dense_output : bool
+            Keep each step's interpolant: ``result.sol(t)`` then gives (q, qd) at any t of
+            the run.
 
         Returns
         -------
@@ -532,6 +548,8 @@ class Mechanism:
             progress=progress,
             max_steps=checked["max_steps"],
             motion=native_motion(motion, self.coordinate_names),
+            events=native_events(events, self.coordinate_names),
+            dense_output=bool(dense_output),
         )
         result = SimulationResult.from_raw(
             raw,
@@ -544,7 +562,10 @@ class Mechanism:
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
                         drives="callable" if callable(drives) else drives,
                         motion=None if motion is None else
-                        {k: "callable" if callable(v) else v for k, v in motion.items()})
+                        {k: "callable" if callable(v) else v for k, v in motion.items()},
+                        **({} if events is None else {"events": [
+                            dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
+                        **({"dense_output": True} if dense_output else {}))
         result = attach_metadata(result, self, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]

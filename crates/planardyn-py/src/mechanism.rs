@@ -622,7 +622,7 @@ impl PyMechanism {
     }
 
     /// Simulate; see `planardyn.Mechanism.simulate` for the arguments.
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None, motion=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None, motion=None, events=Vec::new(), dense_output=false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -640,6 +640,8 @@ impl PyMechanism {
         progress: Option<Py<PyAny>>,
         max_steps: Option<usize>,
         motion: Option<Vec<(usize, crate::simulate::MotionArg)>>,
+        events: Vec<crate::simulate::EventArg>,
+        dense_output: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let t_eval = t_eval
             .map(|a| {
@@ -668,7 +670,16 @@ impl PyMechanism {
             // The caller's motions go to the run with its callables (`simulate::simulate`).
             motion: Vec::new(),
         };
-        crate::simulate::simulate(py, &self.inner, args, drives, motion.unwrap_or_default(), progress)
+        crate::simulate::simulate(
+            py,
+            &self.inner,
+            args,
+            drives,
+            motion.unwrap_or_default(),
+            progress,
+            events,
+            dense_output,
+        )
     }
 
     fn __repr__(&self) -> String {

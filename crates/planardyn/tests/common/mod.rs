@@ -242,3 +242,12 @@ pairs:
 coordinates:
   - {name: theta, pair: O1, value: 1.0471975511965976}
 "#;
+
+/// Arithmetic-geometric mean, for the complete elliptic integral K(k) = pi / (2 agm(1, k')).
+pub fn agm(mut a: f64, mut b: f64) -> f64 {
+    // Quadratic convergence: 8 iterations reach round-off from any k' in (0, 1].
+    for _ in 0..8 {
+        (a, b) = ((a + b) / 2.0, (a * b).sqrt());
+    }
+    a
+}
