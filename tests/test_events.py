@@ -110,5 +110,7 @@ def test_cli_stop_when(tmp_path):
     res = pd.read_results(out)
     assert res.status == "event"
     assert res.t[-1] == pytest.approx(QUARTER, abs=1e-9)
+    # The file keeps the events, exactly.
+    assert res.t_events[0].tolist() == [res.t[-1]] and res.q_events[0].shape == (1, 1)
     code, err = cli_run("simulate", model, "--stop-when", "theta~0")
     assert code == 2 and "NAME=VALUE" in err

@@ -153,7 +153,8 @@ class SimulationResult:
     qd_events: list[FloatArray] = field(default_factory=list)
     #: With ``simulate(dense_output=True)``: ``sol(t) -> (q, qd)`` at any time(s) t of the run
     #: ((m,) each for a number, (K, m) for (K,) times; a ValueError outside [sol.t_min,
-    #: sol.t_max]), from each step's own interpolant. None otherwise (and when read from a file).
+    #: sol.t_max]), from each step's own interpolant. None otherwise, and when read from a file
+    #: (which keeps the events).
     sol: DenseOutput | None = None
 
     @classmethod
@@ -283,4 +284,7 @@ class SimulationResult:
             "body_names": self.body_names,
             "layout": [[g, len(cols)] for g, cols in layout],
         }
+        if self.t_events:
+            meta["events"] = {"t": [a.tolist() for a in self.t_events], "q": [a.tolist() for a in self.q_events],
+                              "qd": [a.tolist() for a in self.qd_events]}
         return results_format.write(path, meta, groups, layout, ext)
