@@ -204,12 +204,12 @@ def write(res: dict, out: Path, docs: Path | None) -> None:
         write_docs(res, docs)
 
 
-def _spread(values: dict[str, float], spec: str = ".1f") -> str:
+def _spread(values: dict[str, float], spec: str = ".1f", unit: str = "") -> str:
     """'lo to hi (four-bar a, five-bar b, ...)' of per-mechanism values, or the one value."""
-    lo, hi = min(values.values()), max(values.values())
-    each = ", ".join(f"{k} {format(v, spec)}" for k, v in values.items())
-    span = format(lo, spec) if format(lo, spec) == format(hi, spec) else f"{format(lo, spec)} to {format(hi, spec)}"
-    return f"{span} ({each})"
+    f = lambda v: format(v, spec) + unit  # noqa: E731
+    lo, hi = f(min(values.values())), f(max(values.values()))
+    each = ", ".join(f"{k} {f(v)}" for k, v in values.items())
+    return f"{lo if lo == hi else f'{lo} to {hi}'} ({each})"
 
 
 def summary_sentences(res: dict) -> str:
@@ -234,7 +234,7 @@ def summary_sentences(res: dict) -> str:
         if dyn:
             ratios = {k: mechs[k]["summary"]["dynamics_ratio_at_accuracy"][tool] for k in dyn}
             line += (f" It is driven by an RK4 loop written in Python (as a Python user drives it): its "
-                     f"`constraintDynamics` calls are {_spread({k: 100 * v for k, v in dyn.items()}, '.0f')} % "
+                     f"`constraintDynamics` calls are {_spread({k: 100 * v for k, v in dyn.items()}, '.0f', ' %')} "
                      f"of its time, the rest the Python loop, its numpy arithmetic and the springs' Jacobians. "
                      f"Against those calls alone the ratio is {_spread(ratios)} at the stated accuracy.")
         lines.append(line)
