@@ -45,6 +45,7 @@ def test_a_function_event_finds_both_turning_points(pendulum):
     rising.direction = 1  # type: ignore[attr-defined]
     res = released(pendulum, t_end=1.2 * period, t_eval=[0.0, 1.2 * period], events=[turning, rising])
     assert res.status == "success", res.message
+    assert res.sol is None  # kept only with dense_output=True
     # qd = 0 at t = 0 is the start, not a crossing; then T/2 (rising) and T (falling).
     np.testing.assert_allclose(res.t_events[0], [period / 2, period], atol=1e-8)
     np.testing.assert_allclose(res.q_events[0][:, 0], [-THETA0, THETA0], atol=1e-8)

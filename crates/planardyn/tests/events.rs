@@ -107,6 +107,7 @@ fn turning_points_are_found_in_both_directions_by_a_closure() {
         Observe { events: vec![Event { g, terminal: false, direction: 0.0 }], ..Default::default() },
     );
     assert_eq!(tr.status, Status::Success, "{}", tr.message);
+    assert!(tr.dense.is_none(), "kept only when asked for");
     // qd = 0 at the start (not an event: a zero at t0 is not a crossing), T/2 and T.
     let t = &tr.events.t[0];
     assert_eq!(t.len(), 2, "{t:?}");

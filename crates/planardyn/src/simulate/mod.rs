@@ -367,7 +367,7 @@ pub fn simulate_observed<'a>(
     };
     // Dense output is only needed to interpolate at requested times (DOP853 pays 3 extra
     // evaluations in each step that holds one).
-    let observing = !observe.is_empty();
+    let (observing, keep_dense) = (!observe.is_empty(), observe.dense_output);
     let options = Options { dense_output: settings.t_eval.is_some() || observing, ..settings.options.clone() };
     let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
     let mut y = y0;
@@ -510,7 +510,8 @@ pub fn simulate_observed<'a>(
     traj.stats.integrator = stepper.stats();
     traj.stats.failed_evaluations = ode.failed_evaluations;
     traj.events = watch.records;
-    traj.dense = dense;
+    // Events alone need the dense output only while the run lasts.
+    traj.dense = dense.filter(|_| keep_dense);
     if matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
         // Steps that shrink to nothing usually mean the passive mechanism is at a change
         // point (a parallelogram folding flat): say so when it is.
