@@ -365,8 +365,8 @@ pub fn simulate_observed<'a>(
         }
         Err(e) => return Err(e),
     };
-    // Dense output is only needed to interpolate at requested times (DOP853 pays 3 extra
-    // evaluations in each step that holds one).
+    // Dense output is only needed to interpolate at requested times, and for events and the
+    // kept interpolant (DOP853 pays 3 extra evaluations in each step that uses it).
     let (observing, keep_dense) = (!observe.is_empty(), observe.dense_output);
     let options = Options { dense_output: settings.t_eval.is_some() || observing, ..settings.options.clone() };
     let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
