@@ -40,6 +40,8 @@ pub struct Workspace {
     pub f: Vec<f64>,
     /// Power of the non-conservative forces: drives, dampers, external loads (W) (forces).
     pub power: f64,
+    /// Power dissipated by the pairs' Coulomb friction (W, >= 0) (forces, with losses).
+    pub dissipated: f64,
     /// (m x m, row-major) A = U^T M U, then its Cholesky factor (A, b).
     pub a: Vec<f64>,
     /// (m) b = U^T (f - M c), then zdd (A, b).
@@ -72,6 +74,7 @@ impl Workspace {
             tau: vec![0.0; m],
             f: vec![0.0; nx],
             power: 0.0,
+            dissipated: 0.0,
             a: vec![0.0; m * m],
             b: vec![0.0; m],
             xdd: vec![0.0; nx],
