@@ -7,7 +7,7 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::{inverse_rows_checked, regressor_rows, Branch};
+use planardyn::batch::{dissipation_rows, inverse_rows_checked, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
@@ -471,6 +471,105 @@ impl PyMechanism {
             Ok(inverse_rows_checked(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         arr_dyn(py, &shape, tau)
+    }
+
+    /// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
+    /// (m,) or (N, m): a float or (N,), on the branch of x as `inverse_dynamics`.
+    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    fn dissipated_power<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        x: Option<ArrayArg<'py>>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let mech = self.inner.clone();
+        let single = q.shape.len() == 1;
+        let p = run(py, move || {
+            Ok(dissipation_rows(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+        })?;
+        if single {
+            return Ok(p[0].into_pyobject(py)?.into_any());
+        }
+        Ok(arr1(py, p))
+    }
+
+    /// Motor torques (N m, motor side) giving the joint-side efforts `tau` at rates `qd`,
+    /// each (m,) or (N, m); on a coordinate without an actuator, the effort itself.
+    fn motor_torques<'py>(
+        &self,
+        py: Python<'py>,
+        qd: ArrayArg<'py>,
+        tau: ArrayArg<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (m, what) = (self.m(), self.coords_what());
+        let (qd, tau) = (rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
+        if qd.shape != tau.shape {
+            return Err(PyValueError::new_err(format!(
+                "qd and tau must have the same shape, got {:?} and {:?}",
+                qd.shape, tau.shape
+            )));
+        }
+        let mut out = vec![0.0; tau.data.len()];
+        for ((o, qd), tau) in out.chunks_exact_mut(m).zip(qd.data.chunks_exact(m)).zip(tau.data.chunks_exact(m)) {
+            dynamics::motor_torques(&self.inner, qd, tau, o);
+        }
+        arr_dyn(py, &tau.shape, out)
+    }
+
+    /// The actuators, one entry per coordinate (None: an ideal effort source): dicts of
+    /// name, gear_ratio, efficiency, rotor_inertia (kg m^2), viscous, coulomb, stiction_speed
+    /// and the limits peak_torque, continuous_torque (N m), max_speed (rad/s) (None when not
+    /// given) and envelope ((k, 2) [speed, torque] points).
+    #[getter]
+    fn actuators<'py>(&self, py: Python<'py>) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
+        self.inner
+            .actuators
+            .iter()
+            .map(|slot| {
+                slot.as_ref()
+                    .map(|a| {
+                        let d = PyDict::new(py);
+                        d.set_item("name", &a.name)?;
+                        d.set_item("gear_ratio", a.ratio)?;
+                        d.set_item("efficiency", a.efficiency)?;
+                        d.set_item("rotor_inertia", a.rotor_inertia)?;
+                        d.set_item("viscous", a.viscous)?;
+                        d.set_item("coulomb", a.coulomb)?;
+                        d.set_item("stiction_speed", a.stiction_speed)?;
+                        d.set_item("peak_torque", a.limits.peak_torque)?;
+                        d.set_item("continuous_torque", a.limits.continuous_torque)?;
+                        d.set_item("max_speed", a.limits.max_speed)?;
+                        let env = &a.limits.envelope;
+                        d.set_item("envelope", arr2(py, env.len(), 2, env.as_flattened().to_vec())?)?;
+                        Ok(d)
+                    })
+                    .transpose()
+            })
+            .collect()
+    }
+
+    /// The torque (N m) coordinate `coordinate`'s motor can give at motor speeds `speed`
+    /// (rad/s, any shape): its envelope, else its peak torque; None without limits.
+    fn available_torque<'py>(
+        &self,
+        py: Python<'py>,
+        coordinate: usize,
+        speed: ArrayArg<'py>,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let Some(slot) = self.inner.actuators.get(coordinate) else {
+            return Err(PyValueError::new_err(format!(
+                "coordinate {coordinate} out of range: the model has {} coordinates",
+                self.m()
+            )));
+        };
+        let Some(a) = slot else { return Ok(None) };
+        let v = Values::read(&speed);
+        let out: Option<Vec<f64>> = v.data.iter().map(|&w| a.limits.available_torque(w)).collect();
+        out.map(|t| arr_dyn(py, &v.shape, t)).transpose()
     }
 
     /// The regressor form along rows of a motion, on the branch of x as `inverse_dynamics`:

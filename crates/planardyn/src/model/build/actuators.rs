@@ -109,11 +109,14 @@ fn build_limits(ctx: &Ctx, path: &str, l: Option<&LimitsSpec>) -> R<Limits> {
 pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[LoadSpec]) -> R<Vec<JointFriction>> {
     let mut out = Vec::new();
     for (k, l) in loads.iter().enumerate() {
-        let LoadSpec::Friction { pair, mu, mu_static, pin_radius, length, stiction_speed, stribeck_speed, .. } = l
+        let LoadSpec::Friction { pair, viscous, mu, mu_static, pin_radius, length, stiction_speed, stribeck_speed } = l
         else {
             continue;
         };
         let path = format!("loads[{k}]");
+        if mu.is_none() && *viscous == 0.0 {
+            return Err(ctx.err(&path, "give `viscous` (N m s/rad or N s/m), Coulomb friction `mu`, or both"));
+        }
         let Some(mu) = mu else {
             if mu_static.is_some() || pin_radius.is_some() || length.is_some() {
                 return Err(ctx.err(format!("{path}.mu"), "Coulomb friction needs its sliding coefficient `mu`"));
