@@ -36,6 +36,9 @@ pub struct Workspace {
     pub qdd: Vec<f64>,
     /// (m) drive efforts on q (forces).
     pub tau: Vec<f64>,
+    /// Efforts (N m or N) of the redundant pair actuators during a forward evaluation
+    /// (`dynamics::redundant::forward_redundant`), zero otherwise (forces).
+    pub pair_tau: Vec<f64>,
     /// (3n) applied forces and moments at the centres of mass, drives included (forces).
     pub f: Vec<f64>,
     /// Power of the non-conservative forces: drives, dampers, external loads (W) (forces).
@@ -72,6 +75,7 @@ impl Workspace {
             qd: vec![0.0; m],
             qdd: vec![0.0; m],
             tau: vec![0.0; m],
+            pair_tau: vec![0.0; mech.pair_actuators.len()],
             f: vec![0.0; nx],
             power: 0.0,
             dissipated: 0.0,

@@ -4,7 +4,7 @@
 
 use super::forces::{applied_forces, Drives};
 use super::losses::forward_with_losses;
-use super::transmission;
+use super::{redundant, transmission};
 use crate::kinematics::constraints::{coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_rate};
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
 use crate::linalg::{cholesky_in_place, cholesky_solve};
@@ -92,6 +92,7 @@ pub fn forward(
     drive_efforts(t, drives, ws)?;
     transmission::to_joint_efforts(mech, ws);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    ws.power += redundant::apply_pair_efforts(mech, ws);
     mass_matrix(mech, ws);
     bias(mech, ws);
     if mech.has_losses() {

@@ -13,6 +13,7 @@ mod losses;
 pub mod motion;
 pub mod prescribed;
 pub mod reactions;
+pub mod redundant;
 pub mod regressor;
 pub mod regular;
 pub mod task;

@@ -78,3 +78,11 @@ pub struct JointFriction {
     pub stiction_speed: f64,
     pub stribeck_speed: f64,
 }
+
+/// A redundant actuator: an ideal effort source on the relative coordinate of a pair that
+/// is not a generalized coordinate's (docs/actuators.md, *Redundant actuation*).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairActuator {
+    pub name: String,
+    pub pair: PairId,
+}

@@ -144,6 +144,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         motions: Vec::new(),
         loads: Vec::new(),
         actuators: Vec::new(),
+        pair_actuators: Vec::new(),
         friction: Vec::new(),
         simulate: SimulateDefaults::default(),
         x0: Vec::new(),
@@ -176,7 +177,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     (mech.drives, mech.motions) = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.friction = actuators::build_friction(&ctx, &mech, &spec.loads)?;
-    mech.actuators = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
+    (mech.actuators, mech.pair_actuators) = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
 }

@@ -14,7 +14,7 @@ mod parse_errors;
 pub mod spec;
 mod tags;
 
-pub use actuators::{Actuator, JointFriction, Limits};
+pub use actuators::{Actuator, JointFriction, Limits, PairActuator};
 pub use io::{load, loads, parse_spec, Format};
 pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
@@ -196,6 +196,9 @@ pub struct Mechanism {
     pub loads: Vec<Load>,
     /// One motor and transmission slot per coordinate (`None`: an ideal effort source).
     pub actuators: Vec<Option<Actuator>>,
+    /// Redundant actuators on pairs that are not coordinates (the coordinates count as
+    /// actuated too when there are any).
+    pub pair_actuators: Vec<PairActuator>,
     /// Coulomb friction from the pairs' loads.
     pub friction: Vec<JointFriction>,
     pub simulate: SimulateDefaults,

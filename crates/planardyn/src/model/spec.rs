@@ -282,12 +282,18 @@ pub enum LoadSpec {
 }
 
 /// A motor driving a coordinate through a transmission of ratio n (motor angle = n q): the
-/// file's drive effort on that coordinate is then the motor torque (N m, motor side).
+/// file's drive effort on that coordinate is then the motor torque (N m, motor side). Or a
+/// redundant actuator on a pair (`pair`), without transmission.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ActuatorSpec {
     /// The driven coordinate.
-    pub coordinate: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Or a driven pair that is not a coordinate's: a redundant actuator (more actuators
+    /// than degrees of freedom), an ideal effort source on the pair's relative coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pair: Option<String>,
     /// A name for reports (default: the coordinate's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,

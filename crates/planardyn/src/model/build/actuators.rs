@@ -2,7 +2,7 @@
 
 use super::{coordinate_index, relative_pair, Ctx, R};
 use crate::kinematics::pairs::{self, Relative};
-use crate::model::actuators::{Actuator, JointFriction, Limits};
+use crate::model::actuators::{Actuator, JointFriction, Limits, PairActuator};
 use crate::model::spec::{ActuatorSpec, LimitsSpec, LoadSpec};
 use crate::model::{Mechanism, PairKind};
 
@@ -11,20 +11,30 @@ const MOTOR_STICTION_SPEED: f64 = 1e-2;
 const PAIR_STICTION_SPEED: f64 = 1e-4;
 const STRIBECK_SPEED: f64 = 1e-2;
 
-/// One actuator slot per coordinate (`None`: an ideal effort source).
+/// One actuator slot per coordinate (`None`: an ideal effort source), and the redundant
+/// actuators on pairs.
 pub(in crate::model) fn build_actuators(
     ctx: &Ctx,
     mech: &Mechanism,
     specs: &[ActuatorSpec],
-) -> R<Vec<Option<Actuator>>> {
+) -> R<(Vec<Option<Actuator>>, Vec<PairActuator>)> {
     let mut out: Vec<Option<Actuator>> = vec![None; mech.dof()];
+    let mut on_pairs: Vec<PairActuator> = Vec::new();
     for (k, a) in specs.iter().enumerate() {
         let path = format!("actuators[{k}]");
-        let i = coordinate_index(ctx, mech, &format!("{path}.coordinate"), &a.coordinate)?;
+        let coordinate = match (&a.coordinate, &a.pair) {
+            (Some(c), None) => c,
+            (None, Some(pair)) => {
+                on_pairs.push(pair_actuator(ctx, mech, &path, a, pair, &on_pairs)?);
+                continue;
+            }
+            _ => return Err(ctx.err(path, "give exactly one of `coordinate` or `pair` (a redundant actuator)")),
+        };
+        let i = coordinate_index(ctx, mech, &format!("{path}.coordinate"), coordinate)?;
         if out[i].is_some() {
             return Err(ctx.err(
                 format!("{path}.coordinate"),
-                format!("coordinate '{}' already has an actuator; remove one of the two", a.coordinate),
+                format!("coordinate '{coordinate}' already has an actuator; remove one of the two"),
             ));
         }
         let positive = |field: &str, v: f64| -> R<f64> {
@@ -42,7 +52,7 @@ pub(in crate::model) fn build_actuators(
             ));
         }
         out[i] = Some(Actuator {
-            name: a.name.clone().unwrap_or_else(|| a.coordinate.clone()),
+            name: a.name.clone().unwrap_or_else(|| coordinate.clone()),
             coordinate: i,
             ratio: positive("gear_ratio", a.gear_ratio)?,
             efficiency,
@@ -53,7 +63,50 @@ pub(in crate::model) fn build_actuators(
             limits: build_limits(ctx, &format!("{path}.limits"), a.limits.as_ref())?,
         });
     }
-    Ok(out)
+    Ok((out, on_pairs))
+}
+
+/// A redundant actuator: a pair with a relative coordinate, not a coordinate's, driven by an
+/// ideal effort source (no transmission).
+fn pair_actuator(
+    ctx: &Ctx,
+    mech: &Mechanism,
+    path: &str,
+    a: &ActuatorSpec,
+    pair: &str,
+    known: &[PairActuator],
+) -> R<PairActuator> {
+    let id = relative_pair(ctx, mech, &format!("{path}.pair"), pair)?;
+    if !mech.friction.is_empty() {
+        return Err(ctx.err(
+            format!("{path}.pair"),
+            "Coulomb pair friction with redundant actuators is not modelled (the reactions depend on the \
+             effort distribution); use viscous friction",
+        ));
+    }
+    if mech.coordinates.iter().any(|c| c.pair == id) {
+        return Err(ctx.err(
+            format!("{path}.pair"),
+            format!("'{pair}' is a coordinate's pair: give `coordinate` instead of `pair`"),
+        ));
+    }
+    if known.iter().any(|p| p.pair == id) {
+        return Err(ctx.err(format!("{path}.pair"), format!("pair '{pair}' already has an actuator; remove one")));
+    }
+    let ideal = a.gear_ratio == 1.0
+        && a.efficiency == 1.0
+        && a.rotor_inertia == 0.0
+        && a.viscous == 0.0
+        && a.coulomb == 0.0
+        && a.stiction_speed.is_none()
+        && a.limits.is_none();
+    if !ideal {
+        return Err(ctx.err(
+            path.to_string(),
+            "a redundant actuator on a `pair` is an ideal effort source: remove its transmission and limits",
+        ));
+    }
+    Ok(PairActuator { name: a.name.clone().unwrap_or_else(|| pair.to_string()), pair: id })
 }
 
 fn build_limits(ctx: &Ctx, path: &str, l: Option<&LimitsSpec>) -> R<Limits> {
