@@ -170,3 +170,35 @@ def test_bad_actuators_are_refused_with_their_field():
     with pytest.raises(pd.ModelError) as info:
         pd.from_dict({**model, "loads": [{"type": "friction", "pair": "elbow1", "mu": 0.1}]})
     assert info.value.path == "loads[0].pin_radius"
+
+
+def three_legged() -> pd.Mechanism:
+    """The five-bar with a third leg A3 -> C3 -> P (0.25 m, 0.35 m) actuated at A3."""
+    model = pd.load(MODELS / "five-bar.yaml").to_dict()
+    model["loads"], model["drives"] = [], []
+    model["points"] |= {"A3": [0.0, 0.0], "C3": [0.1983444079681374, 0.1521824425739351]}
+    model["ground"].append("A3")
+    model["bodies"] |= {"proximal_mid": {"points": ["A3", "C3"], "uniform_bar": ["A3", "C3"], "mass": 0.5},
+                        "distal_mid": {"points": ["C3", "P"], "uniform_bar": ["C3", "P"], "mass": 0.7}}
+    model["pairs"] += [{"type": "revolute", "name": "motor3", "at": "A3", "bodies": ["ground", "proximal_mid"]},
+                       {"type": "revolute", "name": "elbow3", "at": "C3", "bodies": ["proximal_mid", "distal_mid"]},
+                       {"type": "revolute", "name": "effector3", "at": "P", "bodies": ["distal_left", "distal_mid"]}]
+    model["actuators"] = [{"pair": "motor3"}]
+    return pd.from_dict(model)
+
+
+def test_redundant_efforts_min_norm_and_forward():
+    mech = three_legged()
+    assert mech.actuator_names == ["theta1", "theta2", "motor3"]
+    assert pd.structure.analyse(mech).actuation == 3
+    q, qd, qdd = mech.q0 + [0.05, -0.04], [1.2, -0.7], [3.0, 5.0]
+    out = mech.distribute_efforts(q, qd, qdd)
+    # Minimum norm: numpy's least-squares solution of B tau = the generalized efforts.
+    tau_gen = out["B"] @ out["efforts"]
+    np.testing.assert_allclose(out["efforts"], np.linalg.lstsq(out["B"], tau_gen, rcond=None)[0], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(out["B"] @ out["internal"].T, 0.0, atol=1e-13)
+    for how in ({"method": "min_max"}, {"method": "preload", "preload": [3.0]}):
+        e = mech.distribute_efforts(q, qd, qdd, **how)["efforts"]
+        np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, e), qdd, rtol=1e-10)
+    with pytest.raises(ValueError):
+        mech.distribute_efforts(q, qd, qdd, method="preload")

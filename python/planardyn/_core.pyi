@@ -105,6 +105,20 @@ class Mechanism:
     @property
     def actuators(self) -> list[dict[str, Any] | None]: ...
     def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]: ...
+    @property
+    def actuator_names(self) -> list[str]: ...
+    def distribute_efforts(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        method: str = "min_norm",
+        preload: list[float] | None = None,
+        x_start: ArrayLike | None = None,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    def forward_dynamics_actuated(
+        self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0
+    ) -> NDArray[np.float64]: ...
     def available_torque(self, coordinate: int, speed: ArrayLike) -> NDArray[np.float64] | None: ...
     def dissipated_power(
         self,

@@ -353,6 +353,32 @@ class Mechanism:
         coordinate without an actuator, the effort itself (docs/actuators.md)."""
         return self._native.motor_torques(qd, tau)
 
+    actuator_names: _Native[list[str]] = _Native(
+        "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
+    )
+
+    def distribute_efforts(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        method: Literal["min_norm", "min_max", "preload"] = "min_norm",
+        preload: list[float] | None = None,
+        x_start: ArrayLike | None = None,
+    ) -> dict[str, FloatArray]:
+        """Inverse dynamics with redundant actuators: every actuator's effort for (q, qd, qdd),
+        each (m,). ``method``: ``"min_norm"`` (least Euclidean norm), ``"min_max"`` (least
+        largest magnitude; one internal force), or ``"preload"`` with ``preload`` one value
+        (N m or N) per internal force added to the minimum-norm efforts. Returns ``efforts``
+        (n_a,), ``B`` (m, n_a) the generalized force per unit effort, ``internal`` (r, n_a) an
+        orthonormal basis of the internal forces (B v = 0)."""
+        return self._native.distribute_efforts(q, qd, qdd, method, preload, x_start)
+
+    def forward_dynamics_actuated(self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0) -> FloatArray:
+        """Accelerations qdd (m,) at (q, qd) under every actuator's effort (n_a,, in
+        :attr:`actuator_names` order)."""
+        return self._native.forward_dynamics_actuated(q, qd, efforts, float(t))
+
     def available_torque(self, coordinate: int, speed: ArrayLike) -> FloatArray | None:
         """The torque (N m) the motor of coordinate ``coordinate`` (an index) can give at motor
         speeds ``speed`` (rad/s, any shape): its torque-speed envelope, else its peak torque;

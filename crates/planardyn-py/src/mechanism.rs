@@ -572,6 +572,78 @@ impl PyMechanism {
         out.map(|t| arr_dyn(py, &v.shape, t)).transpose()
     }
 
+    /// The actuators' names: the coordinates', then the redundant actuators' on pairs.
+    #[getter]
+    fn actuator_names(&self) -> Vec<String> {
+        dynamics::redundant::actuator_names(&self.inner)
+    }
+
+    /// Every actuator's effort (n_a,) for (q, qd, qdd), each (m,), shared by `method`
+    /// ("min_norm", "min_max" or "preload" with `preload` one value per internal force),
+    /// with the actuation matrix `B` (m, n_a) and the internal forces (r, n_a).
+    #[pyo3(signature = (q, qd, qdd, method="min_norm", preload=None, x_start=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn distribute_efforts<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        method: &str,
+        preload: Option<Vec<f64>>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use dynamics::redundant::{inverse_redundant, Distribution};
+        let (q, qd, qdd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?, self.q_arg("qdd", &qdd)?);
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
+        let how = match (method, preload) {
+            ("min_norm", None) => Distribution::MinNorm,
+            ("min_max", None) => Distribution::MinMax,
+            ("preload", Some(p)) => Distribution::Preload(p),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "method {method:?}: use \"min_norm\", \"min_max\", or \"preload\" with preload=[one value \
+                     per internal force] (and preload only with it)"
+                )))
+            }
+        };
+        let mech = self.inner.clone();
+        let (act, efforts) = run(py, move || {
+            let mut ws = Self::assembled(&mech, &q, x_start.as_deref())?;
+            Ok(inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws)?)
+        })?;
+        let d = PyDict::new(py);
+        d.set_item("efforts", arr1(py, efforts))?;
+        d.set_item("B", arr2(py, act.m, act.n_a, act.b.clone())?)?;
+        d.set_item("internal", arr2(py, act.internal.len(), act.n_a, act.internal.concat())?)?;
+        Ok(d)
+    }
+
+    /// Accelerations qdd (m,) at (q, qd) and time t (s) under every actuator's effort
+    /// `efforts` (n_a,: the coordinates' first, as drive efforts, then the pair actuators').
+    #[pyo3(signature = (q, qd, efforts, t=0.0))]
+    fn forward_dynamics_actuated<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        efforts: ArrayArg<'py>,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let efforts = vector("efforts", &efforts, n_a, "one value per actuator (actuator_names)")?;
+        check_time(t)?;
+        let mech = self.inner.clone();
+        let qdd = run(py, move || {
+            let mut ws = Self::assembled(&mech, &q, None)?;
+            dynamics::redundant::forward_redundant(&mech, t, &q, &qd, &efforts, &mut ws)?;
+            dynamics::finite("accelerations qdd", &ws.qdd)?;
+            Ok(ws.qdd)
+        })?;
+        Ok(arr1(py, qdd))
+    }
+
     /// The regressor form along rows of a motion, on the branch of x as `inverse_dynamics`:
     /// `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with efforts = Y pi + tau_o.
     #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
