@@ -4,6 +4,7 @@ checks (docs/actuators.md), through the Python API."""
 from __future__ import annotations
 
 import copy
+import json
 
 import numpy as np
 import planardyn as pd
@@ -202,3 +203,28 @@ def test_redundant_efforts_min_norm_and_forward():
         np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, e), qdd, rtol=1e-10)
     with pytest.raises(ValueError):
         mech.distribute_efforts(q, qd, qdd, method="preload")
+
+
+def test_sizing_a_redundantly_actuated_robot_sizes_every_actuator(tmp_path):
+    mech = three_legged()
+    ee = robot.EndEffector(mech, "P")
+    home = ee.home()
+    path = robot.circle(home[:2] + [0.0, 0.02], 0.02, 0.5)
+    rep = robot.size(ee, path, dt=5e-3)
+    assert [d.name for d in rep.drives] == ["theta1", "theta2", "motor3"]
+    m = rep.motion
+    peaks = np.array([d.peak_effort for d in rep.drives])
+    # The shares reproduce the generalized efforts of the motion: B tau_a = tau at every row.
+    row = len(m.t) // 2
+    out = mech.distribute_efforts(m.q[row], m.qd[row], m.qdd[row])
+    np.testing.assert_allclose(out["B"] @ out["efforts"], m.tau[row], rtol=1e-10, atol=1e-10)
+    # Min-max makes every row's largest effort least, so its peak over the motion is at most
+    # min-norm's.
+    mm = robot.size(ee, path, dt=5e-3, distribution="min_max")
+    assert max(d.peak_effort for d in mm.drives) <= peaks.max() * (1 + 1e-12)
+    # From the shell, with a preload.
+    model = tmp_path / "three.json"
+    model.write_text(json.dumps(mech.to_dict()))
+    c = home[:2] + [0.0, 0.02]
+    assert robot.size_cli([str(model), "--circle", str(c[0]), str(c[1]), "0.02", "--duration", "0.5", "--dt", "5e-3",
+                           "--distribution", "preload", "--preload", "2.0"]) == 0

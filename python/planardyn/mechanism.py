@@ -356,6 +356,7 @@ class Mechanism:
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
     )
+    actuator_kinds: _Native[list[str]] = _Native("``'angle'`` or ``'displacement'``: what each actuator's effort turns.")
 
     def distribute_efforts(
         self,

@@ -21,6 +21,13 @@ use std::sync::Arc;
 
 type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
+fn kind_name(kind: CoordinateKind) -> &'static str {
+    match kind {
+        CoordinateKind::Angle => "angle",
+        CoordinateKind::Displacement => "displacement",
+    }
+}
+
 /// A validated planar mechanism (immutable). Made by `load`/`loads`.
 #[pyclass(frozen, module = "planardyn._core", name = "Mechanism")]
 pub struct PyMechanism {
@@ -175,14 +182,14 @@ impl PyMechanism {
     /// 'angle' (rad) or 'displacement' (m) for each coordinate.
     #[getter]
     fn coordinate_kinds(&self) -> Vec<&'static str> {
-        self.inner
-            .coordinates
-            .iter()
-            .map(|c| match c.kind {
-                CoordinateKind::Angle => "angle",
-                CoordinateKind::Displacement => "displacement",
-            })
-            .collect()
+        self.inner.coordinates.iter().map(|c| kind_name(c.kind)).collect()
+    }
+    /// "angle" or "displacement" per actuator (`actuator_names`): what its effort turns.
+    #[getter]
+    fn actuator_kinds(&self) -> Vec<&'static str> {
+        let mech = &self.inner;
+        let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
+        pairs.map(|p| pairs::coordinate_kind(&mech.pairs[p.0]).map_or("displacement", kind_name)).collect()
     }
     #[getter]
     fn body_names(&self) -> Vec<String> {

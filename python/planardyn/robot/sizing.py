@@ -212,8 +212,21 @@ def _rms(t: FloatArray, y: FloatArray) -> float:
     return float(np.sqrt(integral / (t[-1] - t[0])))
 
 
+def distributed_efforts(mech: Mechanism, motion: TaskMotion, distribution: str = "min_norm",
+                        preload: list[float] | None = None) -> tuple[FloatArray, FloatArray]:
+    """Every actuator's effort (N, n_a) along a motion of a redundantly actuated mechanism,
+    shared by ``distribution`` (:meth:`Mechanism.distribute_efforts`), and each actuator's
+    rate (N, n_a): B^T qd (rad/s or m/s on its pair)."""
+    efforts, rates = [], []
+    for q, qd, qdd in zip(motion.q, motion.qd, motion.qdd):
+        out = mech.distribute_efforts(q, qd, qdd, distribution, preload)  # type: ignore[arg-type]
+        efforts.append(out["efforts"])
+        rates.append(out["B"].T @ qd)
+    return np.array(efforts), np.array(rates)
+
+
 def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payload: float = 0.0,
-         **solve_options: Any) -> SizingReport:
+         distribution: str = "min_norm", preload: list[float] | None = None, **solve_options: Any) -> SizingReport:
     """Actuator sizing report of a task-space motion.
 
     Parameters
@@ -225,6 +238,10 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
     payload : float
         Mass (kg) added at the end-effector point first (:func:`with_payload`); only with an
         end effector and a path (a solved motion already has its model).
+    distribution, preload
+        With more actuators than coordinates (``actuators: [{pair: ...}]``), how their
+        efforts are shared: ``"min_norm"``, ``"min_max"`` or ``"preload"`` with ``preload``
+        (:meth:`Mechanism.distribute_efforts`); every actuator is then sized.
     solve_options
         Passed to :func:`solve_motion` (``dt``, ``n``, ``q_start``, ``singular_tol``).
     """
@@ -239,14 +256,21 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
     elif payload or path is not None:
         raise ValueError("a solved motion already has its model and path: pass size(effector, path, payload=...)")
     mech = motion.mech
+    names = mech.actuator_names
+    m = len(mech.coordinate_names)
+    if len(names) > m:
+        efforts, rates = distributed_efforts(mech, motion, distribution, preload)
+    else:
+        efforts, rates = motion.tau, motion.qd
+    kinds = mech.actuator_kinds
     drives = []
-    for k, name in enumerate(mech.coordinate_names):
-        tau, qd = motion.tau[:, k], motion.qd[:, k]
+    for k, name in enumerate(names):
+        tau, qd = efforts[:, k], rates[:, k]
         ev, ee_ = envelope(qd, tau)
-        speed_unit = "rad/s" if mech.coordinate_kinds[k] == "angle" else "m/s"
-        drives.append(DriveSizing(name, mech.effort_units[k], speed_unit, float(np.abs(tau).max()), _rms(motion.t, tau),
-                                  float(np.abs(qd).max()), float(np.abs(tau * qd).max()), ev, ee_,
-                                  motor_sizing(mech, k, motion.t, motion.qd, motion.tau)))
+        angle = kinds[k] == "angle"
+        drives.append(DriveSizing(name, "N m" if angle else "N", "rad/s" if angle else "m/s", float(np.abs(tau).max()),
+                                  _rms(motion.t, tau), float(np.abs(qd).max()), float(np.abs(tau * qd).max()), ev, ee_,
+                                  motor_sizing(mech, k, motion.t, rates[:, :m], efforts[:, :m]) if k < m else None))
     iI, iII = int(np.argmin(motion.sigma_I)), int(np.argmin(motion.sigma_II))
     return SizingReport(motion, float(payload), drives,
                         (float(motion.sigma_I[iI]), float(motion.t[iI]), motion.X[iI]),
