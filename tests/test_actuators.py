@@ -10,7 +10,7 @@ import numpy as np
 import planardyn as pd
 import pytest
 from conftest import MODELS
-from planardyn import robot
+from planardyn import robot, structure
 from scipy.integrate import solve_ivp
 
 G = 9.81
@@ -191,7 +191,7 @@ def three_legged() -> pd.Mechanism:
 def test_redundant_efforts_min_norm_and_forward():
     mech = three_legged()
     assert mech.actuator_names == ["theta1", "theta2", "motor3"]
-    assert pd.structure.analyse(mech).actuation == 3
+    assert structure.analyse(mech).actuation == 3
     q, qd, qdd = mech.q0 + [0.05, -0.04], [1.2, -0.7], [3.0, 5.0]
     out = mech.distribute_efforts(q, qd, qdd)
     # Minimum norm: numpy's least-squares solution of B tau = the generalized efforts.
