@@ -814,7 +814,7 @@ fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
         LoadSpec::Friction { pair, viscous, .. } => Load::PairSpring {
             pair: relative_pair(ctx, mech, &format!("{path}.pair"), pair)?,
             stiffness: 0.0,
-            damping: ctx.non_negative(&format!("{path}.viscous"), *viscous)?,
+            damping: ctx.non_negative(&format!("{path}.viscous"), viscous.unwrap_or(0.0))?,
             rest: 0.0,
         },
     })

@@ -258,8 +258,8 @@ pub enum LoadSpec {
     /// along a prismatic pair of length L, mu |N| along a slot.
     Friction {
         pair: String,
-        #[serde(default)]
-        viscous: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        viscous: Option<f64>,
         /// Sliding (kinetic) friction coefficient.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         mu: Option<f64>,

@@ -167,7 +167,7 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
             continue;
         };
         let path = format!("loads[{k}]");
-        if mu.is_none() && *viscous == 0.0 {
+        if mu.is_none() && viscous.is_none() {
             return Err(ctx.err(&path, "give `viscous` (N m s/rad or N s/m), Coulomb friction `mu`, or both"));
         }
         let Some(mu) = mu else {
