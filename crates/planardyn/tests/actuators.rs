@@ -5,6 +5,7 @@ mod common;
 
 use common::{run, yaml};
 use planardyn::dynamics::{forward, inverse, motor_torques, ModelDrives};
+use planardyn::kinematics::{assemble_into, velocity_analogues, Chart};
 use planardyn::{Mechanism, Workspace};
 
 const G: f64 = 9.81;
@@ -175,6 +176,13 @@ fn pendulum_with_pin_friction_matches_its_one_coordinate_equation() {
     assert!(tr.work[n] < -1e-3, "friction dissipated {}", -tr.work[n]);
 }
 
+/// Coulomb friction at every pair of common::SLIDER_CRANK.
+const FRICTION: &str = "loads:\n\
+  - {type: friction, pair: O, mu: 0.15, pin_radius: 0.01}\n\
+  - {type: friction, pair: A, mu: 0.1, pin_radius: 0.008}\n\
+  - {type: friction, pair: B, mu: 0.1, pin_radius: 0.008}\n\
+  - {type: friction, pair: guide, mu: 0.2, length: 0.04}\n";
+
 fn slider_crank(friction: &str) -> Mechanism {
     let drawing = common::SLIDER_CRANK.split("loads:").next().unwrap_or_default();
     let named = drawing
@@ -187,12 +195,7 @@ fn slider_crank(friction: &str) -> Mechanism {
 fn drive_power_is_frictionless_power_plus_dissipated_power() {
     // Along a non-uniform crank motion, at every point: tau qd = tau_0 qd + dissipated, by
     // the principle of virtual power (the same motion, the same dT/dt + dV/dt).
-    let friction = "loads:\n\
-      - {type: friction, pair: O, mu: 0.15, pin_radius: 0.01}\n\
-      - {type: friction, pair: A, mu: 0.1, pin_radius: 0.008}\n\
-      - {type: friction, pair: B, mu: 0.1, pin_radius: 0.008}\n\
-      - {type: friction, pair: guide, mu: 0.2, length: 0.04}\n";
-    let (with, without) = (slider_crank(friction), slider_crank(""));
+    let (with, without) = (slider_crank(FRICTION), slider_crank(""));
     let (mut ws, mut ws0) = (Workspace::new(&with), Workspace::new(&without));
     let (mut work, mut work0, mut lost) = (0.0, 0.0, 0.0);
     let n = 400;
@@ -214,4 +217,43 @@ fn drive_power_is_frictionless_power_plus_dissipated_power() {
     }
     assert!((work - work0 - lost).abs() <= 1e-10 * work.abs());
     assert!(lost > 0.01 * work.abs(), "friction costs {lost} J of {work} J");
+}
+
+#[test]
+fn forward_with_losses_inverts_and_holds_in_a_partition_chart() {
+    // The slider-crank with pin friction and a geared motor whose torque is the file's drive
+    // effort, 0.4 N m: inverse dynamics at the forward accelerations gives that torque back,
+    // and forward dynamics in a partition chart (components of x as coordinates) gives the
+    // same qdd (the rotor's g, h and the friction's levers taken through U).
+    let motor = "actuators:\n  - {coordinate: phi, gear_ratio: 10, efficiency: 0.9, rotor_inertia: 1.0e-4, \
+                 viscous: 1.0e-4, coulomb: 0.005}\n";
+    let mech = slider_crank(&format!("{FRICTION}{motor}"));
+    let (q, qd) = ([0.9], [4.0]);
+    let assembled = || {
+        let mut ws = Workspace::new(&mech);
+        assemble_into(&mech, &q, &mut ws).unwrap();
+        velocity_analogues(&mut ws).unwrap();
+        ws
+    };
+    let mut ws = assembled();
+    forward(&mech, 0.0, &q, &qd, &mut ModelDrives(&mech), &mut ws).unwrap();
+    let qdd = ws.qdd[0];
+    assert!(ws.dissipated > 0.0);
+    let mut inv = assembled();
+    inverse(&mech, &q, &qd, &[qdd], &mut inv).unwrap();
+    let mut t_m = [0.0];
+    motor_torques(&mech, &qd, &inv.tau, &mut t_m);
+    assert!((t_m[0] - 0.4).abs() <= 1e-12, "motor torque {} vs 0.4 N m", t_m[0]);
+    assert!((inv.dissipated - ws.dissipated).abs() <= 1e-12 * ws.dissipated);
+
+    // The slider's X (x[6]) as the chart coordinate: dq/dz is then not 1 (the crank is 0.9 rad
+    // from its dead centres, where it would vanish).
+    let mut part = assembled();
+    let idx = vec![6];
+    let z: Vec<f64> = idx.iter().map(|&i| part.x[i]).collect();
+    let zd: Vec<f64> = idx.iter().map(|&i| part.u_col(0)[i] * qd[0]).collect();
+    part.chart = Chart::Partition(idx);
+    forward(&mech, 0.0, &z, &zd, &mut ModelDrives(&mech), &mut part).unwrap();
+    assert!((part.qdd[0] - qdd).abs() <= 1e-9 * qdd.abs(), "partition chart {} vs {qdd}", part.qdd[0]);
+    assert!((part.dissipated - ws.dissipated).abs() <= 1e-9 * ws.dissipated);
 }
