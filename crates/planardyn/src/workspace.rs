@@ -5,6 +5,7 @@
 //! fills each buffer is named, in the order a forward-dynamics evaluation runs them:
 //! positions -> analogues -> convective term -> forces -> A, b -> accelerations.
 
+use crate::dynamics::LossBuffers;
 use crate::kinematics::{Chart, System};
 use crate::model::Mechanism;
 
@@ -55,6 +56,8 @@ pub struct Workspace {
     pub rhs: Vec<f64>,
     /// (3n) scratch for residuals and second derivatives.
     pub tmp: Vec<f64>,
+    /// The transmissions' and the pair friction's buffers (forward and inverse with losses).
+    pub losses: LossBuffers,
 }
 
 impl Workspace {
@@ -84,6 +87,7 @@ impl Workspace {
             xdd: vec![0.0; nx],
             rhs: vec![0.0; nx],
             tmp: vec![0.0; nx],
+            losses: LossBuffers::new(mech),
         }
     }
 

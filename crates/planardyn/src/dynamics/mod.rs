@@ -24,6 +24,7 @@ pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};
 pub use inverse::inverse;
+pub use losses::LossBuffers;
 pub use motion::{Motion, MotionFunction, Prescribed};
 pub use prescribed::{forward_prescribed, prescribed_sigma_min};
 pub use reactions::reactions;

@@ -10,7 +10,7 @@
 //! part of the joint-side effort (the efficiency is applied to the whole gear torque except
 //! that of the rotor, which keeps A linear: docs/actuators.md states it).
 
-use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
+use crate::kinematics::constraints::pair_coordinate_gamma;
 use crate::model::{Actuator, Mechanism};
 use crate::workspace::Workspace;
 
@@ -60,44 +60,28 @@ pub(crate) fn to_joint_efforts(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
-/// A rotor seen in the chart z: qdd_k = g . zdd + h, inertia n^2 J.
-pub(crate) struct Rotor {
-    pub coordinate: usize,
-    pub inertia: f64,
-    pub g: Vec<f64>,
-    pub h: f64,
-}
-
-/// The rotors of `mech` at the point in `ws` (after the kinematic stages); `grad` is 3n scratch.
-pub(crate) fn rotors(mech: &Mechanism, ws: &Workspace, grad: &mut [f64]) -> Vec<Rotor> {
+/// h_k = grad_k . c + gamma_k(xd, xd) of every coordinate k with a rotor (`inertia[k]` > 0),
+/// so that qdd_k = g_k . zdd + h_k; `grad` holds the coordinates' gradients (m x 3n).
+pub(crate) fn rotor_terms(mech: &Mechanism, ws: &Workspace, inertia: &[f64], grad: &[f64], h: &mut [f64]) {
     let n = ws.x.len();
-    mech.actuators
-        .iter()
-        .flatten()
-        .filter(|a| a.rotor_inertia > 0.0)
-        .map(|a| {
-            let pair = &mech.pairs[mech.coordinates[a.coordinate].pair.0];
-            grad.fill(0.0);
-            pair_coordinate_grad(pair, &ws.x, &mut Dense { j: grad, ncols: n }, 0);
-            let dot = |v: &[f64]| grad.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
-            Rotor {
-                coordinate: a.coordinate,
-                inertia: a.ratio * a.ratio * a.rotor_inertia,
-                g: ws.u.chunks_exact(n).map(dot).collect(),
-                h: dot(&ws.c) + pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd),
-            }
-        })
-        .collect()
+    for (k, ((h, g), &j)) in h.iter_mut().zip(grad.chunks_exact(n)).zip(inertia).enumerate() {
+        if j > 0.0 {
+            let pair = &mech.pairs[mech.coordinates[k].pair.0];
+            *h = g.iter().zip(&ws.c).map(|(a, b)| a * b).sum::<f64>()
+                + pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd);
+        }
+    }
 }
 
-/// A += n^2 J g g^T and b -= n^2 J h g: the rotors' kinetic energy 1/2 n^2 J qd_k^2.
-pub(crate) fn add_rotor_inertia(rotors: &[Rotor], a: &mut [f64], b: &mut [f64]) {
+/// A += n^2 J g_k g_k^T and b -= n^2 J h_k g_k for every coordinate k (`inertia[k]` = n^2 J,
+/// 0 without a rotor; `g` m x m, row k = dq_k/dz): the rotors' kinetic energy 1/2 n^2 J qd_k^2.
+pub(crate) fn add_rotor_inertia(inertia: &[f64], g: &[f64], h: &[f64], a: &mut [f64], b: &mut [f64]) {
     let m = b.len();
-    for r in rotors {
-        for j in 0..m {
-            b[j] -= r.inertia * r.h * r.g[j];
-            for k in 0..m {
-                a[j * m + k] += r.inertia * r.g[j] * r.g[k];
+    for ((&j, g), &h) in inertia.iter().zip(g.chunks_exact(m)).zip(h).filter(|((j, _), _)| **j > 0.0) {
+        for r in 0..m {
+            b[r] -= j * h * g[r];
+            for c in 0..m {
+                a[r * m + c] += j * g[r] * g[c];
             }
         }
     }
