@@ -120,6 +120,12 @@ class Mechanism:
         "or None) and ``rows`` (start, stop): the pair's rows among the pair-constraint rows."
     )
     simulate_defaults: _Native[dict[str, Any]] = _Native("The model file's ``simulate`` section (None for a setting not given).")
+    actuators: _Native[list[dict[str, Any] | None]] = _Native(
+        "One entry per coordinate, None for an ideal effort source: the motor and transmission (``name``, "
+        "``gear_ratio``, ``efficiency``, ``rotor_inertia`` kg m^2, ``viscous`` N m s/rad, ``coulomb`` N m, "
+        "``stiction_speed`` rad/s) and its limits (``peak_torque``, ``continuous_torque`` N m, ``max_speed`` rad/s, "
+        "None when not given; ``envelope`` (k, 2) [speed, torque] points), docs/actuators.md."
+    )
 
     @property
     def coordinate_units(self) -> list[str]:
@@ -326,7 +332,9 @@ class Mechanism:
         Returns
         -------
         tau : ndarray of the same shape
-            Efforts (N m on angles, N on displacements), the model's drives not included.
+            Efforts (N m on angles, N on displacements), the model's drives not included;
+            joint-side: with the pairs' Coulomb friction and the rotors' n^2 J qdd
+            (:meth:`motor_torques` gives the motor side).
 
         Raises
         ------
@@ -338,6 +346,54 @@ class Mechanism:
             efforts or rates.
         """
         return self._native.inverse_dynamics(q, qd, qdd, x, allow_singular)
+
+    def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray:
+        """Motor torques (N m, motor side) that give the joint-side efforts ``tau`` (N m or N)
+        at rates ``qd``, each (m,) or (N, m): t_m = tau / (n eta) + motor friction while
+        motoring (tau qd >= 0), tau eta / n + motor friction while generating; on a
+        coordinate without an actuator, the effort itself (docs/actuators.md)."""
+        return self._native.motor_torques(qd, tau)
+
+    actuator_names: _Native[list[str]] = _Native(
+        "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
+    )
+    actuator_kinds: _Native[list[str]] = _Native("``'angle'`` or ``'displacement'``: what each actuator's effort turns.")
+
+    def distribute_efforts(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        method: Literal["min_norm", "min_max", "preload"] = "min_norm",
+        preload: list[float] | None = None,
+        x_start: ArrayLike | None = None,
+    ) -> dict[str, FloatArray]:
+        """Inverse dynamics with redundant actuators: every actuator's effort for (q, qd, qdd),
+        each (m,). ``method``: ``"min_norm"`` (least Euclidean norm), ``"min_max"`` (least
+        largest magnitude; one internal force), or ``"preload"`` with ``preload`` one value
+        (N m or N) per internal force added to the minimum-norm efforts. Returns ``efforts``
+        (n_a,), ``B`` (m, n_a) the generalized force per unit effort, ``internal`` (r, n_a) an
+        orthonormal basis of the internal forces (B v = 0)."""
+        return self._native.distribute_efforts(q, qd, qdd, method, preload, x_start)
+
+    def forward_dynamics_actuated(self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0) -> FloatArray:
+        """Accelerations qdd (m,) at (q, qd) under every actuator's effort (n_a,, in
+        :attr:`actuator_names` order)."""
+        return self._native.forward_dynamics_actuated(q, qd, efforts, float(t))
+
+    def available_torque(self, coordinate: int, speed: ArrayLike) -> FloatArray | None:
+        """The torque (N m) the motor of coordinate ``coordinate`` (an index) can give at motor
+        speeds ``speed`` (rad/s, any shape): its torque-speed envelope, else its peak torque;
+        None when it has no actuator or no torque limit."""
+        return self._native.available_torque(int(coordinate), speed)
+
+    def dissipated_power(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None, allow_singular: bool = False
+    ) -> Any:
+        """Power (W, >= 0) the pairs' Coulomb friction dissipates along a motion (arguments as
+        :meth:`inverse_dynamics`): a float for one row, (N,) for rows. The drive power
+        ``tau . qd`` exceeds the frictionless one by exactly this."""
+        return self._native.dissipated_power(q, qd, qdd, x, allow_singular)
 
     def reactions(
         self,

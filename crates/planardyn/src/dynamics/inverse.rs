@@ -4,13 +4,15 @@
 
 use super::forces::applied_forces;
 use super::forward::{bias, kinematic_stages, mass_matrix};
+use super::losses::inverse_with_losses;
 use crate::kinematics::Chart;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Drive efforts (N m or N) into `ws.tau` for user coordinates q, rates qd and accelerations
-/// qdd, starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
+/// qdd (joint-side: with the pairs' friction and the rotors' n^2 J qdd; the motor torques are
+/// [`super::motor_torques`] of them), starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
 /// distant q).
 pub fn inverse(
     mech: &Mechanism,
@@ -28,6 +30,9 @@ pub fn inverse(
     let m = q.len();
     for j in 0..m {
         ws.tau[j] = (0..m).map(|k| ws.a[j * m + k] * qdd[k]).sum::<f64>() - ws.b[j];
+    }
+    if mech.has_losses() {
+        inverse_with_losses(mech, qdd, ws)?;
     }
     ws.qdd.copy_from_slice(qdd);
     super::finite("efforts tau", &ws.tau)?;
