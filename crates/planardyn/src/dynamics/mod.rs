@@ -4,7 +4,9 @@
 //! run in a [`crate::Workspace`].
 
 pub mod along;
+pub mod derivatives;
 pub mod energy;
+pub mod force_rates;
 pub mod forces;
 pub mod forward;
 pub mod inverse;
@@ -16,6 +18,7 @@ pub mod regular;
 pub mod task;
 
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
+pub use derivatives::{forward_derivatives, inverse_derivatives, Jacobians};
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};

@@ -242,3 +242,18 @@ pairs:
 coordinates:
   - {name: theta, pair: O1, value: 1.0471975511965976}
 "#;
+
+/// Every shipped model file (examples/models and its library) and the inline models.
+pub fn every_model() -> Vec<Mechanism> {
+    let dir = format!("{}/../../examples/models", env!("CARGO_MANIFEST_DIR"));
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .chain(std::fs::read_dir(format!("{dir}/library")).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .map(|p| p.strip_prefix(&dir).unwrap().to_string_lossy().trim_start_matches('/').to_string())
+        .collect();
+    names.sort();
+    assert!(names.len() >= 20, "{names:?}");
+    names.iter().map(|n| shipped(n)).chain(all_models()).collect()
+}
