@@ -4,7 +4,9 @@
 mod common;
 
 use common::{every_model, test_state, yaml};
-use planardyn::dynamics::{forward, forward_derivatives, inverse, inverse_derivatives, FixedDrives, Jacobians};
+use planardyn::dynamics::{
+    forward, forward_derivatives, inverse, inverse_derivatives, motion_derivatives, FixedDrives, Jacobians,
+};
 use planardyn::kinematics::{assemble_into, Chart};
 use planardyn::{Mechanism, Workspace};
 
@@ -19,12 +21,14 @@ fn difference(
     k: usize,
     h: f64,
 ) -> Vec<f64> {
-    let mut out = vec![0.0; at[0].len()];
+    let mut out = Vec::new();
     for (i, w) in STENCIL.iter().enumerate() {
         for sign in [1.0, -1.0] {
             let mut p = at.clone();
             p[which][k] += sign * (i + 1) as f64 * h;
-            for (o, v) in out.iter_mut().zip(f(&p)) {
+            let value = f(&p);
+            out.resize(value.len(), 0.0);
+            for (o, v) in out.iter_mut().zip(value) {
                 *o += sign * w * v / h;
             }
         }
@@ -114,5 +118,27 @@ fn forward_dynamics_derivatives_match_central_differences_on_every_model() {
         };
         assert_eq!(qdd, f(&at), "{}", mech.name);
         check(&format!("{} forward", mech.name), &jac, &mut f, &at);
+    }
+}
+
+#[test]
+fn power_derivatives_match_central_differences_on_every_model() {
+    // The power of the non-conservative forces P(q, qd) at fixed tau, drives included.
+    for mech in models() {
+        let (ws0, at) = state(&mech);
+        let mut ws = ws0.clone();
+        let (_, _, power) = motion_derivatives(&mech, &at[0], &at[1], &at[2], &mut ws).unwrap();
+        let mut f = |p: &[Vec<f64>; 3]| {
+            let mut ws = ws0.clone();
+            ws.chart = Chart::Inputs;
+            forward(&mech, 0.0, &p[0], &p[1], &mut FixedDrives(&p[2]), &mut ws).unwrap();
+            vec![ws.power]
+        };
+        for (which, exact, h) in [(0, &power.dq, 1e-3), (1, &power.dqd, 1e-1)] {
+            let fd: Vec<f64> = (0..exact.len()).map(|k| difference(&mut f, &at, which, k, h)[0]).collect();
+            let scale = exact.iter().chain(&fd).fold(0.0_f64, |a, v| a.max(v.abs()));
+            let err = exact.iter().zip(&fd).fold(0.0_f64, |a, (e, d)| a.max((e - d).abs()));
+            assert!(err <= 1e-8 * scale.max(1e-4), "{}: argument {which}: {exact:?} vs {fd:?}", mech.name);
+        }
     }
 }

@@ -11,7 +11,7 @@
 //! dqdd/dtau = A^-1, dqdd/dq = -A^-1 dtau/dq, dqdd/dqd = -A^-1 dtau/dqd.
 
 use super::along::FixedDrives;
-use super::force_rates::{applied_forces_dx, applied_forces_dxd, RateScratch};
+use super::force_rates::{applied_forces_dx, applied_forces_dxd, load_power_dx, load_power_dxd, RateScratch};
 use super::forward::{body_accelerations, factor_mass_matrix, forward};
 use super::inverse::inverse;
 use crate::kinematics::third::convective_derivative;
@@ -56,6 +56,15 @@ fn contract(w: &[f64], k: usize, s: &[f64], out: &mut [f64]) {
     }
 }
 
+/// The derivatives of the power P of the non-conservative forces (W), drives included.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PowerRates {
+    /// dP/dq (m).
+    pub dq: Vec<f64>,
+    /// dP/dqd (m).
+    pub dqd: Vec<f64>,
+}
+
 /// dtau/dq, dtau/dqd, dtau/dqdd of inverse dynamics at (q, qd, qdd) (each m, SI units per
 /// coordinate), starting Newton from `ws.x`; leaves `ws` as [`inverse`] does.
 pub fn inverse_derivatives(
@@ -65,6 +74,17 @@ pub fn inverse_derivatives(
     qdd: &[f64],
     ws: &mut Workspace,
 ) -> Result<Jacobians, KinematicsError> {
+    Ok(inverse_derivatives_with(mech, q, qd, qdd, ws)?.0)
+}
+
+/// [`inverse_derivatives`] and the acceleration analogues w it computed.
+fn inverse_derivatives_with(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    ws: &mut Workspace,
+) -> Result<(Jacobians, Vec<f64>), KinematicsError> {
     inverse(mech, q, qd, qdd, ws)?;
     let (n, m) = (ws.x.len(), q.len());
     let w = acceleration_analogues(mech, ws);
@@ -105,7 +125,7 @@ pub fn inverse_derivatives(
     }
     super::finite("effort derivatives", &jac.dq)?;
     super::finite("effort derivatives", &jac.dqd)?;
-    Ok(jac)
+    Ok((jac, w))
 }
 
 /// dqdd/dq, dqdd/dqd, dqdd/dtau of forward dynamics at (q, qd) with efforts `tau` held
@@ -117,10 +137,24 @@ pub fn forward_derivatives(
     tau: &[f64],
     ws: &mut Workspace,
 ) -> Result<(Vec<f64>, Jacobians), Error> {
+    let (qdd, jac, _) = motion_derivatives(mech, q, qd, tau, ws)?;
+    Ok((qdd, jac))
+}
+
+/// [`forward_derivatives`] and the derivatives of the power of the non-conservative forces
+/// P = tau . qd + P_loads(x, xd): what the equations of motion with their work need.
+pub fn motion_derivatives(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    ws: &mut Workspace,
+) -> Result<(Vec<f64>, Jacobians, PowerRates), Error> {
     ws.chart = Chart::Inputs;
     forward(mech, 0.0, q, qd, &mut FixedDrives(tau), ws)?;
     let qdd = ws.qdd.clone();
-    let mut jac = inverse_derivatives(mech, q, qd, &qdd, ws)?;
+    let (mut jac, w) = inverse_derivatives_with(mech, q, qd, &qdd, ws)?;
+    let power = power_rates(mech, ws, &w, qd, tau);
     let m = q.len();
     factor_mass_matrix(ws)?;
     solve_columns(&ws.a, m, &mut jac.dq, -1.0);
@@ -128,7 +162,23 @@ pub fn forward_derivatives(
     jac.dthird.fill(0.0);
     jac.dthird.iter_mut().step_by(m + 1).for_each(|v| *v = 1.0);
     solve_columns(&ws.a, m, &mut jac.dthird, 1.0);
-    Ok((qdd, jac))
+    Ok((qdd, jac, power))
+}
+
+/// dP/dq_k = P_x u_k + P_xd v_k and dP/dqd_k = tau_k + P_xd u_k (in the input chart
+/// tau . D_x xd = tau . qd), from the analysed `ws` and the acceleration analogues w.
+fn power_rates(mech: &Mechanism, ws: &Workspace, w: &[f64], qd: &[f64], tau: &[f64]) -> PowerRates {
+    let (n, m) = (ws.x.len(), qd.len());
+    let mut rs = RateScratch::new(mech);
+    let mut v = vec![0.0; n];
+    let mut power = PowerRates { dq: vec![0.0; m], dqd: vec![0.0; m] };
+    for (k, tau_k) in tau.iter().enumerate() {
+        let uk = ws.u_col(k);
+        contract(w, k, qd, &mut v);
+        power.dq[k] = load_power_dx(mech, &ws.x, &ws.xd, uk) + load_power_dxd(mech, &ws.x, &ws.xd, &v, &mut rs);
+        power.dqd[k] = tau_k + load_power_dxd(mech, &ws.x, &ws.xd, uk, &mut rs);
+    }
+    power
 }
 
 /// X <- sign A^-1 X for the m x m row-major X, A given by its Cholesky factor.

@@ -41,14 +41,23 @@ fn point_velocity_rate(at: &Attachment, x: &[f64], xd: &[f64], t: &[f64]) -> [f6
     [k * p[0], k * p[1]]
 }
 
-/// Add d/dx of a spring-damper's end forces along t.
-#[allow(clippy::too_many_arguments)]
-fn spring_rate(ends: &[Attachment; 2], k: f64, c: f64, rest: f64, x: &[f64], xd: &[f64], t: &[f64], df: &mut [f64]) {
+/// A spring-damper's geometry at (x, xd) and its derivatives along t at fixed xd: length,
+/// unit vector from end 0 to end 1, rate of extension.
+struct SpringRates {
+    len: f64,
+    e: [f64; 2],
+    dlen: f64,
+    de: [f64; 2],
+    rate: f64,
+    drate: f64,
+}
+
+fn spring_rates(ends: &[Attachment; 2], x: &[f64], xd: &[f64], t: &[f64]) -> Option<SpringRates> {
     let (p0, p1) = (world_point(ends[0].link, ends[0].s, x), world_point(ends[1].link, ends[1].s, x));
     let d = [p1[0] - p0[0], p1[1] - p0[1]];
     let len = d[0].hypot(d[1]);
     if len == 0.0 {
-        return; // as in `applied_forces`: no force, no change
+        return None; // as in `applied_forces`: no force, no change
     }
     let e = [d[0] / len, d[1] / len];
     let (dp0, dp1) = (point_velocity(ends[0].link, ends[0].s, x, t), point_velocity(ends[1].link, ends[1].s, x, t));
@@ -60,12 +69,44 @@ fn spring_rate(ends: &[Attachment; 2], k: f64, c: f64, rest: f64, x: &[f64], xd:
     let dv = [v1[0] - v0[0], v1[1] - v0[1]];
     let rate = e[0] * dv[0] + e[1] * dv[1];
     let drate = de[0] * dv[0] + de[1] * dv[1] + e[0] * (dv1[0] - dv0[0]) + e[1] * (dv1[1] - dv0[1]);
+    Some(SpringRates { len, e, dlen, de, rate, drate })
+}
+
+/// Add d/dx of a spring-damper's end forces along t.
+#[allow(clippy::too_many_arguments)]
+fn spring_rate(ends: &[Attachment; 2], k: f64, c: f64, rest: f64, x: &[f64], xd: &[f64], t: &[f64], df: &mut [f64]) {
+    let Some(SpringRates { len, e, dlen, de, rate, drate }) = spring_rates(ends, x, xd, t) else { return };
     let tension = k * (len - rest) + c * rate;
     let dtension = k * dlen + c * drate;
     let force = [tension * e[0], tension * e[1]];
     let dforce = [dtension * e[0] + tension * de[0], dtension * e[1] + tension * de[1]];
     add_point_force_rate(&ends[0], force, dforce, x, t, df);
     add_point_force_rate(&ends[1], force.map(|v| -v), dforce.map(|v| -v), x, t, df);
+}
+
+/// d/dx . t at fixed xd of the power of the loads (point forces, torques, dampers; drives
+/// left out), the value `applied_forces` returns.
+pub fn load_power_dx(mech: &Mechanism, x: &[f64], xd: &[f64], t: &[f64]) -> f64 {
+    let mut dp = 0.0;
+    for load in &mech.loads {
+        match load {
+            Load::Force { at, value } => {
+                let dv = point_velocity_rate(at, x, xd, t);
+                dp += value[0] * dv[0] + value[1] * dv[1];
+            }
+            Load::Torque { .. } => {}
+            Load::Spring { ends, damping, .. } => {
+                if let Some(s) = spring_rates(ends, x, xd, t) {
+                    dp -= 2.0 * damping * s.rate * s.drate;
+                }
+            }
+            Load::PairSpring { pair, damping, .. } => {
+                let p = &mech.pairs[pair.0];
+                dp -= 2.0 * damping * pair_coordinate_rate(p, x, xd) * pair_coordinate_gamma(p, x, xd, t);
+            }
+        }
+    }
+    dp
 }
 
 /// Add d/dx of an effort on a pair's relative coordinate, f = effort grad(x), along t:
@@ -130,18 +171,26 @@ pub fn applied_forces_dx(
     }
 }
 
-/// Buffers for [`applied_forces_dxd`]: zero rates (3n) and efforts (m), and two of 3n.
+/// Buffers for [`applied_forces_dxd`] and [`load_power_dxd`]: zero rates (3n) and efforts
+/// (m), and three of 3n.
 pub struct RateScratch {
     zeros: Vec<f64>,
     tau0: Vec<f64>,
     base: Vec<f64>,
     tmp: Vec<f64>,
+    shifted: Vec<f64>,
 }
 
 impl RateScratch {
     pub fn new(mech: &Mechanism) -> Self {
         let (n, m) = (mech.n_x(), mech.dof());
-        RateScratch { zeros: vec![0.0; n], tau0: vec![0.0; m], base: vec![0.0; n], tmp: vec![0.0; n] }
+        RateScratch {
+            zeros: vec![0.0; n],
+            tau0: vec![0.0; m],
+            base: vec![0.0; n],
+            tmp: vec![0.0; n],
+            shifted: vec![0.0; n],
+        }
     }
 }
 
@@ -151,4 +200,14 @@ pub fn applied_forces_dxd(mech: &Mechanism, x: &[f64], v: &[f64], df: &mut [f64]
     applied_forces(mech, x, v, &s.tau0, df, &mut s.tmp);
     applied_forces(mech, x, &s.zeros, &s.tau0, &mut s.base, &mut s.tmp);
     df.iter_mut().zip(&s.base).for_each(|(d, b)| *d -= b);
+}
+
+/// d/dxd . v of the power of the loads at (x, xd): a central difference, exact because the
+/// power is quadratic in xd (dampers) or linear (forces, torques).
+pub fn load_power_dxd(mech: &Mechanism, x: &[f64], xd: &[f64], v: &[f64], s: &mut RateScratch) -> f64 {
+    let power = |sign: f64, s: &mut RateScratch| {
+        s.shifted.iter_mut().zip(xd.iter().zip(v)).for_each(|(o, (a, b))| *o = a + sign * b);
+        applied_forces(mech, x, &s.shifted, &s.tau0, &mut s.base, &mut s.tmp)
+    };
+    0.5 * (power(1.0, s) - power(-1.0, s))
 }

@@ -18,7 +18,7 @@ pub mod regular;
 pub mod task;
 
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
-pub use derivatives::{forward_derivatives, inverse_derivatives, Jacobians};
+pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivatives, Jacobians, PowerRates};
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};

@@ -3,6 +3,7 @@
 //! computed so far with a status saying why it stopped.
 
 pub mod charts;
+mod jacobian;
 pub mod ode;
 mod overrides;
 pub mod trajectory;
