@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism
 from ..result import SimulationResult
+from ..robot import EndEffector
 
 FloatArray = NDArray[np.float64]
 
@@ -176,7 +177,7 @@ def time_optimal(
     waypoints : (K, m) array_like
         Coordinates (rad or m) the path passes through, K >= 2, joined by a C2 cubic spline
         in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, 1]. For
-        a task-space path, solve the waypoints by :meth:`planardyn.robot.EndEffector.inverse`.
+        a task-space path, :func:`task_waypoints`.
     effort : (m,) or (m, 2) array_like, or callable ``f(q) -> (lo, hi)``, or None
         Effort limits (N m or N): symmetric magnitudes, [lo, hi] per coordinate, or a function
         of the coordinates (see :data:`EffortLimit`); None: none (then ``speed`` is needed).
@@ -257,3 +258,27 @@ def _solve(instance: Any) -> tuple[Any, Any, Any, str]:
     sdd, sd, v, data = instance.compute_parameterization(0.0, 0.0, return_data=True)
     status = str(getattr(instance.problem_data, "return_code", "unknown"))
     return sdd, sd, v, status
+
+
+def task_waypoints(effector: EndEffector, X: ArrayLike, spacing: float) -> FloatArray:
+    """Coordinates (K, m) along a task-space polyline, for :func:`time_optimal`.
+
+    Each segment between the rows of ``X`` ((J, k) task coordinates: m, m[, rad]) is cut into
+    pieces no longer than ``spacing`` (m) and solved by inverse kinematics, continued from
+    the drawing through the first point (on the drawing's working mode). The joint-space
+    spline through them leaves the task path by O(spacing^4) between them: check with
+    ``effector.state(q).X`` along the plan's ``q``.
+    """
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    if len(X) < 2 or spacing <= 0:
+        raise PlanError(f"task path: need >= 2 points and a positive spacing, got {len(X)} points, {spacing}")
+    points = [X[0]]
+    for a, b in zip(X[:-1], X[1:]):
+        n = max(1, int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / spacing)))
+        points.extend(a + (b - a) * f for f in np.linspace(0.0, 1.0, n + 1)[1:])
+    state = effector.inverse(points[0])
+    q = [state.q]
+    for Xi in points[1:]:
+        state = effector.solve(Xi, state.q, state.kin["x"])
+        q.append(state.q)
+    return np.array(q)
