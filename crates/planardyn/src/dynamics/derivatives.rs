@@ -10,9 +10,9 @@
 //! A qdd = tau + U^T (f - M c) has the same residual, so at qdd = FD(q, qd, tau):
 //! dqdd/dtau = A^-1, dqdd/dq = -A^-1 dtau/dq, dqdd/dqd = -A^-1 dtau/dqd.
 
-use super::along::FixedDrives;
 use super::force_rates::{applied_forces_dx, applied_forces_dxd, load_power_dx, load_power_dxd, RateScratch};
-use super::forward::{body_accelerations, factor_mass_matrix, forward};
+use super::forces::applied_forces;
+use super::forward::{bias, body_accelerations, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::inverse::inverse;
 use crate::kinematics::third::convective_derivative;
 use crate::kinematics::{acceleration_analogues, Chart};
@@ -74,22 +74,28 @@ pub fn inverse_derivatives(
     qdd: &[f64],
     ws: &mut Workspace,
 ) -> Result<Jacobians, KinematicsError> {
-    Ok(inverse_derivatives_with(mech, q, qd, qdd, ws)?.0)
+    inverse(mech, q, qd, qdd, ws)?;
+    let w = acceleration_analogues(mech, ws);
+    let mut rs = RateScratch::at(mech, &ws.x);
+    let jac = effort_jacobians(mech, qd, qdd, &w, ws, &mut rs);
+    super::finite("effort derivatives", &jac.dq)?;
+    super::finite("effort derivatives", &jac.dqd)?;
+    Ok(jac)
 }
 
-/// [`inverse_derivatives`] and the acceleration analogues w it computed.
-fn inverse_derivatives_with(
+/// The Jacobians of the efforts from `ws` analysed in the input chart at (q, qd) (x, U, xd,
+/// c, A unfactored, f without drives), with the acceleration analogues w.
+fn effort_jacobians(
     mech: &Mechanism,
-    q: &[f64],
     qd: &[f64],
     qdd: &[f64],
+    w: &[f64],
     ws: &mut Workspace,
-) -> Result<(Jacobians, Vec<f64>), KinematicsError> {
-    inverse(mech, q, qd, qdd, ws)?;
-    let (n, m) = (ws.x.len(), q.len());
-    let w = acceleration_analogues(mech, ws);
+    rs: &mut RateScratch,
+) -> Jacobians {
+    let (n, m) = (ws.x.len(), qd.len());
     body_accelerations(&ws.u, &ws.c, qdd, &mut ws.xdd);
-    // r = M xdd - f, stored as the 3n vector M xdd - f.
+    // r = M xdd - f.
     let mut r = vec![0.0; n];
     for (i, body) in mech.bodies.iter().enumerate() {
         let mi = [body.mass, body.mass, body.inertia];
@@ -98,34 +104,36 @@ fn inverse_derivatives_with(
         }
     }
     let tau0 = vec![0.0; m];
-    let mut rs = RateScratch::new(mech);
-    let (mut v, mut a_k, mut dc, mut dfx, mut dfv, mut scratch) =
-        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut buf = vec![0.0; 7 * n];
+    let (uk, rest) = buf.split_at_mut(n);
+    let (v, rest) = rest.split_at_mut(n);
+    let (a_k, rest) = rest.split_at_mut(n);
+    let (dc, rest) = rest.split_at_mut(n);
+    let (dfx, rest) = rest.split_at_mut(n);
+    let (dfv, scratch) = rest.split_at_mut(n);
     let mut jac = Jacobians { dq: vec![0.0; m * m], dqd: vec![0.0; m * m], dthird: ws.a.clone() };
     for k in 0..m {
-        let uk = ws.u_col(k).to_vec();
+        uk.copy_from_slice(ws.u_col(k));
         // Rates: dxdd/dqd_k = 2 v_k, and f changes by df/dxd u_k.
-        contract(&w, k, qd, &mut v);
-        applied_forces_dxd(mech, &ws.x, &uk, &mut dfv, &mut rs);
+        contract(w, k, qd, v);
+        applied_forces_dxd(mech, &ws.x, uk, dfv, rs);
         for i in 0..m {
             let ui = ws.u_col(i);
-            jac.dqd[i * m + k] = 2.0 * m_dot(mech, ui, &v) - dot(ui, &dfv);
+            jac.dqd[i * m + k] = 2.0 * m_dot(mech, ui, v) - dot(ui, dfv);
         }
         // Coordinates: dxdd/dq_k = sum_l w_kl qdd_l + dc/dq_k.
-        convective_derivative(mech, ws, &uk, &v, &mut dc, &mut scratch);
-        contract(&w, k, qdd, &mut a_k);
-        a_k.iter_mut().zip(&dc).for_each(|(a, d)| *a += d);
-        applied_forces_dx(mech, &ws.x, &ws.xd, &tau0, &uk, &mut dfx, &mut scratch);
-        applied_forces_dxd(mech, &ws.x, &v, &mut dfv, &mut rs);
+        convective_derivative(mech, ws, uk, v, dc, scratch);
+        contract(w, k, qdd, a_k);
+        a_k.iter_mut().zip(dc.iter()).for_each(|(a, d)| *a += d);
+        applied_forces_dx(mech, &ws.x, &ws.xd, &tau0, uk, dfx, scratch);
+        applied_forces_dxd(mech, &ws.x, v, dfv, rs);
         for j in 0..m {
             let wjk = &w[(j * m + k) * n..(j * m + k + 1) * n];
             let uj = ws.u_col(j);
-            jac.dq[j * m + k] = dot(wjk, &r) + m_dot(mech, uj, &a_k) - dot(uj, &dfx) - dot(uj, &dfv);
+            jac.dq[j * m + k] = dot(wjk, &r) + m_dot(mech, uj, a_k) - dot(uj, dfx) - dot(uj, dfv);
         }
     }
-    super::finite("effort derivatives", &jac.dq)?;
-    super::finite("effort derivatives", &jac.dqd)?;
-    Ok((jac, w))
+    jac
 }
 
 /// dqdd/dq, dqdd/dqd, dqdd/dtau of forward dynamics at (q, qd) with efforts `tau` held
@@ -142,7 +150,8 @@ pub fn forward_derivatives(
 }
 
 /// [`forward_derivatives`] and the derivatives of the power of the non-conservative forces
-/// P = tau . qd + P_loads(x, xd): what the equations of motion with their work need.
+/// P = tau . qd + P_loads(x, xd): what the equations of motion with their work need. One
+/// position solve: qdd = A^-1 (tau + b) with b of the forces without drives (input chart).
 pub fn motion_derivatives(
     mech: &Mechanism,
     q: &[f64],
@@ -151,32 +160,53 @@ pub fn motion_derivatives(
     ws: &mut Workspace,
 ) -> Result<(Vec<f64>, Jacobians, PowerRates), Error> {
     ws.chart = Chart::Inputs;
-    forward(mech, 0.0, q, qd, &mut FixedDrives(tau), ws)?;
-    let qdd = ws.qdd.clone();
-    let (mut jac, w) = inverse_derivatives_with(mech, q, qd, &qdd, ws)?;
-    let power = power_rates(mech, ws, &w, qd, tau);
-    let m = q.len();
+    kinematic_stages(mech, q, qd, ws)?;
+    ws.tau.fill(0.0);
+    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    mass_matrix(mech, ws);
+    bias(mech, ws);
+    let a = ws.a.clone();
     factor_mass_matrix(ws)?;
-    solve_columns(&ws.a, m, &mut jac.dq, -1.0);
-    solve_columns(&ws.a, m, &mut jac.dqd, -1.0);
+    let m = q.len();
+    let mut qdd: Vec<f64> = tau.iter().zip(&ws.b).map(|(t, b)| t + b).collect();
+    cholesky_solve(&ws.a, m, &mut qdd);
+    super::finite("accelerations qdd", &qdd)?;
+    let factor = std::mem::replace(&mut ws.a, a);
+    ws.tau.copy_from_slice(tau);
+    ws.qdd.copy_from_slice(&qdd);
+    let w = acceleration_analogues(mech, ws);
+    let mut rs = RateScratch::at(mech, &ws.x);
+    let mut jac = effort_jacobians(mech, qd, &qdd, &w, ws, &mut rs);
+    let power = power_rates(mech, ws, &w, qd, tau, &mut rs);
+    solve_columns(&factor, m, &mut jac.dq, -1.0);
+    solve_columns(&factor, m, &mut jac.dqd, -1.0);
     jac.dthird.fill(0.0);
     jac.dthird.iter_mut().step_by(m + 1).for_each(|v| *v = 1.0);
-    solve_columns(&ws.a, m, &mut jac.dthird, 1.0);
+    solve_columns(&factor, m, &mut jac.dthird, 1.0);
+    super::finite("acceleration derivatives", &jac.dq)?;
+    super::finite("acceleration derivatives", &jac.dqd)?;
+    ws.a = factor;
     Ok((qdd, jac, power))
 }
 
 /// dP/dq_k = P_x u_k + P_xd v_k and dP/dqd_k = tau_k + P_xd u_k (in the input chart
 /// tau . D_x xd = tau . qd), from the analysed `ws` and the acceleration analogues w.
-fn power_rates(mech: &Mechanism, ws: &Workspace, w: &[f64], qd: &[f64], tau: &[f64]) -> PowerRates {
+fn power_rates(
+    mech: &Mechanism,
+    ws: &Workspace,
+    w: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    rs: &mut RateScratch,
+) -> PowerRates {
     let (n, m) = (ws.x.len(), qd.len());
-    let mut rs = RateScratch::new(mech);
     let mut v = vec![0.0; n];
     let mut power = PowerRates { dq: vec![0.0; m], dqd: vec![0.0; m] };
     for (k, tau_k) in tau.iter().enumerate() {
         let uk = ws.u_col(k);
         contract(w, k, qd, &mut v);
-        power.dq[k] = load_power_dx(mech, &ws.x, &ws.xd, uk) + load_power_dxd(mech, &ws.x, &ws.xd, &v, &mut rs);
-        power.dqd[k] = tau_k + load_power_dxd(mech, &ws.x, &ws.xd, uk, &mut rs);
+        power.dq[k] = load_power_dx(mech, &ws.x, &ws.xd, uk) + load_power_dxd(mech, &ws.x, &ws.xd, &v, rs);
+        power.dqd[k] = tau_k + load_power_dxd(mech, &ws.x, &ws.xd, uk, rs);
     }
     power
 }
