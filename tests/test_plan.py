@@ -96,3 +96,20 @@ def test_dampers_and_bad_limits_are_refused(robot) -> None:
         time_optimal(robot, [q0, q0 + 0.1], effort=[1.0, 2.0, 3.0])
     with pytest.raises(PlanError, match="no timing"):
         time_optimal(robot, [q0, q0 + 0.1], effort=[1e-3, 1e-3])
+
+
+def test_cli_writes_a_motion_table_inverse_dynamics_reads(tmp_path) -> None:
+    # Exit 0 and a table whose efforts inverse dynamics reproduces (the same computation);
+    # exit 1 when no timing exists (0.1 N m cannot hold the robot up against gravity).
+    from planardyn.cli import main
+    from planardyn.results_io import read_motion
+
+    out = tmp_path / "timed.csv"
+    line = ["--line", "-0.08", "0.28", "0.08", "0.36"]
+    assert main(["plan", str(FIVE_BAR), *line, "--effort", "3", "3", "--grid", "60", "-o", str(out)]) == 0
+    robot = planardyn.load(FIVE_BAR)
+    table = read_motion(out, robot.coordinate_names)
+    tau = robot.inverse_dynamics(table["q"], table["qd"], table["qdd"])
+    assert np.abs(tau - table["tau"]).max() < 1e-9
+    assert np.abs(table["tau"]).max() == pytest.approx(3.0, rel=1e-6)
+    assert main(["plan", str(FIVE_BAR), *line, "--effort", "0.1", "0.1"]) == 1

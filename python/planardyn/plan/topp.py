@@ -256,7 +256,8 @@ def time_optimal(
 
 def _solve(instance: Any) -> tuple[Any, Any, Any, str]:
     sdd, sd, v, data = instance.compute_parameterization(0.0, 0.0, return_data=True)
-    status = str(getattr(instance.problem_data, "return_code", "unknown"))
+    code = getattr(instance.problem_data, "return_code", "unknown")
+    status = str(getattr(code, "value", code))
     return sdd, sd, v, status
 
 
