@@ -145,7 +145,7 @@ pub fn forward_derivatives(
     tau: &[f64],
     ws: &mut Workspace,
 ) -> Result<(Vec<f64>, Jacobians), Error> {
-    let (qdd, jac, _) = motion_derivatives(mech, q, qd, tau, ws)?;
+    let (qdd, jac, _) = accelerations_and_jacobians(mech, q, qd, tau, ws)?;
     Ok((qdd, jac))
 }
 
@@ -159,6 +159,19 @@ pub fn motion_derivatives(
     tau: &[f64],
     ws: &mut Workspace,
 ) -> Result<(Vec<f64>, Jacobians, PowerRates), Error> {
+    let (qdd, jac, w) = accelerations_and_jacobians(mech, q, qd, tau, ws)?;
+    let power = power_rates(mech, ws, &w, qd, tau, &mut RateScratch::at(mech, &ws.x));
+    Ok((qdd, jac, power))
+}
+
+/// qdd and its Jacobians, with the acceleration analogues w; `ws` left analysed at (q, qd).
+fn accelerations_and_jacobians(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    ws: &mut Workspace,
+) -> Result<(Vec<f64>, Jacobians, Vec<f64>), Error> {
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
     ws.tau.fill(0.0);
@@ -177,7 +190,6 @@ pub fn motion_derivatives(
     let w = acceleration_analogues(mech, ws);
     let mut rs = RateScratch::at(mech, &ws.x);
     let mut jac = effort_jacobians(mech, qd, &qdd, &w, ws, &mut rs);
-    let power = power_rates(mech, ws, &w, qd, tau, &mut rs);
     solve_columns(&factor, m, &mut jac.dq, -1.0);
     solve_columns(&factor, m, &mut jac.dqd, -1.0);
     jac.dthird.fill(0.0);
@@ -186,7 +198,7 @@ pub fn motion_derivatives(
     super::finite("acceleration derivatives", &jac.dq)?;
     super::finite("acceleration derivatives", &jac.dqd)?;
     ws.a = factor;
-    Ok((qdd, jac, power))
+    Ok((qdd, jac, w))
 }
 
 /// dP/dq_k = P_x u_k + P_xd v_k and dP/dqd_k = tau_k + P_xd u_k (in the input chart
