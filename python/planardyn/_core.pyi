@@ -145,6 +145,17 @@ class Mechanism:
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
+    def forward_dynamics_derivatives(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    def inverse_dynamics_derivatives(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, allow_singular: bool = False
+    ) -> dict[str, NDArray[np.float64]]: ...
     def inverse_dynamics(
         self,
         q: ArrayLike,

@@ -8,6 +8,7 @@
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
+    planardyn plan MODEL --line X0 Y0 X1 Y1 --effort T [T ...] [--speed V ...] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn --version
 
@@ -586,6 +587,11 @@ def _main(argv: list[str]) -> int:
             from .robot import size_cli
 
             return size_cli(argv[1:])
+        if argv[:1] == ["plan"]:
+            # Time-optimal timing has its own parser in planardyn.plan (planardyn plan --help).
+            from .plan.cli import plan_cli
+
+            return plan_cli(argv[1:])
         args = _parser().parse_args(argv)
         if getattr(args, "model", None) is not None:
             args.model = models.resolve(args.model)

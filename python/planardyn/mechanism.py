@@ -395,6 +395,60 @@ class Mechanism:
         ``tau . qd`` exceeds the frictionless one by exactly this."""
         return self._native.dissipated_power(q, qd, qdd, x, allow_singular)
 
+    def forward_dynamics_derivatives(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> dict[str, FloatArray]:
+        """Exact first derivatives of forward dynamics (docs/formulation.md, *Derivatives*).
+
+        Parameters
+        ----------
+        q, qd, t, tau
+            As for :meth:`forward_dynamics`; the efforts are held fixed (a drive that depends
+            on q or qd is differentiated as its value at this state).
+
+        Returns
+        -------
+        dict
+            ``qdd`` (m,) and the (m, m) Jacobians ``dq``, ``dqd``, ``dtau`` with entry
+            [i, k] = d qdd_i / d q_k (1/s^2), d qdd_i / d qd_k (1/s), d qdd_i / d tau_k
+            (the inverse mass matrix).
+
+        Raises
+        ------
+        SingularityError
+            As for :meth:`mass_matrix`.
+        """
+        return self._native.forward_dynamics_derivatives(q, qd, t, tau, allow_singular)
+
+    def inverse_dynamics_derivatives(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, allow_singular: bool = False
+    ) -> dict[str, FloatArray]:
+        """Exact first derivatives of inverse dynamics (docs/formulation.md, *Derivatives*).
+
+        Parameters
+        ----------
+        q, qd, qdd : (m,) array_like
+            Coordinates (rad or m), rates and accelerations, on the branch continued from
+            the drawing.
+
+        Returns
+        -------
+        dict
+            ``tau`` (m,) as :meth:`inverse_dynamics` gives it and the (m, m) Jacobians
+            ``dq``, ``dqd``, ``dqdd`` (the mass matrix A), entry [i, k] = d tau_i / d (.)_k.
+
+        Raises
+        ------
+        SingularityError
+            As for :meth:`mass_matrix`.
+        """
+        return self._native.inverse_dynamics_derivatives(q, qd, qdd, allow_singular)
+
     def reactions(
         self,
         q: ArrayLike | SimulationResult,

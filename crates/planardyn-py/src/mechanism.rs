@@ -13,7 +13,7 @@ use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::{CoordinateKind, Link, PairId};
-use planardyn::{Mechanism, Workspace};
+use planardyn::{Error, Mechanism, Workspace};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -144,6 +144,23 @@ impl PyMechanism {
         dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
         dynamics::finite("accelerations qdd", &ws.qdd)?;
         Ok(ws)
+    }
+    /// A dict of the named value and the three Jacobians, the third under `third`.
+    fn jacobians<'py>(
+        &self,
+        py: Python<'py>,
+        value: [(&str, Vec<f64>); 1],
+        jac: dynamics::Jacobians,
+        third: &str,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let m = self.m();
+        let d = PyDict::new(py);
+        let [(name, v)] = value;
+        d.set_item(name, arr1(py, v))?;
+        d.set_item("dq", arr2(py, m, m, jac.dq)?)?;
+        d.set_item("dqd", arr2(py, m, m, jac.dqd)?)?;
+        d.set_item(third, arr2(py, m, m, jac.dthird)?)?;
+        Ok(d)
     }
 }
 
@@ -456,6 +473,56 @@ impl PyMechanism {
         check_time(t)?;
         let ws = run(py, || self.forward_ws(&q, &qd, t, tau, allow_singular))?;
         Ok(arr1(py, ws.qdd))
+    }
+
+    /// Exact first derivatives of forward dynamics at (q, qd), time t (s), with efforts tau
+    /// (m,) or the model's drives held fixed: a dict of `qdd` (m,) and `dq`, `dqd`, `dtau`
+    /// (m, m), entry [i, k] = d qdd_i / d (q, qd, tau)_k.
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
+    fn forward_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        t: f64,
+        tau: Option<ArrayArg<'py>>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
+        check_time(t)?;
+        let mech = &*self.inner;
+        let (qdd, jac) = run(py, || {
+            let mut ws = Self::assembled(mech, &q, None)?;
+            let mut efforts = vec![0.0; q.len()];
+            self.drives_for(tau).efforts(t, &q, &qd, &mut efforts).map_err(|message| Error::Drive { t, message })?;
+            let out = dynamics::forward_derivatives(mech, &q, &qd, &efforts, &mut ws)?;
+            dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
+            Ok(out)
+        })?;
+        self.jacobians(py, [("qdd", qdd)], jac, "dtau")
+    }
+
+    /// Exact first derivatives of inverse dynamics at (q, qd, qdd), each (m,): a dict of
+    /// `tau` (m,) and `dq`, `dqd`, `dqdd` (m, m), entry [i, k] = d tau_i / d (q, qd, qdd)_k.
+    #[pyo3(signature = (q, qd, qdd, allow_singular=false))]
+    fn inverse_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd, qdd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?, self.q_arg("qdd", &qdd)?);
+        let mech = &*self.inner;
+        let (tau, jac) = run(py, || {
+            let mut ws = Self::assembled(mech, &q, None)?;
+            let jac = dynamics::inverse_derivatives(mech, &q, &qd, &qdd, &mut ws)?;
+            dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
+            Ok((ws.tau, jac))
+        })?;
+        self.jacobians(py, [("tau", tau)], jac, "dqdd")
     }
 
     /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body

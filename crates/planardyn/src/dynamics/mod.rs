@@ -4,7 +4,9 @@
 //! run in a [`crate::Workspace`].
 
 pub mod along;
+pub mod derivatives;
 pub mod energy;
+pub mod force_rates;
 pub mod forces;
 pub mod forward;
 pub mod friction;
@@ -20,6 +22,7 @@ pub mod task;
 pub mod transmission;
 
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
+pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivatives, Jacobians, PowerRates};
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{forward, mass_matrix};

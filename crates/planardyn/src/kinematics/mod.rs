@@ -9,6 +9,7 @@ pub mod pairs;
 pub mod position;
 pub mod singularity;
 pub mod system;
+pub mod third;
 
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
 pub use constraints::{coordinate_rates, coordinates, Chart};

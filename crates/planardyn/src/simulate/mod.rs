@@ -5,6 +5,7 @@
 pub mod charts;
 pub mod dense;
 pub mod events;
+mod jacobian;
 pub mod ode;
 mod overrides;
 pub mod trajectory;
