@@ -5,6 +5,7 @@
 pub mod analogues;
 pub mod constraints;
 pub mod effector;
+pub mod group_sigma;
 pub mod pairs;
 pub mod position;
 pub mod singularity;

@@ -2,8 +2,10 @@
 //! (docs/formulation.md, *Singularities* and *Charts*).
 //!
 //! Both measures are singular values of the scaled (dimensionless, see `system.rs`) Jacobian:
-//! - type II (parallel): the smallest singular value of J = [Phi_x; D_x] with the inputs
-//!   fixed. It is 0 where the actuated mechanism gains an uncontrolled motion.
+//! - type II (parallel): the smallest singular value of the blocks of J = [Phi_x; D_x] with the
+//!   inputs fixed (its input links and Assur groups), each at its own length (`group_sigma`).
+//!   It is 0 where the actuated mechanism gains an uncontrolled motion, and means the same
+//!   whatever the size of the mechanism around the group.
 //! - passive: the smallest singular value of Phi_x alone (its independent rows x 3n). It is 0 where the
 //!   mechanism without its drives changes mobility (a folded four-bar, a change point).
 //!
@@ -12,7 +14,7 @@
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
 use super::constraints::{body_trig, Chart};
-use super::system::{col_scales, scaled_jacobian};
+use super::system::{col_scales, scaled_jacobian, System};
 use crate::linalg::pivot_columns;
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
@@ -37,13 +39,15 @@ fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     j
 }
 
-/// Smallest singular value of the scaled J of a chart at x (type II measure for `Inputs`).
+/// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
+/// length (type II measure for `Inputs`; `group_sigma`). Cost linear in the bodies.
 pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
-    let n = x.len();
-    if n == 0 {
+    if x.is_empty() {
         return f64::INFINITY;
     }
-    singular_values(n, n, &scaled(mech, chart, x))[0]
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    System::new(mech).group_sigma_exact(mech, chart, x, &trig)
 }
 
 /// Smallest singular value of the scaled pair-constraint Jacobian Phi_x, its independent

@@ -15,7 +15,7 @@
 //! that cost more than the whole factorisation at these sizes (n = 9 to ~60, microseconds);
 //! the graph algorithms come from petgraph.
 
-use super::lu::{lu_factor, lu_solve_transpose, LuError};
+use super::lu::{lu_factor, lu_solve, lu_solve_transpose, LuError};
 use super::sink::Sink;
 use petgraph::algo::{maximum_matching, tarjan_scc};
 use petgraph::graph::{DiGraph, NodeIndex, UnGraph};
@@ -159,6 +159,42 @@ impl BlockLu {
             cols.sort_unstable();
             (rows, cols)
         })
+    }
+
+    /// Number of diagonal blocks.
+    pub fn n_blocks(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Permuted positions of block k: its local row (and column) i is position `span(k).start + i`.
+    pub fn span(&self, k: usize) -> std::ops::Range<usize> {
+        self.start[k]..self.start[k + 1]
+    }
+
+    /// Original row and column of each permuted position.
+    pub fn position_rows(&self) -> &[usize] {
+        &self.row
+    }
+    pub fn position_cols(&self) -> &[usize] {
+        &self.col
+    }
+
+    /// Block k, row-major in its local order: the filled matrix B between [`BlockLu::sink`]
+    /// and [`BlockLu::factor`], its factors after.
+    pub fn block(&self, k: usize) -> &[f64] {
+        let s = self.start[k + 1] - self.start[k];
+        &self.store[self.lu_at[k]..self.lu_at[k] + s * s]
+    }
+
+    /// Solve B_k y = b in place with the factors of block k alone (b in its local row order,
+    /// y in its local column order).
+    pub fn block_solve(&self, k: usize, b: &mut [f64]) {
+        lu_solve(self.block(k), b.len(), &self.piv[self.span(k)], b)
+    }
+
+    /// Solve B_k^T y = b in place with the factors of block k alone.
+    pub fn block_solve_transpose(&self, k: usize, b: &mut [f64]) {
+        lu_solve_transpose(self.block(k), b.len(), &self.piv[self.span(k)], b)
     }
 
     /// Start filling the matrix B = diag(rs) A diag(cs) to factorise: every entry is zeroed,

@@ -5,7 +5,7 @@
 //! The ground is not part of `x`; its local frame is the global frame.
 
 mod build;
-mod diameter;
+pub(crate) mod diameter;
 mod io;
 mod nesting;
 mod parse_errors;

@@ -28,8 +28,9 @@ pub struct Measures {
 
 /// Measure the point analysed in `ode.ws`. In the user's chart the type II measure comes
 /// from the factorisation already in the workspace (inverse iteration, see
-/// `System::sigma_min_estimate`); near a singularity, where a partition is in use, both
-/// measures are exact singular values (an SVD, at a few steps only).
+/// `System::sigma_min_estimate`); near a singularity, where a partition is in use, it is exact
+/// (an SVD of each block of the user's chart, linear in the bodies), and the passive measure
+/// an SVD of the whole Phi_x (at the few steps near a type II singularity only).
 pub fn measure(ode: &mut MechanismOde) -> Measures {
     let estimate = match ode.ws.chart {
         Chart::Inputs => ode.ws.sys.sigma_min_estimate(),
@@ -40,13 +41,15 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
     Measures { sigma, passive }
 }
 
-/// Smallest scaled singular value of the current chart's J at the point in `ode.ws`, given
-/// the type II measure `sigma` there (which it is in the user's chart; a partition costs an
-/// SVD, taken at the few steps integrated in one).
-pub fn chart_sigma(ode: &MechanismOde, sigma: f64) -> f64 {
+/// The measure of the current chart's J at the point in `ode.ws` (smallest singular value of
+/// its blocks at their own lengths), given the type II measure `sigma` there (which it is in
+/// the user's chart; in a partition it is estimated from the factorisation in the workspace).
+pub fn chart_sigma(ode: &mut MechanismOde, sigma: f64) -> f64 {
     match &ode.ws.chart {
         Chart::Inputs => sigma,
-        Chart::Partition(_) => sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x),
+        Chart::Partition(_) => {
+            ode.ws.sys.sigma_min_estimate().unwrap_or_else(|| sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x))
+        }
     }
 }
 

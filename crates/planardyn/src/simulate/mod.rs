@@ -146,7 +146,7 @@ fn start<'a>(
     let mut y = vec![0.0; 2 * m + 1];
     state_in(&ode, &chart, 0.0, &mut y);
     ode.set_chart(chart, s.t0, &y)?;
-    let own = chart_sigma(&ode, m0.sigma);
+    let own = chart_sigma(&mut ode, m0.sigma);
     ode.limit_correction(own);
     Ok((ode, y))
 }
@@ -314,7 +314,7 @@ pub fn simulate(
             keep_last = true;
             break;
         }
-        let mut own = chart_sigma(&ode, meas.sigma);
+        let mut own = chart_sigma(&mut ode, meas.sigma);
         if let Some(chart) = next_chart(&ode, &meas, own) {
             state_in(&ode, &chart, y[2 * m], &mut y);
             traj.stats.chart_switches += 1;
@@ -323,7 +323,7 @@ pub fn simulate(
                 (status, message) = (Status::AssemblyFailed, format!("changing coordinates at t = {t} s: {e}"));
                 break;
             }
-            own = chart_sigma(&ode, meas.sigma);
+            own = chart_sigma(&mut ode, meas.sigma);
         }
         ode.limit_correction(own);
         if let Some(cb) = progress.as_mut() {

@@ -10,8 +10,8 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
 
-/// Largest Newton correction as a fraction of the chart's smallest scaled singular value
-/// (see `MechanismOde::limit_correction`).
+/// Largest Newton correction as a fraction of the chart's type II measure (see
+/// `MechanismOde::limit_correction`); both in each group's own length (`group_sigma`).
 const BASIN_FRACTION: f64 = 0.5;
 
 /// Largest move of a solution from the converged point it was predicted from, as a multiple
@@ -166,8 +166,8 @@ impl<'a> MechanismOde<'a> {
         self.last_t = f64::NAN;
         self.base_valid = false;
         let mut outcome = forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws);
-        let correction = scaled_distance(&self.ws.x, &self.predicted, &self.ws.sys.col_scale);
-        let moved = scaled_distance(&self.ws.x, &self.base, &self.ws.sys.col_scale);
+        let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
+        let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
         if outcome.is_ok() && moved > self.max_move {
             outcome = Err(KinematicsError::AssemblyFailed { residual: moved, iterations: self.ws.iterations }.into());
         }
