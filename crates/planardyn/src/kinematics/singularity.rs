@@ -6,8 +6,9 @@
 //!   inputs fixed (its input links and Assur groups), each at its own length (`group_sigma`).
 //!   It is 0 where the actuated mechanism gains an uncontrolled motion, and means the same
 //!   whatever the size of the mechanism around the group.
-//! - passive: the smallest singular value of Phi_x alone (its independent rows x 3n). It is 0 where the
-//!   mechanism without its drives changes mobility (a folded four-bar, a change point).
+//! - passive: the type II measure of the better of two charts, the user's coordinates and the
+//!   partition below. It is 0 where Phi_x alone (its independent rows x 3n) loses rank, i.e.
+//!   where the mechanism without its drives changes mobility (a folded four-bar, a change point).
 //!
 //! Near a type II singularity the integrator changes to m components of x chosen by Gaussian
 //! elimination with complete pivoting on Phi_x (Wehage & Haug 1982, generalized coordinate
@@ -17,18 +18,6 @@ use super::constraints::{body_trig, Chart};
 use super::system::{col_scales, scaled_jacobian, System};
 use crate::linalg::pivot_columns;
 use crate::model::Mechanism;
-use nalgebra::DMatrix;
-
-fn singular_values(rows: usize, cols: usize, data: &[f64]) -> Vec<f64> {
-    // The SVD iteration need not end on non-finite entries: such a matrix is singular.
-    if data[..rows * cols].iter().any(|v| !v.is_finite()) {
-        return vec![0.0; rows.min(cols)];
-    }
-    let mat = DMatrix::from_row_slice(rows, cols, &data[..rows * cols]);
-    let mut sv: Vec<f64> = mat.singular_values().iter().copied().collect();
-    sv.sort_by(|a, b| a.total_cmp(b));
-    sv
-}
 
 fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     let n = x.len();
@@ -50,14 +39,16 @@ pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
     System::new(mech).group_sigma_exact(mech, chart, x, &trig)
 }
 
-/// Smallest singular value of the scaled pair-constraint Jacobian Phi_x, its independent
-/// rows only (passive measure).
+/// Passive measure: the better of the type II measures of the two charts the integrator
+/// can use at x, the user's coordinates and the partition [`select_partition`] chooses. Phi_x
+/// loses rank exactly where every chart's J is singular, so it is 0 at a singularity of the
+/// passive mechanism; elsewhere it is at least the type II measure, in the same units.
 pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
-    let (n, rows) = (x.len(), mech.n_constraints);
-    if rows == 0 {
+    if mech.n_constraints == 0 {
         return f64::INFINITY;
     }
-    singular_values(rows, n, &scaled(mech, &Chart::Inputs, x))[0]
+    let inputs = sigma_min(mech, &Chart::Inputs, x);
+    inputs.max(sigma_min(mech, &Chart::Partition(select_partition(mech, x)), x))
 }
 
 /// The m best independent components of x at x: the columns of the scaled Phi_x (its
