@@ -31,12 +31,18 @@ fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
 /// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
 /// length (type II measure for `Inputs`; `group_sigma`). Cost linear in the bodies.
 pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
+    sigma_min_with(&mut System::new(mech), mech, chart, x)
+}
+
+/// [`sigma_min`] with the blocks of a `sys` kept by the caller (analysed once per chart,
+/// not at each call); its factorisation is left invalid.
+pub fn sigma_min_with(sys: &mut System, mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
     if x.is_empty() {
         return f64::INFINITY;
     }
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
-    System::new(mech).group_sigma_exact(mech, chart, x, &trig)
+    sys.group_sigma_exact(mech, chart, x, &trig)
 }
 
 /// Passive measure: the better of the type II measures of the two charts the integrator

@@ -3,7 +3,7 @@
 //! singularity, and back again once past it. Decisions are taken between accepted steps.
 
 use super::ode::MechanismOde;
-use crate::kinematics::{passive_sigma_min, select_partition, sigma_min, Chart};
+use crate::kinematics::{passive_sigma_min, select_partition, sigma_min, sigma_min_with, Chart};
 
 /// Below this scaled type II measure the integrator leaves the user's coordinates. The scaled
 /// J has O(1) entries; at 0.05 the position solve still loses under 2 digits, and a step of
@@ -36,7 +36,7 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
         Chart::Inputs => ode.ws.sys.sigma_min_estimate(),
         Chart::Partition(_) => None,
     };
-    let sigma = estimate.unwrap_or_else(|| sigma_min(ode.mech, &Chart::Inputs, &ode.ws.x));
+    let sigma = estimate.unwrap_or_else(|| sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x));
     let passive = if sigma < SWITCH_TO_PARTITION { passive_sigma_min(ode.mech, &ode.ws.x) } else { sigma };
     Measures { sigma, passive }
 }

@@ -5,7 +5,7 @@
 use crate::dynamics::{forward, Drives};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{scaled_distance, Chart, MAX_CORRECTION};
+use crate::kinematics::{scaled_distance, Chart, System, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
@@ -46,6 +46,9 @@ pub struct MechanismOde<'a> {
     max_move: f64,
     /// Evaluations that failed (Newton did not converge, or its correction was too large).
     pub failed_evaluations: usize,
+    /// The blocks of the user's chart, analysed once: the type II measure while a partition
+    /// is integrated (`charts::measure`).
+    pub inputs_sys: System,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -65,6 +68,7 @@ impl<'a> MechanismOde<'a> {
             max_correction: MAX_CORRECTION,
             max_move: f64::INFINITY,
             failed_evaluations: 0,
+            inputs_sys: System::new(mech),
             mech,
             ws,
             drives,
