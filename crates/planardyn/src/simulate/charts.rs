@@ -21,8 +21,8 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 pub struct Measures {
     /// Type II measure: smallest scaled singular value of [Phi_x; D_x].
     pub sigma: f64,
-    /// Passive measure (smallest scaled singular value of Phi_x), computed only near a type
-    /// II singularity; elsewhere `sigma` bounds it from below (interlacing).
+    /// Passive measure (`kinematics::passive_sigma_min`, with the partition in use where there
+    /// is one), computed only near a type II singularity; elsewhere `sigma` bounds it from below.
     pub passive: f64,
 }
 
@@ -37,7 +37,17 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
         Chart::Partition(_) => None,
     };
     let sigma = estimate.unwrap_or_else(|| sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x));
-    let passive = if sigma < SWITCH_TO_PARTITION { passive_sigma_min(ode.mech, &ode.ws.x) } else { sigma };
+    // Passive: the better of the user's chart and the partition in use (its factorisation is
+    // in the workspace), else the partition complete pivoting would choose.
+    let passive = if sigma >= SWITCH_TO_PARTITION {
+        sigma
+    } else {
+        let own = match ode.ws.chart {
+            Chart::Partition(_) => ode.ws.sys.sigma_min_estimate(),
+            Chart::Inputs => None,
+        };
+        own.map_or_else(|| passive_sigma_min(ode.mech, &ode.ws.x), |own| own.max(sigma))
+    };
     Measures { sigma, passive }
 }
 
@@ -62,9 +72,10 @@ pub fn next_chart(ode: &MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
         Chart::Inputs if m.sigma < SWITCH_TO_PARTITION => Some(Chart::Partition(select_partition(ode.mech, &ode.ws.x))),
         Chart::Inputs => None,
         Chart::Partition(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
+        Chart::Partition(_) if own >= SWITCH_TO_PARTITION => None,
         Chart::Partition(idx) => {
             let best = select_partition(ode.mech, &ode.ws.x);
-            (own < SWITCH_TO_PARTITION && &best != idx).then_some(Chart::Partition(best))
+            (&best != idx).then_some(Chart::Partition(best))
         }
     }
 }
