@@ -11,34 +11,58 @@ use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 
 /// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
+/// a^T M b over the bodies `first..end` (a and b: 3n values each).
 #[inline]
-fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64]) -> f64 {
-    mech.bodies
+fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
+    if first >= end {
+        return 0.0;
+    }
+    let (a, b) = (&a[3 * first..3 * end], &b[3 * first..3 * end]);
+    mech.bodies[first..end]
         .iter()
         .zip(a.chunks_exact(3).zip(b.chunks_exact(3)))
         .map(|(body, (a, b))| body.mass * (a[0] * b[0] + a[1] * b[1]) + body.inertia * a[2] * b[2])
         .sum()
 }
 
-/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`.
+/// The bodies each column of `ws.u` is non-zero on, into `ws.u_support`: the columns of
+/// independent parts of a mechanism (five-bars side by side) share none, and the sums over
+/// the others' bodies are exactly 0.
+fn u_support(ws: &mut Workspace) {
+    let n = ws.x.len();
+    for (j, support) in ws.u_support.iter_mut().enumerate() {
+        let col = &ws.u[j * n..(j + 1) * n];
+        let first = col.iter().position(|v| *v != 0.0).map_or(0, |i| i / 3);
+        let end = col.iter().rposition(|v| *v != 0.0).map_or(0, |i| i / 3 + 1);
+        *support = (first, end.max(first));
+    }
+}
+
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`; the supports of its columns
+/// into `ws.u_support` (for [`bias`]).
 pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
+    u_support(ws);
     let n = ws.x.len();
     let m = ws.b.len();
     for j in 0..m {
         for k in j..m {
-            let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n]);
+            let ((fj, ej), (fk, ek)) = (ws.u_support[j], ws.u_support[k]);
+            let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
             ws.a[j * m + k] = s;
             ws.a[k * m + j] = s;
         }
     }
 }
 
-/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
+/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c` and the
+/// supports [`mass_matrix`] found.
 pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     for (j, bj) in ws.b.iter_mut().enumerate() {
         let uj = &ws.u[j * n..(j + 1) * n];
-        *bj = uj.iter().zip(&ws.f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c);
+        let (first, end) = ws.u_support[j];
+        let (u, f) = (&uj[3 * first..3 * end], &ws.f[3 * first..3 * end]);
+        *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c, (first, end));
     }
 }
 
@@ -101,8 +125,9 @@ pub fn forward(
     let n = ws.x.len();
     ws.xdd.copy_from_slice(&ws.c);
     for j in 0..m {
-        let zdd = ws.b[j];
-        for (a, u) in ws.xdd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
+        let (zdd, (first, end)) = (ws.b[j], ws.u_support[j]);
+        let u = &ws.u[j * n + 3 * first..j * n + 3 * end];
+        for (a, u) in ws.xdd[3 * first..3 * end].iter_mut().zip(u) {
             *a += u * zdd;
         }
     }
