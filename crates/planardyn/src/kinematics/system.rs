@@ -11,7 +11,7 @@
 use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
 use super::group_sigma::GroupScales;
 use super::pairs;
-use crate::linalg::BlockLu;
+use crate::linalg::{BlockLu, MAX_COLUMNS};
 use crate::model::{CoordinateKind, Mechanism};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
@@ -33,6 +33,9 @@ pub struct System {
     chart: Chart,
     /// The blocks' own scales and the type II estimate's vectors (`group_sigma`).
     groups: GroupScales,
+    /// Per sweep of [`MAX_COLUMNS`] columns of J U = [0; I_m], the blocks U may be non-zero
+    /// on (`BlockLu::reach`): a coordinate moves only the groups that depend on it.
+    unit_reach: Vec<Vec<usize>>,
 }
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
@@ -45,6 +48,7 @@ impl System {
         let lu = BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs));
         System {
             groups: GroupScales::new(mech, &Chart::Inputs, &lu),
+            unit_reach: unit_reach(mech, &lu),
             lu,
             pattern_chart: Chart::Inputs,
             row_scale: vec![1.0; mech.n_x()],
@@ -68,6 +72,7 @@ impl System {
         if self.pattern_chart != *chart {
             self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
             self.groups = GroupScales::new(mech, chart, &self.lu);
+            self.unit_reach = unit_reach(mech, &self.lu);
             self.pattern_chart.clone_from(chart);
         }
         set_row_scale(mech, chart, &mut self.row_scale);
@@ -112,9 +117,10 @@ impl System {
         self.lu.solve_scaled(b, &self.row_scale, &self.col_scale);
     }
 
-    /// Solve J Y = B in place for the columns of `b` (3n values each, one after the other).
-    pub fn solve_many(&mut self, b: &mut [f64]) {
-        self.lu.solve_many_scaled(b, &self.row_scale, &self.col_scale);
+    /// Solve J U = [0; I_m] in place: `u` holds the m unit columns (1 in row 3n - m + j of
+    /// column j, 0 elsewhere) and gets U; each column is solved on the blocks it reaches only.
+    pub fn solve_unit_columns(&mut self, u: &mut [f64]) {
+        self.lu.solve_many_over(u, &self.row_scale, &self.col_scale, Some(&self.unit_reach));
     }
 
     /// Solve J^T y = b in place (b and y unscaled).
@@ -127,6 +133,14 @@ impl System {
             *v *= s;
         }
     }
+}
+
+/// The blocks of `lu` each sweep of unit columns of [0; I_m] reaches (see
+/// [`System::solve_unit_columns`]).
+fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Vec<Vec<usize>> {
+    let (n, m) = (mech.n_x(), mech.dof());
+    let rows: Vec<usize> = (n - m..n).collect();
+    rows.chunks(MAX_COLUMNS).map(|sweep| lu.reach(sweep)).collect()
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
