@@ -19,7 +19,7 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]
 pub struct Measures {
-    /// Type II measure: smallest scaled singular value of [Phi_x; D_x].
+    /// Type II measure: smallest scaled singular value of the blocks of [Phi_x; D_x] (`group_sigma`).
     pub sigma: f64,
     /// Passive measure (`kinematics::passive_sigma_min`, with the partition in use where there
     /// is one), computed only near a type II singularity; elsewhere `sigma` bounds it from below.
