@@ -34,8 +34,9 @@ pub struct System {
     /// The blocks' own scales and the type II estimate's vectors (`group_sigma`).
     groups: GroupScales,
     /// Per sweep of [`MAX_COLUMNS`] columns of J U = [0; I_m], the blocks U may be non-zero
-    /// on (`BlockLu::reach`): a coordinate moves only the groups that depend on it.
-    unit_reach: Vec<Vec<usize>>,
+    /// on (`BlockLu::reach`): a coordinate moves only the groups that depend on it. None when
+    /// every sweep reaches every block (a single closed chain): the plain solve, no zeroing.
+    unit_reach: Option<Vec<Vec<usize>>>,
 }
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
@@ -120,7 +121,7 @@ impl System {
     /// Solve J U = [0; I_m] in place: `u` holds the m unit columns (1 in row 3n - m + j of
     /// column j, 0 elsewhere) and gets U; each column is solved on the blocks it reaches only.
     pub fn solve_unit_columns(&mut self, u: &mut [f64]) {
-        self.lu.solve_many_over(u, &self.row_scale, &self.col_scale, Some(&self.unit_reach));
+        self.lu.solve_many_over(u, &self.row_scale, &self.col_scale, self.unit_reach.as_deref());
     }
 
     /// Solve J^T y = b in place (b and y unscaled).
@@ -137,10 +138,11 @@ impl System {
 
 /// The blocks of `lu` each sweep of unit columns of [0; I_m] reaches (see
 /// [`System::solve_unit_columns`]).
-fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Vec<Vec<usize>> {
+fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Option<Vec<Vec<usize>>> {
     let (n, m) = (mech.n_x(), mech.dof());
     let rows: Vec<usize> = (n - m..n).collect();
-    rows.chunks(MAX_COLUMNS).map(|sweep| lu.reach(sweep)).collect()
+    let reach: Vec<Vec<usize>> = rows.chunks(MAX_COLUMNS).map(|sweep| lu.reach(sweep)).collect();
+    reach.iter().any(|blocks| blocks.len() < lu.n_blocks()).then_some(reach)
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
