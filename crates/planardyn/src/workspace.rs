@@ -50,9 +50,6 @@ pub struct Workspace {
     pub rhs: Vec<f64>,
     /// (3n) scratch for residuals and second derivatives.
     pub tmp: Vec<f64>,
-    /// (m) the bodies each column of u is non-zero on, [first, end): mass matrix (the
-    /// products of columns that share no body are 0 and skipped).
-    pub u_support: Vec<(usize, usize)>,
 }
 
 impl Workspace {
@@ -80,7 +77,6 @@ impl Workspace {
             xdd: vec![0.0; nx],
             rhs: vec![0.0; nx],
             tmp: vec![0.0; nx],
-            u_support: vec![(0, mech.n_bodies()); m],
         }
     }
 

@@ -25,28 +25,16 @@ fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -
         .sum()
 }
 
-/// The bodies each column of `ws.u` is non-zero on, into `ws.u_support`: the columns of
-/// independent parts of a mechanism (five-bars side by side) share none, and the sums over
-/// the others' bodies are exactly 0.
-fn u_support(ws: &mut Workspace) {
-    let n = ws.x.len();
-    for (j, support) in ws.u_support.iter_mut().enumerate() {
-        let col = &ws.u[j * n..(j + 1) * n];
-        let first = col.iter().position(|v| *v != 0.0).map_or(0, |i| i / 3);
-        let end = col.iter().rposition(|v| *v != 0.0).map_or(0, |i| i / 3 + 1);
-        *support = (first, end.max(first));
-    }
-}
-
-/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`; the supports of its columns
-/// into `ws.u_support` (for [`bias`]).
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`, over the bodies where both
+/// columns may be non-zero (`System::u_support`: the columns of independent parts of a
+/// mechanism, five-bars side by side, share none).
 pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
-    u_support(ws);
     let n = ws.x.len();
     let m = ws.b.len();
+    let support = ws.sys.u_support();
     for j in 0..m {
         for k in j..m {
-            let ((fj, ej), (fk, ek)) = (ws.u_support[j], ws.u_support[k]);
+            let ((fj, ej), (fk, ek)) = (support[j], support[k]);
             let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
             ws.a[j * m + k] = s;
             ws.a[k * m + j] = s;
@@ -54,13 +42,12 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
-/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c` and the
-/// supports [`mass_matrix`] found.
+/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
 pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     for (j, bj) in ws.b.iter_mut().enumerate() {
         let uj = &ws.u[j * n..(j + 1) * n];
-        let (first, end) = ws.u_support[j];
+        let (first, end) = ws.sys.u_support()[j];
         let (u, f) = (&uj[3 * first..3 * end], &ws.f[3 * first..3 * end]);
         *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c, (first, end));
     }
@@ -125,7 +112,7 @@ pub fn forward(
     let n = ws.x.len();
     ws.xdd.copy_from_slice(&ws.c);
     for j in 0..m {
-        let (zdd, (first, end)) = (ws.b[j], ws.u_support[j]);
+        let (zdd, (first, end)) = (ws.b[j], ws.sys.u_support()[j]);
         let u = &ws.u[j * n + 3 * first..j * n + 3 * end];
         for (a, u) in ws.xdd[3 * first..3 * end].iter_mut().zip(u) {
             *a += u * zdd;

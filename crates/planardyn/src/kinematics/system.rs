@@ -37,6 +37,9 @@ pub struct System {
     /// on (`BlockLu::reach`): a coordinate moves only the groups that depend on it. None when
     /// every sweep reaches every block (a single closed chain): the plain solve, no zeroing.
     unit_reach: Option<Vec<Vec<usize>>>,
+    /// Per column j of U, the bodies it may be non-zero on, [first, end): those of the blocks
+    /// its coordinate's row reaches.
+    u_support: Vec<(usize, usize)>,
 }
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
@@ -50,6 +53,7 @@ impl System {
         System {
             groups: GroupScales::new(mech, &Chart::Inputs, &lu),
             unit_reach: unit_reach(mech, &lu),
+            u_support: u_support(mech, &lu),
             lu,
             pattern_chart: Chart::Inputs,
             row_scale: vec![1.0; mech.n_x()],
@@ -74,6 +78,7 @@ impl System {
             self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
             self.groups = GroupScales::new(mech, chart, &self.lu);
             self.unit_reach = unit_reach(mech, &self.lu);
+            self.u_support = u_support(mech, &self.lu);
             self.pattern_chart.clone_from(chart);
         }
         set_row_scale(mech, chart, &mut self.row_scale);
@@ -124,6 +129,12 @@ impl System {
         self.lu.solve_many_over(u, &self.row_scale, &self.col_scale, self.unit_reach.as_deref());
     }
 
+    /// Per column j of U = dx/dz, the bodies it may be non-zero on, [first, end) (from the
+    /// blocks its coordinate reaches): the products of U's columns skip the others.
+    pub fn u_support(&self) -> &[(usize, usize)] {
+        &self.u_support
+    }
+
     /// Solve J^T y = b in place (b and y unscaled).
     pub fn solve_transpose(&mut self, b: &mut [f64]) {
         for (v, s) in b.iter_mut().zip(&self.col_scale) {
@@ -143,6 +154,19 @@ fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Option<Vec<Vec<usize>>> {
     let rows: Vec<usize> = (n - m..n).collect();
     let reach: Vec<Vec<usize>> = rows.chunks(MAX_COLUMNS).map(|sweep| lu.reach(sweep)).collect();
     reach.iter().any(|blocks| blocks.len() < lu.n_blocks()).then_some(reach)
+}
+
+/// The bodies each column of U may be non-zero on (see [`System::u_support`]).
+fn u_support(mech: &Mechanism, lu: &BlockLu) -> Vec<(usize, usize)> {
+    let (n, m) = (mech.n_x(), mech.dof());
+    let cols = lu.position_cols();
+    (n - m..n)
+        .map(|row| {
+            let bodies = lu.reach(&[row]).into_iter().flat_map(|k| lu.span(k)).map(|p| cols[p] / 3);
+            bodies.fold((usize::MAX, 0), |(first, end), b| (first.min(b), end.max(b + 1)))
+        })
+        .map(|(first, end)| (first.min(end), end))
+        .collect()
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
