@@ -28,7 +28,7 @@ from ._core import (
     __version__,
 )
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
-from .result import Energy, SimulationInterrupted, SimulationResult
+from .result import Energy, PointMotion, SimulationInterrupted, SimulationResult
 from .results_io import read_results
 
 __all__ = [
@@ -38,6 +38,7 @@ __all__ = [
     "ModelError",
     "PlanardynError",
     "PlanardynWarning",
+    "PointMotion",
     "SimulationError",
     "SimulationInterrupted",
     "SimulationResult",

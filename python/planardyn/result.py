@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
-import csv
+import dataclasses
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
+
+from . import results_format
+from ._core import __version__
 
 if TYPE_CHECKING:
     import pandas
@@ -45,6 +50,44 @@ class Energy:
 
     def __repr__(self) -> str:
         return f"Energy(N={len(self.kinetic)}, drift={self.drift:.3g} J)"
+
+
+def _dataframe(cols: Mapping[str, FloatArray]) -> pandas.DataFrame:
+    """``cols`` as a DataFrame indexed by its ``t`` column (needs pandas)."""
+    try:
+        import pandas as pd
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+    return pd.DataFrame(cols).set_index("t")
+
+
+@dataclass(frozen=True)
+class PointMotion:
+    """Positions, velocities and accelerations of named points along a trajectory
+    (``Mechanism.point_motion``); each array (N, P, 2), points in the order of ``names``."""
+
+    t: FloatArray
+    names: list[str]
+    position: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+
+    def __getitem__(self, name: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Position (m), velocity (m/s) and acceleration (m/s^2) of one point, (N, 2) each."""
+        if name not in self.names:
+            raise KeyError(f"no point {name!r}; the points carried by a link are {', '.join(self.names)}")
+        k = self.names.index(name)
+        return self.position[:, k], self.velocity[:, k], self.acceleration[:, k]
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """Indexed by ``t``: per point ``<name>_x``, ``<name>_y``, ``<name>_vx``, ``<name>_vy``,
+        ``<name>_ax``, ``<name>_ay`` (m, m/s, m/s^2)."""
+        cols: dict[str, FloatArray] = {"t": self.t}
+        for k, name in enumerate(self.names):
+            for prefix, arr in (("", self.position), ("v", self.velocity), ("a", self.acceleration)):
+                cols[f"{name}_{prefix}x"] = arr[:, k, 0]
+                cols[f"{name}_{prefix}y"] = arr[:, k, 1]
+        return _dataframe(cols)
 
 
 class SimulationInterrupted(KeyboardInterrupt):
@@ -150,6 +193,22 @@ class SimulationResult:
             f"steps={self.stats.get('naccept', 0)}, energy drift={self.energy.drift:.3g} J)"
         )
 
+    def take(self, rows: ArrayLike) -> SimulationResult:
+        """The result at some of its rows: indices or a boolean mask, e.g. every tenth row
+        ``res.take(np.arange(0, len(res), 10))``. The energy balance keeps its reference
+        (the first output of the whole run)."""
+        k = np.arange(len(self.t))[np.asarray(rows)]
+
+        def rows_of(obj: Any) -> dict[str, Any]:  # every per-row array field, at rows k
+            return {f.name: v[k] for f in dataclasses.fields(obj) if isinstance(v := getattr(obj, f.name), np.ndarray)}
+
+        return dataclasses.replace(self, **rows_of(self), energy=Energy(**rows_of(self.energy)))
+
+    @property
+    def power(self) -> FloatArray:
+        """(N, m) power of each drive, tau * qd (W): positive where the drive gives energy."""
+        return self.tau * self.qd
+
     def columns(self) -> dict[str, FloatArray]:
         """The table of :meth:`to_dataframe` as a dict of (N,) arrays, in column order:
         ``t``, the coordinate names, ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``,
@@ -165,18 +224,50 @@ class SimulationResult:
         return cols
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """A pandas DataFrame with the columns of :meth:`columns` (needs pandas)."""
-        try:
-            import pandas as pd
-        except ImportError as e:  # pragma: no cover - depends on the environment
-            raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
-        return pd.DataFrame(self.columns())
-
-    def to_csv(self, path: str | os.PathLike[str]) -> None:
-        """Write the table of :meth:`columns` as CSV (full double precision; no pandas needed)."""
+        """A pandas DataFrame indexed by ``t`` (s) with the other columns of :meth:`columns`,
+        then ``power_<name>`` (W) per drive (needs pandas)."""
         cols = self.columns()
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(cols)
-            for row in zip(*(c.tolist() for c in cols.values())):
-                w.writerow([repr(v) for v in row])
+        for k, name in enumerate(self.coordinate_names):
+            cols["power_" + name] = self.power[:, k]
+        return _dataframe(cols)
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write a results file (``.csv``, ``.parquet`` or ``.npz``, by the name's extension;
+        format in :mod:`planardyn.results_io`): every array, exactly, and the metadata
+        (model, settings, version when attached), read back by :func:`planardyn.read_results`,
+        ``planardyn plot`` and ``planardyn animate``. Written whole or not at all. Returns
+        the path."""
+        return self._write(path, None)
+
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
+        """:meth:`save` in the CSV form whatever the name: the metadata on ``# `` lines, then
+        the columns of :meth:`columns` and the body coordinates, full double precision."""
+        return self._write(path, ".csv")
+
+    def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:
+        layout = results_format.columns(self.coordinate_names, self.body_names)
+        e = self.energy
+        groups = {
+            "t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau,
+            "kinetic": e.kinetic, "potential": e.potential, "work": e.work,
+            "sigma": self.sigma, "residual": self.residual, "partitioned": self.partitioned,
+            "x": self.x, "xd": self.xd,
+        }
+        meta = {
+            "format": results_format.FORMAT,
+            "format_version": results_format.FORMAT_VERSION,
+            "kind": "simulation",
+            "planardyn_version": __version__,
+            "model": None,
+            "settings": None,
+            **{k: v for k, v in self.metadata.items() if k != "path"},
+            "status": self.status,
+            "success": self.success,
+            "message": self.message,
+            "stats": {k: results_format.plain(v) for k, v in self.stats.items()},
+            "coordinate_names": self.coordinate_names,
+            "coordinate_kinds": self.coordinate_kinds,
+            "body_names": self.body_names,
+            "layout": [[g, len(cols)] for g, cols in layout],
+        }
+        return results_format.write(path, meta, groups, layout, ext)

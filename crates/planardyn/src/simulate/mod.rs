@@ -10,7 +10,7 @@ pub mod trajectory;
 pub use overrides::Overrides;
 pub use trajectory::{SimStats, Status, Trajectory};
 
-use crate::dynamics::Drives;
+use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
 use crate::integrate::{Method, Options, StepError, Stepper};
 use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Chart};
 use crate::model::Mechanism;
@@ -110,14 +110,23 @@ fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
 }
 
 /// The start: assembled at q0, in the user's chart unless it is near-singular there.
+/// Coordinates driven by motion start where their motion is at t0 (a `speed` counts from q0).
 fn start<'a>(
     mech: &'a Mechanism,
     s: &Settings,
     drives: &'a mut dyn Drives,
+    motion: &'a mut Prescribed<'a>,
 ) -> Result<(MechanismOde<'a>, Vec<f64>), Error> {
     let (q0m, qd0m) = mech.initial_state();
-    let q0 = s.q0.clone().unwrap_or(q0m);
-    let qd0 = s.qd0.clone().unwrap_or(qd0m);
+    let mut q0 = s.q0.clone().unwrap_or(q0m);
+    let mut qd0 = s.qd0.clone().unwrap_or(qd0m);
+    if !motion.is_empty() {
+        motion.start(s.t0, s.t_end, &q0).map_err(Error::Options)?;
+        motion.eval(s.t0).map_err(|message| Error::Drive { t: s.t0, message })?;
+        for (i, &k) in motion.p.iter().enumerate() {
+            (q0[k], qd0[k]) = (motion.q[i], motion.qd[i]);
+        }
+    }
     let mut ws = Workspace::new(mech);
     assemble_into(mech, &q0, &mut ws)?;
     // Body velocities from qd0 need U in the user's chart, i.e. a regular start; at rest a
@@ -134,7 +143,7 @@ fn start<'a>(
     }
     ws.q.copy_from_slice(&q0);
     ws.qd.copy_from_slice(&qd0);
-    let mut ode = MechanismOde::new(mech, ws, drives);
+    let mut ode = MechanismOde::new(mech, ws, drives).with_motion(motion);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
         return Err(
@@ -212,19 +221,38 @@ fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi
     ode.evaluate_walking(t_out, yi)
 }
 
-/// Simulate from the model's (or the given) initial state. `progress(t)` is called after
-/// each accepted step and may return false to stop. Errors in the settings or at the
-/// start return Err; anything after the start returns the partial trajectory with a status.
+/// Simulate from the model's (or the given) initial state, the coordinates the model drives
+/// by motion following it. `progress(t)` is called after each accepted step and may return
+/// false to stop. Errors in the settings or at the start return Err; anything after the
+/// start returns the partial trajectory with a status.
 pub fn simulate(
     mech: &Mechanism,
     settings: &Settings,
     drives: &mut dyn Drives,
+    progress: Option<&mut dyn FnMut(f64) -> bool>,
+) -> Result<Trajectory, Error> {
+    simulate_prescribed(mech, settings, drives, &mut Prescribed::from_model(mech), progress)
+}
+
+/// As [`simulate`], with the coordinates of `motion` driven by it (instead of the model's
+/// motions; start from [`Prescribed::from_model`] to keep them) and given the efforts their
+/// motion needs, reported in the trajectory's `tau`; their work is part of `work`. The
+/// drives' efforts on them are not applied. The state integrated is that of all m
+/// coordinates, the prescribed ones replaced by their motion at every evaluation (in the
+/// user's chart; in a partition chart, near a type II singularity, they follow it to the
+/// integrator's accuracy). With every coordinate prescribed this is kinematics and inverse
+/// dynamics at each output, the integrator computing only the work.
+pub fn simulate_prescribed<'a>(
+    mech: &'a Mechanism,
+    settings: &Settings,
+    drives: &'a mut dyn Drives,
+    motion: &'a mut Prescribed<'a>,
     mut progress: Option<&mut dyn FnMut(f64) -> bool>,
 ) -> Result<Trajectory, Error> {
     check(settings, mech)?;
     let m = mech.dof();
     let mut traj = Trajectory::new(m, mech.n_x());
-    let (mut ode, y0) = match start(mech, settings, drives) {
+    let (mut ode, y0) = match start(mech, settings, drives, motion) {
         Ok(started) => started,
         // A drive that fails at once is a failed run, not bad input: say so in the status.
         Err(e @ Error::Drive { .. }) => {
@@ -328,7 +356,8 @@ pub fn simulate(
         ode.limit_correction(own);
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
-                (status, message) = (Status::Cancelled, format!("stopped by the progress callback at t = {t} s"));
+                (status, message) =
+                    (Status::Cancelled, format!("cancelled at t = {t} s: the progress callback asked to stop"));
                 keep_last = true;
                 break;
             }
@@ -343,11 +372,18 @@ pub fn simulate(
         // Steps that shrink to nothing usually mean the passive mechanism is at a change
         // point (a parallelogram folding flat): say so when it is.
         let passive = passive_sigma_min(mech, ode.anchor_x());
+        let driven = ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x()));
         if passive < NEAR_PASSIVE_SINGULAR {
             status = Status::PassiveSingularity;
             message = format!(
                 "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
                  a change point where its motion is not determined"
+            );
+        } else if driven < NEAR_PASSIVE_SINGULAR {
+            message = format!(
+                "{message}; the coordinates driven by motion are near a singularity of their own there (scaled \
+                 measure {driven:.2e}): they stop determining their part of the mechanism, and the efforts their \
+                 motion needs grow without bound. Change the motion so that it avoids this configuration"
             );
         }
     }

@@ -2,7 +2,7 @@
 //! y = [z, zd, W] with y' = [zd, zdd, P], where W is the work done by the non-conservative
 //! forces and P its power, so that T + V - W is constant along any exact trajectory.
 
-use crate::dynamics::{forward, Drives};
+use crate::dynamics::{forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
 use crate::kinematics::{scaled_distance, Chart, System, MAX_CORRECTION};
@@ -26,6 +26,11 @@ pub struct MechanismOde<'a> {
     pub mech: &'a Mechanism,
     pub ws: Workspace,
     pub drives: &'a mut dyn Drives,
+    /// The coordinates driven by motion, if any ([`MechanismOde::with_motion`]).
+    pub motion: Option<&'a mut Prescribed<'a>>,
+    /// (2m + 1) The state evaluated last: y with, in the user's chart, the prescribed
+    /// coordinates and rates replaced by their motion's.
+    eval_y: Vec<f64>,
     /// The last accepted point: body coordinates, analogues U (3n x m) and chart values z.
     anchor_x: Vec<f64>,
     anchor_u: Vec<f64>,
@@ -56,6 +61,8 @@ impl<'a> MechanismOde<'a> {
     pub fn new(mech: &'a Mechanism, ws: Workspace, drives: &'a mut dyn Drives) -> Self {
         let m = mech.dof();
         MechanismOde {
+            motion: None,
+            eval_y: vec![0.0; 2 * m + 1],
             anchor_x: ws.x.clone(),
             anchor_u: ws.u.clone(),
             anchor_z: vec![0.0; m],
@@ -73,6 +80,11 @@ impl<'a> MechanismOde<'a> {
             ws,
             drives,
         }
+    }
+
+    /// The same system with the coordinates of `motion` driven by it.
+    pub fn with_motion(self, motion: &'a mut Prescribed<'a>) -> Self {
+        MechanismOde { motion: Some(motion).filter(|p| !p.is_empty()), ..self }
     }
 
     pub fn m(&self) -> usize {
@@ -163,13 +175,40 @@ impl<'a> MechanismOde<'a> {
     /// evaluation (the integrator then takes a shorter step), so a long step cannot carry
     /// the mechanism onto another assembly branch, however close it is (`limit_correction`).
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let mut z = std::mem::take(&mut self.eval_y);
+        z.copy_from_slice(y);
+        let outcome = self.evaluate_at(t, &mut z);
+        if outcome.is_err() {
+            self.failed_evaluations += 1;
+        }
+        self.eval_y = z;
+        outcome?;
+        self.base_valid = true;
+        self.last_t = t;
+        self.last_y.copy_from_slice(y);
+        Ok(())
+    }
+
+    /// The body of [`MechanismOde::evaluate`] at state `y`, whose prescribed coordinates it
+    /// replaces by their motion's in the user's chart.
+    fn evaluate_at(&mut self, t: f64, y: &mut [f64]) -> Result<(), Error> {
         let m = self.m();
+        if let Some(motion) = self.motion.as_deref_mut() {
+            motion.eval(t).map_err(|message| Error::Drive { t, message })?;
+            if self.ws.chart == Chart::Inputs {
+                motion.overwrite(m, y);
+            }
+        }
         self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
         self.predict(&y[..m]);
         self.predicted.copy_from_slice(&self.ws.x);
         self.last_t = f64::NAN;
         self.base_valid = false;
-        let mut outcome = forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws);
+        let (z, zd) = (&y[..m], &y[m..2 * m]);
+        let mut outcome = match self.motion.as_deref_mut() {
+            None => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
+            Some(motion) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
+        };
         let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
         let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
         if outcome.is_ok() && moved > self.max_move {
@@ -179,14 +218,7 @@ impl<'a> MechanismOde<'a> {
             outcome =
                 Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
         }
-        if outcome.is_err() {
-            self.failed_evaluations += 1;
-        }
-        outcome?;
-        self.base_valid = true;
-        self.last_t = t;
-        self.last_y.copy_from_slice(y);
-        Ok(())
+        outcome
     }
 }
 
@@ -222,10 +254,10 @@ impl MechanismOde<'_> {
         Err(error)
     }
 
-    /// dy = [zd, zdd, P] from the evaluation held in `ws` at state y.
-    fn derivative(&self, y: &[f64], dy: &mut [f64]) {
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`).
+    fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
-        dy[..m].copy_from_slice(&y[m..2 * m]);
+        dy[..m].copy_from_slice(&self.eval_y[m..2 * m]);
         dy[m..2 * m].copy_from_slice(&self.ws.b);
         dy[2 * m] = self.ws.power;
     }
@@ -238,12 +270,12 @@ impl OdeSystem for MechanismOde<'_> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.evaluate(t, y)?;
-        self.derivative(y, dy);
+        self.derivative(dy);
         Ok(())
     }
     fn rhs_dense(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.evaluate_walking(t, y)?;
-        self.derivative(y, dy);
+        self.derivative(dy);
         Ok(())
     }
 }
