@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._core import SingularityError
 from .mechanism import Mechanism, attach_metadata
-from .result import Energy, SimulationResult
+from .result import ChangePoint, Energy, SimulationResult
 from .results_format import EXTENSIONS, FORMAT, FORMAT_VERSION
 from .results_format import checksum as _checksum
 from .results_format import columns as _columns
@@ -85,7 +85,7 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
     n_t, n_b = len(table), len(meta["body_names"])
     flat = lambda g: np.ascontiguousarray(groups[g].reshape(n_t))  # noqa: E731
     own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
-           "coordinate_kinds", "body_names", "layout", "rows", "checksum"}
+           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "change_points"}
     return SimulationResult(
         t=flat("t"), q=groups["q"], qd=groups["qd"], qdd=groups["qdd"], tau=groups["tau"],
         x=groups["x"], xd=groups["xd"], poses=groups["x"].reshape(n_t, n_b, 3),
@@ -96,6 +96,7 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
         coordinate_names=list(meta["coordinate_names"]),
         coordinate_kinds=list(meta["coordinate_kinds"]),
         body_names=list(meta["body_names"]),
+        change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
         metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
     )
 

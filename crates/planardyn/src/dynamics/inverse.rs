@@ -44,8 +44,7 @@ pub fn inverse(
 ///   J xd = [0; qd],   J xdd = -gamma(xd, xd) + [0; qdd].
 /// Near a type II singularity U qd and U qdd + c add columns of size 1/sigma into a vector
 /// of size 1, each carrying its solve's error eps/sigma^2; one solve of the summed
-/// right-hand side errs by eps/sigma only, and the efforts then by eps/sigma^2 instead of
-/// eps/sigma^3 (five-bar free fall at sigma 1.4e-3: 2.2e-8 -> see the commit).
+/// right-hand side errs by eps/sigma only.
 fn body_motion(mech: &Mechanism, qd: &[f64], qdd: &[f64], ws: &mut Workspace) {
     let nc = mech.n_constraints;
     ws.xd.fill(0.0);

@@ -3,6 +3,7 @@
 //! computed so far with a status saying why it stopped.
 
 pub mod charts;
+pub mod crossing;
 pub mod ode;
 mod overrides;
 pub mod trajectory;
@@ -17,6 +18,7 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
+use crossing::{cross, stepped_over, user_state, Approach, Landing, Path, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW};
 use ode::MechanismOde;
 
 /// Relative tolerance of a model's run when its file gives none (docs/model-format.md,
@@ -221,6 +223,64 @@ fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi
     ode.evaluate_walking(t_out, yi)
 }
 
+/// The output grid and where the run is in it.
+struct Outputs<'t> {
+    t_eval: Option<&'t [f64]>,
+    next: usize,
+}
+
+/// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
+/// passive measures `sigma`, `passive`, work `work`), `approach` the points before it, and
+/// restart the stepper past it. Outputs inside the crossing come from the path it followed;
+/// without a grid the point past it is recorded. Returns whether t_end was reached inside
+/// the crossing; Err says why the motion cannot be continued.
+fn cross_change_point(
+    ode: &mut MechanismOde,
+    stepper: &mut Stepper,
+    traj: &mut Trajectory,
+    out: &mut Outputs,
+    (t, sigma, passive, work): (f64, f64, f64, f64),
+    approach: &mut Approach,
+    t_end: f64,
+) -> Result<bool, String> {
+    let landing: Landing = cross(ode, t, passive, work, approach)?;
+    let inside = |s: f64| s < landing.t.min(t_end) || s == t_end && landing.t >= t_end;
+    if let Some(te) = out.t_eval {
+        while out.next < te.len() && inside(te[out.next]) {
+            path_row(ode, traj, &landing, te[out.next], work, sigma);
+            out.next += 1;
+        }
+    }
+    traj.change_points.push(landing.point.clone());
+    if landing.t >= t_end {
+        if out.t_eval.is_none() {
+            path_row(ode, traj, &landing, t_end, work, sigma);
+        }
+        return Ok(true);
+    }
+    ode.ws.x.copy_from_slice(&landing.x);
+    ode.set_chart(landing.chart.clone(), landing.t, &landing.y).map_err(|e| format!("past the change point: {e}"))?;
+    stepper.reset(ode, landing.t, &landing.y).map_err(|e| format!("restarting past the change point: {e}"))?;
+    traj.stats.chart_switches += 1;
+    let meas = measure(ode);
+    if out.t_eval.is_none() {
+        traj.record(ode, landing.t, landing.y[landing.y.len() - 1], meas.sigma);
+    }
+    let own = chart_sigma(ode, meas.sigma);
+    ode.limit_correction(own);
+    approach.clear();
+    approach.keep(ode, landing.t, meas.passive);
+    Ok(false)
+}
+
+/// Record the row at time s inside a crossing, from the path it followed.
+fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, landing: &Landing, s: f64, work: f64, sigma: f64) {
+    let ws = &mut ode.ws;
+    landing.path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
+    user_state(ode);
+    traj.record(ode, s, work, sigma);
+}
+
 /// Simulate from the model's (or the given) initial state, the coordinates the model drives
 /// by motion following it. `progress(t)` is called after each accepted step and may return
 /// false to stop. Errors in the settings or at the start return Err; anything after the
@@ -271,13 +331,15 @@ pub fn simulate_prescribed<'a>(
         return Ok(traj);
     }
     let t_eval = settings.t_eval.as_deref();
-    let mut next_out = 0;
+    let mut out = Outputs { t_eval, next: 0 };
+    let mut approach = Approach::default();
     // The start counts in the least measures, so that a run of no step reports its start's.
     let first = measure(&mut ode);
     (traj.stats.min_sigma, traj.stats.min_passive_sigma) = (first.sigma, first.passive);
+    approach.keep(&ode, settings.t0, first.passive);
     if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
         traj.record(&ode, settings.t0, y[2 * m], first.sigma);
-        next_out = 1;
+        out.next = 1;
     }
     let mut yi = vec![0.0; 2 * m + 1];
     let (mut status, mut message) = (Status::Success, String::new());
@@ -288,6 +350,34 @@ pub fn simulate_prescribed<'a>(
         if let Err(e) = stepper.step(&mut ode, settings.t_end) {
             (status, message) = failure(&e);
             keep_last = true;
+            // Steps that shrink to nothing before a change point: cross it from the last
+            // accepted point when it is near enough.
+            let (t, y) = (stepper.t(), stepper.y().to_vec());
+            ode.restart_from_anchor();
+            if ode.motion.is_none() && approach.last().is_some_and(|p| p.t == t) && ode.accept(t, &y).is_ok() {
+                let meas = measure(&mut ode);
+                if meas.passive < NEAR_PASSIVE_SINGULAR {
+                    let at = (t, meas.sigma, meas.passive, y[2 * m]);
+                    match cross_change_point(
+                        &mut ode,
+                        &mut stepper,
+                        &mut traj,
+                        &mut out,
+                        at,
+                        &mut approach,
+                        settings.t_end,
+                    ) {
+                        Ok(false) => {
+                            (status, message, keep_last) = (Status::Success, String::new(), false);
+                            continue;
+                        }
+                        Ok(true) => {
+                            (status, message, keep_last) = (Status::Success, String::new(), false);
+                        }
+                        Err(why) => message = format!("{message}; {why}"),
+                    }
+                }
+            }
             break;
         }
         let t = stepper.t();
@@ -296,19 +386,19 @@ pub fn simulate_prescribed<'a>(
             traj.stats.partition_steps += 1;
         }
         if let Some(te) = t_eval {
-            if next_out < te.len() && te[next_out] <= t {
+            if out.next < te.len() && te[out.next] <= t {
                 // DOP853's dense-output stages (at 0.1, 0.2 and 7/9 of the step, evaluated by
                 // the first interpolation) are predicted from the step's start, not its end.
                 ode.restart_from_anchor();
             }
-            while next_out < te.len() && te[next_out] <= t {
-                if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[next_out], &mut yi) {
-                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[next_out]));
+            while out.next < te.len() && te[out.next] <= t {
+                if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[out.next], &mut yi) {
+                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[out.next]));
                     break;
                 }
                 let sigma = measure(&mut ode).sigma;
-                traj.record(&ode, te[next_out], yi[2 * m], sigma);
-                next_out += 1;
+                traj.record(&ode, te[out.next], yi[2 * m], sigma);
+                out.next += 1;
             }
             if status != Status::Success {
                 break;
@@ -333,6 +423,26 @@ pub fn simulate_prescribed<'a>(
         }
         traj.stats.min_sigma = traj.stats.min_sigma.min(meas.sigma);
         traj.stats.min_passive_sigma = traj.stats.min_passive_sigma.min(meas.passive);
+        let falling = approach.last().is_some_and(|p| meas.passive < p.passive);
+        if meas.passive < CROSS_BELOW && falling && ode.motion.is_none() {
+            let at = (t, meas.sigma, meas.passive, y[2 * m]);
+            match cross_change_point(&mut ode, &mut stepper, &mut traj, &mut out, at, &mut approach, settings.t_end) {
+                Ok(false) => continue,
+                Ok(true) => break,
+                Err(why) => {
+                    let m = format!(
+                        "the passive mechanism is singular at t = {t} s (scaled measure {:.2e}) and {why}",
+                        meas.passive
+                    );
+                    (status, message) = (Status::PassiveSingularity, m);
+                    break;
+                }
+            }
+        }
+        if let Some(point) = stepped_over(&ode, &approach, t, meas.passive) {
+            traj.change_points.push(point);
+        }
+        approach.keep(&ode, t, meas.passive);
         if meas.passive < PASSIVE_SINGULAR {
             (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
             break;
@@ -354,6 +464,9 @@ pub fn simulate_prescribed<'a>(
             own = chart_sigma(&mut ode, meas.sigma);
         }
         ode.limit_correction(own);
+        if meas.passive < WATCH_BELOW && ode.motion.is_none() {
+            ode.limit_move(APPROACH_FRACTION * meas.passive);
+        }
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
                 (status, message) =

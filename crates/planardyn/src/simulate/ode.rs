@@ -121,6 +121,12 @@ impl<'a> MechanismOde<'a> {
         self.max_move = MOVE_FRACTION * sigma;
     }
 
+    /// Bound the move of a solution from its predictor's anchor by `max` as well (scaled, as
+    /// [`MechanismOde::limit_correction`]'s).
+    pub fn limit_move(&mut self, max: f64) {
+        self.max_move = self.max_move.min(max);
+    }
+
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
     pub fn restart_from_anchor(&mut self) {
         self.base_valid = false;
