@@ -36,7 +36,9 @@ pub const CROSS_BELOW: f64 = 5e-3;
 /// point down to [`CROSS_BELOW`] instead of stepping over it: its stages would evaluate
 /// where the evaluations are inaccurate (see [`CROSS_BELOW`]; a step over A02's change point
 /// left its rate 4e-7 rad/s off). A step that still went over is recognised (`stepped_over`).
-pub const WATCH_BELOW: f64 = 0.1;
+/// Not higher: the five-bar passes type II singularities with the passive measure at 0.05,
+/// where the limit would only cost steps.
+pub const WATCH_BELOW: f64 = 0.02;
 /// See [`WATCH_BELOW`].
 pub const APPROACH_FRACTION: f64 = 0.5;
 /// A scaled pivot of Phi_x below this at the change point counts as a lost rank.
@@ -144,8 +146,9 @@ pub struct Landing {
     pub chart: Chart,
     pub y: Vec<f64>,
     pub point: ChangePoint,
-    /// The path the crossing followed, for outputs inside it.
+    /// The path the crossing followed, and the point it started from.
     pub path: Extrapolation,
+    pub start: Passed,
 }
 
 /// A path x(t) of the body coordinates: position, rate and acceleration at time t.
@@ -218,7 +221,7 @@ pub struct Quintic {
 }
 
 impl Quintic {
-    fn new(a: &Passed, b: (&[f64], &[f64], &[f64]), tb: f64) -> Self {
+    pub fn new(a: &Passed, b: (&[f64], &[f64], &[f64]), tb: f64) -> Self {
         let span = tb - a.t;
         let n = a.x.len();
         let mut c: [Vec<f64>; 6] = std::array::from_fn(|_| vec![0.0; n]);
@@ -284,6 +287,7 @@ pub fn cross(ode: &mut MechanismOde, t: f64, passive: f64, work: f64, approach: 
     let to_point = time_to_point(approach, t, passive).ok_or_else(|| {
         format!("the time to the change point could not be estimated (passive measure {passive:.2e})")
     })?;
+    let start = Passed::of(ode, t, passive);
     let ws = &ode.ws;
     let samples = approach.samples(t, to_point / 2.0);
     let path = Extrapolation::new(t, (&ws.x, &ws.xd, &ws.xdd), &samples, to_point);
@@ -305,7 +309,7 @@ pub fn cross(ode: &mut MechanismOde, t: f64, passive: f64, work: f64, approach: 
                 }
                 y[2 * m] = work + h * power;
                 let point = change_point(mech, &path, locate(mech, &path, t, t + h));
-                return Ok(Landing { t: t + h, x: ode.ws.x.clone(), chart, y, point, path });
+                return Ok(Landing { t: t + h, x: ode.ws.x.clone(), chart, y, point, path, start });
             }
             Ok((_, past)) => why = format!("{h:.2e} s past it the passive measure is still {past:.2e}"),
             Err(e) => {
