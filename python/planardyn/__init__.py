@@ -29,11 +29,12 @@ from ._core import (
 )
 from .events import Crossing
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
-from .result import Energy, PointMotion, SimulationInterrupted, SimulationResult
+from .result import ChangePoint, Energy, PointMotion, SimulationInterrupted, SimulationResult
 from .results_io import read_results
 
 __all__ = [
     "AssemblyError",
+    "ChangePoint",
     "Crossing",
     "Energy",
     "Mechanism",

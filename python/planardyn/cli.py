@@ -124,6 +124,7 @@ def summary(res: SimulationResult) -> str:
         f"{res.status}: {len(res.t)} outputs to t = {t_last} s, {st.get('naccept', 0)} steps "
         f"({st.get('nreject', 0)} rejected, {st.get('nfev', 0)} evaluations), "
         f"energy drift {res.energy.drift:.3g} J, min sigma {sigma_text}"
+        + "".join(f"; change point at t = {c.t:.6g} s (rank -{c.rank_drop})" for c in res.change_points)
     )
 
 

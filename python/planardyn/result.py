@@ -99,6 +99,30 @@ class SimulationInterrupted(KeyboardInterrupt):
         self.result = result
 
 
+@dataclass(frozen=True)
+class ChangePoint:
+    """A change point the run crossed: where the pair constraints lost rank and the passive
+    mechanism's mobility jumped, and the motion went on along the branch it arrived on."""
+
+    #: Time of the crossing (s).
+    t: float
+    #: (m,) coordinates and (3n,) body coordinates there.
+    q: FloatArray
+    x: FloatArray
+    #: Rank the pair constraints lost there: the mobility jumps by this much.
+    rank_drop: int
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> ChangePoint:
+        """From the native dict or a results file's metadata entry."""
+        return cls(t=float(d["t"]), q=np.asarray(d["q"], dtype=float), x=np.asarray(d["x"], dtype=float),
+                   rank_drop=int(d["rank_drop"]))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values, for a results file's metadata."""
+        return {"t": self.t, "q": self.q.tolist(), "x": self.x.tolist(), "rank_drop": self.rank_drop}
+
+
 @dataclass(frozen=True, repr=False)
 class SimulationResult:
     """A trajectory, kept whole even when the run stopped early (see ``status``).
@@ -141,6 +165,8 @@ class SimulationResult:
     #: 'angle' or 'displacement' per coordinate.
     coordinate_kinds: list[str] = field(default_factory=list)
     body_names: list[str] = field(default_factory=list)
+    #: The change points crossed, in time order (see :meth:`change_points_frame`).
+    change_points: list[ChangePoint] = field(default_factory=list)
     #: Where the result came from, for reproducing and re-plotting it: ``model`` (the model
     #: as a dict, ``Mechanism.to_dict()``), ``settings`` (keyword arguments of
     #: ``Mechanism.simulate``), ``planardyn_version``, ``kind`` ('simulation' or 'inverse').
@@ -189,12 +215,22 @@ class SimulationResult:
             coordinate_names=list(coordinate_names),
             coordinate_kinds=list(coordinate_kinds),
             body_names=list(body_names),
+            change_points=[ChangePoint.from_dict(c) for c in raw.get("change_points", [])],
             metadata=dict(metadata or {}),
             t_events=list(raw.get("t_events", [])),
             q_events=list(raw.get("q_events", [])),
             qd_events=list(raw.get("qd_events", [])),
             sol=raw.get("sol"),
         )
+
+    def change_points_frame(self) -> pandas.DataFrame:
+        """The change points as a DataFrame: ``t``, ``rank_drop`` and the coordinates (needs
+        pandas)."""
+        cols: dict[str, Any] = {"t": np.array([c.t for c in self.change_points])}
+        cols["rank_drop"] = np.array([c.rank_drop for c in self.change_points], dtype=int)
+        for k, name in enumerate(self.coordinate_names):
+            cols[name] = np.array([c.q[k] for c in self.change_points])
+        return _dataframe(cols)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -279,6 +315,7 @@ class SimulationResult:
             "success": self.success,
             "message": self.message,
             "stats": {k: results_format.plain(v) for k, v in self.stats.items()},
+            "change_points": [c.to_dict() for c in self.change_points],
             "coordinate_names": self.coordinate_names,
             "coordinate_kinds": self.coordinate_kinds,
             "body_names": self.body_names,

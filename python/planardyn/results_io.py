@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._core import SingularityError
 from .mechanism import Mechanism, attach_metadata
-from .result import Energy, SimulationResult
+from .result import ChangePoint, Energy, SimulationResult
 from .results_format import EXTENSIONS, FORMAT, FORMAT_VERSION
 from .results_format import checksum as _checksum
 from .results_format import columns as _columns
@@ -85,7 +85,8 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
     n_t, n_b = len(table), len(meta["body_names"])
     flat = lambda g: np.ascontiguousarray(groups[g].reshape(n_t))  # noqa: E731
     own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
-           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "events"}
+           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "events",
+           "change_points"}
     m = len(meta["coordinate_names"])
     events = meta.get("events") or {}
     per_event = lambda key, shape: [np.asarray(v, dtype=float).reshape(shape) for v in events.get(key, [])]  # noqa: E731
@@ -99,6 +100,7 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
         coordinate_names=list(meta["coordinate_names"]),
         coordinate_kinds=list(meta["coordinate_kinds"]),
         body_names=list(meta["body_names"]),
+        change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
         metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
         t_events=per_event("t", (-1,)), q_events=per_event("q", (-1, m)), qd_events=per_event("qd", (-1, m)),
     )

@@ -12,7 +12,7 @@ use planardyn::simulate::{Event, EventFn, Observe, Overrides, Settings, Trajecto
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -304,6 +304,16 @@ pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<Strin
     d.set_item("q_events", event_rows(ev.q)?)?;
     d.set_item("qd_events", event_rows(ev.qd)?)?;
     d.set_item("sol", t.dense.map(|inner| crate::dense::PyDenseOutput { inner }))?;
+    let points = PyList::empty(py);
+    for p in &t.change_points {
+        let c = PyDict::new(py);
+        c.set_item("t", p.t)?;
+        c.set_item("q", arr1(py, p.q.clone()))?;
+        c.set_item("x", arr1(py, p.x.clone()))?;
+        c.set_item("rank_drop", p.rank_drop)?;
+        points.append(c)?;
+    }
+    d.set_item("change_points", points)?;
     d.set_item("status", t.status.name())?;
     let message = match (t.status, cancel_reason) {
         (planardyn::simulate::Status::Cancelled, Some(reason)) => reason,

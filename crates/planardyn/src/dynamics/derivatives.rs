@@ -91,6 +91,8 @@ pub fn inverse_derivatives(
 ) -> Result<Jacobians, KinematicsError> {
     lossless(mech)?;
     inverse(mech, q, qd, qdd, ws)?;
+    // dtau/dqdd = A, which inverse dynamics does not form.
+    mass_matrix(mech, ws);
     let w = acceleration_analogues(mech, ws);
     let mut rs = RateScratch::at(mech, &ws.x);
     let jac = effort_jacobians(mech, qd, qdd, &w, ws, &mut rs);
@@ -110,7 +112,7 @@ fn effort_jacobians(
     rs: &mut RateScratch,
 ) -> Jacobians {
     let (n, m) = (ws.x.len(), qd.len());
-    body_accelerations(&ws.u, &ws.c, qdd, &mut ws.xdd);
+    body_accelerations(&ws.u, &ws.c, qdd, ws.sys.u_support(), &mut ws.xdd);
     // r = M xdd - f.
     let mut r = vec![0.0; n];
     for (i, body) in mech.bodies.iter().enumerate() {

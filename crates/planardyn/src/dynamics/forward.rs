@@ -13,22 +13,31 @@ use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 
 /// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
+/// a^T M b over the bodies `first..end` (a and b: 3n values each).
 #[inline]
-fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64]) -> f64 {
-    mech.bodies
+pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
+    if first >= end {
+        return 0.0;
+    }
+    let (a, b) = (&a[3 * first..3 * end], &b[3 * first..3 * end]);
+    mech.bodies[first..end]
         .iter()
         .zip(a.chunks_exact(3).zip(b.chunks_exact(3)))
         .map(|(body, (a, b))| body.mass * (a[0] * b[0] + a[1] * b[1]) + body.inertia * a[2] * b[2])
         .sum()
 }
 
-/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`.
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`, over the bodies where both
+/// columns may be non-zero (`System::u_support`: the columns of independent parts of a
+/// mechanism, five-bars side by side, share none).
 pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     let m = ws.b.len();
+    let support = ws.sys.u_support();
     for j in 0..m {
         for k in j..m {
-            let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n]);
+            let ((fj, ej), (fk, ek)) = (support[j], support[k]);
+            let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
             ws.a[j * m + k] = s;
             ws.a[k * m + j] = s;
         }
@@ -40,7 +49,9 @@ pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     for (j, bj) in ws.b.iter_mut().enumerate() {
         let uj = &ws.u[j * n..(j + 1) * n];
-        *bj = uj.iter().zip(&ws.f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c);
+        let (first, end) = ws.sys.u_support()[j];
+        let (u, f) = (&uj[3 * first..3 * end], &ws.f[3 * first..3 * end]);
+        *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c, (first, end));
     }
 }
 
@@ -125,17 +136,18 @@ pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsErr
 /// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd
 /// in `ws.b`, at chart state (z, zd).
 pub(crate) fn accelerations(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Workspace) {
-    body_accelerations(&ws.u, &ws.c, &ws.b, &mut ws.xdd);
+    body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
     user_coordinates(mech, ws, z, zd, true);
 }
 
 /// xdd = U zdd + c: the body accelerations of chart accelerations zdd (U column-major,
-/// one column of 3n a coordinate).
-pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], xdd: &mut [f64]) {
+/// one column of 3n a coordinate), each column over the bodies of its `support`
+/// (`System::u_support`), where it may be non-zero.
+pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
     let n = c.len();
     xdd.copy_from_slice(c);
-    for (u, &a) in u.chunks_exact(n).zip(zdd) {
-        for (x, u) in xdd.iter_mut().zip(u) {
+    for ((u, &a), &(first, end)) in u.chunks_exact(n).zip(zdd).zip(support) {
+        for (x, u) in xdd[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
             *x += u * a;
         }
     }

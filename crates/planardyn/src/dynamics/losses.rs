@@ -163,7 +163,7 @@ fn forward_stages(
             add_scaled(&mut ws.b, e, &lb.gu[i * m..(i + 1) * m]);
         }
         cholesky_solve(&ws.a, m, &mut ws.b);
-        body_accelerations(&ws.u, &ws.c, &ws.b, &mut ws.xdd);
+        body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
         // f -= n^2 J qdd_k grad_k: the rotors' inertia torques, qdd_k = gu_k . zdd + h_k.
         for (k, &inertia) in lb.rotor_inertia.iter().enumerate().filter(|(_, j)| **j > 0.0) {
             let l = nf + k;
@@ -199,8 +199,8 @@ fn inverse_stages(
     ws: &mut Workspace,
     lb: &mut LossBuffers,
 ) -> Result<(), KinematicsError> {
+    // ws.xdd holds the body accelerations inverse dynamics formed.
     let (nf, m, n) = (mech.friction.len(), ws.b.len(), ws.x.len());
-    body_accelerations(&ws.u, &ws.c, qdd, &mut ws.xdd);
     set_levers(mech, ws, lb);
     lb.f0.copy_from_slice(&ws.f);
     lb.b0.copy_from_slice(&ws.tau);

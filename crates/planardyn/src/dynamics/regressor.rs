@@ -37,7 +37,7 @@ pub fn parameters(mech: &Mechanism) -> Vec<f64> {
 /// the drive efforts of inverse dynamics are Y pi + tau_o.
 pub fn regressor(mech: &Mechanism, ws: &mut Workspace, qdd: &[f64], y: &mut [f64], tau_o: &mut [f64]) {
     let (n, m, nb) = (ws.x.len(), qdd.len(), mech.bodies.len());
-    body_accelerations(&ws.u, &ws.c, qdd, &mut ws.xdd);
+    body_accelerations(&ws.u, &ws.c, qdd, ws.sys.u_support(), &mut ws.xdd);
     // The loads other than gravity, without drives.
     ws.tau.fill(0.0);
     applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);

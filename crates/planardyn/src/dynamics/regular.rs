@@ -7,13 +7,14 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{KinematicsError, SingularityKind};
 
-/// Below this scaled type II measure (smallest singular value of the scaled J, dimensionless,
-/// so the same for any size of mechanism) the mass matrix, forward and inverse dynamics and
-/// the reactions are refused. The analogues U grow as 1/sigma and the efforts of a given
-/// motion as 1/sigma^2, and so does their sensitivity to the last bit of q: on the
-/// slider-driven slider-crank approaching its dead centre the efforts' relative spread over
-/// the next representable slider positions is 4e-5 at sigma 1.7e-6, 3.5e-4 at 5.5e-7, 4.7e-3
-/// at 1.7e-7, and below 7e-8 they are off their 1/sigma^2 law by a factor 2 (test
+/// Below this scaled type II measure (smallest singular value of the blocks of the scaled J,
+/// each at its group's own length, `kinematics::group_sigma`: dimensionless and the same for
+/// any size of mechanism) the mass matrix, forward and inverse dynamics and the reactions are
+/// refused. The analogues U grow as 1/sigma and the efforts of a given motion as 1/sigma^2,
+/// and so does their sensitivity to the last bit of q: on the slider-driven slider-crank
+/// approaching its dead centre the efforts' relative spread over the next representable
+/// slider positions is 4e-5 at sigma 2.0e-6, 3.5e-4 at 6.4e-7, 4.7e-3 at 2.0e-7, and below
+/// 8e-8 they are off their 1/sigma^2 law by a factor 2 (test
 /// `dynamics_guards::threshold_is_where_the_efforts_keep_three_digits`). Above this value the
 /// results keep 3 digits or more.
 pub const SINGULAR_SIGMA: f64 = 1e-6;

@@ -17,7 +17,7 @@
 use crate::dynamics;
 use crate::kinematics::constraints::coordinates;
 use crate::kinematics::effector::{solve_square, Effector, EffectorError, EffectorState};
-use crate::kinematics::{convective, sigma_min, solve_position, Chart};
+use crate::kinematics::{convective, sigma_min_with, solve_position, Chart, System};
 use crate::model::Mechanism;
 use crate::{Error, KinematicsError, Workspace};
 use thiserror::Error as ThisError;
@@ -182,6 +182,8 @@ struct Tracker<'a> {
     ws: Workspace,
     /// Body coordinates (3n) of the last solved sample.
     x_last: Vec<f64>,
+    /// The blocks of J of the inputs chart, analysed once, for the type II measure.
+    sys: System,
 }
 
 impl Tracker<'_> {
@@ -209,8 +211,8 @@ impl Tracker<'_> {
         solve_square(&st.jt, &mut qdd).then_some((qd, qdd))
     }
 
-    fn sigma_ii(&self) -> f64 {
-        sigma_min(self.mech, &Chart::Inputs, &self.ws.x)
+    fn sigma_ii(&mut self) -> f64 {
+        sigma_min_with(&mut self.sys, self.mech, &Chart::Inputs, &self.ws.x)
     }
 
     /// Put the workspace back at the body coordinates of the last solved sample (after a
@@ -230,7 +232,7 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
     check_path(mech, path)?;
     let (m, n) = (mech.dof(), path.t.len());
     let q_start = path.q_start.clone().unwrap_or_else(|| mech.drawn_q());
-    let mut tr = Tracker { mech, ee, ws: Workspace::new(mech), x_last: mech.x0.clone() };
+    let mut tr = Tracker { mech, ee, ws: Workspace::new(mech), x_last: mech.x0.clone(), sys: System::new(mech) };
     let mut out = TaskSolution::zeros(n, m);
     let row = |a: &[f64], i: usize| a[i * m..(i + 1) * m].to_vec();
     for i in 0..n {

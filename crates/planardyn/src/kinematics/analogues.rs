@@ -21,7 +21,7 @@ pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
     for j in 0..m {
         ws.u[j * n + n - m + j] = 1.0;
     }
-    ws.sys.solve_many(&mut ws.u);
+    ws.sys.solve_unit_columns(&mut ws.u);
     Ok(())
 }
 

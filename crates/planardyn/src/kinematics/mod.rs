@@ -5,6 +5,7 @@
 pub mod analogues;
 pub mod constraints;
 pub mod effector;
+pub mod group_sigma;
 pub mod pairs;
 pub mod position;
 pub mod singularity;
@@ -18,5 +19,5 @@ pub use pairs::{pair_geometry, PairGeometry};
 pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL,
 };
-pub use singularity::{passive_sigma_min, select_partition, sigma_min};
+pub use singularity::{passive_sigma_min, select_partition, sigma_min, sigma_min_with};
 pub use system::System;

@@ -2,31 +2,22 @@
 //! (docs/formulation.md, *Singularities* and *Charts*).
 //!
 //! Both measures are singular values of the scaled (dimensionless, see `system.rs`) Jacobian:
-//! - type II (parallel): the smallest singular value of J = [Phi_x; D_x] with the inputs
-//!   fixed. It is 0 where the actuated mechanism gains an uncontrolled motion.
-//! - passive: the smallest singular value of Phi_x alone (its independent rows x 3n). It is 0 where the
-//!   mechanism without its drives changes mobility (a folded four-bar, a change point).
+//! - type II (parallel): the smallest singular value of the blocks of J = [Phi_x; D_x] with the
+//!   inputs fixed (its input links and Assur groups), each at its own length (`group_sigma`).
+//!   It is 0 where the actuated mechanism gains an uncontrolled motion, and means the same
+//!   whatever the size of the mechanism around the group.
+//! - passive: the type II measure of the better of two charts, the user's coordinates and the
+//!   partition below. It is 0 where Phi_x alone (its independent rows x 3n) loses rank, i.e.
+//!   where the mechanism without its drives changes mobility (a folded four-bar, a change point).
 //!
 //! Near a type II singularity the integrator changes to m components of x chosen by Gaussian
 //! elimination with complete pivoting on Phi_x (Wehage & Haug 1982, generalized coordinate
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
 use super::constraints::{body_trig, Chart};
-use super::system::{col_scales, scaled_jacobian};
+use super::system::{col_scales, scaled_jacobian, System};
 use crate::linalg::pivot_columns;
 use crate::model::Mechanism;
-use nalgebra::DMatrix;
-
-fn singular_values(rows: usize, cols: usize, data: &[f64]) -> Vec<f64> {
-    // The SVD iteration need not end on non-finite entries: such a matrix is singular.
-    if data[..rows * cols].iter().any(|v| !v.is_finite()) {
-        return vec![0.0; rows.min(cols)];
-    }
-    let mat = DMatrix::from_row_slice(rows, cols, &data[..rows * cols]);
-    let mut sv: Vec<f64> = mat.singular_values().iter().copied().collect();
-    sv.sort_by(|a, b| a.total_cmp(b));
-    sv
-}
 
 fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     let n = x.len();
@@ -37,31 +28,48 @@ fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     j
 }
 
-/// Smallest singular value of the scaled J of a chart at x (type II measure for `Inputs`).
-pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
-    let n = x.len();
-    if n == 0 {
-        return f64::INFINITY;
-    }
-    singular_values(n, n, &scaled(mech, chart, x))[0]
+/// The scaled Phi_x at x (its independent rows x 3n, row-major).
+pub(crate) fn scaled_phi_x(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
+    let mut a = scaled(mech, &Chart::Inputs, x);
+    a.truncate(mech.n_constraints * x.len());
+    a
 }
 
-/// Smallest singular value of the scaled pair-constraint Jacobian Phi_x, its independent
-/// rows only (passive measure).
-pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
-    let (n, rows) = (x.len(), mech.n_constraints);
-    if rows == 0 {
+/// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
+/// length (type II measure for `Inputs`; `group_sigma`). Cost linear in the bodies.
+pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
+    sigma_min_with(&mut System::new(mech), mech, chart, x)
+}
+
+/// [`sigma_min`] with the blocks of a `sys` kept by the caller (analysed once per chart,
+/// not at each call); its factorisation is left invalid.
+pub fn sigma_min_with(sys: &mut System, mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
+    if x.is_empty() {
         return f64::INFINITY;
     }
-    singular_values(rows, n, &scaled(mech, &Chart::Inputs, x))[0]
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    sys.group_sigma_exact(mech, chart, x, &trig)
+}
+
+/// Passive measure: the better of the type II measures of the two charts the integrator
+/// can use at x, the user's coordinates and the partition [`select_partition`] chooses. Phi_x
+/// loses rank exactly where every chart's J is singular, so it is 0 at a singularity of the
+/// passive mechanism; elsewhere it is at least the type II measure, in the same units.
+pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
+    if mech.n_constraints == 0 {
+        return f64::INFINITY;
+    }
+    let inputs = sigma_min(mech, &Chart::Inputs, x);
+    inputs.max(sigma_min(mech, &Chart::Partition(select_partition(mech, x)), x))
 }
 
 /// The m best independent components of x at x: the columns of the scaled Phi_x (its
 /// independent rows) left without a pivot by complete-pivoting elimination. Ascending.
 pub fn select_partition(mech: &Mechanism, x: &[f64]) -> Vec<usize> {
     let (n, rows) = (x.len(), mech.n_constraints);
-    let mut a = scaled(mech, &Chart::Inputs, x);
-    let pivots = pivot_columns(&mut a[..rows * n], rows, n, rows);
+    let mut a = scaled_phi_x(mech, x);
+    let pivots = pivot_columns(&mut a, rows, n, rows);
     let mut free: Vec<usize> = (0..n).filter(|c| !pivots.contains(c)).collect();
     free.truncate(mech.dof());
     free

@@ -9,20 +9,14 @@
 //! the blocks found once per chart from the pattern of J.
 
 use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
+use super::group_sigma::GroupScales;
 use super::pairs;
-use crate::linalg::BlockLu;
+use crate::linalg::{BlockLu, MAX_COLUMNS};
 use crate::model::{CoordinateKind, Mechanism};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
 pub const SINGULAR_PIVOT: f64 = 1e-12;
-/// Inverse iterations of the singularity estimate from a cold start: 2 digits when the two
-/// smallest singular values differ by 30 %, many more near a singularity (where they separate).
-const SIGMA_ITERATIONS: usize = 8;
-/// A warm-started estimate stops when an iteration changes 1/sigma^2 by less than this
-/// (relative): sigma to about 1e-3, far finer than the chart thresholds (0.05, 0.1) need.
-const SIGMA_RTOL: f64 = 2e-3;
-
 /// J(x) for one chart, scaled and LU-factorised.
 #[derive(Debug, Clone)]
 pub struct System {
@@ -37,11 +31,15 @@ pub struct System {
     factored: bool,
     /// The chart of the last factorisation.
     chart: Chart,
-    /// Inverse-iteration vectors of [`System::sigma_min_estimate`].
-    v: Vec<f64>,
-    w: Vec<f64>,
-    /// Whether `v` holds the singular vector of a previous estimate (a warm start).
-    sigma_warm: bool,
+    /// The blocks' own scales and the type II estimate's vectors (`group_sigma`).
+    groups: GroupScales,
+    /// Per sweep of [`MAX_COLUMNS`] columns of J U = [0; I_m], the blocks U may be non-zero
+    /// on (`BlockLu::reach`): a coordinate moves only the groups that depend on it. None when
+    /// every sweep reaches every block (a single closed chain): the plain solve, no zeroing.
+    unit_reach: Option<Vec<Vec<usize>>>,
+    /// Per column j of U, the bodies it may be non-zero on, [first, end): those of the blocks
+    /// its coordinate's row reaches.
+    u_support: Vec<(usize, usize)>,
 }
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
@@ -51,33 +49,50 @@ pub fn col_scales(mech: &Mechanism) -> Vec<f64> {
 
 impl System {
     pub fn new(mech: &Mechanism) -> Self {
-        let n = mech.n_x();
+        let lu = BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs));
         System {
-            lu: BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs)),
+            groups: GroupScales::new(mech, &Chart::Inputs, &lu),
+            unit_reach: unit_reach(mech, &lu),
+            u_support: u_support(mech, &lu),
+            lu,
             pattern_chart: Chart::Inputs,
-            row_scale: vec![1.0; n],
+            row_scale: vec![1.0; mech.n_x()],
             col_scale: col_scales(mech),
             factored: false,
             chart: Chart::Inputs,
-            v: vec![0.0; n],
-            w: vec![0.0; n],
-            sigma_warm: false,
         }
     }
 
     /// Evaluate and factorise J(x). Err carries the column (body coordinate) that had no
     /// pivot. A new chart's pattern is analysed here (at a chart switch, not in a step).
     pub fn factor(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]]) -> Result<(), usize> {
+        self.fill(mech, chart, x, trig);
+        let out = self.lu.factor(SINGULAR_PIVOT).map_err(|e| e.column);
+        self.factored = out.is_ok();
+        out
+    }
+
+    /// Evaluate J(x) into the blocks without factorising it.
+    fn fill(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]]) {
         if self.pattern_chart != *chart {
             self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
+            self.groups = GroupScales::new(mech, chart, &self.lu);
+            self.unit_reach = unit_reach(mech, &self.lu);
+            self.u_support = u_support(mech, &self.lu);
             self.pattern_chart.clone_from(chart);
         }
         set_row_scale(mech, chart, &mut self.row_scale);
         jacobian_into(mech, chart, x, trig, &mut self.lu.sink(&self.row_scale, &self.col_scale));
         self.chart.clone_from(chart);
-        let out = self.lu.factor(SINGULAR_PIVOT).map_err(|e| e.column);
-        self.factored = out.is_ok();
-        out
+        self.factored = false;
+    }
+
+    /// The exact type II measure of `chart`'s J at x (see `group_sigma`): J is evaluated and
+    /// each of its blocks decomposed (SVD); the factorisation is left invalid.
+    pub fn group_sigma_exact(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]]) -> f64 {
+        self.fill(mech, chart, x, trig);
+        self.groups.reset();
+        self.groups.exact(&self.lu)
     }
 
     /// Whether J is factorised (the last [`System::factor`] succeeded).
@@ -90,42 +105,17 @@ impl System {
         self.factored && self.chart == *chart
     }
 
-    /// The smallest singular value of the factorised scaled J, by inverse iteration on
-    /// (J^T J)^-1 with the LU factors (Golub & Van Loan 8.2.2): no new factorisation, 2n^2
-    /// flops per iteration. The estimate approaches sigma_min from above; the error falls as
-    /// (sigma_1 / sigma_2)^(2k) with the two smallest singular values, so it is sharpest
-    /// exactly where it matters, near a singularity. Along a simulation each call starts
-    /// from the previous singular vector, which is nearly right, and stops once the estimate
-    /// moves by less than [`SIGMA_RTOL`] (usually after 2 iterations instead of 8).
-    /// `None` if J is not factorised.
+    /// The type II measure of the factorised J (see `group_sigma`): the smallest singular
+    /// value of its blocks at their own lengths, estimated by inverse iteration with the factors
+    /// in hand, warm-started from the previous call. `None` if J is not factorised.
     pub fn sigma_min_estimate(&mut self) -> Option<f64> {
-        if !self.factored {
-            return None;
-        }
-        // A fixed start with no special structure, so it is never orthogonal by design to
-        // the singular vector of a symmetric mechanism; a little of it is mixed into the warm
-        // start so that no direction is missing there either.
-        let fixed = |i: usize| 1.0 + 0.37 * ((i * 7 + 3) % 11) as f64;
-        let warm = self.sigma_warm;
-        for (i, v) in self.v.iter_mut().enumerate() {
-            *v = if warm { *v + 1e-3 * fixed(i) } else { fixed(i) };
-        }
-        let mut lambda = 0.0;
-        for k in 0..SIGMA_ITERATIONS {
-            let norm = self.v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            self.v.iter_mut().for_each(|x| *x /= norm);
-            self.w.copy_from_slice(&self.v);
-            self.lu.solve(&mut self.w);
-            self.lu.solve_transpose(&mut self.w);
-            let previous = lambda;
-            lambda = self.w.iter().zip(&self.v).map(|(a, b)| a * b).sum::<f64>();
-            std::mem::swap(&mut self.v, &mut self.w);
-            if warm && k > 0 && (lambda - previous).abs() <= SIGMA_RTOL * lambda {
-                break;
-            }
-        }
-        self.sigma_warm = lambda.is_finite() && lambda > 0.0;
-        Some(if lambda > 0.0 { 1.0 / lambda.sqrt() } else { 0.0 })
+        self.factored.then(|| self.groups.estimate(&self.lu))
+    }
+
+    /// Column scales with each group's own length (L_k for translations, 1 for angles): the
+    /// units in which a Newton correction is compared with the type II measure.
+    pub fn group_col_scale(&self) -> &[f64] {
+        &self.groups.col_scale
     }
 
     /// Solve J y = b in place (b and y unscaled).
@@ -133,9 +123,16 @@ impl System {
         self.lu.solve_scaled(b, &self.row_scale, &self.col_scale);
     }
 
-    /// Solve J Y = B in place for the columns of `b` (3n values each, one after the other).
-    pub fn solve_many(&mut self, b: &mut [f64]) {
-        self.lu.solve_many_scaled(b, &self.row_scale, &self.col_scale);
+    /// Solve J U = [0; I_m] in place: `u` holds the m unit columns (1 in row 3n - m + j of
+    /// column j, 0 elsewhere) and gets U; each column is solved on the blocks it reaches only.
+    pub fn solve_unit_columns(&mut self, u: &mut [f64]) {
+        self.lu.solve_many_over(u, &self.row_scale, &self.col_scale, self.unit_reach.as_deref());
+    }
+
+    /// Per column j of U = dx/dz, the bodies it may be non-zero on, [first, end) (from the
+    /// blocks its coordinate reaches): the products of U's columns skip the others.
+    pub fn u_support(&self) -> &[(usize, usize)] {
+        &self.u_support
     }
 
     /// Solve J^T y = b in place (b and y unscaled).
@@ -148,6 +145,28 @@ impl System {
             *v *= s;
         }
     }
+}
+
+/// The blocks of `lu` each sweep of unit columns of [0; I_m] reaches (see
+/// [`System::solve_unit_columns`]).
+fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Option<Vec<Vec<usize>>> {
+    let (n, m) = (mech.n_x(), mech.dof());
+    let rows: Vec<usize> = (n - m..n).collect();
+    let reach: Vec<Vec<usize>> = rows.chunks(MAX_COLUMNS).map(|sweep| lu.reach(sweep)).collect();
+    reach.iter().any(|blocks| blocks.len() < lu.n_blocks()).then_some(reach)
+}
+
+/// The bodies each column of U may be non-zero on (see [`System::u_support`]).
+fn u_support(mech: &Mechanism, lu: &BlockLu) -> Vec<(usize, usize)> {
+    let (n, m) = (mech.n_x(), mech.dof());
+    let cols = lu.position_cols();
+    (n - m..n)
+        .map(|row| {
+            let bodies = lu.reach(&[row]).into_iter().flat_map(|k| lu.span(k)).map(|p| cols[p] / 3);
+            bodies.fold((usize::MAX, 0), |(first, end), b| (first.min(b), end.max(b + 1)))
+        })
+        .map(|(first, end)| (first.min(end), end))
+        .collect()
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
@@ -173,7 +192,11 @@ pub fn scaled_jacobian(
 
 /// 1/L for rows measured in metres, 1 for rows measured in radians.
 pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
-    let inv = 1.0 / mech.scale;
+    fill_row_scale(mech, chart, 1.0 / mech.scale, rs)
+}
+
+/// `inv` for rows measured in metres, 1 for rows measured in radians.
+pub fn fill_row_scale(mech: &Mechanism, chart: &Chart, inv: f64, rs: &mut [f64]) {
     for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
         for (slot, scale) in slots.iter().zip(pairs::row_scales(pair, inv)) {
             if let Some(i) = *slot {

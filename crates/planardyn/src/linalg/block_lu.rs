@@ -15,7 +15,7 @@
 //! that cost more than the whole factorisation at these sizes (n = 9 to ~60, microseconds);
 //! the graph algorithms come from petgraph.
 
-use super::lu::{lu_factor, lu_solve_transpose, LuError};
+use super::lu::{lu_factor, lu_solve, lu_solve_transpose, LuError};
 use super::sink::Sink;
 use petgraph::algo::{maximum_matching, tarjan_scc};
 use petgraph::graph::{DiGraph, NodeIndex, UnGraph};
@@ -161,6 +161,42 @@ impl BlockLu {
         })
     }
 
+    /// Number of diagonal blocks.
+    pub fn n_blocks(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Permuted positions of block k: its local row (and column) i is position `span(k).start + i`.
+    pub fn span(&self, k: usize) -> std::ops::Range<usize> {
+        self.start[k]..self.start[k + 1]
+    }
+
+    /// Original row and column of each permuted position.
+    pub fn position_rows(&self) -> &[usize] {
+        &self.row
+    }
+    pub fn position_cols(&self) -> &[usize] {
+        &self.col
+    }
+
+    /// Block k, row-major in its local order: the filled matrix B between [`BlockLu::sink`]
+    /// and [`BlockLu::factor`], its factors after.
+    pub fn block(&self, k: usize) -> &[f64] {
+        let s = self.start[k + 1] - self.start[k];
+        &self.store[self.lu_at[k]..self.lu_at[k] + s * s]
+    }
+
+    /// Solve B_k y = b in place with the factors of block k alone (b in its local row order,
+    /// y in its local column order).
+    pub fn block_solve(&self, k: usize, b: &mut [f64]) {
+        lu_solve(self.block(k), b.len(), &self.piv[self.span(k)], b)
+    }
+
+    /// Solve B_k^T y = b in place with the factors of block k alone.
+    pub fn block_solve_transpose(&self, k: usize, b: &mut [f64]) {
+        lu_solve_transpose(self.block(k), b.len(), &self.piv[self.span(k)], b)
+    }
+
     /// Start filling the matrix B = diag(rs) A diag(cs) to factorise: every entry is zeroed,
     /// and the sink scales the entries of A it is given. Then [`BlockLu::factor`].
     pub fn sink<'a>(&'a mut self, rs: &'a [f64], cs: &'a [f64]) -> BlockSink<'a> {
@@ -193,45 +229,81 @@ impl BlockLu {
 
     /// Solve B y = b in place for the factorised (scaled) B.
     pub fn solve(&mut self, b: &mut [f64]) {
-        self.solve_columns::<1>(b, None)
+        self.solve_columns::<1>(b, None, None)
     }
 
     /// Solve A x = b in place for the unscaled A: x = diag(cs) B^-1 diag(rs) b, the scalings
     /// folded into the gather and the scatter.
     pub fn solve_scaled(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64]) {
-        self.solve_columns::<1>(b, Some((rs, cs)))
+        self.solve_columns::<1>(b, Some((rs, cs)), None)
     }
 
     /// As [`BlockLu::solve_scaled`] for the columns of `b` (n values each, one after the
     /// other), up to [`MAX_COLUMNS`] in one sweep: each factor entry is read once for all.
     pub fn solve_many_scaled(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64]) {
+        self.solve_many_over(b, rs, cs, None)
+    }
+
+    /// As [`BlockLu::solve_many_scaled`], with `reach[c]` the blocks (ascending, from
+    /// [`BlockLu::reach`]) on which the solution of the c-th sweep of columns may be non-zero:
+    /// only those are solved, the others are 0.
+    pub fn solve_many_over(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64], reach: Option<&[Vec<usize>]>) {
         let n = self.n.max(1);
-        for chunk in b.chunks_mut(MAX_COLUMNS * n) {
+        for (c, chunk) in b.chunks_mut(MAX_COLUMNS * n).enumerate() {
+            let blocks = reach.map(|r| r[c].as_slice());
             match chunk.len() / n {
-                3 => self.solve_columns::<3>(chunk, Some((rs, cs))),
-                2 => self.solve_columns::<2>(chunk, Some((rs, cs))),
-                _ => self.solve_columns::<1>(chunk, Some((rs, cs))),
+                3 => self.solve_columns::<3>(chunk, Some((rs, cs)), blocks),
+                2 => self.solve_columns::<2>(chunk, Some((rs, cs)), blocks),
+                _ => self.solve_columns::<1>(chunk, Some((rs, cs)), blocks),
             }
         }
+    }
+
+    /// The blocks (ascending) on which the solution of B y = b may be non-zero when b is
+    /// non-zero only on the original `rows`: their blocks and every block that depends on one
+    /// of them through an entry left of its diagonal block.
+    pub fn reach(&self, rows: &[usize]) -> Vec<usize> {
+        let mut block_of = vec![0; self.n];
+        let mut seeded = vec![false; self.n_blocks()];
+        for (k, seed) in seeded.iter_mut().enumerate() {
+            for p in self.span(k) {
+                block_of[p] = k;
+                *seed |= rows.contains(&self.row[p]);
+            }
+        }
+        let mut hit = vec![false; self.n_blocks()];
+        for k in 0..self.n_blocks() {
+            hit[k] = seeded[k]
+                || self.span(k).any(|p| (self.off_at[p]..self.off_at[p + 1]).any(|e| hit[block_of[self.off_col[e]]]));
+        }
+        (0..self.n_blocks()).filter(|&k| hit[k]).collect()
     }
 
     /// Block after block: forward rows (the right-hand side in pivoted order less the
     /// entries of the blocks already solved, then L), then backward rows (U), for R
     /// right-hand sides at once.
-    fn solve_columns<const R: usize>(&mut self, b: &mut [f64], scales: Scales) {
+    /// `blocks`: solve only these (ascending; the solution is 0 on the others), else all.
+    fn solve_columns<const R: usize>(&mut self, b: &mut [f64], scales: Scales, blocks: Option<&[usize]>) {
         let n = self.n;
         assert!(b.len() == R * n && R <= MAX_COLUMNS && scales.is_none_or(|(rs, cs)| rs.len() == n && cs.len() == n));
+        assert!(blocks.is_none_or(|ks| ks.iter().all(|&k| k < self.n_blocks())));
         let y = &mut self.work;
+        if blocks.is_some() {
+            y[..R * n].fill(0.0);
+        }
+        let all = self.start.len() - 1;
         // SAFETY: every index read below was built in `new` from the n x n pattern: `row`,
         // `col` and `src` hold 0..n, `off_col` < n, `off_at` and `start` index inside their
         // arrays, a block's L and U entries lie in its s x s slice of `store`; b has R columns
-        // of n and rs, cs have n values (asserted), `work` has n * MAX_COLUMNS. Unchecked
+        // of n and rs, cs have n values and the listed blocks exist (asserted), `work` has
+        // n * MAX_COLUMNS. Unchecked
         // because the blocks have 1 to ~12 rows: bounds checks cost more than the arithmetic
         // there, and the solves are a third of a forward-dynamics evaluation.
         unsafe {
             let at = |v: &[f64], i: usize| *v.get_unchecked(i);
             let ix = |v: &[usize], i: usize| *v.get_unchecked(i);
-            for k in 0..self.start.len() - 1 {
+            for idx in 0..blocks.map_or(all, <[usize]>::len) {
+                let k = blocks.map_or(idx, |ks| ix(ks, idx));
                 let (s0, s1, base) = (ix(&self.start, k), ix(&self.start, k + 1), ix(&self.lu_at, k));
                 let s = s1 - s0;
                 for i in s0..s1 {
@@ -428,6 +500,30 @@ mod tests {
         lu.solve_many_scaled(&mut b, &rs, &cs);
         for (k, (got, want)) in b.iter().zip(&xs).enumerate() {
             assert!((got - want).abs() < 1e-13, "entry {k}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn solves_unit_columns_on_the_blocks_they_reach_only() {
+        // Blocks in solve order: {row 2} (a), {rows 0, 4} (b, c: use a), {rows 1, 3} (d, e: use b).
+        let (a, pattern) = example();
+        let mut lu = BlockLu::new(&pattern);
+        assert_eq!(lu.reach(&[2]), vec![0, 1, 2]);
+        assert_eq!(lu.reach(&[4]), vec![1, 2]);
+        assert_eq!(lu.reach(&[3]), vec![2]);
+        fill(&mut lu, &a, 5);
+        lu.factor(1e-300).unwrap();
+        // Unit columns e_2, e_4, e_3 in one sweep, then e_3 alone: the same as the full solve.
+        let unit = |rows: &[usize]| -> Vec<f64> {
+            rows.iter().flat_map(|&r| (0..5).map(move |i| if i == r { 1.0 } else { 0.0 })).collect()
+        };
+        let ones = [1.0; 5];
+        for rows in [vec![2, 4, 3], vec![3]] {
+            let (mut full, mut over) = (unit(&rows), unit(&rows));
+            lu.solve_many_scaled(&mut full, &ones, &ones);
+            let reach = vec![lu.reach(&rows)];
+            lu.solve_many_over(&mut over, &ones, &ones, Some(&reach));
+            assert_eq!(over, full, "columns {rows:?}");
         }
     }
 

@@ -1,25 +1,31 @@
 //! Cholesky factorisation of the small symmetric positive definite mass matrix A (m x m).
 
-/// Factor a row-major SPD matrix in place into its lower factor L (A = L L^T).
-/// Returns false if A is not positive definite to working precision.
+/// Factor a row-major SPD matrix in place into its lower factor L (A = L L^T), row by row
+/// (Cholesky-Banachiewicz). L keeps the envelope of A (the zeros left of each row's first
+/// non-zero), so the products there are skipped: a block-diagonal A (independent parts of a
+/// mechanism) costs its blocks' factorisations. Returns false if A is not positive definite
+/// to working precision.
 pub fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
-    for j in 0..m {
-        let mut d = a[j * m + j];
-        for k in 0..j {
-            d -= a[j * m + k] * a[j * m + k];
+    for i in 0..m {
+        let row = i * m;
+        let first = a[row..row + i].iter().position(|v| *v != 0.0).unwrap_or(i);
+        for j in first..i {
+            // Row j of L is zero left of its own first non-zero.
+            let start = (first..j).find(|&k| a[j * m + k] != 0.0).unwrap_or(j);
+            let mut s = a[row + j];
+            for k in start..j {
+                s -= a[row + k] * a[j * m + k];
+            }
+            a[row + j] = s / a[j * m + j];
+        }
+        let mut d = a[row + i];
+        for k in first..i {
+            d -= a[row + k] * a[row + k];
         }
         if !(d > 0.0) {
             return false;
         }
-        let d = d.sqrt();
-        a[j * m + j] = d;
-        for i in j + 1..m {
-            let mut s = a[i * m + j];
-            for k in 0..j {
-                s -= a[i * m + k] * a[j * m + k];
-            }
-            a[i * m + j] = s / d;
-        }
+        a[row + i] = d.sqrt();
     }
     true
 }
@@ -56,5 +62,40 @@ mod tests {
         assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] + 1.0).abs() < 1e-15);
         let mut not_pd = [1.0, 2.0, 2.0, 1.0];
         assert!(!cholesky_in_place(&mut not_pd, 2));
+    }
+
+    #[test]
+    fn a_block_diagonal_matrix_gives_the_plain_factor_bit_for_bit() {
+        // A = B B^T with B lower triangular of blocks 2, 3, 1 and a coupled tail: every L
+        // entry must equal the column-by-column factorisation's, zeros skipped or not.
+        let m = 7;
+        let mut b = vec![0.0f64; m * m];
+        for (i, j, v) in [(0, 0, 2.0), (1, 0, 0.5), (1, 1, 1.5), (2, 2, 1.0), (3, 2, -0.3), (3, 3, 0.9)] {
+            b[i * m + j] = v;
+        }
+        for (i, j, v) in [(4, 2, 0.2), (4, 4, 1.1), (5, 5, 0.7), (6, 5, 0.4), (6, 1, -0.6), (6, 6, 1.3)] {
+            b[i * m + j] = v;
+        }
+        let mut a = vec![0.0; m * m];
+        for i in 0..m {
+            for j in 0..m {
+                a[i * m + j] = (0..m).map(|k| b[i * m + k] * b[j * m + k]).sum();
+            }
+        }
+        let mut plain = a.clone();
+        for j in 0..m {
+            let d = (0..j).fold(plain[j * m + j], |d, k| d - plain[j * m + k] * plain[j * m + k]).sqrt();
+            plain[j * m + j] = d;
+            for i in j + 1..m {
+                let s = (0..j).fold(plain[i * m + j], |s, k| s - plain[i * m + k] * plain[j * m + k]);
+                plain[i * m + j] = s / d;
+            }
+        }
+        assert!(cholesky_in_place(&mut a, m));
+        for i in 0..m {
+            for j in 0..=i {
+                assert_eq!(a[i * m + j], plain[i * m + j], "L[{i}][{j}]");
+            }
+        }
     }
 }

@@ -13,7 +13,7 @@ mod lu;
 mod pivot;
 mod sink;
 
-pub use block_lu::{BlockLu, BlockSink};
+pub use block_lu::{BlockLu, BlockSink, MAX_COLUMNS};
 pub use cholesky::{cholesky_in_place, cholesky_solve};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
 pub use pivot::pivot_columns;

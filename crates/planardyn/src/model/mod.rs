@@ -6,7 +6,7 @@
 
 pub mod actuators;
 mod build;
-mod diameter;
+pub(crate) mod diameter;
 mod io;
 mod motion;
 mod nesting;

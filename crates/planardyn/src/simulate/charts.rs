@@ -3,7 +3,7 @@
 //! singularity, and back again once past it. Decisions are taken between accepted steps.
 
 use super::ode::MechanismOde;
-use crate::kinematics::{passive_sigma_min, select_partition, sigma_min, Chart};
+use crate::kinematics::{passive_sigma_min, select_partition, sigma_min, sigma_min_with, Chart};
 
 /// Below this scaled type II measure the integrator leaves the user's coordinates. The scaled
 /// J has O(1) entries; at 0.05 the position solve still loses under 2 digits, and a step of
@@ -19,34 +19,47 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]
 pub struct Measures {
-    /// Type II measure: smallest scaled singular value of [Phi_x; D_x].
+    /// Type II measure: smallest scaled singular value of the blocks of [Phi_x; D_x] (`group_sigma`).
     pub sigma: f64,
-    /// Passive measure (smallest scaled singular value of Phi_x), computed only near a type
-    /// II singularity; elsewhere `sigma` bounds it from below (interlacing).
+    /// Passive measure (`kinematics::passive_sigma_min`, with the partition in use where there
+    /// is one), computed only near a type II singularity; elsewhere `sigma` bounds it from below.
     pub passive: f64,
 }
 
 /// Measure the point analysed in `ode.ws`. In the user's chart the type II measure comes
 /// from the factorisation already in the workspace (inverse iteration, see
-/// `System::sigma_min_estimate`); near a singularity, where a partition is in use, both
-/// measures are exact singular values (an SVD, at a few steps only).
+/// `System::sigma_min_estimate`); near a singularity, where a partition is in use, it is exact
+/// (an SVD of each block of the user's chart, linear in the bodies), and the passive measure
+/// an SVD of the whole Phi_x (at the few steps near a type II singularity only).
 pub fn measure(ode: &mut MechanismOde) -> Measures {
     let estimate = match ode.ws.chart {
         Chart::Inputs => ode.ws.sys.sigma_min_estimate(),
         Chart::Partition(_) => None,
     };
-    let sigma = estimate.unwrap_or_else(|| sigma_min(ode.mech, &Chart::Inputs, &ode.ws.x));
-    let passive = if sigma < SWITCH_TO_PARTITION { passive_sigma_min(ode.mech, &ode.ws.x) } else { sigma };
+    let sigma = estimate.unwrap_or_else(|| sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x));
+    // Passive: the better of the user's chart and the partition in use (its factorisation is
+    // in the workspace), else the partition complete pivoting would choose.
+    let passive = if sigma >= SWITCH_TO_PARTITION {
+        sigma
+    } else {
+        let own = match ode.ws.chart {
+            Chart::Partition(_) => ode.ws.sys.sigma_min_estimate(),
+            Chart::Inputs => None,
+        };
+        own.map_or_else(|| passive_sigma_min(ode.mech, &ode.ws.x), |own| own.max(sigma))
+    };
     Measures { sigma, passive }
 }
 
-/// Smallest scaled singular value of the current chart's J at the point in `ode.ws`, given
-/// the type II measure `sigma` there (which it is in the user's chart; a partition costs an
-/// SVD, taken at the few steps integrated in one).
-pub fn chart_sigma(ode: &MechanismOde, sigma: f64) -> f64 {
+/// The measure of the current chart's J at the point in `ode.ws` (smallest singular value of
+/// its blocks at their own lengths), given the type II measure `sigma` there (which it is in
+/// the user's chart; in a partition it is estimated from the factorisation in the workspace).
+pub fn chart_sigma(ode: &mut MechanismOde, sigma: f64) -> f64 {
     match &ode.ws.chart {
         Chart::Inputs => sigma,
-        Chart::Partition(_) => sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x),
+        Chart::Partition(_) => {
+            ode.ws.sys.sigma_min_estimate().unwrap_or_else(|| sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x))
+        }
     }
 }
 
@@ -59,9 +72,10 @@ pub fn next_chart(ode: &MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
         Chart::Inputs if m.sigma < SWITCH_TO_PARTITION => Some(Chart::Partition(select_partition(ode.mech, &ode.ws.x))),
         Chart::Inputs => None,
         Chart::Partition(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
+        Chart::Partition(_) if own >= SWITCH_TO_PARTITION => None,
         Chart::Partition(idx) => {
             let best = select_partition(ode.mech, &ode.ws.x);
-            (own < SWITCH_TO_PARTITION && &best != idx).then_some(Chart::Partition(best))
+            (&best != idx).then_some(Chart::Partition(best))
         }
     }
 }

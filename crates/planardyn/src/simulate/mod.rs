@@ -3,6 +3,7 @@
 //! computed so far with a status saying why it stopped.
 
 pub mod charts;
+pub mod crossing;
 pub mod dense;
 pub mod events;
 mod jacobian;
@@ -22,6 +23,9 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
+use crossing::{
+    cross, stepped_over, user_state, Approach, Landing, Path, Quintic, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW,
+};
 use events::Watch;
 use ode::MechanismOde;
 
@@ -161,7 +165,7 @@ fn start<'a>(
     let mut y = vec![0.0; 2 * m + 1];
     state_in(&ode, &chart, 0.0, &mut y);
     ode.set_chart(chart, s.t0, &y)?;
-    let own = chart_sigma(&ode, m0.sigma);
+    let own = chart_sigma(&mut ode, m0.sigma);
     ode.limit_correction(own);
     Ok((ode, y))
 }
@@ -301,6 +305,76 @@ fn end_at_event(
     Ok(())
 }
 
+/// The output grid and where the run is in it.
+struct Outputs<'t> {
+    t_eval: Option<&'t [f64]>,
+    next: usize,
+}
+
+/// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
+/// passive measures `sigma`, `passive`, work `work`), `approach` the points before it, and
+/// restart the stepper past it. Outputs inside the crossing come from the quintic through its
+/// ends (from its Taylor step if t_end is inside it); without a grid the point past it is
+/// recorded. Returns whether t_end was reached inside
+/// the crossing; Err says why the motion cannot be continued.
+fn cross_change_point(
+    ode: &mut MechanismOde,
+    stepper: &mut Stepper,
+    traj: &mut Trajectory,
+    out: &mut Outputs,
+    (t, sigma, passive, work): (f64, f64, f64, f64),
+    approach: &mut Approach,
+    t_end: f64,
+) -> Result<bool, String> {
+    let landing: Landing = cross(ode, t, passive, work, approach)?;
+    traj.change_points.push(landing.point.clone());
+    let inside = |s: f64, end: f64| s < end || s == t_end && end >= t_end;
+    if landing.t >= t_end {
+        // Ends inside the crossing: the rest from its Taylor step.
+        let rows: Vec<f64> = match out.t_eval {
+            Some(te) => te[out.next..].iter().copied().take_while(|&s| inside(s, t_end)).collect(),
+            None => vec![t_end],
+        };
+        for s in rows {
+            path_row(ode, traj, &landing.path, s, work, sigma);
+        }
+        out.next = out.t_eval.map_or(0, <[f64]>::len);
+        return Ok(true);
+    }
+    ode.ws.x.copy_from_slice(&landing.x);
+    ode.set_chart(landing.chart.clone(), landing.t, &landing.y).map_err(|e| format!("past the change point: {e}"))?;
+    stepper.reset(ode, landing.t, &landing.y).map_err(|e| format!("restarting past the change point: {e}"))?;
+    traj.stats.chart_switches += 1;
+    let meas = measure(ode);
+    let own = chart_sigma(ode, meas.sigma);
+    ode.limit_correction(own);
+    approach.clear();
+    approach.keep(ode, landing.t, meas.passive);
+    match out.t_eval {
+        None => traj.record(ode, landing.t, landing.y[landing.y.len() - 1], meas.sigma),
+        Some(te) => {
+            // Outputs inside the crossing: the quintic through its two ends (x, xd, xdd), an
+            // interpolation, where the Taylor step's own error grows towards its end.
+            let ws = &ode.ws;
+            let path = Quintic::new(&landing.start, (&ws.x, &ws.xd, &ws.xdd), landing.t);
+            while out.next < te.len() && inside(te[out.next], landing.t) {
+                path_row(ode, traj, &path, te[out.next], work, sigma);
+                out.next += 1;
+            }
+            ode.restart_from_anchor();
+        }
+    }
+    Ok(false)
+}
+
+/// Record the row at time s inside a crossing, from `path`.
+fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &dyn Path, s: f64, work: f64, sigma: f64) {
+    let ws = &mut ode.ws;
+    path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
+    user_state(ode);
+    traj.record(ode, s, work, sigma);
+}
+
 /// Simulate from the model's (or the given) initial state, the coordinates the model drives
 /// by motion following it. `progress(t)` is called after each accepted step and may return
 /// false to stop. Errors in the settings or at the start return Err; anything after the
@@ -377,13 +451,15 @@ pub fn simulate_observed<'a>(
         return Ok(traj);
     }
     let t_eval = settings.t_eval.as_deref();
-    let mut next_out = 0;
+    let mut out = Outputs { t_eval, next: 0 };
+    let mut approach = Approach::default();
     // The start counts in the least measures, so that a run of no step reports its start's.
     let first = measure(&mut ode);
     (traj.stats.min_sigma, traj.stats.min_passive_sigma) = (first.sigma, first.passive);
+    approach.keep(&ode, settings.t0, first.passive);
     if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
         traj.record(&ode, settings.t0, y[2 * m], first.sigma);
-        next_out = 1;
+        out.next = 1;
     }
     let mut yi = vec![0.0; 2 * m + 1];
     let (mut status, mut message) = (Status::Success, String::new());
@@ -400,6 +476,34 @@ pub fn simulate_observed<'a>(
         if let Err(e) = stepper.step(&mut ode, settings.t_end) {
             (status, message) = failure(&e);
             keep_last = true;
+            // Steps that shrink to nothing before a change point: cross it from the last
+            // accepted point when it is near enough.
+            let (t, y) = (stepper.t(), stepper.y().to_vec());
+            ode.restart_from_anchor();
+            if ode.motion.is_none() && approach.last().is_some_and(|p| p.t == t) && ode.accept(t, &y).is_ok() {
+                let meas = measure(&mut ode);
+                if meas.passive < NEAR_PASSIVE_SINGULAR {
+                    let at = (t, meas.sigma, meas.passive, y[2 * m]);
+                    match cross_change_point(
+                        &mut ode,
+                        &mut stepper,
+                        &mut traj,
+                        &mut out,
+                        at,
+                        &mut approach,
+                        settings.t_end,
+                    ) {
+                        Ok(false) => {
+                            (status, message, keep_last) = (Status::Success, String::new(), false);
+                            continue;
+                        }
+                        Ok(true) => {
+                            (status, message, keep_last) = (Status::Success, String::new(), false);
+                        }
+                        Err(why) => message = format!("{message}; {why}"),
+                    }
+                }
+            }
             break;
         }
         let t = stepper.t();
@@ -426,19 +530,19 @@ pub fn simulate_observed<'a>(
         }
         let t_last = stop.map_or(t, |(t_star, _)| t_star);
         if let Some(te) = t_eval {
-            if next_out < te.len() && te[next_out] <= t_last {
+            if out.next < te.len() && te[out.next] <= t_last {
                 // DOP853's dense-output stages (at 0.1, 0.2 and 7/9 of the step, evaluated by
                 // the first interpolation) are predicted from the step's start, not its end.
                 ode.restart_from_anchor();
             }
-            while next_out < te.len() && te[next_out] <= t_last {
-                if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[next_out], &mut yi) {
-                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[next_out]));
+            while out.next < te.len() && te[out.next] <= t_last {
+                if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[out.next], &mut yi) {
+                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[out.next]));
                     break;
                 }
                 let sigma = measure(&mut ode).sigma;
-                traj.record(&ode, te[next_out], yi[2 * m], sigma);
-                next_out += 1;
+                traj.record(&ode, te[out.next], yi[2 * m], sigma);
+                out.next += 1;
             }
             if status != Status::Success {
                 break;
@@ -475,6 +579,26 @@ pub fn simulate_observed<'a>(
         }
         traj.stats.min_sigma = traj.stats.min_sigma.min(meas.sigma);
         traj.stats.min_passive_sigma = traj.stats.min_passive_sigma.min(meas.passive);
+        let falling = approach.last().is_some_and(|p| meas.passive < p.passive);
+        if meas.passive < CROSS_BELOW && falling && ode.motion.is_none() {
+            let at = (t, meas.sigma, meas.passive, y[2 * m]);
+            match cross_change_point(&mut ode, &mut stepper, &mut traj, &mut out, at, &mut approach, settings.t_end) {
+                Ok(false) => continue,
+                Ok(true) => break,
+                Err(why) => {
+                    let m = format!(
+                        "the passive mechanism is singular at t = {t} s (scaled measure {:.2e}) and {why}",
+                        meas.passive
+                    );
+                    (status, message) = (Status::PassiveSingularity, m);
+                    break;
+                }
+            }
+        }
+        if let Some(point) = stepped_over(&ode, &approach, t, meas.passive) {
+            traj.change_points.push(point);
+        }
+        approach.keep(&ode, t, meas.passive);
         if meas.passive < PASSIVE_SINGULAR {
             (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
             break;
@@ -484,7 +608,7 @@ pub fn simulate_observed<'a>(
             keep_last = true;
             break;
         }
-        let mut own = chart_sigma(&ode, meas.sigma);
+        let mut own = chart_sigma(&mut ode, meas.sigma);
         if let Some(chart) = next_chart(&ode, &meas, own) {
             state_in(&ode, &chart, y[2 * m], &mut y);
             traj.stats.chart_switches += 1;
@@ -493,9 +617,14 @@ pub fn simulate_observed<'a>(
                 (status, message) = (Status::AssemblyFailed, format!("changing coordinates at t = {t} s: {e}"));
                 break;
             }
-            own = chart_sigma(&ode, meas.sigma);
+            own = chart_sigma(&mut ode, meas.sigma);
         }
         ode.limit_correction(own);
+        // In the user's chart the passive measure is only bounded by sigma_II (it is
+        // measured in a partition, which the integrator takes below 0.05).
+        if meas.passive < WATCH_BELOW && ode.motion.is_none() && ode.ws.chart != Chart::Inputs {
+            ode.limit_move(APPROACH_FRACTION * meas.passive);
+        }
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
                 (status, message) =

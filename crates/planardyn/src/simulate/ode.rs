@@ -5,13 +5,13 @@
 use crate::dynamics::{forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{scaled_distance, Chart, MAX_CORRECTION};
+use crate::kinematics::{scaled_distance, Chart, System, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
 
-/// Largest Newton correction as a fraction of the chart's smallest scaled singular value
-/// (see `MechanismOde::limit_correction`).
+/// Largest Newton correction as a fraction of the chart's type II measure (see
+/// `MechanismOde::limit_correction`); both in each group's own length (`group_sigma`).
 const BASIN_FRACTION: f64 = 0.5;
 
 /// Largest move of a solution from the converged point it was predicted from, as a multiple
@@ -51,6 +51,9 @@ pub struct MechanismOde<'a> {
     max_move: f64,
     /// Evaluations that failed (Newton did not converge, or its correction was too large).
     pub failed_evaluations: usize,
+    /// The blocks of the user's chart, analysed once: the type II measure while a partition
+    /// is integrated (`charts::measure`).
+    pub inputs_sys: System,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -72,6 +75,7 @@ impl<'a> MechanismOde<'a> {
             max_correction: MAX_CORRECTION,
             max_move: f64::INFINITY,
             failed_evaluations: 0,
+            inputs_sys: System::new(mech),
             mech,
             ws,
             drives,
@@ -115,6 +119,12 @@ impl<'a> MechanismOde<'a> {
     pub fn limit_correction(&mut self, sigma: f64) {
         self.max_correction = MAX_CORRECTION.min(BASIN_FRACTION * sigma);
         self.max_move = MOVE_FRACTION * sigma;
+    }
+
+    /// Bound the move of a solution from its predictor's anchor by `max` as well (scaled, as
+    /// [`MechanismOde::limit_correction`]'s).
+    pub fn limit_move(&mut self, max: f64) {
+        self.max_move = self.max_move.min(max);
     }
 
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
@@ -205,8 +215,8 @@ impl<'a> MechanismOde<'a> {
             None => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
             Some(motion) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
         };
-        let correction = scaled_distance(&self.ws.x, &self.predicted, &self.ws.sys.col_scale);
-        let moved = scaled_distance(&self.ws.x, &self.base, &self.ws.sys.col_scale);
+        let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
+        let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
         if outcome.is_ok() && moved > self.max_move {
             outcome = Err(KinematicsError::AssemblyFailed { residual: moved, iterations: self.ws.iterations }.into());
         }

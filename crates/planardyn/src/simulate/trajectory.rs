@@ -1,6 +1,7 @@
 //! A simulation result: the trajectory computed (all of it, even when the run stopped early),
 //! why it ended, and the figures that say how far to trust it.
 
+use super::crossing::ChangePoint;
 use super::dense::DenseOutput;
 use super::events::EventRecords;
 use super::ode::MechanismOde;
@@ -108,6 +109,8 @@ pub struct Trajectory {
     pub events: EventRecords,
     /// The continuous solution over the run, when asked for (see [`super::Observe`]).
     pub dense: Option<DenseOutput>,
+    /// The change points crossed, in time order.
+    pub change_points: Vec<ChangePoint>,
     pub status: Status,
     pub message: String,
     pub stats: SimStats,

@@ -1,0 +1,105 @@
+"""Cost against size: simulate the families of benchmarks/families.py for N = 1 ... 80 and print,
+per N, the wall time per right-hand-side evaluation (as the integrator makes it, monitor included)
+and per simulated second, the integrator's counters, and the fitted log-log exponent of each cost
+against the number of bodies.
+
+    .venv/bin/python benchmarks/scaling.py                      # parallelograms and five-bars
+    .venv/bin/python benchmarks/scaling.py --family a02 --n 2 5 10 20 --t-end 0.5
+    .venv/bin/python benchmarks/scaling.py --budget 60          # skip larger N once a run takes > 60 s
+
+The parallelogram chain has the same one-coordinate motion for every N (a simple pendulum of
+1 m, families.py): each run is checked against its closed-form period.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import planardyn  # noqa: E402
+from families import FAMILIES, parallelograms, pendulum_period  # noqa: E402
+
+THETA0 = math.radians(30)
+DEFAULT_N = [1, 2, 5, 10, 20, 40, 80]
+
+
+def run(family: str, n: int, t_end: float, rtol: float, atol: float) -> dict[str, float]:
+    spec = parallelograms(n, THETA0) if family == "parallelograms" else FAMILIES[family](n)
+    mech = planardyn.from_dict(spec)
+    # Every step is an output (a stopped run's last row is where it stopped), except for the
+    # parallelograms: the start, one closed-form period and the end.
+    period = pendulum_period(THETA0)
+    times = [0.0, period, t_end] if family == "parallelograms" and period < t_end else None
+    start = time.perf_counter()
+    res = mech.simulate(t_end=t_end, rtol=rtol, atol=atol, t_eval=times)
+    wall = time.perf_counter() - start
+    st = res.stats
+    row = {
+        "N": n,
+        "bodies": len(spec["bodies"]),
+        "status": res.status,
+        "t": float(res.t[-1]),
+        "wall": wall,
+        "nfev": st["nfev"],
+        "steps": st["naccept"],
+        "rejected": st["nreject"],
+        "refused": st.get("failed_evaluations", 0),
+        "switches": st.get("chart_switches", 0),
+        "min_sigma": st.get("min_sigma", float("nan")),
+        "err": float("nan"),
+    }
+    if family == "parallelograms" and len(res.t) == 3:
+        row["err"] = abs(float(res.q[1, 0]) - (-math.pi / 2 + THETA0))
+    return row
+
+
+def slope(x: list[float], y: list[float]) -> float:
+    """Least-squares slope of log y against log x."""
+    return float(np.polyfit(np.log(x), np.log(y), 1)[0]) if len(x) > 1 else float("nan")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--family", nargs="+", default=["parallelograms", "five-bars"], choices=list(FAMILIES))
+    ap.add_argument("--n", nargs="+", type=int, default=DEFAULT_N)
+    ap.add_argument("--t-end", type=float, default=3.0, help="simulated time (s)")
+    ap.add_argument("--rtol", type=float, default=1e-9)
+    ap.add_argument("--atol", type=float, default=1e-12)
+    ap.add_argument("--budget", type=float, default=120.0, help="skip larger N after a run longer than this (s)")
+    args = ap.parse_args()
+    for family in args.family:
+        print(f"\n{family}: t_end {args.t_end} s, rtol {args.rtol:g}, atol {args.atol:g}")
+        head = "| N | bodies | status | t reached (s) | wall (s) | per eval (us) | per sim. s (ms) | nfev | steps | rejected | refused | switches | min sigma | period err (rad) |"
+        print(head)
+        print("|" + "---|" * (head.count("|") - 1))
+        rows = []
+        for n in sorted(args.n):
+            r = run(family, n, args.t_end, args.rtol, args.atol)
+            r["per_eval"] = r["wall"] / max(r["nfev"], 1) * 1e6
+            r["per_s"] = r["wall"] / max(r["t"], 1e-12) * 1e3
+            rows.append(r)
+            print(
+                f"| {r['N']} | {r['bodies']} | {r['status']} | {r['t']:.3g} | {r['wall']:.3g} | {r['per_eval']:.3g} "
+                f"| {r['per_s']:.3g} | {r['nfev']} | {r['steps']} | {r['rejected']} | {r['refused']} "
+                f"| {r['switches']} | {r['min_sigma']:.2g} | {r['err']:.1e} |",
+                flush=True,
+            )
+            if r["wall"] > args.budget:
+                print(f"(larger N skipped: {r['wall']:.0f} s > --budget {args.budget:g} s)")
+                break
+        big = [r for r in rows if r["bodies"] >= 10] or rows
+        b = [r["bodies"] for r in big]
+        print(
+            f"exponent (bodies >= 10): per evaluation {slope(b, [r['per_eval'] for r in big]):.2f}, "
+            f"per simulated second {slope(b, [r['per_s'] for r in big]):.2f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
