@@ -96,6 +96,19 @@ pub fn forward(
     ws: &mut Workspace,
 ) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
+    dynamic_stages(mech, t, z, zd, drives, ws)
+}
+
+/// The stages of [`forward`] after the kinematic ones (whose results `ws` holds): forces,
+/// A, b, zdd, xdd and the user's accelerations.
+pub fn dynamic_stages(
+    mech: &Mechanism,
+    t: f64,
+    z: &[f64],
+    zd: &[f64],
+    drives: &mut dyn Drives,
+    ws: &mut Workspace,
+) -> Result<(), Error> {
     drives.efforts(t, &ws.q, &ws.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
     if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {
         return Err(Error::Drive { t, message: format!("effort {bad} is {}", ws.tau[bad]) });

@@ -12,7 +12,7 @@ pub mod task;
 
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
-pub use forward::{forward, mass_matrix};
+pub use forward::{dynamic_stages, forward, mass_matrix};
 pub use inverse::inverse;
 pub use reactions::reactions;
 pub use regular::{finite, type_ii_measure, SINGULAR_SIGMA};

@@ -2,10 +2,10 @@
 //! y = [z, zd, W] with y' = [zd, zdd, P], where W is the work done by the non-conservative
 //! forces and P its power, so that T + V - W is constant along any exact trajectory.
 
-use crate::dynamics::{forward, Drives};
+use crate::dynamics::{dynamic_stages, forward, Drives};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{scaled_distance, Chart, System, MAX_CORRECTION};
+use crate::kinematics::{scaled_distance, Chart, ClosedForm, System, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
@@ -49,12 +49,21 @@ pub struct MechanismOde<'a> {
     /// The blocks of the user's chart, analysed once: the type II measure while a partition
     /// is integrated (`charts::measure`).
     pub inputs_sys: System,
+    /// The user's chart in closed form, where every group has one (`kinematics::closed_form`),
+    /// its branches those of the last accepted point; and whether `ws.sys` is then behind the
+    /// point in `ws` (factorised at the monitor's request only, once a step).
+    closed: Option<ClosedForm>,
+    stale_j: bool,
 }
 
 impl<'a> MechanismOde<'a> {
     /// A system whose workspace `ws` holds a converged, analysed point of chart `ws.chart`.
     pub fn new(mech: &'a Mechanism, ws: Workspace, drives: &'a mut dyn Drives) -> Self {
         let m = mech.dof();
+        let mut closed = ClosedForm::new(mech);
+        if let Some(c) = closed.as_mut() {
+            c.set_reference(&ws.x);
+        }
         MechanismOde {
             anchor_x: ws.x.clone(),
             anchor_u: ws.u.clone(),
@@ -69,6 +78,8 @@ impl<'a> MechanismOde<'a> {
             max_move: f64::INFINITY,
             failed_evaluations: 0,
             inputs_sys: System::new(mech),
+            closed,
+            stale_j: false,
             mech,
             ws,
             drives,
@@ -94,6 +105,9 @@ impl<'a> MechanismOde<'a> {
         self.anchor_u.copy_from_slice(&self.ws.u);
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
+        if let Some(c) = self.closed.as_mut() {
+            c.set_reference(&self.ws.x);
+        }
         Ok(())
     }
 
@@ -109,6 +123,17 @@ impl<'a> MechanismOde<'a> {
         self.max_move = MOVE_FRACTION * sigma;
     }
 
+    /// Factorise J at the point in `ws` if a closed-form evaluation left it behind (for the
+    /// monitor's type II measure). A singular J stays unfactorised, and the monitor then takes
+    /// the exact measure, which finds the singularity.
+    pub fn factor_stale_j(&mut self) {
+        if self.stale_j {
+            self.stale_j = false;
+            let ws = &mut self.ws;
+            let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
+        }
+    }
+
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
     pub fn restart_from_anchor(&mut self) {
         self.base_valid = false;
@@ -120,6 +145,10 @@ impl<'a> MechanismOde<'a> {
     pub fn set_chart(&mut self, chart: Chart, t: f64, y: &[f64]) -> Result<(), Error> {
         self.ws.chart = chart;
         self.anchor_x.copy_from_slice(&self.ws.x);
+        if let Some(c) = self.closed.as_mut() {
+            // A partition may have carried a dyad through its fold onto its other branch.
+            c.set_reference(&self.ws.x);
+        }
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
         self.last_t = f64::NAN;
@@ -162,15 +191,31 @@ impl<'a> MechanismOde<'a> {
     /// Forward dynamics at (t, y). A large Newton correction from the prediction fails the
     /// evaluation (the integrator then takes a shorter step), so a long step cannot carry
     /// the mechanism onto another assembly branch, however close it is (`limit_correction`).
+    /// In closed form the branches are those of the last accepted point by construction.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let m = self.m();
+        let (z, zd) = (&y[..m], &y[m..2 * m]);
         self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
-        self.predict(&y[..m]);
-        self.predicted.copy_from_slice(&self.ws.x);
         self.last_t = f64::NAN;
         self.base_valid = false;
-        let mut outcome = forward(self.mech, t, &y[..m], &y[m..2 * m], self.drives, &mut self.ws);
-        let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
+        let closed = if self.ws.chart == Chart::Inputs { self.closed.as_ref() } else { None };
+        let newton = closed.is_none();
+        let mut outcome = match closed {
+            Some(c) => {
+                self.stale_j = true;
+                c.kinematic_stages(z, zd, &mut self.ws)
+                    .map_err(Error::from)
+                    .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws))
+            }
+            None => {
+                self.predict(z);
+                self.predicted.copy_from_slice(&self.ws.x);
+                self.stale_j = false;
+                forward(self.mech, t, z, zd, self.drives, &mut self.ws)
+            }
+        };
+        let correction =
+            if newton { scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale()) } else { 0.0 };
         let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
         if outcome.is_ok() && moved > self.max_move {
             outcome = Err(KinematicsError::AssemblyFailed { residual: moved, iterations: self.ws.iterations }.into());
