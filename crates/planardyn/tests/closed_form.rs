@@ -184,7 +184,7 @@ fn reports_coordinates_where_a_dyad_does_not_assemble() {
     // Five-bar cranks turned apart until the dyad's two links cannot reach: no configuration,
     // the error a Newton solve that does not converge gives, never NaN positions.
     let mech = planardyn::load(root().join("examples/models/five-bar.yaml").to_str().unwrap()).unwrap();
-    let cf = ClosedForm::new(&mech).unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
     let mut ws = Workspace::new(&mech);
     let (q0, qd0) = mech.initial_state();
     let apart = [q0[0] + 1.5, q0[1] - 1.5];

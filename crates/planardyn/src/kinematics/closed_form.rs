@@ -8,8 +8,9 @@
 //! Other mechanisms (prismatic, gear and slot pairs, class III groups and up, relative inputs,
 //! redundant pairs) take the general path (`position`, `analogues`).
 
+use super::analogues::body_rates;
 use super::dyads::crank::Crank;
-use super::dyads::rrr::{Branch, Rrr};
+use super::dyads::rrr::{Branch, Geometry, Rrr};
 use super::dyads::Joint;
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::structure::assur;
@@ -20,8 +21,10 @@ use crate::KinematicsError;
 pub struct ClosedForm {
     cranks: Vec<Crank>,
     dyads: Vec<Rrr>,
-    /// Per dyad, the branch of the reference configuration.
+    /// Per dyad, the branch of the reference configuration, and its geometry at the last
+    /// positions (for the rates and accelerations).
     branches: Vec<Branch>,
+    geometry: Vec<Geometry>,
 }
 
 /// The end of a revolute pair on `body` (its point there) and the other end.
@@ -79,7 +82,7 @@ impl ClosedForm {
             let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
             let (i1, _) = ends(mech, *inner, bodies[0]);
             let (i2, _) = ends(mech, *inner, bodies[1]);
-            dyads.push(Rrr { bodies, outer: [a, b], s_outer: [s1, s2], s_inner: [i1, i2] });
+            dyads.push(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]));
             pairs_used += 3;
         }
         let mut solved = vec![0; mech.n_bodies()];
@@ -88,7 +91,7 @@ impl ClosedForm {
             return None;
         }
         let branches = dyads.iter().map(|d| d.branch(&mech.x0)).collect();
-        Some(ClosedForm { cranks, dyads, branches })
+        Some(ClosedForm { cranks, geometry: vec![Geometry::default(); dyads.len()], dyads, branches })
     }
 
     /// Take the assembly branches from the configuration x (a solution).
@@ -99,12 +102,12 @@ impl ClosedForm {
     }
 
     /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.
-    pub fn positions(&self, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    pub fn positions(&mut self, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
         for c in &self.cranks {
             c.position(z, &mut ws.x, &mut ws.trig);
         }
-        for (d, b) in self.dyads.iter().zip(&self.branches) {
-            d.position(b, &mut ws.x, &mut ws.trig)?;
+        for ((d, b), g) in self.dyads.iter().zip(&self.branches).zip(&mut self.geometry) {
+            *g = d.position(b, &mut ws.x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -112,12 +115,12 @@ impl ClosedForm {
     }
 
     /// Body rates for coordinate rates zd into v (3n), at the positions in `ws`.
-    fn rates(&self, ws: &Workspace, zd: &[f64], v: &mut [f64]) {
+    fn rates(&self, trig: &[[f64; 2]], zd: &[f64], v: &mut [f64]) {
         for c in &self.cranks {
-            c.velocity(&ws.trig, zd, v);
+            c.velocity(trig, zd, v);
         }
-        for d in &self.dyads {
-            d.velocity(&ws.x, &ws.trig, v);
+        for (d, g) in self.dyads.iter().zip(&self.geometry) {
+            d.velocity(g, v);
         }
     }
 
@@ -129,28 +132,27 @@ impl ClosedForm {
         unit[..m].fill(0.0);
         for j in 0..m {
             unit[j] = 1.0;
-            self.rates(ws, &unit[..m], &mut u[j * n..(j + 1) * n]);
+            self.rates(&ws.trig, &unit[..m], &mut u[j * n..(j + 1) * n]);
             unit[j] = 0.0;
         }
         (ws.u, ws.rhs) = (u, unit);
     }
 
-    /// Body rates `ws.xd` for zd and the convective term `ws.c` (accelerations at zdd = 0).
+    /// Body rates `ws.xd` = U zd and the convective term `ws.c` (accelerations at zdd = 0),
+    /// from `ws.u`.
     pub fn convective(&self, zd: &[f64], ws: &mut Workspace) {
-        let (mut xd, mut c) = (std::mem::take(&mut ws.xd), std::mem::take(&mut ws.c));
-        self.rates(ws, zd, &mut xd);
+        body_rates(zd, ws);
         for k in &self.cranks {
-            k.acceleration(&ws.trig, &xd, &mut c);
+            k.acceleration(&ws.trig, &ws.xd, &mut ws.c);
         }
-        for d in &self.dyads {
-            d.acceleration(&ws.x, &ws.trig, &xd, &mut c);
+        for (d, g) in self.dyads.iter().zip(&self.geometry) {
+            d.acceleration(g, &ws.xd, &mut ws.c);
         }
-        (ws.xd, ws.c) = (xd, c);
     }
 
     /// Positions, analogues and the convective term at (z, zd) in the user's chart, and the
     /// user's coordinates q = z, qd = zd: what `dynamics::kinematic_stages` computes there.
-    pub fn kinematic_stages(&self, z: &[f64], zd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
         self.positions(z, ws)?;
         self.velocity_analogues(ws);
         self.convective(zd, ws);

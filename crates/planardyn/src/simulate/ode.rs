@@ -191,38 +191,34 @@ impl<'a> MechanismOde<'a> {
     /// Forward dynamics at (t, y). A large Newton correction from the prediction fails the
     /// evaluation (the integrator then takes a shorter step), so a long step cannot carry
     /// the mechanism onto another assembly branch, however close it is (`limit_correction`).
-    /// In closed form the branches are those of the last accepted point by construction.
+    /// In closed form the branches are those of the last accepted point by construction, and
+    /// neither bound applies.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let m = self.m();
         let (z, zd) = (&y[..m], &y[m..2 * m]);
-        self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
+        let newton = self.closed.is_none() || self.ws.chart != Chart::Inputs;
+        if newton {
+            self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
+            self.predict(z);
+            self.predicted.copy_from_slice(&self.ws.x);
+        }
         self.last_t = f64::NAN;
         self.base_valid = false;
-        let closed = if self.ws.chart == Chart::Inputs { self.closed.as_ref() } else { None };
-        let newton = closed.is_none();
-        let mut outcome = match closed {
-            Some(c) => {
-                self.stale_j = true;
-                c.kinematic_stages(z, zd, &mut self.ws)
-                    .map_err(Error::from)
-                    .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws))
-            }
-            None => {
-                self.predict(z);
-                self.predicted.copy_from_slice(&self.ws.x);
-                self.stale_j = false;
-                forward(self.mech, t, z, zd, self.drives, &mut self.ws)
-            }
+        self.stale_j = !newton;
+        let mut outcome = match self.closed.as_mut().filter(|_| !newton) {
+            Some(c) => c
+                .kinematic_stages(z, zd, &mut self.ws)
+                .map_err(Error::from)
+                .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws)),
+            None => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
         };
-        let correction =
-            if newton { scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale()) } else { 0.0 };
-        let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
-        if outcome.is_ok() && moved > self.max_move {
-            outcome = Err(KinematicsError::AssemblyFailed { residual: moved, iterations: self.ws.iterations }.into());
-        }
-        if outcome.is_ok() && correction > self.max_correction {
-            outcome =
-                Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
+        if newton && outcome.is_ok() {
+            let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
+            let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
+            let residual = if moved > self.max_move { moved } else { correction };
+            if moved > self.max_move || correction > self.max_correction {
+                outcome = Err(KinematicsError::AssemblyFailed { residual, iterations: self.ws.iterations }.into());
+            }
         }
         if outcome.is_err() {
             self.failed_evaluations += 1;

@@ -7,7 +7,7 @@
 pub mod crank;
 pub mod rrr;
 
-use super::pairs::frames::{perp, rot};
+use super::pairs::frames::rot;
 use crate::model::Link;
 
 /// A point fixed in a link: the link and the point in its frame (m).
@@ -44,21 +44,20 @@ impl Joint {
         ([r[0] + p[0], r[1] + p[1]], p)
     }
 
-    /// Velocity of the point for rates v: r' + w E R s.
+    /// Velocity of the point for rates v, given R s (`place`): r' + w E R s.
     #[inline]
-    pub(crate) fn velocity(&self, x: &[f64], trig: &[[f64; 2]], v: &[f64]) -> [f64; 2] {
-        let p = perp(self.place(x, trig).1);
+    pub(crate) fn velocity(&self, rs: [f64; 2], v: &[f64]) -> [f64; 2] {
         let (rd, w) = rate(self.link, v);
-        [rd[0] + w * p[0], rd[1] + w * p[1]]
+        [rd[0] - w * rs[1], rd[1] + w * rs[0]]
     }
 
-    /// Acceleration of the point for rates v and accelerations a: r'' + al E R s - w^2 R s.
+    /// Acceleration of the point for rates v and accelerations a, given R s:
+    /// r'' + al E R s - w^2 R s.
     #[inline]
-    pub(crate) fn acceleration(&self, x: &[f64], trig: &[[f64; 2]], v: &[f64], a: &[f64]) -> [f64; 2] {
-        let p = self.place(x, trig).1;
+    pub(crate) fn acceleration(&self, rs: [f64; 2], v: &[f64], a: &[f64]) -> [f64; 2] {
         let (_, w) = rate(self.link, v);
         let (rdd, al) = rate(self.link, a);
-        [rdd[0] - al * p[1] - w * w * p[0], rdd[1] + al * p[0] - w * w * p[1]]
+        [rdd[0] - al * rs[1] - w * w * rs[0], rdd[1] + al * rs[0] - w * w * rs[1]]
     }
 }
 
