@@ -142,11 +142,18 @@ impl ClosedForm {
     /// from `ws.u`.
     pub fn convective(&self, zd: &[f64], ws: &mut Workspace) {
         body_rates(zd, ws);
+        self.accelerations(&ws.trig, &ws.xd, &mut ws.c);
+    }
+
+    /// Body accelerations `a` at zero coordinate accelerations for body rates v (3n, a velocity
+    /// of the mechanism), at the last positions (`trig` theirs): the convective term for v,
+    /// -J^-1 gamma(v, v).
+    pub fn accelerations(&self, trig: &[[f64; 2]], v: &[f64], a: &mut [f64]) {
         for k in &self.cranks {
-            k.acceleration(&ws.trig, &ws.xd, &mut ws.c);
+            k.acceleration(trig, v, a);
         }
         for (d, g) in self.dyads.iter().zip(&self.geometry) {
-            d.acceleration(g, &ws.xd, &mut ws.c);
+            d.acceleration(g, v, a);
         }
     }
 

@@ -158,8 +158,9 @@ impl<'a> MechanismOde<'a> {
 
     /// Newton's start for chart values z: a second-order prediction
     /// x + U dz + 1/2 w(dz, dz) from the last evaluation when it succeeded (its x, U and
-    /// factorised J are still in `ws`; w(dz, dz) costs one solve), else a first-order one
-    /// from the last accepted point. Both start from converged points of the same branch.
+    /// factorised J are still in `ws`; w(dz, dz) costs one solve, or the closed forms'
+    /// accelerations for the rates U dz), else a first-order one from the last accepted point.
+    /// Both start from converged points of the same branch.
     fn predict(&mut self, z: &[f64]) {
         let m = self.m();
         let n = self.ws.x.len();
@@ -172,8 +173,16 @@ impl<'a> MechanismOde<'a> {
                     *d += u * dz;
                 }
             }
-            gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
-            ws.sys.solve(&mut ws.tmp);
+            match self.closed.as_ref().filter(|_| ws.chart == Chart::Inputs) {
+                Some(c) => {
+                    c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
+                    ws.tmp.iter_mut().for_each(|w| *w = -*w);
+                }
+                None => {
+                    gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
+                    ws.sys.solve(&mut ws.tmp);
+                }
+            }
             for ((x, d), w) in ws.x.iter_mut().zip(&ws.rhs).zip(&ws.tmp) {
                 *x += d - 0.5 * w;
             }
@@ -191,17 +200,17 @@ impl<'a> MechanismOde<'a> {
     /// Forward dynamics at (t, y). A large Newton correction from the prediction fails the
     /// evaluation (the integrator then takes a shorter step), so a long step cannot carry
     /// the mechanism onto another assembly branch, however close it is (`limit_correction`).
-    /// In closed form the branches are those of the last accepted point by construction, and
-    /// neither bound applies.
+    /// In closed form the solution is that of the last accepted point's branches, and the same
+    /// bounds refuse a step along which the predictor fails (near a fold, where the passive
+    /// motion may leave that branch): the integrator then shortens it, and the monitor moves
+    /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let m = self.m();
         let (z, zd) = (&y[..m], &y[m..2 * m]);
+        self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
+        self.predict(z);
+        self.predicted.copy_from_slice(&self.ws.x);
         let newton = self.closed.is_none() || self.ws.chart != Chart::Inputs;
-        if newton {
-            self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
-            self.predict(z);
-            self.predicted.copy_from_slice(&self.ws.x);
-        }
         self.last_t = f64::NAN;
         self.base_valid = false;
         self.stale_j = !newton;
@@ -212,7 +221,7 @@ impl<'a> MechanismOde<'a> {
                 .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws)),
             None => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
         };
-        if newton && outcome.is_ok() {
+        if outcome.is_ok() {
             let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
             let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
             let residual = if moved > self.max_move { moved } else { correction };
