@@ -469,14 +469,18 @@ def test_result_table(four_bar, tmp_path):
     assert len(res) == 4
     cols = ["t", "theta", "qd_theta", "qdd_theta", "tau_theta", "kinetic", "potential", "work", "sigma"]
     df = res.to_dataframe()
-    assert list(df.columns) == cols and len(df) == 4
+    assert df.index.name == "t" and list(df.columns) == [*cols[1:], "power_theta"] and len(df) == 4
     np.testing.assert_array_equal(df["theta"].to_numpy(), res.q[:, 0])
-    path = tmp_path / "r.csv"
-    res.to_csv(path)
-    lines = path.read_text().splitlines()
-    assert lines[0].split(",") == cols and len(lines) == 5
-    back = np.loadtxt(path, delimiter=",", skiprows=1)
-    np.testing.assert_array_equal(back[:, 1], res.q[:, 0])  # full precision
+    # to_csv and save write the results file that read_results, plot and animate read.
+    path = res.to_csv(tmp_path / "r.txt")
+    rows = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    assert rows[0].split(",")[: len(cols) + 2] == [*cols, "residual", "partitioned"] and len(rows) == 5
+    back = pd.read_results(res.save(tmp_path / "r.csv"))
+    for name in ("t", "q", "qd", "qdd", "tau", "x", "xd", "sigma"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(res, name))  # full precision
+    assert back.metadata["settings"] == res.metadata["settings"]
+    with pytest.raises(ValueError, match="unknown results format '.txt'"):
+        res.save(tmp_path / "r.txt")
     assert "status='success'" in repr(res) and "N=4" in repr(res)
     assert set(res.stats) >= {"nfev", "naccept", "nreject", "min_sigma", "energy_drift", "max_residual"}
 

@@ -6,6 +6,9 @@ monte_carlo make the variants they say."""
 from __future__ import annotations
 
 import math
+import os
+import signal
+import threading
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -13,7 +16,7 @@ import planardyn as pd
 import pytest
 from conftest import MODELS
 from planardyn import robot
-from planardyn.batch import BatchError, inverse_dynamics, monte_carlo, simulate, sweep
+from planardyn.batch import BatchError, BatchInterrupted, inverse_dynamics, monte_carlo, simulate, sweep
 
 T_END = 0.1  # s: short runs, the test is about bookkeeping, not dynamics
 # Proximal links straight out: C1 C2 = 0.8 m > 2 x 0.35 m, the distal links cannot meet.
@@ -217,3 +220,44 @@ def test_monte_carlo_is_seeded(five_bar):
     assert ms == again
     assert [m.masses[0] for m in ms] == values["bodies.proximal_left.mass"].tolist()
     assert [m.gravity[1] for m in ms] == values["gravity.1"].tolist()
+
+
+def test_ctrl_c_keeps_the_variants_finished_and_stops_the_rest():
+    # Six 1e4 s four-bar runs (over a minute of work each) on 2 threads and a real SIGINT
+    # 0.3 s in: the binding checks for Ctrl-C every 0.1 s while the pool works, the two
+    # runs under way stop at their next step with what they have, the four not started are
+    # not run, and the interrupt goes on (a KeyboardInterrupt) carrying them all.
+    mech = pd.load_example("four-bar-gravity")
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(BatchInterrupted) as caught:
+        simulate([mech] * 6, t_end=1e4, output_dt=0.1, threads=2)
+    timer.join()
+    results = caught.value.results
+    assert isinstance(caught.value, KeyboardInterrupt) and len(results) == 6
+    runs = [r for r in results if isinstance(r, pd.SimulationResult)]
+    assert len(runs) == 2
+    for r in runs:
+        assert r.status == "cancelled" and "Ctrl-C" in r.message and 0 < r.t[-1] < 1e3
+        assert np.isfinite(r.q).all() and np.allclose(np.diff(r.t[:-1]), 0.1, rtol=1e-9)
+    assert [r.type for r in results if isinstance(r, BatchError)] == ["Cancelled"] * 4
+
+
+def test_batch_motions_equal_mechanism_simulate(five_bar):
+    # Speeds and tables by coordinate name, common or per variant, run without Python in the
+    # loop and equal, bit for bit, mech.simulate with the same motion; the metadata reruns.
+    table = {"t": [0.0, 0.1, 0.2, 0.3], "q": [1.0, 1.05, 1.08, 1.2]}
+    variants = [five_bar, (five_bar, {"motion": {"theta2": table}})]
+    out = simulate(variants, t_end=0.3, output_dt=0.05, motion={"theta1": 2.0})
+    for r, motion in zip(out, [{"theta1": 2.0}, {"theta2": table}]):
+        assert r.success, r
+        alone = five_bar.simulate(t_end=0.3, output_dt=0.05, motion=motion)
+        np.testing.assert_array_equal(r.q, alone.q)
+        np.testing.assert_array_equal(r.tau, alone.tau)
+        assert r.metadata["settings"]["motion"] == motion
+        rerun = five_bar.simulate(**r.metadata["settings"])
+        np.testing.assert_array_equal(rerun.q, r.q)
+    # The first coordinate turns at 2 rad/s from its start.
+    np.testing.assert_allclose(out[0].q[:, 0], five_bar.q0[0] + 2.0 * out[0].t, rtol=0, atol=1e-12)
+    bad = simulate([(five_bar, {"motion": {"theta1": lambda t: (0.0, 0.0, 0.0)}})], t_end=0.1)
+    assert isinstance(bad[0], BatchError) and "speeds or tables" in bad[0].message

@@ -6,12 +6,14 @@ Exit status: 0 success, 1 the computation failed, 2 usage or model error (cli.py
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import re
 import subprocess
 import sys
 
 import numpy as np
+import planardyn as pd
 import pytest
 import yaml
 from conftest import MODELS, four_bar_dict
@@ -144,19 +146,6 @@ def test_bad_option_exit_2(tmp_path):
     assert p.returncode == 2
 
 
-def test_demo_writes_plots_animation_and_viewer(tmp_path):
-    p = run("demo", "--out", tmp_path / "demo")
-    assert p.returncode == 0, p.stderr
-    for name in ("coordinates.png", "efforts.png", "torque-speed.png", "energy.png", "mechanism.png",
-                 "results.csv", "animation.gif", "viewer.html"):
-        f = tmp_path / "demo" / name
-        assert f.is_file() and f.stat().st_size > 1000, name
-    with Image.open(tmp_path / "demo" / "animation.gif") as im:
-        assert im.n_frames == 61  # 1.5 s shown in 3 s at 20 frames/s
-    assert "viewer.html in a browser" in p.stdout
-    assert read_results(tmp_path / "demo" / "results.csv").t[-1] == 1.5
-
-
 # ------------------------------------------------------------------ the other commands
 
 FIVE_BAR = MODELS / "five-bar.yaml"
@@ -244,6 +233,18 @@ def test_plot_and_animate(tmp_path):
     p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.html", "--channel", "tau_theta2")
     assert p.returncode == 0, p.stderr
     assert '"key":"tau_theta2"' in (tmp_path / "a.html").read_text()
+    # The model is in the results file: it is enough alone, and gives the same frames.
+    p = run("animate", sim, "-o", tmp_path / "b.gif", "--fps", "10", "--speed", "0.1")
+    assert p.returncode == 0, p.stderr
+    with Image.open(tmp_path / "a.gif") as a, Image.open(tmp_path / "b.gif") as b:
+        assert a.n_frames == b.n_frames and np.array_equal(np.asarray(a.convert("L")), np.asarray(b.convert("L")))
+
+
+def test_animate_without_a_model_in_the_file_asks_for_it(tmp_path):
+    res = pd.load_example("five-bar").simulate(t_end=0.05)
+    bare = dataclasses.replace(res, metadata={}).save(tmp_path / "bare.npz")
+    p = run("animate", bare, "-o", tmp_path / "a.gif")
+    assert p.returncode == 2 and "does not hold its model" in p.stderr and "planardyn animate MODEL" in p.stderr
 
 
 def test_plot_and_animate_errors(tmp_path):

@@ -1,24 +1,22 @@
 """The user guide works as written: every ```python block of README.md and docs/*.md runs
 (the blocks of a page in order, in one namespace), and every `planardyn ...` line of their
 ```bash blocks runs with exit status 0, interleaved in page order, in an empty folder where
-`examples/` is the repository's. `planardyn demo` is left to test_cli (it takes seconds).
+`examples/` is the repository's. `planardyn demo` is left to test_demo (it takes seconds).
 The site builds with `mkdocs build --strict` when mkdocs is installed.
 """
 
 from __future__ import annotations
 
-import re
 import subprocess
 import sys
 import textwrap
 
 import pytest
 from conftest import ROOT
+from wheel_smoke import snippets
 
 DOCS = ROOT / "docs"
 PAGES = [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]
-BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.S | re.M)
-SKIPPED_COMMANDS = ("planardyn demo",)
 
 PRELUDE = textwrap.dedent(
     """
@@ -37,18 +35,9 @@ PRELUDE = textwrap.dedent(
 
 def page_script(page) -> tuple[str, int]:
     """The page as one Python script, and the number of blocks and commands in it."""
-    parts, n = [PRELUDE], 0
-    for lang, body in BLOCK.findall(page.read_text()):
-        if lang == "python":
-            parts.append(body)
-            n += 1
-        elif lang == "bash":
-            for line in body.splitlines():
-                cmd = line.split("#")[0].strip()
-                if cmd.startswith("planardyn ") and not cmd.startswith(SKIPPED_COMMANDS):
-                    parts.append(f"_planardyn({cmd!r})")
-                    n += 1
-    return "\n".join(parts), n
+    code = snippets(page.read_text())
+    parts = [PRELUDE] + [text if kind == "python" else f"_planardyn({text!r})" for kind, text in code]
+    return "\n".join(parts), len(code)
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)

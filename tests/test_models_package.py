@@ -10,11 +10,12 @@ from __future__ import annotations
 import ast
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import planardyn as pd
 import pytest
-from planardyn import cli, models
+from planardyn import demo, models
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -83,6 +84,26 @@ def test_models_imports_nothing_of_the_package():
     assert imported == []
 
 
-def test_demo_runs_a_shipped_model():
-    """`planardyn demo` finds its model in the package, not relative to a source tree."""
-    assert cli.DEMO_MODEL in models.names()
+def test_demo_runs_shipped_models():
+    """`planardyn demo` finds its models in the package, not relative to a source tree."""
+    assert {demo.ROBOT_MODEL, demo.PASSIVE_MODEL} <= set(models.names())
+
+
+def test_resolve_takes_a_file_first_then_a_shipped_name(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert models.resolve("five-bar") == models.path("five-bar")
+    assert models.resolve("library/four-bar") == models.path("library/four-bar")
+    (tmp_path / "five-bar").write_text("name: mine\n")  # a file of that name wins
+    assert models.resolve("five-bar") == Path("five-bar")
+    assert models.resolve("missing.json") == Path("missing.json")  # for the loader to report
+    with pytest.raises(models.UnknownModelError, match=r"^fivebar: no such model file, and no shipped model"):
+        models.resolve("fivebar")
+
+
+def test_cli_takes_shipped_names(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "planardyn", "check", "five-bar"], capture_output=True, text=True,
+                       cwd=tmp_path)
+    assert p.returncode == 0 and p.stdout.startswith("model: five-bar 5R robot"), p.stderr
+    p = subprocess.run([sys.executable, "-m", "planardyn", "check", "fivebar"], capture_output=True, text=True,
+                       cwd=tmp_path)
+    assert p.returncode == 2 and "no shipped model is named 'fivebar'" in p.stderr and "five-bar-free-fall" in p.stderr

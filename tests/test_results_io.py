@@ -71,7 +71,8 @@ def test_round_trip_every_array_equal(five_bar_run, tmp_path, ext):
     assert meta["model"] == mech.to_dict()
     assert pd.from_result(back) == mech
     df = back.to_dataframe()
-    assert list(df.columns[:3]) == ["t", "theta1", "theta2"]
+    assert df.index.name == "t" and list(df.columns[:2]) == ["theta1", "theta2"]
+    np.testing.assert_array_equal(df.index.to_numpy(), res.t)
     np.testing.assert_array_equal(df["tau_theta2"].to_numpy(), res.tau[:, 1])
 
 

@@ -112,9 +112,10 @@ def test_ctrl_c_keeps_the_run_as_a_cancelled_file(tmp_path, monkeypatch):
     back = read_results(out)
     assert back.status == "cancelled" and not back.success and "Ctrl-C" in back.message
     # Stopped at the first progress call (t = 1% of 5000 s, just past 50 s), far before
-    # 5000 s, with every output row up to there (one every 0.5 s from 0).
-    assert back.t[-1] == 50.0
-    assert np.allclose(back.t, 0.5 * np.arange(len(back.t)), rtol=0, atol=1e-9)
+    # 5000 s, with every output row up to there (one every 0.5 s from 0), then the last
+    # accepted state (the step that passed 50 s).
+    assert back.t[-2] == 50.0 and 50.0 < back.t[-1] < 50.5
+    assert np.allclose(back.t[:-1], 0.5 * np.arange(len(back.t) - 1), rtol=0, atol=1e-9)
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
@@ -225,3 +226,15 @@ def test_damaged_integrity_key_does_not_switch_the_check_off(run_5bar, tmp_path)
     head = "".join(f"# {ln}\n" for ln in json.dumps(meta, indent=1).splitlines())
     path.write_text(head + "".join(ln for ln in lines if not ln.startswith("#")))
     assert np.array_equal(read_results(path).q, res.q)
+
+
+def test_api_run_that_cannot_fit_is_refused_up_front(monkeypatch):
+    """The same rule in Mechanism.simulate: 10001 rows of 305 B, 4 times over, exceed 10 MiB;
+    10000 t_eval rows (12.2 MB) too; 1001 rows (1.2 MB) run."""
+    mech = pd.load(FIVE_BAR)
+    monkeypatch.setattr(pd.mechanism, "available_memory", lambda: 10 * 2**20)
+    with pytest.raises(ValueError, match="output rows need about 0.0114 GiB.*larger output_dt"):
+        mech.simulate(t_end=10.0, output_dt=0.001)
+    with pytest.raises(ValueError, match="fewer t_eval"):
+        mech.simulate(t_end=1.0, t_eval=np.linspace(0.0, 1.0, 10_000))
+    assert mech.simulate(t_end=0.01, output_dt=1e-5).success

@@ -65,8 +65,13 @@ def test_circle_and_table_paths_have_exact_derivatives():
     assert np.linalg.norm(Xd[0]) == pytest.approx(0.05 * w)
     assert np.linalg.norm(Xdd[0]) == pytest.approx(0.05 * w**2)
     tt = np.linspace(0, 1, 11)
-    tab = robot.table(tt, np.column_stack([tt**2, tt]))  # clamped ends: not x = t^2 exactly
+    tab = robot.table(tt, np.column_stack([tt**2, tt]))  # not-a-knot ends: x = t^2 exactly
     assert tab.duration == 1.0 and tab.sample(0.5)[0].shape == (1, 2)
+    # Not-a-knot cubic splines reproduce any cubic, so x = t^2 and its derivatives to round-off.
+    X, Xd, Xdd = tab.sample(np.array([0.0, 0.55, 1.0]))
+    np.testing.assert_allclose(X[:, 0], [0.0, 0.3025, 1.0], atol=1e-14)
+    np.testing.assert_allclose(Xd, [[0.0, 1.0], [1.1, 1.0], [2.0, 1.0]], atol=1e-12)
+    np.testing.assert_allclose(Xdd, [[2.0, 0.0]] * 3, atol=1e-10)
 
 
 @pytest.mark.parametrize("which", ["five", "rrr"])
@@ -188,3 +193,51 @@ def test_size_cli(tmp_path, capsys):
     assert "type II" in capsys.readouterr().err
     assert robot.size_cli([str(tmp_path / "missing.yaml"), "--line", "0", "0", "1", "1"]) == 2
     assert robot.size_cli([model]) == 2
+
+
+def test_a_formula_path_and_its_table_agree_at_the_ends(five):
+    # A motion that starts and ends moving: X = home + r (sin w t, 1 - cos w t), one turn of
+    # a circle at constant speed r w = 0.19 m/s. As functions its derivatives are exact; a
+    # table of 201 samples with the default (not-a-knot) ends gives the same efforts to the
+    # spline's h^2 accuracy, where clamped ends (the former default) invent a stop at t = 0
+    # and t = 1 and are off by orders of magnitude there.
+    home, r, w = five.home()[:2], 0.03, 2 * np.pi
+
+    def X(t):
+        return home + r * np.column_stack([np.sin(w * t), 1 - np.cos(w * t)])
+
+    def Xd(t):
+        return r * w * np.column_stack([np.cos(w * t), np.sin(w * t)])
+
+    def Xdd(t):
+        return r * w * w * np.column_stack([-np.sin(w * t), np.cos(w * t)])
+
+    exact = robot.solve_motion(five, robot.from_functions(X, Xd, Xdd, 1.0), dt=5e-3)
+    tt = np.linspace(0.0, 1.0, 201)
+    tab = robot.solve_motion(five, robot.table(tt, X(tt)), dt=5e-3)
+    clamped = robot.solve_motion(five, robot.table(tt, X(tt), bc_type="clamped"), dt=5e-3)
+    scale = np.abs(exact.tau).max()
+    ends = [0, -1]
+    # Cubic spline with h = 5 ms: the acceleration's error ~ h^2 |X''''| / 12 = 1e-4 m/s^2
+    # against r w^2 = 1.2 m/s^2, so ~1e-4 of the efforts (measured 3.4e-5); clamped ends
+    # were off by 5.7 times the largest effort.
+    assert np.abs(tab.tau - exact.tau).max() < 2e-4 * scale
+    assert np.abs(clamped.tau[ends] - exact.tau[ends]).max() > 1.0 * scale
+
+
+def test_formula_derivatives_are_checked(five):
+    home = five.home()[:2]
+
+    def X(t):
+        return home + 0.02 * np.column_stack([np.sin(t), t])
+
+    def Xd(t):
+        return 0.02 * np.column_stack([-np.cos(t), np.ones_like(t)])  # wrong sign
+
+    def Xdd(t):
+        return 0.02 * np.column_stack([-np.sin(t), np.zeros_like(t)])
+
+    with pytest.raises(ValueError, match="Xd.t. is not the time derivative"):
+        robot.from_functions(X, Xd, Xdd, 1.0)
+    with pytest.raises(ValueError, match="shape"):
+        robot.from_functions(lambda t: np.zeros(len(t)), Xd, Xdd, 1.0)

@@ -24,7 +24,7 @@ from conftest import MODELS
 from PIL import Image
 from planardyn.notebook import mechanism_html, mechanism_svg, register_display, result_html, viewer
 from planardyn.results_io import attach_metadata
-from planardyn.viewer import viewer_data, viewer_html, write_viewer
+from planardyn.viewer import DIGITS, viewer_data, viewer_html, write_viewer
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 needs_browser = pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (./dev installs it as root)")
@@ -201,3 +201,25 @@ def test_register_display_hands_both_views_to_ipython(five_bar):
     assert printers == {pd.Mechanism: mechanism_html, pd.SimulationResult: result_html}
     assert printers[type(mech)](mech).startswith('<div style="display:flex')
     assert register_display() is False  # no running IPython shell under pytest: nothing to do
+
+
+def test_viewer_has_pair_forces_and_point_motion_channels(five_bar):
+    # Each pair's force magnitude and each traced point's speed and acceleration, computed
+    # along the frames kept (each on its own branch): the values are those of
+    # mech.reactions(res) and mech.point_motion(res), rounded to the page's DIGITS (6)
+    # significant digits of each channel's largest value: within half a unit of that digit.
+    mech, res = five_bar
+    data = viewer_data(mech, res, channels=["F_elbow1", "v_P"])
+    chans = {c["key"]: c for c in data["channels"]}
+    assert {g["key"] for g in data["groups"]} >= {"reactions", "speeds", "point_accelerations"}
+    assert {f"F_{p}" for p in mech.pair_names} | {"v_P", "a_P"} <= set(chans)
+    assert chans["F_elbow1"]["on"] and chans["v_P"]["on"] and not chans["a_P"]["on"]
+    f = mech.reactions(res)[:, mech.pair_names.index("elbow1"), :2]
+    def half_unit(v):
+        return 0.5 * 10.0 ** (np.floor(np.log10(v.max())) - (DIGITS - 1))
+
+    force = np.hypot(*f.T)
+    np.testing.assert_allclose(chans["F_elbow1"]["values"], force, rtol=0, atol=half_unit(force))
+    v = mech.point_motion(res)["P"][1]
+    speed = np.hypot(*v.T)
+    np.testing.assert_allclose(chans["v_P"]["values"], speed, rtol=0, atol=half_unit(speed))

@@ -28,16 +28,18 @@ from ._core import (
     __version__,
 )
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
-from .result import Energy, SimulationInterrupted, SimulationResult
+from .result import ChangePoint, Energy, PointMotion, SimulationInterrupted, SimulationResult
 from .results_io import read_results
 
 __all__ = [
     "AssemblyError",
+    "ChangePoint",
     "Energy",
     "Mechanism",
     "ModelError",
     "PlanardynError",
     "PlanardynWarning",
+    "PointMotion",
     "SimulationError",
     "SimulationInterrupted",
     "SimulationResult",

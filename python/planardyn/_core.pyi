@@ -132,6 +132,26 @@ class Mechanism:
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
+    def regressor(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    @property
+    def parameters(self) -> tuple[list[float], list[str]]: ...
+    def along(
+        self,
+        t: ArrayLike,
+        x: ArrayLike,
+        q: ArrayLike,
+        qd: ArrayLike,
+        tau: ArrayLike,
+        allow_singular: bool = False,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    def point_motion(self, x: ArrayLike, xd: ArrayLike, xdd: ArrayLike) -> dict[str, Any]: ...
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]: ...
     def simulate(
         self,
@@ -147,6 +167,7 @@ class Mechanism:
         drives: Callable[[float, NDArray[np.float64], NDArray[np.float64]], ArrayLike] | None = None,
         progress: Callable[[float], Any] | None = None,
         max_steps: int | None = None,
+        motion: list[tuple[int, float | tuple[list[float], list[float]] | Callable[[float], Any]]] | None = None,
     ) -> dict[str, Any]: ...
 
 @final

@@ -9,6 +9,7 @@ and the time.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -106,6 +107,12 @@ def render_frames(
         yield np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
 
 
+def _reporting(frames: Iterable[Any], total: int, progress: Callable[[int, int], Any]) -> Iterator[Any]:
+    for done, frame in enumerate(frames, 1):
+        yield frame
+        progress(done, total)
+
+
 def write_gif(frames, path: Path, fps: float) -> int:
     """Encode RGB frames as a looping GIF with Pillow. Returns the number of frames."""
     from PIL import Image
@@ -151,6 +158,7 @@ def animate(
     traces: list[str] | None = None,
     labels: bool = True,
     max_frames: int = MAX_FRAMES,
+    progress: Callable[[int, int], Any] | None = None,
     **viewer_kw: Any,
 ) -> Path:
     """Write an animation of ``result``: ``.gif``, ``.mp4`` or ``.html`` (the interactive
@@ -167,6 +175,8 @@ def animate(
         Width and height in pixels (multiples of 16 for MP4).
     traces : list of str
         Points whose paths are drawn (default :func:`planardyn.plot.default_trace_points`).
+    progress : callable, optional
+        GIF and MP4: ``progress(done, total)`` after each frame is drawn (frame counts).
 
     Returns the path written.
     """
@@ -185,6 +195,8 @@ def animate(
     frames = render_frames(
         mech, result, fps=fps, speed=speed, size=size, traces=traces, labels=labels, max_frames=max_frames
     )
+    if progress is not None:
+        frames = _reporting(frames, len(frame_indices(result.t, fps, speed, max_frames)), progress)
     if ext == ".gif":
         write_gif(frames, path, fps)
     else:

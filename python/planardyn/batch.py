@@ -31,14 +31,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import inverse_batch, simulate_batch
-from .mechanism import Mechanism, attach_metadata, from_dict
+from .mechanism import Mechanism, attach_metadata, from_dict, native_motion
 from .result import SimulationResult
 from .settings import MAX_THREADS, check_settings, count
 
 if TYPE_CHECKING:
     from .robot import TaskMotion, TaskPath
 
-__all__ = ["BatchError", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
+__all__ = ["BatchError", "BatchInterrupted", "inverse_dynamics", "monte_carlo", "simulate", "sweep"]
 
 #: A variant: a model, or a model with its own settings.
 VariantLike = Mechanism | Mapping[str, Any] | tuple[Mechanism | Mapping[str, Any], Mapping[str, Any]]
@@ -69,12 +69,36 @@ class BatchError:
         return f"variant {self.index}: {self.type}: {self.message}"
 
 
-def _settings(common: Mapping[str, Any], own: Mapping[str, Any]) -> dict[str, Any]:
-    """The settings of one variant, arrays as lists of floats (exact for float64)."""
-    unknown = set(own) - set(_SETTINGS)
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a batch: still a KeyboardInterrupt (loops stop), carrying ``results``,
+    one per variant as the call would return them: the finished ones, runs stopped on the
+    way (status ``'cancelled'``) and a :class:`BatchError` of type ``'Cancelled'`` for the
+    variants not run."""
+
+    def __init__(self, results: list[Any]) -> None:
+        done = sum(1 for r in results if not isinstance(r, BatchError) or r.type != "Cancelled")
+        super().__init__(f"batch interrupted (Ctrl-C): {done} of {len(results)} variants kept")
+        self.results = results
+
+
+def _settings(common: Mapping[str, Any], own: Mapping[str, Any], mech: Mechanism) -> dict[str, Any]:
+    """The settings of one variant, arrays as lists of floats (exact for float64); its
+    motions by coordinate index for the native call (``motion``) and by name for the
+    result's metadata (``_motion``)."""
+    unknown = set(own) - set(_SETTINGS) - {"motion"}
     if unknown:
-        raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of {', '.join(_SETTINGS)}")
-    out = check_settings(**{k: v for k, v in {**common, **own}.items() if v is not None})
+        raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of "
+                         f"{', '.join(_SETTINGS)}, motion")
+    given = {k: v for k, v in {**common, **own}.items() if v is not None}
+    motion = given.pop("motion", None)
+    out = check_settings(**given)
+    if motion is not None:
+        if any(callable(m) for m in dict(motion).values()):
+            raise TypeError("a batch's motions are speeds or tables {'t': ..., 'q': ...}; "
+                            "a motion function runs only in Mechanism.simulate")
+        out["motion"] = native_motion(motion, mech.coordinate_names)
+        out["_motion"] = {k: v if np.isscalar(v) else {c: np.asarray(a, float).tolist() for c, a in v.items()}
+                          for k, v in motion.items()}
     for k in _ARRAYS:
         if k in out:
             out[k] = np.asarray(out[k], dtype=np.float64).ravel().tolist()
@@ -135,6 +159,7 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
         futures = [executor.submit(_run_chunk, kind, items[s:s + chunk_size], threads, **kw) for s in starts]
         pending = [f.result for f in futures]
     done, stopped = 0, None
+    interrupted: KeyboardInterrupt | None = None
     for s, get in zip(starts, pending):
         chunk = items[s:s + chunk_size]
         if stopped is not None:
@@ -143,17 +168,22 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
             continue
         try:
             raws = get()
+        except KeyboardInterrupt as e:  # the native batch hands back what it has
+            interrupted, stopped = e, "not run: interrupted (Ctrl-C)"
+            raws = getattr(e, "partial", None) or [("Cancelled", stopped)] * len(chunk)
         except Exception as e:  # noqa: BLE001 - a lost chunk loses only its own variants
             raws = [(type(e).__name__, f"the chunk with this variant failed: {e}")] * len(chunk)
         for k, ((mech, args), raw) in enumerate(zip(chunk, raws)):
             i = todo[s + k]
             out[i] = finish(raw, mech, args) if isinstance(raw, dict) else BatchError(i, *raw)
         done += len(chunk)
-        if progress is not None:
+        if progress is not None and stopped is None:
             stopped = _progress_stop(progress, done, n)
     if stopped is not None:
         for f in futures:
             f.cancel()
+    if interrupted is not None:
+        raise BatchInterrupted(out) from interrupted
     return out
 
 
@@ -181,6 +211,7 @@ def simulate(
     t_eval: ArrayLike | None = None,
     output_dt: float | None = None,
     max_steps: int | None = None,
+    motion: Mapping[str, float | Mapping[str, ArrayLike]] | None = None,
     threads: int | None = None,
     executor: Any = None,
     chunk_size: int | None = None,
@@ -197,6 +228,10 @@ def simulate(
         ``qd0`` (m,) in rad or m and rad/s or m/s, ``t_end``, ``method``...).
     t_end, method, rtol, atol, dt, t_eval, output_dt, max_steps
         As for :meth:`Mechanism.simulate` (None: the model file's value).
+    motion : dict, optional
+        Coordinates driven by motion, as for :meth:`Mechanism.simulate`: a speed or a table
+        ``{"t": ..., "q": ...}`` by coordinate name (not a function: the batch runs without
+        Python). A variant's own ``motion`` replaces it.
     threads : int, optional
         Native threads per batch (here, or on each worker), 1 to
         :data:`planardyn.settings.MAX_THREADS` (256); default one per core. Another value is
@@ -218,17 +253,22 @@ def simulate(
         result, as from :meth:`Mechanism.simulate`; a run that could not start, or a model
         that could not be built, is a :class:`BatchError`.
     """
-    common = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, t_eval=t_eval,
-                  output_dt=output_dt, max_steps=max_steps)
+    common: dict[str, Any] = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt,
+                                  t_eval=t_eval, output_dt=output_dt, max_steps=max_steps)
     check_settings(**common)
-    return _run("simulate", variants, lambda mech, own: _settings(common, own), _result,
+    common["motion"] = motion
+    return _run("simulate", variants, lambda mech, own: _settings(common, own, mech), _result,
                 threads, executor, chunk_size, progress)
 
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
     result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
                                        coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names)
-    return attach_metadata(result, mech, settings)
+    # The metadata's settings rerun the variant: mech.simulate(**settings), motions by name.
+    rerun = {k: v for k, v in settings.items() if k not in ("motion", "_motion")}
+    if "_motion" in settings:
+        rerun["motion"] = settings["_motion"]
+    return attach_metadata(result, mech, rerun)
 
 
 def inverse_dynamics(

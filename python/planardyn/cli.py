@@ -4,9 +4,14 @@
     planardyn simulate MODEL [--t-end T] [--method M] [--rtol R] [--atol A] [--dt H]
                              [--output-dt H] [--max-steps N] [-o results.csv|.parquet|.npz]
     planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
+    planardyn identify MODEL DATA [--cutoff HZ] [--validate DATA] [-o FILE.json]
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
-    planardyn animate MODEL RESULTS -o FILE.gif|FILE.mp4|FILE.html
+    planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
+    planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
     planardyn demo [--out DIR] [--model MODEL]
+    planardyn --version
+
+MODEL is a model file, or a shipped model by name (``five-bar``: planardyn.models.resolve).
 
 Exit status: 0 success; 1 the computation failed (the simulation stopped before t_end: the
 results file still holds the trajectory computed; the start could not be assembled); 2 a
@@ -17,22 +22,34 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import importlib.util
+import json
 import os
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from . import AssemblyError, PlanardynError, SimulationError, SingularityError, load, models, structure
+from . import (
+    AssemblyError,
+    Mechanism,
+    PlanardynError,
+    SimulationError,
+    SingularityError,
+    __version__,
+    from_result,
+    load,
+    models,
+    structure,
+)
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
-#: The demo's model: a shipped model (package data, ``planardyn.models``).
-DEMO_MODEL = "five-bar"
 RESULT_EXTENSIONS = (".csv", ".parquet", ".npz")
 
 
@@ -40,20 +57,46 @@ class UsageError(Exception):
     """A command line that cannot be carried out as given (exit 2)."""
 
 
+#: What writing a file of this extension needs beyond the dependencies: (module, package, extra).
+OPTIONAL_WRITERS = {
+    ".parquet": ("pyarrow", "pyarrow", "parquet"),
+    ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg", "mp4"),
+}
+#: Integration methods without error control, whose step must be given (--dt).
+FIXED_STEP_METHODS = ("rk4",)
+
+
+def require_writer(path: Path | None) -> None:
+    """Refuse, before any computation, an output file whose optional package is missing."""
+    if path is None or path.suffix.lower() not in OPTIONAL_WRITERS:
+        return
+    module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
+    if importlib.util.find_spec(module) is None:
+        raise UsageError(f"{path}: writing {path.suffix} files needs {package}, which is not installed: "
+                         f"pip install {package} (or pip install 'planardyn[{extra}]')")
+
+
+def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
+    """warnings.showwarning for the command: one line, no source line or file position."""
+    print(f"planardyn: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 class ProgressBar:
-    """A one-line text bar on a stream, redrawn from the simulation's progress callback."""
+    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` for t
+    from 0 to ``t_end``; ``unit`` formats t after the percentage (default: the simulated time)."""
 
     WIDTH = 30
 
-    def __init__(self, t_end: float, stream: TextIO = sys.stderr) -> None:
-        self.t_end, self.stream, self.start = t_end, stream, time.monotonic()
+    def __init__(self, t_end: float, stream: TextIO | None = None, unit: str = "t = {:.4g} s") -> None:
+        self.t_end, self.unit, self.start = t_end, unit, time.monotonic()
+        self.stream = sys.stderr if stream is None else stream
 
     def __call__(self, t: float) -> None:
         frac = min(max(t / self.t_end, 0.0), 1.0) if self.t_end > 0 else 1.0
         filled = int(round(frac * self.WIDTH))
         bar = "#" * filled + "." * (self.WIDTH - filled)
         elapsed = time.monotonic() - self.start
-        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  t = {t:.4g} s  ({elapsed:.1f} s)")
+        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  {self.unit.format(t)}  ({elapsed:.1f} s)")
         self.stream.flush()
 
     def close(self) -> None:
@@ -71,11 +114,13 @@ def summary(res: SimulationResult) -> str:
         f"{res.status}: {len(res.t)} outputs to t = {t_last} s, {st.get('naccept', 0)} steps "
         f"({st.get('nreject', 0)} rejected, {st.get('nfev', 0)} evaluations), "
         f"energy drift {res.energy.drift:.3g} J, min sigma {sigma_text}"
+        + "".join(f"; change point at t = {c.t:.6g} s (rank -{c.rank_drop})" for c in res.change_points)
     )
 
 
 # ------------------------------------------------------------------ the parser
 
+MODEL_HELP = "model file (.yaml, .yml or .json), or a shipped model by name (five-bar; see planardyn.models.names())"
 EPILOG = "Exit status: 0 ok, 1 the computation failed, 2 usage or model error."
 SIZE_NOTE = "Also: planardyn size MODEL ...: actuator sizing for an end-effector motion (see planardyn size --help)."
 
@@ -146,13 +191,14 @@ def _parser() -> argparse.ArgumentParser:
             "  planardyn check examples/models/five-bar.yaml\n"
             "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
             "  planardyn plot five-bar.csv -o five-bar.png\n"
-            "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
+            "  planardyn animate five-bar.csv -o five-bar.html\n"
             "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
             "  planardyn demo\n\n"
             "Run 'planardyn COMMAND --help' for a command's options. " + SIZE_NOTE + "\n" + EPILOG
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    p.add_argument("--version", action="version", version=f"planardyn {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     c = _sub(sub, "check", "describe a model: structure, mobility, coordinates, singularity measures",
@@ -161,7 +207,7 @@ def _parser() -> argparse.ArgumentParser:
              "measures at the start configuration.",
              "  planardyn check examples/models/five-bar.yaml\n"
              "  planardyn check my-linkage.json")
-    c.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    c.add_argument("model", type=Path, help=MODEL_HELP)
 
     s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
              "Integrate the equations of motion from the model's start state. Options left out take\n"
@@ -171,7 +217,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
              "  planardyn simulate examples/models/slider-crank.yaml --t-end 2 --method radau5 -o run.npz\n"
              "  planardyn simulate model.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
-    s.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    s.add_argument("model", type=Path, help=MODEL_HELP)
     s.add_argument("--t-end", type=_setting("t_end"), help="end time (s); default: the model's, else 1")
     s.add_argument("--method", help="dop853 (default), dopri5, radau5 or rk4 (needs --dt)")
     s.add_argument("--rtol", type=_setting("rtol"), help="relative tolerance (default 1e-9)")
@@ -179,6 +225,10 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--dt", type=_setting("dt"), help="fixed step (s): for rk4, or to switch error control off")
     s.add_argument("--output-dt", type=_setting("output_dt"), help="spacing of the output rows (s); default: the model's, else every step")
     s.add_argument("--max-steps", type=_setting("max_steps"), help="most step attempts before giving up")
+    s.add_argument("--speed", action="append", metavar="NAME=RATE", default=[],
+                   help="drive coordinate NAME at a constant rate instead of its effort (its torque or force is "
+                        "computed): rad/s, rev/s, rpm, deg/s, or m/s, mm/s for a displacement, e.g. crank=1rev/s; "
+                        "repeatable")
     s.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write: .csv, .parquet or .npz (by extension)")
     s.add_argument("--progress", action="store_true", help="show a progress bar on stderr even when it is not a terminal")
@@ -199,10 +249,25 @@ def _parser() -> argparse.ArgumentParser:
              "  0.0,2.0071,1.0472\n"
              "  0.01,2.0080,1.0460\n"
              "  ...")
-    i.add_argument("model", type=Path, help="model file (.yaml, .yml or .json)")
+    i.add_argument("model", type=Path, help=MODEL_HELP)
     i.add_argument("--motion", type=Path, required=True, help="motion table (.csv) or results file")
     i.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write (.csv, .parquet or .npz) with tau_<name> columns")
+
+    idf = _sub(sub, "identify", "identify the inertial parameters from a measured motion",
+               "Estimate the model's base inertial parameters (the combinations the efforts can\n"
+               "tell apart) from a measured motion: a CSV table with t (s), one column per coordinate\n"
+               "(rad or m) and tau_<name> (N m or N), or a planardyn results file. Rates and\n"
+               "accelerations come from qd_<name>/qdd_<name> columns, else from the positions\n"
+               "low-pass filtered at --cutoff (the efforts filtered alike). Prints each base\n"
+               "parameter identified with its standard error, against the model's.",
+               "  planardyn identify five-bar measured.csv --cutoff 10\n"
+               "  planardyn identify five-bar run.npz --validate other.npz -o identified.json")
+    idf.add_argument("model", type=Path, help=MODEL_HELP)
+    idf.add_argument("data", type=Path, help="measured motion: CSV table or results file")
+    idf.add_argument("--cutoff", type=_within(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
+    idf.add_argument("--validate", type=Path, help="another measured motion: RMS effort error, identified vs model")
+    idf.add_argument("-o", "--output", type=Path, help="write the identification as JSON")
 
     pl = _sub(sub, "plot", "plot a results file: coordinates, rates, drive efforts, energy",
               "Plot the time histories of a results file (coordinates, rates, drive efforts and\n"
@@ -220,11 +285,12 @@ def _parser() -> argparse.ArgumentParser:
              "Animate the mechanism along a results file. .gif and .mp4 are videos (MP4 needs\n"
              "imageio-ffmpeg); .html is a self-contained viewer (play, pause, speed, time slider,\n"
              "point paths, linked plots) that works offline in any browser.",
-             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.gif\n"
-             "  planardyn animate examples/models/five-bar.yaml five-bar.csv -o five-bar.html\n"
-             "  planardyn animate examples/models/five-bar.yaml five-bar.npz -o five-bar.mp4 --fps 30 --speed 0.5")
-    a.add_argument("model", type=Path, help="model file the results were computed with")
-    a.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz)")
+             "  planardyn animate five-bar.csv -o five-bar.gif       # the model from the file\n"
+             "  planardyn animate five-bar five-bar.csv -o five-bar.html\n"
+             "  planardyn animate five-bar.npz -o five-bar.mp4 --fps 30 --speed 0.5")
+    a.add_argument("files", type=Path, nargs="+", metavar="[MODEL] RESULTS",
+                   help="results file (.csv, .parquet or .npz), after the model it was computed with when "
+                        "the file does not hold its model (files planardyn writes do)")
     a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
     a.add_argument("--fps", type=_within(1e-3, MAX_FPS), default=20.0,
                    help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
@@ -232,14 +298,15 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
-    d = _sub(sub, "demo", "show what planardyn does: simulate the five-bar robot, write plots, GIF and viewer",
-             "Simulate the shipped five-bar robot and write, into one folder: the results (CSV),\n"
-             "plots of the coordinates, efforts, energy and the mechanism (PNG), an animation (GIF)\n"
-             "and the interactive viewer (HTML, open it in a browser).",
+    d = _sub(sub, "demo", "show what planardyn does: a robot's path, torques, sizing, singularities; a mechanism moving",
+             "Write, into one folder and in seconds, from the shipped models: the 5R robot tracing a\n"
+             "circle with its drive torques, actuator sizing report and singularity map; a passive\n"
+             "mechanism (a four-bar under gravity) simulated, plotted and animated; and both in the\n"
+             "interactive viewer (HTML, open it in a browser). One line per file says what it is.",
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    d.add_argument("--model", type=Path, help=f"model file (default: the shipped model {DEMO_MODEL!r})")
+    d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
     return p
 
 
@@ -284,6 +351,11 @@ def _simulate(args: argparse.Namespace) -> int:
         mech, t_end=args.t_end, method=args.method, rtol=args.rtol, atol=args.atol, dt=args.dt,
         output_dt=args.output_dt, max_steps=args.max_steps,
     )
+    if (settings["method"] or "").lower() in FIXED_STEP_METHODS and settings["dt"] is None:
+        raise UsageError(f"--method {settings['method']} takes fixed steps: give the step with --dt (e.g. --dt 1e-3; "
+                         "or dt in the model file's simulate section), or choose an adaptive method (--method dopri5)")
+    require_writer(args.output)
+    motion = _speeds(args.speed, mech)
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
         refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
@@ -293,7 +365,7 @@ def _simulate(args: argparse.Namespace) -> int:
     bar = ProgressBar(t_end) if show else None
     try:
         with RunGuard(bar) as guard:
-            res = mech.simulate(**settings, progress=guard)
+            res = mech.simulate(**settings, progress=guard, motion=motion)
         if bar is not None and res.success:
             bar(t_end)
     finally:
@@ -301,7 +373,7 @@ def _simulate(args: argparse.Namespace) -> int:
             bar.close()
     if guard.reason is not None and res.status == "cancelled":
         res = dataclasses.replace(res, message=guard.reason)
-    res = attach_metadata(res, mech, settings)
+    res = attach_metadata(res, mech, dict(settings, motion=motion))
     if args.output is not None:
         args.output.parent.mkdir(parents=True, exist_ok=True)
         write_results(res, args.output)
@@ -313,11 +385,28 @@ def _simulate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _speeds(given: list[str], mech: Mechanism) -> dict[str, float] | None:
+    """``--speed NAME=RATE`` options as ``Mechanism.simulate``'s ``motion`` (rates in SI)."""
+    from .units import parse_rate
+
+    motion: dict[str, float] = {}
+    for text in given:
+        name, _, rate = text.partition("=")
+        if name not in mech.coordinate_names:
+            raise UsageError(f"--speed {text}: give NAME=RATE with NAME one of {', '.join(mech.coordinate_names)}")
+        try:
+            motion[name] = parse_rate(rate, mech.coordinate_kinds[mech.coordinate_names.index(name)])
+        except ValueError as e:
+            raise UsageError(f"--speed {text}: {e}") from None
+    return motion or None
+
+
 def _inverse(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .results_io import inverse_from_file, write_results
 
+    require_writer(args.output)
     mech = load(args.model)
     res = inverse_from_file(mech, args.motion)
     if args.output is not None:
@@ -329,6 +418,53 @@ def _inverse(args: argparse.Namespace) -> int:
     print(f"inverse dynamics: {len(res.t)} rows, t = {res.t[0]:.6g}..{res.t[-1]:.6g} s, {peaks}, "
           f"min sigma {float(res.sigma.min()):.3g}; branch: {res.metadata['branch']}"
           + (f" -> {args.output}" if args.output else ""))
+    return EXIT_OK
+
+
+def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
+    """q, qd, qdd, tau, x of a measured motion (rates from columns, or differentiated)."""
+    from .identify import differentiate, inside, lowpass
+    from .results_io import read_motion
+
+    m = read_motion(path, mech.coordinate_names)
+    if m["tau"] is None:
+        names = ", ".join(f"tau_{n}" for n in mech.coordinate_names)
+        raise UsageError(f"{path}: identification needs the measured efforts: columns {names}")
+    if m["qd"] is not None and m["qdd"] is not None:
+        return m["q"], m["qd"], m["qdd"], m["tau"], m["x"]
+    if cutoff is None:
+        raise UsageError(f"{path}: no qd_/qdd_ columns: give --cutoff (Hz) to differentiate the positions")
+    q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
+    keep = inside(m["t"], cutoff)
+    if not keep.any():
+        raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at --cutoff "
+                         f"{cutoff:g} Hz: record longer or raise --cutoff")
+    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], m["tau"], cutoff)[keep], None
+
+
+def _identify(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .identify import identify
+
+    mech = load(args.model)
+    found = identify(mech, *_measured(mech, args.data, args.cutoff))
+    print(found.report())
+    if args.validate is not None:
+        q, qd, qdd, tau, x = _measured(mech, args.validate, args.cutoff)
+        Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+        rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
+        ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
+        prior = rms(mech.inverse_dynamics(q, qd, qdd, x=x) - tau)
+        print(f"validation on {args.validate}: RMS effort error {ident:.4g} identified, {prior:.4g} with the model")
+    if args.output is not None:
+        out = {"base_parameters": found.base.expressions, "identified": found.beta.tolist(),
+               "std_error": found.std_error.tolist(), "model": found.prior.tolist(),
+               "parameters": {k: float(v) for k, v in found.pi.items()},
+               "residual_rms": found.residual_rms.tolist(), "samples": found.samples}
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        args.output.write_text(json.dumps(out, indent=1))
+        print(f"wrote {args.output}")
     return EXIT_OK
 
 
@@ -368,99 +504,56 @@ def _animate(args: argparse.Namespace) -> int:
 
     if args.output.suffix.lower() not in FORMATS:
         raise UsageError(f"{args.output}: an animation is .gif, .mp4 or .html")
-    mech = load(args.model)
-    res = read_results(args.results)
-    if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
-        raise UsageError(
-            f"{args.results} was not computed with {args.model}: its coordinates are "
-            f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})"
-        )
+    require_writer(args.output)
+    if len(args.files) > 2:
+        raise UsageError(f"animate takes [MODEL] RESULTS, got {len(args.files)} files")
+    *model, results = args.files
+    res = read_results(results)
+    if model:
+        mech = load(models.resolve(model[0]))
+        if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
+            raise UsageError(
+                f"{results} was not computed with {model[0]}: its coordinates are "
+                f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})"
+            )
+    elif res.metadata.get("model") is None:
+        raise UsageError(f"{results} does not hold its model: give the model file first, "
+                         f"planardyn animate MODEL {results} -o {args.output}")
+    else:
+        mech = from_result(res)
     args.output.parent.mkdir(parents=True, exist_ok=True)
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
+    bar = ProgressBar(1.0, unit="of the frames drawn") if not kw and sys.stderr.isatty() else None
+    if bar is not None:  # GIF and MP4 take seconds
+        kw["progress"] = lambda done, total, bar=bar: bar(done / total)
     start = time.monotonic()
-    animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    try:
+        animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+    finally:
+        if bar is not None:
+            bar.close()
     size = args.output.stat().st_size
     print(f"wrote {args.output} ({size / 1024:.0f} KiB, {time.monotonic() - start:.1f} s)")
     return EXIT_OK
 
 
 def _demo(args: argparse.Namespace) -> int:
-    import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from .demo import run
 
-    from .animate import animate
-    from .plot import draw_mechanism, plot_coordinates, plot_efforts, plot_energy, plot_torque_speed
-    from .results_io import attach_metadata, simulate_settings, write_results
-
-    mech = load(models.path(DEMO_MODEL) if args.model is None else args.model)
-    settings = simulate_settings(mech)
-    res = attach_metadata(mech.simulate(**settings), mech, settings)
-    print(summary(res))
     out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-
-    def figure(size):
-        fig = Figure(figsize=size)
-        FigureCanvasAgg(fig)
-        return fig
-
-    def save(fig, name: str) -> None:
-        fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
-        written.append(out / name)
-
-    fig = figure((8, 6))
-    axes = fig.subplots(2, 1, sharex=True)
-    plot_coordinates(res, ax=axes[0])
-    plot_coordinates(res, ax=axes[1], which="qd")
-    axes[0].set_title(f"{mech.name}: coordinates")
-    save(fig, "coordinates.png")
-
-    plotters: list[tuple[tuple[float, float], Callable[..., Any], str, str]] = [
-        ((8, 4), plot_efforts, "drive efforts", "efforts.png"),
-        ((6, 5), plot_torque_speed, "drive effort vs speed", "torque-speed.png"),
-        ((8, 4.5), plot_energy, f"energy (balance drift {res.energy.drift:.2g} J)", "energy.png"),
-    ]
-    for size, plotter, title, name in plotters:
-        fig = figure(size)
-        ax = fig.add_subplot()
-        plotter(res, ax=ax)
-        ax.set_title(title)
-        save(fig, name)
-
-    n_snap = 4
-    idx = np.linspace(0, len(res.t) - 1, n_snap).round().astype(int) if len(res.t) else []
-    fig = figure((4 * n_snap, 4))
-    axes = fig.subplots(1, n_snap)
-    pts = mech.point_positions(res.x)  # (N, P, 2): one frame for every snapshot
-    lo, hi = np.nanmin(pts, axis=(0, 1)), np.nanmax(pts, axis=(0, 1))
-    pad = 0.1 * mech.scale
-    for ax, k in zip(np.atleast_1d(axes), idx):
-        draw_mechanism(mech, res.x[k], ax=ax, labels=True)
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - 2 * pad, hi[1] + pad)
-        ax.set_title(f"t = {res.t[k]:.3g} s")
-    save(fig, "mechanism.png")
-
-    write_results(res, out / "results.csv")
-    written.append(out / "results.csv")
-    animate(mech, res, out / "animation.gif")
-    written.append(out / "animation.gif")
-    animate(mech, res, out / "viewer.html")
-    written.append(out / "viewer.html")
-    print("wrote " + ", ".join(str(p) for p in written))
-    print(f"open {out / 'viewer.html'} in a browser to play the motion")
-    return EXIT_OK if res.success else EXIT_FAILED
+    print(f"planardyn demo: writing into {out}/")
+    demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
+    print(f"open {out / 'robot.html'} and {out / 'passive.html'} in a browser to play the motions")
+    return EXIT_OK if demo.success else EXIT_FAILED
 
 
 COMMANDS = {
     "check": _check,
     "simulate": _simulate,
     "inverse": _inverse,
+    "identify": _identify,
     "plot": _plot,
     "animate": _animate,
     "demo": _demo,
@@ -468,7 +561,12 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    with warnings.catch_warnings():  # restores showwarning for a caller in the same process
+        warnings.showwarning = _warning_line
+        return _main(list(sys.argv[1:] if argv is None else argv))
+
+
+def _main(argv: list[str]) -> int:
     try:
         if argv[:1] == ["size"]:
             # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
@@ -476,6 +574,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             return size_cli(argv[1:])
         args = _parser().parse_args(argv)
+        if getattr(args, "model", None) is not None:
+            args.model = models.resolve(args.model)
         code = COMMANDS[args.command](args)
         sys.stdout.flush()
         return code
@@ -486,7 +586,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (AssemblyError, SingularityError) as e:
         # The start state (or a row of a motion) could not be computed: the computation failed.
         return _fail(str(e), EXIT_FAILED)
-    except (PlanardynError, UsageError, ValueError, OSError, ImportError) as e:
+    except (PlanardynError, UsageError, ValueError, OSError, ImportError, models.UnknownModelError) as e:
         return _fail(str(e), EXIT_USAGE)
     except MemoryError:
         return _fail("out of memory: ask for fewer outputs (--output-dt, --t-end) or a smaller image", EXIT_FAILED)

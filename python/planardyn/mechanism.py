@@ -21,8 +21,10 @@ from ._core import Mechanism as NativeMechanism
 from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
+from .guard import available_memory, rows_message
 from .models import path as model_path
-from .result import SimulationInterrupted, SimulationResult
+from .result import PointMotion, SimulationInterrupted, SimulationResult
+from .results_format import plain
 from .settings import check_settings
 
 
@@ -32,6 +34,8 @@ class PlanardynWarning(UserWarning):
 FloatArray = NDArray[np.float64]
 DriveFunction = Callable[[float, FloatArray, FloatArray], ArrayLike]
 ProgressFunction = Callable[[float], Any]
+#: A coordinate's motion ``f(t) -> (q, qd, qdd)`` (rad, rad/s, rad/s^2 or m, m/s, m/s^2).
+MotionFunction = Callable[[float], tuple[float, float, float]]
 
 
 T = TypeVar("T")
@@ -286,10 +290,8 @@ class Mechanism:
         Raises
         ------
         SingularityError
-            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
-            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
-            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
-            ``allow_singular=True`` the value is computed anyway.
+            Below the type II threshold, as for :meth:`mass_matrix`, unless
+            ``allow_singular=True``.
         ValueError
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
@@ -328,10 +330,8 @@ class Mechanism:
         Raises
         ------
         SingularityError
-            Where the scaled type II measure (``kinematics(q)['sigma_min']``) is below
-            ``planardyn::dynamics::SINGULAR_SIGMA`` (1e-6): there the results keep no
-            reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
-            ``allow_singular=True`` every row is computed anyway.
+            Below the type II threshold, as for :meth:`mass_matrix`, unless
+            ``allow_singular=True`` (then every row is computed).
         ValueError
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
@@ -340,31 +340,88 @@ class Mechanism:
 
     def reactions(
         self,
-        q: ArrayLike,
-        qd: ArrayLike,
+        q: ArrayLike | SimulationResult,
+        qd: ArrayLike | None = None,
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> FloatArray:
-        """Pair reactions during the motion from (q, qd) under drives tau.
+        """Pair reactions during the motion from (q, qd) under drives tau, or along a whole
+        trajectory: ``mech.reactions(res)``.
 
         Parameters
         ----------
         q, qd, t, tau, allow_singular
             As for :meth:`forward_dynamics`.
+        q : SimulationResult
+            A run of this mechanism (qd, t, tau not given): every row on its own branch
+            (``res.x``) under the efforts the run applied (``res.tau``).
 
         Returns
         -------
-        (p, 3) ndarray
+        (p, 3) ndarray, or (N, p, 3) along a result
             Per pair (order of :attr:`pair_names`): [F_x, F_y, M], the force (N, global
             frame) and couple (N m) that the pair's first body exerts on its second.
 
         Raises
         ------
         SingularityError, ValueError
-            As for :meth:`forward_dynamics`.
+            As for :meth:`forward_dynamics`; along a result, with attributes ``row`` and
+            ``t`` of the row.
         """
+        if isinstance(q, SimulationResult):
+            if qd is not None or tau is not None:
+                raise TypeError("reactions(res) takes the result alone: its rows carry q, qd and tau")
+            return self._along(q, allow_singular)["reactions"]
+        if qd is None:
+            raise TypeError("reactions(q, qd, ...) needs qd (or give a SimulationResult alone)")
         return self._native.reactions(q, qd, float(t), tau, allow_singular)
+
+    def point_motion(self, res: SimulationResult, allow_singular: bool = False) -> PointMotion:
+        """Positions, velocities and accelerations of the named points (those a body or the
+        ground carries) along a run of this mechanism, each row on its own branch.
+
+        ``mech.point_motion(res)["P"]`` is the (N, 2) position, velocity and acceleration of
+        point P; ``.to_dataframe()`` a table indexed by t. Raises as :meth:`reactions`.
+        """
+        xdd = self._along(res, allow_singular)["xdd"]
+        raw = self._native.point_motion(res.x, res.xd, xdd)
+        return PointMotion(t=res.t, names=list(raw["names"]), position=raw["position"],
+                           velocity=raw["velocity"], acceleration=raw["acceleration"])
+
+    @property
+    def inertial_parameters(self) -> dict[str, float]:
+        """The model's inertial parameters pi, by name: per body ``m_<body>`` (kg),
+        ``mcx_<body>``, ``mcy_<body>`` (kg m: the mass times the centre of mass in the body's
+        frame, whose origin is the drawn centre of mass, so 0 here) and ``I_<body>`` (kg m^2,
+        about that origin). The order is that of :meth:`regressor`'s columns."""
+        values, names = self._native.parameters
+        return dict(zip(names, values))
+
+    def regressor(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> tuple[FloatArray, FloatArray]:
+        """The dynamics in linear form: the efforts of :meth:`inverse_dynamics` are
+        ``Y @ pi + tau_o``, with pi the inertial parameters (:attr:`inertial_parameters`,
+        whatever their values: the kinematics do not depend on them) and tau_o the efforts of
+        the other loads (springs, dampers, external forces).
+
+        Parameters and branch as :meth:`inverse_dynamics`. Returns ``(Y, tau_o)``: (m, p)
+        and (m,), or (N, m, p) and (N, m) for rows, p = 4 per body.
+        """
+        out = self._native.regressor(q, qd, qdd, x, allow_singular)
+        return out["Y"], out["tau_o"]
+
+    def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:
+        if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
+            raise ValueError("the result is not a run of this mechanism (its bodies differ); "
+                             "use pd.from_result(res) for the mechanism it was made with")
+        return self._native.along(res.t, res.x, res.q, res.qd, res.tau, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
         """Kinetic and potential energy (J) at (q, qd): ``(T, V)``, the position reached from
@@ -393,6 +450,7 @@ class Mechanism:
         drives: DriveFunction | None = None,
         progress: ProgressFunction | None = None,
         max_steps: int | None = None,
+        motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None = None,
     ) -> SimulationResult:
         """Integrate the equations of motion from t = 0 (forward dynamics in time).
 
@@ -431,6 +489,15 @@ class Mechanism:
             ``t_end / (10 max_steps)`` cannot finish and stops early with status
             ``'step_size_too_small'`` (efforts too large for the model, or tolerances too
             tight), keeping its last accepted state as the last row.
+        motion : dict, optional
+            Coordinates driven by motion instead of effort, by name (with those of the model
+            file's ``drives: [{coordinate, motion}]``, which an entry here replaces): a number,
+            a constant speed (rad/s or m/s) from the start value; a table
+            ``{"t": times (s), "q": positions (rad or m)}`` covering [0, t_end], through which
+            a C2 cubic spline with not-a-knot ends runs; or a function ``f(t) -> (q, qd,
+            qdd)``. Their efforts are the ones the motion needs (in ``tau``; ``drives`` on them
+            are not applied), their work is part of ``work``, and the other coordinates move
+            freely under their drives.
 
         Returns
         -------
@@ -450,6 +517,7 @@ class Mechanism:
             An argument with the wrong shape or a non-finite value.
         """
         checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
+        self._check_rows_fit(checked, t_eval)
         raw = self._native.simulate(
             t_end=checked["t_end"],
             method=method,
@@ -463,6 +531,7 @@ class Mechanism:
             drives=drives,
             progress=progress,
             max_steps=checked["max_steps"],
+            motion=native_motion(motion, self.coordinate_names),
         )
         result = SimulationResult.from_raw(
             raw,
@@ -473,11 +542,59 @@ class Mechanism:
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
-                        drives="callable" if callable(drives) else drives)
+                        drives="callable" if callable(drives) else drives,
+                        motion=None if motion is None else
+                        {k: "callable" if callable(v) else v for k, v in motion.items()})
         result = attach_metadata(result, self, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
+
+    def _check_rows_fit(self, checked: dict[str, Any], t_eval: ArrayLike | None) -> None:
+        """Refuse up front a run whose output rows cannot fit in the memory available (a run
+        that outputs every step has no count known up front)."""
+        defaults = self.simulate_defaults
+        output_dt = checked.get("output_dt") or defaults.get("output_dt")
+        if t_eval is not None:
+            rows = float(np.size(t_eval))
+        elif output_dt is not None:
+            rows = (checked.get("t_end") or defaults.get("t_end") or 1.0) / output_dt + 1
+        else:
+            return
+        refused = rows_message(rows, self.dof, self.n_bodies, available_memory())
+        if refused:
+            raise ValueError(f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
+
+
+def native_motion(
+    motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None, names: list[str]
+) -> list[tuple[int, Any]] | None:
+    """``Mechanism.simulate``'s ``motion`` as the native call takes it: (coordinate index, a
+    speed, a (t, q) pair of lists or a callable)."""
+    if motion is None:
+        return None
+    if not isinstance(motion, Mapping):
+        raise TypeError(f"motion must be a dict from coordinate names to motions, got {type(motion).__name__}")
+    out: list[tuple[int, Any]] = []
+    for name, m in motion.items():
+        if name not in names:
+            raise ValueError(f"motion: unknown coordinate {name!r}; coordinates are: {', '.join(names)}")
+        k = names.index(name)
+        if isinstance(m, Mapping):
+            if set(m) != {"t", "q"}:
+                raise ValueError(f"motion of {name!r}: a table is {{'t': times, 'q': positions}}, got keys {sorted(m)}")
+            t, q = (np.asarray(m[key], dtype=float) for key in ("t", "q"))
+            if t.ndim != 1 or q.ndim != 1:
+                raise ValueError(f"motion table of {name!r}: t and q must be 1-D, got shapes {t.shape} and {q.shape}")
+            out.append((k, (t.tolist(), q.tolist())))
+        elif callable(m):
+            out.append((k, m))
+        elif isinstance(m, (int, float, np.integer, np.floating)) and not isinstance(m, bool):
+            out.append((k, float(m)))
+        else:
+            raise TypeError(f"motion of {name!r}: give a speed (a number, rad/s or m/s), a table "
+                            f"{{'t': ..., 'q': ...}} or a function f(t) -> (q, qd, qdd); got {type(m).__name__}")
+    return out
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:
@@ -562,10 +679,3 @@ def attach_metadata(
         meta["settings"] = {k: plain(v) for k, v in settings.items()}
     meta.update(extra)
     return dataclasses.replace(result, metadata=meta)
-
-
-def plain(v: Any) -> Any:
-    """``v`` as JSON takes it: numpy arrays and numbers as lists and Python numbers."""
-    if isinstance(v, (np.ndarray, np.generic)):
-        return v.tolist()
-    return v

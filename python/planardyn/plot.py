@@ -68,24 +68,32 @@ def plot_efforts(result: SimulationResult, ax: Axes | None = None, **line_kw: An
 def plot_energy(result: SimulationResult, ax: Axes | None = None, balance: bool = True) -> list[Artist]:
     """Kinetic T, potential V, total T + V and work W of the non-conservative forces (J).
 
-    With ``balance=True`` the energy balance T + V - W - E0 (the integration error) is drawn
-    on a second y axis. Returns the lines.
+    With ``balance=True`` a second y axis shows, for a simulation, the energy balance
+    T + V - W - E0 (the integration error); for inverse dynamics (``metadata["kind"] ==
+    "inverse"``, W the work of the drive efforts only), W - (T + V - E0): the energy the
+    model's dampers, friction and other non-conservative loads took. Returns the lines.
     """
     ax = _axes(ax)
     e = result.energy
+    inverse = result.metadata.get("kind") == "inverse"
     lines: list[Artist] = []
     lines += ax.plot(result.t, e.kinetic, label="kinetic T")
     lines += ax.plot(result.t, e.potential, label="potential V")
     lines += ax.plot(result.t, e.total, label="total T + V", linewidth=2)
-    lines += ax.plot(result.t, e.work, label="work W", linestyle="--")
+    lines += ax.plot(result.t, e.work, label="work W of the drives" if inverse else "work W", linestyle="--")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.grid(True, alpha=0.3)
     handles = list(lines)
     if balance:
         ax2 = ax.twinx()
-        bal = ax2.plot(result.t, e.balance, color="k", linewidth=0.8, label="balance T + V - W - E0")
-        ax2.set_ylabel("energy balance (J)")
+        if inverse:
+            bal = ax2.plot(result.t, -e.balance, color="k", linewidth=0.8,
+                           label="taken by dampers, friction, loads: W - (T + V - E0)")
+            ax2.set_ylabel("energy dissipated (J)")
+        else:
+            bal = ax2.plot(result.t, e.balance, color="k", linewidth=0.8, label="balance T + V - W - E0")
+            ax2.set_ylabel("energy balance (J)")
         lines += bal
         handles += bal
     ax.legend(handles=handles, loc="best", fontsize="small")
@@ -236,6 +244,34 @@ def draw_mechanism_at(
     return artists
 
 
+def plot_reaction(mech: Mechanism, result: SimulationResult, pair: str, fig: Any = None) -> list[Artist]:
+    """The force of one pair along a run: its magnitude against time, and a polar diagram of
+    the force on the pair's second body in that body's frame (the load a pin or bearing
+    sees as the body turns; in the world frame when the second body is the ground).
+
+    ``fig`` is a matplotlib figure to draw in (a new one when None). Returns the artists.
+    """
+    if pair not in mech.pair_names:
+        raise ValueError(f"no pair {pair!r}; the pairs are {', '.join(mech.pair_names)}")
+    k = mech.pair_names.index(pair)
+    force = mech.reactions(result)[:, k, :2]
+    second = mech.pairs[k]["bodies"][1]
+    phi = result.poses[:, mech.body_names.index(second), 2] if second != "ground" else np.zeros(len(result.t))
+    magnitude = np.hypot(force[:, 0], force[:, 1])
+    if fig is None:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(10, 4))
+    left, right = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2, projection="polar")
+    artists: list[Artist] = left.plot(result.t, magnitude)
+    left.set_xlabel("t (s)")
+    left.set_ylabel(f"|F| at {pair} (N)")
+    left.grid(True, alpha=0.3)
+    artists += right.plot(np.arctan2(force[:, 1], force[:, 0]) - phi, magnitude)
+    right.set_title(f"force on {second} at {pair}, in its frame (N)", fontsize="medium")
+    return artists
+
+
 def plot_torque_speed(result: SimulationResult, ax: Axes | None = None, **line_kw: Any) -> list[Artist]:
     """Drive effort against speed of each coordinate (tau_k vs qd_k): the operating points a
     motor must reach, start marked with a circle. Returns the lines."""
@@ -272,8 +308,8 @@ def plot_results(result: SimulationResult, fig: Any = None) -> list[Artist]:
     axes[0, 1].set_title("rates")
     axes[1, 0].set_title("drive efforts")
     kind = result.metadata.get("kind", "simulation")
-    if kind == "inverse":  # the balance then also holds what dampers dissipate
-        axes[1, 1].set_title("energy (W: work of the drive efforts only)")
+    if kind == "inverse":
+        axes[1, 1].set_title("energy: the drives' work W, and what the loads dissipate")
     else:
         axes[1, 1].set_title(f"energy (balance drift {result.energy.drift:.2g} J)")
     for ax in axes[0]:

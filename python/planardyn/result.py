@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
-import csv
+import dataclasses
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
+
+from . import results_format
+from ._core import __version__
 
 if TYPE_CHECKING:
     import pandas
@@ -47,6 +52,44 @@ class Energy:
         return f"Energy(N={len(self.kinetic)}, drift={self.drift:.3g} J)"
 
 
+def _dataframe(cols: Mapping[str, FloatArray]) -> pandas.DataFrame:
+    """``cols`` as a DataFrame indexed by its ``t`` column (needs pandas)."""
+    try:
+        import pandas as pd
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+    return pd.DataFrame(cols).set_index("t")
+
+
+@dataclass(frozen=True)
+class PointMotion:
+    """Positions, velocities and accelerations of named points along a trajectory
+    (``Mechanism.point_motion``); each array (N, P, 2), points in the order of ``names``."""
+
+    t: FloatArray
+    names: list[str]
+    position: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+
+    def __getitem__(self, name: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Position (m), velocity (m/s) and acceleration (m/s^2) of one point, (N, 2) each."""
+        if name not in self.names:
+            raise KeyError(f"no point {name!r}; the points carried by a link are {', '.join(self.names)}")
+        k = self.names.index(name)
+        return self.position[:, k], self.velocity[:, k], self.acceleration[:, k]
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """Indexed by ``t``: per point ``<name>_x``, ``<name>_y``, ``<name>_vx``, ``<name>_vy``,
+        ``<name>_ax``, ``<name>_ay`` (m, m/s, m/s^2)."""
+        cols: dict[str, FloatArray] = {"t": self.t}
+        for k, name in enumerate(self.names):
+            for prefix, arr in (("", self.position), ("v", self.velocity), ("a", self.acceleration)):
+                cols[f"{name}_{prefix}x"] = arr[:, k, 0]
+                cols[f"{name}_{prefix}y"] = arr[:, k, 1]
+        return _dataframe(cols)
+
+
 class SimulationInterrupted(KeyboardInterrupt):
     """Ctrl-C during ``Mechanism.simulate``: still a KeyboardInterrupt (loops stop), carrying
     the trajectory computed so far as ``result`` (status ``'cancelled'``)."""
@@ -54,6 +97,30 @@ class SimulationInterrupted(KeyboardInterrupt):
     def __init__(self, result: SimulationResult) -> None:
         super().__init__(result.message)
         self.result = result
+
+
+@dataclass(frozen=True)
+class ChangePoint:
+    """A change point the run crossed: where the pair constraints lost rank and the passive
+    mechanism's mobility jumped, and the motion went on along the branch it arrived on."""
+
+    #: Time of the crossing (s).
+    t: float
+    #: (m,) coordinates and (3n,) body coordinates there.
+    q: FloatArray
+    x: FloatArray
+    #: Rank the pair constraints lost there: the mobility jumps by this much.
+    rank_drop: int
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> ChangePoint:
+        """From the native dict or a results file's metadata entry."""
+        return cls(t=float(d["t"]), q=np.asarray(d["q"], dtype=float), x=np.asarray(d["x"], dtype=float),
+                   rank_drop=int(d["rank_drop"]))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values, for a results file's metadata."""
+        return {"t": self.t, "q": self.q.tolist(), "x": self.x.tolist(), "rank_drop": self.rank_drop}
 
 
 @dataclass(frozen=True, repr=False)
@@ -98,6 +165,8 @@ class SimulationResult:
     #: 'angle' or 'displacement' per coordinate.
     coordinate_kinds: list[str] = field(default_factory=list)
     body_names: list[str] = field(default_factory=list)
+    #: The change points crossed, in time order (see :meth:`change_points_frame`).
+    change_points: list[ChangePoint] = field(default_factory=list)
     #: Where the result came from, for reproducing and re-plotting it: ``model`` (the model
     #: as a dict, ``Mechanism.to_dict()``), ``settings`` (keyword arguments of
     #: ``Mechanism.simulate``), ``planardyn_version``, ``kind`` ('simulation' or 'inverse').
@@ -136,8 +205,18 @@ class SimulationResult:
             coordinate_names=list(coordinate_names),
             coordinate_kinds=list(coordinate_kinds),
             body_names=list(body_names),
+            change_points=[ChangePoint.from_dict(c) for c in raw.get("change_points", [])],
             metadata=dict(metadata or {}),
         )
+
+    def change_points_frame(self) -> pandas.DataFrame:
+        """The change points as a DataFrame: ``t``, ``rank_drop`` and the coordinates (needs
+        pandas)."""
+        cols: dict[str, Any] = {"t": np.array([c.t for c in self.change_points])}
+        cols["rank_drop"] = np.array([c.rank_drop for c in self.change_points], dtype=int)
+        for k, name in enumerate(self.coordinate_names):
+            cols[name] = np.array([c.q[k] for c in self.change_points])
+        return _dataframe(cols)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -149,6 +228,22 @@ class SimulationResult:
             f"coordinates=({', '.join(self.coordinate_names)}), "
             f"steps={self.stats.get('naccept', 0)}, energy drift={self.energy.drift:.3g} J)"
         )
+
+    def take(self, rows: ArrayLike) -> SimulationResult:
+        """The result at some of its rows: indices or a boolean mask, e.g. every tenth row
+        ``res.take(np.arange(0, len(res), 10))``. The energy balance keeps its reference
+        (the first output of the whole run)."""
+        k = np.arange(len(self.t))[np.asarray(rows)]
+
+        def rows_of(obj: Any) -> dict[str, Any]:  # every per-row array field, at rows k
+            return {f.name: v[k] for f in dataclasses.fields(obj) if isinstance(v := getattr(obj, f.name), np.ndarray)}
+
+        return dataclasses.replace(self, **rows_of(self), energy=Energy(**rows_of(self.energy)))
+
+    @property
+    def power(self) -> FloatArray:
+        """(N, m) power of each drive, tau * qd (W): positive where the drive gives energy."""
+        return self.tau * self.qd
 
     def columns(self) -> dict[str, FloatArray]:
         """The table of :meth:`to_dataframe` as a dict of (N,) arrays, in column order:
@@ -165,18 +260,51 @@ class SimulationResult:
         return cols
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """A pandas DataFrame with the columns of :meth:`columns` (needs pandas)."""
-        try:
-            import pandas as pd
-        except ImportError as e:  # pragma: no cover - depends on the environment
-            raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
-        return pd.DataFrame(self.columns())
-
-    def to_csv(self, path: str | os.PathLike[str]) -> None:
-        """Write the table of :meth:`columns` as CSV (full double precision; no pandas needed)."""
+        """A pandas DataFrame indexed by ``t`` (s) with the other columns of :meth:`columns`,
+        then ``power_<name>`` (W) per drive (needs pandas)."""
         cols = self.columns()
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(cols)
-            for row in zip(*(c.tolist() for c in cols.values())):
-                w.writerow([repr(v) for v in row])
+        for k, name in enumerate(self.coordinate_names):
+            cols["power_" + name] = self.power[:, k]
+        return _dataframe(cols)
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write a results file (``.csv``, ``.parquet`` or ``.npz``, by the name's extension;
+        format in :mod:`planardyn.results_io`): every array, exactly, and the metadata
+        (model, settings, version when attached), read back by :func:`planardyn.read_results`,
+        ``planardyn plot`` and ``planardyn animate``. Written whole or not at all. Returns
+        the path."""
+        return self._write(path, None)
+
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
+        """:meth:`save` in the CSV form whatever the name: the metadata on ``# `` lines, then
+        the columns of :meth:`columns` and the body coordinates, full double precision."""
+        return self._write(path, ".csv")
+
+    def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:
+        layout = results_format.columns(self.coordinate_names, self.body_names)
+        e = self.energy
+        groups = {
+            "t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau,
+            "kinetic": e.kinetic, "potential": e.potential, "work": e.work,
+            "sigma": self.sigma, "residual": self.residual, "partitioned": self.partitioned,
+            "x": self.x, "xd": self.xd,
+        }
+        meta = {
+            "format": results_format.FORMAT,
+            "format_version": results_format.FORMAT_VERSION,
+            "kind": "simulation",
+            "planardyn_version": __version__,
+            "model": None,
+            "settings": None,
+            **{k: v for k, v in self.metadata.items() if k != "path"},
+            "status": self.status,
+            "success": self.success,
+            "message": self.message,
+            "stats": {k: results_format.plain(v) for k, v in self.stats.items()},
+            "change_points": [c.to_dict() for c in self.change_points],
+            "coordinate_names": self.coordinate_names,
+            "coordinate_kinds": self.coordinate_kinds,
+            "body_names": self.body_names,
+            "layout": [[g, len(cols)] for g, cols in layout],
+        }
+        return results_format.write(path, meta, groups, layout, ext)

@@ -30,36 +30,34 @@ the metadata), so a coordinate may be named like another column.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import io
 import json
 import os
 import zipfile
 import zlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._core import SingularityError, __version__
-from .mechanism import Mechanism, attach_metadata, plain
-from .result import Energy, SimulationResult
+from ._core import SingularityError
+from .mechanism import Mechanism, attach_metadata
+from .result import ChangePoint, Energy, SimulationResult
+from .results_format import EXTENSIONS, FORMAT, FORMAT_VERSION
+from .results_format import checksum as _checksum
+from .results_format import columns as _columns
+from .results_format import pyarrow as _pyarrow
+from .results_format import table as _table
 
 FloatArray = NDArray[np.float64]
 
-FORMAT = "planardyn-results"
-#: 2: the metadata records ``rows`` and ``checksum`` (version 1 files, without them, are read).
-FORMAT_VERSION = 2
-EXTENSIONS = (".csv", ".parquet", ".npz")
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
 #: Metadata a results file cannot be read without (the others may be absent or None).
 REQUIRED_FIELDS = ("coordinate_names", "coordinate_kinds", "body_names", "status", "success", "message", "layout")
-#: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
-CSV_BLOCK = 4096
 
 
 # ------------------------------------------------------------------ metadata
@@ -78,63 +76,6 @@ def simulate_settings(mech: Mechanism, **given: Any) -> dict[str, Any]:
     return {k: given[k] if given.get(k) is not None else model.get(k) for k in SETTING_NAMES}
 
 
-def _layout(res: SimulationResult) -> list[tuple[str, list[str]]]:
-    """(group, column names) in file order; groups are result fields or energy entries."""
-    return _columns(res.coordinate_names, res.body_names)
-
-
-def _columns(names: list[str], bodies: list[str]) -> list[tuple[str, list[str]]]:
-    body_cols = [f"{c}_{b}" for b in bodies for c in ("X", "Y", "phi")]
-    return [
-        ("t", ["t"]),
-        ("q", list(names)),
-        ("qd", [f"qd_{n}" for n in names]),
-        ("qdd", [f"qdd_{n}" for n in names]),
-        ("tau", [f"tau_{n}" for n in names]),
-        ("kinetic", ["kinetic"]),
-        ("potential", ["potential"]),
-        ("work", ["work"]),
-        ("sigma", ["sigma"]),
-        ("residual", ["residual"]),
-        ("partitioned", ["partitioned"]),
-        ("x", body_cols),
-        ("xd", [c.replace("_", "d_", 1) for c in body_cols]),
-    ]
-
-
-def _group_arrays(res: SimulationResult) -> dict[str, np.ndarray]:
-    e = res.energy
-    return {
-        "t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau,
-        "kinetic": e.kinetic, "potential": e.potential, "work": e.work,
-        "sigma": res.sigma, "residual": res.residual, "partitioned": res.partitioned,
-        "x": res.x, "xd": res.xd,
-    }
-
-
-def _metadata(res: SimulationResult) -> dict[str, Any]:
-    meta = {
-        "format": FORMAT,
-        "format_version": FORMAT_VERSION,
-        "kind": "simulation",
-        "planardyn_version": __version__,
-        "model": None,
-        "settings": None,
-    }
-    meta.update(res.metadata)
-    meta.update(
-        status=res.status,
-        success=res.success,
-        message=res.message,
-        stats={k: plain(v) for k, v in res.stats.items()},
-        coordinate_names=res.coordinate_names,
-        coordinate_kinds=res.coordinate_kinds,
-        body_names=res.body_names,
-        layout=[[g, len(cols)] for g, cols in _layout(res)],
-    )
-    return meta
-
-
 def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationResult:
     """Rebuild a result from its checked metadata and its (rows, columns) table."""
     groups, col = {}, 0
@@ -144,7 +85,7 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
     n_t, n_b = len(table), len(meta["body_names"])
     flat = lambda g: np.ascontiguousarray(groups[g].reshape(n_t))  # noqa: E731
     own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
-           "coordinate_kinds", "body_names", "layout", "rows", "checksum"}
+           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "change_points"}
     return SimulationResult(
         t=flat("t"), q=groups["q"], qd=groups["qd"], qdd=groups["qdd"], tau=groups["tau"],
         x=groups["x"], xd=groups["xd"], poses=groups["x"].reshape(n_t, n_b, 3),
@@ -155,26 +96,9 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
         coordinate_names=list(meta["coordinate_names"]),
         coordinate_kinds=list(meta["coordinate_kinds"]),
         body_names=list(meta["body_names"]),
+        change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
         metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
     )
-
-
-def _table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> FloatArray:
-    """The groups side by side in layout order: one row per output time, float64."""
-    cols = [np.asarray(groups[g], dtype=np.float64).reshape(n_t, k) for g, k in layout]
-    return np.hstack(cols) if cols else np.empty((n_t, 0))
-
-
-def _checksum(meta: dict[str, Any], table: FloatArray) -> int:
-    """CRC-32 of the metadata (as JSON in its order, without the checksum) and of the
-    table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
-    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")})
-    crc = zlib.crc32(text.encode())
-    for start in range(0, len(table), CSV_BLOCK):
-        block = table[start:start + CSV_BLOCK]
-        canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
-        crc = zlib.crc32(np.ascontiguousarray(canonical).tobytes(), crc)
-    return crc
 
 
 class _Damaged(Exception):
@@ -254,64 +178,13 @@ def write_results(
     mechanism: Mechanism | None = None,
     settings: dict[str, Any] | None = None,
 ) -> Path:
-    """Write ``result`` to ``path`` (``.csv``, ``.parquet`` or ``.npz``) with its metadata.
-
-    ``mechanism`` and ``settings`` are recorded when given (see :func:`attach_metadata`).
-    The file is written whole or not at all: into a temporary file in the same folder,
-    renamed over ``path`` when complete. Its metadata records the number of rows and a
-    CRC-32 of the numbers, which :func:`read_results` checks. Parquet needs pyarrow.
-    Returns the path.
+    """Write ``result`` to ``path`` (``.csv``, ``.parquet`` or ``.npz``) with its metadata:
+    ``result.save(path)``, recording ``mechanism`` and ``settings`` when given (see
+    :func:`attach_metadata`). Returns the path.
     """
-    path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in EXTENSIONS:
-        raise ValueError(f"{path}: unknown results format {ext!r} (use {', '.join(EXTENSIONS)})")
     if mechanism is not None or settings is not None:
         result = attach_metadata(result, mechanism, settings)
-    meta = _metadata(result)
-    meta.pop("path", None)
-    columns = _layout(result)
-    n_t = len(result.t)
-    table = _table(_group_arrays(result), [(g, len(c)) for g, c in columns], n_t)
-    meta["rows"] = n_t
-    meta["checksum"] = _checksum(meta, table)
-    names = [c for _, cols in columns for c in cols]
-    with _replacing(path) as tmp:
-        if ext == ".npz":
-            # Any: numpy's signature would also take a group for its allow_pickle flag.
-            arrays: dict[str, Any] = {g: np.asarray(a) for g, a in _group_arrays(result).items()}
-            with open(tmp, "wb") as f:
-                np.savez_compressed(f, metadata=np.array(json.dumps(meta)), **arrays)
-        elif ext == ".parquet":
-            pa, pq = _pyarrow()
-            pa_columns = [pa.array(table[:, k].astype(bool) if n == "partitioned" else table[:, k])
-                          for k, n in enumerate(names)]
-            pq.write_table(pa.Table.from_arrays(pa_columns, names=names).replace_schema_metadata(
-                {"planardyn": json.dumps(meta)}), tmp)
-        else:
-            with open(tmp, "w", newline="") as f:
-                for line in json.dumps(meta, indent=1).splitlines():
-                    f.write(f"# {line}\n")
-                w = csv.writer(f)
-                w.writerow(names)
-                for start in range(0, n_t, CSV_BLOCK):
-                    w.writerows([repr(v) for v in row] for row in table[start:start + CSV_BLOCK].tolist())
-    return path
-
-
-@contextlib.contextmanager
-def _replacing(path: Path) -> Iterator[Path]:
-    """A temporary file next to ``path`` that replaces it (one rename) when the block ends
-    without an error, and is removed when it fails: ``path`` is never half written."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
-    try:
-        yield tmp
-        with open(tmp, "rb+") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    return result.save(path)
 
 
 def read_results(path: str | os.PathLike[str]) -> SimulationResult:
@@ -473,15 +346,6 @@ def _read_named_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[
         raise ValueError(f"{path}: {e}") from None
 
 
-def _pyarrow() -> tuple[Any, Any]:
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("Parquet results files need pyarrow: pip install pyarrow") from e
-    return pa, pq
-
-
 # ------------------------------------------------------------------ motions and inverse dynamics
 
 
@@ -489,13 +353,13 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     """Read a prescribed motion: a CSV table, or any planardyn results file.
 
     The CSV has a header row with ``t`` (s) and one column per coordinate name (rad or m),
-    and optionally ``qd_<name>`` and ``qdd_<name>`` columns; other columns are ignored, and
-    so are leading ``#`` comment lines.
+    and optionally ``qd_<name>``, ``qdd_<name>`` and ``tau_<name>`` (measured efforts, N m or
+    N) columns; other columns are ignored, and so are leading ``#`` comment lines.
 
     Returns
     -------
-    dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``: (N, m) arrays where every
-    coordinate had such a column (a results file has both), else None; ``x`` (N, 3n) the
+    dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``, ``tau``: (N, m) arrays where
+    every coordinate had such a column (a results file has all three), else None; ``x`` (N, 3n) the
     body coordinates of a results file (the branch it is on), None for a table; and
     per-coordinate lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
     """
@@ -510,7 +374,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 f"{path}: the results' coordinates ({', '.join(res.coordinate_names)}) are not "
                 f"the model's ({', '.join(coordinate_names)})"
             )
-        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "x": res.x,
+        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau, "x": res.x,
                 "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
@@ -523,7 +387,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
             f"(it needs t and the coordinates {', '.join(coordinate_names)}; found {', '.join(header)})"
         )
     col = {h: i for i, h in enumerate(header)}
-    used = need + [f"{p}_{n}" for p in ("qd", "qdd") for n in coordinate_names if f"{p}_{n}" in col]
+    used = need + [f"{p}_{n}" for p in ("qd", "qdd", "tau") for n in coordinate_names if f"{p}_{n}" in col]
     data = np.empty((len(rows), len(header)))
     for i, r in enumerate(rows):
         for h in used:
@@ -543,7 +407,8 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     qd_cols = [get(f"qd_{n}") for n in coordinate_names]
     qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
     both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731
-    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "x": None,
+    tau = both([get(f"tau_{n}") for n in coordinate_names])
+    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "x": None,
             "qd_columns": qd_cols, "qdd_columns": qdd_cols}
 
 

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._core import __version__
+from ._core import PlanardynError, __version__
 from .playback import auto_speed
 from .plot import default_trace_points
 from .units import group_unit
@@ -61,8 +61,38 @@ def _nan_to_none(v: Any) -> Any:
     return None if isinstance(v, float) and not math.isfinite(v) else v
 
 
-def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | None) -> tuple[list, list]:
-    """(groups, channels): each channel a dict key, label, group, values, on."""
+def _along_channels(mech: Mechanism, result: SimulationResult, keep: np.ndarray,
+                    traces: list[str]) -> tuple[list, list]:
+    """(groups, channels) of the pairs' force magnitudes (N) and the traced points' speeds
+    (m/s) and accelerations (m/s²) at the frames kept, each frame on its own branch; none
+    when a frame cannot be computed (a singular row of an imported motion)."""
+    frames = result.take(keep)
+    try:
+        reactions = mech.reactions(frames, allow_singular=True)
+        pts = mech.point_motion(frames, allow_singular=True)
+    except (PlanardynError, ValueError):
+        return [], []
+    groups = [{"key": "reactions", "label": "pair forces", "unit": "N"},
+              {"key": "speeds", "label": "point speeds", "unit": "m/s"},
+              {"key": "point_accelerations", "label": "point accelerations", "unit": "m/s²"}]
+    chans: list[dict[str, Any]] = []
+    for j, name in enumerate(mech.pair_names):
+        force = np.hypot(reactions[:, j, 0], reactions[:, j, 1])
+        chans.append({"key": f"F_{name}", "label": f"|F| {name}", "group": "reactions", "values": force, "unit": "N"})
+    for p in traces:
+        if p in pts.names:
+            k = pts.names.index(p)
+            for key, arr, group, unit in (("v", pts.velocity, "speeds", "m/s"),
+                                          ("a", pts.acceleration, "point_accelerations", "m/s²")):
+                chans.append({"key": f"{key}_{p}", "label": f"|{key}| {p}", "group": group,
+                              "values": np.hypot(arr[:, k, 0], arr[:, k, 1]), "unit": unit})
+    return groups, chans
+
+
+def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | None,
+              extra: tuple[list, list] = ([], [])) -> tuple[list, list]:
+    """(groups, channels): each channel a dict key, label, group, values, on; ``extra``
+    groups and channels appended (computed along the trajectory)."""
     names, kinds = result.coordinate_names, result.coordinate_kinds
     # Per coordinate group: key, values, channel names, label, unit (on an angle, on a displacement).
     per_coordinate = [
@@ -87,6 +117,8 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
                             ("total", "T + V", e.total), ("work", "W", e.work), ("balance", "balance", e.balance)):
         chans.append({"key": key, "label": label, "group": "energy", "values": arr[keep], "unit": "J"})
     chans.append({"key": "sigma", "label": "sigma", "group": "sigma", "values": result.sigma[keep], "unit": "1"})
+    groups += extra[0]
+    chans += extra[1]
     default = {c["key"] for c in chans if c["group"] in ("q", "tau")}
     chosen = default if selected is None else set(selected)
     unknown = chosen - {c["key"] for c in chans}
@@ -136,7 +168,7 @@ def viewer_data(
         | {part: [_round(np.array(_flatten(f[j][part])), L) for f in frames] for part in parts}
         for j, pair in enumerate(mech.pairs)
     ]
-    groups, chans = _channels(result, keep, channels)
+    groups, chans = _channels(result, keep, channels, _along_channels(mech, result, keep, traces))
     st = result.stats
     info = (
         f"{result.status}: {n} outputs, t = {result.t[0]:.4g}..{result.t[-1]:.4g} s; "

@@ -12,15 +12,20 @@ use crate::convert::arr2;
 use crate::effector::solution_dict;
 use crate::errors::{run, task_error, to_pyerr, Failure};
 use crate::mechanism::PyMechanism;
+use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};
-use planardyn::batch::{map_many, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::batch::{map_many_until, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::Mechanism;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 
 /// Keys a variant's overrides dict may have (the keyword arguments of `Mechanism.simulate`
 /// that need no Python callback).
-const KEYS: [&str; 10] = ["t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps"];
+const KEYS: [&str; 11] =
+    ["t_end", "method", "rtol", "atol", "dt", "t_eval", "output_dt", "q0", "qd0", "max_steps", "motion"];
 
 /// Keys of an inverse-dynamics motion dict: coordinate rows, or a sampled task path.
 const MOTION_KEYS: [&str; 11] = ["q", "qd", "qdd", "t", "X", "Xd", "Xdd", "point", "body", "q_start", "singular_tol"];
@@ -48,8 +53,18 @@ fn check_keys(d: &Bound<'_, PyDict>, keys: &[&str], what: &str) -> PyResult<()> 
     Ok(())
 }
 
-fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
+fn overrides(mech: &Mechanism, d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
     check_keys(d, &KEYS, "simulation setting")?;
+    // A batch runs without the GIL: its motions are laws (speeds, tables), not callables.
+    let motion = motion_entries(mech, get(d, "motion")?.unwrap_or_default())?
+        .into_iter()
+        .map(|(k, entry)| match entry {
+            MotionEntry::Law(law) => Ok((k, law)),
+            MotionEntry::Function(_) => Err(PyValueError::new_err(
+                "a batch's motions are speeds or tables; a Python function runs only in Mechanism.simulate",
+            )),
+        })
+        .collect::<PyResult<Vec<_>>>()?;
     Ok(Overrides {
         t_end: get(d, "t_end")?,
         method: get(d, "method")?,
@@ -61,23 +76,80 @@ fn overrides(d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
         q0: get(d, "q0")?,
         qd0: get(d, "qd0")?,
         max_steps: get(d, "max_steps")?,
+        motion,
     })
+}
+
+/// `f(stop)` on a worker thread with the GIL released, while this thread checks for Ctrl-C
+/// every `SIGNAL_INTERVAL`: on one, `stop` is set (the work winds down and returns what it
+/// has) and the KeyboardInterrupt is handed back with the result.
+fn run_until_interrupt<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce(&AtomicBool) -> Result<T, Failure> + Send,
+) -> PyResult<(T, Option<PyErr>)> {
+    let stop = AtomicBool::new(false);
+    let mut interrupt = None;
+    let out = run(py, || {
+        std::thread::scope(|s| {
+            let (tx, rx) = mpsc::channel();
+            let stop = &stop;
+            // A panic in the worker is re-raised by the scope, where `run` catches it.
+            s.spawn(move || tx.send(f(stop)));
+            loop {
+                match rx.recv_timeout(SIGNAL_INTERVAL) {
+                    Ok(done) => return done,
+                    Err(mpsc::RecvTimeoutError::Timeout) if interrupt.is_none() => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            interrupt = Some(e);
+                            stop.store(true, Ordering::Relaxed);
+                        }
+                    }
+                    Err(mpsc::RecvTimeoutError::Timeout) => {}
+                    Err(mpsc::RecvTimeoutError::Disconnected) => {
+                        return Err(PyValueError::new_err("the batch worker stopped without a result").into());
+                    }
+                }
+            }
+        })
+    })?;
+    Ok((out, interrupt))
 }
 
 /// The native variants (`make` from each pair), solved by `solve` on the batch pool with
 /// the GIL released; each outcome turned into a Python object by `out`, in input order.
+/// On Ctrl-C the KeyboardInterrupt is raised with the list as its attribute `partial`: the
+/// variants finished, those stopped on the way (`solve` sees the stop flag), and
+/// ("Cancelled", reason) for the rest.
 fn run_batch<'py, V: Sync, R: Send>(
     py: Python<'py>,
     variants: &[(Bound<'py, PyMechanism>, Bound<'py, PyDict>)],
     threads: Option<usize>,
     make: impl Fn(&Bound<'py, PyMechanism>, &Bound<'py, PyDict>) -> PyResult<V>,
-    solve: impl Fn(&V) -> R + Sync + Send,
+    solve: impl Fn(&V, &AtomicBool) -> R + Sync + Send,
     out: impl Fn(R, &Bound<'py, PyMechanism>) -> PyResult<Bound<'py, PyAny>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let vs = variants.iter().map(|(m, d)| make(m, d)).collect::<PyResult<Vec<_>>>()?;
-    let done = run(py, || map_many(&vs, threads, solve).map_err(Failure::from))?;
-    done.into_iter().zip(variants).map(|(r, (m, _))| out(r, m)).collect()
+    let (done, interrupt) =
+        run_until_interrupt(py, |stop| map_many_until(&vs, threads, stop, solve).map_err(Failure::from))?;
+    let results = done
+        .into_iter()
+        .zip(variants)
+        .map(|(r, (m, _))| match r {
+            Some(r) => out(r, m),
+            None => Ok(PyTuple::new(py, ["Cancelled", INTERRUPTED])?.into_any()),
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    match interrupt {
+        Some(e) => {
+            e.value(py).setattr("partial", results)?;
+            Err(e)
+        }
+        None => Ok(results),
+    }
 }
+
+/// Why a variant was not run, or stopped.
+const INTERRUPTED: &str = "not run: interrupted (Ctrl-C)";
 
 /// Simulate `(mechanism, overrides)` pairs on `threads` threads (None: all cores); results
 /// in input order.
@@ -89,10 +161,12 @@ fn simulate_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(d)? })
+        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(&m.get().inner, d)? })
     };
-    run_batch(py, &variants, threads, make, Variant::simulate, |r, _| match r {
-        Ok(traj) => Ok(crate::simulate::to_dict(py, traj, None)?.into_any()),
+    let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
+    run_batch(py, &variants, threads, make, solve, |r, _| match r {
+        // A batch's runs are cancelled only by Ctrl-C.
+        Ok(traj) => Ok(crate::simulate::to_dict(py, traj, Some("interrupted (Ctrl-C)".to_string()))?.into_any()),
         Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
     })
 }
@@ -149,10 +223,17 @@ fn inverse_batch<'py>(
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
         Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? })
     };
-    run_batch(py, &variants, threads, make, InverseVariant::solve, |r, m| match r {
-        Ok(e) => efforts_dict(py, e, m.get().inner.dof()),
-        Err(e) => failure(py, &e),
-    })
+    run_batch(
+        py,
+        &variants,
+        threads,
+        make,
+        |v, _| v.solve(),
+        |r, m| match r {
+            Ok(e) => efforts_dict(py, e, m.get().inner.dof()),
+            Err(e) => failure(py, &e),
+        },
+    )
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -11,7 +11,8 @@
 //! ```
 //!
 //! A task motion's failures (`TaskError`) are `SingularityError` and `AssemblyError` too, with
-//! the data of where the motion stopped as attributes.
+//! the data of where the motion stopped as attributes. A failure at one row of a trajectory
+//! (`Error::Row`) is its row's error, with attributes `row` and `t` and the row in the message.
 //!
 //! Shape and value errors in the arguments are plain `ValueError`s (attribute `argument`
 //! where the core names it), and so are finite arguments whose results overflow
@@ -205,6 +206,12 @@ pub fn to_pyerr(py: Python<'_>, e: &Error) -> PyErr {
         Error::BranchUndecided { row, sigma_min, .. } => {
             let attrs = vec![("kind", attr(py, "II")), ("row", attr(py, *row)), ("sigma_min", attr(py, *sigma_min))];
             set_attrs(py, SingularityError::new_err(e.to_string()), attrs)
+        }
+        // The row's own error class, its message prefixed with the row, attributes `row`, `t`.
+        Error::Row { row, t, source } => {
+            let err = to_pyerr(py, source);
+            let attrs = vec![("args", attr(py, (e.to_string(),))), ("row", attr(py, *row)), ("t", attr(py, *t))];
+            set_attrs(py, err, attrs)
         }
         _ => PlanardynError::new_err(e.to_string()),
     }

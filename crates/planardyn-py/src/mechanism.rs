@@ -7,8 +7,8 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::{inverse_rows_checked, Branch};
-use planardyn::dynamics::{self, Drives, ModelDrives};
+use planardyn::batch::{inverse_rows_checked, regressor_rows, Branch};
+use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
@@ -30,26 +30,10 @@ pub struct PyMechanism {
     carriers: Vec<Option<(Link, [f64; 2])>>,
 }
 
-/// Fixed efforts (N m or N) on the coordinates.
-pub struct FixedDrives(pub Vec<f64>);
-
-impl Drives for FixedDrives {
-    fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
-        tau.copy_from_slice(&self.0);
-        Ok(())
-    }
-}
-
 impl PyMechanism {
     pub fn new(mech: Mechanism) -> Self {
-        let carriers = (0..mech.points.len())
-            .map(|p| {
-                let id = planardyn::model::PointId(p);
-                std::iter::once(Link::Ground)
-                    .chain((0..mech.n_bodies()).map(|b| Link::Body(planardyn::model::BodyId(b))))
-                    .find_map(|link| mech.attachment(link, id).map(|a| (link, a.s)))
-            })
-            .collect();
+        let carriers =
+            (0..mech.points.len()).map(|p| mech.carrier(planardyn::model::PointId(p)).map(|a| (a.link, a.s))).collect();
         PyMechanism { inner: Arc::new(mech), carriers }
     }
 
@@ -87,6 +71,27 @@ impl PyMechanism {
         let mut out = Vec::with_capacity(2 * self.carriers.len());
         self.per_point(&mut out, |link, s| point_velocity(link, s, x, xd));
         out
+    }
+
+    /// q, qd, qdd of one shape, (m,) or (N, m), and the branch's body coordinates x, (3n,)
+    /// or (N, 3n), if given.
+    fn motion_rows(
+        &self,
+        q: &ArrayArg<'_>,
+        qd: &ArrayArg<'_>,
+        qdd: &ArrayArg<'_>,
+        x: Option<&ArrayArg<'_>>,
+    ) -> PyResult<(Values, Values, Values, Option<Values>)> {
+        let x = x.map(|a| rows("x", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
+        let (m, what) = (self.m(), self.coords_what());
+        let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
+        if qd.shape != q.shape || qdd.shape != q.shape {
+            return Err(PyValueError::new_err(format!(
+                "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
+                q.shape, qd.shape, qdd.shape
+            )));
+        }
+        Ok((q, qd, qdd, x))
     }
 
     /// Drive efforts: the given tau, or the model's drives.
@@ -459,27 +464,50 @@ impl PyMechanism {
         x: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let x = x.map(|a| rows("x", &a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
-        let m = self.m();
-        let what = self.coords_what();
-        let (q, qd, qdd) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("qdd", &qdd, m, &what)?);
-        if qd.shape != q.shape || qdd.shape != q.shape {
-            return Err(PyValueError::new_err(format!(
-                "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
-                q.shape, qd.shape, qdd.shape
-            )));
-        }
+        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
         let mech = self.inner.clone();
         let shape = q.shape.clone();
         let tau = run(py, move || {
-            let branch = match &x {
-                None => Branch::Drawing,
-                Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
-                Some(x) => Branch::Rows(&x.data),
-            };
-            Ok(inverse_rows_checked(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
+            Ok(inverse_rows_checked(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         arr_dyn(py, &shape, tau)
+    }
+
+    /// The regressor form along rows of a motion, on the branch of x as `inverse_dynamics`:
+    /// `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with efforts = Y pi + tau_o.
+    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    fn regressor<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        x: Option<ArrayArg<'py>>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let mech = self.inner.clone();
+        let (m, p) = (self.m(), planardyn::dynamics::regressor::BODY_PARAMETERS * mech.bodies.len());
+        let (y, tau_o) = run(py, || {
+            Ok(regressor_rows(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+        })?;
+        let n = q.rows();
+        let d = PyDict::new(py);
+        if q.shape.len() == 1 {
+            d.set_item("Y", arr2(py, m, p, y)?)?;
+            d.set_item("tau_o", arr1(py, tau_o))?;
+        } else {
+            d.set_item("Y", arr3(py, (n, m, p), y)?)?;
+            d.set_item("tau_o", arr2(py, n, m, tau_o)?)?;
+        }
+        Ok(d)
+    }
+
+    /// The model's inertial parameters pi (4 per body: m, m cx, m cy, I_O) and their names.
+    #[getter]
+    fn parameters(&self) -> (Vec<f64>, Vec<String>) {
+        use planardyn::dynamics::regressor::{parameter_names, parameters};
+        (parameters(&self.inner), parameter_names(&self.inner))
     }
 
     /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
@@ -503,6 +531,68 @@ impl PyMechanism {
             Ok(dynamics::finite("reactions", r.as_flattened())?.to_vec())
         })?;
         arr2(py, r.len() / 3, 3, r)
+    }
+
+    /// Body accelerations (N, 3n) and pair reactions (N, p, 3) along a trajectory's rows, each
+    /// on its own body coordinates x (`planardyn::dynamics::along`).
+    #[pyo3(signature = (t, x, q, qd, tau, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
+    fn along<'py>(
+        &self,
+        py: Python<'py>,
+        t: ArrayArg<'py>,
+        x: ArrayArg<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        tau: ArrayArg<'py>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (m, nx, p) = (self.m(), self.inner.n_x(), self.inner.pairs.len());
+        let what = self.coords_what();
+        let x = rows("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
+        let (q, qd, tau) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
+        let t = Values::read(&t);
+        let mech = self.inner.clone();
+        let out = run(py, || {
+            let r = Rows { t: &t.data, x: &x.data, q: &q.data, qd: &qd.data, tau: &tau.data };
+            Ok(dynamics::along(&mech, r, allow_singular)?)
+        })?;
+        let n = out.xdd.len() / nx;
+        let d = PyDict::new(py);
+        d.set_item("xdd", arr2(py, n, nx, out.xdd)?)?;
+        d.set_item("reactions", arr3(py, (n, p, 3), out.reactions)?)?;
+        Ok(d)
+    }
+
+    /// Positions, velocities and accelerations (N, P, 2) of the named points a link carries
+    /// (`names`), for rows of x, xd, xdd (N, 3n).
+    fn point_motion<'py>(
+        &self,
+        py: Python<'py>,
+        x: ArrayArg<'py>,
+        xd: ArrayArg<'py>,
+        xdd: ArrayArg<'py>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let nx = self.inner.n_x();
+        let what = "body coordinates [X, Y, phi] per body";
+        let (x, xd, xdd) = (rows("x", &x, nx, what)?, rows("xd", &xd, nx, what)?, rows("xdd", &xdd, nx, what)?);
+        if xd.data.len() != x.data.len() || xdd.data.len() != x.data.len() {
+            return Err(PyValueError::new_err(format!(
+                "x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}",
+                x.shape, xd.shape, xdd.shape
+            )));
+        }
+        let mech = &self.inner;
+        let names: Vec<&str> =
+            dynamics::carried_points(mech).iter().map(|(p, _)| mech.points[p.0].0.as_str()).collect();
+        let [pos, vel, acc] = dynamics::point_motion(mech, &x.data, &xd.data, &xdd.data);
+        let shape = (x.rows(), names.len(), 2);
+        let d = PyDict::new(py);
+        d.set_item("names", names)?;
+        d.set_item("position", arr3(py, shape, pos)?)?;
+        d.set_item("velocity", arr3(py, shape, vel)?)?;
+        d.set_item("acceleration", arr3(py, shape, acc)?)?;
+        Ok(d)
     }
 
     /// Kinetic and potential energy (J) at (q, qd), reached from `x_start` (else the drawing).
@@ -532,7 +622,7 @@ impl PyMechanism {
     }
 
     /// Simulate; see `planardyn.Mechanism.simulate` for the arguments.
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None, motion=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -549,6 +639,7 @@ impl PyMechanism {
         drives: Option<Py<PyAny>>,
         progress: Option<Py<PyAny>>,
         max_steps: Option<usize>,
+        motion: Option<Vec<(usize, crate::simulate::MotionArg)>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let t_eval = t_eval
             .map(|a| {
@@ -574,8 +665,10 @@ impl PyMechanism {
             q0: q0.map(|a| self.q_arg("q0", &a)).transpose()?,
             qd0: qd0.map(|a| self.q_arg("qd0", &a)).transpose()?,
             max_steps,
+            // The caller's motions go to the run with its callables (`simulate::simulate`).
+            motion: Vec::new(),
         };
-        crate::simulate::simulate(py, &self.inner, args, drives, progress)
+        crate::simulate::simulate(py, &self.inner, args, drives, motion.unwrap_or_default(), progress)
     }
 
     fn __repr__(&self) -> String {
@@ -602,4 +695,14 @@ fn check_time(t: f64) -> PyResult<()> {
 
 fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
     serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
+}
+
+/// The branch of a motion: the drawn one, from the first row's body coordinates (3n,), or
+/// every row's (N, 3n).
+fn branch_of(x: Option<&Values>) -> Branch<'_> {
+    match x {
+        None => Branch::Drawing,
+        Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
+        Some(x) => Branch::Rows(&x.data),
+    }
 }

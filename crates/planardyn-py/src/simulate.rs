@@ -1,17 +1,18 @@
 //! `Mechanism.simulate`: settings from the model file's defaults and the caller's
-//! overrides, Python callables as drives and progress callback, and the trajectory as a
-//! dict of time-major numpy arrays. The whole loop runs in Rust with the GIL released;
+//! overrides, Python callables as drives, motions and progress callback, and the trajectory
+//! as a dict of time-major numpy arrays. The whole loop runs in Rust with the GIL released;
 //! callbacks re-attach to the interpreter for the duration of each call.
 
 use crate::convert::{arr1, arr2, bool1, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
-use planardyn::dynamics::{Drives, ModelDrives};
+use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
+use planardyn::model::{MotionLaw, Spline};
 use planardyn::simulate::{Overrides, Settings, Trajectory};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 use std::time::{Duration, Instant};
 
 /// The progress callback runs each time t has advanced by this fraction of the run: at most
@@ -20,7 +21,7 @@ const PROGRESS_FRACTION: f64 = 0.01;
 
 /// Ctrl-C is also checked at least this often in wall time, so a slow run answers it at once
 /// whatever its progress in t.
-const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
+pub(crate) const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
 
 /// The model's simulation settings with the caller's overrides; a bad `t_end` is a
 /// ValueError (an argument), everything else the core's option error.
@@ -74,16 +75,84 @@ impl Drives for PyDrives {
     }
 }
 
+/// The motion of one coordinate as `Mechanism.simulate` passes it: a speed (rad/s or m/s),
+/// a table (times in s, positions in rad or m), or a callable `f(t) -> (q, qd, qdd)`.
+#[derive(FromPyObject)]
+pub enum MotionArg {
+    Speed(f64),
+    Table(Vec<f64>, Vec<f64>),
+    Function(Py<PyAny>),
+}
+
+/// A Python callable `f(t) -> (q, qd, qdd)` as the motion of one coordinate.
+pub(crate) struct PyMotion {
+    f: Py<PyAny>,
+    name: String,
+    /// As `PyDrives::fatal`.
+    fatal: Option<PyErr>,
+}
+
+impl MotionFunction for PyMotion {
+    fn motion(&mut self, t: f64) -> Result<[f64; 3], String> {
+        if self.fatal.is_some() {
+            return Err("interrupted".to_string());
+        }
+        Python::attach(|py| match self.f.bind(py).call1((t,)).and_then(|r| r.extract::<(f64, f64, f64)>()) {
+            Ok((q, qd, qdd)) => Ok([q, qd, qdd]),
+            Err(e) => {
+                let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
+                if !e.is_instance_of::<PyException>(py) {
+                    self.fatal = Some(e);
+                }
+                Err(format!(
+                    "the motion function of '{}' must return (q, qd, qdd), three numbers; it raised {text}",
+                    self.name
+                ))
+            }
+        })
+    }
+}
+
+/// A motion ready for the core: a law, or a Python function.
+pub(crate) enum MotionEntry {
+    Law(MotionLaw),
+    Function(PyMotion),
+}
+
+/// The caller's motions by coordinate index, checked (a table's spline built).
+pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) -> PyResult<Vec<(usize, MotionEntry)>> {
+    let names = mech.coordinate_names();
+    motion
+        .into_iter()
+        .map(|(k, arg)| {
+            let name = names.get(k).ok_or_else(|| PyValueError::new_err(format!("motion: no coordinate {k}")))?;
+            let entry = match arg {
+                MotionArg::Speed(w) if w.is_finite() => MotionEntry::Law(MotionLaw::Speed(w)),
+                MotionArg::Speed(w) => {
+                    return Err(PyValueError::new_err(format!("motion of '{name}': speed {w} must be finite")))
+                }
+                MotionArg::Table(t, q) => MotionEntry::Law(MotionLaw::Table(
+                    Spline::new(&t, &q).map_err(|e| PyValueError::new_err(format!("motion table of '{name}': {e}")))?,
+                )),
+                MotionArg::Function(f) => MotionEntry::Function(PyMotion { f, name: name.to_string(), fatal: None }),
+            };
+            Ok((k, entry))
+        })
+        .collect()
+}
+
 /// Run a simulation and return its trajectory as a dict (see `planardyn.SimulationResult`).
 pub fn simulate<'py>(
     py: Python<'py>,
     mech: &Mechanism,
     args: Overrides,
     drives: Option<Py<PyAny>>,
+    motion: Vec<(usize, MotionArg)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = mech.dof();
     let mut py_drives = drives.map(|f| PyDrives { f, m, fatal: None });
+    let mut motions = motion_entries(mech, motion)?;
     let mut fatal: Option<PyErr> = None;
     let mut cancel_reason: Option<String> = None;
     let traj = run(py, || {
@@ -125,9 +194,21 @@ pub fn simulate<'py>(
             Some(d) => d,
             None => &mut model_drives,
         };
-        Ok(planardyn::simulate::simulate(mech, &s, d, Some(&mut on_step))?)
+        let mut prescribed = Prescribed::from_model(mech);
+        for (k, entry) in motions.iter_mut() {
+            let motion = match entry {
+                MotionEntry::Law(law) => Motion::Law(law.clone()),
+                MotionEntry::Function(f) => Motion::Function(f),
+            };
+            prescribed.set(*k, motion).map_err(PyValueError::new_err)?;
+        }
+        Ok(planardyn::simulate::simulate_prescribed(mech, &s, d, &mut prescribed, Some(&mut on_step))?)
     })?;
-    let fatal = fatal.or_else(|| py_drives.and_then(|d| d.fatal));
+    let motion_fatal = motions.into_iter().find_map(|(_, e)| match e {
+        MotionEntry::Function(f) => f.fatal,
+        MotionEntry::Law(_) => None,
+    });
+    let fatal = fatal.or_else(|| py_drives.and_then(|d| d.fatal)).or(motion_fatal);
     match fatal {
         // Ctrl-C keeps the trajectory so far: `Mechanism.simulate` raises the interrupt with
         // it attached (`SimulationInterrupted.result`).
@@ -164,6 +245,16 @@ pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<Strin
     d.set_item("sigma", arr1(py, t.sigma))?;
     d.set_item("residual", arr1(py, t.residual))?;
     d.set_item("partitioned", bool1(py, t.partitioned))?;
+    let points = PyList::empty(py);
+    for p in &t.change_points {
+        let c = PyDict::new(py);
+        c.set_item("t", p.t)?;
+        c.set_item("q", arr1(py, p.q.clone()))?;
+        c.set_item("x", arr1(py, p.x.clone()))?;
+        c.set_item("rank_drop", p.rank_drop)?;
+        points.append(c)?;
+    }
+    d.set_item("change_points", points)?;
     d.set_item("status", t.status.name())?;
     let message = match (t.status, cancel_reason) {
         (planardyn::simulate::Status::Cancelled, Some(reason)) => reason,

@@ -20,9 +20,10 @@ use crate::dynamics::{self, ModelDrives};
 use crate::kinematics::{assemble_from, assemble_into, continue_to};
 use crate::simulate::charts::SWITCH_TO_PARTITION;
 pub use crate::simulate::Overrides;
-use crate::simulate::{simulate, Trajectory};
+use crate::simulate::{simulate_prescribed, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use task::{TaskError, TaskPath, TaskSolution};
 
@@ -54,9 +55,18 @@ impl Model {
 impl Variant {
     /// Build (if needed), set up and simulate with the model's drives, in the caller's thread.
     pub fn simulate(&self) -> Result<Trajectory, Error> {
+        self.simulate_until(&AtomicBool::new(false))
+    }
+
+    /// [`Variant::simulate`] (the coordinates of the overrides' and the model's motions
+    /// driven by them), stopping at the first step after `stop` is set (status
+    /// `Cancelled`, the trajectory so far kept).
+    pub fn simulate_until(&self, stop: &AtomicBool) -> Result<Trajectory, Error> {
         self.model.with(|mech| {
             let settings = self.overrides.settings(mech)?;
-            simulate(mech, &settings, &mut ModelDrives(mech), None)
+            let mut motion = self.overrides.prescribed(mech)?;
+            let mut go_on = |_t: f64| !stop.load(Ordering::Relaxed);
+            simulate_prescribed(mech, &settings, &mut ModelDrives(mech), &mut motion, Some(&mut go_on))
         })
     }
 }
@@ -144,6 +154,52 @@ pub fn inverse_rows_checked(
     qdd: &[f64],
     allow_singular: bool,
 ) -> Result<Vec<f64>, Error> {
+    let mut tau = Vec::with_capacity(q.len());
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
+        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], ws)?;
+        tau.extend_from_slice(&ws.tau);
+        Ok(())
+    })?;
+    Ok(tau)
+}
+
+/// The regressor form along rows of a motion on `branch` (as [`inverse_rows_checked`]):
+/// Y (N x m x p, p = [`dynamics::regressor::BODY_PARAMETERS`] per body) and tau_o (N x m),
+/// so that every row's efforts are Y pi + tau_o.
+pub fn regressor_rows(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    let p = dynamics::regressor::BODY_PARAMETERS * mech.bodies.len();
+    let m = mech.dof().max(1);
+    let (mut y, mut tau_o) = (vec![0.0; q.len() * p], vec![0.0; q.len()]);
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
+        dynamics::forward::kinematic_stages(mech, &q[row.clone()], &qd[row.clone()], ws)?;
+        let k = row.start / m;
+        let (y_row, tau_row) = (&mut y[k * m * p..(k + 1) * m * p], &mut tau_o[row.clone()]);
+        dynamics::regressor::regressor(mech, ws, &qdd[row], y_row, tau_row);
+        Ok(())
+    })?;
+    Ok((y, tau_o))
+}
+
+/// Assemble every row of (q, qd, qdd) on `branch` in one workspace and call `each` with the
+/// row's index range (which computes into the workspace); then the type II measure: below
+/// [`dynamics::SINGULAR_SIGMA`] refused unless `allow_singular`, and with q alone (no `Rows`)
+/// a motion that goes on past a row within [`BRANCH_SIGMA`] refused as `BranchUndecided`.
+fn walk_rows(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+    mut each: impl FnMut(&mut Workspace, std::ops::Range<usize>) -> Result<(), Error>,
+) -> Result<(), Error> {
     let (m, nx) = (mech.dof(), mech.n_x());
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
         return Err(KinematicsError::bad_argument(
@@ -161,7 +217,6 @@ pub fn inverse_rows_checked(
         }
     }
     let mut ws = Workspace::new(mech);
-    let mut tau = Vec::with_capacity(q.len());
     for k in 0..n {
         let row = k * m..(k + 1) * m;
         match (branch, k) {
@@ -170,32 +225,49 @@ pub fn inverse_rows_checked(
             (Branch::Drawing, 0) => assemble_into(mech, &q[row.clone()], &mut ws)?,
             _ => continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?,
         }
-        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], &mut ws)?;
+        each(&mut ws, row)?;
         let sigma_min = dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
         // Only the rows after a near-singular one are in doubt.
         if !matches!(branch, Branch::Rows(_)) && k + 1 < n && sigma_min < BRANCH_SIGMA {
             return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
         }
-        tau.extend_from_slice(&ws.tau);
     }
-    Ok(tau)
+    Ok(())
+}
+
+/// A pool of `threads` threads (`None` or 0: one per core). Fails only if the operating
+/// system refuses the threads.
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .thread_name(|i| format!("planardyn-batch-{i}"))
+        .build()
+        .map_err(|e| Error::Options(format!("cannot start the batch thread pool: {e}")))
 }
 
 /// Apply `f` to every item on a pool of `threads` threads (`None` or 0: one per core), the
-/// results in input order. Fails only if the operating system refuses the threads.
+/// results in input order.
 pub fn map_many<T: Sync, R: Send>(
     items: &[T],
     threads: Option<usize>,
     f: impl Fn(&T) -> R + Sync + Send,
 ) -> Result<Vec<R>, Error> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .thread_name(|i| format!("planardyn-batch-{i}"))
-        .build()
-        .map_err(|e| Error::Options(format!("cannot start the batch thread pool: {e}")))?;
     // One item a task: runs take from milliseconds to seconds, so work stealing balances
     // them better than fixed chunks.
-    Ok(pool.install(|| items.par_iter().with_max_len(1).map(&f).collect()))
+    Ok(pool(threads)?.install(|| items.par_iter().with_max_len(1).map(&f).collect()))
+}
+
+/// [`map_many`] that another thread can stop (on Ctrl-C, a closed window...) by setting
+/// `stop`: the items not started by then are `None`; `f` gets the flag too, so a long item
+/// can stop early ([`Variant::simulate_until`]).
+pub fn map_many_until<T: Sync, R: Send>(
+    items: &[T],
+    threads: Option<usize>,
+    stop: &AtomicBool,
+    f: impl Fn(&T, &AtomicBool) -> R + Sync + Send,
+) -> Result<Vec<Option<R>>, Error> {
+    let one = |item: &T| (!stop.load(Ordering::Relaxed)).then(|| f(item, stop));
+    Ok(pool(threads)?.install(|| items.par_iter().with_max_len(1).map(one).collect()))
 }
 
 /// Simulate every variant in parallel on `threads` threads (`None`: all cores). The outer

@@ -145,6 +145,9 @@ pub enum Error {
          give the body coordinates of every row (x=, which a simulation result and a results file carry)"
     )]
     BranchUndecided { row: usize, sigma_min: f64, tol: f64 },
+    /// A computation along the rows of a trajectory failed at one row.
+    #[error("row {row} (t = {t} s): {source}")]
+    Row { row: usize, t: f64, source: Box<Error> },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

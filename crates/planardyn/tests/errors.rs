@@ -130,3 +130,15 @@ fn an_unmeasured_singularity_has_no_sigma_and_says_nothing_of_one() {
     assert!(measured.to_string().contains("(smallest scaled singular value 1.500e-9)"), "{measured}");
     assert_eq!(SingularityKind::MassMatrix { type_ii: true }.name(), "mass_matrix");
 }
+
+#[test]
+fn an_angle_beyond_a_full_turn_is_warned_about_as_likely_degrees() {
+    // Loaded (angles are unwrapped, so 30 rad is legal) with one warning: 30 deg = pi/6 rad.
+    let mech = yaml(&FOUR_BAR.replacen("value: 1.0471975511965976", "value: 30.0", 1));
+    assert_eq!(
+        mech.warnings,
+        ["coordinates[0].value of angle 'theta1' is 30 rad, more than a full turn (2 pi = 6.283 rad): angles are in \
+          radians; if 30 is in degrees, write 0.523599"]
+    );
+    assert!(yaml(FOUR_BAR).warnings.is_empty());
+}

@@ -7,16 +7,20 @@ use planardyn::dynamics::ModelDrives;
 use planardyn::integrate::OdeSystem;
 use planardyn::kinematics::{assemble_into, velocity_analogues, Chart};
 use planardyn::simulate::ode::MechanismOde;
-use planardyn::Workspace;
+use planardyn::{Mechanism, Workspace};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    // Per thread: the tests run in parallel, and the harness allocates on its own threads.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // `try_with`: a thread's last allocations may come after its locals are gone.
+        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
@@ -27,30 +31,86 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
+/// The workspace assembled at `q` with its velocity analogues.
+fn assembled(mech: &Mechanism, q: &[f64]) -> Workspace {
+    let mut ws = Workspace::new(mech);
+    assemble_into(mech, q, &mut ws).unwrap();
+    velocity_analogues(&mut ws).unwrap();
+    ws
+}
+
+/// Start `ode` at (q, qd) in `chart`, then count the allocations of ten
+/// evaluations and acceptances at states that `vary` moves a little each step.
+fn allocations(ode: &mut MechanismOde, chart: Chart, q: &[f64], qd: &[f64], vary: impl Fn(&mut [f64], usize)) -> usize {
+    let m = q.len();
+    let mut y = vec![0.0; 2 * m + 1];
+    y[..m].copy_from_slice(q);
+    y[m..2 * m].copy_from_slice(qd);
+    ode.set_chart(chart, 0.0, &y).unwrap();
+    let mut dy = vec![0.0; 2 * m + 1];
+    let before = ALLOCATIONS.with(Cell::get);
+    for step in 0..10 {
+        vary(&mut y, step);
+        let t = 1e-3 * step as f64;
+        ode.rhs(t, &y, &mut dy).unwrap();
+        ode.accept(t, &y).unwrap();
+    }
+    ALLOCATIONS.with(Cell::get) - before
+}
+
 #[test]
 fn rhs_evaluation_does_not_allocate() {
     for mech in all_models() {
         let m = mech.dof();
         let (q, qd) = test_state(&mech);
-        let mut ws = Workspace::new(&mech);
-        assemble_into(&mech, &q, &mut ws).unwrap();
-        velocity_analogues(&mut ws).unwrap();
+        let mut drives = ModelDrives(&mech);
+        let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives);
+        // Away from the start, so that Newton runs.
+        let vary = |y: &mut [f64], step: usize| {
+            if step == 0 {
+                y[..m].iter_mut().for_each(|v| *v += 1e-3);
+            }
+            y[0] += 1e-4 * step as f64;
+        };
+        assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "{}: allocations in rhs/accept", mech.name);
+    }
+}
+
+/// The same with the first coordinate driven by a table motion. (In the user's chart: an
+/// evaluation in a partition chart allocates once, with or without motion.)
+#[test]
+fn prescribed_rhs_evaluation_does_not_allocate() {
+    use planardyn::dynamics::{Motion, Prescribed};
+    use planardyn::model::{MotionLaw, Spline};
+    for mech in all_models() {
+        let m = mech.dof();
+        let (q, qd) = test_state(&mech);
+        let mut drives = ModelDrives(&mech);
+        let law = Spline::new(&[0.0, 0.5, 1.0, 1.5], &[q[0], q[0] + 0.01, q[0] + 0.03, q[0] + 0.02]).unwrap();
+        let mut motion = Prescribed::from_model(&mech);
+        motion.set(0, Motion::Law(MotionLaw::Table(law))).unwrap();
+        motion.start(0.0, 1.0, &q).unwrap();
+        let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives).with_motion(&mut motion);
+        let vary = |y: &mut [f64], _: usize| y[m..2 * m].iter_mut().for_each(|v| *v *= 1.0 + 1e-6);
+        assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "{}: allocations in rhs/accept", mech.name);
+    }
+}
+
+/// In a partition chart (components of x as coordinates, as near a type II singularity):
+/// the state is those components, their rates from the user's via U.
+#[test]
+fn partition_chart_evaluation_does_not_allocate() {
+    use planardyn::kinematics::select_partition;
+    for mech in all_models() {
+        let (q, qd) = test_state(&mech);
+        let ws = assembled(&mech, &q);
+        let idx = select_partition(&mech, &ws.x);
+        let z: Vec<f64> = idx.iter().map(|&i| ws.x[i]).collect();
+        let zd: Vec<f64> = idx.iter().map(|&i| (0..q.len()).map(|j| ws.u_col(j)[i] * qd[j]).sum()).collect();
         let mut drives = ModelDrives(&mech);
         let mut ode = MechanismOde::new(&mech, ws, &mut drives);
-        let mut y = vec![0.0; 2 * m + 1];
-        y[..m].copy_from_slice(&q);
-        y[m..2 * m].copy_from_slice(&qd);
-        ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
-        let mut dy = vec![0.0; 2 * m + 1];
-        for yk in &mut y[..m] {
-            *yk += 1e-3;
-        }
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        for step in 0..10 {
-            y[0] += 1e-4 * step as f64;
-            ode.rhs(0.01 * step as f64, &y, &mut dy).unwrap();
-            ode.accept(0.01 * step as f64, &y).unwrap();
-        }
-        assert_eq!(ALLOCATIONS.load(Ordering::Relaxed) - before, 0, "{}: allocations in rhs/accept", mech.name);
+        let vary = |y: &mut [f64], step: usize| y[0] += 1e-6 * step as f64;
+        let n = allocations(&mut ode, Chart::Partition(idx), &z, &zd, vary);
+        assert_eq!(n, 0, "{}: allocations in rhs/accept in a partition chart", mech.name);
     }
 }

@@ -4,6 +4,7 @@
     >>> models.names()[:3]
     ['3-rrr', 'andrews-squeezer', 'five-bar']
     >>> models.path("five-bar")            # a pathlib.Path to five-bar.yaml
+    >>> models.resolve("my-linkage.yaml")  # a file as given; a shipped model by name if no such file
 
 The files of the mechanism library (``planardyn.library``) are named ``library/<name>``.
 ``planardyn.load_example(name)`` loads one into a :class:`~planardyn.Mechanism`.
@@ -13,10 +14,11 @@ This module imports nothing of the package: it only locates data files.
 
 from __future__ import annotations
 
+import os
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["UnknownModelError", "directory", "names", "path"]
+__all__ = ["UnknownModelError", "directory", "names", "path", "resolve"]
 
 #: The extension of every shipped model file.
 SUFFIX = ".yaml"
@@ -62,3 +64,22 @@ def path(name: str) -> Path:
     if stem in names():
         return directory() / f"{stem}{SUFFIX}"
     raise UnknownModelError(f"no shipped model is named {name!r}; the shipped models are: {', '.join(names())}")
+
+
+def resolve(name_or_file: str | os.PathLike[str]) -> Path:
+    """A model argument as the command line takes it: an existing file, or else the shipped
+    model of that name (``five-bar``). A name with a suffix (``.json``...) is taken as a file,
+    for the loader to report if missing.
+
+    Raises
+    ------
+    UnknownModelError
+        (a ``KeyError``) Neither a file nor a shipped model; the message lists the shipped ones.
+    """
+    given = Path(name_or_file)
+    if given.exists() or given.suffix not in ("", SUFFIX):
+        return given
+    try:
+        return path(os.fspath(given))
+    except UnknownModelError as e:
+        raise UnknownModelError(f"{given}: no such model file, and {e}") from None

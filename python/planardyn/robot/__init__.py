@@ -18,7 +18,7 @@ from .effector import EffectorState, EndEffector
 from .maps import TaskGrid, Workspace, flood, singularity_map, workspace
 from .modes import Mode, assembly_modes, working_modes
 from .motion import TaskMotion, singularity_message, solve_motion
-from .paths import TaskPath, circle, line, point_to_point, table, time_law
+from .paths import TaskPath, circle, from_functions, line, point_to_point, table, time_law
 from .plots import plot_capability, plot_modes, plot_motion, plot_singularity_map, plot_sizing, plot_workspace
 from .sizing import DriveSizing, SizingReport, envelope, size, with_payload
 from .tolerances import SINGULAR_TOL
@@ -42,6 +42,7 @@ __all__ = [
     "TaskMotion",
     "TaskPath",
     "circle",
+    "from_functions",
     "line",
     "point_to_point",
     "solve_motion",

@@ -15,6 +15,7 @@ import sys
 
 from .._core import AssemblyError, ModelError, SingularityError
 from ..mechanism import load
+from ..models import UnknownModelError, resolve
 from .effector import EndEffector
 from .paths import circle, line
 from .plots import plot_sizing
@@ -23,7 +24,7 @@ from .sizing import size
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="planardyn size", description="Actuator sizing of an end-effector motion.")
-    p.add_argument("model", help="model file (.yaml/.json)")
+    p.add_argument("model", help="model file (.yaml/.json), or a shipped model by name (five-bar)")
     p.add_argument("--point", default="P", help="end-effector point (default P)")
     p.add_argument("--body", default=None, help="body carrying it, when several do (3-DOF pose)")
     shape = p.add_mutually_exclusive_group(required=True)
@@ -45,13 +46,13 @@ def size_cli(argv: list[str] | None = None) -> int:
     except SystemExit as exc:
         return 0 if exc.code == 0 else 2
     try:
-        ee = EndEffector(load(args.model), args.point, args.body)
+        ee = EndEffector(load(resolve(args.model)), args.point, args.body)
         if args.circle:
             path = circle(args.circle[:2], args.circle[2], args.duration, profile=args.profile)
         else:
             path = line(args.line[:2], args.line[2:], args.duration, profile=args.profile)
         report = size(ee, path, payload=args.payload, dt=args.dt)
-    except (ModelError, ValueError) as exc:
+    except (ModelError, ValueError, UnknownModelError) as exc:
         print(f"planardyn size: {exc}", file=sys.stderr)
         return 2
     except (SingularityError, AssemblyError) as exc:

@@ -181,7 +181,54 @@ def circle(
     return TaskPath(T, 2 if angles is None else 3, f"circle r = {r:g} m about {c.round(4).tolist()} in {T:g} s ({profile})", sample)
 
 
-def table(t: ArrayLike, X: ArrayLike, bc_type: str = "clamped") -> TaskPath:
+#: Relative mismatch between the derivative functions of :func:`from_functions` and central
+#: differences of the position function (step 1e-4 of the duration: error ~1e-8 relative for
+#: a smooth motion) beyond which they are refused as not each other's derivatives.
+DERIVATIVE_CHECK_RTOL = 1e-4
+
+
+def from_functions(
+    X: Callable[[FloatArray], ArrayLike],
+    Xd: Callable[[FloatArray], ArrayLike],
+    Xdd: Callable[[FloatArray], ArrayLike],
+    duration: float,
+    label: str = "functions of time",
+) -> TaskPath:
+    """A path given as functions of time: the pose and its first two derivatives, exact.
+
+    Each function takes t, an (N,) array of times in [0, duration] (s), and returns (N, k)
+    (k = 2 for a point, 3 with psi in rad). This is the route for a motion known as a formula:
+    no interpolation error, and the ends move as the formula says.
+
+    The derivatives are checked against central differences of X at a few times inside
+    (:data:`DERIVATIVE_CHECK_RTOL`), so a wrong sign or a forgotten chain-rule factor is an
+    error here rather than wrong efforts later.
+    """
+    duration = _check_duration(duration)
+
+    def sample(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        out = tuple(np.asarray(f(t), dtype=float) for f in (X, Xd, Xdd))
+        for name, a in zip(("X", "Xd", "Xdd"), out):
+            if a.shape not in ((len(t), 2), (len(t), 3)):
+                raise ValueError(f"{name}(t) must return shape (N, 2) or (N, 3) for t of shape (N,); "
+                                 f"got {a.shape} for N = {len(t)}")
+            if not np.isfinite(a).all():
+                raise ValueError(f"{name}(t) returned a NaN or an infinity")
+        return out  # type: ignore[return-value]
+
+    t = duration * np.array([0.1, 0.37, 0.5, 0.73, 0.9])
+    h = 1e-4 * duration
+    (x0, v0, a0), (xp, vp, _), (xm, vm, _) = sample(t), sample(t + h), sample(t - h)
+    for name, got, want in (("Xd", v0, (xp - xm) / (2 * h)), ("Xdd", a0, (vp - vm) / (2 * h))):
+        scale = np.abs(want).max() + np.abs(x0).max() / duration ** (1 if name == "Xd" else 2)
+        err = np.abs(got - want).max()
+        if err > DERIVATIVE_CHECK_RTOL * scale:
+            raise ValueError(f"{name}(t) is not the time derivative of the path: it differs from a central "
+                             f"difference by {err:.3g} (scale {scale:.3g}); check signs and chain-rule factors")
+    return TaskPath(duration, x0.shape[1], label, sample)
+
+
+def table(t: ArrayLike, X: ArrayLike, bc_type: str = "not-a-knot") -> TaskPath:
     """A time table of task coordinates, interpolated by a cubic spline in t.
 
     Parameters
@@ -191,7 +238,10 @@ def table(t: ArrayLike, X: ArrayLike, bc_type: str = "clamped") -> TaskPath:
     X : (K, 2) or (K, 3) array_like
         Positions (m), with psi (rad) as a third column for a pose.
     bc_type : str
-        scipy's CubicSpline end conditions; ``'clamped'`` (default) starts and ends at rest.
+        scipy's CubicSpline end conditions. The default ``'not-a-knot'`` assumes nothing at
+        the ends (the velocity and acceleration there follow from the table), so a motion
+        that does not start or end at rest keeps its speed; ``'clamped'`` makes it start and
+        end at rest (zero velocity), right only for a table that does.
     """
     from scipy.interpolate import CubicSpline
 

@@ -13,7 +13,7 @@ use crate::{Error, KinematicsError, SingularityKind};
 /// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
 /// a^T M b over the bodies `first..end` (a and b: 3n values each).
 #[inline]
-fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
+pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
     if first >= end {
         return 0.0;
     }
@@ -109,28 +109,50 @@ pub fn dynamic_stages(
     drives: &mut dyn Drives,
     ws: &mut Workspace,
 ) -> Result<(), Error> {
+    drive_efforts(t, drives, ws)?;
+    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    mass_matrix(mech, ws);
+    bias(mech, ws);
+    factor_mass_matrix(ws)?;
+    cholesky_solve(&ws.a, ws.b.len(), &mut ws.b);
+    accelerations(mech, z, zd, ws);
+    Ok(())
+}
+
+/// The drives' efforts at time t (s) and the point in `ws` into `ws.tau`, checked finite.
+pub(crate) fn drive_efforts(t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
     drives.efforts(t, &ws.q, &ws.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
     if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {
         return Err(Error::Drive { t, message: format!("effort {bad} is {}", ws.tau[bad]) });
     }
-    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
-    mass_matrix(mech, ws);
-    bias(mech, ws);
-    let m = ws.b.len();
-    if !cholesky_in_place(&mut ws.a, m) {
+    Ok(())
+}
+
+/// `ws.a` into its Cholesky factor, or the singularity that keeps A from being positive definite.
+pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsError> {
+    if !cholesky_in_place(&mut ws.a, ws.b.len()) {
         let type_ii = matches!(ws.chart, Chart::Inputs);
-        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }).into());
+        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }));
     }
-    cholesky_solve(&ws.a, m, &mut ws.b);
-    let n = ws.x.len();
-    ws.xdd.copy_from_slice(&ws.c);
-    for j in 0..m {
-        let (zdd, (first, end)) = (ws.b[j], ws.sys.u_support()[j]);
-        let u = &ws.u[j * n + 3 * first..j * n + 3 * end];
-        for (a, u) in ws.xdd[3 * first..3 * end].iter_mut().zip(u) {
-            *a += u * zdd;
+    Ok(())
+}
+
+/// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd
+/// in `ws.b`, at chart state (z, zd).
+pub(crate) fn accelerations(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Workspace) {
+    body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
+    user_coordinates(mech, ws, z, zd, true);
+}
+
+/// xdd = U zdd + c: the body accelerations of chart accelerations zdd (U column-major,
+/// one column of 3n a coordinate), each column over the bodies of its `support`
+/// (`System::u_support`), where it may be non-zero.
+pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
+    let n = c.len();
+    xdd.copy_from_slice(c);
+    for ((u, &a), &(first, end)) in u.chunks_exact(n).zip(zdd).zip(support) {
+        for (x, u) in xdd[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
+            *x += u * a;
         }
     }
-    user_coordinates(mech, ws, z, zd, true);
-    Ok(())
 }

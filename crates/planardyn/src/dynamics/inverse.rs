@@ -1,9 +1,10 @@
-//! Inverse dynamics: the drive efforts a motion needs, tau = A qdd - U^T (f - M c), with f
-//! the applied forces without drives (docs/formulation.md, *Inverse dynamics*). Defined only where the user's
-//! coordinates determine the mechanism (away from type II singularities).
+//! Inverse dynamics: the drive efforts a motion needs, tau = U^T (M xdd - f), with f the
+//! applied forces without drives (docs/formulation.md, *Inverse dynamics*). Defined only where
+//! the user's coordinates determine the mechanism (away from type II singularities).
 
 use super::forces::applied_forces;
-use super::forward::{bias, kinematic_stages, mass_matrix};
+use super::forward::{kinematic_stages, m_dot};
+use crate::kinematics::constraints::gamma;
 use crate::kinematics::Chart;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
@@ -11,7 +12,7 @@ use crate::KinematicsError;
 
 /// Drive efforts (N m or N) into `ws.tau` for user coordinates q, rates qd and accelerations
 /// qdd, starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
-/// distant q).
+/// distant q). Leaves the body rates and accelerations in `ws.xd`, `ws.xdd`.
 pub fn inverse(
     mech: &Mechanism,
     q: &[f64],
@@ -21,15 +22,38 @@ pub fn inverse(
 ) -> Result<(), KinematicsError> {
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
+    body_motion(mech, qd, qdd, ws);
     ws.tau.fill(0.0);
     applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
-    mass_matrix(mech, ws);
-    bias(mech, ws);
-    let m = q.len();
-    for j in 0..m {
-        ws.tau[j] = (0..m).map(|k| ws.a[j * m + k] * qdd[k]).sum::<f64>() - ws.b[j];
+    // tau = A qdd - b, formed as U^T (M xdd - f): M xdd - f is the constraint reaction,
+    // of the motion's own size, where A qdd and b are each of size 1/sigma^2.
+    let n = ws.x.len();
+    for (j, tau) in ws.tau.iter_mut().enumerate() {
+        let u = &ws.u[j * n..(j + 1) * n];
+        let (first, end) = ws.sys.u_support()[j];
+        let uf: f64 = u[3 * first..3 * end].iter().zip(&ws.f[3 * first..3 * end]).map(|(u, f)| u * f).sum();
+        *tau = m_dot(mech, u, &ws.xdd, (first, end)) - uf;
     }
     ws.qdd.copy_from_slice(qdd);
     super::finite("efforts tau", &ws.tau)?;
     Ok(())
+}
+
+/// Body rates and accelerations of rates qd and accelerations qdd in the user's chart, each
+/// from one solve with the factorised J:
+///   J xd = [0; qd],   J xdd = -gamma(xd, xd) + [0; qdd].
+/// Near a type II singularity U qd and U qdd + c add columns of size 1/sigma into a vector
+/// of size 1, each carrying its solve's error eps/sigma^2; one solve of the summed
+/// right-hand side errs by eps/sigma only.
+fn body_motion(mech: &Mechanism, qd: &[f64], qdd: &[f64], ws: &mut Workspace) {
+    let nc = mech.n_constraints;
+    ws.xd.fill(0.0);
+    ws.xd[nc..].copy_from_slice(qd);
+    ws.sys.solve(&mut ws.xd);
+    gamma(mech, &ws.chart, &ws.x, &ws.trig, &ws.xd, &ws.xd, &mut ws.xdd);
+    for (i, a) in ws.xdd.iter_mut().enumerate() {
+        let drive = if i >= nc { qdd[i - nc] } else { 0.0 };
+        *a = drive - *a;
+    }
+    ws.sys.solve(&mut ws.xdd);
 }

@@ -1,19 +1,27 @@
 //! Dynamics (docs/formulation.md): applied forces, A and b, forward and inverse dynamics,
+//! forward dynamics with coordinates driven by motion,
 //! pair reactions, energies, task-space inverse dynamics along an end-effector path. Stages
 //! run in a [`crate::Workspace`].
 
+pub mod along;
 pub mod energy;
 pub mod forces;
 pub mod forward;
 pub mod inverse;
+pub mod motion;
+pub mod prescribed;
 pub mod reactions;
+pub mod regressor;
 pub mod regular;
 pub mod task;
 
+pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{dynamic_stages, forward, mass_matrix};
 pub use inverse::inverse;
+pub use motion::{Motion, MotionFunction, Prescribed};
+pub use prescribed::{forward_prescribed, prescribed_sigma_min};
 pub use reactions::reactions;
 pub use regular::{finite, type_ii_measure, SINGULAR_SIGMA};
 pub use task::{SingularityKind, TaskError, TaskPath, TaskSolution};

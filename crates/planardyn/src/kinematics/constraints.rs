@@ -18,13 +18,31 @@ pub use crate::linalg::{Dense, Sink};
 use crate::model::{Link, Mechanism};
 
 /// Which m functions of x are the independent coordinates.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, PartialEq, Eq)]
 pub enum Chart {
     /// The user's generalized coordinates q.
     Inputs,
     /// Components of x (indices into the 3n body coordinates), chosen near a singularity
     /// of the actuated mechanism.
     Partition(Vec<usize>),
+}
+
+// By hand for `clone_from`: the factorisation records its chart at every evaluation, and a
+// derived `clone_from` would allocate a new index list each time in a partition chart.
+impl Clone for Chart {
+    fn clone(&self) -> Self {
+        match self {
+            Chart::Inputs => Chart::Inputs,
+            Chart::Partition(idx) => Chart::Partition(idx.clone()),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        match (self, source) {
+            (Chart::Partition(idx), Chart::Partition(from)) => idx.clone_from(from),
+            (this, _) => *this = source.clone(),
+        }
+    }
 }
 
 /// [cos(phi), sin(phi)] of every body, computed once per configuration: the hot functions

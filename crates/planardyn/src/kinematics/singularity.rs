@@ -28,6 +28,13 @@ fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
     j
 }
 
+/// The scaled Phi_x at x (its independent rows x 3n, row-major).
+pub(crate) fn scaled_phi_x(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
+    let mut a = scaled(mech, &Chart::Inputs, x);
+    a.truncate(mech.n_constraints * x.len());
+    a
+}
+
 /// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
 /// length (type II measure for `Inputs`; `group_sigma`). Cost linear in the bodies.
 pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
@@ -61,8 +68,8 @@ pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
 /// independent rows) left without a pivot by complete-pivoting elimination. Ascending.
 pub fn select_partition(mech: &Mechanism, x: &[f64]) -> Vec<usize> {
     let (n, rows) = (x.len(), mech.n_constraints);
-    let mut a = scaled(mech, &Chart::Inputs, x);
-    let pivots = pivot_columns(&mut a[..rows * n], rows, n, rows);
+    let mut a = scaled_phi_x(mech, x);
+    let pivots = pivot_columns(&mut a, rows, n, rows);
     let mut free: Vec<usize> = (0..n).filter(|c| !pivots.contains(c)).collect();
     free.truncate(mech.dof());
     free

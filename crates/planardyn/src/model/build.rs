@@ -2,7 +2,7 @@
 //! inertias are positive, the mobility equals the number of coordinates, the constraints are
 //! independent in the drawing, and the mechanism assembles at its start coordinates.
 
-use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, PairSpec, PartSpec, SimulateSpec};
+use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, MotionSpec, PairSpec, PartSpec, SimulateSpec};
 use super::*;
 use crate::kinematics::assemble;
 use crate::kinematics::constraints::rotate;
@@ -139,6 +139,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         pairs: Vec::new(),
         coordinates: Vec::new(),
         drives: Vec::new(),
+        motions: Vec::new(),
         loads: Vec::new(),
         simulate: SimulateDefaults::default(),
         x0: Vec::new(),
@@ -167,7 +168,8 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.row_slot = (0..mech.n_constraints).map(Some).collect();
     mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
     build_coordinates(&ctx, &mut mech)?;
-    mech.drives = build_drives(&ctx, &mech, &spec.drives)?;
+    warn_degree_like_angles(&mut mech);
+    (mech.drives, mech.motions) = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
@@ -648,6 +650,29 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     Ok(())
 }
 
+/// An angle beyond a full turn is legal (angles are unwrapped) but, in a drawing, more often
+/// degrees written where radians are meant (`value: 30`): say so, with the radian value.
+fn warn_degree_like_angles(mech: &mut Mechanism) {
+    let mut found = Vec::new();
+    for (k, c) in mech.coordinates.iter().enumerate() {
+        if c.kind != CoordinateKind::Angle {
+            continue;
+        }
+        let given_q0 = (c.q0 != c.value).then_some(("q0", c.q0));
+        for (field, v) in std::iter::once(("value", c.value)).chain(given_q0) {
+            if v.abs() > std::f64::consts::TAU {
+                found.push(format!(
+                    "coordinates[{k}].{field} of angle '{}' is {v} rad, more than a full turn (2 pi = 6.283 rad): \
+                     angles are in radians; if {v} is in degrees, write {:.6}",
+                    c.name,
+                    v.to_radians()
+                ));
+            }
+        }
+    }
+    mech.warnings.extend(found);
+}
+
 fn coordinate_index(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<usize> {
     mech.coordinates.iter().position(|c| c.name == name).ok_or_else(|| {
         ctx.err(
@@ -660,20 +685,23 @@ fn coordinate_index(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<us
     })
 }
 
-fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<Vec<Option<DriveLaw>>> {
-    let mut out = vec![None; mech.dof()];
+/// Effort laws and motion laws, one slot per coordinate (a coordinate has at most one).
+type DriveLaws = (Vec<Option<DriveLaw>>, Vec<Option<MotionLaw>>);
+
+fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<DriveLaws> {
+    let (mut efforts, mut motions) = (vec![None; mech.dof()], vec![None; mech.dof()]);
     for (k, d) in drives.iter().enumerate() {
         let path = format!("drives[{k}]");
         let i = coordinate_index(ctx, mech, &format!("{path}.coordinate"), &d.coordinate)?;
-        if out[i].is_some() {
+        if efforts[i].is_some() || motions[i].is_some() {
             return Err(ctx.err(
                 format!("{path}.coordinate"),
                 format!("coordinate '{}' already has a drive; remove one of the two", d.coordinate),
             ));
         }
-        out[i] = Some(match (&d.effort, &d.table) {
-            (Some(e), None) => DriveLaw::Constant(ctx.finite(&format!("{path}.effort"), *e)?),
-            (None, Some(table)) => {
+        match (&d.effort, &d.table, &d.motion) {
+            (Some(e), None, None) => efforts[i] = Some(DriveLaw::Constant(ctx.finite(&format!("{path}.effort"), *e)?)),
+            (None, Some(table), None) => {
                 let n = table.t.len();
                 if n == 0 || n != table.effort.len() {
                     return Err(
@@ -687,12 +715,48 @@ fn build_drives(ctx: &Ctx, mech: &Mechanism, drives: &[DriveSpec]) -> R<Vec<Opti
                         return Err(ctx.err(format!("{path}.table.t[{j}]"), "times must increase strictly"));
                     }
                 }
-                DriveLaw::Table { t: table.t.clone(), effort: table.effort.clone() }
+                efforts[i] = Some(DriveLaw::Table { t: table.t.clone(), effort: table.effort.clone() });
             }
-            _ => return Err(ctx.err(&path, "give exactly one of `effort` (a constant) or `table: {t, effort}`")),
-        });
+            (None, None, Some(motion)) => motions[i] = Some(build_motion(ctx, &format!("{path}.motion"), motion)?),
+            _ => {
+                return Err(ctx.err(
+                    &path,
+                    "give exactly one of `effort` (a constant), `table: {t, effort}` or `motion: {speed}` / \
+                     `motion: {table: {t, q}}`",
+                ))
+            }
+        }
     }
-    Ok(out)
+    Ok((efforts, motions))
+}
+
+/// A motion law: `speed` (rad/s or m/s) or `table: {t, q}` (s; rad or m).
+fn build_motion(ctx: &Ctx, path: &str, m: &MotionSpec) -> R<MotionLaw> {
+    match (&m.speed, &m.table) {
+        (Some(w), None) => Ok(MotionLaw::Speed(ctx.finite(&format!("{path}.speed"), *w)?)),
+        (None, Some(table)) => {
+            let (n, nq) = (table.t.len(), table.q.len());
+            if n < 2 || n != nq {
+                return Err(ctx.err(
+                    format!("{path}.table"),
+                    format!("`t` and `q` must have the same length, 2 or more; got {n} and {nq}"),
+                ));
+            }
+            for (j, (&t, &q)) in table.t.iter().zip(&table.q).enumerate() {
+                ctx.finite(&format!("{path}.table.t[{j}]"), t)?;
+                ctx.finite(&format!("{path}.table.q[{j}]"), q)?;
+                if j > 0 && t <= table.t[j - 1] {
+                    return Err(ctx.err(format!("{path}.table.t[{j}]"), "times must increase strictly"));
+                }
+            }
+            let spline = Spline::new(&table.t, &table.q).map_err(|e| ctx.err(format!("{path}.table"), e))?;
+            Ok(MotionLaw::Table(spline))
+        }
+        _ => Err(ctx.err(
+            path,
+            "give exactly one of `speed` (rad/s or m/s, from the start value) or `table: {t, q}` (s; rad or m)",
+        )),
+    }
 }
 
 fn body_point(ctx: &Ctx, mech: &Mechanism, path: &str, body: &str, point: &str) -> R<Attachment> {

@@ -23,7 +23,12 @@ pub fn diameter(points: &[[f64; 2]]) -> f64 {
                 while cross(hull[i], hull[next], hull[(j + 1) % n]) > cross(hull[i], hull[next], hull[j]) {
                     j = (j + 1) % n;
                 }
-                best = best.max(dist(hull[i], hull[j])).max(dist(hull[next], hull[j]));
+                // With an edge parallel to (i, next), both ends of it are antipodal to i and
+                // next, and rounding decides which one the strict comparison stops at: look
+                // at the vertices on both sides of j too.
+                for k in [j + n - 1, j, j + 1] {
+                    best = best.max(dist(hull[i], hull[k % n])).max(dist(hull[next], hull[k % n]));
+                }
             }
             best
         }
@@ -86,6 +91,10 @@ mod tests {
         assert_eq!(diameter(&[[0.0, 0.0], [1.0, 0.0], [3.0, 0.0], [2.0, 0.0]]), 3.0);
         assert_eq!(diameter(&[[1.0, 2.0], [1.0, 2.0]]), 0.0);
         assert_eq!(diameter(&[]), 0.0);
+        // A trapezoid with two parallel edges (found by the property test below): the
+        // farthest pair (-0.2, 0)-(0.3, -0.2), 0.5385, is one of two tied antipodal pairs.
+        let trapezoid = [[-0.2, 0.0], [-0.1, -0.2], [0.30000000000000004, -0.2], [0.2, 0.0]];
+        assert_eq!(diameter(&trapezoid), brute(&trapezoid));
     }
 
     proptest! {

@@ -7,12 +7,14 @@
 mod build;
 pub(crate) mod diameter;
 mod io;
+mod motion;
 mod nesting;
 mod parse_errors;
 pub mod spec;
 mod tags;
 
 pub use io::{load, loads, parse_spec, Format};
+pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
 
 /// Index of a mobile body (its coordinates are `x[3i..3i+3]`).
@@ -187,6 +189,8 @@ pub struct Mechanism {
     pub coordinates: Vec<Coordinate>,
     /// One drive law per coordinate (`None`: no drive).
     pub drives: Vec<Option<DriveLaw>>,
+    /// One motion law per coordinate (`None`: the coordinate moves freely under its effort).
+    pub motions: Vec<Option<MotionLaw>>,
     pub loads: Vec<Load>,
     pub simulate: SimulateDefaults,
     /// Body coordinates in the drawing, 3n values [X, Y, phi] per body.
@@ -283,6 +287,13 @@ impl Mechanism {
     /// Look a point up by name.
     pub fn point_id(&self, name: &str) -> Option<PointId> {
         self.points.iter().position(|p| p.0 == name).map(PointId)
+    }
+    /// The link that carries a point (ground first, then the bodies in order) and where, or
+    /// None for a point no link carries (declared, unused).
+    pub fn carrier(&self, point: PointId) -> Option<Attachment> {
+        std::iter::once(Link::Ground)
+            .chain((0..self.n_bodies()).map(|b| Link::Body(BodyId(b))))
+            .find_map(|link| self.attachment(link, point))
     }
     /// Look a body up by name.
     pub fn body_id(&self, name: &str) -> Option<BodyId> {

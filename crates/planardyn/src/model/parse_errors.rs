@@ -204,8 +204,10 @@ fn plain(message: &str) -> String {
         ("struct BodySpec", "a body (a mapping: points, mass...)"),
         ("struct PartSpec", "a part (a mapping: mass, and com, uniform_bar or point_mass)"),
         ("struct CoordinateSpec", "a coordinate (a mapping: name, pair, value)"),
-        ("struct DriveSpec", "a drive (a mapping: coordinate, and effort or table)"),
+        ("struct DriveSpec", "a drive (a mapping: coordinate, and effort, table or motion)"),
         ("struct TableSpec", "a table (a mapping: t, effort)"),
+        ("struct MotionSpec", "a motion (a mapping: speed or table)"),
+        ("struct MotionTableSpec", "a motion table (a mapping: t, q)"),
         ("struct SimulateSpec", "simulation settings (a mapping: t_end, method...)"),
         ("internally tagged enum PairSpec", "a pair (a mapping with type: revolute or prismatic)"),
         (

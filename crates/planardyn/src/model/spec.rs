@@ -179,8 +179,8 @@ pub struct CoordinateSpec {
     pub about: Option<String>,
 }
 
-/// A drive effort on one coordinate: a constant, or a time table interpolated linearly
-/// (held at its end values outside the table).
+/// A drive on one coordinate: an effort (a constant, or a time table interpolated linearly,
+/// held at its end values outside the table), or a motion the coordinate is made to follow.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct DriveSpec {
@@ -189,6 +189,27 @@ pub struct DriveSpec {
     pub effort: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table: Option<TableSpec>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionSpec>,
+}
+
+/// A prescribed motion: a constant rate from the start value (rad/s or m/s), or a table of
+/// times (s) and positions (rad or m) through which a C2 cubic spline runs.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table: Option<MotionTableSpec>,
+}
+
+/// A motion table: times (s, increasing) and positions (rad or m), of equal length.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MotionTableSpec {
+    pub t: Vec<f64>,
+    pub q: Vec<f64>,
 }
 
 /// A time table: times (s, increasing) and efforts (N m or N), of equal length.

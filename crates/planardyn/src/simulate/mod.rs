@@ -3,6 +3,7 @@
 //! computed so far with a status saying why it stopped.
 
 pub mod charts;
+pub mod crossing;
 pub mod ode;
 mod overrides;
 pub mod trajectory;
@@ -10,13 +11,14 @@ pub mod trajectory;
 pub use overrides::Overrides;
 pub use trajectory::{SimStats, Status, Trajectory};
 
-use crate::dynamics::Drives;
+use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
 use crate::integrate::{Method, Options, StepError, Stepper};
 use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Chart};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
+use crossing::{cross, stepped_over, user_state, Approach, Landing, Path, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW};
 use ode::MechanismOde;
 
 /// Relative tolerance of a model's run when its file gives none (docs/model-format.md,
@@ -110,14 +112,23 @@ fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
 }
 
 /// The start: assembled at q0, in the user's chart unless it is near-singular there.
+/// Coordinates driven by motion start where their motion is at t0 (a `speed` counts from q0).
 fn start<'a>(
     mech: &'a Mechanism,
     s: &Settings,
     drives: &'a mut dyn Drives,
+    motion: &'a mut Prescribed<'a>,
 ) -> Result<(MechanismOde<'a>, Vec<f64>), Error> {
     let (q0m, qd0m) = mech.initial_state();
-    let q0 = s.q0.clone().unwrap_or(q0m);
-    let qd0 = s.qd0.clone().unwrap_or(qd0m);
+    let mut q0 = s.q0.clone().unwrap_or(q0m);
+    let mut qd0 = s.qd0.clone().unwrap_or(qd0m);
+    if !motion.is_empty() {
+        motion.start(s.t0, s.t_end, &q0).map_err(Error::Options)?;
+        motion.eval(s.t0).map_err(|message| Error::Drive { t: s.t0, message })?;
+        for (i, &k) in motion.p.iter().enumerate() {
+            (q0[k], qd0[k]) = (motion.q[i], motion.qd[i]);
+        }
+    }
     let mut ws = Workspace::new(mech);
     assemble_into(mech, &q0, &mut ws)?;
     // Body velocities from qd0 need U in the user's chart, i.e. a regular start; at rest a
@@ -134,7 +145,7 @@ fn start<'a>(
     }
     ws.q.copy_from_slice(&q0);
     ws.qd.copy_from_slice(&qd0);
-    let mut ode = MechanismOde::new(mech, ws, drives);
+    let mut ode = MechanismOde::new(mech, ws, drives).with_motion(motion);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
         return Err(
@@ -212,19 +223,96 @@ fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi
     ode.evaluate_walking(t_out, yi)
 }
 
-/// Simulate from the model's (or the given) initial state. `progress(t)` is called after
-/// each accepted step and may return false to stop. Errors in the settings or at the
-/// start return Err; anything after the start returns the partial trajectory with a status.
+/// The output grid and where the run is in it.
+struct Outputs<'t> {
+    t_eval: Option<&'t [f64]>,
+    next: usize,
+}
+
+/// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
+/// passive measures `sigma`, `passive`, work `work`), `approach` the points before it, and
+/// restart the stepper past it. Outputs inside the crossing come from the path it followed;
+/// without a grid the point past it is recorded. Returns whether t_end was reached inside
+/// the crossing; Err says why the motion cannot be continued.
+fn cross_change_point(
+    ode: &mut MechanismOde,
+    stepper: &mut Stepper,
+    traj: &mut Trajectory,
+    out: &mut Outputs,
+    (t, sigma, passive, work): (f64, f64, f64, f64),
+    approach: &mut Approach,
+    t_end: f64,
+) -> Result<bool, String> {
+    let landing: Landing = cross(ode, t, passive, work, approach)?;
+    let inside = |s: f64| s < landing.t.min(t_end) || s == t_end && landing.t >= t_end;
+    if let Some(te) = out.t_eval {
+        while out.next < te.len() && inside(te[out.next]) {
+            path_row(ode, traj, &landing, te[out.next], work, sigma);
+            out.next += 1;
+        }
+    }
+    traj.change_points.push(landing.point.clone());
+    if landing.t >= t_end {
+        if out.t_eval.is_none() {
+            path_row(ode, traj, &landing, t_end, work, sigma);
+        }
+        return Ok(true);
+    }
+    ode.ws.x.copy_from_slice(&landing.x);
+    ode.set_chart(landing.chart.clone(), landing.t, &landing.y).map_err(|e| format!("past the change point: {e}"))?;
+    stepper.reset(ode, landing.t, &landing.y).map_err(|e| format!("restarting past the change point: {e}"))?;
+    traj.stats.chart_switches += 1;
+    let meas = measure(ode);
+    if out.t_eval.is_none() {
+        traj.record(ode, landing.t, landing.y[landing.y.len() - 1], meas.sigma);
+    }
+    let own = chart_sigma(ode, meas.sigma);
+    ode.limit_correction(own);
+    approach.clear();
+    approach.keep(ode, landing.t, meas.passive);
+    Ok(false)
+}
+
+/// Record the row at time s inside a crossing, from the path it followed.
+fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, landing: &Landing, s: f64, work: f64, sigma: f64) {
+    let ws = &mut ode.ws;
+    landing.path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
+    user_state(ode);
+    traj.record(ode, s, work, sigma);
+}
+
+/// Simulate from the model's (or the given) initial state, the coordinates the model drives
+/// by motion following it. `progress(t)` is called after each accepted step and may return
+/// false to stop. Errors in the settings or at the start return Err; anything after the
+/// start returns the partial trajectory with a status.
 pub fn simulate(
     mech: &Mechanism,
     settings: &Settings,
     drives: &mut dyn Drives,
+    progress: Option<&mut dyn FnMut(f64) -> bool>,
+) -> Result<Trajectory, Error> {
+    simulate_prescribed(mech, settings, drives, &mut Prescribed::from_model(mech), progress)
+}
+
+/// As [`simulate`], with the coordinates of `motion` driven by it (instead of the model's
+/// motions; start from [`Prescribed::from_model`] to keep them) and given the efforts their
+/// motion needs, reported in the trajectory's `tau`; their work is part of `work`. The
+/// drives' efforts on them are not applied. The state integrated is that of all m
+/// coordinates, the prescribed ones replaced by their motion at every evaluation (in the
+/// user's chart; in a partition chart, near a type II singularity, they follow it to the
+/// integrator's accuracy). With every coordinate prescribed this is kinematics and inverse
+/// dynamics at each output, the integrator computing only the work.
+pub fn simulate_prescribed<'a>(
+    mech: &'a Mechanism,
+    settings: &Settings,
+    drives: &'a mut dyn Drives,
+    motion: &'a mut Prescribed<'a>,
     mut progress: Option<&mut dyn FnMut(f64) -> bool>,
 ) -> Result<Trajectory, Error> {
     check(settings, mech)?;
     let m = mech.dof();
     let mut traj = Trajectory::new(m, mech.n_x());
-    let (mut ode, y0) = match start(mech, settings, drives) {
+    let (mut ode, y0) = match start(mech, settings, drives, motion) {
         Ok(started) => started,
         // A drive that fails at once is a failed run, not bad input: say so in the status.
         Err(e @ Error::Drive { .. }) => {
@@ -243,13 +331,15 @@ pub fn simulate(
         return Ok(traj);
     }
     let t_eval = settings.t_eval.as_deref();
-    let mut next_out = 0;
+    let mut out = Outputs { t_eval, next: 0 };
+    let mut approach = Approach::default();
     // The start counts in the least measures, so that a run of no step reports its start's.
     let first = measure(&mut ode);
     (traj.stats.min_sigma, traj.stats.min_passive_sigma) = (first.sigma, first.passive);
+    approach.keep(&ode, settings.t0, first.passive);
     if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
         traj.record(&ode, settings.t0, y[2 * m], first.sigma);
-        next_out = 1;
+        out.next = 1;
     }
     let mut yi = vec![0.0; 2 * m + 1];
     let (mut status, mut message) = (Status::Success, String::new());
@@ -260,6 +350,34 @@ pub fn simulate(
         if let Err(e) = stepper.step(&mut ode, settings.t_end) {
             (status, message) = failure(&e);
             keep_last = true;
+            // Steps that shrink to nothing before a change point: cross it from the last
+            // accepted point when it is near enough.
+            let (t, y) = (stepper.t(), stepper.y().to_vec());
+            ode.restart_from_anchor();
+            if ode.motion.is_none() && approach.last().is_some_and(|p| p.t == t) && ode.accept(t, &y).is_ok() {
+                let meas = measure(&mut ode);
+                if meas.passive < NEAR_PASSIVE_SINGULAR {
+                    let at = (t, meas.sigma, meas.passive, y[2 * m]);
+                    match cross_change_point(
+                        &mut ode,
+                        &mut stepper,
+                        &mut traj,
+                        &mut out,
+                        at,
+                        &mut approach,
+                        settings.t_end,
+                    ) {
+                        Ok(false) => {
+                            (status, message, keep_last) = (Status::Success, String::new(), false);
+                            continue;
+                        }
+                        Ok(true) => {
+                            (status, message, keep_last) = (Status::Success, String::new(), false);
+                        }
+                        Err(why) => message = format!("{message}; {why}"),
+                    }
+                }
+            }
             break;
         }
         let t = stepper.t();
@@ -268,19 +386,19 @@ pub fn simulate(
             traj.stats.partition_steps += 1;
         }
         if let Some(te) = t_eval {
-            if next_out < te.len() && te[next_out] <= t {
+            if out.next < te.len() && te[out.next] <= t {
                 // DOP853's dense-output stages (at 0.1, 0.2 and 7/9 of the step, evaluated by
                 // the first interpolation) are predicted from the step's start, not its end.
                 ode.restart_from_anchor();
             }
-            while next_out < te.len() && te[next_out] <= t {
-                if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[next_out], &mut yi) {
-                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[next_out]));
+            while out.next < te.len() && te[out.next] <= t {
+                if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[out.next], &mut yi) {
+                    (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[out.next]));
                     break;
                 }
                 let sigma = measure(&mut ode).sigma;
-                traj.record(&ode, te[next_out], yi[2 * m], sigma);
-                next_out += 1;
+                traj.record(&ode, te[out.next], yi[2 * m], sigma);
+                out.next += 1;
             }
             if status != Status::Success {
                 break;
@@ -305,6 +423,26 @@ pub fn simulate(
         }
         traj.stats.min_sigma = traj.stats.min_sigma.min(meas.sigma);
         traj.stats.min_passive_sigma = traj.stats.min_passive_sigma.min(meas.passive);
+        let falling = approach.last().is_some_and(|p| meas.passive < p.passive);
+        if meas.passive < CROSS_BELOW && falling && ode.motion.is_none() {
+            let at = (t, meas.sigma, meas.passive, y[2 * m]);
+            match cross_change_point(&mut ode, &mut stepper, &mut traj, &mut out, at, &mut approach, settings.t_end) {
+                Ok(false) => continue,
+                Ok(true) => break,
+                Err(why) => {
+                    let m = format!(
+                        "the passive mechanism is singular at t = {t} s (scaled measure {:.2e}) and {why}",
+                        meas.passive
+                    );
+                    (status, message) = (Status::PassiveSingularity, m);
+                    break;
+                }
+            }
+        }
+        if let Some(point) = stepped_over(&ode, &approach, t, meas.passive) {
+            traj.change_points.push(point);
+        }
+        approach.keep(&ode, t, meas.passive);
         if meas.passive < PASSIVE_SINGULAR {
             (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
             break;
@@ -326,9 +464,13 @@ pub fn simulate(
             own = chart_sigma(&mut ode, meas.sigma);
         }
         ode.limit_correction(own);
+        if meas.passive < WATCH_BELOW && ode.motion.is_none() {
+            ode.limit_move(APPROACH_FRACTION * meas.passive);
+        }
         if let Some(cb) = progress.as_mut() {
             if !cb(t) {
-                (status, message) = (Status::Cancelled, format!("stopped by the progress callback at t = {t} s"));
+                (status, message) =
+                    (Status::Cancelled, format!("cancelled at t = {t} s: the progress callback asked to stop"));
                 keep_last = true;
                 break;
             }
@@ -343,11 +485,18 @@ pub fn simulate(
         // Steps that shrink to nothing usually mean the passive mechanism is at a change
         // point (a parallelogram folding flat): say so when it is.
         let passive = passive_sigma_min(mech, ode.anchor_x());
+        let driven = ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x()));
         if passive < NEAR_PASSIVE_SINGULAR {
             status = Status::PassiveSingularity;
             message = format!(
                 "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
                  a change point where its motion is not determined"
+            );
+        } else if driven < NEAR_PASSIVE_SINGULAR {
+            message = format!(
+                "{message}; the coordinates driven by motion are near a singularity of their own there (scaled \
+                 measure {driven:.2e}): they stop determining their part of the mechanism, and the efforts their \
+                 motion needs grow without bound. Change the motion so that it avoids this configuration"
             );
         }
     }

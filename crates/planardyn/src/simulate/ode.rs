@@ -2,7 +2,7 @@
 //! y = [z, zd, W] with y' = [zd, zdd, P], where W is the work done by the non-conservative
 //! forces and P its power, so that T + V - W is constant along any exact trajectory.
 
-use crate::dynamics::{dynamic_stages, forward, Drives};
+use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
 use crate::kinematics::{scaled_distance, Chart, ClosedForm, System, MAX_CORRECTION};
@@ -26,6 +26,11 @@ pub struct MechanismOde<'a> {
     pub mech: &'a Mechanism,
     pub ws: Workspace,
     pub drives: &'a mut dyn Drives,
+    /// The coordinates driven by motion, if any ([`MechanismOde::with_motion`]).
+    pub motion: Option<&'a mut Prescribed<'a>>,
+    /// (2m + 1) The state evaluated last: y with, in the user's chart, the prescribed
+    /// coordinates and rates replaced by their motion's.
+    eval_y: Vec<f64>,
     /// The last accepted point: body coordinates, analogues U (3n x m) and chart values z.
     anchor_x: Vec<f64>,
     anchor_u: Vec<f64>,
@@ -65,6 +70,8 @@ impl<'a> MechanismOde<'a> {
             c.set_reference(&ws.x);
         }
         MechanismOde {
+            motion: None,
+            eval_y: vec![0.0; 2 * m + 1],
             anchor_x: ws.x.clone(),
             anchor_u: ws.u.clone(),
             anchor_z: vec![0.0; m],
@@ -84,6 +91,11 @@ impl<'a> MechanismOde<'a> {
             ws,
             drives,
         }
+    }
+
+    /// The same system with the coordinates of `motion` driven by it.
+    pub fn with_motion(self, motion: &'a mut Prescribed<'a>) -> Self {
+        MechanismOde { motion: Some(motion).filter(|p| !p.is_empty()), ..self }
     }
 
     pub fn m(&self) -> usize {
@@ -121,6 +133,18 @@ impl<'a> MechanismOde<'a> {
     pub fn limit_correction(&mut self, sigma: f64) {
         self.max_correction = MAX_CORRECTION.min(BASIN_FRACTION * sigma);
         self.max_move = MOVE_FRACTION * sigma;
+    }
+
+    /// Bound the move of a solution from its predictor's anchor by `max` as well (scaled, as
+    /// [`MechanismOde::limit_correction`]'s).
+    pub fn limit_move(&mut self, max: f64) {
+        self.max_move = self.max_move.min(max);
+    }
+
+    /// Whether evaluations take the closed forms: there are some, in the user's chart, with
+    /// no coordinate driven by a prescribed motion.
+    fn closed_form_in_use(&self) -> bool {
+        self.closed.is_some() && self.ws.chart == Chart::Inputs && self.motion.is_none()
     }
 
     /// Factorise J at the point in `ws` if a closed-form evaluation left it behind (for the
@@ -164,6 +188,7 @@ impl<'a> MechanismOde<'a> {
     fn predict(&mut self, z: &[f64]) {
         let m = self.m();
         let n = self.ws.x.len();
+        let closed = self.closed_form_in_use();
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);
@@ -173,7 +198,7 @@ impl<'a> MechanismOde<'a> {
                     *d += u * dz;
                 }
             }
-            match self.closed.as_ref().filter(|_| ws.chart == Chart::Inputs) {
+            match self.closed.as_ref().filter(|_| closed) {
                 Some(c) => {
                     c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
                     ws.tmp.iter_mut().for_each(|w| *w = -*w);
@@ -205,21 +230,45 @@ impl<'a> MechanismOde<'a> {
     /// motion may leave that branch): the integrator then shortens it, and the monitor moves
     /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let mut z = std::mem::take(&mut self.eval_y);
+        z.copy_from_slice(y);
+        let outcome = self.evaluate_at(t, &mut z);
+        if outcome.is_err() {
+            self.failed_evaluations += 1;
+        }
+        self.eval_y = z;
+        outcome?;
+        self.base_valid = true;
+        self.last_t = t;
+        self.last_y.copy_from_slice(y);
+        Ok(())
+    }
+
+    /// The body of [`MechanismOde::evaluate`] at state `y`, whose prescribed coordinates it
+    /// replaces by their motion's in the user's chart.
+    fn evaluate_at(&mut self, t: f64, y: &mut [f64]) -> Result<(), Error> {
         let m = self.m();
+        if let Some(motion) = self.motion.as_deref_mut() {
+            motion.eval(t).map_err(|message| Error::Drive { t, message })?;
+            if self.ws.chart == Chart::Inputs {
+                motion.overwrite(m, y);
+            }
+        }
         let (z, zd) = (&y[..m], &y[m..2 * m]);
         self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
         self.predict(z);
         self.predicted.copy_from_slice(&self.ws.x);
-        let newton = self.closed.is_none() || self.ws.chart != Chart::Inputs;
+        let newton = !self.closed_form_in_use();
         self.last_t = f64::NAN;
         self.base_valid = false;
         self.stale_j = !newton;
-        let mut outcome = match self.closed.as_mut().filter(|_| !newton) {
-            Some(c) => c
+        let mut outcome = match (self.closed.as_mut().filter(|_| !newton), self.motion.as_deref_mut()) {
+            (Some(c), _) => c
                 .kinematic_stages(z, zd, &mut self.ws)
                 .map_err(Error::from)
                 .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws)),
-            None => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
+            (_, None) => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
+            (_, Some(motion)) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
         };
         if outcome.is_ok() {
             let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
@@ -229,14 +278,7 @@ impl<'a> MechanismOde<'a> {
                 outcome = Err(KinematicsError::AssemblyFailed { residual, iterations: self.ws.iterations }.into());
             }
         }
-        if outcome.is_err() {
-            self.failed_evaluations += 1;
-        }
-        outcome?;
-        self.base_valid = true;
-        self.last_t = t;
-        self.last_y.copy_from_slice(y);
-        Ok(())
+        outcome
     }
 }
 
@@ -272,10 +314,10 @@ impl MechanismOde<'_> {
         Err(error)
     }
 
-    /// dy = [zd, zdd, P] from the evaluation held in `ws` at state y.
-    fn derivative(&self, y: &[f64], dy: &mut [f64]) {
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`).
+    fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
-        dy[..m].copy_from_slice(&y[m..2 * m]);
+        dy[..m].copy_from_slice(&self.eval_y[m..2 * m]);
         dy[m..2 * m].copy_from_slice(&self.ws.b);
         dy[2 * m] = self.ws.power;
     }
@@ -288,12 +330,12 @@ impl OdeSystem for MechanismOde<'_> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.evaluate(t, y)?;
-        self.derivative(y, dy);
+        self.derivative(dy);
         Ok(())
     }
     fn rhs_dense(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.evaluate_walking(t, y)?;
-        self.derivative(y, dy);
+        self.derivative(dy);
         Ok(())
     }
 }

@@ -2,8 +2,9 @@
 //! Python `Mechanism.simulate`, the batch runner and Rust users.
 
 use super::{grid, Settings};
+use crate::dynamics::{Motion, Prescribed};
 use crate::integrate::Method;
-use crate::model::Mechanism;
+use crate::model::{Mechanism, MotionLaw};
 use crate::Error;
 
 /// Most output times an `output_dt` may ask for (a guard against output_dt = 1e-12).
@@ -24,6 +25,9 @@ pub struct Overrides {
     pub q0: Option<Vec<f64>>,
     pub qd0: Option<Vec<f64>>,
     pub max_steps: Option<usize>,
+    /// Coordinates driven by motion (index, law), replacing the model file's motion of that
+    /// coordinate if it has one.
+    pub motion: Vec<(usize, MotionLaw)>,
 }
 
 impl Overrides {
@@ -55,6 +59,15 @@ impl Overrides {
         s.q0 = self.q0.clone();
         s.qd0 = self.qd0.clone();
         Ok(s)
+    }
+
+    /// The motions of a run: the model file's, with [`Overrides::motion`] replacing them.
+    pub fn prescribed<'a>(&self, mech: &Mechanism) -> Result<Prescribed<'a>, Error> {
+        let mut p = Prescribed::from_model(mech);
+        for (k, law) in &self.motion {
+            p.set(*k, Motion::Law(law.clone())).map_err(Error::Options)?;
+        }
+        Ok(p)
     }
 }
 

@@ -1,6 +1,7 @@
 //! A simulation result: the trajectory computed (all of it, even when the run stopped early),
 //! why it ended, and the figures that say how far to trust it.
 
+use super::crossing::ChangePoint;
 use super::ode::MechanismOde;
 use crate::dynamics::{kinetic_energy, potential_energy};
 use crate::integrate::Stats;
@@ -96,6 +97,8 @@ pub struct Trajectory {
     pub residual: Vec<f64>,
     /// (N) whether the point was integrated in a partition chart.
     pub partitioned: Vec<bool>,
+    /// The change points crossed, in time order.
+    pub change_points: Vec<ChangePoint>,
     pub status: Status,
     pub message: String,
     pub stats: SimStats,

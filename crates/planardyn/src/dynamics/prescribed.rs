@@ -1,0 +1,148 @@
+//! Forward dynamics with some coordinates q_p driven by motion (docs/formulation.md,
+//! *Prescribed motion*). In a chart z with A zdd = b + G^T tau_p, the prescribed
+//! coordinates' rows G = D_p,x U and their accelerations G zdd = h with
+//! h = qdd_p - D_p,x c - gamma_p(xd, xd), the efforts tau_p they need are the multipliers
+//! of G zdd = h:
+//!   (G A^-1 G^T) tau_p = h - G A^-1 b,   zdd = A^-1 (b + G^T tau_p).
+//! In the user's chart G = [0 I] picks q_p and h = qdd_p, and this is
+//! A_ff qdd_f = b_f - A_fp qdd_p, tau_p = A_pf qdd_f + A_pp qdd_p - b_p; in a partition chart
+//! (near a type II singularity of the user's coordinates) the same equations hold the
+//! prescribed coordinates to their motion while x components integrate.
+
+use super::forces::{applied_forces, Drives};
+use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
+use super::motion::Prescribed;
+use crate::kinematics::constraints::body_trig;
+use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
+use crate::kinematics::system::{col_scales, scaled_jacobian};
+use crate::kinematics::Chart;
+use crate::linalg::{cholesky_in_place, cholesky_solve};
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::{Error, KinematicsError, SingularityKind};
+use nalgebra::DMatrix;
+
+/// Buffers of [`forward_prescribed`] (held by [`Prescribed`]), sized for m coordinates, m_p of them prescribed, and
+/// 3n body coordinates.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    /// (m_p x 3n) the prescribed coordinates' gradients D_p,x.
+    grad: Vec<f64>,
+    /// (m_p x m) G = D_p,x U, then (m x m_p, column-major) A^-1 G^T.
+    g: Vec<f64>,
+    ainv_gt: Vec<f64>,
+    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) h, then tau_p.
+    s: Vec<f64>,
+    h: Vec<f64>,
+}
+
+impl Scratch {
+    pub fn new(m: usize, mp: usize, nx: usize) -> Scratch {
+        Scratch {
+            grad: vec![0.0; mp * nx],
+            g: vec![0.0; mp * m],
+            ainv_gt: vec![0.0; m * mp],
+            s: vec![0.0; mp * mp],
+            h: vec![0.0; mp],
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// D_p,x, G and h of the prescribed rows at the point in `ws` (after the kinematic stages),
+/// with the motion's accelerations `qdd_p`.
+fn prescribed_rows(mech: &Mechanism, p: &[usize], qdd_p: &[f64], ws: &Workspace, w: &mut Scratch) {
+    let (m, nx) = (ws.q.len(), ws.x.len());
+    w.grad.fill(0.0);
+    for (i, &k) in p.iter().enumerate() {
+        let pair = &mech.pairs[mech.coordinates[k].pair.0];
+        let grad = &mut w.grad[i * nx..(i + 1) * nx];
+        pair_coordinate_grad(pair, &ws.x, &mut Dense { j: grad, ncols: nx }, 0);
+        let g = &mut w.g[i * m..(i + 1) * m];
+        if ws.chart == Chart::Inputs {
+            // D_x U = I and D_x c + gamma(xd, xd) = 0 in the user's chart, by construction of U and c.
+            g.iter_mut().enumerate().for_each(|(j, g)| *g = f64::from(j == k));
+            w.h[i] = qdd_p[i];
+        } else {
+            g.iter_mut().enumerate().for_each(|(j, g)| *g = dot(grad, ws.u_col(j)));
+            w.h[i] = qdd_p[i] - dot(grad, &ws.c) - pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd);
+        }
+    }
+}
+
+/// One evaluation at time t (s) and chart state (z, zd) with the coordinates of `motion`
+/// (evaluated at t) driven by it: fills every buffer of `ws` as `forward` does, with the
+/// prescribed efforts in `ws.tau` (the drives' values there are replaced) and their power
+/// in `ws.power`.
+pub fn forward_prescribed(
+    mech: &Mechanism,
+    t: f64,
+    z: &[f64],
+    zd: &[f64],
+    drives: &mut dyn Drives,
+    motion: &mut Prescribed,
+    ws: &mut Workspace,
+) -> Result<(), Error> {
+    kinematic_stages(mech, z, zd, ws)?;
+    drive_efforts(t, drives, ws)?;
+    let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;
+    p.iter().for_each(|&k| ws.tau[k] = 0.0);
+    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    mass_matrix(mech, ws);
+    bias(mech, ws);
+    prescribed_rows(mech, p, qdd_p, ws, w);
+    factor_mass_matrix(ws)?;
+    let (m, mp, nx) = (ws.b.len(), p.len(), ws.x.len());
+    cholesky_solve(&ws.a, m, &mut ws.b);
+    for i in 0..mp {
+        let col = &mut w.ainv_gt[i * m..(i + 1) * m];
+        col.copy_from_slice(&w.g[i * m..(i + 1) * m]);
+        cholesky_solve(&ws.a, m, col);
+    }
+    for i in 0..mp {
+        w.h[i] -= dot(&w.g[i * m..(i + 1) * m], &ws.b);
+        for k in 0..mp {
+            w.s[i * mp + k] = dot(&w.g[i * m..(i + 1) * m], &w.ainv_gt[k * m..(k + 1) * m]);
+        }
+    }
+    // G A^-1 G^T is positive definite unless the prescribed coordinates are dependent where
+    // the motion takes them (a type II singularity of their own drives).
+    if !cholesky_in_place(&mut w.s, mp) {
+        return Err(KinematicsError::singular(SingularityKind::TypeII).into());
+    }
+    cholesky_solve(&w.s, mp, &mut w.h);
+    for (i, &k) in p.iter().enumerate() {
+        let tau = w.h[i];
+        for (zdd, a) in ws.b.iter_mut().zip(&w.ainv_gt[i * m..(i + 1) * m]) {
+            *zdd += a * tau;
+        }
+        for (f, g) in ws.f.iter_mut().zip(&w.grad[i * nx..(i + 1) * nx]) {
+            *f += tau * g;
+        }
+        ws.tau[k] = tau;
+        ws.power += tau * ws.qd[k];
+    }
+    accelerations(mech, z, zd, ws);
+    Ok(())
+}
+
+/// Smallest singular value of the scaled [Phi_x; D_p,x] at x: the pair constraints with the
+/// prescribed coordinates `p` fixed. It is 0 where they stop determining their part of the
+/// mechanism, and the efforts their motion needs grow without bound (with every coordinate
+/// prescribed, the type II measure).
+pub fn prescribed_sigma_min(mech: &Mechanism, p: &[usize], x: &[f64]) -> f64 {
+    let (n, nc) = (x.len(), mech.n_constraints);
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    let mut j = vec![0.0; n * n];
+    scaled_jacobian(mech, &Chart::Inputs, x, &trig, &mut vec![1.0; n], &col_scales(mech), &mut j);
+    let rows: Vec<usize> = (0..nc).chain(p.iter().map(|k| nc + k)).collect();
+    if rows.is_empty() || j.iter().any(|v| !v.is_finite()) {
+        return if rows.is_empty() { f64::INFINITY } else { 0.0 };
+    }
+    let a = DMatrix::from_fn(rows.len(), n, |r, c| j[rows[r] * n + c]);
+    a.singular_values().iter().copied().fold(f64::INFINITY, f64::min)
+}

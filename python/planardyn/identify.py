@@ -1,0 +1,341 @@
+"""Identification of a built mechanism's inertial parameters: which combinations of them the
+drive efforts can tell apart (the base parameters).
+
+The efforts are linear in the inertial parameters pi (``Mechanism.regressor``:
+tau = Y pi + tau_o), but some parameters act only in fixed combinations (a link's mass moved
+along a ground pivot's axis, the masses of two bodies joined at a point...), so only r of the
+p columns of Y are independent. :func:`base_parameters` finds them numerically, by QR with
+column pivoting of Y stacked over many states, and writes each base parameter as a named
+linear combination of the physical ones.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._core import PlanardynError
+from .mechanism import Mechanism
+
+FloatArray = NDArray[np.float64]
+
+#: A pivot of the QR factor below this fraction of the largest is a dependent column: the
+#: columns are scaled to unit norm first, so this is a relative singular-value-like bound,
+#: far above round-off (~1e-14 for these sums) and far below any physical effect.
+RANK_RTOL = 1e-9
+#: Coefficients of a combination smaller than this are round-off of an exact zero.
+COEFFICIENT_TOL = 1e-9
+#: The excitation's cost of a motion out of reach, unassembled or near a singularity: far
+#: above any condition number, and finite, which Powell's line searches need.
+INFEASIBLE = 1e12
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """The identifiable combinations of the inertial parameters.
+
+    ``beta = pi[independent] + K @ pi[dependent]``, and for every state
+    ``Y @ pi == Y[..., independent] @ beta``. ``names[k]`` and ``expressions[k]`` describe
+    ``beta[k]``.
+    """
+
+    #: All parameter names (the columns of Y).
+    parameters: list[str]
+    #: Indices of the base parameters' own columns, and of the columns folded into them.
+    independent: list[int]
+    dependent: list[int]
+    #: (r, p - r): how the dependent parameters add to each base parameter.
+    K: FloatArray
+    #: Samples the rank was found from, and the condition number of the scaled base columns.
+    samples: int
+    condition: float
+
+    @property
+    def rank(self) -> int:
+        return len(self.independent)
+
+    @property
+    def names(self) -> list[str]:
+        return [self.parameters[i] for i in self.independent]
+
+    @property
+    def expressions(self) -> list[str]:
+        """Each base parameter as text, e.g. ``I_crank + 0.09 m_coupler``."""
+        out = []
+        for k, i in enumerate(self.independent):
+            terms = [self.parameters[i]]
+            for c, j in zip(self.K[k], self.dependent):
+                if abs(c) > COEFFICIENT_TOL:
+                    terms.append(f"{'-' if c < 0 else '+'} {abs(c):.6g} {self.parameters[j]}")
+            out.append(" ".join(terms))
+        return out
+
+    def of(self, pi: FloatArray | dict[str, float]) -> FloatArray:
+        """The base parameters of a full parameter vector (or dict by name)."""
+        p = np.array([pi[n] for n in self.parameters]) if isinstance(pi, dict) else np.asarray(pi, float)
+        return p[self.independent] + self.K @ p[self.dependent]
+
+
+def sample_states(mech: Mechanism, n: int = 200, seed: int = 0) -> tuple[FloatArray, ...]:
+    """``n`` states (q, qd, qdd, x) of one assembly branch: a random walk in q from the
+    model's start (steps of 0.1 rad, or 0.1 of the drawing's size for a displacement), each
+    step continued from the last and kept only where the mechanism assembles; rates and
+    accelerations drawn from a standard normal (any values serve: Y is linear in them)."""
+    rng = np.random.default_rng(seed)
+    scale = np.array([0.1 if k == "angle" else 0.1 * mech.scale for k in mech.coordinate_kinds])
+    q, x = np.array(mech.q0, float), mech.assemble(mech.q0)
+    qs: list[FloatArray] = []
+    xs: list[FloatArray] = []
+    for _ in range(20 * n):
+        if len(qs) == n:
+            break
+        step = q + scale * rng.standard_normal(mech.dof)
+        try:
+            x = mech.assemble(step, x_start=x)
+        except (PlanardynError, ValueError):  # outside the workspace: try another step
+            continue
+        q = step
+        qs.append(q)
+        xs.append(x)
+    if len(qs) < n:
+        raise ValueError(f"only {len(qs)} of {n} random states assembled; the mechanism hardly moves from its start")
+    shape = (n, mech.dof)
+    return np.array(qs), rng.standard_normal(shape), rng.standard_normal(shape), np.array(xs)
+
+
+def base_parameters(mech: Mechanism, samples: int = 200, seed: int = 0) -> BaseParameters:
+    """The base parameters of ``mech``, from Y at ``samples`` random states
+    (:func:`sample_states`), by QR with column pivoting (scipy)."""
+    from scipy.linalg import qr
+
+    q, qd, qdd, x = sample_states(mech, samples, seed)
+    Y, _ = mech.regressor(q, qd, qdd, x=x)
+    W = Y.reshape(-1, Y.shape[-1])
+    norms = np.linalg.norm(W, axis=0)
+    live = norms > 0.0
+    scaled = W[:, live] / norms[live]
+    _, R, perm = qr(scaled, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(R))
+    r = int(np.sum(diag > RANK_RTOL * diag[0]))
+    cols = np.flatnonzero(live)[perm]
+    independent, dependent = cols[:r], np.concatenate([cols[r:], np.flatnonzero(~live)])
+    # W[:, dep] = W[:, ind] @ K (least squares, exact up to round-off for dependent columns).
+    K = np.zeros((r, 0))
+    if len(dependent):
+        K = np.asarray(np.linalg.lstsq(W[:, independent], W[:, dependent], rcond=None)[0], dtype=np.float64)
+    condition = float(np.linalg.cond(scaled[:, perm[:r]]))
+    names = list(mech.inertial_parameters)
+    return BaseParameters(names, independent.tolist(), dependent.tolist(), K, samples, condition)
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Base parameters estimated from a measured motion (:func:`identify`).
+
+    ``beta`` with ``std_error`` (one standard deviation, from the residuals' variance per
+    coordinate), ``prior`` the base parameters of the model identified against; ``pi`` a
+    full parameter vector with the estimated base parameters that is physically consistent
+    (positive masses, positive inertia about every centre of mass), nearest the model's.
+    """
+
+    base: BaseParameters
+    beta: FloatArray
+    std_error: FloatArray
+    prior: FloatArray
+    pi: dict[str, float]
+    #: RMS of the efforts' residual per coordinate (N m or N), and the samples used.
+    residual_rms: FloatArray
+    samples: int
+
+    def report(self) -> str:
+        """A table: each base parameter, identified ± standard error, and the prior."""
+        lines = [f"{'base parameter':<60} {'identified':>12} {'std error':>10} {'prior':>12}"]
+        for e, b, s, p in zip(self.base.expressions, self.beta, self.std_error, self.prior):
+            lines.append(f"{e[:60]:<60} {b:12.6g} {s:10.3g} {p:12.6g}")
+        rms = ", ".join(f"{v:.3g}" for v in self.residual_rms)
+        lines.append(f"{self.samples} samples; residual RMS per coordinate: {rms}")
+        return "\n".join(lines)
+
+
+def identify(
+    mech: Mechanism,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    tau: ArrayLike,
+    x: ArrayLike | None = None,
+    base: BaseParameters | None = None,
+) -> Identification:
+    """Estimate the base parameters from a motion's rows (q, qd, qdd, measured efforts tau;
+    (N, m) each; x the body coordinates of the branch, as for ``inverse_dynamics``).
+
+    Weighted least squares (two passes: ordinary least squares, then each coordinate's rows
+    weighted by the inverse of its residual's standard deviation), with standard errors from
+    the weighted residual's variance. Then the physically consistent full parameters nearest
+    the model's that have those base parameters (scipy's SLSQP: m > 0 and m I_O - (m cx)^2 -
+    (m cy)^2 > 0, i.e. a positive inertia about the centre of mass).
+
+    Rates and accelerations from measured positions: differentiate a low-pass filtered q,
+    e.g. :func:`differentiate`, and filter tau with the same filter.
+    """
+    base = base or base_parameters(mech)
+    Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+    Wb = Y[..., base.independent]  # (N, m, r)
+    rhs = np.asarray(tau, float) - tau_o
+    n, m, r = Wb.shape
+    if n * m <= r:
+        raise ValueError(f"{n} samples of {m} efforts cannot determine {r} base parameters: give more samples")
+    beta = np.linalg.lstsq(Wb.reshape(-1, r), rhs.reshape(-1), rcond=None)[0]
+    sigma = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0)) + 1e-300  # per coordinate
+    Ww, rw = (Wb / sigma[None, :, None]).reshape(-1, r), (rhs / sigma).reshape(-1)
+    beta, *_ = np.linalg.lstsq(Ww, rw, rcond=None)
+    dof = n * m - r
+    s2 = float(np.sum((rw - Ww @ beta) ** 2) / dof)
+    std = np.sqrt(s2 * np.diag(np.linalg.inv(Ww.T @ Ww)))
+    prior_pi = np.array(list(mech.inertial_parameters.values()))
+    resid = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0))
+    pi = _consistent(base, beta, prior_pi)
+    return Identification(base, beta, std, base.of(prior_pi), dict(zip(base.parameters, pi)), resid, n)
+
+
+def _consistent(base: BaseParameters, beta: FloatArray, prior: FloatArray) -> FloatArray:
+    """The full parameters nearest ``prior`` (scaled per parameter) with base parameters
+    ``beta`` and a physical body each: m > 0, m I_O > (m cx)^2 + (m cy)^2."""
+    from scipy.optimize import minimize
+
+    scale = np.maximum(np.abs(prior), 1e-6 * np.abs(prior).max())
+    nb = len(prior) // 4
+
+    def body_margins(z: FloatArray) -> FloatArray:
+        p = (z * scale).reshape(nb, 4)
+        return np.concatenate([p[:, 0], p[:, 0] * p[:, 3] - p[:, 1] ** 2 - p[:, 2] ** 2])
+
+    cons = [{"type": "eq", "fun": lambda z: base.of(z * scale) - beta},
+            {"type": "ineq", "fun": body_margins}]
+    out = minimize(lambda z: float(np.sum((z - 1.0) ** 2)), np.ones_like(prior), constraints=cons, method="SLSQP",
+                   options={"maxiter": 500, "ftol": 1e-14})
+    return np.asarray(out.x * scale, dtype=np.float64)
+
+
+def differentiate(t: ArrayLike, q: ArrayLike, cutoff: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """q filtered by a zero-phase 4th-order Butterworth low-pass at ``cutoff`` (Hz), and its
+    first two derivatives by a cubic spline through the filtered samples; t evenly spaced (s).
+    Filter the efforts with :func:`lowpass` at the same cutoff (the same delay-free filter on
+    both sides keeps the equations), and keep the rows :func:`inside` the record."""
+    from scipy.interpolate import CubicSpline
+
+    qf = lowpass(t, q, cutoff)
+    spline = CubicSpline(np.asarray(t, float), qf, axis=0)
+    return qf, spline(t, 1), spline(t, 2)
+
+
+#: The filter's edge transients spoil about this many periods of the cutoff at each end of
+#: a record (4th-order Butterworth run forwards and backwards: measured on an encoder
+#: signal, tests/test_identify.py).
+EDGE_PERIODS = 2.0
+
+
+def inside(t: ArrayLike, cutoff: float) -> NDArray[np.bool_]:
+    """The rows of a record filtered at ``cutoff`` (Hz) clear of its ends' transients
+    (:data:`EDGE_PERIODS` periods of the cutoff at each end)."""
+    t = np.asarray(t, float)
+    edge = EDGE_PERIODS / cutoff
+    return np.asarray((t >= t[0] + edge) & (t <= t[-1] - edge))
+
+
+def lowpass(t: ArrayLike, v: ArrayLike, cutoff: float) -> FloatArray:
+    """Zero-phase 4th-order Butterworth low-pass of the columns of v at ``cutoff`` (Hz)."""
+    from scipy.signal import butter, sosfiltfilt
+
+    t = np.asarray(t, float)
+    fs = 1.0 / float(np.mean(np.diff(t)))
+    if not 0.0 < cutoff < fs / 2:
+        raise ValueError(f"cutoff = {cutoff} Hz must be between 0 and half the sampling rate ({fs / 2:g} Hz)")
+    # Second-order sections: the transfer-function form loses digits at low cutoffs.
+    sos = butter(4, cutoff / (fs / 2), output="sos")
+    return np.asarray(sosfiltfilt(sos, np.asarray(v, float), axis=0), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """A periodic motion of the coordinates for identification (:func:`excitation`):
+    q_k(t) = q0_k + sum_l a_kl (sin(l w t)) + b_kl (cos(l w t) - 1), w = 2 pi / period.
+
+    ``motion`` is the dict ``Mechanism.simulate(motion=...)`` takes; ``condition`` the
+    condition number of the scaled base columns of Y along it, ``start_condition`` that of
+    the simple sine it started from."""
+
+    q0: FloatArray
+    period: float
+    a: FloatArray
+    b: FloatArray
+    condition: float
+    start_condition: float
+
+    def sample(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """q, qd, qdd (N, m) at times t (N,)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        w = 2 * np.pi / self.period
+        ell = np.arange(1, self.a.shape[1] + 1)
+        s, c = np.sin(np.outer(t, ell * w)), np.cos(np.outer(t, ell * w))
+        q = self.q0 + s @ self.a.T + (c - 1.0) @ self.b.T
+        qd = (c * ell * w) @ self.a.T - (s * ell * w) @ self.b.T
+        qdd = -(s * (ell * w) ** 2) @ self.a.T - (c * (ell * w) ** 2) @ self.b.T
+        return q, qd, qdd
+
+    def motion(self, names: list[str]) -> dict[str, Any]:
+        """For ``Mechanism.simulate(motion=...)``: one function of t per coordinate."""
+        return {n: (lambda t, k=k: tuple(float(v[0, k]) for v in self.sample(t))) for k, n in enumerate(names)}
+
+
+def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitude: float = 0.3,
+               samples: int = 100, base: BaseParameters | None = None, max_evaluations: int = 2000) -> Excitation:
+    """A periodic motion that makes the base parameters well observable: the Fourier
+    coefficients (``harmonics`` per coordinate) minimising the condition number of the scaled
+    base columns of Y over ``samples`` points of a period, from a simple sine (amplitude / 2
+    at the first harmonic on every coordinate).
+
+    Every coordinate stays within ``amplitude`` (rad, or 0.1 of it times the drawing's size for
+    a displacement) of the model's start; a motion that cannot be assembled along the way, or
+    passes within the branch guard of a type II singularity, counts as infinitely bad.
+    Solved by scipy's Powell method (no derivatives: the objective is not smooth where the
+    extreme singular values cross).
+    """
+    from scipy.optimize import minimize
+
+    base = base or base_parameters(mech)
+    m = mech.dof
+    reach = np.array([amplitude if k == "angle" else 0.1 * amplitude * mech.scale for k in mech.coordinate_kinds])
+    t = np.linspace(0.0, period, samples, endpoint=False)
+    # The reach is checked on a grid fine enough that a trigonometric polynomial of this
+    # degree cannot exceed it between points by more than (pi h / period)^2 / 2 ~ 1e-5 of it.
+    fine = np.linspace(0.0, period, 1000 * harmonics)
+    q0 = np.array(mech.q0, float)
+
+    def make(z: FloatArray, start: float = np.inf) -> Excitation:
+        a, b = z[: m * harmonics].reshape(m, harmonics), z[m * harmonics:].reshape(m, harmonics)
+        return Excitation(q0, period, a * reach[:, None], b * reach[:, None], np.inf, start)
+
+    def cost(z: FloatArray) -> float:
+        exc = make(z)
+        if np.any(np.abs(exc.sample(fine)[0] - q0) > reach):
+            return INFEASIBLE
+        q, qd, qdd = exc.sample(t)
+        try:
+            Y, _ = mech.regressor(q, qd, qdd)
+        except (PlanardynError, ValueError):  # not assembled, or too near a singularity
+            return INFEASIBLE
+        W = Y[..., base.independent].reshape(-1, base.rank)
+        W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
+        return float(np.linalg.cond(W))
+
+    z0 = np.zeros(2 * m * harmonics)
+    z0[::harmonics][:m] = 0.5
+    start = cost(z0)
+    out = minimize(cost, z0, method="Powell", options={"maxfev": max_evaluations, "xtol": 1e-3, "ftol": 1e-4})
+    best = out.x if out.fun < start else z0
+    exc = make(best, start)
+    return Excitation(exc.q0, period, exc.a, exc.b, min(float(out.fun), start), start)

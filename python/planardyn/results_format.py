@@ -1,0 +1,139 @@
+"""The results file format, written from plain arrays: the column layout, the checksum, the
+atomic replacement of a file, and the writers of its three forms (CSV, Parquet, NPZ).
+
+It sits below :mod:`planardyn.result` so that a result can save itself
+(``SimulationResult.save``/``to_csv``) in the one format :func:`planardyn.read_results`,
+``planardyn plot`` and ``planardyn animate`` read; :mod:`planardyn.results_io` reads it back
+and describes the format.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import json
+import os
+import zlib
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+FORMAT = "planardyn-results"
+#: 2: the metadata records ``rows`` and ``checksum`` (version 1 files, without them, are read).
+FORMAT_VERSION = 2
+EXTENSIONS = (".csv", ".parquet", ".npz")
+#: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
+CSV_BLOCK = 4096
+
+
+def plain(v: Any) -> Any:
+    """``v`` as JSON takes it: numpy arrays and numbers as lists and Python numbers."""
+    if isinstance(v, (np.ndarray, np.generic)):
+        return v.tolist()
+    return v
+
+
+def columns(names: list[str], bodies: list[str]) -> list[tuple[str, list[str]]]:
+    """(group, column names) in file order, for coordinates ``names`` and ``bodies``; groups
+    are result fields or energy entries."""
+    body_cols = [f"{c}_{b}" for b in bodies for c in ("X", "Y", "phi")]
+    return [
+        ("t", ["t"]),
+        ("q", list(names)),
+        ("qd", [f"qd_{n}" for n in names]),
+        ("qdd", [f"qdd_{n}" for n in names]),
+        ("tau", [f"tau_{n}" for n in names]),
+        ("kinetic", ["kinetic"]),
+        ("potential", ["potential"]),
+        ("work", ["work"]),
+        ("sigma", ["sigma"]),
+        ("residual", ["residual"]),
+        ("partitioned", ["partitioned"]),
+        ("x", body_cols),
+        ("xd", [c.replace("_", "d_", 1) for c in body_cols]),
+    ]
+
+
+def table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> FloatArray:
+    """The groups side by side in layout order: one row per output time, float64."""
+    cols = [np.asarray(groups[g], dtype=np.float64).reshape(n_t, k) for g, k in layout]
+    return np.hstack(cols) if cols else np.empty((n_t, 0))
+
+
+def checksum(meta: dict[str, Any], table: FloatArray) -> int:
+    """CRC-32 of the metadata (as JSON in its order, without the checksum) and of the
+    table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
+    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")})
+    crc = zlib.crc32(text.encode())
+    for start in range(0, len(table), CSV_BLOCK):
+        block = table[start:start + CSV_BLOCK]
+        canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
+        crc = zlib.crc32(np.ascontiguousarray(canonical).tobytes(), crc)
+    return crc
+
+
+def pyarrow() -> tuple[Any, Any]:
+    """pyarrow and pyarrow.parquet, or an ImportError saying how to get them."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("Parquet results files need pyarrow: pip install pyarrow") from e
+    return pa, pq
+
+
+@contextlib.contextmanager
+def replacing(path: Path) -> Iterator[Path]:
+    """A temporary file next to ``path`` that replaces it (one rename) when the block ends
+    without an error, and is removed when it fails: ``path`` is never half written."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
+    try:
+        yield tmp
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def write(path: str | os.PathLike[str], meta: dict[str, Any], groups: dict[str, Any],
+          layout: list[tuple[str, list[str]]], ext: str | None = None) -> Path:
+    """Write a results file: ``meta`` (JSON-plain metadata, without ``rows`` and
+    ``checksum``, which are added), the arrays ``groups`` in ``layout`` order. The form is
+    ``ext`` or the name's extension. The file is written whole or not at all."""
+    path = Path(path)
+    ext = (ext or path.suffix).lower()
+    if ext not in EXTENSIONS:
+        raise ValueError(f"{path}: unknown results format {ext!r} (use {', '.join(EXTENSIONS)})")
+    n_t = len(groups["t"])
+    tab = table(groups, [(g, len(c)) for g, c in layout], n_t)
+    meta = {**meta, "rows": n_t}
+    meta["checksum"] = checksum(meta, tab)
+    names = [c for _, cols in layout for c in cols]
+    with replacing(path) as tmp:
+        if ext == ".npz":
+            # Any: numpy's signature would also take a group for its allow_pickle flag.
+            arrays: dict[str, Any] = {g: np.asarray(a) for g, a in groups.items()}
+            with open(tmp, "wb") as f:
+                np.savez_compressed(f, metadata=np.array(json.dumps(meta)), **arrays)
+        elif ext == ".parquet":
+            pa, pq = pyarrow()
+            pa_columns = [pa.array(tab[:, k].astype(bool) if n == "partitioned" else tab[:, k])
+                          for k, n in enumerate(names)]
+            pq.write_table(pa.Table.from_arrays(pa_columns, names=names).replace_schema_metadata(
+                {"planardyn": json.dumps(meta)}), tmp)
+        else:
+            with open(tmp, "w", newline="") as f:
+                for line in json.dumps(meta, indent=1).splitlines():
+                    f.write(f"# {line}\n")
+                w = csv.writer(f)
+                w.writerow(names)
+                for start in range(0, n_t, CSV_BLOCK):
+                    w.writerows([repr(v) for v in row] for row in tab[start:start + CSV_BLOCK].tolist())
+    return path

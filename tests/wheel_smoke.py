@@ -1,0 +1,95 @@
+"""The wheel stands alone: run by `./dev test` with the python of a fresh venv holding only the
+wheel and its dependencies, from a folder outside the repository.
+
+    python wheel_smoke.py README.md
+
+Checks that planardyn is imported from the installed wheel, not a source tree; that the wheel
+holds the licence and every shipped model file, each of which loads; that `planardyn --version`
+prints the installed version; and that every snippet of README.md runs in page order, the
+```python blocks in one namespace, the `planardyn` lines of its ```bash blocks as commands (as
+tests/test_docs.py runs every page in the repository). Needs nothing but the wheel.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import re
+import shlex
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.S | re.M)
+#: Commands the snippets leave out: the demo has its own run and test (it takes seconds).
+SKIPPED_COMMANDS = ("planardyn demo",)
+
+
+def python_blocks(markdown: str) -> list[str]:
+    """The ```python blocks of a Markdown text, in order."""
+    return [code for kind, code in snippets(markdown) if kind == "python"]
+
+
+def snippets(markdown: str) -> list[tuple[str, str]]:
+    """The code a page asks its reader to run, in page order: ("python", block) for each
+    ```python block, ("planardyn", line) for each `planardyn ...` line of a ```bash block
+    (its comment cut), the commands in SKIPPED_COMMANDS left out."""
+    out = []
+    for lang, body in BLOCK.findall(markdown):
+        if lang == "python":
+            out.append(("python", body))
+        elif lang == "bash":
+            for line in body.splitlines():
+                cmd = line.split("#")[0].strip()
+                if cmd.startswith("planardyn ") and not cmd.startswith(SKIPPED_COMMANDS):
+                    out.append(("planardyn", cmd))
+    return out
+
+
+def check_installed() -> None:
+    import planardyn as pd
+
+    where = Path(pd.__file__).resolve()
+    assert "site-packages" in where.parts, f"planardyn is imported from {where}, not from an installed wheel"
+    files = [str(f) for f in importlib.metadata.distribution("planardyn").files or []]
+    assert any(f.endswith("licenses/LICENSE") for f in files), "the wheel holds no LICENSE"
+    shipped = sorted(f.removeprefix("planardyn/models/").removesuffix(".yaml") for f in files
+                     if f.startswith("planardyn/models/") and f.endswith(".yaml"))
+    assert shipped and shipped == sorted(pd.models.names()), (shipped, pd.models.names())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pd.PlanardynWarning)  # e.g. the library's redundant double parallelogram
+        for name in shipped:
+            pd.load_example(name)
+    print(f"wheel: {where.parent}: LICENSE, {len(shipped)} model files, each loads")
+
+
+def check_version() -> None:
+    command = Path(sys.executable).parent / "planardyn"
+    out = subprocess.run([str(command), "--version"], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == f"planardyn {importlib.metadata.version('planardyn')}", out
+    print(f"wheel: {out.strip()}")
+
+
+def run_readme(readme: Path) -> None:
+    """Every snippet of the README, in order, in the current folder: the python blocks in one
+    namespace, the commands with this venv's `planardyn`."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    code = snippets(readme.read_text())
+    assert code, f"{readme} has no python block or planardyn command"
+    namespace: dict[str, object] = {"__name__": "__main__"}
+    command = Path(sys.executable).parent / "planardyn"
+    for k, (kind, text) in enumerate(code, 1):
+        if kind == "python":
+            exec(compile(text, f"{readme.name}, snippet {k}", "exec"), namespace)
+        else:
+            p = subprocess.run([str(command), *shlex.split(text)[1:]], capture_output=True, text=True)
+            assert p.returncode == 0, f"{text!r} exited {p.returncode}: {p.stderr}"
+    print(f"wheel: the {len(code)} snippets of {readme.name} ran (python blocks and planardyn commands)")
+
+
+if __name__ == "__main__":
+    check_installed()
+    check_version()
+    run_readme(Path(sys.argv[1]))
