@@ -21,6 +21,14 @@ const BASIN_FRACTION: f64 = 0.5;
 /// 0.47 jump in one 3.5 ms step, corrections all under 0.05, -1.8 J).
 const MOVE_FRACTION: f64 = 2.0;
 
+/// Below this type II measure at the last accepted point the user's chart takes the Newton
+/// path even where closed forms exist. A dyad's branch changes where the passive motion goes
+/// through its fold (the five-bar's type II singularities, A02's change points, where the
+/// parallelogram branch crosses the dyad's base line); the closed forms keep the branch by
+/// construction, while the Newton path's predictor follows the motion's tangent there. The
+/// monitor leaves the user's chart below 0.05 and returns above 0.1 (`charts`).
+const CLOSED_FORM_SIGMA: f64 = 0.1;
+
 /// A mechanism in one chart, with the state the Newton predictor starts from.
 pub struct MechanismOde<'a> {
     pub mech: &'a Mechanism,
@@ -59,6 +67,8 @@ pub struct MechanismOde<'a> {
     /// point in `ws` (factorised at the monitor's request only, once a step).
     closed: Option<ClosedForm>,
     stale_j: bool,
+    /// Whether the last accepted point is clear of folds ([`CLOSED_FORM_SIGMA`]).
+    clear_of_folds: bool,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -87,6 +97,7 @@ impl<'a> MechanismOde<'a> {
             inputs_sys: System::new(mech),
             closed,
             stale_j: false,
+            clear_of_folds: true,
             mech,
             ws,
             drives,
@@ -129,22 +140,26 @@ impl<'a> MechanismOde<'a> {
     /// is O(1)), and Newton from a predictor past half-way lands on it with a correction well
     /// under MAX_CORRECTION: the five-bar of the benchmarks, DOPRI5 at rtol 1e-4, jumped
     /// branch with a 0.047 correction at sigma ~ 0.06 and lost 6e-3 J, ending 4 rad off.
-    /// A quarter of the separation keeps the start inside its own basin.
+    /// A quarter of the separation keeps the start inside its own basin. Below
+    /// [`CLOSED_FORM_SIGMA`] the evaluations also leave the closed forms for Newton.
     pub fn limit_correction(&mut self, sigma: f64) {
         self.max_correction = MAX_CORRECTION.min(BASIN_FRACTION * sigma);
+        self.clear_of_folds = sigma >= CLOSED_FORM_SIGMA;
         self.max_move = MOVE_FRACTION * sigma;
     }
 
     /// Bound the move of a solution from its predictor's anchor by `max` as well (scaled, as
     /// [`MechanismOde::limit_correction`]'s).
+    /// Near a change point the evaluations take the Newton path (see [`CLOSED_FORM_SIGMA`]).
     pub fn limit_move(&mut self, max: f64) {
         self.max_move = self.max_move.min(max);
+        self.clear_of_folds = false;
     }
 
-    /// Whether evaluations take the closed forms: there are some, in the user's chart, with
-    /// no coordinate driven by a prescribed motion.
+    /// Whether evaluations take the closed forms: there are some, in the user's chart, clear
+    /// of folds, with no coordinate driven by a prescribed motion.
     fn closed_form_in_use(&self) -> bool {
-        self.closed.is_some() && self.ws.chart == Chart::Inputs && self.motion.is_none()
+        self.closed.is_some() && self.ws.chart == Chart::Inputs && self.clear_of_folds && self.motion.is_none()
     }
 
     /// Factorise J at the point in `ws` if a closed-form evaluation left it behind (for the
