@@ -97,7 +97,7 @@ pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result
 /// the tolerance, as accurate as the analogues are anyway. Then record the figures.
 fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize) -> Result<(), KinematicsError> {
     factor(mech, ws)?;
-    if norm > POLISH_BELOW {
+    if norm > POLISH_BELOW || matches!(ws.chart, Chart::Partition(_)) {
         newton_update(ws);
     }
     ws.residual = norm;

@@ -13,6 +13,7 @@
 //! crossing is only detected and reported.
 
 use super::ode::MechanismOde;
+use crate::dynamics::{kinetic_energy, potential_energy};
 use crate::kinematics::constraints::{body_trig, pair_coordinate_gamma, pair_coordinate_rate};
 use crate::kinematics::singularity::scaled_phi_x;
 use crate::kinematics::{
@@ -23,17 +24,21 @@ use crate::linalg::pivot_columns;
 use crate::model::Mechanism;
 
 /// A passive measure below this at an accepted step, falling, starts a crossing. Nearer the
-/// point the evaluations themselves lose accuracy: the position solve leaves x off the
-/// branch by about its tolerance / sigma along the other branch's tangent, where U turns by
-/// that over sigma (A02 at 1e-5: accelerations 2e-3 off); at 1e-3 they are accurate to ~1e-8,
-/// and the crossing, about 3e-3 s of A02's motion, is bridged by the quintic below.
-pub const CROSS_BELOW: f64 = 1e-3;
+/// point the evaluations themselves lose accuracy like eps / sigma^2: the position solve
+/// leaves x off the branch by about its tolerance / sigma along the other branch's tangent,
+/// where U turns by that over sigma (A02 at 1e-5: accelerations 2e-3 off). Farther, the Taylor
+/// step is longer. On A02 at N = 40 (rate error after the first crossing, before the energy
+/// is restored): 3e-4: 6e-6 rad/s, 1e-3: 1e-8, 3e-3: 3e-9, 5e-3: 4e-9 with the smallest
+/// error after 20 s, 1e-2: 2e-8.
+pub const CROSS_BELOW: f64 = 5e-3;
 /// Below this passive measure at an accepted step the next step may move the mechanism by
 /// at most [`APPROACH_FRACTION`] of it (scaled), so that the integrator approaches a change
 /// point down to [`CROSS_BELOW`] instead of stepping over it: its stages would evaluate
 /// where the evaluations are inaccurate (see [`CROSS_BELOW`]; a step over A02's change point
 /// left its rate 4e-7 rad/s off). A step that still went over is recognised (`stepped_over`).
-pub const WATCH_BELOW: f64 = 0.1;
+/// Not higher: the five-bar passes type II singularities with the passive measure at 0.05,
+/// where the limit would only cost steps.
+pub const WATCH_BELOW: f64 = 0.02;
 /// See [`WATCH_BELOW`].
 pub const APPROACH_FRACTION: f64 = 0.5;
 /// A scaled pivot of Phi_x below this at the change point counts as a lost rank.
@@ -141,8 +146,9 @@ pub struct Landing {
     pub chart: Chart,
     pub y: Vec<f64>,
     pub point: ChangePoint,
-    /// The path the crossing followed, for outputs inside it.
+    /// The path the crossing followed, and the point it started from.
     pub path: Extrapolation,
+    pub start: Passed,
 }
 
 /// A path x(t) of the body coordinates: position, rate and acceleration at time t.
@@ -215,7 +221,7 @@ pub struct Quintic {
 }
 
 impl Quintic {
-    fn new(a: &Passed, b: (&[f64], &[f64], &[f64]), tb: f64) -> Self {
+    pub fn new(a: &Passed, b: (&[f64], &[f64], &[f64]), tb: f64) -> Self {
         let span = tb - a.t;
         let n = a.x.len();
         let mut c: [Vec<f64>; 6] = std::array::from_fn(|_| vec![0.0; n]);
@@ -281,10 +287,12 @@ pub fn cross(ode: &mut MechanismOde, t: f64, passive: f64, work: f64, approach: 
     let to_point = time_to_point(approach, t, passive).ok_or_else(|| {
         format!("the time to the change point could not be estimated (passive measure {passive:.2e})")
     })?;
+    let start = Passed::of(ode, t, passive);
     let ws = &ode.ws;
     let samples = approach.samples(t, to_point / 2.0);
     let path = Extrapolation::new(t, (&ws.x, &ws.xd, &ws.xdd), &samples, to_point);
     let power = ws.power;
+    let energy = kinetic_energy(mech, &ws.xd) + potential_energy(mech, &ws.x);
     let (mut x, mut xd, mut xdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut why = String::new();
     for attempt in 0..ATTEMPTS {
@@ -292,6 +300,7 @@ pub fn cross(ode: &mut MechanismOde, t: f64, passive: f64, work: f64, approach: 
         path.at(t + h, &mut x, &mut xd, &mut xdd);
         match project(ode, &x, &xd, passive) {
             Ok((chart, past)) if past >= 0.5 * passive => {
+                keep_energy(ode, energy + h * power);
                 let mut y = vec![0.0; 2 * m + 1];
                 if let Chart::Partition(idx) = &chart {
                     for (k, &i) in idx.iter().enumerate() {
@@ -300,7 +309,7 @@ pub fn cross(ode: &mut MechanismOde, t: f64, passive: f64, work: f64, approach: 
                 }
                 y[2 * m] = work + h * power;
                 let point = change_point(mech, &path, locate(mech, &path, t, t + h));
-                return Ok(Landing { t: t + h, x: ode.ws.x.clone(), chart, y, point, path });
+                return Ok(Landing { t: t + h, x: ode.ws.x.clone(), chart, y, point, path, start });
             }
             Ok((_, past)) => why = format!("{h:.2e} s past it the passive measure is still {past:.2e}"),
             Err(e) => {
@@ -310,6 +319,21 @@ pub fn cross(ode: &mut MechanismOde, t: f64, passive: f64, work: f64, approach: 
         }
     }
     Err(format!("no branch continues the motion through the change point: {why}"))
+}
+
+/// Scale the rates `ode.ws.xd` so that T + V = `energy` (J): the balance T + V - W holds
+/// across the crossing as along the integration, W growing by the power before it times the
+/// crossing's length. On a branch of mobility 1 the direction of xd is the tangent's, so
+/// this makes the rate exact for the position; any branch keeps its energy. A change of more
+/// than [`TANGENT_MISMATCH`] is not made (the projection's test already bounds it).
+fn keep_energy(ode: &mut MechanismOde, energy: f64) {
+    let ws = &mut ode.ws;
+    let kinetic = kinetic_energy(ode.mech, &ws.xd);
+    let target = energy - potential_energy(ode.mech, &ws.x);
+    let scale = (target / kinetic).sqrt();
+    if kinetic > 0.0 && (scale - 1.0).abs() < TANGENT_MISMATCH {
+        ws.xd.iter_mut().for_each(|v| *v *= scale);
+    }
 }
 
 /// Project the predicted (x, xd) onto the constraints and their tangent in the partition

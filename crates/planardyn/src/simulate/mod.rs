@@ -18,7 +18,9 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
-use crossing::{cross, stepped_over, user_state, Approach, Landing, Path, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW};
+use crossing::{
+    cross, stepped_over, user_state, Approach, Landing, Path, Quintic, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW,
+};
 use ode::MechanismOde;
 
 /// Relative tolerance of a model's run when its file gives none (docs/model-format.md,
@@ -231,8 +233,9 @@ struct Outputs<'t> {
 
 /// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
 /// passive measures `sigma`, `passive`, work `work`), `approach` the points before it, and
-/// restart the stepper past it. Outputs inside the crossing come from the path it followed;
-/// without a grid the point past it is recorded. Returns whether t_end was reached inside
+/// restart the stepper past it. Outputs inside the crossing come from the quintic through its
+/// ends (from its Taylor step if t_end is inside it); without a grid the point past it is
+/// recorded. Returns whether t_end was reached inside
 /// the crossing; Err says why the motion cannot be continued.
 fn cross_change_point(
     ode: &mut MechanismOde,
@@ -244,18 +247,18 @@ fn cross_change_point(
     t_end: f64,
 ) -> Result<bool, String> {
     let landing: Landing = cross(ode, t, passive, work, approach)?;
-    let inside = |s: f64| s < landing.t.min(t_end) || s == t_end && landing.t >= t_end;
-    if let Some(te) = out.t_eval {
-        while out.next < te.len() && inside(te[out.next]) {
-            path_row(ode, traj, &landing, te[out.next], work, sigma);
-            out.next += 1;
-        }
-    }
     traj.change_points.push(landing.point.clone());
+    let inside = |s: f64, end: f64| s < end || s == t_end && end >= t_end;
     if landing.t >= t_end {
-        if out.t_eval.is_none() {
-            path_row(ode, traj, &landing, t_end, work, sigma);
+        // Ends inside the crossing: the rest from its Taylor step.
+        let rows: Vec<f64> = match out.t_eval {
+            Some(te) => te[out.next..].iter().copied().take_while(|&s| inside(s, t_end)).collect(),
+            None => vec![t_end],
+        };
+        for s in rows {
+            path_row(ode, traj, &landing.path, s, work, sigma);
         }
+        out.next = out.t_eval.map_or(0, <[f64]>::len);
         return Ok(true);
     }
     ode.ws.x.copy_from_slice(&landing.x);
@@ -263,20 +266,31 @@ fn cross_change_point(
     stepper.reset(ode, landing.t, &landing.y).map_err(|e| format!("restarting past the change point: {e}"))?;
     traj.stats.chart_switches += 1;
     let meas = measure(ode);
-    if out.t_eval.is_none() {
-        traj.record(ode, landing.t, landing.y[landing.y.len() - 1], meas.sigma);
-    }
     let own = chart_sigma(ode, meas.sigma);
     ode.limit_correction(own);
     approach.clear();
     approach.keep(ode, landing.t, meas.passive);
+    match out.t_eval {
+        None => traj.record(ode, landing.t, landing.y[landing.y.len() - 1], meas.sigma),
+        Some(te) => {
+            // Outputs inside the crossing: the quintic through its two ends (x, xd, xdd), an
+            // interpolation, where the Taylor step's own error grows towards its end.
+            let ws = &ode.ws;
+            let path = Quintic::new(&landing.start, (&ws.x, &ws.xd, &ws.xdd), landing.t);
+            while out.next < te.len() && inside(te[out.next], landing.t) {
+                path_row(ode, traj, &path, te[out.next], work, sigma);
+                out.next += 1;
+            }
+            ode.restart_from_anchor();
+        }
+    }
     Ok(false)
 }
 
-/// Record the row at time s inside a crossing, from the path it followed.
-fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, landing: &Landing, s: f64, work: f64, sigma: f64) {
+/// Record the row at time s inside a crossing, from `path`.
+fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &dyn Path, s: f64, work: f64, sigma: f64) {
     let ws = &mut ode.ws;
-    landing.path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
+    path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
     user_state(ode);
     traj.record(ode, s, work, sigma);
 }
@@ -464,7 +478,9 @@ pub fn simulate_prescribed<'a>(
             own = chart_sigma(&mut ode, meas.sigma);
         }
         ode.limit_correction(own);
-        if meas.passive < WATCH_BELOW && ode.motion.is_none() {
+        // In the user's chart the passive measure is only bounded by sigma_II (it is
+        // measured in a partition, which the integrator takes below 0.05).
+        if meas.passive < WATCH_BELOW && ode.motion.is_none() && ode.ws.chart != Chart::Inputs {
             ode.limit_move(APPROACH_FRACTION * meas.passive);
         }
         if let Some(cb) = progress.as_mut() {

@@ -1,0 +1,88 @@
+"""Change points: the IFToMM A02 N-four-bar crosses one whenever its rods are horizontal.
+
+On the parallelogram branch every rod has the same angle theta and the couplers translate, so
+the motion is the exact one-coordinate reduction
+    ((N + 1)/3 + N) theta'' = -g cos(theta) ((N + 1)/2 + N)
+(uniform 1 kg bars of 1 m: rods J = 1/3 about their pivots, couplers translating), integrated
+here by scipy at rtol 1e-13. The run must follow it within 1e-6 rad at every output and
+report each crossing (theta = -k pi) with the N windows' rank lost.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import planardyn as pd
+import pytest
+from planardyn.cli import summary
+from planardyn.results_io import read_results
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+from families import G, a02  # noqa: E402
+
+solve_ivp = pytest.importorskip("scipy.integrate").solve_ivp
+
+TIGHT = dict(method="dop853", rtol=1e-12, atol=1e-14)
+
+
+def reduction(n: int, t: np.ndarray) -> np.ndarray:
+    k = G * ((n + 1) / 2 + n) / ((n + 1) / 3 + n)
+    sol = solve_ivp(lambda _, y: [y[1], -k * math.cos(y[0])], (0.0, t[-1]), [math.pi / 2, -1.0],
+                    method="DOP853", rtol=1e-13, atol=1e-14, t_eval=t)
+    return sol.y[0]
+
+
+@pytest.fixture(scope="module")
+def n2():
+    t = np.linspace(0.0, 10.0, 1001)
+    return pd.from_dict(a02(2)).simulate(t_end=10.0, t_eval=t, **TIGHT)
+
+
+def test_a02_n2_follows_the_reduction_through_its_change_points(n2):
+    assert n2.status == "success", n2.message
+    assert np.abs(n2.q[:, 0] - reduction(2, n2.t)).max() < 1e-6
+
+
+def test_each_crossing_is_reported_where_the_rods_are_horizontal(n2):
+    # theta falls from pi/2: it crosses -k pi for k = 0 .. K, K the last below theta(10 s).
+    crossings = -math.floor(n2.q[-1, 0] / math.pi)
+    assert crossings >= 10
+    assert len(n2.change_points) == crossings
+    for k, cp in enumerate(n2.change_points):
+        assert isinstance(cp, pd.ChangePoint)
+        assert cp.rank_drop == 2
+        assert cp.q[0] == pytest.approx(-k * math.pi, abs=1e-6)
+        # At its time the reduction is there too (theta' ~ 4.9 rad/s: 1e-6 rad is 2e-7 s).
+        assert reduction(2, np.array([0.0, cp.t]))[-1] == pytest.approx(-k * math.pi, abs=1e-6)
+        assert cp.x.shape == (3 * 5,)
+    frame = n2.change_points_frame()
+    assert list(frame.columns) == ["rank_drop", "theta"]
+    assert np.allclose(frame.index, [c.t for c in n2.change_points])
+
+
+def test_crossings_are_kept_by_results_files_and_the_cli_summary(n2, tmp_path):
+    back = read_results(n2.save(tmp_path / "a02.npz"))
+    assert [c.t for c in back.change_points] == [c.t for c in n2.change_points]
+    assert all(np.array_equal(a.x, b.x) and a.rank_drop == b.rank_drop
+               for a, b in zip(back.change_points, n2.change_points))
+    line = summary(n2)
+    assert line.count("change point at t = ") == len(n2.change_points)
+    assert f"change point at t = {n2.change_points[0].t:.6g} s (rank -2)" in line
+
+
+def test_a02_n40_runs_its_official_20_s():
+    t = np.linspace(0.0, 20.0, 2001)
+    res = pd.from_dict(a02(40)).simulate(t_end=20.0, t_eval=t, **TIGHT)
+    assert res.status == "success", res.message
+    assert np.abs(res.q[:, 0] - reduction(40, res.t)).max() < 1e-6
+    assert len(res.change_points) == -math.floor(res.q[-1, 0] / math.pi)
+    assert {c.rank_drop for c in res.change_points} == {40}
+
+
+def test_a_run_without_change_points_reports_none():
+    res = pd.load_example("five-bar-free-fall").simulate(t_end=0.2)
+    assert res.change_points == []
