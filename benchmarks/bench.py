@@ -103,6 +103,9 @@ def summarise(bm, runs: list[Run], tools: list[str]) -> dict:
         s[f"best_at_{name}"] = {t: dataclasses.asdict(r) if r else None for t, r in best.items()}
         pd = best.get("planardyn")
         s[f"ratio_at_{name}"] = {t: r.wall / pd.wall for t, r in best.items() if r and pd and t != "planardyn"}
+        # A peer whose own dynamics calls were clocked: the ratio against those calls alone.
+        s[f"dynamics_ratio_at_{name}"] = {t: r.wall * r.extra["dynamics_share"] / pd.wall for t, r in best.items()
+                                          if r and pd and "dynamics_share" in r.extra}
     e0 = {t: [r.e0 for r in runs if r.tool == t and r.ok] for t in tools}
     s["start_energy"] = {t: v[0] for t, v in e0.items() if v}
     if "planardyn" in s["start_energy"]:

@@ -13,7 +13,7 @@
 - ``a02(n)``: IFToMM benchmark A02, the N-four-bar: n + 1 upright rods of 1 m hinged to the
   ground at (i, 0), n couplers joining their tops, every link a uniform 1 kg bar, gravity -y,
   B0 (the first rod's top) moving at +1 m/s in x. One coordinate; its mobility jumps to n + 1
-  whenever the rods are horizontal (the first time near t = 0.57 s).
+  whenever the rods are horizontal (the first time at t = 0.714 s for N = 2, 0.722 s for N = 40).
 """
 
 from __future__ import annotations

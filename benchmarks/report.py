@@ -204,12 +204,51 @@ def write(res: dict, out: Path, docs: Path | None) -> None:
         write_docs(res, docs)
 
 
+def _spread(values: dict[str, float], spec: str = ".1f", unit: str = "") -> str:
+    """'lo to hi (four-bar a, five-bar b, ...)' of per-mechanism values, or the one value."""
+    f = lambda v: format(v, spec) + unit  # noqa: E731
+    lo, hi = f(min(values.values())), f(max(values.values()))
+    each = ", ".join(f"{k} {f(v)}" for k, v in values.items())
+    return f"{lo if lo == hi else f'{lo} to {hi}'} ({each})"
+
+
+def summary_sentences(res: dict) -> str:
+    """The summary of the tables, generated from the same numbers: per peer, its wall time
+    over planardyn's at each mechanism's stated accuracy and stated error, and for a peer
+    whose dynamics calls were clocked, the same ratio for those calls alone."""
+    mechs = res["mechanisms"]
+    tools = [t for m in mechs.values() for t in m["summary"]["ratio_at_accuracy"]]
+    lines = []
+    for tool in dict.fromkeys(tools):
+        parts = []
+        for kind, what in (("accuracy", "at each mechanism's stated accuracy"), ("error", "at its stated error")):
+            ratios = {k: m["summary"][f"ratio_at_{kind}"][tool] for k, m in mechs.items()
+                      if tool in m["summary"][f"ratio_at_{kind}"]}
+            if ratios:
+                parts.append(f"{_spread(ratios)} {what}")
+        missing = [k for k, m in mechs.items() if tool not in m["summary"]["ratio_at_accuracy"]]
+        line = f"- **{tool}**: its wall time over planardyn's is " + ", and ".join(parts)
+        line += f" (no setting met the stated accuracy on: {', '.join(missing)})." if missing else "."
+        dyn = {k: m["summary"]["best_at_accuracy"][tool]["extra"]["dynamics_share"] for k, m in mechs.items()
+               if tool in m["summary"].get("dynamics_ratio_at_accuracy", {})}
+        if dyn:
+            ratios = {k: mechs[k]["summary"]["dynamics_ratio_at_accuracy"][tool] for k in dyn}
+            line += (f" It is driven by an RK4 loop written in Python (as a Python user drives it): its "
+                     f"`constraintDynamics` calls are {_spread({k: 100 * v for k, v in dyn.items()}, '.0f', ' %')} "
+                     f"of its time, the rest the Python loop, its numpy arithmetic and the springs' Jacobians. "
+                     f"Against those calls alone the ratio is {_spread(ratios)} at the stated accuracy.")
+        lines.append(line)
+    return "\n".join(lines)
+
+
 def docs_section(res: dict) -> str:
     env = res["environment"]
     vers = ", ".join(f"{k} {v}" for k, v in env["versions"].items())
     parts = [f"{env['cpus']} CPUs, Python {env['python']}; {vers}."
              + (" Not available: " + "; ".join(f"{k} ({v})" for k, v in env["not_available"].items()) + "."
-                if env["not_available"] else ""), ""]
+                if env["not_available"] else ""), "",
+             "In short (generated from the tables below: each ratio is a peer's cheapest setting "
+             "over planardyn's cheapest at the same target):", "", summary_sentences(res), ""]
     for m in res["mechanisms"].values():
         s = m["summary"]
         parts += [f"### {m['title']}", "", f"`{m['model']}`: {m['scenario']}. Measured {measured_line(m['measured'])}."

@@ -177,6 +177,32 @@ def test_optimised_excitation_is_better_conditioned_than_a_sine(experiment):
     assert np.median(std["sine"] / std["optimised"]) > 1e3
 
 
+def test_excitation_keeps_actuator_limits_and_a_singularity_margin(experiment):
+    # Unconstrained, the optimised motion of the test above peaks at 7.6 and 8.0 N m, 3.7 rad/s,
+    # and comes to a type II measure of 0.206; the plain sine at 4.8 and 5.0 N m, 0.94 rad/s,
+    # 0.244. Limits below the former: 6 N m, 2.5 rad/s, a margin of 0.22. Measured: condition
+    # 61 (the sine's 7.7e6), peaks 6.0003 N m and 0.21999 between the 100 points the
+    # optimiser checks (a 3-harmonic motion varies little between them: 1e-3 allowed here).
+    from planardyn.identify import excitation
+
+    prior, _, base, _ = experiment
+    exc = excitation(prior, period=1.0, harmonics=3, amplitude=0.3, base=base, tau_max=6.0, qd_max=2.5,
+                     sigma_margin=0.22)
+    assert exc.start_condition > 1e6 and exc.condition < 100
+    for t, slack in ((np.linspace(0.0, 1.0, 100, endpoint=False), 1e-12), (np.linspace(0.0, 1.0, 1001), 1e-3)):
+        q, qd, qdd = exc.sample(t)
+        tau = prior.inverse_dynamics(q, qd, qdd)  # the model's inverse dynamics, not the regressor
+        assert np.abs(tau).max() <= 6.0 * (1 + slack), np.abs(tau).max()
+        assert np.abs(qd).max() <= 2.5
+        x, least = None, np.inf
+        for row in q:
+            k = prior.kinematics(row, x_start=x)
+            x, least = k["x"], min(least, k["sigma_min"])
+        assert least >= 0.22 * (1 - slack), least
+    with pytest.raises(ValueError, match="tau_max"):
+        excitation(prior, base=base, tau_max=[1.0, -1.0])
+
+
 def test_identify_command(experiment, tmp_path):
     # Encoder readings (16-bit) and efforts with 1 % noise in a CSV table at 200 Hz: the
     # command filters at 10 Hz (the motion's tones reach 3 Hz), differentiates, drops the

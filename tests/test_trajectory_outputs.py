@@ -4,11 +4,22 @@ the drives' power, and a table indexed by t; each against a closed form."""
 from __future__ import annotations
 
 import math
+from decimal import Decimal, localcontext
 
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import PENDULUM_I, PENDULUM_L, PENDULUM_M, G, four_bar_B
+from conftest import (
+    FOUR_BAR_A,
+    FOUR_BAR_B,
+    FOUR_BAR_C,
+    FOUR_BAR_D,
+    PENDULUM_I,
+    PENDULUM_L,
+    PENDULUM_M,
+    G,
+    four_bar_B,
+)
 from scipy.integrate import cumulative_simpson
 
 
@@ -34,28 +45,58 @@ def test_pendulum_pin_reaction_along_a_swing(pendulum):
                                rtol=1e-13, atol=1e-13)
 
 
+def _decimal_cos_sin(x: Decimal) -> tuple[Decimal, Decimal]:
+    # Taylor series to 45 digits (|x| < 8 here: 60 terms at most).
+    c, s, ct, st, i = Decimal(0), Decimal(0), Decimal(1), x, 0
+    while abs(ct) > Decimal("1e-45") or abs(st) > Decimal("1e-45"):
+        c, s = c + ct, s + st
+        ct, st = -ct * x * x / ((2 * i + 1) * (2 * i + 2)), -st * x * x / ((2 * i + 2) * (2 * i + 3))
+        i += 1
+    return c, s
+
+
+def _four_bar_B_derivatives(theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """B and its first two theta derivatives from conftest.four_bar_B's closed form evaluated
+    at 40 digits, by five-point central differences with step 1e-6 rad (truncation ~h^4 =
+    1e-24, round-off 1e-40 / h^2 = 1e-28): exact to double precision."""
+    with localcontext() as ctx:
+        ctx.prec = 40
+        a, b, c, d = (Decimal(v) for v in (FOUR_BAR_A, FOUR_BAR_B, FOUR_BAR_C, FOUR_BAR_D))
+
+        def B(th: Decimal) -> list[Decimal]:
+            co, si = _decimal_cos_sin(th)
+            ax, ay = a * co, a * si
+            dx, dy = d - ax, -ay
+            e = (dx * dx + dy * dy).sqrt()
+            along = (b * b - c * c + e * e) / (2 * e)
+            h = (b * b - along * along).sqrt()
+            return [ax + (along * dx - h * dy) / e, ay + (along * dy + h * dx) / e]
+
+        h, t = Decimal("1e-6"), Decimal(theta)
+        b2, b1, b0, a1, a2 = (B(t + j * h) for j in (2, 1, 0, -1, -2))
+        d1 = [(-p2 + 8 * p1 - 8 * m1 + m2) / (12 * h) for p2, p1, m1, m2 in zip(b2, b1, a1, a2)]
+        d2 = [(-p2 + 16 * p1 - 30 * p0 + 16 * m1 - m2) / (12 * h * h)
+              for p2, p1, p0, m1, m2 in zip(b2, b1, b0, a1, a2)]
+        return tuple(np.array([float(v) for v in vs]) for vs in (b0, d1, d2))  # type: ignore[return-value]
+
+
 def test_four_bar_coupler_point_against_its_closed_form_path(four_bar):
     # B is on the circles |B - A| = b and |B - D| = c (conftest.four_bar_B); its velocity is
     # dB/dtheta thetad and its acceleration d2B/dtheta2 thetad^2 + dB/dtheta thetadd, the
-    # theta derivatives by five-point central differences of the closed form (step 2e-3 rad:
-    # truncation ~h^4 = 2e-11; round-off eps / h^2 = 6e-11 per unit of |B| for the second
-    # derivative, times thetad^2 up to 1100 (rad/s)^2 here: 1e-7 m/s^2).
+    # theta derivatives of the closed form exact to double precision (_four_bar_B_derivatives).
+    # Bounds: the point motion's own round-off, measured 2.3e-14 m, 2.5e-12 m/s and 1.6e-11
+    # m/s^2 (|B''| thetad^2 up to 170 m/s^2 here).
     res = four_bar.simulate(t_end=1.0, output_dt=0.02, drives=lambda t, q, qd: [2.0], rtol=1e-11, atol=1e-12)
     pm = four_bar.point_motion(res)
     assert pm.names == ["O", "A", "B", "D"] and pm.position.shape == (len(res.t), 4, 2)
     pos, vel, acc = pm["B"]
 
-    def B(th: float) -> np.ndarray:
-        return np.array(four_bar_B(th))
-
     for k, (th, thd, thdd) in enumerate(zip(res.q[:, 0], res.qd[:, 0], res.qdd[:, 0])):
-        h = 2e-3
-        b2, b1, b0, a1, a2 = (B(th + j * h) for j in (2, 1, 0, -1, -2))
-        d1 = (-b2 + 8 * b1 - 8 * a1 + a2) / (12 * h)
-        d2 = (-b2 + 16 * b1 - 30 * b0 + 16 * a1 - a2) / (12 * h * h)
+        b0, d1, d2 = _four_bar_B_derivatives(float(th))
+        np.testing.assert_allclose(b0, four_bar_B(th), rtol=0, atol=1e-15)  # the same closed form
         np.testing.assert_allclose(pos[k], b0, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(vel[k], d1 * thd, rtol=0, atol=1e-9)
-        np.testing.assert_allclose(acc[k], d2 * thd**2 + d1 * thdd, rtol=0, atol=2e-7)
+        np.testing.assert_allclose(vel[k], d1 * thd, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(acc[k], d2 * thd**2 + d1 * thdd, rtol=0, atol=1e-9)
     # The ground points stand still; A turns on the crank circle.
     assert np.all(pm["O"][0] == 0.0) and np.all(pm["D"][1] == 0.0)
     np.testing.assert_allclose(np.hypot(*pm["A"][0].T), 0.3, rtol=1e-13)

@@ -7,10 +7,15 @@ Drive torques enter as joint torques; a spring's force enters as J^T f through t
 Jacobians of its two ends (the way a Pinocchio user adds a force element).
 
 Timed: the RK4 loop, storing q and v at every step. Energy, loop gap and coordinates are
-computed afterwards from the stored states (untimed).
+computed afterwards from the stored states (untimed). One more run, untimed as a whole, clocks
+each ``constraintDynamics`` call inside the loop: its share of that run's time is the part of
+Pinocchio's cost that is its C++ dynamics (the rest is the Python loop, the RK4 arithmetic on
+numpy arrays and the springs' Jacobians), in ``Run.extra['dynamics_share']``.
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 from common import Drawing, Run, best_time, coordinates, energy, loop_gap
@@ -109,14 +114,23 @@ class Model:
                 tau += sign * (J[:3].T @ f)
         return tau
 
-    def simulate(self, dt: float, n: int) -> tuple[np.ndarray, np.ndarray]:
-        """Classic RK4 over (q, v), n steps of dt; (n+1, nq) q and v."""
+    def simulate(self, dt: float, n: int, clock: list[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Classic RK4 over (q, v), n steps of dt; (n+1, nq) q and v. With ``clock``, the
+        time spent inside ``constraintDynamics`` (s) is added to ``clock[0]``."""
         pin, model, data = self.pin, self.model, self.data
         cm, cd, prox = self.cmodels, self.cdatas, self.prox
         torques = self.spring_tau if self.springs else (lambda q: self.tau)
 
         def f(q, v):
             return pin.constraintDynamics(model, data, q, v, torques(q), cm, cd, prox)
+
+        if clock is not None:
+            def f(q, v):  # noqa: F811 - the same, with the call clocked
+                tau = torques(q)
+                t0 = time.perf_counter()
+                a = pin.constraintDynamics(model, data, q, v, tau, cm, cd, prox)
+                clock[0] += time.perf_counter() - t0
+                return a
 
         q = np.zeros(model.nq)
         v = np.zeros(model.nv)
@@ -167,6 +181,10 @@ def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
     m = Model(d, w)
     with np.errstate(all="ignore"):
         r.wall, (Q, V) = best_time(lambda: m.simulate(dt, n))
+        clock = [0.0]
+        t0 = time.perf_counter()
+        m.simulate(dt, n, clock)
+        r.extra["dynamics_share"] = clock[0] / (time.perf_counter() - t0)
         poses, rates = m.body_states(Q, V)
         q = coordinates(d, poses)[bm.grid_indices(dt)]
         return r.finish(energy(d, poses, rates), loop_gap(d, poses), q, ref_grid)

@@ -27,6 +27,7 @@ from ._core import (
     SingularityError,
     __version__,
 )
+from .events import Crossing
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
 from .result import ChangePoint, Energy, PointMotion, SimulationInterrupted, SimulationResult
 from .results_io import read_results
@@ -34,6 +35,7 @@ from .results_io import read_results
 __all__ = [
     "AssemblyError",
     "ChangePoint",
+    "Crossing",
     "Energy",
     "Mechanism",
     "ModelError",

@@ -25,6 +25,7 @@ __all__ = [
     "structure",
     "structure_of_model",
     "Effector",
+    "DenseOutput",
     "SINGULAR_TOL",
     "JUMP_TOL",
     "simulate_batch",
@@ -102,6 +103,34 @@ class Mechanism:
     def pairs(self) -> list[dict[str, Any]]: ...
     @property
     def simulate_defaults(self) -> dict[str, Any]: ...
+    @property
+    def actuators(self) -> list[dict[str, Any] | None]: ...
+    def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]: ...
+    @property
+    def actuator_names(self) -> list[str]: ...
+    @property
+    def actuator_kinds(self) -> list[str]: ...
+    def distribute_efforts(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        method: str = "min_norm",
+        preload: list[float] | None = None,
+        x_start: ArrayLike | None = None,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    def forward_dynamics_actuated(
+        self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0
+    ) -> NDArray[np.float64]: ...
+    def available_torque(self, coordinate: int, speed: ArrayLike) -> NDArray[np.float64] | None: ...
+    def dissipated_power(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> Any: ...
     def spec_json(self) -> str: ...
     def assemble(self, q: ArrayLike, x_start: ArrayLike | None = None) -> NDArray[np.float64]: ...
     def pair_geometry(self, x: ArrayLike) -> list[dict[str, Any]]: ...
@@ -116,6 +145,17 @@ class Mechanism:
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
+    def forward_dynamics_derivatives(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> dict[str, NDArray[np.float64]]: ...
+    def inverse_dynamics_derivatives(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, allow_singular: bool = False
+    ) -> dict[str, NDArray[np.float64]]: ...
     def inverse_dynamics(
         self,
         q: ArrayLike,
@@ -168,7 +208,19 @@ class Mechanism:
         progress: Callable[[float], Any] | None = None,
         max_steps: int | None = None,
         motion: list[tuple[int, float | tuple[list[float], list[float]] | Callable[[float], Any]]] | None = None,
+        events: list[tuple[Any, ...]] = ...,
+        dense_output: bool = False,
     ) -> dict[str, Any]: ...
+
+@final
+class DenseOutput:
+    def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+    @property
+    def t_min(self) -> float: ...
+    @property
+    def t_max(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
 
 @final
 class Effector:

@@ -8,6 +8,7 @@
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
+    planardyn plan MODEL --line X0 Y0 X1 Y1 --effort T [T ...] [--speed V ...] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn --version
 
@@ -44,6 +45,7 @@ from . import (
     models,
     structure,
 )
+from .events import Crossing, parse_crossing
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings
@@ -102,6 +104,14 @@ class ProgressBar:
     def close(self) -> None:
         self.stream.write("\n")
         self.stream.flush()
+
+
+def _crossing(text: str) -> Crossing:
+    """``--stop-when``'s argument (argparse reports a ValueError as a usage error)."""
+    try:
+        return parse_crossing(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def summary(res: SimulationResult) -> str:
@@ -229,6 +239,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="drive coordinate NAME at a constant rate instead of its effort (its torque or force is "
                         "computed): rad/s, rev/s, rpm, deg/s, or m/s, mm/s for a displacement, e.g. crank=1rev/s; "
                         "repeatable")
+    s.add_argument("--stop-when", action="append", metavar="NAME=VALUE", default=[], type=_crossing,
+                   help="stop when coordinate NAME crosses VALUE (rad or m; NAME>VALUE rising only, NAME<VALUE "
+                        "falling only), located on the integrator's interpolant; the last row is at that time "
+                        "(status 'event'); repeatable, the first crossing stops")
     s.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write: .csv, .parquet or .npz (by extension)")
     s.add_argument("--progress", action="store_true", help="show a progress bar on stderr even when it is not a terminal")
@@ -365,7 +379,7 @@ def _simulate(args: argparse.Namespace) -> int:
     bar = ProgressBar(t_end) if show else None
     try:
         with RunGuard(bar) as guard:
-            res = mech.simulate(**settings, progress=guard, motion=motion)
+            res = mech.simulate(**settings, progress=guard, motion=motion, events=args.stop_when or None)
         if bar is not None and res.success:
             bar(t_end)
     finally:
@@ -373,7 +387,8 @@ def _simulate(args: argparse.Namespace) -> int:
             bar.close()
     if guard.reason is not None and res.status == "cancelled":
         res = dataclasses.replace(res, message=guard.reason)
-    res = attach_metadata(res, mech, dict(settings, motion=motion))
+    stops = {"events": [dataclasses.asdict(c) for c in args.stop_when]} if args.stop_when else {}
+    res = attach_metadata(res, mech, dict(settings, motion=motion, **stops))
     if args.output is not None:
         args.output.parent.mkdir(parents=True, exist_ok=True)
         write_results(res, args.output)
@@ -573,6 +588,11 @@ def _main(argv: list[str]) -> int:
             from .robot import size_cli
 
             return size_cli(argv[1:])
+        if argv[:1] == ["plan"]:
+            # Time-optimal timing has its own parser in planardyn.plan (planardyn plan --help).
+            from .plan.cli import plan_cli
+
+            return plan_cli(argv[1:])
         args = _parser().parse_args(argv)
         if getattr(args, "model", None) is not None:
             args.model = models.resolve(args.model)

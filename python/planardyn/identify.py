@@ -292,17 +292,29 @@ class Excitation:
 
 
 def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitude: float = 0.3,
-               samples: int = 100, base: BaseParameters | None = None, max_evaluations: int = 2000) -> Excitation:
+               samples: int = 100, base: BaseParameters | None = None, max_evaluations: int = 2000,
+               tau_max: ArrayLike | None = None, qd_max: ArrayLike | None = None,
+               sigma_margin: float | None = None) -> Excitation:
     """A periodic motion that makes the base parameters well observable: the Fourier
     coefficients (``harmonics`` per coordinate) minimising the condition number of the scaled
     base columns of Y over ``samples`` points of a period, from a simple sine (amplitude / 2
     at the first harmonic on every coordinate).
 
-    Every coordinate stays within ``amplitude`` (rad, or 0.1 of it times the drawing's size for
-    a displacement) of the model's start; a motion that cannot be assembled along the way, or
-    passes within the branch guard of a type II singularity, counts as infinitely bad.
-    Solved by scipy's Powell method (no derivatives: the objective is not smooth where the
-    extreme singular values cross).
+    Constraints along the motion (checked at the ``samples`` points; the reach and speeds on a
+    grid 10 times finer per harmonic):
+
+    - every coordinate stays within ``amplitude`` (rad, or 0.1 of it times the drawing's size
+      for a displacement) of the model's start;
+    - ``qd_max``: (m,) or scalar peak speed of each drive (rad/s or m/s);
+    - ``tau_max``: (m,) or scalar peak effort of each drive (N m or N), from the model's
+      inverse dynamics (the regressor with the model's parameters: tau = Y pi + tau_o);
+    - ``sigma_margin``: the type II measure (``kinematics``' ``sigma_min``) stays above it;
+    - it can be assembled all along, away from the branch guard of a type II singularity.
+
+    A motion past a limit costs ``INFEASIBLE`` (1 + its worst relative excess), so that the
+    search is led back inside. Solved by scipy's Powell method (no derivatives: the objective
+    is not smooth where the extreme singular values cross). ``Excitation.start_condition``
+    is that of the starting sine, whether or not it kept the limits.
     """
     from scipy.optimize import minimize
 
@@ -314,6 +326,7 @@ def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitu
     # degree cannot exceed it between points by more than (pi h / period)^2 / 2 ~ 1e-5 of it.
     fine = np.linspace(0.0, period, 1000 * harmonics)
     q0 = np.array(mech.q0, float)
+    limits = _Limits(mech, tau_max, qd_max, sigma_margin)
 
     def make(z: FloatArray, start: float = np.inf) -> Excitation:
         a, b = z[: m * harmonics].reshape(m, harmonics), z[m * harmonics:].reshape(m, harmonics)
@@ -321,13 +334,18 @@ def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitu
 
     def cost(z: FloatArray) -> float:
         exc = make(z)
-        if np.any(np.abs(exc.sample(fine)[0] - q0) > reach):
-            return INFEASIBLE
+        q_fine, qd_fine, _ = exc.sample(fine)
+        excess = max(float(np.max(np.abs(q_fine - q0) / reach)) - 1.0, limits.speed_excess(qd_fine))
+        if excess > 0.0:
+            return INFEASIBLE * (1.0 + excess)
         q, qd, qdd = exc.sample(t)
         try:
-            Y, _ = mech.regressor(q, qd, qdd)
+            Y, tau_o = mech.regressor(q, qd, qdd)
+            excess = max(limits.effort_excess(Y, tau_o), limits.sigma_excess(q))
         except (PlanardynError, ValueError):  # not assembled, or too near a singularity
-            return INFEASIBLE
+            return INFEASIBLE * 2.0
+        if excess > 0.0:
+            return INFEASIBLE * (1.0 + excess)
         W = Y[..., base.independent].reshape(-1, base.rank)
         W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
         return float(np.linalg.cond(W))
@@ -339,3 +357,44 @@ def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitu
     best = out.x if out.fun < start else z0
     exc = make(best, start)
     return Excitation(exc.q0, period, exc.a, exc.b, min(float(out.fun), start), start)
+
+
+class _Limits:
+    """The drives' limits of :func:`excitation`, each as a worst relative excess (> 0: past it)."""
+
+    def __init__(self, mech: Mechanism, tau_max: ArrayLike | None, qd_max: ArrayLike | None,
+                 sigma_margin: float | None) -> None:
+        self.mech = mech
+        self.pi = np.array(list(mech.inertial_parameters.values()))
+        self.tau_max = _per_drive("tau_max", tau_max, mech.dof)
+        self.qd_max = _per_drive("qd_max", qd_max, mech.dof)
+        if sigma_margin is not None and not (np.isfinite(sigma_margin) and sigma_margin > 0):
+            raise ValueError(f"sigma_margin = {sigma_margin} must be a finite number > 0 (a type II measure)")
+        self.sigma_margin = sigma_margin
+
+    def speed_excess(self, qd: FloatArray) -> float:
+        return -1.0 if self.qd_max is None else float(np.max(np.abs(qd) / self.qd_max)) - 1.0
+
+    def effort_excess(self, Y: FloatArray, tau_o: FloatArray) -> float:
+        if self.tau_max is None:
+            return -1.0
+        return float(np.max(np.abs(Y @ self.pi + tau_o) / self.tau_max)) - 1.0
+
+    def sigma_excess(self, q: FloatArray) -> float:
+        if self.sigma_margin is None:
+            return -1.0
+        x, least = None, np.inf
+        for row in q:  # continued point to point: the branch of the start
+            k = self.mech.kinematics(row, x_start=x)
+            x, least = k["x"], min(least, k["sigma_min"])
+        return self.sigma_margin / max(least, 1e-300) - 1.0
+
+
+def _per_drive(name: str, v: ArrayLike | None, m: int) -> FloatArray | None:
+    """A limit given as a number or one per drive, as an (m,) array of positive values."""
+    if v is None:
+        return None
+    a = np.broadcast_to(np.asarray(v, float), (m,)).copy()
+    if not np.all(np.isfinite(a) & (a > 0)):
+        raise ValueError(f"{name} = {v!r}: give a positive finite number, or one per drive ({m})")
+    return a

@@ -11,7 +11,7 @@ import dataclasses
 import json
 import os
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Generic, Literal, TypeVar, overload
 
 import numpy as np
@@ -21,6 +21,7 @@ from ._core import Mechanism as NativeMechanism
 from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
+from .events import Crossing, Event, native_events
 from .guard import available_memory, rows_message
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
@@ -119,6 +120,12 @@ class Mechanism:
         "or None) and ``rows`` (start, stop): the pair's rows among the pair-constraint rows."
     )
     simulate_defaults: _Native[dict[str, Any]] = _Native("The model file's ``simulate`` section (None for a setting not given).")
+    actuators: _Native[list[dict[str, Any] | None]] = _Native(
+        "One entry per coordinate, None for an ideal effort source: the motor and transmission (``name``, "
+        "``gear_ratio``, ``efficiency``, ``rotor_inertia`` kg m^2, ``viscous`` N m s/rad, ``coulomb`` N m, "
+        "``stiction_speed`` rad/s) and its limits (``peak_torque``, ``continuous_torque`` N m, ``max_speed`` rad/s, "
+        "None when not given; ``envelope`` (k, 2) [speed, torque] points), docs/actuators.md."
+    )
 
     @property
     def coordinate_units(self) -> list[str]:
@@ -325,7 +332,9 @@ class Mechanism:
         Returns
         -------
         tau : ndarray of the same shape
-            Efforts (N m on angles, N on displacements), the model's drives not included.
+            Efforts (N m on angles, N on displacements), the model's drives not included;
+            joint-side: with the pairs' Coulomb friction and the rotors' n^2 J qdd
+            (:meth:`motor_torques` gives the motor side).
 
         Raises
         ------
@@ -337,6 +346,108 @@ class Mechanism:
             efforts or rates.
         """
         return self._native.inverse_dynamics(q, qd, qdd, x, allow_singular)
+
+    def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray:
+        """Motor torques (N m, motor side) that give the joint-side efforts ``tau`` (N m or N)
+        at rates ``qd``, each (m,) or (N, m): t_m = tau / (n eta) + motor friction while
+        motoring (tau qd >= 0), tau eta / n + motor friction while generating; on a
+        coordinate without an actuator, the effort itself (docs/actuators.md)."""
+        return self._native.motor_torques(qd, tau)
+
+    actuator_names: _Native[list[str]] = _Native(
+        "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
+    )
+    actuator_kinds: _Native[list[str]] = _Native("``'angle'`` or ``'displacement'``: what each actuator's effort turns.")
+
+    def distribute_efforts(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        method: Literal["min_norm", "min_max", "preload"] = "min_norm",
+        preload: list[float] | None = None,
+        x_start: ArrayLike | None = None,
+    ) -> dict[str, FloatArray]:
+        """Inverse dynamics with redundant actuators: every actuator's effort for (q, qd, qdd),
+        each (m,). ``method``: ``"min_norm"`` (least Euclidean norm), ``"min_max"`` (least
+        largest magnitude; one internal force), or ``"preload"`` with ``preload`` one value
+        (N m or N) per internal force added to the minimum-norm efforts. Returns ``efforts``
+        (n_a,), ``B`` (m, n_a) the generalized force per unit effort, ``internal`` (r, n_a) an
+        orthonormal basis of the internal forces (B v = 0)."""
+        return self._native.distribute_efforts(q, qd, qdd, method, preload, x_start)
+
+    def forward_dynamics_actuated(self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0) -> FloatArray:
+        """Accelerations qdd (m,) at (q, qd) under every actuator's effort (n_a,, in
+        :attr:`actuator_names` order)."""
+        return self._native.forward_dynamics_actuated(q, qd, efforts, float(t))
+
+    def available_torque(self, coordinate: int, speed: ArrayLike) -> FloatArray | None:
+        """The torque (N m) the motor of coordinate ``coordinate`` (an index) can give at motor
+        speeds ``speed`` (rad/s, any shape): its torque-speed envelope, else its peak torque;
+        None when it has no actuator or no torque limit."""
+        return self._native.available_torque(int(coordinate), speed)
+
+    def dissipated_power(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None, allow_singular: bool = False
+    ) -> Any:
+        """Power (W, >= 0) the pairs' Coulomb friction dissipates along a motion (arguments as
+        :meth:`inverse_dynamics`): a float for one row, (N,) for rows. The drive power
+        ``tau . qd`` exceeds the frictionless one by exactly this."""
+        return self._native.dissipated_power(q, qd, qdd, x, allow_singular)
+
+    def forward_dynamics_derivatives(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        t: float = 0.0,
+        tau: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> dict[str, FloatArray]:
+        """Exact first derivatives of forward dynamics (docs/formulation.md, *Derivatives*).
+
+        Parameters
+        ----------
+        q, qd, t, tau
+            As for :meth:`forward_dynamics`; the efforts are held fixed (a drive that depends
+            on q or qd is differentiated as its value at this state).
+
+        Returns
+        -------
+        dict
+            ``qdd`` (m,) and the (m, m) Jacobians ``dq``, ``dqd``, ``dtau`` with entry
+            [i, k] = d qdd_i / d q_k (1/s^2), d qdd_i / d qd_k (1/s), d qdd_i / d tau_k
+            (the inverse mass matrix).
+
+        Raises
+        ------
+        SingularityError
+            As for :meth:`mass_matrix`.
+        """
+        return self._native.forward_dynamics_derivatives(q, qd, t, tau, allow_singular)
+
+    def inverse_dynamics_derivatives(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, allow_singular: bool = False
+    ) -> dict[str, FloatArray]:
+        """Exact first derivatives of inverse dynamics (docs/formulation.md, *Derivatives*).
+
+        Parameters
+        ----------
+        q, qd, qdd : (m,) array_like
+            Coordinates (rad or m), rates and accelerations, on the branch continued from
+            the drawing.
+
+        Returns
+        -------
+        dict
+            ``tau`` (m,) as :meth:`inverse_dynamics` gives it and the (m, m) Jacobians
+            ``dq``, ``dqd``, ``dqdd`` (the mass matrix A), entry [i, k] = d tau_i / d (.)_k.
+
+        Raises
+        ------
+        SingularityError
+            As for :meth:`mass_matrix`.
+        """
+        return self._native.inverse_dynamics_derivatives(q, qd, qdd, allow_singular)
 
     def reactions(
         self,
@@ -451,6 +562,8 @@ class Mechanism:
         progress: ProgressFunction | None = None,
         max_steps: int | None = None,
         motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None = None,
+        events: Sequence[Event] | None = None,
+        dense_output: bool = False,
     ) -> SimulationResult:
         """Integrate the equations of motion from t = 0 (forward dynamics in time).
 
@@ -498,6 +611,19 @@ class Mechanism:
             qdd)``. Their efforts are the ones the motion needs (in ``tau``; ``drives`` on them
             are not applied), their work is part of ``work``, and the other coordinates move
             freely under their drives.
+        events : list, optional
+            Events as in scipy's ``solve_ivp`` (:mod:`planardyn.events`): functions
+            ``g(t, q, qd) -> float`` with optional attributes ``terminal`` and ``direction``,
+            or :class:`planardyn.Crossing` (a coordinate crossing a value). Zeros are found
+            where g changes sign between accepted steps and located on the step's own
+            interpolant to a few units in the last place of t (``EVENT_XTOL``); they are in
+            ``t_events``, ``q_events`` and ``qd_events``. A terminal event ends the run at its
+            first zero with status ``'event'`` (``success`` stays True), the last row at that
+            time and no output after it. A zero exactly at t = 0 is not an event. An exception
+            in g ends the run with status ``'event_failed'``.
+        dense_output : bool
+            Keep each step's interpolant: ``result.sol(t)`` then gives (q, qd) at any t of
+            the run.
 
         Returns
         -------
@@ -532,6 +658,8 @@ class Mechanism:
             progress=progress,
             max_steps=checked["max_steps"],
             motion=native_motion(motion, self.coordinate_names),
+            events=native_events(events, self.coordinate_names),
+            dense_output=bool(dense_output),
         )
         result = SimulationResult.from_raw(
             raw,
@@ -544,7 +672,10 @@ class Mechanism:
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
                         drives="callable" if callable(drives) else drives,
                         motion=None if motion is None else
-                        {k: "callable" if callable(v) else v for k, v in motion.items()})
+                        {k: "callable" if callable(v) else v for k, v in motion.items()},
+                        **({} if events is None else {"events": [
+                            dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
+                        **({"dense_output": True} if dense_output else {}))
         result = attach_metadata(result, self, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]

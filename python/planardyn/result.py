@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import results_format
-from ._core import __version__
+from ._core import DenseOutput, __version__
 
 if TYPE_CHECKING:
     import pandas
@@ -150,9 +150,9 @@ class SimulationResult:
     residual: FloatArray
     #: (N,) True where the point was integrated in body coordinates near a singularity.
     partitioned: NDArray[np.bool_]
-    #: True when the run reached t_end.
+    #: True when the run reached t_end or a terminal event.
     success: bool
-    #: 'success', 'assembly_failed', 'passive_singularity', 'step_size_underflow',
+    #: 'success', 'event' (a terminal event ended it), 'event_failed', 'assembly_failed', 'passive_singularity', 'step_size_underflow',
     #: 'non_finite', 'drive_failed', 'too_many_steps', 'step_size_too_small' (the steps are
     #: too small to reach t_end within max_steps: stopped early) or 'cancelled'. A stopped
     #: run's last row is its last accepted state, on the output grid or not.
@@ -172,6 +172,16 @@ class SimulationResult:
     #: ``Mechanism.simulate``), ``planardyn_version``, ``kind`` ('simulation' or 'inverse').
     #: Empty unless attached (:func:`planardyn.results_io.attach_metadata`) or read from a file.
     metadata: dict[str, Any] = field(default_factory=dict)
+    #: Per event of ``simulate(events=...)``, in order: the times of its zeros (k,) (s), and
+    #: q and qd there (k, m) each (scipy's ``y_events`` is ``hstack`` of the two).
+    t_events: list[FloatArray] = field(default_factory=list)
+    q_events: list[FloatArray] = field(default_factory=list)
+    qd_events: list[FloatArray] = field(default_factory=list)
+    #: With ``simulate(dense_output=True)``: ``sol(t) -> (q, qd)`` at any time(s) t of the run
+    #: ((m,) each for a number, (K, m) for (K,) times; a ValueError outside [sol.t_min,
+    #: sol.t_max]), from each step's own interpolant. None otherwise, and when read from a file
+    #: (which keeps the events).
+    sol: DenseOutput | None = None
 
     @classmethod
     def from_raw(
@@ -198,7 +208,7 @@ class SimulationResult:
             sigma=raw["sigma"],
             residual=raw["residual"],
             partitioned=raw["partitioned"],
-            success=raw["status"] == "success",
+            success=raw["status"] in ("success", "event"),
             status=raw["status"],
             message=raw["message"],
             stats=dict(raw["stats"]),
@@ -207,6 +217,10 @@ class SimulationResult:
             body_names=list(body_names),
             change_points=[ChangePoint.from_dict(c) for c in raw.get("change_points", [])],
             metadata=dict(metadata or {}),
+            t_events=list(raw.get("t_events", [])),
+            q_events=list(raw.get("q_events", [])),
+            qd_events=list(raw.get("qd_events", [])),
+            sol=raw.get("sol"),
         )
 
     def change_points_frame(self) -> pandas.DataFrame:
@@ -307,4 +321,7 @@ class SimulationResult:
             "body_names": self.body_names,
             "layout": [[g, len(cols)] for g, cols in layout],
         }
+        if self.t_events:
+            meta["events"] = {"t": [a.tolist() for a in self.t_events], "q": [a.tolist() for a in self.q_events],
+                              "qd": [a.tolist() for a in self.qd_events]}
         return results_format.write(path, meta, groups, layout, ext)

@@ -85,7 +85,11 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
     n_t, n_b = len(table), len(meta["body_names"])
     flat = lambda g: np.ascontiguousarray(groups[g].reshape(n_t))  # noqa: E731
     own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
-           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "change_points"}
+           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "events",
+           "change_points"}
+    m = len(meta["coordinate_names"])
+    events = meta.get("events") or {}
+    per_event = lambda key, shape: [np.asarray(v, dtype=float).reshape(shape) for v in events.get(key, [])]  # noqa: E731
     return SimulationResult(
         t=flat("t"), q=groups["q"], qd=groups["qd"], qdd=groups["qdd"], tau=groups["tau"],
         x=groups["x"], xd=groups["xd"], poses=groups["x"].reshape(n_t, n_b, 3),
@@ -98,6 +102,7 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
         body_names=list(meta["body_names"]),
         change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
         metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
+        t_events=per_event("t", (-1,)), q_events=per_event("q", (-1, m)), qd_events=per_event("qd", (-1, m)),
     )
 
 

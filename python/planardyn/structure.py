@@ -110,6 +110,9 @@ class Structure:
     #: The loader's message when the model cannot be built (the analysis then uses the drawing).
     load_error: str | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    #: Degree of actuation: the coordinates and the redundant actuators on other pairs; more
+    #: than the mobility is redundant actuation (internal forces, preload: docs/actuators.md).
+    actuation: int = 0
 
 
 def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
@@ -178,6 +181,7 @@ def analyse(mech: Mechanism | Mapping[str, Any]) -> Structure:
         sigma_min=sigma,
         load_error=load_error,
         notes=tuple(notes),
+        actuation=core["actuation"],
     )
 
 
@@ -202,6 +206,10 @@ def report(mech: Mechanism | Mapping[str, Any] | Structure) -> str:
     out.append(f"  mobility: Chebyshev-Grubler {grubler_formula(s)}; "
                f"from the constraint Jacobian 3n - rank = {3 * n} - {s.rank} = {s.mobility}; "
                f"coordinates {len(s.coordinates)}")
+    if s.actuation > len(s.coordinates):
+        out.append(f"  actuation: {s.actuation} actuators ({len(s.coordinates)} coordinates + "
+                   f"{s.actuation - len(s.coordinates)} on other pairs) for mobility {s.mobility}: redundantly "
+                   f"actuated, {s.actuation - s.mobility} internal force(s)")
     if s.singular_values.size:
         out.append(f"  singular values of the scaled Phi_x ({rows} x {3 * n}) at the drawing: "
                    f"smallest {s.singular_values[0]:.3g}, largest {s.singular_values[-1]:.3g}")

@@ -10,6 +10,9 @@
 //! └── SimulationError                          Error::Options, Error::Drive
 //! ```
 //!
+//! Pair friction that does not settle (`KinematicsError::FrictionUnsettled`: the mechanism
+//! self-locks) is a `PlanardynError` with attributes `iterations` and `change`.
+//!
 //! A task motion's failures (`TaskError`) are `SingularityError` and `AssemblyError` too, with
 //! the data of where the motion stopped as attributes. A failure at one row of a trajectory
 //! (`Error::Row`) is its row's error, with attributes `row` and `t` and the row in the message.
@@ -138,6 +141,12 @@ pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
         KinematicsError::BadArgument { name, .. } => {
             let Ok(n) = name.into_pyobject(py);
             with_attrs(py, PyValueError::new_err(e.to_string()), &[("argument", n.into_any().unbind())])
+        }
+        KinematicsError::FrictionUnsettled { iterations, change } => {
+            let Ok(i) = iterations.into_pyobject(py);
+            let Ok(c) = change.into_pyobject(py);
+            let attrs = [("iterations", i.into_any().unbind()), ("change", c.into_any().unbind())];
+            with_attrs(py, PlanardynError::new_err(e.to_string()), &attrs)
         }
         _ => PlanardynError::new_err(e.to_string()),
     }

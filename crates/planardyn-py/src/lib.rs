@@ -1,12 +1,13 @@
 //! PyO3 glue for planardyn: the native module `planardyn._core`. Conversions live in
 //! `convert.rs`, the mapping of errors to Python exceptions in `errors.rs` (the only place),
 //! the `Mechanism` class in `mechanism.rs`, the end effector and task-space motions in
-//! `effector.rs`, and the simulation entry point in `simulate.rs`.
+//! `effector.rs`, and the simulation entry point in `simulate.rs` (its dense output in `dense.rs`).
 //! The typed Python face is the package `python/planardyn`; its stub `_core.pyi` mirrors
 //! this module.
 
 mod batch;
 mod convert;
+mod dense;
 mod effector;
 mod errors;
 mod mechanism;
@@ -58,6 +59,7 @@ fn loads(py: Python<'_>, text: &str, format: &str, source: &str) -> PyResult<PyM
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyMechanism>()?;
+    m.add_class::<dense::PyDenseOutput>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;
     errors::register(m)?;

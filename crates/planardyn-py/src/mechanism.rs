@@ -7,19 +7,26 @@
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
 use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::batch::{inverse_rows_checked, regressor_rows, Branch};
+use planardyn::batch::{dissipation_rows, inverse_rows_checked, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::{CoordinateKind, Link, PairId};
-use planardyn::{Mechanism, Workspace};
+use planardyn::{Error, Mechanism, Workspace};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
 
 type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+fn kind_name(kind: CoordinateKind) -> &'static str {
+    match kind {
+        CoordinateKind::Angle => "angle",
+        CoordinateKind::Displacement => "displacement",
+    }
+}
 
 /// A validated planar mechanism (immutable). Made by `load`/`loads`.
 #[pyclass(frozen, module = "planardyn._core", name = "Mechanism")]
@@ -138,6 +145,23 @@ impl PyMechanism {
         dynamics::finite("accelerations qdd", &ws.qdd)?;
         Ok(ws)
     }
+    /// A dict of the named value and the three Jacobians, the third under `third`.
+    fn jacobians<'py>(
+        &self,
+        py: Python<'py>,
+        value: [(&str, Vec<f64>); 1],
+        jac: dynamics::Jacobians,
+        third: &str,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let m = self.m();
+        let d = PyDict::new(py);
+        let [(name, v)] = value;
+        d.set_item(name, arr1(py, v))?;
+        d.set_item("dq", arr2(py, m, m, jac.dq)?)?;
+        d.set_item("dqd", arr2(py, m, m, jac.dqd)?)?;
+        d.set_item(third, arr2(py, m, m, jac.dthird)?)?;
+        Ok(d)
+    }
 }
 
 #[pymethods]
@@ -175,14 +199,14 @@ impl PyMechanism {
     /// 'angle' (rad) or 'displacement' (m) for each coordinate.
     #[getter]
     fn coordinate_kinds(&self) -> Vec<&'static str> {
-        self.inner
-            .coordinates
-            .iter()
-            .map(|c| match c.kind {
-                CoordinateKind::Angle => "angle",
-                CoordinateKind::Displacement => "displacement",
-            })
-            .collect()
+        self.inner.coordinates.iter().map(|c| kind_name(c.kind)).collect()
+    }
+    /// "angle" or "displacement" per actuator (`actuator_names`): what its effort turns.
+    #[getter]
+    fn actuator_kinds(&self) -> Vec<&'static str> {
+        let mech = &self.inner;
+        let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
+        pairs.map(|p| pairs::coordinate_kind(&mech.pairs[p.0]).map_or("displacement", kind_name)).collect()
     }
     #[getter]
     fn body_names(&self) -> Vec<String> {
@@ -451,6 +475,56 @@ impl PyMechanism {
         Ok(arr1(py, ws.qdd))
     }
 
+    /// Exact first derivatives of forward dynamics at (q, qd), time t (s), with efforts tau
+    /// (m,) or the model's drives held fixed: a dict of `qdd` (m,) and `dq`, `dqd`, `dtau`
+    /// (m, m), entry [i, k] = d qdd_i / d (q, qd, tau)_k.
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
+    fn forward_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        t: f64,
+        tau: Option<ArrayArg<'py>>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
+        check_time(t)?;
+        let mech = &*self.inner;
+        let (qdd, jac) = run(py, || {
+            let mut ws = Self::assembled(mech, &q, None)?;
+            let mut efforts = vec![0.0; q.len()];
+            self.drives_for(tau).efforts(t, &q, &qd, &mut efforts).map_err(|message| Error::Drive { t, message })?;
+            let out = dynamics::forward_derivatives(mech, &q, &qd, &efforts, &mut ws)?;
+            dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
+            Ok(out)
+        })?;
+        self.jacobians(py, [("qdd", qdd)], jac, "dtau")
+    }
+
+    /// Exact first derivatives of inverse dynamics at (q, qd, qdd), each (m,): a dict of
+    /// `tau` (m,) and `dq`, `dqd`, `dqdd` (m, m), entry [i, k] = d tau_i / d (q, qd, qdd)_k.
+    #[pyo3(signature = (q, qd, qdd, allow_singular=false))]
+    fn inverse_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd, qdd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?, self.q_arg("qdd", &qdd)?);
+        let mech = &*self.inner;
+        let (tau, jac) = run(py, || {
+            let mut ws = Self::assembled(mech, &q, None)?;
+            let jac = dynamics::inverse_derivatives(mech, &q, &qd, &qdd, &mut ws)?;
+            dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
+            Ok((ws.tau, jac))
+        })?;
+        self.jacobians(py, [("tau", tau)], jac, "dqdd")
+    }
+
     /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
     /// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
     /// (`planardyn::batch::Branch`).
@@ -471,6 +545,177 @@ impl PyMechanism {
             Ok(inverse_rows_checked(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         arr_dyn(py, &shape, tau)
+    }
+
+    /// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
+    /// (m,) or (N, m): a float or (N,), on the branch of x as `inverse_dynamics`.
+    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    fn dissipated_power<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        x: Option<ArrayArg<'py>>,
+        allow_singular: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let mech = self.inner.clone();
+        let single = q.shape.len() == 1;
+        let p = run(py, move || {
+            Ok(dissipation_rows(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+        })?;
+        if single {
+            return Ok(p[0].into_pyobject(py)?.into_any());
+        }
+        Ok(arr1(py, p))
+    }
+
+    /// Motor torques (N m, motor side) giving the joint-side efforts `tau` at rates `qd`,
+    /// each (m,) or (N, m); on a coordinate without an actuator, the effort itself.
+    fn motor_torques<'py>(
+        &self,
+        py: Python<'py>,
+        qd: ArrayArg<'py>,
+        tau: ArrayArg<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (m, what) = (self.m(), self.coords_what());
+        let (qd, tau) = (rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
+        if qd.shape != tau.shape {
+            return Err(PyValueError::new_err(format!(
+                "qd and tau must have the same shape, got {:?} and {:?}",
+                qd.shape, tau.shape
+            )));
+        }
+        let mut out = vec![0.0; tau.data.len()];
+        for ((o, qd), tau) in out.chunks_exact_mut(m).zip(qd.data.chunks_exact(m)).zip(tau.data.chunks_exact(m)) {
+            dynamics::motor_torques(&self.inner, qd, tau, o);
+        }
+        arr_dyn(py, &tau.shape, out)
+    }
+
+    /// The actuators, one entry per coordinate (None: an ideal effort source): dicts of
+    /// name, gear_ratio, efficiency, rotor_inertia (kg m^2), viscous, coulomb, stiction_speed
+    /// and the limits peak_torque, continuous_torque (N m), max_speed (rad/s) (None when not
+    /// given) and envelope ((k, 2) [speed, torque] points).
+    #[getter]
+    fn actuators<'py>(&self, py: Python<'py>) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
+        self.inner
+            .actuators
+            .iter()
+            .map(|slot| {
+                slot.as_ref()
+                    .map(|a| {
+                        let d = PyDict::new(py);
+                        d.set_item("name", &a.name)?;
+                        d.set_item("gear_ratio", a.ratio)?;
+                        d.set_item("efficiency", a.efficiency)?;
+                        d.set_item("rotor_inertia", a.rotor_inertia)?;
+                        d.set_item("viscous", a.viscous)?;
+                        d.set_item("coulomb", a.coulomb)?;
+                        d.set_item("stiction_speed", a.stiction_speed)?;
+                        d.set_item("peak_torque", a.limits.peak_torque)?;
+                        d.set_item("continuous_torque", a.limits.continuous_torque)?;
+                        d.set_item("max_speed", a.limits.max_speed)?;
+                        let env = &a.limits.envelope;
+                        d.set_item("envelope", arr2(py, env.len(), 2, env.as_flattened().to_vec())?)?;
+                        Ok(d)
+                    })
+                    .transpose()
+            })
+            .collect()
+    }
+
+    /// The torque (N m) coordinate `coordinate`'s motor can give at motor speeds `speed`
+    /// (rad/s, any shape): its envelope, else its peak torque; None without limits.
+    fn available_torque<'py>(
+        &self,
+        py: Python<'py>,
+        coordinate: usize,
+        speed: ArrayArg<'py>,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let Some(slot) = self.inner.actuators.get(coordinate) else {
+            return Err(PyValueError::new_err(format!(
+                "coordinate {coordinate} out of range: the model has {} coordinates",
+                self.m()
+            )));
+        };
+        let Some(a) = slot else { return Ok(None) };
+        let v = Values::read(&speed);
+        let out: Option<Vec<f64>> = v.data.iter().map(|&w| a.limits.available_torque(w)).collect();
+        out.map(|t| arr_dyn(py, &v.shape, t)).transpose()
+    }
+
+    /// The actuators' names: the coordinates', then the redundant actuators' on pairs.
+    #[getter]
+    fn actuator_names(&self) -> Vec<String> {
+        dynamics::redundant::actuator_names(&self.inner)
+    }
+
+    /// Every actuator's effort (n_a,) for (q, qd, qdd), each (m,), shared by `method`
+    /// ("min_norm", "min_max" or "preload" with `preload` one value per internal force),
+    /// with the actuation matrix `B` (m, n_a) and the internal forces (r, n_a).
+    #[pyo3(signature = (q, qd, qdd, method="min_norm", preload=None, x_start=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn distribute_efforts<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        method: &str,
+        preload: Option<Vec<f64>>,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use dynamics::redundant::{inverse_redundant, Distribution};
+        let (q, qd, qdd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?, self.q_arg("qdd", &qdd)?);
+        let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
+        let how = match (method, preload) {
+            ("min_norm", None) => Distribution::MinNorm,
+            ("min_max", None) => Distribution::MinMax,
+            ("preload", Some(p)) => Distribution::Preload(p),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "method {method:?}: use \"min_norm\", \"min_max\", or \"preload\" with preload=[one value \
+                     per internal force] (and preload only with it)"
+                )))
+            }
+        };
+        let mech = self.inner.clone();
+        let (act, efforts) = run(py, move || {
+            let mut ws = Self::assembled(&mech, &q, x_start.as_deref())?;
+            Ok(inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws)?)
+        })?;
+        let d = PyDict::new(py);
+        d.set_item("efforts", arr1(py, efforts))?;
+        d.set_item("B", arr2(py, act.m, act.n_a, act.b.clone())?)?;
+        d.set_item("internal", arr2(py, act.internal.len(), act.n_a, act.internal.concat())?)?;
+        Ok(d)
+    }
+
+    /// Accelerations qdd (m,) at (q, qd) and time t (s) under every actuator's effort
+    /// `efforts` (n_a,: the coordinates' first, as drive efforts, then the pair actuators').
+    #[pyo3(signature = (q, qd, efforts, t=0.0))]
+    fn forward_dynamics_actuated<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        qd: ArrayArg<'py>,
+        efforts: ArrayArg<'py>,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
+        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let efforts = vector("efforts", &efforts, n_a, "one value per actuator (actuator_names)")?;
+        check_time(t)?;
+        let mech = self.inner.clone();
+        let qdd = run(py, move || {
+            let mut ws = Self::assembled(&mech, &q, None)?;
+            dynamics::redundant::forward_redundant(&mech, t, &q, &qd, &efforts, &mut ws)?;
+            dynamics::finite("accelerations qdd", &ws.qdd)?;
+            Ok(ws.qdd)
+        })?;
+        Ok(arr1(py, qdd))
     }
 
     /// The regressor form along rows of a motion, on the branch of x as `inverse_dynamics`:
@@ -622,7 +867,7 @@ impl PyMechanism {
     }
 
     /// Simulate; see `planardyn.Mechanism.simulate` for the arguments.
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None, motion=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, dt=None, t_eval=None, output_dt=None, q0=None, qd0=None, drives=None, progress=None, max_steps=None, motion=None, events=Vec::new(), dense_output=false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -640,6 +885,8 @@ impl PyMechanism {
         progress: Option<Py<PyAny>>,
         max_steps: Option<usize>,
         motion: Option<Vec<(usize, crate::simulate::MotionArg)>>,
+        events: Vec<crate::simulate::EventArg>,
+        dense_output: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let t_eval = t_eval
             .map(|a| {
@@ -668,7 +915,16 @@ impl PyMechanism {
             // The caller's motions go to the run with its callables (`simulate::simulate`).
             motion: Vec::new(),
         };
-        crate::simulate::simulate(py, &self.inner, args, drives, motion.unwrap_or_default(), progress)
+        crate::simulate::simulate(
+            py,
+            &self.inner,
+            args,
+            drives,
+            motion.unwrap_or_default(),
+            progress,
+            events,
+            dense_output,
+        )
     }
 
     fn __repr__(&self) -> String {

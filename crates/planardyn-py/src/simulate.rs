@@ -8,11 +8,12 @@ use crate::errors::{run, Failure};
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
-use planardyn::simulate::{Overrides, Settings, Trajectory};
+use planardyn::simulate::{Event, EventFn, Observe, Overrides, Settings, Trajectory};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// The progress callback runs each time t has advanced by this fraction of the run: at most
@@ -113,6 +114,50 @@ impl MotionFunction for PyMotion {
     }
 }
 
+/// An event as `Mechanism.simulate` passes it: a coordinate crossing a value
+/// (index, value in rad or m, terminal, direction), or a callable `g(t, q, qd) -> float`
+/// (g, terminal, direction).
+#[derive(FromPyObject)]
+pub enum EventArg {
+    Coordinate(usize, f64, bool, f64),
+    Function(Py<PyAny>, bool, f64),
+}
+
+/// The core's events for `args`. A BaseException that is not an Exception raised in an
+/// event function goes to `fatal` (as `PyDrives::fatal`).
+fn core_events<'e>(args: &'e [EventArg], fatal: &'e Mutex<Option<PyErr>>) -> Vec<Event<'e>> {
+    args.iter()
+        .map(|a| match a {
+            EventArg::Coordinate(k, value, terminal, direction) => Event::coordinate(*k, *value, *terminal, *direction),
+            EventArg::Function(f, terminal, direction) => Event {
+                g: EventFn::Function(Box::new(move |t, q, qd| call_event(f, fatal, t, q, qd))),
+                terminal: *terminal,
+                direction: *direction,
+            },
+        })
+        .collect()
+}
+
+fn call_event(f: &Py<PyAny>, fatal: &Mutex<Option<PyErr>>, t: f64, q: &[f64], qd: &[f64]) -> Result<f64, String> {
+    let mut fatal = fatal.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    if fatal.is_some() {
+        return Err("interrupted".to_string());
+    }
+    Python::attach(|py| {
+        let args = (t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd));
+        match f.bind(py).call1(args).and_then(|r| r.extract::<f64>()) {
+            Ok(g) => Ok(g),
+            Err(e) => {
+                let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
+                if !e.is_instance_of::<PyException>(py) {
+                    *fatal = Some(e);
+                }
+                Err(format!("the event function must return a number; it raised {text}"))
+            }
+        }
+    })
+}
+
 /// A motion ready for the core: a law, or a Python function.
 pub(crate) enum MotionEntry {
     Law(MotionLaw),
@@ -142,6 +187,7 @@ pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) 
 }
 
 /// Run a simulation and return its trajectory as a dict (see `planardyn.SimulationResult`).
+#[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
     mech: &Mechanism,
@@ -149,7 +195,10 @@ pub fn simulate<'py>(
     drives: Option<Py<PyAny>>,
     motion: Vec<(usize, MotionArg)>,
     progress: Option<Py<PyAny>>,
+    events: Vec<EventArg>,
+    dense_output: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let event_fatal = Mutex::new(None);
     let m = mech.dof();
     let mut py_drives = drives.map(|f| PyDrives { f, m, fatal: None });
     let mut motions = motion_entries(mech, motion)?;
@@ -202,13 +251,15 @@ pub fn simulate<'py>(
             };
             prescribed.set(*k, motion).map_err(PyValueError::new_err)?;
         }
-        Ok(planardyn::simulate::simulate_prescribed(mech, &s, d, &mut prescribed, Some(&mut on_step))?)
+        let observe = Observe { events: core_events(&events, &event_fatal), dense_output };
+        Ok(planardyn::simulate::simulate_observed(mech, &s, d, &mut prescribed, observe, Some(&mut on_step))?)
     })?;
     let motion_fatal = motions.into_iter().find_map(|(_, e)| match e {
         MotionEntry::Function(f) => f.fatal,
         MotionEntry::Law(_) => None,
     });
-    let fatal = fatal.or_else(|| py_drives.and_then(|d| d.fatal)).or(motion_fatal);
+    let event_fatal = event_fatal.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let fatal = fatal.or_else(|| py_drives.and_then(|d| d.fatal)).or(motion_fatal).or(event_fatal);
     match fatal {
         // Ctrl-C keeps the trajectory so far: `Mechanism.simulate` raises the interrupt with
         // it attached (`SimulationInterrupted.result`).
@@ -245,6 +296,14 @@ pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<Strin
     d.set_item("sigma", arr1(py, t.sigma))?;
     d.set_item("residual", arr1(py, t.residual))?;
     d.set_item("partitioned", bool1(py, t.partitioned))?;
+    let event_rows = |rows: Vec<Vec<f64>>| -> PyResult<Vec<Bound<'_, PyAny>>> {
+        rows.into_iter().map(|r| Ok(arr2(py, r.len() / m.max(1), m, r)?.into_any())).collect()
+    };
+    let ev = t.events;
+    d.set_item("t_events", ev.t.into_iter().map(|r| arr1(py, r)).collect::<Vec<_>>())?;
+    d.set_item("q_events", event_rows(ev.q)?)?;
+    d.set_item("qd_events", event_rows(ev.qd)?)?;
+    d.set_item("sol", t.dense.map(|inner| crate::dense::PyDenseOutput { inner }))?;
     let points = PyList::empty(py);
     for p in &t.change_points {
         let c = PyDict::new(py);

@@ -95,6 +95,7 @@ fn to_dict<'py>(py: Python<'py>, s: &Structure) -> PyResult<Bound<'py, PyDict>> 
         .collect::<PyResult<Vec<_>>>()?;
     d.set_item("self_stresses", stresses)?;
     d.set_item("actuation", s.actuation)?;
+    d.set_item("redundantly_actuated", s.redundantly_actuated())?;
     let loops = s
         .loops
         .iter()

@@ -163,6 +163,25 @@ pub fn inverse_rows_checked(
     Ok(tau)
 }
 
+/// The power (W, >= 0) the pairs' Coulomb friction dissipates along rows of a motion, on
+/// `branch` (as [`inverse_rows_checked`], whose efforts include that friction).
+pub fn dissipation_rows(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+) -> Result<Vec<f64>, Error> {
+    let mut out = Vec::with_capacity(q.len() / mech.dof().max(1));
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
+        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], ws)?;
+        out.push(ws.dissipated);
+        Ok(())
+    })?;
+    Ok(out)
+}
+
 /// The regressor form along rows of a motion on `branch` (as [`inverse_rows_checked`]):
 /// Y (N x m x p, p = [`dynamics::regressor::BODY_PARAMETERS`] per body) and tau_o (N x m),
 /// so that every row's efforts are Y pi + tau_o.

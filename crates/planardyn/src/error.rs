@@ -102,6 +102,13 @@ pub enum KinematicsError {
          for the mechanism; try smaller efforts (tau) or rates (qd)"
     )]
     Overflow { what: &'static str },
+    /// The pairs' Coulomb friction efforts and the reactions they depend on did not settle
+    /// to a common solution: the mechanism self-locks (or nearly) under its friction.
+    #[error(
+        "the friction efforts did not settle in {iterations} iterations (last change {change:.3e} N m): \
+         the mechanism self-locks under its pair friction here; lower mu or the pin radii"
+    )]
+    FrictionUnsettled { iterations: usize, change: f64 },
     /// An argument with the wrong length or a non-finite value.
     #[error("{name}: expected {expected}, got {got}")]
     BadArgument { name: &'static str, expected: String, got: String },

@@ -5,6 +5,7 @@
 //! fills each buffer is named, in the order a forward-dynamics evaluation runs them:
 //! positions -> analogues -> convective term -> forces -> A, b -> accelerations.
 
+use crate::dynamics::LossBuffers;
 use crate::kinematics::{Chart, System};
 use crate::model::Mechanism;
 
@@ -36,10 +37,15 @@ pub struct Workspace {
     pub qdd: Vec<f64>,
     /// (m) drive efforts on q (forces).
     pub tau: Vec<f64>,
+    /// Efforts (N m or N) of the redundant pair actuators during a forward evaluation
+    /// (`dynamics::redundant::forward_redundant`), zero otherwise (forces).
+    pub pair_tau: Vec<f64>,
     /// (3n) applied forces and moments at the centres of mass, drives included (forces).
     pub f: Vec<f64>,
     /// Power of the non-conservative forces: drives, dampers, external loads (W) (forces).
     pub power: f64,
+    /// Power dissipated by the pairs' Coulomb friction (W, >= 0) (forces, with losses).
+    pub dissipated: f64,
     /// (m x m, row-major) A = U^T M U, then its Cholesky factor (A, b).
     pub a: Vec<f64>,
     /// (m) b = U^T (f - M c), then zdd (A, b).
@@ -50,6 +56,8 @@ pub struct Workspace {
     pub rhs: Vec<f64>,
     /// (3n) scratch for residuals and second derivatives.
     pub tmp: Vec<f64>,
+    /// The transmissions' and the pair friction's buffers (forward and inverse with losses).
+    pub losses: LossBuffers,
 }
 
 impl Workspace {
@@ -70,13 +78,16 @@ impl Workspace {
             qd: vec![0.0; m],
             qdd: vec![0.0; m],
             tau: vec![0.0; m],
+            pair_tau: vec![0.0; mech.pair_actuators.len()],
             f: vec![0.0; nx],
             power: 0.0,
+            dissipated: 0.0,
             a: vec![0.0; m * m],
             b: vec![0.0; m],
             xdd: vec![0.0; nx],
             rhs: vec![0.0; nx],
             tmp: vec![0.0; nx],
+            losses: LossBuffers::new(mech),
         }
     }
 

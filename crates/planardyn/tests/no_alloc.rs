@@ -114,3 +114,34 @@ fn partition_chart_evaluation_does_not_allocate() {
         assert_eq!(n, 0, "{}: allocations in rhs/accept in a partition chart", mech.name);
     }
 }
+
+/// With transmissions and pair friction the fixed point of friction and reactions runs in
+/// the workspace's loss buffers, in the input and in a partition chart.
+#[test]
+fn evaluation_with_losses_does_not_allocate() {
+    let drawing = SLIDER_CRANK
+        .split("loads:")
+        .next()
+        .unwrap_or_default()
+        .replace("{type: revolute, at: A,", "{type: revolute, name: A, at: A,");
+    let mech = yaml(&format!(
+        "{drawing}loads:\n  - {{type: friction, pair: O, mu: 0.15, pin_radius: 0.01}}\n  \
+         - {{type: friction, pair: A, mu: 0.1, pin_radius: 0.008}}\n  \
+         - {{type: friction, pair: guide, mu: 0.2, length: 0.04}}\n\
+         actuators:\n  - {{coordinate: phi, gear_ratio: 10, efficiency: 0.9, rotor_inertia: 1.0e-4, coulomb: 0.005}}\n"
+    ));
+    let (q, qd) = test_state(&mech);
+    let m = mech.dof();
+    let vary = |y: &mut [f64], _: usize| y[m..2 * m].iter_mut().for_each(|v| *v *= 1.0 + 1e-6);
+    let mut drives = ModelDrives(&mech);
+    let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives);
+    assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "allocations with losses");
+    let ws = assembled(&mech, &q);
+    let idx = vec![6];
+    let z: Vec<f64> = idx.iter().map(|&i| ws.x[i]).collect();
+    let zd: Vec<f64> = idx.iter().map(|&i| ws.u_col(0)[i] * qd[0]).collect();
+    let mut drives = ModelDrives(&mech);
+    let mut ode = MechanismOde::new(&mech, ws, &mut drives);
+    let vary = |y: &mut [f64], step: usize| y[0] += 1e-6 * step as f64;
+    assert_eq!(allocations(&mut ode, Chart::Partition(idx), &z, &zd, vary), 0, "in a partition chart");
+}

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{all_models, shipped, test_state, yaml, FOUR_BAR};
+use common::{every_model, test_state, yaml, FOUR_BAR};
 use planardyn::dynamics::forward::kinematic_stages;
 use planardyn::dynamics::inverse;
 use planardyn::dynamics::regressor::{parameter_names, parameters, regressor, BODY_PARAMETERS};
@@ -34,20 +34,6 @@ fn both(
     assemble_into(model, q, &mut ws).unwrap();
     inverse(model, q, qd, qdd, &mut ws).unwrap();
     (linear, ws.tau.clone(), scale)
-}
-
-fn every_model() -> Vec<Mechanism> {
-    let dir = format!("{}/../../examples/models", env!("CARGO_MANIFEST_DIR"));
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .chain(std::fs::read_dir(format!("{dir}/library")).unwrap())
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
-        .map(|p| p.strip_prefix(&dir).unwrap().to_string_lossy().trim_start_matches('/').to_string())
-        .collect();
-    names.sort();
-    assert!(names.len() >= 20, "{names:?}");
-    names.iter().map(|n| shipped(n)).chain(all_models()).collect()
 }
 
 #[test]

@@ -54,15 +54,6 @@ fn five_bar_free_fall_crosses_type_ii_singularities_with_its_energy() {
     assert!((0.1..0.2).contains(&first), "first partition at {first} s");
 }
 
-/// Arithmetic-geometric mean, for the complete elliptic integral K(k) = pi / (2 agm(1, k')).
-fn agm(mut a: f64, mut b: f64) -> f64 {
-    // Quadratic convergence: 8 iterations reach round-off from any k' in (0, 1].
-    for _ in 0..8 {
-        (a, b) = ((a + b) / 2.0, (a * b).sqrt());
-    }
-    a
-}
-
 #[test]
 fn pendulum_period_at_large_amplitude_is_exact() {
     // Physical pendulum released from rest at 1 rad from the vertical: period

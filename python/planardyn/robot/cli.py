@@ -34,6 +34,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--profile", default="quintic", choices=["quintic", "trapezoid", "constant"])
     p.add_argument("--payload", type=float, default=0.0, help="kg at the end-effector point")
     p.add_argument("--dt", type=float, default=1e-3, help="sample spacing, s")
+    p.add_argument("--distribution", default="min_norm", choices=["min_norm", "min_max", "preload"],
+                   help="with redundant actuators: how their efforts are shared (default min_norm)")
+    p.add_argument("--preload", type=float, nargs="+", default=None, metavar="LAMBDA",
+                   help="with --distribution preload: N m or N along each internal force")
     p.add_argument("--plot", default=None, help="write the report's figure (PNG, PDF...)")
     p.add_argument("--json", default=None, help="write the numbers as JSON")
     return p
@@ -51,7 +55,8 @@ def size_cli(argv: list[str] | None = None) -> int:
             path = circle(args.circle[:2], args.circle[2], args.duration, profile=args.profile)
         else:
             path = line(args.line[:2], args.line[2:], args.duration, profile=args.profile)
-        report = size(ee, path, payload=args.payload, dt=args.dt)
+        report = size(ee, path, payload=args.payload, dt=args.dt, distribution=args.distribution,
+                      preload=args.preload)
     except (ModelError, ValueError, UnknownModelError) as exc:
         print(f"planardyn size: {exc}", file=sys.stderr)
         return 2

@@ -84,11 +84,19 @@ def plot_sizing(report: SizingReport, fig: Any = None) -> list[Any]:
         c = line.get_color()
         out.append(line)
         out += ax[0, 0].plot(m.t, np.full_like(m.t, d.rms_effort), "--", color=c, linewidth=0.8)
-        out += ax[0, 1].plot(np.abs(m.qd[:, k]), np.abs(m.tau[:, k]), ".", color=c, markersize=2, alpha=0.5)
-        out += ax[0, 1].step(d.envelope_speed, d.envelope_effort, where="post", color=c, label=f"{d.name} envelope")
+        if d.motor is None:
+            out += ax[0, 1].plot(np.abs(m.qd[:, k]), np.abs(m.tau[:, k]), ".", color=c, markersize=2, alpha=0.5)
+            out += ax[0, 1].step(d.envelope_speed, d.envelope_effort, where="post", color=c, label=f"{d.name} envelope")
+        else:
+            mo = d.motor
+            out += ax[0, 1].plot(np.abs(mo.speed), np.abs(mo.torque), ".", color=c, markersize=2, alpha=0.5)
+            out += ax[0, 1].plot(mo.envelope_speed, mo.envelope_torque, color=c,
+                                 label=f"{d.name} motor {mo.name} ({'pass' if mo.passed else 'FAIL'})")
         out += ax[1, 0].plot(m.t, m.tau[:, k] * m.qd[:, k], color=c, label=f"{d.name} (peak {d.peak_power:.3g} W)")
     ax[0, 0].set(xlabel="t (s)", ylabel="effort (N m or N)", title="efforts (dashed: RMS)")
-    ax[0, 1].set(xlabel="|speed| (rad/s or m/s)", ylabel="|effort| (N m or N)", title="torque-speed envelope")
+    motors = any(d.motor is not None for d in report.drives)
+    ax[0, 1].set(xlabel="|speed| (rad/s or m/s)", ylabel="|effort| (N m or N)",
+                 title="torque-speed: motor side and motor envelope" if motors else "torque-speed envelope")
     ax[1, 0].set(xlabel="t (s)", ylabel="power tau qd (W)", title="mechanical power")
     for a in (ax[0, 0], ax[0, 1], ax[1, 0]):
         a.legend(loc="best", fontsize="small")

@@ -19,6 +19,9 @@ impl<T: AsRef<[f64]>> Drives for FixedDrives<T> {
         tau.copy_from_slice(self.0.as_ref());
         Ok(())
     }
+    fn time_only(&self) -> bool {
+        true
+    }
 }
 
 /// The rows of a trajectory, time-major: N rows of t, x (3n), q, qd, tau (m).

@@ -12,6 +12,11 @@ use crate::model::{Attachment, Link, Load, Mechanism};
 pub trait Drives {
     /// Write the efforts at time t (s), coordinates q and rates qd into `tau`.
     fn efforts(&mut self, t: f64, q: &[f64], qd: &[f64], tau: &mut [f64]) -> Result<(), String>;
+    /// Whether the efforts depend on t alone (not on q, qd): then the exact Jacobian of the
+    /// equations of motion holds them fixed. The default, false, is always safe.
+    fn time_only(&self) -> bool {
+        false
+    }
 }
 
 /// The drives written in the model file (constants and time tables; none is zero).
@@ -23,6 +28,9 @@ impl Drives for ModelDrives<'_> {
             *e = law.as_ref().map_or(0.0, |l| l.effort(t));
         }
         Ok(())
+    }
+    fn time_only(&self) -> bool {
+        true
     }
 }
 

@@ -3,6 +3,8 @@
 //!   b = U^T (f - M c) -> zdd = A^-1 b -> xdd = U zdd + c, qdd.
 
 use super::forces::{applied_forces, Drives};
+use super::losses::forward_with_losses;
+use super::{redundant, transmission};
 use crate::kinematics::constraints::{coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_rate};
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
 use crate::linalg::{cholesky_in_place, cholesky_solve};
@@ -87,6 +89,8 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Worksp
 
 /// One forward-dynamics evaluation at time t (s) and chart state (z, zd): fills every
 /// buffer of `ws`; the chart accelerations zdd are left in `ws.b`, the user's in `ws.qdd`.
+/// On a coordinate with an actuator the drive's effort is the motor torque (N m, motor
+/// side); `ws.tau` ends with the joint-side efforts.
 pub fn forward(
     mech: &Mechanism,
     t: f64,
@@ -110,9 +114,14 @@ pub fn dynamic_stages(
     ws: &mut Workspace,
 ) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
+    transmission::to_joint_efforts(mech, ws);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    ws.power += redundant::apply_pair_efforts(mech, ws);
     mass_matrix(mech, ws);
     bias(mech, ws);
+    if mech.has_losses() {
+        return Ok(forward_with_losses(mech, z, zd, ws)?);
+    }
     factor_mass_matrix(ws)?;
     cholesky_solve(&ws.a, ws.b.len(), &mut ws.b);
     accelerations(mech, z, zd, ws);

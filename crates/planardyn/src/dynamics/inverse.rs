@@ -4,6 +4,7 @@
 
 use super::forces::applied_forces;
 use super::forward::{kinematic_stages, m_dot};
+use super::losses::inverse_with_losses;
 use crate::kinematics::constraints::gamma;
 use crate::kinematics::Chart;
 use crate::model::Mechanism;
@@ -11,7 +12,8 @@ use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Drive efforts (N m or N) into `ws.tau` for user coordinates q, rates qd and accelerations
-/// qdd, starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
+/// qdd (joint-side: with the pairs' friction and the rotors' n^2 J qdd; the motor torques are
+/// [`super::motor_torques`] of them), starting Newton from `ws.x` (use [`crate::kinematics::assemble_into`] first for a
 /// distant q). Leaves the body rates and accelerations in `ws.xd`, `ws.xdd`.
 pub fn inverse(
     mech: &Mechanism,
@@ -33,6 +35,9 @@ pub fn inverse(
         let (first, end) = ws.sys.u_support()[j];
         let uf: f64 = u[3 * first..3 * end].iter().zip(&ws.f[3 * first..3 * end]).map(|(u, f)| u * f).sum();
         *tau = m_dot(mech, u, &ws.xdd, (first, end)) - uf;
+    }
+    if mech.has_losses() {
+        inverse_with_losses(mech, qdd, ws)?;
     }
     ws.qdd.copy_from_slice(qdd);
     super::finite("efforts tau", &ws.tau)?;

@@ -4,24 +4,33 @@
 //! run in a [`crate::Workspace`].
 
 pub mod along;
+pub mod derivatives;
 pub mod energy;
+pub mod force_rates;
 pub mod forces;
 pub mod forward;
+pub mod friction;
 pub mod inverse;
+mod losses;
 pub mod motion;
 pub mod prescribed;
 pub mod reactions;
+pub mod redundant;
 pub mod regressor;
 pub mod regular;
 pub mod task;
+pub mod transmission;
 
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
+pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivatives, Jacobians, PowerRates};
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{dynamic_stages, forward, mass_matrix};
 pub use inverse::inverse;
+pub use losses::LossBuffers;
 pub use motion::{Motion, MotionFunction, Prescribed};
 pub use prescribed::{forward_prescribed, prescribed_sigma_min};
 pub use reactions::reactions;
 pub use regular::{finite, type_ii_measure, SINGULAR_SIGMA};
 pub use task::{SingularityKind, TaskError, TaskPath, TaskSolution};
+pub use transmission::{joint_effort, motor_torque, motor_torques};

@@ -86,6 +86,13 @@ pub fn forward_prescribed(
     motion: &mut Prescribed,
     ws: &mut Workspace,
 ) -> Result<(), Error> {
+    if mech.has_losses() && !motion.p.is_empty() {
+        return Err(Error::Options(
+            "prescribed motions with actuators' transmissions or Coulomb pair friction are not modelled: drive \
+             those coordinates by effort, or take their efforts from inverse dynamics (which includes both)"
+                .into(),
+        ));
+    }
     kinematic_stages(mech, z, zd, ws)?;
     drive_efforts(t, drives, ws)?;
     let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;

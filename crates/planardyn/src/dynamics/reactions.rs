@@ -12,21 +12,22 @@ use crate::workspace::Workspace;
 /// gear's centre); a revolute pair transmits no couple; a prismatic pair's force is normal
 /// to its guide; each kind's is described in its module of `kinematics::pairs`.
 pub fn reactions(mech: &Mechanism, ws: &mut Workspace) -> Vec<[f64; 3]> {
-    let mut lambda: Vec<f64> = (0..ws.x.len())
-        .map(|i| {
-            let b = &mech.bodies[i / 3];
-            let mi = if i % 3 == 2 { b.inertia } else { b.mass };
-            mi * ws.xdd[i] - ws.f[i]
-        })
-        .collect();
-    ws.sys.solve_transpose(&mut lambda);
-    mech.pairs
-        .iter()
-        .zip(&mech.pair_slots)
-        .map(|(pair, slots)| {
-            // A redundant row left out of F carries no multiplier: the split of the load
-            // between redundant pairs is statically indeterminate.
-            pairs::reaction(pair, &ws.x, slots.map(|s| s.map_or(0.0, |i| lambda[i])))
-        })
-        .collect()
+    let (mut lambda, mut out) = (vec![0.0; ws.x.len()], vec![[0.0; 3]; mech.pairs.len()]);
+    reactions_into(mech, ws, &mut lambda, &mut out);
+    out
+}
+
+/// [`reactions`] into `out` (one per pair), with `lambda` (3n) as scratch.
+pub(crate) fn reactions_into(mech: &Mechanism, ws: &mut Workspace, lambda: &mut [f64], out: &mut [[f64; 3]]) {
+    for (i, l) in lambda.iter_mut().enumerate() {
+        let b = &mech.bodies[i / 3];
+        let mi = if i % 3 == 2 { b.inertia } else { b.mass };
+        *l = mi * ws.xdd[i] - ws.f[i];
+    }
+    ws.sys.solve_transpose(lambda);
+    for ((pair, slots), r) in mech.pairs.iter().zip(&mech.pair_slots).zip(out.iter_mut()) {
+        // A redundant row left out of F carries no multiplier: the split of the load
+        // between redundant pairs is statically indeterminate.
+        *r = pairs::reaction(pair, &ws.x, slots.map(|s| s.map_or(0.0, |i| lambda[i])));
+    }
 }

@@ -69,6 +69,11 @@ pub trait OdeSystem {
     fn rhs_dense(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Self::Error> {
         self.rhs(t, y, dy)
     }
+    /// The exact Jacobian df/dy (row-major, dim x dim) into `jac`, where the system has one;
+    /// None (the default): the implicit integrators difference `rhs` instead.
+    fn jacobian(&mut self, _t: f64, _y: &[f64], _jac: &mut [f64]) -> Option<Result<(), Self::Error>> {
+        None
+    }
 }
 
 /// The integration method, chosen at run time.
@@ -307,7 +312,8 @@ pub struct Stats {
     pub naccept: usize,
     /// Rejected trial steps (error too large, `rhs` failure, non-finite values, Newton failure).
     pub nreject: usize,
-    /// Jacobian evaluations (Radau5, by finite differences: `dim` `rhs` calls each).
+    /// Jacobian evaluations (Radau5: the system's exact one, or by finite differences, `dim`
+    /// `rhs` calls each).
     pub njev: usize,
     /// LU decompositions (Radau5: the real and the complex matrix count one each).
     pub nlu: usize,

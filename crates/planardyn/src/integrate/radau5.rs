@@ -20,7 +20,8 @@
 //!   `(μ_r/h I - J)` and one complex one `(μ_c/h I - J)` (HW II, IV.8,
 //!   (8.15)-(8.18)); at most 6 iterations, stopped early when the contraction
 //!   rate predicts failure. Tolerance `max(10 eps/rtol, min(0.03, √rtol))`.
-//! * **Jacobian**: forward differences of `rhs`, column `j` perturbed by
+//! * **Jacobian**: the system's exact one ([`OdeSystem::jacobian`]) where it has
+//!   one; else forward differences of `rhs`, column `j` perturbed by
 //!   `δ_j = sqrt(eps max(1e-5, |y_j|))` (RADAU5's choice), `n` `rhs` calls. It
 //!   is kept across steps and only recomputed when Newton converges slowly
 //!   (more than 2 iterations and rate > 1e-3) or fails with a stale one. If a
@@ -189,11 +190,18 @@ impl Radau5 {
         eval_dense(&self.q, &c.y_prev, s, out);
     }
 
-    /// Forward-difference Jacobian at the current point (module doc).
+    /// The Jacobian at the current point: exact, or by forward differences (module doc).
     fn compute_jacobian<S: OdeSystem>(&mut self, sys: &mut S) -> Result<(), S::Error> {
         let n = self.core.n;
         let t = self.core.t;
         self.core.stats.njev += 1;
+        if let Some(exact) = sys.jacobian(t, &self.core.y, &mut self.jac) {
+            exact?;
+            self.jac_valid = true;
+            self.jac_current = true;
+            self.lu_h = 0.0;
+            return Ok(());
+        }
         self.ytmp.copy_from_slice(&self.core.y);
         for j in 0..n {
             let yj = self.core.y[j];

@@ -12,6 +12,7 @@ pub mod pairs;
 pub mod position;
 pub mod singularity;
 pub mod system;
+pub mod third;
 
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
 pub use closed_form::ClosedForm;

@@ -11,6 +11,8 @@ use crate::kinematics::position::MAX_CONTINUATION_DISTANCE;
 use crate::structure::constraint_rank;
 use crate::ModelError;
 
+mod actuators;
+
 /// Collects the context for error messages: the source name.
 struct Ctx<'a> {
     source: &'a str,
@@ -141,6 +143,9 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         drives: Vec::new(),
         motions: Vec::new(),
         loads: Vec::new(),
+        actuators: Vec::new(),
+        pair_actuators: Vec::new(),
+        friction: Vec::new(),
         simulate: SimulateDefaults::default(),
         x0: Vec::new(),
         scale: 1.0,
@@ -171,6 +176,8 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     warn_degree_like_angles(&mut mech);
     (mech.drives, mech.motions) = build_drives(&ctx, &mech, &spec.drives)?;
     mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
+    mech.friction = actuators::build_friction(&ctx, &mech, &spec.loads)?;
+    (mech.actuators, mech.pair_actuators) = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
 }
@@ -804,10 +811,10 @@ fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
             damping: ctx.non_negative(&format!("{path}.damping"), *damping)?,
             rest: ctx.finite(&format!("{path}.rest"), *rest)?,
         },
-        LoadSpec::Friction { pair, viscous } => Load::PairSpring {
+        LoadSpec::Friction { pair, viscous, .. } => Load::PairSpring {
             pair: relative_pair(ctx, mech, &format!("{path}.pair"), pair)?,
             stiffness: 0.0,
-            damping: ctx.non_negative(&format!("{path}.viscous"), *viscous)?,
+            damping: ctx.non_negative(&format!("{path}.viscous"), viscous.unwrap_or(0.0))?,
             rest: 0.0,
         },
     })

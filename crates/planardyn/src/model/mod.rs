@@ -4,6 +4,7 @@
 //! the body's drawn angle, so that a world point is `r + R(phi) s` with `x_i = [X, Y, phi]`.
 //! The ground is not part of `x`; its local frame is the global frame.
 
+pub mod actuators;
 mod build;
 pub(crate) mod diameter;
 mod io;
@@ -13,6 +14,7 @@ mod parse_errors;
 pub mod spec;
 mod tags;
 
+pub use actuators::{Actuator, JointFriction, Limits, PairActuator};
 pub use io::{load, loads, parse_spec, Format};
 pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
@@ -192,6 +194,13 @@ pub struct Mechanism {
     /// One motion law per coordinate (`None`: the coordinate moves freely under its effort).
     pub motions: Vec<Option<MotionLaw>>,
     pub loads: Vec<Load>,
+    /// One motor and transmission slot per coordinate (`None`: an ideal effort source).
+    pub actuators: Vec<Option<Actuator>>,
+    /// Redundant actuators on pairs that are not coordinates (the coordinates count as
+    /// actuated too when there are any).
+    pub pair_actuators: Vec<PairActuator>,
+    /// Coulomb friction from the pairs' loads.
+    pub friction: Vec<JointFriction>,
     pub simulate: SimulateDefaults,
     /// Body coordinates in the drawing, 3n values [X, Y, phi] per body.
     pub x0: Vec<f64>,
@@ -227,6 +236,11 @@ impl Mechanism {
     /// Number of degrees of freedom m (= number of generalized coordinates).
     pub fn dof(&self) -> usize {
         self.coordinates.len()
+    }
+    /// Whether forward and inverse dynamics need the transmissions or the load-dependent
+    /// friction (`dynamics::losses`).
+    pub fn has_losses(&self) -> bool {
+        !self.friction.is_empty() || self.actuators.iter().any(Option::is_some)
     }
     /// Number of mobile bodies n.
     pub fn n_bodies(&self) -> usize {

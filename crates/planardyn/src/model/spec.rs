@@ -44,6 +44,9 @@ pub struct MechanismSpec {
     /// External loads and force elements.
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
+    /// Motors with their transmissions, one per driven coordinate (docs/actuators.md).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub actuators: Vec<ActuatorSpec>,
     /// Default simulation settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulate: Option<SimulateSpec>,
@@ -249,8 +252,99 @@ pub enum LoadSpec {
         #[serde(default)]
         rest: f64,
     },
-    /// Viscous friction at a pair: -c times the relative rate (N m s/rad or N s/m).
-    Friction { pair: String, viscous: f64 },
+    /// Friction at a pair: viscous, -c times the relative rate (N m s/rad or N s/m), and
+    /// Coulomb friction from the pair's load (docs/actuators.md, *Friction from the joint
+    /// loads*): torque mu r |F| at a revolute pair of pin radius r, force mu max(|N|, 2|M|/L)
+    /// along a prismatic pair of length L, mu |N| along a slot.
+    Friction {
+        pair: String,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        viscous: Option<f64>,
+        /// Sliding (kinetic) friction coefficient.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        mu: Option<f64>,
+        /// Static coefficient (Stribeck peak at low speed); default `mu`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        mu_static: Option<f64>,
+        /// Pin radius of a revolute pair (m): the friction arm.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pin_radius: Option<f64>,
+        /// Length of a prismatic pair's slider (m): the arm over which it carries a couple.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        length: Option<f64>,
+        /// Slip speed (m/s) below which the regularised law lets the pair creep (default 1e-4).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        stiction_speed: Option<f64>,
+        /// Slip speed (m/s) over which the coefficient falls from `mu_static` to `mu` (default 1e-2).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        stribeck_speed: Option<f64>,
+    },
+}
+
+/// A motor driving a coordinate through a transmission of ratio n (motor angle = n q): the
+/// file's drive effort on that coordinate is then the motor torque (N m, motor side). Or a
+/// redundant actuator on a pair (`pair`), without transmission.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorSpec {
+    /// The driven coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Or a driven pair that is not a coordinate's: a redundant actuator (more actuators
+    /// than degrees of freedom), an ideal effort source on the pair's relative coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pair: Option<String>,
+    /// A name for reports (default: the coordinate's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Transmission ratio n (motor rad per coordinate rad, or per metre of a displacement).
+    #[serde(default = "one")]
+    pub gear_ratio: f64,
+    /// Transmission efficiency eta in (0, 1].
+    #[serde(default = "one")]
+    pub efficiency: f64,
+    /// Rotor (and gearbox input) inertia J (kg m^2, motor side); n^2 J is added to A.
+    #[serde(default)]
+    pub rotor_inertia: f64,
+    /// Motor-side viscous friction (N m s/rad).
+    #[serde(default)]
+    pub viscous: f64,
+    /// Motor-side Coulomb friction torque (N m).
+    #[serde(default)]
+    pub coulomb: f64,
+    /// Motor speed (rad/s) below which the regularised Coulomb torque fades (default 1e-2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiction_speed: Option<f64>,
+    /// The motor's limits, for the sizing report.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits: Option<LimitsSpec>,
+    /// Free text.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<String>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A motor's limits, motor side: torques (N m), speeds (rad/s). The torque available at a
+/// speed is `torque_speed` interpolated linearly, or the peak torque up to `corner_speed`
+/// falling linearly to zero at `max_speed`, or the peak torque.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_torque: Option<f64>,
+    /// The RMS torque the motor carries without overheating.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub continuous_torque: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_speed: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner_speed: Option<f64>,
+    /// Points [speed, torque] of the envelope, speeds increasing from 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque_speed: Option<Vec<[f64; 2]>>,
 }
 
 /// Default settings for `simulate`.

@@ -4,10 +4,15 @@
 
 pub mod charts;
 pub mod crossing;
+pub mod dense;
+pub mod events;
+mod jacobian;
 pub mod ode;
 mod overrides;
 pub mod trajectory;
 
+pub use dense::DenseOutput;
+pub use events::{Event, EventFn, EventRecords, EVENT_XTOL};
 pub use overrides::Overrides;
 pub use trajectory::{SimStats, Status, Trajectory};
 
@@ -21,6 +26,7 @@ use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, 
 use crossing::{
     cross, stepped_over, user_state, Approach, Landing, Path, Quintic, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW,
 };
+use events::Watch;
 use ode::MechanismOde;
 
 /// Relative tolerance of a model's run when its file gives none (docs/model-format.md,
@@ -225,6 +231,80 @@ fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi
     ode.evaluate_walking(t_out, yi)
 }
 
+/// What a run watches besides its output rows: events, located on each step's interpolant
+/// (their zeros in the trajectory's `events`; a terminal one ends the run with status
+/// `Event`, its time the last row's), and whether to keep that interpolant as the
+/// trajectory's `dense` output. Either costs, in each step, the interpolant at p + 1 nodes
+/// (p its degree), and for DOP853 its 3 dense-output stages.
+#[derive(Default)]
+pub struct Observe<'e> {
+    pub events: Vec<Event<'e>>,
+    pub dense_output: bool,
+}
+
+impl Observe<'_> {
+    fn is_empty(&self) -> bool {
+        self.events.is_empty() && !self.dense_output
+    }
+}
+
+/// Append the step just taken to `dense`: the user's q and qd at its nodes, from the step's
+/// interpolant. In the user's chart that is the interpolant itself, the coordinates driven by
+/// motion following it; in a partition chart, the point assembled at the interpolated chart
+/// values (the interpolant of q through those points is then as accurate as the step's own).
+fn sample_step(
+    ode: &mut MechanismOde,
+    stepper: &mut Stepper,
+    dense: &mut DenseOutput,
+    yi: &mut [f64],
+    rows: &mut Vec<f64>,
+) -> Result<(), Error> {
+    let m = ode.m();
+    let (t0, t1) = (stepper.t_prev(), stepper.t());
+    rows.clear();
+    ode.restart_from_anchor();
+    for j in 0..dense.nodes {
+        let t = t0 + dense::node(j, dense.nodes) * (t1 - t0);
+        if j + 1 == dense.nodes {
+            yi.copy_from_slice(stepper.y());
+        } else {
+            stepper.interpolate(ode, t, yi);
+        }
+        if ode.ws.chart == Chart::Inputs {
+            if let Some(motion) = ode.motion.as_deref_mut() {
+                motion.eval(t).map_err(|message| Error::Drive { t, message })?;
+                motion.overwrite(m, yi);
+            }
+            rows.extend_from_slice(&yi[..2 * m]);
+        } else {
+            ode.evaluate_walking(t, yi)?;
+            rows.extend_from_slice(&ode.ws.q);
+            rows.extend_from_slice(&ode.ws.qd);
+        }
+    }
+    dense.push(t0, t1, rows);
+    Ok(())
+}
+
+/// The last row of a run ended by a terminal event at `t_star`, within the step just taken
+/// (unless the outputs already hold it).
+fn end_at_event(
+    ode: &mut MechanismOde,
+    stepper: &mut Stepper,
+    t_star: f64,
+    yi: &mut [f64],
+    traj: &mut Trajectory,
+) -> Result<(), Error> {
+    if traj.t.last() == Some(&t_star) {
+        return Ok(());
+    }
+    ode.restart_from_anchor();
+    evaluate_output(ode, stepper, t_star, yi)?;
+    let sigma = measure(ode).sigma;
+    traj.record(ode, t_star, yi[yi.len() - 1], sigma);
+    Ok(())
+}
+
 /// The output grid and where the run is in it.
 struct Outputs<'t> {
     t_eval: Option<&'t [f64]>,
@@ -321,9 +401,34 @@ pub fn simulate_prescribed<'a>(
     settings: &Settings,
     drives: &'a mut dyn Drives,
     motion: &'a mut Prescribed<'a>,
+    progress: Option<&mut dyn FnMut(f64) -> bool>,
+) -> Result<Trajectory, Error> {
+    simulate_observed(mech, settings, drives, motion, Observe::default(), progress)
+}
+
+/// As [`simulate_prescribed`], watching `observe`'s events and keeping the dense output if
+/// asked. Event coordinates are checked here: an index past m is an error in the settings.
+pub fn simulate_observed<'a>(
+    mech: &'a Mechanism,
+    settings: &Settings,
+    drives: &'a mut dyn Drives,
+    motion: &'a mut Prescribed<'a>,
+    observe: Observe,
     mut progress: Option<&mut dyn FnMut(f64) -> bool>,
 ) -> Result<Trajectory, Error> {
     check(settings, mech)?;
+    for e in &observe.events {
+        if let EventFn::Coordinate { index, value } = e.g {
+            if index >= mech.dof() || !value.is_finite() {
+                return Err(Error::Options(format!(
+                    "an event's coordinate {index} and value {value}: the coordinate must be one of {} ({}) \
+                     and the value finite",
+                    mech.dof(),
+                    mech.coordinate_names().join(", ")
+                )));
+            }
+        }
+    }
     let m = mech.dof();
     let mut traj = Trajectory::new(m, mech.n_x());
     let (mut ode, y0) = match start(mech, settings, drives, motion) {
@@ -335,9 +440,10 @@ pub fn simulate_prescribed<'a>(
         }
         Err(e) => return Err(e),
     };
-    // Dense output is only needed to interpolate at requested times (DOP853 pays 3 extra
-    // evaluations in each step that holds one).
-    let options = Options { dense_output: settings.t_eval.is_some(), ..settings.options.clone() };
+    // Dense output is only needed to interpolate at requested times, and for events and the
+    // kept interpolant (DOP853 pays 3 extra evaluations in each step that uses it).
+    let (observing, keep_dense) = (!observe.is_empty(), observe.dense_output);
+    let options = Options { dense_output: settings.t_eval.is_some() || observing, ..settings.options.clone() };
     let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
     let mut y = y0;
     if let Err(e) = stepper.reset(&mut ode, settings.t0, &y) {
@@ -357,10 +463,16 @@ pub fn simulate_prescribed<'a>(
     }
     let mut yi = vec![0.0; 2 * m + 1];
     let (mut status, mut message) = (Status::Success, String::new());
+    let mut dense = observing.then(|| DenseOutput::new(m, settings.method.dense_order()));
+    let mut watch = Watch::new(observe.events, m);
+    let mut rows = Vec::new();
+    if let Err(e) = watch.start(settings.t0, &ode.ws.q, &ode.ws.qd) {
+        (status, message) = (Status::EventFailed, format!("at t = {} s: {e}", settings.t0));
+    }
     // Whether a stop leaves the last accepted state in the stepper's chart, to be kept as
     // the final row when the output grid did not reach it.
     let mut keep_last = false;
-    while stepper.t() < settings.t_end {
+    while status == Status::Success && stepper.t() < settings.t_end {
         if let Err(e) = stepper.step(&mut ode, settings.t_end) {
             (status, message) = failure(&e);
             keep_last = true;
@@ -399,13 +511,31 @@ pub fn simulate_prescribed<'a>(
         if ode.ws.chart != Chart::Inputs {
             traj.stats.partition_steps += 1;
         }
+        // The end of the run within this step: t, or a terminal event's time.
+        let mut stop: Option<(f64, usize)> = None;
+        if let Some(dense) = dense.as_mut() {
+            if let Err(e) = sample_step(&mut ode, &mut stepper, dense, &mut yi, &mut rows) {
+                let kind = if matches!(e, Error::Drive { .. }) { Status::DriveFailed } else { Status::AssemblyFailed };
+                (status, message, keep_last) = (kind, format!("dense output of the step to t = {t} s: {e}"), true);
+                break;
+            }
+            match watch.step(dense) {
+                Ok(found) => stop = found,
+                Err(e) => {
+                    (status, message, keep_last) =
+                        (Status::EventFailed, format!("in the step to t = {t} s: {e}"), true);
+                    break;
+                }
+            }
+        }
+        let t_last = stop.map_or(t, |(t_star, _)| t_star);
         if let Some(te) = t_eval {
-            if out.next < te.len() && te[out.next] <= t {
+            if out.next < te.len() && te[out.next] <= t_last {
                 // DOP853's dense-output stages (at 0.1, 0.2 and 7/9 of the step, evaluated by
                 // the first interpolation) are predicted from the step's start, not its end.
                 ode.restart_from_anchor();
             }
-            while out.next < te.len() && te[out.next] <= t {
+            while out.next < te.len() && te[out.next] <= t_last {
                 if let Err(e) = evaluate_output(&mut ode, &mut stepper, te[out.next], &mut yi) {
                     (status, message) = (Status::AssemblyFailed, format!("output at t = {}: {e}", te[out.next]));
                     break;
@@ -418,10 +548,22 @@ pub fn simulate_prescribed<'a>(
                 break;
             }
         }
-        // Outputs moved the evaluation away from the step's end; if going straight back is
-        // refused, come back along the interpolant as the outputs did.
+        if let Some((t_star, i)) = stop {
+            if let Err(e) = end_at_event(&mut ode, &mut stepper, t_star, &mut yi, &mut traj) {
+                (status, message) =
+                    (Status::AssemblyFailed, format!("the state at terminal event {i}, t = {t_star} s: {e}"));
+                break;
+            }
+            if let Some(d) = dense.as_mut() {
+                d.truncate(t_star);
+            }
+            (status, message) = (Status::Event, format!("terminal event {i} at t = {t_star} s"));
+            break;
+        }
+        // Outputs and the dense output moved the evaluation away from the step's end; if going
+        // straight back is refused, come back along the interpolant as they did.
         let accepted = ode.accept(t, &y).or_else(|e| {
-            if t_eval.is_none() {
+            if t_eval.is_none() && !observing {
                 return Err(e);
             }
             evaluate_output(&mut ode, &mut stepper, t, &mut yi)?;
@@ -497,6 +639,9 @@ pub fn simulate_prescribed<'a>(
     }
     traj.stats.integrator = stepper.stats();
     traj.stats.failed_evaluations = ode.failed_evaluations;
+    traj.events = watch.records;
+    // Events alone need the dense output only while the run lasts.
+    traj.dense = dense.filter(|_| keep_dense);
     if matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
         // Steps that shrink to nothing usually mean the passive mechanism is at a change
         // point (a parallelogram folding flat): say so when it is.

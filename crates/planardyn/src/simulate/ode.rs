@@ -355,4 +355,12 @@ impl OdeSystem for MechanismOde<'_> {
         self.derivative(dy);
         Ok(())
     }
+    fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Option<Result<(), Error>> {
+        // The exact Jacobian is written for ideal joints and drives (dynamics::derivatives).
+        let exact = self.ws.chart == Chart::Inputs
+            && self.motion.is_none()
+            && self.drives.time_only()
+            && !self.mech.has_losses();
+        exact.then(|| super::jacobian::exact_jacobian(self.mech, &self.ws, self.drives, t, y, jac))
+    }
 }

@@ -2,6 +2,8 @@
 //! why it ended, and the figures that say how far to trust it.
 
 use super::crossing::ChangePoint;
+use super::dense::DenseOutput;
+use super::events::EventRecords;
 use super::ode::MechanismOde;
 use crate::dynamics::{kinetic_energy, potential_energy};
 use crate::integrate::Stats;
@@ -30,6 +32,10 @@ pub enum Status {
     StepSizeTooSmall,
     /// The progress callback asked to stop.
     Cancelled,
+    /// A terminal event occurred: the run ends at its time.
+    Event,
+    /// An event function failed or returned a non-finite value.
+    EventFailed,
 }
 
 impl Status {
@@ -45,6 +51,8 @@ impl Status {
             Status::TooManySteps => "too_many_steps",
             Status::StepSizeTooSmall => "step_size_too_small",
             Status::Cancelled => "cancelled",
+            Status::Event => "event",
+            Status::EventFailed => "event_failed",
         }
     }
 }
@@ -97,6 +105,10 @@ pub struct Trajectory {
     pub residual: Vec<f64>,
     /// (N) whether the point was integrated in a partition chart.
     pub partitioned: Vec<bool>,
+    /// The zeros of each event (see [`super::Observe`]): times and states.
+    pub events: EventRecords,
+    /// The continuous solution over the run, when asked for (see [`super::Observe`]).
+    pub dense: Option<DenseOutput>,
     /// The change points crossed, in time order.
     pub change_points: Vec<ChangePoint>,
     pub status: Status,
@@ -119,8 +131,9 @@ impl Trajectory {
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
     }
+    /// Whether the run ended as asked: at t_end, or at a terminal event (as in `solve_ivp`).
     pub fn success(&self) -> bool {
-        self.status == Status::Success
+        matches!(self.status, Status::Success | Status::Event)
     }
     /// Record the point analysed in `ode.ws` at time t with work W and type II measure sigma.
     pub fn record(&mut self, ode: &MechanismOde, t: f64, work: f64, sigma: f64) {

@@ -49,8 +49,9 @@ pub struct Structure {
     /// constraint), each naming the pairs it involves.
     pub redundant: usize,
     pub self_stresses: Vec<SelfStress>,
-    /// Degree of actuation: the number of generalized coordinates m (inputs). The
-    /// mechanism is fully actuated when it equals `mobility`.
+    /// Degree of actuation: the number of actuators, the m generalized coordinates (inputs)
+    /// and the redundant actuators on other pairs. The mechanism is fully actuated when it
+    /// equals `mobility`, redundantly actuated beyond.
     pub actuation: usize,
     /// A basis of the independent loops (pairs outside a breadth-first spanning forest of
     /// the body-pair graph close one each), and whether every link reaches the ground.
@@ -78,6 +79,10 @@ impl Structure {
     /// Whether the inputs drive every freedom the constraints leave.
     pub fn fully_actuated(&self) -> bool {
         self.actuation == self.mobility
+    }
+    /// Whether it has more actuators than freedoms (internal forces: preload is possible).
+    pub fn redundantly_actuated(&self) -> bool {
+        self.actuation > self.mobility
     }
     /// The name of a link of a group: its bodies' names joined by `+`.
     pub fn link_name(&self, link: &[BodyId]) -> String {
@@ -125,7 +130,7 @@ fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
         mobility: 3 * n - rank,
         redundant: rows - rank,
         self_stresses,
-        actuation: mech.dof(),
+        actuation: crate::dynamics::redundant::n_actuators(mech),
         loops,
         connected,
         input_links: a.input_links,

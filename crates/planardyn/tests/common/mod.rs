@@ -242,3 +242,27 @@ pairs:
 coordinates:
   - {name: theta, pair: O1, value: 1.0471975511965976}
 "#;
+
+/// Arithmetic-geometric mean, for the complete elliptic integral K(k) = pi / (2 agm(1, k')).
+pub fn agm(mut a: f64, mut b: f64) -> f64 {
+    // Quadratic convergence: 8 iterations reach round-off from any k' in (0, 1].
+    for _ in 0..8 {
+        (a, b) = ((a + b) / 2.0, (a * b).sqrt());
+    }
+    a
+}
+
+/// Every shipped model file (examples/models and its library) and the inline models.
+pub fn every_model() -> Vec<Mechanism> {
+    let dir = format!("{}/../../examples/models", env!("CARGO_MANIFEST_DIR"));
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .chain(std::fs::read_dir(format!("{dir}/library")).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .map(|p| p.strip_prefix(&dir).unwrap().to_string_lossy().trim_start_matches('/').to_string())
+        .collect();
+    names.sort();
+    assert!(names.len() >= 20, "{names:?}");
+    names.iter().map(|n| shipped(n)).chain(all_models()).collect()
+}

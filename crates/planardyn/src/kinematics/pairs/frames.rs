@@ -183,4 +183,20 @@ impl Projection {
             + dot(ed, sub(urb, ura)) * vpa
             + h * (upa * vpb + upb * vpa - upb * vpb)
     }
+    /// Third derivative as a trilinear form gamma3(u, v, t) = d/dx gamma(u, v) . t: the
+    /// derivative of `gamma` along t, with d' = E d t_phi_a, (E d)' = -d t_phi_a and
+    /// (R_b s_b)' = E R_b s_b t_phi_b.
+    #[inline]
+    pub fn gamma3(&self, u: &[f64], v: &[f64], t: &[f64]) -> f64 {
+        let (ura, upa) = part(&self.a, u);
+        let (urb, upb) = part(&self.b, u);
+        let (vra, vpa) = part(&self.a, v);
+        let (vrb, vpb) = part(&self.b, v);
+        let (tra, tpa) = part(&self.a, t);
+        let (trb, tpb) = part(&self.b, t);
+        let k = dot(perp(self.d), self.rbsb);
+        let dw = dot(perp(self.d), self.w) * tpa + dot(self.d, sub(trb, tra)) - k * tpb;
+        -dw * upa * vpa - dot(self.d, sub(vrb, vra)) * tpa * upa - dot(self.d, sub(urb, ura)) * tpa * vpa
+            + k * (tpa - tpb) * (upa * vpb + upb * vpa - upb * vpb)
+    }
 }

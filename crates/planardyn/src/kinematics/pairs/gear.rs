@@ -100,6 +100,14 @@ impl PairType for Gear {
         }
     }
 
+    #[inline]
+    fn gamma3(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], t: &[f64]) -> Rows {
+        match self.mesh {
+            Mesh::Gear { .. } => [0.0; 2],
+            Mesh::Rack { axis, sc, .. } => [-self.travel(pair, x, trig, sc, axis).gamma3(u, v, t), 0.0],
+        }
+    }
+
     fn row_scales(&self, inv_l: f64) -> Rows {
         [inv_l, 0.0]
     }

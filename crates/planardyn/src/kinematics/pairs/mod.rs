@@ -72,6 +72,8 @@ pub trait PairType {
     fn jacobian<S: Sink>(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, rows: [Option<usize>; 2]);
     /// Second derivatives of the rows as bilinear forms gamma(u, v).
     fn gamma(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows;
+    /// Third derivatives of the rows as trilinear forms gamma3(u, v, t) (symmetric).
+    fn gamma3(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], t: &[f64]) -> Rows;
     /// Row scales: `inv_l` (1/L) for rows in metres, 1 for rows in radians.
     fn row_scales(&self, inv_l: f64) -> Rows;
     /// The columns of x each row may touch (its sparsity pattern), ascending.
@@ -97,6 +99,13 @@ pub trait PairType {
     #[inline]
     fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
         relative_gamma(self.relative(), pair, x, u, v)
+    }
+    #[inline]
+    fn coordinate_gamma3(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64 {
+        match self.relative() {
+            Some(Relative::Along { axis }) => along(pair, axis, x).gamma3(u, v, t),
+            Some(Relative::Angle) | None => 0.0,
+        }
     }
     #[inline]
     fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
@@ -169,6 +178,11 @@ pub fn gamma(pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) ->
 }
 
 #[inline]
+pub fn gamma3(pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], t: &[f64]) -> Rows {
+    dispatch!(&pair.kind, k => k.gamma3(pair, x, trig, u, v, t))
+}
+
+#[inline]
 pub fn row_scales(pair: &Pair, inv_l: f64) -> Rows {
     dispatch!(&pair.kind, t => t.row_scales(inv_l))
 }
@@ -237,6 +251,12 @@ pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
 #[inline]
 pub fn coordinate_gamma(pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate_gamma(pair, x, u, v))
+}
+
+/// Third derivative of [`coordinate`] as a trilinear form.
+#[inline]
+pub fn coordinate_gamma3(pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64 {
+    dispatch!(&pair.kind, k => k.coordinate_gamma3(pair, x, u, v, t))
 }
 
 /// Rate of [`coordinate`]: its gradient times xd.

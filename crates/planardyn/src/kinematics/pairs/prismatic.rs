@@ -39,6 +39,11 @@ impl PairType for Prismatic {
         [0.0, Projection::normal(pair, self.axis, x, trig).gamma(u, v)]
     }
 
+    #[inline]
+    fn gamma3(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], t: &[f64]) -> Rows {
+        [0.0, Projection::normal(pair, self.axis, x, trig).gamma3(u, v, t)]
+    }
+
     fn row_scales(&self, inv_l: f64) -> Rows {
         [1.0, inv_l]
     }

@@ -43,6 +43,16 @@ impl PairType for Revolute {
         [-pa[0] * ka + pb[0] * kb, -pa[1] * ka + pb[1] * kb]
     }
 
+    #[inline]
+    fn gamma3(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], t: &[f64]) -> Rows {
+        // d3(R(phi) s)/dphi3 = -E R(phi) s.
+        let (a, b) = (link_state_t(pair.a, x, trig), link_state_t(pair.b, x, trig));
+        let (ea, eb) = (perp(a.rot(pair.sa)), perp(b.rot(pair.sb)));
+        let ka = part(&a, u).1 * part(&a, v).1 * part(&a, t).1;
+        let kb = part(&b, u).1 * part(&b, v).1 * part(&b, t).1;
+        [-ea[0] * ka + eb[0] * kb, -ea[1] * ka + eb[1] * kb]
+    }
+
     fn row_scales(&self, inv_l: f64) -> Rows {
         [inv_l, inv_l]
     }

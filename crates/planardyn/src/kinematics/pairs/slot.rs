@@ -39,6 +39,11 @@ impl PairType for Slot {
         [Projection::normal(pair, self.axis, x, trig).gamma(u, v), 0.0]
     }
 
+    #[inline]
+    fn gamma3(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64], t: &[f64]) -> Rows {
+        [Projection::normal(pair, self.axis, x, trig).gamma3(u, v, t), 0.0]
+    }
+
     fn row_scales(&self, inv_l: f64) -> Rows {
         [inv_l, 0.0]
     }

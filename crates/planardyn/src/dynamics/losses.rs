@@ -1,0 +1,227 @@
+//! Forward and inverse dynamics with the actuators' transmissions and the pairs' Coulomb
+//! friction (docs/actuators.md). The friction efforts e depend on the reactions, which
+//! depend on the accelerations, which depend on e: at each evaluation the three are solved
+//! together by a fixed-point iteration on e, to round-off. It converges while a unit
+//! change of the efforts changes the friction by less than itself (mu r small against the
+//! mechanism's lever arms); a mechanism that self-locks is reported, not guessed.
+
+use super::forward::{accelerations, body_accelerations, factor_mass_matrix};
+use super::friction;
+use super::reactions::reactions_into;
+use super::transmission::{add_rotor_inertia, rotor_terms};
+use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
+use crate::linalg::cholesky_solve;
+use crate::model::{Mechanism, PairId};
+use crate::workspace::Workspace;
+use crate::KinematicsError;
+
+/// Largest number of fixed-point iterations, and the change of the friction efforts,
+/// relative to the largest, at which they count as settled.
+const MAX_ITERATIONS: usize = 100;
+const SETTLED: f64 = 1e-13;
+
+/// The buffers of an evaluation with losses, sized once for a mechanism (empty without
+/// losses). A lever is a pair's relative coordinate seen from the bodies: its gradient (3n)
+/// and that gradient times U (m); the friction entries' come first, then one per coordinate.
+#[derive(Debug, Clone, Default)]
+pub struct LossBuffers {
+    /// (3n) the applied forces, and (m) b or the efforts, before the friction.
+    f0: Vec<f64>,
+    b0: Vec<f64>,
+    /// ((n_f + m) x 3n) lever gradients and ((n_f + m) x m) their products with U.
+    grad: Vec<f64>,
+    gu: Vec<f64>,
+    /// (n_f) the friction pairs' rates and efforts.
+    rates: Vec<f64>,
+    e: Vec<f64>,
+    /// (m) per coordinate: the rotor's n^2 J (0 without) and its h (qdd_k = gu_k . zdd + h_k).
+    rotor_inertia: Vec<f64>,
+    rotor_h: Vec<f64>,
+    /// (3n) the multipliers and (p) the reactions of the last fixed-point step.
+    lambda: Vec<f64>,
+    reactions: Vec<[f64; 3]>,
+}
+
+impl LossBuffers {
+    /// Buffers for `mech` (none when it has no losses).
+    pub fn new(mech: &Mechanism) -> Self {
+        if !mech.has_losses() {
+            return LossBuffers::default();
+        }
+        let (nx, m, nf) = (mech.n_x(), mech.dof(), mech.friction.len());
+        let rotor_inertia =
+            mech.actuators.iter().map(|a| a.as_ref().map_or(0.0, |a| a.ratio * a.ratio * a.rotor_inertia)).collect();
+        LossBuffers {
+            f0: vec![0.0; nx],
+            b0: vec![0.0; m],
+            grad: vec![0.0; (nf + m) * nx],
+            gu: vec![0.0; (nf + m) * m],
+            rates: vec![0.0; nf],
+            e: vec![0.0; nf],
+            rotor_inertia,
+            rotor_h: vec![0.0; m],
+            lambda: vec![0.0; nx],
+            reactions: vec![[0.0; 3]; mech.pairs.len()],
+        }
+    }
+}
+
+fn add_scaled(out: &mut [f64], s: f64, v: &[f64]) {
+    for (o, v) in out.iter_mut().zip(v) {
+        *o += s * v;
+    }
+}
+
+/// Lever `i` of `pair` at the point in `ws`; returns the pair's relative rate.
+fn set_lever(mech: &Mechanism, pair: PairId, ws: &Workspace, lb: &mut LossBuffers, i: usize) -> f64 {
+    let (n, m) = (ws.x.len(), ws.b.len());
+    let grad = &mut lb.grad[i * n..(i + 1) * n];
+    grad.fill(0.0);
+    let p = &mech.pairs[pair.0];
+    pair_coordinate_grad(p, &ws.x, &mut Dense { j: grad, ncols: n }, 0);
+    for (g, u) in lb.gu[i * m..(i + 1) * m].iter_mut().zip(ws.u.chunks_exact(n)) {
+        *g = u.iter().zip(grad.iter()).map(|(a, b)| a * b).sum();
+    }
+    pair_coordinate_rate(p, &ws.x, &ws.xd)
+}
+
+/// Every lever at the point in `ws`: the friction pairs', then the coordinates'.
+fn set_levers(mech: &Mechanism, ws: &Workspace, lb: &mut LossBuffers) {
+    let nf = mech.friction.len();
+    for (i, fr) in mech.friction.iter().enumerate() {
+        lb.rates[i] = set_lever(mech, fr.pair, ws, lb, i);
+    }
+    for (k, c) in mech.coordinates.iter().enumerate() {
+        set_lever(mech, c.pair, ws, lb, nf + k);
+    }
+}
+
+/// One fixed-point step: the friction efforts from the reactions in `ws` (evaluated with
+/// the efforts `lb.e`) replace them, unless they settled (then true and `lb.e` is kept).
+fn step_friction(
+    mech: &Mechanism,
+    ws: &mut Workspace,
+    lb: &mut LossBuffers,
+    iteration: usize,
+) -> Result<bool, KinematicsError> {
+    reactions_into(mech, ws, &mut lb.lambda, &mut lb.reactions);
+    let (mut change, mut largest) = (0.0f64, 0.0f64);
+    for (fr, (&rate, &e)) in mech.friction.iter().zip(lb.rates.iter().zip(&lb.e)) {
+        let new = friction::effort(mech, fr, lb.reactions[fr.pair.0], rate);
+        change = change.max((new - e).abs());
+        largest = largest.max(new.abs());
+    }
+    if change <= SETTLED * largest {
+        return Ok(true);
+    }
+    if iteration + 1 == MAX_ITERATIONS {
+        return Err(KinematicsError::FrictionUnsettled { iterations: MAX_ITERATIONS, change });
+    }
+    for (fr, (&rate, e)) in mech.friction.iter().zip(lb.rates.iter().zip(lb.e.iter_mut())) {
+        *e = friction::effort(mech, fr, lb.reactions[fr.pair.0], rate);
+    }
+    Ok(false)
+}
+
+/// Forward dynamics' last stages with losses, after A, b and f (joint-side drive efforts
+/// included) are in `ws`: rotor inertia into A and b, then zdd, xdd, qdd with the friction
+/// efforts settled; `ws.f` ends with the friction and the rotors' torques, `ws.power` with
+/// their power, `ws.dissipated` with the friction's.
+pub(crate) fn forward_with_losses(
+    mech: &Mechanism,
+    z: &[f64],
+    zd: &[f64],
+    ws: &mut Workspace,
+) -> Result<(), KinematicsError> {
+    // Taken out of `ws` for the evaluation (no allocation: the buffers move), put back after.
+    let mut lb = std::mem::take(&mut ws.losses);
+    let result = forward_stages(mech, z, zd, ws, &mut lb);
+    ws.losses = lb;
+    result
+}
+
+fn forward_stages(
+    mech: &Mechanism,
+    z: &[f64],
+    zd: &[f64],
+    ws: &mut Workspace,
+    lb: &mut LossBuffers,
+) -> Result<(), KinematicsError> {
+    let (nf, m, n) = (mech.friction.len(), ws.b.len(), ws.x.len());
+    set_levers(mech, ws, lb);
+    rotor_terms(mech, ws, &lb.rotor_inertia, &lb.grad[nf * n..], &mut lb.rotor_h);
+    add_rotor_inertia(&lb.rotor_inertia, &lb.gu[nf * m..], &lb.rotor_h, &mut ws.a, &mut ws.b);
+    factor_mass_matrix(ws)?;
+    lb.f0.copy_from_slice(&ws.f);
+    lb.b0.copy_from_slice(&ws.b);
+    lb.e.fill(0.0);
+    for iteration in 0..MAX_ITERATIONS {
+        ws.f.copy_from_slice(&lb.f0);
+        ws.b.copy_from_slice(&lb.b0);
+        for (i, &e) in lb.e.iter().enumerate() {
+            add_scaled(&mut ws.f, e, &lb.grad[i * n..(i + 1) * n]);
+            add_scaled(&mut ws.b, e, &lb.gu[i * m..(i + 1) * m]);
+        }
+        cholesky_solve(&ws.a, m, &mut ws.b);
+        body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
+        // f -= n^2 J qdd_k grad_k: the rotors' inertia torques, qdd_k = gu_k . zdd + h_k.
+        for (k, &inertia) in lb.rotor_inertia.iter().enumerate().filter(|(_, j)| **j > 0.0) {
+            let l = nf + k;
+            let qdd = lb.gu[l * m..(l + 1) * m].iter().zip(&ws.b).map(|(g, a)| g * a).sum::<f64>() + lb.rotor_h[k];
+            add_scaled(&mut ws.f, -inertia * qdd, &lb.grad[l * n..(l + 1) * n]);
+        }
+        if nf == 0 || step_friction(mech, ws, lb, iteration)? {
+            break;
+        }
+    }
+    accelerations(mech, z, zd, ws);
+    let friction_power: f64 = lb.e.iter().zip(&lb.rates).map(|(e, r)| e * r).sum();
+    let rotor_power: f64 = lb.rotor_inertia.iter().zip(ws.qdd.iter().zip(&ws.qd)).map(|(j, (a, v))| -j * a * v).sum();
+    ws.power += friction_power + rotor_power;
+    ws.dissipated = -friction_power;
+    Ok(())
+}
+
+/// Inverse dynamics' losses, after `ws.tau` = A qdd - b (no friction, no rotor) with `ws.f`
+/// without drives, in the input chart: the friction efforts settled against the reactions,
+/// then the rotors' n^2 J qdd. `ws.tau` ends joint-side, `ws.f` with the friction and the
+/// drive efforts the bodies feel, `ws.dissipated` with the friction's power.
+pub(crate) fn inverse_with_losses(mech: &Mechanism, qdd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    let mut lb = std::mem::take(&mut ws.losses);
+    let result = inverse_stages(mech, qdd, ws, &mut lb);
+    ws.losses = lb;
+    result
+}
+
+fn inverse_stages(
+    mech: &Mechanism,
+    qdd: &[f64],
+    ws: &mut Workspace,
+    lb: &mut LossBuffers,
+) -> Result<(), KinematicsError> {
+    // ws.xdd holds the body accelerations inverse dynamics formed.
+    let (nf, m, n) = (mech.friction.len(), ws.b.len(), ws.x.len());
+    set_levers(mech, ws, lb);
+    lb.f0.copy_from_slice(&ws.f);
+    lb.b0.copy_from_slice(&ws.tau);
+    lb.e.fill(0.0);
+    for iteration in 0..MAX_ITERATIONS {
+        ws.f.copy_from_slice(&lb.f0);
+        ws.tau.copy_from_slice(&lb.b0);
+        for (i, &e) in lb.e.iter().enumerate() {
+            add_scaled(&mut ws.f, e, &lb.grad[i * n..(i + 1) * n]);
+            add_scaled(&mut ws.tau, -e, &lb.gu[i * m..(i + 1) * m]);
+        }
+        for (k, &tau) in ws.tau.iter().enumerate() {
+            add_scaled(&mut ws.f, tau, &lb.grad[(nf + k) * n..(nf + k + 1) * n]);
+        }
+        if nf == 0 || step_friction(mech, ws, lb, iteration)? {
+            break;
+        }
+    }
+    for ((tau, j), a) in ws.tau.iter_mut().zip(&lb.rotor_inertia).zip(qdd) {
+        *tau += j * a;
+    }
+    ws.dissipated = -lb.e.iter().zip(&lb.rates).map(|(e, r)| e * r).sum::<f64>();
+    Ok(())
+}

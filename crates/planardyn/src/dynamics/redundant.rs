@@ -1,0 +1,249 @@
+//! Redundant actuation (docs/actuators.md, *Redundant actuation*): more actuators than
+//! degrees of freedom. The actuators are the m coordinates followed by the pair actuators
+//! (`Mechanism::pair_actuators`); a unit effort of actuator a on its pair's relative
+//! coordinate q_a gives the generalized force column B_a = U^T D_x q_a^T, so the efforts tau_a
+//! (n_a) produce B tau_a (m). B = L Q with Q's m rows orthonormal (Gram-Schmidt of B's rows,
+//! L lower triangular): the minimum-norm efforts are Q^T L^-1 tau, the internal forces (the
+//! efforts that move nothing, B N = 0) an orthonormal basis N of the complement of Q's rows.
+
+use super::forward::forward;
+use super::inverse::inverse;
+use super::Drives;
+use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
+use crate::model::{Mechanism, PairId};
+use crate::workspace::Workspace;
+use crate::{Error, KinematicsError, SingularityKind};
+
+/// Below this (relative to B's largest row norm) a direction counts as lost: the actuators
+/// cannot produce some generalized force (an actuation singularity).
+const RANK_TOL: f64 = 1e-10;
+
+/// How the efforts are shared among redundant actuators.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Distribution {
+    /// The efforts of least Euclidean norm.
+    MinNorm,
+    /// The efforts whose largest magnitude is least (one internal force direction).
+    MinMax,
+    /// The minimum-norm efforts plus the internal forces N lambda (lambda: one value per
+    /// basis vector of [`Actuation::internal`], N m or N): a prescribed preload.
+    Preload(Vec<f64>),
+}
+
+/// The actuation of a mechanism at one point: B, its factors, and the internal forces.
+#[derive(Debug, Clone)]
+pub struct Actuation {
+    /// Number of coordinates m and of actuators n_a.
+    pub m: usize,
+    pub n_a: usize,
+    /// (m x n_a, row-major) B: generalized force per unit effort of each actuator.
+    pub b: Vec<f64>,
+    /// (n_a - m) orthonormal internal-force vectors, each n_a.
+    pub internal: Vec<Vec<f64>>,
+    /// (m x n_a) Q and (m x m) L of B = L Q (row-major).
+    q: Vec<Vec<f64>>,
+    l: Vec<f64>,
+}
+
+/// Number of actuators n_a: the coordinates, then the pair actuators.
+pub fn n_actuators(mech: &Mechanism) -> usize {
+    mech.dof() + mech.pair_actuators.len()
+}
+
+/// The actuators' names: the coordinates', then the pair actuators'.
+pub fn actuator_names(mech: &Mechanism) -> Vec<String> {
+    let coords = mech.coordinates.iter().map(|c| c.name.clone());
+    coords.chain(mech.pair_actuators.iter().map(|a| a.name.clone())).collect()
+}
+
+fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f64]) {
+    grad.fill(0.0);
+    pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// Unit vector of `v` after removing its components along `basis` (twice, for round-off),
+/// with the norm before scaling.
+fn orthogonalise(v: &mut [f64], basis: &[Vec<f64>]) -> f64 {
+    for _ in 0..2 {
+        for e in basis {
+            let c = dot(v, e);
+            v.iter_mut().zip(e).for_each(|(v, e)| *v -= c * e);
+        }
+    }
+    let norm = dot(v, v).sqrt();
+    if norm > 0.0 {
+        v.iter_mut().for_each(|v| *v /= norm);
+    }
+    norm
+}
+
+impl Actuation {
+    /// The actuation at the point in `ws` (after the kinematic stages, in its chart).
+    pub fn at(mech: &Mechanism, ws: &Workspace) -> Result<Self, KinematicsError> {
+        let (m, n_a, n) = (mech.dof(), n_actuators(mech), ws.x.len());
+        let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
+        let mut b = vec![0.0; m * n_a];
+        let mut grad = vec![0.0; n];
+        for (a, pair) in pairs.enumerate() {
+            pair_grad(mech, pair, &ws.x, &mut grad);
+            for (j, u) in ws.u.chunks_exact(n).enumerate() {
+                b[j * n_a + a] = dot(&grad, u);
+            }
+        }
+        let scale = b.chunks_exact(n_a).map(|r| dot(r, r).sqrt()).fold(0.0, f64::max);
+        let (mut q, mut l): (Vec<Vec<f64>>, Vec<f64>) = (Vec::with_capacity(m), vec![0.0; m * m]);
+        for j in 0..m {
+            let mut row = b[j * n_a..(j + 1) * n_a].to_vec();
+            for (k, e) in q.iter().enumerate() {
+                l[j * m + k] = dot(&row, e);
+            }
+            let norm = orthogonalise(&mut row, &q);
+            if !(norm > RANK_TOL * scale) {
+                return Err(KinematicsError::singular(SingularityKind::TypeII));
+            }
+            l[j * m + j] = norm;
+            q.push(row);
+        }
+        let mut internal: Vec<Vec<f64>> = Vec::with_capacity(n_a - m);
+        for i in 0..n_a {
+            if internal.len() == n_a - m {
+                break;
+            }
+            let mut v = vec![0.0; n_a];
+            v[i] = 1.0;
+            let both: Vec<Vec<f64>> = q.iter().chain(&internal).cloned().collect();
+            if orthogonalise(&mut v, &both) > 1e-6 {
+                internal.push(v);
+            }
+        }
+        Ok(Actuation { m, n_a, b, internal, q, l })
+    }
+
+    /// The minimum-norm efforts (n_a) that produce generalized efforts `tau` (m).
+    pub fn min_norm(&self, tau: &[f64]) -> Vec<f64> {
+        let m = self.m;
+        let mut y = vec![0.0; m];
+        for j in 0..m {
+            y[j] = (tau[j] - (0..j).map(|k| self.l[j * m + k] * y[k]).sum::<f64>()) / self.l[j * m + j];
+        }
+        let mut out = vec![0.0; self.n_a];
+        for (yj, qj) in y.iter().zip(&self.q) {
+            out.iter_mut().zip(qj).for_each(|(o, q)| *o += yj * q);
+        }
+        out
+    }
+
+    /// The efforts (n_a) producing generalized efforts `tau` (m), shared as `how` says.
+    pub fn distribute(&self, tau: &[f64], how: &Distribution) -> Result<Vec<f64>, KinematicsError> {
+        let mut out = self.min_norm(tau);
+        match how {
+            Distribution::MinNorm => {}
+            Distribution::Preload(lambda) => {
+                if lambda.len() != self.internal.len() {
+                    return Err(KinematicsError::BadArgument {
+                        name: "preload",
+                        expected: format!("{} values, one per internal force", self.internal.len()),
+                        got: format!("{}", lambda.len()),
+                    });
+                }
+                for (l, v) in lambda.iter().zip(&self.internal) {
+                    out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
+                }
+            }
+            Distribution::MinMax => {
+                let [v] = self.internal.as_slice() else {
+                    return Err(KinematicsError::BadArgument {
+                        name: "distribution",
+                        expected: "one internal force for min-max (n_a = m + 1); use min-norm or a preload".into(),
+                        got: format!("{} internal forces", self.internal.len()),
+                    });
+                };
+                let lambda = min_max_step(&out, v);
+                out.iter_mut().zip(v).for_each(|(o, v)| *o += lambda * v);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The lambda minimising max_a |t_a + lambda v_a|: a convex piecewise-linear function, least
+/// where two of its lines cross (or at 0 when it is flat).
+fn min_max_step(t: &[f64], v: &[f64]) -> f64 {
+    let worst = |l: f64| t.iter().zip(v).map(|(t, v)| (t + l * v).abs()).fold(0.0, f64::max);
+    let mut best = (worst(0.0), 0.0);
+    for a in 0..t.len() {
+        for b in 0..t.len() {
+            for (num, den) in [(t[a] - t[b], v[a] - v[b]), (t[a] + t[b], v[a] + v[b])] {
+                if den != 0.0 {
+                    let l = -num / den;
+                    let w = worst(l);
+                    if w < best.0 {
+                        best = (w, l);
+                    }
+                }
+            }
+        }
+    }
+    best.1
+}
+
+/// Inverse dynamics with redundant actuators: the efforts (n_a) of every actuator for
+/// coordinates q, rates qd, accelerations qdd, shared as `how` says; `ws` is left with the
+/// point's kinematics (and `ws.tau` the generalized efforts they produce).
+pub fn inverse_redundant(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    how: &Distribution,
+    ws: &mut Workspace,
+) -> Result<(Actuation, Vec<f64>), KinematicsError> {
+    inverse(mech, q, qd, qdd, ws)?;
+    let act = Actuation::at(mech, ws)?;
+    let efforts = act.distribute(&ws.tau, how)?;
+    Ok((act, efforts))
+}
+
+/// Drives for a forward evaluation with every actuator's effort: the coordinates' part.
+struct CoordinateEfforts<'a>(&'a [f64]);
+
+impl Drives for CoordinateEfforts<'_> {
+    fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {
+        tau.copy_from_slice(&self.0[..tau.len()]);
+        Ok(())
+    }
+}
+
+/// Forward dynamics with every actuator's effort `efforts` (n_a: the coordinates' first, as
+/// drive efforts, then the pair actuators'), at time t (s) and chart state (z, zd).
+pub fn forward_redundant(
+    mech: &Mechanism,
+    t: f64,
+    z: &[f64],
+    zd: &[f64],
+    efforts: &[f64],
+    ws: &mut Workspace,
+) -> Result<(), Error> {
+    let m = mech.dof();
+    ws.pair_tau.copy_from_slice(&efforts[m..]);
+    let result = forward(mech, t, z, zd, &mut CoordinateEfforts(efforts), ws);
+    ws.pair_tau.fill(0.0);
+    result
+}
+
+/// Add the pair actuators' efforts `ws.pair_tau` to `ws.f`; returns their power (W).
+pub(crate) fn apply_pair_efforts(mech: &Mechanism, ws: &mut Workspace) -> f64 {
+    let mut power = 0.0;
+    for (a, &e) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
+        if e != 0.0 {
+            pair_grad(mech, a.pair, &ws.x, &mut ws.tmp);
+            ws.f.iter_mut().zip(&ws.tmp).for_each(|(f, g)| *f += e * g);
+            power += e * pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
+        }
+    }
+    power
+}

@@ -1,0 +1,145 @@
+//! Redundant actuation: a 5R robot with a third actuated leg (2 degrees of freedom, 3
+//! actuators), its efforts shared by minimum norm, min-max and a preload.
+
+mod common;
+
+use common::yaml;
+use planardyn::dynamics::redundant::{forward_redundant, inverse_redundant, Distribution};
+use planardyn::{Mechanism, Workspace};
+
+/// The five-bar of examples/models/five-bar.yaml (without its PD springs) with a third leg
+/// A3 -> C3 -> P (0.25 m and 0.35 m) whose base pivot is actuated.
+fn three_legs() -> Mechanism {
+    yaml(
+        r#"
+name: 5R with a third actuated leg
+gravity: [0.0, -9.81]
+points:
+  A1: [-0.15, 0.0]
+  A2: [0.15, 0.0]
+  A3: [0.0, 0.0]
+  C1: [-0.25565456543517484, 0.2265769467591625]
+  C2: [0.275, 0.21650635094610965]
+  C3: [0.1983444079681374, 0.1521824425739351]
+  P: [0.014002680494367873, 0.44970240410926887]
+ground: [A1, A2, A3]
+bodies:
+  proximal_left: {points: [A1, C1], uniform_bar: [A1, C1], mass: 0.5}
+  proximal_right: {points: [A2, C2], uniform_bar: [A2, C2], mass: 0.5}
+  proximal_mid: {points: [A3, C3], uniform_bar: [A3, C3], mass: 0.5}
+  distal_left:
+    points: [C1, P]
+    parts: [{uniform_bar: [C1, P], mass: 0.7}, {point_mass: P, mass: 0.3}]
+  distal_right: {points: [C2, P], uniform_bar: [C2, P], mass: 0.7}
+  distal_mid: {points: [C3, P], uniform_bar: [C3, P], mass: 0.7}
+pairs:
+  - {type: revolute, name: motor1, at: A1, bodies: [ground, proximal_left]}
+  - {type: revolute, name: elbow1, at: C1, bodies: [proximal_left, distal_left]}
+  - {type: revolute, name: effector, at: P, bodies: [distal_left, distal_right]}
+  - {type: revolute, name: elbow2, at: C2, bodies: [proximal_right, distal_right]}
+  - {type: revolute, name: motor2, at: A2, bodies: [ground, proximal_right]}
+  - {type: revolute, name: motor3, at: A3, bodies: [ground, proximal_mid]}
+  - {type: revolute, name: elbow3, at: C3, bodies: [proximal_mid, distal_mid]}
+  - {type: revolute, name: effector3, at: P, bodies: [distal_left, distal_mid]}
+coordinates:
+  - {name: theta1, pair: motor1, value: 2.007128639793479}
+  - {name: theta2, pair: motor2, value: 1.0471975511965976}
+actuators:
+  - {pair: motor3}
+"#,
+    )
+}
+
+/// A point of a motion near the drawing.
+fn point(mech: &Mechanism) -> ([f64; 2], [f64; 2], [f64; 2]) {
+    let (q0, _) = mech.initial_state();
+    ([q0[0] + 0.05, q0[1] - 0.04], [1.2, -0.7], [3.0, 5.0])
+}
+
+#[test]
+fn min_norm_efforts_are_the_least_squares_solution() {
+    let mech = three_legs();
+    let (q, qd, qdd) = point(&mech);
+    let mut ws = Workspace::new(&mech);
+    let (act, tau) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinNorm, &mut ws).unwrap();
+    assert_eq!((act.m, act.n_a, act.internal.len()), (2, 3, 1));
+    // Independently: tau = B^T (B B^T)^-1 f, the 2 x 2 system solved by Cramer's rule.
+    let (b, f) = (&act.b, &ws.tau);
+    let g = |i: usize, j: usize| (0..3).map(|a| b[i * 3 + a] * b[j * 3 + a]).sum::<f64>();
+    let det = g(0, 0) * g(1, 1) - g(0, 1) * g(1, 0);
+    let y = [(f[0] * g(1, 1) - f[1] * g(0, 1)) / det, (g(0, 0) * f[1] - g(1, 0) * f[0]) / det];
+    for a in 0..3 {
+        let expected = b[a] * y[0] + b[3 + a] * y[1];
+        assert!((tau[a] - expected).abs() <= 1e-12 * (1.0 + expected.abs()), "{a}: {} vs {expected}", tau[a]);
+    }
+    // The internal force moves nothing: B v = 0, |v| = 1.
+    let v = &act.internal[0];
+    for j in 0..2 {
+        assert!((0..3).map(|a| b[j * 3 + a] * v[a]).sum::<f64>().abs() <= 1e-13);
+    }
+    assert!(((v.iter().map(|x| x * x).sum::<f64>()) - 1.0).abs() <= 1e-14);
+}
+
+#[test]
+fn distributed_efforts_reproduce_the_motion_in_forward_dynamics() {
+    let mech = three_legs();
+    let (q, qd, qdd) = point(&mech);
+    for how in [Distribution::MinNorm, Distribution::MinMax, Distribution::Preload(vec![4.0])] {
+        let mut ws = Workspace::new(&mech);
+        let (_, efforts) = inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws).unwrap();
+        forward_redundant(&mech, 0.0, &q, &qd, &efforts, &mut ws).unwrap();
+        for k in 0..2 {
+            assert!((ws.qdd[k] - qdd[k]).abs() <= 1e-10 * qdd[k].abs(), "{how:?}: qdd {:?} vs {qdd:?}", ws.qdd);
+        }
+    }
+}
+
+#[test]
+fn min_max_is_the_least_largest_effort() {
+    let mech = three_legs();
+    let (q, qd, qdd) = point(&mech);
+    let mut ws = Workspace::new(&mech);
+    let (act, mm) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinMax, &mut ws).unwrap();
+    let (_, mn) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinNorm, &mut ws).unwrap();
+    let largest = |t: &[f64]| t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // A scan of lambda over +-50 N m in 1e-4 steps never does better (to the step's error).
+    let v = &act.internal[0];
+    let scanned = (-500_000..=500_000)
+        .map(|i| {
+            let l = i as f64 * 1e-4;
+            largest(&mn.iter().zip(v).map(|(t, v)| t + l * v).collect::<Vec<_>>())
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(largest(&mm) <= scanned + 1e-12 && scanned - largest(&mm) <= 1e-4, "{} vs {scanned}", largest(&mm));
+    assert!(largest(&mm) <= largest(&mn));
+}
+
+#[test]
+fn the_smallest_sign_keeping_preload_found_by_bisection() {
+    let mech = three_legs();
+    let (q, qd, qdd) = point(&mech);
+    let mut ws = Workspace::new(&mech);
+    let (act, mn) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinNorm, &mut ws).unwrap();
+    let v = act.internal[0].clone();
+    assert!(v.iter().all(|x| x.abs() > 1e-3), "every actuator takes part in the internal force: {v:?}");
+    // Efforts keep the signs of the internal force v (backlash-free) once the preload
+    // lambda is large enough; bisect on lambda for the smallest.
+    let keeps = |l: f64| {
+        let (_, t) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::Preload(vec![l]), &mut ws.clone()).unwrap();
+        t.iter().zip(&v).all(|(t, v)| t * v > 0.0)
+    };
+    let (mut lo, mut hi) = (-1e3, 1e3);
+    assert!(!keeps(lo) && keeps(hi));
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if keeps(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    // The closed form: lambda* = max_a (-t_a / v_a) over the minimum-norm efforts t.
+    let closed = mn.iter().zip(&v).map(|(t, v)| -t / v).fold(f64::NEG_INFINITY, f64::max);
+    assert!((hi - closed).abs() <= 1e-9 * (1.0 + closed.abs()), "bisection {hi} vs {closed}");
+    assert!(keeps(closed + 1e-6) && !keeps(closed - 1e-6));
+}

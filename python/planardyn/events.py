@@ -1,0 +1,67 @@
+"""Events of a simulation, as in scipy's ``solve_ivp``: functions g(t, q, qd) whose zeros a
+run reports in ``SimulationResult.t_events`` (with the states there), a terminal one ending
+the run at its time.
+
+An event is a callable ``g(t, q, qd) -> float`` (t in s, q and qd (m,) arrays) with optional
+attributes ``terminal`` (bool, default False) and ``direction`` (> 0: only zeros where g
+rises, < 0: only where it falls, 0 (default): both), or a :class:`Crossing` of a coordinate,
+which the core evaluates without calling Python (an end stop, a crank angle reached).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: g(t, q, qd) -> float.
+EventFunction = Callable[[float, NDArray[np.float64], NDArray[np.float64]], float]
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """Coordinate ``coordinate`` (by name) crossing ``value`` (rad or m): g = q - value."""
+
+    coordinate: str
+    value: float
+    terminal: bool = False
+    direction: float = 0.0
+
+
+Event = Crossing | EventFunction
+
+
+def parse_crossing(text: str) -> Crossing:
+    """A terminal :class:`Crossing` from the CLI's ``NAME=VALUE``, ``NAME>VALUE`` (rising
+    through it) or ``NAME<VALUE`` (falling), e.g. ``theta=1.5`` or ``s>0.2``."""
+    for op, direction in (("=", 0.0), (">", 1.0), ("<", -1.0)):
+        name, sep, value = text.partition(op)
+        if sep and name.strip():
+            try:
+                return Crossing(name.strip(), float(value), terminal=True, direction=direction)
+            except ValueError:
+                break
+    raise ValueError(f"--stop-when {text!r}: write NAME=VALUE, NAME>VALUE (rising) or NAME<VALUE (falling), "
+                     "a coordinate's name and a number in rad or m, e.g. theta=1.5")
+
+
+def native_events(events: Sequence[Event | Mapping[str, Any]] | None, names: list[str]) -> list[tuple[Any, ...]]:
+    """``Mechanism.simulate``'s ``events`` as the native call takes them: (index, value,
+    terminal, direction) for a crossing, (g, terminal, direction) for a function."""
+    out: list[tuple[Any, ...]] = []
+    for e in events or ():
+        if isinstance(e, Mapping):  # a crossing as a results file's settings hold it
+            e = Crossing(**e)
+        if isinstance(e, Crossing):
+            if e.coordinate not in names:
+                raise ValueError(f"event: unknown coordinate {e.coordinate!r}; coordinates are: {', '.join(names)}")
+            out.append((names.index(e.coordinate), float(e.value), bool(e.terminal), float(e.direction)))
+        elif callable(e):
+            out.append((e, bool(getattr(e, "terminal", False)), float(getattr(e, "direction", 0.0))))
+        else:
+            raise TypeError(f"an event is a function g(t, q, qd) -> float or a planardyn.Crossing, "
+                            f"got {type(e).__name__}")
+    return out

@@ -1,0 +1,230 @@
+"""Motors with transmissions, friction from the pair loads, and the sizing report's limit
+checks (docs/actuators.md), through the Python API."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import numpy as np
+import planardyn as pd
+import pytest
+from conftest import MODELS
+from planardyn import robot, structure
+from scipy.integrate import solve_ivp
+
+G = 9.81
+PENDULUM = """
+name: pendulum with pin friction
+gravity: [0, -9.81]
+points: {O: [0, 0], A: [0.8, 0]}
+ground: [O]
+bodies:
+  bar: {points: [O, A], uniform_bar: [O, A], mass: 2.0}
+pairs:
+  - {type: revolute, name: O, at: O, bodies: [ground, bar]}
+coordinates:
+  - {name: theta, pair: O, value: 0.0}
+loads:
+  - {type: friction, pair: O, mu: 0.3, pin_radius: 0.02, stiction_speed: 1.0e-3}
+"""
+
+
+def pendulum_rhs(_t: float, y: np.ndarray) -> list[float]:
+    """theta'' of the bar (m = 2 kg, L = 0.8 m, I_O = m L^2 / 3) with pin friction
+    mu r |F| tanh(r theta' / v_st), F = m a_c - m g solved with theta'' by fixed point."""
+    theta, w = y
+    m, lc, i_o, mu, r, v_st = 2.0, 0.4, 2.0 * 0.64 / 3.0, 0.3, 0.02, 1e-3
+    s, c = np.sin(theta), np.cos(theta)
+    qdd = 0.0
+    for _ in range(200):
+        f = np.hypot(m * lc * (-s * qdd - c * w * w), m * lc * (c * qdd - s * w * w) + m * G)
+        new = (-m * G * lc * c - mu * r * f * np.tanh(r * w / v_st)) / i_o
+        if abs(new - qdd) <= 1e-15 * max(abs(new), 1.0):
+            break
+        qdd = new
+    return [w, new]
+
+
+def test_pendulum_with_pin_friction_against_scipy():
+    mech = pd.loads(PENDULUM)
+    res = mech.simulate(2.0, method="dop853", rtol=1e-11, atol=1e-13, t_eval=[1.0, 2.0])
+    ref = solve_ivp(pendulum_rhs, (0.0, 2.0), [0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-13, t_eval=[1.0, 2.0])
+    # Both integrate to ~1e-11 relative: they agree to 1e-8 rad and 1e-7 rad/s.
+    np.testing.assert_allclose(res.q[:, 0], ref.y[0], atol=1e-8)
+    np.testing.assert_allclose(res.qd[:, 0], ref.y[1], atol=1e-7)
+
+
+def slider_crank(friction: bool) -> pd.Mechanism:
+    model = pd.load(MODELS / "slider-crank.yaml").to_dict()
+    model["loads"] = [ld for ld in model.get("loads", []) if ld["type"] != "friction"]
+    if friction:
+        names = [p.get("name") for p in model["pairs"]]
+        for k, p in enumerate(model["pairs"]):
+            if p.get("name") is None:
+                p["name"] = f"pin{k}"
+                names[k] = p["name"]
+            if p["type"] == "revolute":
+                model["loads"].append({"type": "friction", "pair": p["name"], "mu": 0.15, "pin_radius": 0.01})
+            else:
+                model["loads"].append({"type": "friction", "pair": p["name"], "mu": 0.2, "length": 0.04})
+    return pd.from_dict(model)
+
+
+def test_drive_power_is_frictionless_power_plus_dissipated_power():
+    with_f, without = slider_crank(True), slider_crank(False)
+    t = np.linspace(0.0, 1.0, 201)
+    q0 = with_f.q0[0]
+    q = (q0 + 6.0 * t + 0.8 * np.sin(3 * t))[:, None]
+    qd = (6.0 + 2.4 * np.cos(3 * t))[:, None]
+    qdd = (-7.2 * np.sin(3 * t))[:, None]
+    tau, tau0 = with_f.inverse_dynamics(q, qd, qdd), without.inverse_dynamics(q, qd, qdd)
+    lost = with_f.dissipated_power(q, qd, qdd)
+    assert lost.shape == (201,) and np.all(lost > 0)
+    # The balance holds at every row to round-off (virtual power, the same motion).
+    np.testing.assert_allclose(tau[:, 0] * qd[:, 0], tau0[:, 0] * qd[:, 0] + lost, rtol=1e-10, atol=1e-10)
+
+
+GEARED = {"gear_ratio": 40.0, "efficiency": 0.85, "rotor_inertia": 2e-5, "viscous": 1e-5, "coulomb": 0.005}
+
+
+def five_bar_with_motors(limits: dict[str, dict[str, float]] | None = None) -> pd.Mechanism:
+    model = copy.deepcopy(pd.load(MODELS / "five-bar.yaml").to_dict())
+    model["actuators"] = [{"coordinate": c, **GEARED, **({"limits": limits[c]} if limits else {})}
+                          for c in ("theta1", "theta2")]
+    return pd.from_dict(model)
+
+
+def sized(mech: pd.Mechanism) -> robot.SizingReport:
+    ee = robot.EndEffector(mech, "P")
+    home = ee.home()
+    return robot.size(ee, robot.circle(home[:2] + [0.0, 0.03], 0.03, 0.5), dt=2e-3)
+
+
+def test_motor_side_of_the_sizing_report():
+    rep = sized(five_bar_with_motors())
+    n, eta = GEARED["gear_ratio"], GEARED["efficiency"]
+    m = rep.motion
+    for k, d in enumerate(rep.drives):
+        mo = d.motor
+        assert mo is not None and mo.checks == []
+        # Motor speed n qd; motor torque tau / (n eta) + friction while motoring, tau eta / n +
+        # friction while generating (the transmission's definition, docs/actuators.md).
+        w = n * m.qd[:, k]
+        fr = GEARED["viscous"] * w + GEARED["coulomb"] * np.tanh(w / 1e-2)
+        gear = np.where(m.tau[:, k] * m.qd[:, k] >= 0, m.tau[:, k] / (n * eta), m.tau[:, k] * eta / n)
+        np.testing.assert_allclose(mo.torque, gear + fr, rtol=1e-12, atol=1e-15)
+        assert mo.peak_speed == pytest.approx(np.abs(w).max(), rel=1e-14)
+    # The rotors' reflected inertia n^2 J is in the joint efforts: inverse dynamics with and
+    # without it differ by n^2 J qdd.
+    bare = pd.load(MODELS / "five-bar.yaml")
+    tau0 = bare.inverse_dynamics(m.q, m.qd, m.qdd)
+    np.testing.assert_allclose(m.tau - tau0, n * n * GEARED["rotor_inertia"] * m.qdd, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("quantity", ["peak torque", "RMS torque", "speed", "torque-speed"])
+def test_limit_checks_pass_just_inside_and_fail_just_outside(quantity):
+    need = sized(five_bar_with_motors()).drives
+    for factor, expected in ((1.0 + 1e-6, True), (1.0 - 1e-6, False)):
+        limits = {}
+        for d in need:
+            mo = d.motor
+            assert mo is not None
+            if quantity == "peak torque":
+                lim = {"peak_torque": mo.peak_torque * factor}
+            elif quantity == "RMS torque":
+                lim = {"continuous_torque": mo.rms_torque * factor}
+            elif quantity == "speed":
+                lim = {"max_speed": mo.peak_speed * factor}
+            else:
+                # A flat envelope at the peak torque up to 10x the speed: the ratio is the peak's.
+                top = 10 * mo.peak_speed
+                lim = {"torque_speed": [[0.0, mo.peak_torque * factor], [top, mo.peak_torque * factor]]}
+            limits[d.name] = lim
+        rep = sized(five_bar_with_motors(limits))
+        for d in rep.drives:
+            assert d.motor is not None
+            (check,) = d.motor.checks
+            assert check.quantity == quantity
+            assert check.passed is expected and d.motor.passed is expected
+            assert check.margin == pytest.approx(1.0 - 1.0 / factor, rel=1e-6)
+        text = str(rep)
+        assert ("FAIL" in text) is not expected
+
+
+def test_motor_envelope_with_a_corner():
+    mech = five_bar_with_motors({c: {"peak_torque": 1.0, "max_speed": 300.0, "corner_speed": 200.0}
+                                 for c in ("theta1", "theta2")})
+    # Peak torque up to the corner, then linear to 0 at the maximum speed.
+    np.testing.assert_allclose(mech.available_torque(0, [0.0, 150.0, -200.0, 250.0, 300.0, 400.0]),
+                               [1.0, 1.0, 1.0, 0.5, 0.0, 0.0], atol=1e-15)
+
+
+def test_bad_actuators_are_refused_with_their_field():
+    model = pd.load(MODELS / "five-bar.yaml").to_dict()
+    for bad, path in (({"coordinate": "theta1", "efficiency": 1.2}, "actuators[0].efficiency"),
+                      ({"coordinate": "nope"}, "actuators[0].coordinate"),
+                      ({"coordinate": "theta1", "limits": {"corner_speed": 3.0}}, "actuators[0].limits")):
+        with pytest.raises(pd.ModelError) as info:
+            pd.from_dict({**model, "actuators": [bad]})
+        assert info.value.path == path
+    with pytest.raises(pd.ModelError) as info:
+        pd.from_dict({**model, "loads": [{"type": "friction", "pair": "elbow1", "mu": 0.1}]})
+    assert info.value.path == "loads[0].pin_radius"
+
+
+def three_legged() -> pd.Mechanism:
+    """The five-bar with a third leg A3 -> C3 -> P (0.25 m, 0.35 m) actuated at A3."""
+    model = pd.load(MODELS / "five-bar.yaml").to_dict()
+    model["loads"], model["drives"] = [], []
+    model["points"] |= {"A3": [0.0, 0.0], "C3": [0.1983444079681374, 0.1521824425739351]}
+    model["ground"].append("A3")
+    model["bodies"] |= {"proximal_mid": {"points": ["A3", "C3"], "uniform_bar": ["A3", "C3"], "mass": 0.5},
+                        "distal_mid": {"points": ["C3", "P"], "uniform_bar": ["C3", "P"], "mass": 0.7}}
+    model["pairs"] += [{"type": "revolute", "name": "motor3", "at": "A3", "bodies": ["ground", "proximal_mid"]},
+                       {"type": "revolute", "name": "elbow3", "at": "C3", "bodies": ["proximal_mid", "distal_mid"]},
+                       {"type": "revolute", "name": "effector3", "at": "P", "bodies": ["distal_left", "distal_mid"]}]
+    model["actuators"] = [{"pair": "motor3"}]
+    return pd.from_dict(model)
+
+
+def test_redundant_efforts_min_norm_and_forward():
+    mech = three_legged()
+    assert mech.actuator_names == ["theta1", "theta2", "motor3"]
+    assert structure.analyse(mech).actuation == 3
+    q, qd, qdd = mech.q0 + [0.05, -0.04], [1.2, -0.7], [3.0, 5.0]
+    out = mech.distribute_efforts(q, qd, qdd)
+    # Minimum norm: numpy's least-squares solution of B tau = the generalized efforts.
+    tau_gen = out["B"] @ out["efforts"]
+    np.testing.assert_allclose(out["efforts"], np.linalg.lstsq(out["B"], tau_gen, rcond=None)[0], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(out["B"] @ out["internal"].T, 0.0, atol=1e-13)
+    for how in ({"method": "min_max"}, {"method": "preload", "preload": [3.0]}):
+        e = mech.distribute_efforts(q, qd, qdd, **how)["efforts"]
+        np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, e), qdd, rtol=1e-10)
+    with pytest.raises(ValueError):
+        mech.distribute_efforts(q, qd, qdd, method="preload")
+
+
+def test_sizing_a_redundantly_actuated_robot_sizes_every_actuator(tmp_path):
+    mech = three_legged()
+    ee = robot.EndEffector(mech, "P")
+    home = ee.home()
+    path = robot.circle(home[:2] + [0.0, 0.02], 0.02, 0.5)
+    rep = robot.size(ee, path, dt=5e-3)
+    assert [d.name for d in rep.drives] == ["theta1", "theta2", "motor3"]
+    m = rep.motion
+    peaks = np.array([d.peak_effort for d in rep.drives])
+    # The shares reproduce the generalized efforts of the motion: B tau_a = tau at every row.
+    row = len(m.t) // 2
+    out = mech.distribute_efforts(m.q[row], m.qd[row], m.qdd[row])
+    np.testing.assert_allclose(out["B"] @ out["efforts"], m.tau[row], rtol=1e-10, atol=1e-10)
+    # Min-max makes every row's largest effort least, so its peak over the motion is at most
+    # min-norm's.
+    mm = robot.size(ee, path, dt=5e-3, distribution="min_max")
+    assert max(d.peak_effort for d in mm.drives) <= peaks.max() * (1 + 1e-12)
+    # From the shell, with a preload.
+    model = tmp_path / "three.json"
+    model.write_text(json.dumps(mech.to_dict()))
+    c = home[:2] + [0.0, 0.02]
+    assert robot.size_cli([str(model), "--circle", str(c[0]), str(c[1]), "0.02", "--duration", "0.5", "--dt", "5e-3",
+                           "--distribution", "preload", "--preload", "2.0"]) == 0
