@@ -26,7 +26,7 @@ pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivativ
 pub use energy::{kinetic_energy, potential_energy};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{dynamic_stages, forward, mass_matrix};
-pub use inverse::inverse;
+pub use inverse::{inverse, inverse_at_rates, rates_mismatch};
 pub use losses::LossBuffers;
 pub use motion::{Motion, MotionFunction, Prescribed};
 pub use prescribed::{forward_prescribed, prescribed_sigma_min};
