@@ -89,7 +89,7 @@ impl PyMechanism {
         qdd: &ArrayArg<'_>,
         x: Option<&ArrayArg<'_>>,
         xd: Option<&ArrayArg<'_>>,
-    ) -> PyResult<(Values, Values, Values, Option<Values>, Option<Values>)> {
+    ) -> PyResult<MotionRows> {
         let x = x.map(|a| rows("x", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
         let xd = xd.map(|a| rows("xd", a, self.inner.n_x(), "body rates [Xd, Yd, phid] per body")).transpose()?;
         if let Some(xd) = &xd {
@@ -971,6 +971,9 @@ fn check_time(t: f64) -> PyResult<()> {
 fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
     serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
 }
+
+/// A motion's q, qd, qdd rows and the optional body coordinates x and rates xd of its rows.
+type MotionRows = (Values, Values, Values, Option<Values>, Option<Values>);
 
 /// The branch of a motion: the drawn one, from the first row's body coordinates (3n,), or
 /// every row's (N, 3n); with body rates (x's shape, checked by `motion_rows`) every row's.
