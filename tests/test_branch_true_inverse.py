@@ -30,7 +30,10 @@ def free_fall():
 
 def test_free_fall_efforts_are_zero_from_the_result(free_fall):
     mech, res = free_fall
-    tau = mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x)
+    # With the run's body rates: at its most singular row (sigma 8.6e-4) one rounding unit of
+    # qd moves the rates solved from it, and the efforts by ~2e-8 N m (2.5e-8 measured from
+    # x alone); xd holds the integrator's state.
+    tau = mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x, xd=res.xd)
     # Passive: 0 exactly; 1e-8 N m is the bound, ~1e4 times the round-off of A qdd - b.
     assert np.abs(tau).max() < 1e-8
 
@@ -39,10 +42,24 @@ def test_free_fall_efforts_are_zero_from_its_results_file(free_fall, tmp_path):
     mech, res = free_fall
     path = tmp_path / "free-fall.npz"
     write_results(res, path)
+    # The file's xd are passed with its x (see the test above for why).
     inv = inverse_from_file(mech, path)
     assert np.abs(inv.tau).max() < 1e-8
+    assert np.array_equal(inv.xd, res.xd)
     assert inv.metadata["branch"] == "each row's body coordinates"
     assert np.allclose(inv.x, res.x, atol=1e-9)
+
+
+def test_body_rates_that_are_not_qd_s_are_refused_naming_the_row(free_fall):
+    mech, res = free_fall
+    xd = res.xd.copy()
+    # Another state's rates: one body's angular rate off by 1e-6 rad/s, far above the
+    # round-off (relative 1e-10 accepted) and far below the rates themselves (~1-10 rad/s).
+    xd[7, 2] += 1e-6
+    with pytest.raises(ValueError, match="row 7"):
+        mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x, xd=xd)
+    with pytest.raises(ValueError, match="xd needs x"):
+        mech.inverse_dynamics(res.q, res.qd, res.qdd, xd=res.xd)
 
 
 def test_free_fall_from_q_alone_is_refused_at_the_singularity(free_fall):
@@ -72,8 +89,9 @@ def test_slider_crank_through_its_dead_centre(v0):
 
 def test_a_single_row_near_a_singularity_is_not_refused(free_fall):
     # One row has no "after": nothing to decide. At the run's most singular row (sigma
-    # 1.4e-3) the passive efforts are still 0 to round-off amplified by 1/sigma.
+    # 8.6e-4) the passive efforts are still 0 to round-off amplified by 1/sigma, given the
+    # row's body rates (from qd's rounding alone they are 2.5e-8 N m off).
     mech, res = free_fall
     i = int(np.argmin(res.sigma))
-    tau = mech.inverse_dynamics(res.q[i], res.qd[i], res.qdd[i], x=res.x[i])
+    tau = mech.inverse_dynamics(res.q[i], res.qd[i], res.qdd[i], x=res.x[i], xd=res.xd[i])
     assert np.abs(tau).max() < 1e-8

@@ -129,6 +129,7 @@ class Mechanism:
         qd: ArrayLike,
         qdd: ArrayLike,
         x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> Any: ...
     def spec_json(self) -> str: ...
@@ -162,6 +163,7 @@ class Mechanism:
         qd: ArrayLike,
         qdd: ArrayLike,
         x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> NDArray[np.float64]: ...
     def reactions(

@@ -311,6 +311,7 @@ class Mechanism:
         qd: ArrayLike,
         qdd: ArrayLike,
         x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> FloatArray:
         """Drive efforts that produce a motion: tau = A qdd - U^T (f - M c).
@@ -328,6 +329,13 @@ class Mechanism:
             (0.05) of a type II singularity raise ``SingularityError`` (attributes ``row``,
             ``sigma_min``): there the motion may have left on the other branch, which q
             alone cannot tell.
+        xd : array_like of x's shape, optional
+            Body rates of x's rows (a result's ``xd``; needs ``x``), used instead of the rates
+            solved from qd: near a type II singularity (measure sigma) one rounding unit of
+            qd moves those by eps/sigma, and the efforts with them (2.5e-8 N m at sigma
+            8.6e-4 on the free-falling five-bar). Rows whose xd are not the rates of their qd
+            (J xd = [0; qd] within ``planardyn::batch::RATES_TOL``, 1e-10 relative) raise
+            ``ValueError`` naming the row.
 
         Returns
         -------
@@ -345,7 +353,7 @@ class Mechanism:
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
         """
-        return self._native.inverse_dynamics(q, qd, qdd, x, allow_singular)
+        return self._native.inverse_dynamics(q, qd, qdd, x, xd, allow_singular)
 
     def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray:
         """Motor torques (N m, motor side) that give the joint-side efforts ``tau`` (N m or N)
@@ -388,12 +396,18 @@ class Mechanism:
         return self._native.available_torque(int(coordinate), speed)
 
     def dissipated_power(
-        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, x: ArrayLike | None = None, allow_singular: bool = False
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
+        allow_singular: bool = False,
     ) -> Any:
         """Power (W, >= 0) the pairs' Coulomb friction dissipates along a motion (arguments as
         :meth:`inverse_dynamics`): a float for one row, (N,) for rows. The drive power
         ``tau . qd`` exceeds the frictionless one by exactly this."""
-        return self._native.dissipated_power(q, qd, qdd, x, allow_singular)
+        return self._native.dissipated_power(q, qd, qdd, x, xd, allow_singular)
 
     def forward_dynamics_derivatives(
         self,

@@ -365,7 +365,8 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     -------
     dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``, ``tau``: (N, m) arrays where
     every coordinate had such a column (a results file has all three), else None; ``x`` (N, 3n) the
-    body coordinates of a results file (the branch it is on), None for a table; and
+    body coordinates of a results file (the branch it is on) and ``xd`` (N, 3n) its body rates,
+    None for a table; and
     per-coordinate lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
     """
     path = Path(path)
@@ -380,7 +381,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 f"the model's ({', '.join(coordinate_names)})"
             )
         return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau, "x": res.x,
-                "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
+                "xd": res.xd, "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
     _, header, rows = _read_named_csv(path)
@@ -413,7 +414,7 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
     both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731
     tau = both([get(f"tau_{n}") for n in coordinate_names])
-    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "x": None,
+    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "x": None, "xd": None,
             "qd_columns": qd_cols, "qdd_columns": qdd_cols}
 
 
@@ -455,6 +456,7 @@ def inverse_result(
     qd: ArrayLike | None = None,
     qdd: ArrayLike | None = None,
     x: ArrayLike | None = None,
+    xd: ArrayLike | None = None,
 ) -> SimulationResult:
     """Drive efforts for a prescribed motion, as a result (``metadata['kind'] = 'inverse'``).
 
@@ -474,6 +476,9 @@ def inverse_result(
     x : (3n,) or (N, 3n) array_like, optional
         Body coordinates (m, m, rad per body) at the first row, or at every row (a results
         file's ``x``).
+    xd : array_like of x's shape, optional
+        Body rates of x's rows (a results file's ``xd``), used instead of those solved from
+        qd (:meth:`Mechanism.inverse_dynamics`); then also the result's ``xd``.
 
     Returns
     -------
@@ -495,8 +500,9 @@ def inverse_result(
     qd = np.ascontiguousarray(qd, dtype=np.float64).reshape(q.shape)
     qdd = np.ascontiguousarray(qdd, dtype=np.float64).reshape(q.shape)
     given = None if x is None else np.asarray(x, dtype=np.float64)
+    given_xd = None if xd is None else np.asarray(xd, dtype=np.float64)
     try:
-        tau = np.asarray(mech.inverse_dynamics(q, qd, qdd, given), dtype=np.float64).reshape(q.shape)
+        tau = np.asarray(mech.inverse_dynamics(q, qd, qdd, given, given_xd), dtype=np.float64).reshape(q.shape)
     except SingularityError as e:
         row = getattr(e, "row", None)
         if row is not None:
@@ -513,7 +519,7 @@ def inverse_result(
         else:
             start = given if i == 0 else x[i - 1]
         k = mech.kinematics(q[i], qd[i], x_start=start)
-        x[i], xd[i] = k["x"], k["xd"]
+        x[i], xd[i] = k["x"], k["xd"] if given_xd is None else given_xd.reshape(n_t, -1)[i]
         sigma[i], residual[i] = k["sigma_min"], k["residual"]
         kinetic[i], potential[i] = mech.energy(q[i], qd[i], x_start=x[i])
     power = np.sum(tau * qd, axis=1)
@@ -543,7 +549,7 @@ def inverse_from_file(mech: Mechanism, path: str | os.PathLike[str]) -> Simulati
     m = read_motion(path, mech.coordinate_names)
     qd, qdd = motion_derivatives(m["t"], m["q"], m["qd_columns"], m["qdd_columns"])
     try:
-        res = inverse_result(mech, m["t"], m["q"], qd, qdd, x=m["x"])
+        res = inverse_result(mech, m["t"], m["q"], qd, qdd, x=m["x"], xd=m["xd"])
     except SingularityError as e:
         e.args = (f"{path}: {e}",)
         raise

@@ -88,8 +88,19 @@ impl PyMechanism {
         qd: &ArrayArg<'_>,
         qdd: &ArrayArg<'_>,
         x: Option<&ArrayArg<'_>>,
-    ) -> PyResult<(Values, Values, Values, Option<Values>)> {
+        xd: Option<&ArrayArg<'_>>,
+    ) -> PyResult<MotionRows> {
         let x = x.map(|a| rows("x", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
+        let xd = xd.map(|a| rows("xd", a, self.inner.n_x(), "body rates [Xd, Yd, phid] per body")).transpose()?;
+        if let Some(xd) = &xd {
+            if x.as_ref().map(|x| &x.shape) != Some(&xd.shape) {
+                let x_shape = x.as_ref().map(|x| format!("{:?}", x.shape)).unwrap_or_else(|| "none".into());
+                return Err(PyValueError::new_err(format!(
+                    "xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}",
+                    xd.shape
+                )));
+            }
+        }
         let (m, what) = (self.m(), self.coords_what());
         let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
         if qd.shape != q.shape || qdd.shape != q.shape {
@@ -98,7 +109,7 @@ impl PyMechanism {
                 q.shape, qd.shape, qdd.shape
             )));
         }
-        Ok((q, qd, qdd, x))
+        Ok((q, qd, qdd, x, xd))
     }
 
     /// Drive efforts: the given tau, or the model's drives.
@@ -527,8 +538,10 @@ impl PyMechanism {
 
     /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
     /// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
-    /// (`planardyn::batch::Branch`).
-    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    /// (`planardyn::batch::Branch`). `xd`, the body rates of x's rows, replaces the rates
+    /// solved from qd.
+    #[pyo3(signature = (q, qd, qdd, x=None, xd=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
     fn inverse_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -536,20 +549,24 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
         x: Option<ArrayArg<'py>>,
+        xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let (q, qd, qdd, x, xd) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), xd.as_ref())?;
         let mech = self.inner.clone();
         let shape = q.shape.clone();
         let tau = run(py, move || {
-            Ok(inverse_rows_checked(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+            let branch = branch_of(x.as_ref(), xd.as_ref());
+            Ok(inverse_rows_checked(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         arr_dyn(py, &shape, tau)
     }
 
     /// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
-    /// (m,) or (N, m): a float or (N,), on the branch of x as `inverse_dynamics`.
-    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    /// (m,) or (N, m): a float or (N,), on the branch of x (and with the rates xd) as
+    /// `inverse_dynamics`.
+    #[pyo3(signature = (q, qd, qdd, x=None, xd=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
     fn dissipated_power<'py>(
         &self,
         py: Python<'py>,
@@ -557,13 +574,15 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
         x: Option<ArrayArg<'py>>,
+        xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let (q, qd, qdd, x, xd) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), xd.as_ref())?;
         let mech = self.inner.clone();
         let single = q.shape.len() == 1;
         let p = run(py, move || {
-            Ok(dissipation_rows(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+            let branch = branch_of(x.as_ref(), xd.as_ref());
+            Ok(dissipation_rows(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         if single {
             return Ok(p[0].into_pyobject(py)?.into_any());
@@ -730,11 +749,11 @@ impl PyMechanism {
         x: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (q, qd, qdd, x) = self.motion_rows(&q, &qd, &qdd, x.as_ref())?;
+        let (q, qd, qdd, x, _) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), None)?;
         let mech = self.inner.clone();
         let (m, p) = (self.m(), planardyn::dynamics::regressor::BODY_PARAMETERS * mech.bodies.len());
         let (y, tau_o) = run(py, || {
-            Ok(regressor_rows(&mech, branch_of(x.as_ref()), &q.data, &qd.data, &qdd.data, allow_singular)?)
+            Ok(regressor_rows(&mech, branch_of(x.as_ref(), None), &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         let n = q.rows();
         let d = PyDict::new(py);
@@ -953,12 +972,16 @@ fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
     serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
 }
 
+/// A motion's q, qd, qdd rows and the optional body coordinates x and rates xd of its rows.
+type MotionRows = (Values, Values, Values, Option<Values>, Option<Values>);
+
 /// The branch of a motion: the drawn one, from the first row's body coordinates (3n,), or
-/// every row's (N, 3n).
-fn branch_of(x: Option<&Values>) -> Branch<'_> {
-    match x {
-        None => Branch::Drawing,
-        Some(x) if x.shape.len() == 1 => Branch::From(&x.data),
-        Some(x) => Branch::Rows(&x.data),
+/// every row's (N, 3n); with body rates (x's shape, checked by `motion_rows`) every row's.
+fn branch_of<'a>(x: Option<&'a Values>, xd: Option<&'a Values>) -> Branch<'a> {
+    match (x, xd) {
+        (None, _) => Branch::Drawing,
+        (Some(x), Some(xd)) => Branch::Rows(&x.data, Some(&xd.data)),
+        (Some(x), None) if x.shape.len() == 1 => Branch::From(&x.data),
+        (Some(x), None) => Branch::Rows(&x.data, None),
     }
 }

@@ -113,8 +113,11 @@ pub enum Branch<'a> {
     /// The one through these body coordinates (3n, e.g. a result's first row), then row to row.
     From(&'a [f64]),
     /// Each row's own body coordinates (N x 3n, as a simulation records them): exact whatever
-    /// branches the motion went through.
-    Rows(&'a [f64]),
+    /// branches the motion went through; with each row's body rates xd too (N x 3n, a
+    /// simulation's), which near a type II singularity hold the state more exactly than qd
+    /// (one rounding unit of qd moves the rates J xd = [0; qd] gives by eps/sigma). Rows whose
+    /// xd and qd disagree by more than [`RATES_TOL`] are refused.
+    Rows(&'a [f64], Option<&'a [f64]>),
 }
 
 /// A motion given by q alone whose continuation passes below this type II measure is
@@ -122,6 +125,12 @@ pub enum Branch<'a> {
 /// the singularity may leave on either (the free-falling five-bar does). The integrator's own
 /// threshold for leaving the input chart (`simulate::charts::SWITCH_TO_PARTITION`).
 pub const BRANCH_SIGMA: f64 = SWITCH_TO_PARTITION;
+
+/// The largest relative mismatch of given body rates xd with a row's qd,
+/// [`dynamics::rates_mismatch`], accepted: round-off leaves a few eps, whatever J's
+/// conditioning; rates of another state are off by O(1) (one body's rate 1e-6 rad/s off,
+/// about 1e-7 relative, is refused in tests/test_branch_true_inverse.py).
+pub const RATES_TOL: f64 = 1e-10;
 
 /// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each) on the drawn branch;
 /// see [`inverse_rows_on`].
@@ -155,8 +164,8 @@ pub fn inverse_rows_checked(
     allow_singular: bool,
 ) -> Result<Vec<f64>, Error> {
     let mut tau = Vec::with_capacity(q.len());
-    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
-        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], ws)?;
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, xd| {
+        dynamics::inverse_at_rates(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], xd, ws)?;
         tau.extend_from_slice(&ws.tau);
         Ok(())
     })?;
@@ -174,8 +183,8 @@ pub fn dissipation_rows(
     allow_singular: bool,
 ) -> Result<Vec<f64>, Error> {
     let mut out = Vec::with_capacity(q.len() / mech.dof().max(1));
-    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
-        dynamics::inverse(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], ws)?;
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, xd| {
+        dynamics::inverse_at_rates(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], xd, ws)?;
         out.push(ws.dissipated);
         Ok(())
     })?;
@@ -184,7 +193,8 @@ pub fn dissipation_rows(
 
 /// The regressor form along rows of a motion on `branch` (as [`inverse_rows_checked`]):
 /// Y (N x m x p, p = [`dynamics::regressor::BODY_PARAMETERS`] per body) and tau_o (N x m),
-/// so that every row's efforts are Y pi + tau_o.
+/// so that every row's efforts are Y pi + tau_o. Its body rates come from qd (U qd), so
+/// rows' given xd are refused rather than ignored.
 pub fn regressor_rows(
     mech: &Mechanism,
     branch: Branch<'_>,
@@ -193,10 +203,14 @@ pub fn regressor_rows(
     qdd: &[f64],
     allow_singular: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    if let Branch::Rows(_, Some(_)) = branch {
+        let expected = "no body rates: the regressor takes the rates of qd (pass x alone)";
+        return Err(KinematicsError::bad_argument("xd", expected, "body rates").into());
+    }
     let p = dynamics::regressor::BODY_PARAMETERS * mech.bodies.len();
     let m = mech.dof().max(1);
     let (mut y, mut tau_o) = (vec![0.0; q.len() * p], vec![0.0; q.len()]);
-    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row| {
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, _| {
         dynamics::forward::kinematic_stages(mech, &q[row.clone()], &qd[row.clone()], ws)?;
         let k = row.start / m;
         let (y_row, tau_row) = (&mut y[k * m * p..(k + 1) * m * p], &mut tau_o[row.clone()]);
@@ -207,7 +221,8 @@ pub fn regressor_rows(
 }
 
 /// Assemble every row of (q, qd, qdd) on `branch` in one workspace and call `each` with the
-/// row's index range (which computes into the workspace); then the type II measure: below
+/// row's index range and given body rates (which computes into the workspace); then the
+/// given rates' agreement with qd (within [`RATES_TOL`]) and the type II measure: below
 /// [`dynamics::SINGULAR_SIGMA`] refused unless `allow_singular`, and with q alone (no `Rows`)
 /// a motion that goes on past a row within [`BRANCH_SIGMA`] refused as `BranchUndecided`.
 fn walk_rows(
@@ -217,7 +232,7 @@ fn walk_rows(
     qd: &[f64],
     qdd: &[f64],
     allow_singular: bool,
-    mut each: impl FnMut(&mut Workspace, std::ops::Range<usize>) -> Result<(), Error>,
+    mut each: impl FnMut(&mut Workspace, std::ops::Range<usize>, Option<&[f64]>) -> Result<(), Error>,
 ) -> Result<(), Error> {
     let (m, nx) = (mech.dof(), mech.n_x());
     if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
@@ -229,25 +244,47 @@ fn walk_rows(
         .into());
     }
     let n = q.len() / m;
-    if let Branch::Rows(x) = branch {
-        if x.len() != n * nx {
-            let expected = format!("{n} rows of {nx} body coordinates, one per row of q");
-            return Err(KinematicsError::bad_argument("x", expected, format!("{} values", x.len())).into());
+    if let Branch::Rows(x, xd) = branch {
+        for (name, v) in [("x", Some(x)), ("xd", xd)] {
+            let Some(v) = v else { continue };
+            if v.len() != n * nx {
+                let expected = format!("{n} rows of {nx} body values, one per row of q");
+                return Err(KinematicsError::bad_argument(name, expected, format!("{} values", v.len())).into());
+            }
+        }
+        if let Some(k) = xd.and_then(|xd| xd.iter().position(|v| !v.is_finite())) {
+            let got = format!("{} in row {}", xd.unwrap_or_default()[k], k / nx);
+            return Err(KinematicsError::bad_argument("xd", "finite body rates", got).into());
         }
     }
     let mut ws = Workspace::new(mech);
+    let mut jac = Vec::new();
     for k in 0..n {
         let row = k * m..(k + 1) * m;
+        let mut xd_row = None;
         match (branch, k) {
-            (Branch::Rows(x), _) => assemble_from(mech, &x[k * nx..(k + 1) * nx], &q[row.clone()], &mut ws)?,
+            (Branch::Rows(x, xd), _) => {
+                assemble_from(mech, &x[k * nx..(k + 1) * nx], &q[row.clone()], &mut ws)?;
+                xd_row = xd.map(|xd| &xd[k * nx..(k + 1) * nx]);
+            }
             (Branch::From(x), 0) => assemble_from(mech, x, &q[row.clone()], &mut ws)?,
             (Branch::Drawing, 0) => assemble_into(mech, &q[row.clone()], &mut ws)?,
             _ => continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?,
         }
-        each(&mut ws, row)?;
+        each(&mut ws, row.clone(), xd_row)?;
+        if let Some(xd) = xd_row {
+            jac.resize(nx * nx, 0.0);
+            let mismatch = dynamics::rates_mismatch(mech, &ws, &qd[row], xd, &mut jac);
+            if mismatch > RATES_TOL {
+                let expected = format!("the body rates of row {k}'s qd (J xd = [0; qd] within {RATES_TOL:e} relative)");
+                let got =
+                    format!("a relative mismatch of {mismatch:.2e} in row {k}: pass the xd of the same rows as q, qd");
+                return Err(KinematicsError::bad_argument("xd", expected, got).into());
+            }
+        }
         let sigma_min = dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
         // Only the rows after a near-singular one are in doubt.
-        if !matches!(branch, Branch::Rows(_)) && k + 1 < n && sigma_min < BRANCH_SIGMA {
+        if !matches!(branch, Branch::Rows(..)) && k + 1 < n && sigma_min < BRANCH_SIGMA {
             return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
         }
     }

@@ -100,6 +100,19 @@ pub fn forward(
     ws: &mut Workspace,
 ) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
+    dynamic_stages(mech, t, z, zd, drives, ws)
+}
+
+/// The stages of [`forward`] after the kinematic ones (whose results `ws` holds): forces,
+/// A, b, zdd, xdd and the user's accelerations.
+pub fn dynamic_stages(
+    mech: &Mechanism,
+    t: f64,
+    z: &[f64],
+    zd: &[f64],
+    drives: &mut dyn Drives,
+    ws: &mut Workspace,
+) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
     transmission::to_joint_efforts(mech, ws);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);

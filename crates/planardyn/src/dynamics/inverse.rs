@@ -5,7 +5,7 @@
 use super::forces::applied_forces;
 use super::forward::{kinematic_stages, m_dot};
 use super::losses::inverse_with_losses;
-use crate::kinematics::constraints::gamma;
+use crate::kinematics::constraints::{gamma, jacobian};
 use crate::kinematics::Chart;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
@@ -22,9 +22,23 @@ pub fn inverse(
     qdd: &[f64],
     ws: &mut Workspace,
 ) -> Result<(), KinematicsError> {
+    inverse_at_rates(mech, q, qd, qdd, None, ws)
+}
+
+/// [`inverse`], with `xd` the body rates of the same state (3n, e.g. a result's row; see
+/// [`rates_mismatch`]) used instead of solving J xd = [0; qd] when given: near a type II
+/// singularity one rounding unit of qd moves that solution, and the efforts, by eps/sigma.
+pub fn inverse_at_rates(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    xd: Option<&[f64]>,
+    ws: &mut Workspace,
+) -> Result<(), KinematicsError> {
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
-    body_motion(mech, qd, qdd, ws);
+    body_motion(mech, qd, qdd, xd, ws);
     ws.tau.fill(0.0);
     applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
     // tau = A qdd - b, formed as U^T (M xdd - f): M xdd - f is the constraint reaction,
@@ -45,20 +59,47 @@ pub fn inverse(
 }
 
 /// Body rates and accelerations of rates qd and accelerations qdd in the user's chart, each
-/// from one solve with the factorised J:
+/// from one solve with the factorised J (the rates only when `given` is `None`):
 ///   J xd = [0; qd],   J xdd = -gamma(xd, xd) + [0; qdd].
 /// Near a type II singularity U qd and U qdd + c add columns of size 1/sigma into a vector
 /// of size 1, each carrying its solve's error eps/sigma^2; one solve of the summed
 /// right-hand side errs by eps/sigma only.
-fn body_motion(mech: &Mechanism, qd: &[f64], qdd: &[f64], ws: &mut Workspace) {
+fn body_motion(mech: &Mechanism, qd: &[f64], qdd: &[f64], given: Option<&[f64]>, ws: &mut Workspace) {
     let nc = mech.n_constraints;
-    ws.xd.fill(0.0);
-    ws.xd[nc..].copy_from_slice(qd);
-    ws.sys.solve(&mut ws.xd);
+    if let Some(xd) = given {
+        ws.xd.copy_from_slice(xd);
+    } else {
+        ws.xd.fill(0.0);
+        ws.xd[nc..].copy_from_slice(qd);
+        ws.sys.solve(&mut ws.xd);
+    }
     gamma(mech, &ws.chart, &ws.x, &ws.trig, &ws.xd, &ws.xd, &mut ws.xdd);
     for (i, a) in ws.xdd.iter_mut().enumerate() {
         let drive = if i >= nc { qdd[i - nc] } else { 0.0 };
         *a = drive - *a;
     }
     ws.sys.solve(&mut ws.xdd);
+}
+
+/// How far body rates xd are from being the rates of user rates qd at the positions in `ws`
+/// (`ws.x`, `ws.trig`): the largest row of |J xd - [0; qd]| relative to that row's own size,
+/// sum |J_ki xd_i| + |[0; qd]_k|. A product and a subtraction, so independent of J's
+/// conditioning: round-off gives a few eps, rates of another state O(1). `j` is a 3n x 3n
+/// scratch buffer.
+pub fn rates_mismatch(mech: &Mechanism, ws: &Workspace, qd: &[f64], xd: &[f64], j: &mut [f64]) -> f64 {
+    let (n, nc) = (xd.len(), mech.n_constraints);
+    jacobian(mech, &Chart::Inputs, &ws.x, &ws.trig, j);
+    (0..n)
+        .map(|k| {
+            let rhs = if k >= nc { qd[k - nc] } else { 0.0 };
+            let row = &j[k * n..(k + 1) * n];
+            let jxd: f64 = row.iter().zip(xd).map(|(a, v)| a * v).sum();
+            let size: f64 = row.iter().zip(xd).map(|(a, v)| (a * v).abs()).sum::<f64>() + rhs.abs();
+            if size > 0.0 {
+                (jxd - rhs).abs() / size
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
 }

@@ -25,8 +25,8 @@ pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
     Ok(())
 }
 
-/// Body velocities `ws.xd = U zd` and the convective term `ws.c`, from `ws.u`.
-pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Workspace) {
+/// Body velocities `ws.xd = U zd`, from `ws.u`.
+pub(crate) fn body_rates(zd: &[f64], ws: &mut Workspace) {
     let n = ws.x.len();
     ws.xd.fill(0.0);
     for (j, &r) in zd.iter().enumerate() {
@@ -34,6 +34,11 @@ pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Workspace) {
             *v += u * r;
         }
     }
+}
+
+/// Body velocities `ws.xd = U zd` and the convective term `ws.c`, from `ws.u`.
+pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Workspace) {
+    body_rates(zd, ws);
     gamma(mech, &ws.chart, &ws.x, &ws.trig, &ws.xd, &ws.xd, &mut ws.c);
     for v in ws.c.iter_mut() {
         *v = -*v;

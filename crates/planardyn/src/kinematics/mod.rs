@@ -3,7 +3,9 @@
 //! One algorithm a file; all of them work on the body coordinates x (3n values).
 
 pub mod analogues;
+pub mod closed_form;
 pub mod constraints;
+pub mod dyads;
 pub mod effector;
 pub mod group_sigma;
 pub mod pairs;
@@ -13,6 +15,7 @@ pub mod system;
 pub mod third;
 
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
+pub use closed_form::ClosedForm;
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
 pub use pairs::{pair_geometry, PairGeometry};

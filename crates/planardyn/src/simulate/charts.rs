@@ -32,6 +32,7 @@ pub struct Measures {
 /// (an SVD of each block of the user's chart, linear in the bodies), and the passive measure
 /// an SVD of the whole Phi_x (at the few steps near a type II singularity only).
 pub fn measure(ode: &mut MechanismOde) -> Measures {
+    ode.factor_stale_j();
     let estimate = match ode.ws.chart {
         Chart::Inputs => ode.ws.sys.sigma_min_estimate(),
         Chart::Partition(_) => None,

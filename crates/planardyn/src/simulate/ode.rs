@@ -2,10 +2,10 @@
 //! y = [z, zd, W] with y' = [zd, zdd, P], where W is the work done by the non-conservative
 //! forces and P its power, so that T + V - W is constant along any exact trajectory.
 
-use crate::dynamics::{forward, forward_prescribed, Drives, Prescribed};
+use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{scaled_distance, Chart, System, MAX_CORRECTION};
+use crate::kinematics::{scaled_distance, Chart, ClosedForm, System, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
@@ -20,6 +20,16 @@ const BASIN_FRACTION: f64 = 0.5;
 /// on the other branch with a small correction (DOPRI5 at rtol 1e-4 on the five-bar: a
 /// 0.47 jump in one 3.5 ms step, corrections all under 0.05, -1.8 J).
 const MOVE_FRACTION: f64 = 2.0;
+
+/// Below this type II measure at the last accepted point the user's chart takes the Newton
+/// path even where closed forms exist. A dyad's branch changes where the passive motion goes
+/// through its fold (the five-bar's type II singularities, A02's change points, where the
+/// parallelogram branch crosses the dyad's base line); the closed forms keep the branch by
+/// construction, while the Newton path's predictor follows the motion's tangent there. A step
+/// can start well clear of such a point: at 0.1 A02 at N = 2 stepped over a change point once
+/// (reported without its rank drop) and at 0.3 A02 at N = 40 ended 1.09e-6 rad from the exact
+/// reduction (tests/change_points.rs); at 0.5 both keep their Newton-path results.
+const CLOSED_FORM_SIGMA: f64 = 0.5;
 
 /// A mechanism in one chart, with the state the Newton predictor starts from.
 pub struct MechanismOde<'a> {
@@ -54,12 +64,23 @@ pub struct MechanismOde<'a> {
     /// The blocks of the user's chart, analysed once: the type II measure while a partition
     /// is integrated (`charts::measure`).
     pub inputs_sys: System,
+    /// The user's chart in closed form, where every group has one (`kinematics::closed_form`),
+    /// its branches those of the last accepted point; and whether `ws.sys` is then behind the
+    /// point in `ws` (factorised at the monitor's request only, once a step).
+    closed: Option<ClosedForm>,
+    stale_j: bool,
+    /// Whether the last accepted point is clear of folds ([`CLOSED_FORM_SIGMA`]).
+    clear_of_folds: bool,
 }
 
 impl<'a> MechanismOde<'a> {
     /// A system whose workspace `ws` holds a converged, analysed point of chart `ws.chart`.
     pub fn new(mech: &'a Mechanism, ws: Workspace, drives: &'a mut dyn Drives) -> Self {
         let m = mech.dof();
+        let mut closed = ClosedForm::new(mech);
+        if let Some(c) = closed.as_mut() {
+            c.set_reference(&ws.x);
+        }
         MechanismOde {
             motion: None,
             eval_y: vec![0.0; 2 * m + 1],
@@ -76,6 +97,9 @@ impl<'a> MechanismOde<'a> {
             max_move: f64::INFINITY,
             failed_evaluations: 0,
             inputs_sys: System::new(mech),
+            closed,
+            stale_j: false,
+            clear_of_folds: true,
             mech,
             ws,
             drives,
@@ -106,6 +130,9 @@ impl<'a> MechanismOde<'a> {
         self.anchor_u.copy_from_slice(&self.ws.u);
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
+        if let Some(c) = self.closed.as_mut() {
+            c.set_reference(&self.ws.x);
+        }
         Ok(())
     }
 
@@ -115,16 +142,37 @@ impl<'a> MechanismOde<'a> {
     /// is O(1)), and Newton from a predictor past half-way lands on it with a correction well
     /// under MAX_CORRECTION: the five-bar of the benchmarks, DOPRI5 at rtol 1e-4, jumped
     /// branch with a 0.047 correction at sigma ~ 0.06 and lost 6e-3 J, ending 4 rad off.
-    /// A quarter of the separation keeps the start inside its own basin.
+    /// A quarter of the separation keeps the start inside its own basin. Below
+    /// [`CLOSED_FORM_SIGMA`] the evaluations also leave the closed forms for Newton.
     pub fn limit_correction(&mut self, sigma: f64) {
         self.max_correction = MAX_CORRECTION.min(BASIN_FRACTION * sigma);
+        self.clear_of_folds = sigma >= CLOSED_FORM_SIGMA;
         self.max_move = MOVE_FRACTION * sigma;
     }
 
     /// Bound the move of a solution from its predictor's anchor by `max` as well (scaled, as
     /// [`MechanismOde::limit_correction`]'s).
+    /// Near a change point the evaluations take the Newton path (see [`CLOSED_FORM_SIGMA`]).
     pub fn limit_move(&mut self, max: f64) {
         self.max_move = self.max_move.min(max);
+        self.clear_of_folds = false;
+    }
+
+    /// Whether evaluations take the closed forms: there are some, in the user's chart, clear
+    /// of folds, with no coordinate driven by a prescribed motion.
+    fn closed_form_in_use(&self) -> bool {
+        self.closed.is_some() && self.ws.chart == Chart::Inputs && self.clear_of_folds && self.motion.is_none()
+    }
+
+    /// Factorise J at the point in `ws` if a closed-form evaluation left it behind (for the
+    /// monitor's type II measure). A singular J stays unfactorised, and the monitor then takes
+    /// the exact measure, which finds the singularity.
+    pub fn factor_stale_j(&mut self) {
+        if self.stale_j {
+            self.stale_j = false;
+            let ws = &mut self.ws;
+            let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
+        }
     }
 
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
@@ -138,6 +186,10 @@ impl<'a> MechanismOde<'a> {
     pub fn set_chart(&mut self, chart: Chart, t: f64, y: &[f64]) -> Result<(), Error> {
         self.ws.chart = chart;
         self.anchor_x.copy_from_slice(&self.ws.x);
+        if let Some(c) = self.closed.as_mut() {
+            // A partition may have carried a dyad through its fold onto its other branch.
+            c.set_reference(&self.ws.x);
+        }
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
         self.last_t = f64::NAN;
@@ -147,11 +199,13 @@ impl<'a> MechanismOde<'a> {
 
     /// Newton's start for chart values z: a second-order prediction
     /// x + U dz + 1/2 w(dz, dz) from the last evaluation when it succeeded (its x, U and
-    /// factorised J are still in `ws`; w(dz, dz) costs one solve), else a first-order one
-    /// from the last accepted point. Both start from converged points of the same branch.
+    /// factorised J are still in `ws`; w(dz, dz) costs one solve, or the closed forms'
+    /// accelerations for the rates U dz), else a first-order one from the last accepted point.
+    /// Both start from converged points of the same branch.
     fn predict(&mut self, z: &[f64]) {
         let m = self.m();
         let n = self.ws.x.len();
+        let closed = self.closed_form_in_use();
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);
@@ -161,8 +215,16 @@ impl<'a> MechanismOde<'a> {
                     *d += u * dz;
                 }
             }
-            gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
-            ws.sys.solve(&mut ws.tmp);
+            match self.closed.as_ref().filter(|_| closed) {
+                Some(c) => {
+                    c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
+                    ws.tmp.iter_mut().for_each(|w| *w = -*w);
+                }
+                None => {
+                    gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
+                    ws.sys.solve(&mut ws.tmp);
+                }
+            }
             for ((x, d), w) in ws.x.iter_mut().zip(&ws.rhs).zip(&ws.tmp) {
                 *x += d - 0.5 * w;
             }
@@ -180,6 +242,10 @@ impl<'a> MechanismOde<'a> {
     /// Forward dynamics at (t, y). A large Newton correction from the prediction fails the
     /// evaluation (the integrator then takes a shorter step), so a long step cannot carry
     /// the mechanism onto another assembly branch, however close it is (`limit_correction`).
+    /// In closed form the solution is that of the last accepted point's branches, and the same
+    /// bounds refuse a step along which the predictor fails (near a fold, where the passive
+    /// motion may leave that branch): the integrator then shortens it, and the monitor moves
+    /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let mut z = std::mem::take(&mut self.eval_y);
         z.copy_from_slice(y);
@@ -205,24 +271,29 @@ impl<'a> MechanismOde<'a> {
                 motion.overwrite(m, y);
             }
         }
+        let (z, zd) = (&y[..m], &y[m..2 * m]);
         self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
-        self.predict(&y[..m]);
+        self.predict(z);
         self.predicted.copy_from_slice(&self.ws.x);
+        let newton = !self.closed_form_in_use();
         self.last_t = f64::NAN;
         self.base_valid = false;
-        let (z, zd) = (&y[..m], &y[m..2 * m]);
-        let mut outcome = match self.motion.as_deref_mut() {
-            None => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
-            Some(motion) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
+        self.stale_j = !newton;
+        let mut outcome = match (self.closed.as_mut().filter(|_| !newton), self.motion.as_deref_mut()) {
+            (Some(c), _) => c
+                .kinematic_stages(z, zd, &mut self.ws)
+                .map_err(Error::from)
+                .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws)),
+            (_, None) => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
+            (_, Some(motion)) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
         };
-        let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
-        let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
-        if outcome.is_ok() && moved > self.max_move {
-            outcome = Err(KinematicsError::AssemblyFailed { residual: moved, iterations: self.ws.iterations }.into());
-        }
-        if outcome.is_ok() && correction > self.max_correction {
-            outcome =
-                Err(KinematicsError::AssemblyFailed { residual: correction, iterations: self.ws.iterations }.into());
+        if outcome.is_ok() {
+            let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
+            let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
+            let residual = if moved > self.max_move { moved } else { correction };
+            if moved > self.max_move || correction > self.max_correction {
+                outcome = Err(KinematicsError::AssemblyFailed { residual, iterations: self.ws.iterations }.into());
+            }
         }
         outcome
     }

@@ -39,7 +39,7 @@ pub struct AssurGroup {
 }
 
 /// What the decomposition finds (see [`super::Structure`]).
-pub(super) struct Assur {
+pub(crate) struct Assur {
     pub input_links: Vec<BodyId>,
     pub relative_inputs: Vec<PairId>,
     pub groups: Vec<AssurGroup>,
@@ -96,7 +96,7 @@ fn augment(r: usize, rows: &[Vec<usize>], col_row: &mut [Option<usize>], seen: &
     false
 }
 
-pub(super) fn assur(mech: &Mechanism) -> Assur {
+pub(crate) fn assur(mech: &Mechanism) -> Assur {
     let (n, nx) = (mech.n_bodies(), mech.n_x());
     let mut input = vec![false; mech.pairs.len()];
     for c in &mech.coordinates {

@@ -14,7 +14,7 @@
 //! - **Assur groups**: the blocks of the block-triangular form of the position Jacobian with
 //!   the inputs locked, see [`AssurGroup`].
 
-mod assur;
+pub(crate) mod assur;
 mod loops;
 mod rank;
 

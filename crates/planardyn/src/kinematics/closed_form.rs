@@ -1,0 +1,170 @@
+//! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
+//! mechanism is made of input links turned by revolute pairs and class II RRR dyads only, the
+//! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
+//! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
+//! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
+//! assembly branch of a reference configuration (the integrator's last accepted point); where
+//! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
+//! Other mechanisms (prismatic, gear and slot pairs, class III groups and up, relative inputs,
+//! redundant pairs) take the general path (`position`, `analogues`).
+
+use super::analogues::body_rates;
+use super::dyads::crank::Crank;
+use super::dyads::rrr::{Branch, Geometry, Rrr};
+use super::dyads::Joint;
+use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
+use crate::structure::assur;
+use crate::workspace::Workspace;
+use crate::KinematicsError;
+
+#[derive(Debug, Clone)]
+pub struct ClosedForm {
+    cranks: Vec<Crank>,
+    dyads: Vec<Rrr>,
+    /// Per dyad, the branch of the reference configuration, and its geometry at the last
+    /// positions (for the rates and accelerations).
+    branches: Vec<Branch>,
+    geometry: Vec<Geometry>,
+}
+
+/// The end of a revolute pair on `body` (its point there) and the other end.
+fn ends(mech: &Mechanism, pair: PairId, body: usize) -> ([f64; 2], Joint) {
+    let p = &mech.pairs[pair.0];
+    if p.a == Link::Body(BodyId(body)) {
+        (p.sa, Joint { link: p.b, s: p.sb })
+    } else {
+        (p.sb, Joint { link: p.a, s: p.sa })
+    }
+}
+
+impl ClosedForm {
+    /// The closed forms of `mech`'s groups, if every group has one (see the module's doc); the
+    /// branches are those of the drawing until [`ClosedForm::set_reference`].
+    pub fn new(mech: &Mechanism) -> Option<Self> {
+        let decomposition = assur::assur(mech);
+        if !decomposition.relative_inputs.is_empty() || !decomposition.left_over.is_empty() {
+            return None;
+        }
+        let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
+        let mut cranks = Vec::new();
+        for (k, c) in mech.coordinates.iter().enumerate() {
+            let p = &mech.pairs[c.pair.0];
+            let body = match (p.a, p.b) {
+                (Link::Ground, Link::Body(b)) | (Link::Body(b), Link::Ground) => b.0,
+                _ => return None,
+            };
+            if !revolute(c.pair) {
+                return None;
+            }
+            let (s, ground) = ends(mech, c.pair, body);
+            let pivot = ground.s;
+            let sign = if p.b == Link::Body(BodyId(body)) { 1.0 } else { -1.0 };
+            cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
+        }
+        let mut dyads = Vec::new();
+        let mut pairs_used = mech.coordinates.len();
+        for g in &decomposition.groups {
+            let [inner] = g.inner_pairs.as_slice() else { return None };
+            if g.class != 2 || g.kind != "RRR" || g.links.iter().any(|l| l.len() != 1) {
+                return None;
+            }
+            if !g.inner_pairs.iter().chain(&g.outer_pairs).all(|&k| revolute(k)) {
+                return None;
+            }
+            let bodies = [g.links[0][0].0, g.links[1][0].0];
+            let touching = |b: usize| {
+                g.outer_pairs.iter().copied().find(|&k| {
+                    let p = &mech.pairs[k.0];
+                    p.a == Link::Body(BodyId(b)) || p.b == Link::Body(BodyId(b))
+                })
+            };
+            let (Some(o1), Some(o2)) = (touching(bodies[0]), touching(bodies[1])) else { return None };
+            let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
+            let (i1, _) = ends(mech, *inner, bodies[0]);
+            let (i2, _) = ends(mech, *inner, bodies[1]);
+            dyads.push(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]));
+            pairs_used += 3;
+        }
+        let mut solved = vec![0; mech.n_bodies()];
+        cranks.iter().map(|c| c.body).chain(dyads.iter().flat_map(|d| d.bodies)).for_each(|b| solved[b] += 1);
+        if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
+            return None;
+        }
+        let branches = dyads.iter().map(|d| d.branch(&mech.x0)).collect();
+        Some(ClosedForm { cranks, geometry: vec![Geometry::default(); dyads.len()], dyads, branches })
+    }
+
+    /// Take the assembly branches from the configuration x (a solution).
+    pub fn set_reference(&mut self, x: &[f64]) {
+        for (b, d) in self.branches.iter_mut().zip(&self.dyads) {
+            *b = d.branch(x);
+        }
+    }
+
+    /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.
+    pub fn positions(&mut self, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+        for c in &self.cranks {
+            c.position(z, &mut ws.x, &mut ws.trig);
+        }
+        for ((d, b), g) in self.dyads.iter().zip(&self.branches).zip(&mut self.geometry) {
+            *g = d.position(b, &mut ws.x, &mut ws.trig)?;
+        }
+        ws.residual = 0.0;
+        ws.iterations = 0;
+        Ok(())
+    }
+
+    /// Body rates for coordinate rates zd into v (3n), at the positions in `ws`.
+    fn rates(&self, trig: &[[f64; 2]], zd: &[f64], v: &mut [f64]) {
+        for c in &self.cranks {
+            c.velocity(trig, zd, v);
+        }
+        for (d, g) in self.dyads.iter().zip(&self.geometry) {
+            d.velocity(g, v);
+        }
+    }
+
+    /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
+    pub fn velocity_analogues(&self, ws: &mut Workspace) {
+        let (n, m) = (ws.x.len(), self.cranks.len());
+        // Each crank body has 3 coordinates, so the 3n scratch holds the m unit rates.
+        let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
+        unit[..m].fill(0.0);
+        for j in 0..m {
+            unit[j] = 1.0;
+            self.rates(&ws.trig, &unit[..m], &mut u[j * n..(j + 1) * n]);
+            unit[j] = 0.0;
+        }
+        (ws.u, ws.rhs) = (u, unit);
+    }
+
+    /// Body rates `ws.xd` = U zd and the convective term `ws.c` (accelerations at zdd = 0),
+    /// from `ws.u`.
+    pub fn convective(&self, zd: &[f64], ws: &mut Workspace) {
+        body_rates(zd, ws);
+        self.accelerations(&ws.trig, &ws.xd, &mut ws.c);
+    }
+
+    /// Body accelerations `a` at zero coordinate accelerations for body rates v (3n, a velocity
+    /// of the mechanism), at the last positions (`trig` theirs): the convective term for v,
+    /// -J^-1 gamma(v, v).
+    pub fn accelerations(&self, trig: &[[f64; 2]], v: &[f64], a: &mut [f64]) {
+        for k in &self.cranks {
+            k.acceleration(trig, v, a);
+        }
+        for (d, g) in self.dyads.iter().zip(&self.geometry) {
+            d.acceleration(g, v, a);
+        }
+    }
+
+    /// Positions, analogues and the convective term at (z, zd) in the user's chart, and the
+    /// user's coordinates q = z, qd = zd: what `dynamics::kinematic_stages` computes there.
+    pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+        self.positions(z, ws)?;
+        self.velocity_analogues(ws);
+        self.convective(zd, ws);
+        ws.q.copy_from_slice(z);
+        ws.qd.copy_from_slice(zd);
+        Ok(())
+    }
+}

@@ -1,0 +1,80 @@
+//! Closed forms of the groups the Assur decomposition finds (`kinematics::closed_form`), one
+//! file a kind: the input link turned by its revolute pair ([`crank`]) and the class II dyad
+//! of three revolute pairs ([`rrr`]). Each gives positions, velocities (a column of U for a unit
+//! rate) and accelerations with zero input accelerations (the convective term c), from the links
+//! solved before it, in the order of the decomposition.
+
+pub mod crank;
+pub mod rrr;
+
+use super::pairs::frames::rot;
+use crate::model::Link;
+
+/// A point fixed in a link: the link and the point in its frame (m).
+#[derive(Debug, Clone, Copy)]
+pub struct Joint {
+    pub link: Link,
+    pub s: [f64; 2],
+}
+
+/// Pose (centre, [cos, sin]) of a link in x and trig; the ground's is the identity.
+#[inline]
+pub(crate) fn pose(link: Link, x: &[f64], trig: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
+    match link {
+        Link::Ground => ([0.0; 2], [1.0, 0.0]),
+        Link::Body(b) => ([x[3 * b.0], x[3 * b.0 + 1]], trig[b.0]),
+    }
+}
+
+/// (linear, angular) part of a rate vector for a link (zeros for the ground).
+#[inline]
+pub(crate) fn rate(link: Link, v: &[f64]) -> ([f64; 2], f64) {
+    match link {
+        Link::Ground => ([0.0; 2], 0.0),
+        Link::Body(b) => ([v[3 * b.0], v[3 * b.0 + 1]], v[3 * b.0 + 2]),
+    }
+}
+
+impl Joint {
+    /// World position of the point, and R(phi) s.
+    #[inline]
+    pub(crate) fn place(&self, x: &[f64], trig: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
+        let (r, cs) = pose(self.link, x, trig);
+        let p = rot(cs, self.s);
+        ([r[0] + p[0], r[1] + p[1]], p)
+    }
+
+    /// Velocity of the point for rates v, given R s (`place`): r' + w E R s.
+    #[inline]
+    pub(crate) fn velocity(&self, rs: [f64; 2], v: &[f64]) -> [f64; 2] {
+        let (rd, w) = rate(self.link, v);
+        [rd[0] - w * rs[1], rd[1] + w * rs[0]]
+    }
+
+    /// Acceleration of the point for rates v and accelerations a, given R s:
+    /// r'' + al E R s - w^2 R s.
+    #[inline]
+    pub(crate) fn acceleration(&self, rs: [f64; 2], v: &[f64], a: &[f64]) -> [f64; 2] {
+        let (_, w) = rate(self.link, v);
+        let (rdd, al) = rate(self.link, a);
+        [rdd[0] - al * rs[1] - w * w * rs[0], rdd[1] + al * rs[0] - w * w * rs[1]]
+    }
+}
+
+/// Write a body's rates (centre velocity r' = v_p - w E R s from a point p = r + R s of
+/// velocity v_p, and w) into v.
+#[inline]
+pub(crate) fn put_rate(v: &mut [f64], body: usize, vp: [f64; 2], rs: [f64; 2], w: f64) {
+    v[3 * body] = vp[0] + w * rs[1];
+    v[3 * body + 1] = vp[1] - w * rs[0];
+    v[3 * body + 2] = w;
+}
+
+/// Write a body's accelerations (r'' = a_p - al E R s + w^2 R s from a point p = r + R s of
+/// acceleration a_p, and al) into a.
+#[inline]
+pub(crate) fn put_acceleration(a: &mut [f64], body: usize, ap: [f64; 2], rs: [f64; 2], w: f64, al: f64) {
+    a[3 * body] = ap[0] + al * rs[1] + w * w * rs[0];
+    a[3 * body + 1] = ap[1] - al * rs[0] + w * w * rs[1];
+    a[3 * body + 2] = al;
+}

@@ -1,0 +1,139 @@
+//! The class II dyad of three revolute pairs: bodies 1 and 2 hinged to each other at P and to
+//! links solved before them at A and B. P is where the circles about A and B of radii
+//! l1 = |AP| and l2 = |BP| meet, on the side of AB it is on in the reference configuration
+//! (the assembly branch); the two bodies' rates and accelerations solve
+//! w1 E e1 - w2 E e2 = v_B - v_A (and its derivative) with e1 = P - A, e2 = P - B, whose
+//! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
+
+use super::{put_acceleration, put_rate, Joint};
+use crate::kinematics::pairs::frames::{dot, link_state, perp, rot, sub};
+use crate::model::{BodyId, Link};
+use crate::{KinematicsError, SingularityKind};
+use std::f64::consts::{PI, TAU};
+
+#[inline]
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+#[derive(Debug, Clone)]
+pub struct Rrr {
+    pub bodies: [usize; 2],
+    /// A and B on the links solved before, and the same points in the frames of bodies 1, 2.
+    pub outer: [Joint; 2],
+    pub s_outer: [[f64; 2]; 2],
+    /// P - A in body 1's frame and P - B in body 2's, and their squared lengths.
+    pub arms: [[f64; 2]; 2],
+    pub arms2: [f64; 2],
+}
+
+/// What the dyad keeps from the reference configuration: the side of AB that P is on (+1 to
+/// the left of A -> B) and the bodies' angles, each as a whole number of turns plus a
+/// remainder in (-pi, pi] (the new angles are taken within pi of them).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Branch {
+    pub side: f64,
+    pub turns: [f64; 2],
+    pub rest: [f64; 2],
+}
+
+/// The dyad at its solved position, for the rates and accelerations: R s of A and B on their
+/// links and on bodies 1 and 2, e1, e2 in the world and 1 / (e1 x e2).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Geometry {
+    known: [[f64; 2]; 2],
+    own: [[f64; 2]; 2],
+    e: [[f64; 2]; 2],
+    inv_det: f64,
+}
+
+impl Rrr {
+    /// A dyad of `bodies` hinged at A and B to the links before it (`outer`, with the same
+    /// points `s_outer` in the bodies' frames) and to each other at P (`s_inner` in each frame).
+    pub fn new(bodies: [usize; 2], outer: [Joint; 2], s_outer: [[f64; 2]; 2], s_inner: [[f64; 2]; 2]) -> Self {
+        let arms = [sub(s_inner[0], s_outer[0]), sub(s_inner[1], s_outer[1])];
+        Rrr { bodies, outer, s_outer, arms2: arms.map(|a| dot(a, a)), arms }
+    }
+
+    /// The branch of the configuration x.
+    pub fn branch(&self, x: &[f64]) -> Branch {
+        let [a, b] = self.outer.map(|j| link_state(j.link, x).point(j.s));
+        let s_p = [self.s_outer[0][0] + self.arms[0][0], self.s_outer[0][1] + self.arms[0][1]];
+        let p = link_state(Link::Body(BodyId(self.bodies[0])), x).point(s_p);
+        let phi = self.bodies.map(|i| x[3 * i + 2]);
+        let turns = phi.map(|f| TAU * (f / TAU).round());
+        Branch { side: cross(sub(b, a), sub(p, a)).signum(), turns, rest: [phi[0] - turns[0], phi[1] - turns[1]] }
+    }
+
+    /// The bodies' poses (x and trig) on `branch`, the links before them solved.
+    #[inline]
+    pub fn position(&self, branch: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
+        let (a, ra) = self.outer[0].place(x, trig);
+        let (b, rb) = self.outer[1].place(x, trig);
+        let [l1, l2] = self.arms2;
+        let d = sub(b, a);
+        let dd = dot(d, d);
+        let along = (l1 - l2 + dd) / (2.0 * dd);
+        let h2 = l1 / dd - along * along;
+        if !(h2 >= 0.0) {
+            // The circles miss each other (or A = B): no assembly at these coordinates.
+            return Err(if dd > 0.0 {
+                KinematicsError::AssemblyFailed { residual: (-h2).sqrt(), iterations: 0 }
+            } else {
+                KinematicsError::singular(SingularityKind::TypeII)
+            });
+        }
+        let h = branch.side * h2.sqrt();
+        let n = perp(d);
+        let p = [a[0] + along * d[0] + h * n[0], a[1] + along * d[1] + h * n[1]];
+        let mut g = Geometry { known: [ra, rb], ..Geometry::default() };
+        for (i, q) in [a, b].into_iter().enumerate() {
+            // The rotation taking the arm in the body's frame to e = P - q in the world.
+            let (arm, e) = (self.arms[i], sub(p, q));
+            let (c, s) = (dot(arm, e), cross(arm, e));
+            let r = (c * c + s * s).sqrt();
+            let cs = [c / r, s / r];
+            let mut turn = s.atan2(c) - branch.rest[i];
+            if turn > PI {
+                turn -= TAU;
+            } else if turn < -PI {
+                turn += TAU;
+            }
+            let rs = rot(cs, self.s_outer[i]);
+            let k = 3 * self.bodies[i];
+            x[k] = q[0] - rs[0];
+            x[k + 1] = q[1] - rs[1];
+            x[k + 2] = branch.turns[i] + branch.rest[i] + turn;
+            trig[self.bodies[i]] = cs;
+            g.own[i] = rs;
+            g.e[i] = e;
+        }
+        g.inv_det = 1.0 / cross(g.e[0], g.e[1]);
+        Ok(g)
+    }
+
+    /// The bodies' rates, those of the links before them in v.
+    #[inline]
+    pub fn velocity(&self, g: &Geometry, v: &mut [f64]) {
+        let va = self.outer[0].velocity(g.known[0], v);
+        let vb = self.outer[1].velocity(g.known[1], v);
+        let dv = sub(vb, va);
+        let (w1, w2) = (dot(dv, g.e[1]) * g.inv_det, dot(dv, g.e[0]) * g.inv_det);
+        put_rate(v, self.bodies[0], va, g.own[0], w1);
+        put_rate(v, self.bodies[1], vb, g.own[1], w2);
+    }
+
+    /// The bodies' accelerations, from the rates v and the accelerations of the links before
+    /// them in a.
+    #[inline]
+    pub fn acceleration(&self, g: &Geometry, v: &[f64], a: &mut [f64]) {
+        let aa = self.outer[0].acceleration(g.known[0], v, a);
+        let ab = self.outer[1].acceleration(g.known[1], v, a);
+        let (w1, w2) = (v[3 * self.bodies[0] + 2], v[3 * self.bodies[1] + 2]);
+        let (k1, k2, [e1, e2]) = (w1 * w1, w2 * w2, g.e);
+        let da = [ab[0] - aa[0] + k1 * e1[0] - k2 * e2[0], ab[1] - aa[1] + k1 * e1[1] - k2 * e2[1]];
+        let (al1, al2) = (dot(da, e2) * g.inv_det, dot(da, e1) * g.inv_det);
+        put_acceleration(a, self.bodies[0], aa, g.own[0], w1, al1);
+        put_acceleration(a, self.bodies[1], ab, g.own[1], w2, al2);
+    }
+}

@@ -1,0 +1,196 @@
+//! The closed-form kinematics of the user's chart (`kinematics::closed_form`) against the
+//! general path (Newton on the block-triangular J, then U and c by solves with its factors), on
+//! every shipped model that has one, at random configurations and rates: positions, U, xd, c,
+//! A and zdd must agree to round-off.
+//!
+//! Tolerance: the general path stops Newton at a scaled residual of 1e-14 and polishes it to
+//! round-off, so its x is exact to about 1e-14 / sigma (sigma the type II measure, >= 0.05 where
+//! the integrator uses the user's chart); U, c and A inherit that relative error, amplified
+//! once more by 1/sigma. The measured worst differences over these models and states are quoted
+//! with the bounds (printed with --nocapture).
+
+use planardyn::dynamics::{dynamic_stages, forward, mass_matrix, ModelDrives};
+use planardyn::kinematics::{assemble_into, sigma_min, Chart, ClosedForm};
+use planardyn::{KinematicsError, Mechanism, Workspace};
+use std::path::{Path, PathBuf};
+
+/// Positions (scaled: lengths / L, angles in rad). Measured worst: 2.4e-13 (Watt six-bar).
+const X_TOL: f64 = 1e-11;
+/// U, xd, c, A, qdd, xdd relative to the largest entry of each. Measured worst: 1e-13 for U,
+/// xd, c and A; 1.4e-11 for qdd (the four-bar under gravity, where b = U^T (f - M c) is a
+/// difference of terms up to 10 times larger than itself).
+const REL_TOL: f64 = 1e-10;
+
+fn model_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for sub in [dir.to_path_buf(), dir.join("library")] {
+        for e in std::fs::read_dir(&sub).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "yaml") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// Name relative to the models directory, e.g. `library/four-bar`.
+fn name(dir: &Path, p: &Path) -> String {
+    p.strip_prefix(dir).unwrap().with_extension("").to_string_lossy().into_owned()
+}
+
+/// xorshift64*: reproducible uniform numbers in [0, 1).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m: f64, x| m.max(x.abs()))
+}
+
+/// Largest difference relative to the largest entry of `a`.
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let d = a.iter().zip(b).fold(0.0, |m: f64, (x, y)| m.max((x - y).abs()));
+    d / max_abs(a).max(f64::MIN_POSITIVE)
+}
+
+#[test]
+fn shipped_models_with_closed_forms() {
+    let (examples, package) = (root().join("examples/models"), root().join("python/planardyn/models"));
+    let files = model_files(&examples);
+    // The package ships the same files: what holds for one list holds for the other.
+    let package_files = model_files(&package);
+    assert_eq!(files.iter().map(|p| name(&examples, p)).collect::<Vec<_>>(), {
+        package_files.iter().map(|p| name(&package, p)).collect::<Vec<_>>()
+    });
+    for (a, b) in files.iter().zip(&package_files) {
+        assert_eq!(std::fs::read(a).unwrap(), std::fs::read(b).unwrap(), "{}", a.display());
+    }
+    let closed: Vec<String> = files
+        .iter()
+        .filter(|p| ClosedForm::new(&planardyn::load(p.to_str().unwrap()).unwrap()).is_some())
+        .map(|p| name(&examples, p))
+        .collect();
+    // The others have prismatic, gear or slot pairs, a class III group (3-RRR, the Stephenson
+    // six-bar) or redundant pairs (the double parallelogram): they take the general path.
+    assert_eq!(closed, CLOSED);
+}
+
+/// The shipped models made of revolute input links and RRR dyads only.
+const CLOSED: [&str; 7] = [
+    "andrews-squeezer",
+    "five-bar-free-fall",
+    "five-bar",
+    "four-bar-gravity",
+    "library/five-bar-5r",
+    "library/four-bar",
+    "library/watt-six-bar",
+];
+
+/// The general path's forward dynamics at (q, qd) from the drawing, and the same with the
+/// closed forms on the general solution's branches; A is left in `ws.a` (not its factor).
+fn both(mech: &Mechanism, cf: &mut ClosedForm, q: &[f64], qd: &[f64]) -> Option<(Workspace, Workspace)> {
+    let mut drives = ModelDrives(mech);
+    let mut general = Workspace::new(mech);
+    assemble_into(mech, q, &mut general).ok()?;
+    if sigma_min(mech, &Chart::Inputs, &general.x) < 0.05 {
+        return None; // the integrator leaves the user's chart there
+    }
+    forward(mech, 0.0, q, qd, &mut drives, &mut general).unwrap();
+    cf.set_reference(&general.x);
+    let mut closed = Workspace::new(mech);
+    cf.kinematic_stages(q, qd, &mut closed).unwrap();
+    dynamic_stages(mech, 0.0, q, qd, &mut drives, &mut closed).unwrap();
+    for ws in [&mut general, &mut closed] {
+        mass_matrix(mech, ws);
+    }
+    Some((general, closed))
+}
+
+#[test]
+fn equals_the_general_path_at_random_states() {
+    let dir = root().join("examples/models");
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    for model in CLOSED {
+        let mech = planardyn::load(dir.join(format!("{model}.yaml")).to_str().unwrap()).unwrap();
+        let mut cf = ClosedForm::new(&mech).unwrap();
+        let (q0, _) = mech.initial_state();
+        let (mut compared, mut worst) = (0, [0.0_f64; 7]);
+        for _ in 0..60 {
+            let q: Vec<f64> = q0.iter().map(|v| v + 1.2 * (rng.next() - 0.5)).collect();
+            let qd: Vec<f64> = q0.iter().map(|_| 6.0 * (rng.next() - 0.5)).collect();
+            let Some((g, c)) = both(&mech, &mut cf, &q, &qd) else { continue };
+            compared += 1;
+            let dx =
+                g.x.iter()
+                    .zip(&c.x)
+                    .enumerate()
+                    .fold(0.0_f64, |m, (i, (a, b))| m.max((a - b).abs() / if i % 3 == 2 { 1.0 } else { mech.scale }));
+            let figures =
+                [dx, rel_diff(&g.u, &c.u), rel_diff(&g.xd, &c.xd), rel_diff(&g.c, &c.c), rel_diff(&g.a, &c.a)];
+            let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd)];
+            for (w, f) in worst.iter_mut().zip(figures.iter().chain(&more)) {
+                *w = w.max(*f);
+            }
+            assert_eq!((c.q.as_slice(), c.qd.as_slice()), (q.as_slice(), qd.as_slice()));
+        }
+        eprintln!(
+            "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd: {:?}",
+            worst.map(|w| format!("{w:.1e}"))
+        );
+        assert!(compared >= 30, "{model}: only {compared} of 60 random states assembled clear of singularities");
+        assert!(worst[0] < X_TOL, "{model}: positions differ by {:e} (scaled)", worst[0]);
+        for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..]) {
+            assert!(*w < REL_TOL, "{model}: {what} differs by {w:e} relative");
+        }
+    }
+}
+
+#[test]
+fn keeps_the_branch_of_its_reference() {
+    // The five-bar's dyad on its other branch: P mirrored in the line AB. From either
+    // reference the closed form stays on that reference's branch at a nearby q.
+    let mech = planardyn::load(root().join("examples/models/five-bar.yaml").to_str().unwrap()).unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    let (q0, qd0) = mech.initial_state();
+    let mut ws = Workspace::new(&mech);
+    cf.set_reference(&mech.x0);
+    cf.kinematic_stages(&q0, &qd0, &mut ws).unwrap();
+    let here = ws.x.clone();
+    let q1: Vec<f64> = q0.iter().map(|v| v + 0.02).collect();
+    cf.kinematic_stages(&q1, &qd0, &mut ws).unwrap();
+    let near = ws.x.clone();
+    // Newton from the drawing's branch lands on the same solution.
+    let mut general = Workspace::new(&mech);
+    assemble_into(&mech, &q1, &mut general).unwrap();
+    let d = near.iter().zip(&general.x).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(d < 1e-12 * mech.scale.max(1.0), "closed form and Newton differ by {d:e}");
+    assert!(near.iter().zip(&here).all(|(a, b)| (a - b).abs() < 0.1));
+}
+
+#[test]
+fn reports_coordinates_where_a_dyad_does_not_assemble() {
+    // Five-bar cranks turned apart until the dyad's two links cannot reach: no configuration,
+    // the error a Newton solve that does not converge gives, never NaN positions.
+    let mech = planardyn::load(root().join("examples/models/five-bar.yaml").to_str().unwrap()).unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    let mut ws = Workspace::new(&mech);
+    let (q0, qd0) = mech.initial_state();
+    let apart = [q0[0] + 1.5, q0[1] - 1.5];
+    match cf.kinematic_stages(&apart, &qd0, &mut ws) {
+        Err(KinematicsError::AssemblyFailed { residual, .. }) => assert!(residual > 0.0),
+        other => panic!("expected AssemblyFailed, got {other:?}"),
+    }
+    assert!(assemble_into(&mech, &apart, &mut Workspace::new(&mech)).is_err());
+}
