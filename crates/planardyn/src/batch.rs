@@ -164,12 +164,26 @@ pub fn inverse_rows_checked(
     allow_singular: bool,
 ) -> Result<Vec<f64>, Error> {
     let mut tau = Vec::with_capacity(q.len());
+    inverse_walk(mech, branch, q, qd, qdd, allow_singular, |ws| tau.extend_from_slice(&ws.tau))?;
+    Ok(tau)
+}
+
+/// Inverse dynamics at every row of a motion on `branch` (as [`inverse_rows_checked`]),
+/// `keep` taking what it needs from each row's workspace.
+fn inverse_walk(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    allow_singular: bool,
+    mut keep: impl FnMut(&Workspace),
+) -> Result<(), Error> {
     walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, xd| {
         dynamics::inverse_at_rates(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], xd, ws)?;
-        tau.extend_from_slice(&ws.tau);
+        keep(ws);
         Ok(())
-    })?;
-    Ok(tau)
+    })
 }
 
 /// The power (W, >= 0) the pairs' Coulomb friction dissipates along rows of a motion, on
@@ -183,11 +197,7 @@ pub fn dissipation_rows(
     allow_singular: bool,
 ) -> Result<Vec<f64>, Error> {
     let mut out = Vec::with_capacity(q.len() / mech.dof().max(1));
-    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, xd| {
-        dynamics::inverse_at_rates(mech, &q[row.clone()], &qd[row.clone()], &qdd[row], xd, ws)?;
-        out.push(ws.dissipated);
-        Ok(())
-    })?;
+    inverse_walk(mech, branch, q, qd, qdd, allow_singular, |ws| out.push(ws.dissipated))?;
     Ok(out)
 }
 
