@@ -23,8 +23,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism
-from ..result import SimulationResult
 from ..robot import EndEffector
+from .planned import PlanError, PlannedMotion, effort_bounds, speed_bounds
 
 FloatArray = NDArray[np.float64]
 
@@ -37,12 +37,8 @@ LINEAR_TOL = 1e-9
 EffortLimit = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
 
 
-class PlanError(ValueError):
-    """A path or limits that cannot be planned, with what to change."""
-
-
 @dataclass
-class TimedPath:
+class TimedPath(PlannedMotion):
     """A path with its time-optimal timing.
 
     ``s`` (N,) the grid of the path parameter (dimensionless, 0 to 1); ``sd`` (N,) s' at the
@@ -71,11 +67,6 @@ class TimedPath:
     speed: FloatArray
     status: str
 
-    @property
-    def duration(self) -> float:
-        """The time to run the path (s)."""
-        return float(self.t[-1])
-
     def timing(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """s, s', s'' at times t (s), from the piecewise-quadratic s(t)."""
         tt = np.clip(np.asarray(t, dtype=float), 0.0, self.t[-1])
@@ -98,21 +89,6 @@ class TimedPath:
         i = int(np.clip(np.searchsorted(self.t, t[0]), 0, len(self.t) - 1))
         return np.asarray(self.mech.inverse_dynamics(q, qd, qdd, x=self.x[i]))
 
-    def motion(self, n: int = 400) -> dict[str, dict[str, FloatArray]]:
-        """The timed path as ``simulate(motion=...)`` tables: {name: {"t", "q"}} at n times."""
-        t = np.linspace(0.0, self.duration, n)
-        q = self.state(t)[0]
-        return {name: {"t": t, "q": q[:, k]} for k, name in enumerate(self.mech.coordinate_names)}
-
-    def simulate(self, **options: Any) -> SimulationResult:
-        """Forward dynamics under the planned efforts (open loop, evaluated exactly at every
-        time the integrator asks), from the path's start at rest; output at the grid times.
-        ``options`` go to :meth:`Mechanism.simulate` (default dop853, rtol 1e-11, atol 1e-13)."""
-        kw: dict[str, Any] = dict(method="dop853", rtol=1e-11, atol=1e-13, t_eval=self.t, q0=self.q[0],
-                                  qd0=self.qd[0], drives=lambda t, q, qd: self.efforts([t])[0])
-        kw.update(options)
-        return self.mech.simulate(self.duration, **kw)
-
 
 def _limits(mech: Mechanism, effort: ArrayLike | EffortLimit, q: FloatArray) -> tuple[FloatArray, FloatArray]:
     m = mech.dof
@@ -121,11 +97,8 @@ def _limits(mech: Mechanism, effort: ArrayLike | EffortLimit, q: FloatArray) -> 
         lo = np.array([np.broadcast_to(np.asarray(p[0], dtype=float), (m,)) for p in pairs])
         hi = np.array([np.broadcast_to(np.asarray(p[1], dtype=float), (m,)) for p in pairs])
     else:
-        e = np.asarray(effort, dtype=float)
-        if e.shape not in ((m,), (m, 2)):
-            raise PlanError(f"effort limits: expected (m,) = ({m},) magnitudes or (m, 2) [lo, hi], got shape {e.shape}")
-        lo_hi = np.stack([-e, e], axis=1) if e.ndim == 1 else e
-        lo, hi = np.tile(lo_hi[:, 0], (len(q), 1)), np.tile(lo_hi[:, 1], (len(q), 1))
+        lo1, hi1 = effort_bounds(m, effort)
+        lo, hi = np.tile(lo1, (len(q), 1)), np.tile(hi1, (len(q), 1))
     if not (np.all(lo < hi) and np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         raise PlanError("effort limits: need finite lo < hi for every coordinate")
     return lo, hi
@@ -211,9 +184,7 @@ def time_optimal(
         raise PlanError("waypoints: consecutive waypoints must differ")
     path = toppra.SplineInterpolator(chord / chord[-1], q_w)
     s = np.linspace(0.0, 1.0, n_grid)
-    v = np.full(m, np.inf) if speed is None else np.asarray(speed, dtype=float)
-    if v.shape != (m,) or np.any(v <= 0):
-        raise PlanError(f"speed limits: expected (m,) = ({m},) positive values, got {v}")
+    v = speed_bounds(m, speed)
     if effort is None and not np.isfinite(v).any():
         raise PlanError("no limits: give effort limits, speed limits or both")
     x = branch(mech, path(s))
@@ -241,6 +212,11 @@ def time_optimal(
         constraints.append(constraint.JointVelocityConstraint(np.stack([-vmax, vmax], axis=1)))
     instance = algo.TOPPRA(constraints, path, gridpoints=s, parametrizer="ParametrizeConstAccel")
     sdd, sd, _, status = _solve(instance)
+    if sd is None:
+        from .stage_lp import HighsWrapper
+
+        instance.solver_wrapper = HighsWrapper(instance.constraints, instance.path, instance.gridpoints)
+        sdd, sd, _, status = _solve(instance)
     if sd is None:
         raise PlanError(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
                         "(gravity, springs) may exceed them somewhere: raise the limits or move the path")
