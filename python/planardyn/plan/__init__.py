@@ -1,5 +1,9 @@
-"""Motion planning: time-optimal timing of a path (:func:`time_optimal`)."""
+"""Motion planning: time-optimal timing of a path (:func:`time_optimal`), point-to-point
+trajectory optimisation by collocation (:func:`collocate`)."""
 
-from .topp import PlanError, TimedPath, task_waypoints, time_optimal
+from .collocation import CollocatedMotion, Workspace, collocate
+from .planned import PlanError, PlannedMotion
+from .topp import TimedPath, task_waypoints, time_optimal
 
-__all__ = ["PlanError", "TimedPath", "task_waypoints", "time_optimal"]
+__all__ = ["CollocatedMotion", "PlanError", "PlannedMotion", "TimedPath", "Workspace", "collocate", "task_waypoints",
+           "time_optimal"]

@@ -185,13 +185,21 @@ def _sigma(mech: Mechanism, q: FloatArray) -> float:
 
 def _warm_start(mech: Mechanism, q_start: FloatArray, q_end: FloatArray, lo: FloatArray | None, hi: FloatArray | None,
                 speed: FloatArray, duration: float | None, n: int, previous: PlannedMotion | None) -> tuple[Any, ...]:
-    """(t, q, qd, tau) at n + 1 nodes: a previous motion, or the straight joint path timed by
+    """(T, q, qd, tau) at n + 1 nodes: a previous motion, or the straight joint path timed by
     TOPP within the limits, stretched to ``duration`` when one is given (efforts by inverse
-    dynamics of the stretched motion)."""
-    if previous is None:
-        effort = None if lo is None or hi is None else np.stack([lo, hi], axis=1)
-        if effort is None and not np.isfinite(speed).any():
+    dynamics of the stretched motion); without limits, the straight path in ``duration`` with
+    the cubic timing s = 3 r^2 - 2 r^3, r = t / T (the minimum-effort timing of a double integrator)."""
+    effort = None if lo is None or hi is None else np.stack([lo, hi], axis=1)
+    if previous is None and effort is None and not np.isfinite(speed).any():
+        if duration is None:
             raise PlanError("no limits to time the warm start: give effort or speed limits, or warm_start=")
+        r = np.linspace(0.0, 1.0, n + 1)[:, None]
+        dq = q_end - q_start
+        q = q_start + dq * (3 * r**2 - 2 * r**3)
+        qd = dq * (6 * r - 6 * r**2) / duration
+        qdd = dq * (6 - 12 * r) / duration**2
+        return duration, q, qd, np.asarray(mech.inverse_dynamics(q, qd, qdd))
+    if previous is None:
         previous = time_optimal(mech, [q_start, q_end], effort, None if not np.isfinite(speed).any() else speed,
                                 n_grid=max(2 * n, 50))
     t_ref = previous.duration
@@ -350,7 +358,8 @@ def collocate(
     x0 = np.concatenate([q_w.ravel(), qd_w.ravel(), np.clip(tau_w, lbu, ubu).ravel(), [T0]])
 
     opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.max_iter": max_iter,
-            "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"}
+            "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+            "ipopt.bound_relax_factor": 0.0}
     solver = ca.nlpsol("collocation", "ipopt", {"x": w, "f": J, "g": ca.vertcat(*g)}, opts)
     sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
     stats = solver.stats()
