@@ -109,7 +109,7 @@ def _function(ca: Any, name: str, sizes: Sequence[int], n_out: int, value: Calla
     giving dy/d(each arg). ``keep`` holds both alive while the solver uses them."""
     n_in = len(sizes)
 
-    class Jacobian(ca.Callback):  # type: ignore[misc]
+    class Jacobian(ca.Callback):
         def __init__(self, jname: str, opts: dict[str, Any]) -> None:
             ca.Callback.__init__(self)
             self.construct(jname, opts)
@@ -129,7 +129,7 @@ def _function(ca: Any, name: str, sizes: Sequence[int], n_out: int, value: Calla
         def eval(self, arg: list[Any]) -> list[Any]:
             return [ca.DM(j) for j in jacobian(*(np.asarray(a, dtype=float).ravel() for a in arg[:n_in]))]
 
-    class Function(ca.Callback):  # type: ignore[misc]
+    class Function(ca.Callback):
         def __init__(self) -> None:
             ca.Callback.__init__(self)
             self.construct(name, {"enable_fd": False})
@@ -206,8 +206,8 @@ def _warm_start(mech: Mechanism, q_start: FloatArray, q_end: FloatArray, lo: Flo
     T = t_ref if duration is None else duration
     t = np.linspace(0.0, T, n + 1)
     q, qd, qdd = previous.state(t * t_ref / T)
-    r = t_ref / T
-    qd, qdd = qd * r, qdd * r**2
+    stretch = t_ref / T
+    qd, qdd = qd * stretch, qdd * stretch**2
     tau = np.asarray(mech.inverse_dynamics(q, qd, qdd))
     return T, q, qd, tau
 
@@ -357,10 +357,11 @@ def collocate(
     ubx = np.concatenate([ubq.ravel(), ubqd.ravel(), ubu.ravel(), [ubT]])
     x0 = np.concatenate([q_w.ravel(), qd_w.ravel(), np.clip(tau_w, lbu, ubu).ravel(), [T0]])
 
-    opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.max_iter": max_iter,
+    opts: dict[str, Any] = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.max_iter": max_iter,
             "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
             "ipopt.bound_relax_factor": 0.0}
-    solver = ca.nlpsol("collocation", "ipopt", {"x": w, "f": J, "g": ca.vertcat(*g)}, opts)
+    nlp: dict[str, Any] = {"x": w, "f": J, "g": ca.vertcat(*g)}
+    solver = ca.nlpsol("collocation", "ipopt", nlp, opts)
     sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
     stats = solver.stats()
     status = str(stats.get("return_status", "unknown"))

@@ -19,7 +19,7 @@ from toppra.constraint import ConstraintType
 from toppra.solverwrapper.solverwrapper import SolverWrapper
 
 
-class HighsWrapper(SolverWrapper):  # type: ignore[misc]
+class HighsWrapper(SolverWrapper):
     """A toppra solver wrapper for canonical linear constraints, by HiGHS."""
 
     def solve_stagewise_optim(self, i: int, H: Any, g: Any, x_min: float, x_max: float, x_next_min: float,
