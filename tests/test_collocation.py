@@ -146,3 +146,21 @@ def test_an_unfinished_solve_is_reported_and_bad_arguments_refused(robot, ends) 
         collocate(robot, qa, qb)
     with pytest.raises(PlanError, match="margin"):
         collocate(robot, qa, qb, **LIMITS, sigma_min=0.9)
+
+
+def test_cli_collocates_between_the_line_ends(tmp_path) -> None:
+    # Exit 0 and a table whose efforts inverse dynamics reproduces at its nodes (qdd there is
+    # forward dynamics of them), at the effort limit somewhere; exit 2 without a duration for
+    # minimum effort.
+    from planardyn.cli import main
+    from planardyn.results_io import read_motion
+
+    out = tmp_path / "p2p.csv"
+    line = ["--line", *map(str, PICK + PLACE), "--effort", "3", "3"]
+    assert main(["plan", str(FIVE_BAR), *line, "--collocate", "time", "--intervals", "20", "-o", str(out)]) == 0
+    robot = planardyn.load(FIVE_BAR)
+    table = read_motion(out, robot.coordinate_names)
+    tau = robot.inverse_dynamics(table["q"], table["qd"], table["qdd"])
+    assert np.abs(tau - table["tau"]).max() < 1e-9
+    assert np.abs(table["tau"]).max() == pytest.approx(3.0, rel=1e-6)
+    assert main(["plan", str(FIVE_BAR), *line, "--collocate", "effort"]) == 2

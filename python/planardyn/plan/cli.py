@@ -1,12 +1,18 @@
-"""``planardyn plan``: the time-optimal timing of an end-effector line, from the shell.
+"""``planardyn plan``: the time-optimal timing of an end-effector line, or the optimal
+point-to-point motion between its ends, from the shell.
 
     planardyn plan MODEL --line X0 Y0 X1 Y1 --effort T [T ...] [--speed V [V ...]] [--point P]
-                   [--spacing M] [--grid N] [-o FILE.csv]
+                   [--spacing M] [--grid N]
+                   [--collocate {time,effort} [--duration S] [--intervals N] [--sigma-min S]]
+                   [-o FILE.csv]
 
-The CSV has ``t`` and per coordinate its value, ``qd_``, ``qdd_`` and ``tau_`` columns at the
-grid points: the motion table ``planardyn inverse MODEL --motion FILE.csv`` and
-``planardyn simulate`` take. Exit status: 0 done; 1 no timing (limits too low, a
-singularity, out of reach); 2 a usage or model error.
+Without ``--collocate`` the effector follows the line (TOPP); with it, only the line's ends
+are kept and the motion between them is the minimum-time one, or the minimum-effort one in
+``--duration`` seconds (collocation, IPOPT). The CSV has ``t`` and per coordinate its value,
+``qd_``, ``qdd_`` and ``tau_`` columns at the grid points (collocation: its nodes): the motion
+table ``planardyn inverse MODEL --motion FILE.csv`` and ``planardyn simulate`` take. Exit
+status: 0 done; 1 no timing (limits too low, a singularity, out of reach) or IPOPT did not
+converge (its status is printed, nothing is written); 2 a usage or model error.
 """
 
 from __future__ import annotations
@@ -20,11 +26,13 @@ from .._core import AssemblyError, ModelError, SingularityError
 from ..mechanism import load
 from ..models import UnknownModelError, resolve
 from ..robot import EndEffector
-from .topp import PlanError, TimedPath, task_waypoints, time_optimal
+from .collocation import collocate
+from .planned import PlanError, PlannedMotion
+from .topp import task_waypoints, time_optimal
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="planardyn plan", description="Time-optimal timing of an end-effector line.")
+    p = argparse.ArgumentParser(prog="planardyn plan", description="Time-optimal timing of an end-effector line, or optimal motion between its ends.")
     p.add_argument("model", help="model file (.yaml/.json), or a shipped model by name")
     p.add_argument("--point", default="P", help="end-effector point (default P)")
     p.add_argument("--line", nargs=4, type=float, required=True, metavar=("X0", "Y0", "X1", "Y1"), help="m")
@@ -32,12 +40,17 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--speed", nargs="+", type=float, default=None, help="|qd| limit per coordinate (rad/s or m/s)")
     p.add_argument("--spacing", type=float, default=0.01, help="inverse kinematics every this many m (default 0.01)")
     p.add_argument("--grid", type=int, default=200, help="grid points in the path parameter (default 200)")
+    p.add_argument("--collocate", choices=["time", "effort"], default=None,
+                   help="free path between the line's ends: minimum time, or minimum effort in --duration")
+    p.add_argument("--duration", type=float, default=None, help="s, for --collocate effort")
+    p.add_argument("--intervals", type=int, default=40, help="collocation intervals (default 40)")
+    p.add_argument("--sigma-min", type=float, default=None, help="type II singularity margin for --collocate")
     p.add_argument("-o", "--output", default=None, help="write the timed motion (CSV)")
     return p
 
 
-def write_csv(plan: TimedPath, path: str) -> None:
-    """The timed path at its grid points as a motion CSV (t, q, qd_, qdd_, tau_ columns)."""
+def write_csv(plan: PlannedMotion, path: str) -> None:
+    """The planned motion at its grid points as a motion CSV (t, q, qd_, qdd_, tau_ columns)."""
     names = plan.mech.coordinate_names
     header = ["t", *names, *(f"qd_{n}" for n in names), *(f"qdd_{n}" for n in names), *(f"tau_{n}" for n in names)]
     table = np.column_stack([plan.t, plan.q, plan.qd, plan.qdd, plan.tau])
@@ -53,8 +66,23 @@ def plan_cli(argv: list[str] | None = None) -> int:
     try:
         mech = load(resolve(args.model))
         ee = EndEffector(mech, args.point)
-        q = task_waypoints(ee, [args.line[:2], args.line[2:]], args.spacing)
-        plan = time_optimal(mech, q, args.effort, args.speed, n_grid=args.grid)
+        if args.collocate is None:
+            q = task_waypoints(ee, [args.line[:2], args.line[2:]], args.spacing)
+            plan: PlannedMotion = time_optimal(mech, q, args.effort, args.speed, n_grid=args.grid)
+            what = f"along the line ({len(plan.t)} grid points)"
+        else:
+            start = ee.inverse(args.line[:2])
+            end = ee.inverse(args.line[2:], start.q, start.kin["x"])
+            plan = c = collocate(mech, start.q, end.q, objective=args.collocate, duration=args.duration,
+                                 effort=args.effort, speed=args.speed, sigma_min=args.sigma_min,
+                                 n_intervals=args.intervals)
+            print(f"IPOPT: {c.status}, {c.iterations} iterations, constraint violation {c.violation:.2g}, "
+                  f"stated accuracy of q {c.error.max():.2g}")
+            if not c.success:
+                print("planardyn plan: IPOPT did not converge: nothing written; try more --intervals or "
+                      "other limits", file=sys.stderr)
+                return 1
+            what = f"between the line's ends, minimum {args.collocate} ({len(plan.t)} nodes)"
     except PlanError as exc:
         print(f"planardyn plan: {exc}", file=sys.stderr)
         return 1 if "no timing" in str(exc) else 2
@@ -65,8 +93,7 @@ def plan_cli(argv: list[str] | None = None) -> int:
         print(f"planardyn plan: refused: {exc}", file=sys.stderr)
         return 1
     peak = np.abs(plan.tau).max(axis=0)
-    print(f"{mech.name}: {plan.duration:.6g} s along the line ({len(plan.t)} grid points); "
-          f"peak |tau| {np.round(peak, 4).tolist()}")
+    print(f"{mech.name}: {plan.duration:.6g} s {what}; peak |tau| {np.round(peak, 4).tolist()}")
     if args.output:
         write_csv(plan, args.output)
         print(f"wrote {args.output}")
