@@ -24,16 +24,21 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism
 from ..robot import EndEffector
+from .actuator_limits import drives, exact_bounds, tangent_rows
 from .planned import PlanError, PlannedMotion, effort_bounds, speed_bounds
 
 FloatArray = NDArray[np.float64]
+
+#: effort="actuators": the rounds of tangents stop when the time changes by less than this
+#: fraction, and fail after ACTUATOR_ROUNDS rounds.
+ACTUATOR_TOL = 1e-7
+ACTUATOR_ROUNDS = 60
 
 #: Relative size of the s'-linear part of the efforts beyond which a model is refused.
 LINEAR_TOL = 1e-9
 
 #: An effort limit that may depend on the coordinates: ``f(q) -> (lo, hi)``, each (m,) in
-#: N m or N. The hook for torque-speed curves: toppra's constraints are linear in s'^2, so a
-#: speed-dependent curve enters as its value at each grid point's coordinates.
+#: N m or N. Limits that depend on the speed: ``effort="actuators"``.
 EffortLimit = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
 
 
@@ -137,7 +142,7 @@ def _coefficients(mech: Mechanism, path: Any, s: FloatArray,
 def time_optimal(
     mech: Mechanism,
     waypoints: ArrayLike,
-    effort: ArrayLike | EffortLimit | None,
+    effort: ArrayLike | EffortLimit | str | None,
     speed: ArrayLike | None = None,
     n_grid: int = 200,
 ) -> TimedPath:
@@ -151,9 +156,12 @@ def time_optimal(
         Coordinates (rad or m) the path passes through, K >= 2, joined by a C2 cubic spline
         in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, 1]. For
         a task-space path, :func:`task_waypoints`.
-    effort : (m,) or (m, 2) array_like, or callable ``f(q) -> (lo, hi)``, or None
+    effort : (m,) or (m, 2) array_like, or callable ``f(q) -> (lo, hi)``, "actuators", or None
         Effort limits (N m or N): symmetric magnitudes, [lo, hi] per coordinate, or a function
-        of the coordinates (see :data:`EffortLimit`); None: none (then ``speed`` is needed).
+        of the coordinates (see :data:`EffortLimit`); "actuators": every coordinate's motor
+        torque within the torque its envelope offers at its speed, through its transmission
+        (planardyn.plan.actuator_limits says how; the motors' top speeds become speed limits);
+        None: none (then ``speed`` is needed).
     speed : (m,) array_like, optional
         Speed limits |qd| (rad/s or m/s); none by default.
     n_grid : int
@@ -170,8 +178,6 @@ def time_optimal(
         Bad arguments, a model with dampers, or a path no timing can follow within the limits.
     """
     import toppra
-    import toppra.algorithm as algo
-    import toppra.constraint as constraint
 
     q_w = np.atleast_2d(np.asarray(waypoints, dtype=float))
     m = mech.dof
@@ -189,24 +195,66 @@ def time_optimal(
         raise PlanError("no limits: give effort limits, speed limits or both")
     x = branch(mech, path(s))
     a, b, c = _coefficients(mech, path, s, x)
-    if effort is None:
-        lo, hi = np.full((n_grid, m), -np.inf), np.full((n_grid, m), np.inf)
+    p1 = path(s, 1)
+    if isinstance(effort, str):
+        if effort != "actuators":
+            raise PlanError(f"effort: limits, a function of q, 'actuators' or None, got {effort!r}")
+        ds = drives(mech)
+        v = np.minimum(v, [d.max_speed / d.ratio for d in ds])
+        # The speed limits' s'^2 bound (a quarter of it) as the first tangent point.
+        with np.errstate(divide="ignore"):
+            x_v = np.min((v / np.abs(p1)) ** 2, axis=1)
+        x0 = np.minimum(np.where(np.isfinite(x_v), x_v / 4, 1.0), 1e6)
+        duration, rounds = np.inf, 0
+        while True:
+            rounds += 1
+            sdd, sd, status = _toppra(path, s, tangent_rows(mech, ds, a, b, c, p1, x0), v)
+            t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
+            if abs(duration - t_new) <= ACTUATOR_TOL * t_new:
+                break
+            if rounds == ACTUATOR_ROUNDS:
+                raise PlanError(f"effort='actuators': the time did not settle in {rounds} rounds of tangents "
+                                f"({duration:.9g} s, then {t_new:.9g} s); use a finer n_grid")
+            duration, x0 = t_new, sd**2
+        status = f"{status}; {rounds} rounds of tangents"
+        lo, hi = exact_bounds(mech, p1 * sd[:, None])
     else:
-        lo, hi = _limits(mech, effort, path(s))
+        if effort is None:
+            lo, hi = np.full((n_grid, m), -np.inf), np.full((n_grid, m), np.inf)
+        else:
+            lo, hi = _limits(mech, effort, path(s))
+        rows = (np.hstack([a, -a]), np.hstack([b, -b]), np.hstack([c - hi, lo - c]))
+        sdd, sd, status = _toppra(path, s, None if effort is None else rows, v)
+    sd2 = sd**2
+    dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
+    t = np.concatenate([[0.0], np.cumsum(dt)])
+    u = np.append(sdd, sdd[-1])
+    p2 = path(s, 2)
+    tau = a * u[:, None] + b * sd2[:, None] + c
+    return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=t, x=x, q=path(s), qd=p1 * sd[:, None],
+                     qdd=p1 * u[:, None] + p2 * sd2[:, None], tau=tau, lo=lo, hi=hi, speed=v, status=status)
 
-    class _Efforts(constraint.SecondOrderConstraint):
+
+def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray] | None,
+            v: FloatArray) -> tuple[FloatArray, FloatArray, str]:
+    """toppra's timing (s'' per interval, s' at the grid) within rows (N, R) A u + B x + C <= 0
+    (u = s'', x = s'^2) and speed limits v."""
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    class _Rows(constraint.SecondOrderConstraint):
         def compute_constraint_params(self, _path: Any, gridpoints: FloatArray) -> tuple[Any, ...]:
             if not np.array_equal(gridpoints, s):
                 raise PlanError("toppra asked for efforts off the planned grid")
-            eye = np.eye(m)
-            F = np.tile(np.vstack([eye, -eye]), (len(s), 1, 1))
-            g = np.hstack([hi, -lo])
-            return a, b, c, F, g, None, None
+            assert rows is not None
+            r = rows[0].shape[1]
+            return rows[0], rows[1], rows[2], np.tile(np.eye(r), (len(s), 1, 1)), np.zeros((len(s), r)), None, None
 
-    eye = np.eye(m)
     constraints: list[Any] = []
-    if effort is not None:
-        constraints.append(_Efforts(None, lambda q: np.vstack([eye, -eye]), lambda q: np.zeros(2 * m), m))
+    m = len(v)
+    if rows is not None:
+        r = rows[0].shape[1]
+        constraints.append(_Rows(None, lambda q: np.eye(r), lambda q: np.zeros(r), m))
     if np.isfinite(v).any():
         vmax = np.where(np.isfinite(v), v, 1e300)
         constraints.append(constraint.JointVelocityConstraint(np.stack([-vmax, vmax], axis=1)))
@@ -220,14 +268,7 @@ def time_optimal(
     if sd is None:
         raise PlanError(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
                         "(gravity, springs) may exceed them somewhere: raise the limits or move the path")
-    sd2 = sd**2
-    dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
-    t = np.concatenate([[0.0], np.cumsum(dt)])
-    u = np.append(sdd, sdd[-1])
-    p1, p2 = path(s, 1), path(s, 2)
-    tau = a * u[:, None] + b * sd2[:, None] + c
-    return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=t, x=x, q=path(s), qd=p1 * sd[:, None],
-                     qdd=p1 * u[:, None] + p2 * sd2[:, None], tau=tau, lo=lo, hi=hi, speed=v, status=status)
+    return sdd, sd, status
 
 
 def _solve(instance: Any) -> tuple[Any, Any, Any, str]:
