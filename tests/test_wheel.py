@@ -37,7 +37,7 @@ def test_extras_and_licence():
     extras = meta["optional-dependencies"]
     assert extras["parquet"] == ["pyarrow>=14"] and extras["mp4"] == ["imageio-ffmpeg>=0.4"]
     assert extras["dask"] == ["dask[distributed]>=2023.1"]
-    assert extras["plan"] == ["toppra>=0.6.10"]
+    assert extras["plan"] == ["toppra>=0.6.10", "casadi>=3.6"]
     assert extras["all"] == ["planardyn[pandas,parquet,mp4,dask,plan]"]
     assert set(extras) == {"pandas", "parquet", "mp4", "dask", "plan", "all"}
     assert meta["license"] == {"text": "MIT"}
