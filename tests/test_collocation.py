@@ -164,3 +164,14 @@ def test_cli_collocates_between_the_line_ends(tmp_path) -> None:
     assert np.abs(tau - table["tau"]).max() < 1e-9
     assert np.abs(table["tau"]).max() == pytest.approx(3.0, rel=1e-6)
     assert main(["plan", str(FIVE_BAR), *line, "--collocate", "effort"]) == 2
+
+
+def test_a_previous_solution_warm_starts_a_finer_grid(robot, ends, fastest) -> None:
+    # From the N = 30 optimum (interpolated at the 61 nodes) IPOPT reaches the N = 60 one,
+    # 0.1360753 s, in 14 iterations against 19 from the TOPP-timed straight joint path.
+    _, qa, qb = ends
+    coarse = collocate(robot, qa, qb, **LIMITS, n_intervals=30)
+    fine = collocate(robot, qa, qb, **LIMITS, n_intervals=60, warm_start=coarse)
+    assert fine.success, fine.status
+    assert fine.duration == pytest.approx(fastest.duration, rel=1e-8)
+    assert fine.iterations < fastest.iterations

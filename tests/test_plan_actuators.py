@@ -113,3 +113,27 @@ def test_missing_actuators_are_refused(path) -> None:
         time_optimal(bare, path, "actuators")
     with pytest.raises(PlanError, match="effort"):
         time_optimal(bare, path, "motors")
+
+
+def test_cli_plans_within_the_motors(tmp_path, path) -> None:
+    # The same timing from the shell (--actuators), written as a motion table whose motor
+    # torques stay within the envelope; --collocate does not take --actuators (exit 2).
+    import json
+
+    from planardyn.cli import main
+    from planardyn.results_io import read_motion
+
+    model = library.five_bar_model()
+    model["actuators"] = [{"coordinate": c, "gear_ratio": RATIO, "efficiency": 0.8, "rotor_inertia": 1e-5,
+                           "limits": CURVE} for c in ("theta1", "theta2")]
+    file, out = tmp_path / "geared.json", tmp_path / "timed.csv"
+    file.write_text(json.dumps(model))
+    line = ["--line", *map(str, PICK + PLACE), "--actuators"]
+    assert main(["plan", str(file), *line, "-o", str(out)]) == 0
+    mech = planardyn.load(file)
+    table = read_motion(out, mech.coordinate_names)
+    t_m = np.asarray(mech.motor_torques(table["qd"], table["tau"]))[:-1]
+    avail = np.column_stack([mech.available_torque(k, RATIO * table["qd"][:-1, k]) for k in range(2)])
+    assert np.all(np.abs(t_m) <= avail * (1 + 1e-9))
+    assert table["t"][-1] == pytest.approx(time_optimal(geared(CURVE), path, "actuators").duration, rel=1e-9)
+    assert main(["plan", str(file), *line, "--collocate", "time"]) == 2

@@ -8,7 +8,7 @@
     planardyn plot RESULTS [-o FILE.png] [--torque-speed]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
-    planardyn plan MODEL --line X0 Y0 X1 Y1 --effort T [T ...] [--speed V ...] [--collocate time|effort] [-o FILE.csv]
+    planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V ...] [--collocate time|effort] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn --version
 

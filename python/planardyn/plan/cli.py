@@ -1,12 +1,13 @@
 """``planardyn plan``: the time-optimal timing of an end-effector line, or the optimal
 point-to-point motion between its ends, from the shell.
 
-    planardyn plan MODEL --line X0 Y0 X1 Y1 --effort T [T ...] [--speed V [V ...]] [--point P]
+    planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V [V ...]] [--point P]
                    [--spacing M] [--grid N]
                    [--collocate {time,effort} [--duration S] [--intervals N] [--sigma-min S]]
                    [-o FILE.csv]
 
-Without ``--collocate`` the effector follows the line (TOPP); with it, only the line's ends
+Without ``--collocate`` the effector follows the line (TOPP), within ``--effort`` limits or
+its motors' torque-speed envelopes (``--actuators``); with ``--collocate``, only the line's ends
 are kept and the motion between them is the minimum-time one, or the minimum-effort one in
 ``--duration`` seconds (collocation, IPOPT). The CSV has ``t`` and per coordinate its value,
 ``qd_``, ``qdd_`` and ``tau_`` columns at the grid points (collocation: its nodes): the motion
@@ -36,7 +37,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("model", help="model file (.yaml/.json), or a shipped model by name")
     p.add_argument("--point", default="P", help="end-effector point (default P)")
     p.add_argument("--line", nargs=4, type=float, required=True, metavar=("X0", "Y0", "X1", "Y1"), help="m")
-    p.add_argument("--effort", nargs="+", type=float, required=True, help="|tau| limit per coordinate (N m or N)")
+    limits = p.add_mutually_exclusive_group(required=True)
+    limits.add_argument("--effort", nargs="+", type=float, help="|tau| limit per coordinate (N m or N)")
+    limits.add_argument("--actuators", action="store_true",
+                        help="the model's motors: torque within their torque-speed envelopes (not with --collocate)")
     p.add_argument("--speed", nargs="+", type=float, default=None, help="|qd| limit per coordinate (rad/s or m/s)")
     p.add_argument("--spacing", type=float, default=0.01, help="inverse kinematics every this many m (default 0.01)")
     p.add_argument("--grid", type=int, default=200, help="grid points in the path parameter (default 200)")
@@ -68,8 +72,12 @@ def plan_cli(argv: list[str] | None = None) -> int:
         ee = EndEffector(mech, args.point)
         if args.collocate is None:
             q = task_waypoints(ee, [args.line[:2], args.line[2:]], args.spacing)
-            plan: PlannedMotion = time_optimal(mech, q, args.effort, args.speed, n_grid=args.grid)
+            effort = "actuators" if args.actuators else args.effort
+            plan: PlannedMotion = time_optimal(mech, q, effort, args.speed, n_grid=args.grid)
             what = f"along the line ({len(plan.t)} grid points)"
+        elif args.actuators:
+            print("planardyn plan: --collocate takes --effort limits, not --actuators", file=sys.stderr)
+            return 2
         else:
             start = ee.inverse(args.line[:2])
             end = ee.inverse(args.line[2:], start.q, start.kin["x"])
