@@ -162,7 +162,7 @@ def _function(ca: Any, name: str, sizes: Sequence[int], n_out: int, value: Calla
     return f
 
 
-def _or_nan(n: int, shapes: Sequence[tuple[int, ...]]) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+def _or_nan(shapes: Sequence[tuple[int, ...]]) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Evaluations where the kinematics fail (a singularity, out of reach) give NaN to IPOPT,
     which then shortens its step; they never reach the result (checked there)."""
 
@@ -187,21 +187,25 @@ def _warm_start(mech: Mechanism, q_start: FloatArray, q_end: FloatArray, lo: Flo
                 speed: FloatArray, duration: float | None, n: int, previous: PlannedMotion | None) -> tuple[Any, ...]:
     """(T, q, qd, tau) at n + 1 nodes: a previous motion, or the straight joint path timed by
     TOPP within the limits, stretched to ``duration`` when one is given (efforts by inverse
-    dynamics of the stretched motion); without limits, the straight path in ``duration`` with
-    the cubic timing s = 3 r^2 - 2 r^3, r = t / T (the minimum-effort timing of a double integrator)."""
-    effort = None if lo is None or hi is None else np.stack([lo, hi], axis=1)
-    if previous is None and effort is None and not np.isfinite(speed).any():
-        if duration is None:
-            raise PlanError("no limits to time the warm start: give effort or speed limits, or warm_start=")
-        r = np.linspace(0.0, 1.0, n + 1)[:, None]
-        dq = q_end - q_start
-        q = q_start + dq * (3 * r**2 - 2 * r**3)
-        qd = dq * (6 * r - 6 * r**2) / duration
-        qdd = dq * (6 - 12 * r) / duration**2
-        return duration, q, qd, np.asarray(mech.inverse_dynamics(q, qd, qdd))
+    dynamics of the stretched motion); without limits, or for a model TOPP refuses (dampers),
+    the straight path in ``duration`` with the cubic timing s = 3 r^2 - 2 r^3, r = t / T (the
+    minimum-effort timing of a double integrator)."""
     if previous is None:
-        previous = time_optimal(mech, [q_start, q_end], effort, None if not np.isfinite(speed).any() else speed,
-                                n_grid=max(2 * n, 50))
+        effort = None if lo is None or hi is None else np.stack([lo, hi], axis=1)
+        try:
+            if effort is None and not np.isfinite(speed).any():
+                raise PlanError("no limits to time the warm start with")
+            previous = time_optimal(mech, [q_start, q_end], effort, None if not np.isfinite(speed).any() else speed,
+                                    n_grid=max(2 * n, 50))
+        except PlanError as exc:
+            if duration is None:
+                raise PlanError(f"warm start: {exc}; give a first guess duration= (s) or warm_start=") from exc
+            r = np.linspace(0.0, 1.0, n + 1)[:, None]
+            dq = q_end - q_start
+            q = q_start + dq * (3 * r**2 - 2 * r**3)
+            qd = dq * (6 * r - 6 * r**2) / duration
+            qdd = dq * (6 - 12 * r) / duration**2
+            return duration, q, qd, np.asarray(mech.inverse_dynamics(q, qd, qdd))
     t_ref = previous.duration
     T = t_ref if duration is None else duration
     t = np.linspace(0.0, T, n + 1)
@@ -239,7 +243,8 @@ def collocate(
     objective : "time" or "effort"
         Minimise the duration T, or the integral over [0, T] of sum tau_i^2 at a given T.
     duration : float, optional
-        T (s); required for "effort" (and then fixed), not allowed for "time".
+        T (s): for "effort" required, and fixed; for "time" a first guess (the warm start is
+        stretched to it; needed where TOPP cannot time the warm start, e.g. with dampers).
     effort : (m,) or (m, 2) array_like, optional
         Effort limits (N m or N): magnitudes or [lo, hi]; "time" needs them or ``speed``.
     speed : (m,) array_like, optional
@@ -276,12 +281,16 @@ def collocate(
         raise PlanError(f"objective: 'time' or 'effort', got {objective!r}")
     if objective == "effort" and (duration is None or not np.isfinite(duration) or duration <= 0):
         raise PlanError(f"objective 'effort' needs a positive duration (s), got {duration}")
-    if objective == "time" and duration is not None:
-        raise PlanError("objective 'time' finds the duration: leave duration=None")
     if objective == "time" and effort is None and speed is None:
         raise PlanError("objective 'time' needs effort or speed limits")
     if n_intervals < 2:
         raise PlanError(f"n_intervals: need at least 2, got {n_intervals}")
+    if duration is not None and not (np.isfinite(duration) and duration > 0):
+        raise PlanError(f"duration: a positive time (s), got {duration}")
+    try:
+        mech.forward_dynamics_derivatives(q0, np.zeros(m), tau=np.zeros(m))
+    except ValueError as exc:
+        raise PlanError(f"collocation needs the exact derivatives of forward dynamics: {exc}") from exc
     n = n_intervals
     lo, hi = effort_bounds(m, effort) if effort is not None else (None, None)
     v = speed_bounds(m, speed)
@@ -299,8 +308,8 @@ def collocate(
     keep: list[Any] = []
     fd = _function(
         ca, "forward_dynamics", [m, m, m], m,
-        _or_nan(m, [(m,)])(lambda q, qd, tau: mech.forward_dynamics(q, qd, tau=tau)),
-        _or_nan(m, [(m, m)] * 3)(lambda q, qd, tau: [(d := mech.forward_dynamics_derivatives(q, qd, tau=tau))["dq"],
+        _or_nan([(m,)])(lambda q, qd, tau: mech.forward_dynamics(q, qd, tau=tau)),
+        _or_nan([(m, m)] * 3)(lambda q, qd, tau: [(d := mech.forward_dynamics_derivatives(q, qd, tau=tau))["dq"],
                                                      d["dqd"], d["dtau"]]),
         keep)
 
@@ -321,8 +330,8 @@ def collocate(
             e = SIGMA_STEP * np.eye(m)
             return [np.array([[(_sigma(mech, q + ei) - _sigma(mech, q - ei)) / (2 * SIGMA_STEP) for ei in e]])]
 
-        sig = _function(ca, "sigma_II", [m], 1, _or_nan(m, [(1,)])(lambda q: np.array([_sigma(mech, q)])),
-                        _or_nan(m, [(1, m)])(sigma_grad), keep)
+        sig = _function(ca, "sigma_II", [m], 1, _or_nan([(1,)])(lambda q: np.array([_sigma(mech, q)])),
+                        _or_nan([(1, m)])(sigma_grad), keep)
         g += [sig(Q[:, k]) for k in range(1, n)]
         lbg += [sigma_min] * (n - 1)
         ubg += [np.inf] * (n - 1)
@@ -331,8 +340,8 @@ def collocate(
         k_x = len(ee.names)
         box_lo = np.broadcast_to(np.asarray(workspace.lo, dtype=float), (k_x,))
         box_hi = np.broadcast_to(np.asarray(workspace.hi, dtype=float), (k_x,))
-        task = _function(ca, "task", [m], k_x, _or_nan(m, [(k_x,)])(lambda q: ee.state(q).X),
-                         _or_nan(m, [(k_x, m)])(lambda q: [ee.state(q).J]), keep)
+        task = _function(ca, "task", [m], k_x, _or_nan([(k_x,)])(lambda q: ee.state(q).X),
+                         _or_nan([(k_x, m)])(lambda q: [ee.state(q).J]), keep)
         g += [task(Q[:, k]) for k in range(1, n)]
         lbg += list(box_lo) * (n - 1)
         ubg += list(box_hi) * (n - 1)
