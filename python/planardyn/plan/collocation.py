@@ -66,7 +66,8 @@ class CollocatedMotion(PlannedMotion):
     True only when IPOPT converged (``Solve_Succeeded`` or ``Solved_To_Acceptable_Level``),
     ``iterations`` its iteration count, ``violation`` the largest constraint violation of the
     final point as IPOPT measured it, ``max_defect`` the largest trapezoidal defect
-    (rad or m, and per s); ``error`` (m,) the stated accuracy of q (rad or m; see the module).
+    (rad or m, and per s); ``error`` (m,) the stated accuracy of q (rad or m; see the module;
+    inf when the motion between nodes meets a singularity).
     """
 
     mech: Mechanism
@@ -401,12 +402,16 @@ def collocate(
 
 
 def _error_estimate(c: CollocatedMotion) -> FloatArray:
-    """The stated accuracy of q (m,): see the module."""
+    """The stated accuracy of q (m,): see the module; inf where the interpolant meets a
+    singularity between nodes (an unconverged solution's)."""
     h = np.diff(c.t)[:, None]
     mid = (c.t[:-1] + c.t[1:]) / 2
     q_m, qd_m, qdd_m = c.state(mid)
     tau_m = c.efforts(mid)
-    f_m = np.array([c.mech.forward_dynamics(a, b, tau=u) for a, b, u in zip(q_m, qd_m, tau_m)])
+    try:
+        f_m = np.array([c.mech.forward_dynamics(a, b, tau=u) for a, b, u in zip(q_m, qd_m, tau_m)])
+    except (SingularityError, AssemblyError):
+        return np.full(c.q.shape[1], np.inf)
     eta_q = 2 * h / 3 * np.abs((c.qd[:-1] + c.qd[1:]) / 2 - qd_m)
     eta_qd = 2 * h / 3 * np.abs(qdd_m - f_m)
     return np.asarray((eta_q + eta_qd * (c.t[-1] - c.t[1:])[:, None]).sum(axis=0))
