@@ -378,7 +378,7 @@ class Mechanism:
     ) -> dict[str, FloatArray]:
         """Inverse dynamics with redundant actuators: every actuator's effort for (q, qd, qdd),
         each (m,). ``method``: ``"min_norm"`` (least Euclidean norm), ``"min_max"`` (least
-        largest magnitude; one internal force), or ``"preload"`` with ``preload`` one value
+        largest magnitude, any number of internal forces: a linear program), or ``"preload"`` with ``preload`` one value
         (N m or N) per internal force added to the minimum-norm efforts. Returns ``efforts``
         (n_a,), ``B`` (m, n_a) the generalized force per unit effort, ``internal`` (r, n_a) an
         orthonormal basis of the internal forces (B v = 0)."""

@@ -1,5 +1,6 @@
 //! Redundant actuation: a 5R robot with a third actuated leg (2 degrees of freedom, 3
-//! actuators), its efforts shared by minimum norm, min-max and a preload.
+//! actuators; with its left and middle elbows actuated too, 5), its efforts shared by minimum
+//! norm, min-max and a preload.
 
 mod common;
 
@@ -10,8 +11,16 @@ use planardyn::{Mechanism, Workspace};
 /// The five-bar of examples/models/five-bar.yaml (without its PD springs) with a third leg
 /// A3 -> C3 -> P (0.25 m and 0.35 m) whose base pivot is actuated.
 fn three_legs() -> Mechanism {
-    yaml(
-        r#"
+    yaml(&three_legs_yaml("  - {pair: motor3}\n"))
+}
+
+/// The same with the elbows elbow1 and elbow3 actuated too: 5 actuators, 3 internal forces.
+fn three_legs_actuated_elbows() -> Mechanism {
+    yaml(&three_legs_yaml("  - {pair: motor3}\n  - {pair: elbow1}\n  - {pair: elbow3}\n"))
+}
+
+fn three_legs_yaml(actuators: &str) -> String {
+    r#"
 name: 5R with a third actuated leg
 gravity: [0.0, -9.81]
 points:
@@ -45,9 +54,9 @@ coordinates:
   - {name: theta1, pair: motor1, value: 2.007128639793479}
   - {name: theta2, pair: motor2, value: 1.0471975511965976}
 actuators:
-  - {pair: motor3}
-"#,
-    )
+"#
+    .to_owned()
+        + actuators
 }
 
 /// A point of a motion near the drawing.
@@ -112,6 +121,67 @@ fn min_max_is_the_least_largest_effort() {
         .fold(f64::INFINITY, f64::min);
     assert!(largest(&mm) <= scanned + 1e-12 && scanned - largest(&mm) <= 1e-4, "{} vs {scanned}", largest(&mm));
     assert!(largest(&mm) <= largest(&mn));
+    // The closed form with one internal force v: max_a |t_a + lambda v_a| is convex and
+    // piecewise linear in lambda, least where two of its lines t_a + lambda v_a and
+    // +-(t_b + lambda v_b) cross; the least over every crossing.
+    let worst = |l: f64| largest(&mn.iter().zip(v).map(|(t, v)| t + l * v).collect::<Vec<_>>());
+    let (t, v) = (&mn, v);
+    let closed = (0..3)
+        .flat_map(|a| (0..3).flat_map(move |b| [(t[a] - t[b], v[a] - v[b]), (t[a] + t[b], v[a] + v[b])]))
+        .filter(|(_, den)| *den != 0.0)
+        .map(|(num, den)| worst(-num / den))
+        .fold(largest(&mn), f64::min);
+    assert!((largest(&mm) - closed).abs() <= 1e-13 * closed, "LP {} vs closed form {closed}", largest(&mm));
+}
+
+#[test]
+fn min_max_with_three_internal_forces() {
+    let mech = three_legs_actuated_elbows();
+    let (q, qd, qdd) = point(&mech);
+    let mut ws = Workspace::new(&mech);
+    let (act, mm) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinMax, &mut ws).unwrap();
+    assert_eq!((act.n_a, act.internal.len()), (5, 3));
+    let largest = |t: &[f64]| t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // The drive map holds: B tau = the generalized efforts, to round-off.
+    for j in 0..2 {
+        let f: f64 = (0..5).map(|a| act.b[j * 5 + a] * mm[a]).sum();
+        assert!((f - ws.tau[j]).abs() <= 1e-12 * (1.0 + ws.tau[j].abs()), "row {j}: {f} vs {}", ws.tau[j]);
+    }
+    // Optimality (LP duality): at the optimum s the efforts at +-s (the active set) admit
+    // weights y_a >= 0, one per active effort, with sum_a y_a sgn(tau_a) N_a = 0 and
+    // sum y_a = 1. Here the optimum equalises 4 of the 5 efforts (3 internal forces + s).
+    let s = largest(&mm);
+    let active: Vec<usize> = (0..5).filter(|&a| (mm[a].abs() - s).abs() <= 1e-12 * s).collect();
+    assert_eq!(active.len(), 4, "efforts {mm:?}");
+    // Solve for y in the 4 x 4 system [sgn_a N_a^T; 1] y = [0; 1] by Gaussian elimination.
+    let mut m4: Vec<[f64; 5]> = (0..4)
+        .map(|r| {
+            let mut row = [0.0; 5];
+            for (c, &a) in active.iter().enumerate() {
+                row[c] = if r < 3 { mm[a].signum() * act.internal[r][a] } else { 1.0 };
+            }
+            row[4] = f64::from(r == 3);
+            row
+        })
+        .collect();
+    for c in 0..4 {
+        let p = (c..4).max_by(|&i, &j| m4[i][c].abs().total_cmp(&m4[j][c].abs())).unwrap();
+        m4.swap(c, p);
+        let pivot = m4[c];
+        for (_, row) in m4.iter_mut().enumerate().filter(|(r, _)| *r != c) {
+            let k = row[c] / pivot[c];
+            row.iter_mut().zip(pivot).for_each(|(x, p)| *x -= k * p);
+        }
+    }
+    let y: Vec<f64> = (0..4).map(|c| m4[c][4] / m4[c][c]).collect();
+    assert!(y.iter().all(|&y| y >= 0.0), "dual weights {y:?}: not optimal");
+    // And the drives reproduce the motion.
+    forward_redundant(&mech, 0.0, &q, &qd, &mm, &mut ws).unwrap();
+    for k in 0..2 {
+        assert!((ws.qdd[k] - qdd[k]).abs() <= 1e-10 * qdd[k].abs(), "qdd {:?} vs {qdd:?}", ws.qdd);
+    }
+    let (_, mn) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinNorm, &mut ws).unwrap();
+    assert!(s < largest(&mn));
 }
 
 #[test]

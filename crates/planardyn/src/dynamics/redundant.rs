@@ -13,6 +13,7 @@ use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate,
 use crate::model::{Mechanism, PairId};
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
+use microlp::{ComparisonOp, OptimizationDirection, Problem, Variable};
 
 /// Below this (relative to B's largest row norm) a direction counts as lost: the actuators
 /// cannot produce some generalized force (an actuation singularity).
@@ -23,7 +24,8 @@ const RANK_TOL: f64 = 1e-10;
 pub enum Distribution {
     /// The efforts of least Euclidean norm.
     MinNorm,
-    /// The efforts whose largest magnitude is least (one internal force direction).
+    /// The efforts whose largest magnitude is least (any number of internal forces; the
+    /// efforts' units as they are, N m and N alike).
     MinMax,
     /// The minimum-norm efforts plus the internal forces N lambda (lambda: one value per
     /// basis vector of [`Actuation::internal`], N m or N): a prescribed preload.
@@ -140,55 +142,52 @@ impl Actuation {
     /// The efforts (n_a) producing generalized efforts `tau` (m), shared as `how` says.
     pub fn distribute(&self, tau: &[f64], how: &Distribution) -> Result<Vec<f64>, KinematicsError> {
         let mut out = self.min_norm(tau);
-        match how {
-            Distribution::MinNorm => {}
-            Distribution::Preload(lambda) => {
-                if lambda.len() != self.internal.len() {
-                    return Err(KinematicsError::BadArgument {
-                        name: "preload",
-                        expected: format!("{} values, one per internal force", self.internal.len()),
-                        got: format!("{}", lambda.len()),
-                    });
-                }
-                for (l, v) in lambda.iter().zip(&self.internal) {
-                    out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
-                }
+        let lambda = match how {
+            Distribution::MinNorm => return Ok(out),
+            Distribution::Preload(lambda) if lambda.len() != self.internal.len() => {
+                return Err(KinematicsError::BadArgument {
+                    name: "preload",
+                    expected: format!("{} values, one per internal force", self.internal.len()),
+                    got: format!("{}", lambda.len()),
+                })
             }
-            Distribution::MinMax => {
-                let [v] = self.internal.as_slice() else {
-                    return Err(KinematicsError::BadArgument {
-                        name: "distribution",
-                        expected: "one internal force for min-max (n_a = m + 1); use min-norm or a preload".into(),
-                        got: format!("{} internal forces", self.internal.len()),
-                    });
-                };
-                let lambda = min_max_step(&out, v);
-                out.iter_mut().zip(v).for_each(|(o, v)| *o += lambda * v);
-            }
+            Distribution::Preload(lambda) => lambda.clone(),
+            Distribution::MinMax => min_max_lambda(&out, &self.internal)?,
+        };
+        for (l, v) in lambda.iter().zip(&self.internal) {
+            out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
         }
         Ok(out)
     }
 }
 
-/// The lambda minimising max_a |t_a + lambda v_a|: a convex piecewise-linear function, least
-/// where two of its lines cross (or at 0 when it is flat).
-fn min_max_step(t: &[f64], v: &[f64]) -> f64 {
-    let worst = |l: f64| t.iter().zip(v).map(|(t, v)| (t + l * v).abs()).fold(0.0, f64::max);
-    let mut best = (worst(0.0), 0.0);
-    for a in 0..t.len() {
-        for b in 0..t.len() {
-            for (num, den) in [(t[a] - t[b], v[a] - v[b]), (t[a] + t[b], v[a] + v[b])] {
-                if den != 0.0 {
-                    let l = -num / den;
-                    let w = worst(l);
-                    if w < best.0 {
-                        best = (w, l);
-                    }
-                }
-            }
+/// The internal-force amounts lambda minimising max_a |t_a + (N lambda)_a|, as the LP
+///   minimise s over (lambda, s)  subject to  -s <= t_a + N_a . lambda <= s  for every a,
+/// with t scaled to a largest magnitude of 1 (the solver's feasibility tolerance is absolute).
+/// microlp: pure Rust, maintained, few dependencies, and a simplex, whose optimum is a vertex
+/// exact to round-off where an interior-point solver (clarabel) stops at its tolerance.
+/// The drive map holds whatever lambda is: the efforts stay t + N lambda.
+fn min_max_lambda(t: &[f64], internal: &[Vec<f64>]) -> Result<Vec<f64>, KinematicsError> {
+    let scale = t.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+    if scale == 0.0 {
+        return Ok(vec![0.0; internal.len()]);
+    }
+    let mut lp = Problem::new(OptimizationDirection::Minimize);
+    let lambda: Vec<Variable> = internal.iter().map(|_| lp.add_var(0.0, (f64::NEG_INFINITY, f64::INFINITY))).collect();
+    let s = lp.add_var(1.0, (0.0, f64::INFINITY));
+    for (a, &t_a) in t.iter().enumerate() {
+        for sign in [1.0, -1.0] {
+            let row = lambda.iter().zip(internal).map(|(&l, v)| (l, sign * v[a])).chain([(s, -1.0)]);
+            lp.add_constraint(row.collect::<Vec<_>>(), ComparisonOp::Le, -sign * t_a / scale);
         }
     }
-    best.1
+    let failed = |message: String| KinematicsError::EffortSharing { message };
+    let solution = lp
+        .solve()
+        .map_err(|e| failed(e.to_string()))?
+        .into_solution()
+        .map_err(|_| failed("the LP solve was interrupted".into()))?;
+    Ok(lambda.iter().map(|&l| scale * solution.var_value(l)).collect())
 }
 
 /// Inverse dynamics with redundant actuators: the efforts (n_a) of every actuator for
