@@ -6,6 +6,7 @@ mod common;
 
 use common::yaml;
 use planardyn::dynamics::redundant::{forward_redundant, inverse_redundant, Distribution};
+use planardyn::dynamics::transmission::motor_torques;
 use planardyn::{Mechanism, Workspace};
 
 /// The five-bar of examples/models/five-bar.yaml (without its PD springs) with a third leg
@@ -17,6 +18,21 @@ fn three_legs() -> Mechanism {
 /// The same with the elbows elbow1 and elbow3 actuated too: 5 actuators, 3 internal forces.
 fn three_legs_actuated_elbows() -> Mechanism {
     yaml(&three_legs_yaml("  - {pair: motor3}\n  - {pair: elbow1}\n  - {pair: elbow3}\n"))
+}
+
+/// Gear ratio, efficiency, rotor inertia (kg m^2), viscous (N m s/rad) and Coulomb (N m)
+/// friction of the geared motors on theta1 and theta2 in [`three_legs_geared`].
+const GEAR: (f64, f64, f64, f64, f64) = (20.0, 0.8, 2e-5, 1e-4, 0.01);
+
+/// The three-legged five-bar with geared motors on its two coordinates.
+fn three_legs_geared() -> Mechanism {
+    let (n, eta, j, c, tc) = GEAR;
+    let motor = |q: &str| {
+        format!(
+            "  - {{coordinate: {q}, gear_ratio: {n}, efficiency: {eta}, rotor_inertia: {j}, viscous: {c}, coulomb: {tc}}}\n"
+        )
+    };
+    yaml(&three_legs_yaml(&(motor("theta1") + &motor("theta2") + "  - {pair: motor3}\n")))
 }
 
 fn three_legs_yaml(actuators: &str) -> String {
@@ -212,4 +228,48 @@ fn the_smallest_sign_keeping_preload_found_by_bisection() {
     let closed = mn.iter().zip(&v).map(|(t, v)| -t / v).fold(f64::NEG_INFINITY, f64::max);
     assert!((hi - closed).abs() <= 1e-9 * (1.0 + closed.abs()), "bisection {hi} vs {closed}");
     assert!(keeps(closed + 1e-6) && !keeps(closed - 1e-6));
+}
+
+#[test]
+fn geared_motors_share_the_joint_side_efforts_and_keep_their_rotors() {
+    let (geared, ideal) = (three_legs_geared(), three_legs());
+    let (q, qd, qdd) = point(&geared);
+    let (n, eta, j, c, tc) = GEAR;
+    for how in [Distribution::MinNorm, Distribution::MinMax, Distribution::Preload(vec![4.0])] {
+        let mut ws = Workspace::new(&geared);
+        let (act, e) = inverse_redundant(&geared, &q, &qd, &qdd, &how, &mut ws).unwrap();
+        let (_, e0) = inverse_redundant(&ideal, &q, &qd, &qdd, &how, &mut Workspace::new(&ideal)).unwrap();
+        // The rotors' torques n^2 J qdd_k stay with their motors; the rest is shared as
+        // without them.
+        for a in 0..3 {
+            let rotor = if a < 2 { n * n * j * qdd[a] } else { 0.0 };
+            assert!((e[a] - e0[a] - rotor).abs() <= 1e-12 * (1.0 + e0[a].abs()), "{how:?} {a}: {e:?} vs {e0:?}");
+        }
+        // The motor torques reproduce the motion in forward dynamics.
+        let mut t_m = vec![0.0; 2];
+        motor_torques(&geared, &qd, &e[..2], &mut t_m);
+        let inputs = [t_m[0], t_m[1], e[2]];
+        forward_redundant(&geared, 0.0, &q, &qd, &inputs, &mut ws).unwrap();
+        for k in 0..2 {
+            assert!((ws.qdd[k] - qdd[k]).abs() <= 1e-10 * qdd[k].abs(), "{how:?}: qdd {:?} vs {qdd:?}", ws.qdd);
+        }
+        // Power balance: the motors' and the third actuator's input power = the mechanism's
+        // (B e0 . qd) + the rotors' n^2 J qdd qd + each gearbox's and motor's loss, in closed
+        // form (1/eta - 1) e qd while motoring, (1 - eta) |e qd| while generating, plus the
+        // motor friction's (c w + T_c tanh(w / 1e-2)) w at motor speed w = n qd.
+        let rate3: f64 = (0..2).map(|k| act.b[k * 3 + 2] * qd[k]).sum();
+        let input = t_m[0] * n * qd[0] + t_m[1] * n * qd[1] + e[2] * rate3;
+        let mechanism: f64 = (0..2).map(|k| (0..3).map(|a| act.b[k * 3 + a] * e0[a]).sum::<f64>() * qd[k]).sum();
+        let rotors: f64 = (0..2).map(|k| n * n * j * qdd[k] * qd[k]).sum();
+        let losses: f64 = (0..2)
+            .map(|k| {
+                let (p, w) = (e[k] * qd[k], n * qd[k]);
+                let gear = if p >= 0.0 { (1.0 / eta - 1.0) * p } else { (1.0 - eta) * -p };
+                gear + (c * w + tc * (w / 1e-2).tanh()) * w
+            })
+            .sum();
+        assert!(losses > 0.0);
+        let balance = input - mechanism - rotors - losses;
+        assert!(balance.abs() <= 1e-12 * input.abs(), "{how:?}: {input} W in, {balance} W unbalanced");
+    }
 }

@@ -8,7 +8,7 @@
 use super::forward::{accelerations, body_accelerations, factor_mass_matrix};
 use super::friction;
 use super::reactions::reactions_into;
-use super::transmission::{add_rotor_inertia, rotor_terms};
+use super::transmission::{add_rotor_inertia, reflected_inertia, rotor_terms};
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::linalg::cholesky_solve;
 use crate::model::{Mechanism, PairId};
@@ -49,8 +49,7 @@ impl LossBuffers {
             return LossBuffers::default();
         }
         let (nx, m, nf) = (mech.n_x(), mech.dof(), mech.friction.len());
-        let rotor_inertia =
-            mech.actuators.iter().map(|a| a.as_ref().map_or(0.0, |a| a.ratio * a.ratio * a.rotor_inertia)).collect();
+        let rotor_inertia = mech.actuators.iter().map(|a| a.as_ref().map_or(0.0, reflected_inertia)).collect();
         LossBuffers {
             f0: vec![0.0; nx],
             b0: vec![0.0; m],

@@ -8,6 +8,7 @@
 
 use super::forward::forward;
 use super::inverse::inverse;
+use super::transmission::reflected_inertia;
 use super::Drives;
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::model::{Mechanism, PairId};
@@ -190,9 +191,14 @@ fn min_max_lambda(t: &[f64], internal: &[Vec<f64>]) -> Result<Vec<f64>, Kinemati
     Ok(lambda.iter().map(|&l| scale * solution.var_value(l)).collect())
 }
 
-/// Inverse dynamics with redundant actuators: the efforts (n_a) of every actuator for
-/// coordinates q, rates qd, accelerations qdd, shared as `how` says; `ws` is left with the
-/// point's kinematics (and `ws.tau` the generalized efforts they produce).
+/// Inverse dynamics with redundant actuators: the joint-side efforts (n_a) of every actuator
+/// for coordinates q, rates qd, accelerations qdd, shared as `how` says; `ws` is left with the
+/// point's kinematics (and `ws.tau` the generalized efforts they produce). The sharing is of
+/// the joint-side efforts: B and its internal forces are the mechanism's, linear, where a
+/// motor's torque is not (its efficiency changes with the sign of its power, its Coulomb
+/// friction with that of its speed). A rotor's torque n^2 J qdd_k is its own motor's: it is
+/// added to that coordinate's share, not shared. [`super::transmission::motor_torques`] gives the
+/// coordinates' motor torques.
 pub fn inverse_redundant(
     mech: &Mechanism,
     q: &[f64],
@@ -203,7 +209,11 @@ pub fn inverse_redundant(
 ) -> Result<(Actuation, Vec<f64>), KinematicsError> {
     inverse(mech, q, qd, qdd, ws)?;
     let act = Actuation::at(mech, ws)?;
-    let efforts = act.distribute(&ws.tau, how)?;
+    let rotor: Vec<f64> =
+        mech.actuators.iter().zip(qdd).map(|(a, qdd)| a.as_ref().map_or(0.0, |a| reflected_inertia(a) * qdd)).collect();
+    let shared: Vec<f64> = ws.tau.iter().zip(&rotor).map(|(t, r)| t - r).collect();
+    let mut efforts = act.distribute(&shared, how)?;
+    efforts.iter_mut().zip(&rotor).for_each(|(e, r)| *e += r);
     Ok((act, efforts))
 }
 
@@ -218,7 +228,9 @@ impl Drives for CoordinateEfforts<'_> {
 }
 
 /// Forward dynamics with every actuator's effort `efforts` (n_a: the coordinates' first, as
-/// drive efforts, then the pair actuators'), at time t (s) and chart state (z, zd).
+/// drive efforts, motor torques where a coordinate has a motor as in [`forward`], then the
+/// pair actuators'), at time t (s) and chart state (z, zd). The model's drive laws are not
+/// evaluated: `efforts` replaces them.
 pub fn forward_redundant(
     mech: &Mechanism,
     t: f64,
