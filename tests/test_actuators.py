@@ -173,8 +173,9 @@ def test_bad_actuators_are_refused_with_their_field():
     assert info.value.path == "loads[0].pin_radius"
 
 
-def three_legged() -> pd.Mechanism:
-    """The five-bar with a third leg A3 -> C3 -> P (0.25 m, 0.35 m) actuated at A3."""
+def three_legged(actuated: tuple[str, ...] = ("motor3",)) -> pd.Mechanism:
+    """The five-bar with a third leg A3 -> C3 -> P (0.25 m, 0.35 m); ``actuated``: the pairs
+    with an actuator besides the coordinates' (A3's)."""
     model = pd.load(MODELS / "five-bar.yaml").to_dict()
     model["loads"], model["drives"] = [], []
     model["points"] |= {"A3": [0.0, 0.0], "C3": [0.1983444079681374, 0.1521824425739351]}
@@ -184,7 +185,7 @@ def three_legged() -> pd.Mechanism:
     model["pairs"] += [{"type": "revolute", "name": "motor3", "at": "A3", "bodies": ["ground", "proximal_mid"]},
                        {"type": "revolute", "name": "elbow3", "at": "C3", "bodies": ["proximal_mid", "distal_mid"]},
                        {"type": "revolute", "name": "effector3", "at": "P", "bodies": ["distal_left", "distal_mid"]}]
-    model["actuators"] = [{"pair": "motor3"}]
+    model["actuators"] = [{"pair": p} for p in actuated]
     return pd.from_dict(model)
 
 
@@ -203,6 +204,29 @@ def test_redundant_efforts_min_norm_and_forward():
         np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, e), qdd, rtol=1e-10)
     with pytest.raises(ValueError):
         mech.distribute_efforts(q, qd, qdd, method="preload")
+
+
+def test_min_max_with_three_internal_forces_against_linprog():
+    """5 actuators on 2 degrees of freedom (motor3 and two elbows besides the coordinates):
+    the least largest effort against scipy's HiGHS on the LP over the efforts themselves,
+    min s subject to B tau = B tau_min_norm, -s <= tau_a <= s."""
+    from scipy.optimize import linprog
+
+    mech = three_legged(("motor3", "elbow1", "elbow3"))
+    q, qd, qdd = mech.q0 + [0.05, -0.04], [1.2, -0.7], [3.0, 5.0]
+    out = mech.distribute_efforts(q, qd, qdd, method="min_max")
+    assert out["internal"].shape == (3, 5)
+    b, tau = out["B"], out["B"] @ mech.distribute_efforts(q, qd, qdd)["efforts"]
+    eye, ones = np.eye(5), np.ones((5, 1))
+    ref = linprog(c=[0.0] * 5 + [1.0], A_ub=np.block([[eye, -ones], [-eye, -ones]]), b_ub=np.zeros(10),
+                  A_eq=np.hstack([b, np.zeros((2, 1))]), b_eq=tau, bounds=[(None, None)] * 6, method="highs")
+    assert ref.status == 0
+    largest = np.abs(out["efforts"]).max()
+    # HiGHS's optimality tolerance (1e-7 relative) bounds the agreement.
+    assert largest == pytest.approx(ref.fun, rel=1e-7)
+    assert largest < np.abs(mech.distribute_efforts(q, qd, qdd)["efforts"]).max()
+    np.testing.assert_allclose(b @ out["efforts"], tau, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, out["efforts"]), qdd, rtol=1e-10)
 
 
 def test_sizing_a_redundantly_actuated_robot_sizes_every_actuator(tmp_path):

@@ -378,15 +378,18 @@ class Mechanism:
     ) -> dict[str, FloatArray]:
         """Inverse dynamics with redundant actuators: every actuator's effort for (q, qd, qdd),
         each (m,). ``method``: ``"min_norm"`` (least Euclidean norm), ``"min_max"`` (least
-        largest magnitude; one internal force), or ``"preload"`` with ``preload`` one value
+        largest magnitude, any number of internal forces: a linear program), or ``"preload"`` with ``preload`` one value
         (N m or N) per internal force added to the minimum-norm efforts. Returns ``efforts``
         (n_a,), ``B`` (m, n_a) the generalized force per unit effort, ``internal`` (r, n_a) an
-        orthonormal basis of the internal forces (B v = 0)."""
+        orthonormal basis of the internal forces (B v = 0). The efforts are joint-side, a
+        motor's rotor torque n^2 J qdd kept on its own coordinate (:meth:`motor_torques`
+        gives the coordinates' motor torques)."""
         return self._native.distribute_efforts(q, qd, qdd, method, preload, x_start)
 
     def forward_dynamics_actuated(self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0) -> FloatArray:
         """Accelerations qdd (m,) at (q, qd) under every actuator's effort (n_a,, in
-        :attr:`actuator_names` order)."""
+        :attr:`actuator_names` order): on a coordinate with a motor its motor torque (N m), as
+        in :meth:`forward_dynamics`; the model's drive laws are not evaluated."""
         return self._native.forward_dynamics_actuated(q, qd, efforts, float(t))
 
     def available_torque(self, coordinate: int, speed: ArrayLike) -> FloatArray | None:

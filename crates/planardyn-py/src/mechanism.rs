@@ -713,7 +713,8 @@ impl PyMechanism {
     }
 
     /// Accelerations qdd (m,) at (q, qd) and time t (s) under every actuator's effort
-    /// `efforts` (n_a,: the coordinates' first, as drive efforts, then the pair actuators').
+    /// `efforts` (n_a,: the coordinates' first, as drive efforts (motor torques where a motor
+    /// is), then the pair actuators').
     #[pyo3(signature = (q, qd, efforts, t=0.0))]
     fn forward_dynamics_actuated<'py>(
         &self,

@@ -109,6 +109,9 @@ pub enum KinematicsError {
          the mechanism self-locks under its pair friction here; lower mu or the pin radii"
     )]
     FrictionUnsettled { iterations: usize, change: f64 },
+    /// The linear program of min-max effort sharing found no optimum (`message`: the solver's).
+    #[error("the min-max sharing of the efforts failed: {message}; share them by minimum norm or a preload")]
+    EffortSharing { message: String },
     /// An argument with the wrong length or a non-finite value.
     #[error("{name}: expected {expected}, got {got}")]
     BadArgument { name: &'static str, expected: String, got: String },

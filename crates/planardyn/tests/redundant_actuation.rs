@@ -1,17 +1,42 @@
 //! Redundant actuation: a 5R robot with a third actuated leg (2 degrees of freedom, 3
-//! actuators), its efforts shared by minimum norm, min-max and a preload.
+//! actuators; with its left and middle elbows actuated too, 5), its efforts shared by minimum
+//! norm, min-max and a preload.
 
 mod common;
 
 use common::yaml;
 use planardyn::dynamics::redundant::{forward_redundant, inverse_redundant, Distribution};
+use planardyn::dynamics::transmission::motor_torques;
 use planardyn::{Mechanism, Workspace};
 
 /// The five-bar of examples/models/five-bar.yaml (without its PD springs) with a third leg
 /// A3 -> C3 -> P (0.25 m and 0.35 m) whose base pivot is actuated.
 fn three_legs() -> Mechanism {
-    yaml(
-        r#"
+    yaml(&three_legs_yaml("  - {pair: motor3}\n"))
+}
+
+/// The same with the elbows elbow1 and elbow3 actuated too: 5 actuators, 3 internal forces.
+fn three_legs_actuated_elbows() -> Mechanism {
+    yaml(&three_legs_yaml("  - {pair: motor3}\n  - {pair: elbow1}\n  - {pair: elbow3}\n"))
+}
+
+/// Gear ratio, efficiency, rotor inertia (kg m^2), viscous (N m s/rad) and Coulomb (N m)
+/// friction of the geared motors on theta1 and theta2 in [`three_legs_geared`].
+const GEAR: (f64, f64, f64, f64, f64) = (20.0, 0.8, 2e-5, 1e-4, 0.01);
+
+/// The three-legged five-bar with geared motors on its two coordinates.
+fn three_legs_geared() -> Mechanism {
+    let (n, eta, j, c, tc) = GEAR;
+    let motor = |q: &str| {
+        format!(
+            "  - {{coordinate: {q}, gear_ratio: {n}, efficiency: {eta}, rotor_inertia: {j}, viscous: {c}, coulomb: {tc}}}\n"
+        )
+    };
+    yaml(&three_legs_yaml(&(motor("theta1") + &motor("theta2") + "  - {pair: motor3}\n")))
+}
+
+fn three_legs_yaml(actuators: &str) -> String {
+    r#"
 name: 5R with a third actuated leg
 gravity: [0.0, -9.81]
 points:
@@ -45,9 +70,9 @@ coordinates:
   - {name: theta1, pair: motor1, value: 2.007128639793479}
   - {name: theta2, pair: motor2, value: 1.0471975511965976}
 actuators:
-  - {pair: motor3}
-"#,
-    )
+"#
+    .to_owned()
+        + actuators
 }
 
 /// A point of a motion near the drawing.
@@ -112,6 +137,67 @@ fn min_max_is_the_least_largest_effort() {
         .fold(f64::INFINITY, f64::min);
     assert!(largest(&mm) <= scanned + 1e-12 && scanned - largest(&mm) <= 1e-4, "{} vs {scanned}", largest(&mm));
     assert!(largest(&mm) <= largest(&mn));
+    // The closed form with one internal force v: max_a |t_a + lambda v_a| is convex and
+    // piecewise linear in lambda, least where two of its lines t_a + lambda v_a and
+    // +-(t_b + lambda v_b) cross; the least over every crossing.
+    let worst = |l: f64| largest(&mn.iter().zip(v).map(|(t, v)| t + l * v).collect::<Vec<_>>());
+    let (t, v) = (&mn, v);
+    let closed = (0..3)
+        .flat_map(|a| (0..3).flat_map(move |b| [(t[a] - t[b], v[a] - v[b]), (t[a] + t[b], v[a] + v[b])]))
+        .filter(|(_, den)| *den != 0.0)
+        .map(|(num, den)| worst(-num / den))
+        .fold(largest(&mn), f64::min);
+    assert!((largest(&mm) - closed).abs() <= 1e-13 * closed, "LP {} vs closed form {closed}", largest(&mm));
+}
+
+#[test]
+fn min_max_with_three_internal_forces() {
+    let mech = three_legs_actuated_elbows();
+    let (q, qd, qdd) = point(&mech);
+    let mut ws = Workspace::new(&mech);
+    let (act, mm) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinMax, &mut ws).unwrap();
+    assert_eq!((act.n_a, act.internal.len()), (5, 3));
+    let largest = |t: &[f64]| t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // The drive map holds: B tau = the generalized efforts, to round-off.
+    for j in 0..2 {
+        let f: f64 = (0..5).map(|a| act.b[j * 5 + a] * mm[a]).sum();
+        assert!((f - ws.tau[j]).abs() <= 1e-12 * (1.0 + ws.tau[j].abs()), "row {j}: {f} vs {}", ws.tau[j]);
+    }
+    // Optimality (LP duality): at the optimum s the efforts at +-s (the active set) admit
+    // weights y_a >= 0, one per active effort, with sum_a y_a sgn(tau_a) N_a = 0 and
+    // sum y_a = 1. Here the optimum equalises 4 of the 5 efforts (3 internal forces + s).
+    let s = largest(&mm);
+    let active: Vec<usize> = (0..5).filter(|&a| (mm[a].abs() - s).abs() <= 1e-12 * s).collect();
+    assert_eq!(active.len(), 4, "efforts {mm:?}");
+    // Solve for y in the 4 x 4 system [sgn_a N_a^T; 1] y = [0; 1] by Gaussian elimination.
+    let mut m4: Vec<[f64; 5]> = (0..4)
+        .map(|r| {
+            let mut row = [0.0; 5];
+            for (c, &a) in active.iter().enumerate() {
+                row[c] = if r < 3 { mm[a].signum() * act.internal[r][a] } else { 1.0 };
+            }
+            row[4] = f64::from(r == 3);
+            row
+        })
+        .collect();
+    for c in 0..4 {
+        let p = (c..4).max_by(|&i, &j| m4[i][c].abs().total_cmp(&m4[j][c].abs())).unwrap();
+        m4.swap(c, p);
+        let pivot = m4[c];
+        for (_, row) in m4.iter_mut().enumerate().filter(|(r, _)| *r != c) {
+            let k = row[c] / pivot[c];
+            row.iter_mut().zip(pivot).for_each(|(x, p)| *x -= k * p);
+        }
+    }
+    let y: Vec<f64> = (0..4).map(|c| m4[c][4] / m4[c][c]).collect();
+    assert!(y.iter().all(|&y| y >= 0.0), "dual weights {y:?}: not optimal");
+    // And the drives reproduce the motion.
+    forward_redundant(&mech, 0.0, &q, &qd, &mm, &mut ws).unwrap();
+    for k in 0..2 {
+        assert!((ws.qdd[k] - qdd[k]).abs() <= 1e-10 * qdd[k].abs(), "qdd {:?} vs {qdd:?}", ws.qdd);
+    }
+    let (_, mn) = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::MinNorm, &mut ws).unwrap();
+    assert!(s < largest(&mn));
 }
 
 #[test]
@@ -142,4 +228,48 @@ fn the_smallest_sign_keeping_preload_found_by_bisection() {
     let closed = mn.iter().zip(&v).map(|(t, v)| -t / v).fold(f64::NEG_INFINITY, f64::max);
     assert!((hi - closed).abs() <= 1e-9 * (1.0 + closed.abs()), "bisection {hi} vs {closed}");
     assert!(keeps(closed + 1e-6) && !keeps(closed - 1e-6));
+}
+
+#[test]
+fn geared_motors_share_the_joint_side_efforts_and_keep_their_rotors() {
+    let (geared, ideal) = (three_legs_geared(), three_legs());
+    let (q, qd, qdd) = point(&geared);
+    let (n, eta, j, c, tc) = GEAR;
+    for how in [Distribution::MinNorm, Distribution::MinMax, Distribution::Preload(vec![4.0])] {
+        let mut ws = Workspace::new(&geared);
+        let (act, e) = inverse_redundant(&geared, &q, &qd, &qdd, &how, &mut ws).unwrap();
+        let (_, e0) = inverse_redundant(&ideal, &q, &qd, &qdd, &how, &mut Workspace::new(&ideal)).unwrap();
+        // The rotors' torques n^2 J qdd_k stay with their motors; the rest is shared as
+        // without them.
+        for a in 0..3 {
+            let rotor = if a < 2 { n * n * j * qdd[a] } else { 0.0 };
+            assert!((e[a] - e0[a] - rotor).abs() <= 1e-12 * (1.0 + e0[a].abs()), "{how:?} {a}: {e:?} vs {e0:?}");
+        }
+        // The motor torques reproduce the motion in forward dynamics.
+        let mut t_m = vec![0.0; 2];
+        motor_torques(&geared, &qd, &e[..2], &mut t_m);
+        let inputs = [t_m[0], t_m[1], e[2]];
+        forward_redundant(&geared, 0.0, &q, &qd, &inputs, &mut ws).unwrap();
+        for k in 0..2 {
+            assert!((ws.qdd[k] - qdd[k]).abs() <= 1e-10 * qdd[k].abs(), "{how:?}: qdd {:?} vs {qdd:?}", ws.qdd);
+        }
+        // Power balance: the motors' and the third actuator's input power = the mechanism's
+        // (B e0 . qd) + the rotors' n^2 J qdd qd + each gearbox's and motor's loss, in closed
+        // form (1/eta - 1) e qd while motoring, (1 - eta) |e qd| while generating, plus the
+        // motor friction's (c w + T_c tanh(w / 1e-2)) w at motor speed w = n qd.
+        let rate3: f64 = (0..2).map(|k| act.b[k * 3 + 2] * qd[k]).sum();
+        let input = t_m[0] * n * qd[0] + t_m[1] * n * qd[1] + e[2] * rate3;
+        let mechanism: f64 = (0..2).map(|k| (0..3).map(|a| act.b[k * 3 + a] * e0[a]).sum::<f64>() * qd[k]).sum();
+        let rotors: f64 = (0..2).map(|k| n * n * j * qdd[k] * qd[k]).sum();
+        let losses: f64 = (0..2)
+            .map(|k| {
+                let (p, w) = (e[k] * qd[k], n * qd[k]);
+                let gear = if p >= 0.0 { (1.0 / eta - 1.0) * p } else { (1.0 - eta) * -p };
+                gear + (c * w + tc * (w / 1e-2).tanh()) * w
+            })
+            .sum();
+        assert!(losses > 0.0);
+        let balance = input - mechanism - rotors - losses;
+        assert!(balance.abs() <= 1e-12 * input.abs(), "{how:?}: {input} W in, {balance} W unbalanced");
+    }
 }

@@ -8,7 +8,7 @@
 use super::forward::{accelerations, body_accelerations, factor_mass_matrix};
 use super::friction;
 use super::reactions::reactions_into;
-use super::transmission::{add_rotor_inertia, rotor_terms};
+use super::transmission::{add_rotor_inertia, reflected_inertia, rotor_terms};
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::linalg::cholesky_solve;
 use crate::model::{Mechanism, PairId};
@@ -49,8 +49,7 @@ impl LossBuffers {
             return LossBuffers::default();
         }
         let (nx, m, nf) = (mech.n_x(), mech.dof(), mech.friction.len());
-        let rotor_inertia =
-            mech.actuators.iter().map(|a| a.as_ref().map_or(0.0, |a| a.ratio * a.ratio * a.rotor_inertia)).collect();
+        let rotor_inertia = mech.actuators.iter().map(|a| a.as_ref().map_or(0.0, reflected_inertia)).collect();
         LossBuffers {
             f0: vec![0.0; nx],
             b0: vec![0.0; m],
@@ -133,9 +132,26 @@ pub(crate) fn forward_with_losses(
     zd: &[f64],
     ws: &mut Workspace,
 ) -> Result<(), KinematicsError> {
+    let m = ws.b.len();
+    forward_with_losses_by(mech, z, zd, ws, &mut |ws| {
+        cholesky_solve(&ws.a, m, &mut ws.b);
+        Ok(())
+    })
+}
+
+/// [`forward_with_losses`] with `solve` turning `ws.b` into zdd once A is factored: A zdd = b
+/// alone, or with the multipliers of prescribed coordinates (`dynamics::prescribed`), whose
+/// efforts `solve` adds to `ws.f`. It runs once per fixed-point step.
+pub(crate) fn forward_with_losses_by(
+    mech: &Mechanism,
+    z: &[f64],
+    zd: &[f64],
+    ws: &mut Workspace,
+    solve: &mut dyn FnMut(&mut Workspace) -> Result<(), KinematicsError>,
+) -> Result<(), KinematicsError> {
     // Taken out of `ws` for the evaluation (no allocation: the buffers move), put back after.
     let mut lb = std::mem::take(&mut ws.losses);
-    let result = forward_stages(mech, z, zd, ws, &mut lb);
+    let result = forward_stages(mech, z, zd, ws, &mut lb, solve);
     ws.losses = lb;
     result
 }
@@ -146,6 +162,7 @@ fn forward_stages(
     zd: &[f64],
     ws: &mut Workspace,
     lb: &mut LossBuffers,
+    solve: &mut dyn FnMut(&mut Workspace) -> Result<(), KinematicsError>,
 ) -> Result<(), KinematicsError> {
     let (nf, m, n) = (mech.friction.len(), ws.b.len(), ws.x.len());
     set_levers(mech, ws, lb);
@@ -162,7 +179,7 @@ fn forward_stages(
             add_scaled(&mut ws.f, e, &lb.grad[i * n..(i + 1) * n]);
             add_scaled(&mut ws.b, e, &lb.gu[i * m..(i + 1) * m]);
         }
-        cholesky_solve(&ws.a, m, &mut ws.b);
+        solve(ws)?;
         body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
         // f -= n^2 J qdd_k grad_k: the rotors' inertia torques, qdd_k = gu_k . zdd + h_k.
         for (k, &inertia) in lb.rotor_inertia.iter().enumerate().filter(|(_, j)| **j > 0.0) {

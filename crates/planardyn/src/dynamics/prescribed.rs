@@ -11,7 +11,9 @@
 
 use super::forces::{applied_forces, Drives};
 use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
+use super::losses::forward_with_losses_by;
 use super::motion::Prescribed;
+use super::transmission;
 use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
 use crate::kinematics::system::{col_scales, scaled_jacobian};
@@ -31,8 +33,9 @@ pub struct Scratch {
     /// (m_p x m) G = D_p,x U, then (m x m_p, column-major) A^-1 G^T.
     g: Vec<f64>,
     ainv_gt: Vec<f64>,
-    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) h, then tau_p.
+    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) the rows' h, and h - G A^-1 b, then tau_p.
     s: Vec<f64>,
+    h0: Vec<f64>,
     h: Vec<f64>,
 }
 
@@ -43,6 +46,7 @@ impl Scratch {
             g: vec![0.0; mp * m],
             ainv_gt: vec![0.0; m * mp],
             s: vec![0.0; mp * mp],
+            h0: vec![0.0; mp],
             h: vec![0.0; mp],
         }
     }
@@ -65,18 +69,21 @@ fn prescribed_rows(mech: &Mechanism, p: &[usize], qdd_p: &[f64], ws: &Workspace,
         if ws.chart == Chart::Inputs {
             // D_x U = I and D_x c + gamma(xd, xd) = 0 in the user's chart, by construction of U and c.
             g.iter_mut().enumerate().for_each(|(j, g)| *g = f64::from(j == k));
-            w.h[i] = qdd_p[i];
+            w.h0[i] = qdd_p[i];
         } else {
             g.iter_mut().enumerate().for_each(|(j, g)| *g = dot(grad, ws.u_col(j)));
-            w.h[i] = qdd_p[i] - dot(grad, &ws.c) - pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd);
+            w.h0[i] = qdd_p[i] - dot(grad, &ws.c) - pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd);
         }
     }
 }
 
 /// One evaluation at time t (s) and chart state (z, zd) with the coordinates of `motion`
 /// (evaluated at t) driven by it: fills every buffer of `ws` as `forward` does, with the
-/// prescribed efforts in `ws.tau` (the drives' values there are replaced) and their power
-/// in `ws.power`.
+/// prescribed efforts in `ws.tau` (joint-side, a rotor's n^2 J qdd included; the drives'
+/// values there are replaced) and their power in `ws.power`. With the actuators'
+/// transmissions or Coulomb pair friction, the prescribed efforts are the multipliers of each
+/// fixed-point step of `dynamics::losses`, so the friction, the reactions, the free
+/// coordinates' accelerations and the prescribed efforts settle together.
 pub fn forward_prescribed(
     mech: &Mechanism,
     t: f64,
@@ -86,22 +93,32 @@ pub fn forward_prescribed(
     motion: &mut Prescribed,
     ws: &mut Workspace,
 ) -> Result<(), Error> {
-    if mech.has_losses() && !motion.p.is_empty() {
-        return Err(Error::Options(
-            "prescribed motions with actuators' transmissions or Coulomb pair friction are not modelled: drive \
-             those coordinates by effort, or take their efforts from inverse dynamics (which includes both)"
-                .into(),
-        ));
-    }
     kinematic_stages(mech, z, zd, ws)?;
     drive_efforts(t, drives, ws)?;
+    transmission::to_joint_efforts(mech, ws);
     let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;
     p.iter().for_each(|&k| ws.tau[k] = 0.0);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
     mass_matrix(mech, ws);
     bias(mech, ws);
     prescribed_rows(mech, p, qdd_p, ws, w);
-    factor_mass_matrix(ws)?;
+    if mech.has_losses() {
+        forward_with_losses_by(mech, z, zd, ws, &mut |ws| solve_prescribed(p, w, ws))?;
+    } else {
+        factor_mass_matrix(ws)?;
+        solve_prescribed(p, w, ws)?;
+        accelerations(mech, z, zd, ws);
+    }
+    for (&k, &tau) in p.iter().zip(&w.h) {
+        ws.tau[k] = tau;
+        ws.power += tau * ws.qd[k];
+    }
+    Ok(())
+}
+
+/// With A factored in `ws.a`: zdd into `ws.b` and the prescribed efforts tau_p into `w.h`
+/// (from the rows' `w.h0`), their forces added to `ws.f`.
+fn solve_prescribed(p: &[usize], w: &mut Scratch, ws: &mut Workspace) -> Result<(), KinematicsError> {
     let (m, mp, nx) = (ws.b.len(), p.len(), ws.x.len());
     cholesky_solve(&ws.a, m, &mut ws.b);
     for i in 0..mp {
@@ -110,7 +127,7 @@ pub fn forward_prescribed(
         cholesky_solve(&ws.a, m, col);
     }
     for i in 0..mp {
-        w.h[i] -= dot(&w.g[i * m..(i + 1) * m], &ws.b);
+        w.h[i] = w.h0[i] - dot(&w.g[i * m..(i + 1) * m], &ws.b);
         for k in 0..mp {
             w.s[i * mp + k] = dot(&w.g[i * m..(i + 1) * m], &w.ainv_gt[k * m..(k + 1) * m]);
         }
@@ -118,10 +135,10 @@ pub fn forward_prescribed(
     // G A^-1 G^T is positive definite unless the prescribed coordinates are dependent where
     // the motion takes them (a type II singularity of their own drives).
     if !cholesky_in_place(&mut w.s, mp) {
-        return Err(KinematicsError::singular(SingularityKind::TypeII).into());
+        return Err(KinematicsError::singular(SingularityKind::TypeII));
     }
     cholesky_solve(&w.s, mp, &mut w.h);
-    for (i, &k) in p.iter().enumerate() {
+    for i in 0..mp {
         let tau = w.h[i];
         for (zdd, a) in ws.b.iter_mut().zip(&w.ainv_gt[i * m..(i + 1) * m]) {
             *zdd += a * tau;
@@ -129,10 +146,7 @@ pub fn forward_prescribed(
         for (f, g) in ws.f.iter_mut().zip(&w.grad[i * nx..(i + 1) * nx]) {
             *f += tau * g;
         }
-        ws.tau[k] = tau;
-        ws.power += tau * ws.qd[k];
     }
-    accelerations(mech, z, zd, ws);
     Ok(())
 }
 

@@ -8,11 +8,13 @@
 
 use super::forward::forward;
 use super::inverse::inverse;
+use super::transmission::reflected_inertia;
 use super::Drives;
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::model::{Mechanism, PairId};
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
+use microlp::{ComparisonOp, OptimizationDirection, Problem, Variable};
 
 /// Below this (relative to B's largest row norm) a direction counts as lost: the actuators
 /// cannot produce some generalized force (an actuation singularity).
@@ -23,7 +25,8 @@ const RANK_TOL: f64 = 1e-10;
 pub enum Distribution {
     /// The efforts of least Euclidean norm.
     MinNorm,
-    /// The efforts whose largest magnitude is least (one internal force direction).
+    /// The efforts whose largest magnitude is least (any number of internal forces; the
+    /// efforts' units as they are, N m and N alike).
     MinMax,
     /// The minimum-norm efforts plus the internal forces N lambda (lambda: one value per
     /// basis vector of [`Actuation::internal`], N m or N): a prescribed preload.
@@ -140,60 +143,62 @@ impl Actuation {
     /// The efforts (n_a) producing generalized efforts `tau` (m), shared as `how` says.
     pub fn distribute(&self, tau: &[f64], how: &Distribution) -> Result<Vec<f64>, KinematicsError> {
         let mut out = self.min_norm(tau);
-        match how {
-            Distribution::MinNorm => {}
-            Distribution::Preload(lambda) => {
-                if lambda.len() != self.internal.len() {
-                    return Err(KinematicsError::BadArgument {
-                        name: "preload",
-                        expected: format!("{} values, one per internal force", self.internal.len()),
-                        got: format!("{}", lambda.len()),
-                    });
-                }
-                for (l, v) in lambda.iter().zip(&self.internal) {
-                    out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
-                }
+        let lambda = match how {
+            Distribution::MinNorm => return Ok(out),
+            Distribution::Preload(lambda) if lambda.len() != self.internal.len() => {
+                return Err(KinematicsError::BadArgument {
+                    name: "preload",
+                    expected: format!("{} values, one per internal force", self.internal.len()),
+                    got: format!("{}", lambda.len()),
+                })
             }
-            Distribution::MinMax => {
-                let [v] = self.internal.as_slice() else {
-                    return Err(KinematicsError::BadArgument {
-                        name: "distribution",
-                        expected: "one internal force for min-max (n_a = m + 1); use min-norm or a preload".into(),
-                        got: format!("{} internal forces", self.internal.len()),
-                    });
-                };
-                let lambda = min_max_step(&out, v);
-                out.iter_mut().zip(v).for_each(|(o, v)| *o += lambda * v);
-            }
+            Distribution::Preload(lambda) => lambda.clone(),
+            Distribution::MinMax => min_max_lambda(&out, &self.internal)?,
+        };
+        for (l, v) in lambda.iter().zip(&self.internal) {
+            out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
         }
         Ok(out)
     }
 }
 
-/// The lambda minimising max_a |t_a + lambda v_a|: a convex piecewise-linear function, least
-/// where two of its lines cross (or at 0 when it is flat).
-fn min_max_step(t: &[f64], v: &[f64]) -> f64 {
-    let worst = |l: f64| t.iter().zip(v).map(|(t, v)| (t + l * v).abs()).fold(0.0, f64::max);
-    let mut best = (worst(0.0), 0.0);
-    for a in 0..t.len() {
-        for b in 0..t.len() {
-            for (num, den) in [(t[a] - t[b], v[a] - v[b]), (t[a] + t[b], v[a] + v[b])] {
-                if den != 0.0 {
-                    let l = -num / den;
-                    let w = worst(l);
-                    if w < best.0 {
-                        best = (w, l);
-                    }
-                }
-            }
+/// The internal-force amounts lambda minimising max_a |t_a + (N lambda)_a|, as the LP
+///   minimise s over (lambda, s)  subject to  -s <= t_a + N_a . lambda <= s  for every a,
+/// with t scaled to a largest magnitude of 1 (the solver's feasibility tolerance is absolute).
+/// microlp: pure Rust, maintained, few dependencies, and a simplex, whose optimum is a vertex
+/// exact to round-off where an interior-point solver (clarabel) stops at its tolerance.
+/// The drive map holds whatever lambda is: the efforts stay t + N lambda.
+fn min_max_lambda(t: &[f64], internal: &[Vec<f64>]) -> Result<Vec<f64>, KinematicsError> {
+    let scale = t.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+    if scale == 0.0 {
+        return Ok(vec![0.0; internal.len()]);
+    }
+    let mut lp = Problem::new(OptimizationDirection::Minimize);
+    let lambda: Vec<Variable> = internal.iter().map(|_| lp.add_var(0.0, (f64::NEG_INFINITY, f64::INFINITY))).collect();
+    let s = lp.add_var(1.0, (0.0, f64::INFINITY));
+    for (a, &t_a) in t.iter().enumerate() {
+        for sign in [1.0, -1.0] {
+            let row = lambda.iter().zip(internal).map(|(&l, v)| (l, sign * v[a])).chain([(s, -1.0)]);
+            lp.add_constraint(row.collect::<Vec<_>>(), ComparisonOp::Le, -sign * t_a / scale);
         }
     }
-    best.1
+    let failed = |message: String| KinematicsError::EffortSharing { message };
+    let solution = lp
+        .solve()
+        .map_err(|e| failed(e.to_string()))?
+        .into_solution()
+        .map_err(|_| failed("the LP solve was interrupted".into()))?;
+    Ok(lambda.iter().map(|&l| scale * solution.var_value(l)).collect())
 }
 
-/// Inverse dynamics with redundant actuators: the efforts (n_a) of every actuator for
-/// coordinates q, rates qd, accelerations qdd, shared as `how` says; `ws` is left with the
-/// point's kinematics (and `ws.tau` the generalized efforts they produce).
+/// Inverse dynamics with redundant actuators: the joint-side efforts (n_a) of every actuator
+/// for coordinates q, rates qd, accelerations qdd, shared as `how` says; `ws` is left with the
+/// point's kinematics (and `ws.tau` the generalized efforts they produce). The sharing is of
+/// the joint-side efforts: B and its internal forces are the mechanism's, linear, where a
+/// motor's torque is not (its efficiency changes with the sign of its power, its Coulomb
+/// friction with that of its speed). A rotor's torque n^2 J qdd_k is its own motor's: it is
+/// added to that coordinate's share, not shared. [`super::transmission::motor_torques`] gives the
+/// coordinates' motor torques.
 pub fn inverse_redundant(
     mech: &Mechanism,
     q: &[f64],
@@ -204,7 +209,11 @@ pub fn inverse_redundant(
 ) -> Result<(Actuation, Vec<f64>), KinematicsError> {
     inverse(mech, q, qd, qdd, ws)?;
     let act = Actuation::at(mech, ws)?;
-    let efforts = act.distribute(&ws.tau, how)?;
+    let rotor: Vec<f64> =
+        mech.actuators.iter().zip(qdd).map(|(a, qdd)| a.as_ref().map_or(0.0, |a| reflected_inertia(a) * qdd)).collect();
+    let shared: Vec<f64> = ws.tau.iter().zip(&rotor).map(|(t, r)| t - r).collect();
+    let mut efforts = act.distribute(&shared, how)?;
+    efforts.iter_mut().zip(&rotor).for_each(|(e, r)| *e += r);
     Ok((act, efforts))
 }
 
@@ -219,7 +228,9 @@ impl Drives for CoordinateEfforts<'_> {
 }
 
 /// Forward dynamics with every actuator's effort `efforts` (n_a: the coordinates' first, as
-/// drive efforts, then the pair actuators'), at time t (s) and chart state (z, zd).
+/// drive efforts, motor torques where a coordinate has a motor as in [`forward`], then the
+/// pair actuators'), at time t (s) and chart state (z, zd). The model's drive laws are not
+/// evaluated: `efforts` replaces them.
 pub fn forward_redundant(
     mech: &Mechanism,
     t: f64,

@@ -36,6 +36,12 @@ pub fn joint_effort(a: &Actuator, t_m: f64, qd: f64) -> f64 {
     }
 }
 
+/// The rotor's inertia reflected to the driven coordinate, n^2 J (kg m^2, or kg on a
+/// sliding coordinate).
+pub fn reflected_inertia(a: &Actuator) -> f64 {
+    a.ratio * a.ratio * a.rotor_inertia
+}
+
 /// The motor torque (N m) that gives joint-side effort `tau` at rate qd: the inverse of
 /// [`joint_effort`].
 pub fn motor_torque(a: &Actuator, tau: f64, qd: f64) -> f64 {
