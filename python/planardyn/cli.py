@@ -470,7 +470,7 @@ def _identify(args: argparse.Namespace) -> int:
         Y, tau_o = mech.regressor(q, qd, qdd, x=x)
         rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
         ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
-        prior = rms(mech.inverse_dynamics(q, qd, qdd, x=x) - tau)
+        prior = rms(Y @ np.array(list(mech.regressor_parameters.values())) + tau_o - tau)
         print(f"validation on {args.validate}: RMS effort error {ident:.4g} identified, {prior:.4g} with the model")
     if args.output is not None:
         out = {"base_parameters": found.base.expressions, "identified": found.beta.tolist(),

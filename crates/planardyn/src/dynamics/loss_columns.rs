@@ -4,8 +4,10 @@
 //! - per actuator (coordinate order) `J_<actuator>` (rotor inertia, kg m^2), `fv_<actuator>`
 //!   (motor viscous, N m s/rad), `fc_<actuator>` (motor Coulomb, N m): the rotor's torque
 //!   n^2 J qdd is joint-side, the motor friction c n qd + T_c tanh(n qd / v_m) motor-side;
-//! - per pair with a spring-damper load `fvp_<pair>`: the summed damping c of its loads,
-//!   whose effort on the pair's relative coordinate is -c rate;
+//! - per pair with a viscous damper (a pair spring-damper of zero stiffness: the viscous
+//!   part of a `friction` load) `fvp_<pair>`: the summed damping c of those loads, whose
+//!   effort on the pair's relative coordinate is -c rate (a spring's own damping, like a
+//!   servo's PD gains, stays a known load in tau_o);
 //! - per friction load `mu_<pair>` (the sliding coefficient of the load-dependent pin
 //!   friction) and `fcp_<pair>` (a constant Coulomb effort T, -T tanh(arm rate / v_st), 0 in
 //!   the model: the load-independent part a real pin shows).
@@ -43,7 +45,7 @@ fn actuated(mech: &Mechanism) -> impl Iterator<Item = (usize, &Actuator)> {
 /// Which loss columns a mechanism has.
 #[derive(Debug, Clone)]
 pub(crate) struct LossLayout {
-    /// Pairs with a spring-damper load, in pair order.
+    /// Pairs with a viscous damper, in pair order.
     damped: Vec<PairId>,
 }
 
@@ -51,7 +53,7 @@ impl LossLayout {
     pub(crate) fn new(mech: &Mechanism) -> Self {
         let damped = (0..mech.pairs.len())
             .map(PairId)
-            .filter(|&id| mech.loads.iter().any(|l| matches!(l, Load::PairSpring { pair, .. } if *pair == id)))
+            .filter(|&id| mech.loads.iter().any(|l| damper(l, id).is_some()))
             .collect();
         LossLayout { damped }
     }
@@ -86,13 +88,17 @@ impl LossLayout {
     }
 }
 
-/// The summed damping (N m s/rad or N s/m) of the spring-damper loads on `pair`.
+/// The damping of `load` if it is a viscous damper on pair `id`.
+fn damper(load: &Load, id: PairId) -> Option<f64> {
+    match load {
+        Load::PairSpring { pair, stiffness, damping, .. } if *pair == id && *stiffness == 0.0 => Some(*damping),
+        _ => None,
+    }
+}
+
+/// The summed damping (N m s/rad or N s/m) of the viscous dampers on pair `id`.
 fn damping(mech: &Mechanism, id: PairId) -> f64 {
-    let of = |l: &Load| match l {
-        Load::PairSpring { pair, damping, .. } if *pair == id => *damping,
-        _ => 0.0,
-    };
-    mech.loads.iter().map(of).sum()
+    mech.loads.iter().filter_map(|l| damper(l, id)).sum()
 }
 
 /// The friction law of `fr` with other coefficients: mu(s) is linear in (mu, mu_s).
