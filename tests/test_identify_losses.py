@@ -78,15 +78,14 @@ def test_identified_base_parameters_are_within_three_standard_errors(experiment)
     prior, _, runs, base, truth = experiment
     q, qd, qdd, tau = runs["fit"]
     # Over 20 noise draws z = (estimate - truth) / standard error is standard normal when
-    # the errors are right: |z| <= 3 for 99.7 % of them.
+    # the errors are right: |z| <= 3 for 99.7 % of them (measured: all 300, mean |z| 0.75).
     fits = [identify(prior, q, qd, qdd, noisy(tau, s), base=base) for s in range(20)]
     z = np.array([(f.beta - truth) / f.std_error for f in fits])
-    print("MEASURE z", np.mean(np.abs(z) <= 3), np.mean(np.abs(z)))
     assert np.mean(np.abs(z) <= 3) >= 0.97 and 0.6 < np.mean(np.abs(z)) < 1.2
-    # Four times the samples: every base parameter within 3 standard errors, which halve.
+    # Four times the samples: every base parameter within 3 standard errors (largest |z|
+    # measured 1.9), which halve (ratios 1.99 to 2.04 measured).
     q, qd, qdd, tau = runs["long"]
     long = identify(prior, q, qd, qdd, noisy(tau, 7), base=base)
-    print("MEASURE long", np.abs(long.beta - truth) / long.std_error, fits[0].std_error / long.std_error)
     assert np.all(np.abs(long.beta - truth) <= 3 * long.std_error)
     np.testing.assert_allclose(fits[0].std_error / long.std_error, 2.0, rtol=0.15)
     # The friction and rotor estimates of the consistent full parameters are physical.
@@ -104,5 +103,6 @@ def test_identified_model_predicts_a_validation_motion_better_than_the_prior(exp
     rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
     err_identified = rms(Y[..., base.independent] @ ident.beta + tau_o - tau)
     err_prior = rms(Y @ np.array(list(prior.regressor_parameters.values())) + tau_o - tau)
-    print("MEASURE validation", err_identified, err_prior, rms(tau))
+    # Measured: RMS 4.6e-4 N m identified against 0.027 N m with the prior (motor torques
+    # of 0.27 N m RMS): the prior's motor friction and rotors are 30-40 % off.
     assert err_identified < 0.05 * err_prior
