@@ -186,7 +186,9 @@ def identify(
     (docs/identification.md, *Losses*): a transmission's branch (motoring or generating, when
     its efficiency is below 1) and the pin friction's load, the reaction, which the ``mu_``
     columns multiply. Both are exact when the model is near the robot; where the robot's
-    loads differ from the model's by d, the pin friction is off by d of itself.
+    loads differ from the model's by d, the pin friction is off by d of itself. The loads
+    are not re-evaluated from the estimate: they depend on parameters the efforts do not
+    determine (not only on the base parameters).
 
     Rates and accelerations from measured positions: differentiate a low-pass filtered q,
     e.g. :func:`differentiate`, and filter tau with the same filter.
