@@ -1,7 +1,7 @@
-//! The dynamics in linear form for identification: tau = Y(q, qd, qdd) pi + tau_o, with pi
-//! the inertial parameters of every body, then the loss parameters (docs/identification.md,
-//! *Losses*), and tau_o the efforts of the loads that do not depend on them (springs,
-//! external forces; docs/formulation.md, *Regressor*).
+//! The dynamics in linear form for identification (docs/identification.md): tau =
+//! Y(q, qd, qdd) pi + tau_o, with pi the inertial parameters of every body, then the loss
+//! parameters (*Losses* there), and tau_o the efforts of the loads that do not depend on them
+//! (springs, external forces).
 //!
 //! Each body's parameters are taken in its own frame as the model defines it (origin at the
 //! drawn centre of mass, axes turning with the body angle phi): [m, m cx, m cy, I_O], where
