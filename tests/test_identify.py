@@ -17,8 +17,10 @@ def test_y_pi_plus_tau_o_is_the_inverse_dynamics_of_a_run(name):
     mech = pd.load_example(name)
     res = mech.simulate(t_end=0.05, output_dt=0.005)
     Y, tau_o = mech.regressor(res.q, res.qd, res.qdd, x=res.x)
-    pi = np.array(list(mech.inertial_parameters.values()))
-    assert Y.shape == (len(res.t), mech.dof, 4 * mech.n_bodies) and tau_o.shape == res.q.shape
+    pi = np.array(list(mech.regressor_parameters.values()))
+    # The bodies' 4 each, and the slider-crank's and the boom's viscous friction.
+    assert Y.shape == (len(res.t), mech.dof, len(pi)) and tau_o.shape == res.q.shape
+    assert len(pi) == 4 * mech.n_bodies + {"slider-crank": 1, "hydraulic-boom": 1}.get(name, 0)
     tau = mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x)
     np.testing.assert_allclose(Y @ pi + tau_o, tau, rtol=0, atol=1e-12 * max(1.0, np.abs(tau).max()))
 

@@ -180,6 +180,7 @@ class Mechanism:
         qd: ArrayLike,
         qdd: ArrayLike,
         x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> dict[str, NDArray[np.float64]]: ...
     @property

@@ -268,10 +268,12 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("-o", "--output", "--out", type=_results_path, dest="output",
                    help="results file to write (.csv, .parquet or .npz) with tau_<name> columns")
 
-    idf = _sub(sub, "identify", "identify the inertial parameters from a measured motion",
-               "Estimate the model's base inertial parameters (the combinations the efforts can\n"
-               "tell apart) from a measured motion: a CSV table with t (s), one column per coordinate\n"
-               "(rad or m) and tau_<name> (N m or N), or a planardyn results file. Rates and\n"
+    idf = _sub(sub, "identify", "identify the inertial and friction parameters from a measured motion",
+               "Estimate the model's base parameters (the combinations of the inertial parameters,\n"
+               "rotor inertias and friction coefficients the efforts can tell apart) from a measured\n"
+               "motion: a CSV table with t (s), one column per coordinate (rad or m) and tau_<name>\n"
+               "(N m or N; the motor torque where the model has an actuator), or a planardyn results\n"
+               "file (a run's tau is joint-side: give a geared model's motor torques in a table). Rates and\n"
                "accelerations come from qd_<name>/qdd_<name> columns, else from the positions\n"
                "low-pass filtered at --cutoff (the efforts filtered alike). Prints each base\n"
                "parameter identified with its standard error, against the model's.",
@@ -470,7 +472,7 @@ def _identify(args: argparse.Namespace) -> int:
         Y, tau_o = mech.regressor(q, qd, qdd, x=x)
         rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
         ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
-        prior = rms(mech.inverse_dynamics(q, qd, qdd, x=x) - tau)
+        prior = rms(Y @ np.array(list(mech.regressor_parameters.values())) + tau_o - tau)
         print(f"validation on {args.validate}: RMS effort error {ident:.4g} identified, {prior:.4g} with the model")
     if args.output is not None:
         out = {"base_parameters": found.base.expressions, "identified": found.beta.tolist(),

@@ -1,10 +1,12 @@
-"""Identification of a built mechanism's inertial parameters: which combinations of them the
-drive efforts can tell apart (the base parameters).
+"""Identification of a built mechanism's inertial and loss parameters: which combinations of
+them the drive efforts can tell apart (the base parameters), and their estimates.
 
-The efforts are linear in the inertial parameters pi (``Mechanism.regressor``:
-tau = Y pi + tau_o), but some parameters act only in fixed combinations (a link's mass moved
-along a ground pivot's axis, the masses of two bodies joined at a point...), so only r of the
-p columns of Y are independent. :func:`base_parameters` finds them numerically, by QR with
+The efforts are linear in the parameters pi (``Mechanism.regressor``: tau = Y pi + tau_o;
+the bodies' inertial parameters, then the rotors' inertias and the friction coefficients,
+``Mechanism.regressor_parameters``), but some parameters act only in fixed combinations (a
+link's mass moved along a ground pivot's axis, the masses of two bodies joined at a point, a
+rotor's inertia and that of the crank it turns...), so only r of the p columns of Y are
+independent. :func:`base_parameters` finds them numerically, by QR with
 column pivoting of Y stacked over many states, and writes each base parameter as a named
 linear combination of the physical ones.
 """
@@ -127,7 +129,7 @@ def base_parameters(mech: Mechanism, samples: int = 200, seed: int = 0) -> BaseP
     if len(dependent):
         K = np.asarray(np.linalg.lstsq(W[:, independent], W[:, dependent], rcond=None)[0], dtype=np.float64)
     condition = float(np.linalg.cond(scaled[:, perm[:r]]))
-    names = list(mech.inertial_parameters)
+    names = list(mech.regressor_parameters)
     return BaseParameters(names, independent.tolist(), dependent.tolist(), K, samples, condition)
 
 
@@ -176,7 +178,17 @@ def identify(
     weighted by the inverse of its residual's standard deviation), with standard errors from
     the weighted residual's variance. Then the physically consistent full parameters nearest
     the model's that have those base parameters (scipy's SLSQP: m > 0 and m I_O - (m cx)^2 -
-    (m cy)^2 > 0, i.e. a positive inertia about the centre of mass).
+    (m cy)^2 > 0, i.e. a positive inertia about the centre of mass; rotor inertias and
+    friction coefficients >= 0).
+
+    With actuators the measured efforts of their coordinates are the motor torques (as a
+    simulation's ``tau`` and ``Mechanism.motor_torques``). Two terms are taken from the model
+    (docs/identification.md, *Losses*): a transmission's branch (motoring or generating, when
+    its efficiency is below 1) and the pin friction's load, the reaction, which the ``mu_``
+    columns multiply. Both are exact when the model is near the robot; where the robot's
+    loads differ from the model's by d, the pin friction is off by d of itself. The loads
+    are not re-evaluated from the estimate: they depend on parameters the efforts do not
+    determine (not only on the base parameters).
 
     Rates and accelerations from measured positions: differentiate a low-pass filtered q,
     e.g. :func:`differentiate`, and filter tau with the same filter.
@@ -195,23 +207,24 @@ def identify(
     dof = n * m - r
     s2 = float(np.sum((rw - Ww @ beta) ** 2) / dof)
     std = np.sqrt(s2 * np.diag(np.linalg.inv(Ww.T @ Ww)))
-    prior_pi = np.array(list(mech.inertial_parameters.values()))
+    prior_pi = np.array(list(mech.regressor_parameters.values()))
     resid = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0))
-    pi = _consistent(base, beta, prior_pi)
+    pi = _consistent(base, beta, prior_pi, mech.n_bodies)
     return Identification(base, beta, std, base.of(prior_pi), dict(zip(base.parameters, pi)), resid, n)
 
 
-def _consistent(base: BaseParameters, beta: FloatArray, prior: FloatArray) -> FloatArray:
+def _consistent(base: BaseParameters, beta: FloatArray, prior: FloatArray, nb: int) -> FloatArray:
     """The full parameters nearest ``prior`` (scaled per parameter) with base parameters
-    ``beta`` and a physical body each: m > 0, m I_O > (m cx)^2 + (m cy)^2."""
+    ``beta``, a physical body each (m > 0, m I_O > (m cx)^2 + (m cy)^2: the first 4 nb) and
+    loss parameters >= 0."""
     from scipy.optimize import minimize
 
     scale = np.maximum(np.abs(prior), 1e-6 * np.abs(prior).max())
-    nb = len(prior) // 4
 
     def body_margins(z: FloatArray) -> FloatArray:
-        p = (z * scale).reshape(nb, 4)
-        return np.concatenate([p[:, 0], p[:, 0] * p[:, 3] - p[:, 1] ** 2 - p[:, 2] ** 2])
+        p = z * scale
+        b = p[: 4 * nb].reshape(nb, 4)
+        return np.concatenate([b[:, 0], b[:, 0] * b[:, 3] - b[:, 1] ** 2 - b[:, 2] ** 2, p[4 * nb:]])
 
     cons = [{"type": "eq", "fun": lambda z: base.of(z * scale) - beta},
             {"type": "ineq", "fun": body_margins}]
@@ -306,8 +319,9 @@ def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitu
     - every coordinate stays within ``amplitude`` (rad, or 0.1 of it times the drawing's size
       for a displacement) of the model's start;
     - ``qd_max``: (m,) or scalar peak speed of each drive (rad/s or m/s);
-    - ``tau_max``: (m,) or scalar peak effort of each drive (N m or N), from the model's
-      inverse dynamics (the regressor with the model's parameters: tau = Y pi + tau_o);
+    - ``tau_max``: (m,) or scalar peak effort of each drive (N m or N; the motor torque where
+      an actuator is), from the model's inverse dynamics (the regressor with the model's
+      parameters: tau = Y pi + tau_o);
     - ``sigma_margin``: the type II measure (``kinematics``' ``sigma_min``) stays above it;
     - it can be assembled all along, away from the branch guard of a type II singularity.
 
@@ -365,7 +379,7 @@ class _Limits:
     def __init__(self, mech: Mechanism, tau_max: ArrayLike | None, qd_max: ArrayLike | None,
                  sigma_margin: float | None) -> None:
         self.mech = mech
-        self.pi = np.array(list(mech.inertial_parameters.values()))
+        self.pi = np.array(list(mech.regressor_parameters.values()))
         self.tau_max = _per_drive("tau_max", tau_max, mech.dof)
         self.qd_max = _per_drive("qd_max", qd_max, mech.dof)
         if sigma_margin is not None and not (np.isfinite(sigma_margin) and sigma_margin > 0):

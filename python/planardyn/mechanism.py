@@ -519,10 +519,21 @@ class Mechanism:
 
     @property
     def inertial_parameters(self) -> dict[str, float]:
-        """The model's inertial parameters pi, by name: per body ``m_<body>`` (kg),
+        """The model's inertial parameters, by name: per body ``m_<body>`` (kg),
         ``mcx_<body>``, ``mcy_<body>`` (kg m: the mass times the centre of mass in the body's
         frame, whose origin is the drawn centre of mass, so 0 here) and ``I_<body>`` (kg m^2,
-        about that origin). The order is that of :meth:`regressor`'s columns."""
+        about that origin). The first columns of :meth:`regressor`, in order."""
+        return dict(list(self.regressor_parameters.items())[: 4 * self.n_bodies])
+
+    @property
+    def regressor_parameters(self) -> dict[str, float]:
+        """All the parameters pi of :meth:`regressor`'s columns, by name, in order: the
+        :attr:`inertial_parameters`, then the losses' (docs/identification.md, *Losses*): per
+        actuator ``J_<actuator>`` (rotor inertia, kg m^2), ``fv_<actuator>`` (motor viscous,
+        N m s/rad), ``fc_<actuator>`` (motor Coulomb, N m); per pair with a viscous damper
+        (a ``friction`` load's ``viscous``, or a pair spring of zero stiffness) ``fvp_<pair>``
+        (its damping); per friction load with ``mu`` ``mu_<pair>`` (the sliding coefficient)
+        and ``fcp_<pair>`` (a constant Coulomb effort, 0 in the model)."""
         values, names = self._native.parameters
         return dict(zip(names, values))
 
@@ -532,17 +543,21 @@ class Mechanism:
         qd: ArrayLike,
         qdd: ArrayLike,
         x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
         allow_singular: bool = False,
     ) -> tuple[FloatArray, FloatArray]:
         """The dynamics in linear form: the efforts of :meth:`inverse_dynamics` are
-        ``Y @ pi + tau_o``, with pi the inertial parameters (:attr:`inertial_parameters`,
-        whatever their values: the kinematics do not depend on them) and tau_o the efforts of
-        the other loads (springs, dampers, external forces).
+        ``Y @ pi + tau_o``, with pi the parameters (:attr:`regressor_parameters`: whatever
+        the bodies' values, since the kinematics do not depend on them) and tau_o the efforts
+        of the other loads (springs, external forces). On a coordinate with an actuator the
+        row is the motor torque (:meth:`motor_torques` of the efforts); the pin friction's
+        load and the transmission's branch (motoring or generating) are the model's own, so
+        Y @ pi + tau_o is exact at the model's parameters (docs/identification.md, *Losses*).
 
-        Parameters and branch as :meth:`inverse_dynamics`. Returns ``(Y, tau_o)``: (m, p)
-        and (m,), or (N, m, p) and (N, m) for rows, p = 4 per body.
+        Parameters, branch and body rates ``xd`` as :meth:`inverse_dynamics`. Returns
+        ``(Y, tau_o)``: (m, p) and (m,), or (N, m, p) and (N, m) for rows.
         """
-        out = self._native.regressor(q, qd, qdd, x, allow_singular)
+        out = self._native.regressor(q, qd, qdd, x, xd, allow_singular)
         return out["Y"], out["tau_o"]
 
     def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:

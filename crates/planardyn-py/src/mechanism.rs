@@ -738,9 +738,11 @@ impl PyMechanism {
         Ok(arr1(py, qdd))
     }
 
-    /// The regressor form along rows of a motion, on the branch of x as `inverse_dynamics`:
-    /// `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with efforts = Y pi + tau_o.
-    #[pyo3(signature = (q, qd, qdd, x=None, allow_singular=false))]
+    /// The regressor form along rows of a motion, on the branch of x (and with the body rates
+    /// xd) as `inverse_dynamics`: `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with
+    /// efforts = Y pi + tau_o.
+    #[pyo3(signature = (q, qd, qdd, x=None, xd=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
     fn regressor<'py>(
         &self,
         py: Python<'py>,
@@ -748,13 +750,15 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
         x: Option<ArrayArg<'py>>,
+        xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (q, qd, qdd, x, _) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), None)?;
+        let (q, qd, qdd, x, xd) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), xd.as_ref())?;
         let mech = self.inner.clone();
-        let (m, p) = (self.m(), planardyn::dynamics::regressor::BODY_PARAMETERS * mech.bodies.len());
+        let (m, p) = (self.m(), planardyn::dynamics::regressor::n_parameters(&mech));
         let (y, tau_o) = run(py, || {
-            Ok(regressor_rows(&mech, branch_of(x.as_ref(), None), &q.data, &qd.data, &qdd.data, allow_singular)?)
+            let branch = branch_of(x.as_ref(), xd.as_ref());
+            Ok(regressor_rows(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
         })?;
         let n = q.rows();
         let d = PyDict::new(py);
@@ -768,7 +772,8 @@ impl PyMechanism {
         Ok(d)
     }
 
-    /// The model's inertial parameters pi (4 per body: m, m cx, m cy, I_O) and their names.
+    /// The model's parameters pi (4 per body: m, m cx, m cy, I_O; then the losses') and their
+    /// names, in the order of the regressor's columns.
     #[getter]
     fn parameters(&self) -> (Vec<f64>, Vec<String>) {
         use planardyn::dynamics::regressor::{parameter_names, parameters};

@@ -201,10 +201,9 @@ pub fn dissipation_rows(
     Ok(out)
 }
 
-/// The regressor form along rows of a motion on `branch` (as [`inverse_rows_checked`]):
-/// Y (N x m x p, p = [`dynamics::regressor::BODY_PARAMETERS`] per body) and tau_o (N x m),
-/// so that every row's efforts are Y pi + tau_o. Its body rates come from qd (U qd), so
-/// rows' given xd are refused rather than ignored.
+/// The regressor form along rows of a motion on `branch` (as [`inverse_rows_checked`], with
+/// a result's body rates when given): Y (N x m x p, p = [`dynamics::regressor::n_parameters`])
+/// and tau_o (N x m), so that every row's efforts are Y pi + tau_o.
 pub fn regressor_rows(
     mech: &Mechanism,
     branch: Branch<'_>,
@@ -213,18 +212,14 @@ pub fn regressor_rows(
     qdd: &[f64],
     allow_singular: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), Error> {
-    if let Branch::Rows(_, Some(_)) = branch {
-        let expected = "no body rates: the regressor takes the rates of qd (pass x alone)";
-        return Err(KinematicsError::bad_argument("xd", expected, "body rates").into());
-    }
-    let p = dynamics::regressor::BODY_PARAMETERS * mech.bodies.len();
+    let p = dynamics::regressor::n_parameters(mech);
     let m = mech.dof().max(1);
     let (mut y, mut tau_o) = (vec![0.0; q.len() * p], vec![0.0; q.len()]);
-    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, _| {
-        dynamics::forward::kinematic_stages(mech, &q[row.clone()], &qd[row.clone()], ws)?;
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, row, xd| {
         let k = row.start / m;
         let (y_row, tau_row) = (&mut y[k * m * p..(k + 1) * m * p], &mut tau_o[row.clone()]);
-        dynamics::regressor::regressor(mech, ws, &qdd[row], y_row, tau_row);
+        let (q, qd, qdd) = (&q[row.clone()], &qd[row.clone()], &qdd[row]);
+        dynamics::regressor::regressor(mech, q, qd, qdd, xd, ws, y_row, tau_row)?;
         Ok(())
     })?;
     Ok((y, tau_o))

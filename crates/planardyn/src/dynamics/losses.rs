@@ -63,6 +63,12 @@ impl LossBuffers {
             reactions: vec![[0.0; 3]; mech.pairs.len()],
         }
     }
+
+    /// The pairs' reactions [F_x, F_y, M] of the last evaluation with friction (empty
+    /// without losses).
+    pub(crate) fn reactions(&self) -> &[[f64; 3]] {
+        &self.reactions
+    }
 }
 
 fn add_scaled(out: &mut [f64], s: f64, v: &[f64]) {
@@ -74,11 +80,18 @@ fn add_scaled(out: &mut [f64], s: f64, v: &[f64]) {
 /// Lever `i` of `pair` at the point in `ws`; returns the pair's relative rate.
 fn set_lever(mech: &Mechanism, pair: PairId, ws: &Workspace, lb: &mut LossBuffers, i: usize) -> f64 {
     let (n, m) = (ws.x.len(), ws.b.len());
-    let grad = &mut lb.grad[i * n..(i + 1) * n];
+    pair_lever(mech, pair, ws, &mut lb.grad[i * n..(i + 1) * n], &mut lb.gu[i * m..(i + 1) * m])
+}
+
+/// The lever of `pair` at the point in `ws` (after the kinematic stages): its relative
+/// coordinate's gradient (3n) into `grad`, that gradient times U (m) into `gu`; returns the
+/// pair's relative rate.
+pub(crate) fn pair_lever(mech: &Mechanism, pair: PairId, ws: &Workspace, grad: &mut [f64], gu: &mut [f64]) -> f64 {
+    let n = ws.x.len();
     grad.fill(0.0);
     let p = &mech.pairs[pair.0];
     pair_coordinate_grad(p, &ws.x, &mut Dense { j: grad, ncols: n }, 0);
-    for (g, u) in lb.gu[i * m..(i + 1) * m].iter_mut().zip(ws.u.chunks_exact(n)) {
+    for (g, u) in gu.iter_mut().zip(ws.u.chunks_exact(n)) {
         *g = u.iter().zip(grad.iter()).map(|(a, b)| a * b).sum();
     }
     pair_coordinate_rate(p, &ws.x, &ws.xd)

@@ -11,6 +11,7 @@ pub mod forces;
 pub mod forward;
 pub mod friction;
 pub mod inverse;
+mod loss_columns;
 mod losses;
 pub mod motion;
 pub mod prescribed;
