@@ -101,6 +101,13 @@ impl ClosedForm {
         }
     }
 
+    /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
+    /// reference branch ([`Rrr::keeps_side`]); if not, a step crosses a fold and the closed
+    /// forms would leave the motion's branch there.
+    pub fn keeps_branches(&self, x: &[f64]) -> bool {
+        self.dyads.iter().zip(&self.branches).all(|(d, b)| d.keeps_side(b, x))
+    }
+
     /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.
     pub fn positions(&mut self, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
         for c in &self.cranks {
