@@ -1,7 +1,8 @@
 //! The closed-form kinematics of the user's chart (`kinematics::closed_form`) against the
 //! general path (Newton on the block-triangular J, then U and c by solves with its factors), on
 //! every shipped model that has one, at random configurations and rates: positions, U, xd, c,
-//! A and zdd must agree to round-off.
+//! A and zdd must agree to round-off, and the type II measure from the closed forms with the
+//! SVD of J's blocks.
 //!
 //! Tolerance: the general path stops Newton at a scaled residual of 1e-14 and polishes it to
 //! round-off, so its x is exact to about 1e-14 / sigma (sigma the type II measure, >= 0.05 where
@@ -20,6 +21,10 @@ const X_TOL: f64 = 1e-11;
 /// xd, c and A; 1.4e-11 for qdd (the four-bar under gravity, where b = U^T (f - M c) is a
 /// difference of terms up to 10 times larger than itself).
 const REL_TOL: f64 = 1e-10;
+/// The type II measure from the closed forms against the SVD of each block of J
+/// (`sigma_min`), relative: both are exact to round-off, about 1e-16 / sigma relative with
+/// sigma >= 0.05 here.
+const SIGMA_TOL: f64 = 1e-10;
 
 fn model_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
@@ -126,7 +131,7 @@ fn equals_the_general_path_at_random_states() {
         let mech = planardyn::load(dir.join(format!("{model}.yaml")).to_str().unwrap()).unwrap();
         let mut cf = ClosedForm::new(&mech).unwrap();
         let (q0, _) = mech.initial_state();
-        let (mut compared, mut worst) = (0, [0.0_f64; 7]);
+        let (mut compared, mut worst) = (0, [0.0_f64; 8]);
         for _ in 0..60 {
             let q: Vec<f64> = q0.iter().map(|v| v + 1.2 * (rng.next() - 0.5)).collect();
             let qd: Vec<f64> = q0.iter().map(|_| 6.0 * (rng.next() - 0.5)).collect();
@@ -139,21 +144,23 @@ fn equals_the_general_path_at_random_states() {
                     .fold(0.0_f64, |m, (i, (a, b))| m.max((a - b).abs() / if i % 3 == 2 { 1.0 } else { mech.scale }));
             let figures =
                 [dx, rel_diff(&g.u, &c.u), rel_diff(&g.xd, &c.xd), rel_diff(&g.c, &c.c), rel_diff(&g.a, &c.a)];
-            let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd)];
+            let sigma = sigma_min(&mech, &Chart::Inputs, &g.x);
+            let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd), (cf.sigma() - sigma).abs() / sigma];
             for (w, f) in worst.iter_mut().zip(figures.iter().chain(&more)) {
                 *w = w.max(*f);
             }
             assert_eq!((c.q.as_slice(), c.qd.as_slice()), (q.as_slice(), qd.as_slice()));
         }
         eprintln!(
-            "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd: {:?}",
+            "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd, sigma: {:?}",
             worst.map(|w| format!("{w:.1e}"))
         );
         assert!(compared >= 30, "{model}: only {compared} of 60 random states assembled clear of singularities");
         assert!(worst[0] < X_TOL, "{model}: positions differ by {:e} (scaled)", worst[0]);
-        for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..]) {
+        for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..7]) {
             assert!(*w < REL_TOL, "{model}: {what} differs by {w:e} relative");
         }
+        assert!(worst[7] < SIGMA_TOL, "{model}: the type II measure differs by {:e} relative", worst[7]);
     }
 }
 

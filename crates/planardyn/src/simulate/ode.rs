@@ -184,6 +184,12 @@ impl<'a> MechanismOde<'a> {
         }
     }
 
+    /// The type II measure of the point in `ws` from the closed forms, if it was evaluated with
+    /// them (J is then not factorised there).
+    pub fn closed_form_sigma(&self) -> Option<f64> {
+        self.closed.as_ref().filter(|_| self.stale_j && self.ws.chart == Chart::Inputs).map(ClosedForm::sigma)
+    }
+
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
     pub fn restart_from_anchor(&mut self) {
         self.base_valid = false;
@@ -215,6 +221,10 @@ impl<'a> MechanismOde<'a> {
         let m = self.m();
         let n = self.ws.x.len();
         let closed = self.closed_form_in_use();
+        if !closed && self.base_valid {
+            // The second-order term solves with J at the last evaluation.
+            self.factor_stale_j();
+        }
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);

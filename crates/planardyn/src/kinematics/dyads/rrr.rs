@@ -6,6 +6,7 @@
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
 use super::{put_acceleration, put_rate, Joint};
+use crate::kinematics::group_sigma::dyad_sigma;
 use crate::kinematics::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
 use crate::{KinematicsError, SingularityKind};
@@ -48,6 +49,18 @@ pub struct Geometry {
     own: [[f64; 2]; 2],
     e: [[f64; 2]; 2],
     inv_det: f64,
+}
+
+impl Geometry {
+    /// The dyad's type II measure at these positions, 1 / L_k its group's inverse length
+    /// (`group_sigma::dyad_sigma`): the arms of A and P on body 1 (R s_A, R s_A + e1) and of
+    /// B and P on body 2.
+    pub fn sigma(&self, inv_length: f64) -> f64 {
+        let [a, b] = self.own.map(|r| [r[0] * inv_length, r[1] * inv_length]);
+        let [p1, p2] = [0, 1]
+            .map(|i| [(self.own[i][0] + self.e[i][0]) * inv_length, (self.own[i][1] + self.e[i][1]) * inv_length]);
+        dyad_sigma(a, b, p1, p2)
+    }
 }
 
 impl Rrr {
