@@ -40,7 +40,7 @@ pub fn regressor(mech: &Mechanism, ws: &mut Workspace, qdd: &[f64], y: &mut [f64
     body_accelerations(&ws.u, &ws.c, qdd, ws.sys.u_support(), &mut ws.xdd);
     // The loads other than gravity, without drives.
     ws.tau.fill(0.0);
-    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     let g = mech.gravity;
     for (f, body) in ws.f.chunks_exact_mut(3).zip(&mech.bodies) {
         f[0] -= body.mass * g[0];
