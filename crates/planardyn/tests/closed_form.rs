@@ -15,6 +15,8 @@ use planardyn::kinematics::{assemble_into, sigma_min, Chart, ClosedForm};
 use planardyn::{KinematicsError, Mechanism, Workspace};
 use std::path::{Path, PathBuf};
 
+mod common;
+
 /// Positions (scaled: lengths / L, angles in rad). Measured worst: 2.4e-13 (Watt six-bar).
 const X_TOL: f64 = 1e-11;
 /// U, xd, c, A, qdd, xdd relative to the largest entry of each. Measured worst: 1e-13 for U,
@@ -200,4 +202,42 @@ fn reports_coordinates_where_a_dyad_does_not_assemble() {
         other => panic!("expected AssemblyFailed, got {other:?}"),
     }
     assert!(assemble_into(&mech, &apart, &mut Workspace::new(&mech)).is_err());
+}
+
+/// One parallelogram of unit rods (A02 at N = 1): rods 0 and 1 hinged to the ground 1 m
+/// apart, the coupler joining their tops; theta the first rod's angle from the ground.
+const PARALLELOGRAM: &str = "name: parallelogram\ngravity: [0, -9.81]\n\
+points: {O0: [0, 0], A0: [0, 1], O1: [1, 0], A1: [1, 1]}\nground: [O0, O1]\nbodies:\n  \
+rod0: {points: [O0, A0], uniform_bar: [O0, A0], mass: 1.0}\n  \
+rod1: {points: [O1, A1], uniform_bar: [O1, A1], mass: 1.0}\n  \
+coupler1: {points: [A0, A1], uniform_bar: [A0, A1], mass: 1.0}\npairs:\n  \
+- {type: revolute, name: ground_rod0, at: O0, bodies: [ground, rod0]}\n  \
+- {type: revolute, name: ground_rod1, at: O1, bodies: [ground, rod1]}\n  \
+- {type: revolute, at: A0, bodies: [rod0, coupler1]}\n  \
+- {type: revolute, at: A1, bodies: [coupler1, rod1]}\n\
+coordinates:\n  - {name: theta, pair: ground_rod0, value: 1.5707963267948966}\n";
+
+#[test]
+fn a_predictor_past_a_fold_is_recognised() {
+    // On the parallelogram branch (every rod at angle theta, the coupler level) the dyad of the
+    // coupler and rod 1 folds where the rods lie flat, theta = 0: its joint P crosses the line
+    // from A (rod 0's top) to B (rod 1's pivot), A = B there. A predicted point on that branch
+    // past theta = 0 is on the other side of the kept branch; one short of it is not.
+    let mech = common::yaml(PARALLELOGRAM);
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    let mut ws = Workspace::new(&mech);
+    assemble_into(&mech, &[0.3], &mut ws).unwrap();
+    cf.set_reference(&ws.x);
+    assert!(cf.keeps_branches(&ws.x));
+    let on_branch = |theta: f64| {
+        let mut x = ws.x.clone();
+        (x[2], x[5], x[8]) = (theta, theta, 0.0);
+        x
+    };
+    assert!(cf.keeps_branches(&on_branch(1e-3)));
+    assert!(!cf.keeps_branches(&on_branch(-1e-3)));
+    // The closed form at -1e-3 keeps the side: P at the circles' other intersection, the
+    // coupler turned over by about pi, which is why such a step takes Newton.
+    cf.kinematic_stages(&[-1e-3], &[0.0], &mut ws).unwrap();
+    assert!((ws.x[8].abs() - std::f64::consts::PI).abs() < 1e-2, "coupler angle {}", ws.x[8]);
 }
