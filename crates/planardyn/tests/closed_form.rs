@@ -1,7 +1,8 @@
 //! The closed-form kinematics of the user's chart (`kinematics::closed_form`) against the
 //! general path (Newton on the block-triangular J, then U and c by solves with its factors), on
 //! every shipped model that has one, at random configurations and rates: positions, U, xd, c,
-//! A and zdd must agree to round-off.
+//! A and zdd must agree to round-off, and the type II measure from the closed forms with the
+//! SVD of J's blocks.
 //!
 //! Tolerance: the general path stops Newton at a scaled residual of 1e-14 and polishes it to
 //! round-off, so its x is exact to about 1e-14 / sigma (sigma the type II measure, >= 0.05 where
@@ -14,12 +15,18 @@ use planardyn::kinematics::{assemble_into, sigma_min, Chart, ClosedForm};
 use planardyn::{KinematicsError, Mechanism, Workspace};
 use std::path::{Path, PathBuf};
 
+mod common;
+
 /// Positions (scaled: lengths / L, angles in rad). Measured worst: 2.4e-13 (Watt six-bar).
 const X_TOL: f64 = 1e-11;
 /// U, xd, c, A, qdd, xdd relative to the largest entry of each. Measured worst: 1e-13 for U,
 /// xd, c and A; 1.4e-11 for qdd (the four-bar under gravity, where b = U^T (f - M c) is a
 /// difference of terms up to 10 times larger than itself).
 const REL_TOL: f64 = 1e-10;
+/// The type II measure from the closed forms against the SVD of each block of J
+/// (`sigma_min`), relative: both are exact to round-off, about 1e-16 / sigma relative with
+/// sigma >= 0.05 here.
+const SIGMA_TOL: f64 = 1e-10;
 
 fn model_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
@@ -126,7 +133,7 @@ fn equals_the_general_path_at_random_states() {
         let mech = planardyn::load(dir.join(format!("{model}.yaml")).to_str().unwrap()).unwrap();
         let mut cf = ClosedForm::new(&mech).unwrap();
         let (q0, _) = mech.initial_state();
-        let (mut compared, mut worst) = (0, [0.0_f64; 7]);
+        let (mut compared, mut worst) = (0, [0.0_f64; 8]);
         for _ in 0..60 {
             let q: Vec<f64> = q0.iter().map(|v| v + 1.2 * (rng.next() - 0.5)).collect();
             let qd: Vec<f64> = q0.iter().map(|_| 6.0 * (rng.next() - 0.5)).collect();
@@ -139,21 +146,23 @@ fn equals_the_general_path_at_random_states() {
                     .fold(0.0_f64, |m, (i, (a, b))| m.max((a - b).abs() / if i % 3 == 2 { 1.0 } else { mech.scale }));
             let figures =
                 [dx, rel_diff(&g.u, &c.u), rel_diff(&g.xd, &c.xd), rel_diff(&g.c, &c.c), rel_diff(&g.a, &c.a)];
-            let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd)];
+            let sigma = sigma_min(&mech, &Chart::Inputs, &g.x);
+            let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd), (cf.sigma() - sigma).abs() / sigma];
             for (w, f) in worst.iter_mut().zip(figures.iter().chain(&more)) {
                 *w = w.max(*f);
             }
             assert_eq!((c.q.as_slice(), c.qd.as_slice()), (q.as_slice(), qd.as_slice()));
         }
         eprintln!(
-            "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd: {:?}",
+            "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd, sigma: {:?}",
             worst.map(|w| format!("{w:.1e}"))
         );
         assert!(compared >= 30, "{model}: only {compared} of 60 random states assembled clear of singularities");
         assert!(worst[0] < X_TOL, "{model}: positions differ by {:e} (scaled)", worst[0]);
-        for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..]) {
+        for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..7]) {
             assert!(*w < REL_TOL, "{model}: {what} differs by {w:e} relative");
         }
+        assert!(worst[7] < SIGMA_TOL, "{model}: the type II measure differs by {:e} relative", worst[7]);
     }
 }
 
@@ -193,4 +202,42 @@ fn reports_coordinates_where_a_dyad_does_not_assemble() {
         other => panic!("expected AssemblyFailed, got {other:?}"),
     }
     assert!(assemble_into(&mech, &apart, &mut Workspace::new(&mech)).is_err());
+}
+
+/// One parallelogram of unit rods (A02 at N = 1): rods 0 and 1 hinged to the ground 1 m
+/// apart, the coupler joining their tops; theta the first rod's angle from the ground.
+const PARALLELOGRAM: &str = "name: parallelogram\ngravity: [0, -9.81]\n\
+points: {O0: [0, 0], A0: [0, 1], O1: [1, 0], A1: [1, 1]}\nground: [O0, O1]\nbodies:\n  \
+rod0: {points: [O0, A0], uniform_bar: [O0, A0], mass: 1.0}\n  \
+rod1: {points: [O1, A1], uniform_bar: [O1, A1], mass: 1.0}\n  \
+coupler1: {points: [A0, A1], uniform_bar: [A0, A1], mass: 1.0}\npairs:\n  \
+- {type: revolute, name: ground_rod0, at: O0, bodies: [ground, rod0]}\n  \
+- {type: revolute, name: ground_rod1, at: O1, bodies: [ground, rod1]}\n  \
+- {type: revolute, at: A0, bodies: [rod0, coupler1]}\n  \
+- {type: revolute, at: A1, bodies: [coupler1, rod1]}\n\
+coordinates:\n  - {name: theta, pair: ground_rod0, value: 1.5707963267948966}\n";
+
+#[test]
+fn a_predictor_past_a_fold_is_recognised() {
+    // On the parallelogram branch (every rod at angle theta, the coupler level) the dyad of the
+    // coupler and rod 1 folds where the rods lie flat, theta = 0: its joint P crosses the line
+    // from A (rod 0's top) to B (rod 1's pivot), A = B there. A predicted point on that branch
+    // past theta = 0 is on the other side of the kept branch; one short of it is not.
+    let mech = common::yaml(PARALLELOGRAM);
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    let mut ws = Workspace::new(&mech);
+    assemble_into(&mech, &[0.3], &mut ws).unwrap();
+    cf.set_reference(&ws.x);
+    assert!(cf.keeps_branches(&ws.x));
+    let on_branch = |theta: f64| {
+        let mut x = ws.x.clone();
+        (x[2], x[5], x[8]) = (theta, theta, 0.0);
+        x
+    };
+    assert!(cf.keeps_branches(&on_branch(1e-3)));
+    assert!(!cf.keeps_branches(&on_branch(-1e-3)));
+    // The closed form at -1e-3 keeps the side: P at the circles' other intersection, the
+    // coupler turned over by about pi, which is why such a step takes Newton.
+    cf.kinematic_stages(&[-1e-3], &[0.0], &mut ws).unwrap();
+    assert!((ws.x[8].abs() - std::f64::consts::PI).abs() < 1e-2, "coupler angle {}", ws.x[8]);
 }

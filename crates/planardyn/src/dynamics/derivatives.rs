@@ -194,7 +194,7 @@ fn accelerations_and_jacobians(
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
     ws.tau.fill(0.0);
-    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     mass_matrix(mech, ws);
     bias(mech, ws);
     let a = ws.a.clone();

@@ -176,7 +176,6 @@ pub fn applied_forces_dx(
 pub struct RateScratch {
     base: Vec<f64>,
     tau0: Vec<f64>,
-    tmp: Vec<f64>,
     shifted: Vec<f64>,
     out: Vec<f64>,
 }
@@ -185,15 +184,9 @@ impl RateScratch {
     /// The buffers at body coordinates x (3n).
     pub fn at(mech: &Mechanism, x: &[f64]) -> Self {
         let (n, m) = (mech.n_x(), mech.dof());
-        let mut s = RateScratch {
-            base: vec![0.0; n],
-            tau0: vec![0.0; m],
-            tmp: vec![0.0; n],
-            shifted: vec![0.0; n],
-            out: vec![0.0; n],
-        };
+        let mut s = RateScratch { base: vec![0.0; n], tau0: vec![0.0; m], shifted: vec![0.0; n], out: vec![0.0; n] };
         s.shifted.fill(0.0);
-        applied_forces(mech, x, &s.shifted, &s.tau0, &mut s.base, &mut s.tmp);
+        applied_forces(mech, x, &s.shifted, &s.tau0, &mut s.base);
         s
     }
 }
@@ -201,7 +194,7 @@ impl RateScratch {
 /// df/dxd . v (3n) into `df` at the x of `s`, drives left out: f(x, v) - f(x, 0), exact
 /// because f is affine in xd.
 pub fn applied_forces_dxd(mech: &Mechanism, x: &[f64], v: &[f64], df: &mut [f64], s: &mut RateScratch) {
-    applied_forces(mech, x, v, &s.tau0, df, &mut s.tmp);
+    applied_forces(mech, x, v, &s.tau0, df);
     df.iter_mut().zip(&s.base).for_each(|(d, b)| *d -= b);
 }
 
@@ -210,7 +203,7 @@ pub fn applied_forces_dxd(mech: &Mechanism, x: &[f64], v: &[f64], df: &mut [f64]
 pub fn load_power_dxd(mech: &Mechanism, x: &[f64], xd: &[f64], v: &[f64], s: &mut RateScratch) -> f64 {
     let power = |sign: f64, s: &mut RateScratch| {
         s.shifted.iter_mut().zip(xd.iter().zip(v)).for_each(|(o, (a, b))| *o = a + sign * b);
-        applied_forces(mech, x, &s.shifted, &s.tau0, &mut s.out, &mut s.tmp)
+        applied_forces(mech, x, &s.shifted, &s.tau0, &mut s.out)
     };
     0.5 * (power(1.0, s) - power(-1.0, s))
 }

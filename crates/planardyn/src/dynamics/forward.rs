@@ -115,7 +115,7 @@ pub fn dynamic_stages(
 ) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
     transmission::to_joint_efforts(mech, ws);
-    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     ws.power += redundant::apply_pair_efforts(mech, ws);
     mass_matrix(mech, ws);
     bias(mech, ws);

@@ -40,7 +40,7 @@ pub fn inverse_at_rates(
     kinematic_stages(mech, q, qd, ws)?;
     body_motion(mech, qd, qdd, xd, ws);
     ws.tau.fill(0.0);
-    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     // tau = A qdd - b, formed as U^T (M xdd - f): M xdd - f is the constraint reaction,
     // of the motion's own size, where A qdd and b are each of size 1/sigma^2.
     let n = ws.x.len();

@@ -98,7 +98,7 @@ pub fn forward_prescribed(
     transmission::to_joint_efforts(mech, ws);
     let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;
     p.iter().for_each(|&k| ws.tau[k] = 0.0);
-    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f, &mut ws.tmp);
+    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     mass_matrix(mech, ws);
     bias(mech, ws);
     prescribed_rows(mech, p, qdd_p, ws, w);

@@ -66,7 +66,8 @@ pub fn regressor(
     let (n, m, nb) = (ws.x.len(), qdd.len(), mech.bodies.len());
     let p = y.len() / m.max(1);
     // The loads other than gravity, without drives or friction.
-    applied_forces(mech, &ws.x, &ws.xd, &vec![0.0; m], &mut ws.f, &mut ws.tmp);
+    ws.tau.fill(0.0);
+    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     let g = mech.gravity;
     for (f, body) in ws.f.chunks_exact_mut(3).zip(&mech.bodies) {
         f[0] -= body.mass * g[0];

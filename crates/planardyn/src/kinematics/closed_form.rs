@@ -12,6 +12,7 @@ use super::analogues::body_rates;
 use super::dyads::crank::Crank;
 use super::dyads::rrr::{Branch, Geometry, Rrr};
 use super::dyads::Joint;
+use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::structure::assur;
 use crate::workspace::Workspace;
@@ -25,6 +26,10 @@ pub struct ClosedForm {
     /// positions (for the rates and accelerations).
     branches: Vec<Branch>,
     geometry: Vec<Geometry>,
+    /// Per dyad 1 / L_k (its group's length, `group_sigma`), and the smallest input link
+    /// measure (constant).
+    inv_length: Vec<f64>,
+    inputs_sigma: f64,
 }
 
 /// The end of a revolute pair on `body` (its point there) and the other end.
@@ -47,6 +52,7 @@ impl ClosedForm {
         }
         let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
         let mut cranks = Vec::new();
+        let mut inputs_sigma = f64::INFINITY;
         for (k, c) in mech.coordinates.iter().enumerate() {
             let p = &mech.pairs[c.pair.0];
             let body = match (p.a, p.b) {
@@ -59,6 +65,8 @@ impl ClosedForm {
             let (s, ground) = ends(mech, c.pair, body);
             let pivot = ground.s;
             let sign = if p.b == Link::Body(BodyId(body)) { 1.0 } else { -1.0 };
+            let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
+            inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
             cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
         }
         let mut dyads = Vec::new();
@@ -91,7 +99,9 @@ impl ClosedForm {
             return None;
         }
         let branches = dyads.iter().map(|d| d.branch(&mech.x0)).collect();
-        Some(ClosedForm { cranks, geometry: vec![Geometry::default(); dyads.len()], dyads, branches })
+        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies)).collect();
+        let geometry = vec![Geometry::default(); dyads.len()];
+        Some(ClosedForm { cranks, geometry, dyads, branches, inv_length, inputs_sigma })
     }
 
     /// Take the assembly branches from the configuration x (a solution).
@@ -99,6 +109,21 @@ impl ClosedForm {
         for (b, d) in self.branches.iter_mut().zip(&self.dyads) {
             *b = d.branch(x);
         }
+    }
+
+    /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
+    /// reference branch ([`Rrr::keeps_side`]); if not, a step crosses a fold and the closed
+    /// forms would leave the motion's branch there.
+    pub fn keeps_branches(&self, x: &[f64]) -> bool {
+        self.dyads.iter().zip(&self.branches).all(|(d, b)| d.keeps_side(b, x))
+    }
+
+    /// The type II measure at the last positions (`group_sigma`'s: the smallest singular
+    /// value of each group's block at its own length), from the groups' closed forms: no
+    /// factorisation of J.
+    pub fn sigma(&self) -> f64 {
+        let dyads = self.geometry.iter().zip(&self.inv_length).map(|(g, &k)| g.sigma(k));
+        dyads.fold(self.inputs_sigma, f64::min)
     }
 
     /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.

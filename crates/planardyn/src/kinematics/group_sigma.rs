@@ -151,13 +151,18 @@ impl GroupScales {
     }
 }
 
-/// Length of the group whose block has the columns `cols` (body coordinates): the diameter of
-/// its bodies' drawn points and centres of mass (m); the mechanism's length if that is 0 (a
-/// group of one point).
+/// Length of the group whose block has the columns `cols` (body coordinates): see
+/// [`bodies_length`].
 fn group_length(mech: &Mechanism, cols: &[usize]) -> f64 {
     let mut bodies: Vec<usize> = cols.iter().map(|c| c / 3).collect();
     bodies.sort_unstable();
     bodies.dedup();
+    bodies_length(mech, &bodies)
+}
+
+/// Length L_k of the group of `bodies`: the diameter of their drawn points and centres of mass
+/// (m); the mechanism's length if that is 0 (a group of one point).
+pub(crate) fn bodies_length(mech: &Mechanism, bodies: &[usize]) -> f64 {
     let points: Vec<[f64; 2]> = bodies
         .iter()
         .flat_map(|&b| {
@@ -171,4 +176,69 @@ fn group_length(mech: &Mechanism, cols: &[usize]) -> f64 {
     } else {
         mech.scale
     }
+}
+
+/// The measure of an input link turned by a revolute pair about the ground, in closed form:
+/// its block [[I, E R s / L_k], [0, +-1]] (the pair's rows, the coordinate's row) has the
+/// singular values 1 and those of [[1, a], [0, 1]], a = |s| / L_k, the smaller
+/// (sqrt(a^2 + 4) - a) / 2, whatever the link's angle.
+pub(crate) fn input_link_sigma(a: f64) -> f64 {
+    0.5 * ((a * a + 4.0).sqrt() - a)
+}
+
+/// Newton iterations of [`dyad_sigma`]'s scalar equation; from its start it converges
+/// monotonically and quadratically, in 4 to 8.
+const DYAD_ITERATIONS: usize = 40;
+
+/// The measure of an RRR dyad's block in closed form, from its lever arms at its own length:
+/// `a`, `b` the points A, B and `p1`, `p2` the point P, each as R s / L_k on body 1 (A, P) or
+/// body 2 (B, P). The block, columns (r1, r2 | phi1, phi2), is [T, Phi] with T the pairs' rows
+/// on the translations (constant: T^T T = [[2, -1], [-1, 2]] (x) I, eigenvalues 1 and 3) and
+/// Phi their rows on the angles (the arms turned by E, which changes no dot product). Its
+/// smallest squared singular value lambda is the smallest root of the 2 x 2 secular equation
+/// mu(lambda) = lambda_min(Phi^T Phi - lambda - C^T (T^T T - lambda)^-1 C) = 0, C = T^T Phi,
+/// in [0, 1] (lambda <= 1: r1 = r2, no turn, is a unit vector that B' maps to a unit one).
+/// mu is decreasing and concave there, so Newton from 0 lands past the root once and then
+/// falls back to it monotonically. A root at 0 (mu(0) <= 0) is a type II singularity.
+pub(crate) fn dyad_sigma(a: [f64; 2], b: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -> f64 {
+    let dot = |u: [f64; 2], v: [f64; 2]| u[0] * v[0] + u[1] * v[1];
+    let g = [dot(a, a) + dot(p1, p1), -dot(p1, p2), dot(b, b) + dot(p2, p2)];
+    // C^T P1 C and C^T P3 C (P1, P3 the projections on T^T T's eigenspaces, times 2): the
+    // sums and differences of C's two row blocks, (a, b) and (a + 2 p1, -(b + 2 p2)).
+    let s = [dot(a, a), dot(a, b), dot(b, b)];
+    let d1 = [a[0] + 2.0 * p1[0], a[1] + 2.0 * p1[1]];
+    let d2 = [-b[0] - 2.0 * p2[0], -b[1] - 2.0 * p2[1]];
+    let d = [dot(d1, d1), dot(d1, d2), dot(d2, d2)];
+    // mu(lambda) and mu'(lambda): the smaller eigenvalue of the symmetric 2 x 2 M(lambda) and
+    // its derivative along M'(lambda).
+    let mu = |l: f64| {
+        let (k1, k3) = (0.5 / (1.0 - l), 0.5 / (3.0 - l));
+        let m = [0, 1, 2].map(|i| g[i] - k1 * s[i] - k3 * d[i] - if i == 1 { 0.0 } else { l });
+        let n = [0, 1, 2].map(|i| -k1 * k1 * 2.0 * s[i] - k3 * k3 * 2.0 * d[i] - if i == 1 { 0.0 } else { 1.0 });
+        let (half, r) = (0.5 * (m[0] - m[2]), (0.25 * (m[0] - m[2]).powi(2) + m[1] * m[1]).sqrt());
+        let value = 0.5 * (m[0] + m[2]) - r;
+        let slope = if r > 0.0 {
+            0.5 * (n[0] + n[2]) - (half * 0.5 * (n[0] - n[2]) + m[1] * n[1]) / r
+        } else {
+            0.5 * (n[0] + n[2]) - (0.25 * (n[0] - n[2]).powi(2) + n[1] * n[1]).sqrt()
+        };
+        (value, slope)
+    };
+    let (mut l, (mut f, mut df)) = (0.0, mu(0.0));
+    if !(f > 0.0) {
+        return 0.0;
+    }
+    for _ in 0..DYAD_ITERATIONS {
+        let mut next = l - f / df;
+        if !(next < 1.0) {
+            next = 0.5 * (l + 1.0);
+        }
+        if (next - l).abs() <= 4.0 * f64::EPSILON * next.abs() {
+            l = next;
+            break;
+        }
+        l = next;
+        (f, df) = mu(l);
+    }
+    l.max(0.0).sqrt()
 }

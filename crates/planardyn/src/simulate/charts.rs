@@ -27,14 +27,17 @@ pub struct Measures {
 }
 
 /// Measure the point analysed in `ode.ws`. In the user's chart the type II measure comes
-/// from the factorisation already in the workspace (inverse iteration, see
+/// from the closed forms where they gave the point (`ClosedForm::sigma`), else from the
+/// factorisation already in the workspace (inverse iteration, see
 /// `System::sigma_min_estimate`); near a singularity, where a partition is in use, it is exact
 /// (an SVD of each block of the user's chart, linear in the bodies), and the passive measure
 /// an SVD of the whole Phi_x (at the few steps near a type II singularity only).
 pub fn measure(ode: &mut MechanismOde) -> Measures {
-    ode.factor_stale_j();
     let estimate = match ode.ws.chart {
-        Chart::Inputs => ode.ws.sys.sigma_min_estimate(),
+        Chart::Inputs => ode.closed_form_sigma().or_else(|| {
+            ode.factor_stale_j();
+            ode.ws.sys.sigma_min_estimate()
+        }),
         Chart::Partition(_) => None,
     };
     let sigma = estimate.unwrap_or_else(|| sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x));

@@ -25,11 +25,11 @@ const MOVE_FRACTION: f64 = 2.0;
 /// path even where closed forms exist. A dyad's branch changes where the passive motion goes
 /// through its fold (the five-bar's type II singularities, A02's change points, where the
 /// parallelogram branch crosses the dyad's base line); the closed forms keep the branch by
-/// construction, while the Newton path's predictor follows the motion's tangent there. A step
-/// can start well clear of such a point: at 0.1 A02 at N = 2 stepped over a change point once
-/// (reported without its rank drop) and at 0.3 A02 at N = 40 ended 1.09e-6 rad from the exact
-/// reduction (tests/change_points.rs); at 0.5 both keep their Newton-path results.
-const CLOSED_FORM_SIGMA: f64 = 0.5;
+/// construction, while the Newton path's predictor follows the motion's tangent there. An
+/// evaluation whose predictor has crossed a fold takes the Newton path
+/// (`ClosedForm::keeps_branches`); this threshold keeps the closed forms away from the
+/// partition threshold (0.05), below which the chart changes.
+const CLOSED_FORM_SIGMA: f64 = 0.1;
 
 /// A mechanism in one chart, with the state the Newton predictor starts from.
 pub struct MechanismOde<'a> {
@@ -59,6 +59,9 @@ pub struct MechanismOde<'a> {
     /// Largest scaled Newton correction accepted from the predictor (see `limit_correction`).
     max_correction: f64,
     max_move: f64,
+    /// Largest move of a solution from the last accepted point while a change point is
+    /// approached ([`MechanismOde::limit_move`]).
+    max_approach: f64,
     /// Evaluations that failed (Newton did not converge, or its correction was too large).
     pub failed_evaluations: usize,
     /// The blocks of the user's chart, analysed once: the type II measure while a partition
@@ -95,6 +98,7 @@ impl<'a> MechanismOde<'a> {
             base: vec![0.0; ws.x.len()],
             max_correction: MAX_CORRECTION,
             max_move: f64::INFINITY,
+            max_approach: f64::INFINITY,
             failed_evaluations: 0,
             inputs_sys: System::new(mech),
             closed,
@@ -148,13 +152,18 @@ impl<'a> MechanismOde<'a> {
         self.max_correction = MAX_CORRECTION.min(BASIN_FRACTION * sigma);
         self.clear_of_folds = sigma >= CLOSED_FORM_SIGMA;
         self.max_move = MOVE_FRACTION * sigma;
+        self.max_approach = f64::INFINITY;
     }
 
-    /// Bound the move of a solution from its predictor's anchor by `max` as well (scaled, as
-    /// [`MechanismOde::limit_correction`]'s).
+    /// Bound the move of a solution from the point it was predicted from by `max` as well
+    /// (scaled, as [`MechanismOde::limit_correction`]'s), and from the last accepted point by
+    /// `2 max`, whatever the stages between: a step's stages are each predicted from the one
+    /// before, and bounding only those moves let a step of DOP853 (whose stages advance by up
+    /// to a third of it) go past a change point (A02 at N = 2).
     /// Near a change point the evaluations take the Newton path (see [`CLOSED_FORM_SIGMA`]).
     pub fn limit_move(&mut self, max: f64) {
         self.max_move = self.max_move.min(max);
+        self.max_approach = 2.0 * max;
         self.clear_of_folds = false;
     }
 
@@ -173,6 +182,12 @@ impl<'a> MechanismOde<'a> {
             let ws = &mut self.ws;
             let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
         }
+    }
+
+    /// The type II measure of the point in `ws` from the closed forms, if it was evaluated with
+    /// them (J is then not factorised there).
+    pub fn closed_form_sigma(&self) -> Option<f64> {
+        self.closed.as_ref().filter(|_| self.stale_j && self.ws.chart == Chart::Inputs).map(ClosedForm::sigma)
     }
 
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
@@ -206,6 +221,10 @@ impl<'a> MechanismOde<'a> {
         let m = self.m();
         let n = self.ws.x.len();
         let closed = self.closed_form_in_use();
+        if !closed && self.base_valid {
+            // The second-order term solves with J at the last evaluation.
+            self.factor_stale_j();
+        }
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);
@@ -275,7 +294,10 @@ impl<'a> MechanismOde<'a> {
         self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
         self.predict(z);
         self.predicted.copy_from_slice(&self.ws.x);
-        let newton = !self.closed_form_in_use();
+        // A predictor past a dyad's fold means the motion leaves the closed forms' branch
+        // there: Newton from the predictor follows it.
+        let newton =
+            !self.closed_form_in_use() || !self.closed.as_ref().is_some_and(|c| c.keeps_branches(&self.predicted));
         self.last_t = f64::NAN;
         self.base_valid = false;
         self.stale_j = !newton;
@@ -290,8 +312,13 @@ impl<'a> MechanismOde<'a> {
         if outcome.is_ok() {
             let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
             let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
+            let approach = if self.max_approach < f64::INFINITY {
+                scaled_distance(&self.ws.x, &self.anchor_x, self.ws.sys.group_col_scale())
+            } else {
+                0.0
+            };
             let residual = if moved > self.max_move { moved } else { correction };
-            if moved > self.max_move || correction > self.max_correction {
+            if moved > self.max_move || correction > self.max_correction || approach > self.max_approach {
                 outcome = Err(KinematicsError::AssemblyFailed { residual, iterations: self.ws.iterations }.into());
             }
         }

@@ -6,6 +6,7 @@
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
 use super::{put_acceleration, put_rate, Joint};
+use crate::kinematics::group_sigma::dyad_sigma;
 use crate::kinematics::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
 use crate::{KinematicsError, SingularityKind};
@@ -25,6 +26,9 @@ pub struct Rrr {
     /// P - A in body 1's frame and P - B in body 2's, and their squared lengths.
     pub arms: [[f64; 2]; 2],
     pub arms2: [f64; 2],
+    /// The angle from e1 to e2 less phi2 - phi1 (the arms' directions in their frames): the
+    /// angle at P is psi = phi2 - phi1 + bend, and sin(psi) has the sign of the branch's side.
+    pub bend: f64,
 }
 
 /// What the dyad keeps from the reference configuration: the side of AB that P is on (+1 to
@@ -47,12 +51,38 @@ pub struct Geometry {
     inv_det: f64,
 }
 
+impl Geometry {
+    /// The dyad's type II measure at these positions, 1 / L_k its group's inverse length
+    /// (`group_sigma::dyad_sigma`): the arms of A and P on body 1 (R s_A, R s_A + e1) and of
+    /// B and P on body 2.
+    pub fn sigma(&self, inv_length: f64) -> f64 {
+        let [a, b] = self.own.map(|r| [r[0] * inv_length, r[1] * inv_length]);
+        let [p1, p2] = [0, 1]
+            .map(|i| [(self.own[i][0] + self.e[i][0]) * inv_length, (self.own[i][1] + self.e[i][1]) * inv_length]);
+        dyad_sigma(a, b, p1, p2)
+    }
+}
+
 impl Rrr {
     /// A dyad of `bodies` hinged at A and B to the links before it (`outer`, with the same
     /// points `s_outer` in the bodies' frames) and to each other at P (`s_inner` in each frame).
     pub fn new(bodies: [usize; 2], outer: [Joint; 2], s_outer: [[f64; 2]; 2], s_inner: [[f64; 2]; 2]) -> Self {
         let arms = [sub(s_inner[0], s_outer[0]), sub(s_inner[1], s_outer[1])];
-        Rrr { bodies, outer, s_outer, arms2: arms.map(|a| dot(a, a)), arms }
+        let bend = arms[1][1].atan2(arms[1][0]) - arms[0][1].atan2(arms[0][0]);
+        Rrr { bodies, outer, s_outer, arms2: arms.map(|a| dot(a, a)), arms, bend }
+    }
+
+    /// Whether the bodies' angles in x (any x, not necessarily assembled: the Newton
+    /// predictor's) put P on `branch`'s side of AB: sin(psi) of x's angles has the side's sign.
+    /// A predictor that follows the motion through the dyad's fold (where e1 and e2 align and
+    /// the branches meet) lands on the other side; the closed form on the kept side would then
+    /// go on along the other branch.
+    #[inline]
+    pub fn keeps_side(&self, branch: &Branch, x: &[f64]) -> bool {
+        let [b1, b2] = self.bodies;
+        let psi = x[3 * b2 + 2] - x[3 * b1 + 2] + self.bend;
+        // psi reduced to [-pi, pi] has the sign of sin(psi).
+        (psi - TAU * (psi / TAU).round()) * branch.side > 0.0
     }
 
     /// The branch of the configuration x.
