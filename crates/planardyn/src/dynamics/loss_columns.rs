@@ -21,8 +21,8 @@
 //! - the pin friction's load N is the pair's reaction, which depends on pi: the `mu` column
 //!   is arm N (1 - E) tanh(arm rate / v_st) U^T grad with N the model's, and the static
 //!   coefficient's share arm N mu_s E tanh(...) (E = exp(-(arm rate / v_str)^2)) goes to
-//!   tau_o; Y pi + tau_o is exact at the model's pi, and identification iterates (the
-//!   reactions from the last estimate);
+//!   tau_o; Y pi + tau_o is exact at the model's pi (identification keeps the model's
+//!   reactions: they depend on parameters the efforts do not determine);
 //! - the transmission's branch (motoring or generating) is that of the model's joint-side
 //!   effort times qd.
 
