@@ -300,12 +300,17 @@ impl<'a> MechanismOde<'a> {
             !self.closed_form_in_use() || !self.closed.as_ref().is_some_and(|c| c.keeps_branches(&self.predicted));
         self.last_t = f64::NAN;
         self.base_valid = false;
-        self.stale_j = !newton;
+        // The pairs' friction needs the reactions, solved with J at this point.
+        let reactions = !self.mech.friction.is_empty();
+        self.stale_j = !newton && !reactions;
         let mut outcome = match (self.closed.as_mut().filter(|_| !newton), self.motion.as_deref_mut()) {
-            (Some(c), _) => c
-                .kinematic_stages(z, zd, &mut self.ws)
-                .map_err(Error::from)
-                .and_then(|()| dynamic_stages(self.mech, t, z, zd, self.drives, &mut self.ws)),
+            (Some(c), _) => c.kinematic_stages(z, zd, &mut self.ws).map_err(Error::from).and_then(|()| {
+                let ws = &mut self.ws;
+                if reactions {
+                    let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
+                }
+                dynamic_stages(self.mech, t, z, zd, self.drives, ws)
+            }),
             (_, None) => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
             (_, Some(motion)) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
         };
