@@ -74,8 +74,6 @@ def test_crossings_are_kept_by_results_files_and_the_cli_summary(n2, tmp_path):
     assert f"change point at t = {n2.change_points[0].t:.6g} s (rank -2)" in line
 
 
-@pytest.mark.xfail(strict=True, reason="1.31e-6 rad from this dict model (the Rust test's YAML model of "
-                   "the same mechanism: under 1e-6); the error grows at the passages near the upright pose")
 def test_a02_n40_runs_its_official_20_s():
     t = np.linspace(0.0, 20.0, 2001)
     res = pd.from_dict(a02(40)).simulate(t_end=20.0, t_eval=t, **TIGHT)
