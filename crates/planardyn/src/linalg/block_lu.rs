@@ -250,7 +250,8 @@ impl BlockLu {
 
     /// As [`BlockLu::solve_many_scaled`], with `reach[c]` the blocks (ascending, from
     /// [`BlockLu::reach`]) on which the solution of the c-th sweep of columns may be non-zero:
-    /// only those are solved, the others are 0.
+    /// only those are solved and written, the solution is 0 on the others (whose entries of `b`
+    /// are left as they are).
     pub fn solve_many_over(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64], reach: Option<&[Vec<usize>]>) {
         self.solve_sweeps(b, rs, cs, reach, None)
     }
@@ -576,17 +577,24 @@ mod tests {
         assert_eq!(lu.reach(&[3]), vec![2]);
         fill(&mut lu, &a, 5);
         lu.factor(1e-300).unwrap();
-        // Unit columns e_2, e_4, e_3 in one sweep, then e_3 alone: the same as the full solve.
-        let unit = |rows: &[usize]| -> Vec<f64> {
-            rows.iter().flat_map(|&r| (0..5).map(move |i| if i == r { 1.0 } else { 0.0 })).collect()
-        };
-        let ones = [1.0; 5];
-        for rows in [vec![2, 4, 3], vec![3]] {
-            let (mut full, mut over) = (unit(&rows), unit(&rows));
-            lu.solve_many_scaled(&mut full, &ones, &ones);
-            let reach = vec![lu.reach(&rows)];
-            lu.solve_many_over(&mut over, &ones, &ones, Some(&reach));
-            assert_eq!(over, full, "columns {rows:?}");
+        let (rs, cs) = ([2.0, 0.5, 1.0, 4.0, 0.25], [1.0, 3.0, 0.5, 2.0, 1.0]);
+        // Unit columns from row `first` on, in one sweep: the same values as the full solve of
+        // [0; I] where reached, and the entries outside the reached blocks untouched (NaN
+        // here). A full solve in between leaves the solver's buffer dirty: no effect either.
+        for (first, count) in [(2, 3), (3, 2), (4, 1), (3, 1)] {
+            let mut full: Vec<f64> = (0..count).flat_map(|r| (0..5).map(move |i| f64::from(i == first + r))).collect();
+            lu.solve_many_scaled(&mut full, &rs, &cs);
+            let reach = vec![lu.reach(&(first..first + count).collect::<Vec<_>>())];
+            let written: Vec<usize> = reach[0].iter().flat_map(|&k| lu.span(k)).map(|p| lu.col[p]).collect();
+            let mut over = vec![f64::NAN; 5 * count];
+            lu.solve_unit_columns(&mut over, first, &rs, &cs, Some(&reach));
+            for (k, (o, f)) in over.iter().zip(&full).enumerate() {
+                if written.contains(&(k % 5)) {
+                    assert_eq!(o, f, "rows from {first}: entry {k}");
+                } else {
+                    assert!(o.is_nan() && *f == 0.0, "rows from {first}: entry {k} = {o}, full {f}");
+                }
+            }
         }
     }
 

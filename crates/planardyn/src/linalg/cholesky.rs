@@ -114,11 +114,27 @@ mod tests {
                 plain[i * m + j] = s / d;
             }
         }
+        // A's envelope: the first column of each row of B (B's envelope is A's).
+        let first: Vec<usize> = (0..m).map(|i| (0..=i).find(|&k| b[i * m + k] != 0.0).unwrap()).collect();
+        let mut env = a.clone();
         assert!(cholesky_in_place(&mut a, m));
+        assert!(cholesky_envelope(&mut env, m, &first));
         for i in 0..m {
             for j in 0..=i {
                 assert_eq!(a[i * m + j], plain[i * m + j], "L[{i}][{j}]");
+                assert_eq!(env[i * m + j], plain[i * m + j], "L[{i}][{j}] over the envelope");
             }
+        }
+        // The solves: x = (1, ..., 7) back from A x, over the envelope and whole, to round-off.
+        let x: Vec<f64> = (1..=m).map(|v| v as f64).collect();
+        let ax: Vec<f64> = (0..m)
+            .map(|i| (0..m).map(|j| (0..m).map(|k| b[i * m + k] * b[j * m + k]).sum::<f64>() * x[j]).sum())
+            .collect();
+        let (mut whole, mut over) = (ax.clone(), ax);
+        cholesky_solve(&a, m, &mut whole);
+        cholesky_solve_envelope(&env, m, &first, &mut over);
+        for i in 0..m {
+            assert!((whole[i] - x[i]).abs() < 1e-13 && (over[i] - x[i]).abs() < 1e-13, "{whole:?} {over:?}");
         }
     }
 }
