@@ -30,8 +30,8 @@ pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize
 /// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`: the pairs of columns whose
 /// supports meet (`System::a_pairs`), over the bodies where both may be non-zero (the columns
 /// of independent parts of a mechanism, five-bars side by side, share none). The other
-/// entries keep the zeros of the last clearing, except A's envelope below the diagonal (where
-/// the Cholesky factor may have filled in): cleared at each call.
+/// entries keep the zeros of the last clearing, except where the Cholesky factor may have
+/// filled in (`System::a_fill_in`): cleared at each call.
 pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     let m = ws.b.len();
@@ -41,8 +41,8 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
         ws.a.fill(0.0);
         ws.a_zeros_for = if mech.has_losses() { 0 } else { id };
     } else {
-        for (k, &first) in ws.sys.a_first().iter().enumerate() {
-            ws.a[k * m + first..k * m + k].fill(0.0);
+        for &(k, j) in ws.sys.a_fill_in() {
+            ws.a[k * m + j] = 0.0;
         }
     }
     let support = ws.sys.u_support();

@@ -28,6 +28,7 @@ pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
 
 /// `out += sum_j dz(j) u_j` over each column's support (`supports`, from
 /// `System::u_support`: U is zero outside it), for U column-major (3n per column).
+#[inline]
 pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) -> f64, out: &mut [f64]) {
     let n = out.len();
     for (j, (u, &(first, end))) in u.chunks_exact(n).zip(supports).enumerate() {
@@ -39,6 +40,7 @@ pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) ->
 }
 
 /// Body velocities `ws.xd = U zd`, from `ws.u`.
+#[inline]
 pub(crate) fn body_rates(zd: &[f64], ws: &mut Workspace) {
     ws.xd.fill(0.0);
     add_u_times(&ws.u, ws.sys.u_support(), |j| zd[j], &mut ws.xd);

@@ -42,9 +42,12 @@ pub struct System {
     /// its coordinate's row reaches.
     u_support: Vec<(usize, usize)>,
     /// The entries of A = U^T M U that may be non-zero: the pairs j <= k of columns whose
-    /// supports meet, and per row k the first such j (A's envelope, kept by its Cholesky factor).
+    /// supports meet, and per row k the first such j (A's envelope, kept by its Cholesky factor);
+    /// the entries (k, j) of the envelope below the diagonal that are no such pair, where the
+    /// factor may fill in.
     a_pairs: Vec<(usize, usize)>,
     a_first: Vec<usize>,
+    a_fill_in: Vec<(usize, usize)>,
     /// Identifies the analysis the supports above come from (unique over all systems): buffers
     /// that keep zeros outside the supports are cleared once when it changes.
     supports_id: u64,
@@ -65,13 +68,14 @@ impl System {
     pub fn new(mech: &Mechanism) -> Self {
         let lu = BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs));
         let u_support = u_support(mech, &lu);
-        let (a_pairs, a_first) = a_pattern(&u_support);
+        let (a_pairs, a_first, a_fill_in) = a_pattern(&u_support);
         System {
             groups: GroupScales::new(mech, &Chart::Inputs, &lu),
             unit_reach: unit_reach(mech, &lu),
             u_support,
             a_pairs,
             a_first,
+            a_fill_in,
             supports_id: next_supports_id(),
             lu,
             pattern_chart: Chart::Inputs,
@@ -98,7 +102,7 @@ impl System {
             self.groups = GroupScales::new(mech, chart, &self.lu);
             self.unit_reach = unit_reach(mech, &self.lu);
             self.u_support = u_support(mech, &self.lu);
-            (self.a_pairs, self.a_first) = a_pattern(&self.u_support);
+            (self.a_pairs, self.a_first, self.a_fill_in) = a_pattern(&self.u_support);
             self.supports_id = next_supports_id();
             self.pattern_chart.clone_from(chart);
         }
@@ -169,6 +173,12 @@ impl System {
         &self.a_first
     }
 
+    /// The entries (k, j), j < k, of A's envelope that are not in [`System::a_pairs`]: zero in A,
+    /// possibly not in its Cholesky factor.
+    pub fn a_fill_in(&self) -> &[(usize, usize)] {
+        &self.a_fill_in
+    }
+
     /// Changes whenever [`System::u_support`] and the pattern of A may have changed (a new
     /// chart's pattern): a buffer that relies on zeros outside them is cleared then.
     pub fn supports_id(&self) -> u64 {
@@ -209,22 +219,20 @@ fn u_support(mech: &Mechanism, lu: &BlockLu) -> Vec<(usize, usize)> {
         .collect()
 }
 
-/// The pairs of columns whose supports meet, and A's envelope (see [`System::a_pairs`]). Once
-/// per chart: the m^2 / 2 comparisons are not made in a step.
-fn a_pattern(support: &[(usize, usize)]) -> (Vec<(usize, usize)>, Vec<usize>) {
+/// The pairs of columns whose supports meet, A's envelope and its fill-in (see
+/// [`System::a_pairs`]). Once per chart: the m^2 / 2 comparisons are not made in a step.
+type APattern = (Vec<(usize, usize)>, Vec<usize>, Vec<(usize, usize)>);
+fn a_pattern(support: &[(usize, usize)]) -> APattern {
     let meet = |(f1, e1): (usize, usize), (f2, e2): (usize, usize)| f1.max(f2) < e1.min(e2);
-    let mut pairs = Vec::new();
-    let mut first = Vec::with_capacity(support.len());
+    let (mut pairs, mut first, mut fill_in) = (Vec::new(), Vec::with_capacity(support.len()), Vec::new());
     for (k, &sk) in support.iter().enumerate() {
-        first.push(k);
-        for (j, &sj) in support[..=k].iter().enumerate() {
-            if j == k || meet(sj, sk) {
-                pairs.push((j, k));
-                first[k] = first[k].min(j);
-            }
-        }
+        let row: Vec<usize> = (0..k).filter(|&j| meet(support[j], sk)).collect();
+        let f = row.first().copied().unwrap_or(k);
+        fill_in.extend((f..k).filter(|j| !row.contains(j)).map(|j| (k, j)));
+        pairs.extend(row.into_iter().chain([k]).map(|j| (j, k)));
+        first.push(f);
     }
-    (pairs, first)
+    (pairs, first, fill_in)
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
