@@ -42,6 +42,18 @@ def test_parallelogram_chain_swings_with_the_simple_pendulum_period(n):
     assert res.q[-1, 0] == pytest.approx(-math.pi / 2 + THETA0, abs=1e-9)
 
 
+@pytest.mark.parametrize("spec", [a02(80), parallelograms(80, THETA0)], ids=["a02", "parallelograms"])
+def test_every_window_is_an_exact_parallelogram(spec):
+    # Tips drawn exactly one apart, as the ground points are: a window whose coupler is off by
+    # an ulp has imperfect change points (with cos(pi/2) = 6.1e-17 unrounded, A02's first
+    # coupler was 1.1e-16 m short of its ground).
+    points = spec["points"]
+    for i in range(1, 81):
+        assert [b - a for a, b in zip(points[f"A{i - 1}"], points[f"A{i}"])] == [1.0, 0.0]
+        assert [b - a for a, b in zip(points[f"O{i}"], points[f"A{i}"])] == points["A0"]
+    assert math.hypot(*points["A0"]) == pytest.approx(1.0, abs=1e-12)
+
+
 def test_type_ii_measure_is_the_same_for_every_length_of_chain():
     # Every group of the chain is the same dyad at the same length, so the measure is too; the
     # smallest singular value of the whole J fell from 0.19 (N = 1) to 5.8e-4 (N = 40) here.

@@ -25,7 +25,12 @@ pub struct Workspace {
     /// Newton iterations of the last position solve (position).
     pub iterations: usize,
     /// (3n x m) velocity analogues, column j = dx/dz_j stored at `u[j*3n..(j+1)*3n]` (analogues).
+    /// Zero outside each column's support (`System::u_support`).
     pub u: Vec<f64>,
+    /// The `System::supports_id` for which `u` and `a` hold zeros outside the supports and
+    /// A's envelope (0: not known, cleared whole at the next use).
+    pub u_zeros_for: u64,
+    pub a_zeros_for: u64,
     /// (3n) body velocities U zd (convective).
     pub xd: Vec<f64>,
     /// (3n) convective accelerations sum_jl zd_j zd_l w_jl (convective).
@@ -72,6 +77,8 @@ impl Workspace {
             residual: 0.0,
             iterations: 0,
             u: vec![0.0; nx * m],
+            u_zeros_for: 0,
+            a_zeros_for: 0,
             xd: vec![0.0; nx],
             c: vec![0.0; nx],
             q: vec![0.0; m],

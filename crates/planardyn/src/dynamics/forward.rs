@@ -7,7 +7,7 @@ use super::losses::forward_with_losses;
 use super::{redundant, transmission};
 use crate::kinematics::constraints::{coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_rate};
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
-use crate::linalg::{cholesky_in_place, cholesky_solve};
+use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
@@ -27,20 +27,30 @@ pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize
         .sum()
 }
 
-/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`, over the bodies where both
-/// columns may be non-zero (`System::u_support`: the columns of independent parts of a
-/// mechanism, five-bars side by side, share none).
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`: the pairs of columns whose
+/// supports meet (`System::a_pairs`), over the bodies where both may be non-zero (the columns
+/// of independent parts of a mechanism, five-bars side by side, share none). The other
+/// entries keep the zeros of the last clearing, except where the Cholesky factor may have
+/// filled in (`System::a_fill_in`): cleared at each call.
 pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     let m = ws.b.len();
-    let support = ws.sys.u_support();
-    for j in 0..m {
-        for k in j..m {
-            let ((fj, ej), (fk, ek)) = (support[j], support[k]);
-            let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
-            ws.a[j * m + k] = s;
-            ws.a[k * m + j] = s;
+    let id = ws.sys.supports_id();
+    // With losses the rotors' inertia is added to A outside the supports' pattern.
+    if mech.has_losses() || ws.a_zeros_for != id {
+        ws.a.fill(0.0);
+        ws.a_zeros_for = if mech.has_losses() { 0 } else { id };
+    } else {
+        for &(k, j) in ws.sys.a_fill_in() {
+            ws.a[k * m + j] = 0.0;
         }
+    }
+    let support = ws.sys.u_support();
+    for &(j, k) in ws.sys.a_pairs() {
+        let ((fj, ej), (fk, ek)) = (support[j], support[k]);
+        let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
+        ws.a[j * m + k] = s;
+        ws.a[k * m + j] = s;
     }
 }
 
@@ -123,7 +133,7 @@ pub fn dynamic_stages(
         return Ok(forward_with_losses(mech, z, zd, ws)?);
     }
     factor_mass_matrix(ws)?;
-    cholesky_solve(&ws.a, ws.b.len(), &mut ws.b);
+    solve_mass_matrix(ws);
     accelerations(mech, z, zd, ws);
     Ok(())
 }
@@ -138,12 +148,29 @@ pub(crate) fn drive_efforts(t: f64, drives: &mut dyn Drives, ws: &mut Workspace)
 }
 
 /// `ws.a` into its Cholesky factor, or the singularity that keeps A from being positive definite.
+/// Over A's envelope from the supports of U when `mass_matrix` left A within it.
 pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsError> {
-    if !cholesky_in_place(&mut ws.a, ws.b.len()) {
+    let m = ws.b.len();
+    let factored = if ws.a_zeros_for == ws.sys.supports_id() {
+        cholesky_envelope(&mut ws.a, m, ws.sys.a_first())
+    } else {
+        cholesky_in_place(&mut ws.a, m)
+    };
+    if !factored {
         let type_ii = matches!(ws.chart, Chart::Inputs);
         return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }));
     }
     Ok(())
+}
+
+/// zdd = A^-1 b in `ws.b`, with the factor from [`factor_mass_matrix`].
+pub(crate) fn solve_mass_matrix(ws: &mut Workspace) {
+    let m = ws.b.len();
+    if ws.a_zeros_for == ws.sys.supports_id() {
+        cholesky_solve_envelope(&ws.a, m, ws.sys.a_first(), &mut ws.b);
+    } else {
+        cholesky_solve(&ws.a, m, &mut ws.b);
+    }
 }
 
 /// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd

@@ -9,31 +9,41 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
-/// Fill `ws.u` (column j = u_j) from J factorised at `ws.x`.
+/// Fill `ws.u` (column j = u_j) from J factorised at `ws.x`. Each column is solved and
+/// written on the blocks its coordinate reaches only (`System::u_support`); U is cleared
+/// whole only when the supports change (a new chart's pattern), so its other entries hold
+/// the zeros of that clearing: a step costs the reached blocks, not 3n per coordinate.
 pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
     if !ws.sys.is_factored() {
         // The analogues are undefined where J is singular (no factorisation of it).
         return Err(KinematicsError::singular(chart_singularity(&ws.chart)));
     }
-    let n = ws.x.len();
-    let m = ws.u.len() / n.max(1);
-    ws.u.fill(0.0);
-    for j in 0..m {
-        ws.u[j * n + n - m + j] = 1.0;
+    if ws.u_zeros_for != ws.sys.supports_id() {
+        ws.u.fill(0.0);
+        ws.u_zeros_for = ws.sys.supports_id();
     }
     ws.sys.solve_unit_columns(&mut ws.u);
     Ok(())
 }
 
-/// Body velocities `ws.xd = U zd`, from `ws.u`.
-pub(crate) fn body_rates(zd: &[f64], ws: &mut Workspace) {
-    let n = ws.x.len();
-    ws.xd.fill(0.0);
-    for (j, &r) in zd.iter().enumerate() {
-        for (v, u) in ws.xd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
+/// `out += sum_j dz(j) u_j` over each column's support (`supports`, from
+/// `System::u_support`: U is zero outside it), for U column-major (3n per column).
+#[inline]
+pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) -> f64, out: &mut [f64]) {
+    let n = out.len();
+    for (j, (u, &(first, end))) in u.chunks_exact(n).zip(supports).enumerate() {
+        let r = dz(j);
+        for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
             *v += u * r;
         }
     }
+}
+
+/// Body velocities `ws.xd = U zd`, from `ws.u`.
+#[inline]
+pub(crate) fn body_rates(zd: &[f64], ws: &mut Workspace) {
+    ws.xd.fill(0.0);
+    add_u_times(&ws.u, ws.sys.u_support(), |j| zd[j], &mut ws.xd);
 }
 
 /// Body velocities `ws.xd = U zd` and the convective term `ws.c`, from `ws.u`.

@@ -14,7 +14,7 @@ pub mod singularity;
 pub mod system;
 pub mod third;
 
-pub use analogues::{acceleration_analogues, convective, velocity_analogues};
+pub use analogues::{acceleration_analogues, add_u_times, convective, velocity_analogues};
 pub use closed_form::ClosedForm;
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};

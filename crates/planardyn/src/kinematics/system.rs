@@ -13,6 +13,7 @@ use super::group_sigma::GroupScales;
 use super::pairs;
 use crate::linalg::{BlockLu, MAX_COLUMNS};
 use crate::model::{CoordinateKind, Mechanism};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
@@ -40,6 +41,22 @@ pub struct System {
     /// Per column j of U, the bodies it may be non-zero on, [first, end): those of the blocks
     /// its coordinate's row reaches.
     u_support: Vec<(usize, usize)>,
+    /// The entries of A = U^T M U that may be non-zero: the pairs j <= k of columns whose
+    /// supports meet, and per row k the first such j (A's envelope, kept by its Cholesky factor);
+    /// the entries (k, j) of the envelope below the diagonal that are no such pair, where the
+    /// factor may fill in.
+    a_pairs: Vec<(usize, usize)>,
+    a_first: Vec<usize>,
+    a_fill_in: Vec<(usize, usize)>,
+    /// Identifies the analysis the supports above come from (unique over all systems): buffers
+    /// that keep zeros outside the supports are cleared once when it changes.
+    supports_id: u64,
+}
+
+/// The next [`System::supports_id`].
+fn next_supports_id() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
@@ -50,10 +67,16 @@ pub fn col_scales(mech: &Mechanism) -> Vec<f64> {
 impl System {
     pub fn new(mech: &Mechanism) -> Self {
         let lu = BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs));
+        let u_support = u_support(mech, &lu);
+        let (a_pairs, a_first, a_fill_in) = a_pattern(&u_support);
         System {
             groups: GroupScales::new(mech, &Chart::Inputs, &lu),
             unit_reach: unit_reach(mech, &lu),
-            u_support: u_support(mech, &lu),
+            u_support,
+            a_pairs,
+            a_first,
+            a_fill_in,
+            supports_id: next_supports_id(),
             lu,
             pattern_chart: Chart::Inputs,
             row_scale: vec![1.0; mech.n_x()],
@@ -79,6 +102,8 @@ impl System {
             self.groups = GroupScales::new(mech, chart, &self.lu);
             self.unit_reach = unit_reach(mech, &self.lu);
             self.u_support = u_support(mech, &self.lu);
+            (self.a_pairs, self.a_first, self.a_fill_in) = a_pattern(&self.u_support);
+            self.supports_id = next_supports_id();
             self.pattern_chart.clone_from(chart);
         }
         set_row_scale(mech, chart, &mut self.row_scale);
@@ -123,16 +148,41 @@ impl System {
         self.lu.solve_scaled(b, &self.row_scale, &self.col_scale);
     }
 
-    /// Solve J U = [0; I_m] in place: `u` holds the m unit columns (1 in row 3n - m + j of
-    /// column j, 0 elsewhere) and gets U; each column is solved on the blocks it reaches only.
+    /// Solve J U = [0; I_m] into `u` (m columns of 3n): each column is solved and written on
+    /// the blocks it reaches only; its other entries must be 0 already (see [`System::supports_id`]).
     pub fn solve_unit_columns(&mut self, u: &mut [f64]) {
-        self.lu.solve_many_over(u, &self.row_scale, &self.col_scale, self.unit_reach.as_deref());
+        let n = self.col_scale.len();
+        let first_row = n - u.len() / n.max(1);
+        self.lu.solve_unit_columns(u, first_row, &self.row_scale, &self.col_scale, self.unit_reach.as_deref());
     }
 
     /// Per column j of U = dx/dz, the bodies it may be non-zero on, [first, end) (from the
     /// blocks its coordinate reaches): the products of U's columns skip the others.
     pub fn u_support(&self) -> &[(usize, usize)] {
         &self.u_support
+    }
+
+    /// The pairs (j, k), j <= k, of columns of U whose supports meet: the entries of
+    /// A = U^T M U (and its mirror) that may be non-zero.
+    pub fn a_pairs(&self) -> &[(usize, usize)] {
+        &self.a_pairs
+    }
+
+    /// Per row k of A, the first column j with (j, k) in [`System::a_pairs`]: A's envelope.
+    pub fn a_first(&self) -> &[usize] {
+        &self.a_first
+    }
+
+    /// The entries (k, j), j < k, of A's envelope that are not in [`System::a_pairs`]: zero in A,
+    /// possibly not in its Cholesky factor.
+    pub fn a_fill_in(&self) -> &[(usize, usize)] {
+        &self.a_fill_in
+    }
+
+    /// Changes whenever [`System::u_support`] and the pattern of A may have changed (a new
+    /// chart's pattern): a buffer that relies on zeros outside them is cleared then.
+    pub fn supports_id(&self) -> u64 {
+        self.supports_id
     }
 
     /// Solve J^T y = b in place (b and y unscaled).
@@ -167,6 +217,22 @@ fn u_support(mech: &Mechanism, lu: &BlockLu) -> Vec<(usize, usize)> {
         })
         .map(|(first, end)| (first.min(end), end))
         .collect()
+}
+
+/// The pairs of columns whose supports meet, A's envelope and its fill-in (see
+/// [`System::a_pairs`]). Once per chart: the m^2 / 2 comparisons are not made in a step.
+type APattern = (Vec<(usize, usize)>, Vec<usize>, Vec<(usize, usize)>);
+fn a_pattern(support: &[(usize, usize)]) -> APattern {
+    let meet = |(f1, e1): (usize, usize), (f2, e2): (usize, usize)| f1.max(f2) < e1.min(e2);
+    let (mut pairs, mut first, mut fill_in) = (Vec::new(), Vec::with_capacity(support.len()), Vec::new());
+    for (k, &sk) in support.iter().enumerate() {
+        let row: Vec<usize> = (0..k).filter(|&j| meet(support[j], sk)).collect();
+        let f = row.first().copied().unwrap_or(k);
+        fill_in.extend((f..k).filter(|j| !row.contains(j)).map(|j| (k, j)));
+        pairs.extend(row.into_iter().chain([k]).map(|j| (j, k)));
+        first.push(f);
+    }
+    (pairs, first, fill_in)
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row

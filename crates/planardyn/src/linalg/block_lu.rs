@@ -53,6 +53,9 @@ pub struct BlockLu {
     /// The solution in permuted column order while a solve runs, up to [`MAX_COLUMNS`]
     /// right-hand sides interleaved (`work[i * R + r]`).
     work: Vec<f64>,
+    /// Whether `work` is all zero: a solve over some blocks leaves it so (it reads the
+    /// unsolved blocks' values as 0), so a sequence of them costs their blocks only.
+    work_clean: bool,
 }
 
 /// Row and column scales applied on the way in and out of a solve (see [`BlockLu::sink`]).
@@ -139,6 +142,7 @@ impl BlockLu {
             off_col,
             inv_diag: vec![0.0; n],
             work: vec![0.0; n * MAX_COLUMNS],
+            work_clean: true,
             row,
             col,
         }
@@ -229,13 +233,13 @@ impl BlockLu {
 
     /// Solve B y = b in place for the factorised (scaled) B.
     pub fn solve(&mut self, b: &mut [f64]) {
-        self.solve_columns::<1>(b, None, None)
+        self.solve_columns::<1>(b, None, None, None)
     }
 
     /// Solve A x = b in place for the unscaled A: x = diag(cs) B^-1 diag(rs) b, the scalings
     /// folded into the gather and the scatter.
     pub fn solve_scaled(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64]) {
-        self.solve_columns::<1>(b, Some((rs, cs)), None)
+        self.solve_columns::<1>(b, Some((rs, cs)), None, None)
     }
 
     /// As [`BlockLu::solve_scaled`] for the columns of `b` (n values each, one after the
@@ -246,15 +250,46 @@ impl BlockLu {
 
     /// As [`BlockLu::solve_many_scaled`], with `reach[c]` the blocks (ascending, from
     /// [`BlockLu::reach`]) on which the solution of the c-th sweep of columns may be non-zero:
-    /// only those are solved, the others are 0.
+    /// only those are solved and written, the solution is 0 on the others (whose entries of `b`
+    /// are left as they are).
     pub fn solve_many_over(&mut self, b: &mut [f64], rs: &[f64], cs: &[f64], reach: Option<&[Vec<usize>]>) {
+        self.solve_sweeps(b, rs, cs, reach, None)
+    }
+
+    /// Solve A X = [0; I] for the unscaled A: column j of `b` gets the solution whose
+    /// right-hand side is 1 in row `first_row + j` and 0 elsewhere (the right-hand side is not
+    /// read from `b`). With `reach` (from [`BlockLu::reach`] of each sweep's rows) only the
+    /// reached blocks are solved and only their entries of `b` written: the others must hold 0
+    /// already, so that the cost is that of the reached blocks, not n per column.
+    pub fn solve_unit_columns(
+        &mut self,
+        b: &mut [f64],
+        first_row: usize,
+        rs: &[f64],
+        cs: &[f64],
+        reach: Option<&[Vec<usize>]>,
+    ) {
+        self.solve_sweeps(b, rs, cs, reach, Some(first_row))
+    }
+
+    /// The sweeps of [`MAX_COLUMNS`] columns of the solves above; `unit`: the row of the first
+    /// column's unit right-hand side, else the right-hand sides are `b`'s.
+    fn solve_sweeps(
+        &mut self,
+        b: &mut [f64],
+        rs: &[f64],
+        cs: &[f64],
+        reach: Option<&[Vec<usize>]>,
+        unit: Option<usize>,
+    ) {
         let n = self.n.max(1);
         for (c, chunk) in b.chunks_mut(MAX_COLUMNS * n).enumerate() {
             let blocks = reach.map(|r| r[c].as_slice());
+            let unit = unit.map(|row| row + c * MAX_COLUMNS);
             match chunk.len() / n {
-                3 => self.solve_columns::<3>(chunk, Some((rs, cs)), blocks),
-                2 => self.solve_columns::<2>(chunk, Some((rs, cs)), blocks),
-                _ => self.solve_columns::<1>(chunk, Some((rs, cs)), blocks),
+                3 => self.solve_columns::<3>(chunk, Some((rs, cs)), blocks, unit),
+                2 => self.solve_columns::<2>(chunk, Some((rs, cs)), blocks, unit),
+                _ => self.solve_columns::<1>(chunk, Some((rs, cs)), blocks, unit),
             }
         }
     }
@@ -282,14 +317,22 @@ impl BlockLu {
     /// Block after block: forward rows (the right-hand side in pivoted order less the
     /// entries of the blocks already solved, then L), then backward rows (U), for R
     /// right-hand sides at once.
-    /// `blocks`: solve only these (ascending; the solution is 0 on the others), else all.
-    fn solve_columns<const R: usize>(&mut self, b: &mut [f64], scales: Scales, blocks: Option<&[usize]>) {
+    /// `blocks`: solve only these (ascending; the solution is 0 on the others, whose entries of
+    /// `b` are left as they are), else all. `unit`: right-hand side r is 1 in row `unit + r`
+    /// and 0 elsewhere, instead of `b`'s column r.
+    fn solve_columns<const R: usize>(
+        &mut self,
+        b: &mut [f64],
+        scales: Scales,
+        blocks: Option<&[usize]>,
+        unit: Option<usize>,
+    ) {
         let n = self.n;
         assert!(b.len() == R * n && R <= MAX_COLUMNS && scales.is_none_or(|(rs, cs)| rs.len() == n && cs.len() == n));
         assert!(blocks.is_none_or(|ks| ks.iter().all(|&k| k < self.n_blocks())));
         let y = &mut self.work;
-        if blocks.is_some() {
-            y[..R * n].fill(0.0);
+        if blocks.is_some() && !self.work_clean {
+            y.fill(0.0);
         }
         let all = self.start.len() - 1;
         // SAFETY: every index read below was built in `new` from the n x n pattern: `row`,
@@ -312,7 +355,10 @@ impl BlockLu {
                     let scale = scales.map_or(1.0, |(rs, _)| at(rs, r0));
                     let mut v = [0.0; R];
                     for (r, v) in v.iter_mut().enumerate() {
-                        *v = at(b, r * n + r0) * scale;
+                        *v = match unit {
+                            Some(row) => f64::from(r0 == row + r) * scale,
+                            None => at(b, r * n + r0) * scale,
+                        };
                     }
                     for e in ix(&self.off_at, p)..ix(&self.off_at, p + 1) {
                         let (a, c) = (at(&self.store, self.off_base + e), ix(&self.off_col, e));
@@ -350,10 +396,27 @@ impl BlockLu {
                 }
             }
         }
-        for (j, &c) in self.col.iter().enumerate() {
+        let (col, start) = (&self.col, &self.start);
+        let scatter = |j: usize, y: &[f64], b: &mut [f64]| {
+            let c = col[j];
             let scale = scales.map_or(1.0, |(_, cs)| cs[c]);
             for r in 0..R {
                 b[r * n + c] = y[j * R + r] * scale;
+            }
+        };
+        match blocks {
+            Some(ks) => {
+                for &k in ks {
+                    for j in start[k]..start[k + 1] {
+                        scatter(j, y, b);
+                        y[j * R..(j + 1) * R].fill(0.0);
+                    }
+                }
+                self.work_clean = true;
+            }
+            None => {
+                (0..n).for_each(|j| scatter(j, y, b));
+                self.work_clean = false;
             }
         }
     }
@@ -362,6 +425,7 @@ impl BlockLu {
     /// each by the dense transposed solve of its factors, its transposed off-diagonal entries
     /// then taken from the earlier blocks' right-hand sides. Used by the singularity monitor.
     pub fn solve_transpose(&mut self, b: &mut [f64]) {
+        self.work_clean = false;
         let y = &mut self.work;
         for (w, &c) in y.iter_mut().zip(&self.col) {
             *w = b[c];
@@ -513,17 +577,24 @@ mod tests {
         assert_eq!(lu.reach(&[3]), vec![2]);
         fill(&mut lu, &a, 5);
         lu.factor(1e-300).unwrap();
-        // Unit columns e_2, e_4, e_3 in one sweep, then e_3 alone: the same as the full solve.
-        let unit = |rows: &[usize]| -> Vec<f64> {
-            rows.iter().flat_map(|&r| (0..5).map(move |i| if i == r { 1.0 } else { 0.0 })).collect()
-        };
-        let ones = [1.0; 5];
-        for rows in [vec![2, 4, 3], vec![3]] {
-            let (mut full, mut over) = (unit(&rows), unit(&rows));
-            lu.solve_many_scaled(&mut full, &ones, &ones);
-            let reach = vec![lu.reach(&rows)];
-            lu.solve_many_over(&mut over, &ones, &ones, Some(&reach));
-            assert_eq!(over, full, "columns {rows:?}");
+        let (rs, cs) = ([2.0, 0.5, 1.0, 4.0, 0.25], [1.0, 3.0, 0.5, 2.0, 1.0]);
+        // Unit columns from row `first` on, in one sweep: the same values as the full solve of
+        // [0; I] where reached, and the entries outside the reached blocks untouched (NaN
+        // here). A full solve in between leaves the solver's buffer dirty: no effect either.
+        for (first, count) in [(2, 3), (3, 2), (4, 1), (3, 1)] {
+            let mut full: Vec<f64> = (0..count).flat_map(|r| (0..5).map(move |i| f64::from(i == first + r))).collect();
+            lu.solve_many_scaled(&mut full, &rs, &cs);
+            let reach = vec![lu.reach(&(first..first + count).collect::<Vec<_>>())];
+            let written: Vec<usize> = reach[0].iter().flat_map(|&k| lu.span(k)).map(|p| lu.col[p]).collect();
+            let mut over = vec![f64::NAN; 5 * count];
+            lu.solve_unit_columns(&mut over, first, &rs, &cs, Some(&reach));
+            for (k, (o, f)) in over.iter().zip(&full).enumerate() {
+                if written.contains(&(k % 5)) {
+                    assert_eq!(o, f, "rows from {first}: entry {k}");
+                } else {
+                    assert!(o.is_nan() && *f == 0.0, "rows from {first}: entry {k} = {o}, full {f}");
+                }
+            }
         }
     }
 

@@ -4,14 +4,25 @@
 /// (Cholesky-Banachiewicz). L keeps the envelope of A (the zeros left of each row's first
 /// non-zero), so the products there are skipped: a block-diagonal A (independent parts of a
 /// mechanism) costs its blocks' factorisations. Returns false if A is not positive definite
-/// to working precision.
+/// to working precision. Only the lower triangle is read.
 pub fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
+    factor(a, m, |a, i| a[i * m..i * m + i].iter().position(|v| *v != 0.0).unwrap_or(i))
+}
+
+/// As [`cholesky_in_place`] with the envelope given: `first[i]`, the first column of row i that
+/// may be non-zero (from the supports of U), so that no row is scanned for it.
+pub fn cholesky_envelope(a: &mut [f64], m: usize, first: &[usize]) -> bool {
+    factor(a, m, |_, i| first[i])
+}
+
+/// The factorisation, `first(a, i)` giving row i's first non-zero column (of A for the row being
+/// factorised, of L for one already done: L keeps the envelope).
+fn factor(a: &mut [f64], m: usize, first: impl Fn(&[f64], usize) -> usize) -> bool {
     for i in 0..m {
         let row = i * m;
-        let first = a[row..row + i].iter().position(|v| *v != 0.0).unwrap_or(i);
-        for j in first..i {
-            // Row j of L is zero left of its own first non-zero.
-            let start = (first..j).find(|&k| a[j * m + k] != 0.0).unwrap_or(j);
+        let fi = first(a, i);
+        for j in fi..i {
+            let start = fi.max(first(a, j));
             let mut s = a[row + j];
             for k in start..j {
                 s -= a[row + k] * a[j * m + k];
@@ -19,7 +30,7 @@ pub fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
             a[row + j] = s / a[j * m + j];
         }
         let mut d = a[row + i];
-        for k in first..i {
+        for k in fi..i {
             d -= a[row + k] * a[row + k];
         }
         if !(d > 0.0) {
@@ -32,19 +43,31 @@ pub fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
 
 /// Solve A x = b in place with the factor from [`cholesky_in_place`].
 pub fn cholesky_solve(l: &[f64], m: usize, b: &mut [f64]) {
+    solve(l, m, b, |_| 0)
+}
+
+/// As [`cholesky_solve`] over the envelope `first` of [`cholesky_envelope`]: m plus the
+/// envelope's size, not m^2.
+pub fn cholesky_solve_envelope(l: &[f64], m: usize, first: &[usize], b: &mut [f64]) {
+    solve(l, m, b, |i| first[i])
+}
+
+/// L y = b by rows, then L^T x = y by columns (row i of L is column i of L^T), each over the
+/// envelope.
+fn solve(l: &[f64], m: usize, b: &mut [f64], first: impl Fn(usize) -> usize) {
     for i in 0..m {
         let mut s = b[i];
-        for k in 0..i {
+        for k in first(i)..i {
             s -= l[i * m + k] * b[k];
         }
         b[i] = s / l[i * m + i];
     }
     for i in (0..m).rev() {
-        let mut s = b[i];
-        for k in i + 1..m {
-            s -= l[k * m + i] * b[k];
+        let x = b[i] / l[i * m + i];
+        b[i] = x;
+        for k in first(i)..i {
+            b[k] -= l[i * m + k] * x;
         }
-        b[i] = s / l[i * m + i];
     }
 }
 
@@ -91,11 +114,27 @@ mod tests {
                 plain[i * m + j] = s / d;
             }
         }
+        // A's envelope: the first column of each row of B (B's envelope is A's).
+        let first: Vec<usize> = (0..m).map(|i| (0..=i).find(|&k| b[i * m + k] != 0.0).unwrap()).collect();
+        let mut env = a.clone();
         assert!(cholesky_in_place(&mut a, m));
+        assert!(cholesky_envelope(&mut env, m, &first));
         for i in 0..m {
             for j in 0..=i {
                 assert_eq!(a[i * m + j], plain[i * m + j], "L[{i}][{j}]");
+                assert_eq!(env[i * m + j], plain[i * m + j], "L[{i}][{j}] over the envelope");
             }
+        }
+        // The solves: x = (1, ..., 7) back from A x, over the envelope and whole, to round-off.
+        let x: Vec<f64> = (1..=m).map(|v| v as f64).collect();
+        let ax: Vec<f64> = (0..m)
+            .map(|i| (0..m).map(|j| (0..m).map(|k| b[i * m + k] * b[j * m + k]).sum::<f64>() * x[j]).sum())
+            .collect();
+        let (mut whole, mut over) = (ax.clone(), ax);
+        cholesky_solve(&a, m, &mut whole);
+        cholesky_solve_envelope(&env, m, &first, &mut over);
+        for i in 0..m {
+            assert!((whole[i] - x[i]).abs() < 1e-13 && (over[i] - x[i]).abs() < 1e-13, "{whole:?} {over:?}");
         }
     }
 }

@@ -14,7 +14,7 @@ mod pivot;
 mod sink;
 
 pub use block_lu::{BlockLu, BlockSink, MAX_COLUMNS};
-pub use cholesky::{cholesky_in_place, cholesky_solve};
+pub use cholesky::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
 pub use pivot::pivot_columns;
 pub use sink::{Dense, Sink};

@@ -264,7 +264,8 @@ fn time_to_point(approach: &Approach, t: f64, passive: f64) -> Option<f64> {
 /// Whether the step from the last point kept to the one accepted at `t` (held by `ode.ws`,
 /// passive measure `passive`) went over a change point: the measure fell towards 0 before it
 /// and rose after it as |t - t*| does (a V), not as past a minimum above 0. The change point
-/// then, from the quintic through the step's two ends.
+/// then, located on the quintic through the step's two ends (the V's linear extrapolation
+/// only tells that it is there: at its time Phi_x's pivots can still be above [`LOST_PIVOT`]).
 pub fn stepped_over(ode: &MechanismOde, approach: &Approach, t: f64, passive: f64) -> Option<ChangePoint> {
     let last = approach.last().filter(|p| p.passive < WATCH_BELOW && p.t < t)?;
     let to_point = time_to_point(approach, last.t, last.passive)?;
@@ -275,7 +276,7 @@ pub fn stepped_over(ode: &MechanismOde, approach: &Approach, t: f64, passive: f6
     }
     let ws = &ode.ws;
     let path = Quintic::new(last, (&ws.x, &ws.xd, &ws.xdd), t);
-    Some(change_point(ode.mech, &path, t_star))
+    Some(change_point(ode.mech, &path, locate(ode.mech, &path, last.t, t)))
 }
 
 /// Cross the change point ahead of the point accepted at `t` with passive measure `passive`

@@ -5,7 +5,7 @@
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{scaled_distance, Chart, ClosedForm, System, MAX_CORRECTION};
+use crate::kinematics::{add_u_times, scaled_distance, Chart, ClosedForm, System, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
@@ -218,8 +218,6 @@ impl<'a> MechanismOde<'a> {
     /// accelerations for the rates U dz), else a first-order one from the last accepted point.
     /// Both start from converged points of the same branch.
     fn predict(&mut self, z: &[f64]) {
-        let m = self.m();
-        let n = self.ws.x.len();
         let closed = self.closed_form_in_use();
         if !closed && self.base_valid {
             // The second-order term solves with J at the last evaluation.
@@ -228,12 +226,8 @@ impl<'a> MechanismOde<'a> {
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);
-            for (j, (zj, last)) in z[..m].iter().zip(&self.last_y).enumerate() {
-                let dz = zj - last;
-                for (d, u) in ws.rhs.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
-                    *d += u * dz;
-                }
-            }
+            let last = &self.last_y;
+            add_u_times(&ws.u, ws.sys.u_support(), |j| z[j] - last[j], &mut ws.rhs);
             match self.closed.as_ref().filter(|_| closed) {
                 Some(c) => {
                     c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
@@ -249,12 +243,8 @@ impl<'a> MechanismOde<'a> {
             }
         } else {
             ws.x.copy_from_slice(&self.anchor_x);
-            for (j, (zj, anchor)) in z[..m].iter().zip(&self.anchor_z).enumerate() {
-                let dz = zj - anchor;
-                for (x, u) in ws.x.iter_mut().zip(&self.anchor_u[j * n..(j + 1) * n]) {
-                    *x += u * dz;
-                }
-            }
+            let anchor = &self.anchor_z;
+            add_u_times(&self.anchor_u, ws.sys.u_support(), |j| z[j] - anchor[j], &mut ws.x);
         }
     }
 
