@@ -200,6 +200,9 @@ impl<'a> MechanismOde<'a> {
     /// there and anchors the predictor to it.
     pub fn set_chart(&mut self, chart: Chart, t: f64, y: &[f64]) -> Result<(), Error> {
         self.ws.chart = chart;
+        // The first point of a chart takes the Newton path, which analyses the chart's
+        // structure (the supports of U that the closed forms' dynamic stages use).
+        self.clear_of_folds = false;
         self.anchor_x.copy_from_slice(&self.ws.x);
         if let Some(c) = self.closed.as_mut() {
             // A partition may have carried a dyad through its fold onto its other branch.
