@@ -70,12 +70,6 @@ class CollocatedMotion(PlannedMotion):
     inf when the motion between nodes meets a singularity).
     """
 
-    mech: Mechanism
-    t: FloatArray
-    q: FloatArray
-    qd: FloatArray
-    qdd: FloatArray
-    tau: FloatArray
     objective: str
     cost: float
     status: str

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -18,11 +19,12 @@ class PlanError(ValueError):
     """A path or limits that cannot be planned, with what to change."""
 
 
+@dataclass
 class PlannedMotion:
     """A motion from rest to rest with the efforts that run it.
 
-    Subclasses hold ``mech``, the grid times ``t`` (N,) (s), and ``q``, ``qd``, ``qdd``, ``tau``
-    (N, m) there, and give :meth:`state` and :meth:`efforts` between the grid points.
+    It holds ``mech``, the grid times ``t`` (N,) (s), and ``q``, ``qd``, ``qdd``, ``tau``
+    (N, m) there; subclasses give :meth:`state` and :meth:`efforts` between the grid points.
     ``motor_sizing(mech, k, plan.t, plan.qd[:, k], plan.tau[:, k])`` (planardyn.robot.sizing)
     sizes a drive on it.
     """

@@ -56,17 +56,11 @@ class TimedPath(PlannedMotion):
     (inf where none); ``status`` toppra's.
     """
 
-    mech: Mechanism
     path: Any
     s: FloatArray
     sd: FloatArray
     sdd: FloatArray
-    t: FloatArray
     x: FloatArray
-    q: FloatArray
-    qd: FloatArray
-    qdd: FloatArray
-    tau: FloatArray
     lo: FloatArray
     hi: FloatArray
     speed: FloatArray
