@@ -9,37 +9,15 @@ use planardyn::dynamics::{inverse, ModelDrives, Motion, MotionFunction, Prescrib
 use planardyn::simulate::{simulate, simulate_prescribed, Settings, Trajectory};
 use planardyn::{loads, Format, Mechanism, Workspace};
 
-/// The offset slider-crank of `common::SLIDER_CRANK` without dissipation (spring without
-/// damping, no friction), its crank turned at 2 pi rad/s by a motion instead of a torque:
-/// tau omega = dT/dt + dV/dt exactly.
+/// The slider-crank of `common::slider_crank_at_speed`, its crank turned by `motion` instead
+/// of a torque: tau omega = dT/dt + dV/dt exactly.
 fn slider_crank(motion: &str) -> Mechanism {
-    yaml(&format!(
-        r#"
-name: slider-crank at constant speed
-gravity: [0, -9.81]
-points:
-  O: [0, 0]
-  A: [0.08660254037844387, 0.05]
-  B: [0.43531445586169776, 0.02]
-  G: [0.0, 0.02]
-ground: [O, G]
-bodies:
-  crank: {{points: [O, A], uniform_bar: [O, A], mass: 0.3}}
-  rod: {{points: [A, B], uniform_bar: [A, B], mass: 0.6}}
-  slider: {{points: [B], mass: 0.5, inertia: 0.001, com: B}}
-pairs:
-  - {{type: revolute, name: O, at: O, bodies: [ground, crank]}}
-  - {{type: revolute, at: A, bodies: [crank, rod]}}
-  - {{type: revolute, at: B, bodies: [rod, slider]}}
-  - {{type: prismatic, name: guide, at: B, bodies: [ground, slider], axis: [1, 0]}}
-coordinates:
-  - {{name: phi, pair: O, value: 0.5235987755982988}}
-drives:
-  - {{coordinate: phi, motion: {motion}}}
-loads:
-  - {{type: spring, between: [[slider, B], [ground, G]], stiffness: 30.0, rest_length: 0.35}}
-"#
-    ))
+    slider_crank_at_speed(
+        &format!(
+            "coordinates:\n  - {{name: phi, pair: O, value: 0.5235987755982988}}\ndrives:\n  - {{coordinate: phi, motion: {motion}}}\n"
+        ),
+        false,
+    )
 }
 
 const OMEGA: f64 = std::f64::consts::TAU;

@@ -10,44 +10,6 @@ use planardyn::{Mechanism, Workspace};
 
 const OMEGA: f64 = std::f64::consts::TAU;
 
-/// The offset slider-crank of tests/prescribed.rs with named pins, `rider` a body on a guide
-/// `ride` of the slider (or nothing), and `rest` the loads after its spring, the coordinates
-/// and the drives.
-fn slider_crank(rest: &str, rider: bool) -> Mechanism {
-    let (body, pair) = if rider {
-        (
-            "  rider: {points: [C], mass: 0.2, inertia: 0.0005, com: C}\n",
-            "  - {type: prismatic, name: ride, at: C, bodies: [slider, rider], axis: [1, 0]}\n",
-        )
-    } else {
-        ("", "")
-    };
-    yaml(&format!(
-        r#"
-name: slider-crank at constant speed, pin friction
-gravity: [0, -9.81]
-points:
-  O: [0, 0]
-  A: [0.08660254037844387, 0.05]
-  B: [0.43531445586169776, 0.02]
-  G: [0.0, 0.02]
-  C: [0.53531445586169776, 0.02]
-ground: [O, G]
-bodies:
-  crank: {{points: [O, A], uniform_bar: [O, A], mass: 0.3}}
-  rod: {{points: [A, B], uniform_bar: [A, B], mass: 0.6}}
-  slider: {{points: [B], mass: 0.5, inertia: 0.001, com: B}}
-{body}pairs:
-  - {{type: revolute, name: O, at: O, bodies: [ground, crank]}}
-  - {{type: revolute, name: A, at: A, bodies: [crank, rod]}}
-  - {{type: revolute, name: B, at: B, bodies: [rod, slider]}}
-  - {{type: prismatic, name: guide, at: B, bodies: [ground, slider], axis: [1, 0]}}
-{pair}loads:
-  - {{type: spring, between: [[slider, B], [ground, G]], stiffness: 30.0, rest_length: 0.35}}
-{rest}"#
-    ))
-}
-
 const PINS: &str = "  - {type: friction, pair: O, mu: 0.2, pin_radius: 0.01}
   - {type: friction, pair: A, mu: 0.2, pin_radius: 0.008}
   - {type: friction, pair: B, mu: 0.2, pin_radius: 0.008}
@@ -81,7 +43,8 @@ fn run(mech: &Mechanism, t_end: f64) -> Trajectory {
 /// dissipates (drive = frictionless + dissipated, W).
 #[test]
 fn crank_power_is_the_frictionless_power_plus_the_dissipated_power() {
-    let (rough, smooth) = (slider_crank(&format!("{PINS}{CRANK_ONLY}"), false), slider_crank(CRANK_ONLY, false));
+    let (rough, smooth) =
+        (slider_crank_at_speed(&format!("{PINS}{CRANK_ONLY}"), false), slider_crank_at_speed(CRANK_ONLY, false));
     let tr = run(&rough, 1.0);
     let (mut ws, mut ws0) = (Workspace::new(&rough), Workspace::new(&smooth));
     let nx = rough.n_x();
@@ -118,7 +81,7 @@ drives:
   - {{coordinate: phi, motion: {{speed: 6.283185307179586}}}}
 "
     );
-    let mech = slider_crank(&text, true);
+    let mech = slider_crank_at_speed(&text, true);
     let tr = run(&mech, 1.0);
     let mut ws = Workspace::new(&mech);
     let nx = mech.n_x();

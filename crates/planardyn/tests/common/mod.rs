@@ -266,3 +266,42 @@ pub fn every_model() -> Vec<Mechanism> {
     assert!(names.len() >= 20, "{names:?}");
     names.iter().map(|n| shipped(n)).chain(all_models()).collect()
 }
+
+/// The offset slider-crank of [`SLIDER_CRANK`] without dissipation (its spring undamped),
+/// for prescribed motions: named pins O, A, B and guide, `rider` a body on a guide `ride` of
+/// the slider (or nothing), and `rest` the loads after its spring, the coordinates and the
+/// drives.
+pub fn slider_crank_at_speed(rest: &str, rider: bool) -> Mechanism {
+    let (body, pair) = if rider {
+        (
+            "  rider: {points: [C], mass: 0.2, inertia: 0.0005, com: C}\n",
+            "  - {type: prismatic, name: ride, at: C, bodies: [slider, rider], axis: [1, 0]}\n",
+        )
+    } else {
+        ("", "")
+    };
+    yaml(&format!(
+        r#"
+name: slider-crank at constant speed
+gravity: [0, -9.81]
+points:
+  O: [0, 0]
+  A: [0.08660254037844387, 0.05]
+  B: [0.43531445586169776, 0.02]
+  G: [0.0, 0.02]
+  C: [0.53531445586169776, 0.02]
+ground: [O, G]
+bodies:
+  crank: {{points: [O, A], uniform_bar: [O, A], mass: 0.3}}
+  rod: {{points: [A, B], uniform_bar: [A, B], mass: 0.6}}
+  slider: {{points: [B], mass: 0.5, inertia: 0.001, com: B}}
+{body}pairs:
+  - {{type: revolute, name: O, at: O, bodies: [ground, crank]}}
+  - {{type: revolute, name: A, at: A, bodies: [crank, rod]}}
+  - {{type: revolute, name: B, at: B, bodies: [rod, slider]}}
+  - {{type: prismatic, name: guide, at: B, bodies: [ground, slider], axis: [1, 0]}}
+{pair}loads:
+  - {{type: spring, between: [[slider, B], [ground, G]], stiffness: 30.0, rest_length: 0.35}}
+{rest}"#
+    ))
+}
