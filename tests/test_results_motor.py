@@ -12,7 +12,7 @@ import numpy as np
 import planardyn as pd
 import pytest
 from conftest import cli_run
-from planardyn import cli
+from planardyn import batch, cli
 from planardyn.identify import base_parameters
 from test_regressor_losses import geared_five_bar
 
@@ -49,6 +49,9 @@ def test_a_runs_motor_torques_are_its_drives_laws():
     # The joint side is ~n eta (or n / eta) times larger: the two are not the same column.
     assert np.abs(res.tau).max() > 8 * np.abs(res.tau_motor).max()
     assert np.any(res.tau * res.qd > 0) and np.any(res.tau * res.qd < 0)
+    # A batch run is the same run, motor torques included.
+    np.testing.assert_array_equal(batch.simulate([(mech, {"qd0": [1.0, -0.8]})], t_end=0.5, output_dt=0.005)[0].tau_motor,
+                                  res.tau_motor)
 
 
 @pytest.mark.parametrize("ext", [".csv", ".parquet", ".npz"])
