@@ -25,8 +25,9 @@ Columns, in order: ``t``; the coordinate names (q); ``qd_<name>``; ``qdd_<name>`
 ``tau_<name>``; ``kinetic``, ``potential``, ``work`` (J); ``sigma``; ``residual``;
 ``partitioned`` (0/1); ``X_<body>``, ``Y_<body>``, ``phi_<body>`` (x) and ``Xd_<body>``,
 ``Yd_<body>``, ``phid_<body>`` (xd); for a model with actuators, ``tau_motor_<name>`` (the
-motor torques, N m: ``Mechanism.motor_torques(qd, tau)``, what identification reads). Readers split the table by position (the layout is in
-the metadata), so a coordinate may be named like another column.
+motor torques, N m: ``Mechanism.motor_torques(qd, tau)``, what identification reads).
+Readers split the table by position (the layout is in the metadata), so a coordinate may be
+named like another column.
 """
 
 from __future__ import annotations
