@@ -451,9 +451,10 @@ def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
         names = ", ".join(f"tau_{n}" for n in mech.coordinate_names)
         raise UsageError(f"{path}: identification needs the measured efforts: columns {names}")
     if m["tau_motor"] is None and m["from_results"] and any(a is not None for a in mech.actuators):
-        raise UsageError(f"{path}: a results file without motor torques (no tau_motor_<name> columns: format version 2 or "
-                         "older): its tau is joint-side, while the model's actuators need the motor torques; "
-                         "save the run again with this planardyn, or give the motor torques as tau_<name> in a table")
+        raise UsageError(f"{path}: a results file without motor torques (no tau_motor_<name> columns: format "
+                         "version 2 or older): its tau is joint-side, while the model's actuators need the motor "
+                         "torques; save the run again with this planardyn, or give the motor torques as tau_<name> "
+                         "in a table")
     if m["qd"] is not None and m["qdd"] is not None:
         return m["q"], m["qd"], m["qdd"], tau, m["x"]
     if cutoff is None:
