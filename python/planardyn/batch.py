@@ -263,7 +263,8 @@ def simulate(
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
     result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
-                                       coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names)
+                                       coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names,
+                                       tau_motor=mech._result_motor_torques(raw["qd"], raw["tau"]))
     # The metadata's settings rerun the variant: mech.simulate(**settings), motions by name.
     rerun = {k: v for k, v in settings.items() if k not in ("motion", "_motion")}
     if "_motion" in settings:

@@ -272,8 +272,9 @@ def _parser() -> argparse.ArgumentParser:
                "Estimate the model's base parameters (the combinations of the inertial parameters,\n"
                "rotor inertias and friction coefficients the efforts can tell apart) from a measured\n"
                "motion: a CSV table with t (s), one column per coordinate (rad or m) and tau_<name>\n"
-               "(N m or N; the motor torque where the model has an actuator), or a planardyn results\n"
-               "file (a run's tau is joint-side: give a geared model's motor torques in a table). Rates and\n"
+               "(N m or N; the motor torque where the model has an actuator; tau_motor_<name> columns,\n"
+               "when present, are taken instead), or a planardyn results file (its motor torques\n"
+               "tau_motor_<name> where the model has actuators, else tau_<name>). Rates and\n"
                "accelerations come from qd_<name>/qdd_<name> columns, else from the positions\n"
                "low-pass filtered at --cutoff (the efforts filtered alike). Prints each base\n"
                "parameter identified with its standard error, against the model's.",
@@ -444,11 +445,18 @@ def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
     from .results_io import read_motion
 
     m = read_motion(path, mech.coordinate_names)
-    if m["tau"] is None:
+    # The regressor's rows are motor torques where the model has actuators.
+    tau = m["tau_motor"] if m["tau_motor"] is not None else m["tau"]
+    if tau is None:
         names = ", ".join(f"tau_{n}" for n in mech.coordinate_names)
         raise UsageError(f"{path}: identification needs the measured efforts: columns {names}")
+    if m["tau_motor"] is None and m["from_results"] and any(a is not None for a in mech.actuators):
+        raise UsageError(f"{path}: a results file without motor torques (no tau_motor_<name> columns: format "
+                         "version 2 or older): its tau is joint-side, while the model's actuators need the motor "
+                         "torques; save the run again with this planardyn, or give the motor torques as tau_<name> "
+                         "in a table")
     if m["qd"] is not None and m["qdd"] is not None:
-        return m["q"], m["qd"], m["qdd"], m["tau"], m["x"]
+        return m["q"], m["qd"], m["qdd"], tau, m["x"]
     if cutoff is None:
         raise UsageError(f"{path}: no qd_/qdd_ columns: give --cutoff (Hz) to differentiate the positions")
     q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
@@ -456,7 +464,7 @@ def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
     if not keep.any():
         raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at --cutoff "
                          f"{cutoff:g} Hz: record longer or raise --cutoff")
-    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], m["tau"], cutoff)[keep], None
+    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
 
 
 def _identify(args: argparse.Namespace) -> int:

@@ -362,6 +362,13 @@ class Mechanism:
         coordinate without an actuator, the effort itself (docs/actuators.md)."""
         return self._native.motor_torques(qd, tau)
 
+    def _result_motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray | None:
+        """A result's ``tau_motor``: :meth:`motor_torques` of its rows (N, m) when the model has
+        an actuator, else None."""
+        if all(a is None for a in self.actuators):
+            return None
+        return np.asarray(self.motor_torques(qd, tau), dtype=np.float64).reshape(np.shape(tau))
+
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
     )
@@ -698,6 +705,7 @@ class Mechanism:
             coordinate_names=self.coordinate_names,
             coordinate_kinds=self.coordinate_kinds,
             body_names=self.body_names,
+            tau_motor=self._result_motor_torques(raw["qd"], raw["tau"]),
         )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,

@@ -136,7 +136,7 @@ class SimulationResult:
     q: FloatArray
     qd: FloatArray
     qdd: FloatArray
-    #: (N, m) drive efforts applied (N m or N).
+    #: (N, m) drive efforts applied (N m or N), joint-side (after the transmissions).
     tau: FloatArray
     #: (N, 3n) body coordinates [X, Y, phi] per body (m, m, rad) and their rates.
     x: FloatArray
@@ -182,6 +182,10 @@ class SimulationResult:
     #: sol.t_max]), from each step's own interpolant. None otherwise, and when read from a file
     #: (which keeps the events).
     sol: DenseOutput | None = None
+    #: (N, m) motor torques (N m) of a model with actuators, what its drives measure
+    #: (``Mechanism.motor_torques(qd, tau)``; tau itself on a coordinate without one); None
+    #: for a model without actuators. What identification reads from a results file.
+    tau_motor: FloatArray | None = None
 
     @classmethod
     def from_raw(
@@ -192,6 +196,7 @@ class SimulationResult:
         coordinate_kinds: list[str],
         body_names: list[str],
         metadata: dict[str, Any] | None = None,
+        tau_motor: FloatArray | None = None,
     ) -> SimulationResult:
         """Wrap the dict returned by the native ``Mechanism.simulate``."""
         x = raw["x"]
@@ -221,6 +226,7 @@ class SimulationResult:
             q_events=list(raw.get("q_events", [])),
             qd_events=list(raw.get("qd_events", [])),
             sol=raw.get("sol"),
+            tau_motor=tau_motor,
         )
 
     def change_points_frame(self) -> pandas.DataFrame:
@@ -261,10 +267,12 @@ class SimulationResult:
 
     def columns(self) -> dict[str, FloatArray]:
         """The table of :meth:`to_dataframe` as a dict of (N,) arrays, in column order:
-        ``t``, the coordinate names, ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``,
-        ``kinetic``, ``potential``, ``work``, ``sigma``."""
+        ``t``, the coordinate names, ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``, with
+        actuators ``tau_motor_<name>``, then ``kinetic``, ``potential``, ``work``, ``sigma``."""
         cols: dict[str, FloatArray] = {"t": self.t}
-        for prefix, arr in (("", self.q), ("qd_", self.qd), ("qdd_", self.qdd), ("tau_", self.tau)):
+        arrays = (("", self.q), ("qd_", self.qd), ("qdd_", self.qdd), ("tau_", self.tau),
+                  *((("tau_motor_", self.tau_motor),) if self.tau_motor is not None else ()))
+        for prefix, arr in arrays:
             for k, name in enumerate(self.coordinate_names):
                 cols[prefix + name] = arr[:, k]
         cols["kinetic"] = self.energy.kinetic
@@ -291,17 +299,18 @@ class SimulationResult:
 
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
         """:meth:`save` in the CSV form whatever the name: the metadata on ``# `` lines, then
-        the columns of :meth:`columns` and the body coordinates, full double precision."""
+        the file's columns (:mod:`planardyn.results_io`), full double precision."""
         return self._write(path, ".csv")
 
     def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:
-        layout = results_format.columns(self.coordinate_names, self.body_names)
+        layout = results_format.columns(self.coordinate_names, self.body_names, self.tau_motor is not None)
         e = self.energy
         groups = {
             "t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau,
             "kinetic": e.kinetic, "potential": e.potential, "work": e.work,
             "sigma": self.sigma, "residual": self.residual, "partitioned": self.partitioned,
             "x": self.x, "xd": self.xd,
+            **({"tau_motor": self.tau_motor} if self.tau_motor is not None else {}),
         }
         meta = {
             "format": results_format.FORMAT,

@@ -24,8 +24,9 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 FORMAT = "planardyn-results"
-#: 2: the metadata records ``rows`` and ``checksum`` (version 1 files, without them, are read).
-FORMAT_VERSION = 2
+#: 2: the metadata records ``rows`` and ``checksum`` (version 1 files, without them, are read);
+#: 3: a model with actuators adds the motor torques ``tau_motor``.
+FORMAT_VERSION = 3
 EXTENSIONS = (".csv", ".parquet", ".npz")
 #: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
 CSV_BLOCK = 4096
@@ -38,9 +39,10 @@ def plain(v: Any) -> Any:
     return v
 
 
-def columns(names: list[str], bodies: list[str]) -> list[tuple[str, list[str]]]:
+def columns(names: list[str], bodies: list[str], motor: bool = False) -> list[tuple[str, list[str]]]:
     """(group, column names) in file order, for coordinates ``names`` and ``bodies``; groups
-    are result fields or energy entries."""
+    are result fields or energy entries. ``motor``: the motor torques ``tau_motor`` last (a
+    model with actuators), so the other columns keep their places."""
     body_cols = [f"{c}_{b}" for b in bodies for c in ("X", "Y", "phi")]
     return [
         ("t", ["t"]),
@@ -56,7 +58,7 @@ def columns(names: list[str], bodies: list[str]) -> list[tuple[str, list[str]]]:
         ("partitioned", ["partitioned"]),
         ("x", body_cols),
         ("xd", [c.replace("_", "d_", 1) for c in body_cols]),
-    ]
+    ] + ([("tau_motor", [f"tau_motor_{n}" for n in names])] if motor else [])
 
 
 def table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> FloatArray:

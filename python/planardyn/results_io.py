@@ -24,8 +24,10 @@ for an interrupted run written as far as it got, ...).
 Columns, in order: ``t``; the coordinate names (q); ``qd_<name>``; ``qdd_<name>``;
 ``tau_<name>``; ``kinetic``, ``potential``, ``work`` (J); ``sigma``; ``residual``;
 ``partitioned`` (0/1); ``X_<body>``, ``Y_<body>``, ``phi_<body>`` (x) and ``Xd_<body>``,
-``Yd_<body>``, ``phid_<body>`` (xd). Readers split the table by position (the layout is in
-the metadata), so a coordinate may be named like another column.
+``Yd_<body>``, ``phid_<body>`` (xd); for a model with actuators, ``tau_motor_<name>`` (the
+motor torques, N m: ``Mechanism.motor_torques(qd, tau)``, what identification reads).
+Readers split the table by position (the layout is in the metadata), so a coordinate may be
+named like another column.
 """
 
 from __future__ import annotations
@@ -103,6 +105,7 @@ def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationRe
         change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
         metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
         t_events=per_event("t", (-1,)), q_events=per_event("q", (-1, m)), qd_events=per_event("qd", (-1, m)),
+        tau_motor=groups.get("tau_motor"),
     )
 
 
@@ -149,11 +152,17 @@ def _check_meta(meta: Any) -> dict[str, Any]:
             raise _Damaged(f"metadata field {name!r} is {_short(meta.get(name))}, not {what}")
     if len(meta["coordinate_kinds"]) != len(meta["coordinate_names"]):
         raise _Damaged("metadata fields 'coordinate_names' and 'coordinate_kinds' differ in length")
-    layout = [[g, len(c)] for g, c in _columns(meta["coordinate_names"], meta["body_names"])]
+    layout = [[g, len(c)] for g, c in _layout(meta)]
     if meta["layout"] != layout:
         raise _Damaged(f"metadata field 'layout' is {_short(meta['layout'])}, not the layout of its "
                        f"coordinates and bodies {layout}")
     return meta
+
+
+def _layout(meta: dict[str, Any]) -> list[tuple[str, list[str]]]:
+    """The columns of a file with this metadata: with the motor torques when its layout names them."""
+    motor = isinstance(meta["layout"], list) and ["tau_motor", len(meta["coordinate_names"])] in meta["layout"]
+    return _columns(meta["coordinate_names"], meta["body_names"], motor)
 
 
 def _short(v: Any) -> str:
@@ -301,7 +310,7 @@ def _read_csv_table(path: Path) -> tuple[dict[str, Any], FloatArray]:
 
 
 def _check_header(meta: dict[str, Any], header: list[str]) -> None:
-    names = [c for _, cols in _columns(meta["coordinate_names"], meta["body_names"]) for c in cols]
+    names = [c for _, cols in _layout(meta) for c in cols]
     if header != names:
         wrong = next((k for k, (h, n) in enumerate(zip(header, names)) if h != n), min(len(header), len(names)))
         raise _Damaged(f"{len(header)} columns where its metadata says {len(names)}: column {wrong + 1} is "
@@ -358,13 +367,16 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     """Read a prescribed motion: a CSV table, or any planardyn results file.
 
     The CSV has a header row with ``t`` (s) and one column per coordinate name (rad or m),
-    and optionally ``qd_<name>``, ``qdd_<name>`` and ``tau_<name>`` (measured efforts, N m or
-    N) columns; other columns are ignored, and so are leading ``#`` comment lines.
+    and optionally ``qd_<name>``, ``qdd_<name>``, ``tau_<name>`` (measured efforts, N m or
+    N) and ``tau_motor_<name>`` (motor torques, N m) columns; other columns are ignored, and
+    so are leading ``#`` comment lines.
 
     Returns
     -------
     dict with ``t`` (N,), ``q`` (N, m), and ``qd``, ``qdd``, ``tau``: (N, m) arrays where
-    every coordinate had such a column (a results file has all three), else None; ``x`` (N, 3n) the
+    every coordinate had such a column (a results file has all three), else None;
+    ``tau_motor`` (N, m) likewise (a results file's motor torques, None without actuators);
+    ``from_results`` True for a results file (its ``tau`` is joint-side); ``x`` (N, 3n) the
     body coordinates of a results file (the branch it is on) and ``xd`` (N, 3n) its body rates,
     None for a table; and
     per-coordinate lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
@@ -380,8 +392,9 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
                 f"{path}: the results' coordinates ({', '.join(res.coordinate_names)}) are not "
                 f"the model's ({', '.join(coordinate_names)})"
             )
-        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau, "x": res.x,
-                "xd": res.xd, "qd_columns": list(res.qd.T), "qdd_columns": list(res.qdd.T)}
+        return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau, "tau_motor": res.tau_motor,
+                "from_results": True, "x": res.x, "xd": res.xd, "qd_columns": list(res.qd.T),
+                "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
     _, header, rows = _read_named_csv(path)
@@ -393,7 +406,8 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
             f"(it needs t and the coordinates {', '.join(coordinate_names)}; found {', '.join(header)})"
         )
     col = {h: i for i, h in enumerate(header)}
-    used = need + [f"{p}_{n}" for p in ("qd", "qdd", "tau") for n in coordinate_names if f"{p}_{n}" in col]
+    used = need + [f"{p}_{n}" for p in ("qd", "qdd", "tau", "tau_motor") for n in coordinate_names
+                   if f"{p}_{n}" in col]
     data = np.empty((len(rows), len(header)))
     for i, r in enumerate(rows):
         for h in used:
@@ -414,8 +428,9 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
     both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731
     tau = both([get(f"tau_{n}") for n in coordinate_names])
-    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "x": None, "xd": None,
-            "qd_columns": qd_cols, "qdd_columns": qdd_cols}
+    tau_motor = both([get(f"tau_motor_{n}") for n in coordinate_names])
+    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "tau_motor": tau_motor,
+            "from_results": False, "x": None, "xd": None, "qd_columns": qd_cols, "qdd_columns": qdd_cols}
 
 
 def motion_derivatives(
@@ -485,7 +500,8 @@ def inverse_result(
     SimulationResult
         ``tau`` (N, m): the drive efforts (N m or N) that produce the motion together with
         the model's loads (springs, dampers, gravity; the model's own drives are not
-        counted); ``x``, ``xd``, ``sigma``, ``residual`` from the kinematics at each row;
+        counted), joint-side; ``tau_motor`` their motor torques where the model has
+        actuators; ``x``, ``xd``, ``sigma``, ``residual`` from the kinematics at each row;
         kinetic and potential energy; ``work`` the work of tau (J, trapezoidal rule);
         ``metadata["branch"]`` says which branch the rows were computed on.
     """
@@ -534,6 +550,7 @@ def inverse_result(
         coordinate_names=list(mech.coordinate_names),
         coordinate_kinds=list(mech.coordinate_kinds),
         body_names=list(mech.body_names),
+        tau_motor=mech._result_motor_torques(qd, tau),
     )
     if given is not None and given.ndim == 2:
         branch = "each row's body coordinates"

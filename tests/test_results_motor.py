@@ -1,0 +1,114 @@
+"""A geared model's results carry its motor torques (``tau_motor``), through results files, to
+identification: what the drives of a robot with transmissions measure."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import io
+import json
+
+import numpy as np
+import planardyn as pd
+import pytest
+from conftest import cli_run
+from planardyn import batch, cli
+from planardyn.identify import base_parameters
+from test_regressor_losses import geared_five_bar
+
+
+@pytest.fixture(scope="module")
+def run():
+    # The geared five-bar (ratio 10, efficiency 0.9, motor and pin friction) moved through a
+    # two-tone motion of both cranks, as tests/test_identify.py moves the bare five-bar.
+    mech = geared_five_bar()
+    q0 = mech.q0
+
+    def law(k, a, w, b, v):
+        return lambda t: (q0[k] + a * np.sin(w * t) + b * np.sin(v * t),
+                          a * w * np.cos(w * t) + b * v * np.cos(v * t),
+                          -a * w * w * np.sin(w * t) - b * v * v * np.sin(v * t))
+
+    motion = {"theta1": law(0, 0.25, 2 * np.pi, 0.15, 6 * np.pi), "theta2": law(1, 0.2, 4 * np.pi, 0.15, 2 * np.pi)}
+    res = mech.simulate(t_end=2.0, output_dt=0.005, motion=motion)
+    assert res.success, res.message
+    return mech, res
+
+
+def test_a_runs_motor_torques_are_its_drives_laws():
+    # Under the model's drives (motor-side laws: a constant and a table) the result's motor
+    # torques are the laws' values: tau is the joint side they produce, and motor_torques
+    # maps it back (both gear branches occur; round-off 1e-15 of the efforts, bound 1e-12).
+    mech = geared_five_bar()
+    res = mech.simulate(t_end=0.5, output_dt=0.005, qd0=[1.0, -0.8])
+    assert res.success, res.message
+    drives = mech.to_dict()["drives"]
+    table = drives[1]["table"]
+    t_m = np.column_stack([np.full_like(res.t, drives[0]["effort"]), np.interp(res.t, table["t"], table["effort"])])
+    np.testing.assert_allclose(res.tau_motor, t_m, rtol=0, atol=1e-12 * np.abs(t_m).max())
+    # The joint side is ~n eta (or n / eta) times larger: the two are not the same column.
+    assert np.abs(res.tau).max() > 8 * np.abs(res.tau_motor).max()
+    assert np.any(res.tau * res.qd > 0) and np.any(res.tau * res.qd < 0)
+    # A batch run is the same run, motor torques included.
+    same = batch.simulate([(mech, {"qd0": [1.0, -0.8]})], t_end=0.5, output_dt=0.005)[0]
+    np.testing.assert_array_equal(same.tau_motor, res.tau_motor)
+
+
+@pytest.mark.parametrize("ext", [".csv", ".parquet", ".npz"])
+def test_results_files_keep_the_motor_torques(run, tmp_path, ext):
+    mech, res = run
+    back = pd.read_results(res.save(tmp_path / f"run{ext}"))
+    # Files hold every double exactly; the motor torques are motor_torques(qd, tau) of the
+    # rows read back (the same function of the same numbers: 0 difference).
+    np.testing.assert_array_equal(back.tau_motor, res.tau_motor)
+    np.testing.assert_array_equal(back.tau_motor, mech.motor_torques(back.qd, back.tau))
+    np.testing.assert_array_equal(back.tau, res.tau)
+    frame = back.to_dataframe()
+    np.testing.assert_array_equal(frame["tau_motor_theta2"].to_numpy(), res.tau_motor[:, 1])
+    # A table keeps the rows: taking every other row keeps their motor torques.
+    np.testing.assert_array_equal(res.take(np.arange(0, len(res), 2)).tau_motor, res.tau_motor[::2])
+
+
+def test_a_model_without_actuators_has_no_motor_columns(tmp_path):
+    mech = pd.load_example("five-bar")
+    res = mech.simulate(t_end=0.1, output_dt=0.01)
+    assert res.tau_motor is None
+    path = res.save(tmp_path / "run.csv")
+    header = next(line for line in path.read_text().splitlines() if not line.startswith("#"))
+    assert "tau_motor" not in header and header.split(",")[-1] == "phid_distal_right"
+    assert pd.read_results(path).tau_motor is None
+
+
+def test_identify_command_reads_a_geared_runs_motor_torques(run, tmp_path):
+    # The run's results file with 1 % noise (of each motor's RMS) on its motor torques, what
+    # the drives would measure: `planardyn identify` recovers every base parameter of the
+    # model within 3 of its standard errors (measured: largest |z| 1.69 of 21; fitting the
+    # joint-side tau instead puts one 186 standard errors off).
+    mech, res = run
+    rng = np.random.default_rng(5)
+    t_m = res.tau_motor + 0.01 * np.sqrt(np.mean(res.tau_motor**2, axis=0)) * rng.standard_normal(res.tau.shape)
+    data = dataclasses.replace(res, tau_motor=t_m).save(tmp_path / "measured.npz")
+    model = tmp_path / "geared.json"
+    model.write_text(json.dumps(mech.to_dict()))
+    out = tmp_path / "found.json"
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert cli.main(["identify", str(model), str(data), "-o", str(out)]) == 0
+    found = json.loads(out.read_text())
+    base = base_parameters(mech)
+    assert found["base_parameters"] == base.expressions and found["samples"] == len(res.t)
+    truth = base.of(mech.regressor_parameters)
+    z = (np.array(found["identified"]) - truth) / np.array(found["std_error"])
+    assert np.all(np.abs(z) <= 3), z
+    # Without the noise the file's motor torques give the model's base parameters: least
+    # squares of exact rows (the regressor is exact at the model's parameters to 1e-13 of the
+    # efforts, tests/test_regressor_losses.py), measured 3.0e-13 off at worst, bound 1e-10.
+    exact = tmp_path / "exact.csv"
+    res.save(exact)
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert cli.main(["identify", str(model), str(exact), "-o", str(out)]) == 0
+    np.testing.assert_allclose(json.loads(out.read_text())["identified"], truth, rtol=0, atol=1e-10)
+    # The joint-side efforts instead (a file without the motor torques) are refused, naming the fix.
+    old = dataclasses.replace(res, tau_motor=None).save(tmp_path / "old.npz")
+    code, err = cli_run("identify", model, old)
+    assert code == 2 and "tau_motor" in err and "joint-side" in err
