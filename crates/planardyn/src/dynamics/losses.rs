@@ -278,8 +278,8 @@ fn inverse_stages(
             // The coordinates supply r gu_k; the bodies feel it, less the rotor's reaction r grad_k.
             add_scaled(&mut ws.tau, r, gu);
             add_scaled(&mut ws.f, -r, &lb.grad[l * n..(l + 1) * n]);
-            for j in 0..m {
-                add_scaled(&mut ws.f, r * gu[j], &lb.grad[(nf + j) * n..(nf + j + 1) * n]);
+            for (&g, coordinate) in gu.iter().zip(lb.grad[nf * n..].chunks_exact(n)) {
+                add_scaled(&mut ws.f, r * g, coordinate);
             }
         }
     }
