@@ -51,7 +51,7 @@ pub fn motor_torque(a: &Actuator, tau: f64, qd: f64) -> f64 {
 
 /// Every actuator's motor, in actuator order: the coordinates', then the pair actuators'
 /// (`None`: an ideal effort source).
-pub(crate) fn motors(mech: &Mechanism) -> impl Iterator<Item = Option<&Actuator>> {
+pub fn motors(mech: &Mechanism) -> impl Iterator<Item = Option<&Actuator>> {
     mech.actuators.iter().map(Option::as_ref).chain(mech.pair_actuators.iter().map(|a| a.drive.as_ref()))
 }
 
