@@ -600,7 +600,7 @@ impl PyMechanism {
         tau: ArrayArg<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n_a = dynamics::redundant::n_actuators(&self.inner);
-        let every = tau.shape().last() == Some(&n_a);
+        let every = tau.as_array().shape().last() == Some(&n_a);
         let (m, what) = if every {
             (n_a, format!("one per actuator: {}", dynamics::redundant::actuator_names(&self.inner).join(", ")))
         } else {
