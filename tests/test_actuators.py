@@ -229,6 +229,52 @@ def test_min_max_with_three_internal_forces_against_linprog():
     np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, out["efforts"]), qdd, rtol=1e-10)
 
 
+def three_legged_geared_pair() -> pd.Mechanism:
+    """The three-legged five-bar whose motor3 actuator is a geared motor (n = 15, eta = 0.85,
+    J = 3e-5 kg m^2, no motor friction, peak torque 2 N m); the coordinates' drives ideal."""
+    model = three_legged().to_dict()
+    model["actuators"] = [{"pair": "motor3", "gear_ratio": 15.0, "efficiency": 0.85, "rotor_inertia": 3e-5,
+                           "limits": {"peak_torque": 2.0}}]
+    return pd.from_dict(model)
+
+
+def test_a_geared_pair_actuator_motor_torque_reproduces_the_motion():
+    mech, ideal = three_legged_geared_pair(), three_legged()
+    assert [a is None for a in mech.actuators] == [True, True, False]
+    assert mech.actuators[2]["gear_ratio"] == 15.0
+    q, qd, qdd = mech.q0 + [0.05, -0.04], [1.2, -0.7], [3.0, 5.0]
+    out = mech.distribute_efforts(q, qd, qdd)
+    rates = out["B"].T @ qd
+    t_m = mech.motor_torques(rates, out["efforts"])
+    # Closed form without motor friction: tau / (n eta) motoring, tau eta / n generating; the
+    # ideal drives' torques are their efforts.
+    e3, p3 = out["efforts"][2], out["efforts"][2] * rates[2]
+    assert t_m[2] == pytest.approx(e3 / (15.0 * 0.85) if p3 >= 0 else e3 * 0.85 / 15.0, rel=1e-14)
+    np.testing.assert_array_equal(t_m[:2], out["efforts"][:2])
+    np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, t_m), qdd, rtol=1e-10)
+    # The rotor's torque n^2 J qdd_3 (qdd_3 = B_3 . qdd + the pair's own convective part, the
+    # difference of the two models' shares) stays on motor3: the shares differ by it alone.
+    e0 = ideal.distribute_efforts(q, qd, qdd)["efforts"]
+    np.testing.assert_allclose(out["efforts"][:2], e0[:2], rtol=1e-12, atol=1e-12)
+    assert out["efforts"][2] - e0[2] != pytest.approx(0.0, abs=1e-4)
+
+
+def test_sizing_sizes_a_geared_pair_actuators_motor():
+    mech = three_legged_geared_pair()
+    ee = robot.EndEffector(mech, "P")
+    home = ee.home()
+    rep = robot.size(ee, robot.circle(home[:2] + [0.0, 0.02], 0.02, 0.5), dt=5e-3)
+    drive = rep.drives[2]
+    assert [d.motor is None for d in rep.drives] == [True, True, False]
+    m = rep.motion
+    efforts, rates = robot.sizing.distributed_efforts(mech, m)
+    t_m = mech.motor_torques(rates, efforts)[:, 2]
+    assert drive.motor.peak_torque == pytest.approx(np.abs(t_m).max(), rel=1e-12)
+    assert drive.motor.peak_speed == pytest.approx(15.0 * np.abs(rates[:, 2]).max(), rel=1e-12)
+    assert [c.quantity for c in drive.motor.checks] == ["peak torque"]
+    assert drive.motor.checks[0].limit == 2.0
+
+
 def test_sizing_a_redundantly_actuated_robot_sizes_every_actuator(tmp_path):
     mech = three_legged()
     ee = robot.EndEffector(mech, "P")

@@ -121,7 +121,8 @@ class Mechanism:
     )
     simulate_defaults: _Native[dict[str, Any]] = _Native("The model file's ``simulate`` section (None for a setting not given).")
     actuators: _Native[list[dict[str, Any] | None]] = _Native(
-        "One entry per coordinate, None for an ideal effort source: the motor and transmission (``name``, "
+        "One entry per actuator (the coordinates', then the pair actuators'), None for an ideal effort "
+        "source: the motor and transmission (``name``, "
         "``gear_ratio``, ``efficiency``, ``rotor_inertia`` kg m^2, ``viscous`` N m s/rad, ``coulomb`` N m, "
         "``stiction_speed`` rad/s) and its limits (``peak_torque``, ``continuous_torque`` N m, ``max_speed`` rad/s, "
         "None when not given; ``envelope`` (k, 2) [speed, torque] points), docs/actuators.md."
@@ -357,9 +358,10 @@ class Mechanism:
 
     def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray:
         """Motor torques (N m, motor side) that give the joint-side efforts ``tau`` (N m or N)
-        at rates ``qd``, each (m,) or (N, m): t_m = tau / (n eta) + motor friction while
-        motoring (tau qd >= 0), tau eta / n + motor friction while generating; on a
-        coordinate without an actuator, the effort itself (docs/actuators.md)."""
+        at rates ``qd``, each (m,) or (N, m) — or (n_a,) or (N, n_a): every actuator's, at its
+        rate B^T qd: t_m = tau / (n eta) + motor friction while motoring (tau qd >= 0),
+        tau eta / n + motor friction while generating; on an actuator without a motor, the
+        effort itself (docs/actuators.md)."""
         return self._native.motor_torques(qd, tau)
 
     def _result_motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray | None:
@@ -400,9 +402,9 @@ class Mechanism:
         return self._native.forward_dynamics_actuated(q, qd, efforts, float(t))
 
     def available_torque(self, coordinate: int, speed: ArrayLike) -> FloatArray | None:
-        """The torque (N m) the motor of coordinate ``coordinate`` (an index) can give at motor
-        speeds ``speed`` (rad/s, any shape): its torque-speed envelope, else its peak torque;
-        None when it has no actuator or no torque limit."""
+        """The torque (N m) the motor of actuator ``coordinate`` (an index: the coordinates, then the
+        pair actuators) can give at motor speeds ``speed`` (rad/s, any shape): its torque-speed
+        envelope, else its peak torque; None when it has no motor or no torque limit."""
         return self._native.available_torque(int(coordinate), speed)
 
     def dissipated_power(

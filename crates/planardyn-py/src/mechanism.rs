@@ -591,14 +591,21 @@ impl PyMechanism {
     }
 
     /// Motor torques (N m, motor side) giving the joint-side efforts `tau` at rates `qd`,
-    /// each (m,) or (N, m); on a coordinate without an actuator, the effort itself.
+    /// each (m,) or (N, m) — or (n_a,) or (N, n_a): every actuator's, at its rate B^T qd;
+    /// on an actuator without a motor, the effort itself.
     fn motor_torques<'py>(
         &self,
         py: Python<'py>,
         qd: ArrayArg<'py>,
         tau: ArrayArg<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (m, what) = (self.m(), self.coords_what());
+        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let every = tau.as_array().shape().last() == Some(&n_a);
+        let (m, what) = if every {
+            (n_a, format!("one per actuator: {}", dynamics::redundant::actuator_names(&self.inner).join(", ")))
+        } else {
+            (self.m(), self.coords_what())
+        };
         let (qd, tau) = (rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
         if qd.shape != tau.shape {
             return Err(PyValueError::new_err(format!(
@@ -613,39 +620,37 @@ impl PyMechanism {
         arr_dyn(py, &tau.shape, out)
     }
 
-    /// The actuators, one entry per coordinate (None: an ideal effort source): dicts of
+    /// The actuators, one entry per actuator (the coordinates', then the pair actuators';
+    /// None: an ideal effort source): dicts of
     /// name, gear_ratio, efficiency, rotor_inertia (kg m^2), viscous, coulomb, stiction_speed
     /// and the limits peak_torque, continuous_torque (N m), max_speed (rad/s) (None when not
     /// given) and envelope ((k, 2) [speed, torque] points).
     #[getter]
     fn actuators<'py>(&self, py: Python<'py>) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
-        self.inner
-            .actuators
-            .iter()
+        dynamics::transmission::motors(&self.inner)
             .map(|slot| {
-                slot.as_ref()
-                    .map(|a| {
-                        let d = PyDict::new(py);
-                        d.set_item("name", &a.name)?;
-                        d.set_item("gear_ratio", a.ratio)?;
-                        d.set_item("efficiency", a.efficiency)?;
-                        d.set_item("rotor_inertia", a.rotor_inertia)?;
-                        d.set_item("viscous", a.viscous)?;
-                        d.set_item("coulomb", a.coulomb)?;
-                        d.set_item("stiction_speed", a.stiction_speed)?;
-                        d.set_item("peak_torque", a.limits.peak_torque)?;
-                        d.set_item("continuous_torque", a.limits.continuous_torque)?;
-                        d.set_item("max_speed", a.limits.max_speed)?;
-                        let env = &a.limits.envelope;
-                        d.set_item("envelope", arr2(py, env.len(), 2, env.as_flattened().to_vec())?)?;
-                        Ok(d)
-                    })
-                    .transpose()
+                slot.map(|a| {
+                    let d = PyDict::new(py);
+                    d.set_item("name", &a.name)?;
+                    d.set_item("gear_ratio", a.ratio)?;
+                    d.set_item("efficiency", a.efficiency)?;
+                    d.set_item("rotor_inertia", a.rotor_inertia)?;
+                    d.set_item("viscous", a.viscous)?;
+                    d.set_item("coulomb", a.coulomb)?;
+                    d.set_item("stiction_speed", a.stiction_speed)?;
+                    d.set_item("peak_torque", a.limits.peak_torque)?;
+                    d.set_item("continuous_torque", a.limits.continuous_torque)?;
+                    d.set_item("max_speed", a.limits.max_speed)?;
+                    let env = &a.limits.envelope;
+                    d.set_item("envelope", arr2(py, env.len(), 2, env.as_flattened().to_vec())?)?;
+                    Ok(d)
+                })
+                .transpose()
             })
             .collect()
     }
 
-    /// The torque (N m) coordinate `coordinate`'s motor can give at motor speeds `speed`
+    /// The torque (N m) actuator `coordinate`'s motor can give at motor speeds `speed`
     /// (rad/s, any shape): its envelope, else its peak torque; None without limits.
     fn available_torque<'py>(
         &self,
@@ -653,10 +658,10 @@ impl PyMechanism {
         coordinate: usize,
         speed: ArrayArg<'py>,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let Some(slot) = self.inner.actuators.get(coordinate) else {
+        let Some(slot) = dynamics::transmission::motors(&self.inner).nth(coordinate) else {
             return Err(PyValueError::new_err(format!(
-                "coordinate {coordinate} out of range: the model has {} coordinates",
-                self.m()
+                "actuator {coordinate} out of range: the model has {} actuators",
+                dynamics::redundant::n_actuators(&self.inner)
             )));
         };
         let Some(a) = slot else { return Ok(None) };

@@ -273,3 +273,110 @@ fn geared_motors_share_the_joint_side_efforts_and_keep_their_rotors() {
         assert!(balance.abs() <= 1e-12 * input.abs(), "{how:?}: {input} W in, {balance} W unbalanced");
     }
 }
+
+/// Gear ratio, efficiency, rotor inertia (kg m^2), viscous (N m s/rad) and Coulomb (N m)
+/// friction of the geared motor on the third leg's base pair motor3.
+const PAIR_GEAR: (f64, f64, f64, f64, f64) = (15.0, 0.85, 3e-5, 2e-4, 0.02);
+
+/// The geared motor on motor3 as an actuator spec line.
+fn pair_motor() -> String {
+    let (n, eta, j, c, tc) = PAIR_GEAR;
+    format!(
+        "  - {{pair: motor3, gear_ratio: {n}, efficiency: {eta}, rotor_inertia: {j}, viscous: {c}, coulomb: {tc}}}\n"
+    )
+}
+
+/// The third leg's angular acceleration and rate (proximal_mid is body 2; motor3 joins it to
+/// the ground, so its relative angle is the body's angle), from the body motion in `ws`.
+fn third_leg(ws: &Workspace) -> (f64, f64) {
+    (ws.xdd[8], ws.xd[8])
+}
+
+#[test]
+fn a_geared_pair_actuator_adds_its_reflected_inertia_along_its_lever() {
+    // Ideal drives on the coordinates, so forward dynamics is linear in their efforts and
+    // A^-1 e_j = qdd(e_j) - qdd(0); the pair motor's torque is 0 and, without its friction, so
+    // is its joint-side effort.
+    let (n, _, j, _, _) = PAIR_GEAR;
+    let rotor_only = format!("  - {{pair: motor3, gear_ratio: {n}, rotor_inertia: {j}}}\n");
+    let (geared, ideal) = (yaml(&three_legs_yaml(&rotor_only)), three_legs());
+    let (q, qd, _) = point(&geared);
+    let mass = |mech: &Mechanism| -> (Vec<f64>, Vec<f64>) {
+        let mut ws = Workspace::new(mech);
+        let mut qdd = |efforts: [f64; 3]| {
+            forward_redundant(mech, 0.0, &q, &qd, &efforts, &mut ws).unwrap();
+            [ws.qdd[0], ws.qdd[1]]
+        };
+        let q0 = qdd([0.0; 3]);
+        let (c0, c1) = (qdd([1.0, 0.0, 0.0]), qdd([0.0, 1.0, 0.0]));
+        let inv = [c0[0] - q0[0], c1[0] - q0[0], c0[1] - q0[1], c1[1] - q0[1]];
+        let det = inv[0] * inv[3] - inv[1] * inv[2];
+        (vec![inv[3] / det, -inv[1] / det, -inv[2] / det, inv[0] / det], q0.to_vec())
+    };
+    let ((a, _), (a0, _)) = (mass(&geared), mass(&ideal));
+    let mut ws = Workspace::new(&ideal);
+    let (act, _) = inverse_redundant(&ideal, &q, &qd, &[0.0; 2], &Distribution::MinNorm, &mut ws).unwrap();
+    let g = [act.b[2], act.b[5]];
+    let scale = a0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for r in 0..2 {
+        for c in 0..2 {
+            let expected = a0[r * 2 + c] + n * n * j * g[r] * g[c];
+            assert!((a[r * 2 + c] - expected).abs() <= 1e-10 * scale, "A[{r}][{c}] = {} vs {expected}", a[r * 2 + c]);
+        }
+    }
+    assert!(n * n * j * g[0] * g[0] > 1e-4 * scale, "the rotor's share is visible: {g:?}");
+}
+
+#[test]
+fn a_geared_pair_actuator_keeps_its_rotor_and_its_losses() {
+    let (n, eta, j, c, tc) = GEAR;
+    let motor = |q: &str| {
+        format!(
+            "  - {{coordinate: {q}, gear_ratio: {n}, efficiency: {eta}, rotor_inertia: {j}, viscous: {c}, coulomb: {tc}}}\n"
+        )
+    };
+    let geared = yaml(&three_legs_yaml(&(motor("theta1") + &motor("theta2") + &pair_motor())));
+    let ideal = three_legs();
+    let gears = [GEAR, GEAR, PAIR_GEAR];
+    let (q, qd, qdd) = point(&geared);
+    for how in [Distribution::MinNorm, Distribution::MinMax, Distribution::Preload(vec![4.0])] {
+        let mut ws = Workspace::new(&geared);
+        let (act, e) = inverse_redundant(&geared, &q, &qd, &qdd, &how, &mut ws).unwrap();
+        let (qdd3, rate3) = third_leg(&ws);
+        let (_, e0) = inverse_redundant(&ideal, &q, &qd, &qdd, &how, &mut Workspace::new(&ideal)).unwrap();
+        // The actuators' rates B^T qd; the third is the leg's own rate.
+        let rates: Vec<f64> = (0..3).map(|a| (0..2).map(|k| act.b[k * 3 + a] * qd[k]).sum()).collect();
+        assert!((rates[2] - rate3).abs() <= 1e-12 * rate3.abs(), "{rates:?} vs {rate3}");
+        // Each rotor's torque n^2 J qdd_a stays with its motor; the rest is shared as without.
+        let accelerations = [qdd[0], qdd[1], qdd3];
+        let rotor: Vec<f64> = gears.iter().zip(&accelerations).map(|((n, _, j, _, _), a)| n * n * j * a).collect();
+        for a in 0..3 {
+            assert!((e[a] - e0[a] - rotor[a]).abs() <= 1e-12 * (1.0 + e0[a].abs()), "{how:?} {a}: {e:?} vs {e0:?}");
+        }
+        // The motor torques reproduce the motion in forward dynamics.
+        let mut t_m = vec![0.0; 3];
+        motor_torques(&geared, &rates, &e, &mut t_m);
+        forward_redundant(&geared, 0.0, &q, &qd, &t_m, &mut ws).unwrap();
+        for k in 0..2 {
+            assert!((ws.qdd[k] - qdd[k]).abs() <= 1e-10 * qdd[k].abs(), "{how:?}: qdd {:?} vs {qdd:?}", ws.qdd);
+        }
+        // Power balance: the three motors' input power = the mechanism's (B e0 . qd) + the
+        // rotors' n^2 J qdd_a qd_a + each gearbox's loss in closed form, (1/eta - 1) e qd_a
+        // while motoring, (1 - eta) |e qd_a| while generating, + the motor friction's
+        // (c w + T_c tanh(w / 1e-2)) w at motor speed w = n qd_a.
+        let input: f64 = (0..3).map(|a| t_m[a] * gears[a].0 * rates[a]).sum();
+        let mechanism: f64 = (0..2).map(|k| (0..3).map(|a| act.b[k * 3 + a] * e0[a]).sum::<f64>() * qd[k]).sum();
+        let rotors: f64 = (0..3).map(|a| rotor[a] * rates[a]).sum();
+        let losses: f64 = (0..3)
+            .map(|a| {
+                let (n, eta, _, c, tc) = gears[a];
+                let (p, w) = (e[a] * rates[a], n * rates[a]);
+                let gear = if p >= 0.0 { (1.0 / eta - 1.0) * p } else { (1.0 - eta) * -p };
+                gear + (c * w + tc * (w / 1e-2).tanh()) * w
+            })
+            .sum();
+        assert!(losses > 0.0 && rotor[2].abs() > 1e-3 * e[2].abs(), "{losses} W, {rotor:?}");
+        let balance = input - mechanism - rotors - losses;
+        assert!(balance.abs() <= 1e-12 * input.abs(), "{how:?}: {input} W in, {balance} W unbalanced");
+    }
+}

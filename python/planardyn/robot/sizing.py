@@ -167,8 +167,9 @@ def _motor_dict(mo: MotorSizing) -> dict[str, Any]:
 
 
 def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, tau: FloatArray) -> MotorSizing | None:
-    """The motor side of coordinate ``k``'s drive along samples at times ``t`` (s) with
-    rates ``qd`` (N, m) and joint-side efforts ``tau`` (N, m); None without an actuator."""
+    """The motor side of actuator ``k``'s drive along samples at times ``t`` (s) with the
+    actuators' rates ``qd`` and joint-side efforts ``tau`` (N, m; or N, n_a with the pair
+    actuators); None without a motor."""
     act = mech.actuators[k]
     if act is None:
         return None
@@ -270,7 +271,7 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
         angle = kinds[k] == "angle"
         drives.append(DriveSizing(name, "N m" if angle else "N", "rad/s" if angle else "m/s", float(np.abs(tau).max()),
                                   _rms(motion.t, tau), float(np.abs(qd).max()), float(np.abs(tau * qd).max()), ev, ee_,
-                                  motor_sizing(mech, k, motion.t, rates[:, :m], efforts[:, :m]) if k < m else None))
+                                  motor_sizing(mech, k, motion.t, rates, efforts)))
     iI, iII = int(np.argmin(motion.sigma_I)), int(np.argmin(motion.sigma_II))
     return SizingReport(motion, float(payload), drives,
                         (float(motion.sigma_I[iI]), float(motion.t[iI]), motion.X[iI]),

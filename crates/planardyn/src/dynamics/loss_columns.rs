@@ -121,7 +121,7 @@ pub(crate) fn fill(
     tau_o: &mut [f64],
 ) -> Result<(), KinematicsError> {
     let layout = LossLayout::new(mech);
-    if actuated(mech).next().is_some() && !mech.pair_actuators.is_empty() {
+    if mech.has_losses() && !mech.pair_actuators.is_empty() {
         return Err(KinematicsError::bad_argument(
             "actuators",
             "transmissions only without pair actuators (the regressor's rows are the coordinates' generalized \

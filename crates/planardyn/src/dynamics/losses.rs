@@ -8,7 +8,7 @@
 use super::forward::{accelerations, body_accelerations, factor_mass_matrix};
 use super::friction;
 use super::reactions::reactions_into;
-use super::transmission::{add_rotor_inertia, reflected_inertia, rotor_terms};
+use super::transmission::{actuator_pair, add_rotor_inertia, rotor_inertias, rotor_terms};
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::linalg::cholesky_solve;
 use crate::model::{Mechanism, PairId};
@@ -22,21 +22,25 @@ const SETTLED: f64 = 1e-13;
 
 /// The buffers of an evaluation with losses, sized once for a mechanism (empty without
 /// losses). A lever is a pair's relative coordinate seen from the bodies: its gradient (3n)
-/// and that gradient times U (m); the friction entries' come first, then one per coordinate.
+/// and that gradient times U (m); the friction entries' come first, then one per actuator
+/// (the coordinates', then the pair actuators').
 #[derive(Debug, Clone, Default)]
 pub struct LossBuffers {
     /// (3n) the applied forces, and (m) b or the efforts, before the friction.
     f0: Vec<f64>,
     b0: Vec<f64>,
-    /// ((n_f + m) x 3n) lever gradients and ((n_f + m) x m) their products with U.
+    /// ((n_f + n_a) x 3n) lever gradients and ((n_f + n_a) x m) their products with U.
     grad: Vec<f64>,
     gu: Vec<f64>,
     /// (n_f) the friction pairs' rates and efforts.
     rates: Vec<f64>,
     e: Vec<f64>,
-    /// (m) per coordinate: the rotor's n^2 J (0 without) and its h (qdd_k = gu_k . zdd + h_k).
+    /// (n_a) per actuator: the rotor's n^2 J (0 without), its h (qdd_k = gu_k . zdd + h_k),
+    /// its pair's rate qd_k and the rotor's torque n^2 J qdd_k of the last evaluation.
     rotor_inertia: Vec<f64>,
     rotor_h: Vec<f64>,
+    rotor_rates: Vec<f64>,
+    rotor_torques: Vec<f64>,
     /// (3n) the multipliers and (p) the reactions of the last fixed-point step.
     lambda: Vec<f64>,
     reactions: Vec<[f64; 3]>,
@@ -49,16 +53,18 @@ impl LossBuffers {
             return LossBuffers::default();
         }
         let (nx, m, nf) = (mech.n_x(), mech.dof(), mech.friction.len());
-        let rotor_inertia = mech.actuators.iter().map(|a| a.as_ref().map_or(0.0, reflected_inertia)).collect();
+        let na = m + mech.pair_actuators.len();
         LossBuffers {
             f0: vec![0.0; nx],
             b0: vec![0.0; m],
-            grad: vec![0.0; (nf + m) * nx],
-            gu: vec![0.0; (nf + m) * m],
+            grad: vec![0.0; (nf + na) * nx],
+            gu: vec![0.0; (nf + na) * m],
             rates: vec![0.0; nf],
             e: vec![0.0; nf],
-            rotor_inertia,
-            rotor_h: vec![0.0; m],
+            rotor_inertia: rotor_inertias(mech),
+            rotor_h: vec![0.0; na],
+            rotor_rates: vec![0.0; na],
+            rotor_torques: vec![0.0; na],
             lambda: vec![0.0; nx],
             reactions: vec![[0.0; 3]; mech.pairs.len()],
         }
@@ -68,6 +74,12 @@ impl LossBuffers {
     /// without losses).
     pub(crate) fn reactions(&self) -> &[[f64; 3]] {
         &self.reactions
+    }
+
+    /// Each actuator's rotor torque n^2 J qdd_k (N m or N, joint side; 0 without a rotor) of
+    /// the last evaluation with losses (empty without losses).
+    pub(crate) fn rotor_torques(&self) -> &[f64] {
+        &self.rotor_torques
     }
 }
 
@@ -97,14 +109,14 @@ pub(crate) fn pair_lever(mech: &Mechanism, pair: PairId, ws: &Workspace, grad: &
     pair_coordinate_rate(p, &ws.x, &ws.xd)
 }
 
-/// Every lever at the point in `ws`: the friction pairs', then the coordinates'.
+/// Every lever at the point in `ws`: the friction pairs', then the actuators'.
 fn set_levers(mech: &Mechanism, ws: &Workspace, lb: &mut LossBuffers) {
     let nf = mech.friction.len();
     for (i, fr) in mech.friction.iter().enumerate() {
         lb.rates[i] = set_lever(mech, fr.pair, ws, lb, i);
     }
-    for (k, c) in mech.coordinates.iter().enumerate() {
-        set_lever(mech, c.pair, ws, lb, nf + k);
+    for k in 0..lb.rotor_rates.len() {
+        lb.rotor_rates[k] = set_lever(mech, actuator_pair(mech, k), ws, lb, nf + k);
     }
 }
 
@@ -198,6 +210,7 @@ fn forward_stages(
         for (k, &inertia) in lb.rotor_inertia.iter().enumerate().filter(|(_, j)| **j > 0.0) {
             let l = nf + k;
             let qdd = lb.gu[l * m..(l + 1) * m].iter().zip(&ws.b).map(|(g, a)| g * a).sum::<f64>() + lb.rotor_h[k];
+            lb.rotor_torques[k] = inertia * qdd;
             add_scaled(&mut ws.f, -inertia * qdd, &lb.grad[l * n..(l + 1) * n]);
         }
         if nf == 0 || step_friction(mech, ws, lb, iteration)? {
@@ -206,7 +219,7 @@ fn forward_stages(
     }
     accelerations(mech, z, zd, ws);
     let friction_power: f64 = lb.e.iter().zip(&lb.rates).map(|(e, r)| e * r).sum();
-    let rotor_power: f64 = lb.rotor_inertia.iter().zip(ws.qdd.iter().zip(&ws.qd)).map(|(j, (a, v))| -j * a * v).sum();
+    let rotor_power: f64 = lb.rotor_torques.iter().zip(&lb.rotor_rates).map(|(t, v)| -t * v).sum();
     ws.power += friction_power + rotor_power;
     ws.dissipated = -friction_power;
     Ok(())
@@ -215,7 +228,8 @@ fn forward_stages(
 /// Inverse dynamics' losses, after `ws.tau` = A qdd - b (no friction, no rotor) with `ws.f`
 /// without drives, in the input chart: the friction efforts settled against the reactions,
 /// then the rotors' n^2 J qdd. `ws.tau` ends joint-side, `ws.f` with the friction and the
-/// drive efforts the bodies feel, `ws.dissipated` with the friction's power.
+/// drive efforts the bodies feel, `ws.dissipated` with the friction's power. A pair
+/// actuator's rotor is driven by the coordinates: its torque r adds r gu_k to `ws.tau`.
 pub(crate) fn inverse_with_losses(mech: &Mechanism, qdd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
     let mut lb = std::mem::take(&mut ws.losses);
     let result = inverse_stages(mech, qdd, ws, &mut lb);
@@ -232,6 +246,7 @@ fn inverse_stages(
     // ws.xdd holds the body accelerations inverse dynamics formed.
     let (nf, m, n) = (mech.friction.len(), ws.b.len(), ws.x.len());
     set_levers(mech, ws, lb);
+    rotor_terms(mech, ws, &lb.rotor_inertia, &lb.grad[nf * n..], &mut lb.rotor_h);
     lb.f0.copy_from_slice(&ws.f);
     lb.b0.copy_from_slice(&ws.tau);
     lb.e.fill(0.0);
@@ -251,6 +266,22 @@ fn inverse_stages(
     }
     for ((tau, j), a) in ws.tau.iter_mut().zip(&lb.rotor_inertia).zip(qdd) {
         *tau += j * a;
+    }
+    lb.rotor_torques.fill(0.0);
+    for (k, &inertia) in lb.rotor_inertia.iter().enumerate().filter(|(_, j)| **j > 0.0) {
+        let l = nf + k;
+        let gu = &lb.gu[l * m..(l + 1) * m];
+        let qdd_k = if k < m { qdd[k] } else { gu.iter().zip(qdd).map(|(g, a)| g * a).sum::<f64>() + lb.rotor_h[k] };
+        let r = inertia * qdd_k;
+        lb.rotor_torques[k] = r;
+        if k >= m {
+            // The coordinates supply r gu_k; the bodies feel it, less the rotor's reaction r grad_k.
+            add_scaled(&mut ws.tau, r, gu);
+            add_scaled(&mut ws.f, -r, &lb.grad[l * n..(l + 1) * n]);
+            for (&g, coordinate) in gu.iter().zip(lb.grad[nf * n..].chunks_exact(n)) {
+                add_scaled(&mut ws.f, r * g, coordinate);
+            }
+        }
     }
     ws.dissipated = -lb.e.iter().zip(&lb.rates).map(|(e, r)| e * r).sum::<f64>();
     Ok(())

@@ -8,7 +8,7 @@
 
 use super::forward::forward;
 use super::inverse::inverse;
-use super::transmission::reflected_inertia;
+use super::transmission::joint_effort;
 use super::Drives;
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::model::{Mechanism, PairId};
@@ -196,9 +196,10 @@ fn min_max_lambda(t: &[f64], internal: &[Vec<f64>]) -> Result<Vec<f64>, Kinemati
 /// point's kinematics (and `ws.tau` the generalized efforts they produce). The sharing is of
 /// the joint-side efforts: B and its internal forces are the mechanism's, linear, where a
 /// motor's torque is not (its efficiency changes with the sign of its power, its Coulomb
-/// friction with that of its speed). A rotor's torque n^2 J qdd_k is its own motor's: it is
-/// added to that coordinate's share, not shared. [`super::transmission::motor_torques`] gives the
-/// coordinates' motor torques.
+/// friction with that of its speed). A rotor's torque r_a = n^2 J qdd_a is its own motor's:
+/// the efforts B tau_a = tau - B r are shared, then r_a is added to actuator a's share.
+/// [`super::transmission::motor_torques`] gives the motor torques (the actuators' rates are
+/// B^T qd).
 pub fn inverse_redundant(
     mech: &Mechanism,
     q: &[f64],
@@ -209,9 +210,9 @@ pub fn inverse_redundant(
 ) -> Result<(Actuation, Vec<f64>), KinematicsError> {
     inverse(mech, q, qd, qdd, ws)?;
     let act = Actuation::at(mech, ws)?;
-    let rotor: Vec<f64> =
-        mech.actuators.iter().zip(qdd).map(|(a, qdd)| a.as_ref().map_or(0.0, |a| reflected_inertia(a) * qdd)).collect();
-    let shared: Vec<f64> = ws.tau.iter().zip(&rotor).map(|(t, r)| t - r).collect();
+    let mut rotor = ws.losses.rotor_torques().to_vec();
+    rotor.resize(act.n_a, 0.0);
+    let shared: Vec<f64> = ws.tau.iter().zip(act.b.chunks_exact(act.n_a)).map(|(t, b)| t - dot(b, &rotor)).collect();
     let mut efforts = act.distribute(&shared, how)?;
     efforts.iter_mut().zip(&rotor).for_each(|(e, r)| *e += r);
     Ok((act, efforts))
@@ -227,9 +228,9 @@ impl Drives for CoordinateEfforts<'_> {
     }
 }
 
-/// Forward dynamics with every actuator's effort `efforts` (n_a: the coordinates' first, as
-/// drive efforts, motor torques where a coordinate has a motor as in [`forward`], then the
-/// pair actuators'), at time t (s) and chart state (z, zd). The model's drive laws are not
+/// Forward dynamics with every actuator's effort `efforts` (n_a: the coordinates' first, then
+/// the pair actuators'; motor torques where an actuator has a motor, as in [`forward`]), at
+/// time t (s) and chart state (z, zd). The model's drive laws are not
 /// evaluated: `efforts` replaces them.
 pub fn forward_redundant(
     mech: &Mechanism,
@@ -246,14 +247,17 @@ pub fn forward_redundant(
     result
 }
 
-/// Add the pair actuators' efforts `ws.pair_tau` to `ws.f`; returns their power (W).
+/// Add the pair actuators' joint-side efforts to `ws.f` (`ws.pair_tau`: motor torques where
+/// a pair actuator has a motor); returns their power (W).
 pub(crate) fn apply_pair_efforts(mech: &Mechanism, ws: &mut Workspace) -> f64 {
     let mut power = 0.0;
-    for (a, &e) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
-        if e != 0.0 {
+    for (a, &t) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
+        if t != 0.0 || a.drive.is_some() {
+            let rate = pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
+            let e = a.drive.as_ref().map_or(t, |d| joint_effort(d, t, rate));
             pair_grad(mech, a.pair, &ws.x, &mut ws.tmp);
             ws.f.iter_mut().zip(&ws.tmp).for_each(|(f, g)| *f += e * g);
-            power += e * pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
+            power += e * rate;
         }
     }
     power

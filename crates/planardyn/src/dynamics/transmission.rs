@@ -11,7 +11,7 @@
 //! that of the rotor, which keeps A linear: docs/actuators.md states it).
 
 use crate::kinematics::constraints::pair_coordinate_gamma;
-use crate::model::{Actuator, Mechanism};
+use crate::model::{Actuator, Mechanism, PairId};
 use crate::workspace::Workspace;
 
 /// tanh(v / v_s): the sign function regularised over speed v_s > 0.
@@ -49,11 +49,33 @@ pub fn motor_torque(a: &Actuator, tau: f64, qd: f64) -> f64 {
     gear + motor_friction(a, qd)
 }
 
-/// Motor torques (N m; the joint effort where a coordinate has no actuator) into `t_m` for
-/// joint-side efforts `tau` at rates `qd`.
+/// Every actuator's motor, in actuator order: the coordinates', then the pair actuators'
+/// (`None`: an ideal effort source).
+pub fn motors(mech: &Mechanism) -> impl Iterator<Item = Option<&Actuator>> {
+    mech.actuators.iter().map(Option::as_ref).chain(mech.pair_actuators.iter().map(|a| a.drive.as_ref()))
+}
+
+/// The pair whose relative coordinate actuator `k` drives.
+pub(crate) fn actuator_pair(mech: &Mechanism, k: usize) -> PairId {
+    let m = mech.dof();
+    if k < m {
+        mech.coordinates[k].pair
+    } else {
+        mech.pair_actuators[k - m].pair
+    }
+}
+
+/// Each actuator's n^2 J (0 without a rotor), in actuator order.
+pub(crate) fn rotor_inertias(mech: &Mechanism) -> Vec<f64> {
+    motors(mech).map(|a| a.map_or(0.0, reflected_inertia)).collect()
+}
+
+/// Motor torques (N m; the joint effort where an actuator has no motor) into `t_m` for
+/// joint-side efforts `tau` at rates `qd`: the first `tau.len()` actuators (the coordinates',
+/// then the pair actuators', whose rates are B^T qd).
 pub fn motor_torques(mech: &Mechanism, qd: &[f64], tau: &[f64], t_m: &mut [f64]) {
-    for (k, slot) in mech.actuators.iter().enumerate() {
-        t_m[k] = slot.as_ref().map_or(tau[k], |a| motor_torque(a, tau[k], qd[k]));
+    for (k, (slot, (&tau, &qd))) in motors(mech).zip(tau.iter().zip(qd)).enumerate() {
+        t_m[k] = slot.map_or(tau, |a| motor_torque(a, tau, qd));
     }
 }
 
@@ -66,21 +88,22 @@ pub(crate) fn to_joint_efforts(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
-/// h_k = grad_k . c + gamma_k(xd, xd) of every coordinate k with a rotor (`inertia[k]` > 0),
-/// so that qdd_k = g_k . zdd + h_k; `grad` holds the coordinates' gradients (m x 3n).
+/// h_k = grad_k . c + gamma_k(xd, xd) of every actuator k with a rotor (`inertia[k]` > 0),
+/// so that qdd_k = g_k . zdd + h_k; `grad` holds the actuators' pair gradients (n_a x 3n).
 pub(crate) fn rotor_terms(mech: &Mechanism, ws: &Workspace, inertia: &[f64], grad: &[f64], h: &mut [f64]) {
     let n = ws.x.len();
     for (k, ((h, g), &j)) in h.iter_mut().zip(grad.chunks_exact(n)).zip(inertia).enumerate() {
         if j > 0.0 {
-            let pair = &mech.pairs[mech.coordinates[k].pair.0];
+            let pair = &mech.pairs[actuator_pair(mech, k).0];
             *h = g.iter().zip(&ws.c).map(|(a, b)| a * b).sum::<f64>()
                 + pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd);
         }
     }
 }
 
-/// A += n^2 J g_k g_k^T and b -= n^2 J h_k g_k for every coordinate k (`inertia[k]` = n^2 J,
-/// 0 without a rotor; `g` m x m, row k = dq_k/dz): the rotors' kinetic energy 1/2 n^2 J qd_k^2.
+/// A += n^2 J g_k g_k^T and b -= n^2 J h_k g_k for every actuator k (`inertia[k]` = n^2 J,
+/// 0 without a rotor; `g` n_a x m, row k = dq_k/dz, q_k the actuator's pair coordinate): the
+/// rotors' kinetic energy 1/2 n^2 J qd_k^2.
 pub(crate) fn add_rotor_inertia(inertia: &[f64], g: &[f64], h: &[f64], a: &mut [f64], b: &mut [f64]) {
     let m = b.len();
     for ((&j, g), &h) in inertia.iter().zip(g.chunks_exact(m)).zip(h).filter(|((j, _), _)| **j > 0.0) {

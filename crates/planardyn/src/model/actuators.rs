@@ -4,12 +4,12 @@
 
 use super::PairId;
 
-/// A motor driving coordinate `coordinate` through a transmission of ratio n: motor angle
-/// n q (rad), motor speed n qd (rad/s).
+/// A motor driving actuator `coordinate`'s relative coordinate q through a transmission of
+/// ratio n: motor angle n q (rad), motor speed n qd (rad/s).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Actuator {
     pub name: String,
-    /// Index of the driven coordinate.
+    /// Index of the driven actuator: a coordinate's (< m), or m + a pair actuator's place.
     pub coordinate: usize,
     /// Transmission ratio n (> 0).
     pub ratio: f64,
@@ -79,10 +79,12 @@ pub struct JointFriction {
     pub stribeck_speed: f64,
 }
 
-/// A redundant actuator: an ideal effort source on the relative coordinate of a pair that
-/// is not a generalized coordinate's (docs/actuators.md, *Redundant actuation*).
+/// A redundant actuator on the relative coordinate of a pair that is not a generalized
+/// coordinate's (docs/actuators.md, *Redundant actuation*): a motor with its transmission, or
+/// (`drive` None) an ideal effort source.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PairActuator {
     pub name: String,
     pub pair: PairId,
+    pub drive: Option<Actuator>,
 }

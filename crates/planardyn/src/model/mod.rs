@@ -240,7 +240,9 @@ impl Mechanism {
     /// Whether forward and inverse dynamics need the transmissions or the load-dependent
     /// friction (`dynamics::losses`).
     pub fn has_losses(&self) -> bool {
-        !self.friction.is_empty() || self.actuators.iter().any(Option::is_some)
+        !self.friction.is_empty()
+            || self.actuators.iter().any(Option::is_some)
+            || self.pair_actuators.iter().any(|a| a.drive.is_some())
     }
     /// Number of mobile bodies n.
     pub fn n_bodies(&self) -> usize {

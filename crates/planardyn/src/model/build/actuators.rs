@@ -37,37 +37,42 @@ pub(in crate::model) fn build_actuators(
                 format!("coordinate '{coordinate}' already has an actuator; remove one of the two"),
             ));
         }
-        let positive = |field: &str, v: f64| -> R<f64> {
-            let p = format!("{path}.{field}");
-            if ctx.finite(&p, v)? <= 0.0 {
-                return Err(ctx.err(p, format!("{v} must be > 0")));
-            }
-            Ok(v)
-        };
-        let efficiency = positive("efficiency", a.efficiency)?;
-        if efficiency > 1.0 {
-            return Err(ctx.err(
-                format!("{path}.efficiency"),
-                format!("{efficiency} is above 1; give the fraction of the power transmitted, in (0, 1]"),
-            ));
-        }
-        out[i] = Some(Actuator {
-            name: a.name.clone().unwrap_or_else(|| coordinate.clone()),
-            coordinate: i,
-            ratio: positive("gear_ratio", a.gear_ratio)?,
-            efficiency,
-            rotor_inertia: ctx.non_negative(&format!("{path}.rotor_inertia"), a.rotor_inertia)?,
-            viscous: ctx.non_negative(&format!("{path}.viscous"), a.viscous)?,
-            coulomb: ctx.non_negative(&format!("{path}.coulomb"), a.coulomb)?,
-            stiction_speed: positive("stiction_speed", a.stiction_speed.unwrap_or(MOTOR_STICTION_SPEED))?,
-            limits: build_limits(ctx, &format!("{path}.limits"), a.limits.as_ref())?,
-        });
+        out[i] = Some(motor(ctx, &path, a, coordinate, i)?);
     }
     Ok((out, on_pairs))
 }
 
-/// A redundant actuator: a pair with a relative coordinate, not a coordinate's, driven by an
-/// ideal effort source (no transmission).
+/// The motor of actuator `index` (`default_name` when the spec names none).
+fn motor(ctx: &Ctx, path: &str, a: &ActuatorSpec, default_name: &str, index: usize) -> R<Actuator> {
+    let positive = |field: &str, v: f64| -> R<f64> {
+        let p = format!("{path}.{field}");
+        if ctx.finite(&p, v)? <= 0.0 {
+            return Err(ctx.err(p, format!("{v} must be > 0")));
+        }
+        Ok(v)
+    };
+    let efficiency = positive("efficiency", a.efficiency)?;
+    if efficiency > 1.0 {
+        return Err(ctx.err(
+            format!("{path}.efficiency"),
+            format!("{efficiency} is above 1; give the fraction of the power transmitted, in (0, 1]"),
+        ));
+    }
+    Ok(Actuator {
+        name: a.name.clone().unwrap_or_else(|| default_name.to_string()),
+        coordinate: index,
+        ratio: positive("gear_ratio", a.gear_ratio)?,
+        efficiency,
+        rotor_inertia: ctx.non_negative(&format!("{path}.rotor_inertia"), a.rotor_inertia)?,
+        viscous: ctx.non_negative(&format!("{path}.viscous"), a.viscous)?,
+        coulomb: ctx.non_negative(&format!("{path}.coulomb"), a.coulomb)?,
+        stiction_speed: positive("stiction_speed", a.stiction_speed.unwrap_or(MOTOR_STICTION_SPEED))?,
+        limits: build_limits(ctx, &format!("{path}.limits"), a.limits.as_ref())?,
+    })
+}
+
+/// A redundant actuator: a pair with a relative coordinate, not a coordinate's, driven by a
+/// motor through its transmission, or by an ideal effort source when the spec gives none.
 fn pair_actuator(
     ctx: &Ctx,
     mech: &Mechanism,
@@ -100,13 +105,8 @@ fn pair_actuator(
         && a.coulomb == 0.0
         && a.stiction_speed.is_none()
         && a.limits.is_none();
-    if !ideal {
-        return Err(ctx.err(
-            path.to_string(),
-            "a redundant actuator on a `pair` is an ideal effort source: remove its transmission and limits",
-        ));
-    }
-    Ok(PairActuator { name: a.name.clone().unwrap_or_else(|| pair.to_string()), pair: id })
+    let drive = if ideal { None } else { Some(motor(ctx, path, a, pair, mech.dof() + known.len())?) };
+    Ok(PairActuator { name: a.name.clone().unwrap_or_else(|| pair.to_string()), pair: id, drive })
 }
 
 fn build_limits(ctx: &Ctx, path: &str, l: Option<&LimitsSpec>) -> R<Limits> {
