@@ -95,14 +95,16 @@ fn shipped_models_with_closed_forms() {
 }
 
 /// The shipped models made of revolute input links and RRR dyads only.
-const CLOSED: [&str; 7] = [
+const CLOSED: [&str; 9] = [
     "andrews-squeezer",
     "five-bar-free-fall",
     "five-bar",
     "four-bar-gravity",
     "library/five-bar-5r",
     "library/four-bar",
+    "library/slider-crank",
     "library/watt-six-bar",
+    "slider-crank",
 ];
 
 /// The general path's forward dynamics at (q, qd) from the drawing, and the same with the

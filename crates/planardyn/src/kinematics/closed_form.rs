@@ -1,27 +1,107 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
-//! mechanism is made of input links turned by revolute pairs and class II RRR dyads only, the
+//! mechanism is made of input links turned by revolute pairs and class II RRR and RRP dyads
+//! only, the
 //! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
 //! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
 //! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
 //! assembly branch of a reference configuration (the integrator's last accepted point); where
 //! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
-//! Other mechanisms (prismatic, gear and slot pairs, class III groups and up, relative inputs,
-//! redundant pairs) take the general path (`position`, `analogues`).
+//! Other mechanisms (prismatic inputs, other dyads, gear and slot pairs, class III groups and
+//! up, relative inputs, redundant pairs) take the general path (`position`, `analogues`).
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
-use super::dyads::rrr::{Branch, Geometry, Rrr};
+use super::dyads::rrp::{self, Rrp};
+use super::dyads::rrr::{self, Rrr};
 use super::dyads::Joint;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::structure::assur;
 use crate::workspace::Workspace;
-use crate::KinematicsError;
+use crate::{KinematicsError, SingularityKind};
+
+/// A class II dyad of a kind with a closed form.
+#[derive(Debug, Clone)]
+enum Dyad {
+    Rrr(Rrr),
+    Rrp(Rrp),
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Branch {
+    Rrr(rrr::Branch),
+    Rrp(rrp::Branch),
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Geometry {
+    Rrr(rrr::Geometry),
+    Rrp(rrp::Geometry),
+}
+
+impl Dyad {
+    fn bodies(&self) -> [usize; 2] {
+        match self {
+            Dyad::Rrr(d) => d.bodies,
+            Dyad::Rrp(d) => d.bodies,
+        }
+    }
+
+    fn branch(&self, x: &[f64]) -> Branch {
+        match self {
+            Dyad::Rrr(d) => Branch::Rrr(d.branch(x)),
+            Dyad::Rrp(d) => Branch::Rrp(d.branch(x)),
+        }
+    }
+
+    fn keeps_side(&self, b: &Branch, x: &[f64]) -> bool {
+        match (self, b) {
+            (Dyad::Rrr(d), Branch::Rrr(b)) => d.keeps_side(b, x),
+            (Dyad::Rrp(d), Branch::Rrp(b)) => d.keeps_side(b, x),
+            _ => false,
+        }
+    }
+
+    fn sigma(&self, g: &Geometry, inv_length: f64) -> f64 {
+        match (self, g) {
+            (Dyad::Rrr(_), Geometry::Rrr(g)) => g.sigma(inv_length),
+            (Dyad::Rrp(d), Geometry::Rrp(g)) => g.sigma(inv_length, d.guide_on_g),
+            _ => 0.0,
+        }
+    }
+
+    #[inline]
+    fn position(&self, b: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
+        match (self, b) {
+            (Dyad::Rrr(d), Branch::Rrr(b)) => d.position(b, x, trig).map(Geometry::Rrr),
+            (Dyad::Rrp(d), Branch::Rrp(b)) => d.position(b, x, trig).map(Geometry::Rrp),
+            _ => Err(KinematicsError::singular(SingularityKind::TypeII)),
+        }
+    }
+
+    #[inline]
+    fn velocity(&self, g: &Geometry, v: &mut [f64]) {
+        match (self, g) {
+            (Dyad::Rrr(d), Geometry::Rrr(g)) => d.velocity(g, v),
+            (Dyad::Rrp(d), Geometry::Rrp(g)) => d.velocity(g, v),
+            _ => {}
+        }
+    }
+
+    #[inline]
+    fn acceleration(&self, g: &Geometry, v: &[f64], a: &mut [f64]) {
+        match (self, g) {
+            (Dyad::Rrr(d), Geometry::Rrr(g)) => d.acceleration(g, v, a),
+            (Dyad::Rrp(d), Geometry::Rrp(g)) => d.acceleration(g, v, a),
+            _ => {}
+        }
+    }
+}
 
 #[derive(Debug, Clone)]
 pub struct ClosedForm {
     cranks: Vec<Crank>,
-    dyads: Vec<Rrr>,
+    dyads: Vec<Dyad>,
     /// Per dyad, the branch of the reference configuration, and its geometry at the last
     /// positions (for the rates and accelerations).
     branches: Vec<Branch>,
@@ -73,10 +153,7 @@ impl ClosedForm {
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
             let [inner] = g.inner_pairs.as_slice() else { return None };
-            if g.class != 2 || g.kind != "RRR" || g.links.iter().any(|l| l.len() != 1) {
-                return None;
-            }
-            if !g.inner_pairs.iter().chain(&g.outer_pairs).all(|&k| revolute(k)) {
+            if g.class != 2 || g.links.iter().any(|l| l.len() != 1) || !revolute(*inner) {
                 return None;
             }
             let bodies = [g.links[0][0].0, g.links[1][0].0];
@@ -87,20 +164,39 @@ impl ClosedForm {
                 })
             };
             let (Some(o1), Some(o2)) = (touching(bodies[0]), touching(bodies[1])) else { return None };
-            let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
             let (i1, _) = ends(mech, *inner, bodies[0]);
             let (i2, _) = ends(mech, *inner, bodies[1]);
-            dyads.push(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]));
+            dyads.push(match (g.kind.as_str(), revolute(o1), revolute(o2)) {
+                ("RRR", true, true) => {
+                    let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
+                    Dyad::Rrr(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]))
+                }
+                ("RRP", true, false) => {
+                    let (s1, a) = ends(mech, o1, bodies[0]);
+                    Dyad::Rrp(Rrp::new(bodies, a, s1, [i1, i2], &mech.pairs[o2.0])?)
+                }
+                ("RRP", false, true) => {
+                    let (s2, a) = ends(mech, o2, bodies[1]);
+                    Dyad::Rrp(Rrp::new([bodies[1], bodies[0]], a, s2, [i2, i1], &mech.pairs[o1.0])?)
+                }
+                _ => return None,
+            });
             pairs_used += 3;
         }
         let mut solved = vec![0; mech.n_bodies()];
-        cranks.iter().map(|c| c.body).chain(dyads.iter().flat_map(|d| d.bodies)).for_each(|b| solved[b] += 1);
+        cranks.iter().map(|c| c.body).chain(dyads.iter().flat_map(Dyad::bodies)).for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
         let branches = dyads.iter().map(|d| d.branch(&mech.x0)).collect();
-        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies)).collect();
-        let geometry = vec![Geometry::default(); dyads.len()];
+        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies())).collect();
+        let geometry = dyads
+            .iter()
+            .map(|d| match d {
+                Dyad::Rrr(_) => Geometry::Rrr(rrr::Geometry::default()),
+                Dyad::Rrp(_) => Geometry::Rrp(rrp::Geometry::default()),
+            })
+            .collect();
         Some(ClosedForm { cranks, geometry, dyads, branches, inv_length, inputs_sigma })
     }
 
@@ -112,7 +208,7 @@ impl ClosedForm {
     }
 
     /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
-    /// reference branch ([`Rrr::keeps_side`]); if not, a step crosses a fold and the closed
+    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`]); if not, a step crosses a fold and the closed
     /// forms would leave the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
         self.dyads.iter().zip(&self.branches).all(|(d, b)| d.keeps_side(b, x))
@@ -122,7 +218,8 @@ impl ClosedForm {
     /// value of each group's block at its own length), from the groups' closed forms: no
     /// factorisation of J.
     pub fn sigma(&self) -> f64 {
-        let dyads = self.geometry.iter().zip(&self.inv_length).map(|(g, &k)| g.sigma(k));
+        let groups = self.dyads.iter().zip(&self.geometry).zip(&self.inv_length);
+        let dyads = groups.map(|((d, g), &k)| d.sigma(g, k));
         dyads.fold(self.inputs_sigma, f64::min)
     }
 

@@ -5,6 +5,7 @@
 //! solved before it, in the order of the decomposition.
 
 pub mod crank;
+pub mod rrp;
 pub mod rrr;
 
 use super::pairs::frames::rot;
