@@ -12,6 +12,7 @@
 
 use planardyn::dynamics::{dynamic_stages, forward, mass_matrix, ModelDrives};
 use planardyn::kinematics::{assemble_into, sigma_min, Chart, ClosedForm};
+use planardyn::model::CoordinateKind;
 use planardyn::{KinematicsError, Mechanism, Workspace};
 use std::path::{Path, PathBuf};
 
@@ -95,14 +96,17 @@ fn shipped_models_with_closed_forms() {
     assert_eq!(closed, CLOSED);
 }
 
-/// The shipped models made of revolute input links and RRR and RRP dyads only.
-const CLOSED: [&str; 9] = [
+/// The shipped models made of input links (revolute, or sliders on the ground) and RRR and RRP
+/// dyads only.
+const CLOSED: [&str; 11] = [
     "andrews-squeezer",
     "five-bar-free-fall",
     "five-bar",
     "four-bar-gravity",
+    "library/biglide",
     "library/five-bar-5r",
     "library/four-bar",
+    "library/slider-crank-slider-driven",
     "library/slider-crank",
     "library/watt-six-bar",
     "slider-crank",
@@ -167,9 +171,12 @@ fn rrp_on_a_turning_guide_either_way() {
 fn compare(model: &str, mech: &Mechanism, rng: &mut Rng) {
     let mut cf = ClosedForm::new(mech).unwrap();
     let (q0, _) = mech.initial_state();
+    // Angles within 0.6 rad of the drawing's, displacements within 0.1 L.
+    let span: Vec<f64> =
+        mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.2 } else { 0.2 * mech.scale }).collect();
     let (mut compared, mut worst) = (0, [0.0_f64; 8]);
     for _ in 0..60 {
-        let q: Vec<f64> = q0.iter().map(|v| v + 1.2 * (rng.next() - 0.5)).collect();
+        let q: Vec<f64> = q0.iter().zip(&span).map(|(v, s)| v + s * (rng.next() - 0.5)).collect();
         let qd: Vec<f64> = q0.iter().map(|_| 6.0 * (rng.next() - 0.5)).collect();
         let Some((g, c)) = both(mech, &mut cf, &q, &qd) else { continue };
         compared += 1;

@@ -1,18 +1,19 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
-//! mechanism is made of input links turned by revolute pairs and class II RRR and RRP dyads
-//! only, the
+//! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
+//! the ground) and class II RRR and RRP dyads only, the
 //! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
 //! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
 //! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
 //! assembly branch of a reference configuration (the integrator's last accepted point); where
 //! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
-//! Other mechanisms (prismatic inputs, other dyads, gear and slot pairs, class III groups and
+//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads, gear and slot pairs, class III groups and
 //! up, relative inputs, redundant pairs) take the general path (`position`, `analogues`).
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
+use super::dyads::slider::Slider;
 use super::dyads::Joint;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
@@ -101,6 +102,7 @@ impl Dyad {
 #[derive(Debug, Clone)]
 pub struct ClosedForm {
     cranks: Vec<Crank>,
+    sliders: Vec<Slider>,
     dyads: Vec<Dyad>,
     /// Per dyad, the branch of the reference configuration, and its geometry at the last
     /// positions (for the rates and accelerations).
@@ -131,7 +133,7 @@ impl ClosedForm {
             return None;
         }
         let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
-        let mut cranks = Vec::new();
+        let (mut cranks, mut sliders) = (Vec::new(), Vec::new());
         let mut inputs_sigma = f64::INFINITY;
         for (k, c) in mech.coordinates.iter().enumerate() {
             let p = &mech.pairs[c.pair.0];
@@ -139,13 +141,22 @@ impl ClosedForm {
                 (Link::Ground, Link::Body(b)) | (Link::Body(b), Link::Ground) => b.0,
                 _ => return None,
             };
-            if !revolute(c.pair) {
-                return None;
-            }
             let (s, ground) = ends(mech, c.pair, body);
+            let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
+            match p.kind {
+                PairKind::Revolute => {}
+                // A slider on a guide fixed to the ground: its block has the crank's singular
+                // values (`input_link_sigma`), the guide's normal and axis in place of I.
+                PairKind::Prismatic { axis } if p.a == Link::Ground => {
+                    inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
+                    let (phi, origin) = (p.rel_angle0, ground.s);
+                    sliders.push(Slider { body, origin, axis, s, k, value: c.value, phi, cs: [phi.cos(), phi.sin()] });
+                    continue;
+                }
+                _ => return None,
+            }
             let pivot = ground.s;
             let sign = if p.b == Link::Body(BodyId(body)) { 1.0 } else { -1.0 };
-            let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
             inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
             cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
         }
@@ -184,7 +195,12 @@ impl ClosedForm {
             pairs_used += 3;
         }
         let mut solved = vec![0; mech.n_bodies()];
-        cranks.iter().map(|c| c.body).chain(dyads.iter().flat_map(Dyad::bodies)).for_each(|b| solved[b] += 1);
+        cranks
+            .iter()
+            .map(|c| c.body)
+            .chain(sliders.iter().map(|s| s.body))
+            .chain(dyads.iter().flat_map(Dyad::bodies))
+            .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
@@ -197,7 +213,7 @@ impl ClosedForm {
                 Dyad::Rrp(_) => Geometry::Rrp(rrp::Geometry::default()),
             })
             .collect();
-        Some(ClosedForm { cranks, geometry, dyads, branches, inv_length, inputs_sigma })
+        Some(ClosedForm { cranks, sliders, geometry, dyads, branches, inv_length, inputs_sigma })
     }
 
     /// Take the assembly branches from the configuration x (a solution).
@@ -228,6 +244,9 @@ impl ClosedForm {
         for c in &self.cranks {
             c.position(z, &mut ws.x, &mut ws.trig);
         }
+        for s in &self.sliders {
+            s.position(z, &mut ws.x, &mut ws.trig);
+        }
         for ((d, b), g) in self.dyads.iter().zip(&self.branches).zip(&mut self.geometry) {
             *g = d.position(b, &mut ws.x, &mut ws.trig)?;
         }
@@ -241,6 +260,9 @@ impl ClosedForm {
         for c in &self.cranks {
             c.velocity(trig, zd, v);
         }
+        for s in &self.sliders {
+            s.velocity(zd, v);
+        }
         for (d, g) in self.dyads.iter().zip(&self.geometry) {
             d.velocity(g, v);
         }
@@ -248,8 +270,8 @@ impl ClosedForm {
 
     /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
     pub fn velocity_analogues(&self, ws: &mut Workspace) {
-        let (n, m) = (ws.x.len(), self.cranks.len());
-        // Each crank body has 3 coordinates, so the 3n scratch holds the m unit rates.
+        let (n, m) = (ws.x.len(), self.cranks.len() + self.sliders.len());
+        // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
         let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
         unit[..m].fill(0.0);
         for j in 0..m {
@@ -273,6 +295,9 @@ impl ClosedForm {
     pub fn accelerations(&self, trig: &[[f64; 2]], v: &[f64], a: &mut [f64]) {
         for k in &self.cranks {
             k.acceleration(trig, v, a);
+        }
+        for s in &self.sliders {
+            s.acceleration(a);
         }
         for (d, g) in self.dyads.iter().zip(&self.geometry) {
             d.acceleration(g, v, a);
