@@ -280,3 +280,28 @@ fn a_predictor_past_a_fold_is_recognised() {
     cf.kinematic_stages(&[-1e-3], &[0.0], &mut ws).unwrap();
     assert!((ws.x[8].abs() - std::f64::consts::PI).abs() < 1e-2, "coupler angle {}", ws.x[8]);
 }
+
+#[test]
+fn an_rrp_predictor_past_its_fold_is_recognised() {
+    // The slider-crank's rod (body 1 of its RRP dyad) at direction alpha from the guide's axis
+    // (x); its fold is where the rod stands normal to the guide (alpha = +-pi/2). A predicted
+    // rod just past the normal, or mirrored about it (pi - alpha), puts the wrist behind the
+    // crank pin along the guide; one just short of the normal does not.
+    let mech = planardyn::load(root().join("examples/models/slider-crank.yaml").to_str().unwrap()).unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    cf.set_reference(&mech.x0);
+    let rod = mech.bodies.iter().position(|b| b.name == "rod").unwrap();
+    // The rod's direction A -> B in the drawing (A = (0.04, 0.0693), B = (0.3319, 0)).
+    let alpha0 = (-0.06928203230275509_f64).atan2(0.33189039038652846 - 0.04);
+    // The rod turned to direction alpha (its body angle moves with it).
+    let turned = |alpha: f64| {
+        let mut x = mech.x0.clone();
+        x[3 * rod + 2] += alpha - alpha0;
+        x
+    };
+    assert!(cf.keeps_branches(&mech.x0));
+    let half = 0.5 * std::f64::consts::PI;
+    assert!(cf.keeps_branches(&turned(-half + 1e-3)));
+    assert!(!cf.keeps_branches(&turned(-half - 1e-3)));
+    assert!(!cf.keeps_branches(&turned(std::f64::consts::PI - alpha0)));
+}

@@ -19,82 +19,67 @@ use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::structure::assur;
 use crate::workspace::Workspace;
-use crate::{KinematicsError, SingularityKind};
+use crate::KinematicsError;
 
-/// A class II dyad of a kind with a closed form.
+/// A class II dyad of a kind with a closed form, with the branch of its reference
+/// configuration and its geometry at the last positions (for the rates and accelerations).
 #[derive(Debug, Clone)]
 enum Dyad {
-    Rrr(Rrr),
-    Rrp(Rrp),
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Branch {
-    Rrr(rrr::Branch),
-    Rrp(rrp::Branch),
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Geometry {
-    Rrr(rrr::Geometry),
-    Rrp(rrp::Geometry),
+    Rrr(Rrr, rrr::Branch, rrr::Geometry),
+    Rrp(Rrp, rrp::Branch, rrp::Geometry),
 }
 
 impl Dyad {
     fn bodies(&self) -> [usize; 2] {
         match self {
-            Dyad::Rrr(d) => d.bodies,
-            Dyad::Rrp(d) => d.bodies,
+            Dyad::Rrr(d, ..) => d.bodies,
+            Dyad::Rrp(d, ..) => d.bodies,
         }
     }
 
-    fn branch(&self, x: &[f64]) -> Branch {
+    fn set_reference(&mut self, x: &[f64]) {
         match self {
-            Dyad::Rrr(d) => Branch::Rrr(d.branch(x)),
-            Dyad::Rrp(d) => Branch::Rrp(d.branch(x)),
+            Dyad::Rrr(d, b, _) => *b = d.branch(x),
+            Dyad::Rrp(d, b, _) => *b = d.branch(x),
         }
     }
 
-    fn keeps_side(&self, b: &Branch, x: &[f64]) -> bool {
-        match (self, b) {
-            (Dyad::Rrr(d), Branch::Rrr(b)) => d.keeps_side(b, x),
-            (Dyad::Rrp(d), Branch::Rrp(b)) => d.keeps_side(b, x),
-            _ => false,
+    fn keeps_side(&self, x: &[f64]) -> bool {
+        match self {
+            Dyad::Rrr(d, b, _) => d.keeps_side(b, x),
+            Dyad::Rrp(d, b, _) => d.keeps_side(b, x),
         }
     }
 
-    fn sigma(&self, g: &Geometry, inv_length: f64) -> f64 {
-        match (self, g) {
-            (Dyad::Rrr(_), Geometry::Rrr(g)) => g.sigma(inv_length),
-            (Dyad::Rrp(d), Geometry::Rrp(g)) => g.sigma(inv_length, d.guide_on_g),
-            _ => 0.0,
-        }
-    }
-
-    #[inline]
-    fn position(&self, b: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
-        match (self, b) {
-            (Dyad::Rrr(d), Branch::Rrr(b)) => d.position(b, x, trig).map(Geometry::Rrr),
-            (Dyad::Rrp(d), Branch::Rrp(b)) => d.position(b, x, trig).map(Geometry::Rrp),
-            _ => Err(KinematicsError::singular(SingularityKind::TypeII)),
+    fn sigma(&self, inv_length: f64) -> f64 {
+        match self {
+            Dyad::Rrr(_, _, g) => g.sigma(inv_length),
+            Dyad::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
         }
     }
 
     #[inline]
-    fn velocity(&self, g: &Geometry, v: &mut [f64]) {
-        match (self, g) {
-            (Dyad::Rrr(d), Geometry::Rrr(g)) => d.velocity(g, v),
-            (Dyad::Rrp(d), Geometry::Rrp(g)) => d.velocity(g, v),
-            _ => {}
+    fn position(&mut self, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+        match self {
+            Dyad::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
+            Dyad::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn velocity(&self, v: &mut [f64]) {
+        match self {
+            Dyad::Rrr(d, _, g) => d.velocity(g, v),
+            Dyad::Rrp(d, _, g) => d.velocity(g, v),
         }
     }
 
     #[inline]
-    fn acceleration(&self, g: &Geometry, v: &[f64], a: &mut [f64]) {
-        match (self, g) {
-            (Dyad::Rrr(d), Geometry::Rrr(g)) => d.acceleration(g, v, a),
-            (Dyad::Rrp(d), Geometry::Rrp(g)) => d.acceleration(g, v, a),
-            _ => {}
+    fn acceleration(&self, v: &[f64], a: &mut [f64]) {
+        match self {
+            Dyad::Rrr(d, _, g) => d.acceleration(g, v, a),
+            Dyad::Rrp(d, _, g) => d.acceleration(g, v, a),
         }
     }
 }
@@ -104,10 +89,6 @@ pub struct ClosedForm {
     cranks: Vec<Crank>,
     sliders: Vec<Slider>,
     dyads: Vec<Dyad>,
-    /// Per dyad, the branch of the reference configuration, and its geometry at the last
-    /// positions (for the rates and accelerations).
-    branches: Vec<Branch>,
-    geometry: Vec<Geometry>,
     /// Per dyad 1 / L_k (its group's length, `group_sigma`), and the smallest input link
     /// measure (constant).
     inv_length: Vec<f64>,
@@ -180,15 +161,17 @@ impl ClosedForm {
             dyads.push(match (g.kind.as_str(), revolute(o1), revolute(o2)) {
                 ("RRR", true, true) => {
                     let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
-                    Dyad::Rrr(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]))
+                    Dyad::Rrr(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]), Default::default(), Default::default())
                 }
                 ("RRP", true, false) => {
                     let (s1, a) = ends(mech, o1, bodies[0]);
-                    Dyad::Rrp(Rrp::new(bodies, a, s1, [i1, i2], &mech.pairs[o2.0])?)
+                    let d = Rrp::new(bodies, a, s1, [i1, i2], &mech.pairs[o2.0])?;
+                    Dyad::Rrp(d, Default::default(), Default::default())
                 }
                 ("RRP", false, true) => {
                     let (s2, a) = ends(mech, o2, bodies[1]);
-                    Dyad::Rrp(Rrp::new([bodies[1], bodies[0]], a, s2, [i2, i1], &mech.pairs[o1.0])?)
+                    let d = Rrp::new([bodies[1], bodies[0]], a, s2, [i2, i1], &mech.pairs[o1.0])?;
+                    Dyad::Rrp(d, Default::default(), Default::default())
                 }
                 _ => return None,
             });
@@ -204,38 +187,28 @@ impl ClosedForm {
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
-        let branches = dyads.iter().map(|d| d.branch(&mech.x0)).collect();
+        dyads.iter_mut().for_each(|d| d.set_reference(&mech.x0));
         let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies())).collect();
-        let geometry = dyads
-            .iter()
-            .map(|d| match d {
-                Dyad::Rrr(_) => Geometry::Rrr(rrr::Geometry::default()),
-                Dyad::Rrp(_) => Geometry::Rrp(rrp::Geometry::default()),
-            })
-            .collect();
-        Some(ClosedForm { cranks, sliders, geometry, dyads, branches, inv_length, inputs_sigma })
+        Some(ClosedForm { cranks, sliders, dyads, inv_length, inputs_sigma })
     }
 
     /// Take the assembly branches from the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
-        for (b, d) in self.branches.iter_mut().zip(&self.dyads) {
-            *b = d.branch(x);
-        }
+        self.dyads.iter_mut().for_each(|d| d.set_reference(x));
     }
 
     /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
     /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`]); if not, a step crosses a fold and the closed
     /// forms would leave the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
-        self.dyads.iter().zip(&self.branches).all(|(d, b)| d.keeps_side(b, x))
+        self.dyads.iter().all(|d| d.keeps_side(x))
     }
 
     /// The type II measure at the last positions (`group_sigma`'s: the smallest singular
     /// value of each group's block at its own length), from the groups' closed forms: no
     /// factorisation of J.
     pub fn sigma(&self) -> f64 {
-        let groups = self.dyads.iter().zip(&self.geometry).zip(&self.inv_length);
-        let dyads = groups.map(|((d, g), &k)| d.sigma(g, k));
+        let dyads = self.dyads.iter().zip(&self.inv_length).map(|(d, &k)| d.sigma(k));
         dyads.fold(self.inputs_sigma, f64::min)
     }
 
@@ -247,8 +220,8 @@ impl ClosedForm {
         for s in &self.sliders {
             s.position(z, &mut ws.x, &mut ws.trig);
         }
-        for ((d, b), g) in self.dyads.iter().zip(&self.branches).zip(&mut self.geometry) {
-            *g = d.position(b, &mut ws.x, &mut ws.trig)?;
+        for d in &mut self.dyads {
+            d.position(&mut ws.x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -263,8 +236,8 @@ impl ClosedForm {
         for s in &self.sliders {
             s.velocity(zd, v);
         }
-        for (d, g) in self.dyads.iter().zip(&self.geometry) {
-            d.velocity(g, v);
+        for d in &self.dyads {
+            d.velocity(v);
         }
     }
 
@@ -299,8 +272,8 @@ impl ClosedForm {
         for s in &self.sliders {
             s.acceleration(a);
         }
-        for (d, g) in self.dyads.iter().zip(&self.geometry) {
-            d.acceleration(g, v, a);
+        for d in &self.dyads {
+            d.acceleration(v, a);
         }
     }
 
