@@ -6,7 +6,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 cargo build --release -q
 bin=target/release/planardyn-icount
 ir() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bin" "$@" 2>&1 | grep -oP "Collected : \K[0-9]+"; }
-for f in four-bar-gravity five-bar 3-rrr andrews-squeezer; do
+for f in four-bar-gravity five-bar 3-rrr andrews-squeezer slider-crank; do
     for case in same alt; do
         a=$(ir "../../examples/models/$f.yaml" 0 "$case")
         b=$(ir "../../examples/models/$f.yaml" 1000 "$case")

@@ -12,6 +12,7 @@
 
 use planardyn::dynamics::{dynamic_stages, forward, mass_matrix, ModelDrives};
 use planardyn::kinematics::{assemble_into, sigma_min, Chart, ClosedForm};
+use planardyn::model::CoordinateKind;
 use planardyn::{KinematicsError, Mechanism, Workspace};
 use std::path::{Path, PathBuf};
 
@@ -89,20 +90,26 @@ fn shipped_models_with_closed_forms() {
         .filter(|p| ClosedForm::new(&planardyn::load(p.to_str().unwrap()).unwrap()).is_some())
         .map(|p| name(&examples, p))
         .collect();
-    // The others have prismatic, gear or slot pairs, a class III group (3-RRR, the Stephenson
-    // six-bar) or redundant pairs (the double parallelogram): they take the general path.
+    // The others have prismatic inputs (relative ones too), gear or slot pairs, RPR and PRP
+    // dyads, a class III group (3-RRR, the Stephenson six-bar) or redundant pairs (the double
+    // parallelogram): they take the general path.
     assert_eq!(closed, CLOSED);
 }
 
-/// The shipped models made of revolute input links and RRR dyads only.
-const CLOSED: [&str; 7] = [
+/// The shipped models made of input links (revolute, or sliders on the ground) and RRR and RRP
+/// dyads only.
+const CLOSED: [&str; 11] = [
     "andrews-squeezer",
     "five-bar-free-fall",
     "five-bar",
     "four-bar-gravity",
+    "library/biglide",
     "library/five-bar-5r",
     "library/four-bar",
+    "library/slider-crank-slider-driven",
+    "library/slider-crank",
     "library/watt-six-bar",
+    "slider-crank",
 ];
 
 /// The general path's forward dynamics at (q, qd) from the drawing, and the same with the
@@ -131,39 +138,71 @@ fn equals_the_general_path_at_random_states() {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     for model in CLOSED {
         let mech = planardyn::load(dir.join(format!("{model}.yaml")).to_str().unwrap()).unwrap();
-        let mut cf = ClosedForm::new(&mech).unwrap();
-        let (q0, _) = mech.initial_state();
-        let (mut compared, mut worst) = (0, [0.0_f64; 8]);
-        for _ in 0..60 {
-            let q: Vec<f64> = q0.iter().map(|v| v + 1.2 * (rng.next() - 0.5)).collect();
-            let qd: Vec<f64> = q0.iter().map(|_| 6.0 * (rng.next() - 0.5)).collect();
-            let Some((g, c)) = both(&mech, &mut cf, &q, &qd) else { continue };
-            compared += 1;
-            let dx =
-                g.x.iter()
-                    .zip(&c.x)
-                    .enumerate()
-                    .fold(0.0_f64, |m, (i, (a, b))| m.max((a - b).abs() / if i % 3 == 2 { 1.0 } else { mech.scale }));
-            let figures =
-                [dx, rel_diff(&g.u, &c.u), rel_diff(&g.xd, &c.xd), rel_diff(&g.c, &c.c), rel_diff(&g.a, &c.a)];
-            let sigma = sigma_min(&mech, &Chart::Inputs, &g.x);
-            let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd), (cf.sigma() - sigma).abs() / sigma];
-            for (w, f) in worst.iter_mut().zip(figures.iter().chain(&more)) {
-                *w = w.max(*f);
-            }
-            assert_eq!((c.q.as_slice(), c.qd.as_slice()), (q.as_slice(), qd.as_slice()));
-        }
-        eprintln!(
-            "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd, sigma: {:?}",
-            worst.map(|w| format!("{w:.1e}"))
-        );
-        assert!(compared >= 30, "{model}: only {compared} of 60 random states assembled clear of singularities");
-        assert!(worst[0] < X_TOL, "{model}: positions differ by {:e} (scaled)", worst[0]);
-        for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..7]) {
-            assert!(*w < REL_TOL, "{model}: {what} differs by {w:e} relative");
-        }
-        assert!(worst[7] < SIGMA_TOL, "{model}: the type II measure differs by {:e} relative", worst[7]);
+        compare(model, &mech, &mut rng);
     }
+}
+
+/// An RRP dyad whose guide turns: a rod hinged to crank 1 at A and to a slider at P, the
+/// slider on a guide through P of arm 2 (both turned about the ground by the inputs). `{ab}`
+/// orders the prismatic pair's bodies: the guide fixed in arm 2 (arm first) or in the slider.
+const TURNING_GUIDE: &str = "name: turning guide\ngravity: [0, -9.81]\n\
+points: {O1: [0, 0], A: [0.1, 0.15], P: [0.55, 0.45], O2: [0.5, 0]}\nground: [O1, O2]\nbodies:\n  \
+crank: {points: [O1, A], uniform_bar: [O1, A], mass: 1.0}\n  \
+rod: {points: [A, P], uniform_bar: [A, P], mass: 0.5}\n  \
+slider: {points: [P], mass: 0.3, inertia: 1.0e-3, com: P}\n  \
+arm: {points: [O2, P], uniform_bar: [O2, P], mass: 0.8}\npairs:\n  \
+- {type: revolute, name: crank_pivot, at: O1, bodies: [ground, crank]}\n  \
+- {type: revolute, name: arm_pivot, at: O2, bodies: [ground, arm]}\n  \
+- {type: revolute, at: A, bodies: [crank, rod]}\n  \
+- {type: revolute, at: P, bodies: [rod, slider]}\n  \
+- {type: prismatic, at: P, bodies: {ab}, axis: [0.1, 0.9]}\n\
+coordinates:\n  - {name: theta, pair: crank_pivot, value: 0.98}\n  - {name: beta, pair: arm_pivot, value: 2.1}\n";
+
+#[test]
+fn rrp_on_a_turning_guide_either_way() {
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    for (what, ab) in [("guide on the arm", "[arm, slider]"), ("guide on the slider", "[slider, arm]")] {
+        let mech = common::yaml(&TURNING_GUIDE.replace("{ab}", ab));
+        compare(what, &mech, &mut rng);
+    }
+}
+
+/// At 60 random states about the drawing: the closed forms against the general path.
+fn compare(model: &str, mech: &Mechanism, rng: &mut Rng) {
+    let mut cf = ClosedForm::new(mech).unwrap();
+    let (q0, _) = mech.initial_state();
+    // Angles within 0.6 rad of the drawing's, displacements within 0.1 L.
+    let span: Vec<f64> =
+        mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.2 } else { 0.2 * mech.scale }).collect();
+    let (mut compared, mut worst) = (0, [0.0_f64; 8]);
+    for _ in 0..60 {
+        let q: Vec<f64> = q0.iter().zip(&span).map(|(v, s)| v + s * (rng.next() - 0.5)).collect();
+        let qd: Vec<f64> = q0.iter().map(|_| 6.0 * (rng.next() - 0.5)).collect();
+        let Some((g, c)) = both(mech, &mut cf, &q, &qd) else { continue };
+        compared += 1;
+        let dx =
+            g.x.iter()
+                .zip(&c.x)
+                .enumerate()
+                .fold(0.0_f64, |m, (i, (a, b))| m.max((a - b).abs() / if i % 3 == 2 { 1.0 } else { mech.scale }));
+        let figures = [dx, rel_diff(&g.u, &c.u), rel_diff(&g.xd, &c.xd), rel_diff(&g.c, &c.c), rel_diff(&g.a, &c.a)];
+        let sigma = sigma_min(mech, &Chart::Inputs, &g.x);
+        let more = [rel_diff(&g.qdd, &c.qdd), rel_diff(&g.xdd, &c.xdd), (cf.sigma() - sigma).abs() / sigma];
+        for (w, f) in worst.iter_mut().zip(figures.iter().chain(&more)) {
+            *w = w.max(*f);
+        }
+        assert_eq!((c.q.as_slice(), c.qd.as_slice()), (q.as_slice(), qd.as_slice()));
+    }
+    eprintln!(
+        "{model}: {compared} states; worst x, U, xd, c, A, qdd, xdd, sigma: {:?}",
+        worst.map(|w| format!("{w:.1e}"))
+    );
+    assert!(compared >= 30, "{model}: only {compared} of 60 random states assembled clear of singularities");
+    assert!(worst[0] < X_TOL, "{model}: positions differ by {:e} (scaled)", worst[0]);
+    for (what, w) in ["U", "xd", "c", "A", "qdd", "xdd"].iter().zip(&worst[1..7]) {
+        assert!(*w < REL_TOL, "{model}: {what} differs by {w:e} relative");
+    }
+    assert!(worst[7] < SIGMA_TOL, "{model}: the type II measure differs by {:e} relative", worst[7]);
 }
 
 #[test]
@@ -240,4 +279,29 @@ fn a_predictor_past_a_fold_is_recognised() {
     // coupler turned over by about pi, which is why such a step takes Newton.
     cf.kinematic_stages(&[-1e-3], &[0.0], &mut ws).unwrap();
     assert!((ws.x[8].abs() - std::f64::consts::PI).abs() < 1e-2, "coupler angle {}", ws.x[8]);
+}
+
+#[test]
+fn an_rrp_predictor_past_its_fold_is_recognised() {
+    // The slider-crank's rod (body 1 of its RRP dyad) at direction alpha from the guide's axis
+    // (x); its fold is where the rod stands normal to the guide (alpha = +-pi/2). A predicted
+    // rod just past the normal, or mirrored about it (pi - alpha), puts the wrist behind the
+    // crank pin along the guide; one just short of the normal does not.
+    let mech = planardyn::load(root().join("examples/models/slider-crank.yaml").to_str().unwrap()).unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    cf.set_reference(&mech.x0);
+    let rod = mech.bodies.iter().position(|b| b.name == "rod").unwrap();
+    // The rod's direction A -> B in the drawing (A = (0.04, 0.0693), B = (0.3319, 0)).
+    let alpha0 = (-0.06928203230275509_f64).atan2(0.33189039038652846 - 0.04);
+    // The rod turned to direction alpha (its body angle moves with it).
+    let turned = |alpha: f64| {
+        let mut x = mech.x0.clone();
+        x[3 * rod + 2] += alpha - alpha0;
+        x
+    };
+    assert!(cf.keeps_branches(&mech.x0));
+    let half = 0.5 * std::f64::consts::PI;
+    assert!(cf.keeps_branches(&turned(-half + 1e-3)));
+    assert!(!cf.keeps_branches(&turned(-half - 1e-3)));
+    assert!(!cf.keeps_branches(&turned(std::f64::consts::PI - alpha0)));
 }

@@ -1,16 +1,19 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
-//! mechanism is made of input links turned by revolute pairs and class II RRR dyads only, the
+//! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
+//! the ground) and class II RRR and RRP dyads only, the
 //! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
 //! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
 //! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
 //! assembly branch of a reference configuration (the integrator's last accepted point); where
 //! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
-//! Other mechanisms (prismatic, gear and slot pairs, class III groups and up, relative inputs,
-//! redundant pairs) take the general path (`position`, `analogues`).
+//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads, gear and slot pairs, class III groups and
+//! up, relative inputs, redundant pairs) take the general path (`position`, `analogues`).
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
-use super::dyads::rrr::{Branch, Geometry, Rrr};
+use super::dyads::rrp::{self, Rrp};
+use super::dyads::rrr::{self, Rrr};
+use super::dyads::slider::Slider;
 use super::dyads::Joint;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
@@ -18,14 +21,74 @@ use crate::structure::assur;
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
+/// A class II dyad of a kind with a closed form, with the branch of its reference
+/// configuration and its geometry at the last positions (for the rates and accelerations).
+#[derive(Debug, Clone)]
+enum Dyad {
+    Rrr(Rrr, rrr::Branch, rrr::Geometry),
+    Rrp(Rrp, rrp::Branch, rrp::Geometry),
+}
+
+impl Dyad {
+    fn bodies(&self) -> [usize; 2] {
+        match self {
+            Dyad::Rrr(d, ..) => d.bodies,
+            Dyad::Rrp(d, ..) => d.bodies,
+        }
+    }
+
+    fn set_reference(&mut self, x: &[f64]) {
+        match self {
+            Dyad::Rrr(d, b, _) => *b = d.branch(x),
+            Dyad::Rrp(d, b, _) => *b = d.branch(x),
+        }
+    }
+
+    fn keeps_side(&self, x: &[f64]) -> bool {
+        match self {
+            Dyad::Rrr(d, b, _) => d.keeps_side(b, x),
+            Dyad::Rrp(d, b, _) => d.keeps_side(b, x),
+        }
+    }
+
+    fn sigma(&self, inv_length: f64) -> f64 {
+        match self {
+            Dyad::Rrr(_, _, g) => g.sigma(inv_length),
+            Dyad::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
+        }
+    }
+
+    #[inline]
+    fn position(&mut self, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+        match self {
+            Dyad::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
+            Dyad::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn velocity(&self, v: &mut [f64]) {
+        match self {
+            Dyad::Rrr(d, _, g) => d.velocity(g, v),
+            Dyad::Rrp(d, _, g) => d.velocity(g, v),
+        }
+    }
+
+    #[inline]
+    fn acceleration(&self, v: &[f64], a: &mut [f64]) {
+        match self {
+            Dyad::Rrr(d, _, g) => d.acceleration(g, v, a),
+            Dyad::Rrp(d, _, g) => d.acceleration(g, v, a),
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct ClosedForm {
     cranks: Vec<Crank>,
-    dyads: Vec<Rrr>,
-    /// Per dyad, the branch of the reference configuration, and its geometry at the last
-    /// positions (for the rates and accelerations).
-    branches: Vec<Branch>,
-    geometry: Vec<Geometry>,
+    sliders: Vec<Slider>,
+    dyads: Vec<Dyad>,
     /// Per dyad 1 / L_k (its group's length, `group_sigma`), and the smallest input link
     /// measure (constant).
     inv_length: Vec<f64>,
@@ -51,7 +114,7 @@ impl ClosedForm {
             return None;
         }
         let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
-        let mut cranks = Vec::new();
+        let (mut cranks, mut sliders) = (Vec::new(), Vec::new());
         let mut inputs_sigma = f64::INFINITY;
         for (k, c) in mech.coordinates.iter().enumerate() {
             let p = &mech.pairs[c.pair.0];
@@ -59,13 +122,22 @@ impl ClosedForm {
                 (Link::Ground, Link::Body(b)) | (Link::Body(b), Link::Ground) => b.0,
                 _ => return None,
             };
-            if !revolute(c.pair) {
-                return None;
-            }
             let (s, ground) = ends(mech, c.pair, body);
+            let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
+            match p.kind {
+                PairKind::Revolute => {}
+                // A slider on a guide fixed to the ground: its block has the crank's singular
+                // values (`input_link_sigma`), the guide's normal and axis in place of I.
+                PairKind::Prismatic { axis } if p.a == Link::Ground => {
+                    inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
+                    let (phi, origin) = (p.rel_angle0, ground.s);
+                    sliders.push(Slider { body, origin, axis, s, k, value: c.value, phi, cs: [phi.cos(), phi.sin()] });
+                    continue;
+                }
+                _ => return None,
+            }
             let pivot = ground.s;
             let sign = if p.b == Link::Body(BodyId(body)) { 1.0 } else { -1.0 };
-            let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
             inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
             cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
         }
@@ -73,10 +145,7 @@ impl ClosedForm {
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
             let [inner] = g.inner_pairs.as_slice() else { return None };
-            if g.class != 2 || g.kind != "RRR" || g.links.iter().any(|l| l.len() != 1) {
-                return None;
-            }
-            if !g.inner_pairs.iter().chain(&g.outer_pairs).all(|&k| revolute(k)) {
+            if g.class != 2 || g.links.iter().any(|l| l.len() != 1) || !revolute(*inner) {
                 return None;
             }
             let bodies = [g.links[0][0].0, g.links[1][0].0];
@@ -87,42 +156,59 @@ impl ClosedForm {
                 })
             };
             let (Some(o1), Some(o2)) = (touching(bodies[0]), touching(bodies[1])) else { return None };
-            let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
             let (i1, _) = ends(mech, *inner, bodies[0]);
             let (i2, _) = ends(mech, *inner, bodies[1]);
-            dyads.push(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]));
+            dyads.push(match (g.kind.as_str(), revolute(o1), revolute(o2)) {
+                ("RRR", true, true) => {
+                    let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
+                    Dyad::Rrr(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]), Default::default(), Default::default())
+                }
+                ("RRP", true, false) => {
+                    let (s1, a) = ends(mech, o1, bodies[0]);
+                    let d = Rrp::new(bodies, a, s1, [i1, i2], &mech.pairs[o2.0])?;
+                    Dyad::Rrp(d, Default::default(), Default::default())
+                }
+                ("RRP", false, true) => {
+                    let (s2, a) = ends(mech, o2, bodies[1]);
+                    let d = Rrp::new([bodies[1], bodies[0]], a, s2, [i2, i1], &mech.pairs[o1.0])?;
+                    Dyad::Rrp(d, Default::default(), Default::default())
+                }
+                _ => return None,
+            });
             pairs_used += 3;
         }
         let mut solved = vec![0; mech.n_bodies()];
-        cranks.iter().map(|c| c.body).chain(dyads.iter().flat_map(|d| d.bodies)).for_each(|b| solved[b] += 1);
+        cranks
+            .iter()
+            .map(|c| c.body)
+            .chain(sliders.iter().map(|s| s.body))
+            .chain(dyads.iter().flat_map(Dyad::bodies))
+            .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
-        let branches = dyads.iter().map(|d| d.branch(&mech.x0)).collect();
-        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies)).collect();
-        let geometry = vec![Geometry::default(); dyads.len()];
-        Some(ClosedForm { cranks, geometry, dyads, branches, inv_length, inputs_sigma })
+        dyads.iter_mut().for_each(|d| d.set_reference(&mech.x0));
+        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies())).collect();
+        Some(ClosedForm { cranks, sliders, dyads, inv_length, inputs_sigma })
     }
 
     /// Take the assembly branches from the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
-        for (b, d) in self.branches.iter_mut().zip(&self.dyads) {
-            *b = d.branch(x);
-        }
+        self.dyads.iter_mut().for_each(|d| d.set_reference(x));
     }
 
     /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
-    /// reference branch ([`Rrr::keeps_side`]); if not, a step crosses a fold and the closed
+    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`]); if not, a step crosses a fold and the closed
     /// forms would leave the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
-        self.dyads.iter().zip(&self.branches).all(|(d, b)| d.keeps_side(b, x))
+        self.dyads.iter().all(|d| d.keeps_side(x))
     }
 
     /// The type II measure at the last positions (`group_sigma`'s: the smallest singular
     /// value of each group's block at its own length), from the groups' closed forms: no
     /// factorisation of J.
     pub fn sigma(&self) -> f64 {
-        let dyads = self.geometry.iter().zip(&self.inv_length).map(|(g, &k)| g.sigma(k));
+        let dyads = self.dyads.iter().zip(&self.inv_length).map(|(d, &k)| d.sigma(k));
         dyads.fold(self.inputs_sigma, f64::min)
     }
 
@@ -131,8 +217,11 @@ impl ClosedForm {
         for c in &self.cranks {
             c.position(z, &mut ws.x, &mut ws.trig);
         }
-        for ((d, b), g) in self.dyads.iter().zip(&self.branches).zip(&mut self.geometry) {
-            *g = d.position(b, &mut ws.x, &mut ws.trig)?;
+        for s in &self.sliders {
+            s.position(z, &mut ws.x, &mut ws.trig);
+        }
+        for d in &mut self.dyads {
+            d.position(&mut ws.x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -144,15 +233,18 @@ impl ClosedForm {
         for c in &self.cranks {
             c.velocity(trig, zd, v);
         }
-        for (d, g) in self.dyads.iter().zip(&self.geometry) {
-            d.velocity(g, v);
+        for s in &self.sliders {
+            s.velocity(zd, v);
+        }
+        for d in &self.dyads {
+            d.velocity(v);
         }
     }
 
     /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
     pub fn velocity_analogues(&self, ws: &mut Workspace) {
-        let (n, m) = (ws.x.len(), self.cranks.len());
-        // Each crank body has 3 coordinates, so the 3n scratch holds the m unit rates.
+        let (n, m) = (ws.x.len(), self.cranks.len() + self.sliders.len());
+        // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
         let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
         unit[..m].fill(0.0);
         for j in 0..m {
@@ -177,8 +269,11 @@ impl ClosedForm {
         for k in &self.cranks {
             k.acceleration(trig, v, a);
         }
-        for (d, g) in self.dyads.iter().zip(&self.geometry) {
-            d.acceleration(g, v, a);
+        for s in &self.sliders {
+            s.acceleration(a);
+        }
+        for d in &self.dyads {
+            d.acceleration(v, a);
         }
     }
 
