@@ -172,3 +172,59 @@ fn mesh_friction_fields_are_checked() {
     bad("{type: friction, pair: mesh, viscous: 0.1}", "no relative motion");
     bad("{type: friction, pair: s1, mu: 0.1, pin_radius: 0.01, pressure_angle: 0.3}", "no teeth");
 }
+
+#[test]
+fn a_rack_carries_the_loss_while_it_drives_its_pinion() {
+    // The pinion (r_a = 20 mm) drives a rack (m_r = 0.3 kg, x' = r_a theta') against a force
+    // P; the frictionless tooth force is F = m_r r_a qdd + P. Pinion driving (F > 0):
+    // tau = I_a qdd + (1 + c) r_a F; rack driving (F < 0, decelerating): tau = I_a qdd + r_a F / (1 + c).
+    const P: f64 = 0.005;
+    const M_R: f64 = 0.3;
+    let rack = |friction: &str| {
+        yaml(&format!(
+            r#"
+name: rack and pinion
+points: {{O1: [0, 0], T1: [0, 0.02], R1: [-0.1, -0.02], R2: [0.1, -0.02]}}
+ground: [O1]
+bodies:
+  pinion: {{points: [O1, T1], mass: 0.2, com: O1, inertia: {I_A}}}
+  rack: {{points: [R1, R2], uniform_bar: [R1, R2], mass: {M_R}}}
+pairs:
+  - {{type: revolute, name: pinion_shaft, at: O1, bodies: [ground, pinion]}}
+  - {{type: prismatic, name: guide, at: R1, bodies: [ground, rack], axis: [1.0, 0.0]}}
+  - {{type: gear, name: mesh, bodies: [pinion, rack], centers: [O1], radii: [{R_A}], rack: [R1, R2]}}
+coordinates:
+  - {{name: theta, pair: pinion_shaft, value: 0.0}}
+loads:
+  - {{type: force, body: rack, at: R1, value: [{}, 0.0]}}
+{friction}"#,
+            -P
+        ))
+    };
+    let (with, without) = (rack(&mesh_friction()), rack(""));
+    let (mut ws, mut ws0) = (Workspace::new(&with), Workspace::new(&without));
+    let (mut pinion_drove, mut rack_drove) = (0, 0);
+    for k in 0..=200 {
+        let t = k as f64 / 200.0;
+        let q = 10.0 * t + 0.08 * (6.0 * t).sin();
+        let qd = 10.0 + 0.48 * (6.0 * t).cos();
+        let qdd = -2.88 * (6.0 * t).sin();
+        inverse(&with, &[q], &[qd], &[qdd], &mut ws).unwrap();
+        inverse(&without, &[q], &[qd], &[qdd], &mut ws0).unwrap();
+        let (p, p0) = (ws.tau[0] * qd, ws0.tau[0] * qd);
+        assert!((p - p0 - ws.dissipated).abs() <= 1e-12 * p.abs().max(1e-3), "t {t}: {p} {p0} {}", ws.dissipated);
+        let f = M_R * R_A * qdd + P;
+        let tau = if f > 0.0 {
+            pinion_drove += 1;
+            I_A * qdd + (1.0 + C) * R_A * f
+        } else {
+            rack_drove += 1;
+            I_A * qdd + R_A * f / (1.0 + C)
+        };
+        assert!((ws.tau[0] - tau).abs() <= 1e-12 * tau.abs(), "t {t}: tau {} vs {tau}", ws.tau[0]);
+        // c times the tooth force on the driven gear, times the pitch speed.
+        let tooth = if f > 0.0 { f } else { -f / (1.0 + C) };
+        assert!((ws.dissipated - C * tooth * R_A * qd).abs() <= 1e-12 * ws.dissipated, "t {t}: {}", ws.dissipated);
+    }
+    assert!(pinion_drove > 20 && rack_drove > 20, "pinion drove {pinion_drove} times, rack {rack_drove}");
+}
