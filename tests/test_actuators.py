@@ -298,3 +298,26 @@ def test_sizing_a_redundantly_actuated_robot_sizes_every_actuator(tmp_path):
     c = home[:2] + [0.0, 0.02]
     assert robot.size_cli([str(model), "--circle", str(c[0]), str(c[1]), "0.02", "--duration", "0.5", "--dt", "5e-3",
                            "--distribution", "preload", "--preload", "2.0"]) == 0
+
+
+def test_gear_mesh_friction_costs_its_dissipated_power_and_keeps_the_energy_balance() -> None:
+    # The shipped gear train with Coulomb friction at its three meshes (mu = 0.06, pressure
+    # angle 20 degrees): along a speeding-up and slowing-down motion the drive power exceeds
+    # the frictionless one by the dissipated power (virtual power, to round-off), and a run
+    # keeps T + V - W constant with W counting the meshes' loss (docs/actuators.md).
+    text = (MODELS / "gear-train.yaml").read_text()
+    meshes = "".join(f"  - {{type: friction, pair: {m}, mu: 0.06}}\n" for m in ("mesh1", "mesh2", "rack_mesh"))
+    with_friction = pd.loads(text.replace("simulate:", f"loads:\n{meshes}\nsimulate:"))
+    frictionless = pd.load(MODELS / "gear-train.yaml")
+    t = np.linspace(0.0, 1.0, 101)
+    q, qd, qdd = (10 * t + np.sin(6 * t))[:, None], (10 + 6 * np.cos(6 * t))[:, None], (-36 * np.sin(6 * t))[:, None]
+    power = with_friction.inverse_dynamics(q, qd, qdd)[:, 0] * qd[:, 0]
+    power0 = frictionless.inverse_dynamics(q, qd, qdd)[:, 0] * qd[:, 0]
+    lost = with_friction.dissipated_power(q, qd, qdd)
+    # At t = 0 qdd = 0 and nothing loads the teeth (no gravity, no load): no loss there.
+    assert lost[0] == 0.0 and np.all(lost[1:] > 0.0)
+    np.testing.assert_allclose(power - power0, lost, rtol=1e-10, atol=1e-13)
+    run = with_friction.simulate()
+    assert np.max(np.abs(run.energy.balance - run.energy.balance[0])) <= 1e-9
+    # The meshes took energy: the train ends slower than without them (0.1625 J frictionless).
+    assert run.energy.kinetic[-1] < 0.95 * frictionless.simulate().energy.kinetic[-1]

@@ -5,7 +5,10 @@
 //! load: |F| at a revolute pair (the pin of radius arm carries the reaction force F), the
 //! normal force along a slot, and max(|N|, 2|M|/L) along a prismatic pair of length L, whose
 //! normal force N and couple M are carried at the slider's two ends (contact forces
-//! N/2 +- M/L, each rubbing mu times its magnitude). The regularised Coulomb/Stribeck law
+//! N/2 +- M/L, each rubbing mu times its magnitude). At a gear mesh the slip speed is the
+//! pitch speed (arm 1: the lever is the driver's pitch-line travel, `dynamics::losses`) and
+//! N = F_t / cos(alpha), F_t the tangential tooth force and alpha the pressure angle; mu is
+//! then the mesh coefficient referred to the pitch speed. The regularised Coulomb/Stribeck law
 //!
 //!   mu(s) = [mu_k + (mu_s - mu_k) exp(-(s / v_str)^2)] tanh(s / v_st)
 //!
@@ -25,6 +28,7 @@ pub fn normal_load(mech: &Mechanism, fr: &JointFriction, reaction: [f64; 3]) -> 
     let force = reaction[0].hypot(reaction[1]);
     match mech.pairs[fr.pair.0].kind {
         PairKind::Prismatic { .. } if fr.length > 0.0 => force.max(2.0 * reaction[2].abs() / fr.length),
+        PairKind::Gear(_) => force / fr.pressure_angle.cos(),
         _ => force,
     }
 }

@@ -4,14 +4,19 @@
 //! together by a fixed-point iteration on e, to round-off. It converges while a unit
 //! change of the efforts changes the friction by less than itself (mu r small against the
 //! mechanism's lever arms); a mechanism that self-locks is reported, not guessed.
+//!
+//! A gear mesh's friction acts on its driver's pitch-line travel (`gear::Side`): which
+//! gear drives follows the tooth force found at each step, as the sign of the power that
+//! crosses the mesh.
 
 use super::forward::{accelerations, body_accelerations, factor_mass_matrix};
 use super::friction;
 use super::reactions::reactions_into;
 use super::transmission::{actuator_pair, add_rotor_inertia, rotor_inertias, rotor_terms};
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
+use crate::kinematics::pairs::gear::{Gear, Side};
 use crate::linalg::cholesky_solve;
-use crate::model::{Mechanism, PairId};
+use crate::model::{Mechanism, PairId, PairKind};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
@@ -32,9 +37,11 @@ pub struct LossBuffers {
     /// ((n_f + n_a) x 3n) lever gradients and ((n_f + n_a) x m) their products with U.
     grad: Vec<f64>,
     gu: Vec<f64>,
-    /// (n_f) the friction pairs' rates and efforts.
+    /// (n_f) the friction pairs' rates and efforts, and the gear carrying each (a gear
+    /// mesh's driver; `Side::A` for the other pairs).
     rates: Vec<f64>,
     e: Vec<f64>,
+    sides: Vec<Side>,
     /// (n_a) per actuator: the rotor's n^2 J (0 without), its h (qdd_k = gu_k . zdd + h_k),
     /// its pair's rate qd_k and the rotor's torque n^2 J qdd_k of the last evaluation.
     rotor_inertia: Vec<f64>,
@@ -61,6 +68,7 @@ impl LossBuffers {
             gu: vec![0.0; (nf + na) * m],
             rates: vec![0.0; nf],
             e: vec![0.0; nf],
+            sides: vec![Side::A; nf],
             rotor_inertia: rotor_inertias(mech),
             rotor_h: vec![0.0; na],
             rotor_rates: vec![0.0; na],
@@ -89,39 +97,66 @@ fn add_scaled(out: &mut [f64], s: f64, v: &[f64]) {
     }
 }
 
-/// Lever `i` of `pair` at the point in `ws`; returns the pair's relative rate.
-fn set_lever(mech: &Mechanism, pair: PairId, ws: &Workspace, lb: &mut LossBuffers, i: usize) -> f64 {
+/// Lever `i` of `pair` (on `side` of a gear mesh) at the point in `ws`; returns its rate.
+fn set_lever(mech: &Mechanism, pair: PairId, side: Side, ws: &Workspace, lb: &mut LossBuffers, i: usize) -> f64 {
     let (n, m) = (ws.x.len(), ws.b.len());
-    pair_lever(mech, pair, ws, &mut lb.grad[i * n..(i + 1) * n], &mut lb.gu[i * m..(i + 1) * m])
+    lever(mech, pair, side, ws, &mut lb.grad[i * n..(i + 1) * n], &mut lb.gu[i * m..(i + 1) * m])
 }
 
 /// The lever of `pair` at the point in `ws` (after the kinematic stages): its relative
-/// coordinate's gradient (3n) into `grad`, that gradient times U (m) into `gu`; returns the
-/// pair's relative rate.
+/// coordinate (a gear mesh's: a's pitch-line travel) gradient (3n) into `grad`, that
+/// gradient times U (m) into `gu`; returns the lever's rate. U^T grad, and so the
+/// generalized force of an effort on it, is the same on either side of a mesh.
 pub(crate) fn pair_lever(mech: &Mechanism, pair: PairId, ws: &Workspace, grad: &mut [f64], gu: &mut [f64]) -> f64 {
+    lever(mech, pair, Side::A, ws, grad, gu)
+}
+
+fn lever(mech: &Mechanism, pair: PairId, side: Side, ws: &Workspace, grad: &mut [f64], gu: &mut [f64]) -> f64 {
     let n = ws.x.len();
     grad.fill(0.0);
     let p = &mech.pairs[pair.0];
-    pair_coordinate_grad(p, &ws.x, &mut Dense { j: grad, ncols: n }, 0);
+    let mut sink = Dense { j: grad, ncols: n };
+    let rate = match &p.kind {
+        PairKind::Gear(g) => {
+            g.pitch_grad(p, &ws.x, side, &mut sink, 0);
+            g.pitch_speed(p, &ws.x, &ws.xd)
+        }
+        _ => {
+            pair_coordinate_grad(p, &ws.x, &mut sink, 0);
+            pair_coordinate_rate(p, &ws.x, &ws.xd)
+        }
+    };
     for (g, u) in gu.iter_mut().zip(ws.u.chunks_exact(n)) {
         *g = u.iter().zip(grad.iter()).map(|(a, b)| a * b).sum();
     }
-    pair_coordinate_rate(p, &ws.x, &ws.xd)
+    rate
 }
 
 /// Every lever at the point in `ws`: the friction pairs', then the actuators'.
 fn set_levers(mech: &Mechanism, ws: &Workspace, lb: &mut LossBuffers) {
     let nf = mech.friction.len();
+    lb.sides.fill(Side::A);
     for (i, fr) in mech.friction.iter().enumerate() {
-        lb.rates[i] = set_lever(mech, fr.pair, ws, lb, i);
+        lb.rates[i] = set_lever(mech, fr.pair, Side::A, ws, lb, i);
     }
     for k in 0..lb.rotor_rates.len() {
-        lb.rotor_rates[k] = set_lever(mech, actuator_pair(mech, k), ws, lb, nf + k);
+        lb.rotor_rates[k] = set_lever(mech, actuator_pair(mech, k), Side::A, ws, lb, nf + k);
+    }
+}
+
+/// A gear mesh's driver at the reactions in `lb` (`Side::A` for the other pairs).
+fn driver(mech: &Mechanism, ws: &Workspace, lb: &LossBuffers, i: usize) -> Side {
+    let id = mech.friction[i].pair;
+    let p = &mech.pairs[id.0];
+    match &p.kind {
+        PairKind::Gear(g) => Gear::driver(g.tooth_force(&ws.x, lb.reactions[id.0]), lb.rates[i]),
+        _ => Side::A,
     }
 }
 
 /// One fixed-point step: the friction efforts from the reactions in `ws` (evaluated with
-/// the efforts `lb.e`) replace them, unless they settled (then true and `lb.e` is kept).
+/// the efforts `lb.e`) replace them, and a gear mesh whose driver changed moves its effort
+/// to the new driver's lever; true when the efforts and drivers settled (`lb.e` kept).
 fn step_friction(
     mech: &Mechanism,
     ws: &mut Workspace,
@@ -135,7 +170,16 @@ fn step_friction(
         change = change.max((new - e).abs());
         largest = largest.max(new.abs());
     }
-    if change <= SETTLED * largest {
+    let mut moved = false;
+    for i in 0..mech.friction.len() {
+        let side = driver(mech, ws, lb, i);
+        if side != lb.sides[i] {
+            lb.sides[i] = side;
+            set_lever(mech, mech.friction[i].pair, side, ws, lb, i);
+            moved = true;
+        }
+    }
+    if change <= SETTLED * largest && !moved {
         return Ok(true);
     }
     if iteration + 1 == MAX_ITERATIONS {

@@ -77,6 +77,9 @@ pub struct JointFriction {
     /// Slip speeds (m/s) of the regularisation and of the Stribeck fall.
     pub stiction_speed: f64,
     pub stribeck_speed: f64,
+    /// A gear mesh's pressure angle alpha (rad): its teeth press with N = F_t / cos(alpha)
+    /// (0 for the other pairs).
+    pub pressure_angle: f64,
 }
 
 /// A redundant actuator on the relative coordinate of a pair that is not a generalized

@@ -175,7 +175,13 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     build_coordinates(&ctx, &mut mech)?;
     warn_degree_like_angles(&mut mech);
     (mech.drives, mech.motions) = build_drives(&ctx, &mech, &spec.drives)?;
-    mech.loads = spec.loads.iter().enumerate().map(|(k, l)| build_load(&ctx, &mech, k, l)).collect::<R<_>>()?;
+    mech.loads = spec
+        .loads
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| !mesh_coulomb_only(&ctx, &mech, l))
+        .map(|(k, l)| build_load(&ctx, &mech, k, l))
+        .collect::<R<_>>()?;
     mech.friction = actuators::build_friction(&ctx, &mech, &spec.loads)?;
     (mech.actuators, mech.pair_actuators) = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
     mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
@@ -604,6 +610,13 @@ fn pair_name(p: &PairSpec) -> &Option<String> {
     }
 }
 
+/// A `friction` load on a gear pair without `viscous`: all of it is the mesh's Coulomb
+/// friction (`mech.friction`), with no damper on a relative coordinate it lacks.
+fn mesh_coulomb_only(ctx: &Ctx, mech: &Mechanism, l: &LoadSpec) -> bool {
+    let LoadSpec::Friction { pair, viscous: None, .. } = l else { return false };
+    pair_id(ctx, mech, "", pair).is_ok_and(|id| pairs::relative(&mech.pairs[id.0]).is_none())
+}
+
 /// A pair with a relative motion of its own (for a pair spring or friction).
 fn relative_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
     let id = pair_id(ctx, mech, path, name)?;
@@ -612,7 +625,7 @@ fn relative_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairI
         None => Err(ctx.err(
             path,
             format!(
-                "'{name}' is a {} pair, which has no relative motion of its own; put the spring or friction on the revolute pair of one of its gears",
+                "'{name}' is a {} pair, which has no relative motion of its own; put the spring or viscous friction on the revolute pair of one of its gears",
                 pairs::kind_name(&mech.pairs[id.0])
             ),
         )),

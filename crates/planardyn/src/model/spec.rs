@@ -278,6 +278,9 @@ pub enum LoadSpec {
         /// Slip speed (m/s) over which the coefficient falls from `mu_static` to `mu` (default 1e-2).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         stribeck_speed: Option<f64>,
+        /// Pressure angle of a gear pair's teeth (rad, default 20 degrees): normal load F_t / cos.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pressure_angle: Option<f64>,
     },
 }
 

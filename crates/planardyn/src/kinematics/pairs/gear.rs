@@ -21,7 +21,7 @@
 //! revolute pairs holding the gears to the carrier) report their loads without the tooth
 //! force: the physical bearing load of b is its revolute reaction plus this force.
 
-use super::frames::{add_grad, angle, link_columns, link_state, link_state_t, perp, Projection};
+use super::frames::{add_grad, angle, dot, link_columns, link_state, link_state_t, part, perp, Projection};
 use super::{PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{Link, Pair};
@@ -60,6 +60,65 @@ impl Gear {
         match self.mesh {
             Mesh::Gear { rb } => [self.ra, rb],
             Mesh::Rack { sign, .. } => [sign * self.ra, 0.0],
+        }
+    }
+}
+
+/// The gear of a mesh that carries its friction torque (docs/actuators.md, *Friction at a
+/// gear mesh*): the driver, the one that delivers power through the mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Side {
+    #[default]
+    A,
+    B,
+}
+
+impl Gear {
+    /// The pitch speed v = k_a (phi_a' - phi_c') (m/s), k_a = sigma r_a for a rack: the rate
+    /// of both gears' pitch-line travel relative to the carrier.
+    pub fn pitch_speed(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+        let w = |link: Link| part(&link_state(link, x), xd).1;
+        self.coefficients()[0] * (w(pair.a) - w(self.carrier))
+    }
+
+    /// The gradient of `side`'s pitch-line travel relative to the carrier, into row `row` of
+    /// `j`: k_a (phi_a - phi_c) for a, -k_b (phi_b - phi_c) or the rack's travel for b. Both
+    /// move at the pitch speed, and their gradients differ by the row's: an effort on either
+    /// gives the same generalized force, and a different tooth force.
+    pub fn pitch_grad<S: Sink>(&self, pair: &Pair, x: &[f64], side: Side, j: &mut S, row: usize) {
+        let [ka, kb] = self.coefficients();
+        let carrier = link_state(self.carrier, x);
+        match (side, self.mesh) {
+            (Side::A, _) => {
+                add_grad(j, row, &link_state(pair.a, x), [0.0, 0.0, ka]);
+                add_grad(j, row, &carrier, [0.0, 0.0, -ka]);
+            }
+            (Side::B, Mesh::Gear { .. }) => {
+                add_grad(j, row, &link_state(pair.b, x), [0.0, 0.0, -kb]);
+                add_grad(j, row, &carrier, [0.0, 0.0, kb]);
+            }
+            (Side::B, Mesh::Rack { axis, sc, .. }) => {
+                Projection::new(sc, pair.sb, axis, carrier, link_state(pair.b, x)).grad(j, row, 1.0)
+            }
+        }
+    }
+
+    /// The row's multiplier from the pair's reaction (`reaction`'s inverse): the signed
+    /// tooth force (N).
+    pub fn tooth_force(&self, x: &[f64], reaction: [f64; 3]) -> f64 {
+        match self.mesh {
+            Mesh::Gear { rb } => reaction[2] / rb,
+            Mesh::Rack { axis, .. } => -dot([reaction[0], reaction[1]], link_state(self.carrier, x).rot(axis)),
+        }
+    }
+
+    /// The driver at tooth force `tooth` and pitch speed `v`: the tooth force gives b the
+    /// power -tooth v relative to the carrier, so a drives while it is positive.
+    pub fn driver(tooth: f64, v: f64) -> Side {
+        if tooth * v <= 0.0 {
+            Side::A
+        } else {
+            Side::B
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Validation of the actuators and of the Coulomb friction of the pairs.
 
-use super::{coordinate_index, relative_pair, Ctx, R};
+use super::{coordinate_index, pair_id, relative_pair, Ctx, R};
 use crate::kinematics::pairs::{self, Relative};
 use crate::model::actuators::{Actuator, JointFriction, Limits, PairActuator};
 use crate::model::spec::{ActuatorSpec, LimitsSpec, LoadSpec};
@@ -10,6 +10,10 @@ use crate::model::{Mechanism, PairKind};
 const MOTOR_STICTION_SPEED: f64 = 1e-2;
 const PAIR_STICTION_SPEED: f64 = 1e-4;
 const STRIBECK_SPEED: f64 = 1e-2;
+/// Default pressure angle of a gear mesh: the standard involute tooth's 20 degrees.
+const PRESSURE_ANGLE: f64 = 20.0 * std::f64::consts::PI / 180.0;
+/// Largest pressure angle accepted (rad, 45 degrees): beyond, N = F_t / cos(alpha) is no tooth's.
+const MAX_PRESSURE_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
 
 /// One actuator slot per coordinate (`None`: an ideal effort source), and the redundant
 /// actuators on pairs.
@@ -162,7 +166,17 @@ fn build_limits(ctx: &Ctx, path: &str, l: Option<&LimitsSpec>) -> R<Limits> {
 pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[LoadSpec]) -> R<Vec<JointFriction>> {
     let mut out = Vec::new();
     for (k, l) in loads.iter().enumerate() {
-        let LoadSpec::Friction { pair, viscous, mu, mu_static, pin_radius, length, stiction_speed, stribeck_speed } = l
+        let LoadSpec::Friction {
+            pair,
+            viscous,
+            mu,
+            mu_static,
+            pin_radius,
+            length,
+            stiction_speed,
+            stribeck_speed,
+            pressure_angle,
+        } = l
         else {
             continue;
         };
@@ -171,12 +185,12 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
             return Err(ctx.err(&path, "give `viscous` (N m s/rad or N s/m), Coulomb friction `mu`, or both"));
         }
         let Some(mu) = mu else {
-            if mu_static.is_some() || pin_radius.is_some() || length.is_some() {
+            if mu_static.is_some() || pin_radius.is_some() || length.is_some() || pressure_angle.is_some() {
                 return Err(ctx.err(format!("{path}.mu"), "Coulomb friction needs its sliding coefficient `mu`"));
             }
             continue;
         };
-        let id = relative_pair(ctx, mech, &format!("{path}.pair"), pair)?;
+        let id = friction_pair(ctx, mech, &format!("{path}.pair"), pair)?;
         let mu = ctx.non_negative(&format!("{path}.mu"), *mu)?;
         let mu_static = ctx.non_negative(&format!("{path}.mu_static"), mu_static.unwrap_or(mu))?;
         let speed = |field: &str, v: Option<f64>, default: f64| -> R<f64> {
@@ -198,7 +212,10 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
                 ))
             }
             (false, Some(_)) => {
-                return Err(ctx.err(format!("{path}.pin_radius"), format!("'{pair}' slides: remove `pin_radius`")))
+                return Err(ctx.err(
+                    format!("{path}.pin_radius"),
+                    format!("'{pair}' does not turn on a pin: remove `pin_radius`"),
+                ))
             }
             (false, None) => 1.0,
         };
@@ -212,6 +229,25 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
             }
             (_, None) => 0.0,
         };
+        let pressure_angle = match (&p.kind, pressure_angle) {
+            (PairKind::Gear(_), a) => {
+                let a = a.unwrap_or(PRESSURE_ANGLE);
+                if !(0.0..=MAX_PRESSURE_ANGLE).contains(&ctx.finite(&format!("{path}.pressure_angle"), a)?) {
+                    return Err(ctx.err(
+                        format!("{path}.pressure_angle"),
+                        format!("{a} rad is not a tooth's pressure angle: give one in [0, {MAX_PRESSURE_ANGLE}] rad"),
+                    ));
+                }
+                a
+            }
+            (_, Some(_)) => {
+                return Err(ctx.err(
+                    format!("{path}.pressure_angle"),
+                    format!("'{pair}' has no teeth: `pressure_angle` applies to a gear pair only"),
+                ))
+            }
+            (_, None) => 0.0,
+        };
         out.push(JointFriction {
             pair: id,
             mu,
@@ -220,7 +256,18 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
             length,
             stiction_speed: speed("stiction_speed", *stiction_speed, PAIR_STICTION_SPEED)?,
             stribeck_speed: speed("stribeck_speed", *stribeck_speed, STRIBECK_SPEED)?,
+            pressure_angle,
         });
     }
     Ok(out)
+}
+
+/// The pair a Coulomb friction load acts on: one with a relative motion, or a gear mesh
+/// (whose lever is the pitch-line travel).
+fn friction_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<crate::model::PairId> {
+    let id = pair_id(ctx, mech, path, name)?;
+    match mech.pairs[id.0].kind {
+        PairKind::Gear(_) => Ok(id),
+        _ => relative_pair(ctx, mech, path, name),
+    }
 }
