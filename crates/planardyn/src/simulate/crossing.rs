@@ -262,21 +262,34 @@ fn time_to_point(approach: &Approach, t: f64, passive: f64) -> Option<f64> {
 }
 
 /// Whether the step from the last point kept to the one accepted at `t` (held by `ode.ws`,
-/// passive measure `passive`) went over a change point: the measure fell towards 0 before it
-/// and rose after it as |t - t*| does (a V), not as past a minimum above 0. The change point
-/// then, located on the quintic through the step's two ends (the V's linear extrapolation
-/// only tells that it is there: at its time Phi_x's pivots can still be above [`LOST_PIVOT`]).
+/// passive measure `passive`) went over a change point, and the point, located on the
+/// quintic through the step's two ends. From a point near it (below [`WATCH_BELOW`]) the
+/// measure fell towards 0 before it and rose after it as |t - t*| does (a V), not as past a
+/// minimum above 0 (the V's linear extrapolation only tells that it is there: at its time
+/// Phi_x's pivots can still be above [`LOST_PIVOT`]). A step from farther away, whose moves
+/// are not bounded, can land just past the point with the measure below [`CROSS_BELOW`] and
+/// still falling as seen from before it; only the path between tells: Phi_x loses rank inside
+/// the step.
 pub fn stepped_over(ode: &MechanismOde, approach: &Approach, t: f64, passive: f64) -> Option<ChangePoint> {
-    let last = approach.last().filter(|p| p.passive < WATCH_BELOW && p.t < t)?;
-    let to_point = time_to_point(approach, last.t, last.passive)?;
-    let t_star = last.t + to_point;
-    let expected = last.passive / to_point * (t - t_star);
-    if !(t_star < t && passive > 0.5 * expected && passive < 2.0 * expected) {
+    let last = approach.last().filter(|p| p.t < t)?;
+    let near = last.passive < WATCH_BELOW;
+    if near {
+        let to_point = time_to_point(approach, last.t, last.passive)?;
+        let t_star = last.t + to_point;
+        let expected = last.passive / to_point * (t - t_star);
+        if !(t_star < t && passive > 0.5 * expected && passive < 2.0 * expected) {
+            return None;
+        }
+    } else if passive >= CROSS_BELOW {
         return None;
     }
     let ws = &ode.ws;
     let path = Quintic::new(last, (&ws.x, &ws.xd, &ws.xdd), t);
-    Some(change_point(ode.mech, &path, locate(ode.mech, &path, last.t, t)))
+    let point = change_point(ode.mech, &path, locate(ode.mech, &path, last.t, t));
+    // Located at the step's end, the point is still ahead (golden section ends within
+    // 0.618^40 of an end where the pivot only falls).
+    let inside = point.t < t - 1e-6 * (t - last.t);
+    (near || (point.rank_drop > 0 && inside)).then_some(point)
 }
 
 /// Cross the change point ahead of the point accepted at `t` with passive measure `passive`

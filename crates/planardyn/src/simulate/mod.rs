@@ -580,7 +580,8 @@ pub fn simulate_observed<'a>(
         traj.stats.min_sigma = traj.stats.min_sigma.min(meas.sigma);
         traj.stats.min_passive_sigma = traj.stats.min_passive_sigma.min(meas.passive);
         let falling = approach.last().is_some_and(|p| meas.passive < p.passive);
-        if meas.passive < CROSS_BELOW && falling && ode.motion.is_none() {
+        let over = stepped_over(&ode, &approach, t, meas.passive);
+        if over.is_none() && meas.passive < CROSS_BELOW && falling && ode.motion.is_none() {
             let at = (t, meas.sigma, meas.passive, y[2 * m]);
             match cross_change_point(&mut ode, &mut stepper, &mut traj, &mut out, at, &mut approach, settings.t_end) {
                 Ok(false) => continue,
@@ -595,8 +596,10 @@ pub fn simulate_observed<'a>(
                 }
             }
         }
-        if let Some(point) = stepped_over(&ode, &approach, t, meas.passive) {
+        if let Some(point) = over {
             traj.change_points.push(point);
+            // The points kept are on the other side of it.
+            approach.clear();
         }
         approach.keep(&ode, t, meas.passive);
         if meas.passive < PASSIVE_SINGULAR {
