@@ -3,11 +3,25 @@
 from __future__ import annotations
 
 import dataclasses
+from functools import partial
 
 import numpy as np
 import planardyn as pd
 import pytest
 from planardyn.identify import base_parameters, sample_states
+
+
+def two_tones(q0, k, a, w, b, v):
+    """Coordinate k moved about q0[k] by two tones (amplitudes a, b; rad/s w, v): t -> (q, qd, qdd)."""
+    return lambda t: (q0[k] + a * np.sin(w * t) + b * np.sin(v * t),
+                      a * w * np.cos(w * t) + b * v * np.cos(v * t),
+                      -a * w * w * np.sin(w * t) - b * v * v * np.sin(v * t))
+
+
+def excitation(q0):
+    """The five-bar's identification motion: both cranks moved by two tones each."""
+    return {"theta1": two_tones(q0, 0, 0.25, 2 * np.pi, 0.15, 6 * np.pi),
+            "theta2": two_tones(q0, 1, 0.2, 4 * np.pi, 0.15, 2 * np.pi)}
 
 
 @pytest.mark.parametrize("name", ["five-bar", "3-rrr", "slider-crank", "hydraulic-boom", "andrews-squeezer"])
@@ -74,12 +88,8 @@ def experiment():
     real = pd.from_dict(d)
     q0 = prior.q0
 
-    def law(k, a, w, b, v):
-        return lambda t: (q0[k] + a * np.sin(w * t) + b * np.sin(v * t),
-                          a * w * np.cos(w * t) + b * v * np.cos(v * t),
-                          -a * w * w * np.sin(w * t) - b * v * v * np.sin(v * t))
-
-    motion = {"theta1": law(0, 0.25, 2 * np.pi, 0.15, 6 * np.pi), "theta2": law(1, 0.2, 4 * np.pi, 0.15, 2 * np.pi)}
+    law = partial(two_tones, q0)
+    motion = excitation(q0)
     runs = {T: real.simulate(t_end=T, output_dt=0.005, motion=motion) for T in (2.0, 8.0)}
     # Another motion, for validation: other tones, other amplitudes.
     other = {"theta1": law(0, 0.2, 3 * np.pi, 0.1, 8 * np.pi), "theta2": law(1, 0.25, 5 * np.pi, 0.1, 3 * np.pi)}

@@ -25,6 +25,13 @@ def geared_five_bar(efficiency: float = 0.9, pin_mu: float = 0.08):
     return pd.from_dict(d)
 
 
+
+def drive_law_torques(mech, t):
+    """The motor torques (N m) of the five-bar's drive laws at times t (N,): a constant and a table."""
+    drives = mech.to_dict()["drives"]
+    table = drives[1]["table"]
+    return np.column_stack([np.full_like(t, drives[0]["effort"]), np.interp(t, table["t"], table["effort"])])
+
 def test_parameters_follow_the_bodies_with_the_losses():
     mech = geared_five_bar()
     pars = mech.regressor_parameters
@@ -48,9 +55,7 @@ def test_y_pi_plus_tau_o_is_the_simulated_motor_torque():
     # comes to rest under its load, where the switching stalls the integrator.
     res = mech.simulate(t_end=0.5, output_dt=0.005, qd0=[1.0, -0.8])
     assert res.success, res.message
-    drives = mech.to_dict()["drives"]
-    table = drives[1]["table"]
-    t_m = np.column_stack([np.full_like(res.t, drives[0]["effort"]), np.interp(res.t, table["t"], table["effort"])])
+    t_m = drive_law_torques(mech, res.t)
     Y, tau_o = mech.regressor(res.q, res.qd, res.qdd, x=res.x, xd=res.xd)
     assert Y.shape == (len(res.t), 2, 4 * mech.n_bodies + 12)
     pi = np.array(list(mech.regressor_parameters.values()))

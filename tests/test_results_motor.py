@@ -14,7 +14,8 @@ import pytest
 from conftest import cli_run
 from planardyn import batch, cli
 from planardyn.identify import base_parameters
-from test_regressor_losses import geared_five_bar
+from test_identify import excitation
+from test_regressor_losses import drive_law_torques, geared_five_bar
 
 
 @pytest.fixture(scope="module")
@@ -22,14 +23,7 @@ def run():
     # The geared five-bar (ratio 10, efficiency 0.9, motor and pin friction) moved through a
     # two-tone motion of both cranks, as tests/test_identify.py moves the bare five-bar.
     mech = geared_five_bar()
-    q0 = mech.q0
-
-    def law(k, a, w, b, v):
-        return lambda t: (q0[k] + a * np.sin(w * t) + b * np.sin(v * t),
-                          a * w * np.cos(w * t) + b * v * np.cos(v * t),
-                          -a * w * w * np.sin(w * t) - b * v * v * np.sin(v * t))
-
-    motion = {"theta1": law(0, 0.25, 2 * np.pi, 0.15, 6 * np.pi), "theta2": law(1, 0.2, 4 * np.pi, 0.15, 2 * np.pi)}
+    motion = excitation(mech.q0)
     res = mech.simulate(t_end=2.0, output_dt=0.005, motion=motion)
     assert res.success, res.message
     return mech, res
@@ -42,9 +36,7 @@ def test_a_runs_motor_torques_are_its_drives_laws():
     mech = geared_five_bar()
     res = mech.simulate(t_end=0.5, output_dt=0.005, qd0=[1.0, -0.8])
     assert res.success, res.message
-    drives = mech.to_dict()["drives"]
-    table = drives[1]["table"]
-    t_m = np.column_stack([np.full_like(res.t, drives[0]["effort"]), np.interp(res.t, table["t"], table["effort"])])
+    t_m = drive_law_torques(mech, res.t)
     np.testing.assert_allclose(res.tau_motor, t_m, rtol=0, atol=1e-12 * np.abs(t_m).max())
     # The joint side is ~n eta (or n / eta) times larger: the two are not the same column.
     assert np.abs(res.tau).max() > 8 * np.abs(res.tau_motor).max()
