@@ -9,8 +9,6 @@ use super::PairId;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Actuator {
     pub name: String,
-    /// Index of the driven actuator: a coordinate's (< m), or m + a pair actuator's place.
-    pub coordinate: usize,
     /// Transmission ratio n (> 0).
     pub ratio: f64,
     /// Transmission efficiency eta in (0, 1].

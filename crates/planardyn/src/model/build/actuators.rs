@@ -41,13 +41,13 @@ pub(in crate::model) fn build_actuators(
                 format!("coordinate '{coordinate}' already has an actuator; remove one of the two"),
             ));
         }
-        out[i] = Some(motor(ctx, &path, a, coordinate, i)?);
+        out[i] = Some(motor(ctx, &path, a, coordinate)?);
     }
     Ok((out, on_pairs))
 }
 
-/// The motor of actuator `index` (`default_name` when the spec names none).
-fn motor(ctx: &Ctx, path: &str, a: &ActuatorSpec, default_name: &str, index: usize) -> R<Actuator> {
+/// The motor an actuator's spec describes (`default_name` when the spec names none).
+fn motor(ctx: &Ctx, path: &str, a: &ActuatorSpec, default_name: &str) -> R<Actuator> {
     let positive = |field: &str, v: f64| -> R<f64> {
         let p = format!("{path}.{field}");
         if ctx.finite(&p, v)? <= 0.0 {
@@ -64,7 +64,6 @@ fn motor(ctx: &Ctx, path: &str, a: &ActuatorSpec, default_name: &str, index: usi
     }
     Ok(Actuator {
         name: a.name.clone().unwrap_or_else(|| default_name.to_string()),
-        coordinate: index,
         ratio: positive("gear_ratio", a.gear_ratio)?,
         efficiency,
         rotor_inertia: ctx.non_negative(&format!("{path}.rotor_inertia"), a.rotor_inertia)?,
@@ -109,7 +108,7 @@ fn pair_actuator(
         && a.coulomb == 0.0
         && a.stiction_speed.is_none()
         && a.limits.is_none();
-    let drive = if ideal { None } else { Some(motor(ctx, path, a, pair, mech.dof() + known.len())?) };
+    let drive = if ideal { None } else { Some(motor(ctx, path, a, pair)?) };
     Ok(PairActuator { name: a.name.clone().unwrap_or_else(|| pair.to_string()), pair: id, drive })
 }
 
