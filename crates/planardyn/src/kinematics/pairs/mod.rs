@@ -162,9 +162,7 @@ pub fn n_rows(kind: &PairKind) -> usize {
     dispatch!(kind, t => rows(&t))
 }
 
-// Always: the assembler's loops over the pairs keep the dispatch inlined whatever else
-// calls it (`dyads::one_link`).
-#[inline(always)]
+#[inline]
 pub fn residual(pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
     dispatch!(&pair.kind, t => t.residual(pair, x, trig))
 }
@@ -174,9 +172,7 @@ pub fn jacobian<S: Sink>(pair: &Pair, x: &[f64], trig: &[[f64; 2]], j: &mut S, r
     dispatch!(&pair.kind, t => t.jacobian(pair, x, trig, j, rows))
 }
 
-// Always: the assembler's loops over the pairs keep the dispatch inlined whatever else
-// calls it (`dyads::one_link`).
-#[inline(always)]
+#[inline]
 pub fn gamma(pair: &Pair, x: &[f64], trig: &[[f64; 2]], u: &[f64], v: &[f64]) -> Rows {
     dispatch!(&pair.kind, t => t.gamma(pair, x, trig, u, v))
 }
