@@ -1,9 +1,10 @@
 // Instructions per forward-dynamics evaluation, the two cases of crates/planardyn/benches/
 // forward_dynamics.rs, counted by callgrind (deterministic, unlike wall time on a shared
 // machine): `icount MODEL N same|alt` makes N evaluations; run.sh subtracts N = 0.
+// `icount MODEL N sigma` instead takes the type II measure from the closed forms N times.
 use planardyn::dynamics::ModelDrives;
 use planardyn::integrate::OdeSystem;
-use planardyn::kinematics::{assemble_into, sigma_min, velocity_analogues, Chart};
+use planardyn::kinematics::{assemble_into, sigma_min, velocity_analogues, Chart, ClosedForm};
 use planardyn::simulate::ode::MechanismOde;
 use planardyn::Workspace;
 use std::hint::black_box;
@@ -13,7 +14,15 @@ fn main() {
     let (path, n, alt): (&str, usize, bool) = (&args[1], args[2].parse().unwrap(), args[3] == "alt");
     let mech = planardyn::load(path).unwrap();
     let m = mech.dof();
-    let (q0, _) = mech.initial_state();
+    let (q0, qd0) = mech.initial_state();
+    if args[3] == "sigma" {
+        let mut closed = ClosedForm::new(&mech).unwrap();
+        closed.kinematic_stages(&q0, &qd0, &mut Workspace::new(&mech)).unwrap();
+        for _ in 0..n {
+            black_box(black_box(&closed).sigma());
+        }
+        return;
+    }
     let mut ws = Workspace::new(&mech);
     assemble_into(&mech, &q0, &mut ws).unwrap();
     velocity_analogues(&mut ws).unwrap();

@@ -90,25 +90,28 @@ fn shipped_models_with_closed_forms() {
         .filter(|p| ClosedForm::new(&planardyn::load(p.to_str().unwrap()).unwrap()).is_some())
         .map(|p| name(&examples, p))
         .collect();
-    // The others have prismatic inputs (relative ones too), gear or slot pairs, RPR and PRP
-    // dyads, a class III group (3-RRR, the Stephenson six-bar) or redundant pairs (the double
-    // parallelogram): they take the general path.
+    // The others have sliders carrying the ground's point on their guide, relative inputs,
+    // RPR and PRP dyads, a class III group (3-RRR, the Stephenson six-bar) or redundant pairs
+    // (the double parallelogram): they take the general path.
     assert_eq!(closed, CLOSED);
 }
 
-/// The shipped models made of input links (revolute, or sliders on the ground) and RRR and RRP
-/// dyads only.
-const CLOSED: [&str; 11] = [
+/// The shipped models made of input links (revolute, or sliders on the ground), class I groups
+/// with a gear or slot pair (1R1G, 1P1G, 1P1S) and RRR and RRP dyads only.
+const CLOSED: [&str; 14] = [
     "andrews-squeezer",
     "five-bar-free-fall",
     "five-bar",
     "four-bar-gravity",
+    "gear-train",
+    "geared-five-bar",
     "library/biglide",
     "library/five-bar-5r",
     "library/four-bar",
     "library/slider-crank-slider-driven",
     "library/slider-crank",
     "library/watt-six-bar",
+    "scotch-yoke",
     "slider-crank",
 ];
 
@@ -164,6 +167,36 @@ fn rrp_on_a_turning_guide_either_way() {
     for (what, ab) in [("guide on the arm", "[arm, slider]"), ("guide on the slider", "[slider, arm]")] {
         let mech = common::yaml(&TURNING_GUIDE.replace("{ab}", ab));
         compare(what, &mech, &mut rng);
+    }
+}
+
+/// A rack driven along a ground guide turning a pinion on a ground pivot (the pinion a 1R1G
+/// group meshing with the solved rack), and a slotted crank moving a pin on a ground guide (the
+/// pin a 1P1S group in the solved slot): the roles of gear-train's rack and scotch-yoke's yoke
+/// turned around.
+const RACK_DRIVEN: &str = "name: rack-driven pinion\ngravity: [0, -9.81]\n\
+points: {O: [0, 0], T: [0, 0.03], R1: [-0.1, -0.03], R2: [0.1, -0.03]}\nground: [O]\nbodies:\n  \
+pinion: {points: [O, T], mass: 0.2, com: [0.004, 0.002], inertia: 1.0e-4}\n  \
+rack: {points: [R1, R2], uniform_bar: [R1, R2], mass: 0.3}\npairs:\n  \
+- {type: revolute, name: shaft, at: O, bodies: [ground, pinion]}\n  \
+- {type: prismatic, name: guide, at: R1, bodies: [ground, rack], axis: [1.0, 0.0]}\n  \
+- {type: gear, name: mesh, bodies: [pinion, rack], centers: [O], radii: [0.03], rack: [R1, R2]}\n\
+coordinates:\n  - {name: s, pair: guide, value: 0.0}\n";
+
+const SLOTTED_CRANK: &str = "name: slotted crank\ngravity: [0, -9.81]\n\
+points: {O: [0, 0], E: [0.3, 0.3], P: [0.1, 0.1], G: [-0.2, 0.1]}\nground: [O]\nbodies:\n  \
+crank: {points: [O, E], uniform_bar: [O, E], mass: 1.0}\n  \
+pin: {points: [P, G], mass: 0.4, com: [0.12, 0.1], inertia: 2.0e-3}\npairs:\n  \
+- {type: revolute, name: pivot, at: O, bodies: [ground, crank]}\n  \
+- {type: slot, name: slot, at: P, bodies: [crank, pin], along: [O, E]}\n  \
+- {type: prismatic, name: guide, at: G, bodies: [ground, pin], axis: [1.0, 0.0]}\n\
+coordinates:\n  - {name: theta, pair: pivot, value: 0.7853981633974483}\n";
+
+#[test]
+fn class_one_groups_with_the_roles_turned_around() {
+    let mut rng = Rng(0x5851_f42d_4c95_7f2d);
+    for (what, text) in [("rack-driven pinion", RACK_DRIVEN), ("slotted crank", SLOTTED_CRANK)] {
+        compare(what, &common::yaml(text), &mut rng);
     }
 }
 

@@ -1,16 +1,19 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
 //! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
-//! the ground) and class II RRR and RRP dyads only, the
+//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S) and class II RRR
+//! and RRP dyads only, the
 //! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
 //! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
 //! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
 //! assembly branch of a reference configuration (the integrator's last accepted point); where
 //! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
-//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads, gear and slot pairs, class III groups and
-//! up, relative inputs, redundant pairs) take the general path (`position`, `analogues`).
+//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads and class
+//! I groups, class III groups and up, relative inputs, redundant pairs) take the general path
+//! (`position`, `analogues`).
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
+use super::dyads::one_link::OneLink;
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
@@ -22,18 +25,21 @@ use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// A class II dyad of a kind with a closed form, with the branch of its reference
-/// configuration and its geometry at the last positions (for the rates and accelerations).
+/// configuration and its geometry at the last positions (for the rates and accelerations);
+/// or a class I group (one body, no branch).
 #[derive(Debug, Clone)]
 enum Dyad {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
     Rrp(Rrp, rrp::Branch, rrp::Geometry),
+    OneLink(Box<OneLink>),
 }
 
 impl Dyad {
-    fn bodies(&self) -> [usize; 2] {
+    fn bodies(&self) -> &[usize] {
         match self {
-            Dyad::Rrr(d, ..) => d.bodies,
-            Dyad::Rrp(d, ..) => d.bodies,
+            Dyad::Rrr(d, ..) => &d.bodies,
+            Dyad::Rrp(d, ..) => &d.bodies,
+            Dyad::OneLink(g) => g.bodies(),
         }
     }
 
@@ -41,6 +47,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, _) => *b = d.branch(x),
             Dyad::Rrp(d, b, _) => *b = d.branch(x),
+            Dyad::OneLink(_) => {}
         }
     }
 
@@ -48,6 +55,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, _) => d.keeps_side(b, x),
             Dyad::Rrp(d, b, _) => d.keeps_side(b, x),
+            Dyad::OneLink(_) => true,
         }
     }
 
@@ -55,6 +63,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(_, _, g) => g.sigma(inv_length),
             Dyad::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
+            Dyad::OneLink(g) => g.sigma(inv_length),
         }
     }
 
@@ -63,6 +72,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
             Dyad::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
+            Dyad::OneLink(g) => g.position(x, trig)?,
         }
         Ok(())
     }
@@ -72,6 +82,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, _, g) => d.velocity(g, v),
             Dyad::Rrp(d, _, g) => d.velocity(g, v),
+            Dyad::OneLink(g) => g.velocity(v),
         }
     }
 
@@ -80,6 +91,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, _, g) => d.acceleration(g, v, a),
             Dyad::Rrp(d, _, g) => d.acceleration(g, v, a),
+            Dyad::OneLink(g) => g.acceleration(v, a),
         }
     }
 }
@@ -123,12 +135,11 @@ impl ClosedForm {
                 _ => return None,
             };
             let (s, ground) = ends(mech, c.pair, body);
-            let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
             match p.kind {
                 PairKind::Revolute => {}
-                // A slider on a guide fixed to the ground: its block has the crank's singular
-                // values (`input_link_sigma`), the guide's normal and axis in place of I.
+                // A slider on a guide fixed to the ground: one block of J (`input_link_sigma`).
                 PairKind::Prismatic { axis } if p.a == Link::Ground => {
+                    let arm = s[0].hypot(s[1]) / bodies_length(mech, &[body]);
                     inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
                     let (phi, origin) = (p.rel_angle0, ground.s);
                     sliders.push(Slider { body, origin, axis, s, k, value: c.value, phi, cs: [phi.cos(), phi.sin()] });
@@ -138,12 +149,20 @@ impl ClosedForm {
             }
             let pivot = ground.s;
             let sign = if p.b == Link::Body(BodyId(body)) { 1.0 } else { -1.0 };
-            inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
+            // A crank's rows split in J's block-triangular form: the coordinate's on its angle
+            // (+-1) and the pivot's on its centre (I), each of measure 1.
+            inputs_sigma = inputs_sigma.min(1.0);
             cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
         }
         let mut dyads = Vec::new();
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
+            if let ([link], [o1, o2]) = (g.links.as_slice(), g.outer_pairs.as_slice()) {
+                let [body] = link.as_slice() else { return None };
+                dyads.push(Dyad::OneLink(Box::new(OneLink::new(mech, body.0, [*o1, *o2])?)));
+                pairs_used += 2;
+                continue;
+            }
             let [inner] = g.inner_pairs.as_slice() else { return None };
             if g.class != 2 || g.links.iter().any(|l| l.len() != 1) || !revolute(*inner) {
                 return None;
@@ -182,13 +201,13 @@ impl ClosedForm {
             .iter()
             .map(|c| c.body)
             .chain(sliders.iter().map(|s| s.body))
-            .chain(dyads.iter().flat_map(Dyad::bodies))
+            .chain(dyads.iter().flat_map(|d| d.bodies().iter().copied()))
             .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
         dyads.iter_mut().for_each(|d| d.set_reference(&mech.x0));
-        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies())).collect();
+        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
         Some(ClosedForm { cranks, sliders, dyads, inv_length, inputs_sigma })
     }
 

@@ -178,10 +178,11 @@ pub(crate) fn bodies_length(mech: &Mechanism, bodies: &[usize]) -> f64 {
     }
 }
 
-/// The measure of an input link turned by a revolute pair about the ground, in closed form:
-/// its block [[I, E R s / L_k], [0, +-1]] (the pair's rows, the coordinate's row) has the
-/// singular values 1 and those of [[1, a], [0, 1]], a = |s| / L_k, the smaller
-/// (sqrt(a^2 + 4) - a) / 2, whatever the link's angle.
+/// The measure of an input slider on a guide fixed to the ground, in closed form: its block,
+/// rows the pair's angle row, its normal row and the coordinate's (along the guide), is
+/// [[0, 1], [Q, E R s / L_k]] with Q the guide's normal and axis (orthonormal rows), whose
+/// singular values are 1 and those of [[1, a], [0, 1]], a = |s| / L_k, the smaller
+/// (sqrt(a^2 + 4) - a) / 2, whatever the slider's place.
 pub(crate) fn input_link_sigma(a: f64) -> f64 {
     0.5 * ((a * a + 4.0).sqrt() - a)
 }
@@ -215,23 +216,36 @@ pub(crate) fn dyad_sigma(a: [f64; 2], b: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -
         let (k1, k3) = (0.5 / (1.0 - l), 0.5 / (3.0 - l));
         let m = [0, 1, 2].map(|i| g[i] - k1 * s[i] - k3 * d[i] - if i == 1 { 0.0 } else { l });
         let n = [0, 1, 2].map(|i| -k1 * k1 * 2.0 * s[i] - k3 * k3 * 2.0 * d[i] - if i == 1 { 0.0 } else { 1.0 });
-        let (half, r) = (0.5 * (m[0] - m[2]), (0.25 * (m[0] - m[2]).powi(2) + m[1] * m[1]).sqrt());
-        let value = 0.5 * (m[0] + m[2]) - r;
-        let slope = if r > 0.0 {
-            0.5 * (n[0] + n[2]) - (half * 0.5 * (n[0] - n[2]) + m[1] * n[1]) / r
-        } else {
-            0.5 * (n[0] + n[2]) - (0.25 * (n[0] - n[2]).powi(2) + n[1] * n[1]).sqrt()
-        };
-        (value, slope)
+        smaller_eigenvalue(m, n)
     };
+    secular_root(mu, 1.0).sqrt()
+}
+
+/// The smaller eigenvalue of the symmetric 2 x 2 m ([m00, m01, m11]) and its derivative along
+/// the symmetric n.
+fn smaller_eigenvalue(m: [f64; 3], n: [f64; 3]) -> (f64, f64) {
+    let (half, r) = (0.5 * (m[0] - m[2]), (0.25 * (m[0] - m[2]).powi(2) + m[1] * m[1]).sqrt());
+    let value = 0.5 * (m[0] + m[2]) - r;
+    let slope = if r > 0.0 {
+        0.5 * (n[0] + n[2]) - (half * 0.5 * (n[0] - n[2]) + m[1] * n[1]) / r
+    } else {
+        0.5 * (n[0] + n[2]) - (0.25 * (n[0] - n[2]).powi(2) + n[1] * n[1]).sqrt()
+    };
+    (value, slope)
+}
+
+/// The smallest root in [0, pole) of a secular function mu (value and slope), decreasing and
+/// concave there: Newton from 0 lands past the root once and then falls back to it
+/// monotonically; a step to the pole or past it is halved. 0 if mu(0) <= 0.
+fn secular_root(mu: impl Fn(f64) -> (f64, f64), pole: f64) -> f64 {
     let (mut l, (mut f, mut df)) = (0.0, mu(0.0));
     if !(f > 0.0) {
         return 0.0;
     }
     for _ in 0..DYAD_ITERATIONS {
         let mut next = l - f / df;
-        if !(next < 1.0) {
-            next = 0.5 * (l + 1.0);
+        if !(next < pole) {
+            next = 0.5 * (l + pole);
         }
         if (next - l).abs() <= 4.0 * f64::EPSILON * next.abs() {
             l = next;
@@ -240,5 +254,122 @@ pub(crate) fn dyad_sigma(a: [f64; 2], b: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -
         l = next;
         (f, df) = mu(l);
     }
-    l.max(0.0).sqrt()
+    l.max(0.0)
+}
+
+/// The measure of an RRP dyad's block in closed form, from the entries of its angle columns
+/// at its own length: `a` body 1's at A and `p1` at P, `p2` body 2's at P (each E R s / L_k),
+/// and the prismatic pair's normal row: unit normal `n` on body 2's centre (times `sign`) and
+/// `g` on its angle. In the basis (t, n) of the guide (rows of each pair and translation
+/// columns of each body turned alike, which changes no singular value), the translation
+/// columns T split into the t parts of r1, r2, with T^T T = [[2, -1], [-1, 1]], and their n
+/// parts, with [[2, -1], [-1, 2]]. The smallest squared singular value lambda is then the
+/// smallest root of mu(lambda) = lambda_min(Phi^T Phi - lambda - sum C_i^T (M_i - lambda)^-1
+/// C_i) (C_i = T_i^T Phi), below (3 - sqrt 5) / 2, T^T T's smallest eigenvalue (its unit
+/// eigenvector, no turn, is one B maps to that length): as [`dyad_sigma`]'s, mu is
+/// decreasing and concave there.
+///
+/// That root is exact to about 1e-16 absolute, so sigma = sqrt(lambda) would lose its
+/// relative accuracy near a singularity. The root is therefore polished once: with K the
+/// block's angle columns seen from the complement of T's range ([[0, 1], [sign (p1 - a) . n,
+/// g - sign p2 . n] / sqrt 3], whose determinant is the dyad's n . E e / L_k, up to sign and
+/// sqrt 3), mu(lambda) = lambda_min(K^T K - lambda D(lambda)) with D = I + sum C_i^T M_i^-1
+/// (M_i - lambda)^-1 C_i, so lambda is the smallest eigenvalue of the pencil (K^T K, D(lambda)),
+/// det(K)^2 / (det D mu_max) with mu_max its largest: no cancellation, and D changes by
+/// O(lambda) relative over the root's error.
+pub(crate) fn rrp_sigma(a: [f64; 2], p1: [f64; 2], p2: [f64; 2], n: [f64; 2], sign: f64, g: f64) -> f64 {
+    let dot = |u: [f64; 2], v: [f64; 2]| u[0] * v[0] + u[1] * v[1];
+    let t = [n[1], -n[0]];
+    let along = |u: [f64; 2]| [dot(u, t), dot(u, n)];
+    let ([at, an], [p1t, p1n], [p2t, p2n]) = (along(a), along(p1), along(p2));
+    // C_i (rows r1, r2 of the part; columns phi1, phi2) and Phi^T Phi.
+    let c_t = [[at + p1t, -p2t], [-p1t, p2t]];
+    let c_n = [[an + p1n, -p2n], [-p1n, p2n + sign * g]];
+    let gram = [dot(a, a) + dot(p1, p1), -dot(p1, p2), dot(p2, p2) + 1.0 + g * g];
+    // C^T (M - lambda)^-1 C and C^T (M - lambda)^-2 C, M = [[2, -1], [-1, m11]].
+    let terms = |c: [[f64; 2]; 2], m11: f64, l: f64| {
+        let (p, r) = (2.0 - l, m11 - l);
+        let det = p * r - 1.0;
+        // W = (M - lambda)^-1 C.
+        let w = [0, 1].map(|j| [(r * c[0][j] + c[1][j]) / det, (c[0][j] + p * c[1][j]) / det]);
+        let cw = |i: usize, j: usize| c[0][i] * w[j][0] + c[1][i] * w[j][1];
+        let ww = |i: usize, j: usize| w[i][0] * w[j][0] + w[i][1] * w[j][1];
+        ([cw(0, 0), cw(0, 1), cw(1, 1)], [ww(0, 0), ww(0, 1), ww(1, 1)])
+    };
+    let mu = |l: f64| {
+        let ((st, dt), (sn, dn)) = (terms(c_t, 1.0, l), terms(c_n, 2.0, l));
+        let diagonal = |i: usize| if i == 1 { 0.0 } else { 1.0 };
+        let m = [0, 1, 2].map(|i| gram[i] - st[i] - sn[i] - l * diagonal(i));
+        let d = [0, 1, 2].map(|i| -dt[i] - dn[i] - diagonal(i));
+        smaller_eigenvalue(m, d)
+    };
+    let l = secular_root(mu, 0.5 * (3.0 - 5f64.sqrt()));
+    // K (the complement of T's range: the angle row, and (-sign A_n + sign P_n + N) / sqrt 3).
+    let third = 1.0 / 3.0;
+    let (k10, k11) = (sign * (p1n - an), g - sign * p2n);
+    let gk = [k10 * k10 * third, k10 * k11 * third, 1.0 + k11 * k11 * third];
+    let det_k2 = k10 * k10 * third;
+    // D(lambda): Z = M^-1 (M - lambda)^-1 (they commute), D = I + sum C^T Z C.
+    let part = |c: [[f64; 2]; 2], m11: f64| {
+        let (det0, det) = (2.0 * m11 - 1.0, (2.0 - l) * (m11 - l) - 1.0);
+        // M^-1 = [[m11, 1], [1, 2]] / det0, (M - lambda)^-1 = [[m11 - lambda, 1], [1, 2 - lambda]] / det.
+        let z = [m11 * (m11 - l) + 1.0, m11 + 2.0 - l, 1.0 + 2.0 * (2.0 - l)].map(|v| v / (det0 * det));
+        let zc = [0, 1].map(|j| [z[0] * c[0][j] + z[1] * c[1][j], z[1] * c[0][j] + z[2] * c[1][j]]);
+        let q = |i: usize, j: usize| c[0][i] * zc[j][0] + c[1][i] * zc[j][1];
+        [q(0, 0), q(0, 1), q(1, 1)]
+    };
+    let (dt, dn) = (part(c_t, 1.0), part(c_n, 2.0));
+    let d = [1.0 + dt[0] + dn[0], dt[1] + dn[1], 1.0 + dt[2] + dn[2]];
+    let det_d = d[0] * d[2] - d[1] * d[1];
+    // det(K^T K - mu D) = det_d mu^2 - b mu + det_k2: the smaller root without cancellation.
+    let b = d[0] * gk[2] + d[2] * gk[0] - 2.0 * d[1] * gk[1];
+    let lambda = 2.0 * det_k2 / (b + (b * b - 4.0 * det_d * det_k2).max(0.0).sqrt());
+    lambda.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::SMatrix;
+
+    /// rrp_sigma against the SVD of the block it stands for, over random arms and guides,
+    /// down to blocks near singular (the arm p1 turned onto the guide's normal).
+    #[test]
+    fn rrp_sigma_is_the_svd_of_its_block() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut worst, mut smallest) = (0.0_f64, f64::INFINITY);
+        for i in 0..2000 {
+            let angle = std::f64::consts::PI * next();
+            let n = [angle.cos(), angle.sin()];
+            let (a, mut p1, p2) = ([next(), next()], [next(), next()], [next(), next()]);
+            if i % 2 == 1 {
+                // p1 - a = E e / L_k nearly along the guide: the rod nearly normal to it.
+                let off = 1e-6 * next();
+                p1 = [a[0] + p1[0] * off + n[1] * 0.5, a[1] + p1[1] * off - n[0] * 0.5];
+            }
+            let (sign, g) = (if next() > 0.0 { 1.0 } else { -1.0 }, next());
+            #[rustfmt::skip]
+            let b = SMatrix::<f64, 6, 6>::from_row_slice(&[
+                1.0, 0.0, a[0], 0.0, 0.0, 0.0,
+                0.0, 1.0, a[1], 0.0, 0.0, 0.0,
+                1.0, 0.0, p1[0], -1.0, 0.0, -p2[0],
+                0.0, 1.0, p1[1], 0.0, -1.0, -p2[1],
+                0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+                0.0, 0.0, 0.0, sign * n[0], sign * n[1], g,
+            ]);
+            let (svd, closed) = (b.singular_values().min(), rrp_sigma(a, p1, p2, n, sign, g));
+            // Both are exact to about 1e-16 (the block's norm) absolute.
+            worst = worst.max((svd - closed).abs());
+            smallest = smallest.min(svd);
+        }
+        eprintln!("rrp_sigma: worst difference {worst:.1e}, smallest sigma {smallest:.1e}");
+        assert!(smallest < 1e-9, "no near-singular block drawn: smallest {smallest:e}");
+        assert!(worst < 1e-14, "rrp_sigma differs from the SVD by {worst:e}");
+    }
 }

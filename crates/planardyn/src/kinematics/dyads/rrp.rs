@@ -7,10 +7,10 @@
 //! whose coefficient n . E e (e = P - A) vanishes where the rod stands normal to the guide.
 
 use super::{pose, put_acceleration, put_rate, rate, Joint};
+use crate::kinematics::group_sigma::rrp_sigma;
 use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
 use crate::{KinematicsError, SingularityKind};
-use nalgebra::SMatrix;
 use std::f64::consts::{PI, TAU};
 
 #[inline]
@@ -80,7 +80,8 @@ pub struct Geometry {
 impl Geometry {
     /// The dyad's type II measure at these positions, 1 / L_k its group's inverse length: the
     /// smallest singular value of its block of J (columns r1, phi1, r2, phi2; rows of the
-    /// pairs at A and P, the prismatic pair's angle and normal rows), lengths in L_k.
+    /// pairs at A and P, the prismatic pair's angle and normal rows), lengths in L_k, in
+    /// closed form (`group_sigma::rrp_sigma`).
     pub fn sigma(&self, inv_length: f64, guide_on_g: bool) -> f64 {
         let k = inv_length;
         let ea = perp(self.own);
@@ -94,16 +95,8 @@ impl Geometry {
             // K - r2 = R2 s_P - D - R2 w.
             (-1.0, dot(perp(self.n), sub(self.rp, add(self.d, self.rw))))
         };
-        #[rustfmt::skip]
-        let b = SMatrix::<f64, 6, 6>::from_row_slice(&[
-            1.0, 0.0, ea[0] * k, 0.0, 0.0, 0.0,
-            0.0, 1.0, ea[1] * k, 0.0, 0.0, 0.0,
-            1.0, 0.0, ep1[0] * k, -1.0, 0.0, -ep2[0] * k,
-            0.0, 1.0, ep1[1] * k, 0.0, -1.0, -ep2[1] * k,
-            0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-            0.0, 0.0, 0.0, sign * self.n[0], sign * self.n[1], g_phi * k,
-        ]);
-        b.singular_values().min()
+        let scaled = |v: [f64; 2]| [v[0] * k, v[1] * k];
+        rrp_sigma(scaled(ea), scaled(ep1), scaled(ep2), self.n, sign, g_phi * k)
     }
 }
 
