@@ -139,8 +139,7 @@ impl ClosedForm {
             let pivot = ground.s;
             let sign = if p.b == Link::Body(BodyId(body)) { 1.0 } else { -1.0 };
             inputs_sigma = inputs_sigma.min(input_link_sigma(arm));
-            let offset = p.rel_angle0 - c.value;
-            cranks.push(Crank { body, pivot, s, k, sign, offset, reference: Default::default() });
+            cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
         }
         let mut dyads = Vec::new();
         let mut pairs_used = mech.coordinates.len();
@@ -193,10 +192,8 @@ impl ClosedForm {
         Some(ClosedForm { cranks, sliders, dyads, inv_length, inputs_sigma })
     }
 
-    /// Take the assembly branches and the bodies' reference angles from the configuration x (a
-    /// solution).
+    /// Take the assembly branches from the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
-        self.cranks.iter_mut().for_each(|c| c.set_reference(x));
         self.dyads.iter_mut().for_each(|d| d.set_reference(x));
     }
 

@@ -1,7 +1,6 @@
-//! A body's angle and its [cos, sin] about those of a reference configuration: a dyad body's
-//! angle from its rotation, on the reference's turn (within pi of its angle), and an input
-//! link's [cos, sin] from its angle, each through the rotation between the two. Over the
-//! integrator's stages that rotation is small, and short series replace atan2 and sin_cos.
+//! A dyad body's angle from its rotation, on the turn of a reference configuration: the angle
+//! within pi of the reference's, found from the rotation between the two. Over the integrator's
+//! stages that rotation is small, and its angle comes from a short series instead of atan2.
 
 /// A body's angle in the reference configuration and its [cos, sin].
 #[derive(Debug, Clone, Copy)]
@@ -46,30 +45,6 @@ pub fn rotation(from: [f64; 2], to: [f64; 2]) -> [f64; 2] {
     [c / r, s / r]
 }
 
-/// Largest |delta| taken by the sine and cosine series (rad).
-const TURN_BOUND: f64 = 0.5;
-
-/// sin(d) / d = sum_k (-1)^k d^2k / (2k + 1)! to k = 6, and cos(d) to d^14, in d^2: the first
-/// terms left out are d^14 / 15! <= 5e-17 and d^16 / 16! <= 1e-18 relative for |d| <= 1/2.
-const SIN_SERIES: [f64; 7] =
-    [1.0, -1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0, -1.0 / 39_916_800.0, 1.0 / 6_227_020_800.0];
-const COS_SERIES: [f64; 8] = [
-    1.0,
-    -1.0 / 2.0,
-    1.0 / 24.0,
-    -1.0 / 720.0,
-    1.0 / 40_320.0,
-    -1.0 / 3_628_800.0,
-    1.0 / 479_001_600.0,
-    -1.0 / 87_178_291_200.0,
-];
-
-/// sum_k a_k w^k by Horner's rule.
-#[inline]
-fn horner(a: &[f64], w: f64) -> f64 {
-    a.iter().rev().fold(0.0, |p, &a| p * w + a)
-}
-
 impl Reference {
     pub fn new(phi: f64) -> Self {
         let (s, c) = phi.sin_cos();
@@ -84,23 +59,13 @@ impl Reference {
         let [c0, s0] = self.cs;
         let (c, s) = (cs[0] * c0 + cs[1] * s0, cs[1] * c0 - cs[0] * s0);
         let u = s / (1.0 + c);
-        let delta = if u.abs() <= SERIES_BOUND { 2.0 * u * horner(&ATAN_SERIES, u * u) } else { s.atan2(c) };
+        let delta = if u.abs() <= SERIES_BOUND {
+            let w = u * u;
+            2.0 * u * ATAN_SERIES.iter().rev().fold(0.0, |p, &a| p * w + a)
+        } else {
+            s.atan2(c)
+        };
         self.phi + delta
-    }
-
-    /// [cos, sin] of the angle `phi`: near the reference's angle, its [cos, sin] turned by
-    /// delta = phi - (its angle).
-    #[inline]
-    pub fn cos_sin(&self, phi: f64) -> [f64; 2] {
-        let delta = phi - self.phi;
-        if delta.abs() > TURN_BOUND {
-            let (s, c) = phi.sin_cos();
-            return [c, s];
-        }
-        let w = delta * delta;
-        let (s, c) = (delta * horner(&SIN_SERIES, w), horner(&COS_SERIES, w));
-        let [c0, s0] = self.cs;
-        [c0 * c - s0 * s, s0 * c + c0 * s]
     }
 }
 
@@ -125,21 +90,6 @@ mod tests {
                 let ulp = f64::EPSILON * want.abs().max(delta.abs()).max(f64::MIN_POSITIVE);
                 assert!((got - want).abs() <= 2.0 * ulp, "phi {phi}, delta {delta}: {got} against {want}");
                 assert!((got - phi).abs() <= PI + 8.0 * f64::EPSILON * phi.abs().max(1.0));
-            }
-        }
-    }
-
-    /// Against sin_cos over angles up to pi from the reference, across the series' bound: equal
-    /// to within 3e-16 (the rotation of the reference's [cos, sin] adds a few roundings).
-    #[test]
-    fn cos_sin_equal_sin_cos_over_the_whole_turn() {
-        for phi0 in [0.0, 0.3, -2.5, 7.0, -40.0] {
-            let r = Reference::new(phi0);
-            for k in -1000..=1000 {
-                let phi = phi0 + PI * k as f64 / 1000.0;
-                let (s, c) = phi.sin_cos();
-                let [gc, gs] = r.cos_sin(phi);
-                assert!((gc - c).abs().max((gs - s).abs()) <= 3e-16, "phi {phi}: [{gc}, {gs}] against [{c}, {s}]");
             }
         }
     }

@@ -2,7 +2,6 @@
 //! q_k = phi_b - phi_a - (drawn relative angle) + (drawn value), the body's angle is
 //! sign (q_k + offset), sign +1 when the body is the pair's b.
 
-use super::angle::Reference;
 use super::{put_acceleration, put_rate};
 use crate::kinematics::pairs::frames::rot;
 
@@ -16,9 +15,6 @@ pub struct Crank {
     pub k: usize,
     pub sign: f64,
     pub offset: f64,
-    /// The body's angle in the reference configuration, near which its [cos, sin] come from
-    /// the reference's.
-    pub reference: Reference,
 }
 
 impl Crank {
@@ -26,18 +22,13 @@ impl Crank {
     #[inline]
     pub fn position(&self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let phi = self.sign * (z[self.k] + self.offset);
-        let cs = self.reference.cos_sin(phi);
-        let rs = rot(cs, self.s);
+        let (sn, cs) = phi.sin_cos();
+        let rs = rot([cs, sn], self.s);
         let b = 3 * self.body;
         x[b] = self.pivot[0] - rs[0];
         x[b + 1] = self.pivot[1] - rs[1];
         x[b + 2] = phi;
-        trig[self.body] = cs;
-    }
-
-    /// Take the reference angle from the configuration x.
-    pub fn set_reference(&mut self, x: &[f64]) {
-        self.reference = Reference::new(x[3 * self.body + 2]);
+        trig[self.body] = [cs, sn];
     }
 
     /// The body's rates for the coordinate rates zd.
