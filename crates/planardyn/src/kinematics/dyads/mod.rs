@@ -3,10 +3,8 @@
 //! on the ground ([`slider`]), and the class II dyads of three revolute pairs ([`rrr`]) and
 //! of two revolute pairs and an outer prismatic one ([`rrp`]). Each gives positions, velocities (a column of U for a unit
 //! rate) and accelerations with zero input accelerations (the convective term c), from the links
-//! solved before it, in the order of the decomposition; the dyads' bodies take their angles on
-//! the reference configuration's turn ([`angle`]).
+//! solved before it, in the order of the decomposition.
 
-pub mod angle;
 pub mod crank;
 pub mod rrp;
 pub mod rrr;

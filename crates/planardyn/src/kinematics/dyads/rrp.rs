@@ -6,12 +6,17 @@
 //! the reference configuration. Body 1's rates and accelerations solve one scalar equation
 //! whose coefficient n . E e (e = P - A) vanishes where the rod stands normal to the guide.
 
-use super::angle::{rotation, Reference};
 use super::{pose, put_acceleration, put_rate, rate, Joint};
 use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
 use crate::{KinematicsError, SingularityKind};
 use nalgebra::SMatrix;
+use std::f64::consts::{PI, TAU};
+
+#[inline]
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
 
 #[inline]
 fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
@@ -48,11 +53,13 @@ pub struct Rrp {
 }
 
 /// What the dyad keeps from the reference configuration: the side of A along the guide that
-/// P is on (+1 ahead along the axis) and body 1's angle (the new one is taken within pi of it).
+/// P is on (+1 ahead along the axis) and body 1's angle as whole turns plus a remainder in
+/// (-pi, pi].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Branch {
     pub side: f64,
-    pub angle: Reference,
+    pub turns: f64,
+    pub rest: f64,
 }
 
 /// The dyad at its solved position: R s of A on its link and on body 1, of K on g, e = P - A,
@@ -159,7 +166,8 @@ impl Rrp {
     pub fn branch(&self, x: &[f64]) -> Branch {
         let phi = x[3 * self.bodies[0] + 2];
         let psi = phi - self.guide_angle(x) + self.bend;
-        Branch { side: if psi.cos() >= 0.0 { 1.0 } else { -1.0 }, angle: Reference::new(phi) }
+        let turns = TAU * (phi / TAU).round();
+        Branch { side: if psi.cos() >= 0.0 { 1.0 } else { -1.0 }, turns, rest: phi - turns }
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved.
@@ -190,12 +198,20 @@ impl Rrp {
         let e = add(scaled(d, n), scaled(h, u));
         let p = add(a, e);
         // Body 1: the rotation taking its arm to e.
-        let cs = rotation(self.arm, e);
+        let (c, s) = (dot(self.arm, e), cross(self.arm, e));
+        let r = (c * c + s * s).sqrt();
+        let cs = [c / r, s / r];
+        let mut turn = s.atan2(c) - branch.rest;
+        if turn > PI {
+            turn -= TAU;
+        } else if turn < -PI {
+            turn += TAU;
+        }
         let own = rot(cs, self.s_hinge);
         let [b1, b2] = self.bodies;
         x[3 * b1] = a[0] - own[0];
         x[3 * b1 + 1] = a[1] - own[1];
-        x[3 * b1 + 2] = branch.angle.angle(cs);
+        x[3 * b1 + 2] = branch.turns + branch.rest + turn;
         trig[b1] = cs;
         // Body 2: g's angle, P at its point s_P.
         let rp = rot(c2, self.s_p);

@@ -5,13 +5,12 @@
 //! w1 E e1 - w2 E e2 = v_B - v_A (and its derivative) with e1 = P - A, e2 = P - B, whose
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
-use super::angle::{rotation, Reference};
 use super::{put_acceleration, put_rate, Joint};
 use crate::kinematics::group_sigma::dyad_sigma;
 use crate::kinematics::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
 use crate::{KinematicsError, SingularityKind};
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -33,11 +32,13 @@ pub struct Rrr {
 }
 
 /// What the dyad keeps from the reference configuration: the side of AB that P is on (+1 to
-/// the left of A -> B) and the bodies' angles (the new angles are taken within pi of them).
+/// the left of A -> B) and the bodies' angles, each as a whole number of turns plus a
+/// remainder in (-pi, pi] (the new angles are taken within pi of them).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Branch {
     pub side: f64,
-    pub angles: [Reference; 2],
+    pub turns: [f64; 2],
+    pub rest: [f64; 2],
 }
 
 /// The dyad at its solved position, for the rates and accelerations: R s of A and B on their
@@ -89,8 +90,9 @@ impl Rrr {
         let [a, b] = self.outer.map(|j| link_state(j.link, x).point(j.s));
         let s_p = [self.s_outer[0][0] + self.arms[0][0], self.s_outer[0][1] + self.arms[0][1]];
         let p = link_state(Link::Body(BodyId(self.bodies[0])), x).point(s_p);
-        let angles = self.bodies.map(|i| Reference::new(x[3 * i + 2]));
-        Branch { side: cross(sub(b, a), sub(p, a)).signum(), angles }
+        let phi = self.bodies.map(|i| x[3 * i + 2]);
+        let turns = phi.map(|f| TAU * (f / TAU).round());
+        Branch { side: cross(sub(b, a), sub(p, a)).signum(), turns, rest: [phi[0] - turns[0], phi[1] - turns[1]] }
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved.
@@ -117,13 +119,21 @@ impl Rrr {
         let mut g = Geometry { known: [ra, rb], ..Geometry::default() };
         for (i, q) in [a, b].into_iter().enumerate() {
             // The rotation taking the arm in the body's frame to e = P - q in the world.
-            let e = sub(p, q);
-            let cs = rotation(self.arms[i], e);
+            let (arm, e) = (self.arms[i], sub(p, q));
+            let (c, s) = (dot(arm, e), cross(arm, e));
+            let r = (c * c + s * s).sqrt();
+            let cs = [c / r, s / r];
+            let mut turn = s.atan2(c) - branch.rest[i];
+            if turn > PI {
+                turn -= TAU;
+            } else if turn < -PI {
+                turn += TAU;
+            }
             let rs = rot(cs, self.s_outer[i]);
             let k = 3 * self.bodies[i];
             x[k] = q[0] - rs[0];
             x[k + 1] = q[1] - rs[1];
-            x[k + 2] = branch.angles[i].angle(cs);
+            x[k + 2] = branch.turns[i] + branch.rest[i] + turn;
             trig[self.bodies[i]] = cs;
             g.own[i] = rs;
             g.e[i] = e;
