@@ -128,7 +128,7 @@ fn both(mech: &Mechanism, cf: &mut ClosedForm, q: &[f64], qd: &[f64]) -> Option<
     cf.set_reference(&general.x);
     let mut closed = Workspace::new(mech);
     cf.kinematic_stages(q, qd, &mut closed).unwrap();
-    dynamic_stages(mech, 0.0, q, qd, &mut drives, &mut closed).unwrap();
+    dynamic_stages(mech, 0.0, &mut drives, &mut closed).unwrap();
     for ws in [&mut general, &mut closed] {
         mass_matrix(mech, ws);
     }

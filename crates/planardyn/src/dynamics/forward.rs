@@ -65,25 +65,29 @@ pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
-/// The user's coordinates, rates (and, with `xdd` filled, accelerations) from x, xd, xdd.
-/// In the input chart they are the chart's own z, zd (and zdd, in `ws.b`): D(x) = z to the
-/// Newton tolerance and D_x U = I, so they are copied rather than recomputed.
-fn user_coordinates(mech: &Mechanism, ws: &mut Workspace, z: &[f64], zd: &[f64], with_accelerations: bool) {
+/// The user's coordinates and rates from x, xd. In the input chart they are the chart's own
+/// z, zd: D(x) = z to the Newton tolerance and D_x U = I, so they are copied rather than
+/// recomputed.
+fn user_coordinates(mech: &Mechanism, ws: &mut Workspace, z: &[f64], zd: &[f64]) {
     if ws.chart == Chart::Inputs {
         ws.q.copy_from_slice(z);
         ws.qd.copy_from_slice(zd);
-        if with_accelerations {
-            ws.qdd.copy_from_slice(&ws.b);
-        }
+    } else {
+        coordinates(mech, &ws.x, &mut ws.q);
+        coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
+    }
+}
+
+/// The user's accelerations from x, xd and xdd; in the input chart the chart's own zdd, in
+/// `ws.b` (as [`user_coordinates`]).
+fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
+    if ws.chart == Chart::Inputs {
+        ws.qdd.copy_from_slice(&ws.b);
         return;
     }
-    coordinates(mech, &ws.x, &mut ws.q);
-    coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
-    if with_accelerations {
-        for (k, c) in mech.coordinates.iter().enumerate() {
-            let p = &mech.pairs[c.pair.0];
-            ws.qdd[k] = pair_coordinate_rate(p, &ws.x, &ws.xdd) + pair_coordinate_gamma(p, &ws.x, &ws.xd, &ws.xd);
-        }
+    for (k, c) in mech.coordinates.iter().enumerate() {
+        let p = &mech.pairs[c.pair.0];
+        ws.qdd[k] = pair_coordinate_rate(p, &ws.x, &ws.xdd) + pair_coordinate_gamma(p, &ws.x, &ws.xd, &ws.xd);
     }
 }
 
@@ -93,7 +97,7 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Worksp
     solve_position(mech, z, ws)?;
     velocity_analogues(ws)?;
     convective(mech, zd, ws);
-    user_coordinates(mech, ws, z, zd, false);
+    user_coordinates(mech, ws, z, zd);
     Ok(())
 }
 
@@ -110,19 +114,12 @@ pub fn forward(
     ws: &mut Workspace,
 ) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
-    dynamic_stages(mech, t, z, zd, drives, ws)
+    dynamic_stages(mech, t, drives, ws)
 }
 
 /// The stages of [`forward`] after the kinematic ones (whose results `ws` holds): forces,
 /// A, b, zdd, xdd and the user's accelerations.
-pub fn dynamic_stages(
-    mech: &Mechanism,
-    t: f64,
-    z: &[f64],
-    zd: &[f64],
-    drives: &mut dyn Drives,
-    ws: &mut Workspace,
-) -> Result<(), Error> {
+pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
     transmission::to_joint_efforts(mech, ws);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
@@ -130,11 +127,11 @@ pub fn dynamic_stages(
     mass_matrix(mech, ws);
     bias(mech, ws);
     if mech.has_losses() {
-        return Ok(forward_with_losses(mech, z, zd, ws)?);
+        return Ok(forward_with_losses(mech, ws)?);
     }
     factor_mass_matrix(ws)?;
     solve_mass_matrix(ws);
-    accelerations(mech, z, zd, ws);
+    accelerations(mech, ws);
     Ok(())
 }
 
@@ -174,10 +171,10 @@ pub(crate) fn solve_mass_matrix(ws: &mut Workspace) {
 }
 
 /// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd
-/// in `ws.b`, at chart state (z, zd).
-pub(crate) fn accelerations(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Workspace) {
+/// in `ws.b`, at the point of the kinematic stages.
+pub(crate) fn accelerations(mech: &Mechanism, ws: &mut Workspace) {
     body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
-    user_coordinates(mech, ws, z, zd, true);
+    user_accelerations(mech, ws);
 }
 
 /// xdd = U zdd + c: the body accelerations of chart accelerations zdd (U column-major,

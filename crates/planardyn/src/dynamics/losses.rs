@@ -195,14 +195,9 @@ fn step_friction(
 /// included) are in `ws`: rotor inertia into A and b, then zdd, xdd, qdd with the friction
 /// efforts settled; `ws.f` ends with the friction and the rotors' torques, `ws.power` with
 /// their power, `ws.dissipated` with the friction's.
-pub(crate) fn forward_with_losses(
-    mech: &Mechanism,
-    z: &[f64],
-    zd: &[f64],
-    ws: &mut Workspace,
-) -> Result<(), KinematicsError> {
+pub(crate) fn forward_with_losses(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
     let m = ws.b.len();
-    forward_with_losses_by(mech, z, zd, ws, &mut |ws| {
+    forward_with_losses_by(mech, ws, &mut |ws| {
         cholesky_solve(&ws.a, m, &mut ws.b);
         Ok(())
     })
@@ -213,22 +208,18 @@ pub(crate) fn forward_with_losses(
 /// efforts `solve` adds to `ws.f`. It runs once per fixed-point step.
 pub(crate) fn forward_with_losses_by(
     mech: &Mechanism,
-    z: &[f64],
-    zd: &[f64],
     ws: &mut Workspace,
     solve: &mut dyn FnMut(&mut Workspace) -> Result<(), KinematicsError>,
 ) -> Result<(), KinematicsError> {
     // Taken out of `ws` for the evaluation (no allocation: the buffers move), put back after.
     let mut lb = std::mem::take(&mut ws.losses);
-    let result = forward_stages(mech, z, zd, ws, &mut lb, solve);
+    let result = forward_stages(mech, ws, &mut lb, solve);
     ws.losses = lb;
     result
 }
 
 fn forward_stages(
     mech: &Mechanism,
-    z: &[f64],
-    zd: &[f64],
     ws: &mut Workspace,
     lb: &mut LossBuffers,
     solve: &mut dyn FnMut(&mut Workspace) -> Result<(), KinematicsError>,
@@ -261,7 +252,7 @@ fn forward_stages(
             break;
         }
     }
-    accelerations(mech, z, zd, ws);
+    accelerations(mech, ws);
     let friction_power: f64 = lb.e.iter().zip(&lb.rates).map(|(e, r)| e * r).sum();
     let rotor_power: f64 = lb.rotor_torques.iter().zip(&lb.rotor_rates).map(|(t, v)| -t * v).sum();
     ws.power += friction_power + rotor_power;

@@ -103,11 +103,11 @@ pub fn forward_prescribed(
     bias(mech, ws);
     prescribed_rows(mech, p, qdd_p, ws, w);
     if mech.has_losses() {
-        forward_with_losses_by(mech, z, zd, ws, &mut |ws| solve_prescribed(p, w, ws))?;
+        forward_with_losses_by(mech, ws, &mut |ws| solve_prescribed(p, w, ws))?;
     } else {
         factor_mass_matrix(ws)?;
         solve_prescribed(p, w, ws)?;
-        accelerations(mech, z, zd, ws);
+        accelerations(mech, ws);
     }
     for (&k, &tau) in p.iter().zip(&w.h) {
         ws.tau[k] = tau;

@@ -20,7 +20,8 @@ pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
 pub use pairs::{pair_geometry, PairGeometry};
 pub use position::{
-    assemble, assemble_from, assemble_into, continue_to, scaled_distance, solve_position, MAX_CORRECTION, POSITION_TOL,
+    assemble, assemble_from, assemble_into, continue_to, scaled_distance, scaled_distances, solve_position,
+    MAX_CORRECTION, POSITION_TOL,
 };
 pub use singularity::{passive_sigma_min, select_partition, sigma_min, sigma_min_with};
 pub use system::System;

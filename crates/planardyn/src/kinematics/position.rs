@@ -137,7 +137,21 @@ pub const MAX_CONTINUATION_DISTANCE: f64 = 1e3;
 
 /// Largest scaled difference between two body-coordinate vectors.
 pub fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {
-    a.iter().zip(b).zip(col_scale).fold(0.0, |m: f64, ((x, y), s)| m.max((x - y).abs() / s))
+    let [d] = scaled_distances(a, [b], col_scale);
+    d
+}
+
+/// [`scaled_distance`] of `a` from each of `bs`, in one pass.
+#[inline]
+pub fn scaled_distances<const K: usize>(a: &[f64], bs: [&[f64]; K], col_scale: &[f64]) -> [f64; K] {
+    let bs = bs.map(|b| &b[..a.len()]);
+    let mut d = [0.0_f64; K];
+    for (i, (x, s)) in a.iter().zip(col_scale).enumerate() {
+        for (d, b) in d.iter_mut().zip(bs) {
+            *d = d.max((x - b[i]).abs() / s);
+        }
+    }
+    d
 }
 
 /// Move the solution in `ws` (converged at `z_from` in the input chart) to the user

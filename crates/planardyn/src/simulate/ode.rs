@@ -5,7 +5,7 @@
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{add_u_times, scaled_distance, Chart, ClosedForm, System, MAX_CORRECTION};
+use crate::kinematics::{add_u_times, scaled_distances, Chart, ClosedForm, System, MAX_CORRECTION};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
@@ -231,18 +231,20 @@ impl<'a> MechanismOde<'a> {
             ws.rhs.fill(0.0);
             let last = &self.last_y;
             add_u_times(&ws.u, ws.sys.u_support(), |j| z[j] - last[j], &mut ws.rhs);
-            match self.closed.as_ref().filter(|_| closed) {
+            // tmp = w(dz, dz) from the closed forms' accelerations, -w(dz, dz) = J^-1 gamma(dz, dz) by J.
+            let half = match self.closed.as_ref().filter(|_| closed) {
                 Some(c) => {
                     c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
-                    ws.tmp.iter_mut().for_each(|w| *w = -*w);
+                    0.5
                 }
                 None => {
                     gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
                     ws.sys.solve(&mut ws.tmp);
+                    -0.5
                 }
-            }
+            };
             for ((x, d), w) in ws.x.iter_mut().zip(&ws.rhs).zip(&ws.tmp) {
-                *x += d - 0.5 * w;
+                *x += d + half * w;
             }
         } else {
             ws.x.copy_from_slice(&self.anchor_x);
@@ -302,18 +304,18 @@ impl<'a> MechanismOde<'a> {
                 if reactions {
                     let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
                 }
-                dynamic_stages(self.mech, t, z, zd, self.drives, ws)
+                dynamic_stages(self.mech, t, self.drives, ws)
             }),
             (_, None) => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
             (_, Some(motion)) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),
         };
         if outcome.is_ok() {
-            let correction = scaled_distance(&self.ws.x, &self.predicted, self.ws.sys.group_col_scale());
-            let moved = scaled_distance(&self.ws.x, &self.base, self.ws.sys.group_col_scale());
-            let approach = if self.max_approach < f64::INFINITY {
-                scaled_distance(&self.ws.x, &self.anchor_x, self.ws.sys.group_col_scale())
+            let (x, scale) = (&self.ws.x, self.ws.sys.group_col_scale());
+            let [correction, moved, approach] = if self.max_approach < f64::INFINITY {
+                scaled_distances(x, [&self.predicted, &self.base, &self.anchor_x], scale)
             } else {
-                0.0
+                let [correction, moved] = scaled_distances(x, [&self.predicted, &self.base], scale);
+                [correction, moved, 0.0]
             };
             let residual = if moved > self.max_move { moved } else { correction };
             if moved > self.max_move || correction > self.max_correction || approach > self.max_approach {
