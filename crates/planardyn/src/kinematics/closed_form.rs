@@ -14,26 +14,30 @@ use super::dyads::crank::Crank;
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
+use super::dyads::triad::Triad;
 use super::dyads::Joint;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
-use crate::structure::assur;
+use crate::structure::assur::{self, AssurGroup};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// A class II dyad of a kind with a closed form, with the branch of its reference
-/// configuration and its geometry at the last positions (for the rates and accelerations).
+/// configuration and its geometry at the last positions (for the rates and accelerations),
+/// or the class III triad (which keeps its own).
 #[derive(Debug, Clone)]
 enum Dyad {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
     Rrp(Rrp, rrp::Branch, rrp::Geometry),
+    Triad(Box<Triad>),
 }
 
 impl Dyad {
-    fn bodies(&self) -> [usize; 2] {
+    fn bodies(&self) -> &[usize] {
         match self {
-            Dyad::Rrr(d, ..) => d.bodies,
-            Dyad::Rrp(d, ..) => d.bodies,
+            Dyad::Rrr(d, ..) => &d.bodies,
+            Dyad::Rrp(d, ..) => &d.bodies,
+            Dyad::Triad(t) => &t.bodies,
         }
     }
 
@@ -41,6 +45,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, _) => *b = d.branch(x),
             Dyad::Rrp(d, b, _) => *b = d.branch(x),
+            Dyad::Triad(t) => t.set_reference(x),
         }
     }
 
@@ -48,6 +53,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, _) => d.keeps_side(b, x),
             Dyad::Rrp(d, b, _) => d.keeps_side(b, x),
+            Dyad::Triad(t) => t.keeps_side(x),
         }
     }
 
@@ -55,6 +61,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(_, _, g) => g.sigma(inv_length),
             Dyad::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
+            Dyad::Triad(t) => t.sigma(inv_length),
         }
     }
 
@@ -63,6 +70,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
             Dyad::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
+            Dyad::Triad(t) => t.position(x, trig)?,
         }
         Ok(())
     }
@@ -72,6 +80,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, _, g) => d.velocity(g, v),
             Dyad::Rrp(d, _, g) => d.velocity(g, v),
+            Dyad::Triad(t) => t.velocity(v),
         }
     }
 
@@ -80,6 +89,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, _, g) => d.acceleration(g, v, a),
             Dyad::Rrp(d, _, g) => d.acceleration(g, v, a),
+            Dyad::Triad(t) => t.acceleration(v, a),
         }
     }
 }
@@ -103,6 +113,44 @@ fn ends(mech: &Mechanism, pair: PairId, body: usize) -> ([f64; 2], Joint) {
     } else {
         (p.sb, Joint { link: p.a, s: p.sa })
     }
+}
+
+/// The triad of six revolute pairs `g` (class III): three legs, each hinged to the platform and
+/// to a link solved before, and the platform (the link of the three inner pairs).
+fn triad(mech: &Mechanism, g: &AssurGroup) -> Option<Triad> {
+    let pairs = || g.inner_pairs.iter().chain(&g.outer_pairs);
+    if g.links.len() != 4
+        || g.links.iter().any(|l| l.len() != 1)
+        || g.inner_pairs.len() != 3
+        || g.outer_pairs.len() != 3
+    {
+        return None;
+    }
+    if pairs().any(|k| mech.pairs[k.0].kind != PairKind::Revolute) {
+        return None;
+    }
+    let on = |k: &&PairId, b: usize| {
+        let p = &mech.pairs[k.0];
+        p.a == Link::Body(BodyId(b)) || p.b == Link::Body(BodyId(b))
+    };
+    let bodies: Vec<usize> = g.links.iter().map(|l| l[0].0).collect();
+    let platform = *bodies.iter().find(|&&b| g.inner_pairs.iter().all(|k| on(&k, b)))?;
+    let legs: Vec<usize> = bodies.into_iter().filter(|&b| b != platform).collect();
+    let (mut outer, mut s_outer, mut s_inner, mut s_platform) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for &leg in &legs {
+        let (o, i) = (g.outer_pairs.iter().find(|k| on(k, leg))?, g.inner_pairs.iter().find(|k| on(k, leg))?);
+        let (s, a) = ends(mech, *o, leg);
+        (
+            outer.push(a),
+            s_outer.push(s),
+            s_inner.push(ends(mech, *i, leg).0),
+            s_platform.push(ends(mech, *i, platform).0),
+        );
+    }
+    let bodies = [legs[0], legs[1], legs[2], platform];
+    let three = |v: Vec<[f64; 2]>| -> Option<[[f64; 2]; 3]> { v.try_into().ok() };
+    let outer: [Joint; 3] = outer.try_into().ok()?;
+    Some(Triad::new(bodies, outer, three(s_outer)?, three(s_inner)?, three(s_platform)?, mech.scale))
 }
 
 impl ClosedForm {
@@ -144,6 +192,11 @@ impl ClosedForm {
         let mut dyads = Vec::new();
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
+            if g.class == 3 {
+                dyads.push(Dyad::Triad(Box::new(triad(mech, g)?)));
+                pairs_used += 6;
+                continue;
+            }
             let [inner] = g.inner_pairs.as_slice() else { return None };
             if g.class != 2 || g.links.iter().any(|l| l.len() != 1) || !revolute(*inner) {
                 return None;
@@ -182,13 +235,13 @@ impl ClosedForm {
             .iter()
             .map(|c| c.body)
             .chain(sliders.iter().map(|s| s.body))
-            .chain(dyads.iter().flat_map(Dyad::bodies))
+            .chain(dyads.iter().flat_map(|d| d.bodies().iter().copied()))
             .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
         dyads.iter_mut().for_each(|d| d.set_reference(&mech.x0));
-        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, &d.bodies())).collect();
+        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
         Some(ClosedForm { cranks, sliders, dyads, inv_length, inputs_sigma })
     }
 

@@ -9,6 +9,7 @@ pub mod crank;
 pub mod rrp;
 pub mod rrr;
 pub mod slider;
+pub mod triad;
 
 use super::pairs::frames::rot;
 use crate::model::Link;
