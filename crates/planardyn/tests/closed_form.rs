@@ -11,7 +11,7 @@
 //! with the bounds (printed with --nocapture).
 
 use planardyn::dynamics::{dynamic_stages, forward, mass_matrix, ModelDrives};
-use planardyn::kinematics::{assemble_into, sigma_min, Chart, ClosedForm};
+use planardyn::kinematics::{assemble_from, assemble_into, sigma_min, velocity_analogues, Chart, ClosedForm};
 use planardyn::model::CoordinateKind;
 use planardyn::{KinematicsError, Mechanism, Workspace};
 use std::path::{Path, PathBuf};
@@ -326,4 +326,65 @@ fn an_rrp_predictor_past_its_fold_is_recognised() {
     assert!(cf.keeps_branches(&turned(-half + 1e-3)));
     assert!(!cf.keeps_branches(&turned(-half - 1e-3)));
     assert!(!cf.keeps_branches(&turned(std::f64::consts::PI - alpha0)));
+}
+
+#[test]
+fn a_triad_keeps_the_branch_of_its_reference() {
+    // The 3-RRR's platform has another assembly mode at the drawn inputs, turned by 1.28 rad
+    // about its (unmoved) centre: Newton on the triad from the drawing's platform turned by
+    // 1 rad lands on it. From a reference on either mode, the closed form at nearby inputs
+    // stays on that mode: equal to the general path's Newton continued from it.
+    let mech = planardyn::load(root().join("examples/models/3-rrr.yaml").to_str().unwrap()).unwrap();
+    let platform = 3 * mech.bodies.iter().position(|b| b.name == "platform").unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    let (q0, qd0) = mech.initial_state();
+    let mut ws = Workspace::new(&mech);
+    let mut turned = mech.x0.clone();
+    turned[platform + 2] += 1.0;
+    cf.set_reference(&turned);
+    cf.kinematic_stages(&q0, &qd0, &mut ws).unwrap();
+    let other = ws.x.clone();
+    let mut general = Workspace::new(&mech);
+    assemble_from(&mech, &other, &q0, &mut general).unwrap();
+    let d = other.iter().zip(&general.x).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(d < 1e-12, "the other mode is not a solution: Newton moves it by {d:e}");
+    assert!((other[platform + 2] - mech.x0[platform + 2] - 1.2810446253588).abs() < 1e-9, "{}", other[platform + 2]);
+    let q1: Vec<f64> = q0.iter().map(|v| v + 0.02).collect();
+    for reference in [&mech.x0, &other] {
+        cf.set_reference(reference);
+        cf.kinematic_stages(&q1, &qd0, &mut ws).unwrap();
+        assemble_from(&mech, reference, &q1, &mut general).unwrap();
+        let d = ws.x.iter().zip(&general.x).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(d < 1e-12, "closed form and Newton differ by {d:e}");
+        assert!(ws.x.iter().zip(reference).all(|(a, b)| (a - b).abs() < 0.1));
+    }
+}
+
+#[test]
+fn a_predictor_past_a_triads_singularity_is_recognised() {
+    // The 3-RRR with every input turned by t from the drawing passes a type II singularity of
+    // its triad near t = 0.84 (the distal links' lines meet in a point): the measure falls
+    // from 0.033 at t = 0.75 to 0.003 at 0.85 and rises again. From the reference at 0.75,
+    // the first-order predictor x + U dq to 0.78 keeps the side of the singularity, one to
+    // 0.90 does not, nor does the solution the general path's continuation finds there.
+    let mech = planardyn::load(root().join("examples/models/3-rrr.yaml").to_str().unwrap()).unwrap();
+    let mut cf = ClosedForm::new(&mech).unwrap();
+    let (q0, _) = mech.initial_state();
+    let at = |t: f64| -> Workspace {
+        let mut ws = Workspace::new(&mech);
+        assemble_into(&mech, &q0.iter().map(|v| v + t).collect::<Vec<_>>(), &mut ws).unwrap();
+        velocity_analogues(&mut ws).unwrap();
+        ws
+    };
+    let (before, near, past) = (at(0.75), at(0.85), at(0.90));
+    assert!(sigma_min(&mech, &Chart::Inputs, &near.x) < 0.01);
+    cf.set_reference(&before.x);
+    assert!(cf.keeps_branches(&before.x));
+    let n = before.x.len();
+    let predicted = |dt: f64| -> Vec<f64> {
+        (0..n).map(|i| before.x[i] + dt * (0..3).map(|j| before.u[j * n + i]).sum::<f64>()).collect()
+    };
+    assert!(cf.keeps_branches(&predicted(0.03)));
+    assert!(!cf.keeps_branches(&predicted(0.15)));
+    assert!(!cf.keeps_branches(&past.x));
 }

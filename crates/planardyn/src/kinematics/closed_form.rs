@@ -136,21 +136,14 @@ fn triad(mech: &Mechanism, g: &AssurGroup) -> Option<Triad> {
     let bodies: Vec<usize> = g.links.iter().map(|l| l[0].0).collect();
     let platform = *bodies.iter().find(|&&b| g.inner_pairs.iter().all(|k| on(&k, b)))?;
     let legs: Vec<usize> = bodies.into_iter().filter(|&b| b != platform).collect();
-    let (mut outer, mut s_outer, mut s_inner, mut s_platform) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for &leg in &legs {
-        let (o, i) = (g.outer_pairs.iter().find(|k| on(k, leg))?, g.inner_pairs.iter().find(|k| on(k, leg))?);
-        let (s, a) = ends(mech, *o, leg);
-        (
-            outer.push(a),
-            s_outer.push(s),
-            s_inner.push(ends(mech, *i, leg).0),
-            s_platform.push(ends(mech, *i, platform).0),
-        );
+    let (mut outer, mut s_outer) = ([Joint { link: Link::Ground, s: [0.0; 2] }; 3], [[0.0; 2]; 3]);
+    let (mut s_inner, mut s_platform) = ([[0.0; 2]; 3], [[0.0; 2]; 3]);
+    for (i, &leg) in legs.iter().enumerate() {
+        let (o, k) = (g.outer_pairs.iter().find(|k| on(k, leg))?, g.inner_pairs.iter().find(|k| on(k, leg))?);
+        (s_outer[i], outer[i]) = ends(mech, *o, leg);
+        (s_inner[i], s_platform[i]) = (ends(mech, *k, leg).0, ends(mech, *k, platform).0);
     }
-    let bodies = [legs[0], legs[1], legs[2], platform];
-    let three = |v: Vec<[f64; 2]>| -> Option<[[f64; 2]; 3]> { v.try_into().ok() };
-    let outer: [Joint; 3] = outer.try_into().ok()?;
-    Some(Triad::new(bodies, outer, three(s_outer)?, three(s_inner)?, three(s_platform)?, mech.scale))
+    Some(Triad::new([legs[0], legs[1], legs[2], platform], outer, s_outer, s_inner, s_platform, mech.scale))
 }
 
 impl ClosedForm {

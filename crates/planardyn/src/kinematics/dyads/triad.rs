@@ -230,10 +230,10 @@ impl Triad {
         let [vx, vy, w] = times(&g.inv, [0, 1, 2].map(|i| dot(g.e[i], va[i])));
         let p = self.bodies[3];
         v[3 * p..3 * p + 3].copy_from_slice(&[vx, vy, w]);
-        for i in 0..3 {
+        for (i, &leg) in self.bodies[..3].iter().enumerate() {
             let vc = [vx - w * g.lever[i][1], vy + w * g.lever[i][0]];
             let wl = cross(g.e[i], sub(vc, va[i])) * g.inv_e2[i];
-            put_rate(v, self.bodies[i], va[i], g.own[i], wl);
+            put_rate(v, leg, va[i], g.own[i], wl);
         }
     }
 
@@ -255,10 +255,9 @@ impl Triad {
         }
         let [ax, ay, al] = times(&g.inv, rhs);
         a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
-        for i in 0..3 {
+        for (i, &b) in self.bodies[..3].iter().enumerate() {
             let l = g.lever[i];
             let ac = [ax - al * l[1] - w * w * l[0], ay + al * l[0] - w * w * l[1]];
-            let b = self.bodies[i];
             let all = cross(g.e[i], sub(ac, aa[i])) * g.inv_e2[i];
             put_acceleration(a, b, aa[i], g.own[i], v[3 * b + 2], all);
         }
