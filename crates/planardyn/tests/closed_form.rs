@@ -104,13 +104,15 @@ fn shipped_models_with_closed_forms() {
 
 /// The shipped models made of input links (revolute, or sliders on the ground) and RRR and RRP
 /// dyads only.
-const CLOSED: [&str; 15] = [
+const CLOSED: [&str; 17] = [
     "3-rrr",
     "andrews-squeezer",
     "five-bar-free-fall",
     "five-bar",
     "four-bar-gravity",
+    "hydraulic-boom",
     "library/3-prr",
+    "library/3-rpr",
     "library/3-rrr",
     "library/biglide",
     "library/five-bar-5r",
@@ -387,4 +389,31 @@ fn a_predictor_past_a_triads_singularity_is_recognised() {
     assert!(cf.keeps_branches(&predicted(0.03)));
     assert!(!cf.keeps_branches(&predicted(0.15)));
     assert!(!cf.keeps_branches(&past.x));
+}
+
+/// A boom lifted by a cylinder whose rod is bent: the boom's eye R is off the guide's line
+/// (G -> E), so the arm G -> R of the locked barrel + rod turns in the barrel's frame as the
+/// input grows. `{ab}` orders the prismatic pair's bodies (the guide fixed in the barrel or in
+/// the rod) and `{eye}` puts R on the rod (it slides with the input) or on the barrel (the rod
+/// only rides along: its block in J is then its own, and the model takes the general path).
+const BENT_CYLINDER: &str = "name: bent cylinder\ngravity: [0, -9.81]\n\
+points: {O: [0, 0], R: [1.5, 0.4], G: [0.9, -0.5], E: [1.2, 0.1], K: [1.05, -0.2]}\nground: [O, G]\nbodies:\n  \
+boom: {points: [O, R], uniform_bar: [O, R], mass: 5.0}\n  \
+barrel: {points: [G, E, K, R], uniform_bar: [G, E], mass: 2.0}\n  \
+rod: {points: [K, R], uniform_bar: [K, R], mass: 1.0}\npairs:\n  \
+- {type: revolute, name: boom_pivot, at: O, bodies: [ground, boom]}\n  \
+- {type: revolute, name: barrel_pivot, at: G, bodies: [ground, barrel]}\n  \
+- {type: prismatic, name: cylinder, at: K, bodies: {ab}, axis: [0.3, 0.6]}\n  \
+- {type: revolute, at: R, bodies: [{eye}, boom]}\n\
+coordinates:\n  - {name: extension, pair: cylinder, value: 0.7}\n";
+
+#[test]
+fn relative_input_on_a_bent_cylinder_every_way() {
+    let mut rng = Rng(0x1234_5678_9abc_def1);
+    for ab in ["[barrel, rod]", "[rod, barrel]"] {
+        let mech = common::yaml(&BENT_CYLINDER.replace("{ab}", ab).replace("{eye}", "rod"));
+        compare(&format!("bent cylinder {ab}"), &mech, &mut rng, MIN_SIGMA);
+        let riding = common::yaml(&BENT_CYLINDER.replace("{ab}", ab).replace("{eye}", "barrel"));
+        assert!(ClosedForm::new(&riding).is_none());
+    }
 }

@@ -11,6 +11,8 @@
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
+use super::dyads::extended_rrr::ExtendedRrr;
+use super::dyads::extension::{Arm, Extension};
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
@@ -29,6 +31,7 @@ use crate::KinematicsError;
 enum Dyad {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
     Rrp(Rrp, rrp::Branch, rrp::Geometry),
+    Extended(Box<ExtendedRrr>),
     Triad(Box<Triad>),
 }
 
@@ -37,7 +40,8 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, ..) => &d.bodies,
             Dyad::Rrp(d, ..) => &d.bodies,
-            Dyad::Triad(t) => &t.bodies,
+            Dyad::Extended(d) => &d.members,
+            Dyad::Triad(t) => &t.members,
         }
     }
 
@@ -45,6 +49,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, _) => *b = d.branch(x),
             Dyad::Rrp(d, b, _) => *b = d.branch(x),
+            Dyad::Extended(d) => d.set_reference(x),
             Dyad::Triad(t) => t.set_reference(x),
         }
     }
@@ -53,6 +58,7 @@ impl Dyad {
         match self {
             Dyad::Rrr(d, b, _) => d.keeps_side(b, x),
             Dyad::Rrp(d, b, _) => d.keeps_side(b, x),
+            Dyad::Extended(d) => d.keeps_side(x),
             Dyad::Triad(t) => t.keeps_side(x),
         }
     }
@@ -61,34 +67,38 @@ impl Dyad {
         match self {
             Dyad::Rrr(_, _, g) => g.sigma(inv_length),
             Dyad::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
+            Dyad::Extended(d) => d.sigma(inv_length),
             Dyad::Triad(t) => t.sigma(inv_length),
         }
     }
 
     #[inline]
-    fn position(&mut self, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+    fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         match self {
             Dyad::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
             Dyad::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
-            Dyad::Triad(t) => t.position(x, trig)?,
+            Dyad::Extended(d) => d.position(z, x, trig)?,
+            Dyad::Triad(t) => t.position(z, x, trig)?,
         }
         Ok(())
     }
 
     #[inline]
-    fn velocity(&self, v: &mut [f64]) {
+    fn velocity(&self, zd: &[f64], v: &mut [f64]) {
         match self {
-            Dyad::Rrr(d, _, g) => d.velocity(g, v),
+            Dyad::Rrr(d, _, g) => d.velocity(g, [[0.0; 2]; 2], v),
             Dyad::Rrp(d, _, g) => d.velocity(g, v),
-            Dyad::Triad(t) => t.velocity(v),
+            Dyad::Extended(d) => d.velocity(zd, v),
+            Dyad::Triad(t) => t.velocity(zd, v),
         }
     }
 
     #[inline]
     fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         match self {
-            Dyad::Rrr(d, _, g) => d.acceleration(g, v, a),
+            Dyad::Rrr(d, _, g) => d.acceleration(g, [[0.0; 2]; 2], v, a),
             Dyad::Rrp(d, _, g) => d.acceleration(g, v, a),
+            Dyad::Extended(d) => d.acceleration(v, a),
             Dyad::Triad(t) => t.acceleration(v, a),
         }
     }
@@ -115,35 +125,87 @@ fn ends(mech: &Mechanism, pair: PairId, body: usize) -> ([f64; 2], Joint) {
     }
 }
 
-/// The triad of six revolute pairs `g` (class III): three legs, each hinged to the platform and
-/// to a link solved before, and the platform (the link of the three inner pairs).
-fn triad(mech: &Mechanism, g: &AssurGroup) -> Option<Triad> {
-    let pairs = || g.inner_pairs.iter().chain(&g.outer_pairs);
-    if g.links.len() != 4
-        || g.links.iter().any(|l| l.len() != 1)
-        || g.inner_pairs.len() != 3
-        || g.outer_pairs.len() != 3
-    {
-        return None;
-    }
-    if pairs().any(|k| mech.pairs[k.0].kind != PairKind::Revolute) {
-        return None;
-    }
-    let on = |k: &&PairId, b: usize| {
-        let p = &mech.pairs[k.0];
-        p.a == Link::Body(BodyId(b)) || p.b == Link::Body(BodyId(b))
+/// Whether pair k joins body b.
+fn on(mech: &Mechanism, k: PairId, b: usize) -> bool {
+    let p = &mech.pairs[k.0];
+    p.a == Link::Body(BodyId(b)) || p.b == Link::Body(BodyId(b))
+}
+
+/// A group link's base (its body of the group's outer pair), that pair, the body holding
+/// `inner` (a pair to another link of the group) and the base's point of each pair; and if the
+/// link is two bodies, their relative input with the arm between the two points.
+struct LinkParts {
+    base: usize,
+    outer: Joint,
+    s_outer: [f64; 2],
+    s_inner: [f64; 2],
+    arm: Option<Arm>,
+}
+
+fn link_parts(mech: &Mechanism, link: &[BodyId], outer: &[PairId], inner: PairId) -> Option<LinkParts> {
+    let base = link.iter().map(|b| b.0).find(|&b| outer.iter().any(|&k| on(mech, k, b)))?;
+    let o = *outer.iter().find(|&&k| on(mech, k, base))?;
+    let holder = link.iter().map(|b| b.0).find(|&b| on(mech, inner, b))?;
+    let (s_outer, joint) = ends(mech, o, base);
+    let s_inner = ends(mech, inner, holder).0;
+    let arm = match link {
+        [_] => None,
+        [_, _] => {
+            let follower = link.iter().map(|b| b.0).find(|&b| b != base)?;
+            if outer.iter().any(|&k| on(mech, k, follower)) {
+                return None;
+            }
+            let joins = |c: &crate::model::Coordinate| on(mech, c.pair, base) && on(mech, c.pair, follower);
+            let k = mech.coordinates.iter().position(joins)?;
+            if holder != follower {
+                return None; // its follower has a block of its own in J (`Arm`)
+            }
+            Some(Arm::new(Extension::new(mech, k, base)?, s_outer, s_inner))
+        }
+        _ => return None,
     };
-    let bodies: Vec<usize> = g.links.iter().map(|l| l[0].0).collect();
-    let platform = *bodies.iter().find(|&&b| g.inner_pairs.iter().all(|k| on(&k, b)))?;
-    let legs: Vec<usize> = bodies.into_iter().filter(|&b| b != platform).collect();
-    let (mut outer, mut s_outer) = ([Joint { link: Link::Ground, s: [0.0; 2] }; 3], [[0.0; 2]; 3]);
-    let (mut s_inner, mut s_platform) = ([[0.0; 2]; 3], [[0.0; 2]; 3]);
-    for (i, &leg) in legs.iter().enumerate() {
-        let (o, k) = (g.outer_pairs.iter().find(|k| on(k, leg))?, g.inner_pairs.iter().find(|k| on(k, leg))?);
-        (s_outer[i], outer[i]) = ends(mech, *o, leg);
-        (s_inner[i], s_platform[i]) = (ends(mech, *k, leg).0, ends(mech, *k, platform).0);
+    // The inner point in the base's frame (at the drawn input for a two-body link).
+    let s_inner = arm.as_ref().map_or(s_inner, |a| {
+        let d = a.arm(0.0);
+        [s_outer[0] + d[0], s_outer[1] + d[1]]
+    });
+    Some(LinkParts { base, outer: joint, s_outer, s_inner, arm })
+}
+
+/// The RRR dyad `g` with one or two links of two bodies (a relative input each).
+fn extended_rrr(mech: &Mechanism, g: &AssurGroup) -> Option<ExtendedRrr> {
+    let [inner] = g.inner_pairs.as_slice() else { return None };
+    if g.kind != "RRR" || g.links.len() != 2 || mech.pairs[inner.0].kind != PairKind::Revolute {
+        return None;
     }
-    Some(Triad::new([legs[0], legs[1], legs[2], platform], outer, s_outer, s_inner, s_platform, mech.scale))
+    let [l1, l2] = [0, 1].map(|i| link_parts(mech, &g.links[i], &g.outer_pairs, *inner));
+    let (l1, l2) = (l1?, l2?);
+    let rrr = Rrr::new([l1.base, l2.base], [l1.outer, l2.outer], [l1.s_outer, l2.s_outer], [l1.s_inner, l2.s_inner]);
+    Some(ExtendedRrr::new(rrr, [l1.arm, l2.arm]))
+}
+
+/// The triad of six revolute pairs `g` (class III): three legs, each hinged to the platform and
+/// to a link solved before (each one body, or two a relative input locks), and the platform
+/// (the link of the three inner pairs).
+fn triad(mech: &Mechanism, g: &AssurGroup) -> Option<Triad> {
+    if g.links.len() != 4 || g.inner_pairs.len() != 3 || g.outer_pairs.len() != 3 {
+        return None;
+    }
+    if g.inner_pairs.iter().chain(&g.outer_pairs).any(|k| mech.pairs[k.0].kind != PairKind::Revolute) {
+        return None;
+    }
+    let platform = g.links.iter().position(|l| l.len() == 1 && g.inner_pairs.iter().all(|&k| on(mech, k, l[0].0)))?;
+    let p = g.links[platform][0].0;
+    let (mut bodies, mut outer) = ([p; 4], [Joint { link: Link::Ground, s: [0.0; 2] }; 3]);
+    let mut s = [[[0.0; 2]; 3]; 3];
+    let mut extended = [None, None, None];
+    for (i, link) in g.links.iter().enumerate().filter(|(j, _)| *j != platform).map(|(_, l)| l).enumerate() {
+        let inner = *g.inner_pairs.iter().find(|&&k| link.iter().any(|b| on(mech, k, b.0)))?;
+        let parts = link_parts(mech, link, &g.outer_pairs, inner)?;
+        (bodies[i], outer[i], extended[i]) = (parts.base, parts.outer, parts.arm);
+        (s[0][i], s[1][i], s[2][i]) = (parts.s_outer, parts.s_inner, ends(mech, inner, p).0);
+    }
+    Some(Triad::new(bodies, outer, s, extended, mech.scale))
 }
 
 impl ClosedForm {
@@ -151,7 +213,7 @@ impl ClosedForm {
     /// branches are those of the drawing until [`ClosedForm::set_reference`].
     pub fn new(mech: &Mechanism) -> Option<Self> {
         let decomposition = assur::assur(mech);
-        if !decomposition.relative_inputs.is_empty() || !decomposition.left_over.is_empty() {
+        if !decomposition.left_over.is_empty() {
             return None;
         }
         let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
@@ -161,6 +223,8 @@ impl ClosedForm {
             let p = &mech.pairs[c.pair.0];
             let body = match (p.a, p.b) {
                 (Link::Ground, Link::Body(b)) | (Link::Body(b), Link::Ground) => b.0,
+                // A relative prismatic input: its group solves it (`Extension`).
+                (Link::Body(_), Link::Body(_)) if matches!(p.kind, PairKind::Prismatic { .. }) => continue,
                 _ => return None,
             };
             let (s, ground) = ends(mech, c.pair, body);
@@ -185,6 +249,11 @@ impl ClosedForm {
         let mut dyads = Vec::new();
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
+            if g.class == 2 && g.links.iter().any(|l| l.len() == 2) {
+                dyads.push(Dyad::Extended(Box::new(extended_rrr(mech, g)?)));
+                pairs_used += 3;
+                continue;
+            }
             if g.class == 3 {
                 dyads.push(Dyad::Triad(Box::new(triad(mech, g)?)));
                 pairs_used += 6;
@@ -267,7 +336,7 @@ impl ClosedForm {
             s.position(z, &mut ws.x, &mut ws.trig);
         }
         for d in &mut self.dyads {
-            d.position(&mut ws.x, &mut ws.trig)?;
+            d.position(z, &mut ws.x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -283,13 +352,13 @@ impl ClosedForm {
             s.velocity(zd, v);
         }
         for d in &self.dyads {
-            d.velocity(v);
+            d.velocity(zd, v);
         }
     }
 
     /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
     pub fn velocity_analogues(&self, ws: &mut Workspace) {
-        let (n, m) = (ws.x.len(), self.cranks.len() + self.sliders.len());
+        let (n, m) = (ws.x.len(), ws.q.len());
         // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
         let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
         unit[..m].fill(0.0);

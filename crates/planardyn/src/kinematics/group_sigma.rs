@@ -21,6 +21,7 @@
 //! takes the SVD of each block (s^3), never of the whole J.
 
 use super::constraints::Chart;
+use super::pairs::frames::perp;
 use super::system::fill_row_scale;
 use crate::linalg::BlockLu;
 use crate::model::diameter::diameter;
@@ -241,4 +242,44 @@ pub(crate) fn dyad_sigma(a: [f64; 2], b: [f64; 2], p1: [f64; 2], p2: [f64; 2]) -
         (f, df) = mu(l);
     }
     l.max(0.0).sqrt()
+}
+
+/// A group's block at its own length for a fixed-size SVD, where its measure has no closed
+/// form: columns (r, phi) of each of its bodies (by place), rows added a pair at a time; as in
+/// [`dyad_sigma`], translations enter as +-1 and angles by their lever arms R s / L_k.
+pub(crate) struct Block {
+    m: DMatrix<f64>,
+    row: usize,
+    inv_length: f64,
+}
+
+impl Block {
+    /// The block of a group of `bodies` bodies, 1 / L_k = `inv_length`.
+    pub fn new(bodies: usize, inv_length: f64) -> Self {
+        Block { m: DMatrix::zeros(3 * bodies, 3 * bodies), row: 0, inv_length }
+    }
+
+    /// The two rows of a point's coincidence: per body of the group holding it (its place,
+    /// the sign, and R s, the point less the body's centre).
+    pub fn point_rows(&mut self, ends: &[(usize, f64, [f64; 2])]) {
+        for &(b, sign, arm) in ends {
+            let e = perp(arm);
+            for k in 0..2 {
+                self.m[(self.row + k, 3 * b + k)] = sign;
+                self.m[(self.row + k, 3 * b + 2)] = sign * e[k] * self.inv_length;
+            }
+        }
+        self.row += 2;
+    }
+
+    /// The row of two bodies' equal angles.
+    pub fn angle_row(&mut self, a: usize, b: usize) {
+        (self.m[(self.row, 3 * a + 2)], self.m[(self.row, 3 * b + 2)]) = (-1.0, 1.0);
+        self.row += 1;
+    }
+
+    /// Its smallest singular value.
+    pub fn sigma(self) -> f64 {
+        self.m.singular_values().min()
+    }
 }

@@ -6,6 +6,8 @@
 //! solved before it, in the order of the decomposition.
 
 pub mod crank;
+pub mod extended_rrr;
+pub mod extension;
 pub mod rrp;
 pub mod rrr;
 pub mod slider;

@@ -7,12 +7,18 @@
 //! (e_i, (R c_i) x e_i) with e_i = C_i - A_i and R c_i the platform's arm of C_i: its
 //! determinant vanishes where the three legs' lines meet in a point (or are parallel), the
 //! triad's type II singularity, and its sign is the branch's side of it.
+//!
+//! A leg may be two bodies a relative prismatic input locks into one link (the 3-RPR's
+//! cylinders, `extension`): its length l_i then follows the input, C_i moves along it at the
+//! rod's relative velocity s_i, and the leg's equations gain s_i (rates) and its Coriolis
+//! term 2 w_i E s_i (accelerations).
 
+use super::extension::Arm;
 use super::{put_acceleration, put_rate, Joint};
+use crate::kinematics::group_sigma::Block;
 use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
 use crate::{KinematicsError, SingularityKind};
-use nalgebra::SMatrix;
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -48,8 +54,12 @@ fn times(inv: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
 
 #[derive(Debug, Clone)]
 pub struct Triad {
-    /// The legs' bodies, then the platform's.
+    /// The legs' bodies (the bases of two-body legs), then the platform's.
     pub bodies: [usize; 4],
+    /// Those and the followers of two-body legs: the group's bodies.
+    pub members: Vec<usize>,
+    /// Per leg, its relative input if it is two bodies.
+    extended: [Option<Arm>; 3],
     /// A_i on the links solved before, and the same points in the legs' frames.
     outer: [Joint; 3],
     s_outer: [[f64; 2]; 3],
@@ -91,28 +101,44 @@ struct Geometry {
 impl Triad {
     /// A triad of legs `bodies[..3]` hinged at `outer` (the points `s_outer` in the legs'
     /// frames) and at C_i to the platform `bodies[3]` (`s_inner[i]` in leg i's frame,
-    /// `s_platform[i]` in the platform's); `scale` the mechanism's length.
+    /// `s_platform[i]` in the platform's), legs of two bodies in `extended` (whose arms
+    /// replace those of `s_outer` and `s_inner`); `scale` the mechanism's length.
     pub fn new(
         bodies: [usize; 4],
         outer: [Joint; 3],
-        s_outer: [[f64; 2]; 3],
-        s_inner: [[f64; 2]; 3],
-        s_platform: [[f64; 2]; 3],
+        [s_outer, s_inner, s_platform]: [[[f64; 2]; 3]; 3],
+        extended: [Option<Arm>; 3],
         scale: f64,
     ) -> Self {
         let arms = [0, 1, 2].map(|i| sub(s_inner[i], s_outer[i]));
-        let arms2 = arms.map(|a| dot(a, a));
-        Triad {
+        let members = bodies.iter().copied().chain(extended.iter().flatten().map(|a| a.ext.follower)).collect();
+        let mut triad = Triad {
             bodies,
+            members,
+            extended,
             outer,
             s_outer,
             arms,
-            arms2,
-            inv_arm: arms2.map(|l| 1.0 / l.sqrt()),
+            arms2: [0.0; 3],
+            inv_arm: [0.0; 3],
             s_platform,
             inv_scale: 1.0 / scale,
             branch: Branch::default(),
             geometry: Geometry::default(),
+        };
+        triad.set_arms(|_| 0.0);
+        triad
+    }
+
+    /// The legs' arms at the extensions d(leg) of the two-body ones.
+    #[inline]
+    fn set_arms(&mut self, d: impl Fn(&Arm) -> f64) {
+        for (i, a) in self.extended.iter().enumerate() {
+            if let Some(a) = a {
+                self.arms[i] = a.arm(d(a));
+            }
+            self.arms2[i] = dot(self.arms[i], self.arms[i]);
+            self.inv_arm[i] = 1.0 / self.arms2[i].sqrt();
         }
     }
 
@@ -131,6 +157,7 @@ impl Triad {
 
     /// Take the branch of the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
+        self.set_arms(|a| a.ext.shift_in(x));
         let p = 3 * self.bodies[3];
         let legs = [0, 1, 2].map(|i| x[3 * self.bodies[i] + 2]);
         let directions = [0, 1, 2].map(|i| {
@@ -151,7 +178,10 @@ impl Triad {
     /// Newton stops as the general position solve does (`position`): at a scaled residual
     /// (each leg's length error / L) of POSITION_TOL relative to the pose's size, or at
     /// round-off once a step no longer halves it, with one more step above POLISH_BELOW.
-    pub fn position(&mut self, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+    pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+        if self.extended.iter().any(Option::is_some) {
+            self.set_arms(|a| a.ext.shift(z));
+        }
         let mut g = Geometry::default();
         let mut a = [[0.0; 2]; 3];
         for (i, j) in self.outer.iter().enumerate() {
@@ -183,6 +213,9 @@ impl Triad {
             let done = polish || norm <= tol || (norm <= ROUND_OFF_FLOOR && norm > 0.5 * previous);
             if done && (polish || norm <= POLISH_BELOW) {
                 self.place(pose, cs, g, x, trig);
+                for a in self.extended.iter_mut().flatten() {
+                    a.ext.place(z, x, trig);
+                }
                 return Ok(());
             }
             polish = done;
@@ -221,69 +254,87 @@ impl Triad {
         self.geometry = g;
     }
 
-    /// The bodies' rates, those of the links before them in v: the platform's from
-    /// e_i . (v_C_i - v_A_i) = 0, each leg's turning rate from v_C_i - v_A_i = w E e_i.
+    /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg).
     #[inline]
-    pub fn velocity(&self, v: &mut [f64]) {
+    fn slides(&self, d: impl Fn(&Arm) -> f64) -> [[f64; 2]; 3] {
+        self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a))))
+    }
+
+    /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
+    /// the platform's from e_i . (v_C_i - v_A_i - s_i) = 0, each leg's turning rate from
+    /// v_C_i - v_A_i - s_i = w E e_i.
+    #[inline]
+    pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
         let g = &self.geometry;
+        let s = self.slides(|a| a.ext.input_rate(zd));
         let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], v));
-        let [vx, vy, w] = times(&g.inv, [0, 1, 2].map(|i| dot(g.e[i], va[i])));
+        let [vx, vy, w] = times(&g.inv, [0, 1, 2].map(|i| dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]])));
         let p = self.bodies[3];
         v[3 * p..3 * p + 3].copy_from_slice(&[vx, vy, w]);
         for (i, &leg) in self.bodies[..3].iter().enumerate() {
-            let vc = [vx - w * g.lever[i][1], vy + w * g.lever[i][0]];
+            let vc = [vx - w * g.lever[i][1] - s[i][0], vy + w * g.lever[i][0] - s[i][1]];
             let wl = cross(g.e[i], sub(vc, va[i])) * g.inv_e2[i];
             put_rate(v, leg, va[i], g.own[i], wl);
+        }
+        for a in self.extended.iter().flatten() {
+            a.ext.velocity(zd, v);
         }
     }
 
     /// The bodies' accelerations, from the rates v and the accelerations of the links before
-    /// them in a: e_i . (a_C_i - a_A_i) + |v_C_i - v_A_i|^2 = 0.
+    /// them in a: with a_C_i = a_A_i + al_i E e_i - w_i^2 e_i + 2 w_i E s_i (leg i's rates),
+    /// e_i . (a_C_i - a_A_i) = -w_i^2 |e_i|^2 + 2 w_i s_i x e_i.
     #[inline]
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         let g = &self.geometry;
+        let s = self.slides(|x| x.ext.rate(v));
         let p = self.bodies[3];
         let w = v[3 * p + 2];
-        let (mut aa, mut dv) = ([[0.0; 2]; 3], [[0.0; 2]; 3]);
-        let mut rhs = [0.0; 3];
-        for i in 0..3 {
+        let (mut aa, mut rhs) = ([[0.0; 2]; 3], [0.0; 3]);
+        for (i, &b) in self.bodies[..3].iter().enumerate() {
+            let (wl, l) = (v[3 * b + 2], g.lever[i]);
+            // a_A_i plus the Coriolis acceleration of C_i on the leg.
+            let c = perp(s[i]);
             aa[i] = self.outer[i].acceleration(g.known[i], v, a);
-            let va = self.outer[i].velocity(g.known[i], v);
-            dv[i] = sub([v[3 * p] - w * g.lever[i][1], v[3 * p + 1] + w * g.lever[i][0]], va);
-            let l = g.lever[i];
-            rhs[i] = dot(g.e[i], [aa[i][0] + w * w * l[0], aa[i][1] + w * w * l[1]]) - dot(dv[i], dv[i]);
+            let ac = [aa[i][0] + 2.0 * wl * c[0], aa[i][1] + 2.0 * wl * c[1]];
+            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl / g.inv_e2[i];
         }
         let [ax, ay, al] = times(&g.inv, rhs);
         a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
         for (i, &b) in self.bodies[..3].iter().enumerate() {
-            let l = g.lever[i];
+            let (wl, l, c) = (v[3 * b + 2], g.lever[i], perp(s[i]));
             let ac = [ax - al * l[1] - w * w * l[0], ay + al * l[0] - w * w * l[1]];
-            let all = cross(g.e[i], sub(ac, aa[i])) * g.inv_e2[i];
-            put_acceleration(a, b, aa[i], g.own[i], v[3 * b + 2], all);
+            let rel = [ac[0] - aa[i][0] - 2.0 * wl * c[0], ac[1] - aa[i][1] - 2.0 * wl * c[1]];
+            put_acceleration(a, b, aa[i], g.own[i], wl, cross(g.e[i], rel) * g.inv_e2[i]);
+        }
+        for x in self.extended.iter().flatten() {
+            x.ext.acceleration(v, a);
         }
     }
 
     /// The triad's type II measure at the last positions (`group_sigma`'s): the smallest
-    /// singular value of its 12 x 12 block at its own length L_k (1 / L_k = `inv_length`),
-    /// columns (r, phi) of each leg then of the platform, two rows a pair: the outer pair i
-    /// [I, E R s_A] on leg i, the inner pair i [I, E R s_C] on leg i and -[I, E R c_i] on the
-    /// platform, the arms divided by L_k. A fixed-size SVD: the measure is taken once an
-    /// accepted step, not per evaluation.
+    /// singular value of its block at its own length L_k (1 / L_k = `inv_length`), 12 x 12
+    /// (21 x 21 with three two-body legs): columns (r, phi) of each leg, the platform, then the
+    /// followers; two rows a pair, the outer pair i [I, E R s_A] on leg i, the inner pair i
+    /// [I, E R s_C] on the body of leg i that holds C_i and -[I, E R c_i] on the platform, and
+    /// each relative input's three (`Extension::block_rows`). A dense SVD (about 2e4 flops
+    /// for 12 x 12): the monitor takes the measure once an accepted step, not per evaluation.
     pub fn sigma(&self, inv_length: f64) -> f64 {
         let g = &self.geometry;
-        let mut b = SMatrix::<f64, 12, 12>::zeros();
-        let mut put = |row: usize, body: usize, sign: f64, arm: [f64; 2]| {
-            let e = perp(arm);
-            for k in 0..2 {
-                b[(row + k, 3 * body + k)] = sign;
-                b[(row + k, 3 * body + 2)] = sign * e[k] * inv_length;
+        let mut block = Block::new(self.members.len(), inv_length);
+        let mut follower = 4;
+        for (i, x) in self.extended.iter().enumerate() {
+            block.point_rows(&[(i, 1.0, g.own[i])]);
+            let c = [g.own[i][0] + g.e[i][0], g.own[i][1] + g.e[i][1]];
+            match x {
+                Some(x) => {
+                    block.point_rows(&[(follower, 1.0, x.on_follower(c)), (3, -1.0, g.lever[i])]);
+                    x.ext.block_rows(i, follower, &mut block);
+                    follower += 1;
+                }
+                None => block.point_rows(&[(i, 1.0, c), (3, -1.0, g.lever[i])]),
             }
-        };
-        for i in 0..3 {
-            put(4 * i, i, 1.0, g.own[i]);
-            put(4 * i + 2, i, 1.0, [g.own[i][0] + g.e[i][0], g.own[i][1] + g.e[i][1]]);
-            put(4 * i + 2, 3, -1.0, g.lever[i]);
         }
-        b.singular_values().min()
+        block.sigma()
     }
 }
