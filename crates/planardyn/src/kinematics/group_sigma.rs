@@ -263,10 +263,9 @@ impl Block {
     /// the sign, and R s, the point less the body's centre).
     pub fn point_rows(&mut self, ends: &[(usize, f64, [f64; 2])]) {
         for &(b, sign, arm) in ends {
-            let e = perp(arm);
-            for k in 0..2 {
+            for (k, e) in perp(arm).into_iter().enumerate() {
                 self.m[(self.row + k, 3 * b + k)] = sign;
-                self.m[(self.row + k, 3 * b + 2)] = sign * e[k] * self.inv_length;
+                self.m[(self.row + k, 3 * b + 2)] = sign * e * self.inv_length;
             }
         }
         self.row += 2;
