@@ -417,3 +417,29 @@ fn relative_input_on_a_bent_cylinder_every_way() {
         assert!(ClosedForm::new(&riding).is_none());
     }
 }
+
+#[test]
+fn triad_of_bent_cylinders() {
+    // The 3-RPR with its guides turned off the legs' lines A_i -> C_i (0.3, -0.2 and 0.25 rad):
+    // each wrist C_i then slides across its leg as the input grows, so the rates' and the
+    // Coriolis terms of the sliding act on the leg's turning too (along the line they do not);
+    // leg 2's pair ordered rod first (the guide fixed in the rod).
+    let text = std::fs::read_to_string(root().join("examples/models/library/3-rpr.yaml")).unwrap();
+    let turned = |axis: [f64; 2], by: f64| {
+        let (s, c) = f64::sin_cos(by);
+        format!("axis: [{}, {}]", c * axis[0] - s * axis[1], s * axis[0] + c * axis[1])
+    };
+    let mut text = text
+        .replace("bodies: [barrel2, rod2]", "bodies: [rod2, barrel2]")
+        .replace("barrel2: {points: [A2, E2]", "barrel2: {points: [A2, E2, K2]");
+    for (axis, by) in [
+        ([-0.11551861091413643, -0.9933053158684234], 0.3),
+        ([0.917986942713249, 0.3966106062726791], -0.2),
+        ([-0.8024683317991123, 0.5966947095957446], 0.25),
+    ] {
+        text = text.replace(&format!("axis: [{}, {}]", axis[0], axis[1]), &turned(axis, by));
+    }
+    assert_eq!((text.matches("rod2, barrel2").count(), text.matches("E2, K2").count()), (1, 1));
+    let mech = common::yaml(&text);
+    compare("3-RPR with bent cylinders", &mech, &mut Rng(0x0bad_cafe_f00d_1234), MIN_SIGMA);
+}
