@@ -1,13 +1,17 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
 //! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
-//! the ground) and class II RRR and RRP dyads only, the
+//! the ground), class II RRR and RRP dyads and class III triads of six revolute pairs only, the
 //! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
 //! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
-//! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
-//! assembly branch of a reference configuration (the integrator's last accepted point); where
-//! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
-//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads, gear and slot pairs, class III groups and
-//! up, relative inputs, redundant pairs) take the general path (`position`, `analogues`).
+//! decomposition's order: no factorisation of J, and no Newton iteration but the triad's on
+//! its 3 x 3 platform system. A link of an RRR dyad or a triad's leg may be two bodies locked
+//! by a relative prismatic input (a cylinder, `dyads::extension`) whose rod holds the group's
+//! inner pair. Each group keeps the assembly branch of a reference configuration (the
+//! integrator's last accepted point); where a dyad's circles do not meet, or the triad's Newton
+//! does not converge, the evaluation fails as a Newton solve that does not converge does.
+//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads, gear and
+//! slot pairs, other class III groups and larger ones, relative revolute inputs and other
+//! relative prismatic ones, redundant pairs) take the general path (`position`, `analogues`).
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
@@ -312,9 +316,10 @@ impl ClosedForm {
         self.dyads.iter_mut().for_each(|d| d.set_reference(x));
     }
 
-    /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
-    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`]); if not, a step crosses a fold and the closed
-    /// forms would leave the motion's branch there.
+    /// Whether every group's side in the body coordinates x (a predicted point) is that of its
+    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`], [`Triad::keeps_side`]); if
+    /// not, a step crosses a fold or the triad's singularity and the closed forms would leave
+    /// the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
         self.dyads.iter().all(|d| d.keeps_side(x))
     }

@@ -43,7 +43,10 @@ impl ExtendedRrr {
         self.branch = self.rrr.branch(x);
     }
 
-    /// [`Rrr::keeps_side`] with the arms of the last positions.
+    /// [`Rrr::keeps_side`] with the arms of the last positions: a guide off the arm's line
+    /// turns the arm in its frame as the input moves, which shifts the guard's threshold by
+    /// that turn over one step (nothing when the guide is along the arm, as in the shipped
+    /// cylinders).
     pub fn keeps_side(&self, x: &[f64]) -> bool {
         self.rrr.keeps_side(&self.branch, x)
     }

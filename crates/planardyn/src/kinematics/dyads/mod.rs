@@ -1,9 +1,12 @@
 //! Closed forms of the groups the Assur decomposition finds (`kinematics::closed_form`), one
 //! file a kind: the input link turned by its revolute pair ([`crank`]) or moved along a guide
-//! on the ground ([`slider`]), and the class II dyads of three revolute pairs ([`rrr`]) and
-//! of two revolute pairs and an outer prismatic one ([`rrp`]). Each gives positions, velocities (a column of U for a unit
-//! rate) and accelerations with zero input accelerations (the convective term c), from the links
-//! solved before it, in the order of the decomposition.
+//! on the ground ([`slider`]), the class II dyads of three revolute pairs ([`rrr`]) and of two
+//! revolute pairs and an outer prismatic one ([`rrp`]), the class III triad of six revolute
+//! pairs ([`triad`], Newton on its 3 x 3 platform system), and a group link of two bodies a
+//! relative prismatic input locks ([`extension`]; in an RRR dyad, [`extended_rrr`]). Each gives
+//! positions, velocities (a column of U for a unit rate) and accelerations with zero input
+//! accelerations (the convective term c), from the links solved before it, in the order of the
+//! decomposition.
 
 pub mod crank;
 pub mod extended_rrr;
