@@ -52,6 +52,7 @@ impl ExtendedRrr {
     }
 
     /// The bodies' poses at the coordinates z.
+    #[inline(never)]
     pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         self.set_arms(|a| a.ext.shift(z));
         self.geometry = self.rrr.position(&self.branch, x, trig)?;
@@ -62,6 +63,7 @@ impl ExtendedRrr {
     }
 
     /// The bodies' rates for the coordinate rates zd.
+    #[inline(never)]
     pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
         self.rrr.velocity(&self.geometry, self.slides(|a| a.ext.input_rate(zd)), v);
         for a in self.extended.iter().flatten() {
@@ -70,6 +72,7 @@ impl ExtendedRrr {
     }
 
     /// The bodies' accelerations at zero coordinate accelerations, from the rates v.
+    #[inline(never)]
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         self.rrr.acceleration(&self.geometry, self.slides(|x| x.ext.rate(v)), v, a);
         for x in self.extended.iter().flatten() {

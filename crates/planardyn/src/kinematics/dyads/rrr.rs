@@ -105,7 +105,7 @@ impl Rrr {
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved.
-    #[inline]
+    #[inline(always)]
     pub fn position(&self, branch: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
         let (a, ra) = self.outer[0].place(x, trig);
         let (b, rb) = self.outer[1].place(x, trig);
@@ -153,7 +153,7 @@ impl Rrr {
 
     /// The bodies' rates, those of the links before them in v; `slide` P's velocity relative to
     /// body 1 and to body 2 (zero unless a relative input moves it along its link).
-    #[inline]
+    #[inline(always)]
     pub fn velocity(&self, g: &Geometry, slide: [[f64; 2]; 2], v: &mut [f64]) {
         let va = self.outer[0].velocity(g.known[0], v);
         let vb = self.outer[1].velocity(g.known[1], v);
@@ -165,7 +165,7 @@ impl Rrr {
 
     /// The bodies' accelerations, from the rates v and the accelerations of the links before
     /// them in a; `slide` as in [`Rrr::velocity`] (P's Coriolis acceleration 2 w E slide).
-    #[inline]
+    #[inline(always)]
     pub fn acceleration(&self, g: &Geometry, slide: [[f64; 2]; 2], v: &[f64], a: &mut [f64]) {
         let aa = self.outer[0].acceleration(g.known[0], v, a);
         let ab = self.outer[1].acceleration(g.known[1], v, a);

@@ -178,6 +178,7 @@ impl Triad {
     /// Newton stops as the general position solve does (`position`): at a scaled residual
     /// (each leg's length error / L) of POSITION_TOL relative to the pose's size, or at
     /// round-off once a step no longer halves it, with one more step above POLISH_BELOW.
+    #[inline(never)]
     pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         if self.extended.iter().any(Option::is_some) {
             self.set_arms(|a| a.ext.shift(z));
@@ -263,7 +264,7 @@ impl Triad {
     /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
     /// the platform's from e_i . (v_C_i - v_A_i - s_i) = 0, each leg's turning rate from
     /// v_C_i - v_A_i - s_i = w E e_i.
-    #[inline]
+    #[inline(never)]
     pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
         let g = &self.geometry;
         let s = self.slides(|a| a.ext.input_rate(zd));
@@ -284,7 +285,7 @@ impl Triad {
     /// The bodies' accelerations, from the rates v and the accelerations of the links before
     /// them in a: with a_C_i = a_A_i + al_i E e_i - w_i^2 e_i + 2 w_i E s_i (leg i's rates),
     /// e_i . (a_C_i - a_A_i) = -w_i^2 |e_i|^2 + 2 w_i s_i x e_i.
-    #[inline]
+    #[inline(never)]
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         let g = &self.geometry;
         let s = self.slides(|x| x.ext.rate(v));
@@ -297,7 +298,7 @@ impl Triad {
             let c = perp(s[i]);
             aa[i] = self.outer[i].acceleration(g.known[i], v, a);
             let ac = [aa[i][0] + 2.0 * wl * c[0], aa[i][1] + 2.0 * wl * c[1]];
-            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl / g.inv_e2[i];
+            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * dot(g.e[i], g.e[i]);
         }
         let [ax, ay, al] = times(&g.inv, rhs);
         a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
