@@ -15,7 +15,7 @@
 
 use super::extension::Arm;
 use super::{put_acceleration, put_rate, Joint};
-use crate::kinematics::group_sigma::Block;
+use crate::kinematics::group_sigma::{triad_sigma, Block};
 use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
 use crate::{KinematicsError, SingularityKind};
@@ -318,10 +318,16 @@ impl Triad {
     /// (21 x 21 with three two-body legs): columns (r, phi) of each leg, the platform, then the
     /// followers; two rows a pair, the outer pair i [I, E R s_A] on leg i, the inner pair i
     /// [I, E R s_C] on the body of leg i that holds C_i and -[I, E R c_i] on the platform, and
-    /// each relative input's three (`Extension::block_rows`). A dense SVD (about 2e4 flops
-    /// for 12 x 12): the monitor takes the measure once an accepted step, not per evaluation.
+    /// each relative input's three (`Extension::block_rows`). The 6R triad's from a 4 x 4
+    /// secular equation (`group_sigma::triad_sigma`); with cylinder legs, a dense SVD of the
+    /// block (18 us for 21 x 21 on a loaded machine: the monitor takes it once a step).
     pub fn sigma(&self, inv_length: f64) -> f64 {
         let g = &self.geometry;
+        if self.extended.iter().all(Option::is_none) {
+            let k = |v: [f64; 2]| [v[0] * inv_length, v[1] * inv_length];
+            let p = [0, 1, 2].map(|i| k([g.own[i][0] + g.e[i][0], g.own[i][1] + g.e[i][1]]));
+            return triad_sigma(g.own.map(k), p, g.lever.map(k));
+        }
         let mut block = Block::new(self.members.len(), inv_length);
         let mut follower = 4;
         for (i, x) in self.extended.iter().enumerate() {
