@@ -389,6 +389,14 @@ fn a_predictor_past_a_triads_singularity_is_recognised() {
     assert!(cf.keeps_branches(&predicted(0.03)));
     assert!(!cf.keeps_branches(&predicted(0.15)));
     assert!(!cf.keeps_branches(&past.x));
+    // The closed-form measure there, 0.003, equals the block SVD's within 1e-8 relative: both
+    // are exact to about 1e-16 / sigma^2 relative (the secular equation's M is lambda = sigma^2
+    // from a singular point).
+    cf.set_reference(&near.x);
+    let mut ws = Workspace::new(&mech);
+    cf.kinematic_stages(&q0.iter().map(|v| v + 0.85).collect::<Vec<_>>(), &[0.0; 3], &mut ws).unwrap();
+    let sigma = sigma_min(&mech, &Chart::Inputs, &near.x);
+    assert!((cf.sigma() - sigma).abs() < 1e-8 * sigma, "{} against {sigma}", cf.sigma());
 }
 
 /// A boom lifted by a cylinder whose rod is bent: the boom's eye R is off the guide's line
