@@ -1,97 +1,119 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
 //! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
-//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S) and class II RRR
-//! and RRP dyads only, the
-//! positions x at z, the velocity analogues U, the body rates xd and the convective term c come
-//! from the groups' closed forms (`dyads`), each group from the links solved before it, in the
-//! decomposition's order: no Newton iteration and no factorisation of J. Each dyad keeps the
-//! assembly branch of a reference configuration (the integrator's last accepted point); where
-//! its circles do not meet, the evaluation fails as a Newton solve that does not converge does.
-//! Other mechanisms (sliders carrying the ground's point on their guide, other dyads and class
-//! I groups, class III groups and up, relative inputs, redundant pairs) take the general path
-//! (`position`, `analogues`).
+//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S), class II RRR and
+//! RRP dyads and class III triads of six revolute pairs only, the positions x at z, the
+//! velocity analogues U, the body rates xd and the convective term c come from the groups'
+//! closed forms (`dyads`), each group from the links solved before it, in the decomposition's
+//! order: no factorisation of J, and no Newton iteration but the triad's on its 3 x 3 platform
+//! system. A link of an RRR dyad or a triad's leg may be two bodies locked by a relative
+//! prismatic input (a cylinder, `dyads::extension`) whose rod holds the group's inner pair.
+//! Each group keeps the assembly branch of a reference configuration (the integrator's last
+//! accepted point); where a dyad's circles do not meet, or the triad's Newton does not
+//! converge, the evaluation fails as a Newton solve that does not converge does. Other
+//! mechanisms (sliders carrying the ground's point on their guide, other dyads and class I
+//! groups, other class III groups and larger ones, relative revolute inputs and other relative
+//! prismatic ones, redundant pairs) take the general path (`position`, `analogues`).
 
 use super::analogues::body_rates;
 use super::dyads::crank::Crank;
+use super::dyads::extended_rrr::ExtendedRrr;
+use super::dyads::extension::{Arm, Extension};
 use super::dyads::one_link::OneLink;
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
+use super::dyads::triad::Triad;
 use super::dyads::Joint;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
-use crate::structure::assur;
+use crate::structure::assur::{self, AssurGroup};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 
-/// A class II dyad of a kind with a closed form, with the branch of its reference
-/// configuration and its geometry at the last positions (for the rates and accelerations);
-/// or a class I group (one body, no branch).
+/// A group of a kind with a closed form: a class II dyad with the branch of its reference
+/// configuration and its geometry at the last positions (for the rates and accelerations), a
+/// class I group (one body, no branch), or the class III triad (which keeps its own).
 #[derive(Debug, Clone)]
-enum Dyad {
+enum Group {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
     Rrp(Rrp, rrp::Branch, rrp::Geometry),
     OneLink(Box<OneLink>),
+    Extended(Box<ExtendedRrr>),
+    Triad(Box<Triad>),
 }
 
-impl Dyad {
+impl Group {
     fn bodies(&self) -> &[usize] {
         match self {
-            Dyad::Rrr(d, ..) => &d.bodies,
-            Dyad::Rrp(d, ..) => &d.bodies,
-            Dyad::OneLink(g) => g.bodies(),
+            Group::Rrr(d, ..) => &d.bodies,
+            Group::Rrp(d, ..) => &d.bodies,
+            Group::OneLink(g) => g.bodies(),
+            Group::Extended(d) => &d.members,
+            Group::Triad(t) => &t.members,
         }
     }
 
     fn set_reference(&mut self, x: &[f64]) {
         match self {
-            Dyad::Rrr(d, b, _) => *b = d.branch(x),
-            Dyad::Rrp(d, b, _) => *b = d.branch(x),
-            Dyad::OneLink(_) => {}
+            Group::Rrr(d, b, _) => *b = d.branch(x),
+            Group::Rrp(d, b, _) => *b = d.branch(x),
+            Group::OneLink(_) => {}
+            Group::Extended(d) => d.set_reference(x),
+            Group::Triad(t) => t.set_reference(x),
         }
     }
 
     fn keeps_side(&self, x: &[f64]) -> bool {
         match self {
-            Dyad::Rrr(d, b, _) => d.keeps_side(b, x),
-            Dyad::Rrp(d, b, _) => d.keeps_side(b, x),
-            Dyad::OneLink(_) => true,
+            Group::Rrr(d, b, _) => d.keeps_side(b, x),
+            Group::Rrp(d, b, _) => d.keeps_side(b, x),
+            Group::OneLink(_) => true,
+            Group::Extended(d) => d.keeps_side(x),
+            Group::Triad(t) => t.keeps_side(x),
         }
     }
 
     fn sigma(&self, inv_length: f64) -> f64 {
         match self {
-            Dyad::Rrr(_, _, g) => g.sigma(inv_length),
-            Dyad::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
-            Dyad::OneLink(g) => g.sigma(inv_length),
+            Group::Rrr(_, _, g) => g.sigma(inv_length),
+            Group::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
+            Group::OneLink(g) => g.sigma(inv_length),
+            Group::Extended(d) => d.sigma(inv_length),
+            Group::Triad(t) => t.sigma(inv_length),
         }
     }
 
     #[inline]
-    fn position(&mut self, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+    fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         match self {
-            Dyad::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
-            Dyad::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
-            Dyad::OneLink(g) => g.position(x, trig)?,
+            Group::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
+            Group::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
+            Group::OneLink(g) => g.position(x, trig)?,
+            Group::Extended(d) => d.position(z, x, trig)?,
+            Group::Triad(t) => t.position(z, x, trig)?,
         }
         Ok(())
     }
 
     #[inline]
-    fn velocity(&self, v: &mut [f64]) {
+    fn velocity(&self, zd: &[f64], v: &mut [f64]) {
         match self {
-            Dyad::Rrr(d, _, g) => d.velocity(g, v),
-            Dyad::Rrp(d, _, g) => d.velocity(g, v),
-            Dyad::OneLink(g) => g.velocity(v),
+            Group::Rrr(d, _, g) => d.velocity(g, [[0.0; 2]; 2], v),
+            Group::Rrp(d, _, g) => d.velocity(g, v),
+            Group::OneLink(g) => g.velocity(v),
+            Group::Extended(d) => d.velocity(zd, v),
+            Group::Triad(t) => t.velocity(zd, v),
         }
     }
 
     #[inline]
     fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         match self {
-            Dyad::Rrr(d, _, g) => d.acceleration(g, v, a),
-            Dyad::Rrp(d, _, g) => d.acceleration(g, v, a),
-            Dyad::OneLink(g) => g.acceleration(v, a),
+            Group::Rrr(d, _, g) => d.acceleration(g, [[0.0; 2]; 2], v, a),
+            Group::Rrp(d, _, g) => d.acceleration(g, v, a),
+            Group::OneLink(g) => g.acceleration(v, a),
+            Group::Extended(d) => d.acceleration(v, a),
+            Group::Triad(t) => t.acceleration(v, a),
         }
     }
 }
@@ -100,7 +122,7 @@ impl Dyad {
 pub struct ClosedForm {
     cranks: Vec<Crank>,
     sliders: Vec<Slider>,
-    dyads: Vec<Dyad>,
+    groups: Vec<Group>,
     /// Per dyad 1 / L_k (its group's length, `group_sigma`), and the smallest input link
     /// measure (constant).
     inv_length: Vec<f64>,
@@ -117,12 +139,95 @@ fn ends(mech: &Mechanism, pair: PairId, body: usize) -> ([f64; 2], Joint) {
     }
 }
 
+/// Whether pair k joins body b.
+fn on(mech: &Mechanism, k: PairId, b: usize) -> bool {
+    let p = &mech.pairs[k.0];
+    p.a == Link::Body(BodyId(b)) || p.b == Link::Body(BodyId(b))
+}
+
+/// A group link's base (its body of the group's outer pair), that pair, the body holding
+/// `inner` (a pair to another link of the group) and the base's point of each pair; and if the
+/// link is two bodies, their relative input with the arm between the two points.
+struct LinkParts {
+    base: usize,
+    outer: Joint,
+    s_outer: [f64; 2],
+    s_inner: [f64; 2],
+    arm: Option<Arm>,
+}
+
+fn link_parts(mech: &Mechanism, link: &[BodyId], outer: &[PairId], inner: PairId) -> Option<LinkParts> {
+    let base = link.iter().map(|b| b.0).find(|&b| outer.iter().any(|&k| on(mech, k, b)))?;
+    let o = *outer.iter().find(|&&k| on(mech, k, base))?;
+    let holder = link.iter().map(|b| b.0).find(|&b| on(mech, inner, b))?;
+    let (s_outer, joint) = ends(mech, o, base);
+    let s_inner = ends(mech, inner, holder).0;
+    let arm = match link {
+        [_] => None,
+        [_, _] => {
+            let follower = link.iter().map(|b| b.0).find(|&b| b != base)?;
+            if outer.iter().any(|&k| on(mech, k, follower)) {
+                return None;
+            }
+            let joins = |c: &crate::model::Coordinate| on(mech, c.pair, base) && on(mech, c.pair, follower);
+            let k = mech.coordinates.iter().position(joins)?;
+            if holder != follower {
+                return None; // its follower has a block of its own in J (`Arm`)
+            }
+            Some(Arm::new(Extension::new(mech, k, base)?, s_outer, s_inner))
+        }
+        _ => return None,
+    };
+    // The inner point in the base's frame (at the drawn input for a two-body link).
+    let s_inner = arm.as_ref().map_or(s_inner, |a| {
+        let d = a.arm(0.0);
+        [s_outer[0] + d[0], s_outer[1] + d[1]]
+    });
+    Some(LinkParts { base, outer: joint, s_outer, s_inner, arm })
+}
+
+/// The RRR dyad `g` with one or two links of two bodies (a relative input each).
+fn extended_rrr(mech: &Mechanism, g: &AssurGroup) -> Option<ExtendedRrr> {
+    let [inner] = g.inner_pairs.as_slice() else { return None };
+    if g.kind != "RRR" || g.links.len() != 2 || mech.pairs[inner.0].kind != PairKind::Revolute {
+        return None;
+    }
+    let [l1, l2] = [0, 1].map(|i| link_parts(mech, &g.links[i], &g.outer_pairs, *inner));
+    let (l1, l2) = (l1?, l2?);
+    let rrr = Rrr::new([l1.base, l2.base], [l1.outer, l2.outer], [l1.s_outer, l2.s_outer], [l1.s_inner, l2.s_inner]);
+    Some(ExtendedRrr::new(rrr, [l1.arm, l2.arm]))
+}
+
+/// The triad of six revolute pairs `g` (class III): three legs, each hinged to the platform and
+/// to a link solved before (each one body, or two a relative input locks), and the platform
+/// (the link of the three inner pairs).
+fn triad(mech: &Mechanism, g: &AssurGroup) -> Option<Triad> {
+    if g.links.len() != 4 || g.inner_pairs.len() != 3 || g.outer_pairs.len() != 3 {
+        return None;
+    }
+    if g.inner_pairs.iter().chain(&g.outer_pairs).any(|k| mech.pairs[k.0].kind != PairKind::Revolute) {
+        return None;
+    }
+    let platform = g.links.iter().position(|l| l.len() == 1 && g.inner_pairs.iter().all(|&k| on(mech, k, l[0].0)))?;
+    let p = g.links[platform][0].0;
+    let (mut bodies, mut outer) = ([p; 4], [Joint { link: Link::Ground, s: [0.0; 2] }; 3]);
+    let mut s = [[[0.0; 2]; 3]; 3];
+    let mut extended = [None, None, None];
+    for (i, link) in g.links.iter().enumerate().filter(|(j, _)| *j != platform).map(|(_, l)| l).enumerate() {
+        let inner = *g.inner_pairs.iter().find(|&&k| link.iter().any(|b| on(mech, k, b.0)))?;
+        let parts = link_parts(mech, link, &g.outer_pairs, inner)?;
+        (bodies[i], outer[i], extended[i]) = (parts.base, parts.outer, parts.arm);
+        (s[0][i], s[1][i], s[2][i]) = (parts.s_outer, parts.s_inner, ends(mech, inner, p).0);
+    }
+    Some(Triad::new(bodies, outer, s, extended, mech.scale))
+}
+
 impl ClosedForm {
     /// The closed forms of `mech`'s groups, if every group has one (see the module's doc); the
     /// branches are those of the drawing until [`ClosedForm::set_reference`].
     pub fn new(mech: &Mechanism) -> Option<Self> {
         let decomposition = assur::assur(mech);
-        if !decomposition.relative_inputs.is_empty() || !decomposition.left_over.is_empty() {
+        if !decomposition.left_over.is_empty() {
             return None;
         }
         let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
@@ -132,6 +237,8 @@ impl ClosedForm {
             let p = &mech.pairs[c.pair.0];
             let body = match (p.a, p.b) {
                 (Link::Ground, Link::Body(b)) | (Link::Body(b), Link::Ground) => b.0,
+                // A relative prismatic input: its group solves it (`Extension`).
+                (Link::Body(_), Link::Body(_)) if matches!(p.kind, PairKind::Prismatic { .. }) => continue,
                 _ => return None,
             };
             let (s, ground) = ends(mech, c.pair, body);
@@ -154,13 +261,23 @@ impl ClosedForm {
             inputs_sigma = inputs_sigma.min(1.0);
             cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
         }
-        let mut dyads = Vec::new();
+        let mut groups = Vec::new();
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
             if let ([link], [o1, o2]) = (g.links.as_slice(), g.outer_pairs.as_slice()) {
                 let [body] = link.as_slice() else { return None };
-                dyads.push(Dyad::OneLink(Box::new(OneLink::new(mech, body.0, [*o1, *o2])?)));
+                groups.push(Group::OneLink(Box::new(OneLink::new(mech, body.0, [*o1, *o2])?)));
                 pairs_used += 2;
+                continue;
+            }
+            if g.class == 2 && g.links.iter().any(|l| l.len() == 2) {
+                groups.push(Group::Extended(Box::new(extended_rrr(mech, g)?)));
+                pairs_used += 3;
+                continue;
+            }
+            if g.class == 3 {
+                groups.push(Group::Triad(Box::new(triad(mech, g)?)));
+                pairs_used += 6;
                 continue;
             }
             let [inner] = g.inner_pairs.as_slice() else { return None };
@@ -177,20 +294,20 @@ impl ClosedForm {
             let (Some(o1), Some(o2)) = (touching(bodies[0]), touching(bodies[1])) else { return None };
             let (i1, _) = ends(mech, *inner, bodies[0]);
             let (i2, _) = ends(mech, *inner, bodies[1]);
-            dyads.push(match (g.kind.as_str(), revolute(o1), revolute(o2)) {
+            groups.push(match (g.kind.as_str(), revolute(o1), revolute(o2)) {
                 ("RRR", true, true) => {
                     let ((s1, a), (s2, b)) = (ends(mech, o1, bodies[0]), ends(mech, o2, bodies[1]));
-                    Dyad::Rrr(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]), Default::default(), Default::default())
+                    Group::Rrr(Rrr::new(bodies, [a, b], [s1, s2], [i1, i2]), Default::default(), Default::default())
                 }
                 ("RRP", true, false) => {
                     let (s1, a) = ends(mech, o1, bodies[0]);
                     let d = Rrp::new(bodies, a, s1, [i1, i2], &mech.pairs[o2.0])?;
-                    Dyad::Rrp(d, Default::default(), Default::default())
+                    Group::Rrp(d, Default::default(), Default::default())
                 }
                 ("RRP", false, true) => {
                     let (s2, a) = ends(mech, o2, bodies[1]);
                     let d = Rrp::new([bodies[1], bodies[0]], a, s2, [i2, i1], &mech.pairs[o1.0])?;
-                    Dyad::Rrp(d, Default::default(), Default::default())
+                    Group::Rrp(d, Default::default(), Default::default())
                 }
                 _ => return None,
             });
@@ -201,34 +318,35 @@ impl ClosedForm {
             .iter()
             .map(|c| c.body)
             .chain(sliders.iter().map(|s| s.body))
-            .chain(dyads.iter().flat_map(|d| d.bodies().iter().copied()))
+            .chain(groups.iter().flat_map(|d| d.bodies().iter().copied()))
             .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
-        dyads.iter_mut().for_each(|d| d.set_reference(&mech.x0));
-        let inv_length = dyads.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
-        Some(ClosedForm { cranks, sliders, dyads, inv_length, inputs_sigma })
+        groups.iter_mut().for_each(|d| d.set_reference(&mech.x0));
+        let inv_length = groups.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
+        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma })
     }
 
     /// Take the assembly branches from the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
-        self.dyads.iter_mut().for_each(|d| d.set_reference(x));
+        self.groups.iter_mut().for_each(|d| d.set_reference(x));
     }
 
-    /// Whether every dyad's side in the body coordinates x (a predicted point) is that of its
-    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`]); if not, a step crosses a fold and the closed
-    /// forms would leave the motion's branch there.
+    /// Whether every group's side in the body coordinates x (a predicted point) is that of its
+    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`], [`Triad::keeps_side`]); if
+    /// not, a step crosses a fold or the triad's singularity and the closed forms would leave
+    /// the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
-        self.dyads.iter().all(|d| d.keeps_side(x))
+        self.groups.iter().all(|d| d.keeps_side(x))
     }
 
     /// The type II measure at the last positions (`group_sigma`'s: the smallest singular
     /// value of each group's block at its own length), from the groups' closed forms: no
     /// factorisation of J.
     pub fn sigma(&self) -> f64 {
-        let dyads = self.dyads.iter().zip(&self.inv_length).map(|(d, &k)| d.sigma(k));
-        dyads.fold(self.inputs_sigma, f64::min)
+        let groups = self.groups.iter().zip(&self.inv_length).map(|(d, &k)| d.sigma(k));
+        groups.fold(self.inputs_sigma, f64::min)
     }
 
     /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.
@@ -239,8 +357,8 @@ impl ClosedForm {
         for s in &self.sliders {
             s.position(z, &mut ws.x, &mut ws.trig);
         }
-        for d in &mut self.dyads {
-            d.position(&mut ws.x, &mut ws.trig)?;
+        for d in &mut self.groups {
+            d.position(z, &mut ws.x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -255,14 +373,14 @@ impl ClosedForm {
         for s in &self.sliders {
             s.velocity(zd, v);
         }
-        for d in &self.dyads {
-            d.velocity(v);
+        for d in &self.groups {
+            d.velocity(zd, v);
         }
     }
 
     /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
     pub fn velocity_analogues(&self, ws: &mut Workspace) {
-        let (n, m) = (ws.x.len(), self.cranks.len() + self.sliders.len());
+        let (n, m) = (ws.x.len(), ws.q.len());
         // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
         let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
         unit[..m].fill(0.0);
@@ -291,7 +409,7 @@ impl ClosedForm {
         for s in &self.sliders {
             s.acceleration(a);
         }
-        for d in &self.dyads {
+        for d in &self.groups {
             d.acceleration(v, a);
         }
     }

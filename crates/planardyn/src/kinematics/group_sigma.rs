@@ -21,6 +21,7 @@
 //! takes the SVD of each block (s^3), never of the whole J.
 
 use super::constraints::Chart;
+use super::pairs::frames::perp;
 use super::system::fill_row_scale;
 use crate::linalg::BlockLu;
 use crate::model::diameter::diameter;
@@ -372,4 +373,161 @@ mod tests {
         assert!(smallest < 1e-9, "no near-singular block drawn: smallest {smallest:e}");
         assert!(worst < 1e-14, "rrp_sigma differs from the SVD by {worst:e}");
     }
+}
+
+/// A group's block at its own length for a fixed-size SVD, where its measure has no closed
+/// form: columns (r, phi) of each of its bodies (by place), rows added a pair at a time; as in
+/// [`dyad_sigma`], translations enter as +-1 and angles by their lever arms R s / L_k.
+pub(crate) struct Block {
+    m: DMatrix<f64>,
+    row: usize,
+    inv_length: f64,
+}
+
+impl Block {
+    /// The block of a group of `bodies` bodies, 1 / L_k = `inv_length`.
+    pub fn new(bodies: usize, inv_length: f64) -> Self {
+        Block { m: DMatrix::zeros(3 * bodies, 3 * bodies), row: 0, inv_length }
+    }
+
+    /// The two rows of a point's coincidence: per body of the group holding it (its place,
+    /// the sign, and R s, the point less the body's centre).
+    pub fn point_rows(&mut self, ends: &[(usize, f64, [f64; 2])]) {
+        for &(b, sign, arm) in ends {
+            for (k, e) in perp(arm).into_iter().enumerate() {
+                self.m[(self.row + k, 3 * b + k)] = sign;
+                self.m[(self.row + k, 3 * b + 2)] = sign * e * self.inv_length;
+            }
+        }
+        self.row += 2;
+    }
+
+    /// The row of two bodies' equal angles.
+    pub fn angle_row(&mut self, a: usize, b: usize) {
+        (self.m[(self.row, 3 * a + 2)], self.m[(self.row, 3 * b + 2)]) = (-1.0, 1.0);
+        self.row += 1;
+    }
+
+    /// Its smallest singular value.
+    pub fn sigma(self) -> f64 {
+        self.m.singular_values().min()
+    }
+}
+
+/// Iterations of [`triad_sigma`]'s safeguarded Newton; it converges in about 6.
+const TRIAD_ITERATIONS: usize = 60;
+
+/// The measure of a 6R triad's 12 x 12 block in closed form, from its lever arms at its own
+/// length: per leg i, `a[i]` A_i and `p[i]` C_i on the leg (R s / L_k), `l[i]` C_i on the
+/// platform. As in [`dyad_sigma`], the block is [T, Phi] (translations | angles), with T^T T =
+/// K (x) I constant, K = [[2, 0, 0, -1], [0, 2, 0, -1], [0, 0, 2, -1], [-1, -1, -1, 3]]
+/// (the legs, then the platform; eigenvalues 2, 2 and (5 +- 13^(1/2)) / 2). Its smallest
+/// squared singular value lambda is the smallest root of det M(lambda) = 0,
+/// M(lambda) = Phi^T Phi - lambda - C^T (K (x) I - lambda)^-1 C (4 x 4, C = T^T Phi), in
+/// [0, k_min] (a unit translation along K's eigenvector of k_min has |B v|^2 = k_min). M is
+/// positive definite exactly below the root (it decreases with lambda), which brackets the
+/// Newton steps on det M, 1 / tr(M^-1 M') each; a step out of the bracket bisects it.
+pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) -> f64 {
+    let dot = |u: [f64; 2], v: [f64; 2]| u[0] * v[0] + u[1] * v[1];
+    let add = |u: [f64; 2], v: [f64; 2], s: f64| [u[0] + s * v[0], u[1] + s * v[1]];
+    // C's rows (each a 2-vector per angle column): leg i [a_i + p_i at i, -l_i at 3], the
+    // platform [-p_i at i, sum l_i at 3].
+    let mut c = [[[0.0; 2]; 4]; 4];
+    for i in 0..3 {
+        c[i][i] = add(a[i], p[i], 1.0);
+        c[i][3] = add([0.0; 2], l[i], -1.0);
+        c[3][i] = add([0.0; 2], p[i], -1.0);
+        c[3][3] = add(c[3][3], l[i], 1.0);
+    }
+    let root13 = 13.0_f64.sqrt();
+    let (k_plus, k_minus) = (0.5 * (5.0 + root13), 0.5 * (5.0 - root13));
+    let symmetric = |k: f64| {
+        let b = 2.0 - k;
+        let a = 1.0 / (3.0 + b * b).sqrt();
+        [a, a, a, b * a]
+    };
+    let (r2, r6) = (0.5_f64.sqrt(), (1.0_f64 / 6.0).sqrt());
+    let vectors = [[r2, -r2, 0.0, 0.0], [r6, r6, -2.0 * r6, 0.0], symmetric(k_plus), symmetric(k_minus)];
+    // G_r = W_r^T W_r, W_r = (v_r (x) I)^T C; the two of eigenvalue 2 summed.
+    let mut g = [[[0.0; 4]; 4]; 3];
+    for (r, v) in vectors.iter().enumerate() {
+        let w: [[f64; 2]; 4] = [0, 1, 2, 3].map(|j| (0..4).fold([0.0; 2], |s, n| add(s, c[n][j], v[n])));
+        for j in 0..4 {
+            for k in 0..4 {
+                g[r.saturating_sub(1)][j][k] += dot(w[j], w[k]);
+            }
+        }
+    }
+    let poles = [2.0, k_plus, k_minus];
+    let mut phi = [[0.0; 4]; 4];
+    for i in 0..3 {
+        phi[i][i] = dot(a[i], a[i]) + dot(p[i], p[i]);
+        phi[i][3] = -dot(p[i], l[i]);
+        phi[3][i] = phi[i][3];
+        phi[3][3] += dot(l[i], l[i]);
+    }
+    // M(lambda) and M'(lambda).
+    let m = |lambda: f64| {
+        let f = poles.map(|k| 1.0 / (k - lambda));
+        let mut m = [[0.0; 4]; 4];
+        let mut d = [[0.0; 4]; 4];
+        for j in 0..4 {
+            for k in 0..4 {
+                let eye = if j == k { 1.0 } else { 0.0 };
+                m[j][k] = phi[j][k] - eye * lambda - (0..3).map(|r| g[r][j][k] * f[r]).sum::<f64>();
+                d[j][k] = -eye - (0..3).map(|r| g[r][j][k] * f[r] * f[r]).sum::<f64>();
+            }
+        }
+        (m, d)
+    };
+    let (mut lo, mut hi, mut lambda) = (0.0, k_minus, 0.0);
+    for it in 0..TRIAD_ITERATIONS {
+        let (mm, d) = m(lambda);
+        let Some(inv) = spd_inverse(&mm) else {
+            if it == 0 {
+                return 0.0; // M(0) singular: so is the block
+            }
+            hi = lambda;
+            lambda = 0.5 * (lo + hi);
+            continue;
+        };
+        lo = lambda;
+        let trace: f64 = (0..4).map(|j| (0..4).map(|k| inv[j][k] * d[k][j]).sum::<f64>()).sum();
+        let mut next = lambda - 1.0 / trace;
+        if !(next < hi) {
+            next = 0.5 * (lambda + hi);
+        }
+        if (next - lambda).abs() <= 4.0 * f64::EPSILON * next.abs() {
+            return next.max(0.0).sqrt();
+        }
+        lambda = next;
+    }
+    lambda.max(0.0).sqrt()
+}
+
+/// The inverse of a symmetric 4 x 4 matrix by Cholesky, None unless positive definite.
+fn spd_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
+    let mut l = [[0.0; 4]; 4];
+    for j in 0..4 {
+        let d = m[j][j] - (0..j).map(|k| l[j][k] * l[j][k]).sum::<f64>();
+        if !(d > 0.0) {
+            return None;
+        }
+        l[j][j] = d.sqrt();
+        for i in j + 1..4 {
+            l[i][j] = (m[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>()) / l[j][j];
+        }
+    }
+    // M^-1 = L^-T L^-1, column by column (each also a row: it is symmetric).
+    Some([0, 1, 2, 3].map(|c| {
+        let mut y = [0.0; 4];
+        for i in 0..4 {
+            let e = if i == c { 1.0 } else { 0.0 };
+            y[i] = (e - (0..i).map(|k| l[i][k] * y[k]).sum::<f64>()) / l[i][i];
+        }
+        for i in (0..4).rev() {
+            y[i] = (y[i] - (i + 1..4).map(|k| l[k][i] * y[k]).sum::<f64>()) / l[i][i];
+        }
+        y
+    }))
 }

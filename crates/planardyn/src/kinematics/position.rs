@@ -15,10 +15,10 @@ use crate::{KinematicsError, SingularityKind};
 pub const POSITION_TOL: f64 = 1e-14;
 /// A residual this small that Newton no longer reduces is accepted: round-off has been
 /// reached (ill-conditioned J or large coordinates).
-const ROUND_OFF_FLOOR: f64 = 1e-11;
+pub(crate) const ROUND_OFF_FLOOR: f64 = 1e-11;
 /// Residuals above this (scaled) get a last Newton step after convergence, so positions
 /// are accurate to ~1e-14 whichever way the tolerance was met.
-const POLISH_BELOW: f64 = 1e-14;
+pub(crate) const POLISH_BELOW: f64 = 1e-14;
 /// Newton iterations before giving up; from a first-order predictor it takes 1 to 3.
 pub const MAX_NEWTON: usize = 30;
 

@@ -46,8 +46,8 @@ pub struct Branch {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Geometry {
     known: [[f64; 2]; 2],
-    own: [[f64; 2]; 2],
-    e: [[f64; 2]; 2],
+    pub(crate) own: [[f64; 2]; 2],
+    pub(crate) e: [[f64; 2]; 2],
     inv_det: f64,
 }
 
@@ -68,8 +68,17 @@ impl Rrr {
     /// points `s_outer` in the bodies' frames) and to each other at P (`s_inner` in each frame).
     pub fn new(bodies: [usize; 2], outer: [Joint; 2], s_outer: [[f64; 2]; 2], s_inner: [[f64; 2]; 2]) -> Self {
         let arms = [sub(s_inner[0], s_outer[0]), sub(s_inner[1], s_outer[1])];
-        let bend = arms[1][1].atan2(arms[1][0]) - arms[0][1].atan2(arms[0][0]);
-        Rrr { bodies, outer, s_outer, arms2: arms.map(|a| dot(a, a)), arms, bend }
+        let mut d = Rrr { bodies, outer, s_outer, arms2: [0.0; 2], arms, bend: 0.0 };
+        d.set_arms(arms);
+        d
+    }
+
+    /// Set P - A in body 1's frame and P - B in body 2's (a link whose shape a relative input
+    /// changes: `extension`).
+    #[inline]
+    pub fn set_arms(&mut self, arms: [[f64; 2]; 2]) {
+        self.bend = arms[1][1].atan2(arms[1][0]) - arms[0][1].atan2(arms[0][0]);
+        (self.arms, self.arms2) = (arms, arms.map(|a| dot(a, a)));
     }
 
     /// Whether the bodies' angles in x (any x, not necessarily assembled: the Newton
@@ -96,7 +105,7 @@ impl Rrr {
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved.
-    #[inline]
+    #[inline(always)]
     pub fn position(&self, branch: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
         let (a, ra) = self.outer[0].place(x, trig);
         let (b, rb) = self.outer[1].place(x, trig);
@@ -142,26 +151,32 @@ impl Rrr {
         Ok(g)
     }
 
-    /// The bodies' rates, those of the links before them in v.
-    #[inline]
-    pub fn velocity(&self, g: &Geometry, v: &mut [f64]) {
+    /// The bodies' rates, those of the links before them in v; `slide` P's velocity relative to
+    /// body 1 and to body 2 (zero unless a relative input moves it along its link).
+    #[inline(always)]
+    pub fn velocity(&self, g: &Geometry, slide: [[f64; 2]; 2], v: &mut [f64]) {
         let va = self.outer[0].velocity(g.known[0], v);
         let vb = self.outer[1].velocity(g.known[1], v);
-        let dv = sub(vb, va);
+        let dv = [vb[0] + slide[1][0] - va[0] - slide[0][0], vb[1] + slide[1][1] - va[1] - slide[0][1]];
         let (w1, w2) = (dot(dv, g.e[1]) * g.inv_det, dot(dv, g.e[0]) * g.inv_det);
         put_rate(v, self.bodies[0], va, g.own[0], w1);
         put_rate(v, self.bodies[1], vb, g.own[1], w2);
     }
 
     /// The bodies' accelerations, from the rates v and the accelerations of the links before
-    /// them in a.
-    #[inline]
-    pub fn acceleration(&self, g: &Geometry, v: &[f64], a: &mut [f64]) {
+    /// them in a; `slide` as in [`Rrr::velocity`] (P's Coriolis acceleration 2 w E slide).
+    #[inline(always)]
+    pub fn acceleration(&self, g: &Geometry, slide: [[f64; 2]; 2], v: &[f64], a: &mut [f64]) {
         let aa = self.outer[0].acceleration(g.known[0], v, a);
         let ab = self.outer[1].acceleration(g.known[1], v, a);
         let (w1, w2) = (v[3 * self.bodies[0] + 2], v[3 * self.bodies[1] + 2]);
         let (k1, k2, [e1, e2]) = (w1 * w1, w2 * w2, g.e);
-        let da = [ab[0] - aa[0] + k1 * e1[0] - k2 * e2[0], ab[1] - aa[1] + k1 * e1[1] - k2 * e2[1]];
+        let (c1, c2) = (perp(slide[0]), perp(slide[1]));
+        let (t1, t2) = (2.0 * w1, 2.0 * w2);
+        let da = [
+            ab[0] + t2 * c2[0] - aa[0] - t1 * c1[0] + k1 * e1[0] - k2 * e2[0],
+            ab[1] + t2 * c2[1] - aa[1] - t1 * c1[1] + k1 * e1[1] - k2 * e2[1],
+        ];
         let (al1, al2) = (dot(da, e2) * g.inv_det, dot(da, e1) * g.inv_det);
         put_acceleration(a, self.bodies[0], aa, g.own[0], w1, al1);
         put_acceleration(a, self.bodies[1], ab, g.own[1], w2, al2);

@@ -1,0 +1,347 @@
+//! The class III triad of six revolute pairs: three legs (binary links) hinged at A_i to links
+//! solved before them and at C_i to a platform (a ternary link). The platform's pose
+//! p = (X, Y, phi) solves the three distance equations |C_i(p) - A_i| = l_i by Newton on their
+//! 3 x 3 Jacobian, from the pose of the reference configuration (the integrator's last accepted
+//! point), which keeps its assembly branch; each leg then follows from A_i and C_i in closed
+//! form. Rates and accelerations solve with the same Jacobian at the solution, rows
+//! (e_i, (R c_i) x e_i) with e_i = C_i - A_i and R c_i the platform's arm of C_i: its
+//! determinant vanishes where the three legs' lines meet in a point (or are parallel), the
+//! triad's type II singularity, and its sign is the branch's side of it.
+//!
+//! A leg may be two bodies a relative prismatic input locks into one link (the 3-RPR's
+//! cylinders, `extension`): its length l_i then follows the input, C_i moves along it at the
+//! rod's relative velocity s_i, and the leg's equations gain s_i (rates) and its Coriolis
+//! term 2 w_i E s_i (accelerations).
+
+use super::extension::Arm;
+use super::{put_acceleration, put_rate, Joint};
+use crate::kinematics::group_sigma::{triad_sigma, Block};
+use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
+use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
+use crate::{KinematicsError, SingularityKind};
+
+#[inline]
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// Leg i's row of the 3 x 3 Jacobian: (e, lever x e).
+#[inline]
+fn row(e: [f64; 2], lever: [f64; 2]) -> [f64; 3] {
+    [e[0], e[1], cross(lever, e)]
+}
+
+/// Inverse of a 3 x 3 matrix by its cofactors (None where it is singular), and its determinant.
+#[inline]
+fn inverse(m: &[[f64; 3]; 3]) -> Option<([[f64; 3]; 3], f64)> {
+    let c = |i: usize, j: usize| {
+        let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+        m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]
+    };
+    let cof = [[c(0, 0), c(0, 1), c(0, 2)], [c(1, 0), c(1, 1), c(1, 2)], [c(2, 0), c(2, 1), c(2, 2)]];
+    let det = m[0][0] * cof[0][0] + m[0][1] * cof[0][1] + m[0][2] * cof[0][2];
+    if !(det.abs() > 0.0 && det.is_finite()) {
+        return None;
+    }
+    let k = 1.0 / det;
+    Some(([0, 1, 2].map(|i| [0, 1, 2].map(|j| cof[j][i] * k)), det))
+}
+
+#[inline]
+fn times(inv: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
+    inv.map(|r| r[0] * b[0] + r[1] * b[1] + r[2] * b[2])
+}
+
+#[derive(Debug, Clone)]
+pub struct Triad {
+    /// The legs' bodies (the bases of two-body legs), then the platform's.
+    pub bodies: [usize; 4],
+    /// Those and the followers of two-body legs: the group's bodies.
+    pub members: Vec<usize>,
+    /// Per leg, its relative input if it is two bodies.
+    extended: [Option<Arm>; 3],
+    /// A_i on the links solved before, and the same points in the legs' frames.
+    outer: [Joint; 3],
+    s_outer: [[f64; 2]; 3],
+    /// C_i - A_i in leg i's frame, its squared length and 1 / length.
+    arms: [[f64; 2]; 3],
+    arms2: [f64; 3],
+    inv_arm: [f64; 3],
+    /// C_i in the platform's frame.
+    s_platform: [[f64; 2]; 3],
+    /// 1 / L, the mechanism's length (Newton's scaled residual).
+    inv_scale: f64,
+    branch: Branch,
+    geometry: Geometry,
+}
+
+/// What the triad keeps from the reference configuration: the platform's pose (Newton's start),
+/// the sign of its Jacobian's determinant, and each leg's angle with R(angle) arm_i (the new
+/// angles are taken within pi of them).
+#[derive(Debug, Clone, Copy, Default)]
+struct Branch {
+    pose: [f64; 3],
+    side: f64,
+    legs: [f64; 3],
+    directions: [[f64; 2]; 3],
+}
+
+/// The triad at its solved position: R s of A_i on their links and on the legs, e_i, the
+/// platform's arms R c_i, the inverse Jacobian and 1 / |e_i|^2.
+#[derive(Debug, Clone, Copy, Default)]
+struct Geometry {
+    known: [[f64; 2]; 3],
+    own: [[f64; 2]; 3],
+    e: [[f64; 2]; 3],
+    lever: [[f64; 2]; 3],
+    inv: [[f64; 3]; 3],
+    inv_e2: [f64; 3],
+}
+
+impl Triad {
+    /// A triad of legs `bodies[..3]` hinged at `outer` (the points `s_outer` in the legs'
+    /// frames) and at C_i to the platform `bodies[3]` (`s_inner[i]` in leg i's frame,
+    /// `s_platform[i]` in the platform's), legs of two bodies in `extended` (whose arms
+    /// replace those of `s_outer` and `s_inner`); `scale` the mechanism's length.
+    pub fn new(
+        bodies: [usize; 4],
+        outer: [Joint; 3],
+        [s_outer, s_inner, s_platform]: [[[f64; 2]; 3]; 3],
+        extended: [Option<Arm>; 3],
+        scale: f64,
+    ) -> Self {
+        let arms = [0, 1, 2].map(|i| sub(s_inner[i], s_outer[i]));
+        let members = bodies.iter().copied().chain(extended.iter().flatten().map(|a| a.ext.follower)).collect();
+        let mut triad = Triad {
+            bodies,
+            members,
+            extended,
+            outer,
+            s_outer,
+            arms,
+            arms2: [0.0; 3],
+            inv_arm: [0.0; 3],
+            s_platform,
+            inv_scale: 1.0 / scale,
+            branch: Branch::default(),
+            geometry: Geometry::default(),
+        };
+        triad.set_arms(|_| 0.0);
+        triad
+    }
+
+    /// The legs' arms at the extensions d(leg) of the two-body ones.
+    #[inline]
+    fn set_arms(&mut self, d: impl Fn(&Arm) -> f64) {
+        for (i, a) in self.extended.iter().enumerate() {
+            if let Some(a) = a {
+                self.arms[i] = a.arm(d(a));
+            }
+            self.arms2[i] = dot(self.arms[i], self.arms[i]);
+            self.inv_arm[i] = 1.0 / self.arms2[i].sqrt();
+        }
+    }
+
+    /// The sign of the Jacobian's determinant with the bodies' angles in x (any x, not
+    /// necessarily assembled: the legs' directions and the platform's arms are those angles').
+    fn side(&self, x: &[f64]) -> f64 {
+        let (s, c) = x[3 * self.bodies[3] + 2].sin_cos();
+        let rows = [0, 1, 2].map(|i| {
+            let (sl, cl) = x[3 * self.bodies[i] + 2].sin_cos();
+            row(rot([cl, sl], self.arms[i]), rot([c, s], self.s_platform[i]))
+        });
+        let [a, b, d] = rows;
+        (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]))
+            .signum()
+    }
+
+    /// Take the branch of the configuration x (a solution).
+    pub fn set_reference(&mut self, x: &[f64]) {
+        self.set_arms(|a| a.ext.shift_in(x));
+        let p = 3 * self.bodies[3];
+        let legs = [0, 1, 2].map(|i| x[3 * self.bodies[i] + 2]);
+        let directions = [0, 1, 2].map(|i| {
+            let (s, c) = legs[i].sin_cos();
+            rot([c, s], self.arms[i])
+        });
+        self.branch = Branch { pose: [x[p], x[p + 1], x[p + 2]], side: self.side(x), legs, directions };
+    }
+
+    /// Whether the bodies' angles in x (a Newton predictor's) keep the reference's side of the
+    /// triad's singularity; a predictor past it means the motion leaves the branch there,
+    /// which Newton from the reference pose would not follow.
+    pub fn keeps_side(&self, x: &[f64]) -> bool {
+        self.side(x) == self.branch.side
+    }
+
+    /// The bodies' poses (x and trig) on the reference branch, the links before them solved.
+    /// Newton stops as the general position solve does (`position`): at a scaled residual
+    /// (each leg's length error / L) of POSITION_TOL relative to the pose's size, or at
+    /// round-off once a step no longer halves it, with one more step above POLISH_BELOW.
+    #[inline(never)]
+    pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+        if self.extended.iter().any(Option::is_some) {
+            self.set_arms(|a| a.ext.shift(z));
+        }
+        let mut g = Geometry::default();
+        let mut a = [[0.0; 2]; 3];
+        for (i, j) in self.outer.iter().enumerate() {
+            (a[i], g.known[i]) = j.place(x, trig);
+        }
+        let mut pose = self.branch.pose;
+        let size = (pose[0].abs() * self.inv_scale).max(pose[1].abs() * self.inv_scale).max(pose[2].abs());
+        let tol = POSITION_TOL * (1.0 + size);
+        let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
+        for _ in 0..=MAX_NEWTON {
+            let (s, c) = pose[2].sin_cos();
+            let cs = [c, s];
+            let mut f = [0.0; 3];
+            let mut norm: f64 = 0.0;
+            for i in 0..3 {
+                g.lever[i] = rot(cs, self.s_platform[i]);
+                g.e[i] = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], a[i]);
+                f[i] = 0.5 * (dot(g.e[i], g.e[i]) - self.arms2[i]);
+                norm = norm.max(f[i].abs() * self.inv_arm[i]);
+            }
+            norm *= self.inv_scale;
+            if !norm.is_finite() || norm > 1e6 * first.max(1.0) {
+                break;
+            }
+            first = first.min(norm);
+            let jac = [0, 1, 2].map(|i| row(g.e[i], g.lever[i]));
+            let Some((inv, _)) = inverse(&jac) else { return Err(KinematicsError::singular(SingularityKind::TypeII)) };
+            g.inv = inv;
+            let done = polish || norm <= tol || (norm <= ROUND_OFF_FLOOR && norm > 0.5 * previous);
+            if done && (polish || norm <= POLISH_BELOW) {
+                self.place(pose, cs, g, x, trig);
+                for a in self.extended.iter_mut().flatten() {
+                    a.ext.place(z, x, trig);
+                }
+                return Ok(());
+            }
+            polish = done;
+            previous = norm;
+            let d = times(&g.inv, f);
+            pose = [pose[0] - d[0], pose[1] - d[1], pose[2] - d[2]];
+        }
+        let residual = if first.is_finite() { first } else { f64::INFINITY };
+        Err(KinematicsError::AssemblyFailed { residual, iterations: MAX_NEWTON })
+    }
+
+    /// Write the platform at `pose` and the legs from A_i and C_i, keeping the geometry.
+    #[inline]
+    fn place(&mut self, pose: [f64; 3], cs: [f64; 2], mut g: Geometry, x: &mut [f64], trig: &mut [[f64; 2]]) {
+        let p = self.bodies[3];
+        x[3 * p..3 * p + 3].copy_from_slice(&pose);
+        trig[p] = cs;
+        for i in 0..3 {
+            let (arm, e, b) = (self.arms[i], g.e[i], self.bodies[i]);
+            let e2 = dot(e, e);
+            // The rotation taking the arm in the leg's frame to e, and its angle from the
+            // reference's direction.
+            let r = 1.0 / (self.arms2[i] * e2).sqrt();
+            let leg_cs = [dot(arm, e) * r, cross(arm, e) * r];
+            let d = self.branch.directions[i];
+            let turn = cross(d, e).atan2(dot(d, e));
+            let rs = rot(leg_cs, self.s_outer[i]);
+            let c = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], e);
+            x[3 * b] = c[0] - rs[0];
+            x[3 * b + 1] = c[1] - rs[1];
+            x[3 * b + 2] = self.branch.legs[i] + turn;
+            trig[b] = leg_cs;
+            g.own[i] = rs;
+            g.inv_e2[i] = 1.0 / e2;
+        }
+        self.geometry = g;
+    }
+
+    /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg).
+    #[inline]
+    fn slides(&self, d: impl Fn(&Arm) -> f64) -> [[f64; 2]; 3] {
+        self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a))))
+    }
+
+    /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
+    /// the platform's from e_i . (v_C_i - v_A_i - s_i) = 0, each leg's turning rate from
+    /// v_C_i - v_A_i - s_i = w E e_i.
+    #[inline(never)]
+    pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
+        let g = &self.geometry;
+        let s = self.slides(|a| a.ext.input_rate(zd));
+        let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], v));
+        let [vx, vy, w] = times(&g.inv, [0, 1, 2].map(|i| dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]])));
+        let p = self.bodies[3];
+        v[3 * p..3 * p + 3].copy_from_slice(&[vx, vy, w]);
+        for (i, &leg) in self.bodies[..3].iter().enumerate() {
+            let vc = [vx - w * g.lever[i][1] - s[i][0], vy + w * g.lever[i][0] - s[i][1]];
+            let wl = cross(g.e[i], sub(vc, va[i])) * g.inv_e2[i];
+            put_rate(v, leg, va[i], g.own[i], wl);
+        }
+        for a in self.extended.iter().flatten() {
+            a.ext.velocity(zd, v);
+        }
+    }
+
+    /// The bodies' accelerations, from the rates v and the accelerations of the links before
+    /// them in a: with a_C_i = a_A_i + al_i E e_i - w_i^2 e_i + 2 w_i E s_i (leg i's rates),
+    /// e_i . (a_C_i - a_A_i) = -w_i^2 |e_i|^2 + 2 w_i s_i x e_i.
+    #[inline(never)]
+    pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
+        let g = &self.geometry;
+        let s = self.slides(|x| x.ext.rate(v));
+        let p = self.bodies[3];
+        let w = v[3 * p + 2];
+        let (mut aa, mut rhs) = ([[0.0; 2]; 3], [0.0; 3]);
+        for (i, &b) in self.bodies[..3].iter().enumerate() {
+            let (wl, l) = (v[3 * b + 2], g.lever[i]);
+            // a_A_i plus the Coriolis acceleration of C_i on the leg.
+            let c = perp(s[i]);
+            aa[i] = self.outer[i].acceleration(g.known[i], v, a);
+            let ac = [aa[i][0] + 2.0 * wl * c[0], aa[i][1] + 2.0 * wl * c[1]];
+            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * dot(g.e[i], g.e[i]);
+        }
+        let [ax, ay, al] = times(&g.inv, rhs);
+        a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
+        for (i, &b) in self.bodies[..3].iter().enumerate() {
+            let (wl, l, c) = (v[3 * b + 2], g.lever[i], perp(s[i]));
+            let ac = [ax - al * l[1] - w * w * l[0], ay + al * l[0] - w * w * l[1]];
+            let rel = [ac[0] - aa[i][0] - 2.0 * wl * c[0], ac[1] - aa[i][1] - 2.0 * wl * c[1]];
+            put_acceleration(a, b, aa[i], g.own[i], wl, cross(g.e[i], rel) * g.inv_e2[i]);
+        }
+        for x in self.extended.iter().flatten() {
+            x.ext.acceleration(v, a);
+        }
+    }
+
+    /// The triad's type II measure at the last positions (`group_sigma`'s): the smallest
+    /// singular value of its block at its own length L_k (1 / L_k = `inv_length`), 12 x 12
+    /// (21 x 21 with three two-body legs): columns (r, phi) of each leg, the platform, then the
+    /// followers; two rows a pair, the outer pair i [I, E R s_A] on leg i, the inner pair i
+    /// [I, E R s_C] on the body of leg i that holds C_i and -[I, E R c_i] on the platform, and
+    /// each relative input's three (`Extension::block_rows`). The 6R triad's from a 4 x 4
+    /// secular equation (`group_sigma::triad_sigma`); with cylinder legs, a dense SVD of the
+    /// block (18 us for 21 x 21 on a loaded machine: the monitor takes it once a step).
+    pub fn sigma(&self, inv_length: f64) -> f64 {
+        let g = &self.geometry;
+        if self.extended.iter().all(Option::is_none) {
+            let k = |v: [f64; 2]| [v[0] * inv_length, v[1] * inv_length];
+            let p = [0, 1, 2].map(|i| k([g.own[i][0] + g.e[i][0], g.own[i][1] + g.e[i][1]]));
+            return triad_sigma(g.own.map(k), p, g.lever.map(k));
+        }
+        let mut block = Block::new(self.members.len(), inv_length);
+        let mut follower = 4;
+        for (i, x) in self.extended.iter().enumerate() {
+            block.point_rows(&[(i, 1.0, g.own[i])]);
+            let c = [g.own[i][0] + g.e[i][0], g.own[i][1] + g.e[i][1]];
+            match x {
+                Some(x) => {
+                    block.point_rows(&[(follower, 1.0, x.on_follower(c)), (3, -1.0, g.lever[i])]);
+                    x.ext.block_rows(i, follower, &mut block);
+                    follower += 1;
+                }
+                None => block.point_rows(&[(i, 1.0, c), (3, -1.0, g.lever[i])]),
+            }
+        }
+        block.sigma()
+    }
+}
