@@ -328,53 +328,6 @@ pub(crate) fn rrp_sigma(a: [f64; 2], p1: [f64; 2], p2: [f64; 2], n: [f64; 2], si
     lambda.sqrt()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use nalgebra::SMatrix;
-
-    /// rrp_sigma against the SVD of the block it stands for, over random arms and guides,
-    /// down to blocks near singular (the arm p1 turned onto the guide's normal).
-    #[test]
-    fn rrp_sigma_is_the_svd_of_its_block() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        let (mut worst, mut smallest) = (0.0_f64, f64::INFINITY);
-        for i in 0..2000 {
-            let angle = std::f64::consts::PI * next();
-            let n = [angle.cos(), angle.sin()];
-            let (a, mut p1, p2) = ([next(), next()], [next(), next()], [next(), next()]);
-            if i % 2 == 1 {
-                // p1 - a = E e / L_k nearly along the guide: the rod nearly normal to it.
-                let off = 1e-6 * next();
-                p1 = [a[0] + p1[0] * off + n[1] * 0.5, a[1] + p1[1] * off - n[0] * 0.5];
-            }
-            let (sign, g) = (if next() > 0.0 { 1.0 } else { -1.0 }, next());
-            #[rustfmt::skip]
-            let b = SMatrix::<f64, 6, 6>::from_row_slice(&[
-                1.0, 0.0, a[0], 0.0, 0.0, 0.0,
-                0.0, 1.0, a[1], 0.0, 0.0, 0.0,
-                1.0, 0.0, p1[0], -1.0, 0.0, -p2[0],
-                0.0, 1.0, p1[1], 0.0, -1.0, -p2[1],
-                0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-                0.0, 0.0, 0.0, sign * n[0], sign * n[1], g,
-            ]);
-            let (svd, closed) = (b.singular_values().min(), rrp_sigma(a, p1, p2, n, sign, g));
-            // Both are exact to about 1e-16 (the block's norm) absolute.
-            worst = worst.max((svd - closed).abs());
-            smallest = smallest.min(svd);
-        }
-        eprintln!("rrp_sigma: worst difference {worst:.1e}, smallest sigma {smallest:.1e}");
-        assert!(smallest < 1e-9, "no near-singular block drawn: smallest {smallest:e}");
-        assert!(worst < 1e-14, "rrp_sigma differs from the SVD by {worst:e}");
-    }
-}
-
 /// A group's block at its own length for a fixed-size SVD, where its measure has no closed
 /// form: columns (r, phi) of each of its bodies (by place), rows added a pair at a time; as in
 /// [`dyad_sigma`], translations enter as +-1 and angles by their lever arms R s / L_k.
@@ -530,4 +483,51 @@ fn spd_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
         }
         y
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::SMatrix;
+
+    /// rrp_sigma against the SVD of the block it stands for, over random arms and guides,
+    /// down to blocks near singular (the arm p1 turned onto the guide's normal).
+    #[test]
+    fn rrp_sigma_is_the_svd_of_its_block() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut worst, mut smallest) = (0.0_f64, f64::INFINITY);
+        for i in 0..2000 {
+            let angle = std::f64::consts::PI * next();
+            let n = [angle.cos(), angle.sin()];
+            let (a, mut p1, p2) = ([next(), next()], [next(), next()], [next(), next()]);
+            if i % 2 == 1 {
+                // p1 - a = E e / L_k nearly along the guide: the rod nearly normal to it.
+                let off = 1e-6 * next();
+                p1 = [a[0] + p1[0] * off + n[1] * 0.5, a[1] + p1[1] * off - n[0] * 0.5];
+            }
+            let (sign, g) = (if next() > 0.0 { 1.0 } else { -1.0 }, next());
+            #[rustfmt::skip]
+            let b = SMatrix::<f64, 6, 6>::from_row_slice(&[
+                1.0, 0.0, a[0], 0.0, 0.0, 0.0,
+                0.0, 1.0, a[1], 0.0, 0.0, 0.0,
+                1.0, 0.0, p1[0], -1.0, 0.0, -p2[0],
+                0.0, 1.0, p1[1], 0.0, -1.0, -p2[1],
+                0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+                0.0, 0.0, 0.0, sign * n[0], sign * n[1], g,
+            ]);
+            let (svd, closed) = (b.singular_values().min(), rrp_sigma(a, p1, p2, n, sign, g));
+            // Both are exact to about 1e-16 (the block's norm) absolute.
+            worst = worst.max((svd - closed).abs());
+            smallest = smallest.min(svd);
+        }
+        eprintln!("rrp_sigma: worst difference {worst:.1e}, smallest sigma {smallest:.1e}");
+        assert!(smallest < 1e-9, "no near-singular block drawn: smallest {smallest:e}");
+        assert!(worst < 1e-14, "rrp_sigma differs from the SVD by {worst:e}");
+    }
 }
