@@ -4,10 +4,12 @@
 // `icount MODEL N sigma` instead takes the type II measure from the closed forms N times.
 use planardyn::dynamics::ModelDrives;
 use planardyn::integrate::OdeSystem;
-use planardyn::kinematics::{assemble_into, sigma_min, velocity_analogues, Chart, ClosedForm};
-use planardyn::simulate::ode::MechanismOde;
+use planardyn::kinematics::ClosedForm;
 use planardyn::Workspace;
 use std::hint::black_box;
+
+#[path = "../../../crates/planardyn/tests/common/ode.rs"]
+mod ode;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -23,17 +25,8 @@ fn main() {
         }
         return;
     }
-    let mut ws = Workspace::new(&mech);
-    assemble_into(&mech, &q0, &mut ws).unwrap();
-    velocity_analogues(&mut ws).unwrap();
     let mut drives = ModelDrives(&mech);
-    let mut ode = MechanismOde::new(&mech, ws, &mut drives);
-    let mut y0 = vec![0.0; 2 * m + 1];
-    y0[..m].copy_from_slice(&q0);
-    y0[m..2 * m].fill(1.0);
-    ode.set_chart(Chart::Inputs, 0.0, &y0).unwrap();
-    // As the integrator after its first accepted step: clear of folds, the closed forms apply.
-    ode.limit_correction(sigma_min(&mech, &Chart::Inputs, ode.anchor_x()));
+    let (mut ode, y0) = ode::at_drawing(&mech, &mut drives);
     let mut y = y0.clone();
     y[..m].iter_mut().for_each(|v| *v += 1e-3);
     let mut y2 = y.clone();

@@ -12,10 +12,10 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use planardyn::dynamics::ModelDrives;
 use planardyn::integrate::OdeSystem;
-use planardyn::kinematics::{assemble_into, sigma_min, velocity_analogues, Chart};
-use planardyn::simulate::ode::MechanismOde;
-use planardyn::Workspace;
 use std::hint::black_box;
+
+#[path = "../tests/common/ode.rs"]
+mod ode;
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("forward_dynamics");
@@ -23,18 +23,8 @@ fn bench(c: &mut Criterion) {
         let path = format!("{}/../../examples/models/{file}", env!("CARGO_MANIFEST_DIR"));
         let mech = planardyn::load(&path).unwrap();
         let m = mech.dof();
-        let (q0, _) = mech.initial_state();
-        let mut ws = Workspace::new(&mech);
-        assemble_into(&mech, &q0, &mut ws).unwrap();
-        velocity_analogues(&mut ws).unwrap();
         let mut drives = ModelDrives(&mech);
-        let mut ode = MechanismOde::new(&mech, ws, &mut drives);
-        let mut y0 = vec![0.0; 2 * m + 1];
-        y0[..m].copy_from_slice(&q0);
-        y0[m..2 * m].fill(1.0);
-        ode.set_chart(Chart::Inputs, 0.0, &y0).unwrap();
-        // As the integrator after its first accepted step: clear of folds, the closed forms apply.
-        ode.limit_correction(sigma_min(&mech, &Chart::Inputs, ode.anchor_x()));
+        let (mut ode, y0) = ode::at_drawing(&mech, &mut drives);
         // A stage point 1 mrad away, as within an integration step.
         let mut y = y0.clone();
         y[..m].iter_mut().for_each(|v| *v += 1e-3);

@@ -511,22 +511,12 @@ fn first_closed_form_step_after_a_newton_point() {
     // Newton point (where the groups' geometry was never evaluated). Each model's first two
     // evaluations 1 mrad on succeed and give the general path's accelerations.
     use planardyn::integrate::OdeSystem;
-    use planardyn::simulate::ode::MechanismOde;
     let dir = root().join("examples/models");
     for model in ["3-rrr", "library/3-rpr", "hydraulic-boom", "five-bar"] {
         let mech = planardyn::load(dir.join(format!("{model}.yaml")).to_str().unwrap()).unwrap();
         let m = mech.dof();
-        let (q0, _) = mech.initial_state();
-        let mut ws = Workspace::new(&mech);
-        assemble_into(&mech, &q0, &mut ws).unwrap();
-        velocity_analogues(&mut ws).unwrap();
         let mut drives = ModelDrives(&mech);
-        let mut ode = MechanismOde::new(&mech, ws, &mut drives);
-        let mut y = vec![0.0; 2 * m + 1];
-        y[..m].copy_from_slice(&q0);
-        y[m..2 * m].fill(1.0);
-        ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
-        ode.limit_correction(sigma_min(&mech, &Chart::Inputs, ode.anchor_x()));
+        let (mut ode, mut y) = common::ode::at_drawing(&mech, &mut drives);
         let mut dy = vec![0.0; 2 * m + 1];
         for step in 1..=2 {
             y[..m].iter_mut().for_each(|v| *v += 1e-3);

@@ -3,6 +3,8 @@
 
 use planardyn::{loads, Format, Mechanism};
 
+pub mod ode;
+
 pub fn yaml(text: &str) -> Mechanism {
     loads(text, Format::Yaml, "<test>").unwrap_or_else(|e| panic!("{e}"))
 }
