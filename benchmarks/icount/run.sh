@@ -14,7 +14,7 @@ for f in four-bar-gravity five-bar 3-rrr andrews-squeezer slider-crank scotch-yo
     done
 done
 # The type II measure from the closed forms, per call.
-for f in four-bar-gravity slider-crank scotch-yoke gear-train; do
+for f in four-bar-gravity slider-crank scotch-yoke gear-train 3-rrr; do
     a=$(ir "../../examples/models/$f.yaml" 0 sigma)
     b=$(ir "../../examples/models/$f.yaml" 1000 sigma)
     echo "$f sigma $(( (b - a) / 1000 ))"
