@@ -349,7 +349,7 @@ fn cross_change_point(
     let own = chart_sigma(ode, meas.sigma);
     ode.limit_correction(own);
     approach.clear();
-    approach.keep(ode, landing.t, meas.passive);
+    approach.keep(ode, landing.t, meas.passive, landing.y[landing.y.len() - 1]);
     match out.t_eval {
         None => traj.record(ode, landing.t, landing.y[landing.y.len() - 1], meas.sigma),
         Some(te) => {
@@ -456,7 +456,7 @@ pub fn simulate_observed<'a>(
     // The start counts in the least measures, so that a run of no step reports its start's.
     let first = measure(&mut ode);
     (traj.stats.min_sigma, traj.stats.min_passive_sigma) = (first.sigma, first.passive);
-    approach.keep(&ode, settings.t0, first.passive);
+    approach.keep(&ode, settings.t0, first.passive, y[2 * m]);
     if t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
         traj.record(&ode, settings.t0, y[2 * m], first.sigma);
         out.next = 1;
@@ -601,7 +601,15 @@ pub fn simulate_observed<'a>(
             // The points kept are on the other side of it.
             approach.clear();
         }
-        approach.keep(&ode, t, meas.passive);
+        if let Some(scale) = approach.restore(&ode, meas.passive, y[2 * m]) {
+            y[m..2 * m].iter_mut().for_each(|v| *v *= scale);
+            let restored = stepper.reset(&mut ode, t, &y).map_err(|e| e.to_string());
+            if let Err(e) = restored.and_then(|()| ode.accept(t, &y).map_err(|e| e.to_string())) {
+                (status, message) = (Status::AssemblyFailed, format!("restoring the energy at t = {t} s: {e}"));
+                break;
+            }
+        }
+        approach.keep(&ode, t, meas.passive, y[2 * m]);
         if meas.passive < PASSIVE_SINGULAR {
             (status, message) = (Status::PassiveSingularity, format!("the passive mechanism is singular at t = {t} s (scaled measure {:.2e}): its pair constraints lose rank and the motion is not determined beyond", meas.passive));
             break;

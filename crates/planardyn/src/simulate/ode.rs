@@ -68,9 +68,11 @@ pub struct MechanismOde<'a> {
     /// is integrated (`charts::measure`).
     pub inputs_sys: System,
     /// The user's chart in closed form, where every group has one (`kinematics::closed_form`),
-    /// its branches those of the last accepted point; and whether `ws.sys` is then behind the
-    /// point in `ws` (factorised at the monitor's request only, once a step).
+    /// its branches those of the last accepted point; whether the point in `ws` came from it
+    /// (its groups' geometry is then that point's); and whether `ws.sys` is then behind that
+    /// point (factorised at the monitor's request only, once a step).
     closed: Option<ClosedForm>,
+    base_closed: bool,
     stale_j: bool,
     /// Whether the last accepted point is clear of folds ([`CLOSED_FORM_SIGMA`]).
     clear_of_folds: bool,
@@ -102,6 +104,7 @@ impl<'a> MechanismOde<'a> {
             failed_evaluations: 0,
             inputs_sys: System::new(mech),
             closed,
+            base_closed: false,
             stale_j: false,
             clear_of_folds: true,
             mech,
@@ -221,18 +224,15 @@ impl<'a> MechanismOde<'a> {
     /// accelerations for the rates U dz), else a first-order one from the last accepted point.
     /// Both start from converged points of the same branch.
     fn predict(&mut self, z: &[f64]) {
-        let closed = self.closed_form_in_use();
-        if !closed && self.base_valid {
-            // The second-order term solves with J at the last evaluation.
-            self.factor_stale_j();
-        }
         let ws = &mut self.ws;
         if self.base_valid {
             ws.rhs.fill(0.0);
             let last = &self.last_y;
             add_u_times(&ws.u, ws.sys.u_support(), |j| z[j] - last[j], &mut ws.rhs);
-            // tmp = w(dz, dz) from the closed forms' accelerations, -w(dz, dz) = J^-1 gamma(dz, dz) by J.
-            let half = match self.closed.as_ref().filter(|_| closed) {
+            // tmp = w(dz, dz) from the closed forms' accelerations where they gave the last
+            // evaluation (their geometry is its), else -w(dz, dz) = J^-1 gamma(dz, dz) by J,
+            // which Newton left factorised there.
+            let half = match self.closed.as_ref().filter(|_| self.base_closed) {
                 Some(c) => {
                     c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
                     0.5
@@ -297,6 +297,7 @@ impl<'a> MechanismOde<'a> {
         self.base_valid = false;
         // The pairs' friction needs the reactions, solved with J at this point.
         let reactions = !self.mech.friction.is_empty();
+        self.base_closed = !newton;
         self.stale_j = !newton && !reactions;
         let mut outcome = match (self.closed.as_mut().filter(|_| !newton), self.motion.as_deref_mut()) {
             (Some(c), _) => c.kinematic_stages(z, zd, &mut self.ws).map_err(Error::from).and_then(|()| {
