@@ -12,7 +12,10 @@
 pub mod crank;
 pub mod extended_rrr;
 pub mod extension;
+pub mod local;
 pub mod one_link;
+pub mod prp;
+pub mod rpr;
 pub mod rrp;
 pub mod rrr;
 pub mod slider;
