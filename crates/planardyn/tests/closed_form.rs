@@ -97,8 +97,8 @@ fn shipped_models_with_closed_forms() {
         .map(|p| name(&examples, p))
         .collect();
     // The other, the double parallelogram, has redundant pairs: it takes the general path, as
-    // would sliders carrying the ground's point on their guide, RPR and PRP dyads and cylinders
-    // whose rod does not hold the group's inner pair.
+    // would sliders carrying the ground's point on their guide, RPP dyads and cylinders whose
+    // rod does not hold the group's inner pair.
     assert_eq!(closed, CLOSED);
 }
 

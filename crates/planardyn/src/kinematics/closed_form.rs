@@ -1,16 +1,17 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
 //! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
-//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S), class II RRR and
-//! RRP dyads and class III triads of six revolute pairs only, the positions x at z, the
-//! velocity analogues U, the body rates xd and the convective term c come from the groups'
-//! closed forms (`dyads`), each group from the links solved before it, in the decomposition's
-//! order: no factorisation of J, and no Newton iteration but the triad's on its 3 x 3 platform
-//! system. A link of an RRR dyad or a triad's leg may be two bodies locked by a relative
+//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S), class II RRR,
+//! RRP, RPR and PRP dyads and class III triads of six revolute pairs only, the positions x at
+//! z, the velocity analogues U, the body rates xd and the convective term c come from the
+//! groups' closed forms (`dyads`), each group from the links solved before it, in the
+//! decomposition's order: no factorisation of J, and no Newton iteration but the triad's on its
+//! 3 x 3 platform system. A link of an RRR dyad or a triad's leg may be two bodies locked by a relative
 //! prismatic input (a cylinder, `dyads::extension`) whose rod holds the group's inner pair.
 //! Each group keeps the assembly branch of a reference configuration (the integrator's last
-//! accepted point); where a dyad's circles do not meet, or the triad's Newton does not
-//! converge, the evaluation fails as a Newton solve that does not converge does. Other
-//! mechanisms (sliders carrying the ground's point on their guide, other dyads and class I
+//! accepted point); where a dyad's circles do not meet (or an RPR's guide misses its hinge),
+//! or the triad's Newton does not converge, the evaluation fails as a Newton solve that does
+//! not converge does, and where a PRP's guides are parallel as at a type II singularity. Other
+//! mechanisms (sliders carrying the ground's point on their guide, RPP dyads, other class I
 //! groups, other class III groups and larger ones, relative revolute inputs and other relative
 //! prismatic ones, redundant pairs) take the general path (`position`, `analogues`).
 
@@ -34,8 +35,9 @@ use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// A group of a kind with a closed form: a class II dyad with the branch of its reference
-/// configuration and its geometry at the last positions (for the rates and accelerations), a
-/// class I group (one body, no branch), or the class III triad (which keeps its own).
+/// configuration (and for RRR and RRP its geometry at the last positions, for the rates and
+/// accelerations), a group placed in one affine step (a class I group or a PRP dyad: no
+/// branch), or the class III triad (which keeps its own).
 #[derive(Debug, Clone)]
 enum Group {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
@@ -375,9 +377,9 @@ impl ClosedForm {
     }
 
     /// Whether every group's side in the body coordinates x (a predicted point) is that of its
-    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`], [`Triad::keeps_side`]); if
-    /// not, a step crosses a fold or the triad's singularity and the closed forms would leave
-    /// the motion's branch there.
+    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`], [`Rpr::keeps_side`],
+    /// [`Triad::keeps_side`]); if not, a step crosses a fold or the triad's singularity and the
+    /// closed forms would leave the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
         self.groups.iter().all(|d| d.keeps_side(x))
     }

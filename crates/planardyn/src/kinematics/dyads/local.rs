@@ -366,10 +366,8 @@ fn solve<const K: usize>(mut m: [[f64; ROWS]; ROWS], n: usize, mut b: [[f64; ROW
         m.swap(k, p);
         b.iter_mut().for_each(|b| b.swap(k, p));
         for i in k + 1..n {
-            let f = m[i][k] / m[k][k];
-            for c in k..n {
-                m[i][c] -= f * m[k][c];
-            }
+            let (pivot, f) = (m[k], m[i][k] / m[k][k]);
+            m[i][k..n].iter_mut().zip(&pivot[k..n]).for_each(|(v, p)| *v -= f * p);
             b.iter_mut().for_each(|b| b[i] -= f * b[k]);
         }
     }
