@@ -14,7 +14,7 @@ use crate::kinematics::pairs::gear::Mesh;
 use crate::linalg::{BlockLu, Dense};
 use crate::model::{BodyId, Link, Mechanism, Pair, PairId, PairKind};
 use crate::{KinematicsError, SingularityKind};
-use nalgebra::{DMatrix, Matrix3};
+use nalgebra::{Matrix3, Matrix4, Matrix5, Matrix6};
 
 /// Links of the local copy: the group's bodies and the links solved before it.
 const LINKS: usize = 5;
@@ -337,8 +337,16 @@ impl Local {
                 ([r0, r1], [c0, c1]) => {
                     sigma_2x2([[entry(*r0, *c0), entry(*r0, *c1)], [entry(*r1, *c0), entry(*r1, *c1)]])
                 }
-                (r, _) if r.len() == 3 => Matrix3::from_fn(|i, j| entry(rows[i], cols[j])).singular_values().min(),
-                _ => DMatrix::from_fn(rows.len(), cols.len(), |i, j| entry(rows[i], cols[j])).singular_values().min(),
+                _ => {
+                    let m = |i: usize, j: usize| entry(rows[i], cols[j]);
+                    // Fixed sizes: no allocation.
+                    match rows.len() {
+                        3 => Matrix3::from_fn(m).singular_values().min(),
+                        4 => Matrix4::from_fn(m).singular_values().min(),
+                        5 => Matrix5::from_fn(m).singular_values().min(),
+                        _ => Matrix6::from_fn(m).singular_values().min(),
+                    }
+                }
             };
             best = best.min(sigma);
         }
