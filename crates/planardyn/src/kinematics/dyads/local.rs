@@ -236,7 +236,8 @@ impl Local {
             }
             rhs[0][i] = -res[r];
         }
-        let p = solve(m, n, rhs)[0];
+        solve(m, n, &mut rhs);
+        let p = rhs[0];
         if p[..n].iter().any(|v| !v.is_finite()) {
             // The lines (or a line and a pivot's rows) do not cross: J's block is singular.
             return Err(KinematicsError::singular(SingularityKind::TypeII));
@@ -259,13 +260,13 @@ impl Local {
         self.jacobian();
         let n = self.rows();
         let mut m = [[0.0; ROWS]; ROWS];
-        let mut identity = [[0.0; ROWS]; ROWS];
+        let mut columns = [[0.0; ROWS]; ROWS];
         for r in 0..n {
             m[r][..n].copy_from_slice(&self.j[r * COLS..r * COLS + n]);
-            identity[r][r] = 1.0;
+            columns[r][r] = 1.0;
         }
         // Columns of the inverse, transposed back into rows.
-        let columns = solve(m, n, identity);
+        solve(m, n, &mut columns[..n]);
         for (r, inv) in self.inv.iter_mut().enumerate().take(n) {
             for (c, v) in inv.iter_mut().enumerate().take(n) {
                 *v = columns[c][r];
@@ -366,9 +367,10 @@ fn sigma_2x2(m: [[f64; 2]; 2]) -> f64 {
     }
 }
 
-/// The solutions of m y = b for the K right-hand sides b (each of the first n entries), the
-/// n x n system reduced with partial pivoting; infinite or NaN where m is singular.
-fn solve<const K: usize>(mut m: [[f64; ROWS]; ROWS], n: usize, mut b: [[f64; ROWS]; K]) -> [[f64; ROWS]; K] {
+/// The solutions of m y = b, in place, for the right-hand sides b (each of the first n
+/// entries), the n x n system reduced with partial pivoting; infinite or NaN where m is
+/// singular.
+fn solve(mut m: [[f64; ROWS]; ROWS], n: usize, b: &mut [[f64; ROWS]]) {
     for k in 0..n {
         let p = (k..n).max_by(|&i, &j| m[i][k].abs().total_cmp(&m[j][k].abs())).unwrap_or(k);
         m.swap(k, p);
@@ -379,11 +381,10 @@ fn solve<const K: usize>(mut m: [[f64; ROWS]; ROWS], n: usize, mut b: [[f64; ROW
             b.iter_mut().for_each(|b| b[i] -= f * b[k]);
         }
     }
-    for b in &mut b {
+    for b in b.iter_mut() {
         for k in (0..n).rev() {
             let s: f64 = (k + 1..n).map(|c| m[k][c] * b[c]).sum();
             b[k] = (b[k] - s) / m[k][k];
         }
     }
-    b
 }
