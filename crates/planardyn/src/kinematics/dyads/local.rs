@@ -291,20 +291,21 @@ impl Local {
     }
 
     /// The group's rates (or accelerations) y solving block y = -(J_known t_known + extra),
-    /// with the known links' rates (or accelerations) in t, into t.
+    /// with the known links' rates (or accelerations) in t, into t. Fixed width: the rows of
+    /// `j`, `inv` and `extra` past the group's are zero.
     #[inline]
     fn solve_rates(&self, t: &mut [f64], extra: [f64; ROWS]) {
         let n = self.rows();
         let mut rhs = extra;
         for (i, &b) in self.known[..self.n_known].iter().enumerate() {
             let l = self.n_bodies + i;
-            for (r, rhs) in rhs.iter_mut().enumerate().take(n) {
+            for (r, rhs) in rhs.iter_mut().enumerate() {
                 let row = &self.j[r * COLS + 3 * l..r * COLS + 3 * l + 3];
                 *rhs += row[0] * t[3 * b] + row[1] * t[3 * b + 1] + row[2] * t[3 * b + 2];
             }
         }
         for (i, inv) in self.inv.iter().enumerate().take(n) {
-            let y = -(0..n).map(|c| inv[c] * rhs[c]).sum::<f64>();
+            let y = -inv.iter().zip(&rhs).map(|(a, b)| a * b).sum::<f64>();
             t[3 * self.bodies[i / 3] + i % 3] = y;
         }
     }
