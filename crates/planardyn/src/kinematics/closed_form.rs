@@ -1,16 +1,17 @@
 //! Closed-form kinematics of the user's chart, chosen from the Assur decomposition: when the
 //! mechanism is made of input links (turned by revolute pairs, or sliders on guides fixed to
-//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S), class II RRR and
-//! RRP dyads and class III triads of six revolute pairs only, the positions x at z, the
-//! velocity analogues U, the body rates xd and the convective term c come from the groups'
-//! closed forms (`dyads`), each group from the links solved before it, in the decomposition's
-//! order: no factorisation of J, and no Newton iteration but the triad's on its 3 x 3 platform
-//! system. A link of an RRR dyad or a triad's leg may be two bodies locked by a relative
+//! the ground), class I groups with a gear or slot pair (1R1G, 1P1G, 1P1S), class II RRR,
+//! RRP, RPR and PRP dyads and class III triads of six revolute pairs only, the positions x at
+//! z, the velocity analogues U, the body rates xd and the convective term c come from the
+//! groups' closed forms (`dyads`), each group from the links solved before it, in the
+//! decomposition's order: no factorisation of J, and no Newton iteration but the triad's on its
+//! 3 x 3 platform system. A link of an RRR dyad or a triad's leg may be two bodies locked by a relative
 //! prismatic input (a cylinder, `dyads::extension`) whose rod holds the group's inner pair.
 //! Each group keeps the assembly branch of a reference configuration (the integrator's last
-//! accepted point); where a dyad's circles do not meet, or the triad's Newton does not
-//! converge, the evaluation fails as a Newton solve that does not converge does. Other
-//! mechanisms (sliders carrying the ground's point on their guide, other dyads and class I
+//! accepted point); where a dyad's circles do not meet (or an RPR's guide misses its hinge),
+//! or the triad's Newton does not converge, the evaluation fails as a Newton solve that does
+//! not converge does, and where a PRP's guides are parallel as at a type II singularity. Other
+//! mechanisms (sliders carrying the ground's point on their guide, RPP dyads, other class I
 //! groups, other class III groups and larger ones, relative revolute inputs and other relative
 //! prismatic ones, redundant pairs) take the general path (`position`, `analogues`).
 
@@ -18,7 +19,10 @@ use super::analogues::body_rates;
 use super::dyads::crank::Crank;
 use super::dyads::extended_rrr::ExtendedRrr;
 use super::dyads::extension::{Arm, Extension};
-use super::dyads::one_link::OneLink;
+use super::dyads::local::Local;
+use super::dyads::one_link::one_link;
+use super::dyads::prp::prp;
+use super::dyads::rpr::{self, Rpr};
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
@@ -31,13 +35,15 @@ use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// A group of a kind with a closed form: a class II dyad with the branch of its reference
-/// configuration and its geometry at the last positions (for the rates and accelerations), a
-/// class I group (one body, no branch), or the class III triad (which keeps its own).
+/// configuration (and for RRR and RRP its geometry at the last positions, for the rates and
+/// accelerations), a group placed in one affine step (a class I group or a PRP dyad: no
+/// branch), or the class III triad (which keeps its own).
 #[derive(Debug, Clone)]
 enum Group {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
     Rrp(Rrp, rrp::Branch, rrp::Geometry),
-    OneLink(Box<OneLink>),
+    Affine(Box<Local>),
+    Rpr(Box<Rpr>, rpr::Branch),
     Extended(Box<ExtendedRrr>),
     Triad(Box<Triad>),
 }
@@ -47,7 +53,8 @@ impl Group {
         match self {
             Group::Rrr(d, ..) => &d.bodies,
             Group::Rrp(d, ..) => &d.bodies,
-            Group::OneLink(g) => g.bodies(),
+            Group::Affine(g) => g.bodies(),
+            Group::Rpr(d, _) => d.bodies(),
             Group::Extended(d) => &d.members,
             Group::Triad(t) => &t.members,
         }
@@ -57,7 +64,8 @@ impl Group {
         match self {
             Group::Rrr(d, b, _) => *b = d.branch(x),
             Group::Rrp(d, b, _) => *b = d.branch(x),
-            Group::OneLink(_) => {}
+            Group::Affine(_) => {}
+            Group::Rpr(d, b) => *b = d.branch(x),
             Group::Extended(d) => d.set_reference(x),
             Group::Triad(t) => t.set_reference(x),
         }
@@ -67,7 +75,8 @@ impl Group {
         match self {
             Group::Rrr(d, b, _) => d.keeps_side(b, x),
             Group::Rrp(d, b, _) => d.keeps_side(b, x),
-            Group::OneLink(_) => true,
+            Group::Affine(_) => true,
+            Group::Rpr(d, b) => d.keeps_side(b, x),
             Group::Extended(d) => d.keeps_side(x),
             Group::Triad(t) => t.keeps_side(x),
         }
@@ -77,7 +86,8 @@ impl Group {
         match self {
             Group::Rrr(_, _, g) => g.sigma(inv_length),
             Group::Rrp(d, _, g) => g.sigma(inv_length, d.guide_on_g),
-            Group::OneLink(g) => g.sigma(inv_length),
+            Group::Affine(g) => g.sigma(inv_length),
+            Group::Rpr(d, _) => d.sigma(inv_length),
             Group::Extended(d) => d.sigma(inv_length),
             Group::Triad(t) => t.sigma(inv_length),
         }
@@ -88,7 +98,8 @@ impl Group {
         match self {
             Group::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
             Group::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
-            Group::OneLink(g) => g.position(x, trig)?,
+            Group::Affine(g) => g.affine(x, trig)?,
+            Group::Rpr(d, b) => d.position(b, x, trig)?,
             Group::Extended(d) => d.position(z, x, trig)?,
             Group::Triad(t) => t.position(z, x, trig)?,
         }
@@ -100,7 +111,8 @@ impl Group {
         match self {
             Group::Rrr(d, _, g) => d.velocity(g, [[0.0; 2]; 2], v),
             Group::Rrp(d, _, g) => d.velocity(g, v),
-            Group::OneLink(g) => g.velocity(v),
+            Group::Affine(g) => g.velocity(v),
+            Group::Rpr(d, _) => d.velocity(v),
             Group::Extended(d) => d.velocity(zd, v),
             Group::Triad(t) => t.velocity(zd, v),
         }
@@ -111,7 +123,8 @@ impl Group {
         match self {
             Group::Rrr(d, _, g) => d.acceleration(g, [[0.0; 2]; 2], v, a),
             Group::Rrp(d, _, g) => d.acceleration(g, v, a),
-            Group::OneLink(g) => g.acceleration(v, a),
+            Group::Affine(g) => g.acceleration(v, a),
+            Group::Rpr(d, _) => d.acceleration(v, a),
             Group::Extended(d) => d.acceleration(v, a),
             Group::Triad(t) => t.acceleration(v, a),
         }
@@ -198,6 +211,26 @@ fn extended_rrr(mech: &Mechanism, g: &AssurGroup) -> Option<ExtendedRrr> {
     Some(ExtendedRrr::new(rrr, [l1.arm, l2.arm]))
 }
 
+/// The RPR dyad `g`: two one-body links hinged to solved links by the outer revolute pairs,
+/// joined by the inner prismatic one (its `a` the guide's owner, o).
+fn rpr_dyad(mech: &Mechanism, g: &AssurGroup) -> Option<Rpr> {
+    let ([l1, l2], [inner], [_, _]) = (g.links.as_slice(), g.inner_pairs.as_slice(), g.outer_pairs.as_slice()) else {
+        return None;
+    };
+    let ([_], [_]) = (l1.as_slice(), l2.as_slice()) else { return None };
+    let pair = &mech.pairs[inner.0];
+    let (Link::Body(o), Link::Body(f)) = (pair.a, pair.b) else { return None };
+    let hinge = |b: usize| {
+        let k = *g.outer_pairs.iter().find(|&&k| on(mech, k, b))?;
+        (mech.pairs[k.0].kind == PairKind::Revolute).then(|| (k, ends(mech, k, b)))
+    };
+    let ((ka, (sa, a)), (kb, (sb, b))) = (hinge(o.0)?, hinge(f.0)?);
+    if ka == kb {
+        return None;
+    }
+    Rpr::new(mech, [o.0, f.0], [a, b], [sa, sb], [ka, kb], *inner)
+}
+
 /// The triad of six revolute pairs `g` (class III): three legs, each hinged to the platform and
 /// to a link solved before (each one body, or two a relative input locks), and the platform
 /// (the link of the three inner pairs).
@@ -266,7 +299,7 @@ impl ClosedForm {
         for g in &decomposition.groups {
             if let ([link], [o1, o2]) = (g.links.as_slice(), g.outer_pairs.as_slice()) {
                 let [body] = link.as_slice() else { return None };
-                groups.push(Group::OneLink(Box::new(OneLink::new(mech, body.0, [*o1, *o2])?)));
+                groups.push(Group::Affine(Box::new(one_link(mech, body.0, [*o1, *o2])?)));
                 pairs_used += 2;
                 continue;
             }
@@ -278,6 +311,16 @@ impl ClosedForm {
             if g.class == 3 {
                 groups.push(Group::Triad(Box::new(triad(mech, g)?)));
                 pairs_used += 6;
+                continue;
+            }
+            if g.kind == "PRP" {
+                groups.push(Group::Affine(Box::new(prp(mech, g)?)));
+                pairs_used += 3;
+                continue;
+            }
+            if g.kind == "RPR" {
+                groups.push(Group::Rpr(Box::new(rpr_dyad(mech, g)?), Default::default()));
+                pairs_used += 3;
                 continue;
             }
             let [inner] = g.inner_pairs.as_slice() else { return None };
@@ -334,9 +377,9 @@ impl ClosedForm {
     }
 
     /// Whether every group's side in the body coordinates x (a predicted point) is that of its
-    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`], [`Triad::keeps_side`]); if
-    /// not, a step crosses a fold or the triad's singularity and the closed forms would leave
-    /// the motion's branch there.
+    /// reference branch ([`Rrr::keeps_side`], [`Rrp::keeps_side`], [`Rpr::keeps_side`],
+    /// [`Triad::keeps_side`]); if not, a step crosses a fold or the triad's singularity and the
+    /// closed forms would leave the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
         self.groups.iter().all(|d| d.keeps_side(x))
     }

@@ -1,18 +1,23 @@
 //! Closed forms of the groups the Assur decomposition finds (`kinematics::closed_form`), one
 //! file a kind: the input link turned by its revolute pair ([`crank`]) or moved along a guide
 //! on the ground ([`slider`]), the class I groups of one body with a gear or slot pair
-//! ([`one_link`]: 1R1G, 1P1G, 1P1S), the class II dyads of three revolute pairs ([`rrr`]) and
-//! of two revolute pairs and an outer prismatic one ([`rrp`]), the class III triad of six
+//! ([`one_link`]: 1R1G, 1P1G, 1P1S), the class II dyads of three revolute pairs ([`rrr`]), of
+//! two revolute pairs and an outer prismatic one ([`rrp`]) or an inner one ([`rpr`]), and of
+//! two outer prismatic pairs and an inner revolute one ([`prp`]), the class III triad of six
 //! revolute pairs ([`triad`], Newton on its 3 x 3 platform system), and a group link of two
 //! bodies a relative prismatic input locks ([`extension`]; in an RRR dyad, [`extended_rrr`]).
-//! Each gives positions, velocities (a column of U for a unit rate) and accelerations with zero
+//! The class I groups, PRP and RPR share their rows' Jacobian and gamma on a local copy of the
+//! links they touch ([`local`]). Each gives positions, velocities (a column of U for a unit rate) and accelerations with zero
 //! input accelerations (the convective term c), from the links solved before it, in the order
 //! of the decomposition.
 
 pub mod crank;
 pub mod extended_rrr;
 pub mod extension;
+pub mod local;
 pub mod one_link;
+pub mod prp;
+pub mod rpr;
 pub mod rrp;
 pub mod rrr;
 pub mod slider;
