@@ -25,6 +25,22 @@ pub mod triad;
 
 use super::pairs::frames::rot;
 use crate::model::Link;
+use std::f64::consts::{PI, TAU};
+
+/// The rotation whose cosine and sine are proportional to (c, s), as [cos, sin], and its angle
+/// less `rest` (a reference angle's remainder in (-pi, pi]), taken in (-pi, pi]: a body's new
+/// angle is then its reference's whole turns + rest + that, the one within pi of the reference.
+#[inline(always)]
+pub(crate) fn rotation(c: f64, s: f64, rest: f64) -> ([f64; 2], f64) {
+    let r = (c * c + s * s).sqrt();
+    let mut turn = s.atan2(c) - rest;
+    if turn > PI {
+        turn -= TAU;
+    } else if turn < -PI {
+        turn += TAU;
+    }
+    ([c / r, s / r], turn)
+}
 
 /// A point fixed in a link: the link and the point in its frame (m).
 #[derive(Debug, Clone, Copy)]

@@ -8,11 +8,11 @@
 //! and the measure come from the group's block of J (`Local`).
 
 use super::local::Local;
-use super::Joint;
+use super::{rotation, Joint};
 use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{Mechanism, Pair, PairId, PairKind};
 use crate::{KinematicsError, SingularityKind};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 #[derive(Debug, Clone)]
 pub struct Rpr {
@@ -124,14 +124,7 @@ impl Rpr {
         let t = branch.side * m2.sqrt();
         let v = [self.w[0] + (t - along) * self.axis[0], self.w[1] + (t - along) * self.axis[1]];
         let (c, s) = (dot(v, ab), v[0] * ab[1] - v[1] * ab[0]);
-        let r = c.hypot(s);
-        let cs = [c / r, s / r];
-        let mut turn = s.atan2(c) - branch.rest;
-        if turn > PI {
-            turn -= TAU;
-        } else if turn < -PI {
-            turn += TAU;
-        }
+        let (cs, turn) = rotation(c, s, branch.rest);
         let phi = branch.turns + branch.rest + turn;
         let cf = rot(cs, self.turn_cs);
         let (ro, rf) = (rot(cs, self.s_hinges[0]), rot(cf, self.s_hinges[1]));

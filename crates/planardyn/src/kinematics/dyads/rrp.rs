@@ -6,12 +6,12 @@
 //! the reference configuration. Body 1's rates and accelerations solve one scalar equation
 //! whose coefficient n . E e (e = P - A) vanishes where the rod stands normal to the guide.
 
-use super::{pose, put_acceleration, put_rate, rate, Joint};
+use super::{pose, put_acceleration, put_rate, rate, rotation, Joint};
 use crate::kinematics::group_sigma::rrp_sigma;
 use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
 use crate::{KinematicsError, SingularityKind};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -192,14 +192,7 @@ impl Rrp {
         let p = add(a, e);
         // Body 1: the rotation taking its arm to e.
         let (c, s) = (dot(self.arm, e), cross(self.arm, e));
-        let r = (c * c + s * s).sqrt();
-        let cs = [c / r, s / r];
-        let mut turn = s.atan2(c) - branch.rest;
-        if turn > PI {
-            turn -= TAU;
-        } else if turn < -PI {
-            turn += TAU;
-        }
+        let (cs, turn) = rotation(c, s, branch.rest);
         let own = rot(cs, self.s_hinge);
         let [b1, b2] = self.bodies;
         x[3 * b1] = a[0] - own[0];

@@ -5,12 +5,12 @@
 //! w1 E e1 - w2 E e2 = v_B - v_A (and its derivative) with e1 = P - A, e2 = P - B, whose
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
-use super::{put_acceleration, put_rate, Joint};
+use super::{put_acceleration, put_rate, rotation, Joint};
 use crate::kinematics::group_sigma::dyad_sigma;
 use crate::kinematics::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
 use crate::{KinematicsError, SingularityKind};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -130,14 +130,7 @@ impl Rrr {
             // The rotation taking the arm in the body's frame to e = P - q in the world.
             let (arm, e) = (self.arms[i], sub(p, q));
             let (c, s) = (dot(arm, e), cross(arm, e));
-            let r = (c * c + s * s).sqrt();
-            let cs = [c / r, s / r];
-            let mut turn = s.atan2(c) - branch.rest[i];
-            if turn > PI {
-                turn -= TAU;
-            } else if turn < -PI {
-                turn += TAU;
-            }
+            let (cs, turn) = rotation(c, s, branch.rest[i]);
             let rs = rot(cs, self.s_outer[i]);
             let k = 3 * self.bodies[i];
             x[k] = q[0] - rs[0];
