@@ -196,25 +196,16 @@ fn drive_power_is_frictionless_power_plus_dissipated_power() {
     // Along a non-uniform crank motion, at every point: tau qd = tau_0 qd + dissipated, by
     // the principle of virtual power (the same motion, the same dT/dt + dV/dt).
     let (with, without) = (slider_crank(FRICTION), slider_crank(""));
-    let (mut ws, mut ws0) = (Workspace::new(&with), Workspace::new(&without));
     let (mut work, mut work0, mut lost) = (0.0, 0.0, 0.0);
     let n = 400;
     let dt = 1.0 / n as f64;
-    for k in 0..=n {
-        let t = k as f64 * dt;
-        let q = 0.5 + 6.0 * t + 0.8 * (3.0 * t).sin();
-        let qd = 6.0 + 2.4 * (3.0 * t).cos();
-        let qdd = -7.2 * (3.0 * t).sin();
-        inverse(&with, &[q], &[qd], &[qdd], &mut ws).unwrap();
-        inverse(&without, &[q], &[qd], &[qdd], &mut ws0).unwrap();
-        let (p, p0) = (ws.tau[0] * qd, ws0.tau[0] * qd);
-        assert!(ws.dissipated > 0.0);
-        assert!((p - p0 - ws.dissipated).abs() <= 1e-10 * p.abs().max(1.0), "t {t}: {p} {p0} {}", ws.dissipated);
-        let wgt = if k == 0 || k == n { 0.5 } else { 1.0 };
-        work += wgt * dt * p;
-        work0 += wgt * dt * p0;
-        lost += wgt * dt * ws.dissipated;
-    }
+    common::power_balance_along(&with, &without, [0.5, 6.0, 0.8, 3.0], n, (1e-10, 1.0), |s| {
+        assert!(s.ws.dissipated > 0.0);
+        let wgt = if s.k == 0 || s.k == n { 0.5 } else { 1.0 };
+        work += wgt * dt * s.p;
+        work0 += wgt * dt * s.p0;
+        lost += wgt * dt * s.ws.dissipated;
+    });
     assert!((work - work0 - lost).abs() <= 1e-10 * work.abs());
     assert!(lost > 0.01 * work.abs(), "friction costs {lost} J of {work} J");
 }

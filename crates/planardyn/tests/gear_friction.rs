@@ -14,7 +14,7 @@
 mod common;
 
 use common::{run, yaml};
-use planardyn::dynamics::{forward, inverse, reactions, ModelDrives};
+use planardyn::dynamics::{forward, reactions, ModelDrives};
 use planardyn::{Mechanism, Workspace};
 
 const R_A: f64 = 0.02;
@@ -128,18 +128,10 @@ fn inverse_drive_power_is_frictionless_power_plus_dissipated_power() {
     // tau qd = tau_0 qd + dissipated, and while the pinion drives tau is the closed form.
     const T_LOAD: f64 = 0.005;
     let (with, without) = (train(0.0, T_LOAD, 0.0, &mesh_friction()), train(0.0, T_LOAD, 0.0, ""));
-    let (mut ws, mut ws0) = (Workspace::new(&with), Workspace::new(&without));
     let (mut both, mut wheel_drove) = (0, 0);
-    for k in 0..=200 {
-        let t = k as f64 / 200.0;
-        let q = 10.0 * t + 0.8 * (6.0 * t).sin();
-        let qd = 10.0 + 4.8 * (6.0 * t).cos();
-        let qdd = -28.8 * (6.0 * t).sin();
-        inverse(&with, &[q], &[qd], &[qdd], &mut ws).unwrap();
-        inverse(&without, &[q], &[qd], &[qdd], &mut ws0).unwrap();
-        let (p, p0) = (ws.tau[0] * qd, ws0.tau[0] * qd);
+    common::power_balance_along(&with, &without, [0.0, 10.0, 0.8, 6.0], 200, (1e-12, 1e-3), |s| {
+        let (t, qdd, ws) = (s.t, s.qdd, s.ws);
         assert!(ws.dissipated > 0.0);
-        assert!((p - p0 - ws.dissipated).abs() <= 1e-12 * p.abs().max(1e-3), "t {t}: {p} {p0} {}", ws.dissipated);
         let f_t = (I_B * N * qdd + T_LOAD) / R_B;
         if f_t > 0.0 {
             let tau = I_A * qdd + (1.0 + C) * R_A * f_t;
@@ -150,7 +142,7 @@ fn inverse_drive_power_is_frictionless_power_plus_dissipated_power() {
             assert!((ws.tau[0] - tau).abs() <= 1e-12 * tau.abs(), "t {t}: tau {} vs {tau}", ws.tau[0]);
             wheel_drove += 1;
         }
-    }
+    });
     assert!(both > 20 && wheel_drove > 20, "pinion drove {both} times, wheel {wheel_drove}");
 }
 
@@ -202,17 +194,9 @@ loads:
         ))
     };
     let (with, without) = (rack(&mesh_friction()), rack(""));
-    let (mut ws, mut ws0) = (Workspace::new(&with), Workspace::new(&without));
     let (mut pinion_drove, mut rack_drove) = (0, 0);
-    for k in 0..=200 {
-        let t = k as f64 / 200.0;
-        let q = 10.0 * t + 0.08 * (6.0 * t).sin();
-        let qd = 10.0 + 0.48 * (6.0 * t).cos();
-        let qdd = -2.88 * (6.0 * t).sin();
-        inverse(&with, &[q], &[qd], &[qdd], &mut ws).unwrap();
-        inverse(&without, &[q], &[qd], &[qdd], &mut ws0).unwrap();
-        let (p, p0) = (ws.tau[0] * qd, ws0.tau[0] * qd);
-        assert!((p - p0 - ws.dissipated).abs() <= 1e-12 * p.abs().max(1e-3), "t {t}: {p} {p0} {}", ws.dissipated);
+    common::power_balance_along(&with, &without, [0.0, 10.0, 0.08, 6.0], 200, (1e-12, 1e-3), |s| {
+        let (t, qd, qdd, ws) = (s.t, s.qd, s.qdd, s.ws);
         let f = M_R * R_A * qdd + P;
         let tau = if f > 0.0 {
             pinion_drove += 1;
@@ -225,6 +209,6 @@ loads:
         // c times the tooth force on the driven gear, times the pitch speed.
         let tooth = if f > 0.0 { f } else { -f / (1.0 + C) };
         assert!((ws.dissipated - C * tooth * R_A * qd).abs() <= 1e-12 * ws.dissipated, "t {t}: {}", ws.dissipated);
-    }
+    });
     assert!(pinion_drove > 20 && rack_drove > 20, "pinion drove {pinion_drove} times, rack {rack_drove}");
 }

@@ -307,3 +307,42 @@ bodies:
 {rest}"#
     ))
 }
+
+/// A point of [`power_balance_along`]: its index and time, the rate and acceleration, the
+/// drive powers with and without the losses, and the workspace of the model with them.
+pub struct Swept<'w> {
+    pub k: usize,
+    pub t: f64,
+    pub qd: f64,
+    pub qdd: f64,
+    pub p: f64,
+    pub p0: f64,
+    pub ws: &'w planardyn::Workspace,
+}
+
+/// Inverse dynamics of a one-coordinate model with losses (`with`) and without (`without`)
+/// along q(t) = q0 + w t + a sin(f t), at t = k / n for k = 0..=n. At every point the drive
+/// power is the lossless one plus the dissipated power, by the principle of virtual power (the
+/// same motion, the same dT/dt + dV/dt), within rtol * max(|p|, floor); `each` checks the rest.
+pub fn power_balance_along(
+    with: &Mechanism,
+    without: &Mechanism,
+    [q0, w, a, f]: [f64; 4],
+    n: usize,
+    (rtol, floor): (f64, f64),
+    mut each: impl FnMut(Swept),
+) {
+    use planardyn::{dynamics::inverse, Workspace};
+    let (mut ws, mut ws0) = (Workspace::new(with), Workspace::new(without));
+    for k in 0..=n {
+        let t = k as f64 / n as f64;
+        let q = q0 + w * t + a * (f * t).sin();
+        let qd = w + a * f * (f * t).cos();
+        let qdd = -a * f * f * (f * t).sin();
+        inverse(with, &[q], &[qd], &[qdd], &mut ws).unwrap();
+        inverse(without, &[q], &[qd], &[qdd], &mut ws0).unwrap();
+        let (p, p0) = (ws.tau[0] * qd, ws0.tau[0] * qd);
+        assert!((p - p0 - ws.dissipated).abs() <= rtol * p.abs().max(floor), "t {t}: {p} {p0} {}", ws.dissipated);
+        each(Swept { k, t, qd, qdd, p, p0, ws: &ws });
+    }
+}

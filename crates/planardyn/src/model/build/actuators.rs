@@ -202,29 +202,21 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
         };
         let p = &mech.pairs[id.0];
         let revolute = pairs::relative(p) == Some(Relative::Angle);
+        // A field given where it does not apply (or missing where it must be), and the fix.
+        let refuse = |field: &str, fix: String| -> R<f64> { Err(ctx.err(format!("{path}.{field}"), fix)) };
         let arm = match (revolute, pin_radius) {
             (true, Some(r)) => speed("pin_radius", Some(*r), 0.0)?,
-            (true, None) => {
-                return Err(ctx.err(
-                    format!("{path}.pin_radius"),
-                    format!("'{pair}' turns: give its pin radius (m), the arm of the friction force mu |F|"),
-                ))
-            }
-            (false, Some(_)) => {
-                return Err(ctx.err(
-                    format!("{path}.pin_radius"),
-                    format!("'{pair}' does not turn on a pin: remove `pin_radius`"),
-                ))
-            }
+            (true, None) => refuse(
+                "pin_radius",
+                format!("'{pair}' turns: give its pin radius (m), the arm of the friction force mu |F|"),
+            )?,
+            (false, Some(_)) => refuse("pin_radius", format!("'{pair}' does not turn on a pin: remove `pin_radius`"))?,
             (false, None) => 1.0,
         };
         let length = match (&p.kind, length) {
             (PairKind::Prismatic { .. }, Some(l)) => speed("length", Some(*l), 0.0)?,
             (_, Some(_)) => {
-                return Err(ctx.err(
-                    format!("{path}.length"),
-                    format!("'{pair}' carries no couple: `length` applies to a prismatic pair only"),
-                ))
+                refuse("length", format!("'{pair}' carries no couple: `length` applies to a prismatic pair only"))?
             }
             (_, None) => 0.0,
         };
@@ -232,19 +224,17 @@ pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[Loa
             (PairKind::Gear(_), a) => {
                 let a = a.unwrap_or(PRESSURE_ANGLE);
                 if !(0.0..=MAX_PRESSURE_ANGLE).contains(&ctx.finite(&format!("{path}.pressure_angle"), a)?) {
-                    return Err(ctx.err(
-                        format!("{path}.pressure_angle"),
+                    refuse(
+                        "pressure_angle",
                         format!("{a} rad is not a tooth's pressure angle: give one in [0, {MAX_PRESSURE_ANGLE}] rad"),
-                    ));
+                    )?;
                 }
                 a
             }
-            (_, Some(_)) => {
-                return Err(ctx.err(
-                    format!("{path}.pressure_angle"),
-                    format!("'{pair}' has no teeth: `pressure_angle` applies to a gear pair only"),
-                ))
-            }
+            (_, Some(_)) => refuse(
+                "pressure_angle",
+                format!("'{pair}' has no teeth: `pressure_angle` applies to a gear pair only"),
+            )?,
             (_, None) => 0.0,
         };
         out.push(JointFriction {
