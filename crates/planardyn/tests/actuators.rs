@@ -51,24 +51,26 @@ fn reflected_rotor_inertia_adds_n2_j() {
 
 #[test]
 fn efficiency_and_motor_friction_follow_the_power_flow() {
-    // Motoring (qd > 0): tau = n eta (T - c n qd - T_c); generating (qd < 0 against T > 0):
-    // tau = n (T - c n qd + T_c) / eta. Stiction speed 1e-2 rad/s against n qd = 100 rad/s:
-    // tanh(1e4) = 1 exactly.
+    // The rotor sits before the gear: with c = T - c n qd - T_c sgn(qd) the motor's net torque
+    // and t = c - J n qdd what it hands to the gear, I_O qdd = n eta t while motoring (qd > 0:
+    // (I_O + eta n^2 J) qdd = eta n c) and I_O qdd = n t / eta back-driven (qd < 0 against
+    // T > 0: (I_O + n^2 J / eta) qdd = n c / eta). Stiction speed 1e-2 rad/s against
+    // n qd = 100 rad/s: tanh(1e4) = 1 exactly.
     let (n, eta, j, c, tc, t) = (50.0, 0.8, 1e-4, 2e-4, 0.01, 0.3);
     let mech =
         crank(&format!("gear_ratio: {n}, efficiency: {eta}, rotor_inertia: {j}, viscous: {c}, coulomb: {tc}"), t);
-    let a = I_O + n * n * j;
-    let motoring = n * eta * (t - c * n * 2.0 - tc) / a;
-    let generating = n * (t + c * n * 2.0 + tc) / eta / a;
+    let motoring = eta * n * (t - c * n * 2.0 - tc) / (I_O + eta * n * n * j);
+    let generating = n * (t + c * n * 2.0 + tc) / eta / (I_O + n * n * j / eta);
     for (qd, expected) in [(2.0, motoring), (-2.0, generating)] {
         let (qdd, _) = qdd_at(&mech, 0.1, qd);
         assert!((qdd - expected).abs() <= 1e-13 * expected.abs(), "qd {qd}: {qdd} vs {expected}");
-        // Inverse dynamics gives back the motor torque of the forward evaluation.
+        // Inverse dynamics gives the joint side I_O qdd (the rotor is the motor's), and the
+        // motor torque of the forward evaluation back.
         let mut ws = Workspace::new(&mech);
         inverse(&mech, &[0.1], &[qd], &[qdd], &mut ws).unwrap();
-        assert!((ws.tau[0] - (I_O + n * n * j) * qdd).abs() <= 1e-13 * ws.tau[0].abs());
+        assert!((ws.tau[0] - I_O * qdd).abs() <= 1e-13 * ws.tau[0].abs());
         let mut t_m = [0.0];
-        motor_torques(&mech, &[qd], &ws.tau, &mut t_m);
+        motor_torques(&mech, &ws, &ws.tau, &mut t_m);
         assert!((t_m[0] - t).abs() <= 1e-14, "motor torque {} vs {t}", t_m[0]);
     }
 }
@@ -233,7 +235,7 @@ fn forward_with_losses_inverts_and_holds_in_a_partition_chart() {
     let mut inv = assembled();
     inverse(&mech, &q, &qd, &[qdd], &mut inv).unwrap();
     let mut t_m = [0.0];
-    motor_torques(&mech, &qd, &inv.tau, &mut t_m);
+    motor_torques(&mech, &inv, &inv.tau, &mut t_m);
     assert!((t_m[0] - 0.4).abs() <= 1e-12, "motor torque {} vs 0.4 N m", t_m[0]);
     assert!((inv.dissipated - ws.dissipated).abs() <= 1e-12 * ws.dissipated);
 
