@@ -41,7 +41,7 @@ def path():
 
 def usage(mech, plan):
     """|t_m| / available torque (N, m) at the grid points."""
-    t_m = np.asarray(mech.motor_torques(plan.qd, plan.tau))
+    t_m = np.asarray(mech.motor_torques(plan.q, plan.qd, plan.qdd, plan.tau, x=plan.x))
     avail = np.column_stack([mech.available_torque(k, RATIO * plan.qd[:, k]) for k in range(mech.dof)])
     return np.abs(t_m) / avail
 
@@ -71,11 +71,11 @@ def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> N
 
 def test_a_geared_inertia_matches_the_phase_plane_reference() -> None:
     # An inertia J (no gravity) turned 2 rad from rest to rest by a geared motor with the
-    # drooping envelope: the fastest motion accelerates at n eta T(n qd) / J_eff (motoring),
-    # then brakes at n T(n qd) / (eta J_eff) (generating: the gear losses help), J_eff =
-    # J + n^2 J_rotor. Both phases integrated at rtol 1e-12 and joined where their (q, qd)
-    # curves cross give the reference time, 0.2486812 s; toppra's grid (constant s'' per
-    # interval, 400 points) gives 0.2486826 s, 5.6e-6 longer: within 2e-5.
+    # drooping envelope, its rotor before the gear: the fastest motion accelerates at
+    # n eta T(n qd) / (J + eta n^2 J_rotor) (motoring), then brakes at
+    # n T(n qd) / (eta J + n^2 J_rotor) (back-driven: the gear losses help). Both phases
+    # integrated at rtol 1e-12 and joined where their (q, qd) curves cross give the reference
+    # time; toppra's grid (constant s'' per interval, 400 points) is within 2e-5 of it.
     from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
 
@@ -89,14 +89,14 @@ def test_a_geared_inertia_matches_the_phase_plane_reference() -> None:
         "actuators": [{"coordinate": "theta", "gear_ratio": RATIO, "efficiency": eta, "rotor_inertia": J_rotor,
                        "limits": CURVE}],
     })
-    J_eff = J + RATIO**2 * J_rotor
+    J_up, J_down = J + eta * RATIO**2 * J_rotor, eta * J + RATIO**2 * J_rotor
 
     def torque(qd: float) -> float:
         return float(mech.available_torque(0, np.array([RATIO * qd]))[0])
 
-    acc = solve_ivp(lambda t, y: [y[1], RATIO * eta * torque(y[1]) / J_eff], (0, 2), [0.0, 0.0], rtol=1e-12,
+    acc = solve_ivp(lambda t, y: [y[1], RATIO * eta * torque(y[1]) / J_up], (0, 2), [0.0, 0.0], rtol=1e-12,
                     atol=1e-12, dense_output=True, events=lambda t, y: y[0] - theta)
-    brake = solve_ivp(lambda t, y: [-y[1], RATIO * torque(y[1]) / (eta * J_eff)], (0, 2), [theta, 0.0],
+    brake = solve_ivp(lambda t, y: [-y[1], RATIO * torque(y[1]) / J_down], (0, 2), [theta, 0.0],
                       rtol=1e-12, atol=1e-12, dense_output=True, events=lambda t, y: y[0])
 
     def t_at(sol, q: float) -> float:
@@ -135,7 +135,7 @@ def test_cli_plans_within_the_motors(tmp_path, path) -> None:
     assert main(["plan", str(file), *line, "-o", str(out)]) == 0
     mech = planardyn.load(file)
     table = read_motion(out, mech.coordinate_names)
-    t_m = np.asarray(mech.motor_torques(table["qd"], table["tau"]))[:-1]
+    t_m = np.asarray(mech.motor_torques(table["q"], table["qd"], table["qdd"], table["tau"]))[:-1]
     avail = np.column_stack([mech.available_torque(k, RATIO * table["qd"][:-1, k]) for k in range(2)])
     assert np.all(np.abs(t_m) <= avail * (1 + 1e-9))
     assert table["t"][-1] == pytest.approx(time_optimal(geared(CURVE), path, "actuators").duration, rel=1e-9)

@@ -31,8 +31,9 @@ def run():
 
 def test_a_runs_motor_torques_are_its_drives_laws():
     # Under the model's drives (motor-side laws: a constant and a table) the result's motor
-    # torques are the laws' values: tau is the joint side they produce, and motor_torques
-    # maps it back (both gear branches occur; round-off 1e-15 of the efforts, bound 1e-12).
+    # torques are the laws' values: tau is the joint side they produce (the gears' outputs),
+    # and motor_torques maps it back with the rotors' torques (both gear branches occur;
+    # round-off 1e-15 of the efforts, bound 1e-12).
     mech = geared_five_bar()
     res = mech.simulate(t_end=0.5, output_dt=0.005, qd0=[1.0, -0.8])
     assert res.success, res.message
@@ -50,10 +51,11 @@ def test_a_runs_motor_torques_are_its_drives_laws():
 def test_results_files_keep_the_motor_torques(run, tmp_path, ext):
     mech, res = run
     back = pd.read_results(res.save(tmp_path / f"run{ext}"))
-    # Files hold every double exactly; the motor torques are motor_torques(qd, tau) of the
-    # rows read back (the same function of the same numbers: 0 difference).
+    # Files hold every double exactly; the motor torques are motor_torques of the rows read
+    # back (the same function of the same numbers: 0 difference).
     np.testing.assert_array_equal(back.tau_motor, res.tau_motor)
-    np.testing.assert_array_equal(back.tau_motor, mech.motor_torques(back.qd, back.tau))
+    again = mech.motor_torques(back.q, back.qd, back.qdd, back.tau, x=back.x, xd=back.xd, allow_singular=True)
+    np.testing.assert_array_equal(back.tau_motor, again)
     np.testing.assert_array_equal(back.tau, res.tau)
     frame = back.to_dataframe()
     np.testing.assert_array_equal(frame["tau_motor_theta2"].to_numpy(), res.tau_motor[:, 1])

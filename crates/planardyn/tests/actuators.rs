@@ -6,7 +6,7 @@ mod common;
 use common::{run, yaml};
 use planardyn::dynamics::{forward, inverse, motor_torques, ModelDrives};
 use planardyn::kinematics::{assemble_into, velocity_analogues, Chart};
-use planardyn::{Mechanism, Workspace};
+use planardyn::{KinematicsError, Mechanism, Workspace};
 
 const G: f64 = 9.81;
 
@@ -249,4 +249,47 @@ fn forward_with_losses_inverts_and_holds_in_a_partition_chart() {
     forward(&mech, 0.0, &z, &zd, &mut ModelDrives(&mech), &mut part).unwrap();
     assert!((part.qdd[0] - qdd).abs() <= 1e-9 * qdd.abs(), "partition chart {} vs {qdd}", part.qdd[0]);
     assert!((part.dissipated - ws.dissipated).abs() <= 1e-9 * ws.dissipated);
+}
+
+/// A shipped model with Coulomb friction `mu` at `pair` (a pin of radius `radius`, or a slot).
+fn shipped_with_friction(name: &str, pair: &str, mu: f64, radius: Option<f64>) -> Mechanism {
+    let mut spec = common::shipped(name).spec.clone();
+    spec.loads.push(planardyn::model::spec::LoadSpec::Friction {
+        pair: pair.into(),
+        viscous: None,
+        mu: Some(mu),
+        mu_static: None,
+        pin_radius: radius,
+        length: None,
+        stiction_speed: None,
+        stribeck_speed: None,
+        pressure_angle: None,
+    });
+    Mechanism::new(spec, name).unwrap()
+}
+
+#[test]
+fn self_locking_friction_is_reported_at_any_mu() {
+    // Issue 23, finding 4: the slider-crank's crank pin (r = 8 mm) and the Scotch yoke's slot
+    // pin self-lock for mu >= 1e2 at their start states (moving: 5 and 2 rad/s); up to
+    // mu ~ 3e3 the fixed point wandered for 100 iterations, beyond it overflowed and forward
+    // dynamics returned -1.1e297 (mu 1e15 on the crank pin). Every mu must now give the
+    // self-lock error, never a number; a small mu still settles.
+    for (model, pair, radius) in [("slider-crank.yaml", "crank_pin", Some(0.008)), ("scotch-yoke.yaml", "pin", None)] {
+        let settles = shipped_with_friction(model, pair, 0.1, radius);
+        let (q, qd) = settles.initial_state();
+        let mut ws = Workspace::new(&settles);
+        forward(&settles, 0.0, &q, &qd, &mut ModelDrives(&settles), &mut ws).unwrap();
+        assert!(ws.qdd.iter().all(|v| v.is_finite() && v.abs() < 1e4) && ws.dissipated > 0.0, "{model}: {:?}", ws.qdd);
+        for mu in [1e2, 3e2, 1e3, 3e3, 1e4, 1e5, 1e6, 1e8, 1e10, 1e12, 1e15, 1e18, 1e20] {
+            let mech = shipped_with_friction(model, pair, mu, radius);
+            let mut ws = Workspace::new(&mech);
+            match forward(&mech, 0.0, &q, &qd, &mut ModelDrives(&mech), &mut ws) {
+                Err(planardyn::Error::Kinematics(KinematicsError::FrictionUnsettled { iterations, change })) => {
+                    assert!(iterations <= 100 && change.is_finite(), "{model} mu {mu}: {iterations} {change}");
+                }
+                other => panic!("{model} mu {mu}: {other:?}, qdd {:?}", ws.qdd),
+            }
+        }
+    }
 }

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism
 from ..robot import EndEffector
-from .actuator_limits import drives, exact_bounds, tangent_rows
+from .actuator_limits import MotorMap, drives, exact_bounds, tangent_rows
 from .planned import PlanError, PlannedMotion, effort_bounds, speed_bounds
 
 FloatArray = NDArray[np.float64]
@@ -199,10 +199,11 @@ def time_optimal(
         with np.errstate(divide="ignore"):
             x_v = np.min((v / np.abs(p1)) ** 2, axis=1)
         x0 = np.minimum(np.where(np.isfinite(x_v), x_v / 4, 1.0), 1e6)
+        motor = MotorMap.along(mech, path(s), p1, path(s, 2), x)
         duration, rounds = np.inf, 0
         while True:
             rounds += 1
-            sdd, sd, status = _toppra(path, s, tangent_rows(mech, ds, a, b, c, p1, x0), v)
+            sdd, sd, status = _toppra(path, s, tangent_rows(motor, ds, a, b, c, x0), v)
             t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
             if abs(duration - t_new) <= ACTUATOR_TOL * t_new:
                 break
@@ -211,7 +212,7 @@ def time_optimal(
                                 f"({duration:.9g} s, then {t_new:.9g} s); use a finer n_grid")
             duration, x0 = t_new, sd**2
         status = f"{status}; {rounds} rounds of tangents"
-        lo, hi = exact_bounds(mech, p1 * sd[:, None])
+        lo, hi = exact_bounds(mech, motor, np.append(sdd, sdd[-1]), sd**2)
     else:
         if effort is None:
             lo, hi = np.full((n_grid, m), -np.inf), np.full((n_grid, m), np.inf)

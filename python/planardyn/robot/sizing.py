@@ -166,14 +166,15 @@ def _motor_dict(mo: MotorSizing) -> dict[str, Any]:
                         "margin": c.margin, "passed": c.passed} for c in mo.checks]}
 
 
-def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, tau: FloatArray) -> MotorSizing | None:
+def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, t_m: FloatArray) -> MotorSizing | None:
     """The motor side of actuator ``k``'s drive along samples at times ``t`` (s) with the
-    actuators' rates ``qd`` and joint-side efforts ``tau`` (N, m; or N, n_a with the pair
-    actuators); None without a motor."""
+    actuators' rates ``qd`` and motor torques ``t_m`` (N, m; or N, n_a with the pair
+    actuators: :meth:`Mechanism.motor_torques`, a solved motion's ``tau_motor``); None
+    without a motor."""
     act = mech.actuators[k]
     if act is None:
         return None
-    t_m = mech.motor_torques(qd, tau)[:, k]
+    t_m = np.asarray(t_m, dtype=float)[:, k]
     w = act["gear_ratio"] * qd[:, k]
     peak_t, rms_t, peak_w = float(np.abs(t_m).max()), _rms(t, t_m), float(np.abs(w).max())
     checks = []
@@ -214,16 +215,17 @@ def _rms(t: FloatArray, y: FloatArray) -> float:
 
 
 def distributed_efforts(mech: Mechanism, motion: TaskMotion, distribution: str = "min_norm",
-                        preload: list[float] | None = None) -> tuple[FloatArray, FloatArray]:
+                        preload: list[float] | None = None) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Every actuator's effort (N, n_a) along a motion of a redundantly actuated mechanism,
-    shared by ``distribution`` (:meth:`Mechanism.distribute_efforts`), and each actuator's
-    rate (N, n_a): B^T qd (rad/s or m/s on its pair)."""
-    efforts, rates = [], []
+    shared by ``distribution`` (:meth:`Mechanism.distribute_efforts`), each actuator's rate
+    (N, n_a): B^T qd (rad/s or m/s on its pair), and its motor torque (N, n_a)."""
+    efforts, rates, torques = [], [], []
     for q, qd, qdd in zip(motion.q, motion.qd, motion.qdd):
         out = mech.distribute_efforts(q, qd, qdd, distribution, preload)  # type: ignore[arg-type]
         efforts.append(out["efforts"])
         rates.append(out["B"].T @ qd)
-    return np.array(efforts), np.array(rates)
+        torques.append(out["motor_torques"])
+    return np.array(efforts), np.array(rates), np.array(torques)
 
 
 def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payload: float = 0.0,
@@ -260,9 +262,12 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
     names = mech.actuator_names
     m = len(mech.coordinate_names)
     if len(names) > m:
-        efforts, rates = distributed_efforts(mech, motion, distribution, preload)
+        efforts, rates, torques = distributed_efforts(mech, motion, distribution, preload)
     else:
         efforts, rates = motion.tau, motion.qd
+        torques = motion.tau_motor
+        if torques is None:
+            torques = np.asarray(mech.motor_torques(motion.q, motion.qd, motion.qdd, motion.tau, allow_singular=True))
     kinds = mech.actuator_kinds
     drives = []
     for k, name in enumerate(names):
@@ -271,7 +276,7 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
         angle = kinds[k] == "angle"
         drives.append(DriveSizing(name, "N m" if angle else "N", "rad/s" if angle else "m/s", float(np.abs(tau).max()),
                                   _rms(motion.t, tau), float(np.abs(qd).max()), float(np.abs(tau * qd).max()), ev, ee_,
-                                  motor_sizing(mech, k, motion.t, rates, efforts)))
+                                  motor_sizing(mech, k, motion.t, rates, torques)))
     iI, iII = int(np.argmin(motion.sigma_I)), int(np.argmin(motion.sigma_II))
     return SizingReport(motion, float(payload), drives,
                         (float(motion.sigma_I[iI]), float(motion.t[iI]), motion.X[iI]),
