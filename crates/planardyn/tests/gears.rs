@@ -145,7 +145,7 @@ fn a_self_locking_worm_drive_holds_its_load() {
         assert!((qdd[0] - expected).abs() <= 1e-13 * expected.max(1.0), "T {t_m}: {} vs {expected}", qdd[0]);
         let held = I_ARM * qdd[0] + WEIGHT;
         assert!((ws.tau[0] - held).abs() <= 1e-13 * held, "T {t_m}: holding {} vs {held}", ws.tau[0]);
-        assert_eq!(motor_side(&worm, &[0.0], &[-1.0], &qdd)[0], t_m);
+        assert!((motor_side(&worm, &[0.0], &[-1.0], &qdd)[0] - t_m).abs() <= 1e-15);
     }
     // A second of it, motor off, from rest: the arm does not move but for round-off.
     let mut s = Settings::for_model(&worm).unwrap();
@@ -264,13 +264,15 @@ fn two_link_newton_euler(g: [Gear; 2], qd: [f64; 2], t_m: [f64; 2]) -> [f64; 2] 
     let grav = [(m1 * lc1 + m2 * l1) * G * q1.cos() + m2 * lc2 * G * (q1 + q2).cos(), m2 * lc2 * G * (q1 + q2).cos()];
     let c = [t_m[0] - g[0].friction(qd[0]), t_m[1] - g[1].friction(qd[1])];
     let mut found = Vec::new();
-    for (e1, e2) in [(g[0].eta, g[1].eta), (g[0].eta, 1.0 / g[1].eta_b), (1.0 / g[0].eta_b, g[1].eta), (1.0 / g[0].eta_b, 1.0 / g[1].eta_b)] {
+    for (e1, e2) in [
+        (g[0].eta, g[1].eta),
+        (g[0].eta, 1.0 / g[1].eta_b),
+        (1.0 / g[0].eta_b, g[1].eta),
+        (1.0 / g[0].eta_b, 1.0 / g[1].eta_b),
+    ] {
         // t1 = c1 - J1 n1 qdd1, t2 = c2 - J2 (qdd1 + n2 qdd2); Q1 = e1 n1 t1 + t2 - c2, Q2 = e2 n2 t2.
         let (n1, j1, n2, j2) = (g[0].n, g[0].j, g[1].n, g[1].j);
-        let a = [
-            [m11 + e1 * n1 * n1 * j1 + j2, m12 + j2 * n2],
-            [m12 + e2 * n2 * j2, m22 + e2 * n2 * n2 * j2],
-        ];
+        let a = [[m11 + e1 * n1 * n1 * j1 + j2, m12 + j2 * n2], [m12 + e2 * n2 * j2, m22 + e2 * n2 * n2 * j2]];
         let b = [e1 * n1 * c[0] - cor[0] - grav[0], e2 * n2 * c[1] - cor[1] - grav[1]];
         let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
         let qdd = [(b[0] * a[1][1] - a[0][1] * b[1]) / det, (a[0][0] * b[1] - a[1][0] * b[0]) / det];
@@ -295,7 +297,12 @@ fn motors_on_a_moving_link_match_newton_euler() {
     ] {
         let mech = two_link(&GEAR1.spec(), &elbow.spec(), "");
         let mut branches = [0, 0];
-        for (qd, t_m) in [([1.0, -2.0], [0.3, 0.1]), ([1.0, -2.0], [0.3, -0.1]), ([-0.5, 1.5], [-0.1, 0.05]), ([-0.5, 1.5], [0.4, -0.2])] {
+        for (qd, t_m) in [
+            ([1.0, -2.0], [0.3, 0.1]),
+            ([1.0, -2.0], [0.3, -0.1]),
+            ([-0.5, 1.5], [-0.1, 0.05]),
+            ([-0.5, 1.5], [0.4, -0.2]),
+        ] {
             let t_m = [t_m[0], t_m[1] / elbow.n.sqrt()];
             let expected = two_link_newton_euler([GEAR1, elbow], qd, t_m);
             let (qdd, ws) = forward_at(&mech, &q0, &qd, &t_m).unwrap();
@@ -329,14 +336,19 @@ fn lossless_motors_on_a_moving_link_match_lagrange() {
     let (m1, l1, m2, l2, q1, q2) = (1.2f64, 0.4, 0.8, 0.3, 0.3f64, 0.5f64);
     let (lc1, lc2, i1, i2) = (l1 / 2.0, l2 / 2.0, m1 * l1 * l1 / 12.0, m2 * l2 * l2 / 12.0);
     let mut a = [
-        [i1 + i2 + m1 * lc1 * lc1 + m2 * (l1 * l1 + lc2 * lc2 + 2.0 * l1 * lc2 * q2.cos()), i2 + m2 * (lc2 * lc2 + l1 * lc2 * q2.cos())],
+        [
+            i1 + i2 + m1 * lc1 * lc1 + m2 * (l1 * l1 + lc2 * lc2 + 2.0 * l1 * lc2 * q2.cos()),
+            i2 + m2 * (lc2 * lc2 + l1 * lc2 * q2.cos()),
+        ],
         [0.0, i2 + m2 * lc2 * lc2],
     ];
     a[1][0] = a[0][1];
     let rotor = [[g1.j * g1.n * g1.n + g2.j, g2.j * g2.n], [g2.j * g2.n, g2.j * g2.n * g2.n]];
     let h = -m2 * l1 * lc2 * q2.sin();
     let cg = [
-        h * (2.0 * qd[0] * qd[1] + qd[1] * qd[1]) + (m1 * lc1 + m2 * l1) * G * q1.cos() + m2 * lc2 * G * (q1 + q2).cos(),
+        h * (2.0 * qd[0] * qd[1] + qd[1] * qd[1])
+            + (m1 * lc1 + m2 * l1) * G * q1.cos()
+            + m2 * lc2 * G * (q1 + q2).cos(),
         -h * qd[0] * qd[0] + m2 * lc2 * G * (q1 + q2).cos(),
     ];
     let c = [t_m[0] - g1.friction(qd[0]), t_m[1] - g2.friction(qd[1])];
@@ -356,10 +368,16 @@ fn power_balance_input_is_mechanism_rotors_gear_losses_and_friction() {
     // gears' solve: the motors' input power sum T_i n_i qd_i equals the mechanism's
     // d(T + V)/dt (from the body rates and accelerations), the rotors' d(1/2 J omega_r^2)/dt,
     // each gear's loss t_i n_i qd_i - tau_i qd_i (t_i = c_i - J_i omega_r,i'), the motors'
-    // friction f_i n_i qd_i and the pin's dissipated power.
+    // friction f_i n_i qd_i and the pin's dissipated power. A gear loses power (>= 0) but
+    // within its at-rest band (|n qd| <= v_m = 1e-2 rad/s), where it takes the direction of
+    // qdd: there it may hand on up to tau v_m / n.
     let elbow = Gear { n: 15.0, eta: 0.7, eta_b: 0.5, j: 4e-5, c: 1e-4, tc: 0.002 };
     let gears = [GEAR1, elbow];
-    let mech = two_link(&GEAR1.spec(), &elbow.spec(), "loads:\n  - {type: friction, pair: elbow, mu: 0.1, pin_radius: 0.005}\n");
+    let mech = two_link(
+        &GEAR1.spec(),
+        &elbow.spec(),
+        "loads:\n  - {type: friction, pair: elbow, mu: 0.1, pin_radius: 0.005}\n",
+    );
     let torques = |t: f64| vec![0.4 * (3.0 * t).sin() + 0.1, 0.05 * (5.0 * t).cos()];
     let mut s = Settings::for_model(&mech).unwrap();
     s.t_end = 2.0;
@@ -370,7 +388,7 @@ fn power_balance_input_is_mechanism_rotors_gear_losses_and_friction() {
     assert!(tr.success(), "{}", tr.message);
     // The run's own energy balance (the work counts the power into the links).
     assert!(tr.stats.energy_drift <= 1e-8, "energy drift {}", tr.stats.energy_drift);
-    let (mut worst, mut modes) = (0.0f64, [[0usize; 2]; 2]);
+    let (mut worst, mut modes, mut resting) = (0.0f64, [[0usize; 2]; 2], 0);
     let mut ws = Workspace::new(&mech);
     for r in 0..tr.len() {
         let (t, q, qd) = (tr.t[r], &tr.q[2 * r..2 * r + 2], &tr.qd[2 * r..2 * r + 2]);
@@ -394,7 +412,9 @@ fn power_balance_input_is_mechanism_rotors_gear_losses_and_friction() {
             let g = gears[k];
             let t = t_m[k] - g.friction(qd[k]) - g.j * omega_d[k];
             let gear_loss = t * g.n * qd[k] - ws.tau[k] * qd[k];
-            assert!(gear_loss >= -1e-12, "row {r}: gear {k} loses {gear_loss} W");
+            let at_rest = (g.n * qd[k]).abs() <= 1e-2;
+            assert!(gear_loss >= -1e-12 || at_rest, "row {r}: gear {k} loses {gear_loss} W");
+            resting += usize::from(at_rest);
             modes[k][usize::from(t * qd[k] < 0.0)] += 1;
             input += t_m[k] * g.n * qd[k];
             rotors += g.j * omega[k] * omega_d[k];
@@ -406,5 +426,8 @@ fn power_balance_input_is_mechanism_rotors_gear_losses_and_friction() {
     }
     assert!(worst <= 1e-12, "power balance off by {worst:e} of its terms");
     assert!(modes.iter().all(|m| m[0] > 0 && m[1] > 0), "both branches of both gears: {modes:?}");
-    eprintln!("power balance: worst residual {worst:.2e} of the terms over {} rows; branches {modes:?}", tr.len());
+    eprintln!(
+        "power balance: worst residual {worst:.2e} of the terms over {} rows ({resting} at rest); branches {modes:?}",
+        tr.len()
+    );
 }

@@ -163,7 +163,7 @@ pub(crate) fn fill(
     // Motor side: the joint-side row through the gear, then the rotor and the motor friction.
     let mut col = start;
     for ((k, a), rotor) in actuated(mech).zip(gears.each(m).map(|(_, _, r)| r)) {
-        let gear = gear_input(a, 1.0, motoring(tau_model[k], qd[k], qdd[k]));
+        let gear = gear_input(a, 1.0, motoring(a, tau_model[k], qd[k], qdd[k]));
         for v in &mut y[k * p..(k + 1) * p] {
             *v *= gear;
         }

@@ -30,14 +30,31 @@ pub(crate) fn motor_friction(a: &Actuator, qd: f64) -> f64 {
     a.viscous * w + a.coulomb * smooth_sign(w, a.stiction_speed)
 }
 
-/// Whether a gear whose output effort is `tau` moves power from the motor to the load: its
-/// output's power tau qd >= 0; at rest (qd = 0) that of the motion starting, tau qdd_k >= 0;
-/// held still (qdd_k = 0 too) it counts as motoring (the motor torque that holds a load is then
-/// any between the two branches' values: the motoring one, which would start to move the load
-/// along tau, is the one reported).
-pub(crate) fn motoring(tau: f64, qd: f64, qdd: f64) -> bool {
-    let direction = if qd != 0.0 { qd } else { qdd };
-    tau * direction >= 0.0
+/// Whether actuator `a`'s gear counts as at rest at coordinate rate qd: its motor turns slower
+/// than its stiction speed v_m, the band where its Coulomb torque fades too. At rest a gear
+/// takes the direction of the motion starting (qdd), and it can stick (`dynamics::gears`).
+pub(crate) fn at_rest(a: &Actuator, qd: f64) -> bool {
+    (a.ratio * qd).abs() <= a.stiction_speed
+}
+
+/// The direction of actuator `a`'s relative motion that decides its gear's branch: qd, or at
+/// rest ([`at_rest`]) qdd.
+pub(crate) fn direction(a: &Actuator, qd: f64, qdd: f64) -> f64 {
+    if at_rest(a, qd) {
+        qdd
+    } else {
+        qd
+    }
+}
+
+/// Whether the gear of actuator `a` whose output effort is `tau` moves power from the motor
+/// to the load: tau along the [`direction`] of the motion. Held still (at rest, qdd = 0) it
+/// counts as motoring: the motor torque that holds a load is then any between the two
+/// branches' values, and the motoring one, which would start to move the load along tau, is
+/// the one reported.
+pub(crate) fn motoring(a: &Actuator, tau: f64, qd: f64, qdd: f64) -> bool {
+    let d = direction(a, qd, qdd);
+    tau * if d == 0.0 { tau } else { d } >= 0.0
 }
 
 /// The gear's input torque t (N m, motor side) for its output effort `tau`: tau / (n eta)
@@ -55,7 +72,7 @@ pub(crate) fn gear_input(a: &Actuator, tau: f64, motoring: bool) -> f64 {
 /// (rad/s^2, absolute): t_m = J omega_r' + f + t, t the gear's input ([`gear_input`] on the
 /// branch [`motoring`] gives).
 pub fn motor_torque(a: &Actuator, tau: f64, qd: f64, qdd: f64, rotor_acc: f64) -> f64 {
-    a.rotor_inertia * rotor_acc + motor_friction(a, qd) + gear_input(a, tau, motoring(tau, qd, qdd))
+    a.rotor_inertia * rotor_acc + motor_friction(a, qd) + gear_input(a, tau, motoring(a, tau, qd, qdd))
 }
 
 /// Every actuator's motor, in actuator order: the coordinates', then the pair actuators'
