@@ -17,8 +17,9 @@
 //! sigma is the direction of the relative motion (sgn qd_i; at rest sgn qdd_i). At rest means
 //! the motor turning slower than its stiction speed v_m (`transmission::at_rest`), the band
 //! where its Coulomb torque fades too: a joint that comes to rest under a load its gear holds
-//! then sticks (qdd_i = -qd_i / T, [`STUCK_DECAY`]), where an exact qd_i = 0 would make an
-//! integrator chatter across it (a sliding mode). With A factored,
+//! then sticks, its remaining speed decaying (qdd_i = -qd_i / T, `transmission::STUCK_DECAY`,
+//! and sigma the sign of qdd_i + qd_i / T, the way it slips from that), where an exact
+//! qd_i = 0 would make an integrator chatter across it (a sliding mode). With A factored,
 //! zdd = y0 + sum_i (tau_i A^-1 g_i + t_i A^-1 e_i), so each choice of modes is a linear system
 //! in the 2 N unknowns (tau_i, t_i). The choices are tried, the guess first (moving: motoring
 //! when the motor's net torque pushes along the motion; at rest: stuck), and the first whose
@@ -38,7 +39,7 @@
 //! consistent (Painleve's paradox of friction), the evaluation is refused
 //! ([`KinematicsError::GearsJammed`]) rather than guessed.
 
-use super::transmission::{at_rest, direction, housing, motor_friction, motors, pair_term};
+use super::transmission::{at_rest, direction, housing, motor_friction, motors, pair_term, STUCK_DECAY};
 use crate::linalg::{lu_factor, lu_solve};
 use crate::model::{Actuator, Mechanism};
 use crate::workspace::Workspace;
@@ -51,13 +52,6 @@ const MODE_TOL: f64 = 1e-12;
 
 /// Below this pivot (relative to the largest entry) a choice of modes has no solution.
 const PIVOT_TOL: f64 = 1e-14;
-
-/// A stuck gear whose coordinate still turns within its at-rest band (|n qd| <= v_m, the
-/// motor's stiction speed) comes to rest with this time constant (s): qdd = -qd / T. It then
-/// creeps at most v_m T / n (3.3e-6 rad behind a 30:1 gear at the default 1e-2 rad/s), and
-/// the decay rate 1 / T = 100 /s is far below what an explicit integrator's steps resolve
-/// anyway. (Stuck at qd = 0 it does not move.)
-const STUCK_DECAY: f64 = 1e-2;
 
 /// A gear's state in one evaluation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -373,7 +367,9 @@ impl Gears {
             let (qdd, size) = terms.fold((self.gy[i] + r.h, self.gy[i].abs() + r.h.abs()), |(s, z), (p, q)| {
                 (s + p + q, z + p.abs() + q.abs())
             });
-            let direction = direction(a, r.rate, if qdd.abs() > MODE_TOL * size { qdd } else { 0.0 });
+            let direction = direction(a, r.rate, qdd);
+            let direction =
+                if direction.abs() > MODE_TOL * (size + (r.rate / STUCK_DECAY).abs()) { direction } else { 0.0 };
             let slack = MODE_TOL * (tau.abs() + a.ratio * (t.abs() + r.net.abs()));
             match self.mode(i) {
                 Mode::Motoring => direction * tau >= -slack * direction.abs(),
