@@ -47,8 +47,8 @@ def usage(mech, plan):
 
 
 def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> None:
-    # 0.15147 s against 0.14347 s with the flat envelope; theta1's motor reaches 212 rad/s
-    # and runs on the drooping line at 166 of the 200 grid points.
+    # 0.15069 s against 0.14263 s with the flat envelope; theta1's motor reaches 212 rad/s
+    # and runs on the drooping line at 167 of the 200 grid points.
     mech = geared(CURVE)
     plan = time_optimal(mech, path, "actuators", n_grid=200)
     use = usage(mech, plan)[:-1]  # the last point, at rest, has no s'' of its own
