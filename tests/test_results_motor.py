@@ -115,3 +115,16 @@ def test_identify_command_reads_a_geared_runs_motor_torques(run, tmp_path):
     old = dataclasses.replace(res, tau_motor=None).save(tmp_path / "old.npz")
     code, err = cli_run("identify", model, old)
     assert code == 2 and "tau_motor" in err and "joint-side" in err
+
+
+def test_a_geared_runs_point_motion_is_its_own(run):
+    # Along a result the body accelerations (and reactions) come from forward dynamics of each
+    # row under the run's drives: with motors their torques, not res.tau (the gears' output).
+    # The crank tip C1, 0.25 m from A1 at angle theta1: a = 0.25 (theta1'' perp - theta1'^2 e),
+    # from the run's own theta1, theta1', theta1'' (to the 1e-9 of the fixed point's round-off).
+    mech, res = run
+    _, _, a = mech.point_motion(res)["C1"]
+    th, w, al = res.q[:, 0], res.qd[:, 0], res.qdd[:, 0]
+    e, perp = np.column_stack([np.cos(th), np.sin(th)]), np.column_stack([-np.sin(th), np.cos(th)])
+    expected = 0.25 * (al[:, None] * perp - (w**2)[:, None] * e)
+    np.testing.assert_allclose(a, expected, rtol=0, atol=1e-9 * np.abs(expected).max())

@@ -510,7 +510,8 @@ class Mechanism:
             As for :meth:`forward_dynamics`.
         q : SimulationResult
             A run of this mechanism (qd, t, tau not given): every row on its own branch
-            (``res.x``) under the efforts the run applied (``res.tau``).
+            (``res.x``) under the efforts the run applied (``res.tau``; with motors their
+            torques, ``res.tau_motor``).
 
         Returns
         -------
@@ -591,7 +592,9 @@ class Mechanism:
         if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
             raise ValueError("the result is not a run of this mechanism (its bodies differ); "
                              "use pd.from_result(res) for the mechanism it was made with")
-        return self._native.along(res.t, res.x, res.q, res.qd, res.tau, allow_singular)
+        # The run's drives: the motor torques where the model has motors (res.tau is joint-side).
+        drives = res.tau if res.tau_motor is None else res.tau_motor
+        return self._native.along(res.t, res.x, res.q, res.qd, drives, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
         """Kinetic and potential energy (J) at (q, qd): ``(T, V)``, the position reached from

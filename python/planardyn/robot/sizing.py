@@ -265,9 +265,8 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
         efforts, rates, torques = distributed_efforts(mech, motion, distribution, preload)
     else:
         efforts, rates = motion.tau, motion.qd
-        torques = motion.tau_motor
-        if torques is None:
-            torques = np.asarray(mech.motor_torques(motion.q, motion.qd, motion.qdd, motion.tau, allow_singular=True))
+        torques = (np.asarray(mech.motor_torques(motion.q, motion.qd, motion.qdd, motion.tau, allow_singular=True))
+                   if motion.tau_motor is None else motion.tau_motor)
     kinds = mech.actuator_kinds
     drives = []
     for k, name in enumerate(names):
