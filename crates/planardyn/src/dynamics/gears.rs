@@ -28,10 +28,10 @@
 //! **One solution.** With every housing fixed (e_i = 0), -tau_i is a monotone graph of
 //! s_i = g_i . zdd: the gear's law tau = phi(t) is increasing in t (slopes n eta and n / eta_b,
 //! vertical for eta_b = 0) and t = c - J n (s_i + h_i) decreases with s_i; at rest the stuck
-//! band is the vertical segment at s_i = -h_i. So A zdd - b - sum_i g_i tau_i(g_i . zdd) = 0 is
-//! the optimality condition of the strictly convex 1/2 zdd^T A zdd - b^T zdd
-//! + sum_i Phi_i(g_i . zdd) (Phi_i' = -tau_i, convex): exactly one zdd, whatever the number of
-//! motors; for one motor both branch matrices, A + eta n^2 J g g^T and A + n^2 J g g^T / eta_b,
+//! band is the vertical segment where the slip is zero. So
+//! A zdd - b - sum_i g_i tau_i(g_i . zdd) = 0 is the optimality condition of the strictly
+//! convex function 1/2 zdd^T A zdd - b^T zdd plus sum_i Phi_i(g_i . zdd) (Phi_i' = -tau_i,
+//! convex): exactly one zdd, whatever the number of motors; for one motor both branch matrices, A + eta n^2 J g g^T and A + n^2 J g g^T / eta_b,
 //! are positive definite. A housing on a moving link adds J e_i w_i^T, which is not symmetric
 //! when eta < 1: for one motor each branch stays invertible with the same orientation while
 //! 1 + J w^T A^-1 (eps n g + e) > 0 for eps = eta and 1 / eta_b, which fails only where the

@@ -144,9 +144,8 @@ impl Solve for Held<'_> {
             cholesky_solve(&ws.a, m, col);
         }
         let tau = if homogeneous { &mut w.t } else { &mut w.h };
-        for i in 0..mp {
-            let h = if homogeneous { 0.0 } else { w.h0[i] };
-            tau[i] = h - dot(&w.g[i * m..(i + 1) * m], rhs);
+        for (i, (tau, g)) in tau.iter_mut().zip(w.g.chunks_exact(m)).enumerate() {
+            *tau = if homogeneous { 0.0 } else { w.h0[i] } - dot(g, rhs);
             for k in 0..mp {
                 w.s[i * mp + k] = dot(&w.g[i * m..(i + 1) * m], &w.ainv_gt[k * m..(k + 1) * m]);
             }
