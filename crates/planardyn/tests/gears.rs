@@ -8,7 +8,7 @@ mod common;
 use common::yaml;
 use planardyn::dynamics::{forward, inverse, motor_torques, Drives};
 use planardyn::simulate::{simulate, Settings};
-use planardyn::{Error, Mechanism, Workspace};
+use planardyn::{Error, KinematicsError, Mechanism, Workspace};
 
 const G: f64 = 9.81;
 
@@ -247,12 +247,20 @@ impl Gear {
 const GEAR1: Gear = Gear { n: 20.0, eta: 0.9, eta_b: 0.9, j: 3e-5, c: 1e-4, tc: 0.002 };
 
 /// qdd of the two-link arm at the drawing (q1 = 0.3, q2 = 0.5) with rates qd and motor torques
-/// t_m, by Newton-Euler written out: M qdd + C + G = [tau1 + (t2 - c2), tau2] (the elbow motor's
+/// t_m: [`two_link_branches`]'s one consistent solution.
+fn two_link_newton_euler(g: [Gear; 2], qd: [f64; 2], t_m: [f64; 2]) -> [f64; 2] {
+    let found = two_link_branches(g, qd, t_m);
+    assert_eq!(found.len(), 1, "consistent branches: {found:?}");
+    found[0]
+}
+
+/// The accelerations of the two-link arm at the drawing (q1 = 0.3, q2 = 0.5) with rates qd and
+/// motor torques t_m on every consistent choice of branches, by Newton-Euler written out: M qdd + C + G = [tau1 + (t2 - c2), tau2] (the elbow motor's
 /// housing, link 1, takes t2 - c2), rotors J1 n1 q1'' = c1 - t1 and
 /// J2 (q1'' + n2 q2'') = c2 - t2, c_i = T_i - f_i, gears tau_i = eps_i n_i t_i. Every choice of
 /// eps_i (eta_i motoring, 1 / eta_b,i back-driven) is solved and kept when its branch holds
-/// (sgn(qd_i) t_i >= 0 motoring); exactly one must.
-fn two_link_newton_euler(g: [Gear; 2], qd: [f64; 2], t_m: [f64; 2]) -> [f64; 2] {
+/// (sgn(qd_i) t_i >= 0 motoring).
+fn two_link_branches(g: [Gear; 2], qd: [f64; 2], t_m: [f64; 2]) -> Vec<[f64; 2]> {
     let (m1, l1, m2, l2, q2) = (1.2, 0.4, 0.8, 0.3, 0.5f64);
     let (q1, lc1, lc2) = (0.3f64, l1 / 2.0, l2 / 2.0);
     let (i1, i2) = (m1 * l1 * l1 / 12.0, m2 * l2 * l2 / 12.0);
@@ -282,8 +290,7 @@ fn two_link_newton_euler(g: [Gear; 2], qd: [f64; 2], t_m: [f64; 2]) -> [f64; 2] 
             found.push(qdd);
         }
     }
-    assert_eq!(found.len(), 1, "consistent branches: {found:?}");
-    found[0]
+    found
 }
 
 #[test]
@@ -429,5 +436,24 @@ fn power_balance_input_is_mechanism_rotors_gear_losses_and_friction() {
     eprintln!(
         "power balance: worst residual {worst:.2e} of the terms over {} rows ({resting} at rest); branches {modes:?}",
         tr.len()
+    );
+}
+
+#[test]
+fn a_lossy_motor_turning_against_its_housing_is_refused_where_no_branch_holds() {
+    // A direct drive (n = 1) at the elbow on link 1 with eta = eta_b = 0.05 and a rotor heavier
+    // than the links (J = 0.2 kg m^2): its rotor turns at q1' + q2', and the motoring branch's
+    // 1 + J w^T A^-1 (eta n g + e) = 1 + 0.2 (-14.9 + 0.05 * 82.7) < 0 (A^-1 of the arm at the
+    // drawing): that branch's orientation flips, and for T2 = -1.9 N m at qd = [1, -1] rad/s
+    // Newton-Euler written out has no consistent branch (friction's paradox): forward
+    // dynamics says so rather than guess.
+    let elbow = Gear { n: 1.0, eta: 0.05, eta_b: 0.05, j: 0.2, c: 0.0, tc: 0.0 };
+    let mech = two_link(&GEAR1.spec(), &elbow.spec(), "");
+    let (qd, t_m) = ([1.0, -1.0], [0.0, -1.9]);
+    assert!(two_link_branches([GEAR1, elbow], qd, t_m).is_empty());
+    let err = forward_at(&mech, &[0.3, 0.5], &qd, &t_m).unwrap_err();
+    assert!(
+        matches!(&err, Error::Kinematics(KinematicsError::GearsJammed { actuators }) if actuators == "q1, q2"),
+        "{err}"
     );
 }

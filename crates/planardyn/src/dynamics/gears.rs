@@ -186,7 +186,9 @@ impl Gears {
     /// rate.
     pub(crate) fn kinematics(&mut self, mech: &Mechanism, ws: &Workspace, grad: &[f64], rates: &[f64]) {
         let (n, m) = (ws.x.len(), ws.b.len());
-        for (i, (&k, e)) in self.slots.iter().zip(self.e.chunks_exact_mut(m.max(1))).enumerate() {
+        for i in 0..self.slots.len() {
+            let (k, ratio) = (self.slots[i], self.actuator(mech, i).ratio);
+            let e = &mut self.e[i * m..(i + 1) * m];
             let h = pair_term(mech, ws, k, &grad[k * n..(k + 1) * n]);
             let (c_h, omega_h) = match self.housings[i] {
                 Some(b) => {
@@ -195,7 +197,6 @@ impl Gears {
                 }
                 None => (0.0, 0.0),
             };
-            let ratio = motors(mech).nth(k).flatten().map_or(1.0, |a| a.ratio);
             let r = &mut self.rotors[k];
             (r.rate, r.h, r.r, r.housing_rate) = (rates[k], h, ratio * h + c_h, omega_h);
         }
