@@ -1,14 +1,26 @@
-"""Time-optimal path parameterisation (TOPP) of a closed-chain mechanism with toppra.
+"""Time-optimal path parameterisation (TOPP) of a closed-chain mechanism with toppra, within
+its limits along the whole timed path.
 
 Along a path q = p(s), s in [0, 1], the drive efforts are
 
     tau = a(s) s'' + b(s) s'^2 + c(s),   a = A p',  b = A p'' + (convective terms of p'),  c = gravity and springs,
 
-which planardyn's inverse dynamics gives exactly at every grid point of s, continuing the
-assembly branch from one point to the next: c = ID(p, 0, 0), a = ID(p, 0, p') - c,
-b = ID(p, p', p'') - c. toppra (reachability analysis, Pham and Pham 2018) then finds the
-fastest s'(s) within effort limits F tau <= g and speed limits on q'. Between grid points
-s'' is constant (toppra's discretisation), so the timing s(t) is piecewise quadratic in t.
+which planardyn's inverse dynamics gives exactly at any s, continuing the assembly branch
+along the path (planardyn.plan.path_limits). toppra (reachability analysis, Pham and Pham
+2018) finds the fastest s'(s) on a grid of s with s'' constant on each interval, so the timing
+s(t) is piecewise quadratic in t and s'^2 linear in s between grid points.
+
+The limits hold between the grid points too, not only at them: each stage's linear program
+takes the limits at both ends of its interval (toppra's interpolation scheme), and the timing
+is then checked at ten times the grid's density (planardyn.plan.dense_check); an interval
+where a limit is still exceeded gets the limit at its worst point as one more row, and toppra
+is solved again, until no limit is exceeded by more than :data:`RATIO_TOL` of itself. A
+timing that keeps every limit everywhere is a feasible timing of the path, so the duration is
+never shorter than the optimum. It is longer by O(grid spacing) (first order: a constant s''
+per interval must meet the limits at the interval's worst point, where the optimum's s''
+varies across it); with ``rtol`` the grid is doubled until the duration changes by less
+than rtol of itself, and that change, the first-order estimate of the remaining excess, is
+reported (``TimedPath.time_error``).
 
 Dampers add efforts linear in s', which this form cannot hold: such a model is refused.
 """
@@ -24,25 +36,38 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism
 from ..robot import EndEffector
-from .actuator_limits import drives, exact_bounds, tangent_rows
-from .planned import PlanError, PlannedMotion, effort_bounds, speed_bounds
+from .actuator_limits import drives, exact_bounds
+from .dense_check import check
+from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
+from .planned import PlanError, PlannedMotion, effort_bounds, positive_int, positive_number, speed_bounds
 
 FloatArray = NDArray[np.float64]
 
 #: effort="actuators": the rounds of tangents stop when the time changes by less than this
-#: fraction, and fail after ACTUATOR_ROUNDS rounds.
+#: fraction.
 ACTUATOR_TOL = 1e-7
-ACTUATOR_ROUNDS = 60
 
-#: Relative size of the s'-linear part of the efforts beyond which a model is refused.
-LINEAR_TOL = 1e-9
+#: Rounds of toppra on one grid (with new cuts, and new tangents for motor envelopes) before
+#: the plan is given up: the cuts settle in a few rounds, the tangents in ten to twenty.
+MAX_ROUNDS = 60
+
+#: A timing is accepted when its dense check finds no limit exceeded by more than this fraction
+#: of itself: toppra's linear programs hold their rows to about 1e-12 of the row's scale.
+RATIO_TOL = 1e-10
+
+#: Default ``rtol`` of :func:`time_optimal`: the duration within about 0.1 % of the optimum.
+RTOL = 1e-3
+
+#: Grid refinement stops at this many grid points (the status then says the tolerance was not
+#: reached).
+MAX_GRID = 12801
 
 #: An effort limit that may depend on the coordinates: ``f(q) -> (lo, hi)``, each (m,) in
 #: N m or N. Limits that depend on the speed: ``effort="actuators"``.
-EffortLimit = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
+EffortFunction = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
 
 
-@dataclass
+@dataclass(repr=False)
 class TimedPath(PlannedMotion):
     """A path with its time-optimal timing.
 
@@ -53,7 +78,10 @@ class TimedPath(PlannedMotion):
     rates and accelerations at the grid points (rad or m, per s, per s^2), ``tau`` (N, m) the
     efforts there (N m or N; with s'' of the interval that starts there, the last with the
     last interval's); ``lo``, ``hi`` (N, m) the effort limits, ``speed`` (m,) the speed limits
-    (inf where none); ``status`` toppra's.
+    (inf where none); ``limit_ratio`` the largest fraction of a limit used on the dense check
+    (planardyn.plan.dense_check); ``time_error`` the estimated excess of the duration over
+    the optimum (s: the change over the last doubling of the grid; NaN without refinement);
+    ``status`` toppra's, with the rounds and grids.
     """
 
     path: Any
@@ -64,7 +92,11 @@ class TimedPath(PlannedMotion):
     lo: FloatArray
     hi: FloatArray
     speed: FloatArray
+    time_error: float
     status: str
+
+    def _summary(self) -> str:
+        return f"{len(self.s)} grid points, time error {self.time_error:.2g} s, {self.status}"
 
     def timing(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """s, s', s'' at times t (s), from the piecewise-quadratic s(t)."""
@@ -89,18 +121,46 @@ class TimedPath(PlannedMotion):
         return np.asarray(self.mech.inverse_dynamics(q, qd, qdd, x=self.x[i]))
 
 
-def _limits(mech: Mechanism, effort: ArrayLike | EffortLimit, q: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _effort_limit(mech: Mechanism, effort: ArrayLike | EffortFunction) -> EffortLimit:
     m = mech.dof
-    if callable(effort):
-        pairs = [effort(qi) for qi in q]
-        lo = np.array([np.broadcast_to(np.asarray(p[0], dtype=float), (m,)) for p in pairs])
-        hi = np.array([np.broadcast_to(np.asarray(p[1], dtype=float), (m,)) for p in pairs])
-    else:
+    if not callable(effort):
         lo1, hi1 = effort_bounds(m, effort)
-        lo, hi = np.tile(lo1, (len(q), 1)), np.tile(hi1, (len(q), 1))
-    if not (np.all(lo < hi) and np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
-        raise PlanError("effort limits: need finite lo < hi for every coordinate")
-    return lo, hi
+        return EffortLimit(lambda q: (np.tile(lo1, (len(q), 1)), np.tile(hi1, (len(q), 1))))
+
+    def bounds(q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        pairs = [effort(qi) for qi in q]
+        try:
+            lo = np.array([np.broadcast_to(np.asarray(p[0], dtype=float), (m,)) for p in pairs])
+            hi = np.array([np.broadcast_to(np.asarray(p[1], dtype=float), (m,)) for p in pairs])
+        except (TypeError, ValueError, IndexError) as exc:
+            raise PlanError(f"effort: the function must return (lo, hi), each ({m},) N m or N: {exc}") from exc
+        bad = ~(np.isfinite(lo) & np.isfinite(hi) & (lo < hi)).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise PlanError(f"effort: the function gives lo = {lo[k]}, hi = {hi[k]} at q = {q[k]}; it must give "
+                            "finite lo < hi for every coordinate")
+        return lo, hi
+
+    return EffortLimit(bounds)
+
+
+def _limits(mech: Mechanism, effort: ArrayLike | EffortFunction | str | None,
+            speed: ArrayLike | None) -> tuple[list[Limit], MotorLimit | None, FloatArray]:
+    """The limits, the motor limits among them (effort="actuators") and the speed limits (m,)."""
+    v = speed_bounds(mech.dof, speed)
+    if isinstance(effort, str):
+        if effort != "actuators":
+            raise PlanError(f"effort: limits, a function of q, 'actuators' or None, got {effort!r}")
+        ds = drives(mech)
+        v = np.minimum(v, [d.max_speed / d.ratio for d in ds])
+        motor = MotorLimit(mech, ds)
+        return [motor, *([SpeedLimit(v)] if np.isfinite(v).any() else [])], motor, v
+    limits: list[Limit] = [] if effort is None else [_effort_limit(mech, effort)]
+    if np.isfinite(v).any():
+        limits.append(SpeedLimit(v))
+    if not limits:
+        raise PlanError("no limits: give effort limits, speed limits or both")
+    return limits, None, v
 
 
 def branch(mech: Mechanism, q: FloatArray) -> FloatArray:
@@ -112,35 +172,17 @@ def branch(mech: Mechanism, q: FloatArray) -> FloatArray:
     return np.array(x)
 
 
-def _coefficients(mech: Mechanism, path: Any, s: FloatArray,
-                  x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """a(s), b(s), c(s) (N, m) by inverse dynamics along the grid, on the branch x (N, 3n)."""
-    p, p1, p2 = path(s), path(s, 1), path(s, 2)
-    zero = np.zeros_like(p)
-
-    def inverse(qd: FloatArray, qdd: FloatArray) -> FloatArray:
-        return np.asarray(mech.inverse_dynamics(p, qd, qdd, x=x))
-
-    c = inverse(zero, zero)
-    a = inverse(zero, p1) - c
-    b = inverse(p1, p2) - c
-    # Quadratic in s' only if no effort is linear in the rates: tau(2 p', 4 p'') = 4 b + c.
-    b4 = inverse(2 * p1, 4 * p2) - c
-    scale = max(float(np.abs(b).max()), float(np.abs(a).max()), float(np.abs(c).max()), 1e-300)
-    if np.abs(b4 - 4 * b).max() > LINEAR_TOL * scale:
-        raise PlanError(f"{mech.name}: efforts linear in the rates (dampers or viscous friction) are not of "
-                        "TOPP's form a s'' + b s'^2 + c; plan on a copy of the model without them")
-    return a, b, c
-
-
 def time_optimal(
     mech: Mechanism,
     waypoints: ArrayLike,
-    effort: ArrayLike | EffortLimit | str | None,
+    effort: ArrayLike | EffortFunction | str | None,
     speed: ArrayLike | None = None,
     n_grid: int = 200,
+    *,
+    rtol: float | None = RTOL,
 ) -> TimedPath:
-    """The fastest timing of a joint-space path within effort and speed limits.
+    """The fastest timing of a joint-space path within effort and speed limits, everywhere
+    along it (see the module).
 
     Parameters
     ----------
@@ -152,19 +194,23 @@ def time_optimal(
         a task-space path, :func:`task_waypoints`.
     effort : (m,) or (m, 2) array_like, or callable ``f(q) -> (lo, hi)``, "actuators", or None
         Effort limits (N m or N): symmetric magnitudes, [lo, hi] per coordinate, or a function
-        of the coordinates (see :data:`EffortLimit`); "actuators": every coordinate's motor
+        of the coordinates (see :data:`EffortFunction`); "actuators": every coordinate's motor
         torque within the torque its envelope offers at its speed, through its transmission
         (planardyn.plan.actuator_limits says how; the motors' top speeds become speed limits);
         None: none (then ``speed`` is needed).
     speed : (m,) array_like, optional
         Speed limits |qd| (rad/s or m/s); none by default.
     n_grid : int
-        Grid points in s (toppra's stages + 1).
+        Grid points in s to start with (toppra's stages + 1), >= 3.
+    rtol : float or None
+        Double the grid until the duration changes by less than this fraction of itself
+        (default 1e-3: within about 0.1 % of the optimum); None: keep ``n_grid``.
 
     Returns
     -------
     TimedPath
-        Starting and ending at rest.
+        Starting and ending at rest, within every limit along the whole path (its
+        ``limit_ratio`` <= 1 + :data:`RATIO_TOL`).
 
     Raises
     ------
@@ -173,86 +219,128 @@ def time_optimal(
     """
     import toppra
 
-    q_w = np.atleast_2d(np.asarray(waypoints, dtype=float))
     m = mech.dof
+    try:
+        q_w = np.atleast_2d(np.asarray(waypoints, dtype=float))
+    except (TypeError, ValueError) as exc:
+        raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) coordinates: {exc}") from exc
     if q_w.ndim != 2 or q_w.shape[1] != m or len(q_w) < 2 or not np.all(np.isfinite(q_w)):
         raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) finite coordinates, got shape {q_w.shape}")
-    if n_grid < 3:
-        raise PlanError(f"n_grid: need at least 3 grid points, got {n_grid}")
+    n_grid = positive_int("n_grid", n_grid, 3)
+    if rtol is not None:
+        rtol = positive_number("rtol", rtol)
     chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q_w, axis=0), axis=1))])
-    if chord[-1] == 0.0 or np.any(np.diff(chord) == 0.0):
-        raise PlanError("waypoints: consecutive waypoints must differ")
+    if not np.isfinite(chord[-1]) or np.any(np.diff(chord) == 0.0):
+        raise PlanError("waypoints: consecutive waypoints must differ (and their distances be finite)")
+    limits, motor, v = _limits(mech, effort, speed)
     path = toppra.SplineInterpolator(chord / chord[-1], q_w)
     s = np.linspace(0.0, 1.0, n_grid)
-    v = speed_bounds(m, speed)
-    if effort is None and not np.isfinite(v).any():
-        raise PlanError("no limits: give effort limits, speed limits or both")
-    x = branch(mech, path(s))
-    a, b, c = _coefficients(mech, path, s, x)
-    p1 = path(s, 1)
-    if isinstance(effort, str):
-        if effort != "actuators":
-            raise PlanError(f"effort: limits, a function of q, 'actuators' or None, got {effort!r}")
-        ds = drives(mech)
-        v = np.minimum(v, [d.max_speed / d.ratio for d in ds])
-        # The speed limits' s'^2 bound (a quarter of it) as the first tangent point.
-        with np.errstate(divide="ignore"):
-            x_v = np.min((v / np.abs(p1)) ** 2, axis=1)
-        x0 = np.minimum(np.where(np.isfinite(x_v), x_v / 4, 1.0), 1e6)
-        duration, rounds = np.inf, 0
-        while True:
-            rounds += 1
-            sdd, sd, status = _toppra(path, s, tangent_rows(mech, ds, a, b, c, p1, x0), v)
-            t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
-            if abs(duration - t_new) <= ACTUATOR_TOL * t_new:
-                break
-            if rounds == ACTUATOR_ROUNDS:
-                raise PlanError(f"effort='actuators': the time did not settle in {rounds} rounds of tangents "
-                                f"({duration:.9g} s, then {t_new:.9g} s); use a finer n_grid")
-            duration, x0 = t_new, sd**2
-        status = f"{status}; {rounds} rounds of tangents"
-        lo, hi = exact_bounds(mech, p1 * sd[:, None])
+    plan = _time_on_grid(mech, path, s, limits, motor is not None)
+    grids = [len(s)]
+    time_error = np.nan
+    while rtol is not None:
+        s = np.sort(np.concatenate([s, (s[:-1] + s[1:]) / 2]))
+        finer = _time_on_grid(mech, path, s, limits, motor is not None)
+        grids.append(len(s))
+        time_error = abs(plan.duration - finer.duration)
+        plan = finer
+        if time_error <= rtol * plan.duration or len(s) >= MAX_GRID:
+            break
+    note = f"grids {'-'.join(map(str, grids))}" if len(grids) > 1 else f"grid {grids[0]}"
+    if rtol is not None and time_error > rtol * plan.duration:
+        note += f"; rtol {rtol:g} not reached within {MAX_GRID} grid points"
+    if motor is not None:
+        lo, hi = exact_bounds(mech, plan.qd)
+    elif isinstance(limits[0], EffortLimit):
+        lo, hi = limits[0].bounds(plan.q)
     else:
-        if effort is None:
-            lo, hi = np.full((n_grid, m), -np.inf), np.full((n_grid, m), np.inf)
-        else:
-            lo, hi = _limits(mech, effort, path(s))
-        rows = (np.hstack([a, -a]), np.hstack([b, -b]), np.hstack([c - hi, lo - c]))
-        sdd, sd, status = _toppra(path, s, None if effort is None else rows, v)
+        lo, hi = np.full((len(s), m), -np.inf), np.full((len(s), m), np.inf)
+    plan.lo, plan.hi, plan.speed, plan.time_error = lo, hi, v, float(time_error)
+    plan.status = f"{plan.status}; {note}"
+    return plan
+
+
+def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit], tangents: bool) -> TimedPath:
+    """toppra's timing on the grid s within the limits at both ends of every interval, cut
+    where the dense check still finds a limit exceeded (see the module); with tangents (motor
+    envelopes) the rows are linearised at the previous timing until the time settles."""
+    n = len(s)
+    x = branch(mech, path(s))
+    grid = path_points(mech, path, s, x, linear_check=True)
+    # Each stage i < n - 1 holds its interval's start (d = 0) and end (d = s_i+1 - s_i).
+    pts = _take(grid, np.concatenate([np.arange(n), np.arange(1, n)]))
+    stage = np.concatenate([np.arange(n), np.arange(n - 1)])
+    d = np.concatenate([np.zeros(n), np.diff(s)])
+    x0 = _first_speeds(limits, pts)
+    duration, rounds = np.inf, 0
+    while True:
+        rounds += 1
+        rows = stage_rows(stage, d, rows_at(limits, pts, x0), n)
+        sdd, sd, status = _toppra(path, s, rows)
+        t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
+        found = check(mech, path, s, x, sd, sdd, limits)
+        settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
+        if found.ratio <= 1 + RATIO_TOL and settled:
+            break
+        if rounds == MAX_ROUNDS:
+            raise PlanError(f"the timing did not settle in {rounds} rounds ({duration:.9g} s, then {t_new:.9g} s, "
+                            f"limits used to {found.ratio:.9g}); use a finer n_grid")
+        bad = np.flatnonzero(found.worst > 1 + RATIO_TOL)
+        if len(bad):
+            cut = path_points(mech, path, found.at[bad], x[bad])
+            pts = _join(pts, cut)
+            stage = np.concatenate([stage, bad])
+            d = np.concatenate([d, found.at[bad] - s[bad]])
+        duration = t_new
+        x0 = sd[stage] ** 2 + 2 * d * np.append(sdd, 0.0)[stage]
+    status = f"{status}; {rounds} rounds" + (" of tangents" if tangents else "")
     sd2 = sd**2
     dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
-    t = np.concatenate([[0.0], np.cumsum(dt)])
     u = np.append(sdd, sdd[-1])
-    p2 = path(s, 2)
-    tau = a * u[:, None] + b * sd2[:, None] + c
-    return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=t, x=x, q=path(s), qd=p1 * sd[:, None],
-                     qdd=p1 * u[:, None] + p2 * sd2[:, None], tau=tau, lo=lo, hi=hi, speed=v, status=status)
+    return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=np.concatenate([[0.0], np.cumsum(dt)]), x=x,
+                     q=grid.q, qd=grid.p1 * sd[:, None], qdd=grid.p1 * u[:, None] + grid.p2 * sd2[:, None],
+                     tau=grid.efforts(u, sd2), limit_ratio=found.ratio, lo=grid.a * np.nan, hi=grid.a * np.nan,
+                     speed=np.full(mech.dof, np.inf), time_error=np.nan, status=status)
 
 
-def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray] | None,
-            v: FloatArray) -> tuple[FloatArray, FloatArray, str]:
-    """toppra's timing (s'' per interval, s' at the grid) within rows (N, R) A u + B x + C <= 0
-    (u = s'', x = s'^2) and speed limits v."""
+def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
+    """The s'^2 at which the first tangents of motor envelopes are taken: a quarter of the
+    speed limits' bound (1 where none; at most 1e6)."""
+    bound = np.full(len(pts.s), np.inf)
+    for lim in limits:
+        if isinstance(lim, SpeedLimit):
+            with np.errstate(divide="ignore"):
+                bound = np.minimum(bound, np.min((lim.v / np.abs(pts.p1)) ** 2, axis=1))
+    return np.minimum(np.where(np.isfinite(bound), bound / 4, 1.0), 1e6)
+
+
+def _take(p: PathPoints, i: NDArray[np.intp]) -> PathPoints:
+    return PathPoints(p.s[i], p.q[i], p.p1[i], p.p2[i], p.a[i], p.b[i], p.c[i])
+
+
+def _join(p: PathPoints, r: PathPoints) -> PathPoints:
+    return PathPoints(*(np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b", "c")))
+
+
+def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray]) -> tuple[FloatArray, FloatArray, str]:
+    """toppra's timing (s'' per interval, s' at the grid) within the stages' rows (N, R)
+    A u + B x + C <= 0 (u = s'', x = s'^2)."""
     import toppra.algorithm as algo
     import toppra.constraint as constraint
 
+    r = rows[0].shape[1]
+
     class _Rows(constraint.SecondOrderConstraint):
+        def __init__(self) -> None:
+            super().__init__(None, lambda q: np.eye(r), lambda q: np.zeros(r), len(s))
+            self.identical = True
+
         def compute_constraint_params(self, _path: Any, gridpoints: FloatArray) -> tuple[Any, ...]:
             if not np.array_equal(gridpoints, s):
-                raise PlanError("toppra asked for efforts off the planned grid")
-            assert rows is not None
-            r = rows[0].shape[1]
-            return rows[0], rows[1], rows[2], np.tile(np.eye(r), (len(s), 1, 1)), np.zeros((len(s), r)), None, None
+                raise PlanError("toppra asked for limits off the planned grid")
+            return rows[0], rows[1], rows[2], np.eye(r), np.zeros(r), None, None
 
-    constraints: list[Any] = []
-    m = len(v)
-    if rows is not None:
-        r = rows[0].shape[1]
-        constraints.append(_Rows(None, lambda q: np.eye(r), lambda q: np.zeros(r), m))
-    if np.isfinite(v).any():
-        vmax = np.where(np.isfinite(v), v, 1e300)
-        constraints.append(constraint.JointVelocityConstraint(np.stack([-vmax, vmax], axis=1)))
-    instance = algo.TOPPRA(constraints, path, gridpoints=s, parametrizer="ParametrizeConstAccel")
+    instance = algo.TOPPRA([_Rows()], path, gridpoints=s, parametrizer="ParametrizeConstAccel")
     sdd, sd, _, status = _solve(instance)
     if sd is None:
         from .stage_lp import HighsWrapper
