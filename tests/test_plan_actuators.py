@@ -39,7 +39,11 @@ def path():
     return task_waypoints(ee, [PICK, PLACE], 0.01)
 
 
-def usage(mech, plan, f=np.linspace(0.0, 1.0, 11)):
+#: Fractions of each grid interval the tests check: its ends and 9 points between.
+FRACTIONS = np.linspace(0.0, 1.0, 11)
+
+
+def usage(mech, plan, f=FRACTIONS):
     """|t_m| / available torque (I, len(f)): the largest over the motors, at fractions f of
     every grid interval in s, each with that interval's s'' (s'^2 linear in s across it):
     the core's motor torque of the efforts inverse dynamics gives there. The path's end, at

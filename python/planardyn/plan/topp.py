@@ -343,9 +343,9 @@ def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatA
     instance = algo.TOPPRA([_Rows()], path, gridpoints=s, parametrizer="ParametrizeConstAccel")
     sdd, sd, _, status = _solve(instance)
     if sd is None:
-        from .stage_lp import HighsWrapper
+        from .stage_lp import VertexWrapper
 
-        instance.solver_wrapper = HighsWrapper(instance.constraints, instance.path, instance.gridpoints)
+        instance.solver_wrapper = VertexWrapper(instance.constraints, instance.path, instance.gridpoints)
         sdd, sd, _, status = _solve(instance)
     if sd is None:
         raise PlanError(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
