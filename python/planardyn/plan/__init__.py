@@ -2,8 +2,8 @@
 trajectory optimisation by collocation (:func:`collocate`)."""
 
 from .collocation import CollocatedMotion, Workspace, collocate
-from .planned import PlanError, PlannedMotion
+from .planned import InfeasiblePlan, PlanError, PlannedMotion
 from .topp import TimedPath, task_waypoints, time_optimal
 
-__all__ = ["CollocatedMotion", "PlanError", "PlannedMotion", "TimedPath", "Workspace", "collocate", "task_waypoints",
-           "time_optimal"]
+__all__ = ["CollocatedMotion", "InfeasiblePlan", "PlanError", "PlannedMotion", "TimedPath", "Workspace", "collocate",
+           "task_waypoints", "time_optimal"]

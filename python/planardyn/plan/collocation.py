@@ -47,7 +47,15 @@ from ..mechanism import Mechanism
 from ..robot import EndEffector
 from .casadi_callbacks import callback, or_nan
 from .dense_check import CHECK_POINTS
-from .planned import PlanError, PlannedMotion, effort_bounds, positive_int, positive_number, speed_bounds
+from .planned import (
+    InfeasiblePlan,
+    PlanError,
+    PlannedMotion,
+    effort_bounds,
+    positive_int,
+    positive_number,
+    speed_bounds,
+)
 from .topp import time_optimal
 
 FloatArray = NDArray[np.float64]
@@ -324,12 +332,12 @@ def _fastest(mech: Mechanism, p: _Problem, line: PlannedMotion) -> PlannedMotion
     assert p.duration is not None
     fastest = _solve(mech, p, "time", _warm_start(mech, p, None, line, ""))
     if not fastest.success:
-        raise PlanError(f"duration: {p.duration:g} s is shorter than the straight path's fastest timing within the "
-                        f"limits ({line.duration:.6g} s), and the minimum-time motion that would say whether any is "
-                        f"that fast did not converge (IPOPT: {fastest.status}); give a longer duration", "duration")
+        raise InfeasiblePlan(f"duration: {p.duration:g} s is shorter than the straight path's fastest timing within "
+                             f"the limits ({line.duration:.6g} s), and the minimum-time motion that would say whether "
+                             f"any is that fast did not converge (IPOPT: {fastest.status}); give a longer duration")
     if fastest.duration > p.duration:
-        raise PlanError(f"duration: no motion within the limits takes {p.duration:g} s; the fastest takes "
-                        f"{fastest.duration:.6g} s (minimum time, {p.n} intervals): give at least that", "duration")
+        raise InfeasiblePlan(f"duration: no motion within the limits takes {p.duration:g} s; the fastest takes "
+                             f"{fastest.duration:.6g} s (minimum time, {p.n} intervals): give at least that")
     return fastest
 
 

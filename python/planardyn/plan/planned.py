@@ -25,6 +25,10 @@ class PlanError(PlanardynError, ValueError):
         self.argument = argument
 
 
+class InfeasiblePlan(PlanError):
+    """No motion keeps the limits: the message says which and what to change."""
+
+
 @dataclass(repr=False)
 class PlannedMotion:
     """A motion from rest to rest with the efforts that run it.

@@ -39,7 +39,15 @@ from ..robot import EndEffector
 from .actuator_limits import drives, exact_bounds
 from .dense_check import check
 from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
-from .planned import PlanError, PlannedMotion, effort_bounds, positive_int, positive_number, speed_bounds
+from .planned import (
+    InfeasiblePlan,
+    PlanError,
+    PlannedMotion,
+    effort_bounds,
+    positive_int,
+    positive_number,
+    speed_bounds,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -348,7 +356,7 @@ def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatA
         instance.solver_wrapper = VertexWrapper(instance.constraints, instance.path, instance.gridpoints)
         sdd, sd, _, status = _solve(instance)
     if sd is None:
-        raise PlanError(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
+        raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
                         "(gravity, springs) may exceed them somewhere: raise the limits or move the path")
     return sdd, sd, status
 
