@@ -89,8 +89,8 @@ def plan_cli(argv: list[str] | None = None) -> int:
             effort = "actuators" if args.actuators else args.effort
             plan: PlannedMotion = time_optimal(mech, q, effort, args.speed, n_grid=args.grid, rtol=args.rtol)
             assert isinstance(plan, TimedPath)
-            what = (f"along the line ({len(plan.t)} grid points, estimated excess over the optimal time "
-                    f"{plan.time_error:.2g} s)")
+            excess = "" if plan.time_error is None else f", estimated excess over the optimal time {plan.time_error:.2g} s"
+            what = f"along the line ({len(plan.t)} grid points{excess})"
         elif args.actuators:
             print("planardyn plan: --collocate takes --effort limits, not --actuators", file=sys.stderr)
             return 2

@@ -37,10 +37,11 @@ Rows = tuple[FloatArray, FloatArray, FloatArray]
 #: motor drives or brakes, its size (rates of 1e-150 rad/s) changes nothing else.
 X_REST = 1e-300
 
-#: Every row (scaled to a limit of 1) is tightened by this: toppra's stage programs hold
-#: their rows to a few 1e-9 where the timing runs along the maximum-velocity curve with two
-#: limits active together, and the timing must keep its limits to RATIO_TOL (1e-10). The
-#: time it costs is of the same relative size.
+#: Every effort row (scaled to a limit of 1) is tightened by this: toppra's stage programs
+#: hold them to a few 1e-9 where the timing runs along the maximum-velocity curve with two
+#: efforts at their limits together, and the timing must keep its limits to RATIO_TOL (1e-10).
+#: The time it costs is of the same relative size. Speed rows bound s'^2 alone, which toppra
+#: holds exactly.
 ROW_MARGIN = 3e-8
 
 #: Relative size of the s'-linear part of the efforts beyond which a model is refused.
@@ -116,9 +117,9 @@ class EffortLimit:
 
     def rows(self, pts: PathPoints, x0: FloatArray) -> Rows:
         lo, hi = self.bounds(pts.q)
-        half = (hi - lo) / 2
-        return (np.hstack([pts.a, -pts.a]) / np.hstack([half, half]), np.hstack([pts.b, -pts.b]) / np.hstack([half, half]),
-                np.hstack([pts.c - hi, lo - pts.c]) / np.hstack([half, half]))
+        half = np.hstack([(hi - lo) / 2, (hi - lo) / 2])
+        return (np.hstack([pts.a, -pts.a]) / half, np.hstack([pts.b, -pts.b]) / half,
+                np.hstack([pts.c - hi, lo - pts.c]) / half + ROW_MARGIN)
 
     def ratio(self, pts: PathPoints, u: FloatArray, x: FloatArray) -> FloatArray:
         lo, hi = self.bounds(pts.q)
@@ -151,7 +152,8 @@ class MotorLimit:
     drives: list[Drive]
 
     def rows(self, pts: PathPoints, x0: FloatArray) -> Rows:
-        return tangent_rows(self.mech, self.drives, pts.a, pts.b, pts.c, pts.p1, x0)
+        a, b, c = tangent_rows(self.mech, self.drives, pts.a, pts.b, pts.c, pts.p1, x0)
+        return a, b, c + ROW_MARGIN
 
     def ratio(self, pts: PathPoints, u: FloatArray, x: FloatArray) -> FloatArray:
         qd = pts.rates(np.maximum(x, X_REST))
@@ -167,10 +169,9 @@ class MotorLimit:
 
 
 def rows_at(limits: list[Limit], pts: PathPoints, x0: FloatArray) -> Rows:
-    """Every limit's rows (P, R) at the points, tightened by ROW_MARGIN."""
+    """Every limit's rows (P, R) at the points."""
     parts = [lim.rows(pts, x0) for lim in limits]
-    a, b, c = (np.hstack([p[i] for p in parts]) for i in range(3))
-    return a, b, c + ROW_MARGIN
+    return tuple(np.hstack([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
 
 
 def ratio_at(limits: list[Limit], pts: PathPoints, u: FloatArray, x: FloatArray) -> FloatArray:

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from toppra.constants import MAXU, MAXX
 
 from ..mechanism import Mechanism
 from ..robot import EndEffector
@@ -66,6 +67,16 @@ RATIO_TOL = 1e-10
 #: Default ``rtol`` of :func:`time_optimal`: the duration within about 0.1 % of the optimum.
 RTOL = 1e-3
 
+#: toppra bounds s'^2 by MAXX and |s''| by MAXU (1e4 each) and decides with absolute
+#: tolerances of 1e-8 and more on them, so the path parameter's span S is fitted to the
+#: duration T: s' ~ S / T and s'' ~ S / T^2 must stay within FAST_FRACTION of the bounds and
+#: far above the tolerances (see _span). A timing that meets a bound is timed again with S
+#: fitted to it (it is then too slow, so S shrinks), at most SPAN_ROUNDS times; a motion
+#: faster than MIN_DURATION is refused.
+FAST_FRACTION = 0.25
+SPAN_ROUNDS = 8
+MIN_DURATION = 1e-4
+
 #: Grid refinement stops at this many grid points (the status then says the tolerance was not
 #: reached).
 MAX_GRID = 12801
@@ -79,7 +90,8 @@ EffortFunction = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
 class TimedPath(PlannedMotion):
     """A path with its time-optimal timing.
 
-    ``s`` (N,) the grid of the path parameter (dimensionless, 0 to 1); ``sd`` (N,) s' at the
+    ``s`` (N,) the grid of the path parameter (dimensionless, 0 to S: S is 1, or 1e-2, 1e-4 ...
+    for a path so fast that s' would pass toppra's bound, see FAST_SPAN); ``sd`` (N,) s' at the
     grid points (1/s); ``sdd`` (N - 1,) the constant s'' on each interval (1/s^2); ``t`` (N,)
     the times the grid points are reached (s); ``x`` (N, 3n) the body coordinates there (the
     branch, continued from the drawing); ``q``, ``qd``, ``qdd`` (N, m) the coordinates,
@@ -88,7 +100,7 @@ class TimedPath(PlannedMotion):
     last interval's); ``lo``, ``hi`` (N, m) the effort limits, ``speed`` (m,) the speed limits
     (inf where none); ``limit_ratio`` the largest fraction of a limit used on the dense check
     (planardyn.plan.dense_check); ``time_error`` the estimated excess of the duration over
-    the optimum (s: the change over the last doubling of the grid; NaN without refinement);
+    the optimum (s: the change over the last doubling of the grid; None without refinement);
     ``status`` toppra's, with the rounds and grids.
     """
 
@@ -100,11 +112,12 @@ class TimedPath(PlannedMotion):
     lo: FloatArray
     hi: FloatArray
     speed: FloatArray
-    time_error: float
+    time_error: float | None
     status: str
 
     def _summary(self) -> str:
-        return f"{len(self.s)} grid points, time error {self.time_error:.2g} s, {self.status}"
+        error = "not estimated" if self.time_error is None else f"{self.time_error:.2g} s"
+        return f"{len(self.s)} grid points, time error {error}, {self.status}"
 
     def timing(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """s, s', s'' at times t (s), from the piecewise-quadratic s(t)."""
@@ -198,7 +211,7 @@ def time_optimal(
         The model; its drives are not used, the efforts are the plan's.
     waypoints : (K, m) array_like
         Coordinates (rad or m) the path passes through, K >= 2, joined by a C2 cubic spline
-        in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, 1]. For
+        in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, S]. For
         a task-space path, :func:`task_waypoints`.
     effort : (m,) or (m, 2) array_like, or callable ``f(q) -> (lo, hi)``, "actuators", or None
         Effort limits (N m or N): symmetric magnitudes, [lo, hi] per coordinate, or a function
@@ -241,11 +254,22 @@ def time_optimal(
     if not np.isfinite(chord[-1]) or np.any(np.diff(chord) == 0.0):
         raise PlanError("waypoints: consecutive waypoints must differ (and their distances be finite)")
     limits, motor, v = _limits(mech, effort, speed)
-    path = toppra.SplineInterpolator(chord / chord[-1], q_w)
-    s = np.linspace(0.0, 1.0, n_grid)
-    plan = _time_on_grid(mech, path, s, limits, motor is not None)
+    span = 1.0
+    for _ in range(SPAN_ROUNDS):
+        path = toppra.SplineInterpolator(chord / chord[-1] * span, q_w)
+        s = np.linspace(0.0, span, n_grid)
+        plan = _time_on_grid(mech, path, s, limits, motor is not None)
+        capped = plan.sd.max() ** 2 >= FAST_FRACTION * MAXX or np.abs(plan.sdd).max() >= FAST_FRACTION * MAXU
+        if plan.duration < MIN_DURATION:
+            raise InfeasiblePlan(f"the limits let this path run in {plan.duration:.3g} s or less, faster than toppra "
+                                 f"can time (its s' and s'' are bounded): give limits of a motion of {MIN_DURATION:g} s "
+                                 "or more", "effort")
+        want = _span(plan.duration)
+        if not capped and 0.1 < span / want < 10:
+            break
+        span = want
     grids = [len(s)]
-    time_error = np.nan
+    time_error: float | None = None
     while rtol is not None:
         s = np.sort(np.concatenate([s, (s[:-1] + s[1:]) / 2]))
         finer = _time_on_grid(mech, path, s, limits, motor is not None)
@@ -255,7 +279,7 @@ def time_optimal(
         if time_error <= rtol * plan.duration or len(s) >= MAX_GRID:
             break
     note = f"grids {'-'.join(map(str, grids))}" if len(grids) > 1 else f"grid {grids[0]}"
-    if rtol is not None and time_error > rtol * plan.duration:
+    if rtol is not None and time_error is not None and time_error > rtol * plan.duration:
         note += f"; rtol {rtol:g} not reached within {MAX_GRID} grid points"
     if motor is not None:
         lo, hi = exact_bounds(mech, plan.qd)
@@ -263,9 +287,16 @@ def time_optimal(
         lo, hi = limits[0].bounds(plan.q)
     else:
         lo, hi = np.full((len(s), m), -np.inf), np.full((len(s), m), np.inf)
-    plan.lo, plan.hi, plan.speed, plan.time_error = lo, hi, v, float(time_error)
+    plan.lo, plan.hi, plan.speed, plan.time_error = lo, hi, v, time_error
     plan.status = f"{plan.status}; {note}"
     return plan
+
+
+def _span(duration: float) -> float:
+    """The path parameter's span for a motion of about this duration (s): S = T (s' ~ 1,
+    s'' ~ 1 / T) down to 10 ms, then S = 100 T^2 (s'' ~ 100, s'^2 ~ 1e4 T^2, 1e-4 at the
+    shortest motion timed, MIN_DURATION)."""
+    return float(duration if duration >= 1e-2 else 100 * duration**2)
 
 
 def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit], tangents: bool) -> TimedPath:
@@ -285,7 +316,11 @@ def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit]
         rounds += 1
         rows = stage_rows(stage, d, rows_at(limits, pts, x0), n)
         sdd, sd, status = _toppra(path, s, rows)
-        t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
+        with np.errstate(divide="ignore"):
+            t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
+        if not np.isfinite(t_new):
+            raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}, but at rest "
+                                 "somewhere along it): raise the limits or move the path")
         found = check(mech, path, s, x, sd, sdd, limits)
         settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
         if found.ratio <= 1 + RATIO_TOL and settled:
@@ -308,7 +343,7 @@ def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit]
     return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=np.concatenate([[0.0], np.cumsum(dt)]), x=x,
                      q=grid.q, qd=grid.p1 * sd[:, None], qdd=grid.p1 * u[:, None] + grid.p2 * sd2[:, None],
                      tau=grid.efforts(u, sd2), limit_ratio=found.ratio, lo=grid.a * np.nan, hi=grid.a * np.nan,
-                     speed=np.full(mech.dof, np.inf), time_error=np.nan, status=status)
+                     speed=np.full(mech.dof, np.inf), time_error=None, status=status)
 
 
 def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
