@@ -1,7 +1,8 @@
 """Motion planning: time-optimal timing of a path (:func:`time_optimal`), point-to-point
 trajectory optimisation by collocation (:func:`collocate`)."""
 
-from .collocation import CollocatedMotion, Workspace, collocate
+from .collocation import CollocatedMotion, collocate
+from .collocation_problem import Workspace
 from .planned import InfeasiblePlan, PlanError, PlannedMotion
 from .topp import TimedPath, task_waypoints, time_optimal
 

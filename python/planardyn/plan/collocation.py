@@ -44,18 +44,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
 from ..mechanism import Mechanism
-from ..robot import EndEffector
 from .casadi_callbacks import callback, or_nan
+from .collocation_problem import Problem, Workspace, check_ends, problem, sigma
 from .dense_check import CHECK_POINTS
-from .planned import (
-    InfeasiblePlan,
-    PlanError,
-    PlannedMotion,
-    effort_bounds,
-    positive_int,
-    positive_number,
-    speed_bounds,
-)
+from .planned import InfeasiblePlan, PlanError, PlannedMotion
 from .topp import time_optimal
 
 FloatArray = NDArray[np.float64]
@@ -63,18 +55,11 @@ FloatArray = NDArray[np.float64]
 #: Central-difference step (rad or m) of the type II measure's gradient.
 SIGMA_STEP = 1e-6
 
+#: A minimum time within this fraction of the bounds put on T is taken as held by them.
+T_BOUND_TOL = 1e-6
+
 #: IPOPT's final status when it converged.
 CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
-
-
-@dataclass
-class Workspace:
-    """A box the effector's task coordinates X (m, m[, rad]) stay in: lo <= X(q) <= hi at
-    every node (inf where unbounded)."""
-
-    effector: EndEffector
-    lo: ArrayLike
-    hi: ArrayLike
 
 
 @dataclass(repr=False)
@@ -106,7 +91,7 @@ class CollocatedMotion(PlannedMotion):
                 f"iterations, stated accuracy of q {self.error.max():.2g}")
 
     def _interval(self, t: ArrayLike) -> tuple[Any, FloatArray, FloatArray]:
-        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.t[-1])
+        tt = self.times(t)
         i = np.clip(np.searchsorted(self.t, tt, side="right") - 1, 0, len(self.t) - 2)
         h = (self.t[i + 1] - self.t[i])[:, None]
         return i, (tt - self.t[i])[:, None], h
@@ -124,95 +109,7 @@ class CollocatedMotion(PlannedMotion):
         return self.tau[i] + s / h * (self.tau[i + 1] - self.tau[i])
 
 
-@dataclass
-class _Problem:
-    """collocate's arguments, checked: the limits as arrays (inf where none)."""
-
-    q0: FloatArray
-    q1: FloatArray
-    objective: str
-    duration: float | None
-    lo: FloatArray | None
-    hi: FloatArray | None
-    v: FloatArray
-    sigma_min: float | None
-    box: tuple[EndEffector, FloatArray, FloatArray] | None
-    n: int
-    tol: float
-    max_iter: int
-
-
-def _problem(mech: Mechanism, q_start: ArrayLike, q_end: ArrayLike, objective: str, duration: float | None,
-             effort: ArrayLike | None, speed: ArrayLike | None, sigma_min: float | None, workspace: Workspace | None,
-             n_intervals: int, warm_start: PlannedMotion | None, tol: float, max_iter: int) -> _Problem:
-    """The arguments checked, one rule each, the error naming the argument (PlanError)."""
-    m = mech.dof
-    ends = []
-    for name, value in (("q_start", q_start), ("q_end", q_end)):
-        try:
-            qe = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            qe = np.full(0, np.nan)
-        if qe.shape != (m,) or not np.all(np.isfinite(qe)):
-            raise PlanError(f"{name}: expected ({m},) finite coordinates (rad or m), got {value!r}", name)
-        ends.append(qe)
-    if objective not in ("time", "effort"):
-        raise PlanError(f"objective: 'time' or 'effort', got {objective!r}", "objective")
-    if duration is not None or objective == "effort":
-        duration = positive_number("duration", duration, "s; objective 'effort' needs one")
-    if objective == "time" and effort is None and speed is None:
-        raise PlanError("effort, speed: objective 'time' needs effort or speed limits", "effort")
-    if sigma_min is not None:
-        sigma_min = positive_number("sigma_min", sigma_min)
-        if sigma_min >= 1:
-            raise PlanError(f"sigma_min: sigma_II lies in [0, 1]; a margin must be below 1, got {sigma_min}", "sigma_min")
-    if warm_start is not None and (not isinstance(warm_start, PlannedMotion) or warm_start.q.shape[1:] != (m,)):
-        raise PlanError(f"warm_start: expected a planned motion of this model ({m} coordinates), got "
-                        f"{type(warm_start).__name__}", "warm_start")
-    lo, hi = effort_bounds(m, effort) if effort is not None else (None, None)
-    return _Problem(ends[0], ends[1], objective, duration, lo, hi, speed_bounds(m, speed), sigma_min,
-                    _box(workspace), positive_int("n_intervals", n_intervals, 2, 10_000),
-                    positive_number("tol", tol), positive_int("max_iter", max_iter, 1))
-
-
-def _box(workspace: Workspace | None) -> tuple[EndEffector, FloatArray, FloatArray] | None:
-    if workspace is None:
-        return None
-    if not isinstance(workspace, Workspace) or not isinstance(workspace.effector, EndEffector):
-        raise PlanError("workspace: expected Workspace(effector, lo, hi)", "workspace")
-    k = len(workspace.effector.names)
-    box = []
-    for name in ("lo", "hi"):
-        try:
-            b = np.broadcast_to(np.asarray(getattr(workspace, name), dtype=float), (k,))
-        except (TypeError, ValueError) as exc:
-            raise PlanError(f"workspace.{name}: expected one bound or {k} (m, m[, rad]): {exc}", "workspace") from exc
-        if np.isnan(b).any():
-            raise PlanError(f"workspace.{name}: NaN in {b.tolist()}; use inf where unbounded", "workspace")
-        box.append(b)
-    if not np.all(box[0] < box[1]):
-        raise PlanError(f"workspace: need lo < hi, got {box[0].tolist()} and {box[1].tolist()}", "workspace")
-    return workspace.effector, box[0], box[1]
-
-
-def _sigma(mech: Mechanism, q: FloatArray) -> float:
-    return float(mech.kinematics(q)["sigma_min"])
-
-
-def _check_ends(mech: Mechanism, p: _Problem) -> None:
-    """Ends that break the margin or leave the box are refused before solving."""
-    for name, qe in (("q_start", p.q0), ("q_end", p.q1)):
-        if p.sigma_min is not None and _sigma(mech, qe) < p.sigma_min:
-            raise PlanError(f"{name}: sigma_II {_sigma(mech, qe):.3g} is below the margin {p.sigma_min}; move it or "
-                            "lower sigma_min", name)
-        if p.box is not None:
-            ee, lo, hi = p.box
-            X = ee.state(qe).X
-            if np.any(X < lo) or np.any(X > hi):
-                raise PlanError(f"{name}: the effector at {np.round(X, 6).tolist()} is outside the workspace box", name)
-
-
-def _straight(mech: Mechanism, p: _Problem) -> tuple[PlannedMotion | None, str]:
+def _straight(mech: Mechanism, p: Problem) -> tuple[PlannedMotion | None, str]:
     """The straight joint path timed by TOPP within the limits, or None and why not (no
     limits, or a model TOPP refuses: dampers)."""
     effort = None if p.lo is None or p.hi is None else np.stack([p.lo, p.hi], axis=1)
@@ -225,7 +122,7 @@ def _straight(mech: Mechanism, p: _Problem) -> tuple[PlannedMotion | None, str]:
         return None, str(exc)
 
 
-def _warm_start(mech: Mechanism, p: _Problem, duration: float | None, previous: PlannedMotion | None,
+def _warm_start(mech: Mechanism, p: Problem, duration: float | None, previous: PlannedMotion | None,
                 why: str) -> tuple[Any, ...]:
     """(T, q, qd, tau) at n + 1 nodes: a previous motion (by default the straight path's
     fastest timing), stretched to ``duration`` when one is given (efforts by inverse dynamics
@@ -309,9 +206,9 @@ def collocate(
         the workspace, or a minimum-effort duration shorter than the fastest motion within
         the limits (found first by minimum time when the straight path's is longer).
     """
-    p = _problem(mech, q_start, q_end, objective, duration, effort, speed, sigma_min, workspace, n_intervals,
+    p = problem(mech, q_start, q_end, objective, duration, effort, speed, sigma_min, workspace, n_intervals,
                  warm_start, tol, max_iter)
-    _check_ends(mech, p)
+    check_ends(mech, p)
     try:
         mech.forward_dynamics_derivatives(p.q0, np.zeros(mech.dof), tau=np.zeros(mech.dof))
     except ValueError as exc:
@@ -325,7 +222,7 @@ def collocate(
     return _solve(mech, p, p.objective, _warm_start(mech, p, p.duration, warm_start, why))
 
 
-def _fastest(mech: Mechanism, p: _Problem, line: PlannedMotion) -> PlannedMotion:
+def _fastest(mech: Mechanism, p: Problem, line: PlannedMotion) -> PlannedMotion:
     """The minimum-time motion, a start for minimum effort in a duration shorter than the
     straight path's fastest timing ``line``; a duration no motion within the limits can
     keep is refused."""
@@ -341,7 +238,7 @@ def _fastest(mech: Mechanism, p: _Problem, line: PlannedMotion) -> PlannedMotion
     return fastest
 
 
-def _solve(mech: Mechanism, p: _Problem, objective: str, start: tuple[Any, ...]) -> CollocatedMotion:
+def _solve(mech: Mechanism, p: Problem, objective: str, start: tuple[Any, ...]) -> CollocatedMotion:
     """IPOPT on the collocation NLP from the start (T, q, qd, tau) at the nodes."""
     import casadi as ca
 
@@ -382,10 +279,10 @@ def _solve(mech: Mechanism, p: _Problem, objective: str, start: tuple[Any, ...])
     except RuntimeError as exc:
         last = str(exc).strip().splitlines()[-1]
         raise PlanError(f"IPOPT (through CasADi) refused the problem: {last}") from exc
-    return _result(mech, p, objective, sol, solver.stats())
+    return _result(mech, p, objective, sol, solver.stats(), (lbT, ubT))
 
 
-def _constraints(ca: Any, mech: Mechanism, p: _Problem, Q: Any, QD: Any, U: Any, h: Any,
+def _constraints(ca: Any, mech: Mechanism, p: Problem, Q: Any, QD: Any, U: Any, h: Any,
                  keep: list[Any]) -> tuple[list[Any], list[float], list[float]]:
     """The defects, the speed limits between the nodes (see the module), the margin and the
     box at the inner nodes: g with its bounds."""
@@ -410,9 +307,9 @@ def _constraints(ca: Any, mech: Mechanism, p: _Problem, Q: Any, QD: Any, U: Any,
     if p.sigma_min is not None:
         def sigma_grad(q: FloatArray) -> list[FloatArray]:
             e = SIGMA_STEP * np.eye(m)
-            return [np.array([[(_sigma(mech, q + ei) - _sigma(mech, q - ei)) / (2 * SIGMA_STEP) for ei in e]])]
+            return [np.array([[(sigma(mech, q + ei) - sigma(mech, q - ei)) / (2 * SIGMA_STEP) for ei in e]])]
 
-        sig = callback(ca, "sigma_II", [m], 1, or_nan([(1,)])(lambda q: np.array([_sigma(mech, q)])),
+        sig = callback(ca, "sigma_II", [m], 1, or_nan([(1,)])(lambda q: np.array([sigma(mech, q)])),
                        or_nan([(1, m)])(sigma_grad), keep)
         g += [sig(Q[:, k]) for k in range(1, n)]
         lbg += [p.sigma_min] * (n - 1)
@@ -428,11 +325,17 @@ def _constraints(ca: Any, mech: Mechanism, p: _Problem, Q: Any, QD: Any, U: Any,
     return g, lbg, ubg
 
 
-def _result(mech: Mechanism, p: _Problem, objective: str, sol: Any, stats: dict[str, Any]) -> CollocatedMotion:
-    """The motion at IPOPT's final point, with its report, error estimate and dense check."""
+def _result(mech: Mechanism, p: Problem, objective: str, sol: Any, stats: dict[str, Any],
+            t_bounds: tuple[float, float]) -> CollocatedMotion:
+    """The motion at IPOPT's final point, with its report, error estimate and dense check; a
+    minimum time at the bounds put on T (1e-3 and 1e3 times the start's) is no minimum."""
     m, n = mech.dof, p.n
     status = str(stats.get("return_status", "unknown"))
     xs = np.asarray(sol["x"], dtype=float).ravel()
+    at_bound = objective == "time" and not t_bounds[0] * (1 + T_BOUND_TOL) < xs[-1] < t_bounds[1] * (1 - T_BOUND_TOL)
+    if at_bound:
+        status = (f"{status}; T = {xs[-1]:.6g} s is at its bound (1e-3 to 1e3 times the start's {t_bounds[0] * 1e3:.6g} "
+                  "s): give a first guess duration= nearer the minimum")
     if not np.all(np.isfinite(xs)):
         raise PlanError(f"IPOPT ended ({status}) at a point where the dynamics are undefined; start nearer (warm_start=) "
                         "or add a singularity margin (sigma_min=)")
@@ -451,7 +354,7 @@ def _result(mech: Mechanism, p: _Problem, objective: str, sol: Any, stats: dict[
     violation = float(iters["inf_pr"][-1]) if iters.get("inf_pr") else float("nan")
     motion = CollocatedMotion(mech=mech, t=t, q=q, qd=qd, qdd=qdd, tau=tau, limit_ratio=np.nan, objective=objective,
                               cost=float(sol["f"]), status=status,
-                              success=bool(stats.get("success", False)) and status in CONVERGED,
+                              success=bool(stats.get("success", False)) and status in CONVERGED and not at_bound,
                               iterations=int(stats.get("iter_count", -1)), violation=violation,
                               max_defect=float(defect), error=np.zeros(m))
     motion.error = _error_estimate(motion)
@@ -459,7 +362,7 @@ def _result(mech: Mechanism, p: _Problem, objective: str, sol: Any, stats: dict[
     return motion
 
 
-def _limit_ratio(c: CollocatedMotion, p: _Problem) -> float:
+def _limit_ratio(c: CollocatedMotion, p: Problem) -> float:
     """The largest fraction of an effort or speed limit used at CHECK_POINTS points of every
     interval (ends included): |tau - mid| / half of [lo, hi], |qd| / v; 0 without limits."""
     f = np.linspace(0.0, 1.0, CHECK_POINTS)

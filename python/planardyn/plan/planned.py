@@ -70,9 +70,16 @@ class PlannedMotion:
         """The efforts (N, m) (N m or N) that run the motion at times t (N,) (s, ascending)."""
         raise NotImplementedError
 
+    def times(self, t: ArrayLike) -> FloatArray:
+        """Times t (N,) (s) checked finite, clipped to [0, duration]."""
+        tt = np.atleast_1d(_floats("t", t))
+        if tt.ndim != 1 or not np.all(np.isfinite(tt)):
+            raise PlanError(f"t: expected finite times (s), one axis, got {np.asarray(t).tolist()!r:.80}", "t")
+        return np.clip(tt, 0.0, self.duration)
+
     def motion(self, n: int = 400) -> dict[str, dict[str, FloatArray]]:
         """The motion as ``simulate(motion=...)`` tables: {name: {"t", "q"}} at n times."""
-        t = np.linspace(0.0, self.duration, n)
+        t = np.linspace(0.0, self.duration, positive_int("n", n, 2, 10**7))
         q = self.state(t)[0]
         return {name: {"t": t, "q": q[:, k]} for k, name in enumerate(self.mech.coordinate_names)}
 

@@ -77,6 +77,9 @@ FAST_FRACTION = 0.25
 SPAN_ROUNDS = 8
 MIN_DURATION = 1e-4
 
+#: task_waypoints solves inverse kinematics at most this many times (a few seconds).
+MAX_WAYPOINTS = 100_000
+
 #: Grid refinement stops at this many grid points (the status then says the tolerance was not
 #: reached).
 MAX_GRID = 12801
@@ -121,7 +124,7 @@ class TimedPath(PlannedMotion):
 
     def timing(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """s, s', s'' at times t (s), from the piecewise-quadratic s(t)."""
-        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.t[-1])
+        tt = self.times(t)
         i = np.clip(np.searchsorted(self.t, tt, side="right") - 1, 0, len(self.sdd) - 1)
         tau = tt - self.t[i]
         u = self.sdd[i]
@@ -129,14 +132,14 @@ class TimedPath(PlannedMotion):
 
     def state(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, qd, qdd (N, m) at times t (N,) (s): q = p(s), qd = p' s', qdd = p' s'' + p'' s'^2."""
-        s, sd, sdd = self.timing(np.atleast_1d(t))
+        s, sd, sdd = self.timing(t)
         p1, p2 = self.path(s, 1), self.path(s, 2)
         return self.path(s), p1 * sd[:, None], p1 * sdd[:, None] + p2 * (sd**2)[:, None]
 
     def efforts(self, t: ArrayLike) -> FloatArray:
         """The efforts (N, m) that run the timed path at times t (N,) (s, ascending), by
         inverse dynamics on the plan's branch."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        t = self.times(t)
         q, qd, qdd = self.state(t)
         i = int(np.clip(np.searchsorted(self.t, t[0]), 0, len(self.t) - 1))
         return np.asarray(self.mech.inverse_dynamics(q, qd, qdd, x=self.x[i]))
@@ -406,19 +409,31 @@ def _solve(instance: Any) -> tuple[Any, Any, Any, str]:
 def task_waypoints(effector: EndEffector, X: ArrayLike, spacing: float) -> FloatArray:
     """Coordinates (K, m) along a task-space polyline, for :func:`time_optimal`.
 
-    Each segment between the rows of ``X`` ((J, k) task coordinates: m, m[, rad]) is cut into
-    pieces no longer than ``spacing`` (m) and solved by inverse kinematics, continued from
-    the drawing through the first point (on the drawing's working mode). The joint-space
-    spline through them leaves the task path by O(spacing^4) between them: check with
+    Each segment between the rows of ``X`` ((J, k) task coordinates, J >= 2: m, m[, rad], k
+    the effector's) is cut into pieces no longer than ``spacing`` (m, > 0; at most
+    MAX_WAYPOINTS pieces in all) and solved by inverse kinematics, continued from the drawing
+    through the first point (on the drawing's working mode). The joint-space spline through
+    them leaves the task path by O(spacing^4) between them: check with
     ``effector.state(q).X`` along the plan's ``q``.
     """
-    X = np.atleast_2d(np.asarray(X, dtype=float))
-    if len(X) < 2 or spacing <= 0:
-        raise PlanError(f"task path: need >= 2 points and a positive spacing, got {len(X)} points, {spacing}")
+    if not isinstance(effector, EndEffector):
+        raise PlanError(f"effector: expected an EndEffector, got {type(effector).__name__}", "effector")
+    k = len(effector.names)
+    try:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+    except (TypeError, ValueError):
+        X = np.full((0, 0), np.nan)
+    if X.ndim != 2 or X.shape[1] != k or len(X) < 2 or not np.all(np.isfinite(X)):
+        raise PlanError(f"X: expected (J, {k}) finite task coordinates ({', '.join(effector.names)}), J >= 2, got "
+                        f"shape {X.shape}", "X")
+    spacing = positive_number("spacing", spacing, "m")
+    pieces = np.ceil(np.linalg.norm(np.diff(X[:, :2], axis=0), axis=1) / spacing)
+    if pieces.sum() > MAX_WAYPOINTS:
+        raise PlanError(f"spacing: {spacing:g} m cuts the path into {pieces.sum():.3g} pieces, more than "
+                        f"{MAX_WAYPOINTS}; give a larger spacing", "spacing")
     points = [X[0]]
-    for a, b in zip(X[:-1], X[1:]):
-        n = max(1, int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / spacing)))
-        points.extend(a + (b - a) * f for f in np.linspace(0.0, 1.0, n + 1)[1:])
+    for a, b, n in zip(X[:-1], X[1:], pieces.astype(int)):
+        points.extend(a + (b - a) * f for f in np.linspace(0.0, 1.0, max(1, n) + 1)[1:])
     state = effector.inverse(points[0])
     q = [state.q]
     for Xi in points[1:]:

@@ -75,6 +75,14 @@ class LimitCheck:
     limit: float
     unit: str
 
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.limit) and self.limit > 0):
+            raise SizingError(f"limit: a {self.quantity} limit must be a finite number > 0 {self.unit}, got "
+                              f"{self.limit!r}", "limit")
+        if np.isnan(self.demand) or self.demand < 0:
+            raise SizingError(f"demand: the {self.quantity} demand must be >= 0 {self.unit}, got {self.demand!r}",
+                              "demand")
+
     @property
     def margin(self) -> float:
         """1 - demand / limit: the fraction of the limit left (negative: exceeded)."""
@@ -186,6 +194,12 @@ def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, tau: Fl
     actuators); None without a motor. ``dense``: the rates and efforts (M, m or n_a) at more
     samples (the resampling around peaks), from which the peaks are taken too (the RMS is
     the samples' integral)."""
+    names = mech.actuator_names
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < len(names):
+        raise SizingError(f"k: an actuator index from 0 to {len(names) - 1} ({', '.join(names)}), got {k!r}", "k")
+    t, qd, tau = _samples_of(t, qd, tau, len(names) if np.shape(tau)[-1:] == (len(names),) else mech.dof)
+    if dense is not None:
+        dense = (_finite("dense", dense[0], qd.shape[1]), _finite("dense", dense[1], qd.shape[1]))
     act = mech.actuators[k]
     if act is None:
         return None
@@ -210,6 +224,28 @@ def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, tau: Fl
                        float(np.abs(tm_all * w).max()), checks, env_w, np.zeros_like(env_w) if env_t is None else env_t)
 
 
+def _finite(name: str, value: Any, width: int | None = None) -> FloatArray:
+    """(N,) finite values, or (N, width) with a width; else a SizingError naming the argument."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        a = np.full(0, np.nan)
+    want = (1,) if width is None else (2,)
+    if a.ndim not in want or len(a) < 1 or (width is not None and a.shape[1] != width) or not np.all(np.isfinite(a)):
+        raise SizingError(f"{name}: expected {'(N,)' if width is None else f'(N, {width})'} finite values, got "
+                          f"shape {a.shape}", name)
+    return a
+
+
+def _samples_of(t: Any, qd: Any, tau: Any, width: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """t (N,) increasing, qd and tau (N, width), all finite, or a SizingError."""
+    tt, rates, efforts = _finite("t", t), _finite("qd", qd, width), _finite("tau", tau, width)
+    if not len(tt) == len(rates) == len(efforts) or np.any(np.diff(tt) <= 0):
+        raise SizingError(f"t: expected increasing times, one per row of qd and tau, got {len(tt)} times for "
+                          f"{len(rates)} and {len(efforts)} rows", "t")
+    return tt, rates, efforts
+
+
 def _usage(t_m: FloatArray, available: FloatArray) -> FloatArray:
     """|t_m| / available torque, inf where none is available and some is asked."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -220,8 +256,10 @@ def _usage(t_m: FloatArray, available: FloatArray) -> FloatArray:
 def envelope(speed: FloatArray, effort: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Torque-speed envelope: for each speed v, the largest |effort| needed at a speed >= v
     (a staircase falling with speed); a motor whose continuous curve lies above it can drive
-    the motion. Returns (speeds ascending, efforts), both >= 0."""
-    v, e = np.abs(speed), np.abs(effort)
+    the motion. ``speed``, ``effort`` (N,) finite. Returns (speeds ascending, efforts), both >= 0."""
+    v, e = np.abs(_finite("speed", speed)), np.abs(_finite("effort", effort))
+    if len(v) != len(e):
+        raise SizingError(f"effort: one per speed, got {len(e)} for {len(v)}", "effort")
     order = np.argsort(-v)
     env = np.maximum.accumulate(e[order])
     return v[order][::-1], env[::-1]
@@ -290,6 +328,7 @@ def distributed_efforts(mech: Mechanism, motion: TaskMotion, distribution: str =
     """Every actuator's effort (N, n_a) along a motion of a redundantly actuated mechanism,
     shared by ``distribution`` (:meth:`Mechanism.distribute_efforts`), and each actuator's
     rate (N, n_a): B^T qd (rad/s or m/s on its pair)."""
+    preload = _check_arguments(0.0, distribution, preload, {})[1]
     efforts, rates = [], []
     for q, qd, qdd in zip(motion.q, motion.qd, motion.qdd):
         out = mech.distribute_efforts(q, qd, qdd, distribution, preload)  # type: ignore[arg-type]
