@@ -109,21 +109,21 @@ class CollocatedMotion(PlannedMotion):
         return self.tau[i] + s / h * (self.tau[i + 1] - self.tau[i])
 
 
-def _straight(mech: Mechanism, p: Problem) -> tuple[PlannedMotion | None, str]:
+def _straight(mech: Mechanism, p: Problem) -> tuple[PlannedMotion | None, PlanError | None]:
     """The straight joint path timed by TOPP within the limits, or None and why not (no
-    limits, or a model TOPP refuses: dampers)."""
+    limits, limits no timing keeps, or a model TOPP refuses: dampers)."""
     effort = None if p.lo is None or p.hi is None else np.stack([p.lo, p.hi], axis=1)
     if effort is None and not np.isfinite(p.v).any():
-        return None, "no limits to time the warm start with"
+        return None, PlanError("no limits to time the warm start with")
     try:
         return time_optimal(mech, [p.q0, p.q1], effort, None if not np.isfinite(p.v).any() else p.v,
-                            n_grid=max(2 * p.n, 50), rtol=None), ""
+                            n_grid=max(2 * p.n, 50), rtol=None), None
     except PlanError as exc:
-        return None, str(exc)
+        return None, exc
 
 
 def _warm_start(mech: Mechanism, p: Problem, duration: float | None, previous: PlannedMotion | None,
-                why: str) -> tuple[Any, ...]:
+                why: PlanError | None) -> tuple[Any, ...]:
     """(T, q, qd, tau) at n + 1 nodes: a previous motion (by default the straight path's
     fastest timing), stretched to ``duration`` when one is given (efforts by inverse dynamics
     of the stretched motion); without one (``why`` says why), the straight path in
@@ -132,7 +132,10 @@ def _warm_start(mech: Mechanism, p: Problem, duration: float | None, previous: P
     n = p.n
     if previous is None:
         if duration is None:
-            raise PlanError(f"warm start: {why}; give a first guess duration= (s) or warm_start=", "duration")
+            # Limits no timing of the straight path keeps stay the reason; else the start is missing.
+            kind, argument = (InfeasiblePlan, None) if isinstance(why, InfeasiblePlan) else (PlanError, "duration")
+            raise kind(f"duration: the straight path cannot be timed for a start ({why}); give a first guess "
+                       "duration= (s) or warm_start=", argument)
         r = np.linspace(0.0, 1.0, n + 1)[:, None]
         dq = p.q1 - p.q0
         q = p.q0 + dq * (3 * r**2 - 2 * r**3)
@@ -213,7 +216,7 @@ def collocate(
         mech.forward_dynamics_derivatives(p.q0, np.zeros(mech.dof), tau=np.zeros(mech.dof))
     except ValueError as exc:
         raise PlanError(f"collocation needs the exact derivatives of forward dynamics: {exc}") from exc
-    why = ""
+    why = None
     if warm_start is None:
         warm_start, why = _straight(mech, p)
         if p.objective == "effort" and p.duration is not None and warm_start is not None \
@@ -227,7 +230,7 @@ def _fastest(mech: Mechanism, p: Problem, line: PlannedMotion) -> PlannedMotion:
     straight path's fastest timing ``line``; a duration no motion within the limits can
     keep is refused."""
     assert p.duration is not None
-    fastest = _solve(mech, p, "time", _warm_start(mech, p, None, line, ""))
+    fastest = _solve(mech, p, "time", _warm_start(mech, p, None, line, None))
     if not fastest.success:
         raise InfeasiblePlan(f"duration: {p.duration:g} s is shorter than the straight path's fastest timing within "
                              f"the limits ({line.duration:.6g} s), and the minimum-time motion that would say whether "

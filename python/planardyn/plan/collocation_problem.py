@@ -10,7 +10,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism
 from ..robot import EndEffector
-from .planned import PlanError, PlannedMotion, effort_bounds, positive_int, positive_number, speed_bounds
+from .planned import (
+    MAX_COORDINATE,
+    MAX_DURATION,
+    PlanError,
+    PlannedMotion,
+    effort_bounds,
+    positive_int,
+    positive_number,
+    speed_bounds,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -54,13 +63,16 @@ def problem(mech: Mechanism, q_start: ArrayLike, q_end: ArrayLike, objective: st
             qe = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
             qe = np.full(0, np.nan)
-        if qe.shape != (m,) or not np.all(np.isfinite(qe)):
-            raise PlanError(f"{name}: expected ({m},) finite coordinates (rad or m), got {value!r}", name)
+        if qe.shape != (m,) or not np.all(np.abs(qe) <= MAX_COORDINATE):
+            raise PlanError(f"{name}: expected ({m},) finite coordinates within {MAX_COORDINATE:g} (rad or m), got "
+                            f"{value!r}", name)
         ends.append(qe)
     if objective not in ("time", "effort"):
         raise PlanError(f"objective: 'time' or 'effort', got {objective!r}", "objective")
     if duration is not None or objective == "effort":
         duration = positive_number("duration", duration, "s; objective 'effort' needs one")
+        if duration > MAX_DURATION:
+            raise PlanError(f"duration: at most {MAX_DURATION:g} s, got {duration:g}", "duration")
     if objective == "time" and effort is None and speed is None:
         raise PlanError("effort, speed: objective 'time' needs effort or speed limits", "effort")
     if sigma_min is not None:

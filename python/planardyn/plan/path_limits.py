@@ -134,7 +134,7 @@ class SpeedLimit:
 
     def rows(self, pts: PathPoints, x0: FloatArray) -> Rows:
         k = np.isfinite(self.v)
-        b = pts.p1[:, k] ** 2 / self.v[k] ** 2
+        b = (pts.p1[:, k] / self.v[k]) ** 2
         return np.zeros_like(b), b, -np.ones_like(b)
 
     def ratio(self, pts: PathPoints, u: FloatArray, x: FloatArray) -> FloatArray:

@@ -93,6 +93,18 @@ class PlannedMotion:
         return self.mech.simulate(self.duration, **kw)
 
 
+#: Coordinates farther than this from 0 (rad or m) are refused: the core continues the
+#: assembly in moves of at most 1e3 from the drawing, and splines through 1e300 overflow.
+MAX_COORDINATE = 1e6
+
+#: The smallest speed limit (rad/s or m/s): a path of 1 rad then takes 1e6 s, MAX_DURATION.
+MIN_SPEED = 1e-6
+
+#: Limits must let the motion take at most this long (s, about 11 days): slower ones are
+#: refused (their numbers leave the range the solvers work in).
+MAX_DURATION = 1e6
+
+
 def _floats(name: str, value: ArrayLike) -> FloatArray:
     try:
         return np.asarray(value, dtype=float)
@@ -119,9 +131,9 @@ def speed_bounds(m: int, speed: ArrayLike | None) -> FloatArray:
     if speed is None:
         return np.full(m, np.inf)
     v = _floats("speed", speed)
-    if v.shape != (m,) or not np.all(v > 0):
-        raise PlanError(f"speed: expected ({m},) limits > 0 (rad/s or m/s; inf for none), one per coordinate, "
-                        f"got {v.tolist()}", "speed")
+    if v.shape != (m,) or not np.all(v >= MIN_SPEED):
+        raise PlanError(f"speed: expected ({m},) limits >= {MIN_SPEED:g} (rad/s or m/s; inf for none), one per "
+                        f"coordinate, got {v.tolist()}", "speed")
     return v
 
 

@@ -35,12 +35,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from toppra.constants import MAXU, MAXX
 
+from .._core import AssemblyError, PlanardynError, SingularityError
 from ..mechanism import Mechanism
 from ..robot import EndEffector
 from .actuator_limits import drives, exact_bounds
 from .dense_check import check
 from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
 from .planned import (
+    MAX_COORDINATE,
+    MAX_DURATION,
     InfeasiblePlan,
     PlanError,
     PlannedMotion,
@@ -183,7 +186,7 @@ def _limits(mech: Mechanism, effort: ArrayLike | EffortFunction | str | None,
     if np.isfinite(v).any():
         limits.append(SpeedLimit(v))
     if not limits:
-        raise PlanError("no limits: give effort limits, speed limits or both")
+        raise PlanError("effort, speed: no limits: give effort limits, speed limits or both", "effort")
     return limits, None, v
 
 
@@ -241,15 +244,15 @@ def time_optimal(
     PlanError
         Bad arguments, a model with dampers, or a path no timing can follow within the limits.
     """
-    import toppra
 
     m = mech.dof
     try:
         q_w = np.atleast_2d(np.asarray(waypoints, dtype=float))
     except (TypeError, ValueError) as exc:
         raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) coordinates: {exc}") from exc
-    if q_w.ndim != 2 or q_w.shape[1] != m or len(q_w) < 2 or not np.all(np.isfinite(q_w)):
-        raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) finite coordinates, got shape {q_w.shape}")
+    if q_w.ndim != 2 or q_w.shape[1] != m or len(q_w) < 2 or not np.all(np.abs(q_w) <= MAX_COORDINATE):
+        raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) finite coordinates within {MAX_COORDINATE:g} (rad "
+                        f"or m), got shape {q_w.shape}", "waypoints")
     n_grid = positive_int("n_grid", n_grid, 3)
     if rtol is not None:
         rtol = positive_number("rtol", rtol)
@@ -257,6 +260,20 @@ def time_optimal(
     if not np.isfinite(chord[-1]) or np.any(np.diff(chord) == 0.0):
         raise PlanError("waypoints: consecutive waypoints must differ (and their distances be finite)")
     limits, motor, v = _limits(mech, effort, speed)
+    try:
+        return _time_optimal(mech, q_w, chord, limits, motor, v, n_grid, rtol)
+    except ValueError as exc:  # the core's refusal of a coordinate (far from the drawing)
+        if isinstance(exc, PlanardynError):
+            raise
+        raise PlanError(f"waypoints: the path cannot be followed: {exc}", "waypoints") from exc
+
+
+def _time_optimal(mech: Mechanism, q_w: FloatArray, chord: FloatArray, limits: list[Limit], motor: MotorLimit | None,
+                  v: FloatArray, n_grid: int, rtol: float | None) -> TimedPath:
+    """time_optimal on checked arguments: the span fitted, then the grid refined."""
+    import toppra
+
+    m = mech.dof
     span = 1.0
     for _ in range(SPAN_ROUNDS):
         path = toppra.SplineInterpolator(chord / chord[-1] * span, q_w)
@@ -267,6 +284,9 @@ def time_optimal(
             raise InfeasiblePlan(f"the limits let this path run in {plan.duration:.3g} s or less, faster than toppra "
                                  f"can time (its s' and s'' are bounded): give limits of a motion of {MIN_DURATION:g} s "
                                  "or more", "effort")
+        if plan.duration > MAX_DURATION:
+            raise InfeasiblePlan(f"the limits make this path take {plan.duration:.3g} s, more than {MAX_DURATION:g} s: "
+                                 "give limits of a shorter motion")
         want = _span(plan.duration)
         if not capped and 0.1 < span / want < 10:
             break
@@ -355,7 +375,7 @@ def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
     bound = np.full(len(pts.s), np.inf)
     for lim in limits:
         if isinstance(lim, SpeedLimit):
-            with np.errstate(divide="ignore"):
+            with np.errstate(divide="ignore", over="ignore"):  # no bound: inf
                 bound = np.minimum(bound, np.min((lim.v / np.abs(pts.p1)) ** 2, axis=1))
     return np.minimum(np.where(np.isfinite(bound), bound / 4, 1.0), 1e6)
 
@@ -434,9 +454,12 @@ def task_waypoints(effector: EndEffector, X: ArrayLike, spacing: float) -> Float
     points = [X[0]]
     for a, b, n in zip(X[:-1], X[1:], pieces.astype(int)):
         points.extend(a + (b - a) * f for f in np.linspace(0.0, 1.0, max(1, n) + 1)[1:])
-    state = effector.inverse(points[0])
-    q = [state.q]
-    for Xi in points[1:]:
-        state = effector.solve(Xi, state.q, state.kin["x"])
-        q.append(state.q)
+    try:
+        state = effector.inverse(points[0])
+        q = [state.q]
+        for Xi in points[1:]:
+            state = effector.solve(Xi, state.q, state.kin["x"])
+            q.append(state.q)
+    except (AssemblyError, SingularityError) as exc:
+        raise PlanError(f"X: the effector cannot follow the polyline on its working mode: {exc}", "X") from exc
     return np.array(q)

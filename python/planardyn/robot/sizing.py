@@ -26,21 +26,25 @@ FloatArray = NDArray[np.float64]
 #: How redundant actuators' efforts are shared (Mechanism.distribute_efforts).
 DISTRIBUTIONS = ("min_norm", "min_max", "preload")
 
-#: The most samples a sizing takes (n): 1e7 samples of a 3-DOF motion hold about 3 GB.
+#: The most samples a sizing takes (n, or the duration over dt): 1e7 samples of a 3-DOF
+#: motion hold about 3 GB.
 MAX_SAMPLES = 10_000_000
+
+#: The largest payload mass (kg) and inertia (kg m^2): a model file's bound on its numbers.
+MAX_MASS = 1e30
 
 _MASS_FIELDS = ("mass", "inertia", "inertia_about_com", "com", "uniform_bar", "parts")
 
 
 def with_payload(mech: Mechanism, point: str, mass: float, inertia: float = 0.0, body: str | None = None) -> Mechanism:
-    """The mechanism with a payload (mass kg, inertia kg m^2 about its centre) at ``point``,
-    added as a part of the body carrying it (``body``: which, when several do)."""
-    if isinstance(mass, bool) or not isinstance(mass, (int, float, np.floating)) or not (np.isfinite(mass) and mass > 0):
-        raise SizingError(f"mass: the payload's mass must be a finite number > 0 kg, got {mass!r}", "mass")
-    if isinstance(inertia, bool) or not isinstance(inertia, (int, float, np.floating)) or not (
-            np.isfinite(inertia) and inertia >= 0):
-        raise SizingError(f"inertia: the payload's inertia about its centre must be a finite number >= 0 kg m^2, "
-                          f"got {inertia!r}", "inertia")
+    """The mechanism with a payload (mass kg, 0 < mass <= 1e30, inertia kg m^2 about its
+    centre, 0 <= inertia <= 1e30: the model file's bounds) at ``point``, added as a part of
+    the body carrying it (``body``: which, when several do)."""
+    if not 0 < _number(mass) <= MAX_MASS:
+        raise SizingError(f"mass: the payload's mass must be a number > 0 kg and <= {MAX_MASS:g}, got {mass!r}", "mass")
+    if not 0 <= _number(inertia) <= MAX_MASS:
+        raise SizingError(f"inertia: the payload's inertia about its centre must be a number >= 0 kg m^2 and <= "
+                          f"{MAX_MASS:g}, got {inertia!r}", "inertia")
     model = copy.deepcopy(mech.to_dict())
     carriers = [b for b, spec in model["bodies"].items() if point in spec.get("points", [])]
     if body is None:
@@ -76,10 +80,11 @@ class LimitCheck:
     unit: str
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.limit) and self.limit > 0):
+        limit, demand = _number(self.limit), _number(self.demand)
+        if not (np.isfinite(limit) and limit > 0):
             raise SizingError(f"limit: a {self.quantity} limit must be a finite number > 0 {self.unit}, got "
                               f"{self.limit!r}", "limit")
-        if np.isnan(self.demand) or self.demand < 0:
+        if not demand >= 0:
             raise SizingError(f"demand: the {self.quantity} demand must be >= 0 {self.unit}, got {self.demand!r}",
                               "demand")
 
@@ -224,6 +229,13 @@ def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, tau: Fl
                        float(np.abs(tm_all * w).max()), checks, env_w, np.zeros_like(env_w) if env_t is None else env_t)
 
 
+def _number(value: Any) -> float:
+    """A real number as a float; NaN for anything else (a bool, a string, None)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return np.nan
+    return float(value)
+
+
 def _finite(name: str, value: Any, width: int | None = None) -> FloatArray:
     """(N,) finite values, or (N, width) with a width; else a SizingError naming the argument."""
     try:
@@ -240,9 +252,11 @@ def _finite(name: str, value: Any, width: int | None = None) -> FloatArray:
 def _samples_of(t: Any, qd: Any, tau: Any, width: int) -> tuple[FloatArray, FloatArray, FloatArray]:
     """t (N,) increasing, qd and tau (N, width), all finite, or a SizingError."""
     tt, rates, efforts = _finite("t", t), _finite("qd", qd, width), _finite("tau", tau, width)
-    if not len(tt) == len(rates) == len(efforts) or np.any(np.diff(tt) <= 0):
-        raise SizingError(f"t: expected increasing times, one per row of qd and tau, got {len(tt)} times for "
-                          f"{len(rates)} and {len(efforts)} rows", "t")
+    if np.any(np.diff(tt) <= 0):
+        raise SizingError("t: expected increasing times (s)", "t")
+    for name, rows in (("qd", rates), ("tau", efforts)):
+        if len(rows) != len(tt):
+            raise SizingError(f"{name}: one row per time, got {len(rows)} rows for {len(tt)} times", name)
     return tt, rates, efforts
 
 
@@ -377,7 +391,11 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
         if payload:
             mech = with_payload(ee.mech, ee.point, payload, body=ee.body)
             ee = EndEffector(mech, ee.point, ee.body)
-        check_path(path, _sample_times(path.duration, solve_options.get("n"), solve_options.get("dt")))
+        dt = solve_options.get("dt")
+        if solve_options.get("n") is None and dt is not None and path.duration / dt >= MAX_SAMPLES:
+            raise SizingError(f"dt: {dt:g} s makes {path.duration / dt:.3g} samples of the {path.duration:g} s path, more "
+                              f"than {MAX_SAMPLES}; give a larger spacing", "dt")
+        check_path(path, _sample_times(path.duration, solve_options.get("n"), dt))
         motion = solve_motion(ee, path, **solve_options)
         base = _samples(motion, distribution, preload)
         dense = base
@@ -417,12 +435,9 @@ def _report(motion: TaskMotion, payload: float, base: _Samples, dense: _Samples)
 def _check_arguments(payload: Any, distribution: Any, preload: Any,
                      options: dict[str, Any]) -> tuple[float, list[float] | None]:
     """One rule per argument of :func:`size`; the checked payload and preload."""
-    try:
-        mass = float(payload)
-    except (TypeError, ValueError):
-        mass = np.nan
-    if isinstance(payload, bool) or not (np.isfinite(mass) and mass >= 0):
-        raise SizingError(f"payload: a mass >= 0 kg, got {payload!r}", "payload")
+    mass = _number(payload)
+    if not 0 <= mass <= MAX_MASS:
+        raise SizingError(f"payload: a mass >= 0 kg and <= {MAX_MASS:g}, got {payload!r}", "payload")
     if distribution not in DISTRIBUTIONS:
         raise SizingError(f"distribution: one of {', '.join(DISTRIBUTIONS)}, got {distribution!r}", "distribution")
     if preload is not None:
