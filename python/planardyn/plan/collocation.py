@@ -354,7 +354,8 @@ def _result(mech: Mechanism, p: Problem, objective: str, sol: Any, stats: dict[s
     defect = max(np.abs(np.diff(q, axis=0) - hk / 2 * (qd[:-1] + qd[1:])).max(),
                  np.abs(np.diff(qd, axis=0) - hk / 2 * (qdd[:-1] + qdd[1:])).max())
     iters = stats.get("iterations", {})
-    violation = float(iters["inf_pr"][-1]) if iters.get("inf_pr") else float("nan")
+    # Without an iteration recorded the violation is unknown: no bound on it.
+    violation = float(iters["inf_pr"][-1]) if iters.get("inf_pr") else float("inf")
     motion = CollocatedMotion(mech=mech, t=t, q=q, qd=qd, qdd=qdd, tau=tau, limit_ratio=np.nan, objective=objective,
                               cost=float(sol["f"]), status=status,
                               success=bool(stats.get("success", False)) and status in CONVERGED and not at_bound,
