@@ -17,13 +17,15 @@ the body rotations) and slides in the x-y plane, each body with an ``<inertial>`
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .tree import GROUND, Drawing, Edge, actuated, drawing, joint_state, not_carried, pair_loads
-from .xmltext import num, nums, text
 from ..mechanism import Mechanism
+from .planar import SAME_POINT, Builder
+from .tree import GROUND, Drawing, Edge, Vec, actuated, drawing, joint_state, not_carried, pair_loads
+from .xmltext import Document, num, nums, parse, text
 
 #: Default step (s) written in ``<option>``: MuJoCo's RK4 with loops stiffened to this step
 #: keeps the shipped models within the accuracy of tests/test_exchange_mujoco.py.
@@ -235,3 +237,390 @@ def _keyframe(d: Drawing, root: ET.Element, ctrl: list[float]) -> None:
                         qpos=nums(qpos[k] for k in order), qvel=nums(qvel[k] for k in order))
     if ctrl:
         key.set("ctrl", nums(ctrl))
+
+
+# ------------------------------------------------------------------ import
+
+#: A hinge axis counts as z, a slide axis as lying in the plane, when its off-plane (or
+#: in-plane) part is below this fraction of its length (axes are written to ~1e-16).
+AXIS_TOL = 1e-9
+#: Elements of a body that carry no mechanics and are skipped.
+IGNORED = {"geom", "camera", "light"}
+
+
+@dataclass
+class _Reader:
+    """Reads one MJCF document into a Builder (the rules in the module docstring)."""
+
+    doc: Document
+    out: Builder
+    degrees: bool
+    eulerseq: str
+    defaults: dict[str, dict[str, str]] = field(default_factory=dict)
+    sites: dict[str, tuple[str, Vec]] = field(default_factory=dict)  # MJCF site -> (body, world xy)
+    frames: dict[str, tuple[str, Vec, np.ndarray]] = field(default_factory=dict)  # MJCF body -> (pd body, p, R)
+    joints: list[tuple[str, str, str]] = field(default_factory=list)  # (MJCF joint, pair, 'hinge' | 'slide')
+    parts: dict[str, list[tuple[float, float, Vec]]] = field(default_factory=dict)  # pd body -> (m, Izz, com)
+    armature: dict[str, tuple[float, float]] = field(default_factory=dict)  # pair -> (armature, frictionloss)
+    tendons: dict[str, list[tuple[str, float]]] = field(default_factory=dict)  # closing pair -> (joint, coef)
+
+    # -------------------------------------------------------------- attributes
+
+    def attrs(self, el: ET.Element, cls: str) -> dict[str, str]:
+        """The element's attributes over those of its default class."""
+        return {**self.defaults.get(el.get("class", cls), {}).get(el.tag, {}), **el.attrib}
+
+    def read_defaults(self, el: ET.Element, inherited: dict[str, dict[str, str]], name: str = "main") -> None:
+        own = {tag: dict(attrs) for tag, attrs in inherited.items()}
+        for child in el:
+            if child.tag == "default":
+                continue
+            own[child.tag] = {**own.get(child.tag, {}), **child.attrib}
+        self.defaults[name] = own
+        for child in el.findall("default"):
+            self.read_defaults(child, own, child.get("class", name))
+
+    def rotation(self, el: ET.Element) -> np.ndarray:
+        """The 3x3 rotation of a body or inertial frame relative to its parent."""
+        from scipy.spatial.transform import Rotation
+
+        unit = np.pi / 180.0 if self.degrees else 1.0
+        if el.get("quat") is not None:
+            w, x, y, z = self.doc.floats(el, "quat", 4)
+            return Rotation.from_quat([x, y, z, w]).as_matrix()
+        if el.get("axisangle") is not None:
+            x, y, z, a = self.doc.floats(el, "axisangle", 4)
+            return Rotation.from_rotvec(np.array([x, y, z]) / np.linalg.norm([x, y, z]) * a * unit).as_matrix()
+        if el.get("euler") is not None:
+            # MJCF: lower case turns about the moving axes; scipy's lower case is the fixed ones.
+            return Rotation.from_euler(self.eulerseq.swapcase(), np.array(self.doc.floats(el, "euler", 3)) * unit).as_matrix()
+        if el.get("xyaxes") is not None or el.get("zaxis") is not None:
+            raise self.doc.error(el, "xyaxes and zaxis orientations are not read: give quat, axisangle or euler")
+        return np.eye(3)
+
+    # -------------------------------------------------------------- the tree
+
+    def body(self, el: ET.Element, parent: str, p0: Vec, r0: np.ndarray, cls: str) -> None:
+        """An MJCF body: a new planardyn body if it has joints, else part of its parent's."""
+        cls = el.get("childclass", cls)
+        p = p0 + r0 @ np.array(self.doc.floats(el, "pos", 3, "0 0 0"))
+        r = r0 @ self.rotation(el)
+        joints = [c for c in el if c.tag in ("joint", "freejoint")]
+        name = el.get("name") or f"body{len(self.frames)}"
+        owner = name if joints else parent
+        self.frames[name] = (owner, p, r)
+        for child in el:
+            if child.tag == "inertial":
+                self.inertial(child, owner, p, r)
+            elif child.tag == "site":
+                xy = (p + r @ np.array(self.doc.floats(child, "pos", 3, "0 0 0")))[:2]
+                site = child.get("name") or f"site{len(self.sites)}"
+                self.sites[site] = (owner, xy)
+                self.out.point(owner, site.split("@")[0], xy)
+        if joints:
+            if not self.parts.get(owner):
+                raise self.doc.error(el, "a moving body needs an <inertial> (planardyn does not derive mass from geoms)")
+            self.pair(el, joints, parent, owner, p, r, cls)
+        for child in el:
+            if child.tag == "body":
+                self.body(child, owner, p, r, cls)
+            elif child.tag not in IGNORED | {"inertial", "site", "joint"}:
+                raise self.doc.error(child, "not part of the planar subset planardyn reads "
+                                            "(bodies, hinge and slide joints, inertials, sites, geoms)")
+
+    def inertial(self, el: ET.Element, owner: str, p: Vec, r: np.ndarray) -> None:
+        if owner == GROUND:
+            return
+        rot = r @ self.rotation(el)
+        if el.get("fullinertia") is not None:
+            ixx, iyy, izz, ixy, ixz, iyz = self.doc.floats(el, "fullinertia", 6)
+            inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        else:
+            inertia = np.diag(self.doc.floats(el, "diaginertia", 3))
+        com = (p + r @ np.array(self.doc.floats(el, "pos", 3)))[:2]
+        mass = self.doc.floats(el, "mass", 1)[0]
+        self.parts.setdefault(owner, []).append((mass, float((rot @ inertia @ rot.T)[2, 2]), com))
+
+
+    def hint(self, body: str, xy: Vec, default: str) -> str:
+        """A point's name: that of a site of the body at xy (``A@crank`` gives ``A``), else ``default``."""
+        tol = SAME_POINT * max(1.0, float(np.max(np.abs(xy))))
+        for site, (owner, at) in self.sites.items():
+            if owner == body and np.linalg.norm(at - xy) <= tol:
+                return site.split("@")[0]
+        return default
+
+    def pair(self, el: ET.Element, joints: list[ET.Element], parent: str, child: str, p: Vec, r: np.ndarray,
+             cls: str) -> None:
+        """The pair of a body's joints: a hinge, a slide, or a slot (a slide and a hinge)."""
+        found = []
+        for j in joints:
+            a = self.attrs(j, cls)
+            kind = "free" if j.tag == "freejoint" else a.get("type", "hinge")
+            if kind not in ("hinge", "slide"):
+                raise self.doc.error(j, f"a {kind} joint is not planar: planardyn reads hinges about z and slides in the x-y plane")
+            axis = r @ np.array(self.doc.floats(j, "axis", 3, a.get("axis", "0 0 1")))
+            axis /= np.linalg.norm(axis)
+            anchor = (p + r @ np.array([float(v) for v in a.get("pos", "0 0 0").split()]))[:2]
+            off = np.linalg.norm(axis[:2]) if kind == "hinge" else abs(axis[2])
+            if off > AXIS_TOL:
+                what = "turn about the z axis" if kind == "hinge" else "lie in the x-y plane"
+                raise self.doc.error(j, f"its axis {axis.round(12).tolist()} does not {what} (planar subset)")
+            found.append((j, a, kind, axis, anchor))
+        kinds = tuple(f[2] for f in found)
+        name = (found[0][0].get("name") or f"joint{len(self.joints)}").split(".")[0]
+        if kinds == ("hinge",):
+            j, a, _, axis, at = found[0]
+            bodies = [parent, child] if axis[2] > 0 else [child, parent]
+            point = self.out.point(child, self.hint(child, at, name), at)
+            self.out.point(parent, point, at)
+            self.out.pair("revolute", name, *bodies, point)
+        elif kinds == ("slide",):
+            j, a, _, axis, at = found[0]
+            self.out.pair("prismatic", name, parent, child, self.out.point(child, self.hint(child, at, name), at), axis)
+        elif kinds in (("slide", "hinge"), ("hinge", "slide")):
+            slide, hinge = (found[0], found[1]) if kinds[0] == "slide" else (found[1], found[0])
+            at = hinge[4]
+            if kinds[0] == "slide":  # the slot on the parent, the pin on the child
+                self.out.pair("slot", name, parent, child, self.out.point(child, self.hint(child, at, name), at), slide[3])
+            else:  # the slot on the child, turning about the parent's pin
+                self.out.pair("slot", name, child, parent, self.out.point(parent, self.hint(parent, at, name), at), -slide[3])
+        else:
+            raise self.doc.error(el, f"joints {list(kinds)}: planardyn reads one hinge, one slide, or a slide and a hinge "
+                                     "(a slot) per body; put a massive body between the others")
+        for j, a, kind, _, _ in found:
+            self.joints.append((j.get("name", ""), name, kind))
+            if len(found) == 1 or kind == "slide":  # a slot's coordinate is its travel; its hinge turns freely
+                self.joint_terms(a, name, kind)
+            elif any(float(a.get(key, 0.0)) for key in ("stiffness", "damping", "armature", "frictionloss")):
+                raise self.doc.error(j, "a slot's hinge turns freely in planardyn: no stiffness, damping or armature")
+
+    def joint_terms(self, a: dict[str, str], pair: str, kind: str) -> None:
+        """Joint stiffness and damping as the pair's torsional spring and viscous friction
+        (on a slot's slide only: its hinge is free)."""
+        unit = np.pi / 180.0 if self.degrees and kind == "hinge" else 1.0
+        k, c = float(a.get("stiffness", 0.0)), float(a.get("damping", 0.0))
+        if k:
+            self.out.loads.append({"type": "torsional_spring", "pair": pair, "stiffness": k,
+                                   "rest": float(a.get("springref", 0.0)) * unit})
+        if c:
+            self.out.loads.append({"type": "friction", "pair": pair, "viscous": c})
+        if float(a.get("armature", 0.0)) or float(a.get("frictionloss", 0.0)):
+            self.armature[pair] = (float(a.get("armature", 0.0)), float(a.get("frictionloss", 0.0)))
+
+    # -------------------------------------------------------------- after the tree
+
+    def masses(self) -> None:
+        """Each planardyn body's mass, centre of mass and inertia about it, from its parts."""
+        for body, parts in self.parts.items():
+            m = sum(part[0] for part in parts)
+            com = sum(part[0] * part[2] for part in parts) / m
+            inertia = sum(i + mi * float(np.sum((c - com) ** 2)) for mi, i, c in parts)
+            self.out.body(body, m, inertia, com, f"{self.doc.source}: body {body!r}")
+
+    def site(self, el: ET.Element, attr: str) -> tuple[str, Vec]:
+        name = el.get(attr, "")
+        if name not in self.sites:
+            raise self.doc.error(el, f"{attr}={name!r} is not a site of the model")
+        return self.sites[name]
+
+    def equality(self, el: ET.Element, scale: float) -> None:
+        """A ``connect`` between two bodies: a closing revolute pair."""
+        for k, eq in enumerate(el):
+            name = eq.get("name") or f"{eq.tag}{k}"
+            if eq.tag == "joint":
+                self.gear(eq, name)
+                continue
+            if eq.tag != "connect":
+                raise self.doc.error(eq, "only equality connect (a closing revolute pair) and joint (a gear pair) are "
+                                         "read: weld, tendon and distance equalities are not in the planar subset")
+            if eq.get("site1") is not None:
+                (b1, p1), (b2, p2) = self.site(eq, "site1"), self.site(eq, "site2")
+                hint = eq.get("site1", "").split("@")[0]
+            else:
+                f1, f2 = (self.frames.get(eq.get(key, ""), None) for key in ("body1", "body2"))
+                if f1 is None or f2 is None:
+                    raise self.doc.error(eq, "body1 and body2 must name bodies of the model")
+                b1, b2 = f1[0], f2[0]
+                p1 = p2 = (f1[1] + f1[2] @ np.array(self.doc.floats(eq, "anchor", 3)))[:2]
+                hint = name
+            if np.linalg.norm(p1 - p2) > SAME_POINT * scale:
+                raise self.doc.error(eq, f"its two points are {np.linalg.norm(p1 - p2):.3g} m apart in the reference "
+                                         "configuration: planardyn's drawing must be assembled")
+            point = self.out.point(b1, self.hint(b1, p1, hint), p1)
+            self.out.point(b2, point, p1)
+            self.out.pair("revolute", name, b1, b2, point)
+
+    def gear(self, eq: ET.Element, name: str) -> None:
+        """An equality ``joint`` q1 = c1 q2 between two joints on one carrier: a gear pair
+        (two hinges) or a rack and pinion (a slide following a hinge), whose radii follow
+        from the ratio and the drawn distance of the centres (docs/model-format.md)."""
+        coef = self.doc.floats(eq, "polycoef", 5, "0 1 0 0 0")
+        if coef[0] or any(coef[2:]) or not coef[1]:
+            raise self.doc.error(eq, "a gear couples two joints linearly: polycoef must be '0 ratio 0 0 0'")
+        pairs = {p["name"]: p for p in self.out.pairs}
+        joint = {jn: (pr, kind) for jn, pr, kind in self.joints}
+        try:
+            (follow, f_kind), (lead, l_kind) = (joint[eq.get(key, "")] for key in ("joint1", "joint2"))
+        except KeyError:
+            raise self.doc.error(eq, "joint1 and joint2 must name joints of the model") from None
+        pf, pl = pairs[follow], pairs[lead]
+        carrier = set(pf["bodies"]) & set(pl["bodies"])
+        if l_kind != "hinge" or pl["type"] != "revolute" or len(carrier) != 1:
+            raise self.doc.error(eq, "joint2 must be a gear's hinge and both joints hold their bodies to one carrier")
+        c = carrier.pop()
+        s_a = 1.0 if pl["bodies"][0] == c else -1.0  # the gear's turn relative to the carrier per unit of joint
+        s_b = 1.0 if pf["bodies"][0] == c else -1.0
+        a, b = (next(x for x in p["bodies"] if x != c) for p in (pl, pf))
+        entry: dict[str, Any] = {"type": "gear", "name": name, "bodies": [a, b]}
+        if c != GROUND:
+            entry["carrier"] = c
+        center = self.out.points[pl["at"]]
+        if f_kind == "slide" and pf["type"] == "prismatic":
+            r_a = abs(coef[1])
+            e = np.asarray(pf["axis"], dtype=float) / np.linalg.norm(pf["axis"])
+            sigma = coef[1] / (r_a * s_a * s_b)  # the tree module's ratio with P -> Q along the guide's axis
+            pitch = center + sigma * r_a * np.array([e[1], -e[0]])  # on the pinion's right for sigma = +1
+            ends = [self.out.point(b, f"{name}_{k}", pitch + k * r_a * e) for k in (0, 1)]
+            entry.update(centers=[pl["at"]], radii=[r_a], rack=ends)
+        elif f_kind == "hinge" and pf["type"] == "revolute":
+            rho = -coef[1] * s_a * s_b  # r_a / r_b, negative inside a ring gear
+            dist = float(np.linalg.norm(self.out.points[pf["at"]] - center))
+            r_b = dist / abs(1.0 + rho)  # |AB| = r_a + r_b outside, |r_a - r_b| inside a ring
+            entry.update(centers=[pl["at"], pf["at"]], radii=[abs(rho) * r_b, r_b])
+            if rho < 0:
+                entry["internal"] = True
+        else:
+            raise self.doc.error(eq, "joint1 must be a gear's hinge or a rack's slide")
+        self.out.pairs.append(entry)
+
+    def tendon(self, el: ET.Element) -> None:
+        """Spatial tendons between two sites (springs) and planardyn's closing-pair tendons."""
+        pairs = {p["name"] for p in self.out.pairs}
+        for t in el:
+            k, c = float(t.get("stiffness", 0.0)), float(t.get("damping", 0.0))
+            if t.tag == "spatial" and len(t) == 2 and all(s.tag == "site" for s in t):
+                (b1, p1), (b2, p2) = (self.site(s, "site") for s in t)
+                ends = [[b, self.out.point(b, self.hint(b, p, s.get("site", "")), p)] for (b, p), s in zip(((b1, p1), (b2, p2)), t)]
+                spring: dict[str, Any] = {"type": "spring", "between": ends, "stiffness": k, "damping": c}
+                if t.get("springlength") is not None:
+                    spring["rest_length"] = self.doc.floats(t, "springlength", 1)[0]
+                self.out.loads.append(spring)
+            elif t.tag == "fixed" and t.get("name") in pairs:
+                self.tendons[t.get("name", "")] = [(j.get("joint", ""), float(j.get("coef", 1.0))) for j in t]
+                self.joint_terms({key: t.get(key, "0") for key in ("stiffness", "damping", "armature", "frictionloss")}
+                                 | {"springref": t.get("springlength", "0")}, t.get("name", ""), "slide")
+            else:
+                raise self.doc.error(t, "only spatial tendons between two sites (springs) and fixed tendons named "
+                                        "after a closing connect are read")
+
+    def actuators(self, el: ET.Element | None, ctrl: list[float]) -> list[tuple[str, float, float]]:
+        """Motors as (pair, gear, control at the start); constant site forces and torques as loads."""
+        motors = []
+        for k, act in enumerate(el if el is not None else []):
+            target = act.get("joint") or act.get("tendon")
+            if act.tag == "motor" and target:
+                pair = next((pr for jn, pr, _ in self.joints if jn == target), target)
+                motors.append((pair, float(act.get("gear", "1").split()[0]), ctrl[k] if k < len(ctrl) else 0.0))
+            elif act.tag == "general" and act.get("site") and act.get("refsite") and float(act.get("gainprm", "1").split()[0]) == 0.0:
+                body, at = self.site(act, "site")
+                bias = float(act.get("biasprm", "0").split()[0])
+                gear = np.array(self.doc.floats(act, "gear", 6))
+                if gear[3] or gear[4] or gear[2]:
+                    raise self.doc.error(act, "a constant load out of the plane")
+                if gear[5]:
+                    self.out.loads.append({"type": "torque", "body": body, "value": float(gear[5] * bias)})
+                else:
+                    point = self.out.point(body, self.hint(body, at, act.get("site", "")), at)
+                    self.out.loads.append({"type": "force", "body": body, "at": point, "value": (gear[:2] * bias).tolist()})
+            else:
+                raise self.doc.error(act, "only motors on joints or closing tendons, and constant site loads, are read")
+        return motors
+
+
+def from_mjcf(data: str, source: str = "<string>") -> dict[str, Any]:
+    """A planardyn model dict from MJCF text (the planar subset; ``planardyn.from_dict`` builds it).
+
+    Raises
+    ------
+    ExchangeError
+        An element outside the planar subset, named with its line.
+    """
+    doc = parse(data, source)
+    if doc.root.tag != "mujoco":
+        raise doc.error(doc.root, "not an MJCF file: the root element must be <mujoco>")
+    compiler = doc.root.find("compiler")
+    attrs = compiler.attrib if compiler is not None else {}
+    if attrs.get("coordinate", "local") != "local" or attrs.get("inertiafromgeom") == "true":
+        raise doc.error(compiler, "global coordinates and inertia from geoms are not read")  # type: ignore[arg-type]
+    out = Builder(doc.root.get("model", "imported"), source)
+    r = _Reader(doc, out, attrs.get("angle", "degree") == "degree", attrs.get("eulerseq", "xyz"))
+    for el in doc.root.findall("default"):
+        r.read_defaults(el, {})
+    option = doc.root.find("option")
+    out.gravity = np.array(doc.floats(option, "gravity", 3, "0 0 -9.81") if option is not None else [0, 0, -9.81])[:2]
+    world = doc.root.find("worldbody")
+    if world is None:
+        raise doc.error(doc.root, "no <worldbody>")
+    r.frames["world"] = (GROUND, np.zeros(3), np.eye(3))
+    for child in world:
+        if child.tag == "site":
+            xy = np.array(doc.floats(child, "pos", 3, "0 0 0"))[:2]
+            site = child.get("name") or f"site{len(r.sites)}"
+            r.sites[site] = (GROUND, xy)
+            out.point(GROUND, site.split("@")[0], xy)
+        elif child.tag == "body":
+            r.body(child, GROUND, np.zeros(3), np.eye(3), "main")
+        elif child.tag not in IGNORED:
+            raise doc.error(child, "not part of the planar subset planardyn reads")
+    r.masses()
+    scale = max([1.0] + [float(np.max(np.abs(p))) for p in out.points.values()])
+    for tag, read in (("equality", lambda el: r.equality(el, scale)), ("tendon", r.tendon)):
+        for el in doc.root.findall(tag):
+            read(el)
+    key = doc.root.find("keyframe/key")
+    ctrl = doc.floats(key, "ctrl", len(key.get("ctrl", "").split())) if key is not None and key.get("ctrl") else []
+    motors = r.actuators(doc.root.find("actuator"), ctrl)
+    _coordinates(doc, r, motors, key)
+    return out.model()
+
+
+def _coordinates(doc: Document, r: _Reader, motors: list[tuple[str, float, float]], key: ET.Element | None) -> None:
+    """The coordinates (planardyn's own list in <custom>, else chosen), their start state
+    from the keyframe, and the motors as drives and actuators."""
+    out = r.out
+    for text_el in doc.root.iterfind("custom/text"):
+        name = text_el.get("name", "")
+        if name.startswith("planardyn.coordinate."):
+            pair, value = text_el.get("data", "").split()
+            out.coordinates.append({"name": name.removeprefix("planardyn.coordinate."), "pair": pair, "value": float(value)})
+    out.preferred = [m[0] for m in motors]
+    out.choose_coordinates()
+    if key is not None:
+        zeros = " ".join(["0"] * len(r.joints))
+        qpos, qvel = (doc.floats(key, attr, len(r.joints), zeros) for attr in ("qpos", "qvel"))
+        by_joint = {jn: k for k, (jn, _, _) in enumerate(r.joints)}
+        kinds = {p["name"]: p["type"] for p in out.pairs}
+        for c in out.coordinates:
+            own = "hinge" if kinds[c["pair"]] == "revolute" else "slide"
+            terms = r.tendons.get(c["pair"]) or [(jn, 1.0) for jn, pr, kind in r.joints if pr == c["pair"] and kind == own]
+            q = sum(coef * qpos[by_joint[jn]] for jn, coef in terms)
+            qd = sum(coef * qvel[by_joint[jn]] for jn, coef in terms)
+            if q:
+                c["q0"] = c["value"] + q
+            if qd:
+                c["qd0"] = qd
+    coord_of = {c["pair"]: c["name"] for c in out.coordinates}
+    for pair, gear, effort in motors:
+        armature, friction = r.armature.pop(pair, (0.0, 0.0))
+        where = {"coordinate": coord_of[pair]} if pair in coord_of else {"pair": pair}
+        if gear != 1.0 or armature or friction:
+            out.actuators.append({**where, "gear_ratio": gear, "rotor_inertia": armature / gear**2,
+                                  "coulomb": friction / gear})
+        if effort and pair in coord_of:
+            out.drives.append({"coordinate": coord_of[pair], "effort": effort})
+    for pair, (armature, friction) in r.armature.items():
+        if pair not in coord_of:
+            raise doc.error(doc.root, f"joint armature or frictionloss on {pair!r}, which is not a coordinate: "
+                                      "planardyn carries rotor inertia and motor friction on actuated coordinates")
+        out.actuators.append({"coordinate": coord_of[pair], "rotor_inertia": armature, "coulomb": friction})

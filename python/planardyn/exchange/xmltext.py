@@ -1,14 +1,15 @@
 """XML in and out for the exchange formats: numbers written at full precision, files read
 with the line of every element, errors that name the file, the element and its line.
 
-The standard library's ElementTree does the work (no third-party XML package is needed to
-write or read these files); its C parser keeps no line numbers, so ``parse`` records them
-from expat while the tree is built.
+The standard library does the work (no third-party XML package is needed to write or read
+these files): ElementTree builds and writes the trees, expat reads them, telling each
+element's line, which ElementTree's own parser does not keep.
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+import xml.parsers.expat
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -59,29 +60,22 @@ class Document:
         return values
 
 
-class _LineBuilder(ET.TreeBuilder):
-    """A TreeBuilder that notes the line where each element starts."""
-
-    def __init__(self) -> None:
-        super().__init__(insert_comments=False)
-        self.lines: dict[ET.Element, int] = {}
-        self.parser: ET.XMLParser | None = None
-
-    def start(self, tag, attrs):  # type: ignore[no-untyped-def]  # TreeBuilder's own signature
-        el = super().start(tag, attrs)
-        assert self.parser is not None
-        self.lines[el] = self.parser.parser.CurrentLineNumber  # type: ignore[attr-defined]  # expat's
-        return el
-
-
 def parse(data: str, source: str) -> Document:
-    """Parse XML text; a malformed file raises ExchangeError with the line expat gives."""
-    builder = _LineBuilder()
-    parser = ET.XMLParser(target=builder)
-    builder.parser = parser
+    """Parse XML text, noting each element's line; a malformed file raises ExchangeError
+    with the line and column expat gives."""
+    builder = ET.TreeBuilder()
+    expat = xml.parsers.expat.ParserCreate()
+    lines: dict[ET.Element, int] = {}
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        lines[builder.start(tag, attrs)] = expat.CurrentLineNumber
+
+    expat.StartElementHandler = start
+    expat.EndElementHandler = builder.end
+    expat.CharacterDataHandler = builder.data
     try:
-        parser.feed(data)
-        root = parser.close()
-    except ET.ParseError as e:
-        raise ExchangeError(f"{source}: not well-formed XML: {e}") from None
-    return Document(root, source, builder.lines)
+        expat.Parse(data, True)
+    except xml.parsers.expat.ExpatError as e:
+        raise ExchangeError(f"{source}: line {e.lineno} column {e.offset}: not well-formed XML: "
+                            f"{xml.parsers.expat.ErrorString(e.code)}") from None
+    return Document(builder.close(), source, lines)
