@@ -260,7 +260,6 @@ class _Reader:
     sites: dict[str, tuple[str, Vec]] = field(default_factory=dict)  # MJCF site -> (body, world xy)
     frames: dict[str, tuple[str, Vec, np.ndarray]] = field(default_factory=dict)  # MJCF body -> (pd body, p, R)
     joints: list[tuple[str, str, str]] = field(default_factory=list)  # (MJCF joint, pair, 'hinge' | 'slide')
-    parts: dict[str, list[tuple[float, float, Vec]]] = field(default_factory=dict)  # pd body -> (m, Izz, com)
     armature: dict[str, tuple[float, float]] = field(default_factory=dict)  # pair -> (armature, frictionloss)
     tendons: dict[str, list[tuple[str, float]]] = field(default_factory=dict)  # closing pair -> (joint, coef)
 
@@ -318,7 +317,7 @@ class _Reader:
                 self.sites[site] = (owner, xy)
                 self.out.point(owner, site.split("@")[0], xy)
         if joints:
-            if not self.parts.get(owner):
+            if not self.out.parts.get(owner):
                 raise self.doc.error(el, "a moving body needs an <inertial> (planardyn does not derive mass from geoms)")
             self.pair(el, joints, parent, owner, p, r, cls)
         for child in el:
@@ -329,8 +328,6 @@ class _Reader:
                                             "(bodies, hinge and slide joints, inertials, sites, geoms)")
 
     def inertial(self, el: ET.Element, owner: str, p: Vec, r: np.ndarray) -> None:
-        if owner == GROUND:
-            return
         rot = r @ self.rotation(el)
         if el.get("fullinertia") is not None:
             ixx, iyy, izz, ixy, ixz, iyz = self.doc.floats(el, "fullinertia", 6)
@@ -338,8 +335,7 @@ class _Reader:
         else:
             inertia = np.diag(self.doc.floats(el, "diaginertia", 3))
         com = (p + r @ np.array(self.doc.floats(el, "pos", 3)))[:2]
-        mass = self.doc.floats(el, "mass", 1)[0]
-        self.parts.setdefault(owner, []).append((mass, float((rot @ inertia @ rot.T)[2, 2]), com))
+        self.out.part(owner, self.doc.floats(el, "mass", 1)[0], float((rot @ inertia @ rot.T)[2, 2]), com)
 
 
     def hint(self, body: str, xy: Vec, default: str) -> str:
@@ -410,14 +406,6 @@ class _Reader:
 
     # -------------------------------------------------------------- after the tree
 
-    def masses(self) -> None:
-        """Each planardyn body's mass, centre of mass and inertia about it, from its parts."""
-        for body, parts in self.parts.items():
-            m = sum(part[0] for part in parts)
-            com = sum(part[0] * part[2] for part in parts) / m
-            inertia = sum(i + mi * float(np.sum((c - com) ** 2)) for mi, i, c in parts)
-            self.out.body(body, m, inertia, com, f"{self.doc.source}: body {body!r}")
-
     def site(self, el: ET.Element, attr: str) -> tuple[str, Vec]:
         name = el.get(attr, "")
         if name not in self.sites:
@@ -452,47 +440,16 @@ class _Reader:
             self.out.pair("revolute", name, b1, b2, point)
 
     def gear(self, eq: ET.Element, name: str) -> None:
-        """An equality ``joint`` q1 = c1 q2 between two joints on one carrier: a gear pair
-        (two hinges) or a rack and pinion (a slide following a hinge), whose radii follow
-        from the ratio and the drawn distance of the centres (docs/model-format.md)."""
+        """An equality ``joint`` q1 = c1 q2 between two joints on one carrier: a gear pair."""
         coef = self.doc.floats(eq, "polycoef", 5, "0 1 0 0 0")
         if coef[0] or any(coef[2:]) or not coef[1]:
             raise self.doc.error(eq, "a gear couples two joints linearly: polycoef must be '0 ratio 0 0 0'")
-        pairs = {p["name"]: p for p in self.out.pairs}
-        joint = {jn: (pr, kind) for jn, pr, kind in self.joints}
-        try:
-            (follow, f_kind), (lead, l_kind) = (joint[eq.get(key, "")] for key in ("joint1", "joint2"))
-        except KeyError:
-            raise self.doc.error(eq, "joint1 and joint2 must name joints of the model") from None
-        pf, pl = pairs[follow], pairs[lead]
-        carrier = set(pf["bodies"]) & set(pl["bodies"])
-        if l_kind != "hinge" or pl["type"] != "revolute" or len(carrier) != 1:
-            raise self.doc.error(eq, "joint2 must be a gear's hinge and both joints hold their bodies to one carrier")
-        c = carrier.pop()
-        s_a = 1.0 if pl["bodies"][0] == c else -1.0  # the gear's turn relative to the carrier per unit of joint
-        s_b = 1.0 if pf["bodies"][0] == c else -1.0
-        a, b = (next(x for x in p["bodies"] if x != c) for p in (pl, pf))
-        entry: dict[str, Any] = {"type": "gear", "name": name, "bodies": [a, b]}
-        if c != GROUND:
-            entry["carrier"] = c
-        center = self.out.points[pl["at"]]
-        if f_kind == "slide" and pf["type"] == "prismatic":
-            r_a = abs(coef[1])
-            e = np.asarray(pf["axis"], dtype=float) / np.linalg.norm(pf["axis"])
-            sigma = coef[1] / (r_a * s_a * s_b)  # the tree module's ratio with P -> Q along the guide's axis
-            pitch = center + sigma * r_a * np.array([e[1], -e[0]])  # on the pinion's right for sigma = +1
-            ends = [self.out.point(b, f"{name}_{k}", pitch + k * r_a * e) for k in (0, 1)]
-            entry.update(centers=[pl["at"]], radii=[r_a], rack=ends)
-        elif f_kind == "hinge" and pf["type"] == "revolute":
-            rho = -coef[1] * s_a * s_b  # r_a / r_b, negative inside a ring gear
-            dist = float(np.linalg.norm(self.out.points[pf["at"]] - center))
-            r_b = dist / abs(1.0 + rho)  # |AB| = r_a + r_b outside, |r_a - r_b| inside a ring
-            entry.update(centers=[pl["at"], pf["at"]], radii=[abs(rho) * r_b, r_b])
-            if rho < 0:
-                entry["internal"] = True
-        else:
-            raise self.doc.error(eq, "joint1 must be a gear's hinge or a rack's slide")
-        self.out.pairs.append(entry)
+        joint = {jn: pr for jn, pr, _ in self.joints}
+        if eq.get("joint1") not in joint or eq.get("joint2") not in joint:
+            raise self.doc.error(eq, "joint1 and joint2 must name joints of the model")
+        why = self.out.gear(name, joint[eq.get("joint1", "")], joint[eq.get("joint2", "")], coef[1])
+        if why:
+            raise self.doc.error(eq, why)
 
     def tendon(self, el: ET.Element) -> None:
         """Spatial tendons between two sites (springs) and planardyn's closing-pair tendons."""
@@ -573,7 +530,7 @@ def from_mjcf(data: str, source: str = "<string>") -> dict[str, Any]:
             r.body(child, GROUND, np.zeros(3), np.eye(3), "main")
         elif child.tag not in IGNORED:
             raise doc.error(child, "not part of the planar subset planardyn reads")
-    r.masses()
+    out.masses(source)
     scale = max([1.0] + [float(np.max(np.abs(p))) for p in out.points.values()])
     for tag, read in (("equality", lambda el: r.equality(el, scale)), ("tendon", r.tendon)):
         for el in doc.root.findall(tag):

@@ -41,6 +41,56 @@ class Builder:
     loads: list[dict[str, Any]] = field(default_factory=list)
     drives: list[dict[str, Any]] = field(default_factory=list)
     actuators: list[dict[str, Any]] = field(default_factory=list)
+    parts: dict[str, list[tuple[float, float, Vec]]] = field(default_factory=dict)  # body -> (m, Izz, com) parts
+
+    def part(self, body: str, mass: float, izz: float, com: Vec) -> None:
+        """A rigid part of a body: mass (kg), moment about z through its centre (kg m^2), centre (m)."""
+        if body != GROUND:  # mass on the fixed base does not move
+            self.parts.setdefault(body, []).append((mass, izz, np.asarray(com[:2], dtype=float)))
+
+    def masses(self, where: str) -> None:
+        """Each body's mass, centre of mass and inertia about it, from its parts."""
+        for body, parts in self.parts.items():
+            m = sum(part[0] for part in parts)
+            com = sum(part[0] * part[2] for part in parts) / m
+            inertia = sum(i + mi * float(np.sum((c - com) ** 2)) for mi, i, c in parts)
+            self.body(body, m, inertia, com, f"{where}: body {body!r}")
+
+    def gear(self, name: str, follow: str, lead: str, ratio: float) -> str | None:
+        """A linear coupling q_follow = ratio q_lead of two pairs on one carrier as a gear
+        pair (two revolute pairs) or a rack and pinion (a prismatic pair following a
+        revolute one), its radii from the ratio and the drawn centres (docs/model-format.md);
+        or the reason it is not one."""
+        pairs = {p["name"]: p for p in self.pairs}
+        pf, pl = pairs[follow], pairs[lead]
+        carrier = set(pf["bodies"]) & set(pl["bodies"])
+        if pl["type"] != "revolute" or len(carrier) != 1:
+            return "the leader must be a gear's revolute joint, and both joints must hold their bodies to one carrier"
+        c = carrier.pop()
+        s_a = 1.0 if pl["bodies"][0] == c else -1.0  # the gear's turn relative to the carrier per unit of joint
+        s_b = 1.0 if pf["bodies"][0] == c else -1.0
+        a, b = (next(x for x in p["bodies"] if x != c) for p in (pl, pf))
+        entry: dict[str, Any] = {"type": "gear", "name": name, "bodies": [a, b]}
+        if c != GROUND:
+            entry["carrier"] = c
+        center = self.points[pl["at"]]
+        if pf["type"] == "prismatic":
+            r_a = abs(ratio)
+            e = np.asarray(pf["axis"], dtype=float) / np.linalg.norm(pf["axis"])
+            sigma = ratio / (r_a * s_a * s_b)  # tree.py's ratio with P -> Q along the guide's axis
+            pitch = center + sigma * r_a * np.array([e[1], -e[0]])  # on the pinion's right for sigma = +1
+            entry.update(centers=[pl["at"]], radii=[r_a],
+                         rack=[self.point(b, f"{name}_{k}", pitch + k * r_a * e) for k in (0, 1)])
+        elif pf["type"] == "revolute":
+            rho = -ratio * s_a * s_b  # r_a / r_b, negative inside a ring gear
+            r_b = float(np.linalg.norm(self.points[pf["at"]] - center)) / abs(1.0 + rho)  # |AB| = |r_a +- r_b|
+            entry.update(centers=[pl["at"], pf["at"]], radii=[abs(rho) * r_b, r_b])
+            if rho < 0:
+                entry["internal"] = True
+        else:
+            return "the follower must be a gear's revolute joint or a rack's prismatic joint"
+        self.pairs.append(entry)
+        return None
 
     def body(self, name: str, mass: float, inertia: float, com: Vec, where: str) -> None:
         if not (mass > 0.0 and inertia > 0.0):
