@@ -11,7 +11,9 @@ docs/exchange.md.
 
 from __future__ import annotations
 
-from .mjcf import to_mjcf
+from .mjcf import from_mjcf, to_mjcf
+from .sdf import to_sdf
 from .tree import ExchangeError
+from .urdf import from_urdf, to_urdf
 
-__all__ = ["ExchangeError", "to_mjcf"]
+__all__ = ["ExchangeError", "from_mjcf", "from_urdf", "to_mjcf", "to_sdf", "to_urdf"]

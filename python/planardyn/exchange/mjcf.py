@@ -338,14 +338,6 @@ class _Reader:
         self.out.part(owner, self.doc.floats(el, "mass", 1)[0], float((rot @ inertia @ rot.T)[2, 2]), com)
 
 
-    def hint(self, body: str, xy: Vec, default: str) -> str:
-        """A point's name: that of a site of the body at xy (``A@crank`` gives ``A``), else ``default``."""
-        tol = SAME_POINT * max(1.0, float(np.max(np.abs(xy))))
-        for site, (owner, at) in self.sites.items():
-            if owner == body and np.linalg.norm(at - xy) <= tol:
-                return site.split("@")[0]
-        return default
-
     def pair(self, el: ET.Element, joints: list[ET.Element], parent: str, child: str, p: Vec, r: np.ndarray,
              cls: str) -> None:
         """The pair of a body's joints: a hinge, a slide, or a slot (a slide and a hinge)."""
@@ -368,19 +360,17 @@ class _Reader:
         if kinds == ("hinge",):
             j, a, _, axis, at = found[0]
             bodies = [parent, child] if axis[2] > 0 else [child, parent]
-            point = self.out.point(child, self.hint(child, at, name), at)
-            self.out.point(parent, point, at)
-            self.out.pair("revolute", name, *bodies, point)
+            self.out.pair("revolute", name, *bodies, self.out.share(parent, self.out.point(child, name, at)))
         elif kinds == ("slide",):
             j, a, _, axis, at = found[0]
-            self.out.pair("prismatic", name, parent, child, self.out.point(child, self.hint(child, at, name), at), axis)
+            self.out.pair("prismatic", name, parent, child, self.out.point(child, name, at), axis)
         elif kinds in (("slide", "hinge"), ("hinge", "slide")):
             slide, hinge = (found[0], found[1]) if kinds[0] == "slide" else (found[1], found[0])
             at = hinge[4]
             if kinds[0] == "slide":  # the slot on the parent, the pin on the child
-                self.out.pair("slot", name, parent, child, self.out.point(child, self.hint(child, at, name), at), slide[3])
+                self.out.pair("slot", name, parent, child, self.out.point(child, name, at), slide[3])
             else:  # the slot on the child, turning about the parent's pin
-                self.out.pair("slot", name, child, parent, self.out.point(parent, self.hint(parent, at, name), at), -slide[3])
+                self.out.pair("slot", name, child, parent, self.out.point(parent, name, at), -slide[3])
         else:
             raise self.doc.error(el, f"joints {list(kinds)}: planardyn reads one hinge, one slide, or a slide and a hinge "
                                      "(a slot) per body; put a massive body between the others")
@@ -435,9 +425,7 @@ class _Reader:
             if np.linalg.norm(p1 - p2) > SAME_POINT * scale:
                 raise self.doc.error(eq, f"its two points are {np.linalg.norm(p1 - p2):.3g} m apart in the reference "
                                          "configuration: planardyn's drawing must be assembled")
-            point = self.out.point(b1, self.hint(b1, p1, hint), p1)
-            self.out.point(b2, point, p1)
-            self.out.pair("revolute", name, b1, b2, point)
+            self.out.pair("revolute", name, b1, b2, self.out.share(b2, self.out.point(b1, hint, p1)))
 
     def gear(self, eq: ET.Element, name: str) -> None:
         """An equality ``joint`` q1 = c1 q2 between two joints on one carrier: a gear pair."""
@@ -458,7 +446,7 @@ class _Reader:
             k, c = float(t.get("stiffness", 0.0)), float(t.get("damping", 0.0))
             if t.tag == "spatial" and len(t) == 2 and all(s.tag == "site" for s in t):
                 (b1, p1), (b2, p2) = (self.site(s, "site") for s in t)
-                ends = [[b, self.out.point(b, self.hint(b, p, s.get("site", "")), p)] for (b, p), s in zip(((b1, p1), (b2, p2)), t)]
+                ends = [[b, self.out.point(b, s.get("site", ""), p)] for (b, p), s in zip(((b1, p1), (b2, p2)), t)]
                 spring: dict[str, Any] = {"type": "spring", "between": ends, "stiffness": k, "damping": c}
                 if t.get("springlength") is not None:
                     spring["rest_length"] = self.doc.floats(t, "springlength", 1)[0]
@@ -488,7 +476,7 @@ class _Reader:
                 if gear[5]:
                     self.out.loads.append({"type": "torque", "body": body, "value": float(gear[5] * bias)})
                 else:
-                    point = self.out.point(body, self.hint(body, at, act.get("site", "")), at)
+                    point = self.out.point(body, act.get("site", ""), at)
                     self.out.loads.append({"type": "force", "body": body, "at": point, "value": (gear[:2] * bias).tolist()})
             else:
                 raise self.doc.error(act, "only motors on joints or closing tendons, and constant site loads, are read")

@@ -99,10 +99,13 @@ class Builder:
         self.bodies[name] = {"mass": float(mass), "inertia": float(inertia), "com": [float(com[0]), float(com[1])]}
 
     def point(self, body: str, hint: str, p: Vec) -> str:
-        """The name of a point carried by ``body`` at p (m): an existing point there with
-        that name, or a new one named from ``hint``."""
+        """The name of a point carried by ``body`` at p (m): the body's point there, else
+        the point named ``hint`` if it is there, else a new one named from ``hint``."""
         p = np.asarray(p[:2], dtype=float)
         tol = SAME_POINT * max(1.0, float(np.max(np.abs(p))))
+        own = [n for n in self.carried.get(body, []) if np.linalg.norm(self.points[n] - p) <= tol]
+        if own:
+            return own[0]
         name, k = hint, 1
         while name in self.points and np.linalg.norm(self.points[name] - p) > tol:
             k += 1
@@ -111,6 +114,12 @@ class Builder:
         if name not in self.carried.setdefault(body, []):
             self.carried[body].append(name)
         return name
+
+    def share(self, body: str, point: str) -> str:
+        """Let ``body`` carry an existing point too (a pin joins two bodies at one point)."""
+        if point not in self.carried.setdefault(body, []):
+            self.carried[body].append(point)
+        return point
 
     def pair(self, kind: str, name: str, a: str, b: str, at: str, axis: Vec | None = None) -> None:
         entry: dict[str, Any] = {"type": kind, "name": name, "at": at, "bodies": [a, b]}
@@ -148,7 +157,7 @@ class Builder:
         """A pair's constraint rows (motion False) or its relative rate (True) on the 3n body
         velocities [vx, vy, w] per body, in the drawing."""
         names = list(self.bodies)
-        p = self.points[pair["at"]]
+        p = self.points[pair["centers"][0] if pair["type"] == "gear" else pair["at"]]
 
         def point_velocity(body: str, sign: float) -> np.ndarray:
             rows = np.zeros((2, 3 * len(names)))
@@ -165,6 +174,18 @@ class Builder:
             return row
 
         a, b = pair["bodies"]
+        if pair["type"] == "gear":  # r_a w_a + r_b w_b = 0 relative to the carrier; a rack's travel
+            c = pair.get("carrier", GROUND)
+            r_a = pair["radii"][0]
+            if pair.get("rack"):
+                e = self.points[pair["rack"][1]] - self.points[pair["rack"][0]]
+                e /= np.linalg.norm(e)
+                r = self.points[pair["rack"][0]] - p
+                sigma = 1.0 if e[0] * r[1] - e[1] * r[0] < 0 else -1.0
+                p = self.points[pair["rack"][0]]
+                return sigma * r_a * (turn(a, 1.0) + turn(c, -1.0)) - e @ (point_velocity(b, 1.0) + point_velocity(c, -1.0))
+            r_b = pair["radii"][1] * (-1.0 if pair.get("internal") else 1.0)
+            return r_a * (turn(a, 1.0) + turn(c, -1.0)) + r_b * (turn(b, 1.0) + turn(c, -1.0))
         slip = point_velocity(b, 1.0) + point_velocity(a, -1.0)
         spin = turn(b, 1.0) + turn(a, -1.0)
         if pair["type"] == "revolute":

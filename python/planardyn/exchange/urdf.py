@@ -26,6 +26,7 @@ import numpy as np
 
 from ..mechanism import Mechanism
 from .planar import Builder
+from .mjcf import AXIS_TOL
 from .sdf import carriage, closing_joint, edge_joints, header, link_name
 from .tree import GROUND, Drawing, ExchangeError, Vec, actuated, drawing, not_carried, pair_loads
 from .xmltext import Document, num, nums, parse, text
@@ -166,6 +167,7 @@ def from_urdf(data: str, source: str = "<string>", coordinates: list[str] | None
         raise doc.error(doc.root, f"a URDF tree has one root link, this file has {roots}")
     r = _UrdfReader(doc, out, links, joints)
     r.walk(roots[0], GROUND, np.zeros(3), np.eye(3))
+    out.masses(source)
     for g in doc.root.findall("gazebo"):
         for j in g.findall("joint"):
             r.closing(j)
@@ -185,59 +187,107 @@ def from_urdf(data: str, source: str = "<string>", coordinates: list[str] | None
 
 
 class _UrdfReader:
+    """Walks a URDF tree into a Builder; a massless link between a prismatic and a continuous
+    joint is a slot's carriage, a fixed joint merges its child into its parent's body."""
+
     def __init__(self, doc: Document, out: Builder, links: dict[str, ET.Element], joints: list[ET.Element]) -> None:
         self.doc, self.out, self.links, self.joints = doc, out, links, joints
         self.frames: dict[str, tuple[str, Vec, np.ndarray]] = {}  # link -> (planardyn body, p, R)
         self.pair_of: dict[str, str] = {}  # URDF joint -> pair
 
-    def walk(self, link: str, body: str, p: Vec, r: np.ndarray) -> None:
-        """A link and, depth first, its children (a fixed joint merges the child into its body)."""
+    def points(self, link: str, body: str, p: Vec, r: np.ndarray) -> None:
+        """The link's marked points, and its inertial as a part of the body."""
         el = self.links.get(link)
         if el is None:
             raise self.doc.error(self.doc.root, f"link {link!r} is named by a joint but not defined")
-        self.frames[link] = (body, p, r)
-        if body != GROUND or link not in ("world",):
-            self._mass(el, body, p, r)
         for v in el.findall("visual"):
-            name = v.get("name", "")
-            if name.startswith(POINT):
+            if v.get("name", "").startswith(POINT):
                 vp, _ = _rpy(self.doc, v.find("origin"))
-                self.out.point(body, name.removeprefix(POINT), (p + r @ vp)[:2])
+                self.out.point(body, v.get("name", "").removeprefix(POINT), (p + r @ vp)[:2])
+        inertial = el.find("inertial")
+        if inertial is not None and link not in self.frames:
+            op, orr = _rpy(self.doc, inertial.find("origin"))
+            i, m = inertial.find("inertia"), inertial.find("mass")
+            if i is None or m is None:
+                raise self.doc.error(inertial, "an <inertial> needs <mass> and <inertia>")
+            f = {k: float(i.get(k, 0.0)) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+            tensor = np.array([[f["ixx"], f["ixy"], f["ixz"]], [f["ixy"], f["iyy"], f["iyz"]], [f["ixz"], f["iyz"], f["izz"]]])
+            rot = r @ orr
+            self.out.part(body, float(m.get("value", 0.0)), float((rot @ tensor @ rot.T)[2, 2]), p + r @ op)
+        self.frames[link] = (body, p, r)
+
+    def walk(self, link: str, body: str, p: Vec, r: np.ndarray, carriage: tuple | None = None) -> None:
+        """A link and, depth first, the links below it."""
+        self.points(link, body, p, r)
         for j in self.joints:
             parent = j.find("parent")
             if parent is None or parent.get("link") != link:
                 continue
-            child = j.find("child").get("link", "")  # type: ignore[union-attr]  # checked in from_urdf
+            child = j.find("child").get("link", "")  # type: ignore[union-attr]  # from_urdf checked it
             jp, jr = _rpy(self.doc, j.find("origin"))
             cp, cr = p + r @ jp, r @ jr
-            kind = j.get("type", "")
+            kind = {"continuous": "hinge", "revolute": "hinge", "prismatic": "slide", "fixed": "fixed"}.get(j.get("type", ""))
+            if kind is None:
+                raise self.doc.error(j, f"a {j.get('type')} joint is not planar: planardyn reads revolute, continuous, "
+                                        "prismatic and fixed joints")
             if kind == "fixed":
-                self.walk(child, body, cp, cr)
+                self.walk(child, body, cp, cr, carriage)
                 continue
-            if kind not in ("continuous", "revolute", "prismatic"):
-                raise self.doc.error(j, f"a {kind} joint is not planar: planardyn reads revolute, continuous, prismatic and fixed joints")
-            axis = cr @ np.array(self.doc.floats(j.find("axis") if j.find("axis") is not None else j, "xyz", 3, "1 0 0"))
-            self.joint(j, "hinge" if kind != "prismatic" else "slide", body, child, cp, axis)
-            self.walk(child, child if self._massive(child) else body, cp, cr)
+            ax = j.find("axis")
+            axis = cr @ np.array(self.doc.floats(ax, "xyz", 3) if ax is not None else [1.0, 0.0, 0.0])
+            axis /= np.linalg.norm(axis)
+            if (np.linalg.norm(axis[:2]) if kind == "hinge" else abs(axis[2])) > AXIS_TOL:
+                raise self.doc.error(j, f"its axis {axis.round(12).tolist()} is not planar (hinges about z, slides in x-y)")
+            massive = self.links.get(child, j).find("inertial") is not None
+            if not massive and carriage is None:
+                self.walk(child, body, cp, cr, (j, kind, cp[:2], axis))
+                continue
+            self.points(child, child, cp, cr)
+            self.pair(j, kind, body, child, cp[:2], axis, carriage)
+            self.walk(child, child, cp, cr)
 
-    def _massive(self, link: str) -> bool:
-        return self.links[link].find("inertial") is not None
+    def pair(self, j: ET.Element, kind: str, body: str, child: str, at: Vec, axis: Vec, carriage: tuple | None) -> None:
+        name = j.get("name", "").split(".")[0]
+        if carriage is None and kind == "hinge":
+            bodies = [body, child] if axis[2] > 0 else [child, body]
+            self.out.pair("revolute", name, *bodies, self.out.share(body, self.out.point(child, name, at)))
+        elif carriage is None:
+            self.out.pair("prismatic", name, body, child, self.out.point(child, name, at), axis)
+        elif (carriage[1], kind) == ("slide", "hinge"):  # the slot on the parent, the pin on the child
+            self.out.pair("slot", name, body, child, self.out.point(child, name, at), carriage[3])
+        elif (carriage[1], kind) == ("hinge", "slide"):  # the slot on the child, about the parent's pin
+            self.out.pair("slot", name, child, body, self.out.point(body, name, carriage[2]), -axis)
+        else:
+            raise self.doc.error(j, "a massless link must join a prismatic and a revolute joint (a slot)")
+        for joint in ([carriage[0]] if carriage else []) + [j]:
+            self.pair_of[joint.get("name", "")] = name
+            damping = float(joint.find("dynamics").get("damping", 0.0)) if joint.find("dynamics") is not None else 0.0
+            if damping and (len(self.pair_of) and (carriage is None or joint.get("type") == "prismatic")):
+                self.out.loads.append({"type": "friction", "pair": name, "viscous": damping})
 
-    def _mass(self, el: ET.Element, body: str, p: Vec, r: np.ndarray) -> None:
-        inertial = el.find("inertial")
-        if inertial is None:
-            return
-        if body == GROUND:
-            return  # mass on the fixed base does not move
-        op, orr = _rpy(self.doc, inertial.find("origin"))
-        i = inertial.find("inertia")
-        m = inertial.find("mass")
-        if i is None or m is None:
-            raise self.doc.error(inertial, "an <inertial> needs <mass> and <inertia>")
-        f = {k: float(i.get(k, 0.0)) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
-        tensor = np.array([[f["ixx"], f["ixy"], f["ixz"]], [f["ixy"], f["iyy"], f["iyz"]], [f["ixz"], f["iyz"], f["izz"]]])
-        rot = r @ orr
-        self.parts.setdefault(body, []).append((float(m.get("value", 0.0)), float((rot @ tensor @ rot.T)[2, 2]),
-                                                (p + r @ op)[:2]))
+    def closing(self, j: ET.Element) -> None:
+        """An SDF joint in <gazebo>: a closing revolute pair (pose in the child's frame)."""
+        if j.get("type") not in ("revolute", "continuous"):
+            raise self.doc.error(j, "planardyn closes loops with revolute joints only")
+        ends = [j.findtext(k, "").strip() for k in ("parent", "child")]
+        if not all(e in self.frames for e in ends):
+            raise self.doc.error(j, f"parent and child {ends} must be links of the tree")
+        pose = j.find("pose")
+        if pose is not None and pose.get("relative_to", ends[1]) != ends[1]:
+            raise self.doc.error(pose, "a closing joint's pose is read relative to its child link only")
+        xyz = np.array([float(v) for v in (pose.text or "0 0 0").split()[:3]]) if pose is not None else np.zeros(3)
+        axis = np.array([float(v) for v in j.findtext("axis/xyz", "0 0 1").split()])
+        (a, _, _), (b, pb, rb) = self.frames[ends[0]], self.frames[ends[1]]
+        if np.linalg.norm((rb @ axis)[:2]) > AXIS_TOL * np.linalg.norm(axis):
+            raise self.doc.error(j, "its axis does not turn about z (planar subset)")
+        at = (pb + rb @ xyz)[:2]
+        name = j.get("name", "")
+        self.out.pair("revolute", name, a, b, self.out.share(a, self.out.point(b, name, at)))
 
-    parts: dict[str, list[tuple[float, float, Vec]]]
+    def gear(self, j: ET.Element, mimic: ET.Element) -> None:
+        follow, lead = self.pair_of.get(j.get("name", "")), self.pair_of.get(mimic.get("joint", ""))
+        if follow is None or lead is None or float(mimic.get("offset", 0.0)):
+            raise self.doc.error(mimic, "a mimic couples two planar joints of the tree, without offset")
+        why = self.out.gear(f"{follow}_gear", follow, lead, float(mimic.get("multiplier", 1.0)))
+        if why:
+            raise self.doc.error(mimic, why)
