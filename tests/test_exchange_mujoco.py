@@ -19,9 +19,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pytest
-
 import planardyn as pdn
+import pytest
 from planardyn import models
 from planardyn.exchange import ExchangeError, to_mjcf
 from planardyn.exchange.tree import GROUND, drawing

@@ -33,7 +33,6 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from .exchange.cli import register as exchange_commands
 from . import (
     AssemblyError,
     Mechanism,
@@ -47,6 +46,7 @@ from . import (
     structure,
 )
 from .events import Crossing, parse_crossing
+from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .settings import check_settings

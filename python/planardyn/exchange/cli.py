@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..mechanism import load
+from ..mechanism import from_dict, load
 from .mjcf import TIMESTEP, from_mjcf, to_mjcf
 from .sdf import to_sdf
 from .tree import ExchangeError
@@ -24,7 +24,7 @@ WRITERS = {".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf", ".sdf": "sdf"}
 READERS = {".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
 
 
-def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]  # argparse's private class
+def register(sub: argparse._SubParsersAction) -> None:
     """Add ``export`` and ``import`` to the planardyn command's subparsers."""
     formatter = argparse.RawDescriptionHelpFormatter
     e = sub.add_parser("export", help="write a model as MJCF (MuJoCo), URDF (ROS) or SDF (Gazebo)",
@@ -67,16 +67,11 @@ def import_command(args: argparse.Namespace) -> int:
     text = args.file.read_text(encoding="utf-8")
     coords = args.coordinates.split(",") if args.coordinates else None
     model = from_mjcf(text, str(args.file)) if fmt == "mjcf" else from_urdf(text, str(args.file), coords)
-    mech = __import__("planardyn").from_dict(model, str(args.file))  # validates before writing
-    suffix = args.output.suffix.lower()
-    if suffix == ".json":
-        args.output.write_text(json.dumps(model, indent=2), encoding="utf-8")
-    elif suffix in (".yaml", ".yml"):
-        import yaml
-
-        args.output.write_text(yaml.safe_dump(_plain(model), sort_keys=False), encoding="utf-8")
-    else:
+    mech = from_dict(model, str(args.file))  # validates before writing
+    if args.output.suffix.lower() not in (".json", ".yaml", ".yml"):
         raise ExchangeError(f"{args.output}: write a .yaml or .json model file")
+    # JSON is YAML too (YAML 1.2 is a superset): one writer for both, full precision, no PyYAML needed.
+    args.output.write_text(json.dumps(_plain(model), indent=2) + "\n", encoding="utf-8")
     print(f"wrote {args.output} ({mech.n_bodies} bodies, {len(mech.pair_names)} pairs, coordinates "
           f"{', '.join(mech.coordinate_names)})")
     return 0

@@ -127,8 +127,7 @@ def _body(d: Drawing, parent: ET.Element, e: Edge, joints: dict[str, ET.Element]
     b = d.bodies[e.child]
     el = ET.SubElement(parent, "body", name=b.name, pos=_v(d.origin[e.child] - d.origin[e.parent]))
     for kind in e.joints:
-        axis = np.array([0.0, 0.0, e.sign]) if kind == "hinge" else e.sign * np.append(e.pair.axis, 0.0)
-        j = ET.SubElement(el, "joint", name=_joint_name(e, kind), type=kind, axis=nums(axis))
+        j = ET.SubElement(el, "joint", name=_joint_name(e, kind), type=kind, axis=nums(e.axis(kind)))
         if kind == _kind(e):  # the pair's own relative coordinate: a slot's travel, else its only joint
             joints[e.pair.name] = j
     ET.SubElement(el, "inertial", pos=_v(d.local(b.name, b.com)), mass=num(b.mass),
@@ -256,7 +255,7 @@ class _Reader:
     out: Builder
     degrees: bool
     eulerseq: str
-    defaults: dict[str, dict[str, str]] = field(default_factory=dict)
+    defaults: dict[str, dict[str, dict[str, str]]] = field(default_factory=dict)  # class -> tag -> attributes
     sites: dict[str, tuple[str, Vec]] = field(default_factory=dict)  # MJCF site -> (body, world xy)
     frames: dict[str, tuple[str, Vec, np.ndarray]] = field(default_factory=dict)  # MJCF body -> (pd body, p, R)
     joints: list[tuple[str, str, str]] = field(default_factory=list)  # (MJCF joint, pair, 'hinge' | 'slide')
@@ -270,7 +269,7 @@ class _Reader:
         return {**self.defaults.get(el.get("class", cls), {}).get(el.tag, {}), **el.attrib}
 
     def read_defaults(self, el: ET.Element, inherited: dict[str, dict[str, str]], name: str = "main") -> None:
-        own = {tag: dict(attrs) for tag, attrs in inherited.items()}
+        own: dict[str, dict[str, str]] = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in el:
             if child.tag == "default":
                 continue
@@ -360,7 +359,7 @@ class _Reader:
         if kinds == ("hinge",):
             j, a, _, axis, at = found[0]
             bodies = [parent, child] if axis[2] > 0 else [child, parent]
-            self.out.pair("revolute", name, *bodies, self.out.share(parent, self.out.point(child, name, at)))
+            self.out.pair("revolute", name, bodies[0], bodies[1], self.out.share(parent, self.out.point(child, name, at)))
         elif kinds == ("slide",):
             j, a, _, axis, at = found[0]
             self.out.pair("prismatic", name, parent, child, self.out.point(child, name, at), axis)

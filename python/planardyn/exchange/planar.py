@@ -52,7 +52,7 @@ class Builder:
         """Each body's mass, centre of mass and inertia about it, from its parts."""
         for body, parts in self.parts.items():
             m = sum(part[0] for part in parts)
-            com = sum(part[0] * part[2] for part in parts) / m
+            com = np.sum([part[0] * part[2] for part in parts], axis=0) / m
             inertia = sum(i + mi * float(np.sum((c - com) ** 2)) for mi, i, c in parts)
             self.body(body, m, inertia, com, f"{where}: body {body!r}")
 

@@ -62,8 +62,7 @@ def edge_joints(d: Drawing, e: Edge) -> list[tuple[str, str, str, str, np.ndarra
     links = [e.parent, carriage(e.pair), e.child] if e.pair.kind == "slot" else [e.parent, e.child]
     out = []
     for k, (name, kind) in enumerate(zip(names, e.joints)):
-        axis = np.array([0.0, 0.0, e.sign]) if kind == "hinge" else e.sign * np.append(e.pair.axis, 0.0)
-        out.append((name, kind, links[k], links[k + 1], axis))
+        out.append((name, kind, links[k], links[k + 1], e.axis(kind)))
     return out
 
 

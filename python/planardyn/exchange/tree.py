@@ -94,6 +94,15 @@ class Edge:
         return ("hinge",) if self.pair.kind == "revolute" else ("slide",)
 
 
+    def axis(self, kind: str) -> Vec:
+        """(3,) the axis of the edge's hinge (+-z) or slide (+-guide), oriented so that the
+        joint's position is the pair's relative motion of b to a."""
+        if kind == "hinge":
+            return np.array([0.0, 0.0, self.sign])
+        assert self.pair.axis is not None  # a prismatic or slot pair has a guide
+        return self.sign * np.append(self.pair.axis, 0.0)
+
+
 @dataclass(frozen=True)
 class Coupling:
     """A gear pair as a relation of two tree joints: q_follower = ratio q_leader, both

@@ -25,8 +25,8 @@ from typing import Any
 import numpy as np
 
 from ..mechanism import Mechanism
-from .planar import Builder
 from .mjcf import AXIS_TOL
+from .planar import Builder
 from .sdf import carriage, closing_joint, edge_joints, header, link_name
 from .tree import GROUND, Drawing, ExchangeError, Vec, actuated, drawing, not_carried, pair_loads
 from .xmltext import Document, num, nums, parse, text
@@ -250,7 +250,7 @@ class _UrdfReader:
         name = j.get("name", "").split(".")[0]
         if carriage is None and kind == "hinge":
             bodies = [body, child] if axis[2] > 0 else [child, body]
-            self.out.pair("revolute", name, *bodies, self.out.share(body, self.out.point(child, name, at)))
+            self.out.pair("revolute", name, bodies[0], bodies[1], self.out.share(body, self.out.point(child, name, at)))
         elif carriage is None:
             self.out.pair("prismatic", name, body, child, self.out.point(child, name, at), axis)
         elif (carriage[1], kind) == ("slide", "hinge"):  # the slot on the parent, the pin on the child
