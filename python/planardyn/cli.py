@@ -46,6 +46,7 @@ from . import (
     structure,
 )
 from .events import Crossing, parse_crossing
+from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .robot.cli_options import number
@@ -310,6 +311,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
+    exchange_commands(sub)
     return p
 
 
@@ -592,7 +594,8 @@ def _main(argv: list[str]) -> int:
         args = _parser().parse_args(argv)
         if getattr(args, "model", None) is not None:
             args.model = models.resolve(args.model)
-        code = COMMANDS[args.command](args)
+        code = getattr(args, "run", None) or COMMANDS[args.command]
+        code = code(args)
         sys.stdout.flush()
         return code
     except BrokenPipeError:
