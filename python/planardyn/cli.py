@@ -49,6 +49,7 @@ from .events import Crossing, parse_crossing
 from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
+from .robot.cli_options import number
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -172,21 +173,6 @@ def _setting(name: str) -> Callable[[str], float | int]:
     return parse
 
 
-def _within(low: float, high: float) -> Callable[[str], float]:
-    """An argparse type for a number in [low, high] (a finite one: nan and inf are refused)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{text} must be from {low:g} to {high:g}")
-        return value
-
-    return parse
-
-
 #: A frame rate or a playback speed given as 0 < value <= this is taken; beyond, refused.
 MAX_FPS = 240.0
 #: Resolution of plot images (dots per inch): 600 makes an 11 x 7 in figure about 100 MB.
@@ -283,7 +269,7 @@ def _parser() -> argparse.ArgumentParser:
                "  planardyn identify five-bar run.npz --validate other.npz -o identified.json")
     idf.add_argument("model", type=Path, help=MODEL_HELP)
     idf.add_argument("data", type=Path, help="measured motion: CSV table or results file")
-    idf.add_argument("--cutoff", type=_within(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
+    idf.add_argument("--cutoff", type=number(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
     idf.add_argument("--validate", type=Path, help="another measured motion: RMS effort error, identified vs model")
     idf.add_argument("-o", "--output", type=Path, help="write the identification as JSON")
 
@@ -296,7 +282,7 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz) written by planardyn")
     pl.add_argument("-o", "--output", type=Path, help="image to write (.png, .pdf, .svg); default RESULTS with .png")
     pl.add_argument("--torque-speed", action="store_true", help="plot drive effort against speed instead")
-    pl.add_argument("--dpi", type=_within(*DPI_RANGE), default=120,
+    pl.add_argument("--dpi", type=number(*DPI_RANGE), default=120,
                     help=f"resolution of raster images, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} (default 120)")
 
     a = _sub(sub, "animate", "animate a result: GIF, MP4 or an interactive HTML viewer",
@@ -310,9 +296,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="results file (.csv, .parquet or .npz), after the model it was computed with when "
                         "the file does not hold its model (files planardyn writes do)")
     a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
-    a.add_argument("--fps", type=_within(1e-3, MAX_FPS), default=20.0,
+    a.add_argument("--fps", type=number(1e-3, MAX_FPS), default=20.0,
                    help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
-    a.add_argument("--speed", type=_within(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
+    a.add_argument("--speed", type=number(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
