@@ -22,6 +22,7 @@ usage, file or model error. Errors are one message on stderr, never a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import importlib.util
 import json
@@ -29,12 +30,14 @@ import os
 import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
 from . import (
+    ArgumentError,
     AssemblyError,
+    DataError,
     Mechanism,
     PlanardynError,
     SimulationError,
@@ -48,6 +51,7 @@ from . import (
 from .events import Crossing, parse_crossing
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
+from .results_format import check_writable, writing
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -69,8 +73,12 @@ FIXED_STEP_METHODS = ("rk4",)
 
 
 def require_writer(path: Path | None) -> None:
-    """Refuse, before any computation, an output file whose optional package is missing."""
-    if path is None or path.suffix.lower() not in OPTIONAL_WRITERS:
+    """Refuse, before any computation, an output file that cannot be written (its directory
+    made, the cause in words) or whose optional package is missing."""
+    if path is None:
+        return
+    check_writable(path)
+    if path.suffix.lower() not in OPTIONAL_WRITERS:
         return
     module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
     if importlib.util.find_spec(module) is None:
@@ -393,8 +401,8 @@ def _simulate(args: argparse.Namespace) -> int:
     stops = {"events": [dataclasses.asdict(c) for c in args.stop_when]} if args.stop_when else {}
     res = attach_metadata(res, mech, dict(settings, motion=motion, **stops))
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        write_results(res, args.output)
+        with writing(args.output):
+            write_results(res, args.output)
     line = summary(res) + (f" -> {args.output}" if args.output is not None else "")
     print(line)
     if not res.success:
@@ -428,8 +436,8 @@ def _inverse(args: argparse.Namespace) -> int:
     mech = load(args.model)
     res = inverse_from_file(mech, args.motion)
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        write_results(res, args.output)
+        with writing(args.output):
+            write_results(res, args.output)
     peaks = ", ".join(
         f"|tau_{n}| <= {v:.4g} {u}" for n, v, u in zip(mech.coordinate_names, np.abs(res.tau).max(axis=0), mech.effort_units)
     )
@@ -459,12 +467,27 @@ def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
         return m["q"], m["qd"], m["qdd"], tau, m["x"]
     if cutoff is None:
         raise UsageError(f"{path}: no qd_/qdd_ columns: give --cutoff (Hz) to differentiate the positions")
-    q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
-    keep = inside(m["t"], cutoff)
-    if not keep.any():
-        raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at --cutoff "
-                         f"{cutoff:g} Hz: record longer or raise --cutoff")
-    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
+    with _about(path):
+        q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
+        keep = inside(m["t"], cutoff)
+        if not keep.any():
+            raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at "
+                             f"--cutoff {cutoff:g} Hz: record longer or raise --cutoff")
+        return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
+
+
+@contextlib.contextmanager
+def _about(path: Path) -> Iterator[None]:
+    """The errors of computing on a data file (its data, or an argument from an option) as
+    usage errors naming the file; the one option that reaches the computation, ``--cutoff``,
+    named as the user wrote it."""
+    try:
+        yield
+    except DataError as e:
+        raise UsageError(str(e) if getattr(e, "path", None) else f"{path}: {e}") from None
+    except ArgumentError as e:
+        text = f"--{e}" if getattr(e, "argument", None) == "cutoff" else str(e)
+        raise UsageError(f"{path}: {text}") from None
 
 
 def _identify(args: argparse.Namespace) -> int:
@@ -472,12 +495,16 @@ def _identify(args: argparse.Namespace) -> int:
 
     from .identify import identify
 
+    require_writer(args.output)
     mech = load(args.model)
-    found = identify(mech, *_measured(mech, args.data, args.cutoff))
+    measured = _measured(mech, args.data, args.cutoff)
+    with _about(args.data):
+        found = identify(mech, *measured)
     print(found.report())
     if args.validate is not None:
         q, qd, qdd, tau, x = _measured(mech, args.validate, args.cutoff)
-        Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+        with _about(args.validate):
+            Y, tau_o = mech.regressor(q, qd, qdd, x=x)
         rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
         ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
         prior = rms(Y @ np.array(list(mech.regressor_parameters.values())) + tau_o - tau)
@@ -487,8 +514,8 @@ def _identify(args: argparse.Namespace) -> int:
                "std_error": found.std_error.tolist(), "model": found.prior.tolist(),
                "parameters": {k: float(v) for k, v in found.pi.items()},
                "residual_rms": found.residual_rms.tolist(), "samples": found.samples}
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        args.output.write_text(json.dumps(out, indent=1))
+        with writing(args.output):
+            args.output.write_text(json.dumps(out, indent=1))
         print(f"wrote {args.output}")
     return EXIT_OK
 
@@ -500,8 +527,9 @@ def _plot(args: argparse.Namespace) -> int:
     from .plot import plot_results, plot_torque_speed
     from .results_io import read_results
 
-    res = read_results(args.results)
     out = args.output or args.results.with_suffix(".png")
+    require_writer(out)
+    res = read_results(args.results)
     if args.torque_speed:
         fig = Figure(figsize=(7, 5))
         FigureCanvasAgg(fig)
@@ -514,9 +542,9 @@ def _plot(args: argparse.Namespace) -> int:
         fig = Figure(figsize=(11, 7))
         FigureCanvasAgg(fig)
         plot_results(res, fig=fig)
-    out.parent.mkdir(parents=True, exist_ok=True)
     try:
-        fig.savefig(out, dpi=args.dpi)
+        with writing(out):
+            fig.savefig(out, dpi=args.dpi)
     except ValueError as e:  # matplotlib: an image format it does not write
         raise UsageError(f"{out}: {e}") from None
     print(f"wrote {out}")
@@ -546,7 +574,6 @@ def _animate(args: argparse.Namespace) -> int:
                          f"planardyn animate MODEL {results} -o {args.output}")
     else:
         mech = from_result(res)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
@@ -555,7 +582,8 @@ def _animate(args: argparse.Namespace) -> int:
         kw["progress"] = lambda done, total, bar=bar: bar(done / total)
     start = time.monotonic()
     try:
-        animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+        with writing(args.output):
+            animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
     finally:
         if bar is not None:
             bar.close()
@@ -569,7 +597,8 @@ def _demo(args: argparse.Namespace) -> int:
 
     out: Path = args.out
     print(f"planardyn demo: writing into {out}/")
-    demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
+    with writing(out):
+        demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
     print(f"open {out / 'robot.html'} and {out / 'passive.html'} in a browser to play the motions")
     return EXIT_OK if demo.success else EXIT_FAILED
 

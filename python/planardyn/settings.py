@@ -7,9 +7,10 @@ because the error scale is ``atol + rtol * |y_i|``: a state component that passe
 end in "NaN or infinity" instead of an answer. ``rtol`` is also at least :data:`MIN_RTOL`
 (below it the error test asks for more than double precision holds). ``max_steps`` is an integer in 1..=:data:`MAX_STEPS`.
 
-A value that breaks its rule raises what ``Mechanism.simulate`` raises for it: ValueError
-for ``t_end`` (an argument), :class:`~planardyn.SimulationError` for a solver option,
-TypeError for something that is not a number.
+A value that breaks its rule raises what ``Mechanism.simulate`` raises for it:
+:class:`~planardyn.ArgumentError` (a ValueError) for ``t_end`` (an argument),
+:class:`~planardyn.SimulationError` for a solver option, TypeError for something that is not
+a number.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import sys
 from typing import Any
 
 from ._core import SimulationError
+from .arguments import error
 
 #: Settings that are finite numbers > 0 (s, or dimensionless for the tolerances).
 POSITIVE = ("t_end", "rtol", "atol", "dt", "output_dt")
@@ -33,7 +35,7 @@ MAX_THREADS = 256
 
 
 def _error(name: str, text: str) -> Exception:
-    return ValueError(text) if name == "t_end" else SimulationError(f"invalid option: {text}")
+    return error(name, text) if name == "t_end" else SimulationError(f"invalid option: {text}")
 
 
 def positive(name: str, value: Any) -> float:
@@ -58,7 +60,7 @@ def count(name: str, value: Any, high: int) -> int:
     except TypeError:
         raise TypeError(f"{name} = {value!r} must be an integer, not {type(value).__name__}") from None
     if not 1 <= n <= high:
-        raise ValueError(f"{name} = {n} must be an integer from 1 to {high}")
+        raise error(name, f"{name} = {n} must be an integer from 1 to {high}")
     return n
 
 

@@ -3,7 +3,7 @@
 
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, IxDyn};
 use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use crate::errors::{argument_error, PlanardynError};
 use pyo3::prelude::*;
 
 /// An argument read as float64 values in C order, with its shape.
@@ -40,7 +40,7 @@ fn shape_str(shape: &[usize]) -> String {
 pub fn vector(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize, what: &str) -> PyResult<Vec<f64>> {
     let v = Values::read(a);
     if v.shape != [len] {
-        return Err(PyValueError::new_err(format!(
+        return Err(argument_error(Some(name), format!(
             "{name} must have shape ({len},) ({what}), got shape {}",
             shape_str(&v.shape)
         )));
@@ -58,7 +58,7 @@ pub fn rows(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize
         _ => false,
     };
     if !ok {
-        return Err(PyValueError::new_err(format!(
+        return Err(argument_error(Some(name), format!(
             "{name} must have shape ({len},) or (N, {len}) ({what}), got shape {}",
             shape_str(&v.shape)
         )));
@@ -69,7 +69,7 @@ pub fn rows(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize
 
 pub fn finite(name: &str, data: &[f64]) -> PyResult<()> {
     match data.iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(PyValueError::new_err(format!("{name}[{i}] = {} is not a finite number", data[i]))),
+        Some(i) => Err(argument_error(Some(name), format!("{name}[{i}] = {} is not a finite number", data[i]))),
         None => Ok(()),
     }
 }
@@ -80,17 +80,17 @@ pub fn arr1<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
 
 /// An (rows, cols) array from row-major data.
 pub fn arr2<'py>(py: Python<'py>, rows: usize, cols: usize, v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let a = Array2::from_shape_vec((rows, cols), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = Array2::from_shape_vec((rows, cols), v).map_err(|e| PlanardynError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any())
 }
 
 pub fn arr3<'py>(py: Python<'py>, shape: (usize, usize, usize), v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let a = Array3::from_shape_vec(shape, v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = Array3::from_shape_vec(shape, v).map_err(|e| PlanardynError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any())
 }
 
 pub fn arr_dyn<'py>(py: Python<'py>, shape: &[usize], v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| PlanardynError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any())
 }
 

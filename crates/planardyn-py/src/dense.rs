@@ -2,9 +2,9 @@
 //! `simulate::DenseOutput`), called with times to give q and qd there.
 
 use crate::convert::{arr1, arr2, Values};
+use crate::errors::argument_error;
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::simulate::DenseOutput;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 #[pyclass(frozen, module = "planardyn._core", name = "DenseOutput")]
@@ -22,7 +22,7 @@ impl PyDenseOutput {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let v = Values::read(&t);
         if v.shape.len() > 1 {
-            return Err(PyValueError::new_err(format!(
+            return Err(argument_error(Some("t"), format!(
                 "sol(t) takes a time or a 1-D array of times, got shape {:?}",
                 v.shape
             )));
@@ -32,7 +32,7 @@ impl PyDenseOutput {
         for (k, &tk) in v.data.iter().enumerate() {
             self.inner
                 .eval(tk, &mut q[k * m..(k + 1) * m], &mut qd[k * m..(k + 1) * m])
-                .map_err(|e| PyValueError::new_err(format!("sol(t): {e}")))?;
+                .map_err(|e| argument_error(Some("t"), format!("sol(t): {e}")))?;
         }
         if v.shape.is_empty() {
             return Ok((arr1(py, q), arr1(py, qd)));

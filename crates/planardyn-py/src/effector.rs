@@ -4,7 +4,7 @@
 //! drawing.
 
 use crate::convert::{arr1, arr2, finite, rows, vector, Values};
-use crate::errors::{effector_error, run, task_error, Failure};
+use crate::errors::{argument_error, effector_error, run, task_error, Failure};
 use crate::mechanism::PyMechanism;
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::dynamics::task::{self, TaskPath, TaskSolution};
@@ -12,7 +12,6 @@ use planardyn::kinematics::constraints::coordinates;
 use planardyn::kinematics::effector::{Effector, EffectorState};
 use planardyn::kinematics::{self as kin};
 use planardyn::{Mechanism, Workspace};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
@@ -94,7 +93,7 @@ impl PyEffector {
     #[pyo3(signature = (mech, point, body=None))]
     fn new(mech: &Bound<'_, PyMechanism>, point: &str, body: Option<&str>) -> PyResult<Self> {
         let mech = mech.get().inner.clone();
-        let ee = Effector::new(&mech, point, body).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let ee = Effector::new(&mech, point, body).map_err(|e| argument_error(Some("point"), e.to_string()))?;
         Ok(PyEffector { mech, ee })
     }
 
@@ -155,7 +154,7 @@ impl PyEffector {
     fn measures(&self, jt: ArrayArg<'_>) -> PyResult<(f64, f64)> {
         let v = Values::read(&jt);
         if v.shape != [self.ee.dim, self.m()] {
-            return Err(PyValueError::new_err(format!(
+            return Err(argument_error(Some("jt"), format!(
                 "J must have shape ({}, {}), got {:?}",
                 self.ee.dim,
                 self.m(),

@@ -5,7 +5,7 @@
 //! GIL is released while the core computes.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
-use crate::errors::{run, Failure};
+use crate::errors::{argument_error, run, Failure, PlanardynError};
 use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
@@ -14,7 +14,6 @@ use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::{CoordinateKind, Link, PairId};
 use planardyn::{Error, Mechanism, Workspace};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
@@ -95,7 +94,7 @@ impl PyMechanism {
         if let Some(xd) = &xd {
             if x.as_ref().map(|x| &x.shape) != Some(&xd.shape) {
                 let x_shape = x.as_ref().map(|x| format!("{:?}", x.shape)).unwrap_or_else(|| "none".into());
-                return Err(PyValueError::new_err(format!(
+                return Err(argument_error(Some("xd"), format!(
                     "xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}",
                     xd.shape
                 )));
@@ -104,7 +103,7 @@ impl PyMechanism {
         let (m, what) = (self.m(), self.coords_what());
         let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
         if qd.shape != q.shape || qdd.shape != q.shape {
-            return Err(PyValueError::new_err(format!(
+            return Err(argument_error(None, format!(
                 "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
                 q.shape, qd.shape, qdd.shape
             )));
@@ -608,7 +607,7 @@ impl PyMechanism {
         };
         let (qd, tau) = (rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
         if qd.shape != tau.shape {
-            return Err(PyValueError::new_err(format!(
+            return Err(argument_error(Some("tau"), format!(
                 "qd and tau must have the same shape, got {:?} and {:?}",
                 qd.shape, tau.shape
             )));
@@ -659,7 +658,7 @@ impl PyMechanism {
         speed: ArrayArg<'py>,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
         let Some(slot) = dynamics::transmission::motors(&self.inner).nth(coordinate) else {
-            return Err(PyValueError::new_err(format!(
+            return Err(argument_error(Some("coordinate"), format!(
                 "actuator {coordinate} out of range: the model has {} actuators",
                 dynamics::redundant::n_actuators(&self.inner)
             )));
@@ -699,7 +698,7 @@ impl PyMechanism {
             ("min_max", None) => Distribution::MinMax,
             ("preload", Some(p)) => Distribution::Preload(p),
             _ => {
-                return Err(PyValueError::new_err(format!(
+                return Err(argument_error(Some("method"), format!(
                     "method {method:?}: use \"min_norm\", \"min_max\", or \"preload\" with preload=[one value \
                      per internal force] (and preload only with it)"
                 )))
@@ -852,7 +851,7 @@ impl PyMechanism {
         let what = "body coordinates [X, Y, phi] per body";
         let (x, xd, xdd) = (rows("x", &x, nx, what)?, rows("xd", &xd, nx, what)?, rows("xdd", &xdd, nx, what)?);
         if xd.data.len() != x.data.len() || xdd.data.len() != x.data.len() {
-            return Err(PyValueError::new_err(format!(
+            return Err(argument_error(None, format!(
                 "x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}",
                 x.shape, xd.shape, xdd.shape
             )));
@@ -922,7 +921,7 @@ impl PyMechanism {
             .map(|a| {
                 let v = Values::read(&a);
                 if v.shape.len() != 1 {
-                    return Err(PyValueError::new_err(format!(
+                    return Err(argument_error(Some("t_eval"), format!(
                         "t_eval must be 1-D (output times in s), got shape {:?}",
                         v.shape
                     )));
@@ -975,12 +974,12 @@ fn check_time(t: f64) -> PyResult<()> {
     if t.is_finite() {
         Ok(())
     } else {
-        Err(PyValueError::new_err(format!("t = {t} must be a finite time (s)")))
+        Err(argument_error(Some("t"), format!("t = {t} must be a finite time (s)")))
     }
 }
 
 fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
-    serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
+    serde_json::to_string(&mech.spec).map_err(|e| PlanardynError::new_err(format!("cannot write the model as JSON: {e}")))
 }
 
 /// A motion's q, qd, qdd rows and the optional body coordinates x and rates xd of its rows.
