@@ -253,17 +253,18 @@ def _read_npz(path: Path) -> tuple[dict[str, Any], dict[str, FloatArray]]:
     rows = meta.get("rows")
     if rows is not None and n_t != rows:
         raise Damaged(_rows_message(n_t or 0, rows))
+    return meta, _checked(meta, groups, layout, n_t or 0)
+
+
+def _checked(meta: dict[str, Any], groups: dict[str, FloatArray], layout: list[tuple[str, int]],
+             n_t: int) -> dict[str, FloatArray]:
+    """The arrays, once their checksum, taken over their rows in file order CSV_BLOCK rows
+    at a time, is the metadata's."""
     crc = checksum_start(meta)
-    for block in _row_blocks(groups, layout, n_t or 0):
-        crc = checksum_rows(block, crc)
-    _check_sum(meta, crc)
-    return meta, groups
-
-
-def _row_blocks(groups: dict[str, FloatArray], layout: list[tuple[str, int]], n_t: int) -> Iterator[FloatArray]:
-    """The arrays' rows in file order, CSV_BLOCK rows at a time (for the checksum)."""
     for start in range(0, n_t, CSV_BLOCK):
-        yield np.hstack([groups[g][start:start + CSV_BLOCK] for g, _ in layout])
+        crc = checksum_rows(np.hstack([groups[g][start:start + CSV_BLOCK] for g, _ in layout]), crc)
+    _check_sum(meta, crc)
+    return groups
 
 
 def _member(z: Any, name: str) -> NDArray[Any]:
@@ -276,23 +277,39 @@ def _member(z: Any, name: str) -> NDArray[Any]:
         raise Damaged(f"array {name!r} is damaged ({e})") from None
 
 
-# ------------------------------------------------------------------ Parquet: batches of rows
+# ------------------------------------------------------------------ Parquet: one column at a time
 
 
 def _read_parquet(path: Path) -> tuple[dict[str, Any], dict[str, FloatArray]]:
-    _, pq = _pyarrow()
+    pa, pq = _pyarrow()
     f = pq.ParquetFile(path)
     raw = (f.schema_arrow.metadata or {}).get(b"planardyn")
     meta = check_meta(_json(raw) if raw else None)
-    _check_header(meta, f.schema_arrow.names)
-    rows = f.metadata.num_rows
-    if meta.get("rows") is not None and rows != meta["rows"]:
-        raise Damaged(_rows_message(rows, meta["rows"]))
-    arrays = _Arrays(meta, rows)
-    for batch in f.iter_batches(batch_size=CSV_BLOCK):
-        arrays.add(np.column_stack([c.to_numpy(zero_copy_only=False).astype(np.float64) for c in batch.columns])
-                   if batch.num_columns else np.empty((batch.num_rows, 0)))
-    return meta, arrays.done()
+    names = f.schema_arrow.names
+    _check_header(meta, names)
+    n_t = f.metadata.num_rows
+    if meta.get("rows") is not None and n_t != meta["rows"]:
+        raise Damaged(_rows_message(n_t, meta["rows"]))
+    layout = [(g, int(k)) for g, k in meta["layout"]]
+    groups = {g: np.empty((n_t, k)) for g, k in layout}
+    col = iter(names)
+    for g, k in layout:  # a column decompressed at a time, straight into its array
+        for j in range(k):
+            start = 0
+            name = next(col)
+            for chunk in f.read(columns=[name]).column(0).chunks:
+                groups[g][start:start + len(chunk), j] = _floats(pa, chunk, name)
+                start += len(chunk)
+    return meta, _checked(meta, groups, layout, n_t)
+
+
+def _floats(pa: Any, chunk: Any, name: str) -> FloatArray:
+    """A Parquet column's chunk as float64 values, a view of its buffer (pyarrow's own
+    ``to_numpy`` imports pandas, 30 MB and a second, for every read)."""
+    if chunk.null_count:
+        raise Damaged(f"column {name!r} has {chunk.null_count} missing values")
+    values = chunk.cast(pa.float64())
+    return np.frombuffer(values.buffers()[1], dtype="<f8", count=len(values), offset=values.offset * 8)
 
 
 # ------------------------------------------------------------------ CSV: blocks of lines
