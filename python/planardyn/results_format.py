@@ -103,7 +103,7 @@ def pyarrow() -> tuple[Any, Any]:
 
 #: Why a file could not be written, in words, by errno.
 WRITE_CAUSES = {
-    errno.ENOENT: "its directory does not exist",
+    errno.ENOENT: "its directory does not exist (and could not be made)",
     errno.EACCES: "permission denied",
     errno.EPERM: "permission denied",
     errno.EROFS: "the file system is read-only",
@@ -129,6 +129,8 @@ def write_error(path: str | os.PathLike[str], e: OSError) -> WriteError:
     if e.errno in (errno.EEXIST, errno.ENOTDIR):  # a part of the directory is a file
         blocking = next((p for p in reversed(path.parents) if p.exists() and not p.is_dir()), path.parent)
         cause = f"{blocking} is a file, not a directory"
+    elif e.errno == errno.ENOENT and path.parent.is_dir():  # /proc, /sys: no new files there
+        cause = f"{path.parent} does not take new files"
     else:
         cause = WRITE_CAUSES.get(e.errno or 0, e.strerror or str(e))
     return WriteError(e.errno, f"cannot write {path}: {cause}")
