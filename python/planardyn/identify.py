@@ -238,8 +238,8 @@ def identify(
     names = mech.coordinate_names
     q = array("q", q, ndim=2, what="rows of coordinates, rad or m")
     n = len(q)
-    q, qd, qdd, tau = (samples(k, v, n, m, columns=names) for k, v in
-                       (("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)))
+    q, qd, qdd, tau = (samples(k, v, n, m, columns=[f"{prefix}{c}" for c in names]) for k, v, prefix in
+                       (("q", q, ""), ("qd", qd, "qd_"), ("qdd", qdd, "qdd_"), ("tau", tau, "tau_")))
     Y, tau_o = mech.regressor(q, qd, qdd, x=x)
     Wb = Y[..., base.independent]  # (N, m, r)
     rhs = tau - tau_o
