@@ -113,7 +113,8 @@ def array(name: str, value: Any, ndim: int | tuple[int, ...] | None = None,
     wrong = (dims is not None and a.ndim not in dims) or (shape is not None and (
         a.ndim != len(shape) or any(s is not None and s != k for s, k in zip(shape, a.shape))))
     if wrong:
-        want = "x".join("N" if s is None else str(s) for s in shape) if shape is not None else f"{ndim}-D"
+        want = (", ".join("N" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "")
+                if shape is not None else " or ".join(f"{d}-D" for d in (dims or ())))
         raise error(name, f"{name} must have shape ({want}){_unit(what)}, got shape {a.shape}")
     bad = np.argwhere(~np.isfinite(a))
     if len(bad):
@@ -152,6 +153,23 @@ def samples(name: str, value: Any, n: int, m: int | None = None, what: str = "",
         raise error(name, f"{name} must have shape ({n}, {'m' if m is None else m}) (a row per time, a column "
                           f"per coordinate), got shape {a.shape}")
     return a
+
+
+def finite_rates(q: FloatArray, t: FloatArray, *rates: FloatArray) -> None:
+    """Refuse a sampled motion q(t) (N, m) whose slopes between samples, or ``rates``
+    differentiated from it, overflow, naming q and t: samples too large or too close for
+    floating point (before a spline is fitted, which would raise its own error)."""
+    with np.errstate(all="ignore"):
+        slopes = np.diff(q, axis=0) / np.diff(t).reshape((-1,) + (1,) * (q.ndim - 1))
+    if not all(np.isfinite(r).all() for r in (slopes, *rates)):
+        raise rates_overflow(q, t)
+
+
+def rates_overflow(q: FloatArray, t: FloatArray) -> ArgumentError:
+    """The error of a sampled motion q(t) whose rates overflow (a spline's refusal too)."""
+    return error("q", f"the rates of q (largest |q| {np.abs(q).max():.3g}) over t (steps from "
+                      f"{np.diff(t).min():.3g} s, times to {np.abs(t).max():.3g} s) overflow: give q and t in SI "
+                      "units of a physical size")
 
 
 def limits(name: str, value: Any, m: int, unit: str = "") -> FloatArray | None:

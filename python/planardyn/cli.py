@@ -381,6 +381,10 @@ def _simulate(args: argparse.Namespace) -> int:
                          "or dt in the model file's simulate section), or choose an adaptive method (--method dopri5)")
     require_writer(args.output)
     motion = _speeds(args.speed, mech)
+    for c in args.stop_when:
+        if c.coordinate not in mech.coordinate_names:
+            raise UsageError(f"--stop-when {c.coordinate}...: give NAME=VALUE with NAME one of "
+                             f"{', '.join(mech.coordinate_names)}")
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
         refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
@@ -490,6 +494,19 @@ def _about(path: Path) -> Iterator[None]:
         raise UsageError(f"{path}: {text}") from None
 
 
+@contextlib.contextmanager
+def _options(options: dict[str, str]) -> Iterator[None]:
+    """An ArgumentError of an API argument that an option gave, as a usage error naming the
+    option (``options``: argument name -> option)."""
+    try:
+        yield
+    except ArgumentError as e:
+        option = options.get(getattr(e, "argument", None) or "")
+        if option is None:
+            raise
+        raise UsageError(f"{option}: {e}") from None
+
+
 def _identify(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -498,11 +515,13 @@ def _identify(args: argparse.Namespace) -> int:
     require_writer(args.output)
     mech = load(args.model)
     measured = _measured(mech, args.data, args.cutoff)
+    # Both records read before the identification: a bad --validate is refused at once.
+    validation = None if args.validate is None else _measured(mech, args.validate, args.cutoff)
     with _about(args.data):
         found = identify(mech, *measured)
     print(found.report())
-    if args.validate is not None:
-        q, qd, qdd, tau, x = _measured(mech, args.validate, args.cutoff)
+    if validation is not None:
+        q, qd, qdd, tau, x = validation
         with _about(args.validate):
             Y, tau_o = mech.regressor(q, qd, qdd, x=x)
         rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
@@ -582,7 +601,7 @@ def _animate(args: argparse.Namespace) -> int:
         kw["progress"] = lambda done, total, bar=bar: bar(done / total)
     start = time.monotonic()
     try:
-        with writing(args.output):
+        with writing(args.output), _options({"traces": "--trace", "channels": "--channel"}):
             animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
     finally:
         if bar is not None:
@@ -596,6 +615,8 @@ def _demo(args: argparse.Namespace) -> int:
     from .demo import run
 
     out: Path = args.out
+    if args.model is not None and not Path(args.model).is_file():
+        raise UsageError(f"--model {args.model}: not a model file (a file, or a shipped model's name)")
     print(f"planardyn demo: writing into {out}/")
     with writing(out):
         demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
@@ -634,7 +655,10 @@ def _main(argv: list[str]) -> int:
             return plan_cli(argv[1:])
         args = _parser().parse_args(argv)
         if getattr(args, "model", None) is not None:
-            args.model = models.resolve(args.model)
+            try:
+                args.model = models.resolve(args.model)
+            except models.UnknownModelError as e:  # demo's model is an option, the others' an argument
+                raise UsageError(f"--model {e}" if args.command == "demo" else str(e)) from None
         code = COMMANDS[args.command](args)
         sys.stdout.flush()
         return code

@@ -21,7 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import PlanardynError
-from .arguments import array, count, data_error, error, limits, positive, samples, times
+from .arguments import (array, count, data_error, error, finite_rates, limits, positive, rates_overflow, samples,
+                        times)
 from .mechanism import Mechanism
 
 FloatArray = NDArray[np.float64]
@@ -42,6 +43,9 @@ INFEASIBLE = 1e12
 #: without noise): its weight in the second pass is capped there instead of growing without
 #: bound (an exact zero would make it infinite and the estimate NaN).
 RESIDUAL_FLOOR = 1e-12
+#: A motion this many times past its limits is as bad as any: the excitation's cost of a
+#: larger excess (or an infinite one) is that of this one.
+EXCESS_CAP = 1e6
 #: Most harmonics of an excitation: its reach is checked on 1000 points per harmonic, and
 #: Powell's search has 2 m harmonics coefficients to tune; beyond a few tens neither pays.
 MAX_HARMONICS = 50
@@ -51,6 +55,11 @@ FILTER_ORDER = 4
 #: 3 (2 sections + 1) samples (its default ``padlen`` for ``FILTER_ORDER // 2`` sections) and
 #: needs more rows than that.
 MIN_FILTER_ROWS = 3 * (2 * (FILTER_ORDER // 2) + 1) + 1
+#: Lowest cutoff over half the sampling rate: the sections' denominators differ from a double
+#: pole at 1 by about (pi cutoff / (fs / 2))^2, which below this nears round-off (the
+#: filter's start-up solve turns singular; measured: the output drifts by 1e-4 at 1e-7 and
+#: 10 % at 1e-8, and scipy raises at 1e-300).
+MIN_CUTOFF_RATIO = 1e-6
 
 
 @dataclass(frozen=True)
@@ -102,7 +111,11 @@ class BaseParameters:
                                   "(Mechanism.regressor_parameters lists them)")
             pi = [pi[n] for n in self.parameters]
         p = array("pi", pi, shape=(len(self.parameters),), what="one value per parameter")
-        return p[self.independent] + self.K @ p[self.dependent]
+        beta = p[self.independent] + self.K @ p[self.dependent]
+        if not np.isfinite(beta).all():
+            raise error("pi", f"pi's values (largest {np.abs(p).max():.3g}) overflow in the base parameters' sums: "
+                              "give them in SI units of a physical size")
+        return beta
 
 
 def sample_states(mech: Mechanism, n: int = 200, seed: int = 0) -> tuple[FloatArray, ...]:
@@ -253,6 +266,9 @@ def identify(
     beta, variance = _least_squares(Ww, rw)
     s2 = float(np.sum((rw - Ww @ beta) ** 2) / (n * m - r))
     std = np.sqrt(s2 * variance)
+    if not (np.isfinite(beta).all() and np.isfinite(std).all()):
+        raise error("tau", f"tau: the efforts (largest {np.abs(tau).max():.3g}) overflow the least-squares sums: "
+                           "give them in N m or N")
     prior_pi = np.array(list(mech.regressor_parameters.values()))
     resid = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0))
     pi = _consistent(base, beta, prior_pi, mech.n_bodies)
@@ -332,10 +348,16 @@ def differentiate(t: ArrayLike, q: ArrayLike, cutoff: float) -> tuple[FloatArray
     both sides keeps the equations), and keep the rows :func:`inside` the record."""
     from scipy.interpolate import CubicSpline
 
-    qf = lowpass(t, q, cutoff)
-    t = np.asarray(t, float)
-    spline = CubicSpline(t, qf, axis=0)
-    return qf, spline(t, 1), spline(t, 2)
+    t = times("t", t, least=MIN_FILTER_ROWS, why="the zero-phase filter's padding at both ends needs them")
+    qf = lowpass(t, samples("q", q, len(t), what="rad or m"), cutoff)
+    finite_rates(qf, t)
+    try:
+        spline = CubicSpline(t, qf, axis=0)
+    except ValueError:  # scipy's refusal of its own overflow
+        raise rates_overflow(qf, t) from None
+    qd, qdd = spline(t, 1), spline(t, 2)
+    finite_rates(qf, t, qd, qdd)
+    return qf if np.ndim(q) == 2 else qf[:, 0], qd, qdd
 
 
 #: The filter's edge transients spoil about this many periods of the cutoff at each end of
@@ -366,9 +388,17 @@ def lowpass(t: ArrayLike, v: ArrayLike, cutoff: float) -> FloatArray:
     if not cutoff < fs / 2:
         raise error("cutoff", f"cutoff = {cutoff:g} Hz must be below half the sampling rate ({fs / 2:g} Hz): "
                               "a lower cutoff, or a record sampled faster")
+    if cutoff < MIN_CUTOFF_RATIO * fs / 2:
+        raise error("cutoff", f"cutoff = {cutoff:g} Hz is too far below half the sampling rate ({fs / 2:g} Hz; at "
+                              f"least {MIN_CUTOFF_RATIO:g} of it) for the filter: a higher cutoff, or a record "
+                              "sampled slower")
     # Second-order sections: the transfer-function form loses digits at low cutoffs.
     sos = butter(FILTER_ORDER, cutoff / (fs / 2), output="sos")
-    return np.asarray(sosfiltfilt(sos, v, axis=0), dtype=np.float64)
+    out = np.asarray(sosfiltfilt(sos, v, axis=0), dtype=np.float64)
+    if not np.isfinite(out).all():
+        raise error("v", f"v's values (largest {np.abs(v).max():.3g}) overflow in the filter: give them in SI units "
+                         "of a physical size")
+    return out
 
 
 @dataclass(frozen=True)
@@ -389,7 +419,9 @@ class Excitation:
 
     def sample(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, qd, qdd (N, m) at times t (N,) (s)."""
-        t = np.atleast_1d(array("t", t, ndim=(0, 1), what="times in s"))
+        # Reduced to one period (exact in floating point): the motion repeats, and a phase
+        # l w t of a time far out would overflow.
+        t = np.mod(np.atleast_1d(array("t", t, ndim=(0, 1), what="times in s")), self.period)
         w = 2 * np.pi / self.period
         ell = np.arange(1, self.a.shape[1] + 1)
         s, c = np.sin(np.outer(t, ell * w)), np.cos(np.outer(t, ell * w))
@@ -455,27 +487,38 @@ def excitation(mech: Mechanism, period: float = 1.0, harmonics: int = 3, amplitu
         exc = make(z)
         q_fine, qd_fine, _ = exc.sample(fine)
         excess = max(float(np.max(np.abs(q_fine - q0) / reach)) - 1.0, limits.speed_excess(qd_fine))
-        if excess > 0.0:
-            return INFEASIBLE * (1.0 + excess)
+        if not excess <= 0.0:
+            return _penalty(excess)
         q, qd, qdd = exc.sample(t)
         try:
             Y, tau_o = mech.regressor(q, qd, qdd)
             excess = max(limits.effort_excess(Y, tau_o), limits.sigma_excess(q))
         except PlanardynError:  # not assembled, or too near a singularity
             return INFEASIBLE * 2.0
-        if excess > 0.0:
-            return INFEASIBLE * (1.0 + excess)
+        if not excess <= 0.0:
+            return _penalty(excess)
         W = Y[..., base.independent].reshape(-1, base.rank)
         W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
-        return float(np.linalg.cond(W))
+        return min(float(np.linalg.cond(W)), INFEASIBLE)  # a singular W excites too little: no better
 
     z0 = np.zeros(2 * m * harmonics)
     z0[::harmonics][:m] = 0.5
     start = cost(z0)
     out = minimize(cost, z0, method="Powell", options={"maxfev": max_evaluations, "xtol": 1e-3, "ftol": 1e-4})
-    best = out.x if out.fun < start else z0
+    best, condition = (out.x, float(out.fun)) if out.fun < start else (z0, start)
+    if not condition < INFEASIBLE:
+        raise PlanardynError(f"no motion found within the limits in {out.nfev} evaluations (the best breaks them, "
+                             "cannot be assembled, or excites too few base parameters): loosen tau_max, qd_max or "
+                             "sigma_margin, change the amplitude, or allow more harmonics or max_evaluations")
     exc = make(best, start)
-    return Excitation(exc.q0, period, exc.a, exc.b, min(float(out.fun), start), start)
+    return Excitation(exc.q0, period, exc.a, exc.b, condition, start)
+
+
+def _penalty(excess: float) -> float:
+    """The cost of a motion past its limits by ``excess`` (its worst relative excess; NaN
+    counts as far past): ``INFEASIBLE`` (1 + excess), the excess capped at EXCESS_CAP so that
+    the cost stays finite for Powell's line searches."""
+    return INFEASIBLE * (1.0 + (min(excess, EXCESS_CAP) if excess == excess else EXCESS_CAP))
 
 
 class _Limits:

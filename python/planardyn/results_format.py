@@ -145,7 +145,7 @@ def writing(path: str | os.PathLike[str], make_directory: bool = True) -> Iterat
         if make_directory:
             path.parent.mkdir(parents=True, exist_ok=True)
         yield path
-    except WriteError:
+    except (WriteError, BrokenPipeError):  # a closed stdout is not the file's failure
         raise
     except OSError as e:
         raise write_error(path, e) from None

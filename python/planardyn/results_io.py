@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import SingularityError
-from .arguments import data_error, samples, times
+from .arguments import data_error, finite_rates, rates_overflow, samples, times
 from .mechanism import Mechanism, attach_metadata
 from .result import Energy, SimulationResult
 from .results_format import FORMAT
@@ -215,18 +215,23 @@ def motion_derivatives(
     t = times("t", t)
     q = samples("q", q, len(t), what="rad or m")
     m = q.shape[1]
+    finite_rates(q, t)
     qd_columns = qd_columns or [None] * m
     qdd_columns = qdd_columns or [None] * m
     qd, qdd = np.empty_like(q), np.empty_like(q)
     for k in range(m):
-        sq = CubicSpline(t, q[:, k])
-        if qd_columns[k] is not None:
-            qd[:, k] = qd_columns[k]
-            second = CubicSpline(t, qd[:, k])(t, 1)
-        else:
-            qd[:, k] = sq(t, 1)
-            second = sq(t, 2)
+        try:
+            sq = CubicSpline(t, q[:, k])
+            if qd_columns[k] is not None:
+                qd[:, k] = qd_columns[k]
+                second = CubicSpline(t, qd[:, k])(t, 1)
+            else:
+                qd[:, k] = sq(t, 1)
+                second = sq(t, 2)
+        except ValueError:  # scipy's refusal of its own overflow
+            raise rates_overflow(q, t) from None
         qdd[:, k] = qdd_columns[k] if qdd_columns[k] is not None else second
+    finite_rates(q, t, qd, qdd)
     return qd, qdd
 
 

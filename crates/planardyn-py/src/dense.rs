@@ -1,9 +1,8 @@
 //! `planardyn._core.DenseOutput`: a run's continuous solution (the core's
 //! `simulate::DenseOutput`), called with times to give q and qd there.
 
-use crate::convert::{arr1, arr2, Values};
+use crate::convert::{arr1, arr2, Floats, Values};
 use crate::errors::argument_error;
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::simulate::DenseOutput;
 use pyo3::prelude::*;
 
@@ -15,17 +14,13 @@ pub struct PyDenseOutput {
 #[pymethods]
 impl PyDenseOutput {
     /// (q, qd) at time(s) t (s): (m,) each for a number, (K, m) each for (K,) times.
-    fn __call__<'py>(
-        &self,
-        py: Python<'py>,
-        t: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    fn __call__<'py>(&self, py: Python<'py>, t: Floats<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let v = Values::read(&t);
         if v.shape.len() > 1 {
-            return Err(argument_error(Some("t"), format!(
-                "sol(t) takes a time or a 1-D array of times, got shape {:?}",
-                v.shape
-            )));
+            return Err(argument_error(
+                Some("t"),
+                format!("sol(t) takes a time or a 1-D array of times, got shape {:?}", v.shape),
+            ));
         }
         let m = self.inner.m;
         let (mut q, mut qd) = (vec![0.0; v.data.len() * m], vec![0.0; v.data.len() * m]);

@@ -3,10 +3,9 @@
 //! its own `Workspace`, started at the body coordinates `x_start` when given, else at the
 //! drawing.
 
-use crate::convert::{arr1, arr2, finite, rows, vector, Values};
+use crate::convert::{arr1, arr2, finite, rows, vector, Floats, Values};
 use crate::errors::{argument_error, effector_error, run, task_error, Failure};
 use crate::mechanism::PyMechanism;
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::dynamics::task::{self, TaskPath, TaskSolution};
 use planardyn::kinematics::constraints::coordinates;
 use planardyn::kinematics::effector::{Effector, EffectorState};
@@ -16,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
 
-type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+type ArrayArg<'py> = Floats<'py>;
 
 /// A point of a body (k = 2) or its body's pose (k = 3) as task coordinates.
 #[pyclass(frozen, module = "planardyn._core", name = "Effector")]
@@ -154,12 +153,10 @@ impl PyEffector {
     fn measures(&self, jt: ArrayArg<'_>) -> PyResult<(f64, f64)> {
         let v = Values::read(&jt);
         if v.shape != [self.ee.dim, self.m()] {
-            return Err(argument_error(Some("jt"), format!(
-                "J must have shape ({}, {}), got {:?}",
-                self.ee.dim,
-                self.m(),
-                v.shape
-            )));
+            return Err(argument_error(
+                Some("jt"),
+                format!("J must have shape ({}, {}), got {:?}", self.ee.dim, self.m(), v.shape),
+            ));
         }
         Ok(self.ee.measures(&v.data))
     }

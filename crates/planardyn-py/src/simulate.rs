@@ -29,7 +29,9 @@ pub(crate) const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
 fn settings(mech: &Mechanism, a: &Overrides) -> Result<Settings, Failure> {
     if let Some(t_end) = a.t_end {
         if !(t_end.is_finite() && t_end > 0.0) {
-            return Err(argument_error(Some("t_end"), format!("t_end = {t_end} must be a finite time after t0 = 0 s")).into());
+            return Err(
+                argument_error(Some("t_end"), format!("t_end = {t_end} must be a finite time after t0 = 0 s")).into()
+            );
         }
     }
     Ok(a.settings(mech)?)
@@ -170,14 +172,16 @@ pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) 
     motion
         .into_iter()
         .map(|(k, arg)| {
-            let name = names.get(k).ok_or_else(|| argument_error(Some("motion"), format!("motion: no coordinate {k}")))?;
+            let name =
+                names.get(k).ok_or_else(|| argument_error(Some("motion"), format!("motion: no coordinate {k}")))?;
             let entry = match arg {
                 MotionArg::Speed(w) if w.is_finite() => MotionEntry::Law(MotionLaw::Speed(w)),
                 MotionArg::Speed(w) => {
                     return Err(argument_error(Some("motion"), format!("motion of '{name}': speed {w} must be finite")))
                 }
                 MotionArg::Table(t, q) => MotionEntry::Law(MotionLaw::Table(
-                    Spline::new(&t, &q).map_err(|e| argument_error(Some("motion"), format!("motion table of '{name}': {e}")))?,
+                    Spline::new(&t, &q)
+                        .map_err(|e| argument_error(Some("motion"), format!("motion table of '{name}': {e}")))?,
                 )),
                 MotionArg::Function(f) => MotionEntry::Function(PyMotion { f, name: name.to_string(), fatal: None }),
             };

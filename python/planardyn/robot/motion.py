@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from ..arguments import error
 from .effector import EndEffector
 from .paths import TaskPath
 from .tolerances import SINGULAR_TOL
@@ -109,7 +110,7 @@ def _sample_times(duration: float, n: int | None, dt: float | None) -> FloatArra
     if n is None:
         n = int(np.ceil(duration / (dt or DEFAULT_DT))) + 1
     if n < 2:
-        raise ValueError(f"a motion needs at least 2 samples, got n = {n}")
+        raise error("n", f"a motion needs at least 2 samples, got n = {n}")
     return np.linspace(0.0, duration, n)
 
 
