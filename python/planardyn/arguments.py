@@ -29,7 +29,7 @@ FloatArray = NDArray[np.float64]
 def error(name: str | None, message: str) -> ArgumentError:
     """An ``ArgumentError`` with ``message`` for argument ``name`` (its attribute ``argument``)."""
     e = ArgumentError(message)
-    e.argument = name  # type: ignore[attr-defined]
+    e.argument = name
     return e
 
 
@@ -37,7 +37,7 @@ def data_error(path: Any, message: str) -> DataError:
     """A ``DataError`` with ``message``, prefixed by the file's name ``path`` (None: data
     given as arrays), its attribute ``path``."""
     e = DataError(message if path is None else f"{path}: {message}")
-    e.path = None if path is None else str(path)  # type: ignore[attr-defined]
+    e.path = None if path is None else str(path)
     return e
 
 

@@ -21,8 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import PlanardynError
-from .arguments import (array, count, data_error, error, finite_rates, limits, positive, rates_overflow, samples,
-                        times)
+from .arguments import array, count, data_error, error, finite_rates, limits, positive, rates_overflow, samples, times
 from .mechanism import Mechanism
 
 FloatArray = NDArray[np.float64]
@@ -102,7 +101,7 @@ class BaseParameters:
             out.append(" ".join(terms))
         return out
 
-    def of(self, pi: FloatArray | dict[str, float]) -> FloatArray:
+    def of(self, pi: ArrayLike | dict[str, float]) -> FloatArray:
         """The base parameters of a full parameter vector (or dict by name)."""
         if isinstance(pi, dict):
             missing = [n for n in self.parameters if n not in pi]

@@ -17,9 +17,8 @@ from typing import Any, Generic, Literal, TypeVar, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._core import ArgumentError
+from ._core import ArgumentError, __version__
 from ._core import Mechanism as NativeMechanism
-from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
 from .arguments import array, error, index, number
@@ -786,7 +785,7 @@ def load(path: str | os.PathLike[str]) -> Mechanism:
     return Mechanism(native_load(os.fspath(path)))
 
 
-class _UnknownExample(UnknownModelError, ArgumentError):  # type: ignore[misc]
+class _UnknownExample(UnknownModelError, ArgumentError):
     """No shipped model has the name given to :func:`load_example`: a
     ``models.UnknownModelError`` (a ``KeyError``) and an ``ArgumentError`` (argument ``name``)."""
 

@@ -13,8 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import results_format
-from .arguments import error
 from ._core import DenseOutput, __version__
+from .arguments import error
 
 if TYPE_CHECKING:
     import pandas

@@ -23,8 +23,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._core import PlanardynError, __version__
-from .playback import auto_speed
 from .arguments import error
+from .playback import auto_speed
 from .plot import trace_points
 from .units import group_unit
 
