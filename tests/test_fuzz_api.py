@@ -40,11 +40,12 @@ from typing import Any
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import MODELS, pendulum_dict
+from conftest import pendulum_dict
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from planardyn import identify, library, robot
 from planardyn.results_io import inverse_result, motion_derivatives
+from test_actuators import three_legged
 
 FUZZ_EXAMPLES = int(os.environ.get("PLANARDYN_FUZZ_EXAMPLES", "300"))
 
@@ -119,17 +120,9 @@ class Case:
 
 
 def three_legged_geared() -> pd.Mechanism:
-    """The five-bar with a third, redundant leg whose motor is geared (n 15, eta 0.85) with a
-    torque-speed envelope: every argument of the actuator functions applies."""
-    model = pd.load(MODELS / "five-bar.yaml").to_dict()
-    model["loads"], model["drives"] = [], []
-    model["points"] |= {"A3": [0.0, 0.0], "C3": [0.1983444079681374, 0.1521824425739351]}
-    model["ground"].append("A3")
-    model["bodies"] |= {"proximal_mid": {"points": ["A3", "C3"], "uniform_bar": ["A3", "C3"], "mass": 0.5},
-                        "distal_mid": {"points": ["C3", "P"], "uniform_bar": ["C3", "P"], "mass": 0.7}}
-    model["pairs"] += [{"type": "revolute", "name": "motor3", "at": "A3", "bodies": ["ground", "proximal_mid"]},
-                       {"type": "revolute", "name": "elbow3", "at": "C3", "bodies": ["proximal_mid", "distal_mid"]},
-                       {"type": "revolute", "name": "effector3", "at": "P", "bodies": ["distal_left", "distal_mid"]}]
+    """tests/test_actuators.py's five-bar with a third, redundant leg, its motor geared (n 15,
+    eta 0.85) with a torque-speed envelope: every argument of the actuator functions applies."""
+    model = three_legged().to_dict()
     model["actuators"] = [{"pair": "motor3", "gear_ratio": 15.0, "efficiency": 0.85, "rotor_inertia": 3e-5,
                            "limits": {"peak_torque": 2.0, "torque_speed": [[0.0, 2.0], [100.0, 2.0], [300.0, 0.0]]}}]
     return pd.from_dict(model)

@@ -31,10 +31,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import inverse_batch, simulate_batch
-from .arguments import error
+from .arguments import count, error
 from .mechanism import Mechanism, attach_metadata, from_dict, native_motion
 from .result import SimulationResult
-from .settings import MAX_THREADS, check_settings, count
+from .settings import MAX_THREADS, check_settings
 
 if TYPE_CHECKING:
     from .robot import TaskMotion, TaskPath
@@ -143,7 +143,7 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
     """Cut the prepared variants into chunks, run them here or on the executor, and put each
     raw result (``finish``-ed) or BatchError in its variant's place."""
     if threads is not None:
-        threads = count("threads", threads, MAX_THREADS)
+        threads = count("threads", threads, 1, MAX_THREADS)
     out, todo, items = _prepare(variants, own_args)
     n = len(items)
     if chunk_size is None:

@@ -16,12 +16,11 @@ a number.
 from __future__ import annotations
 
 import math
-import operator
 import sys
 from typing import Any
 
 from ._core import SimulationError
-from .arguments import error
+from .arguments import count, error
 
 #: Settings that are finite numbers > 0 (s, or dimensionless for the tolerances).
 POSITIVE = ("t_end", "rtol", "atol", "dt", "output_dt")
@@ -51,19 +50,6 @@ def positive(name: str, value: Any) -> float:
     return x
 
 
-def count(name: str, value: Any, high: int) -> int:
-    """``value`` as an int if it is an integer in 1..=high, else TypeError/ValueError naming ``name``."""
-    if isinstance(value, bool):
-        raise TypeError(f"{name} = {value!r} must be an integer, not bool")
-    try:
-        n = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name} = {value!r} must be an integer, not {type(value).__name__}") from None
-    if not 1 <= n <= high:
-        raise error(name, f"{name} = {n} must be an integer from 1 to {high}")
-    return n
-
-
 def check_settings(**settings: Any) -> dict[str, Any]:
     """Check the given settings (None: not given, skipped) by their rules; returns them with
     numbers as float or int. Unnamed settings (``method``, ``t_eval``...) pass unchanged."""
@@ -78,7 +64,7 @@ def check_settings(**settings: Any) -> dict[str, Any]:
                                       f"cannot be met: use rtol >= {MIN_RTOL:.3g}")
         elif name == "max_steps":
             try:
-                out[name] = count(name, value, MAX_STEPS)
+                out[name] = count(name, value, 1, MAX_STEPS)
             except ValueError as e:
                 raise SimulationError(f"invalid option: {e}") from None
     return out
