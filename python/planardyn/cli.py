@@ -49,6 +49,7 @@ from . import (
     structure,
 )
 from .events import Crossing, parse_crossing
+from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .results_format import check_writable, writing
@@ -332,6 +333,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
+    exchange_commands(sub)
     return p
 
 
@@ -659,7 +661,8 @@ def _main(argv: list[str]) -> int:
                 args.model = models.resolve(args.model)
             except models.UnknownModelError as e:  # demo's model is an option, the others' an argument
                 raise UsageError(f"--model {e}" if args.command == "demo" else str(e)) from None
-        code = COMMANDS[args.command](args)
+        code = getattr(args, "run", None) or COMMANDS[args.command]
+        code = code(args)
         sys.stdout.flush()
         return code
     except BrokenPipeError:
