@@ -262,9 +262,12 @@ def test_plot_and_animate_errors(tmp_path):
 
 @pytest.fixture(scope="module")
 def short_run(tmp_path_factory):
-    """A short five-bar run written as a results file (the input of plot, animate, inverse)."""
+    """A short five-bar run written as a results file (the input of plot, animate, inverse)
+    and a four-bar as MJCF (the input of import)."""
     path = tmp_path_factory.mktemp("run") / "run.csv"
     pd.load(MODELS / "five-bar.yaml").simulate(0.05, output_dt=0.01).save(path)
+    # An MJCF file beside it, the input of planardyn import.
+    assert run("export", "four-bar-gravity", "-o", path.with_name("four-bar.xml")).returncode == 0
     return path
 
 
@@ -278,10 +281,13 @@ def writing_commands(run_file, out):
         "plot": ["plot", run_file, "-o", out.with_suffix(".png")],
         "animate": ["animate", run_file, "-o", out.with_suffix(".html")],
         "demo": ["demo", "--out", out],
+        "export": ["export", five, "-o", out.with_suffix(".urdf")],
+        "import": ["import", run_file.with_name("four-bar.xml"), "-o", out.with_suffix(".yaml")],
     }
 
 
-@pytest.mark.parametrize("command", ["simulate", "inverse", "identify", "plot", "animate", "demo"])
+@pytest.mark.parametrize("command", ["simulate", "inverse", "identify", "plot", "animate", "demo", "export",
+                                     "import"])
 def test_an_output_under_a_file_is_named_with_its_cause(short_run, tmp_path, command):
     """Before: 'planardyn: [Errno 17] File exists: ...' (simulate after the whole run)."""
     from conftest import cli_run
