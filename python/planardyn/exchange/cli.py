@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..mechanism import from_dict, load
+from ..results_format import writing
 from .mjcf import TIMESTEP, from_mjcf, to_mjcf
 from .sdf import to_sdf
 from .tree import ExchangeError
@@ -55,7 +56,8 @@ def export_command(args: argparse.Namespace) -> int:
         raise ExchangeError(f"{args.output}: the extension must be one of {', '.join(WRITERS)}")
     mech = load(args.model)
     xml = to_mjcf(mech, timestep=args.timestep) if fmt == "mjcf" else to_urdf(mech) if fmt == "urdf" else to_sdf(mech)
-    args.output.write_text(xml, encoding="utf-8")
+    with writing(args.output):  # a failure named by the path given, its cause in words
+        args.output.write_text(xml, encoding="utf-8")
     print(f"wrote {args.output} ({fmt.upper()}, {mech.n_bodies} bodies)")
     return 0
 
@@ -71,7 +73,8 @@ def import_command(args: argparse.Namespace) -> int:
     if args.output.suffix.lower() not in (".json", ".yaml", ".yml"):
         raise ExchangeError(f"{args.output}: write a .yaml or .json model file")
     # JSON is YAML too (YAML 1.2 is a superset): one writer for both, full precision, no PyYAML needed.
-    args.output.write_text(json.dumps(_plain(model), indent=2) + "\n", encoding="utf-8")
+    with writing(args.output):
+        args.output.write_text(json.dumps(_plain(model), indent=2) + "\n", encoding="utf-8")
     print(f"wrote {args.output} ({mech.n_bodies} bodies, {len(mech.pair_names)} pairs, coordinates "
           f"{', '.join(mech.coordinate_names)})")
     return 0
