@@ -283,11 +283,19 @@ def writing_commands(run_file, out):
         "demo": ["demo", "--out", out],
         "export": ["export", five, "-o", out.with_suffix(".urdf")],
         "import": ["import", run_file.with_name("four-bar.xml"), "-o", out.with_suffix(".yaml")],
+        "size": ["size", "five-bar", "--circle", "0.014", "0.5097", "0.06", "--json", out.with_suffix(".json")],
+        "plan": ["plan", "library/five-bar-5r", "--line", "-0.08", "0.28", "0.08", "0.36", "--effort", "5", "5",
+                 "-o", out.with_suffix(".csv")],
     }
 
 
+def prefix(command):
+    """How a command's errors start (size and plan name themselves)."""
+    return f"planardyn {command}: " if command in ("size", "plan") else "planardyn: "
+
+
 @pytest.mark.parametrize("command", ["simulate", "inverse", "identify", "plot", "animate", "demo", "export",
-                                     "import"])
+                                     "import", "size", "plan"])
 def test_an_output_under_a_file_is_named_with_its_cause(short_run, tmp_path, command):
     """Before: 'planardyn: [Errno 17] File exists: ...' (simulate after the whole run)."""
     from conftest import cli_run
@@ -297,7 +305,7 @@ def test_an_output_under_a_file_is_named_with_its_cause(short_run, tmp_path, com
     argv = writing_commands(short_run, blocker / "x")[command]
     code, err = cli_run(*argv)
     out = argv[-1]
-    assert (code, err) == (2, f"planardyn: cannot write {out}: {blocker} is a file, not a directory\n")
+    assert (code, err) == (2, f"{prefix(command)}cannot write {out}: {blocker} is a file, not a directory\n")
 
 
 def test_an_output_where_no_file_can_be_made_names_the_path_asked_for(short_run):
@@ -306,7 +314,7 @@ def test_an_output_where_no_file_can_be_made_names_the_path_asked_for(short_run)
 
     for command, argv in writing_commands(short_run, __import__("pathlib").Path("/proc/o")).items():
         code, err = cli_run(*argv)
-        assert (code, err) == (2, f"planardyn: cannot write {argv[-1]}: /proc does not take new files\n"), command
+        assert (code, err) == (2, f"{prefix(command)}cannot write {argv[-1]}: /proc does not take new files\n"), command
 
 
 @pytest.mark.parametrize("errno_, cause", [

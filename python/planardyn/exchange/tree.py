@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._core import PlanardynError
 from ..mechanism import Mechanism
 
 Vec = NDArray[np.float64]
@@ -40,7 +41,7 @@ GROUND = "ground"
 KIND_ORDER = {"prismatic": 0, "slot": 0, "revolute": 3}
 
 
-class ExchangeError(ValueError):
+class ExchangeError(PlanardynError, ValueError):
     """A mechanism or a file that a format cannot carry; the message says what and why."""
 
 

@@ -29,6 +29,7 @@ import numpy as np
 from .._core import AssemblyError, ModelError, SingularityError
 from ..mechanism import load
 from ..models import UnknownModelError, resolve
+from ..results_format import WriteError, check_writable, writing
 from ..robot import EndEffector
 from ..robot.cli_options import integer, number, positive
 from .collocation import collocate
@@ -82,6 +83,12 @@ def plan_cli(argv: list[str] | None = None) -> int:
     except SystemExit as exc:
         return 0 if exc.code == 0 else 2
     try:
+        if args.output:
+            check_writable(args.output)
+    except WriteError as exc:
+        print(f"planardyn plan: {exc}", file=sys.stderr)
+        return 2
+    try:
         mech = load(resolve(args.model))
         ee = EndEffector(mech, args.point)
         if args.collocate is None:
@@ -124,6 +131,11 @@ def plan_cli(argv: list[str] | None = None) -> int:
     print(f"{mech.name}: {plan.duration:.6g} s {what}; peak |tau| {np.round(peak, 4).tolist()}; limits used to "
           f"{plan.limit_ratio:.10g} on the dense check")
     if args.output:
-        write_csv(plan, args.output)
+        try:
+            with writing(args.output) as path:
+                write_csv(plan, str(path))
+        except WriteError as exc:
+            print(f"planardyn plan: {exc}", file=sys.stderr)
+            return 1
         print(f"wrote {args.output}")
     return 0

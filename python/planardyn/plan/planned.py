@@ -9,14 +9,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._core import PlanardynError
+from .._core import ArgumentError
 from ..mechanism import Mechanism
 from ..result import SimulationResult
 
 FloatArray = NDArray[np.float64]
 
 
-class PlanError(PlanardynError, ValueError):
+class PlanError(ArgumentError):
     """A path, limits or an argument that cannot be planned with, with what to change;
     ``argument`` names the argument at fault (None when it is the plan as a whole)."""
 

@@ -18,6 +18,7 @@ import sys
 from .._core import AssemblyError, ModelError, SingularityError
 from ..mechanism import load
 from ..models import UnknownModelError, resolve
+from ..results_format import WriteError, check_writable, writing
 from .cli_options import number, positive
 from .effector import EndEffector
 from .paths import circle, line
@@ -59,6 +60,13 @@ def size_cli(argv: list[str] | None = None) -> int:
     except SystemExit as exc:
         return 0 if exc.code == 0 else 2
     try:
+        for out in (args.json, args.plot):
+            if out:
+                check_writable(out)
+    except WriteError as exc:
+        print(f"planardyn size: {exc}", file=sys.stderr)
+        return 2
+    try:
         ee = EndEffector(load(resolve(args.model)), args.point, args.body)
         if args.circle:
             path = circle(args.circle[:2], args.circle[2], args.duration, profile=args.profile)
@@ -77,13 +85,18 @@ def size_cli(argv: list[str] | None = None) -> int:
         print(f"planardyn size: refused: {exc}", file=sys.stderr)
         return 1
     print(report)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(report.to_dict(), f, indent=2)
-    if args.plot:
-        from matplotlib.figure import Figure
+    try:
+        if args.json:
+            with writing(args.json) as out, open(out, "w") as f:
+                json.dump(report.to_dict(), f, indent=2)
+        if args.plot:
+            from matplotlib.figure import Figure
 
-        fig = Figure(figsize=(11, 7))
-        plot_sizing(report, fig)
-        fig.savefig(args.plot, dpi=100)
+            fig = Figure(figsize=(11, 7))
+            plot_sizing(report, fig)
+            with writing(args.plot) as out:
+                fig.savefig(out, dpi=100)
+    except WriteError as exc:
+        print(f"planardyn size: {exc}", file=sys.stderr)
+        return 1
     return 0

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .._core import PlanardynError
+from .._core import ArgumentError
 from .paths import TaskPath
 
 FloatArray = NDArray[np.float64]
@@ -47,7 +47,7 @@ PEAK_FRACTION = 0.9
 FINE = 64
 
 
-class SizingError(PlanardynError, ValueError):
+class SizingError(ArgumentError):
     """An argument a sizing cannot use, with what to give instead; ``argument`` names it."""
 
     def __init__(self, message: str, argument: str | None = None) -> None:
