@@ -15,13 +15,15 @@ pass:
    that onset, followed by a failure, are *isolated* and are reported, not used;
 2. *bisect*: between the last failing grid point below the onset and the onset itself, down to
    adjacent integers: s* passes, s* - 1 fails;
-3. *check the neighbours*: s* + 1 ... s* + NEIGHBOURS must pass too; if one fails it becomes the
-   failing end and step 2 runs again above it.
+3. *check the neighbours*: s* + 1 ... s* + NEIGHBOURS must pass too; if one fails, the search
+   starts again from step 1 above it (an onset of CONFIRM grid points above the failing neighbour,
+   bisection between them).
 
 The result passes at s* and at its NEIGHBOURS next dearer settings, fails at s* - 1 (the safety
-margin is one setting: 1/n of the steps, or 1/PER_DECADE of a decade of tolerance), and the grid
-points spanning at least SCAN_RATIO^(CONFIRM - 1) above the onset pass. What it cannot see is a
-failing integer between grid points above s* + NEIGHBOURS that the scan skipped.
+margin is one setting: 1/n of the steps, or 1/PER_DECADE of a decade of tolerance), and CONFIRM
+consecutive grid points from the first at or above s* pass (a span of SCAN_RATIO^(CONFIRM - 1)).
+What it cannot see is a failing integer between grid points above s* + NEIGHBOURS that the scan
+skipped.
 """
 
 from __future__ import annotations
@@ -93,37 +95,35 @@ def cheapest(passes: Callable[[int], bool], grid: Sequence[int], *, confirm: int
             found.tried[s] = bool(passes(s))
         return found.tried[s]
 
-    onset, run = None, 0
-    for i, s in enumerate(grid):
-        if ok(s):
-            onset, run = (i if run == 0 else onset), run + 1
-            if run == confirm:
-                break
-        else:
-            run = 0
-    if run == 0:
-        found.note = f"no setting passes up to {grid[-1]}"
-        return found
-    if run < confirm:
-        found.note = f"passing confirmed by only {run} grid point(s) at the dear end of the range"
-    confirmed = [s for s in grid[onset:] if found.tried.get(s)]
-    if onset == 0:
-        found.setting = grid[0]
-        found.note = (found.note + "; " if found.note else "") + "the cheapest setting tried passes (not bracketed)"
-        return found
-    lo, hi = grid[onset - 1], grid[onset]  # lo fails, hi passes
+    def note(text: str) -> None:
+        found.note = f"{found.note}; {text}" if found.note else text
+
+    lo = None  # the dearest setting known to fail below the answer
     while True:
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            lo, hi = (lo, mid) if ok(mid) else (mid, hi)
-        bad = next((s for s in range(hi + 1, hi + 1 + neighbours) if not ok(s)), None)
-        if bad is None:
-            break
-        above = [s for s in confirmed if s > bad]
-        if not above:
-            found.note = (found.note + "; " if found.note else "") + f"{bad} fails above every confirmed pass"
+        first = 0 if lo is None else next((i for i, s in enumerate(grid) if s > lo), len(grid))
+        onset, run = None, 0
+        for i in range(first, len(grid)):
+            if ok(grid[i]):
+                onset, run = (i if run == 0 else onset), run + 1
+                if run == confirm:
+                    break
+            else:
+                run = 0
+        if onset is None or run == 0:
+            note(f"no setting passes for good up to {grid[-1]}")
             return found
-        lo, hi = bad, above[0]
-    found.setting, found.below = hi, lo
-    found.isolated = sorted(s for s, v in found.tried.items() if v and s < hi)
-    return found
+        if run < confirm:
+            note(f"passing confirmed by only {run} grid point(s) at the dear end of the range")
+        if onset == 0:
+            found.setting = grid[0]
+            note("the cheapest setting tried passes (not bracketed)")
+            return found
+        low, hi = max(grid[onset - 1], lo if lo is not None else grid[onset - 1]), grid[onset]
+        while hi - low > 1:  # low fails, hi passes
+            mid = (low + hi) // 2
+            low, hi = (low, mid) if ok(mid) else (mid, hi)
+        lo = next((s for s in range(hi + 1, hi + 1 + neighbours) if not ok(s)), None)
+        if lo is None:
+            found.setting, found.below = hi, low
+            found.isolated = sorted(s for s, v in found.tried.items() if v and s < hi)
+            return found

@@ -74,9 +74,20 @@ def test_short_passing_run_is_not_the_onset():
     assert found.isolated == [g[5], g[6]]
 
 
+def test_holes_beyond_the_confirmed_span_restart_the_scan():
+    # On the tolerance grid (every 4th index): from 600 on, every index = 1 or 2 (mod 4) fails up
+    # to 640. Each bisection lands on 4j + 3 (4j + 2 fails) and its neighbour 4j + 5 fails, so
+    # the search climbs past the three confirmed grid points and must scan again above each
+    # failing neighbour; the first setting with two passing neighbours is 639 (640, 641 pass).
+    grid = C.tolerance_grid(1e-2, 1e-12)
+    found = C.cheapest(lambda k: k >= 600 and (k >= 640 or k % 4 in (0, 3)), grid)
+    assert (found.setting, found.below) == (639, 638)
+    assert found.tried[640] and found.tried[641] and found.note == ""
+
+
 def test_none_and_not_bracketed():
     found = C.cheapest(lambda n: False, GRID)
-    assert found.setting is None and "no setting passes up to 40000" in found.note
+    assert found.setting is None and "no setting passes for good up to 40000" in found.note
     found = C.cheapest(lambda n: True, GRID)
     assert (found.setting, found.below, found.bracketed) == (50, None, False)
     assert "not bracketed" in found.note

@@ -134,10 +134,19 @@ class Sim:
         return state[0]
 
 
+#: MuJoCo's warnings during the run being measured (``mju_user_warning``, instead of its console).
+_warnings: list[str] = []
+
+
 def run(bm: Benchmark, d: Drawing, v: Variant, n: int, ref: Reference) -> Run:
     r = Run(TOOL, v.method, v.label(bm.t_end, n), value=n, steps=n)
     sim = Sim(bm, d, v, n)
+    sim.mujoco.set_mju_user_warning(_warnings.append)
+    _warnings.clear()
     r.wall, states = one_shot(sim.simulate)
+    if _warnings:
+        # An unstable run is reset to the start state and goes on: finite, but not a solution.
+        return r.fail(f"MuJoCo: {_warnings[0]}")
     states = np.vstack([sim.s0, states])
     with np.errstate(all="ignore"):
         poses, rates = body_states(sim.mujoco, sim.model, sim.data, states, sim.spec, d.bodies)
