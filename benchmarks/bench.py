@@ -120,7 +120,8 @@ def misses(r: Run, target: dict) -> str:
     if not r.ok:
         return "failed: " + r.note
     unit = {"drift": "J", "gap": "m", "error": "rad"}
-    return ", ".join(f"{k} {getattr(r, k):.2e} {unit[k]}" for k, lim in target.items() if not getattr(r, k) < lim)
+    return ", ".join(f"{k} {getattr(r, k):.5g} {unit[k]} (limit {lim:g})" for k, lim in target.items()
+                     if not getattr(r, k) < lim)
 
 
 def search(mod, bm, d, v: Variant, ref, verbose: bool) -> tuple[dict[int, Run], dict]:

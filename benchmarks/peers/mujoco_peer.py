@@ -92,23 +92,25 @@ def mjcf(d: Drawing, integrator: str, dt: float, stiff: bool) -> str:
 
 
 def body_states(mujoco, model, data, states: np.ndarray, spec, names) -> tuple[dict, dict]:
-    """Per-body (N, 3) CoM poses (phi from the drawing) and rates."""
-    ids = {k: model.body(k).id for k in names}
-    poses = {k: np.empty((len(states), 3)) for k in names}
-    rates = {k: np.empty((len(states), 3)) for k in names}
+    """Per-body (N, 3) CoM poses (phi from the drawing) and rates, from MuJoCo's own kinematics of
+    each stored state (the position and velocity stages of ``mj_forward``, not its dynamics)."""
+    ids = [model.body(k).id for k in names]
+    P, R = np.empty((len(states), len(ids), 3)), np.empty((len(states), len(ids), 3))
     vel = np.empty(6)
     for i, s in enumerate(states):
         mujoco.mj_setState(model, data, s, spec)
-        mujoco.mj_forward(model, data)
-        for k, b in ids.items():
-            R = data.ximat[b].reshape(3, 3)
-            poses[k][i] = data.xipos[b][0], data.xipos[b][1], np.arctan2(R[1, 0], R[0, 0])
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_comVel(model, data)
+        xmat = data.ximat[ids]
+        P[i, :, 0], P[i, :, 1] = data.xipos[ids, 0], data.xipos[ids, 1]
+        P[i, :, 2] = np.arctan2(xmat[:, 3], xmat[:, 0])
+        for j, b in enumerate(ids):
             # 6D velocity [rot, lin] at the CoM (mjOBJ_BODY: the inertial frame), world axes.
             mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, b, vel, 0)
-            rates[k][i] = vel[3], vel[4], vel[2]
-    for p in poses.values():
-        p[:, 2] = np.unwrap(p[:, 2])
-    return poses, rates
+            R[i, j] = vel[3], vel[4], vel[2]
+    P[:, :, 2] = np.unwrap(P[:, :, 2], axis=0)
+    return {k: P[:, j] for j, k in enumerate(names)}, {k: R[:, j] for j, k in enumerate(names)}
 
 
 class Sim:
