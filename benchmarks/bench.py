@@ -313,7 +313,7 @@ def bench_mechanism(bm, found: dict, rounds: int, verbose: bool) -> dict:
             runs += vruns.values()
             methods.append({"tool": mod.TOOL, "method": v.method, "axis": "steps" if v.steps else "tolerance",
                             "range": v.label(bm.t_end, v.grid()[0]) + " to " + v.label(bm.t_end, v.grid()[-1]),
-                            "targets": res})
+                            "targets": res, "run_columns": RUN_COLUMNS, "runs": run_rows(list(vruns.values()))})
             candidates_of(mod, v, vruns, res, cands)
     load_search = os.getloadavg()
     cands_all = list(cands.values())
@@ -338,9 +338,31 @@ def bench_mechanism(bm, found: dict, rounds: int, verbose: bool) -> dict:
             "changed": bm.changed, "t_end_s": bm.t_end, "grid_dt_s": bm.grid_dt,
             "coordinates": [c.name for c in d.coordinates],
             "targets": {"drift_J": bm.drift_target, "gap_m": bm.gap_target, "error_rad": bm.error_target},
-            "reference": reference, "methods": methods, "runs": [dataclasses.asdict(r) for r in runs],
+            "reference": reference, "methods": methods,
             "not_timed": [{"key": c.key, "targets": c.targets, "pre_median_wall": median[c.key]} for c in skipped],
             "timing": timed, "summary": summarise(runs, cands_all, timed, list(found)), "_candidates": cands_all}
+
+
+#: The fields of every run of a method's search kept in results.json (the winners keep all of theirs).
+RUN_COLUMNS = ("value", "ok", "note", "wall", "steps", "drift", "gap", "error")
+
+
+def run_rows(runs: list[Run]) -> list[list]:
+    """A method's runs as rows of RUN_COLUMNS (thousands in all), by setting, the floats to 6 digits."""
+    def cell(v):
+        return float(f"{v:.6g}") if isinstance(v, float) else v
+
+    return [[cell(getattr(r, c)) for c in RUN_COLUMNS] for r in sorted(runs, key=lambda r: r.value)]
+
+
+def dumps(result: dict) -> str:
+    """results.json, indented, but each list of plain values on one line (the thousands of runs of
+    the searches, the timing samples). JSON strings hold no raw line breaks, so only the layout
+    changes."""
+    def one_line(m: re.Match) -> str:
+        return re.sub(r"\[\s+", "[", re.sub(r"\s+\]", "]", re.sub(r",\n\s*", ", ", m.group(0))))
+
+    return re.sub(r"\[[^\[\]{}]*\]", one_line, json.dumps(result, indent=1, default=_json))
 
 
 def merge_previous(result: dict, path: Path) -> dict:
@@ -408,7 +430,7 @@ def main() -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     if a.only or a.no_criterion:
         result = merge_previous(result, a.out / "results.json")
-    (a.out / "results.json").write_text(json.dumps(result, indent=1, default=_json))
+    (a.out / "results.json").write_text(dumps(result))
     report.write(result, a.out, None if str(a.docs) == "-" else a.docs)
     say(report.summary_text(result))
     say(f"wrote {a.out}/results.json, results.md and the plots in {result['bench_seconds']:.0f} s")

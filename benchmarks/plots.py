@@ -10,7 +10,8 @@ COLORS = {"planardyn": "tab:blue", "MuJoCo": "tab:orange", "Pinocchio": "tab:gre
 MARKERS = ["o", "s", "^", "D", "v", "P", "X"]
 
 
-def plot(m: dict, path: Path) -> None:
+def plot(m: dict, runs: list[dict], path: Path) -> None:
+    """The diagram of one mechanism of results.json, from its runs (report.runs)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -19,17 +20,16 @@ def plot(m: dict, path: Path) -> None:
     t = m["targets"]
     fig, axes = plt.subplots(1, 3, figsize=(17, 6.6), constrained_layout=True)
     series: dict[tuple[str, str], list[dict]] = {}
-    for r in m["runs"]:
+    for r in runs:
         if r["ok"] and all(math.isfinite(r[k]) for k in ("wall", "error", "drift", "gap")):
             series.setdefault((r["tool"], r["method"]), []).append(r)
     marker_of: dict[str, int] = {}
     for (tool, method), rs in series.items():
-        # In setting order (steps or tolerance growing): timing noise shows as a kink, not a reordering.
-        rs = sorted(rs, key=lambda r: r["value"])
         k = marker_of.setdefault(tool, 0)
         marker_of[tool] = k + 1
-        style = dict(color=COLORS.get(tool, "gray"), marker=MARKERS[k % len(MARKERS)], ms=3.5,
-                     lw=1.0, ls="-" if k == 0 else ["--", ":", "-."][(k - 1) % 3])
+        # Points only: a search's runs crowd near the thresholds, and accuracy need not fall
+        # monotonically along the setting, so lines would zigzag.
+        style = dict(color=COLORS.get(tool, "gray"), marker=MARKERS[k % len(MARKERS)], ms=3, alpha=0.6, ls="none")
         for ax, key in zip(axes, ("error", "drift", "gap")):
             y = [min(max(r[key], 1e-16), 1e3) for r in rs]  # blown-up runs at the top edge
             ax.loglog([r["wall"] for r in rs], y, label=f"{tool}: {method}", **style)

@@ -173,16 +173,10 @@ def ratio_table(m: dict) -> str:
     return "\n".join(rows)
 
 
-def runs_table(m: dict) -> str:
-    t = m["targets"]
-    rows = ["| tool | method | setting | one call (ms) | steps | energy drift (J) | loop gap (m) | error (rad) | "
-            f"meets drift < {t['drift_J']:g} J & gap < {t['gap_m']:g} m |", "|---|---|---|---:|---:|---:|---:|---:|:-:|"]
-    for r in sorted(m["runs"], key=lambda r: (r["tool"], r["method"], r["value"])):
-        meets = r["ok"] and r["drift"] < t["drift_J"] and r["gap"] < t["gap_m"]
-        mark = "yes" if meets else ("failed: " + r["note"] if not r["ok"] else "")
-        rows.append(f"| {r['tool']} | {r['method']} | {r['setting']} | {ms(r['wall'])} | {r['steps']} | "
-                    f"{fmt(r['drift'])} | {fmt(r['gap'])} | {fmt(r['error'])} | {mark.replace('|', '/')} |")
-    return "\n".join(rows)
+def runs(m: dict) -> list[dict]:
+    """Every run of the searches, as dicts (results.json keeps them as rows under their method)."""
+    return [{"tool": x["tool"], "method": x["method"], **dict(zip(x["run_columns"], row))}
+            for x in m["methods"] for row in x["runs"]]
 
 
 def _why_none(m: dict, tool: str, kind: str) -> str:
@@ -191,11 +185,11 @@ def _why_none(m: dict, tool: str, kind: str) -> str:
         return "not modelled"
     if any(f["setting"] is not None for f in found):
         return "its passing settings were not timed"
-    runs = [r for r in m["runs"] if r["tool"] == tool]
-    failed = [r for r in runs if not r["ok"]]
-    if runs and len(failed) == len(runs):
+    mine = [r for r in runs(m) if r["tool"] == tool]
+    failed = [r for r in mine if not r["ok"]]
+    if mine and len(failed) == len(mine):
         return f"every run failed ({failed[0]['note'][:80]})"
-    return "no setting met it" + (f" ({len(failed)} of {len(runs)} runs failed)" if failed else "")
+    return "no setting met it" + (f" ({len(failed)} of {len(mine)} runs failed)" if failed else "")
 
 
 def best_table(m: dict) -> str:
@@ -276,8 +270,9 @@ def write(res: dict, out: Path, docs: Path | None) -> None:
                "Timed in the first rounds only (median over 2x their tool's fastest at the same target):"
                + (untimed or " none."), "",
                f"![work-precision diagram, {m['key']}](work_precision_{m['key']}.png)", "",
-               "<details><summary>Every run of the searches</summary>", "", runs_table(m), "", "</details>", ""]
-        plot(m, out / f"work_precision_{m['key']}.png")
+               f"Every one of the {len(runs(m))} runs of the searches is in `results.json` "
+               f"(`mechanisms.{m['key']}.methods[].runs`).", ""]
+        plot(m, runs(m), out / f"work_precision_{m['key']}.png")
     (out / "results.md").write_text("\n".join(md))
     if docs is not None:
         write_docs(res, docs)
