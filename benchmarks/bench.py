@@ -254,6 +254,7 @@ def four_bar_target(m: dict) -> dict:
     if tight and fastest:
         q = timing.paired(E[fastest["key"]]["wall"], E[tight.key]["wall"])
         out["ratio"], out["ratio_quartiles"] = q["median"], [q["q1"], q["q3"]]
+        out["cpu_ratio"] = timing.paired(E[fastest["key"]]["thread_cpu"], E[tight.key]["thread_cpu"])["median"]
         out["meets"] = out["ratio"] >= RATIO_TARGET
     return out
 

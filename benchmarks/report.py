@@ -113,8 +113,8 @@ def summary_text(res: dict) -> str:
     if f and "ratio" in f:
         fp = f["fastest_peer"]
         lines.append(f"fastest peer at the four-bar's accuracy ({fp['tool']}, {ms(fp['wall'])} ms) / planardyn at "
-                     f"{f['drift_target_J']:g} J = {f['ratio']:.2f} [{_iqr(f['ratio_quartiles'], '.2f')}] (target >= "
-                     f"{f['ratio_target']:g}: {'MET' if f['meets'] else 'MISSED'})")
+                     f"{f['drift_target_J']:g} J = {f['ratio']:.2f} [{_iqr(f['ratio_quartiles'], '.2f')}], thread CPU "
+                     f"{f['cpu_ratio']:.2f} (target >= {f['ratio_target']:g}: {'MET' if f['meets'] else 'MISSED'})")
     c = res["criterion"]
     if c.get("ok"):
         for name, v in c["results"].items():
@@ -226,7 +226,8 @@ def targets_table(res: dict) -> str:
         rows.append(f"| passive four-bar, 10 s: drift < {f['drift_target_J']:g} J in at most 1/{f['ratio_target']:g} "
                     f"of the fastest peer at 1e-3 J | planardyn {p['method']} {p['setting']}: {ms(p['wall'])} ms; "
                     f"{fp['tool']} {fp['method']} {fp['setting']}: {ms(fp['wall'])} ms: ratio {f['ratio']:.1f} "
-                    f"[{_iqr(f['ratio_quartiles'])}] | {'met' if f['meets'] else '**missed**'} |")
+                    f"[{_iqr(f['ratio_quartiles'])}], thread CPU {f['cpu_ratio']:.1f} | "
+                    f"{'met' if f['meets'] else '**missed**'} |")
     c = res["criterion"]
     for name, v in (c.get("results") or {}).items():
         tgt = v["target_s"]
