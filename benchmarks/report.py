@@ -114,7 +114,9 @@ def summary_text(res: dict) -> str:
         fp = f["fastest_peer"]
         lines.append(f"fastest peer at the four-bar's accuracy ({fp['tool']}, {ms(fp['wall'])} ms) / planardyn at "
                      f"{f['drift_target_J']:g} J = {f['ratio']:.2f} [{_iqr(f['ratio_quartiles'], '.2f')}], thread CPU "
-                     f"{f['cpu_ratio']:.2f} (target >= {f['ratio_target']:g}: {'MET' if f['meets'] else 'MISSED'})")
+                     f"{f['cpu_ratio']:.2f} (target >= {f['ratio_target']:g}: {'MET' if f['meets'] else 'MISSED'})"
+                     + (f"; its C++ dynamics calls alone / planardyn = {f['dynamics_ratio']:.2f} "
+                        f"[{_iqr(f['dynamics_ratio_quartiles'], '.2f')}]" if "dynamics_ratio" in f else ""))
     c = res["criterion"]
     if c.get("ok"):
         for name, v in c["results"].items():
@@ -226,7 +228,9 @@ def targets_table(res: dict) -> str:
         rows.append(f"| passive four-bar, 10 s: drift < {f['drift_target_J']:g} J in at most 1/{f['ratio_target']:g} "
                     f"of the fastest peer at 1e-3 J | planardyn {p['method']} {p['setting']}: {ms(p['wall'])} ms; "
                     f"{fp['tool']} {fp['method']} {fp['setting']}: {ms(fp['wall'])} ms: ratio {f['ratio']:.1f} "
-                    f"[{_iqr(f['ratio_quartiles'])}], thread CPU {f['cpu_ratio']:.1f} | "
+                    f"[{_iqr(f['ratio_quartiles'])}], thread CPU {f['cpu_ratio']:.1f}"
+                    + (f"; its C++ dynamics calls alone {f['dynamics_ratio']:.1f} [{_iqr(f['dynamics_ratio_quartiles'])}]"
+                       if "dynamics_ratio" in f else "") + " | "
                     f"{'met' if f['meets'] else '**missed**'} |")
     c = res["criterion"]
     for name, v in (c.get("results") or {}).items():
