@@ -266,13 +266,13 @@ def write(res: dict, out: Path, docs: Path | None) -> None:
           "are single calls on a shared machine.", "", "```", summary_text(res).strip(), "```", ""]
     for m in res["mechanisms"].values():
         ref = m["reference"]
-        untimed = "".join(f"\n- {x['key']} ({', '.join(x['targets'])}): {ms(x['pre_median_wall'])} ms"
+        untimed = "".join(f"\n- {x['key']} ({', '.join(x['targets'])}): CPU {ms(x['pre_median_cpu'])} ms"
                           for x in m["not_timed"])
         md += [f"## {m['title']} (`{m['key']}`)", "", _header(m), "",
                f"Reference q({m['t_end_s']:g} s) = "
                + ", ".join(f"{c} {v:.12f}" for c, v in zip(m["coordinates"], ref["q_end"])) + " rad.", "",
                best_table(m), "", ratio_table(m), "", "### Every method's cheapest settings", "", methods_table(m), "",
-               "Timed in the first rounds only (median over 2x their tool's fastest at the same target):"
+               "Timed in the first rounds only (median CPU time over 2x their tool's cheapest at the same target):"
                + (untimed or " none."), "",
                f"![work-precision diagram, {m['key']}](work_precision_{m['key']}.png)", "",
                f"Every one of the {len(runs(m))} runs of the searches is in `results.json` "
