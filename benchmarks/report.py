@@ -195,9 +195,9 @@ def _why_none(m: dict, tool: str, kind: str) -> str:
 
 
 def best_table(m: dict) -> str:
-    """Per tool: the cheapest setting at the stated accuracy and at the stated error (the fastest of
-    its methods, each at its cheapest passing setting), with the median of the per-round ratios of
-    its wall time to planardyn's."""
+    """Per tool: the cheapest setting at the stated accuracy and at the stated error (of its methods,
+    each at its cheapest passing setting, the one with the least median CPU time), with the median
+    of the per-round ratios of its wall time to planardyn's."""
     s = m["summary"]
     rows = [f"| tool | cheapest at {_targets(m, 'accuracy')} | wall (ms) | {_energy(m)} (J) | × planardyn "
             f"| cheapest at {_targets(m, 'error')} | wall (ms) | × planardyn |",
@@ -334,7 +334,7 @@ def docs_section(res: dict) -> str:
                 if env["not_available"] else ""), "",
              "In short (generated from the tables below: each ratio is the median over the interleaved rounds of "
              "a peer's winner's wall time over planardyn's winner's at the same target, each winner its tool's "
-             "fastest method at that method's cheapest passing setting):", "", summary_sentences(res), ""]
+             "method with the least median CPU time, at that method's cheapest passing setting):", "", summary_sentences(res), ""]
     for m in res["mechanisms"].values():
         parts += [f"### {m['title']}", "", _header(m), "", best_table(m), "", ratio_table(m), "",
                   "Every method's cheapest settings, and every run of the searches: "
