@@ -41,6 +41,10 @@ FloatArray = NDArray[np.float64]
 #: Relative step of the tangents' central differences in x = s'^2.
 TANGENT_STEP = 1e-6
 
+#: The rows are scaled by the torque the envelope line offers at x0, at least this fraction of
+#: its largest along the path (where a motor runs out of torque it vanishes).
+ROW_SCALE_MIN = 1e-6
+
 
 @dataclass
 class Drive:
@@ -114,12 +118,21 @@ class MotorMap:
         zero = np.zeros_like(self.q)
         return np.asarray(self.mech.motor_torques(self.q, qd, zero, zero, x=self.x, allow_singular=True))
 
+    def rotor(self, u: FloatArray, x: FloatArray) -> FloatArray:
+        """R = r_a u + r_b x + F (N, m) at s'' = u and s'^2 = x (N,): all of t_m but the gear's."""
+        return np.asarray(self.r_a * u[:, None] + self.r_b * x[:, None] + self.friction(x))
+
+    def torques(self, tau: FloatArray, u: FloatArray, x: FloatArray) -> FloatArray:
+        """t_m (N, m) of the joint-side efforts tau (N, m) at s'' = u and s'^2 = x (N,), on the
+        gear's branch of the path's direction."""
+        return np.asarray(np.where(tau >= 0, self.up, self.down) * tau + self.rotor(u, x))
+
 
 def joint_bounds(motor: MotorMap, u: FloatArray, x: FloatArray, torque: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Joint-side (lo, hi) (N, m) that keep |t_m| <= torque (N, m) at s'' = u and s'^2 = x
     (N,), through the gear's inverse: tau in [g^-1(-T - R), g^-1(T - R)] (infinite where a
     self-locking gear holds any load)."""
-    rotor = motor.r_a * u[:, None] + motor.r_b * x[:, None] + motor.friction(x)
+    rotor = motor.rotor(u, x)
 
     def inverse(y: FloatArray) -> FloatArray:
         slope = np.where(y >= 0, motor.up, motor.down)
@@ -151,13 +164,16 @@ def tangent_rows(motor: MotorMap, ds: list[Drive], a: FloatArray, b: FloatArray,
         k, p1 = d.k, np.abs(motor.p1[:, d.k])
         gear = _gear_lines(motor, k)
         for t0, t1 in d.lines:
+            # Scaled by the torque the line offers at x0, so that C is of order one.
+            torque = np.abs(t0 - t1 * d.ratio * p1 * np.sqrt(x0))
+            scale = np.maximum(torque, ROW_SCALE_MIN * max(float(torque.max()), 1e-300))
             for slope, side in gear:
                 # h(x) = T(x) - side F(x) at the three points, its tangent at x0.
                 h = [t0 - t1 * d.ratio * p1 * np.sqrt(x) - side * f[:, k] for x, f in zip(points, friction)]
                 dh = (h[1] - h[2]) / (2 * dx)
-                rows_a.append(side * (slope * a[:, k] + motor.r_a[:, k]))
-                rows_b.append(side * (slope * b[:, k] + motor.r_b[:, k]) - dh)
-                rows_c.append(side * slope * c[:, k] - h[0] + dh * x0)
+                rows_a.append(side * (slope * a[:, k] + motor.r_a[:, k]) / scale)
+                rows_b.append((side * (slope * b[:, k] + motor.r_b[:, k]) - dh) / scale)
+                rows_c.append((side * slope * c[:, k] - h[0] + dh * x0) / scale)
     return np.column_stack(rows_a), np.column_stack(rows_b), np.column_stack(rows_c)
 
 
