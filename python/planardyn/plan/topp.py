@@ -386,7 +386,9 @@ def _take(p: PathPoints, i: NDArray[np.intp]) -> PathPoints:
 
 
 def _join(p: PathPoints, r: PathPoints) -> PathPoints:
-    return PathPoints(*(np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b", "c", "x")))
+    s, q, p1, p2, a, b, c, x = (np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b",
+                                                                                          "c", "x"))
+    return PathPoints(s, q, p1, p2, a, b, c, x)
 
 
 def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray]) -> tuple[FloatArray, FloatArray, str]:
