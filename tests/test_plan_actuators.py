@@ -84,8 +84,9 @@ def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> N
     assert plan.duration > 1.03 * flat.duration
     # Regression value: the flat envelope's time measured when this test was written (no
     # closed form: the efficiency's branch makes the joint-side limit depend on the power's
-    # sign); 1e-3 is the rtol the grid is refined to.
-    assert flat.duration == pytest.approx(0.143525, rel=1e-3)
+    # sign); 1e-3 is the rtol the grid is refined to. 0.142686 s since the rotor turns before
+    # its gear (issue 23: its torque no longer pays the efficiency; 0.143525 s before).
+    assert flat.duration == pytest.approx(0.142686, rel=1e-3)
 
 
 def test_a_geared_inertia_matches_the_phase_plane_reference() -> None:

@@ -114,7 +114,7 @@ class MotorMap:
 
     def friction(self, x: FloatArray) -> FloatArray:
         """F (N, m) at s'^2 = x (N,): the motors' friction and the rotors' convective torque."""
-        qd = self.p1 * np.sqrt(x)[:, None]
+        qd = self.p1 * np.sqrt(np.maximum(x, 0.0))[:, None]
         zero = np.zeros_like(self.q)
         return np.asarray(self.mech.motor_torques(self.q, qd, zero, zero, x=self.x, allow_singular=True))
 
@@ -177,10 +177,12 @@ def tangent_rows(motor: MotorMap, ds: list[Drive], a: FloatArray, b: FloatArray,
     return np.column_stack(rows_a), np.column_stack(rows_b), np.column_stack(rows_c)
 
 
-def _gear_lines(motor: MotorMap, k: int) -> list[tuple[FloatArray, int]]:
-    """Coordinate k's gear lines as (slope, side): side (slope tau + R) <= T - side F. The
-    upper side (t_m <= T) on both lines where g is convex (up >= down), else on ``up``; the
-    lower side (t_m >= -T) on both where g is concave, else on ``down``."""
+def _gear_lines(motor: MotorMap, k: int) -> list[tuple[FloatArray, FloatArray]]:
+    """Coordinate k's gear lines as (slope, side) (N,) each: side (slope tau + R) <= T - side F.
+    The upper side (t_m <= T) on ``up``, the lower (t_m >= -T) on ``down``, and the third on
+    the other line of the side where both hold: the upper side where g is convex (up >= down),
+    the lower where it is concave (three rows, none repeated: a stage's LP takes no duplicate)."""
     up, down = motor.up[:, k], motor.down[:, k]
     convex = up >= down
-    return [(up, 1), (np.where(convex, down, up), 1), (down, -1), (np.where(convex, down, up), -1)]
+    one = np.ones_like(up)
+    return [(up, one), (down, -one), (np.where(convex, down, up), np.where(convex, one, -one))]
