@@ -64,8 +64,8 @@ def usage(mech, plan, f=FRACTIONS):
 
 
 def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> None:
-    # 0.15159 s against 0.14353 s with the flat envelope (both on 399 grid points, from 200
-    # doubled once); theta1's motor reaches 211 rad/s, and the drooping line binds in most
+    # 0.15081 s against 0.14269 s with the flat envelope (both on 399 grid points, from 200
+    # doubled once); theta1's motor reaches 212 rad/s, and the drooping line binds in most
     # intervals where a motor runs above its corner speed.
     mech = geared(CURVE)
     plan = time_optimal(mech, path, "actuators", n_grid=200)
@@ -91,13 +91,14 @@ def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> N
 
 def test_a_geared_inertia_matches_the_phase_plane_reference() -> None:
     # An inertia J (no gravity) turned 2 rad from rest to rest by a geared motor with the
-    # drooping envelope: the fastest motion accelerates at n eta T(n qd) / J_eff (motoring),
-    # then brakes at n T(n qd) / (eta J_eff) (generating: the gear losses help), J_eff =
-    # J + n^2 J_rotor. Both phases integrated at rtol 1e-12 and joined where their (q, qd)
-    # curves cross give the reference time, 0.2486812 s. The plan, within the envelope along
-    # every interval, is longer by O(grid spacing): 0.2487955 s on 799 grid points (from 400
-    # doubled once), 4.6e-4 longer, never shorter; its estimated excess (the change over
-    # the last doubling) takes it to 0.2486808 s: within 2e-5 of the reference (1.5e-6).
+    # drooping envelope, its rotor before the gear: the fastest motion accelerates at
+    # n eta T(n qd) / (J + eta n^2 J_rotor) (motoring), then brakes at
+    # n T(n qd) / (eta J + n^2 J_rotor) (back-driven: the gear losses help). Both phases
+    # integrated at rtol 1e-12 and joined where their (q, qd) curves cross give the reference
+    # time, 0.2483043 s. The plan, within the envelope along every interval, is longer by
+    # O(grid spacing): 0.2484188 s on 799 grid points (from 400 doubled once), 4.6e-4 longer,
+    # never shorter; its estimated excess (the change over the last doubling) takes it to
+    # 0.2483030 s: within 2e-5 of the reference (5.3e-6).
     from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
 
