@@ -741,7 +741,7 @@ impl PyMechanism {
             let (act, efforts) = inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws)?;
             let mut t_m = vec![0.0; efforts.len()];
             dynamics::motor_torques(&mech, &ws, &efforts, &mut t_m);
-            Ok((act, efforts, t_m))
+            Ok((act, efforts, dynamics::finite("motor torques", t_m)?))
         })?;
         let d = PyDict::new(py);
         d.set_item("efforts", arr1(py, efforts))?;

@@ -276,7 +276,9 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
         let (qd, qdd) = rates.unwrap_or_default();
         dynamics::inverse(mech, &st.q, &qd, &qdd, &mut tr.ws).map_err(Error::from)?;
         out.tau[i * m..(i + 1) * m].copy_from_slice(&tr.ws.tau);
-        dynamics::motor_torques(mech, &tr.ws, &tr.ws.tau, &mut out.tau_motor[i * m..(i + 1) * m]);
+        let t_m = &mut out.tau_motor[i * m..(i + 1) * m];
+        dynamics::motor_torques(mech, &tr.ws, &tr.ws.tau, t_m);
+        dynamics::finite("motor torques", t_m).map_err(Error::from)?;
         out.q[i * m..(i + 1) * m].copy_from_slice(&st.q);
         out.qd[i * m..(i + 1) * m].copy_from_slice(&qd);
         out.qdd[i * m..(i + 1) * m].copy_from_slice(&qdd);
