@@ -128,7 +128,7 @@ def test_the_pages_name_the_minimum_rust_cargo_asks_for():
 def test_pages_have_the_promised_code():
     # What a new user follows: describe a five-bar, simulate it, view it, plot torques, invert.
     examples, _ = page_script(DOCS / "examples.md")
-    for needle in ("pd.load(\"my-five-bar.yaml\")", "mech.simulate(", "animate(mech, res, \"fall.html\")",
+    for needle in ("pdy.load(\"my-five-bar.yaml\")", "mech.simulate(", "animate(mech, res, \"fall.html\")",
                    "plot_efforts(inv", "inverse_result(mech, t, q)"):
         assert needle in examples, needle
     cli, n = page_script(DOCS / "cli.md")
@@ -147,3 +147,22 @@ def test_mkdocs_build_strict(tmp_path):
     for page in ("index.html", "cli/index.html", "api/index.html", "examples/index.html", "model-format/index.html"):
         assert (tmp_path / "site" / page).is_file(), page
     assert "planardyn inverse" in (tmp_path / "site" / "cli" / "index.html").read_text()
+
+
+#: The alias the pages, examples and docstrings use for planardyn (issue 26, first hour 2):
+#: `pd` is pandas' by convention, and a page using both could not tell them apart.
+ALIAS = "pdy"
+
+
+def test_planardyn_is_never_imported_as_pandas_alias():
+    texts = [*PAGES, *sorted((ROOT / "examples").glob("*.py")), *sorted((ROOT / "python" / "planardyn").rglob("*.py")),
+             ROOT / "tests" / "wheel_smoke.py"]
+    clash = re.compile(r"import planardyn as pd\b|\bpd\.(load|load_example|from_result|read_results|models)\b")
+    found = [f"{p.relative_to(ROOT)}:{n}: {line.strip()}" for p in texts
+             for n, line in enumerate(p.read_text().splitlines(), 1) if clash.search(line)]
+    assert not found, "\n".join(found)
+    # One alias everywhere, and the README, the home page and the API page use it.
+    aliases = {a for p in texts for a in re.findall(r"import planardyn as (\w+)", p.read_text())}
+    assert aliases == {ALIAS}, aliases
+    assert all(f"import planardyn as {ALIAS}\n" in (DOCS / name).read_text() for name in ("index.md", "api.md"))
+    assert f"import planardyn as {ALIAS}\n" in (ROOT / "README.md").read_text()

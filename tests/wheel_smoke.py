@@ -47,19 +47,19 @@ def snippets(markdown: str) -> list[tuple[str, str]]:
 
 
 def check_installed() -> None:
-    import planardyn as pd
+    import planardyn as pdy
 
-    where = Path(pd.__file__).resolve()
+    where = Path(pdy.__file__).resolve()
     assert "site-packages" in where.parts, f"planardyn is imported from {where}, not from an installed wheel"
     files = [str(f) for f in importlib.metadata.distribution("planardyn").files or []]
     assert any(f.endswith("licenses/LICENSE") for f in files), "the wheel holds no LICENSE"
     shipped = sorted(f.removeprefix("planardyn/models/").removesuffix(".yaml") for f in files
                      if f.startswith("planardyn/models/") and f.endswith(".yaml"))
-    assert shipped and shipped == sorted(pd.models.names()), (shipped, pd.models.names())
+    assert shipped and shipped == sorted(pdy.models.names()), (shipped, pdy.models.names())
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pd.PlanardynWarning)  # e.g. the library's redundant double parallelogram
+        warnings.simplefilter("ignore", pdy.PlanardynWarning)  # e.g. the library's redundant double parallelogram
         for name in shipped:
-            pd.load_example(name)
+            pdy.load_example(name)
     print(f"wheel: {where.parent}: LICENSE, {len(shipped)} model files, each loads")
 
 

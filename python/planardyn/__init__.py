@@ -3,9 +3,9 @@
 A mechanism is described as it is drawn, in a model file (YAML or JSON, see
 ``docs/model-format.md``), and validated once into an immutable :class:`Mechanism`::
 
-    import planardyn as pd
+    import planardyn as pdy
 
-    mech = pd.load("examples/models/five-bar.yaml")   # or pd.load_example("five-bar")
+    mech = pdy.load("examples/models/five-bar.yaml")   # or pdy.load_example("five-bar")
     res = mech.simulate(t_end=1.0)
     res.q          # (N, m) coordinates, rad or m
     res.to_csv("five-bar.csv")

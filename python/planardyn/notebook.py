@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .mechanism import Mechanism, from_result
-from .plot import default_trace_points
+from .plot import default_trace_points, pivot_points
 from .result import SimulationResult
 from .viewer import viewer_html
 
@@ -66,7 +66,7 @@ def mechanism_svg(
             d = " ".join(f"{X(px)},{Y(py)}" for px, py in np.asarray(paths)[:, j] if np.isfinite(px))
             out.append(f'<polyline points="{d}" fill="none" stroke="{COLORS[(j + 6) % 10]}" stroke-width="1.2" '
                        f'stroke-dasharray="3 2" opacity="0.8"/>')
-    for name in mech.ground_points:
+    for name in pivot_points(mech):
         gx, gy = where[name]
         h = 0.04 * L
         tri = f"{X(gx)},{Y(gy)} {X(gx - h)},{Y(gy - 1.6 * h)} {X(gx + h)},{Y(gy - 1.6 * h)}"
