@@ -35,7 +35,7 @@ def write_model(tmp_path, d: dict, name="model.json"):
 
 
 def csv_rows(path):
-    return list(csv.reader(line for line in path.open() if not line.startswith("#")))
+    return list(csv.reader(path.open()))
 
 
 def test_simulate_writes_csv(tmp_path):
@@ -51,7 +51,7 @@ def test_simulate_writes_csv(tmp_path):
     assert len(rows) == 1 + 21  # t = 0, 0.01, ..., 0.2
     assert float(rows[-1][0]) == pytest.approx(0.2)
     assert float(rows[1][1]) == pytest.approx(four_bar_dict()["coordinates"][0]["value"], abs=1e-12)
-    meta = json.loads("".join(line[2:] for line in out.open() if line.startswith("# ")))
+    meta = json.loads(out.with_name(out.name + ".json").read_text())
     assert meta["settings"]["t_end"] == 0.2 and meta["settings"]["output_dt"] == 0.01
     assert meta["model"]["name"] == "crank-rocker four-bar"
 
@@ -79,7 +79,9 @@ def test_simulate_with_method_and_progress(tmp_path):
     model = write_model(tmp_path, four_bar_dict())
     p = run("simulate", model, "--t-end", "0.1", "--method", "rk4", "--dt", "0.001", "--progress")
     assert p.returncode == 0, p.stderr
-    assert "100.0%" in p.stderr  # the bar ends full
+    # tqdm's bar ends full, once (issue 26: the old bar printed 100 % twice), with the run's
+    # span and the elapsed time < time left.
+    assert p.stderr.count("100%") == 1 and p.stderr.rstrip().endswith("0.1/0.1 s [00:00<00:00]"), p.stderr
 
 
 def test_bad_model_exit_2_names_file_and_field(tmp_path):

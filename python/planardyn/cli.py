@@ -98,26 +98,25 @@ def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__
 
 
 class ProgressBar:
-    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` for t
-    from 0 to ``t_end``; ``unit`` formats t after the percentage (default: the simulated time)."""
+    """A progress bar on a stream (tqdm's: percentage, elapsed time, time left), moved to a
+    position: ``bar(t)`` for a run's time t from 0 to ``total`` s, ``bar(done)`` of ``total``
+    frames. The end is drawn once, by :meth:`close` (tqdm would draw it again there)."""
 
-    WIDTH = 30
+    def __init__(self, total: float, unit: str = "s", stream: TextIO | None = None) -> None:
+        from tqdm import tqdm
 
-    def __init__(self, t_end: float, stream: TextIO | None = None, unit: str = "t = {:.4g} s") -> None:
-        self.t_end, self.unit, self.start = t_end, unit, time.monotonic()
-        self.stream = sys.stderr if stream is None else stream
+        self.total, self.position = float(total), 0.0
+        self.bar = tqdm(total=self.total, file=sys.stderr if stream is None else stream, leave=True,
+                        bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} " + unit + " [{elapsed}<{remaining}]")
 
-    def __call__(self, t: float) -> None:
-        frac = min(max(t / self.t_end, 0.0), 1.0) if self.t_end > 0 else 1.0
-        filled = int(round(frac * self.WIDTH))
-        bar = "#" * filled + "." * (self.WIDTH - filled)
-        elapsed = time.monotonic() - self.start
-        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  {self.unit.format(t)}  ({elapsed:.1f} s)")
-        self.stream.flush()
+    def __call__(self, position: float) -> None:
+        self.position = min(max(float(position), self.position), self.total)
+        if self.position < self.total:
+            self.bar.update(self.position - self.bar.n)
 
     def close(self) -> None:
-        self.stream.write("\n")
-        self.stream.flush()
+        self.bar.n = self.position
+        self.bar.close()
 
 
 def _crossing(text: str) -> Crossing:
@@ -666,9 +665,14 @@ def _animate(args: argparse.Namespace) -> int:
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
-    bar = ProgressBar(1.0, unit="of the frames drawn") if not kw and sys.stderr.isatty() else None
-    if bar is not None:  # GIF and MP4 take seconds
-        kw["progress"] = lambda done, total, bar=bar: bar(done / total)
+    bar: ProgressBar | None = None
+    if not kw and sys.stderr.isatty():  # GIF and MP4 take seconds: a bar over the frames, made at the first
+        def frames(done: int, total: int) -> None:
+            nonlocal bar
+            bar = bar or ProgressBar(total, unit="frames")
+            bar(done)
+
+        kw["progress"] = frames
     start = time.monotonic()
     try:
         with writing(args.output), _options({"traces": "--trace", "channels": "--channel"}):

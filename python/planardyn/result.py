@@ -327,8 +327,9 @@ class SimulationResult:
         return self._write(path, None)
 
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
-        """:meth:`save` in the CSV form whatever the name: the metadata on ``# `` lines, then
-        the file's columns (:mod:`planardyn.results_io`), full double precision."""
+        """:meth:`save` in the CSV form whatever the name: the file's columns, full double
+        precision, a table a spreadsheet opens; the metadata as JSON beside it, in the file
+        named ``<path>.json`` (:mod:`planardyn.results_io`)."""
         return self._write(path, ".csv")
 
     def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:

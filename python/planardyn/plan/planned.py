@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import ArgumentError
 from ..mechanism import Mechanism
+from ..notebook import Summarized, per_coordinate
 from ..result import SimulationResult
 
 FloatArray = NDArray[np.float64]
@@ -30,7 +31,7 @@ class InfeasiblePlan(PlanError):
 
 
 @dataclass(repr=False)
-class PlannedMotion:
+class PlannedMotion(Summarized):
     """A motion from rest to rest with the efforts that run it.
 
     It holds ``mech``, the grid times ``t`` (N,) (s), and ``q``, ``qd``, ``qdd``, ``tau``
@@ -56,6 +57,15 @@ class PlannedMotion:
 
     def _summary(self) -> str:
         return f"{len(self.t)} grid points"
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        m = self.mech
+        return [("model", m.name), ("duration", f"{self.duration:.6g} s"),
+                ("limits used", f"{self.limit_ratio:.6g} of the largest (dense check)"),
+                ("peak |tau|", per_coordinate(m.coordinate_names, np.abs(self.tau).max(axis=0), m.effort_units)),
+                ("peak |qd|", per_coordinate(m.coordinate_names, np.abs(self.qd).max(axis=0),
+                                             [f"{u}/s" for u in m.coordinate_units])),
+                ("solution", self._summary())]
 
     @property
     def duration(self) -> float:
