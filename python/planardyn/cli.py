@@ -26,7 +26,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
-import importlib.util
+import importlib
 import json
 import os
 import sys
@@ -69,11 +69,8 @@ class UsageError(Exception):
     """A command line that cannot be carried out as given (exit 2)."""
 
 
-#: What writing a file of this extension needs beyond the dependencies: (module, package, extra).
-OPTIONAL_WRITERS = {
-    ".parquet": ("pyarrow", "pyarrow", "parquet"),
-    ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg", "mp4"),
-}
+#: What writing a file of this extension needs beyond the dependencies: (extra, what it writes).
+OPTIONAL_WRITERS = {".parquet": ("parquet", "a .parquet file"), ".mp4": ("mp4", "an .mp4 file")}
 #: Integration methods without error control, whose step must be given (--dt).
 FIXED_STEP_METHODS = ("rk4",)
 
@@ -86,10 +83,12 @@ def require_writer(path: Path | None) -> None:
     check_writable(path)
     if path.suffix.lower() not in OPTIONAL_WRITERS:
         return
-    module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
-    if importlib.util.find_spec(module) is None:
-        raise UsageError(f"{path}: writing {path.suffix} files needs {package}, which is not installed: "
-                         f"pip install {package} (or pip install 'planardyn[{extra}]')")
+    extra, what = OPTIONAL_WRITERS[path.suffix.lower()]
+    for module in extras.MODULES[extra]:
+        try:
+            importlib.import_module(module)
+        except ImportError as e:
+            raise UsageError(f"{path}: {extras.missing(extra, what, e)}") from None
 
 
 def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
@@ -633,9 +632,9 @@ def _point_motion(res: SimulationResult, path: Path, points: list[str]) -> Any:
     shared = [p for p in points if p in mech.ground_points and any(p in [n for n, _ in b] for b in mech.body_points)]
     if shared:
         bodies = [mech.body_names[k] for k, b in enumerate(mech.body_points) if shared[0] in [n for n, _ in b]]
-        raise UsageError(f"--points {shared[0]}: the ground carries {shared[0]} as well as {', '.join(bodies)}, and "
-                         "a point's motion is its ground copy's, at rest: give a point only the moving body carries "
-                         f"(add one to {bodies[0]}'s points in the model file)")
+        raise UsageError(f"--points {shared[0]}: the ground carries {shared[0]} as well as {' and '.join(bodies)}, "
+                         "and a point's motion is its ground copy's, at rest: give a point the ground does not carry "
+                         f"(add one at the same place to the points of {' or '.join(bodies)} in the model file)")
     return motion
 
 

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import results_format
+from . import extras, results_format
 from ._core import DenseOutput, __version__
 from .arguments import error
 
@@ -57,8 +57,8 @@ def _dataframe(cols: Mapping[str, FloatArray]) -> pandas.DataFrame:
     """``cols`` as a DataFrame indexed by its ``t`` column (needs pandas)."""
     try:
         import pandas as pd
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+    except ImportError as e:
+        raise extras.missing("pandas", "to_dataframe()", e) from e
     return pd.DataFrame(cols).set_index("t")
 
 

@@ -23,6 +23,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from . import extras
+
 FloatArray = NDArray[np.float64]
 
 FORMAT = "planardyn-results"
@@ -106,8 +108,8 @@ def pyarrow() -> tuple[Any, Any]:
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("Parquet results files need pyarrow: pip install pyarrow") from e
+    except ImportError as e:
+        raise extras.missing("parquet", "a Parquet results file", e) from e
     return pa, pq
 
 

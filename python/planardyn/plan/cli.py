@@ -26,6 +26,7 @@ import sys
 
 import numpy as np
 
+from .. import extras
 from .._core import AssemblyError, ModelError, SingularityError
 from ..mechanism import load
 from ..models import UnknownModelError, resolve
@@ -141,6 +142,10 @@ def run(args: argparse.Namespace) -> int:
     except (SingularityError, AssemblyError) as exc:
         print(f"planardyn plan: refused: {exc}", file=sys.stderr)
         return 1
+    except ImportError as exc:  # casadi is imported by --collocate only
+        if extras.is_missing("plan", exc):
+            raise extras.missing("plan", "planardyn plan", exc) from exc
+        raise
     peak = np.abs(plan.tau).max(axis=0)
     print(f"{mech.name}: {plan.duration:.6g} s {what}; peak |tau| {np.round(peak, 4).tolist()}; limits used to "
           f"{plan.limit_ratio:.10g} on the dense check")
