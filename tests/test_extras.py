@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import MODELS, ROOT
+from conftest import ROOT
 from planardyn import extras
 
 tomllib = pytest.importorskip("tomllib")  # Python 3.11+

@@ -14,10 +14,10 @@ import numpy as np
 import planardyn as pd
 import pytest
 from conftest import MODELS
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from PIL import Image
 from planardyn.animate import frame_indices, render_frames
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from planardyn.plot import (
     default_trace_points,
     draw_mechanism,

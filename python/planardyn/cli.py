@@ -45,13 +45,14 @@ from . import (
     SimulationError,
     SingularityError,
     __version__,
+    extras,
     from_result,
+    guide,
     load,
     models,
     structure,
 )
 from .events import Crossing, parse_crossing
-from . import extras, guide
 from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
@@ -380,7 +381,8 @@ def _check(args: argparse.Namespace) -> int:
     mech = load(args.model)
     n, pairs = mech.n_bodies, mech.pairs
     s = structure.analyse(mech)
-    print(f"model: {mech.name}  ({mech.source})")
+    shipped = Path(args.given) != args.model  # a name: the file's path would be the package's
+    print(f"model: {mech.name}  ({f'shipped model {args.given}' if shipped else mech.source})")
     print(f"bodies: {n}")
     for b, mass, inertia in zip(mech.body_names, mech.masses, mech.inertias):
         print(f"  {b}: mass {mass:.6g} kg, inertia {inertia:.6g} kg m^2")
@@ -736,6 +738,7 @@ def _main(argv: list[str]) -> int:
     try:
         args = _parser(argv[0] if argv else None).parse_args(argv)
         if getattr(args, "model", None) is not None:
+            args.given = str(args.model)
             try:
                 args.model = models.resolve(args.model)
             except models.UnknownModelError as e:  # demo's model is an option, the others' an argument

@@ -27,7 +27,6 @@ from .plots import plot_sizing
 from .sampling import SizingError
 from .sizing import DISTRIBUTIONS, size
 
-
 DESCRIPTION = ("Actuator sizing of an end-effector motion: the end-effector point (--point) runs a circle or\n"
                "a line in --duration seconds with a time law (--profile); the report gives each drive's peak\n"
                "and RMS effort, peak speed and power (the motor side and its limits where the model has\n"
