@@ -4,8 +4,8 @@ wheel and its dependencies, from a folder outside the repository.
     python wheel_smoke.py README.md
 
 Checks that planardyn is imported from the installed wheel, not a source tree; that the wheel
-holds the licence and every shipped model file, each of which loads; that `planardyn --version`
-prints the installed version; and that every snippet of README.md runs in page order, the
+holds the licence and every shipped model file, each of which loads, and the guide's pages
+(`planardyn docs`); that `planardyn --version` prints the installed version; and that every snippet of README.md runs in page order, the
 ```python blocks in one namespace, the `planardyn` lines of its ```bash blocks as commands (as
 tests/test_docs.py runs every page in the repository). Needs nothing but the wheel.
 """
@@ -63,6 +63,19 @@ def check_installed() -> None:
     print(f"wheel: {where.parent}: LICENSE, {len(shipped)} model files, each loads")
 
 
+def check_guide(readme: Path) -> None:
+    """The guide's pages are in the wheel (planardyn/docs/*.md), the repository's, and
+    `planardyn docs PAGE` prints them: the address model errors cite."""
+    files = [str(f) for f in importlib.metadata.distribution("planardyn").files or []]
+    shipped = sorted(f.removeprefix("planardyn/docs/") for f in files if f.startswith("planardyn/docs/"))
+    pages = sorted(p.name for p in (readme.parent / "docs").glob("*.md"))
+    assert shipped == pages, (shipped, pages)
+    command = Path(sys.executable).parent / "planardyn"
+    out = subprocess.run([str(command), "docs", "model-format"], capture_output=True, text=True, check=True).stdout
+    assert out == (readme.parent / "docs" / "model-format.md").read_text(), out[:200]
+    print(f"wheel: the guide's {len(shipped)} pages, planardyn docs prints them")
+
+
 def check_version() -> None:
     command = Path(sys.executable).parent / "planardyn"
     out = subprocess.run([str(command), "--version"], capture_output=True, text=True, check=True).stdout
@@ -92,4 +105,5 @@ def run_readme(readme: Path) -> None:
 if __name__ == "__main__":
     check_installed()
     check_version()
+    check_guide(Path(sys.argv[1]))
     run_readme(Path(sys.argv[1]))

@@ -736,7 +736,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: list[str]) -> int:
     try:
-        args = _parser(argv[0] if argv else None).parse_args(argv)
+        try:
+            args = _parser(argv[0] if argv else None).parse_args(argv)
+        except SystemExit as e:  # argparse: --help, --version (0) or a usage error (2), already printed
+            return e.code if isinstance(e.code, int) else EXIT_OK if e.code is None else EXIT_USAGE
         if getattr(args, "model", None) is not None:
             args.given = str(args.model)
             try:

@@ -197,6 +197,14 @@ def per_coordinate(names: list[str], values: Any, units: list[str]) -> str:
     return ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(names, np.ravel(values), units))
 
 
+def peak_rows(mech: Mechanism, tau: Any, qd: Any) -> list[tuple[str, str]]:
+    """The rows "peak |tau|" and "peak |qd|" of a motion's efforts and rates (N, m), each
+    coordinate's largest magnitude in its unit."""
+    names = mech.coordinate_names
+    return [("peak |tau|", per_coordinate(names, np.abs(tau).max(axis=0), mech.effort_units)),
+            ("peak |qd|", per_coordinate(names, np.abs(qd).max(axis=0), [f"{u}/s" for u in mech.coordinate_units]))]
+
+
 class Summarized:
     """What the result classes share for a notebook: ``_repr_html_`` shows the class's name
     over a table of the rows :meth:`_summary_rows` gives ((field, text), escaped here) and the

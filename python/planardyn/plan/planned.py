@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import ArgumentError
 from ..mechanism import Mechanism
-from ..notebook import Summarized, per_coordinate
+from ..notebook import Summarized, peak_rows
 from ..result import SimulationResult
 
 FloatArray = NDArray[np.float64]
@@ -59,13 +59,9 @@ class PlannedMotion(Summarized):
         return f"{len(self.t)} grid points"
 
     def _summary_rows(self) -> list[tuple[str, str]]:
-        m = self.mech
-        return [("model", m.name), ("duration", f"{self.duration:.6g} s"),
+        return [("model", self.mech.name), ("duration", f"{self.duration:.6g} s"),
                 ("limits used", f"{self.limit_ratio:.6g} of the largest (dense check)"),
-                ("peak |tau|", per_coordinate(m.coordinate_names, np.abs(self.tau).max(axis=0), m.effort_units)),
-                ("peak |qd|", per_coordinate(m.coordinate_names, np.abs(self.qd).max(axis=0),
-                                             [f"{u}/s" for u in m.coordinate_units])),
-                ("solution", self._summary())]
+                *peak_rows(self.mech, self.tau, self.qd), ("solution", self._summary())]
 
     @property
     def duration(self) -> float:

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
 from ..arguments import count, error, positive
-from ..notebook import Summarized, per_coordinate
+from ..notebook import Summarized, peak_rows
 from .effector import EndEffector
 from .paths import TaskPath
 from .tolerances import SINGULAR_TOL
@@ -83,12 +83,9 @@ class TaskMotion(Summarized):
                 f"min sigma_II {self.sigma_II.min():.3g}, peak |tau| {np.abs(self.tau).max(axis=0).round(4).tolist()})")
 
     def _summary_rows(self) -> list[tuple[str, str]]:
-        m = self.mech
-        return [("model", m.name), ("path", f"{self.label} of {self.effector.point}"),
+        return [("model", self.mech.name), ("path", f"{self.label} of {self.effector.point}"),
                 ("samples", f"{len(self.t)}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s"),
-                ("peak |tau|", per_coordinate(m.coordinate_names, np.abs(self.tau).max(axis=0), m.effort_units)),
-                ("peak |qd|", per_coordinate(m.coordinate_names, np.abs(self.qd).max(axis=0),
-                                             [f"{u}/s" for u in m.coordinate_units])),
+                *peak_rows(self.mech, self.tau, self.qd),
                 ("min sigma_I, sigma_II", f"{self.sigma_I.min():.3g}, {self.sigma_II.min():.3g}"),
                 *[("note", n) for n in self.notes]]
 
