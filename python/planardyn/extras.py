@@ -1,8 +1,11 @@
-"""The optional extras of ``pip install 'planardyn[EXTRA]'`` and the error a missing one gives.
+"""The optional extras of ``pip install 'planardyn-<version>.whl[EXTRA]'`` and the error a
+missing one gives.
 
 Every place that imports an optional package turns the ImportError into :func:`missing`'s,
-which names the extra to install (``pip install 'planardyn[plan]'``) and the packages it
-brings, so a user never sees a bare ``No module named 'toppra'``. The table is pyproject.toml's
+which names the extra and the command that installs its packages (``pip install toppra
+casadi``), so a user never sees a bare ``No module named 'toppra'``. The command names the
+packages, not ``planardyn[plan]``: planardyn has no release on a package index, so that would
+ask the index for another project of the name. The table is pyproject.toml's
 ``[project.optional-dependencies]`` (a test keeps them equal).
 """
 
@@ -33,11 +36,12 @@ class MissingExtra(ImportError):
 
 def missing(extra: str, what: str, cause: ImportError | None = None) -> MissingExtra:
     """The error for ``what`` (a feature, e.g. ``"planardyn plan"``) without ``extra``:
-    ``"planardyn plan needs the 'plan' extra: pip install 'planardyn[plan]' (or toppra and
-    casadi; No module named 'toppra')"``."""
-    packages = " and ".join(EXTRAS[extra])
+    ``"planardyn plan needs the 'plan' extra: pip install toppra casadi (or the wheel with
+    it, 'planardyn-<version>.whl[plan]'; No module named 'toppra')"``."""
+    packages = " ".join(f"'{p}'" if "[" in p else p for p in EXTRAS[extra])
     found = f"; {cause}" if cause is not None else ""
-    return MissingExtra(f"{what} needs the '{extra}' extra: pip install 'planardyn[{extra}]' (or {packages}{found})")
+    return MissingExtra(f"{what} needs the '{extra}' extra: pip install {packages} (or the wheel with it, "
+                        f"'planardyn-<version>.whl[{extra}]'{found})")
 
 
 def is_missing(extra: str, error: ImportError) -> bool:

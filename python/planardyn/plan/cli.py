@@ -45,7 +45,7 @@ OPTIONS = {"effort": "--effort", "speed": "--speed", "spacing": "--spacing", "n_
 DESCRIPTION = ("Time-optimal timing of an end-effector line (TOPP, toppra) within effort limits (--effort) or\n"
                "the motors' torque-speed envelopes (--actuators), or with --collocate the optimal motion\n"
                "between the line's ends (minimum time, or minimum effort in --duration; collocation, IPOPT).\n"
-               "Needs the 'plan' extra: pip install 'planardyn[plan]' (toppra and casadi).")
+               "Needs the 'plan' extra: pip install toppra casadi.")
 EXAMPLES = ("examples:\n"
             "  planardyn plan library/five-bar-5r --line -0.08 0.28 0.08 0.36 --effort 3 3 --speed 12 12 -o timed.csv\n"
             "  planardyn plan library/five-bar-5r --line -0.08 0.28 0.08 0.36 --effort 3 3 --collocate time\n"
