@@ -6,7 +6,7 @@ use super::forces::applied_forces;
 use crate::kinematics::constraints::{
     pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, perp, point_velocity, rotate, world_point, Dense,
 };
-use crate::kinematics::pairs::{coordinate_pattern, frames::angle};
+use crate::model::pairs::{coordinate_pattern, frames::angle};
 use crate::model::{Attachment, Link, Load, Mechanism};
 
 #[inline]
@@ -160,7 +160,7 @@ pub fn applied_forces_dx(
             Load::PairSpring { pair, stiffness, damping, rest } => {
                 let p = &mech.pairs[pair.0];
                 let rate = pair_coordinate_rate(p, x, xd);
-                let effort = -stiffness * (crate::kinematics::pairs::coordinate(p, x) - rest) - damping * rate;
+                let effort = -stiffness * (crate::model::pairs::coordinate(p, x) - rest) - damping * rate;
                 let deffort = -stiffness * pair_coordinate_rate(p, x, t) - damping * pair_coordinate_gamma(p, x, xd, t);
                 pair_effort_rate(mech, pair.0, effort, deffort, x, t, df, scratch);
             }

@@ -4,7 +4,7 @@
 //! through the coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
 use crate::kinematics::constraints::{pair_coordinate, pair_coordinate_grad, pair_coordinate_rate, Sink};
-use crate::kinematics::pairs::frames::{link_state, perp};
+use crate::model::pairs::frames::{link_state, perp};
 use crate::model::{Attachment, Load, Mechanism};
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).

@@ -1,20 +1,20 @@
 //! The position equations F(x) = [Phi(x); D(x) - z] = 0 and their derivatives.
 //!
 //! The first rows are the independent pair constraints Phi (each pair kind has its own rows,
-//! `kinematics::pairs`; `Mechanism::row_slot` places them); the last m rows fix the chart's
+//! `model::pairs`; `Mechanism::row_slot` places them); the last m rows fix the chart's
 //! coordinates z: the user's generalized coordinates D(x) (relative angles and displacements
 //! of the input pairs), or m chosen components of x (generalized coordinate partitioning).
 //! Per row we need the value, the gradient (a row of J) and the second derivative as a
 //! bilinear form gamma(a, b) = sum_ij d2F/dx_i dx_j a_i b_j, which gives the convective term
 //! (gamma(xd, xd)) and the acceleration analogues (gamma(u_j, u_k)).
 
-pub use super::pairs::frames::{perp, rotate};
-use super::pairs::{self, frames::link_state, frames::part};
-pub use super::pairs::{
+pub use crate::linalg::{Dense, Sink};
+pub use crate::model::pairs::frames::{perp, rotate};
+use crate::model::pairs::{self, frames::link_state, frames::part};
+pub use crate::model::pairs::{
     coordinate as pair_coordinate, coordinate_gamma as pair_coordinate_gamma, coordinate_grad as pair_coordinate_grad,
     coordinate_rate as pair_coordinate_rate,
 };
-pub use crate::linalg::{Dense, Sink};
 use crate::model::{Link, Mechanism};
 
 /// Which m functions of x are the independent coordinates.

@@ -21,10 +21,10 @@
 //! takes the SVD of each block (s^3), never of the whole J.
 
 use super::constraints::Chart;
-use super::pairs::frames::perp;
 use super::system::fill_row_scale;
 use crate::linalg::BlockLu;
 use crate::model::diameter::diameter;
+use crate::model::pairs::frames::perp;
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
 

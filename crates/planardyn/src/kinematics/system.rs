@@ -10,8 +10,8 @@
 
 use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
 use super::group_sigma::GroupScales;
-use super::pairs;
 use crate::linalg::{BlockLu, MAX_COLUMNS};
+use crate::model::pairs;
 use crate::model::{CoordinateKind, Mechanism};
 use std::sync::atomic::{AtomicU64, Ordering};
 

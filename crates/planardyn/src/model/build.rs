@@ -2,11 +2,11 @@
 //! inertias are positive, the mobility equals the number of coordinates, the constraints are
 //! independent in the drawing, and the mechanism assembles at its start coordinates.
 
+use super::pairs::frames::rotate;
+use super::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
 use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, MotionSpec, PairSpec, PartSpec, SimulateSpec};
 use super::*;
 use crate::kinematics::assemble;
-use crate::kinematics::constraints::rotate;
-use crate::kinematics::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
 use crate::kinematics::position::MAX_CONTINUATION_DISTANCE;
 use crate::structure::constraint_rank;
 use crate::ModelError;

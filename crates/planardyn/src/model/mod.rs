@@ -10,6 +10,7 @@ pub(crate) mod diameter;
 mod io;
 mod motion;
 mod nesting;
+pub mod pairs;
 mod parse_errors;
 pub mod spec;
 mod tags;
@@ -62,10 +63,10 @@ pub enum PairKind {
         /// Unit direction of the guide in a's frame.
         axis: [f64; 2],
     },
-    /// Gears (or a pinion and a rack) rolling without slip: `kinematics::pairs::gear`.
-    Gear(crate::kinematics::pairs::gear::Gear),
-    /// A pin of b in a slot of a: `kinematics::pairs::slot`.
-    Slot(crate::kinematics::pairs::slot::Slot),
+    /// Gears (or a pinion and a rack) rolling without slip: [`pairs::gear`].
+    Gear(pairs::gear::Gear),
+    /// A pin of b in a slot of a: [`pairs::slot`].
+    Slot(pairs::slot::Slot),
 }
 
 /// A kinematic pair between links `a` and `b` at a point both carry (a gear pair: at the

@@ -12,8 +12,8 @@
 //! inner pairs, or (without a contour) the largest number of inner pairs on one of its links,
 //! 2 for a dyad; its order is its number of outer pairs (Artobolevsky).
 
-use crate::kinematics::pairs::letter;
 use crate::linalg::BlockLu;
+use crate::model::pairs::letter;
 use crate::model::{BodyId, Link, Mechanism, PairId};
 use petgraph::algo::tarjan_scc;
 use petgraph::graph::{DiGraph, NodeIndex};

@@ -1,8 +1,8 @@
 //! Validation of the actuators and of the Coulomb friction of the pairs.
 
 use super::{coordinate_index, pair_id, relative_pair, Ctx, R};
-use crate::kinematics::pairs::{self, Relative};
 use crate::model::actuators::{Actuator, JointFriction, Limits, PairActuator};
+use crate::model::pairs::{self, Relative};
 use crate::model::spec::{ActuatorSpec, LimitsSpec, LoadSpec};
 use crate::model::{Mechanism, PairKind};
 
