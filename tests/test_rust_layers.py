@@ -72,6 +72,30 @@ def test_a_path_through_a_reexport_lands_in_the_file_that_defines_it(tmp_path: P
     assert found == ["c: model.rs -> kinematics/ws.rs: upward: model (layer 0) -> kinematics (layer 1)"]
 
 
+def test_a_method_given_to_a_lower_type_from_above_is_an_upward_reference(tmp_path: Path) -> None:
+    # `Mechanism::new` written in the loader looks like the model's own: the model's type
+    # then reaches up to the loader (and round, as the loader uses the model). A trait impl
+    # there is the loader's own business.
+    files = {
+        "model.rs": "pub struct Mechanism;\n",
+        "loader.rs": """\
+            use crate::model::Mechanism;
+            impl Mechanism {
+                pub fn new() -> Self { Mechanism }
+            }
+            impl Default for Mechanism {
+                fn default() -> Self { Mechanism }
+            }
+            """,
+    }
+    found, _ = run(tmp_path, files)
+    assert found == [
+        "c: model.rs -> loader.rs: upward: model (layer 0) -> loader (layer 2) "
+        "(its `Mechanism` gets methods there: make them functions of `loader`)",
+        "c: file cycle (2): loader.rs, model.rs",
+    ]
+
+
 def test_use_groups_are_expanded(tmp_path: Path) -> None:
     files = {"model.rs": "use crate::{kinematics::{self, count as n}, loader::{load}};\n"}
     found, _ = run(tmp_path, files)

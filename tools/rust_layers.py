@@ -46,6 +46,7 @@ _COMMENT = re.compile(r"//[^\n]*|/\*.*?\*/", re.S)
 _TESTS = re.compile(r"#\[cfg\(test\)\]\s*mod\s+tests\s*\{.*", re.S)
 _USE = re.compile(r"^[ \t]*(pub(?:\([^)]*\))?\s+)?use\s+([^;]*);", re.S | re.M)
 _PATH = re.compile(r"(?<![\w:$])((?:crate|super|self)(?:\s*::\s*\w+)+)")
+_IMPL = re.compile(r"^[ \t]*impl\b\s*(?:<[^{>]*>)?\s*([\w:]+)[^{;]*\{", re.M)
 _REEXPORT_DEPTH = 16
 
 
@@ -99,6 +100,8 @@ class Crate:
     texts: dict[Module, str] = field(default_factory=dict)
     # module -> name -> the absolute path it re-exports
     reexports: dict[Module, dict[str, list[str]]] = field(default_factory=dict)
+    # (the type's module, the module with an inherent impl of it) -> the type's name
+    impls: dict[tuple[Module, Module], str] = field(default_factory=dict)
 
     @classmethod
     def read(cls, src: Path) -> Crate:
@@ -173,7 +176,29 @@ class Crate:
                 target = None if absolute is None else self.resolve(absolute)
                 if target is not None and target != mod[: len(target)]:
                     graph[mod].add(target)
+        for (owner, mod), _ in self.foreign_impls().items():
+            graph[owner].add(mod)
         return graph
+
+    def foreign_impls(self) -> dict[tuple[Module, Module], str]:
+        """Inherent impls of a type defined in another file (not an ancestor): the type's
+        file then offers methods written in the impl's file, an edge from the former to the
+        latter (``impl Mechanism { fn new }`` in the loader puts the loader under the model)."""
+        if self.impls:
+            return self.impls
+        for mod, text in self.texts.items():
+            names = {a: p for m in _USE.finditer(text) for p, a in use_paths(m.group(2))}
+            for m in _IMPL.finditer(text):
+                header = text[m.start() : m.end()]
+                *path, name = m.group(1).split("::")
+                if re.search(r"\bfor\b", header) or re.search(rf"\b(?:struct|enum|union|type)\s+{name}\b", text):
+                    continue
+                written = path + [name] if path else names.get(name)
+                absolute = None if written is None else self.absolute(mod, written)
+                owner = None if absolute is None else self.resolve(absolute)
+                if owner is not None and owner != mod and mod != owner[: len(mod)]:
+                    self.impls[(owner, mod)] = name
+        return self.impls
 
 
 def cycles(graph: dict[Module, set[Module]]) -> list[list[Module]]:
@@ -268,6 +293,8 @@ def layer_findings(name: str, crate: Crate, graph: dict, layers: Layers, allow: 
             why = None if "lib" in (a, b) else layers.violation(a, b)
             if why is None:
                 continue
+            if (mod, target) in crate.impls:
+                why += f" (its `{crate.impls[mod, target]}` gets methods there: make them functions of `{b}`)"
             line = f"{name}: {crate.rel(mod)} -> {crate.rel(target)}: {why}"
             entry = by_edge.get((crate.rel(mod), crate.rel(target)))
             if entry is None:
@@ -293,7 +320,7 @@ def cycle_findings(name: str, crate: Crate, graph: dict, allow: list[dict]) -> t
         else:
             used.append(entry)
             allowed.append(line + reason(entry))
-    for entry in used:
+    for entry in {id(e): e for e in used}.values():
         for gone in sorted(set(entry["cycle"]) - in_cycles):
             found.append(f"{name}: {gone} is in no cycle now: remove it from its allow-list entry")
     return found, allowed, used

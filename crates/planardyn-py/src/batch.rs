@@ -14,7 +14,7 @@ use crate::errors::{run, task_error, to_pyerr, Failure};
 use crate::mechanism::PyMechanism;
 use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};
-use planardyn::batch::{map_many_until, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::batch::{map_many_until, Efforts, InverseVariant, Motion, Overrides, Variant};
 use planardyn::Mechanism;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -161,7 +161,7 @@ fn simulate_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(&m.get().inner, d)? })
+        Ok(Variant { model: m.get().inner.clone(), overrides: overrides(&m.get().inner, d)? })
     };
     let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
     run_batch(py, &variants, threads, make, solve, |r, _| match r {
@@ -221,7 +221,7 @@ fn inverse_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? })
+        Ok(InverseVariant { model: m.get().inner.clone(), motion: motion(d)? })
     };
     run_batch(
         py,

@@ -20,12 +20,14 @@ pub mod error;
 pub mod integrate;
 pub mod kinematics;
 pub mod linalg;
+pub mod loader;
 pub mod model;
 pub mod simulate;
 pub mod structure;
 pub mod workspace;
 
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};
-pub use model::{load, loads, Format, Mechanism, MechanismSpec};
+pub use loader::{analyse_spec, build, load, loads, Format};
+pub use model::{Mechanism, MechanismSpec};
 pub use structure::{analyse, Structure};
 pub use workspace::Workspace;

@@ -4,7 +4,7 @@
 use super::analogues::velocity_analogues;
 use super::constraints::{body_trig, residual, Chart};
 use super::system::set_row_scale;
-use crate::model::{CoordinateKind, Mechanism};
+use crate::model::{CoordinateKind, Mechanism, MAX_CONTINUATION_DISTANCE};
 use crate::workspace::Workspace;
 use crate::{KinematicsError, SingularityKind};
 
@@ -129,11 +129,6 @@ const MAX_CONTINUATION_MOVE: f64 = 0.1;
 /// may have left the branch it started on (another assembly mode is O(1) away): the step is
 /// refused and cut, by continuation here and by the integrator in a simulation.
 pub const MAX_CORRECTION: f64 = 0.1;
-/// Largest move one continuation may make (rad, or lengths L for a displacement), for the
-/// loader's `q0` and every API call alike: with steps of [`MAX_CONTINUATION_MOVE`] it bounds
-/// a call to ~10^4 position solves (well under a second), where an unbounded target such as
-/// 1e15 rad would never return. A longer way is a sequence of calls, each from the last.
-pub const MAX_CONTINUATION_DISTANCE: f64 = 1e3;
 
 /// Largest scaled difference between two body-coordinate vectors.
 pub fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {

@@ -1,25 +1,24 @@
-//! Validation of a [`MechanismSpec`] into a [`Mechanism`]: every name resolves, masses and
-//! inertias are positive, the mobility equals the number of coordinates, the constraints are
-//! independent in the drawing, and the mechanism assembles at its start coordinates.
+//! The checks of a [`MechanismSpec`] that need no mechanics, into the [`Mechanism`] as drawn:
+//! every name resolves, masses and inertias are positive, numbers are finite and in range,
+//! each pair, coordinate, drive, load and actuator is well formed. The loader adds the checks
+//! that need kinematics (the mobility, the assembly at q0) and the simulation settings
+//! (`crate::loader`).
 
 use super::pairs::frames::rotate;
 use super::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
-use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, MotionSpec, PairSpec, PartSpec, SimulateSpec};
+use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, MotionSpec, PairSpec, PartSpec};
 use super::*;
-use crate::kinematics::assemble;
-use crate::kinematics::position::MAX_CONTINUATION_DISTANCE;
-use crate::structure::constraint_rank;
 use crate::ModelError;
 
 mod actuators;
 
 /// Collects the context for error messages: the source name.
-struct Ctx<'a> {
-    source: &'a str,
-    spec: &'a MechanismSpec,
+pub(crate) struct Ctx<'a> {
+    pub source: &'a str,
+    pub spec: &'a MechanismSpec,
 }
 
-type R<T> = Result<T, ModelError>;
+pub(crate) type R<T> = Result<T, ModelError>;
 
 /// Largest drawn coordinate accepted (m): beyond it squared lengths overflow and the
 /// numbers cannot describe a machine.
@@ -32,7 +31,7 @@ const MAX_MAGNITUDE: f64 = 1e30;
 const MIN_MASS: f64 = 1e-30;
 
 impl Ctx<'_> {
-    fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
+    pub(crate) fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
         ModelError::Invalid { source_name: self.source.to_string(), path: path.into(), message: message.into() }
     }
     fn point(&self, path: &str, name: &str) -> R<PointId> {
@@ -86,17 +85,8 @@ impl Ctx<'_> {
     }
 }
 
-pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
-    let mut mech = drawing(spec, source)?;
-    let spec = mech.spec.clone();
-    let ctx = Ctx { source, spec: &spec };
-    check_mobility(&ctx, &mut mech)?;
-    check_assembly(&ctx, &mech)?;
-    Ok(mech)
-}
-
-/// Every check but the mobility and the assembly: the mechanism as drawn, all its pair rows
-/// kept, which the structural analysis of a model the loader refuses reads.
+/// Every check that needs no mechanics: the mechanism as drawn, all its pair rows kept
+/// (the loader leaves out the redundant ones), without simulation defaults (the loader's).
 pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     let ctx = Ctx { source, spec: &spec };
     if let Some(units) = &spec.units {
@@ -184,7 +174,6 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         .collect::<R<_>>()?;
     mech.friction = actuators::build_friction(&ctx, &mech, &spec.loads)?;
     (mech.actuators, mech.pair_actuators) = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
-    mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
 }
 
@@ -831,114 +820,6 @@ fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
             rest: 0.0,
         },
     })
-}
-
-fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
-    let Some(s) = s else { return Ok(SimulateDefaults::default()) };
-    let positive = |field: &str, v: Option<f64>| -> R<Option<f64>> {
-        match v {
-            Some(x) if !(x > 0.0 && x.is_finite()) => {
-                Err(ctx.err(format!("simulate.{field}"), format!("{x} must be a positive number")))
-            }
-            _ => Ok(v),
-        }
-    };
-    if let Some(m) = &s.method {
-        m.parse::<crate::integrate::Method>().map_err(|e| ctx.err("simulate.method", e))?;
-    }
-    Ok(SimulateDefaults {
-        t_end: positive("t_end", s.t_end)?,
-        method: s.method.clone(),
-        rtol: positive("rtol", s.rtol)?,
-        atol: positive("atol", s.atol)?,
-        dt: positive("dt", s.dt)?,
-        output_dt: positive("output_dt", s.output_dt)?,
-    })
-}
-
-/// The mobility, 3n minus the rank of the pair constraints in the drawing, must equal the
-/// number of coordinates; the Chebyshev-Grubler count 3n - (sum of the pairs' rows)
-/// explains a mismatch. Redundant constraints (rank below the row count with the right
-/// mobility, as in a parallelogram) are left out of the position equations and reported
-/// in `warnings`.
-fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
-    let (n, rows, m) = (mech.n_bodies() as i64, mech.n_pair_rows(), mech.dof() as i64);
-    let cr = constraint_rank(mech, &mech.x0);
-    let (grubler, mobility) = (3 * n - rows as i64, 3 * n - cr.rank as i64);
-    // The count written out: 2 rows for each revolute and prismatic pair, 1 for each gear or slot.
-    let p1 = mech.pairs.iter().filter(|p| pairs::n_rows(&p.kind) == 1).count();
-    let p2 = mech.pairs.len() - p1;
-    let count =
-        if p1 == 0 { format!("3n - 2p = 3*{n} - 2*{p2}") } else { format!("3n - 2p - p1 = 3*{n} - 2*{p2} - {p1}") };
-    // Whatever the coordinates, a drawing whose constraints have full rank cannot move.
-    if mobility == 0 {
-        let why = if n == 0 {
-            "the model has no mobile body".to_string()
-        } else {
-            format!(
-                "its {rows} pair constraints have rank {} = 3n in the drawing (Chebyshev-Grubler: {count} = {grubler})",
-                cr.rank
-            )
-        };
-        return Err(ctx.err(
-            "coordinates",
-            format!(
-                "the drawing is a structure (mobility 0): {why}, so nothing can move, and planardyn moves \
-                 mechanisms only; remove a pair or a body (or add a body) until the mobility is at least 1, \
-                 or check the drawing, then give one coordinate per degree of freedom"
-            ),
-        ));
-    }
-    if m == 0 {
-        return Err(ctx.err(
-            "coordinates",
-            format!(
-                "no generalized coordinates, but the mechanism has mobility 3n - rank = {mobility}; \
-                 name {mobility} input pair(s) under `coordinates`"
-            ),
-        ));
-    }
-    if mobility != m {
-        let message = if mobility == grubler {
-            format!(
-                "the mechanism has mobility {count} = {mobility} but {m} coordinate(s) are given; \
-                 give exactly {mobility} coordinate(s), or check the pairs (a revolute or prismatic pair removes 2 freedoms, \
-                 a gear or slot pair 1)"
-            )
-        } else {
-            format!(
-                "the {rows} pair constraints have rank {} in the drawing, so it has mobility 3n - rank = {mobility} \
-                 (Chebyshev-Grubler: {count} = {grubler}), but {m} coordinate(s) are given: the drawing is at a \
-                 singular (folded) configuration, or has redundant constraints; draw it away from singular positions",
-                cr.rank
-            )
-        };
-        return Err(ctx.err("coordinates", message));
-    }
-    if cr.rank < rows {
-        mech.row_slot = vec![None; rows];
-        for (slot, &row) in cr.independent_rows.iter().enumerate() {
-            mech.row_slot[row] = Some(slot);
-        }
-        mech.n_constraints = cr.rank;
-        mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
-        for stress in &cr.self_stresses {
-            let names: Vec<&str> = stress.pairs.iter().map(|&k| mech.pairs[k.0].name.as_str()).collect();
-            mech.warnings.push(format!(
-                "redundant constraints among pairs {}: one of their constraint equations is implied by the others \
-                 and left out (Chebyshev-Grubler counts {grubler} degree(s) of freedom, the rank shows {mobility}); \
-                 the reactions shared by these pairs are statically indeterminate",
-                names.join(", ")
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// The mechanism must assemble at its start coordinates (the drawing, or `q0`).
-fn check_assembly(ctx: &Ctx, mech: &Mechanism) -> R<()> {
-    let (q0, _) = mech.initial_state();
-    assemble(mech, &q0).map(|_| ()).map_err(|e| ctx.err("coordinates", format!("cannot start at q0 = {q0:?}: {e}")))
 }
 
 fn characteristic_length(points: &[(String, [f64; 2])]) -> f64 {

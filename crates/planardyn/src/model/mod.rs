@@ -1,22 +1,20 @@
-//! The mechanism model: immutable once built and validated from a [`MechanismSpec`].
+//! The mechanism model, pure data: the bodies, the pairs with their kinds ([`pairs`], one file
+//! a kind), coordinates, drives, loads and actuators; immutable once built from a
+//! [`MechanismSpec`]. The checks that need no mechanics are here (`build`); the loader
+//! (`crate::loader`) reads model files and adds the checks that need kinematics.
 //!
 //! Bodies carry their points in a local frame with origin at the centre of mass, rotated by
 //! the body's drawn angle, so that a world point is `r + R(phi) s` with `x_i = [X, Y, phi]`.
 //! The ground is not part of `x`; its local frame is the global frame.
 
 pub mod actuators;
-mod build;
+pub(crate) mod build;
 pub(crate) mod diameter;
-mod io;
 mod motion;
-mod nesting;
 pub mod pairs;
-mod parse_errors;
 pub mod spec;
-mod tags;
 
 pub use actuators::{Actuator, JointFriction, Limits, PairActuator};
-pub use io::{load, loads, parse_spec, Format};
 pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
 
@@ -108,6 +106,13 @@ pub struct Coordinate {
     /// Initial rate (rad/s or m/s).
     pub qd0: f64,
 }
+
+/// Largest move one continuation of the position analysis may make (rad, or lengths L for
+/// a displacement), for the model's `q0` and every API call alike: with its steps of at most
+/// 0.1 (`kinematics::position`) it bounds a call to ~10^4 position solves (well under a
+/// second), where an unbounded target such as 1e15 rad would never return. A longer way is
+/// a sequence of calls, each from the last.
+pub const MAX_CONTINUATION_DISTANCE: f64 = 1e3;
 
 /// A drive effort law on one coordinate (N m for an angle, N for a displacement).
 #[derive(Debug, Clone, PartialEq)]
@@ -225,12 +230,8 @@ pub struct Mechanism {
 }
 
 impl Mechanism {
-    /// Validate a specification and build the mechanism; `source` names it in messages.
-    pub fn new(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
-        build::build(spec, source)
-    }
-    /// The mechanism as drawn without the mobility and assembly checks (for the structural
-    /// analysis of a model the loader refuses; not for kinematics).
+    /// The mechanism as drawn, with every check that needs no mechanics (the loader's
+    /// `build` adds the mobility, the assembly and the simulation defaults).
     pub(crate) fn drawing(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
         build::drawing(spec, source)
     }

@@ -1,7 +1,7 @@
 //! The model file: a mechanism described as it is drawn (YAML or JSON, one schema).
 //!
 //! These plain structs are what a file deserialises to and what a Rust user fills in to
-//! describe a mechanism in code; [`crate::Mechanism::new`] validates them. The schema is
+//! describe a mechanism in code; [`crate::build`] validates them. The schema is
 //! documented field by field in `docs/model-format.md` and `schema/planardyn-model.schema.json`.
 //! Units are SI throughout: m, kg, kg m^2, s, rad, N, N m.
 

@@ -24,8 +24,8 @@ pub use rank::{scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRE
 
 pub(crate) use rank::constraint_rank;
 
-use crate::model::{BodyId, Mechanism, MechanismSpec, PairId};
-use crate::{KinematicsError, ModelError};
+use crate::model::{BodyId, Mechanism, PairId};
+use crate::KinematicsError;
 
 /// The structural analysis of a mechanism at a configuration.
 #[derive(Debug, Clone, PartialEq)]
@@ -104,17 +104,8 @@ pub fn analyse(mech: &Mechanism, x: &[f64]) -> Result<Structure, KinematicsError
     Ok(structure(mech, x))
 }
 
-/// The structural analysis of a model at its drawing, also when it does not build because
-/// its mobility differs from its number of coordinates or it does not assemble at `q0`
-/// (what a structural analysis is for). Every other check of the loader applies; its errors
-/// are returned as they are.
-pub fn analyse_spec(spec: MechanismSpec, source: &str) -> Result<Structure, ModelError> {
-    let mech = Mechanism::drawing(spec, source)?;
-    Ok(structure(&mech, &mech.x0))
-}
-
 /// The analysis at a finite x of the right length.
-fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
+pub(crate) fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
     let (n, rows) = (mech.n_bodies(), mech.n_pair_rows());
     let Rank { rank, singular_values, independent_rows, self_stresses } = constraint_rank(mech, x);
     let (loops, connected) = loops::loops(mech);
