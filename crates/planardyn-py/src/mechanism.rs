@@ -599,10 +599,10 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         tau: ArrayArg<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let n_a = self.inner.n_actuators();
         let every = tau.as_array().shape().last() == Some(&n_a);
         let (m, what) = if every {
-            (n_a, format!("one per actuator: {}", dynamics::redundant::actuator_names(&self.inner).join(", ")))
+            (n_a, format!("one per actuator: {}", self.inner.actuator_names().join(", ")))
         } else {
             (self.m(), self.coords_what())
         };
@@ -661,7 +661,7 @@ impl PyMechanism {
         let Some(slot) = dynamics::transmission::motors(&self.inner).nth(coordinate) else {
             return Err(PyValueError::new_err(format!(
                 "actuator {coordinate} out of range: the model has {} actuators",
-                dynamics::redundant::n_actuators(&self.inner)
+                self.inner.n_actuators()
             )));
         };
         let Some(a) = slot else { return Ok(None) };
@@ -673,7 +673,7 @@ impl PyMechanism {
     /// The actuators' names: the coordinates', then the redundant actuators' on pairs.
     #[getter]
     fn actuator_names(&self) -> Vec<String> {
-        dynamics::redundant::actuator_names(&self.inner)
+        self.inner.actuator_names()
     }
 
     /// Every actuator's effort (n_a,) for (q, qd, qdd), each (m,), shared by `method`
@@ -730,7 +730,7 @@ impl PyMechanism {
         t: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
-        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let n_a = self.inner.n_actuators();
         let efforts = vector("efforts", &efforts, n_a, "one value per actuator (actuator_names)")?;
         check_time(t)?;
         let mech = self.inner.clone();

@@ -24,6 +24,7 @@ pub mod loader;
 pub mod model;
 pub mod simulate;
 pub mod structure;
+pub mod topology;
 pub mod workspace;
 
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};

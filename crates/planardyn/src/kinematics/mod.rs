@@ -9,6 +9,7 @@ pub mod dyads;
 pub mod effector;
 pub mod group_sigma;
 pub mod position;
+pub mod rank;
 pub mod singularity;
 pub mod system;
 pub mod third;

@@ -5,11 +5,11 @@
 
 use crate::integrate::Method;
 use crate::kinematics::assemble;
+use crate::kinematics::rank::constraint_rank;
 use crate::model::build::{Ctx, R};
 use crate::model::pairs;
 use crate::model::spec::SimulateSpec;
 use crate::model::{Mechanism, MechanismSpec, SimulateDefaults};
-use crate::structure::constraint_rank;
 
 /// Validate a specification and build the mechanism; `source` names it in messages.
 pub fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {

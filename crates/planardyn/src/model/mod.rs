@@ -246,6 +246,15 @@ impl Mechanism {
             || self.actuators.iter().any(Option::is_some)
             || self.pair_actuators.iter().any(|a| a.drive.is_some())
     }
+    /// Number of actuators n_a: the coordinates, then the pair actuators.
+    pub fn n_actuators(&self) -> usize {
+        self.dof() + self.pair_actuators.len()
+    }
+    /// The actuators' names: the coordinates', then the pair actuators'.
+    pub fn actuator_names(&self) -> Vec<String> {
+        let coords = self.coordinates.iter().map(|c| c.name.clone());
+        coords.chain(self.pair_actuators.iter().map(|a| a.name.clone())).collect()
+    }
     /// Number of mobile bodies n.
     pub fn n_bodies(&self) -> usize {
         self.bodies.len()

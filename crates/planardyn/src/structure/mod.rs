@@ -14,17 +14,12 @@
 //! - **Assur groups**: the blocks of the block-triangular form of the position Jacobian with
 //!   the inputs locked, see [`AssurGroup`].
 
-pub(crate) mod assur;
-mod loops;
-mod rank;
+pub use crate::kinematics::rank::{scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRESS_TOL};
+pub use crate::topology::{AssurGroup, Loop};
 
-pub use assur::AssurGroup;
-pub use loops::Loop;
-pub use rank::{scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRESS_TOL};
-
-pub(crate) use rank::constraint_rank;
-
+use crate::kinematics::rank::constraint_rank;
 use crate::model::{BodyId, Mechanism, PairId};
+use crate::topology::{assur, loops};
 use crate::KinematicsError;
 
 /// The structural analysis of a mechanism at a configuration.
@@ -121,7 +116,7 @@ pub(crate) fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
         mobility: 3 * n - rank,
         redundant: rows - rank,
         self_stresses,
-        actuation: crate::dynamics::redundant::n_actuators(mech),
+        actuation: mech.n_actuators(),
         loops,
         connected,
         input_links: a.input_links,

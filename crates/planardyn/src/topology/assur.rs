@@ -38,7 +38,7 @@ pub struct AssurGroup {
     pub description: String,
 }
 
-/// What the decomposition finds (see [`super::Structure`]).
+/// What the decomposition finds (the structure report shows it: `crate::Structure`).
 pub(crate) struct Assur {
     pub input_links: Vec<BodyId>,
     pub relative_inputs: Vec<PairId>,
