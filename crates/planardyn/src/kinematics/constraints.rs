@@ -15,7 +15,8 @@ pub use crate::model::pairs::{
     coordinate as pair_coordinate, coordinate_gamma as pair_coordinate_gamma, coordinate_grad as pair_coordinate_grad,
     coordinate_rate as pair_coordinate_rate,
 };
-use crate::model::{Link, Mechanism};
+use crate::model::{CoordinateKind, Link, Mechanism};
+use crate::SingularityKind;
 
 /// Which m functions of x are the independent coordinates.
 #[derive(Debug, PartialEq, Eq)]
@@ -25,6 +26,17 @@ pub enum Chart {
     /// Components of x (indices into the 3n body coordinates), chosen near a singularity
     /// of the actuated mechanism.
     Partition(Vec<usize>),
+}
+
+impl Chart {
+    /// What a singular J means in this chart: a type II singularity in the generalized
+    /// coordinates, a rank loss of the pair constraints in a partition chart.
+    pub(crate) fn singularity(&self) -> SingularityKind {
+        match self {
+            Chart::Inputs => SingularityKind::TypeII,
+            Chart::Partition(_) => SingularityKind::Passive,
+        }
+    }
 }
 
 // By hand for `clone_from`: the factorisation records its chart at every evaluation, and a
@@ -190,4 +202,28 @@ pub fn point_acceleration(link: Link, s: [f64; 2], x: &[f64], xd: &[f64], xdd: &
     let p = l.rot(s);
     let t = perp(p);
     [a[0] + al * t[0] - w * w * p[0], a[1] + al * t[1] - w * w * p[1]]
+}
+
+/// 1/L for rows measured in metres, 1 for rows measured in radians.
+pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
+    fill_row_scale(mech, chart, 1.0 / mech.scale, rs)
+}
+
+/// `inv` for rows measured in metres, 1 for rows measured in radians.
+pub fn fill_row_scale(mech: &Mechanism, chart: &Chart, inv: f64, rs: &mut [f64]) {
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        for (slot, scale) in slots.iter().zip(pairs::row_scales(pair, inv)) {
+            if let Some(i) = *slot {
+                rs[i] = scale;
+            }
+        }
+    }
+    let nc = mech.n_constraints;
+    for (k, r) in rs[nc..].iter_mut().enumerate() {
+        let angle = match chart {
+            Chart::Inputs => mech.coordinates[k].kind == CoordinateKind::Angle,
+            Chart::Partition(idx) => idx[k] % 3 == 2,
+        };
+        *r = if angle { 1.0 } else { inv };
+    }
 }
