@@ -9,13 +9,13 @@
 //! (gamma(xd, xd)) and the acceleration analogues (gamma(u_j, u_k)).
 
 pub use crate::linalg::{Dense, Sink};
-pub use crate::model::pairs::frames::{perp, rotate};
-use crate::model::pairs::{self, frames::link_state, frames::part};
+use crate::model::pairs;
+pub use crate::model::pairs::frames::{perp, point_acceleration, point_velocity, rotate, world_point};
 pub use crate::model::pairs::{
     coordinate as pair_coordinate, coordinate_gamma as pair_coordinate_gamma, coordinate_grad as pair_coordinate_grad,
     coordinate_rate as pair_coordinate_rate,
 };
-use crate::model::{CoordinateKind, Link, Mechanism};
+use crate::model::{CoordinateKind, Mechanism};
 use crate::SingularityKind;
 
 /// Which m functions of x are the independent coordinates.
@@ -179,29 +179,6 @@ pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &
             Chart::Partition(_) => 0.0,
         };
     }
-}
-
-/// World position of a point of a link.
-pub fn world_point(link: Link, s: [f64; 2], x: &[f64]) -> [f64; 2] {
-    link_state(link, x).point(s)
-}
-
-/// Velocity of a point of a link for body rates xd.
-pub fn point_velocity(link: Link, s: [f64; 2], x: &[f64], xd: &[f64]) -> [f64; 2] {
-    let l = link_state(link, x);
-    let (v, w) = part(&l, xd);
-    let t = perp(l.rot(s));
-    [v[0] + w * t[0], v[1] + w * t[1]]
-}
-
-/// Acceleration of a point of a link for body rates xd and accelerations xdd.
-pub fn point_acceleration(link: Link, s: [f64; 2], x: &[f64], xd: &[f64], xdd: &[f64]) -> [f64; 2] {
-    let l = link_state(link, x);
-    let (_, w) = part(&l, xd);
-    let (a, al) = part(&l, xdd);
-    let p = l.rot(s);
-    let t = perp(p);
-    [a[0] + al * t[0] - w * w * p[0], a[1] + al * t[1] - w * w * p[1]]
 }
 
 /// 1/L for rows measured in metres, 1 for rows measured in radians.

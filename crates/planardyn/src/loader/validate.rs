@@ -6,7 +6,8 @@
 use crate::integrate::Method;
 use crate::kinematics::assemble;
 use crate::kinematics::rank::constraint_rank;
-use crate::model::build::{Ctx, R};
+use crate::model::build::context;
+use crate::model::checks::{Ctx, R};
 use crate::model::pairs;
 use crate::model::spec::SimulateSpec;
 use crate::model::{Mechanism, MechanismSpec, SimulateDefaults};
@@ -15,7 +16,7 @@ use crate::model::{Mechanism, MechanismSpec, SimulateDefaults};
 pub fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     let mut mech = drawing(spec, source)?;
     let spec = mech.spec.clone();
-    let ctx = Ctx { source, spec: &spec };
+    let ctx = context(source, &spec);
     check_mobility(&ctx, &mut mech)?;
     check_assembly(&ctx, &mech)?;
     Ok(mech)
@@ -25,7 +26,7 @@ pub fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
 /// kept, which the structural analysis of a model the loader refuses reads.
 pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     let mut mech = Mechanism::drawing(spec, source)?;
-    mech.simulate = build_simulate(&Ctx { source, spec: &mech.spec }, mech.spec.simulate.as_ref())?;
+    mech.simulate = build_simulate(&context(source, &mech.spec), mech.spec.simulate.as_ref())?;
     Ok(mech)
 }
 

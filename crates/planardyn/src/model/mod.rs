@@ -1,5 +1,6 @@
 //! The mechanism model, pure data: the bodies, the pairs with their kinds ([`pairs`], one file
-//! a kind), coordinates, drives, loads and actuators; immutable once built from a
+//! a kind), coordinates, drives, loads with their kinds ([`loads`], one file a kind) and
+//! actuators; immutable once built from a
 //! [`MechanismSpec`]. The checks that need no mechanics are here (`build`); the loader
 //! (`crate::loader`) reads model files and adds the checks that need kinematics.
 //!
@@ -9,12 +10,15 @@
 
 pub mod actuators;
 pub(crate) mod build;
+pub(crate) mod checks;
 pub(crate) mod diameter;
+pub mod loads;
 mod motion;
 pub mod pairs;
 pub mod spec;
 
 pub use actuators::{Actuator, JointFriction, Limits, PairActuator};
+pub use loads::Load;
 pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
 
@@ -151,20 +155,6 @@ impl DriveLaw {
 pub struct Attachment {
     pub link: Link,
     pub s: [f64; 2],
-}
-
-/// An external load or force element.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Load {
-    /// Constant global force (N) at a point of a body.
-    Force { at: Attachment, value: [f64; 2] },
-    /// Constant torque (N m) on a body.
-    Torque { body: BodyId, value: f64 },
-    /// Linear spring-damper between two points: tension k (L - rest_length) + c L'.
-    Spring { ends: [Attachment; 2], stiffness: f64, damping: f64, rest_length: f64 },
-    /// Spring-damper on the relative motion of a pair (angle or displacement from the
-    /// drawing): generalized effort -k (theta - rest) - c theta'. Viscous friction has k = 0.
-    PairSpring { pair: PairId, stiffness: f64, damping: f64, rest: f64 },
 }
 
 /// Default simulation settings read from the model file.
