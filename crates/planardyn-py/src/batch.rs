@@ -8,8 +8,7 @@
 //! native `Mechanism` and a motion dict, either coordinate rows (`q`, `qd`, `qdd`) or a
 //! sampled end-effector path (`t`, `X`, `Xd`, `Xdd`, `point`, ...), on the same pool.
 
-use crate::convert::arr2;
-use crate::effector::solution_dict;
+use crate::convert::{arr2, solution_dict};
 use crate::errors::{run, task_error, to_pyerr, Failure};
 use crate::mechanism::PyMechanism;
 use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
