@@ -11,6 +11,8 @@
 //!
 //! The shared pieces (error norm, initial step, step-size controller, the
 //! explicit-pair step loop) live in `control`; Radau5's LU is `crate::linalg`'s.
+//! Each file declares its integrator's name, orders and kind ([`Integrator`]); adding a
+//! method is a file and a line of the registration table (`integrators!`).
 //!
 //! # Why hand-written
 //!

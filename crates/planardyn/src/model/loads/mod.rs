@@ -6,7 +6,7 @@
 //! the loads and ask them through the functions below; only this file's `dispatch!` and
 //! `dispatch_spec!` look at the kind, calling the kind's module statically.
 //!
-//! Adding a kind: a file here with its spec struct ([`LoadSpecType`]) and its load
+//! Adding a kind: a file here with its spec struct (`LoadSpecType`) and its load
 //! ([`LoadType`]), a variant of [`LoadSpec`] and of [`Load`] with an arm in each dispatch,
 //! the schema (`schema/planardyn-model.schema.json`) and `docs/model-format.md`.
 
