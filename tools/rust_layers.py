@@ -169,7 +169,7 @@ class Crate:
             paths += [re.sub(r"\s+", "", m.group(1)).split("::") for m in _PATH.finditer(code)]
             children = {c[-1] for c in self.files if c[:-1] == mod and c != mod}
             if children:
-                child = re.compile(r"(?<![\w:$])(%s)((?:::\w+)+)" % "|".join(sorted(children)))
+                child = re.compile(r"(?<![\w:$])(" + "|".join(sorted(children)) + r")((?:::\w+)+)")
                 paths += [[m.group(1), *m.group(2).split("::")[1:]] for m in child.finditer(code)]
             for path in paths:
                 absolute = self.absolute(mod, path)
