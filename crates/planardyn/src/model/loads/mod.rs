@@ -7,8 +7,9 @@
 //! `dispatch_spec!` look at the kind, calling the kind's module statically.
 //!
 //! Adding a kind: a file here with its spec struct (`LoadSpecType`) and its load
-//! ([`LoadType`]), a variant of [`LoadSpec`] and of [`Load`] with an arm in each dispatch,
-//! the schema (`schema/planardyn-model.schema.json`) and `docs/model-format.md`.
+//! ([`LoadType`]), a variant of [`LoadSpec`] (and its name in [`LoadSpec::NAMES`]) and of
+//! [`Load`] with an arm in each dispatch, the schema (`schema/planardyn-model.schema.json`)
+//! and `docs/model-format.md`.
 
 pub(crate) mod apply;
 pub mod force;
@@ -31,6 +32,11 @@ pub enum LoadSpec {
     Spring(spring::SpringSpec),
     TorsionalSpring(pair_spring::TorsionalSpringSpec),
     Friction(friction::FrictionSpec),
+}
+
+impl LoadSpec {
+    /// The kinds' names in a model file (`type:`), in the order of the variants (for messages).
+    pub const NAMES: [&'static str; 5] = ["force", "torque", "spring", "torsional_spring", "friction"];
 }
 
 /// An external load or force element of the model.
@@ -136,5 +142,18 @@ fn mobile_body(ctx: &Ctx, path: &str, name: &str) -> R<BodyId> {
     match ctx.link(&format!("{path}.body"), name)? {
         Link::Body(b) => Ok(b),
         Link::Ground => Err(ctx.err(format!("{path}.body"), "a load on the ground does nothing; name a mobile body")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_names_are_the_kinds_serde_reads() {
+        // serde lists the kinds it knows when a `type` is unknown.
+        let e = serde_json::from_str::<LoadSpec>(r#"{"type": "cam"}"#).unwrap_err().to_string();
+        let listed = LoadSpec::NAMES.map(|n| format!("`{n}`")).join(", ");
+        assert!(e.contains(&format!("expected one of {listed}")), "{e}");
     }
 }
