@@ -256,3 +256,80 @@ def test_plot_and_animate_errors(tmp_path):
     assert p.returncode == 2 and "was not computed with" in p.stderr
     p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.avi")
     assert p.returncode == 2 and ".gif, .mp4 or .html" in p.stderr and "Traceback" not in p.stderr
+
+
+# ---------------------------------------------------------------- issue 23 finding 9: output errors in words
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    """A short five-bar run written as a results file (the input of plot, animate, inverse)
+    and a four-bar as MJCF (the input of import)."""
+    path = tmp_path_factory.mktemp("run") / "run.csv"
+    pd.load(MODELS / "five-bar.yaml").simulate(0.05, output_dt=0.01).save(path)
+    # An MJCF file beside it, the input of planardyn import.
+    assert run("export", "four-bar-gravity", "-o", path.with_name("four-bar.xml")).returncode == 0
+    return path
+
+
+def writing_commands(run_file, out):
+    """Every command that writes, with ``out`` as its output (demo: its folder)."""
+    five = MODELS / "five-bar.yaml"
+    return {
+        "simulate": ["simulate", five, "--t-end", "0.01", "-o", out.with_suffix(".csv")],
+        "inverse": ["inverse", five, "--motion", run_file, "-o", out.with_suffix(".npz")],
+        "identify": ["identify", five, run_file, "-o", out.with_suffix(".json")],
+        "plot": ["plot", run_file, "-o", out.with_suffix(".png")],
+        "animate": ["animate", run_file, "-o", out.with_suffix(".html")],
+        "demo": ["demo", "--out", out],
+        "export": ["export", five, "-o", out.with_suffix(".urdf")],
+        "import": ["import", run_file.with_name("four-bar.xml"), "-o", out.with_suffix(".yaml")],
+        "size": ["size", "five-bar", "--circle", "0.014", "0.5097", "0.06", "--json", out.with_suffix(".json")],
+        "plan": ["plan", "library/five-bar-5r", "--line", "-0.08", "0.28", "0.08", "0.36", "--effort", "5", "5",
+                 "-o", out.with_suffix(".csv")],
+    }
+
+
+def prefix(command):
+    """How a command's errors start (size and plan name themselves)."""
+    return f"planardyn {command}: " if command in ("size", "plan") else "planardyn: "
+
+
+@pytest.mark.parametrize("command", ["simulate", "inverse", "identify", "plot", "animate", "demo", "export",
+                                     "import", "size", "plan"])
+def test_an_output_under_a_file_is_named_with_its_cause(short_run, tmp_path, command):
+    """Before: 'planardyn: [Errno 17] File exists: ...' (simulate after the whole run)."""
+    from conftest import cli_run
+
+    blocker = tmp_path / "file.csv"
+    blocker.write_text("x")
+    argv = writing_commands(short_run, blocker / "x")[command]
+    code, err = cli_run(*argv)
+    out = argv[-1]
+    assert (code, err) == (2, f"{prefix(command)}cannot write {out}: {blocker} is a file, not a directory\n")
+
+
+def test_an_output_where_no_file_can_be_made_names_the_path_asked_for(short_run):
+    """Before: 'planardyn: [Errno 2] No such file or directory: '/proc/.o.csv.123.part'."""
+    from conftest import cli_run
+
+    for command, argv in writing_commands(short_run, __import__("pathlib").Path("/proc/o")).items():
+        code, err = cli_run(*argv)
+        assert (code, err) == (2, f"{prefix(command)}cannot write {argv[-1]}: /proc does not take new files\n"), command
+
+
+@pytest.mark.parametrize("errno_, cause", [
+    (13, "permission denied"), (30, "the file system is read-only"), (28, "the disk is full")])
+def test_a_failed_write_says_why_in_words(short_run, tmp_path, monkeypatch, errno_, cause):
+    """The causes root cannot meet in a test (it may write anywhere, the disk is not full):
+    the results writer raises them, as the file system would, after the whole run."""
+    from conftest import cli_run
+    from planardyn import results_format
+
+    def refused(*args, **kwargs):
+        raise OSError(errno_, "from the OS")
+
+    monkeypatch.setattr(results_format.np, "savez_compressed", refused)
+    out = tmp_path / "run.npz"
+    code, err = cli_run("simulate", MODELS / "five-bar.yaml", "--t-end", "0.01", "-o", out)
+    assert (code, err) == (2, f"planardyn: cannot write {out}: {cause}\n")
+    assert list(tmp_path.iterdir()) == []  # no temporary file left

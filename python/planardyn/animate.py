@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .playback import auto_speed
-from .plot import default_trace_points, draw_mechanism
+from .plot import draw_mechanism, trace_points
 from .viewer import write_viewer
 
 if TYPE_CHECKING:
@@ -84,7 +84,7 @@ def render_frames(
     ax = fig.add_axes((0.08, 0.08, 0.9, 0.84))
     pos = mech.point_positions(result.x)  # (N, P, 2)
     x0, x1, y0, y1 = _bounds(mech, pos)
-    traces = default_trace_points(mech) if traces is None else list(traces)
+    traces = trace_points(mech, traces)
     trace_idx = [mech.point_names.index(n) for n in traces]
     colors = [f"C{(j + 6) % 10}" for j in range(len(trace_idx))]
     for j, i in enumerate(trace_idx):  # the whole paths, faint, drawn once
@@ -184,10 +184,6 @@ def animate(
     ext = path.suffix.lower()
     if ext not in FORMATS:
         raise ValueError(f"{path}: unknown animation format {ext!r} (use .gif, .mp4 or .html)")
-    if traces is not None:
-        unknown = [p for p in traces if p not in mech.point_names]
-        if unknown:
-            raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
     if ext in (".html", ".htm"):
         return write_viewer(mech, result, path, traces=traces, **viewer_kw)
     if ext == ".mp4" and (size[0] % 16 or size[1] % 16):

@@ -22,6 +22,7 @@ usage, file or model error. Errors are one message on stderr, never a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import importlib.util
 import json
@@ -29,12 +30,14 @@ import os
 import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
 from . import (
+    ArgumentError,
     AssemblyError,
+    DataError,
     Mechanism,
     PlanardynError,
     SimulationError,
@@ -46,8 +49,11 @@ from . import (
     structure,
 )
 from .events import Crossing, parse_crossing
+from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
+from .results_format import check_writable, writing
+from .robot.cli_options import number
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -69,8 +75,12 @@ FIXED_STEP_METHODS = ("rk4",)
 
 
 def require_writer(path: Path | None) -> None:
-    """Refuse, before any computation, an output file whose optional package is missing."""
-    if path is None or path.suffix.lower() not in OPTIONAL_WRITERS:
+    """Refuse, before any computation, an output file that cannot be written (its directory
+    made, the cause in words) or whose optional package is missing."""
+    if path is None:
+        return
+    check_writable(path)
+    if path.suffix.lower() not in OPTIONAL_WRITERS:
         return
     module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
     if importlib.util.find_spec(module) is None:
@@ -171,21 +181,6 @@ def _setting(name: str) -> Callable[[str], float | int]:
     return parse
 
 
-def _within(low: float, high: float) -> Callable[[str], float]:
-    """An argparse type for a number in [low, high] (a finite one: nan and inf are refused)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{text} must be from {low:g} to {high:g}")
-        return value
-
-    return parse
-
-
 #: A frame rate or a playback speed given as 0 < value <= this is taken; beyond, refused.
 MAX_FPS = 240.0
 #: Resolution of plot images (dots per inch): 600 makes an 11 x 7 in figure about 100 MB.
@@ -282,7 +277,7 @@ def _parser() -> argparse.ArgumentParser:
                "  planardyn identify five-bar run.npz --validate other.npz -o identified.json")
     idf.add_argument("model", type=Path, help=MODEL_HELP)
     idf.add_argument("data", type=Path, help="measured motion: CSV table or results file")
-    idf.add_argument("--cutoff", type=_within(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
+    idf.add_argument("--cutoff", type=number(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
     idf.add_argument("--validate", type=Path, help="another measured motion: RMS effort error, identified vs model")
     idf.add_argument("-o", "--output", type=Path, help="write the identification as JSON")
 
@@ -295,7 +290,7 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz) written by planardyn")
     pl.add_argument("-o", "--output", type=Path, help="image to write (.png, .pdf, .svg); default RESULTS with .png")
     pl.add_argument("--torque-speed", action="store_true", help="plot drive effort against speed instead")
-    pl.add_argument("--dpi", type=_within(*DPI_RANGE), default=120,
+    pl.add_argument("--dpi", type=number(*DPI_RANGE), default=120,
                     help=f"resolution of raster images, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} (default 120)")
 
     a = _sub(sub, "animate", "animate a result: GIF, MP4 or an interactive HTML viewer",
@@ -309,9 +304,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="results file (.csv, .parquet or .npz), after the model it was computed with when "
                         "the file does not hold its model (files planardyn writes do)")
     a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
-    a.add_argument("--fps", type=_within(1e-3, MAX_FPS), default=20.0,
+    a.add_argument("--fps", type=number(1e-3, MAX_FPS), default=20.0,
                    help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
-    a.add_argument("--speed", type=_within(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
+    a.add_argument("--speed", type=number(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
@@ -324,6 +319,7 @@ def _parser() -> argparse.ArgumentParser:
              "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
+    exchange_commands(sub)
     return p
 
 
@@ -373,6 +369,10 @@ def _simulate(args: argparse.Namespace) -> int:
                          "or dt in the model file's simulate section), or choose an adaptive method (--method dopri5)")
     require_writer(args.output)
     motion = _speeds(args.speed, mech)
+    for c in args.stop_when:
+        if c.coordinate not in mech.coordinate_names:
+            raise UsageError(f"--stop-when {c.coordinate}...: give NAME=VALUE with NAME one of "
+                             f"{', '.join(mech.coordinate_names)}")
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
         refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
@@ -393,8 +393,8 @@ def _simulate(args: argparse.Namespace) -> int:
     stops = {"events": [dataclasses.asdict(c) for c in args.stop_when]} if args.stop_when else {}
     res = attach_metadata(res, mech, dict(settings, motion=motion, **stops))
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        write_results(res, args.output)
+        with writing(args.output):
+            write_results(res, args.output)
     line = summary(res) + (f" -> {args.output}" if args.output is not None else "")
     print(line)
     if not res.success:
@@ -428,8 +428,8 @@ def _inverse(args: argparse.Namespace) -> int:
     mech = load(args.model)
     res = inverse_from_file(mech, args.motion)
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        write_results(res, args.output)
+        with writing(args.output):
+            write_results(res, args.output)
     peaks = ", ".join(
         f"|tau_{n}| <= {v:.4g} {u}" for n, v, u in zip(mech.coordinate_names, np.abs(res.tau).max(axis=0), mech.effort_units)
     )
@@ -459,12 +459,40 @@ def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
         return m["q"], m["qd"], m["qdd"], tau, m["x"]
     if cutoff is None:
         raise UsageError(f"{path}: no qd_/qdd_ columns: give --cutoff (Hz) to differentiate the positions")
-    q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
-    keep = inside(m["t"], cutoff)
-    if not keep.any():
-        raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at --cutoff "
-                         f"{cutoff:g} Hz: record longer or raise --cutoff")
-    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
+    with _about(path):
+        q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
+        keep = inside(m["t"], cutoff)
+        if not keep.any():
+            raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at "
+                             f"--cutoff {cutoff:g} Hz: record longer or raise --cutoff")
+        return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
+
+
+@contextlib.contextmanager
+def _about(path: Path) -> Iterator[None]:
+    """The errors of computing on a data file (its data, or an argument from an option) as
+    usage errors naming the file; the one option that reaches the computation, ``--cutoff``,
+    named as the user wrote it."""
+    try:
+        yield
+    except DataError as e:
+        raise UsageError(str(e) if getattr(e, "path", None) else f"{path}: {e}") from None
+    except ArgumentError as e:
+        text = f"--{e}" if getattr(e, "argument", None) == "cutoff" else str(e)
+        raise UsageError(f"{path}: {text}") from None
+
+
+@contextlib.contextmanager
+def _options(options: dict[str, str]) -> Iterator[None]:
+    """An ArgumentError of an API argument that an option gave, as a usage error naming the
+    option (``options``: argument name -> option)."""
+    try:
+        yield
+    except ArgumentError as e:
+        option = options.get(getattr(e, "argument", None) or "")
+        if option is None:
+            raise
+        raise UsageError(f"{option}: {e}") from None
 
 
 def _identify(args: argparse.Namespace) -> int:
@@ -472,12 +500,18 @@ def _identify(args: argparse.Namespace) -> int:
 
     from .identify import identify
 
+    require_writer(args.output)
     mech = load(args.model)
-    found = identify(mech, *_measured(mech, args.data, args.cutoff))
+    measured = _measured(mech, args.data, args.cutoff)
+    # Both records read before the identification: a bad --validate is refused at once.
+    validation = None if args.validate is None else _measured(mech, args.validate, args.cutoff)
+    with _about(args.data):
+        found = identify(mech, *measured)
     print(found.report())
-    if args.validate is not None:
-        q, qd, qdd, tau, x = _measured(mech, args.validate, args.cutoff)
-        Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+    if validation is not None:
+        q, qd, qdd, tau, x = validation
+        with _about(args.validate):
+            Y, tau_o = mech.regressor(q, qd, qdd, x=x)
         rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
         ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
         prior = rms(Y @ np.array(list(mech.regressor_parameters.values())) + tau_o - tau)
@@ -487,8 +521,8 @@ def _identify(args: argparse.Namespace) -> int:
                "std_error": found.std_error.tolist(), "model": found.prior.tolist(),
                "parameters": {k: float(v) for k, v in found.pi.items()},
                "residual_rms": found.residual_rms.tolist(), "samples": found.samples}
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        args.output.write_text(json.dumps(out, indent=1))
+        with writing(args.output):
+            args.output.write_text(json.dumps(out, indent=1))
         print(f"wrote {args.output}")
     return EXIT_OK
 
@@ -500,8 +534,9 @@ def _plot(args: argparse.Namespace) -> int:
     from .plot import plot_results, plot_torque_speed
     from .results_io import read_results
 
-    res = read_results(args.results)
     out = args.output or args.results.with_suffix(".png")
+    require_writer(out)
+    res = read_results(args.results)
     if args.torque_speed:
         fig = Figure(figsize=(7, 5))
         FigureCanvasAgg(fig)
@@ -514,9 +549,9 @@ def _plot(args: argparse.Namespace) -> int:
         fig = Figure(figsize=(11, 7))
         FigureCanvasAgg(fig)
         plot_results(res, fig=fig)
-    out.parent.mkdir(parents=True, exist_ok=True)
     try:
-        fig.savefig(out, dpi=args.dpi)
+        with writing(out):
+            fig.savefig(out, dpi=args.dpi)
     except ValueError as e:  # matplotlib: an image format it does not write
         raise UsageError(f"{out}: {e}") from None
     print(f"wrote {out}")
@@ -546,7 +581,6 @@ def _animate(args: argparse.Namespace) -> int:
                          f"planardyn animate MODEL {results} -o {args.output}")
     else:
         mech = from_result(res)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
@@ -555,7 +589,8 @@ def _animate(args: argparse.Namespace) -> int:
         kw["progress"] = lambda done, total, bar=bar: bar(done / total)
     start = time.monotonic()
     try:
-        animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+        with writing(args.output), _options({"traces": "--trace", "channels": "--channel"}):
+            animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
     finally:
         if bar is not None:
             bar.close()
@@ -568,8 +603,11 @@ def _demo(args: argparse.Namespace) -> int:
     from .demo import run
 
     out: Path = args.out
+    if args.model is not None and not Path(args.model).is_file():
+        raise UsageError(f"--model {args.model}: not a model file (a file, or a shipped model's name)")
     print(f"planardyn demo: writing into {out}/")
-    demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
+    with writing(out):
+        demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
     print(f"open {out / 'robot.html'} and {out / 'passive.html'} in a browser to play the motions")
     return EXIT_OK if demo.success else EXIT_FAILED
 
@@ -605,8 +643,12 @@ def _main(argv: list[str]) -> int:
             return plan_cli(argv[1:])
         args = _parser().parse_args(argv)
         if getattr(args, "model", None) is not None:
-            args.model = models.resolve(args.model)
-        code = COMMANDS[args.command](args)
+            try:
+                args.model = models.resolve(args.model)
+            except models.UnknownModelError as e:  # demo's model is an option, the others' an argument
+                raise UsageError(f"--model {e}" if args.command == "demo" else str(e)) from None
+        code = getattr(args, "run", None) or COMMANDS[args.command]
+        code = code(args)
         sys.stdout.flush()
         return code
     except BrokenPipeError:

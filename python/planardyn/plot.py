@@ -4,11 +4,13 @@ returns the artists it drew. Nothing here changes rcParams or calls ``plt.show()
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .arguments import error
 from .units import group_unit
 
 if TYPE_CHECKING:
@@ -192,6 +194,16 @@ def default_trace_points(mech: Mechanism) -> list[str]:
     return chosen or [n for n in mech.point_names if n not in ground]
 
 
+def trace_points(mech: Mechanism, points: Sequence[str] | None) -> list[str]:
+    """The points whose paths to draw: ``points`` (default :func:`default_trace_points`),
+    each a named point of the model, else an ArgumentError (argument ``traces``) listing them."""
+    points = default_trace_points(mech) if points is None else list(points)
+    unknown = [p for p in points if p not in mech.point_names]
+    if unknown:
+        raise error("traces", f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
+    return points
+
+
 def plot_point_paths(
     mech: Mechanism,
     result: SimulationResult,
@@ -204,10 +216,7 @@ def plot_point_paths(
     ``points``: names (default :func:`default_trace_points`). Returns the lines, one a point.
     """
     ax = _axes(ax)
-    points = default_trace_points(mech) if points is None else list(points)
-    unknown = [p for p in points if p not in mech.point_names]
-    if unknown:
-        raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
+    points = trace_points(mech, points)
     pos = mech.point_positions(result.x)  # (N, P, 2)
     lines: list[Artist] = []
     for name in points:
@@ -252,7 +261,7 @@ def plot_reaction(mech: Mechanism, result: SimulationResult, pair: str, fig: Any
     ``fig`` is a matplotlib figure to draw in (a new one when None). Returns the artists.
     """
     if pair not in mech.pair_names:
-        raise ValueError(f"no pair {pair!r}; the pairs are {', '.join(mech.pair_names)}")
+        raise error("pair", f"no pair {pair!r}; the pairs are {', '.join(mech.pair_names)}")
     k = mech.pair_names.index(pair)
     force = mech.reactions(result)[:, k, :2]
     second = mech.pairs[k]["bodies"][1]

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import results_format
 from ._core import DenseOutput, __version__
+from .arguments import error
 
 if TYPE_CHECKING:
     import pandas
@@ -253,7 +254,19 @@ class SimulationResult:
         """The result at some of its rows: indices or a boolean mask, e.g. every tenth row
         ``res.take(np.arange(0, len(res), 10))``. The energy balance keeps its reference
         (the first output of the whole run)."""
-        k = np.arange(len(self.t))[np.asarray(rows)]
+        try:
+            r = np.asarray(rows)
+        except ValueError:  # a ragged list
+            raise TypeError("rows must be integer indices or a boolean mask, not a ragged list") from None
+        n = len(self.t)
+        if r.dtype.kind not in "biu":
+            raise TypeError(f"rows must be integer indices or a boolean mask of the {n} rows, got {r.dtype}")
+        if r.dtype.kind == "b" and r.shape != (n,):
+            raise error("rows", f"rows as a boolean mask has one entry per row ({n},), got shape {r.shape}")
+        if r.dtype.kind != "b" and r.size and not (-n <= r.min() and r.max() < n):
+            raise error("rows", f"rows must be indices of the {n} rows (from -{n} to {n - 1}), got "
+                                f"{r.min() if r.min() < -n else r.max()}")
+        k = np.arange(n)[r]
 
         def rows_of(obj: Any) -> dict[str, Any]:  # every per-row array field, at rows k
             return {f.name: v[k] for f in dataclasses.fields(obj) if isinstance(v := getattr(obj, f.name), np.ndarray)}

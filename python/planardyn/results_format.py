@@ -1,5 +1,6 @@
 """The results file format, written from plain arrays: the column layout, the checksum, the
-atomic replacement of a file, and the writers of its three forms (CSV, Parquet, NPZ).
+atomic replacement of a file, the writers of its three forms (CSV, Parquet, NPZ), and the
+errors of a write in words, naming the path asked for (:func:`writing`).
 
 It sits below :mod:`planardyn.result` so that a result can save itself
 (``SimulationResult.save``/``to_csv``) in the one format :func:`planardyn.read_results`,
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import errno
 import json
 import os
 import zlib
@@ -70,13 +72,23 @@ def table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> Fl
 def checksum(meta: dict[str, Any], table: FloatArray) -> int:
     """CRC-32 of the metadata (as JSON in its order, without the checksum) and of the
     table's little-endian float64 bytes, row by row (every NaN as one NaN)."""
-    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")})
-    crc = zlib.crc32(text.encode())
+    crc = checksum_start(meta)
     for start in range(0, len(table), CSV_BLOCK):
-        block = table[start:start + CSV_BLOCK]
-        canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
-        crc = zlib.crc32(np.ascontiguousarray(canonical).tobytes(), crc)
+        crc = checksum_rows(table[start:start + CSV_BLOCK], crc)
     return crc
+
+
+def checksum_start(meta: dict[str, Any]) -> int:
+    """:func:`checksum` of the metadata alone: the value its rows continue from."""
+    text = json.dumps({k: v for k, v in meta.items() if k not in ("checksum", "path")})
+    return zlib.crc32(text.encode())
+
+
+def checksum_rows(block: FloatArray, crc: int) -> int:
+    """:func:`checksum` continued over the rows ``block``: a CRC-32 is the same whichever
+    blocks its bytes come in, so a reader takes it along as it reads."""
+    canonical = np.where(np.isnan(block), np.nan, block).astype("<f8")
+    return zlib.crc32(np.ascontiguousarray(canonical).tobytes(), crc)
 
 
 def pyarrow() -> tuple[Any, Any]:
@@ -89,19 +101,84 @@ def pyarrow() -> tuple[Any, Any]:
     return pa, pq
 
 
+#: Why a file could not be written, in words, by errno.
+WRITE_CAUSES = {
+    errno.ENOENT: "its directory does not exist (and could not be made)",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EROFS: "the file system is read-only",
+    errno.ENOSPC: "the disk is full",
+    errno.EDQUOT: "the disk quota is exceeded",
+    errno.EISDIR: "it is a directory",
+    errno.ENAMETOOLONG: "the name is too long",
+    errno.EFBIG: "the file is larger than the file system allows",
+}
+
+
+class WriteError(OSError):
+    """A file that could not be written (an ``OSError`` with the cause's ``errno``): the
+    message names the path asked for (not a temporary file) and the cause in words."""
+
+    def __str__(self) -> str:
+        return str(self.strerror)
+
+
+def write_error(path: str | os.PathLike[str], e: OSError) -> WriteError:
+    """``e``, raised writing ``path``, as a :class:`WriteError` naming ``path``."""
+    path = Path(path)
+    if e.errno in (errno.EEXIST, errno.ENOTDIR):  # a part of the directory is a file
+        blocking = next((p for p in reversed(path.parents) if p.exists() and not p.is_dir()), path.parent)
+        cause = f"{blocking} is a file, not a directory"
+    elif e.errno == errno.ENOENT and path.parent.is_dir():  # /proc, /sys: no new files there
+        cause = f"{path.parent} does not take new files"
+    else:
+        cause = WRITE_CAUSES.get(e.errno or 0, e.strerror or str(e))
+    return WriteError(e.errno, f"cannot write {path}: {cause}")
+
+
+@contextlib.contextmanager
+def writing(path: str | os.PathLike[str], make_directory: bool = True) -> Iterator[Path]:
+    """Around the writing of ``path``: its directory made first (``make_directory``), and any
+    ``OSError`` raised inside turned into a :class:`WriteError` naming ``path``."""
+    path = Path(path)
+    try:
+        if make_directory:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        yield path
+    except (WriteError, BrokenPipeError):  # a closed stdout is not the file's failure
+        raise
+    except OSError as e:
+        raise write_error(path, e) from None
+
+
+def check_writable(path: str | os.PathLike[str]) -> Path:
+    """Refuse, before a long computation, a file that cannot be written: its directory made
+    and a file created and removed there; a failure is a :class:`WriteError` naming ``path``."""
+    path = Path(path)
+    with writing(path):
+        if path.is_dir():
+            raise IsADirectoryError(errno.EISDIR, "is a directory")
+        probe = path.with_name(f".{path.name}.{os.getpid()}.probe")
+        probe.open("w").close()
+        probe.unlink()
+    return path
+
+
 @contextlib.contextmanager
 def replacing(path: Path) -> Iterator[Path]:
     """A temporary file next to ``path`` that replaces it (one rename) when the block ends
-    without an error, and is removed when it fails: ``path`` is never half written."""
+    without an error, and is removed when it fails: ``path`` is never half written. An
+    ``OSError`` is a :class:`WriteError` naming ``path`` (the temporary file is ours)."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
-    try:
-        yield tmp
-        with open(tmp, "rb+") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with writing(path, make_directory=False):
+        try:
+            yield tmp
+            with open(tmp, "rb+") as f:
+                os.fsync(f.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
 
 
 def write(path: str | os.PathLike[str], meta: dict[str, Any], groups: dict[str, Any],

@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import batch
 from ._core import AssemblyError, ModelError, PlanardynError, SimulationError, SingularityError
+from .arguments import error
 from .mechanism import Mechanism
 
 __all__ = ["Sensitivity", "efforts", "objective", "peak_effort", "rms_effort", "trajectory", "DEFAULT_REL_STEP"]
@@ -88,7 +89,7 @@ def _nominal(design: Design, params: Mapping[str, float] | Sequence[str]) -> tup
     if isinstance(params, Mapping):
         return list(params), np.array([float(v) for v in params.values()])
     if callable(design) and not isinstance(design, Mechanism):
-        raise ValueError("with a model constructor, give the parameters as a mapping {name: nominal value}")
+        raise error("params", "with a model constructor, give the parameters as a mapping {name: nominal value}")
     model = design.to_dict() if isinstance(design, Mechanism) else design
     return list(params), np.array([_read(model, p) for p in params])
 
@@ -98,7 +99,7 @@ def _read(model: Mapping[str, Any], path: str) -> float:
     for key in path.split("."):
         node = batch._child(node, key, path)
     if not isinstance(node, (int, float)):
-        raise ValueError(f"{path}: expected a number in the model, found {node!r}; give its value in params")
+        raise error("params", f"{path}: expected a number in the model, found {node!r}; give its value in params")
     return float(node)
 
 
@@ -125,7 +126,7 @@ def steps(values: ArrayLike, rel_step: float = DEFAULT_REL_STEP, typical: ArrayL
     bad = np.flatnonzero(~(h > 0) | ~np.isfinite(h))
     if len(bad):
         which = names[bad[0]] if names is not None else f"parameter {bad[0]}"
-        raise ValueError(f"{which} = {v[bad[0]]:g}: no step can be made from it; give typical= (a typical "
+        raise error("typical", f"{which} = {v[bad[0]]:g}: no step can be made from it; give typical= (a typical "
                          f"magnitude in its units, e.g. the mechanism's size for a coordinate that is 0)")
     return h
 

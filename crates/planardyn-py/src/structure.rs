@@ -1,10 +1,9 @@
 //! Structural analysis (`planardyn.structure`): the core's `planardyn::structure` results as
 //! Python dicts of names and numbers, and the pair-constraint Jacobian Phi_x.
 
-use crate::convert::{arr1, arr2, vector};
+use crate::convert::{arr1, arr2, vector, Floats};
 use crate::errors::{kinematics_error, model_error};
 use crate::mechanism::PyMechanism;
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x};
 use planardyn::loader::{analyse_spec, parse_spec};
 use planardyn::model::Link;
@@ -13,7 +12,7 @@ use planardyn::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+type ArrayArg<'py> = Floats<'py>;
 
 /// The pair-constraint Jacobian Phi_x = dPhi/dx at body coordinates x: shape
 /// (`n_pair_rows`, 3n), every pair's rows in pair order, also the ones the core leaves out

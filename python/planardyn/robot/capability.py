@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..arguments import error
 from .effector import EndEffector
 from .maps import TaskGrid, flood, grid_size
 
@@ -48,7 +49,7 @@ def capability_at(ee: EndEffector, q: ArrayLike, tau_max: ArrayLike, n_dir: int 
     tau_max = np.broadcast_to(np.asarray(tau_max, dtype=float), (mech.dof,))
     J = ee.state(q).J[:2]
     if ee.dim != 2:
-        raise ValueError("the capability map is for a point end effector (m = 2)")
+        raise error("ee", "the capability map is for a point end effector (m = 2)")
     M = mech.mass_matrix(q) @ np.linalg.inv(J)
     g = mech.inverse_dynamics(q, np.zeros(mech.dof), np.zeros(mech.dof))
     ts = np.linspace(0.0, 2 * np.pi, n_dir, endpoint=False)

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from ..arguments import error
 from .effector import EffectorState, EndEffector
 from .tolerances import EDGE_TOL, JUMP_TOL, QUAD_JUMP, SINGULAR_TOL
 
@@ -235,7 +236,7 @@ def workspace(ee: EndEffector, ranges: ArrayLike | None = None, n: int = 80, cel
         ranges = np.column_stack([q0 - half, q0 + half])
     ranges = np.asarray(ranges, dtype=float)
     if ranges.shape != (mech.dof, 2) or np.any(ranges[:, 1] <= ranges[:, 0]):
-        raise ValueError(f"ranges must be (m, 2) = ({mech.dof}, 2) with low < high, got {ranges.tolist()}")
+        raise error("ranges", f"ranges must be (m, 2) = ({mech.dof}, 2) with low < high, got {ranges.tolist()}")
     if ee.dim == 3:
         return _workspace_pose(ee, ranges, cells, psi)
     a1, a2 = (np.linspace(lo, hi, n) for lo, hi in ranges)

@@ -141,13 +141,23 @@ impl Actuation {
                     got: format!("{}", lambda.len()),
                 })
             }
-            Distribution::Preload(lambda) => lambda.clone(),
+            Distribution::Preload(lambda) => match lambda.iter().position(|l| !l.is_finite()) {
+                Some(i) => {
+                    return Err(KinematicsError::bad_argument(
+                        "preload",
+                        "finite values (N m or N), one per internal force",
+                        format!("preload[{i}] = {}", lambda[i]),
+                    ))
+                }
+                None => lambda.clone(),
+            },
             Distribution::MinMax => min_max_lambda(&out, &self.internal)?,
         };
         for (l, v) in lambda.iter().zip(&self.internal) {
             out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
         }
-        Ok(out)
+        // Finite preloads near the floating-point range can still overflow when added.
+        super::regular::finite("efforts", out)
     }
 }
 
