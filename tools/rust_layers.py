@@ -12,13 +12,17 @@ except the violations the allow-list names, each with its reason and the phase t
 
 The graph is read from the text, not compiled (why hand-written: cargo-modules needs
 rust-analyzer and checks cycles only, arch_test_core is unmaintained since 2021, archaven
-has no file cycles; the rule here is ~200 lines with the allow-list we need). An edge goes
-from a file to the file that defines what a path names:
+has no file cycles nor a declared order; this is a few hundred lines with the allow-list we
+need). An edge goes from a file to the file that defines what a path names:
 
 - ``crate::a::b::Item``, ``super::Item``, ``self::child::Item``, and in a module's own file
   ``child::Item`` for a child module; ``use`` groups ``{a, b::{c, d}}`` are expanded;
 - through the re-exports (``pub use``, ``pub(crate) use``) of the module it lands in, so that
   ``crate::Workspace`` is ``workspace.rs`` and not ``lib.rs``;
+- and from the file of a type to a file with an inherent ``impl`` of it elsewhere: the
+  type then has methods written there (``impl Mechanism { fn new }`` in the loader would
+  hide an arrow from the model up to the loader; the house rule: a function of the upper
+  module taking the object);
 - references to an ancestor module's own file are left out (a child uses its parent's
   types; the parent declares its children), as are comments and a unit-test module
   ``#[cfg(test)] mod tests`` at the end of a file (tests may reach anything).
