@@ -595,7 +595,7 @@ class Mechanism:
     def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:
         if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
             raise error("result", "the result is not a run of this mechanism (its bodies differ); "
-                                  "use pd.from_result(res) for the mechanism it was made with")
+                                  "use pdy.from_result(res) for the mechanism it was made with")
         # The run's drives: the motor torques where the model has motors (res.tau is joint-side).
         drives = res.tau if res.tau_motor is None else res.tau_motor
         return self._native.along(res.t, res.x, res.q, res.qd, drives, allow_singular)

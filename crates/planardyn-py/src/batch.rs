@@ -8,13 +8,12 @@
 //! native `Mechanism` and a motion dict, either coordinate rows (`q`, `qd`, `qdd`) or a
 //! sampled end-effector path (`t`, `X`, `Xd`, `Xdd`, `point`, ...), on the same pool.
 
-use crate::convert::arr2;
-use crate::effector::solution_dict;
+use crate::convert::{arr2, solution_dict};
 use crate::errors::{argument_error, run, task_error, to_pyerr, Failure, PlanardynError};
 use crate::mechanism::PyMechanism;
 use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};
-use planardyn::batch::{map_many_until, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::batch::{map_many_until, Efforts, InverseVariant, Motion, Overrides, Variant};
 use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -161,7 +160,7 @@ fn simulate_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(&m.get().inner, d)? })
+        Ok(Variant { model: m.get().inner.clone(), overrides: overrides(&m.get().inner, d)? })
     };
     let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
     run_batch(py, &variants, threads, make, solve, |r, _| match r {
@@ -221,7 +220,7 @@ fn inverse_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? })
+        Ok(InverseVariant { model: m.get().inner.clone(), motion: motion(d)? })
     };
     run_batch(
         py,

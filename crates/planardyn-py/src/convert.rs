@@ -4,8 +4,10 @@
 use crate::errors::{argument_error, PlanardynError};
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, IxDyn};
 use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
+use planardyn::dynamics::task::TaskSolution;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::ops::Deref;
 
 /// An array argument read as float64 (numpy's conversion of any array-like). Something numpy
@@ -127,4 +129,18 @@ pub fn arr_dyn<'py>(py: Python<'py>, shape: &[usize], v: Vec<f64>) -> PyResult<B
 
 pub fn bool1<'py>(py: Python<'py>, v: Vec<bool>) -> Bound<'py, PyAny> {
     Array1::from_vec(v).into_pyarray(py).into_any()
+}
+
+/// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
+/// `q`, `qd`, `qdd`, `tau`, `tau_motor` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
+pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let TaskSolution { q, qd, qdd, tau, tau_motor, sigma_i, sigma_ii, condition } = s;
+    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("tau_motor", tau_motor)] {
+        d.set_item(k, arr2(py, v.len() / m.max(1), m, v)?)?;
+    }
+    for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
+        d.set_item(k, arr1(py, v))?;
+    }
+    Ok(d)
 }

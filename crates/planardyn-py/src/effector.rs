@@ -3,10 +3,10 @@
 //! its own `Workspace`, started at the body coordinates `x_start` when given, else at the
 //! drawing.
 
-use crate::convert::{arr1, arr2, finite, rows, vector, Floats, Values};
+use crate::convert::{arr1, arr2, finite, rows, solution_dict, vector, Floats, Values};
 use crate::errors::{argument_error, effector_error, run, task_error, Failure};
 use crate::mechanism::PyMechanism;
-use planardyn::dynamics::task::{self, TaskPath, TaskSolution};
+use planardyn::dynamics::task::{self, TaskPath};
 use planardyn::kinematics::constraints::coordinates;
 use planardyn::kinematics::effector::{Effector, EffectorState};
 use planardyn::kinematics::{self as kin};
@@ -22,20 +22,6 @@ type ArrayArg<'py> = Floats<'py>;
 pub struct PyEffector {
     mech: Arc<Mechanism>,
     ee: Effector,
-}
-
-/// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
-/// `q`, `qd`, `qdd`, `tau`, `tau_motor` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
-pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let TaskSolution { q, qd, qdd, tau, tau_motor, sigma_i, sigma_ii, condition } = s;
-    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("tau_motor", tau_motor)] {
-        d.set_item(k, arr2(py, v.len() / m.max(1), m, v)?)?;
-    }
-    for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
-        d.set_item(k, arr1(py, v))?;
-    }
-    Ok(d)
 }
 
 impl PyEffector {

@@ -29,7 +29,7 @@
 //! reaches Python as `PanicException`: [`run`] catches it and raises `PlanardynError` asking
 //! for a bug report.
 
-use crate::effector::solution_dict;
+use crate::convert::solution_dict;
 use planardyn::dynamics::task::{TaskError, TaskSolution};
 use planardyn::kinematics::EffectorError;
 use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
@@ -223,7 +223,7 @@ pub fn effector_error(py: Python<'_>, e: &EffectorError) -> PyErr {
 
 /// A task motion that failed: `SingularityError` (attributes `kind` 'I' or 'II', `t` (s), `X`
 /// (k,), `q` (m,), `sigma`, `tol`) or `AssemblyError` (attribute `t`), both with `partial_rows`,
-/// the dict of the motion solved before the failure (see `effector::solution_dict`).
+/// the dict of the motion solved before the failure (see `convert::solution_dict`).
 pub fn task_error(py: Python<'_>, e: &TaskError) -> PyErr {
     let partial = |p: &TaskSolution, m: usize| solution_dict(py, p.clone(), m).ok().map(|d| d.into_any().unbind());
     match e {

@@ -5,12 +5,12 @@
 //! GIL is released while the core computes.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
-use crate::errors::{argument_error, kinematics_error, run, Failure, PlanardynError};
+use crate::errors::{argument_error, run, Failure, PlanardynError};
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
-use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
+use planardyn::model::pairs::{self, pair_geometry, Relative};
 use planardyn::model::{CoordinateKind, Link, PairId};
 use planardyn::{Error, Mechanism, Workspace};
 use pyo3::prelude::*;
@@ -609,11 +609,11 @@ impl PyMechanism {
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd, qdd, x, xd) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), xd.as_ref())?;
-        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let n_a = self.inner.n_actuators();
         let tau = match &tau {
             Some(tau) => {
                 let (w, what) = if tau.as_array().shape().last() == Some(&n_a) {
-                    (n_a, format!("one per actuator: {}", dynamics::redundant::actuator_names(&self.inner).join(", ")))
+                    (n_a, format!("one per actuator: {}", self.inner.actuator_names().join(", ")))
                 } else {
                     (self.m(), self.coords_what())
                 };
@@ -685,10 +685,7 @@ impl PyMechanism {
         let Some(slot) = dynamics::transmission::motors(&self.inner).nth(coordinate) else {
             return Err(argument_error(
                 Some("coordinate"),
-                format!(
-                    "actuator {coordinate} out of range: the model has {} actuators",
-                    dynamics::redundant::n_actuators(&self.inner)
-                ),
+                format!("actuator {coordinate} out of range: the model has {} actuators", self.inner.n_actuators()),
             ));
         };
         let Some(a) = slot else { return Ok(None) };
@@ -700,7 +697,7 @@ impl PyMechanism {
     /// The actuators' names: the coordinates', then the redundant actuators' on pairs.
     #[getter]
     fn actuator_names(&self) -> Vec<String> {
-        dynamics::redundant::actuator_names(&self.inner)
+        self.inner.actuator_names()
     }
 
     /// Every actuator's effort (n_a,) for (q, qd, qdd), each (m,), shared by `method`
@@ -764,7 +761,7 @@ impl PyMechanism {
         t: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
-        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let n_a = self.inner.n_actuators();
         let efforts = vector("efforts", &efforts, n_a, "one value per actuator (actuator_names)")?;
         check_time(t)?;
         let mech = self.inner.clone();

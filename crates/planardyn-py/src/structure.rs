@@ -5,8 +5,9 @@ use crate::convert::{arr1, arr2, vector, Floats};
 use crate::errors::{kinematics_error, model_error};
 use crate::mechanism::PyMechanism;
 use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x};
-use planardyn::model::{parse_spec, Link};
-use planardyn::structure::{analyse, analyse_spec, scaled_constraint_jacobian, Structure};
+use planardyn::loader::{analyse_spec, parse_spec};
+use planardyn::model::Link;
+use planardyn::structure::{analyse, scaled_constraint_jacobian, Structure};
 use planardyn::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -55,7 +56,7 @@ pub fn structure<'py>(py: Python<'py>, mech: &PyMechanism, x: Option<ArrayArg<'p
 }
 
 /// The structural analysis of a model (JSON text) at its drawing, also of a model whose
-/// mobility differs from its coordinates (`planardyn::structure::analyse_spec`).
+/// mobility differs from its coordinates (`planardyn::loader::analyse_spec`).
 #[pyfunction]
 #[pyo3(signature = (text, source="<dict>"))]
 pub fn structure_of_model<'py>(py: Python<'py>, text: &str, source: &str) -> PyResult<Bound<'py, PyDict>> {

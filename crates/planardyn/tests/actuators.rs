@@ -6,6 +6,8 @@ mod common;
 use common::{run, yaml};
 use planardyn::dynamics::{forward, inverse, motor_torques, ModelDrives};
 use planardyn::kinematics::{assemble_into, velocity_analogues, Chart};
+use planardyn::model::loads::friction::FrictionSpec;
+use planardyn::model::spec::LoadSpec;
 use planardyn::{KinematicsError, Mechanism, Workspace};
 
 const G: f64 = 9.81;
@@ -254,7 +256,7 @@ fn forward_with_losses_inverts_and_holds_in_a_partition_chart() {
 /// A shipped model with Coulomb friction `mu` at `pair` (a pin of radius `radius`, or a slot).
 fn shipped_with_friction(name: &str, pair: &str, mu: f64, radius: Option<f64>) -> Mechanism {
     let mut spec = common::shipped(name).spec.clone();
-    spec.loads.push(planardyn::model::spec::LoadSpec::Friction {
+    spec.loads.push(LoadSpec::Friction(FrictionSpec {
         pair: pair.into(),
         viscous: None,
         mu: Some(mu),
@@ -264,8 +266,8 @@ fn shipped_with_friction(name: &str, pair: &str, mu: f64, radius: Option<f64>) -
         stiction_speed: None,
         stribeck_speed: None,
         pressure_angle: None,
-    });
-    Mechanism::new(spec, name).unwrap()
+    }));
+    planardyn::build(spec, name).unwrap()
 }
 
 #[test]

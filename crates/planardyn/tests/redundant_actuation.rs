@@ -5,8 +5,8 @@
 mod common;
 
 use common::yaml;
+use planardyn::dynamics::motor_torques;
 use planardyn::dynamics::redundant::{forward_redundant, inverse_redundant, Distribution};
-use planardyn::dynamics::transmission::motor_torques;
 use planardyn::{Mechanism, Workspace};
 
 /// The five-bar of examples/models/five-bar.yaml (without its PD springs) with a third leg

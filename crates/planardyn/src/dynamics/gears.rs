@@ -39,10 +39,9 @@
 //! consistent (Painleve's paradox of friction), the evaluation is refused
 //! ([`KinematicsError::GearsJammed`]) rather than guessed.
 
-use super::transmission::{at_rest, direction, housing, motor_friction, motors, pair_term, STUCK_DECAY};
+use super::transmission::{at_rest, direction, housing, motor_friction, motors, STUCK_DECAY};
 use crate::linalg::{lu_factor, lu_solve};
 use crate::model::{Actuator, Mechanism};
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Relative tolerance of a mode's branch test: a solution on the boundary of two modes
@@ -121,17 +120,6 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
-/// Something that solves A zdd = rhs with A factored in the workspace (alone, or with the
-/// multipliers of prescribed coordinates): `dynamics::losses`.
-pub(crate) trait Solve {
-    /// zdd of `rhs` in place; `homogeneous`: with the prescribed rows' accelerations 0.
-    fn solve(&mut self, ws: &Workspace, rhs: &mut [f64], homogeneous: bool) -> Result<(), KinematicsError>;
-    /// Whether coordinate k follows a prescribed motion.
-    fn prescribed(&self, k: usize) -> bool;
-    /// The prescribed coordinates' efforts of the last solve with their motion into `ws.f`.
-    fn add_efforts(&mut self, ws: &mut Workspace);
-}
-
 impl Gears {
     pub(crate) fn new(mech: &Mechanism) -> Self {
         let slots: Vec<usize> = motors(mech).enumerate().filter_map(|(k, a)| a.map(|_| k)).collect();
@@ -181,19 +169,28 @@ impl Gears {
         }
     }
 
-    /// Each motor's kinematics at the point in `ws` (after the kinematic stages), its pair's
-    /// lever in row k of `grad` (n_a x 3n) and its rate `rates[k]`: h, e, r and the housing's
-    /// rate.
-    pub(crate) fn kinematics(&mut self, mech: &Mechanism, ws: &Workspace, grad: &[f64], rates: &[f64]) {
-        let (n, m) = (ws.x.len(), ws.b.len());
+    /// Each motor's kinematics at a point (after the kinematic stages: U (m x 3n), c and xd
+    /// (3n)), `h(k)` = h_k of actuator k (qdd_k = g_k . zdd + h_k) and its rate `rates[k]`:
+    /// h, e, r and the housing's rate.
+    pub(crate) fn kinematics(
+        &mut self,
+        mech: &Mechanism,
+        u: &[f64],
+        c: &[f64],
+        xd: &[f64],
+        h: impl Fn(usize) -> f64,
+        rates: &[f64],
+    ) {
+        let n = xd.len();
+        let m = u.len() / n.max(1);
         for i in 0..self.slots.len() {
             let (k, ratio) = (self.slots[i], self.actuator(mech, i).ratio);
             let e = &mut self.e[i * m..(i + 1) * m];
-            let h = pair_term(mech, ws, k, &grad[k * n..(k + 1) * n]);
+            let h = h(k);
             let (c_h, omega_h) = match self.housings[i] {
                 Some(b) => {
-                    e.iter_mut().zip(ws.u.chunks_exact(n)).for_each(|(e, u)| *e = u[3 * b + 2]);
-                    (ws.c[3 * b + 2], ws.xd[3 * b + 2])
+                    e.iter_mut().zip(u.chunks_exact(n)).for_each(|(e, u)| *e = u[3 * b + 2]);
+                    (c[3 * b + 2], xd[3 * b + 2])
                 }
                 None => (0.0, 0.0),
             };
@@ -202,20 +199,14 @@ impl Gears {
         }
     }
 
-    /// Forward dynamics' set-up after [`Gears::kinematics`] and A's factorisation: each motor's
-    /// net torque c (0 where its coordinate is prescribed), its candidate modes, and the
-    /// columns A^-1 g_i, A^-1 e_i with their products (`gu`: the actuators' g, n_a x m).
-    pub(crate) fn prepare(
-        &mut self,
-        mech: &Mechanism,
-        ws: &Workspace,
-        gu: &[f64],
-        solver: &mut dyn Solve,
-    ) -> Result<(), KinematicsError> {
-        let (m, nm) = (ws.b.len(), self.slots.len());
-        for i in 0..nm {
+    /// Forward dynamics' set-up after [`Gears::kinematics`]: each motor's net torque c (0 where
+    /// its coordinate is `prescribed`), its candidate modes, and the columns g_i, e_i (`gu`: the
+    /// actuators' g, n_a x m) for the caller to turn into A^-1 g_i, A^-1 e_i ([`Gears::columns`])
+    /// before [`Gears::products`].
+    pub(crate) fn prepare(&mut self, mech: &Mechanism, gu: &[f64], m: usize, prescribed: impl Fn(usize) -> bool) {
+        for i in 0..self.slots.len() {
             let (k, a) = (self.slots[i], self.actuator(mech, i));
-            let prescribed = k < m && solver.prescribed(k);
+            let prescribed = k < m && prescribed(k);
             let r = &mut self.rotors[k];
             r.net = if prescribed { 0.0 } else { r.torque - motor_friction(a, r.rate) };
             (self.modes[i], self.first[i]) = if prescribed {
@@ -225,17 +216,22 @@ impl Gears {
             } else {
                 (MOVING, usize::from(r.net * r.rate < 0.0))
             };
-            let col = &mut self.ag[i * m..(i + 1) * m];
-            col.copy_from_slice(&gu[k * m..(k + 1) * m]);
-            solver.solve(ws, col, true)?;
-            let col = &mut self.ae[i * m..(i + 1) * m];
-            if self.housings[i].is_some() {
-                col.copy_from_slice(&self.e[i * m..(i + 1) * m]);
-                solver.solve(ws, col, true)?;
-            } else {
-                col.fill(0.0);
-            }
+            self.ag[i * m..(i + 1) * m].copy_from_slice(&gu[k * m..(k + 1) * m]);
+            let e = &self.e[i * m..(i + 1) * m];
+            self.ae[i * m..(i + 1) * m].copy_from_slice(e);
         }
+    }
+
+    /// The columns to solve with A (homogeneous: prescribed coordinates held), in place:
+    /// g_i, and e_i where the housing moves (the others stay 0).
+    pub(crate) fn columns(&mut self, m: usize) -> impl Iterator<Item = &mut [f64]> {
+        let moving = self.ae.chunks_exact_mut(m.max(1)).zip(&self.housings).filter_map(|(c, h)| h.map(|_| c));
+        self.ag.chunks_exact_mut(m.max(1)).chain(moving)
+    }
+
+    /// The products of the solved columns with g_i and w_i = n_i g_i + e_i.
+    pub(crate) fn products(&mut self, mech: &Mechanism, gu: &[f64], m: usize) {
+        let nm = self.slots.len();
         for i in 0..nm {
             let (g, e) = (&gu[self.slots[i] * m..(self.slots[i] + 1) * m], &self.e[i * m..(i + 1) * m]);
             let n = self.actuator(mech, i).ratio;
@@ -246,7 +242,6 @@ impl Gears {
                 self.we[i * nm + l] = n * self.ge[i * nm + l] + dot(e, ae);
             }
         }
-        Ok(())
     }
 
     /// rhs -= sum_i c_i e_i: the motors' net torques on their housings.

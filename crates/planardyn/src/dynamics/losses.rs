@@ -13,11 +13,11 @@
 
 use super::forward::{accelerations, body_accelerations, factor_mass_matrix, solve_factored};
 use super::friction;
-use super::gears::{Gears, Rotor, Solve};
+use super::gears::{Gears, Rotor};
 use super::reactions::reactions_into;
-use super::transmission::actuator_pair;
-use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
-use crate::kinematics::pairs::gear::{Gear, Side};
+use super::transmission::{actuator_pair, motor_torque, motors};
+use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense};
+use crate::model::pairs::gear::{Gear, Side};
 use crate::model::{Mechanism, PairId, PairKind};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
@@ -163,7 +163,16 @@ fn set_levers(mech: &Mechanism, ws: &Workspace, lb: &mut LossBuffers) {
     for k in 0..lb.actuator_rates.len() {
         lb.actuator_rates[k] = set_lever(mech, actuator_pair(mech, k), Side::A, ws, lb, nf + k);
     }
-    lb.gears.kinematics(mech, ws, &lb.grad[nf * n..], &lb.actuator_rates);
+    let grad = &lb.grad[nf * n..];
+    let h = |k: usize| pair_term(mech, ws, k, &grad[k * n..(k + 1) * n]);
+    lb.gears.kinematics(mech, &ws.u, &ws.c, &ws.xd, h, &lb.actuator_rates);
+}
+
+/// h_k = grad_k . c + gamma_k(xd, xd) of actuator k (`grad`: its pair's gradient, 3n) at the
+/// point in `ws`, so that qdd_k = g_k . zdd + h_k.
+fn pair_term(mech: &Mechanism, ws: &Workspace, k: usize, grad: &[f64]) -> f64 {
+    let pair = &mech.pairs[actuator_pair(mech, k).0];
+    grad.iter().zip(&ws.c).map(|(a, b)| a * b).sum::<f64>() + pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd)
 }
 
 /// A gear mesh's driver at the reactions in `lb` (`Side::A` for the other pairs).
@@ -229,6 +238,17 @@ fn step_friction(
     Ok(false)
 }
 
+/// Something that solves A zdd = rhs with A factored in the workspace (alone, or with the
+/// multipliers of prescribed coordinates: `dynamics::prescribed`).
+pub(crate) trait Solve {
+    /// zdd of `rhs` in place; `homogeneous`: with the prescribed rows' accelerations 0.
+    fn solve(&mut self, ws: &Workspace, rhs: &mut [f64], homogeneous: bool) -> Result<(), KinematicsError>;
+    /// Whether coordinate k follows a prescribed motion.
+    fn prescribed(&self, k: usize) -> bool;
+    /// The prescribed coordinates' efforts of the last solve with their motion into `ws.f`.
+    fn add_efforts(&mut self, ws: &mut Workspace);
+}
+
 /// A = its Cholesky factor alone: zdd = A^-1 rhs (no coordinate prescribed).
 struct Alone;
 
@@ -276,7 +296,11 @@ fn forward_stages(
     let (nf, m, n) = (mech.friction.len(), ws.b.len(), ws.x.len());
     set_levers(mech, ws, lb);
     factor_mass_matrix(ws)?;
-    lb.gears.prepare(mech, ws, &lb.gu[nf * m..], solver)?;
+    lb.gears.prepare(mech, &lb.gu[nf * m..], m, |k| solver.prescribed(k));
+    for col in lb.gears.columns(m) {
+        solver.solve(ws, col, true)?;
+    }
+    lb.gears.products(mech, &lb.gu[nf * m..], m);
     lb.f0.copy_from_slice(&ws.f);
     lb.b0.copy_from_slice(&ws.b);
     lb.e.fill(0.0);
@@ -353,4 +377,18 @@ fn inverse_stages(
     lb.gears.set_outputs(&ws.tau);
     ws.dissipated = -lb.e.iter().zip(&lb.rates).map(|(e, r)| e * r).sum::<f64>();
     Ok(())
+}
+
+/// Motor torques (N m; the effort itself where an actuator has no motor) into `t_m` for
+/// joint-side efforts `tau` of the first `tau.len()` actuators (the coordinates', then the pair
+/// actuators'), at the motion of the last evaluation in `ws` (its rates, the pairs'
+/// accelerations and the rotors', which inverse and forward dynamics leave there).
+pub fn motor_torques(mech: &Mechanism, ws: &Workspace, tau: &[f64], t_m: &mut [f64]) {
+    let rotors = ws.losses.rotors();
+    for (k, (slot, &tau)) in motors(mech).zip(tau).enumerate() {
+        t_m[k] = match (slot, rotors.get(k)) {
+            (Some(a), Some(r)) => motor_torque(a, tau, r.rate, r.accel, r.rotor_acc),
+            _ => tau,
+        };
+    }
 }

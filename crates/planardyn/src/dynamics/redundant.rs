@@ -47,17 +47,6 @@ pub struct Actuation {
     l: Vec<f64>,
 }
 
-/// Number of actuators n_a: the coordinates, then the pair actuators.
-pub fn n_actuators(mech: &Mechanism) -> usize {
-    mech.dof() + mech.pair_actuators.len()
-}
-
-/// The actuators' names: the coordinates', then the pair actuators'.
-pub fn actuator_names(mech: &Mechanism) -> Vec<String> {
-    let coords = mech.coordinates.iter().map(|c| c.name.clone());
-    coords.chain(mech.pair_actuators.iter().map(|a| a.name.clone())).collect()
-}
-
 fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f64]) {
     grad.fill(0.0);
     pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
@@ -86,7 +75,7 @@ fn orthogonalise(v: &mut [f64], basis: &[Vec<f64>]) -> f64 {
 impl Actuation {
     /// The actuation at the point in `ws` (after the kinematic stages, in its chart).
     pub fn at(mech: &Mechanism, ws: &Workspace) -> Result<Self, KinematicsError> {
-        let (m, n_a, n) = (mech.dof(), n_actuators(mech), ws.x.len());
+        let (m, n_a, n) = (mech.dof(), mech.n_actuators(), ws.x.len());
         let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
         let mut b = vec![0.0; m * n_a];
         let mut grad = vec![0.0; n];
@@ -207,7 +196,7 @@ fn min_max_lambda(t: &[f64], internal: &[Vec<f64>]) -> Result<Vec<f64>, Kinemati
 /// linear, where a motor's torque is not (its gear's efficiency changes with the direction of
 /// the power, its Coulomb friction with that of its speed). Each rotor is its own motor's
 /// (before its gear); its reaction on a moving housing is part of the generalized efforts.
-/// [`super::transmission::motor_torques`] with `ws` gives the motor torques.
+/// [`super::motor_torques`] with `ws` gives the motor torques.
 pub fn inverse_redundant(
     mech: &Mechanism,
     q: &[f64],

@@ -11,12 +11,10 @@
 //! (the gear's input power t qd >= 0) tau = n eta t; back-driven (the load drives the rotor)
 //! eta_b tau = n t, eta_b the back-drive efficiency (0: a self-locking gear, t = 0, which holds
 //! any load). Forward dynamics solves these with the accelerations (`dynamics::gears`); here
-//! the motor torque of a known motion.
+//! the motor torque of a known motion (`dynamics::motor_torques` reads the last evaluation's).
 
-use crate::kinematics::constraints::pair_coordinate_gamma;
-use crate::kinematics::pairs::{self, Relative};
+use crate::model::pairs::{self, Relative};
 use crate::model::{Actuator, Link, Mechanism, PairId};
-use crate::workspace::Workspace;
 
 /// tanh(v / v_s): the sign function regularised over speed v_s > 0.
 #[inline]
@@ -107,25 +105,4 @@ pub(crate) fn housing(mech: &Mechanism, k: usize) -> Option<usize> {
         (Some(Relative::Angle), Link::Body(b)) => Some(b.0),
         _ => None,
     }
-}
-
-/// Motor torques (N m; the effort itself where an actuator has no motor) into `t_m` for
-/// joint-side efforts `tau` of the first `tau.len()` actuators (the coordinates', then the pair
-/// actuators'), at the motion of the last evaluation in `ws` (its rates, the pairs'
-/// accelerations and the rotors', which inverse and forward dynamics leave there).
-pub fn motor_torques(mech: &Mechanism, ws: &Workspace, tau: &[f64], t_m: &mut [f64]) {
-    let rotors = ws.losses.rotors();
-    for (k, (slot, &tau)) in motors(mech).zip(tau).enumerate() {
-        t_m[k] = match (slot, rotors.get(k)) {
-            (Some(a), Some(r)) => motor_torque(a, tau, r.rate, r.accel, r.rotor_acc),
-            _ => tau,
-        };
-    }
-}
-
-/// h_k = grad_k . c + gamma_k(xd, xd) of actuator k (`grad`: its pair's gradient, 3n) at the
-/// point in `ws`, so that qdd_k = g_k . zdd + h_k.
-pub(crate) fn pair_term(mech: &Mechanism, ws: &Workspace, k: usize, grad: &[f64]) -> f64 {
-    let pair = &mech.pairs[actuator_pair(mech, k).0];
-    grad.iter().zip(&ws.c).map(|(a, b)| a * b).sum::<f64>() + pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd)
 }
