@@ -113,7 +113,16 @@ class Mechanism:
     def simulate_defaults(self) -> dict[str, Any]: ...
     @property
     def actuators(self) -> list[dict[str, Any] | None]: ...
-    def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]: ...
+    def motor_torques(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        tau: ArrayLike | None = None,
+        x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> NDArray[np.float64]: ...
     @property
     def actuator_names(self) -> list[str]: ...
     @property

@@ -243,10 +243,15 @@ pub struct ActuatorSpec {
     /// Transmission ratio n (motor rad per coordinate rad, or per metre of a displacement).
     #[serde(default = "one")]
     pub gear_ratio: f64,
-    /// Transmission efficiency eta in (0, 1].
+    /// Transmission efficiency eta in (0, 1], while motoring.
     #[serde(default = "one")]
     pub efficiency: f64,
-    /// Rotor (and gearbox input) inertia J (kg m^2, motor side); n^2 J is added to A.
+    /// Back-drive efficiency eta_b in [0, 1], while the load drives the motor (default eta;
+    /// 0: self-locking, the gear holds the load).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backdrive_efficiency: Option<f64>,
+    /// Rotor (and gearbox input) inertia J (kg m^2, motor side), before the gear: its
+    /// kinetic energy 1/2 J (omega_housing + n qd)^2.
     #[serde(default)]
     pub rotor_inertia: f64,
     /// Motor-side viscous friction (N m s/rad).
