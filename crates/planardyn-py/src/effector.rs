@@ -1,6 +1,6 @@
 //! `planardyn._core.Effector`: the core's end effector (`kinematics::effector`) and its
 //! task-space inverse dynamics (`dynamics::task`) on a native `Mechanism`. Every call makes
-//! its own `Workspace`, started at the body coordinates `x_start` when given, else at the
+//! its own kinematic frame (`kinematics::Frame`), started at the body coordinates `x_start` when given, else at the
 //! drawing.
 
 use crate::convert::{arr1, arr2, finite, rows, solution_dict, vector, Floats, Values};
@@ -10,7 +10,7 @@ use planardyn::dynamics::task::{self, TaskPath};
 use planardyn::kinematics::constraints::coordinates;
 use planardyn::kinematics::effector::{Effector, EffectorState};
 use planardyn::kinematics::{self as kin};
-use planardyn::{Mechanism, Workspace};
+use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
@@ -41,18 +41,18 @@ impl PyEffector {
         vector("x", a, self.mech.n_x(), "body coordinates [X, Y, phi] per body")
     }
 
-    /// A workspace at the body coordinates `x` (a closed configuration), or at the drawing.
-    fn workspace(&self, x: Option<&[f64]>) -> Workspace {
-        let mut ws = Workspace::new(&self.mech);
+    /// A kinematic frame at the body coordinates `x` (a closed configuration), or at the drawing.
+    fn frame(&self, x: Option<&[f64]>) -> kin::Frame {
+        let mut ws = kin::Frame::new(&self.mech);
         if let Some(x) = x {
             ws.x.copy_from_slice(x);
         }
         ws
     }
 
-    /// A workspace analysed at the body coordinates `x`, and the end effector there.
-    fn at(&self, x: &[f64]) -> Result<(Workspace, EffectorState), Failure> {
-        let mut ws = self.workspace(Some(x));
+    /// A kinematic frame analysed at the body coordinates `x`, and the end effector there.
+    fn at(&self, x: &[f64]) -> Result<(kin::Frame, EffectorState), Failure> {
+        let mut ws = self.frame(Some(x));
         let mut q = vec![0.0; self.m()];
         coordinates(&self.mech, x, &mut q);
         let st = self.ee.state(&self.mech, &q, &mut ws)?;
@@ -105,7 +105,7 @@ impl PyEffector {
         let q = self.q_arg("q", &q)?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let (st, x) = run(py, || {
-            let mut ws = self.workspace(x_start.as_deref());
+            let mut ws = self.frame(x_start.as_deref());
             let st = self.ee.state(&self.mech, &q, &mut ws)?;
             Ok((st, ws.x))
         })?;
@@ -159,7 +159,7 @@ impl PyEffector {
         let (target, guess) = (self.task_arg("X", &target)?, self.q_arg("q_guess", &q_guess)?);
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let r = run(py, || {
-            let mut ws = self.workspace(x_start.as_deref());
+            let mut ws = self.frame(x_start.as_deref());
             Ok(self.ee.solve(&self.mech, &target, &guess, &mut ws).map(|st| (st, ws.x)))
         })?;
         let (st, x) = r.map_err(|e| effector_error(py, &e))?;
@@ -183,7 +183,7 @@ impl PyEffector {
         };
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let r = run(py, || {
-            let mut ws = self.workspace(x_start.as_deref());
+            let mut ws = self.frame(x_start.as_deref());
             Ok(self.ee.reach(&self.mech, &target, &q_start, &mut ws).map(|st| (st, ws.x)))
         })?;
         let (st, x) = r.map_err(|e| effector_error(py, &e))?;

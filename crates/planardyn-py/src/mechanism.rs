@@ -369,7 +369,7 @@ impl PyMechanism {
         let q = self.q_arg("q", &q)?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
-        let x = run(py, move || Ok(Self::assembled(&mech, &q, x_start.as_deref())?.x))?;
+        let x = run(py, move || Ok(Self::assembled(&mech, &q, x_start.as_deref())?.frame.x))?;
         Ok(arr1(py, x))
     }
 

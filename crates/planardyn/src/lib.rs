@@ -31,10 +31,9 @@ pub mod model;
 pub mod simulate;
 pub mod structure;
 pub mod topology;
-pub mod workspace;
 
+pub use dynamics::Workspace;
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};
 pub use loader::{analyse_spec, build, load, loads, Format};
 pub use model::{Mechanism, MechanismSpec};
 pub use structure::{analyse, Structure};
-pub use workspace::Workspace;

@@ -29,7 +29,7 @@ fn velocity_analogues_match_finite_differences() {
             let (mut qp, mut qm) = (q.clone(), q.clone());
             qp[j] += H;
             qm[j] -= H;
-            let (xp, xm) = (analysed(&mech, &qp).x, analysed(&mech, &qm).x);
+            let (xp, xm) = (analysed(&mech, &qp).frame.x, analysed(&mech, &qm).frame.x);
             for i in 0..mech.n_x() {
                 let fd = (xp[i] - xm[i]) / (2.0 * H);
                 assert!(

@@ -152,7 +152,7 @@ fn both(
     if !mech.friction.is_empty() {
         // The pairs' friction needs the reactions, solved with J at this point (as the
         // simulation's closed-form evaluations factor it: simulate::ode).
-        let ws = &mut closed;
+        let ws = &mut closed.frame;
         ws.sys.factor(mech, &ws.chart, &ws.x, &ws.trig).unwrap();
     }
     dynamic_stages(mech, 0.0, &mut drives, &mut closed).unwrap();

@@ -3,11 +3,11 @@
 //! motion of the named points. A row is one forward evaluation under the efforts the run
 //! applied (its `tau`), so the accelerations are the run's.
 
+use super::workspace::Workspace;
 use super::{forward, reactions, type_ii_measure, Drives};
 use crate::kinematics::assemble_from;
 use crate::kinematics::constraints::{point_acceleration, point_velocity, world_point};
 use crate::model::{Attachment, Mechanism, PointId};
-use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
 
 /// Efforts given as numbers (N m or N per coordinate), whatever t, q and qd: a recorded

@@ -14,11 +14,11 @@ use super::force_rates::{applied_forces_dx, applied_forces_dxd, load_power_dx, l
 use super::forces::applied_forces;
 use super::forward::{bias, body_accelerations, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::inverse::inverse;
+use super::workspace::Workspace;
 use crate::kinematics::third::convective_derivative;
 use crate::kinematics::{acceleration_analogues, Chart};
 use crate::linalg::cholesky_solve;
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
 
 /// Three m x m Jacobians (row-major, entry [i*m + k] = d out_i / d in_k) of a dynamics map.
@@ -112,7 +112,7 @@ fn effort_jacobians(
     rs: &mut RateScratch,
 ) -> Jacobians {
     let (n, m) = (ws.x.len(), qd.len());
-    body_accelerations(&ws.u, &ws.c, qdd, ws.sys.u_support(), &mut ws.xdd);
+    body_accelerations(&ws.frame.u, &ws.frame.c, qdd, ws.frame.sys.u_support(), &mut ws.xdd);
     // r = M xdd - f.
     let mut r = vec![0.0; n];
     for (i, body) in mech.bodies.iter().enumerate() {
@@ -194,7 +194,7 @@ fn accelerations_and_jacobians(
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
     ws.tau.fill(0.0);
-    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
+    applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     mass_matrix(mech, ws);
     bias(mech, ws);
     let a = ws.a.clone();

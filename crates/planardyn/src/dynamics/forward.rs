@@ -5,11 +5,11 @@
 use super::forces::{applied_forces, Drives};
 use super::losses::forward_with_losses;
 use super::redundant;
+use super::workspace::Workspace;
 use crate::kinematics::constraints::{coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_rate};
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
 use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 
 /// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
@@ -40,14 +40,14 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
         ws.a.fill(0.0);
         ws.a_zeros_for = id;
     } else {
-        for &(k, j) in ws.sys.a_fill_in() {
+        for &(k, j) in ws.frame.sys.a_fill_in() {
             ws.a[k * m + j] = 0.0;
         }
     }
-    let support = ws.sys.u_support();
-    for &(j, k) in ws.sys.a_pairs() {
+    let support = ws.frame.sys.u_support();
+    for &(j, k) in ws.frame.sys.a_pairs() {
         let ((fj, ej), (fk, ek)) = (support[j], support[k]);
-        let s = m_dot(mech, &ws.u[j * n..(j + 1) * n], &ws.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
+        let s = m_dot(mech, &ws.frame.u[j * n..(j + 1) * n], &ws.frame.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
         ws.a[j * m + k] = s;
         ws.a[k * m + j] = s;
     }
@@ -57,10 +57,10 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
 pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     for (j, bj) in ws.b.iter_mut().enumerate() {
-        let uj = &ws.u[j * n..(j + 1) * n];
-        let (first, end) = ws.sys.u_support()[j];
+        let uj = &ws.frame.u[j * n..(j + 1) * n];
+        let (first, end) = ws.frame.sys.u_support()[j];
         let (u, f) = (&uj[3 * first..3 * end], &ws.f[3 * first..3 * end]);
-        *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.c, (first, end));
+        *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.frame.c, (first, end));
     }
 }
 
@@ -72,16 +72,16 @@ fn user_coordinates(mech: &Mechanism, ws: &mut Workspace, z: &[f64], zd: &[f64])
         ws.q.copy_from_slice(z);
         ws.qd.copy_from_slice(zd);
     } else {
-        coordinates(mech, &ws.x, &mut ws.q);
-        coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
+        coordinates(mech, &ws.frame.x, &mut ws.frame.q);
+        coordinate_rates(mech, &ws.frame.x, &ws.frame.xd, &mut ws.frame.qd);
     }
 }
 
-/// The user's accelerations from x, xd and xdd; in the input chart the chart's own zdd, in
-/// `ws.b` (as [`user_coordinates`]).
+/// The user's accelerations from x, xd and xdd; in the input chart the chart's own zdd
+/// (as [`user_coordinates`]).
 fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
     if ws.chart == Chart::Inputs {
-        ws.qdd.copy_from_slice(&ws.b);
+        ws.qdd.copy_from_slice(&ws.zdd);
         return;
     }
     for (k, c) in mech.coordinates.iter().enumerate() {
@@ -101,7 +101,7 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Worksp
 }
 
 /// One forward-dynamics evaluation at time t (s) and chart state (z, zd): fills every
-/// buffer of `ws`; the chart accelerations zdd are left in `ws.b`, the user's in `ws.qdd`.
+/// buffer of `ws`; the chart accelerations zdd are left in `ws.zdd`, the user's in `ws.qdd`.
 /// On a coordinate with an actuator the drive's effort is the motor torque (N m, motor
 /// side); `ws.tau` ends with the joint-side efforts.
 pub fn forward(
@@ -121,7 +121,7 @@ pub fn forward(
 pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
     ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
-    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
+    ws.power = applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     ws.power += redundant::apply_pair_efforts(mech, ws);
     mass_matrix(mech, ws);
     bias(mech, ws);
@@ -136,7 +136,7 @@ pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mu
 
 /// The drives' efforts at time t (s) and the point in `ws` into `ws.tau`, checked finite.
 pub(crate) fn drive_efforts(t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
-    drives.efforts(t, &ws.q, &ws.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
+    drives.efforts(t, &ws.frame.q, &ws.frame.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
     if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {
         return Err(Error::Drive { t, message: format!("effort {bad} is {}", ws.tau[bad]) });
     }
@@ -148,7 +148,7 @@ pub(crate) fn drive_efforts(t: f64, drives: &mut dyn Drives, ws: &mut Workspace)
 pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsError> {
     let m = ws.b.len();
     let factored = if ws.a_zeros_for == ws.sys.supports_id() {
-        cholesky_envelope(&mut ws.a, m, ws.sys.a_first())
+        cholesky_envelope(&mut ws.a, m, ws.frame.sys.a_first())
     } else {
         cholesky_in_place(&mut ws.a, m)
     };
@@ -159,11 +159,12 @@ pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsErr
     Ok(())
 }
 
-/// zdd = A^-1 b in `ws.b`, with the factor from [`factor_mass_matrix`].
+/// zdd = A^-1 b into `ws.zdd`, with the factor from [`factor_mass_matrix`].
 pub(crate) fn solve_mass_matrix(ws: &mut Workspace) {
-    let mut b = std::mem::take(&mut ws.b);
-    solve_factored(ws, &mut b);
-    ws.b = b;
+    let mut zdd = std::mem::take(&mut ws.zdd);
+    zdd.copy_from_slice(&ws.b);
+    solve_factored(ws, &mut zdd);
+    ws.zdd = zdd;
 }
 
 /// A^-1 rhs in place, with the factor from [`factor_mass_matrix`] (over its envelope when it
@@ -177,10 +178,10 @@ pub(crate) fn solve_factored(ws: &Workspace, rhs: &mut [f64]) {
     }
 }
 
-/// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations zdd
-/// in `ws.b`, at the point of the kinematic stages.
+/// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations
+/// `ws.zdd`, at the point of the kinematic stages.
 pub(crate) fn accelerations(mech: &Mechanism, ws: &mut Workspace) {
-    body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
+    body_accelerations(&ws.frame.u, &ws.frame.c, &ws.zdd, ws.frame.sys.u_support(), &mut ws.xdd);
     user_accelerations(mech, ws);
 }
 

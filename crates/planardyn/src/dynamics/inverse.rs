@@ -5,10 +5,10 @@
 use super::forces::applied_forces;
 use super::forward::{kinematic_stages, m_dot};
 use super::losses::inverse_with_losses;
+use super::workspace::Workspace;
 use crate::kinematics::constraints::{gamma, jacobian};
 use crate::kinematics::Chart;
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Drive efforts (N m or N) into `ws.tau` for user coordinates q, rates qd and accelerations
@@ -40,13 +40,13 @@ pub fn inverse_at_rates(
     kinematic_stages(mech, q, qd, ws)?;
     body_motion(mech, qd, qdd, xd, ws);
     ws.tau.fill(0.0);
-    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
+    applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     // tau = A qdd - b, formed as U^T (M xdd - f): M xdd - f is the constraint reaction,
     // of the motion's own size, where A qdd and b are each of size 1/sigma^2.
     let n = ws.x.len();
     for (j, tau) in ws.tau.iter_mut().enumerate() {
-        let u = &ws.u[j * n..(j + 1) * n];
-        let (first, end) = ws.sys.u_support()[j];
+        let u = &ws.frame.u[j * n..(j + 1) * n];
+        let (first, end) = ws.frame.sys.u_support()[j];
         let uf: f64 = u[3 * first..3 * end].iter().zip(&ws.f[3 * first..3 * end]).map(|(u, f)| u * f).sum();
         *tau = m_dot(mech, u, &ws.xdd, (first, end)) - uf;
     }
@@ -71,14 +71,14 @@ fn body_motion(mech: &Mechanism, qd: &[f64], qdd: &[f64], given: Option<&[f64]>,
     } else {
         ws.xd.fill(0.0);
         ws.xd[nc..].copy_from_slice(qd);
-        ws.sys.solve(&mut ws.xd);
+        ws.frame.sys.solve(&mut ws.frame.xd);
     }
-    gamma(mech, &ws.chart, &ws.x, &ws.trig, &ws.xd, &ws.xd, &mut ws.xdd);
+    gamma(mech, &ws.frame.chart, &ws.frame.x, &ws.frame.trig, &ws.frame.xd, &ws.frame.xd, &mut ws.xdd);
     for (i, a) in ws.xdd.iter_mut().enumerate() {
         let drive = if i >= nc { qdd[i - nc] } else { 0.0 };
         *a = drive - *a;
     }
-    ws.sys.solve(&mut ws.xdd);
+    ws.frame.sys.solve(&mut ws.xdd);
 }
 
 /// How far body rates xd are from being the rates of user rates qd at the positions in `ws`

@@ -31,8 +31,8 @@
 use super::friction;
 use super::losses::pair_lever;
 use super::transmission::{gear_input, motoring, smooth_sign};
+use super::workspace::Workspace;
 use crate::model::{Actuator, JointFriction, Load, Mechanism, PairId};
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Parameters per actuator and per friction load.

@@ -13,13 +13,13 @@
 
 use super::forward::{accelerations, body_accelerations, factor_mass_matrix, solve_factored};
 use super::friction;
-use super::gears::{Gears, Rotor};
+use super::loss_buffers::LossBuffers;
 use super::reactions::reactions_into;
 use super::transmission::{actuator_pair, motor_torque, motors};
+use super::workspace::Workspace;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::model::pairs::gear::{Gear, Side};
 use crate::model::{Mechanism, PairId, PairKind};
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Largest number of fixed-point iterations, and the change of the friction efforts,
@@ -34,82 +34,6 @@ const SETTLED: f64 = 1e-13;
 /// 1 / (1 - rho) = 3.9 of the first estimate (in the norm where it contracts); a self-locking
 /// mechanism's grow by a factor rho > 1 a step, without bound (to overflow for large mu).
 const GROWTH: f64 = 1e3;
-
-/// The buffers of an evaluation with losses, sized once for a mechanism (empty without
-/// losses). A lever is a pair's relative coordinate seen from the bodies: its gradient (3n)
-/// and that gradient times U (m); the friction entries' come first, then one per actuator
-/// (the coordinates', then the pair actuators').
-#[derive(Debug, Clone, Default)]
-pub struct LossBuffers {
-    /// (3n) the applied forces, and (m) b or the efforts, before the friction.
-    f0: Vec<f64>,
-    b0: Vec<f64>,
-    /// ((n_f + n_a) x 3n) lever gradients and ((n_f + n_a) x m) their products with U.
-    grad: Vec<f64>,
-    gu: Vec<f64>,
-    /// (n_f) the friction pairs' rates and efforts, and the gear carrying each (a gear
-    /// mesh's driver; `Side::A` for the other pairs); (n_a) the actuators' pairs' rates.
-    rates: Vec<f64>,
-    e: Vec<f64>,
-    sides: Vec<Side>,
-    actuator_rates: Vec<f64>,
-    /// The motors' rotors and gears.
-    gears: Gears,
-    /// (m) the right-hand side of a fixed-point step and the accelerations without the gears.
-    rhs: Vec<f64>,
-    y0: Vec<f64>,
-    /// (3n) the multipliers and (p) the reactions of the last fixed-point step.
-    lambda: Vec<f64>,
-    reactions: Vec<[f64; 3]>,
-}
-
-impl LossBuffers {
-    /// Buffers for `mech` (none when it has no losses).
-    pub fn new(mech: &Mechanism) -> Self {
-        if !mech.has_losses() {
-            return LossBuffers::default();
-        }
-        let (nx, m, nf) = (mech.n_x(), mech.dof(), mech.friction.len());
-        let na = m + mech.pair_actuators.len();
-        LossBuffers {
-            f0: vec![0.0; nx],
-            b0: vec![0.0; m],
-            grad: vec![0.0; (nf + na) * nx],
-            gu: vec![0.0; (nf + na) * m],
-            rates: vec![0.0; nf],
-            e: vec![0.0; nf],
-            sides: vec![Side::A; nf],
-            actuator_rates: vec![0.0; na],
-            gears: Gears::new(mech),
-            rhs: vec![0.0; m],
-            y0: vec![0.0; m],
-            lambda: vec![0.0; nx],
-            reactions: vec![[0.0; 3]; mech.pairs.len()],
-        }
-    }
-
-    /// The pairs' reactions [F_x, F_y, M] of the last evaluation with friction (empty
-    /// without losses).
-    pub(crate) fn reactions(&self) -> &[[f64; 3]] {
-        &self.reactions
-    }
-
-    /// Every actuator's rotor and gear at the last evaluation with losses (empty without
-    /// losses): its pair's rate and acceleration, the rotor's acceleration, the gear's torques.
-    pub(crate) fn rotors(&self) -> &[Rotor] {
-        self.gears.rotors()
-    }
-
-    /// The motors' gears of the last evaluation (their housings' rows for the regressor).
-    pub(crate) fn gears(&self) -> &Gears {
-        &self.gears
-    }
-
-    /// The motors' torques t_m of the drives in `tau` and `pair_tau` move to the gears.
-    pub(crate) fn take_motor_torques(&mut self, tau: &mut [f64], pair_tau: &[f64]) {
-        self.gears.take_torques(tau, pair_tau);
-    }
-}
 
 fn add_scaled(out: &mut [f64], s: f64, v: &[f64]) {
     for (o, v) in out.iter_mut().zip(v) {
@@ -318,10 +242,10 @@ fn forward_stages(
         solver.solve(ws, &mut lb.y0, false)?;
         lb.gears.solve(mech, &lb.y0, &lb.gu[nf * m..], &mut lb.rhs)?;
         solver.solve(ws, &mut lb.rhs, false)?;
-        ws.b.copy_from_slice(&lb.rhs);
+        ws.zdd.copy_from_slice(&lb.rhs);
         solver.add_efforts(ws);
-        gear_power = lb.gears.finish(mech, &ws.b, &lb.gu[nf * m..], &lb.grad[nf * n..], &mut ws.tau, &mut ws.f);
-        body_accelerations(&ws.u, &ws.c, &ws.b, ws.sys.u_support(), &mut ws.xdd);
+        gear_power = lb.gears.finish(mech, &ws.zdd, &lb.gu[nf * m..], &lb.grad[nf * n..], &mut ws.tau, &mut ws.f);
+        body_accelerations(&ws.frame.u, &ws.frame.c, &ws.zdd, ws.frame.sys.u_support(), &mut ws.xdd);
         if nf == 0 || step_friction(mech, ws, lb, iteration, &mut progress)? {
             break;
         }

@@ -13,13 +13,13 @@ use super::forces::{applied_forces, Drives};
 use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::losses::{forward_with_losses_by, Solve};
 use super::motion::{Prescribed, Scratch};
+use super::workspace::Workspace;
 use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
 use crate::kinematics::system::{col_scales, scaled_jacobian};
 use crate::kinematics::Chart;
 use crate::linalg::{cholesky_in_place, cholesky_solve};
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use nalgebra::DMatrix;
 
@@ -69,7 +69,7 @@ pub fn forward_prescribed(
     ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
     let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;
     p.iter().for_each(|&k| ws.tau[k] = 0.0);
-    ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
+    ws.power = applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     mass_matrix(mech, ws);
     bias(mech, ws);
     prescribed_rows(mech, p, qdd_p, ws, w);
@@ -78,9 +78,10 @@ pub fn forward_prescribed(
         forward_with_losses_by(mech, ws, &mut solver)?;
     } else {
         factor_mass_matrix(ws)?;
-        let mut zdd = std::mem::take(&mut ws.b);
+        let mut zdd = std::mem::take(&mut ws.zdd);
+        zdd.copy_from_slice(&ws.b);
         let solved = solver.solve(ws, &mut zdd, false);
-        ws.b = zdd;
+        ws.zdd = zdd;
         solved?;
         solver.add_efforts(ws);
         accelerations(mech, ws);

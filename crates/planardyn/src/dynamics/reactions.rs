@@ -2,9 +2,9 @@
 //! M xdd = f + Phi_x^T mu, solved as J^T lambda = M xdd - f in the current chart (the chart
 //! rows carry no force, so their multipliers vanish up to round-off; docs/formulation.md).
 
+use super::workspace::Workspace;
 use crate::model::pairs;
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 
 /// For each pair, [F_x, F_y, M]: the force (N, global) and the couple (N m) that body a
 /// exerts on body b (the pair's first and second body), after a forward evaluation in `ws`.

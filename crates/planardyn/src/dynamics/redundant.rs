@@ -8,10 +8,10 @@
 
 use super::forward::forward;
 use super::inverse::inverse;
+use super::workspace::Workspace;
 use super::Drives;
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::model::{Mechanism, PairId};
-use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use microlp::{ComparisonOp, OptimizationDirection, Problem, Variable};
 
@@ -247,8 +247,8 @@ pub(crate) fn apply_pair_efforts(mech: &Mechanism, ws: &mut Workspace) -> f64 {
     for (a, &e) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
         if e != 0.0 && a.drive.is_none() {
             let rate = pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
-            pair_grad(mech, a.pair, &ws.x, &mut ws.tmp);
-            ws.f.iter_mut().zip(&ws.tmp).for_each(|(f, g)| *f += e * g);
+            pair_grad(mech, a.pair, &ws.frame.x, &mut ws.frame.tmp);
+            ws.f.iter_mut().zip(&ws.frame.tmp).for_each(|(f, g)| *f += e * g);
             power += e * rate;
         }
     }

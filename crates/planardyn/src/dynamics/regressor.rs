@@ -17,9 +17,9 @@
 use super::forces::applied_forces;
 use super::inverse::inverse_at_rates;
 use super::loss_columns::{self, LossLayout};
+use super::workspace::Workspace;
 use crate::model::pairs::frames::rotate;
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Parameters per body: m (kg), m cx, m cy (kg m), I_O (kg m^2).
@@ -67,7 +67,7 @@ pub fn regressor(
     let p = y.len() / m.max(1);
     // The loads other than gravity, without drives or friction.
     ws.tau.fill(0.0);
-    applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
+    applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     let g = mech.gravity;
     for (f, body) in ws.f.chunks_exact_mut(3).zip(&mech.bodies) {
         f[0] -= body.mass * g[0];

@@ -2,9 +2,9 @@
 //! switches charts near singularities and rejects non-finite steps itself): results that
 //! overflow, and configurations too near a type II singularity to compute.
 
+use super::workspace::Workspace;
 use crate::kinematics::{sigma_min, Chart};
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::{KinematicsError, SingularityKind};
 
 /// Below this scaled type II measure (smallest singular value of the blocks of the scaled J,

@@ -4,15 +4,15 @@
 //!   J U = [0; I_m],   J w_jk = -gamma(u_j, u_k),   J c = -gamma(xd, xd) with xd = U zd.
 
 use super::constraints::gamma;
+use super::frame::Frame;
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Fill `ws.u` (column j = u_j) from J factorised at `ws.x`. Each column is solved and
 /// written on the blocks its coordinate reaches only (`System::u_support`); U is cleared
 /// whole only when the supports change (a new chart's pattern), so its other entries hold
 /// the zeros of that clearing: a step costs the reached blocks, not 3n per coordinate.
-pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
+pub fn velocity_analogues(ws: &mut Frame) -> Result<(), KinematicsError> {
     if !ws.sys.is_factored() {
         // The analogues are undefined where J is singular (no factorisation of it).
         return Err(KinematicsError::singular(ws.chart.singularity()));
@@ -40,13 +40,13 @@ pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) ->
 
 /// Body velocities `ws.xd = U zd`, from `ws.u`.
 #[inline]
-pub(crate) fn body_rates(zd: &[f64], ws: &mut Workspace) {
+pub(crate) fn body_rates(zd: &[f64], ws: &mut Frame) {
     ws.xd.fill(0.0);
     add_u_times(&ws.u, ws.sys.u_support(), |j| zd[j], &mut ws.xd);
 }
 
 /// Body velocities `ws.xd = U zd` and the convective term `ws.c`, from `ws.u`.
-pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Workspace) {
+pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Frame) {
     body_rates(zd, ws);
     gamma(mech, &ws.chart, &ws.x, &ws.trig, &ws.xd, &ws.xd, &mut ws.c);
     for v in ws.c.iter_mut() {
@@ -57,7 +57,7 @@ pub fn convective(mech: &Mechanism, zd: &[f64], ws: &mut Workspace) {
 
 /// Acceleration analogues w (3n x m x m): `w[(j*m + k)*3n + i]` = d2 x_i / dz_j dz_k.
 /// Needs `ws.u` filled.
-pub fn acceleration_analogues(mech: &Mechanism, ws: &mut Workspace) -> Vec<f64> {
+pub fn acceleration_analogues(mech: &Mechanism, ws: &mut Frame) -> Vec<f64> {
     let n = ws.x.len();
     let m = ws.u.len() / n.max(1);
     let mut w = vec![0.0; n * m * m];

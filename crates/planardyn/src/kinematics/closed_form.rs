@@ -28,10 +28,10 @@ use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
 use super::dyads::triad::Triad;
 use super::dyads::Joint;
+use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::topology::assur::{self, AssurGroup};
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// A group of a kind with a closed form: a class II dyad with the branch of its reference
@@ -393,7 +393,7 @@ impl ClosedForm {
     }
 
     /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.
-    pub fn positions(&mut self, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    pub fn positions(&mut self, z: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
         for c in &self.cranks {
             c.position(z, &mut ws.x, &mut ws.trig);
         }
@@ -422,7 +422,7 @@ impl ClosedForm {
     }
 
     /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
-    pub fn velocity_analogues(&self, ws: &mut Workspace) {
+    pub fn velocity_analogues(&self, ws: &mut Frame) {
         let (n, m) = (ws.x.len(), ws.q.len());
         // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
         let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
@@ -437,7 +437,7 @@ impl ClosedForm {
 
     /// Body rates `ws.xd` = U zd and the convective term `ws.c` (accelerations at zdd = 0),
     /// from `ws.u`.
-    pub fn convective(&self, zd: &[f64], ws: &mut Workspace) {
+    pub fn convective(&self, zd: &[f64], ws: &mut Frame) {
         body_rates(zd, ws);
         self.accelerations(&ws.trig, &ws.xd, &mut ws.c);
     }
@@ -459,7 +459,7 @@ impl ClosedForm {
 
     /// Positions, analogues and the convective term at (z, zd) in the user's chart, and the
     /// user's coordinates q = z, qd = zd: what `dynamics::kinematic_stages` computes there.
-    pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+    pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
         self.positions(z, ws)?;
         self.velocity_analogues(ws);
         self.convective(zd, ws);

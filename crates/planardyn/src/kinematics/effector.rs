@@ -18,9 +18,9 @@
 
 use super::analogues::velocity_analogues;
 use super::constraints::{coordinates, point_acceleration, point_velocity, world_point, Chart};
+use super::frame::Frame;
 use super::position::{continue_to, solve_position};
 use crate::model::{BodyId, CoordinateKind, Link, Mechanism};
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 use nalgebra::DMatrix;
 use thiserror::Error as ThisError;
@@ -157,7 +157,7 @@ impl Effector {
     }
 
     /// J_t = dX/dq (k x m, row-major) into `jt`, from the velocity analogues in `ws`.
-    pub fn jacobian(&self, ws: &Workspace, jt: &mut [f64]) {
+    pub fn jacobian(&self, ws: &Frame, jt: &mut [f64]) {
         let (k, i) = (self.dim, 3 * self.body.0 + 2);
         for j in 0..k {
             let u = ws.u_col(j);
@@ -170,7 +170,7 @@ impl Effector {
 
     /// J_t' qd = d2X/dq2 [qd, qd] (k; m/s^2, m/s^2[, rad/s^2]) from the body velocities `ws.xd`
     /// and convective term `ws.c` (fill both with [`super::convective`] first).
-    pub fn convective(&self, ws: &Workspace) -> Vec<f64> {
+    pub fn convective(&self, ws: &Frame) -> Vec<f64> {
         let a = point_acceleration(Link::Body(self.body), self.s, &ws.x, &ws.xd, &ws.c);
         [a[0], a[1], ws.c[3 * self.body.0 + 2]][..self.dim].to_vec()
     }
@@ -203,7 +203,7 @@ impl Effector {
     /// Move `ws` to inputs q by continuation from the body coordinates it holds (a converged
     /// position: the drawing of a new workspace, or the last solve), then the velocity
     /// analogues and the end effector there.
-    pub fn state(&self, mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<EffectorState, KinematicsError> {
+    pub fn state(&self, mech: &Mechanism, q: &[f64], ws: &mut Frame) -> Result<EffectorState, KinematicsError> {
         if q.len() != mech.dof() || q.iter().any(|v| !v.is_finite()) {
             return Err(KinematicsError::bad_argument(
                 "q",
@@ -233,7 +233,7 @@ impl Effector {
         mech: &Mechanism,
         target: &[f64],
         guess: &[f64],
-        ws: &mut Workspace,
+        ws: &mut Frame,
     ) -> Result<EffectorState, EffectorError> {
         let mut q = guess.to_vec();
         let mut residual = f64::INFINITY;
@@ -261,7 +261,7 @@ impl Effector {
         mech: &Mechanism,
         target: &[f64],
         q_start: &[f64],
-        ws: &mut Workspace,
+        ws: &mut Frame,
     ) -> Result<EffectorState, EffectorError> {
         let mut st = self.state(mech, q_start, ws)?;
         let x0 = st.pose.clone();

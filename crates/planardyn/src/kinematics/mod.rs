@@ -7,6 +7,7 @@ pub mod closed_form;
 pub mod constraints;
 pub mod dyads;
 pub mod effector;
+pub mod frame;
 pub mod group_sigma;
 pub mod position;
 pub mod rank;
@@ -18,6 +19,7 @@ pub use analogues::{acceleration_analogues, add_u_times, convective, velocity_an
 pub use closed_form::ClosedForm;
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
+pub use frame::Frame;
 pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, scaled_distances, solve_position,
     MAX_CORRECTION, POSITION_TOL,

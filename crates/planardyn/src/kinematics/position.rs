@@ -3,8 +3,8 @@
 
 use super::analogues::velocity_analogues;
 use super::constraints::{body_trig, residual, set_row_scale, Chart};
+use super::frame::Frame;
 use crate::model::{CoordinateKind, Mechanism, MAX_CONTINUATION_DISTANCE};
-use crate::workspace::Workspace;
 use crate::KinematicsError;
 
 /// Convergence test of Newton's method: the largest residual, lengths divided by the
@@ -29,14 +29,14 @@ const MAX_CHORD: usize = 6;
 const CHORD_RATE: f64 = 0.25;
 
 /// F(x) into `ws.tmp` (with `ws.trig` refreshed for x); returns its scaled max-norm.
-fn residual_norm(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> f64 {
+fn residual_norm(mech: &Mechanism, z: &[f64], ws: &mut Frame) -> f64 {
     body_trig(&ws.x, &mut ws.trig);
     residual(mech, &ws.chart, &ws.x, &ws.trig, z, &mut ws.tmp);
     ws.tmp.iter().zip(&ws.sys.row_scale).fold(0.0, |m: f64, (r, s)| m.max((r * s).abs()))
 }
 
 /// x -= J^-1 F with the factorisation held in `ws.sys`.
-fn newton_update(ws: &mut Workspace) {
+fn newton_update(ws: &mut Frame) {
     ws.sys.solve(&mut ws.tmp);
     for (xi, dx) in ws.x.iter_mut().zip(&ws.tmp) {
         *xi -= dx;
@@ -47,7 +47,7 @@ fn newton_update(ws: &mut Workspace) {
 /// success `ws.x` is the solution, `ws.trig` its angles' cos/sin, `ws.sys` holds J(x)
 /// factorised and `ws.residual` the scaled residual. Fails if J is singular on the way or
 /// Newton does not converge.
-pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
     let tol =
         POSITION_TOL * (1.0 + ws.x.iter().zip(&ws.sys.col_scale).fold(0.0, |m: f64, (v, s)| m.max((v / s).abs())));
     set_row_scale(mech, &ws.chart, &mut ws.sys.row_scale);
@@ -94,7 +94,7 @@ pub fn solve_position(mech: &Mechanism, z: &[f64], ws: &mut Workspace) -> Result
 /// the tolerance, take one more Newton step with that J (F(x) is still in `ws.tmp`), which
 /// takes it to round-off for one solve. J and the trig cache then belong to a point within
 /// the tolerance, as accurate as the analogues are anyway. Then record the figures.
-fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize) -> Result<(), KinematicsError> {
+fn converged(mech: &Mechanism, ws: &mut Frame, norm: f64, iterations: usize) -> Result<(), KinematicsError> {
     factor(mech, ws)?;
     if norm > POLISH_BELOW || matches!(ws.chart, Chart::Partition(_)) {
         newton_update(ws);
@@ -104,7 +104,7 @@ fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize)
     Ok(())
 }
 
-fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+fn factor(mech: &Mechanism, ws: &mut Frame) -> Result<(), KinematicsError> {
     let chart = &ws.chart;
     ws.sys.factor(mech, chart, &ws.x, &ws.trig).map_err(|_| KinematicsError::singular(chart.singularity()))
 }
@@ -143,7 +143,7 @@ pub fn scaled_distances<const K: usize>(a: &[f64], bs: [&[f64]; K], col_scale: &
 /// coordinates `q` by continuation: steps of at most 0.1 rad (0.1 L), a first-order predictor
 /// along the velocity analogues, a Newton corrector whose correction must stay small (so the
 /// branch is kept), and the step cut by 4 when either fails.
-pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+pub fn continue_to(mech: &Mechanism, z_from: &[f64], q: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
     ws.chart = Chart::Inputs;
     let (m, n) = (q.len(), ws.x.len());
     let move_scaled = mech.coordinates.iter().zip(q.iter().zip(z_from)).fold(0.0, |acc: f64, (c, (a, b))| {
@@ -218,7 +218,7 @@ fn finite_values(v: &[f64]) -> String {
 
 /// As [`assemble_into`], but continuing from the body coordinates `x_start` (a solution on
 /// the wanted branch, e.g. the previous point of a path) instead of from the drawing.
-pub fn assemble_from(mech: &Mechanism, x_start: &[f64], q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+pub fn assemble_from(mech: &Mechanism, x_start: &[f64], q: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
     if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
         return Err(KinematicsError::bad_argument(
             "x_start",
@@ -236,13 +236,13 @@ pub fn assemble_from(mech: &Mechanism, x_start: &[f64], q: &[f64], ws: &mut Work
 
 /// Body coordinates x at user coordinates q, by continuation from the drawing.
 pub fn assemble(mech: &Mechanism, q: &[f64]) -> Result<Vec<f64>, KinematicsError> {
-    let mut ws = Workspace::new(mech);
+    let mut ws = Frame::new(mech);
     assemble_into(mech, q, &mut ws)?;
     Ok(ws.x)
 }
 
 /// As [`assemble`], leaving the solution (and J factorised, if regular) in `ws`.
-pub fn assemble_into(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<(), KinematicsError> {
+pub fn assemble_into(mech: &Mechanism, q: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
     if q.len() != mech.dof() || q.iter().any(|v| !v.is_finite()) {
         return Err(KinematicsError::bad_argument(
             "q",

@@ -7,9 +7,9 @@
 //! one more right-hand side for the factorised J per coordinate.
 
 use super::constraints::{gamma, Chart};
+use super::frame::Frame;
 use crate::model::pairs;
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
 
 /// gamma3(u, v, t) = d3F/dx3 [u, v, t] for every row of F (the chart rows of a partition
 /// are linear), into `out` (3n).
@@ -45,7 +45,7 @@ pub fn gamma3(
 /// buffers of `ws` after the convective stage; `scratch` has length 3n.
 pub fn convective_derivative(
     mech: &Mechanism,
-    ws: &mut Workspace,
+    ws: &mut Frame,
     uk: &[f64],
     vk: &[f64],
     dc: &mut [f64],

@@ -402,7 +402,7 @@ fn project(ode: &mut MechanismOde, x: &[f64], xd: &[f64], passive: f64) -> Resul
     let n = x.len();
     ws.xd.fill(0.0);
     for (j, &i) in idx.iter().enumerate() {
-        for (v, u) in ws.xd.iter_mut().zip(&ws.u[j * n..(j + 1) * n]) {
+        for (v, u) in ws.frame.xd.iter_mut().zip(&ws.frame.u[j * n..(j + 1) * n]) {
             *v += u * xd[i];
         }
     }
@@ -479,9 +479,9 @@ fn locate(mech: &Mechanism, path: &dyn Path, mut a: f64, mut b: f64) -> f64 {
 /// given there (an output inside a crossing).
 pub fn user_state(ode: &mut MechanismOde) {
     let (mech, ws) = (ode.mech, &mut ode.ws);
-    body_trig(&ws.x, &mut ws.trig);
-    coordinates(mech, &ws.x, &mut ws.q);
-    coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
+    body_trig(&ws.frame.x, &mut ws.frame.trig);
+    coordinates(mech, &ws.frame.x, &mut ws.frame.q);
+    coordinate_rates(mech, &ws.frame.x, &ws.frame.xd, &mut ws.frame.qd);
     for (k, c) in mech.coordinates.iter().enumerate() {
         let p = &mech.pairs[c.pair.0];
         ws.qdd[k] = pair_coordinate_rate(p, &ws.x, &ws.xdd) + pair_coordinate_gamma(p, &ws.x, &ws.xd, &ws.xd);

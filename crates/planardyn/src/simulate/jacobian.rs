@@ -6,7 +6,7 @@
 //! exact (`dynamics::derivatives`) at efforts depending on t alone.
 
 use crate::dynamics::{motion_derivatives, Drives};
-use crate::workspace::Workspace;
+use crate::Workspace;
 use crate::{Error, Mechanism};
 
 /// Fill `jac` ((2m + 1)^2, row-major) at (t, y), Newton starting from `ws.x` (a copy of

@@ -20,7 +20,7 @@ use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
 use crate::integrate::{Method, Options, StepError, Stepper};
 use crate::kinematics::{assemble_into, passive_sigma_min, velocity_analogues, Chart};
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
+use crate::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use charts::{chart_sigma, measure, next_chart, state_in, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
 use crossing::{
@@ -370,7 +370,7 @@ fn cross_change_point(
 /// Record the row at time s inside a crossing, from `path`.
 fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &dyn Path, s: f64, work: f64, sigma: f64) {
     let ws = &mut ode.ws;
-    path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
+    path.at(s, &mut ws.frame.x, &mut ws.frame.xd, &mut ws.xdd);
     user_state(ode);
     traj.record(ode, s, work, sigma);
 }

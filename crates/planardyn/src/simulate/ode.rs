@@ -7,7 +7,7 @@ use crate::integrate::OdeSystem;
 use crate::kinematics::constraints::gamma;
 use crate::kinematics::{add_u_times, scaled_distances, Chart, ClosedForm, System, MAX_CORRECTION};
 use crate::model::Mechanism;
-use crate::workspace::Workspace;
+use crate::Workspace;
 use crate::{Error, KinematicsError};
 
 /// Largest Newton correction as a fraction of the chart's type II measure (see
@@ -183,7 +183,7 @@ impl<'a> MechanismOde<'a> {
         if self.stale_j {
             self.stale_j = false;
             let ws = &mut self.ws;
-            let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
+            let _singular = ws.frame.sys.factor(self.mech, &ws.frame.chart, &ws.frame.x, &ws.frame.trig);
         }
     }
 
@@ -228,28 +228,36 @@ impl<'a> MechanismOde<'a> {
         if self.base_valid {
             ws.rhs.fill(0.0);
             let last = &self.last_y;
-            add_u_times(&ws.u, ws.sys.u_support(), |j| z[j] - last[j], &mut ws.rhs);
+            add_u_times(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], &mut ws.frame.rhs);
             // tmp = w(dz, dz) from the closed forms' accelerations where they gave the last
             // evaluation (their geometry is its), else -w(dz, dz) = J^-1 gamma(dz, dz) by J,
             // which Newton left factorised there.
             let half = match self.closed.as_ref().filter(|_| self.base_closed) {
                 Some(c) => {
-                    c.accelerations(&ws.trig, &ws.rhs, &mut ws.tmp);
+                    c.accelerations(&ws.frame.trig, &ws.frame.rhs, &mut ws.frame.tmp);
                     0.5
                 }
                 None => {
-                    gamma(self.mech, &ws.chart, &ws.x, &ws.trig, &ws.rhs, &ws.rhs, &mut ws.tmp);
-                    ws.sys.solve(&mut ws.tmp);
+                    gamma(
+                        self.mech,
+                        &ws.frame.chart,
+                        &ws.frame.x,
+                        &ws.frame.trig,
+                        &ws.frame.rhs,
+                        &ws.frame.rhs,
+                        &mut ws.frame.tmp,
+                    );
+                    ws.frame.sys.solve(&mut ws.frame.tmp);
                     -0.5
                 }
             };
-            for ((x, d), w) in ws.x.iter_mut().zip(&ws.rhs).zip(&ws.tmp) {
+            for ((x, d), w) in ws.frame.x.iter_mut().zip(&ws.frame.rhs).zip(&ws.frame.tmp) {
                 *x += d + half * w;
             }
         } else {
             ws.x.copy_from_slice(&self.anchor_x);
             let anchor = &self.anchor_z;
-            add_u_times(&self.anchor_u, ws.sys.u_support(), |j| z[j] - anchor[j], &mut ws.x);
+            add_u_times(&self.anchor_u, ws.frame.sys.u_support(), |j| z[j] - anchor[j], &mut ws.frame.x);
         }
     }
 
@@ -303,7 +311,7 @@ impl<'a> MechanismOde<'a> {
             (Some(c), _) => c.kinematic_stages(z, zd, &mut self.ws).map_err(Error::from).and_then(|()| {
                 let ws = &mut self.ws;
                 if reactions {
-                    let _singular = ws.sys.factor(self.mech, &ws.chart, &ws.x, &ws.trig);
+                    let _singular = ws.frame.sys.factor(self.mech, &ws.frame.chart, &ws.frame.x, &ws.frame.trig);
                 }
                 dynamic_stages(self.mech, t, self.drives, ws)
             }),
@@ -363,7 +371,7 @@ impl MechanismOde<'_> {
     fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
         dy[..m].copy_from_slice(&self.eval_y[m..2 * m]);
-        dy[m..2 * m].copy_from_slice(&self.ws.b);
+        dy[m..2 * m].copy_from_slice(&self.ws.zdd);
         dy[2 * m] = self.ws.power;
     }
 }
