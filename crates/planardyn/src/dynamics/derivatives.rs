@@ -12,8 +12,8 @@
 
 use super::force_rates::{applied_forces_dx, applied_forces_dxd, load_power_dx, load_power_dxd, RateScratch};
 use super::forces::applied_forces;
-use super::forward::{bias, body_accelerations, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::inverse::inverse;
+use super::stages::{bias, body_accelerations, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::workspace::Workspace;
 use crate::kinematics::third::convective_derivative;
 use crate::kinematics::{acceleration_analogues, Chart};

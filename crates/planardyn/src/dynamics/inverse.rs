@@ -3,8 +3,8 @@
 //! the user's coordinates determine the mechanism (away from type II singularities).
 
 use super::forces::applied_forces;
-use super::forward::{kinematic_stages, m_dot};
 use super::losses::inverse_with_losses;
+use super::stages::{kinematic_stages, m_dot};
 use super::workspace::Workspace;
 use crate::kinematics::constraints::{gamma, jacobian};
 use crate::kinematics::Chart;

@@ -11,10 +11,10 @@
 //! gear drives follows the tooth force found at each step, as the sign of the power that
 //! crosses the mesh.
 
-use super::forward::{accelerations, body_accelerations, factor_mass_matrix, solve_factored};
 use super::friction;
 use super::loss_buffers::LossBuffers;
 use super::reactions::reactions_into;
+use super::stages::{accelerations, body_accelerations, factor_mass_matrix, solve_factored};
 use super::transmission::{actuator_pair, motor_torque, motors};
 use super::workspace::Workspace;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense};

@@ -10,9 +10,9 @@
 //! prescribed coordinates to their motion while x components integrate.
 
 use super::forces::{applied_forces, Drives};
-use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::losses::{forward_with_losses_by, Solve};
 use super::motion::{Prescribed, Scratch};
+use super::stages::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::workspace::Workspace;
 use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};

@@ -8,10 +8,10 @@
 
 use super::forward::forward;
 use super::inverse::inverse;
+use super::stages::pair_grad;
 use super::workspace::Workspace;
 use super::Drives;
-use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
-use crate::model::{Mechanism, PairId};
+use crate::model::Mechanism;
 use crate::{Error, KinematicsError, SingularityKind};
 use microlp::{ComparisonOp, OptimizationDirection, Problem, Variable};
 
@@ -45,11 +45,6 @@ pub struct Actuation {
     /// (m x n_a) Q and (m x m) L of B = L Q (row-major).
     q: Vec<Vec<f64>>,
     l: Vec<f64>,
-}
-
-fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f64]) {
-    grad.fill(0.0);
-    pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -238,19 +233,4 @@ pub fn forward_redundant(
     let result = forward(mech, t, z, zd, &mut CoordinateEfforts(efforts), ws);
     ws.pair_tau.fill(0.0);
     result
-}
-
-/// Add the efforts of the pair actuators without a motor (`ws.pair_tau`) to `ws.f`; returns
-/// their power (W). A motor's torque goes through its gear (`dynamics::gears`).
-pub(crate) fn apply_pair_efforts(mech: &Mechanism, ws: &mut Workspace) -> f64 {
-    let mut power = 0.0;
-    for (a, &e) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
-        if e != 0.0 && a.drive.is_none() {
-            let rate = pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
-            pair_grad(mech, a.pair, &ws.frame.x, &mut ws.frame.tmp);
-            ws.f.iter_mut().zip(&ws.frame.tmp).for_each(|(f, g)| *f += e * g);
-            power += e * rate;
-        }
-    }
-    power
 }

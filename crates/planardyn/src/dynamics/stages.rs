@@ -1,0 +1,189 @@
+//! The stages of an evaluation (docs/formulation.md eqs. 29-31), shared by forward and inverse
+//! dynamics, the dynamics with losses, with prescribed coordinates and with redundant
+//! actuation, and their derivatives: the kinematic stages (positions -> analogues U ->
+//! convective term c, and the user's q, qd), the drives' efforts, A = U^T M U,
+//! b = U^T (f - M c), its factor and zdd = A^-1 b, xdd = U zdd + c and the user's qdd.
+//! Each reads and fills the buffers of a [`Workspace`] named in its doc.
+
+use super::forces::Drives;
+use super::workspace::Workspace;
+use crate::kinematics::constraints::{
+    coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
+};
+use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame};
+use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
+use crate::model::{Mechanism, PairId};
+use crate::{Error, KinematicsError, SingularityKind};
+
+/// Positions, analogues and the convective term at chart coordinates z, zd (`ws.x` is the
+/// Newton start), then the user's coordinates q and rates qd.
+pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
+    solve_position(mech, z, ws)?;
+    velocity_analogues(ws)?;
+    convective(mech, zd, ws);
+    user_coordinates(mech, ws, z, zd);
+    Ok(())
+}
+
+/// The user's coordinates and rates from x, xd. In the input chart they are the chart's own
+/// z, zd: D(x) = z to the Newton tolerance and D_x U = I, so they are copied rather than
+/// recomputed.
+fn user_coordinates(mech: &Mechanism, ws: &mut Frame, z: &[f64], zd: &[f64]) {
+    if ws.chart == Chart::Inputs {
+        ws.q.copy_from_slice(z);
+        ws.qd.copy_from_slice(zd);
+    } else {
+        coordinates(mech, &ws.x, &mut ws.q);
+        coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
+    }
+}
+
+/// The drives' efforts at time t (s) and the point in `ws` into `ws.tau`, checked finite.
+pub(crate) fn drive_efforts(t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
+    drives.efforts(t, &ws.frame.q, &ws.frame.qd, &mut ws.tau).map_err(|message| Error::Drive { t, message })?;
+    if let Some(bad) = ws.tau.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Drive { t, message: format!("effort {bad} is {}", ws.tau[bad]) });
+    }
+    Ok(())
+}
+
+/// Add the efforts of the pair actuators without a motor (`ws.pair_tau`) to `ws.f`; returns
+/// their power (W). A motor's torque goes through its gear (`dynamics::gears`).
+pub(crate) fn apply_pair_efforts(mech: &Mechanism, ws: &mut Workspace) -> f64 {
+    let mut power = 0.0;
+    for (a, &e) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
+        if e != 0.0 && a.drive.is_none() {
+            let rate = pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
+            pair_grad(mech, a.pair, &ws.frame.x, &mut ws.frame.tmp);
+            ws.f.iter_mut().zip(&ws.frame.tmp).for_each(|(f, g)| *f += e * g);
+            power += e * rate;
+        }
+    }
+    power
+}
+
+/// The gradient of `pair`'s relative coordinate along x into `grad` (3n values).
+pub(crate) fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f64]) {
+    grad.fill(0.0);
+    pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
+}
+
+/// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
+/// a^T M b over the bodies `first..end` (a and b: 3n values each).
+#[inline]
+pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
+    if first >= end {
+        return 0.0;
+    }
+    let (a, b) = (&a[3 * first..3 * end], &b[3 * first..3 * end]);
+    mech.bodies[first..end]
+        .iter()
+        .zip(a.chunks_exact(3).zip(b.chunks_exact(3)))
+        .map(|(body, (a, b))| body.mass * (a[0] * b[0] + a[1] * b[1]) + body.inertia * a[2] * b[2])
+        .sum()
+}
+
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`: the pairs of columns whose
+/// supports meet (`System::a_pairs`), over the bodies where both may be non-zero (the columns
+/// of independent parts of a mechanism, five-bars side by side, share none). The other
+/// entries keep the zeros of the last clearing, except where the Cholesky factor may have
+/// filled in (`System::a_fill_in`): cleared at each call.
+pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
+    let n = ws.x.len();
+    let m = ws.b.len();
+    let id = ws.sys.supports_id();
+    if ws.a_zeros_for != id {
+        ws.a.fill(0.0);
+        ws.a_zeros_for = id;
+    } else {
+        for &(k, j) in ws.frame.sys.a_fill_in() {
+            ws.a[k * m + j] = 0.0;
+        }
+    }
+    let support = ws.frame.sys.u_support();
+    for &(j, k) in ws.frame.sys.a_pairs() {
+        let ((fj, ej), (fk, ek)) = (support[j], support[k]);
+        let s = m_dot(mech, &ws.frame.u[j * n..(j + 1) * n], &ws.frame.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
+        ws.a[j * m + k] = s;
+        ws.a[k * m + j] = s;
+    }
+}
+
+/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
+pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
+    let n = ws.x.len();
+    for (j, bj) in ws.b.iter_mut().enumerate() {
+        let uj = &ws.frame.u[j * n..(j + 1) * n];
+        let (first, end) = ws.frame.sys.u_support()[j];
+        let (u, f) = (&uj[3 * first..3 * end], &ws.f[3 * first..3 * end]);
+        *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.frame.c, (first, end));
+    }
+}
+
+/// `ws.a` into its Cholesky factor, or the singularity that keeps A from being positive definite.
+/// Over A's envelope from the supports of U when `mass_matrix` left A within it.
+pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsError> {
+    let m = ws.b.len();
+    let factored = if ws.a_zeros_for == ws.sys.supports_id() {
+        cholesky_envelope(&mut ws.a, m, ws.frame.sys.a_first())
+    } else {
+        cholesky_in_place(&mut ws.a, m)
+    };
+    if !factored {
+        let type_ii = matches!(ws.chart, Chart::Inputs);
+        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }));
+    }
+    Ok(())
+}
+
+/// zdd = A^-1 b into `ws.zdd`, with the factor from [`factor_mass_matrix`].
+pub(crate) fn solve_mass_matrix(ws: &mut Workspace) {
+    let mut zdd = std::mem::take(&mut ws.zdd);
+    zdd.copy_from_slice(&ws.b);
+    solve_factored(ws, &mut zdd);
+    ws.zdd = zdd;
+}
+
+/// A^-1 rhs in place, with the factor from [`factor_mass_matrix`] (over its envelope when it
+/// kept one).
+pub(crate) fn solve_factored(ws: &Workspace, rhs: &mut [f64]) {
+    let m = rhs.len();
+    if ws.a_zeros_for == ws.sys.supports_id() {
+        cholesky_solve_envelope(&ws.a, m, ws.sys.a_first(), rhs);
+    } else {
+        cholesky_solve(&ws.a, m, rhs);
+    }
+}
+
+/// Body accelerations xdd = U zdd + c and the user's qdd from the chart accelerations
+/// `ws.zdd`, at the point of the kinematic stages.
+pub(crate) fn accelerations(mech: &Mechanism, ws: &mut Workspace) {
+    body_accelerations(&ws.frame.u, &ws.frame.c, &ws.zdd, ws.frame.sys.u_support(), &mut ws.xdd);
+    user_accelerations(mech, ws);
+}
+
+/// The user's accelerations from x, xd and xdd; in the input chart the chart's own zdd
+/// (as [`user_coordinates`]).
+fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
+    if ws.chart == Chart::Inputs {
+        ws.qdd.copy_from_slice(&ws.zdd);
+        return;
+    }
+    for (k, c) in mech.coordinates.iter().enumerate() {
+        let p = &mech.pairs[c.pair.0];
+        ws.qdd[k] = pair_coordinate_rate(p, &ws.x, &ws.xdd) + pair_coordinate_gamma(p, &ws.x, &ws.xd, &ws.xd);
+    }
+}
+
+/// xdd = U zdd + c: the body accelerations of chart accelerations zdd (U column-major,
+/// one column of 3n a coordinate), each column over the bodies of its `support`
+/// (`System::u_support`), where it may be non-zero.
+pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
+    let n = c.len();
+    xdd.copy_from_slice(c);
+    for ((u, &a), &(first, end)) in u.chunks_exact(n).zip(zdd).zip(support) {
+        for (x, u) in xdd[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
+            *x += u * a;
+        }
+    }
+}
