@@ -15,7 +15,8 @@
 //! replaces the sign of s by a slope of mu_s / v_st through zero: a pair the load would hold
 //! ("sticking") creeps at a slip speed below v_st instead of stopping exactly.
 
-use crate::model::{JointFriction, Mechanism, PairKind};
+use crate::model::pairs::contact_load;
+use crate::model::{JointFriction, Mechanism};
 
 /// The signed friction coefficient mu(s) at slip speed s (m/s).
 pub fn coefficient(fr: &JointFriction, s: f64) -> f64 {
@@ -23,14 +24,10 @@ pub fn coefficient(fr: &JointFriction, s: f64) -> f64 {
     (fr.mu + stribeck) * (s / fr.stiction_speed).tanh()
 }
 
-/// The load N (N) that presses a pair's surfaces together, from its reaction [F_x, F_y, M].
+/// The load N (N) that presses a pair's surfaces together, from its reaction [F_x, F_y, M]:
+/// its kind's [`crate::model::pairs::PairType::contact_load`].
 pub fn normal_load(mech: &Mechanism, fr: &JointFriction, reaction: [f64; 3]) -> f64 {
-    let force = reaction[0].hypot(reaction[1]);
-    match mech.pairs[fr.pair.0].kind {
-        PairKind::Prismatic { .. } if fr.length > 0.0 => force.max(2.0 * reaction[2].abs() / fr.length),
-        PairKind::Gear(_) => force / fr.pressure_angle.cos(),
-        _ => force,
-    }
+    contact_load(&mech.pairs[fr.pair.0], fr, reaction)
 }
 
 /// The friction effort (N m or N) on the pair's relative coordinate, moving at `rate`

@@ -17,9 +17,10 @@ use super::reactions::reactions_into;
 use super::stages::{accelerations, body_accelerations, factor_mass_matrix, solve_factored};
 use super::transmission::{actuator_pair, motor_torque, motors};
 use super::workspace::Workspace;
-use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense};
-use crate::model::pairs::gear::{Gear, Side};
-use crate::model::{Mechanism, PairId, PairKind};
+use crate::kinematics::constraints::{pair_coordinate_gamma, Dense};
+use crate::model::pairs::gear::Side;
+use crate::model::pairs::{slip_lever, slip_side};
+use crate::model::{Mechanism, PairId};
 use crate::KinematicsError;
 
 /// Largest number of fixed-point iterations, and the change of the friction efforts,
@@ -60,16 +61,7 @@ fn lever(mech: &Mechanism, pair: PairId, side: Side, ws: &Workspace, grad: &mut 
     grad.fill(0.0);
     let p = &mech.pairs[pair.0];
     let mut sink = Dense { j: grad, ncols: n };
-    let rate = match &p.kind {
-        PairKind::Gear(g) => {
-            g.pitch_grad(p, &ws.x, side, &mut sink, 0);
-            g.pitch_speed(p, &ws.x, &ws.xd)
-        }
-        _ => {
-            pair_coordinate_grad(p, &ws.x, &mut sink, 0);
-            pair_coordinate_rate(p, &ws.x, &ws.xd)
-        }
-    };
+    let rate = slip_lever(p, &ws.x, &ws.xd, side, &mut sink);
     for (g, u) in gu.iter_mut().zip(ws.u.chunks_exact(n)) {
         *g = u.iter().zip(grad.iter()).map(|(a, b)| a * b).sum();
     }
@@ -102,11 +94,7 @@ fn pair_term(mech: &Mechanism, ws: &Workspace, k: usize, grad: &[f64]) -> f64 {
 /// A gear mesh's driver at the reactions in `lb` (`Side::A` for the other pairs).
 fn driver(mech: &Mechanism, ws: &Workspace, lb: &LossBuffers, i: usize) -> Side {
     let id = mech.friction[i].pair;
-    let p = &mech.pairs[id.0];
-    match &p.kind {
-        PairKind::Gear(g) => Gear::driver(g.tooth_force(&ws.x, lb.reactions[id.0]), lb.rates[i]),
-        _ => Side::A,
-    }
+    slip_side(&mech.pairs[id.0], &ws.x, lb.reactions[id.0], lb.rates[i])
 }
 
 /// The fixed point's progress: the first estimate's largest effort, the last change.

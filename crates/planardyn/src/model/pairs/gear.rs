@@ -24,7 +24,7 @@
 use super::frames::{add_grad, angle, dot, link_columns, link_state, link_state_t, part, perp, Projection};
 use super::{PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
-use crate::model::{Link, Pair};
+use crate::model::{JointFriction, Link, Pair};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gear {
@@ -214,5 +214,26 @@ impl PairType for Gear {
             Mesh::Rack { end, .. } => g.lines.push([b.point(pair.sb), b.point(end)]),
         }
         g
+    }
+
+    /// F_t / cos(alpha): the tangential tooth force F_t over the cosine of the pressure
+    /// angle alpha = `fr.pressure_angle` (the reaction force's magnitude is F_t's).
+    #[inline]
+    fn contact_load(&self, fr: &JointFriction, reaction: [f64; 3]) -> f64 {
+        reaction[0].hypot(reaction[1]) / fr.pressure_angle.cos()
+    }
+
+    /// The pitch-line travel of the gear on `side` (the mesh's friction acts on the
+    /// driver's); its rate is the pitch speed.
+    #[inline]
+    fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], side: Side, j: &mut S) -> f64 {
+        self.pitch_grad(pair, x, side, j, 0);
+        self.pitch_speed(pair, x, xd)
+    }
+
+    /// The driver: the side the power crosses the mesh from.
+    #[inline]
+    fn slip_side(&self, x: &[f64], reaction: [f64; 3], rate: f64) -> Side {
+        Gear::driver(self.tooth_force(x, reaction), rate)
     }
 }

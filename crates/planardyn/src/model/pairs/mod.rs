@@ -18,8 +18,9 @@ pub mod revolute;
 pub mod slot;
 
 use crate::linalg::Sink;
-use crate::model::{CoordinateKind, Mechanism, Pair, PairKind};
+use crate::model::{CoordinateKind, JointFriction, Mechanism, Pair, PairKind};
 use frames::{add_grad, angle, link_columns, link_state, part, Projection};
+use gear::Side;
 
 /// Values of a pair's rows (the first `ROWS` entries).
 pub type Rows = [f64; 2];
@@ -85,6 +86,20 @@ pub trait PairType {
     fn reaction(&self, pair: &Pair, x: &[f64], mu: Rows) -> [f64; 3];
     /// What the drawings show, with `scale` the mechanism's characteristic length.
     fn geometry(&self, pair: &Pair, x: &[f64], scale: f64) -> PairGeometry;
+
+    // The friction hooks (docs/actuators.md, *Friction from the joint loads*; used by
+    // `dynamics::friction` and `dynamics::losses`), without a default: a new kind states its
+    // own, or does not compile.
+    /// The load N (N) that presses the pair's surfaces together, from its reaction
+    /// [F_x, F_y, M] (N, N m) and its friction entry `fr`.
+    fn contact_load(&self, fr: &JointFriction, reaction: [f64; 3]) -> f64;
+    /// The lever the friction acts along, on `side` of the pair (its relative coordinate; a
+    /// gear mesh's pitch-line travel of the gear on `side`): its gradient along x added into
+    /// row 0 of `j`; returns its rate at xd (rad/s or m/s).
+    fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], side: Side, j: &mut S) -> f64;
+    /// The side whose lever carries the friction under `reaction` at the lever's `rate`: a
+    /// gear mesh's driver, `Side::A` for a kind with one lever.
+    fn slip_side(&self, x: &[f64], reaction: [f64; 3], rate: f64) -> Side;
 
     // The relative coordinate's value, gradient, second derivative and rate, from
     // `relative` (a constant of the kind, so each folds to one case).
@@ -239,6 +254,24 @@ fn along(pair: &Pair, axis: [f64; 2], x: &[f64]) -> Projection {
 #[inline]
 pub fn coordinate(pair: &Pair, x: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate(pair, x))
+}
+
+/// [`PairType::contact_load`] of the pair's kind.
+#[inline]
+pub fn contact_load(pair: &Pair, fr: &JointFriction, reaction: [f64; 3]) -> f64 {
+    dispatch!(&pair.kind, t => t.contact_load(fr, reaction))
+}
+
+/// [`PairType::slip_lever`] of the pair's kind.
+#[inline]
+pub fn slip_lever<S: Sink>(pair: &Pair, x: &[f64], xd: &[f64], side: Side, j: &mut S) -> f64 {
+    dispatch!(&pair.kind, t => t.slip_lever(pair, x, xd, side, j))
+}
+
+/// [`PairType::slip_side`] of the pair's kind.
+#[inline]
+pub fn slip_side(pair: &Pair, x: &[f64], reaction: [f64; 3], rate: f64) -> Side {
+    dispatch!(&pair.kind, t => t.slip_side(x, reaction, rate))
 }
 
 /// Gradient of [`coordinate`], added into row `row` of `j`.

@@ -3,10 +3,11 @@
 //! from the guide in metres; relative coordinate: the displacement along the guide.
 
 use super::frames::{add_grad, angle, link_state, link_state_t, perp, Projection};
+use super::gear::Side;
 use super::revolute::both_links;
 use super::{guide, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
-use crate::model::Pair;
+use crate::model::{JointFriction, Pair};
 
 pub struct Prismatic {
     /// Unit direction of the guide in a's frame.
@@ -68,5 +69,29 @@ impl PairType for Prismatic {
         let mut g = PairGeometry::new(Self::NAME);
         guide(pair, self.axis, x, scale, &mut g);
         g
+    }
+
+    /// max(|N|, 2|M|/L) for a slider of length L = `fr.length` > 0, whose normal force N and
+    /// couple M are carried at its two ends (contact forces N/2 +- M/L, each rubbing mu times
+    /// its magnitude); |N| for a slider of no length.
+    #[inline]
+    fn contact_load(&self, fr: &JointFriction, reaction: [f64; 3]) -> f64 {
+        let force = reaction[0].hypot(reaction[1]);
+        if fr.length > 0.0 {
+            force.max(2.0 * reaction[2].abs() / fr.length)
+        } else {
+            force
+        }
+    }
+
+    #[inline]
+    fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], _side: Side, j: &mut S) -> f64 {
+        self.coordinate_grad(pair, x, j, 0);
+        self.coordinate_rate(pair, x, xd)
+    }
+
+    #[inline]
+    fn slip_side(&self, _x: &[f64], _reaction: [f64; 3], _rate: f64) -> Side {
+        Side::A
     }
 }

@@ -2,9 +2,10 @@
 //! Phi = p_a - p_b; relative coordinate: the angle phi_b - phi_a.
 
 use super::frames::{add_grad, link_columns, link_state, link_state_t, part, perp};
+use super::gear::Side;
 use super::{PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
-use crate::model::Pair;
+use crate::model::{JointFriction, Pair};
 
 pub struct Revolute;
 
@@ -75,6 +76,23 @@ impl PairType for Revolute {
         let mut g = PairGeometry::new(Self::NAME);
         g.pins.push(link_state(pair.a, x).point(pair.sa));
         g
+    }
+
+    /// The pin (of radius `fr.arm`) carries the reaction force.
+    #[inline]
+    fn contact_load(&self, _fr: &JointFriction, reaction: [f64; 3]) -> f64 {
+        reaction[0].hypot(reaction[1])
+    }
+
+    #[inline]
+    fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], _side: Side, j: &mut S) -> f64 {
+        self.coordinate_grad(pair, x, j, 0);
+        self.coordinate_rate(pair, x, xd)
+    }
+
+    #[inline]
+    fn slip_side(&self, _x: &[f64], _reaction: [f64; 3], _rate: f64) -> Side {
+        Side::A
     }
 }
 

@@ -4,10 +4,11 @@
 //! Reaction: the normal force at the pin (no friction, no couple).
 
 use super::frames::{link_state, perp, Projection};
+use super::gear::Side;
 use super::revolute::both_links;
 use super::{PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
-use crate::model::Pair;
+use crate::model::{JointFriction, Pair};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Slot {
@@ -69,5 +70,22 @@ impl PairType for Slot {
         g.pins.push(b.point(pair.sb));
         g.lines.push(self.ends.map(|e| a.point(e)));
         g
+    }
+
+    /// The slot's normal force.
+    #[inline]
+    fn contact_load(&self, _fr: &JointFriction, reaction: [f64; 3]) -> f64 {
+        reaction[0].hypot(reaction[1])
+    }
+
+    #[inline]
+    fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], _side: Side, j: &mut S) -> f64 {
+        self.coordinate_grad(pair, x, j, 0);
+        self.coordinate_rate(pair, x, xd)
+    }
+
+    #[inline]
+    fn slip_side(&self, _x: &[f64], _reaction: [f64; 3], _rate: f64) -> Side {
+        Side::A
     }
 }
