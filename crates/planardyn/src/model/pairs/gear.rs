@@ -22,7 +22,7 @@
 //! force: the physical bearing load of b is its revolute reaction plus this force.
 
 use super::frames::{add_grad, angle, dot, link_columns, link_state, link_state_t, part, perp, Projection};
-use super::{PairGeometry, PairType, Relative, Rows};
+use super::{reaction_force, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Link, Pair};
 
@@ -220,7 +220,7 @@ impl PairType for Gear {
     /// angle alpha = `fr.pressure_angle` (the reaction force's magnitude is F_t's).
     #[inline]
     fn contact_load(&self, fr: &JointFriction, reaction: [f64; 3]) -> f64 {
-        reaction[0].hypot(reaction[1]) / fr.pressure_angle.cos()
+        reaction_force(reaction) / fr.pressure_angle.cos()
     }
 
     /// The pitch-line travel of the gear on `side` (the mesh's friction acts on the

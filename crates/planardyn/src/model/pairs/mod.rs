@@ -256,6 +256,21 @@ pub fn coordinate(pair: &Pair, x: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate(pair, x))
 }
 
+/// |F| (N) of a reaction [F_x, F_y, M]: the contact load of the kinds without a couple's
+/// share in it.
+#[inline]
+fn reaction_force(reaction: [f64; 3]) -> f64 {
+    reaction[0].hypot(reaction[1])
+}
+
+/// The friction lever of a kind whose friction acts along its relative coordinate: the
+/// coordinate's gradient added into row 0 of `j`; returns its rate at xd.
+#[inline]
+fn coordinate_lever<T: PairType, S: Sink>(t: &T, pair: &Pair, x: &[f64], xd: &[f64], j: &mut S) -> f64 {
+    t.coordinate_grad(pair, x, j, 0);
+    t.coordinate_rate(pair, x, xd)
+}
+
 /// [`PairType::contact_load`] of the pair's kind.
 #[inline]
 pub fn contact_load(pair: &Pair, fr: &JointFriction, reaction: [f64; 3]) -> f64 {

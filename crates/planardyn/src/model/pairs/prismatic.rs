@@ -5,7 +5,7 @@
 use super::frames::{add_grad, angle, link_state, link_state_t, perp, Projection};
 use super::gear::Side;
 use super::revolute::both_links;
-use super::{guide, PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, guide, reaction_force, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -76,7 +76,7 @@ impl PairType for Prismatic {
     /// its magnitude); |N| for a slider of no length.
     #[inline]
     fn contact_load(&self, fr: &JointFriction, reaction: [f64; 3]) -> f64 {
-        let force = reaction[0].hypot(reaction[1]);
+        let force = reaction_force(reaction);
         if fr.length > 0.0 {
             force.max(2.0 * reaction[2].abs() / fr.length)
         } else {
@@ -86,8 +86,7 @@ impl PairType for Prismatic {
 
     #[inline]
     fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], _side: Side, j: &mut S) -> f64 {
-        self.coordinate_grad(pair, x, j, 0);
-        self.coordinate_rate(pair, x, xd)
+        coordinate_lever(self, pair, x, xd, j)
     }
 
     #[inline]

@@ -3,7 +3,7 @@
 
 use super::frames::{add_grad, link_columns, link_state, link_state_t, part, perp};
 use super::gear::Side;
-use super::{PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, reaction_force, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -81,13 +81,12 @@ impl PairType for Revolute {
     /// The pin (of radius `fr.arm`) carries the reaction force.
     #[inline]
     fn contact_load(&self, _fr: &JointFriction, reaction: [f64; 3]) -> f64 {
-        reaction[0].hypot(reaction[1])
+        reaction_force(reaction)
     }
 
     #[inline]
     fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], _side: Side, j: &mut S) -> f64 {
-        self.coordinate_grad(pair, x, j, 0);
-        self.coordinate_rate(pair, x, xd)
+        coordinate_lever(self, pair, x, xd, j)
     }
 
     #[inline]

@@ -6,7 +6,7 @@
 use super::frames::{link_state, perp, Projection};
 use super::gear::Side;
 use super::revolute::both_links;
-use super::{PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, reaction_force, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -75,13 +75,12 @@ impl PairType for Slot {
     /// The slot's normal force.
     #[inline]
     fn contact_load(&self, _fr: &JointFriction, reaction: [f64; 3]) -> f64 {
-        reaction[0].hypot(reaction[1])
+        reaction_force(reaction)
     }
 
     #[inline]
     fn slip_lever<S: Sink>(&self, pair: &Pair, x: &[f64], xd: &[f64], _side: Side, j: &mut S) -> f64 {
-        self.coordinate_grad(pair, x, j, 0);
-        self.coordinate_rate(pair, x, xd)
+        coordinate_lever(self, pair, x, xd, j)
     }
 
     #[inline]
