@@ -14,7 +14,7 @@
 //! The modules are layers, bottom to top, each using only those below it (declared in
 //! `crates/layers.toml`, checked by `tools/rust_layers.py` in `./dev test`): [`error`] and
 //! [`linalg`]; the [`model`], pure data with the pair and load kinds; [`topology`];
-//! [`kinematics`]; [`dynamics`]; the [`structure`] report; [`integrate`] (independent of the
+//! [`kinematics`]; [`dynamics`]; the [`structure`] report; [`elastic`] (stiffness and vibration); [`integrate`] (independent of the
 //! mechanics); [`simulate`]; [`batch`]; and the [`loader`] on top.
 
 // `!(x > 0.0)` is how the validators reject NaN along with the out-of-range values.
@@ -22,6 +22,7 @@
 
 pub mod batch;
 pub mod dynamics;
+pub mod elastic;
 pub mod error;
 pub mod integrate;
 pub mod kinematics;

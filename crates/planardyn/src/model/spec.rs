@@ -5,6 +5,7 @@
 //! documented field by field in `docs/model-format.md` and `schema/planardyn-model.schema.json`.
 //! Units are SI throughout: m, kg, kg m^2, s, rad, N, N m.
 
+pub use super::compliance::ComplianceSpec;
 pub use super::loads::LoadSpec;
 use indexmap::IndexMap;
 use serde::de::{Deserializer, MapAccess, Visitor};
@@ -48,6 +49,9 @@ pub struct MechanismSpec {
     /// Motors with their transmissions, one per driven coordinate (docs/actuators.md).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub actuators: Vec<ActuatorSpec>,
+    /// Transmission, pair and link compliances (`model::compliance`, docs/stiffness.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<ComplianceSpec>,
     /// Default simulation settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulate: Option<SimulateSpec>,

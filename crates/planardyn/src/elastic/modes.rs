@@ -1,0 +1,156 @@
+//! Vibration (docs/stiffness.md, *Natural frequencies*): the natural frequencies, mode shapes
+//! and damping ratios of the compliant mechanism about a pose, and the small oscillations of a
+//! passive mechanism about an equilibrium.
+//!
+//! Both are the generalized symmetric eigenproblem K y = omega^2 M y. M is whitened by its own
+//! symmetric eigendecomposition M = V diag(mu) V^T rather than by a Cholesky factor: the
+//! directions without mass (a slender link's tip node, a rotor without inertia) are then
+//! found and condensed statically (Guyan: they follow the massive ones through K), which a
+//! Cholesky factor of a singular M cannot do; for a positive definite M both give the same
+//! eigenvalues. The damping ratios are modal, zeta_i = y_i^T D y_i / (2 omega_i) for
+//! mass-normalised y_i (exact for damping proportional to K and M, first order otherwise).
+
+use super::stiffness::{elastic_at, elastic_stiffness, null_basis};
+use crate::dynamics::{inverse, inverse_derivatives, mass_matrix};
+use crate::kinematics::assemble_into;
+use crate::model::Mechanism;
+use crate::workspace::Workspace;
+use crate::KinematicsError;
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+/// A mass eigenvalue below this fraction of the largest is a direction without mass (the
+/// lightest real part, 1e-30 kg at most, is still above it for any machine of 1e-12 .. 1e6 kg).
+const MASSLESS_TOL: f64 = 1e-14;
+/// Newton on a passive equilibrium stops when the correction is below this many radians
+/// (or drawing lengths for a displacement).
+const EQUILIBRIUM_TOL: f64 = 1e-13;
+const EQUILIBRIUM_ITERATIONS: usize = 50;
+
+/// Natural modes, by increasing frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modes {
+    /// omega^2 (rad^2/s^2); negative about an unstable equilibrium.
+    pub omega2: Vec<f64>,
+    /// Modal damping ratios (1).
+    pub damping_ratio: Vec<f64>,
+    /// Mass-normalised shapes, one a mode: the body coordinates' displacement [X, Y, phi] per
+    /// body (3n) for the compliant mechanism, the coordinates' (m) for small oscillations.
+    pub shapes: Vec<Vec<f64>>,
+}
+
+impl Modes {
+    /// Natural frequencies omega (rad/s): the root of omega^2, 0 for an unstable direction.
+    pub fn omega(&self) -> Vec<f64> {
+        self.omega2.iter().map(|w| w.max(0.0).sqrt()).collect()
+    }
+}
+
+/// K y = omega^2 M y with damping D, over the columns of the given matrices; the shapes in
+/// those columns.
+pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) -> Modes {
+    let me = SymmetricEigen::new((m + m.transpose()) * 0.5);
+    let top = me.eigenvalues.max();
+    let (heavy, light): (Vec<usize>, Vec<usize>) = (0..m.ncols()).partition(|&i| me.eigenvalues[i] > MASSLESS_TOL * top);
+    let pick = |idx: &[usize], whiten: bool| {
+        let mut t = DMatrix::zeros(m.ncols(), idx.len());
+        for (j, &i) in idx.iter().enumerate() {
+            let s = if whiten { 1.0 / me.eigenvalues[i].sqrt() } else { 1.0 };
+            t.column_mut(j).copy_from(&(me.eigenvectors.column(i) * s));
+        }
+        t
+    };
+    let (th, tl) = (pick(&heavy, true), pick(&light, false));
+    // Static condensation: the massless directions x_l = -K_ll^-1 K_lh x_h.
+    let k_ll = tl.transpose() * k * &tl;
+    let k_lh = tl.transpose() * k * &th;
+    let eps = MASSLESS_TOL * k_ll.norm();
+    let follow = match k_ll.pseudo_inverse(eps) {
+        Ok(p) => -(p * k_lh),
+        Err(_) => DMatrix::zeros(light.len(), heavy.len()),
+    };
+    let t = &th + &tl * follow;
+    let kc = t.transpose() * k * &t;
+    let dc = t.transpose() * d * &t;
+    let eig = SymmetricEigen::new((&kc + kc.transpose()) * 0.5);
+    let mut order: Vec<usize> = (0..heavy.len()).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+    let mut modes = Modes { omega2: Vec::new(), damping_ratio: Vec::new(), shapes: Vec::new() };
+    for i in order {
+        let y = eig.eigenvectors.column(i);
+        let w2 = eig.eigenvalues[i];
+        let c = (y.transpose() * &dc * y)[(0, 0)];
+        modes.omega2.push(w2);
+        modes.damping_ratio.push(if w2 > 0.0 { c / (2.0 * w2.sqrt()) } else { 0.0 });
+        modes.shapes.push((&t * y).iter().copied().collect());
+    }
+    modes
+}
+
+/// The natural modes of the compliant mechanism about coordinates q (its rigid pose): with
+/// each elastic drive's rotor held (`free_rotors` false: a stiff position loop) or free (a
+/// torque-driven motor, its rotor inertia n^2 J a coordinate of its own). The model's own
+/// loads (gravity) are left out: the stiffness is the elements'.
+pub fn modes(mech: &Mechanism, q: &[f64], free_rotors: bool, ws: &mut Workspace) -> Result<Modes, KinematicsError> {
+    let model = elastic_at(mech, q, free_rotors, ws)?;
+    let z = model.z0.clone();
+    let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
+    let k = elastic_stiffness(&model, &z, &n);
+    let mass = DMatrix::from_diagonal(&DVector::from_column_slice(&model.mass));
+    let m = n.transpose() * mass * &n;
+    let mut damping = DMatrix::zeros(n.ncols(), n.ncols());
+    for (e, (_, b)) in model.elements.iter().zip(model.strains(&z)) {
+        let bn = b * &n;
+        damping += bn.transpose() * &e.damping * bn;
+    }
+    let mut modes = generalized(&k, &m, &damping);
+    for s in &mut modes.shapes {
+        let full = &n * DVector::from_column_slice(s);
+        *s = full.rows(0, mech.n_x()).iter().copied().collect();
+    }
+    Ok(modes)
+}
+
+/// The stiffness of a passive mechanism at rest at q: K = d tau / dq with tau(q) = -U^T f the
+/// efforts that hold it there (gravity, springs), exact from the analogues
+/// (`dynamics::inverse_derivatives`), with the viscous damping D = d tau / d qd.
+fn rest_stiffness(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>), KinematicsError> {
+    let m = q.len();
+    let zero = vec![0.0; m];
+    let jac = inverse_derivatives(mech, q, &zero, &zero, ws)?;
+    let tau = ws.tau.clone();
+    Ok((tau, DMatrix::from_row_slice(m, m, &jac.dq), DMatrix::from_row_slice(m, m, &jac.dqd)))
+}
+
+/// The equilibrium of a passive mechanism (no drives: its gravity and springs) nearest
+/// `q_start`, by Newton on tau(q) = 0 with the exact K.
+pub fn equilibrium(mech: &Mechanism, q_start: &[f64], ws: &mut Workspace) -> Result<Vec<f64>, KinematicsError> {
+    let mut q = q_start.to_vec();
+    assemble_into(mech, &q, ws)?;
+    let mut last = f64::INFINITY;
+    for _ in 0..EQUILIBRIUM_ITERATIONS {
+        let (tau, k, _) = rest_stiffness(mech, &q, ws)?;
+        let step = k.lu().solve(&DVector::from_column_slice(&tau)).ok_or_else(|| KinematicsError::BadArgument {
+            name: "q",
+            expected: "a start near an isolated equilibrium (the stiffness d tau/dq regular)".into(),
+            got: "a singular stiffness: the mechanism is indifferent there (no gravity or spring holds it)".into(),
+        })?;
+        q.iter_mut().zip(step.iter()).for_each(|(q, d)| *q -= d);
+        last = step.amax();
+        if last <= EQUILIBRIUM_TOL * mech.scale.max(1.0) {
+            inverse(mech, &q, &vec![0.0; q.len()], &vec![0.0; q.len()], ws)?;
+            return Ok(q);
+        }
+    }
+    Err(KinematicsError::AssemblyFailed { residual: last, iterations: EQUILIBRIUM_ITERATIONS })
+}
+
+/// The small oscillations of a passive mechanism about q (an equilibrium: see [`equilibrium`]):
+/// K y = omega^2 A y, K = d tau/dq, A = U^T M U, damping d tau/d qd. Shapes in the coordinates.
+pub fn small_oscillations(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<Modes, KinematicsError> {
+    assemble_into(mech, q, ws)?;
+    let (_, k, d) = rest_stiffness(mech, q, ws)?;
+    mass_matrix(mech, ws);
+    let m = q.len();
+    let a = DMatrix::from_row_slice(m, m, &ws.a);
+    Ok(generalized(&((&k + k.transpose()) * 0.5), &a, &d))
+}
