@@ -9,8 +9,8 @@
 //! are analyses at a pose, on matrices of a few dozen columns, where allocating is of no
 //! consequence (unlike the hand-written in-place factorisations of `linalg`).
 
-mod model;
 pub mod linearize;
+mod model;
 pub mod modes;
 pub mod stiffness;
 

@@ -341,7 +341,6 @@ impl<'m> ElasticModel<'m> {
         }
         (out.body.0, [0.0, 0.0])
     }
-
 }
 
 /// Whether actuator `a`'s coordinate is an angle.

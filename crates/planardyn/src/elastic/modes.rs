@@ -50,7 +50,8 @@ impl Modes {
 pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) -> Modes {
     let me = SymmetricEigen::new((m + m.transpose()) * 0.5);
     let top = me.eigenvalues.max();
-    let (heavy, light): (Vec<usize>, Vec<usize>) = (0..m.ncols()).partition(|&i| me.eigenvalues[i] > MASSLESS_TOL * top);
+    let (heavy, light): (Vec<usize>, Vec<usize>) =
+        (0..m.ncols()).partition(|&i| me.eigenvalues[i] > MASSLESS_TOL * top);
     let pick = |idx: &[usize], whiten: bool| {
         let mut t = DMatrix::zeros(m.ncols(), idx.len());
         for (j, &i) in idx.iter().enumerate() {
@@ -64,9 +65,9 @@ pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) 
     let k_ll = tl.transpose() * k * &tl;
     let k_lh = tl.transpose() * k * &th;
     let eps = MASSLESS_TOL * k_ll.norm();
-    let follow = match k_ll.pseudo_inverse(eps) {
-        Ok(p) => -(p * k_lh),
-        Err(_) => DMatrix::zeros(light.len(), heavy.len()),
+    let follow = match light.is_empty() {
+        true => DMatrix::zeros(0, heavy.len()),
+        false => -(k_ll.pseudo_inverse(eps).expect("eps >= 0") * k_lh),
     };
     let t = &th + &tl * follow;
     let kc = t.transpose() * k * &t;
@@ -113,7 +114,11 @@ pub fn modes(mech: &Mechanism, q: &[f64], free_rotors: bool, ws: &mut Workspace)
 /// The stiffness of a passive mechanism at rest at q: K = d tau / dq with tau(q) = -U^T f the
 /// efforts that hold it there (gravity, springs), exact from the analogues
 /// (`dynamics::inverse_derivatives`), with the viscous damping D = d tau / d qd.
-fn rest_stiffness(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>), KinematicsError> {
+fn rest_stiffness(
+    mech: &Mechanism,
+    q: &[f64],
+    ws: &mut Workspace,
+) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>), KinematicsError> {
     let m = q.len();
     let zero = vec![0.0; m];
     let jac = inverse_derivatives(mech, q, &zero, &zero, ws)?;

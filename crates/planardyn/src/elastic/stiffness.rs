@@ -181,7 +181,13 @@ pub(crate) fn tangent(
 }
 
 /// The compliance of the output from the tangent stiffness over the rigid rows' null space.
-fn cartesian(model: &ElasticModel, z: &[f64], out: Output, h: DMatrix<f64>, n: &DMatrix<f64>) -> Result<CartesianStiffness, KinematicsError> {
+fn cartesian(
+    model: &ElasticModel,
+    z: &[f64],
+    out: Output,
+    h: DMatrix<f64>,
+    n: &DMatrix<f64>,
+) -> Result<CartesianStiffness, KinematicsError> {
     let (pose, s) = model.output(out, z);
     let freedoms = n.ncols();
     let chol = h.clone().cholesky().ok_or_else(|| {
@@ -302,7 +308,10 @@ pub fn deflection(
                 expected: "a load the compliant mechanism carries (no buckling or snap-through before it): \
                            lower it or raise `steps`"
                     .into(),
-                got: format!("no equilibrium at {:.0}% of it (residual {residual:.3e} after {iterations} iterations)", 100.0 * t),
+                got: format!(
+                    "no equilibrium at {:.0}% of it (residual {residual:.3e} after {iterations} iterations)",
+                    100.0 * t
+                ),
             },
             other => other,
         })?;
@@ -312,7 +321,12 @@ pub fn deflection(
     let tangent_c = cartesian(&model, &z, out, h, &n)?;
     let p = model.output(out, &z).0;
     let linear = std::array::from_fn(|i| (0..3).map(|j| c0.compliance[i][j] * load.wrench[j]).sum());
-    Ok(Deflection { linear, nonlinear: std::array::from_fn(|i| p[i] - p0[i]), tangent: tangent_c, x: z[..mech.n_x()].to_vec() })
+    Ok(Deflection {
+        linear,
+        nonlinear: std::array::from_fn(|i| p[i] - p0[i]),
+        tangent: tangent_c,
+        x: z[..mech.n_x()].to_vec(),
+    })
 }
 
 /// The elements' forces sigma = K_e delta_e(z) + sigma0 (stacked).
@@ -342,7 +356,8 @@ fn equilibrium(
         let sigma = stresses(model, z, sigma0);
         let (g, r) = model.rigid_rows(z);
         let (_, s) = model.output(out, z);
-        let mut grad = -(s.transpose() * DVector::from_column_slice(&wrench)) - r.transpose() * DVector::from_column_slice(lambda);
+        let mut grad =
+            -(s.transpose() * DVector::from_column_slice(&wrench)) - r.transpose() * DVector::from_column_slice(lambda);
         let mut at = 0;
         for (v, b) in model.strains(z).iter() {
             grad += b.transpose() * DVector::from_column_slice(&sigma[at..at + v.len()]);

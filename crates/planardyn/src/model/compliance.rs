@@ -273,10 +273,9 @@ fn link(ctx: &Ctx, mech: &Mechanism, path: &str, l: &LinkComplianceSpec) -> R<Li
             (e * area, e * second_moment)
         }
         _ => {
-            return Err(ctx.err(
-                path,
-                "give either `EA` (N) and `EI` (N m^2), or a `section` and the material's `E` (Pa)",
-            ))
+            return Err(
+                ctx.err(path, "give either `EA` (N) and `EI` (N m^2), or a `section` and the material's `E` (Pa)")
+            )
         }
     };
     Ok(LinkCompliance {
