@@ -8,6 +8,8 @@
     planardyn plot RESULTS [-o FILE.png] [--torque-speed | --points P [P ...]]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
+    planardyn stiffness MODEL --body B [--point P] [--at Q ...] [--load FX FY M] [--map X0 X1 Y0 Y1]
+    planardyn modes MODEL [--at Q ...] [--free-rotors | --passive]
     planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V ...] [--collocate time|effort] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn export MODEL -o FILE.xml|.urdf|.sdf;  planardyn import FILE -o MODEL.yaml
@@ -58,6 +60,7 @@ from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .results_format import check_writable, writing
 from .robot.cli import register as size_command
+from .stiffness_cli import register as stiffness_commands
 from .robot.cli_options import number
 from .settings import check_settings
 
@@ -335,6 +338,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
     size_command(sub)
+    stiffness_commands(sub)
     _plan_command(sub, full=command == "plan")
     exchange_commands(sub)
     g = _sub(sub, "docs", "the user guide, installed with planardyn: list its pages, or print one",
