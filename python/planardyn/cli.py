@@ -60,9 +60,9 @@ from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
 from .results_format import check_writable, writing
 from .robot.cli import register as size_command
-from .stiffness_cli import register as stiffness_commands
 from .robot.cli_options import number
 from .settings import check_settings
+from .stiffness_cli import register as stiffness_commands
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 

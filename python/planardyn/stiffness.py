@@ -28,7 +28,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from ._core import deflection as native_deflection
+from ._core import equilibrium as native_equilibrium
+from ._core import modes as native_modes
+from ._core import small_oscillations as native_small_oscillations
+from ._core import state_space as native_state_space
+from ._core import stiffness as native_stiffness
+from ._core import weakest_direction as native_weakest_direction
 from .mechanism import Mechanism
 from .notebook import Summarized
 from .robot.effector import EndEffector
@@ -81,7 +87,7 @@ class StiffnessReport(Summarized):
     def weakest(self, length: float) -> tuple[FloatArray, float]:
         """The weakest direction [d_x, d_y, length d_phi] of the whole compliance with rotations
         scaled by a characteristic ``length`` (m), and its stiffness (N/m)."""
-        direction, k = _core.weakest_direction(self.compliance.ravel(), float(length))
+        direction, k = native_weakest_direction(self.compliance.ravel(), float(length))
         return direction, k
 
     def ellipse(self) -> tuple[FloatArray, FloatArray]:
@@ -120,7 +126,7 @@ def stiffness(mech: Mechanism, q: ArrayLike | None = None, *, body: str, point: 
     name. Raises ``ArgumentError`` naming the argument (an unknown body, a rigid model...)."""
     qq = _q(mech, q)
     w = np.zeros(3) if wrench is None else np.asarray(wrench, dtype=float)
-    d = _core.stiffness(mech._native, qq, body, point, w, dict(preload) if preload else None)
+    d = native_stiffness(mech._native, qq, body, point, w, dict(preload) if preload else None)
     return StiffnessReport._from(d, body, point, qq, w)
 
 
@@ -159,7 +165,7 @@ def deflection(mech: Mechanism, q: ArrayLike | None = None, *, body: str, wrench
     non-linear (the equilibrium followed in ``steps`` load increments)."""
     qq = _q(mech, q)
     w = np.asarray(wrench, dtype=float)
-    d = _core.deflection(mech._native, qq, body, w, point, steps, dict(preload) if preload else None)
+    d = native_deflection(mech._native, qq, body, w, point, steps, dict(preload) if preload else None)
     tangent = StiffnessReport._from(d["tangent"], body, point, qq, w)
     return DeflectionReport(w, d["linear"], d["nonlinear"], tangent, d["x"])
 
@@ -208,7 +214,7 @@ def modes(mech: Mechanism, q: ArrayLike | None = None, *, free_rotors: bool = Fa
     """The natural modes of the compliant mechanism about coordinates ``q`` (its rigid pose):
     each elastic drive's rotor held (a stiff position loop) or free (a torque-driven motor)."""
     qq = _q(mech, q)
-    return _modes(_core.modes(mech._native, qq, free_rotors), qq)
+    return _modes(native_modes(mech._native, qq, free_rotors), qq)
 
 
 def small_oscillations(mech: Mechanism, q: ArrayLike | None = None, *, equilibrium: bool = True) -> ModesReport:
@@ -216,8 +222,8 @@ def small_oscillations(mech: Mechanism, q: ArrayLike | None = None, *, equilibri
     equilibrium nearest ``q`` (``equilibrium`` False: about ``q`` itself)."""
     qq = _q(mech, q)
     if equilibrium:
-        qq = _core.equilibrium(mech._native, qq)
-    return _modes(_core.small_oscillations(mech._native, qq), qq)
+        qq = native_equilibrium(mech._native, qq)
+    return _modes(native_small_oscillations(mech._native, qq), qq)
 
 
 def state_space(mech: Mechanism, q: ArrayLike | None = None, qd: ArrayLike | None = None,
@@ -230,7 +236,7 @@ def state_space(mech: Mechanism, q: ArrayLike | None = None, qd: ArrayLike | Non
     qq = _q(mech, q)
     rates = np.zeros_like(qq) if qd is None else np.asarray(qd, dtype=float)
     efforts = mech.inverse_dynamics(qq, rates, np.zeros_like(qq)) if tau is None else np.asarray(tau, dtype=float)
-    d = _core.state_space(mech._native, qq, rates, np.asarray(efforts, dtype=float), list(points))
+    d = native_state_space(mech._native, qq, rates, np.asarray(efforts, dtype=float), list(points))
     return d["A"], d["B"], d["C"], d["D"]
 
 

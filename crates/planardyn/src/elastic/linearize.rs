@@ -7,6 +7,7 @@
 //! the points' rows from the velocity analogues (dr_P/dq = S_P U).
 
 use crate::dynamics::forward_derivatives;
+use crate::kinematics::assemble_into;
 use crate::model::pairs::frames::rotate;
 use crate::model::BodyId;
 use crate::model::Mechanism;
@@ -34,6 +35,8 @@ pub fn linearize(
     ws: &mut Workspace,
 ) -> Result<StateSpace, Error> {
     let m = q.len();
+    // By continuation from the drawing (the branch it is drawn in), then Newton from there.
+    assemble_into(mech, q, ws)?;
     let (_, jac) = forward_derivatives(mech, q, qd, tau, ws)?;
     let n2 = 2 * m;
     let mut a = vec![0.0; n2 * n2];

@@ -13,7 +13,7 @@
 use super::stiffness::{elastic_at, elastic_stiffness, null_basis};
 use crate::dynamics::{inverse, inverse_derivatives, mass_matrix};
 use crate::kinematics::assemble_into;
-use crate::model::Mechanism;
+use crate::model::{CoordinateKind, Mechanism};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
@@ -22,9 +22,15 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 /// lightest real part, 1e-30 kg at most, is still above it for any machine of 1e-12 .. 1e6 kg).
 const MASSLESS_TOL: f64 = 1e-14;
 /// Newton on a passive equilibrium stops when the correction is below this many radians
-/// (or drawing lengths for a displacement).
+/// (or drawing lengths for a displacement): a few hundred times the rounding of an angle.
 const EQUILIBRIUM_TOL: f64 = 1e-13;
-const EQUILIBRIUM_ITERATIONS: usize = 50;
+const EQUILIBRIUM_ITERATIONS: usize = 200;
+/// Longest descent step (rad, or drawing lengths): the continuation of the position analysis
+/// follows the branch over it, and a Newton step far from the equilibrium is not trusted further.
+const MAX_DESCENT_STEP: f64 = 0.2;
+/// K is taken as positive definite when its lowest eigenvalue exceeds this fraction of its
+/// largest entry; else shifted to that margin.
+const SHIFT_TOL: f64 = 1e-8;
 
 /// Natural modes, by increasing frequency.
 #[derive(Debug, Clone, PartialEq)]
@@ -126,22 +132,34 @@ fn rest_stiffness(
     Ok((tau, DMatrix::from_row_slice(m, m, &jac.dq), DMatrix::from_row_slice(m, m, &jac.dqd)))
 }
 
-/// The equilibrium of a passive mechanism (no drives: its gravity and springs) nearest
-/// `q_start`, by Newton on tau(q) = 0 with the exact K.
+/// The stable equilibrium of a passive mechanism (no drives: its gravity and springs) reached
+/// from `q_start` by descending its potential: Newton steps on tau(q) = 0 with the exact K,
+/// shifted to K + mu I where K is not positive definite (so each step goes downhill, not to a
+/// maximum or a saddle) and at most `MAX_DESCENT_STEP` long.
 pub fn equilibrium(mech: &Mechanism, q_start: &[f64], ws: &mut Workspace) -> Result<Vec<f64>, KinematicsError> {
     let mut q = q_start.to_vec();
     assemble_into(mech, &q, ws)?;
+    let scale: Vec<f64> = mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.0 } else { mech.scale }).collect();
     let mut last = f64::INFINITY;
     for _ in 0..EQUILIBRIUM_ITERATIONS {
         let (tau, k, _) = rest_stiffness(mech, &q, ws)?;
-        let step = k.lu().solve(&DVector::from_column_slice(&tau)).ok_or_else(|| KinematicsError::BadArgument {
+        let k = (&k + k.transpose()) * 0.5;
+        let lowest = SymmetricEigen::new(k.clone()).eigenvalues.min();
+        let top = k.amax();
+        let shift = if lowest > SHIFT_TOL * top { 0.0 } else { SHIFT_TOL * top - lowest + f64::MIN_POSITIVE };
+        let shifted = &k + DMatrix::identity(q.len(), q.len()) * shift;
+        let mut step = shifted.lu().solve(&DVector::from_column_slice(&tau)).ok_or_else(|| KinematicsError::BadArgument {
             name: "q",
-            expected: "a start near an isolated equilibrium (the stiffness d tau/dq regular)".into(),
-            got: "a singular stiffness: the mechanism is indifferent there (no gravity or spring holds it)".into(),
+            expected: "a start where gravity or a spring holds the mechanism (an isolated equilibrium)".into(),
+            got: "no stiffness: the mechanism is indifferent there".into(),
         })?;
+        let longest = step.iter().zip(&scale).map(|(d, s)| (d / s).abs()).fold(0.0, f64::max);
+        if longest > MAX_DESCENT_STEP {
+            step *= MAX_DESCENT_STEP / longest;
+        }
         q.iter_mut().zip(step.iter()).for_each(|(q, d)| *q -= d);
-        last = step.amax();
-        if last <= EQUILIBRIUM_TOL * mech.scale.max(1.0) {
+        last = longest;
+        if shift == 0.0 && last <= EQUILIBRIUM_TOL {
             inverse(mech, &q, &vec![0.0; q.len()], &vec![0.0; q.len()], ws)?;
             return Ok(q);
         }

@@ -32,6 +32,17 @@ const RANK_TOL: f64 = 1e-12;
 /// lengths (a few hundred times the rounding of the coordinates).
 const NEWTON_TOL: f64 = 1e-13;
 const NEWTON_ITERATIONS: usize = 30;
+/// Singular values of the equilibrium and KKT matrices below this fraction of the largest are
+/// a self-stress or a redundant row (zero but for rounding, ~1e-16 of the largest), whose share
+/// the minimum-norm solution leaves at zero.
+const LSQ_TOL: f64 = 1e-12;
+
+/// The minimum-norm least-squares solution of a x = b.
+fn lstsq(a: DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>, &'static str> {
+    let svd = a.svd(true, true);
+    let eps = LSQ_TOL * svd.singular_values.max();
+    svd.solve(b, eps)
+}
 
 /// A load on the output: the wrench W = [F_x, F_y, M] (N, N, N m) at the output point, and
 /// preload efforts (N m or N) of elastic drives by actuator index.
@@ -142,7 +153,7 @@ fn balance(model: &ElasticModel, z: &[f64], out: Output, load: &Load) -> Result<
             a.column_mut(j).fill(0.0);
         }
     }
-    let y = a.svd(true, true).solve(&rhs, 1e-12).map_err(|e| KinematicsError::BadArgument {
+    let y = lstsq(a, &rhs).map_err(|e| KinematicsError::BadArgument {
         name: "load",
         expected: "a load the compliant mechanism can balance".into(),
         got: e.into(),
@@ -372,7 +383,7 @@ fn equilibrium(
         let mut rhs = DVector::zeros(nc + nr);
         rhs.rows_mut(0, nc).copy_from(&(-grad));
         rhs.rows_mut(nc, nr).copy_from(&(-g));
-        let step = kkt.svd(true, true).solve(&rhs, 1e-14).map_err(|e| KinematicsError::BadArgument {
+        let step = lstsq(kkt, &rhs).map_err(|e| KinematicsError::BadArgument {
             name: "load",
             expected: "a regular equilibrium".into(),
             got: e.into(),
