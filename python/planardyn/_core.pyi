@@ -32,6 +32,13 @@ __all__ = [
     "JUMP_TOL",
     "simulate_batch",
     "inverse_batch",
+    "stiffness",
+    "weakest_direction",
+    "deflection",
+    "modes",
+    "small_oscillations",
+    "equilibrium",
+    "state_space",
 ]
 
 __version__: str

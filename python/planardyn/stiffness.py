@@ -56,8 +56,15 @@ def _matrix(m: Any) -> str:
     return "[" + "; ".join(" ".join(f"{v:.4g}" for v in row) for row in np.atleast_2d(m)) + "]"
 
 
+class _Report(Summarized):
+    """A report printed as its summary rows, one "field: value" a line."""
+
+    def __str__(self) -> str:
+        return "\n".join(f"{k}: {v}" for k, v in self._summary_rows())
+
+
 @dataclass(frozen=True, repr=False)
-class StiffnessReport(Summarized):
+class StiffnessReport(_Report):
     """The Cartesian compliance and stiffness of ``point`` of ``body`` at coordinates ``q``.
 
     ``pose`` (3,) [x, y, phi]; ``compliance`` (3, 3) C; ``stiffness`` (3, 3) K = C^-1, None
@@ -114,9 +121,6 @@ class StiffnessReport(Summarized):
             rows.insert(5, ("translational K", _matrix(self.translational) + " N/m"))
         return rows
 
-    def __str__(self) -> str:
-        return "\n".join(f"{k}: {v}" for k, v in self._summary_rows())
-
 
 def stiffness(mech: Mechanism, q: ArrayLike | None = None, *, body: str, point: str | None = None,
               wrench: ArrayLike | None = None, preload: Mapping[str, float] | None = None) -> StiffnessReport:
@@ -131,7 +135,7 @@ def stiffness(mech: Mechanism, q: ArrayLike | None = None, *, body: str, point: 
 
 
 @dataclass(frozen=True, repr=False)
-class DeflectionReport(Summarized):
+class DeflectionReport(_Report):
     """The deflection of a point under a wrench: ``linear`` C0 W and ``nonlinear`` (3,)
     [dx, dy, dphi] (m, m, rad), ``tangent`` the stiffness at the loaded equilibrium, ``x``
     the body coordinates there."""
@@ -154,9 +158,6 @@ class DeflectionReport(Summarized):
                 ("linear", fmt(self.linear)), ("non-linear", fmt(self.nonlinear)),
                 ("tangent weakest", f"{self.tangent.weakest_stiffness:.6g} N/m")]
 
-    def __str__(self) -> str:
-        return "\n".join(f"{k}: {v}" for k, v in self._summary_rows())
-
 
 def deflection(mech: Mechanism, q: ArrayLike | None = None, *, body: str, wrench: ArrayLike,
                point: str | None = None, steps: int = 10,
@@ -171,7 +172,7 @@ def deflection(mech: Mechanism, q: ArrayLike | None = None, *, body: str, wrench
 
 
 @dataclass(frozen=True, repr=False)
-class ModesReport(Summarized):
+class ModesReport(_Report):
     """Natural modes by increasing frequency: ``omega`` (k,) rad/s, ``omega2`` (negative:
     unstable), ``damping_ratio`` (k,) modal, ``shapes`` (k, 3n) body displacements (or (k, m)
     coordinates for small oscillations), mass-normalised."""
@@ -201,9 +202,6 @@ class ModesReport(Summarized):
         return [(f"mode {k + 1}", f"{f:.6g} Hz ({w:.6g} rad/s), damping ratio {z:.4g}"
                  + (" (unstable)" if w2 < 0 else ""))
                 for k, (f, w, z, w2) in enumerate(zip(self.frequency, self.omega, self.damping_ratio, self.omega2))]
-
-    def __str__(self) -> str:
-        return "\n".join(f"{k}: {v}" for k, v in self._summary_rows())
 
 
 def _modes(d: dict[str, Any], q: FloatArray) -> ModesReport:
@@ -241,7 +239,7 @@ def state_space(mech: Mechanism, q: ArrayLike | None = None, qd: ArrayLike | Non
 
 
 @dataclass(repr=False)
-class StiffnessMap(Summarized):
+class StiffnessMap(_Report):
     """The weakest translational stiffness ``weakest`` (N/m) and the first natural frequency
     ``first_frequency`` (Hz) over a grid of end-effector positions: (ny, nx), NaN where
     unreachable (row j at y[j], column i at x[i])."""
@@ -278,7 +276,7 @@ def stiffness_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float,
 
 
 @dataclass(repr=False)
-class PathStiffness(Summarized):
+class PathStiffness(_Report):
     """Along a path's rows of coordinates: ``position`` (N, 2) m, ``ellipses`` (N, 2) the
     translational compliance's semi-axes (m/N) with ``axes`` (N, 2, 2) their directions as
     columns, ``weakest`` (N,) N/m, ``first_frequency`` (N,) Hz."""

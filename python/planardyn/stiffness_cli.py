@@ -93,7 +93,7 @@ def _run_stiffness(args: argparse.Namespace) -> int:
             raise ArgumentError("--map: give the end-effector --point")
         smap = stiffness_map(EndEffector(mech, args.point, args.body), (args.map[0], args.map[1]),
                              (args.map[2], args.map[3]), args.n)
-        print("\n".join(f"{k}: {v}" for k, v in smap._summary_rows()))
+        print(smap)
         if args.plot:
             from matplotlib.figure import Figure
 

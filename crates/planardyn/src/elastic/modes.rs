@@ -139,7 +139,8 @@ fn rest_stiffness(
 pub fn equilibrium(mech: &Mechanism, q_start: &[f64], ws: &mut Workspace) -> Result<Vec<f64>, KinematicsError> {
     let mut q = q_start.to_vec();
     assemble_into(mech, &q, ws)?;
-    let scale: Vec<f64> = mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.0 } else { mech.scale }).collect();
+    let scale: Vec<f64> =
+        mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.0 } else { mech.scale }).collect();
     let mut last = f64::INFINITY;
     for _ in 0..EQUILIBRIUM_ITERATIONS {
         let (tau, k, _) = rest_stiffness(mech, &q, ws)?;
@@ -148,11 +149,12 @@ pub fn equilibrium(mech: &Mechanism, q_start: &[f64], ws: &mut Workspace) -> Res
         let top = k.amax();
         let shift = if lowest > SHIFT_TOL * top { 0.0 } else { SHIFT_TOL * top - lowest + f64::MIN_POSITIVE };
         let shifted = &k + DMatrix::identity(q.len(), q.len()) * shift;
-        let mut step = shifted.lu().solve(&DVector::from_column_slice(&tau)).ok_or_else(|| KinematicsError::BadArgument {
-            name: "q",
-            expected: "a start where gravity or a spring holds the mechanism (an isolated equilibrium)".into(),
-            got: "no stiffness: the mechanism is indifferent there".into(),
-        })?;
+        let mut step =
+            shifted.lu().solve(&DVector::from_column_slice(&tau)).ok_or_else(|| KinematicsError::BadArgument {
+                name: "q",
+                expected: "a start where gravity or a spring holds the mechanism (an isolated equilibrium)".into(),
+                got: "no stiffness: the mechanism is indifferent there".into(),
+            })?;
         let longest = step.iter().zip(&scale).map(|(d, s)| (d / s).abs()).fold(0.0, f64::max);
         if longest > MAX_DESCENT_STEP {
             step *= MAX_DESCENT_STEP / longest;
