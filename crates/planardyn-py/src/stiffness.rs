@@ -106,7 +106,7 @@ pub fn weakest_direction<'py>(
     length: f64,
 ) -> PyResult<(Bound<'py, PyAny>, f64)> {
     let c = vector("compliance", &compliance, 9, "a (3, 3) compliance, row-major")?;
-    if !(length > 0.0) || !length.is_finite() {
+    if !length.is_finite() || length <= 0.0 {
         return Err(argument_error(Some("length"), format!("the characteristic length must be > 0 m, got {length}")));
     }
     let s = CartesianStiffness {

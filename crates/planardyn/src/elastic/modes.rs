@@ -117,19 +117,24 @@ pub fn modes(mech: &Mechanism, q: &[f64], free_rotors: bool, ws: &mut Workspace)
     Ok(modes)
 }
 
-/// The stiffness of a passive mechanism at rest at q: K = d tau / dq with tau(q) = -U^T f the
-/// efforts that hold it there (gravity, springs), exact from the analogues
-/// (`dynamics::inverse_derivatives`), with the viscous damping D = d tau / d qd.
-fn rest_stiffness(
-    mech: &Mechanism,
-    q: &[f64],
-    ws: &mut Workspace,
-) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>), KinematicsError> {
+/// A passive mechanism at rest at q: the efforts tau(q) = -U^T f that hold it there (gravity,
+/// springs), its stiffness K = d tau/dq exact from the analogues
+/// (`dynamics::inverse_derivatives`), and its viscous damping D = d tau / d qd.
+struct Rest {
+    tau: Vec<f64>,
+    k: DMatrix<f64>,
+    d: DMatrix<f64>,
+}
+
+fn at_rest(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<Rest, KinematicsError> {
     let m = q.len();
     let zero = vec![0.0; m];
     let jac = inverse_derivatives(mech, q, &zero, &zero, ws)?;
-    let tau = ws.tau.clone();
-    Ok((tau, DMatrix::from_row_slice(m, m, &jac.dq), DMatrix::from_row_slice(m, m, &jac.dqd)))
+    Ok(Rest {
+        tau: ws.tau.clone(),
+        k: DMatrix::from_row_slice(m, m, &jac.dq),
+        d: DMatrix::from_row_slice(m, m, &jac.dqd),
+    })
 }
 
 /// The stable equilibrium of a passive mechanism (no drives: its gravity and springs) reached
@@ -143,7 +148,7 @@ pub fn equilibrium(mech: &Mechanism, q_start: &[f64], ws: &mut Workspace) -> Res
         mech.coordinates.iter().map(|c| if c.kind == CoordinateKind::Angle { 1.0 } else { mech.scale }).collect();
     let mut last = f64::INFINITY;
     for _ in 0..EQUILIBRIUM_ITERATIONS {
-        let (tau, k, _) = rest_stiffness(mech, &q, ws)?;
+        let Rest { tau, k, .. } = at_rest(mech, &q, ws)?;
         let k = (&k + k.transpose()) * 0.5;
         let lowest = SymmetricEigen::new(k.clone()).eigenvalues.min();
         let top = k.amax();
@@ -173,7 +178,7 @@ pub fn equilibrium(mech: &Mechanism, q_start: &[f64], ws: &mut Workspace) -> Res
 /// K y = omega^2 A y, K = d tau/dq, A = U^T M U, damping d tau/d qd. Shapes in the coordinates.
 pub fn small_oscillations(mech: &Mechanism, q: &[f64], ws: &mut Workspace) -> Result<Modes, KinematicsError> {
     assemble_into(mech, q, ws)?;
-    let (_, k, d) = rest_stiffness(mech, q, ws)?;
+    let Rest { k, d, .. } = at_rest(mech, q, ws)?;
     mass_matrix(mech, ws);
     let m = q.len();
     let a = DMatrix::from_row_slice(m, m, &ws.a);
