@@ -226,52 +226,71 @@ fn parallelogram_swings_at_its_exact_pendulum_frequency() {
     assert!(rel(modes.omega2[0], expected) < CLOSED_FORM_TOL, "{} vs {expected}", modes.omega2[0]);
 }
 
-/// A 5R with elastic motors and slender distal links, loaded at P.
-fn five_bar() -> Mechanism {
+/// A 5R with elastic motors and slender distal links, loaded at P; `actuators` and `drives`
+/// add actuators and drive compliances.
+fn five_bar(actuators: &str, drives: &str) -> Mechanism {
     let text =
         std::fs::read_to_string(format!("{}/../../examples/models/five-bar.yaml", env!("CARGO_MANIFEST_DIR"))).unwrap();
     let rigid = text.split("\ndrives:").next().unwrap();
     yaml(&format!(
-        "{rigid}\ncompliance:\n  drives:\n    - {{actuator: theta1, stiffness: 2.0e3}}\n    \
-         - {{actuator: theta2, stiffness: 3.0e3}}\n  links:\n    - {{body: distal_left, EA: 1.0e6, EI: 20.0}}\n    \
+        "{rigid}\n{actuators}compliance:\n  drives:\n    - {{actuator: theta1, stiffness: 2.0e3}}\n    \
+         - {{actuator: theta2, stiffness: 3.0e3}}\n{drives}  links:\n    - {{body: distal_left, EA: 1.0e6, EI: 20.0}}\n    \
          - {{body: distal_right, EA: 1.0e6, EI: 25.0}}\n"
     ))
 }
 
-#[test]
-fn tangent_compliance_is_the_derivative_of_the_loaded_equilibrium() {
-    // The tangent compliance at the loaded equilibrium (geometric terms of the load and the
-    // element forces included) against central differences of the non-linear deflection in
-    // the load: truncation (h/W)^2 ~ 1e-10 and rounding 1e-16 L / (h C) ~ 1e-9 relative.
+/// The tangent compliance at the loaded equilibrium (geometric terms of the load, of the
+/// element forces and of the preload included) against central differences of the
+/// non-linear deflection in the load: truncation (h/W)^2 ~ 1e-10 and rounding
+/// 1e-16 L / (h C) ~ 1e-9 relative; and the load changes the compliance by far more than
+/// that, so that the test sees the geometric terms.
+fn check_tangent_against_differences(mech: &Mechanism, preload: Vec<(usize, f64)>) {
     const FD_TOL: f64 = 1e-7;
-    let mech = five_bar();
-    let mut ws = Workspace::new(&mech);
+    let mut ws = Workspace::new(mech);
     let q = mech.drawn_q();
     let out = Output { body: mech.body_id("distal_left").unwrap(), point: mech.point_id("P") };
     let w = [40.0, -60.0, 0.0];
-    let at = |w: [f64; 3], ws: &mut Workspace| {
-        elastic::deflection(&mech, &q, out, &Load { wrench: w, preload: vec![] }, 4, ws).unwrap()
+    let mut at = |w: [f64; 3]| {
+        elastic::deflection(mech, &q, out, &Load { wrench: w, preload: preload.clone() }, 4, &mut ws).unwrap()
     };
-    let loaded = at(w, &mut ws);
-    let c = loaded.tangent.compliance;
-    let unloaded = at([0.0; 3], &mut ws).tangent.compliance;
+    let c = at(w).tangent.compliance;
+    let unloaded = at([0.0; 3]).tangent.compliance;
     let h = 1e-3;
     for k in 0..2 {
         let (mut plus, mut minus) = (w, w);
         plus[k] += h;
         minus[k] -= h;
-        let (dp, dm) = (at(plus, &mut ws).nonlinear, at(minus, &mut ws).nonlinear);
+        let (dp, dm) = (at(plus).nonlinear, at(minus).nonlinear);
         for i in 0..2 {
             let fd = (dp[i] - dm[i]) / (2.0 * h);
-            assert!(
-                (fd - c[i][k]).abs() < FD_TOL * c[i][i].abs().max(c[k][k].abs()),
-                "C[{i}][{k}] {} vs fd {fd}",
-                c[i][k]
-            );
-            // The load changes the compliance measurably: the test sees the geometric term.
-            assert!((c[i][k] - unloaded[i][k]).abs() > 1e3 * FD_TOL * c[i][i].abs(), "geometric term too small");
+            let scale = c[i][i].abs().max(c[k][k].abs());
+            assert!((fd - c[i][k]).abs() < FD_TOL * scale, "C[{i}][{k}] {} vs fd {fd}", c[i][k]);
+            assert!((c[i][k] - unloaded[i][k]).abs() > 1e3 * FD_TOL * scale, "geometric term too small");
         }
     }
+}
+
+#[test]
+fn tangent_compliance_is_the_derivative_of_the_loaded_equilibrium() {
+    check_tangent_against_differences(&five_bar("", ""), vec![]);
+}
+
+#[test]
+fn preload_of_a_redundant_drive_enters_the_tangent_and_the_stiffness() {
+    // A third, redundant motor at the left elbow (a pair actuator), elastic, preloaded with
+    // 50 N m against the two others: a self-stress, which changes the stiffness at the pose
+    // (its geometric term) and the tangent along the loaded equilibria.
+    let mech = five_bar("actuators: [{pair: elbow1}]\n", "    - {actuator: elbow1, stiffness: 1.5e3}\n");
+    let elbow = mech.n_actuators() - 1;
+    check_tangent_against_differences(&mech, vec![(elbow, 50.0)]);
+    let mut ws = Workspace::new(&mech);
+    let out = Output { body: mech.body_id("distal_left").unwrap(), point: mech.point_id("P") };
+    let q = mech.drawn_q();
+    let plain = elastic::stiffness(&mech, &q, out, &Load::default(), &mut ws).unwrap();
+    let loaded = Load { wrench: [0.0; 3], preload: vec![(elbow, 50.0)] };
+    let preloaded = elastic::stiffness(&mech, &q, out, &loaded, &mut ws).unwrap();
+    let change = (preloaded.compliance[1][1] - plain.compliance[1][1]).abs() / plain.compliance[1][1];
+    assert!(change > 1e-4, "the preload's geometric term: {change:e}");
 }
 
 #[test]
