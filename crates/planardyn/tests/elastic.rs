@@ -300,3 +300,57 @@ fn a_rigid_model_is_refused_with_the_fix() {
     let err = elastic::modes(&mech, &[0.0], false, &mut ws).unwrap_err().to_string();
     assert!(err.contains("compliance:"), "{err}");
 }
+
+/// A bar (1.2 kg, 0.5 m) hanging from O under gravity, started at -1.2 rad (hanging is -pi/2),
+/// its rotor (J = 5e-5 kg m^2 behind n = 20) joined to it by a transmission spring k; no
+/// motor torque.
+fn flexible_pendulum(k: f64) -> Mechanism {
+    yaml(&format!(
+        "name: flexible pendulum\ngravity: [0, -9.81]\npoints: {{O: [0, 0], A: [0.5, 0]}}\nground: [O]\n\
+         bodies:\n  bar: {{points: [O, A], uniform_bar: [O, A], mass: 1.2}}\n\
+         pairs:\n  - {{type: revolute, name: O, at: O, bodies: [ground, bar]}}\n\
+         coordinates:\n  - {{name: q, pair: O, value: 0.0, q0: -1.2}}\n\
+         actuators: [{{coordinate: q, gear_ratio: 20, rotor_inertia: 5.0e-5}}]\n\
+         compliance:\n  drives: [{{actuator: q, stiffness: {k}}}]\n"
+    ))
+}
+
+fn flexible_run(k: f64, t_end: f64) -> elastic::FlexibleRun {
+    let options = planardyn::integrate::Options::tol(1e-12, 1e-14);
+    let method = planardyn::integrate::Method::Dop853;
+    elastic::simulate_flexible(&flexible_pendulum(k), t_end, 0.01, method, &options).unwrap()
+}
+
+#[test]
+fn flexible_joint_run_conserves_its_energy() {
+    // No damping and no motor torque: E = T + V + 1/2 n^2 J thetad^2 + 1/2 k (theta - q)^2 is
+    // constant; dop853 at rtol 1e-12 over 2 s (~80 periods of the spring) keeps a 3 J energy
+    // to ~1e-11 J; the usual bound of the energy checks is 1e-9 J.
+    let run = flexible_run(1.0e3, 2.0);
+    let e0 = run.energy[0];
+    let drift = run.energy.iter().map(|e| (e - e0).abs()).fold(0.0, f64::max);
+    assert!(drift < 1e-9, "energy drift {drift:e} J of {e0} J");
+    // The spring works: the rotor lags the bar.
+    let lag = run.q.iter().zip(&run.theta).map(|(q, th)| (q[0] - th[0]).abs()).fold(0.0, f64::max);
+    assert!(lag > 1e-4, "lag {lag}");
+}
+
+#[test]
+fn flexible_joint_run_tends_to_the_rigid_one_like_one_over_k() {
+    // The rigid model's A holds n^2 J on the coordinate (`dynamics::transmission`); the
+    // flexible run differs by the spring's deflection and its fast oscillation, both ~1/k:
+    // each tenfold stiffer spring divides the largest difference over 1 s by about ten (here
+    // by more than 6.7: 1/k or faster).
+    let times: Vec<f64> = (0..=100).map(|j| 0.01 * j as f64).collect();
+    let rigid = common::run(&flexible_pendulum(1.0), "dop853", 1.0, 1e-12, Some(times.clone()));
+    let diffs: Vec<f64> = [1.0e3, 1.0e4, 1.0e5]
+        .iter()
+        .map(|&k| {
+            let run = flexible_run(k, 1.0);
+            assert_eq!(run.t, times);
+            run.q.iter().zip(&rigid.q).map(|(q, r)| (q[0] - r).abs()).fold(0.0, f64::max)
+        })
+        .collect();
+    assert!(diffs[0] < 1e-1, "{diffs:?}");
+    assert!(diffs[1] < diffs[0] / 6.7 && diffs[2] < diffs[1] / 6.7, "{diffs:?}");
+}
