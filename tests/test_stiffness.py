@@ -163,3 +163,20 @@ def test_cli_stiffness_and_modes(tmp_path):
     assert code == 2 and "compliance:" in err, err
     code, err = cli_run("modes", model, "--at", 1.0)
     assert code == 2 and "--at: give 2 values" in err, err
+
+
+def test_flexible_run_from_python_and_its_refusals():
+    # The energy balance and the stiff limit are tested in crates/planardyn/tests/elastic.rs;
+    # here the binding's shapes, that the spring is felt (the rotors lag), and the refusals.
+    text = (ROOT / "examples/models/five-bar.yaml").read_text()
+    flex = pd.loads(text + "\nactuators:\n  - {coordinate: theta1, rotor_inertia: 2.0e-3}\n"
+                    "  - {coordinate: theta2, rotor_inertia: 2.0e-3}\n"
+                    f"compliance:\n  drives:\n    - {{actuator: theta1, stiffness: {K1}}}\n"
+                    f"    - {{actuator: theta2, stiffness: {K2}}}\n")
+    run = st.simulate_flexible(flex, 0.2, 0.01)
+    assert run["q"].shape == (21, 2) and run["theta"].shape == (21, 2) and run["energy"].shape == (21,)
+    assert np.abs(run["theta"] - run["q"]).max() > 1e-6
+    with pytest.raises(pd.ArgumentError, match="rotor_inertia"):
+        st.simulate_flexible(pd.loads(COMPLIANT_FIVE_BAR), 0.2)
+    with pytest.raises(pd.ArgumentError, match="method"):
+        st.simulate_flexible(flex, 0.2, method="euler")

@@ -39,6 +39,7 @@ __all__ = [
     "small_oscillations",
     "equilibrium",
     "state_space",
+    "simulate_flexible",
 ]
 
 __version__: str
@@ -93,6 +94,14 @@ def deflection(
 def modes(mech: Mechanism, q: ArrayLike, free_rotors: bool = False) -> dict[str, Any]: ...
 def small_oscillations(mech: Mechanism, q: ArrayLike) -> dict[str, Any]: ...
 def equilibrium(mech: Mechanism, q_start: ArrayLike) -> NDArray[np.float64]: ...
+def simulate_flexible(
+    mech: Mechanism,
+    t_end: float,
+    output_dt: float,
+    method: str = "dop853",
+    rtol: float = 1e-09,
+    atol: float = 1e-12,
+) -> dict[str, NDArray[np.float64]]: ...
 def state_space(
     mech: Mechanism, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, points: list[tuple[str, str]] = ...
 ) -> dict[str, NDArray[np.float64]]: ...

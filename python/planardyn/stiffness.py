@@ -12,6 +12,7 @@ pair kinds' first and second derivatives:
 - :func:`small_oscillations`: the modes of a passive mechanism about its equilibrium;
 - :func:`state_space`: the linearised model (A, B, C, D) of the rigid mechanism, in
   ``scipy.signal.StateSpace``'s conventions;
+- :func:`simulate_flexible`: a run with compliant drives (the flexible-joint model);
 - :func:`stiffness_map` and :func:`along_path`: the weakest stiffness and the first natural
   frequency over a grid of end-effector positions, and along a path (compliance ellipses).
 
@@ -31,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._core import deflection as native_deflection
 from ._core import equilibrium as native_equilibrium
 from ._core import modes as native_modes
+from ._core import simulate_flexible as native_simulate_flexible
 from ._core import small_oscillations as native_small_oscillations
 from ._core import state_space as native_state_space
 from ._core import stiffness as native_stiffness
@@ -44,7 +46,7 @@ FloatArray = NDArray[np.float64]
 
 __all__ = [
     "DeflectionReport", "ModesReport", "PathStiffness", "StiffnessMap", "StiffnessReport", "along_path",
-    "deflection", "modes", "small_oscillations", "state_space", "stiffness", "stiffness_map",
+    "deflection", "modes", "simulate_flexible", "small_oscillations", "state_space", "stiffness", "stiffness_map",
 ]
 
 
@@ -305,3 +307,13 @@ def along_path(mech: Mechanism, q: ArrayLike, *, body: str, point: str | None = 
     return PathStiffness(np.array([r.pose[:2] for r in reports]), np.array([e[0] for e in ellipses]),
                          np.array([e[1] for e in ellipses]), np.array([r.weakest_stiffness for r in reports]),
                          np.array([modes(mech, r).frequency[0] for r in rows]))
+
+
+def simulate_flexible(mech: Mechanism, t_end: float, output_dt: float = 1e-3, *, method: str = "dop853",
+                      rtol: float = 1e-9, atol: float = 1e-12) -> dict[str, FloatArray]:
+    """Simulate with compliant drives: each elastic drive's rotor (``actuators``: ``gear_ratio``
+    n, ``rotor_inertia`` J) a coordinate of its own joined to its joint by the transmission's
+    spring, the model's drives the motor torques. Returns ``t`` (N,) s, ``q``, ``qd`` (N, m),
+    ``theta``, ``thetad`` (N, r) the rotors' angles and rates on the joint side (motor angle / n),
+    ``energy`` (N,) J: T + V + the rotors' kinetic and the springs' energy."""
+    return native_simulate_flexible(mech._native, float(t_end), float(output_dt), method, rtol, atol)

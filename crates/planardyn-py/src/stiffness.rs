@@ -5,6 +5,7 @@ use crate::convert::{arr1, arr2, vector, Floats};
 use crate::errors::{argument_error, run, Failure};
 use crate::mechanism::PyMechanism;
 use planardyn::elastic::{self, CartesianStiffness, Load, Modes, Output};
+use planardyn::integrate::{Method, Options};
 use planardyn::model::BodyId;
 use planardyn::{Mechanism, Workspace};
 use pyo3::prelude::*;
@@ -224,7 +225,38 @@ pub fn state_space<'py>(
     Ok(d)
 }
 
+/// The flexible-joint simulation (elastic drives' rotors as coordinates of their own) from the
+/// model's start to `t_end` (s), output every `output_dt` (s): `t` (N,), `q`, `qd` (N, m),
+/// `theta`, `thetad` (N, r) the rotors joint side, `energy` (N,) J.
+#[pyfunction]
+#[pyo3(signature = (mech, t_end, output_dt, method="dop853", rtol=1e-9, atol=1e-12))]
+pub fn simulate_flexible<'py>(
+    py: Python<'py>,
+    mech: &PyMechanism,
+    t_end: f64,
+    output_dt: f64,
+    method: &str,
+    rtol: f64,
+    atol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &*mech.inner;
+    let method: Method = method.parse().map_err(|e: String| argument_error(Some("method"), e))?;
+    let options = Options::tol(rtol, atol);
+    let run = run(py, || Ok::<_, Failure>(elastic::simulate_flexible(m, t_end, output_dt, method, &options)?))?;
+    let n = run.t.len();
+    let width = |rows: &[Vec<f64>]| rows.first().map_or(0, Vec::len);
+    let d = PyDict::new(py);
+    d.set_item("q", arr2(py, n, width(&run.q), run.q.concat())?)?;
+    d.set_item("qd", arr2(py, n, width(&run.qd), run.qd.concat())?)?;
+    d.set_item("theta", arr2(py, n, width(&run.theta), run.theta.concat())?)?;
+    d.set_item("thetad", arr2(py, n, width(&run.thetad), run.thetad.concat())?)?;
+    d.set_item("t", arr1(py, run.t))?;
+    d.set_item("energy", arr1(py, run.energy))?;
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate_flexible, m)?)?;
     m.add_function(wrap_pyfunction!(stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(weakest_direction, m)?)?;
     m.add_function(wrap_pyfunction!(deflection, m)?)?;

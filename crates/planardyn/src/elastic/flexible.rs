@@ -20,6 +20,9 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError};
 
+/// Most output times of a run: 1e7 rows of a few numbers, ~1 GB at most.
+const MAX_OUTPUTS: f64 = 1e7;
+
 /// A run: the output times (s), and per time the coordinates q, rates qd (m each), the rotors'
 /// angles theta and rates (one per elastic drive; rad or m, joint side) and the energy E (J).
 #[derive(Debug, Clone, PartialEq)]
@@ -117,8 +120,11 @@ pub fn simulate_flexible(
             format!("actuator '{name}' without one"),
         ));
     }
-    if !(t_end > 0.0 && output_dt > 0.0) || !t_end.is_finite() {
-        return Err(refuse("t_end > 0 and output_dt > 0 (s)", format!("t_end {t_end}, output_dt {output_dt}")));
+    if !(t_end > 0.0 && t_end.is_finite() && output_dt > 0.0 && t_end / output_dt <= MAX_OUTPUTS) {
+        return Err(refuse(
+            "t_end > 0 and output_dt > 0 (s), at most 1e7 outputs",
+            format!("t_end {t_end}, output_dt {output_dt}"),
+        ));
     }
     let mut rigid = mech.clone();
     // The rotors are coordinates of their own: out of A, and the drives are the springs.
