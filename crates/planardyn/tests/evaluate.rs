@@ -1,0 +1,58 @@
+//! `dynamics::evaluate`, the one-call state of an interactive view (the browser app): at rest
+//! its efforts are the holding torques (virtual work, stated in the model file) and the ground
+//! carries the weight; in motion its efforts are inverse dynamics' and its reactions are those
+//! of a forward evaluation under them.
+
+mod common;
+use common::*;
+use planardyn::dynamics::{self, evaluate, FixedDrives};
+use planardyn::kinematics::assemble_into;
+use planardyn::Workspace;
+
+/// The five-bar's holding torques in its drawing, from its model file (dV/dq by virtual work
+/// with the same numbers: an independent computation).
+const HOLDING: [f64; 2] = [-2.41181824467418, 2.6065835618815925];
+/// Those are printed to 15-16 digits, and the statics here are a few operations on numbers of
+/// size 1: agreement to 1e-12 N m.
+const HOLDING_TOL: f64 = 1e-12;
+/// Its total mass (kg): bars 0.5 + 0.5 + 0.7 + 0.7 and the 0.3 kg end effector.
+const MASS: f64 = 2.7;
+const G: f64 = 9.81;
+/// Force balance of sums of a few products of size ~10 N: round-off, 1e-12 N.
+const BALANCE_TOL: f64 = 1e-12;
+
+#[test]
+fn at_rest_the_efforts_hold_the_drawing_and_the_ground_carries_the_weight() {
+    let mech = shipped("five-bar.yaml");
+    let q = mech.drawn_q();
+    let e = evaluate(&mech, &q, &[0.0; 2], &[0.0; 2], None).unwrap();
+    for (tau, holding) in e.tau.iter().zip(HOLDING) {
+        assert!((tau - holding).abs() < HOLDING_TOL, "tau {tau} vs holding {holding}");
+    }
+    // The ground's pairs (motor1, motor2: ground is body a) push the mechanism up by its weight.
+    let names = mech.pair_names();
+    let ground: Vec<_> = ["motor1", "motor2"].iter().map(|n| names.iter().position(|p| p == n).unwrap()).collect();
+    let fx: f64 = ground.iter().map(|&k| e.reactions[k][0]).sum();
+    let fy: f64 = ground.iter().map(|&k| e.reactions[k][1]).sum();
+    assert!(fx.abs() < BALANCE_TOL && (fy - MASS * G).abs() < BALANCE_TOL, "ground force ({fx}, {fy})");
+    assert_eq!((e.kinetic, e.xd.iter().all(|v| *v == 0.0)), (0.0, true));
+    assert!(e.sigma > 0.0 && e.sigma_passive > 0.0);
+}
+
+#[test]
+fn in_motion_the_reactions_are_those_of_forward_dynamics_under_the_efforts() {
+    let mech = shipped("five-bar.yaml");
+    let q: Vec<f64> = mech.drawn_q().iter().zip([0.1, -0.2]).map(|(q, d)| q + d).collect();
+    let (qd, qdd) = ([0.3, -0.5], [1.0, 2.0]);
+    let e = evaluate(&mech, &q, &qd, &qdd, None).unwrap();
+    let mut ws = Workspace::new(&mech);
+    assemble_into(&mech, &q, &mut ws).unwrap();
+    dynamics::inverse(&mech, &q, &qd, &qdd, &mut ws).unwrap();
+    assert_eq!(e.tau, ws.tau);
+    dynamics::forward(&mech, 0.0, &q, &qd, &mut FixedDrives(e.tau.clone()), &mut ws).unwrap();
+    // Forward under the efforts gives back the accelerations asked for (round-off of two solves).
+    for (a, b) in ws.qdd.iter().zip(qdd) {
+        assert!((a - b).abs() < 1e-9, "qdd {a} vs {b}");
+    }
+    assert_eq!(e.reactions, dynamics::reactions(&mech, &mut ws));
+}
