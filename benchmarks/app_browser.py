@@ -6,8 +6,9 @@ extension (the same Rust through the Python API), measured in one run on this ma
   the page; native: inverse_dynamics then reactions through the Python API, so the native
   figure includes two Python calls);
 - a 5R's 100 x 100 singularity map over its two coordinates by continuation (the page's
-  map, web/src/map.js: assemble and measure per cell; native: the same loop in Python over
-  Mechanism.kinematics, which also computes the analogues u and w);
+  map, web/src/map.js over planardyn::dynamics::sigma_rows; native: the same loop in Python
+  over Mechanism.kinematics, which also computes the analogues u and w: the Python API has no
+  call for the map, so the native figure is the Python user's);
 - the engine's size (wasm, the page, gzipped) and the page's load time to its first drawing.
 
 Each figure is the best of REPEAT rounds (timing noise on a shared machine only adds).
@@ -97,7 +98,7 @@ PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
   const frame = best(() => { let x; for (const q of qs) x = m.evaluate(q, qd, qdd, x).x; }) / frames;
   const five = a.mech;
   const { mapRanges, mapper } = a.mapTools;
-  const map = best(() => mapper(five, mapRanges(a.info, a.info.q0), mapN, a.mech.assemble(a.info.q0)).step(Infinity), 1);
+  const map = best(() => mapper(five, mapRanges(a.info, a.info.q0), mapN, five.assemble(a.info.q0), a.info.q0).step(Infinity), 1);
   return { sim, frame, map, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000 };
 }"""
 

@@ -551,13 +551,13 @@ function startMap() {
   const ranges = mapRanges(app.info, app.q);
   const [q, x0] = [Float64Array.from(app.q), app.x];
   let level = 0;
-  let grid = mapper(app.mech, ranges, LEVELS[0], x0);
+  let grid = mapper(app.mech, ranges, LEVELS[0], x0, q);
   const t0 = performance.now();
   const names = app.info.coordinateNames;
   const work = () => {
     const done = grid.step();
     paintMap($("map"), grid, ranges, q);
-    if (done && level + 1 < LEVELS.length) grid = mapper(app.mech, ranges, LEVELS[++level], x0);
+    if (done && level + 1 < LEVELS.length) grid = mapper(app.mech, ranges, LEVELS[++level], x0, q);
     else if (done) {
       note.textContent = `σ (type II) over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms (pale: far from a singularity; dark red: at one; grey: does not assemble on this branch)`;
       app.mapGrid = grid;

@@ -1,13 +1,15 @@
 // The singularity map of a two-coordinate mechanism (a 5R, a two-input robot): over a grid
 // of (q1, q2), the type II measure sigma of the branch reached by continuation from the
-// current state, cell after cell along a serpentine (so each cell starts Newton from its
-// neighbour). Computed progressively, coarse grids first, in slices that leave the page
-// responsive; cells that do not assemble are grey.
+// current state, cell after cell along a serpentine (each cell starts Newton from its
+// neighbour; the engine's `sigmaRows`). Computed progressively, coarse grids first, in slices
+// that leave the page responsive; cells that do not assemble are grey.
 
 /** Grids of the progressive refinement; the last is the map's resolution. */
 export const LEVELS = [25, 50, 100];
 /** Work per slice before the page gets the main thread back (ms). */
 const SLICE_MS = 12;
+/** Rows per call of the engine: a 100-wide row takes about a millisecond. */
+const ROWS_PER_CALL = 4;
 
 /** The grid's ranges: an angle q0 +- pi, a displacement q0 +- L. */
 export function mapRanges(info, q) {
@@ -18,31 +20,23 @@ export function mapRanges(info, q) {
 }
 
 /** sigma on an n x n grid over `ranges` (row j: q2, column i: q1), NaN where it does not
- * assemble. Runs `budget` ms at most per call of the returned step(); done when it returns true. */
-export function mapper(mech, ranges, n, x0) {
+ * assemble, computed by the engine a few rows a call (`Mechanism.sigmaRows`: one workspace,
+ * a serpentine walk by continuation from x0). */
+export function mapper(mech, ranges, n, x0, q) {
   const sigma = new Float64Array(n * n).fill(NaN);
-  const at = (r, i) => r[0] + ((r[1] - r[0]) * (i + 0.5)) / n;
-  let [j, i, x, rowStart] = [0, 0, x0, x0];
-  const q = new Float64Array(2);
-  function cell() {
-    const ii = j % 2 ? n - 1 - i : i;
-    q[0] = at(ranges[0], ii);
-    q[1] = at(ranges[1], j);
-    try {
-      x = mech.assemble(q, x);
-      sigma[j * n + ii] = mech.measures(x).sigma;
-      if (i === 0) rowStart = x;
-    } catch {
-      x = rowStart;
-    }
-    if (++i === n) [i, j] = [0, j + 1];
-  }
+  const axes = ranges.map((r) => Float64Array.from({ length: n }, (_, i) => r[0] + ((r[1] - r[0]) * (i + 0.5)) / n));
+  let [j, x] = [0, x0];
   return {
     sigma, n,
     /** Work for `budget` ms (all at once when Infinity); true when the grid is done. */
     step(budget = SLICE_MS) {
       const end = performance.now() + budget;
-      while (j < n && performance.now() < end) cell();
+      while (j < n && performance.now() < end) {
+        const rows = Math.min(n - j, ROWS_PER_CALL);
+        const out = mech.sigmaRows(q, 0, 1, axes[0], axes[1], j, j + rows, x);
+        sigma.set(out.sigma, j * n);
+        [j, x] = [j + rows, out.x];
+      }
       return j >= n;
     },
   };

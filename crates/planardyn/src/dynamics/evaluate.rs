@@ -2,13 +2,14 @@
 //! motion, the drive efforts that make it, the pair reactions under those efforts, the
 //! singularity measures and the energies. The entry point of an interactive view (the browser
 //! app draws a frame from one [`evaluate`]), so that a binding converts and does not assemble
-//! the pipeline itself.
+//! the pipeline itself. And the rows of a singularity map over two coordinates, for a view
+//! that redraws it as the design changes ([`sigma_rows`]).
 
 use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives};
-use crate::kinematics::{assemble_from, assemble_into, passive_sigma_min, sigma_min, Chart};
+use crate::kinematics::{assemble_from, assemble_into, passive_sigma_min, sigma_min, sigma_min_with, Chart};
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
-use crate::Error;
+use crate::{Error, KinematicsError};
 
 /// One state's quantities; shapes with n bodies, m coordinates, p pairs.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,4 +74,64 @@ pub fn evaluate(
         kinetic,
         potential,
     })
+}
+
+/// Rows of a map of the type II measure over two coordinates, as a design view draws it while
+/// a dimension changes: cell (j, i) is the mechanism at q with `q[k[0]] = axes[0][i]` and
+/// `q[k[1]] = axes[1][j]` (the other coordinates as in q). The cells are visited along a
+/// serpentine (row j left to right when j is even, else right to left), each assembled by
+/// continuation from the last one that assembled (from `x_start`, 3n, for the first), so the
+/// map follows one branch; a cell that does not assemble is NaN and the walk restarts from the
+/// first cell of its row. Rows are computed `rows` at a time so a view can refine
+/// progressively; pass the returned `x` as the next call's `x_start`.
+pub struct SigmaRows {
+    /// sigma of rows `rows`, row-major (rows.len() x axes[0].len()), NaN where not assembled.
+    pub sigma: Vec<f64>,
+    /// Body coordinates (3n) of the last cell that assembled: where the next rows continue.
+    pub x: Vec<f64>,
+}
+
+/// See [`SigmaRows`]. One workspace for all the cells (no allocation per cell).
+pub fn sigma_rows(
+    mech: &Mechanism,
+    q: &[f64],
+    k: [usize; 2],
+    axes: [&[f64]; 2],
+    rows: std::ops::Range<usize>,
+    x_start: &[f64],
+) -> Result<SigmaRows, Error> {
+    let m = mech.dof();
+    if k[0] == k[1] || k.iter().any(|&k| k >= m) {
+        let got = format!("{k:?} (the model has {m} coordinates)");
+        return Err(KinematicsError::bad_argument("k", "two different coordinate indices", got).into());
+    }
+    if rows.end > axes[1].len() || axes.iter().any(|a| a.iter().any(|v| !v.is_finite())) {
+        let got = format!("rows {rows:?} of {} finite values", axes[1].len());
+        return Err(KinematicsError::bad_argument("axes", "finite values, rows within axes[1]", got).into());
+    }
+    if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
+        let got = format!("{} values", x_start.len());
+        return Err(
+            KinematicsError::bad_argument("x_start", format!("{} finite body coordinates", mech.n_x()), got).into()
+        );
+    }
+    let mut ws = Workspace::new(mech);
+    let (n, mut q) = (axes[0].len(), q.to_vec());
+    let (mut last, mut sigma) = (x_start.to_vec(), Vec::with_capacity(rows.len() * n));
+    for j in rows {
+        let (row_start, mut row) = (last.clone(), vec![f64::NAN; n]);
+        q[k[1]] = axes[1][j];
+        for s in 0..n {
+            let i = if j % 2 == 0 { s } else { n - 1 - s };
+            q[k[0]] = axes[0][i];
+            if assemble_from(mech, &last, &q, &mut ws).is_ok() {
+                row[i] = sigma_min_with(&mut ws.sys, mech, &Chart::Inputs, &ws.x);
+                last.copy_from_slice(&ws.x);
+            } else {
+                last.copy_from_slice(&row_start);
+            }
+        }
+        sigma.extend_from_slice(&row);
+    }
+    Ok(SigmaRows { sigma, x: last })
 }

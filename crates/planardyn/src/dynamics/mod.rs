@@ -26,7 +26,7 @@ pub mod transmission;
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
 pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivatives, Jacobians, PowerRates};
 pub use energy::{kinetic_energy, potential_energy};
-pub use evaluate::{evaluate, Evaluation};
+pub use evaluate::{evaluate, sigma_rows, Evaluation, SigmaRows};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{dynamic_stages, forward, mass_matrix};
 pub use inverse::{inverse, inverse_at_rates, rates_mismatch};
