@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from planardyn.app import app_html, app_template, model_payload
 from playwright.sync_api import sync_playwright
 
@@ -48,9 +48,9 @@ def best(f, repeat: int = REPEAT) -> float:
 
 
 def native() -> dict[str, float]:
-    four = pd.load(pd.models.path("four-bar-gravity"))
+    four = pdy.load(pdy.models.path("four-bar-gravity"))
     out = {"sim": best(lambda: four.simulate(t_end=10.0))}
-    rrr = pd.load(pd.models.path("3-rrr"))
+    rrr = pdy.load(pdy.models.path("3-rrr"))
     q0 = rrr.q0
     qs = [q0 + 0.05 * np.sin(0.1 * k) for k in range(FRAMES)]
     qd, qdd = np.full(rrr.dof, 0.2), np.full(rrr.dof, 0.5)
@@ -61,12 +61,12 @@ def native() -> dict[str, float]:
             rrr.reactions(q, qd, tau=tau)
 
     out["frame"] = best(frames) / FRAMES
-    five = pd.load(pd.models.path("five-bar"))
+    five = pdy.load(pdy.models.path("five-bar"))
     out["map"] = best(lambda: python_map(five), repeat=1)
     return out
 
 
-def python_map(mech: pd.Mechanism) -> np.ndarray:
+def python_map(mech: pdy.Mechanism) -> np.ndarray:
     """The page's map (web/src/map.js) through the Python API: a serpentine over the grid,
     each cell continued from the last."""
     q0 = mech.q0
@@ -82,7 +82,7 @@ def python_map(mech: pd.Mechanism) -> np.ndarray:
                 x, sigma[j, ii] = k["x"], k["sigma_min"]
                 if i == 0:
                     row_start = x
-            except pd.PlanardynError:
+            except pdy.PlanardynError:
                 x = row_start
     return sigma
 
@@ -90,9 +90,9 @@ def python_map(mech: pd.Mechanism) -> np.ndarray:
 PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
   const a = window.planardyn, pd = a.pd;
   const best = (f, n = repeat) => { let b = Infinity; for (let i = 0; i < n; i++) { const t = performance.now(); f(); b = Math.min(b, performance.now() - t); } return b / 1000; };
-  const fm = pd.load(four, "yaml", "four-bar-gravity.yaml");
+  const fm = pdy.load(four, "yaml", "four-bar-gravity.yaml");
   const sim = best(() => fm.simulate({tEnd: 10}));
-  const m = pd.load(rrr, "yaml", "3-rrr.yaml"), info = m.info(), q0 = info.q0, n = info.dof;
+  const m = pdy.load(rrr, "yaml", "3-rrr.yaml"), info = m.info(), q0 = info.q0, n = info.dof;
   const qs = [...Array(frames).keys()].map((k) => q0.map((v) => v + 0.05 * Math.sin(0.1 * k)));
   const qd = new Float64Array(n).fill(0.2), qdd = new Float64Array(n).fill(0.5);
   const frame = best(() => { let x; for (const q of qs) x = m.evaluate(q, qd, qdd, x).x; }) / frames;
@@ -109,7 +109,7 @@ def browser() -> dict[str, float]:
         sys.exit("chromium is needed (./dev installs Debian's as root)")
     with tempfile.TemporaryDirectory() as tmp, sync_playwright() as p:
         page_file = Path(tmp) / "app.html"
-        page_file.write_text(app_html(model_payload(pd.models.path("five-bar"))), encoding="utf-8")
+        page_file.write_text(app_html(model_payload(pdy.models.path("five-bar"))), encoding="utf-8")
         b = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
         loads = []
         for _ in range(REPEAT):
@@ -121,7 +121,7 @@ def browser() -> dict[str, float]:
         page = b.new_page()
         page.goto(page_file.as_uri())
         page.wait_for_selector("body[data-ready='1']", timeout=30_000)
-        texts = [pd.models.path(n).read_text() for n in ("four-bar-gravity", "3-rrr")]
+        texts = [pdy.models.path(n).read_text() for n in ("four-bar-gravity", "3-rrr")]
         out = page.evaluate(PAGE_BENCH, [*texts, FRAMES, MAP_N, REPEAT])
         b.close()
     out["load"] = min(t["readyMs"] for t in loads) / 1000

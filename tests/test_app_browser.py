@@ -15,7 +15,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 import pytest
 from planardyn.cli import main
 
@@ -71,8 +71,8 @@ def page(browser, app_file):
     pg.close()
 
 
-def five_bar() -> pd.Mechanism:
-    return pd.load(pd.models.path("five-bar"))
+def five_bar() -> pdy.Mechanism:
+    return pdy.load(pdy.models.path("five-bar"))
 
 
 def test_state_equals_the_python_api(page):

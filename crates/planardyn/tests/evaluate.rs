@@ -57,3 +57,28 @@ fn in_motion_the_reactions_are_those_of_forward_dynamics_under_the_efforts() {
     }
     assert_eq!(e.reactions, dynamics::reactions(&mech, &mut ws));
 }
+
+#[test]
+fn the_map_rows_measure_each_cell_on_the_branch_followed_and_mark_what_does_not_assemble() {
+    use planardyn::dynamics::sigma_rows;
+    use planardyn::kinematics::{assemble, sigma_min, Chart};
+    let mech = shipped("five-bar.yaml");
+    let q = mech.drawn_q();
+    // A 3 x 2 grid of small moves around the drawing: every cell is the branch drawn, so each
+    // measure is that of the configuration assembled from the drawing (the same solution of
+    // the same Newton tolerance: 1e-12 of sigma ~ 0.3 covers the two continuation paths).
+    let axes: [&[f64]; 2] = [&[q[0] - 0.05, q[0], q[0] + 0.05], &[q[1] - 0.04, q[1] + 0.04]];
+    let out = sigma_rows(&mech, &q, [0, 1], axes, 0..2, &mech.x0).unwrap();
+    for j in 0..2 {
+        for i in 0..3 {
+            let x = assemble(&mech, &[axes[0][i], axes[1][j]]).unwrap();
+            let expected = sigma_min(&mech, &Chart::Inputs, &x);
+            assert!((out.sigma[j * 3 + i] - expected).abs() < 1e-12, "cell ({j}, {i})");
+        }
+    }
+    // theta1 = pi, theta2 = 0 puts the elbows C1 = (-0.4, 0) and C2 = (0.4, 0) 0.8 m apart:
+    // two 0.35 m distal links cannot close. NaN, and the walk goes on from where it was.
+    let far = sigma_rows(&mech, &q, [0, 1], [&[std::f64::consts::PI], &[0.0]], 0..1, &out.x).unwrap();
+    assert!(far.sigma[0].is_nan());
+    assert_eq!(far.x, out.x);
+}
