@@ -557,7 +557,7 @@ function startMap() {
   const work = () => {
     const done = grid.step();
     paintMap($("map"), grid, ranges, q);
-    if (done && level + 1 < LEVELS.length) grid = mapper(app.mech, ranges, LEVELS[++level], x0, q);
+    if (done && level + 1 < LEVELS.length) grid = mapper(app.mech, ranges, LEVELS[++level], x0, q, grid);
     else if (done) {
       note.textContent = `σ (type II) over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms (pale: far from a singularity; dark red: at one; grey: does not assemble on this branch)`;
       app.mapGrid = grid;

@@ -21,23 +21,36 @@ export function mapRanges(info, q) {
 
 /** sigma on an n x n grid over `ranges` (row j: q2, column i: q1), NaN where it does not
  * assemble, computed by the engine a few rows a call (`Mechanism.sigmaRows`: one workspace,
- * a serpentine walk by continuation from x0). */
-export function mapper(mech, ranges, n, x0, q) {
+ * continuation outwards from the current state q, whose body coordinates are x0: its row
+ * first, then the rows above it, then those below). `coarse`, a finished coarser grid, fills
+ * the cells not yet computed, so that the map refines in place. */
+export function mapper(mech, ranges, n, x0, q, coarse = null) {
   const sigma = new Float64Array(n * n).fill(NaN);
+  if (coarse) {
+    const c = coarse.n;
+    for (let j = 0; j < n; j++) for (let i = 0; i < n; i++) sigma[j * n + i] = coarse.sigma[Math.floor((j * c) / n) * c + Math.floor((i * c) / n)];
+  }
   const axes = ranges.map((r) => Float64Array.from({ length: n }, (_, i) => r[0] + ((r[1] - r[0]) * (i + 0.5)) / n));
-  let [j, x] = [0, x0];
+  const j0 = Math.floor(n / 2);
+  const order = [...Array(n - j0).keys()].map((d) => j0 + d).concat([...Array(j0).keys()].map((d) => j0 - 1 - d));
+  let [done, x, xMiddle] = [0, x0, null];
   return {
     sigma, n,
     /** Work for `budget` ms (all at once when Infinity); true when the grid is done. */
     step(budget = SLICE_MS) {
       const end = performance.now() + budget;
-      while (j < n && performance.now() < end) {
-        const rows = Math.min(n - j, ROWS_PER_CALL);
-        const out = mech.sigmaRows(q, 0, 1, axes[0], axes[1], j, j + rows, x);
-        sigma.set(out.sigma, j * n);
-        [j, x] = [j + rows, out.x];
+      while (done < n && performance.now() < end) {
+        // The rows below the middle continue from the middle row, not from the top one.
+        if (done === n - j0) x = xMiddle;
+        const count = done === 0 ? 1 : Math.min(ROWS_PER_CALL, (done < n - j0 ? n - j0 : n) - done);
+        const rows = Uint32Array.from(order.slice(done, done + count));
+        const out = mech.sigmaRows(q, 0, 1, axes[0], axes[1], j0, rows, x);
+        rows.forEach((j, r) => sigma.set(out.sigma.subarray(r * n, (r + 1) * n), j * n));
+        x = out.x;
+        if (done === 0) xMiddle = out.x;
+        done += count;
       }
-      return j >= n;
+      return done >= n;
     },
   };
 }

@@ -194,10 +194,10 @@ impl WasmMechanism {
         Ok(Obj::new().set("sigma", sigma).set("sigmaPassive", kin::passive_sigma_min(m, x)).build())
     }
 
-    /// Rows `rowStart..rowEnd` of the type II measure over coordinates k1 (columns, values
-    /// `axis1`) and k2 (rows, `axis2`), the others as in q, by continuation from `xStart`
-    /// (`planardyn::dynamics::sigma_rows`): `{sigma (rows x axis1.length, NaN where it does
-    /// not assemble), x (where the next rows continue)}`.
+    /// Rows `rows` (in that order) of the type II measure over coordinates k1 (columns, values
+    /// `axis1`) and k2 (rows, `axis2`), the others as in q, each row walked from column `i0`,
+    /// by continuation from `xStart` (`planardyn::dynamics::sigma_rows`): `{sigma (rows x
+    /// axis1.length, NaN where it does not assemble), x (where the next rows continue)}`.
     #[wasm_bindgen(js_name = sigmaRows)]
     #[allow(clippy::too_many_arguments)]
     pub fn sigma_rows(
@@ -207,13 +207,13 @@ impl WasmMechanism {
         k2: usize,
         axis1: &[f64],
         axis2: &[f64],
-        row_start: usize,
-        row_end: usize,
+        i0: usize,
+        rows: &[u32],
         x_start: &[f64],
     ) -> Result<JsValue, JsValue> {
         self.q_arg("q", q)?;
-        let rows = row_start..row_end.max(row_start);
-        let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], rows, x_start))?;
+        let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
+        let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
         Ok(Obj::new().f64s("sigma", &out.sigma).f64s("x", &out.x).build())
     }
 

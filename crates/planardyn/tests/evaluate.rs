@@ -68,7 +68,7 @@ fn the_map_rows_measure_each_cell_on_the_branch_followed_and_mark_what_does_not_
     // measure is that of the configuration assembled from the drawing (the same solution of
     // the same Newton tolerance: 1e-12 of sigma ~ 0.3 covers the two continuation paths).
     let axes: [&[f64]; 2] = [&[q[0] - 0.05, q[0], q[0] + 0.05], &[q[1] - 0.04, q[1] + 0.04]];
-    let out = sigma_rows(&mech, &q, [0, 1], axes, 0..2, &mech.x0).unwrap();
+    let out = sigma_rows(&mech, &q, [0, 1], axes, 1, &[0, 1], &mech.x0).unwrap();
     for j in 0..2 {
         for i in 0..3 {
             let x = assemble(&mech, &[axes[0][i], axes[1][j]]).unwrap();
@@ -77,8 +77,8 @@ fn the_map_rows_measure_each_cell_on_the_branch_followed_and_mark_what_does_not_
         }
     }
     // theta1 = pi, theta2 = 0 puts the elbows C1 = (-0.4, 0) and C2 = (0.4, 0) 0.8 m apart:
-    // two 0.35 m distal links cannot close. NaN, and the walk goes on from where it was.
-    let far = sigma_rows(&mech, &q, [0, 1], [&[std::f64::consts::PI], &[0.0]], 0..1, &out.x).unwrap();
+    // two 0.35 m distal links cannot close. NaN, and the next rows continue from where it was.
+    let far = sigma_rows(&mech, &q, [0, 1], [&[std::f64::consts::PI], &[0.0]], 0, &[0], &out.x).unwrap();
     assert!(far.sigma[0].is_nan());
     assert_eq!(far.x, out.x);
 }

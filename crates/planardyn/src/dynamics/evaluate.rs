@@ -78,16 +78,18 @@ pub fn evaluate(
 
 /// Rows of a map of the type II measure over two coordinates, as a design view draws it while
 /// a dimension changes: cell (j, i) is the mechanism at q with `q[k[0]] = axes[0][i]` and
-/// `q[k[1]] = axes[1][j]` (the other coordinates as in q). The cells are visited along a
-/// serpentine (row j left to right when j is even, else right to left), each assembled by
-/// continuation from the last one that assembled (from `x_start`, 3n, for the first), so the
-/// map follows one branch; a cell that does not assemble is NaN and the walk restarts from the
-/// first cell of its row. Rows are computed `rows` at a time so a view can refine
-/// progressively; pass the returned `x` as the next call's `x_start`.
+/// `q[k[1]] = axes[1][j]` (the other coordinates as in q). The map follows one branch by
+/// continuation from the current state outwards: each row in `rows` (in that order) starts at
+/// column `i0` from the previous row's start (from `x_start`, 3n, for the first), then walks
+/// right and left from there, each cell from its neighbour; a cell that does not assemble is
+/// NaN and the walk goes on from the row's start. A view computes the rows from the current
+/// state's row up, then down again from it, a few at a time (refining progressively), passing
+/// the returned `x` as the next call's `x_start`.
 pub struct SigmaRows {
-    /// sigma of rows `rows`, row-major (rows.len() x axes[0].len()), NaN where not assembled.
+    /// sigma of the rows in the order given, row after row (axes[0].len() each), NaN where the
+    /// mechanism does not assemble on the branch followed.
     pub sigma: Vec<f64>,
-    /// Body coordinates (3n) of the last cell that assembled: where the next rows continue.
+    /// Body coordinates (3n) of the last row's start cell: where the next rows continue.
     pub x: Vec<f64>,
 }
 
@@ -97,7 +99,8 @@ pub fn sigma_rows(
     q: &[f64],
     k: [usize; 2],
     axes: [&[f64]; 2],
-    rows: std::ops::Range<usize>,
+    i0: usize,
+    rows: &[usize],
     x_start: &[f64],
 ) -> Result<SigmaRows, Error> {
     let m = mech.dof();
@@ -105,9 +108,10 @@ pub fn sigma_rows(
         let got = format!("{k:?} (the model has {m} coordinates)");
         return Err(KinematicsError::bad_argument("k", "two different coordinate indices", got).into());
     }
-    if rows.end > axes[1].len() || axes.iter().any(|a| a.iter().any(|v| !v.is_finite())) {
-        let got = format!("rows {rows:?} of {} finite values", axes[1].len());
-        return Err(KinematicsError::bad_argument("axes", "finite values, rows within axes[1]", got).into());
+    let n = axes[0].len();
+    if i0 >= n || rows.iter().any(|&j| j >= axes[1].len()) || axes.iter().any(|a| a.iter().any(|v| !v.is_finite())) {
+        let got = format!("i0 {i0}, rows {rows:?} of axes of {n} and {} finite values", axes[1].len());
+        return Err(KinematicsError::bad_argument("axes", "finite axes, i0 and rows within them", got).into());
     }
     if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
         let got = format!("{} values", x_start.len());
@@ -116,22 +120,34 @@ pub fn sigma_rows(
         );
     }
     let mut ws = Workspace::new(mech);
-    let (n, mut q) = (axes[0].len(), q.to_vec());
-    let (mut last, mut sigma) = (x_start.to_vec(), Vec::with_capacity(rows.len() * n));
-    for j in rows {
-        let (row_start, mut row) = (last.clone(), vec![f64::NAN; n]);
+    let mut q = q.to_vec();
+    let (mut start, mut sigma) = (x_start.to_vec(), Vec::with_capacity(rows.len() * n));
+    let mut cell = |q: &[f64], from: &[f64], ws: &mut Workspace| {
+        assemble_from(mech, from, q, ws).ok().map(|()| sigma_min_with(&mut ws.sys, mech, &Chart::Inputs, &ws.x))
+    };
+    for &j in rows {
+        let mut row = vec![f64::NAN; n];
         q[k[1]] = axes[1][j];
-        for s in 0..n {
-            let i = if j % 2 == 0 { s } else { n - 1 - s };
-            q[k[0]] = axes[0][i];
-            if assemble_from(mech, &last, &q, &mut ws).is_ok() {
-                row[i] = sigma_min_with(&mut ws.sys, mech, &Chart::Inputs, &ws.x);
-                last.copy_from_slice(&ws.x);
-            } else {
-                last.copy_from_slice(&row_start);
+        q[k[0]] = axes[0][i0];
+        if let Some(s) = cell(&q, &start, &mut ws) {
+            row[i0] = s;
+            start.copy_from_slice(&ws.x);
+        }
+        let (right, left) = ((i0 + 1..n).collect::<Vec<_>>(), (0..i0).rev().collect::<Vec<_>>());
+        for side in [right, left] {
+            let mut last = start.clone();
+            for i in side {
+                q[k[0]] = axes[0][i];
+                match cell(&q, &last, &mut ws) {
+                    Some(s) => {
+                        row[i] = s;
+                        last.copy_from_slice(&ws.x);
+                    }
+                    None => last.copy_from_slice(&start),
+                }
             }
         }
         sigma.extend_from_slice(&row);
     }
-    Ok(SigmaRows { sigma, x: last })
+    Ok(SigmaRows { sigma, x: start })
 }
