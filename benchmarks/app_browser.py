@@ -91,7 +91,7 @@ PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
   const a = window.planardyn, pd = a.pd;
   const best = (f, n = repeat) => { let b = Infinity; for (let i = 0; i < n; i++) { const t = performance.now(); f(); b = Math.min(b, performance.now() - t); } return b / 1000; };
   const fm = pdy.load(four, "yaml", "four-bar-gravity.yaml");
-  const sim = best(() => fm.simulate({tEnd: 10}));
+  const sim = best(() => fm.simulate({t_end: 10}));
   const m = pdy.load(rrr, "yaml", "3-rrr.yaml"), info = m.info(), q0 = info.q0, n = info.dof;
   const qs = [...Array(frames).keys()].map((k) => q0.map((v) => v + 0.05 * Math.sin(0.1 * k)));
   const qd = new Float64Array(n).fill(0.2), qdd = new Float64Array(n).fill(0.5);

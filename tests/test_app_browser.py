@@ -167,7 +167,7 @@ def test_a_run_in_the_page_agrees_with_python(page):
     res = mech.simulate(t_end=1.0, output_dt=0.01)
     got = page.evaluate(
         """() => {
-            const r = window.planardyn.mech.simulate({tEnd: 1.0, outputDt: 0.01});
+            const r = window.planardyn.mech.simulate({t_end: 1.0, output_dt: 0.01});
             return {t: Array.from(r.t), q: Array.from(r.q), status: r.status};
         }"""
     )

@@ -356,7 +356,7 @@ function simulate() {
   const t0 = performance.now();
   let run;
   try {
-    run = app.mech.simulate({ tEnd, outputDt: tEnd / RUN_OUTPUTS, q0: app.q, qd0: zeros(), motion });
+    run = app.mech.simulate({ t_end: tEnd, output_dt: tEnd / RUN_OUTPUTS, q0: app.q, qd0: zeros(), motion });
   } catch (err) {
     status(describe(err), true);
     return null;

@@ -279,8 +279,8 @@ impl WasmMechanism {
         Ok(self.point_rows(obj, x, xd, &out.xdd).build())
     }
 
-    /// Simulate from the model's defaults changed by `options` (`SimulateOptions`, fields in
-    /// camelCase: tEnd, method, rtol, atol, dt, outputDt, q0, qd0, maxSteps, motion (speeds of
+    /// Simulate from the model's defaults changed by `options` (`SimulateOptions`: the model
+    /// file's t_end, method, rtol, atol, dt, output_dt; q0, qd0, maxSteps, motion (speeds of
     /// driven coordinates), events); the run as typed arrays, as `Mechanism.simulate` in Python.
     pub fn simulate(&self, options: JsValue) -> Result<JsValue, JsValue> {
         let options: SimulateOptions = crate::convert::from_js("options", options)?;

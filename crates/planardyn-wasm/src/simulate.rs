@@ -5,6 +5,7 @@
 use crate::convert::{array, f64s, Obj};
 use crate::errors::{argument_error, js};
 use planardyn::dynamics::ModelDrives;
+use planardyn::model::spec::SimulateSpec;
 use planardyn::model::MotionLaw;
 use planardyn::simulate::{simulate_observed, Event, Observe, Overrides, Trajectory};
 use planardyn::Mechanism;
@@ -30,18 +31,17 @@ pub struct EventOption {
     pub direction: f64,
 }
 
-/// The options of a run, each `undefined` for the model file's (times in s).
+/// The options of a run, each `undefined` for the model file's (times in s): the fields of the
+/// model file's `simulate` section by its names (t_end, method, rtol, atol, dt, output_dt; an
+/// unknown name is refused there), and the start and the motions.
 #[derive(Debug, Default, Deserialize)]
-#[serde(rename_all = "camelCase", deny_unknown_fields, default)]
+#[serde(default)]
 pub struct SimulateOptions {
-    pub t_end: Option<f64>,
-    pub method: Option<String>,
-    pub rtol: Option<f64>,
-    pub atol: Option<f64>,
-    pub dt: Option<f64>,
-    pub output_dt: Option<f64>,
+    #[serde(flatten)]
+    pub settings: SimulateSpec,
     pub q0: Option<Vec<f64>>,
     pub qd0: Option<Vec<f64>>,
+    #[serde(rename = "maxSteps")]
     pub max_steps: Option<usize>,
     pub motion: Vec<MotionOption>,
     pub events: Vec<EventOption>,
@@ -72,13 +72,13 @@ pub fn run(mech: &Mechanism, options: SimulateOptions) -> Result<JsValue, JsValu
         .map(|e| Ok(Event::coordinate(coordinate(e.coordinate, "events")?, e.value, e.terminal, e.direction)))
         .collect::<Result<Vec<_>, JsValue>>()?;
     let overrides = Overrides {
-        t_end: options.t_end,
-        method: options.method,
-        rtol: options.rtol,
-        atol: options.atol,
-        dt: options.dt,
+        t_end: options.settings.t_end,
+        method: options.settings.method,
+        rtol: options.settings.rtol,
+        atol: options.settings.atol,
+        dt: options.settings.dt,
         t_eval: None,
-        output_dt: options.output_dt,
+        output_dt: options.settings.output_dt,
         q0: options.q0,
         qd0: options.qd0,
         max_steps: options.max_steps,

@@ -122,7 +122,7 @@ pub fn sigma_rows(
     let mut ws = Workspace::new(mech);
     let mut q = q.to_vec();
     let (mut start, mut sigma) = (x_start.to_vec(), Vec::with_capacity(rows.len() * n));
-    let mut cell = |q: &[f64], from: &[f64], ws: &mut Workspace| {
+    let cell = |q: &[f64], from: &[f64], ws: &mut Workspace| {
         assemble_from(mech, from, q, ws).ok().map(|()| sigma_min_with(&mut ws.sys, mech, &Chart::Inputs, &ws.x))
     };
     for &j in rows {
