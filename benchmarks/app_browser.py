@@ -32,7 +32,7 @@ from playwright.sync_api import sync_playwright
 
 ROOT = Path(__file__).resolve().parents[1]
 WASM = ROOT / "target" / "app" / "pkg" / "planardyn_wasm_bg.wasm"
-REPEAT = 5
+REPEAT = 15
 FRAMES = 200
 MAP_N = 100
 
@@ -90,9 +90,9 @@ def python_map(mech: pdy.Mechanism) -> np.ndarray:
 PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
   const a = window.planardyn, pd = a.pd;
   const best = (f, n = repeat) => { let b = Infinity; for (let i = 0; i < n; i++) { const t = performance.now(); f(); b = Math.min(b, performance.now() - t); } return b / 1000; };
-  const fm = pdy.load(four, "yaml", "four-bar-gravity.yaml");
+  const fm = pd.load(four, "yaml", "four-bar-gravity.yaml");
   const sim = best(() => fm.simulate({t_end: 10}));
-  const m = pdy.load(rrr, "yaml", "3-rrr.yaml"), info = m.info(), q0 = info.q0, n = info.dof;
+  const m = pd.load(rrr, "yaml", "3-rrr.yaml"), info = m.info(), q0 = info.q0, n = info.dof;
   const qs = [...Array(frames).keys()].map((k) => q0.map((v) => v + 0.05 * Math.sin(0.1 * k)));
   const qd = new Float64Array(n).fill(0.2), qdd = new Float64Array(n).fill(0.5);
   const frame = best(() => { let x; for (const q of qs) x = m.evaluate(q, qd, qdd, x).x; }) / frames;
