@@ -104,19 +104,22 @@ fn trajectory(t: Trajectory) -> JsValue {
         .set("maxResidual", st.max_residual)
         .set("minSigma", st.min_sigma)
         .set("energyDrift", st.energy_drift);
-    Obj::new()
-        .f64s("t", &t.t)
-        .f64s("q", &t.q)
-        .f64s("qd", &t.qd)
-        .f64s("qdd", &t.qdd)
-        .f64s("tau", &t.tau)
-        .f64s("x", &t.x)
-        .f64s("xd", &t.xd)
-        .f64s("kinetic", &t.kinetic)
-        .f64s("potential", &t.potential)
-        .f64s("work", &t.work)
-        .f64s("sigma", &t.sigma)
-        .f64s("residual", &t.residual)
+    let rows = [
+        ("t", &t.t),
+        ("q", &t.q),
+        ("qd", &t.qd),
+        ("qdd", &t.qdd),
+        ("tau", &t.tau),
+        ("x", &t.x),
+        ("xd", &t.xd),
+        ("kinetic", &t.kinetic),
+        ("potential", &t.potential),
+        ("work", &t.work),
+        ("sigma", &t.sigma),
+        ("residual", &t.residual),
+    ];
+    rows.into_iter()
+        .fold(Obj::new(), |obj, (k, v)| obj.f64s(k, v))
         .set("tEvents", array(t.events.t.iter().map(|r| f64s(r).into())))
         .set("qEvents", array(t.events.q.iter().map(|r| f64s(r).into())))
         .set("status", t.status.name())
