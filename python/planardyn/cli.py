@@ -334,6 +334,20 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
              "  planardyn demo --out /tmp/demo --model slider-crank")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
+    w = _sub(sub, "app", "write the browser app: drag, edit and simulate a model in one offline HTML file",
+             "Write one HTML file holding planardyn's engine as WebAssembly and the model: open it in a\n"
+             "browser (no server, no network) to drag a point or a coordinate and see the drive\n"
+             "efforts, pair reactions, singularity measure and point paths follow; edit the model with\n"
+             "the loader's errors in place; simulate, play, chart every channel and export. With\n"
+             "--results, a run computed in Python is in the page too, ready to play.",
+             "  planardyn app five-bar -o five-bar.html\n"
+             "  planardyn app my-linkage.yaml -o app.html\n"
+             "  planardyn app four-bar-gravity --results run.csv -o run.html")
+    w.add_argument("model", nargs="?", type=Path, default=Path("five-bar"), help=MODEL_HELP + "; default five-bar")
+    w.add_argument("-o", "--output", "--out", type=Path, dest="output", default=Path("app.html"),
+                   help="the HTML file to write (default app.html)")
+    w.add_argument("--results", type=_results_path, help="a results file of the model (.csv, .parquet, .npz) to play")
+    w.set_defaults(run=_app)
     size_command(sub)
     _plan_command(sub, full=command == "plan")
     exchange_commands(sub)
@@ -638,6 +652,25 @@ def _point_motion(res: SimulationResult, path: Path, points: list[str]) -> Any:
                          "and a point's motion is its ground copy's, at rest: give a point the ground does not carry "
                          f"(add one at the same place to the points of {' or '.join(bodies)} in the model file)")
     return motion
+
+
+def _app(args: argparse.Namespace) -> int:
+    from .app import write_app
+    from .results_io import read_results
+
+    if args.output.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"{args.output}: the app is an .html file")
+    mech = load(args.model)
+    res = None
+    if args.results is not None:
+        res = read_results(args.results)
+        if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
+            raise UsageError(f"{args.results} was not computed with {args.given}: its coordinates are "
+                             f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})")
+    with writing(args.output):
+        out = write_app(args.output, args.model, res, mech)
+    print(f"{out}: the app for {mech.name} ({out.stat().st_size / 1e6:.1f} MB, one offline file; open it in a browser)")
+    return EXIT_OK
 
 
 def _animate(args: argparse.Namespace) -> int:
