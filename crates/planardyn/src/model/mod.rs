@@ -9,6 +9,7 @@
 //! The ground is not part of `x`; its local frame is the global frame.
 
 pub mod actuators;
+pub mod construction;
 pub(crate) mod build;
 pub(crate) mod checks;
 pub(crate) mod diameter;
