@@ -177,7 +177,7 @@ def test_a_yaml_tag_is_refused_with_its_line_and_column():
     assert e.path == "line 1 column 1"
     assert str(e) == (
         "m.yaml: line 1 column 1: the YAML tag `!model` is not part of the model format; "
-        "remove it and write the value alone (see docs/model-format.md)"
+        "remove it and write the value alone (see `planardyn docs model-format`)"
     )
 
 

@@ -15,6 +15,7 @@ tests/test_cli_fuzz.py`` runs a longer one (default 150 inputs, seed 11).
 from __future__ import annotations
 
 import io
+import itertools
 import json
 import os
 import zipfile
@@ -48,7 +49,24 @@ def originals(tmp_path_factory) -> dict[str, bytes]:
     for ext in FORMATS:
         p = pd.results_io.write_results(res, d / f"run{ext}", mechanism=mech)
         out[ext] = p.read_bytes()
+    # A CSV's metadata are in run.csv.json beside it: fuzzed as one text, the metadata's lines
+    # first as '# ' lines (write_input puts them back beside the table).
+    meta = (d / "run.csv.json").read_text().splitlines()
+    out[".csv"] = "".join(f"# {ln}\n" for ln in meta).encode() + out[".csv"]
     return out
+
+
+def write_input(path: Path, data: bytes) -> None:
+    """A results file from (damaged) bytes: a CSV's leading '# ' lines to its metadata file."""
+    beside = path.with_name(path.name + ".json")
+    beside.unlink(missing_ok=True)
+    if path.suffix != ".csv" or not data.startswith(b"# "):
+        path.write_bytes(data)
+        return
+    lines = data.splitlines(keepends=True)
+    head = [ln for ln in itertools.takewhile(lambda ln: ln.startswith(b"#"), lines)]
+    beside.write_bytes(b"".join(ln[2:] if ln.startswith(b"# ") else ln[1:] for ln in head))
+    path.write_bytes(b"".join(lines[len(head):]))
 
 
 def random_value(rng: np.random.Generator) -> Any:
@@ -212,7 +230,7 @@ def test_cli_fuzz(originals, tmp_path):
     failures: list[str] = []
     written = {}
     for ext in FORMATS:
-        (tmp_path / f"written{ext}").write_bytes(originals[ext])
+        write_input(tmp_path / f"written{ext}", originals[ext])
         written[ext] = pd.read_results(tmp_path / f"written{ext}")
     outcomes: Counter[tuple[str, int]] = Counter()
     for k in range(N_INPUTS):
@@ -223,7 +241,7 @@ def test_cli_fuzz(originals, tmp_path):
             data, how = damage(ext, originals[ext], rng, tmp_path)
         else:
             data, how = originals[ext], "intact"
-        path.write_bytes(data)
+        write_input(path, data)
         argv = command(rng, path, tmp_path)
         # Harmless: the final newline cut off, or the metadata's checksum itself dropped.
         harmless = data.rstrip() == originals[ext].rstrip() or (how == "meta" and b'"checksum"' not in data)

@@ -12,7 +12,10 @@ line "..." stands for any number of lines). The minimum Rust the pages name is C
 
 from __future__ import annotations
 
+import html
+import json
 import re
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -128,7 +131,7 @@ def test_the_pages_name_the_minimum_rust_cargo_asks_for():
 def test_pages_have_the_promised_code():
     # What a new user follows: describe a five-bar, simulate it, view it, plot torques, invert.
     examples, _ = page_script(DOCS / "examples.md")
-    for needle in ("pd.load(\"my-five-bar.yaml\")", "mech.simulate(", "animate(mech, res, \"fall.html\")",
+    for needle in ("pdy.load(\"my-five-bar.yaml\")", "mech.simulate(", "animate(mech, res, \"fall.html\")",
                    "plot_efforts(inv", "inverse_result(mech, t, q)"):
         assert needle in examples, needle
     cli, n = page_script(DOCS / "cli.md")
@@ -138,12 +141,67 @@ def test_pages_have_the_promised_code():
 
 
 def test_mkdocs_build_strict(tmp_path):
+    # --strict: every link checked, those to files of the repository too (docs_hooks/
+    # repository_files.py puts them in the site; issue 26: they were dead on the site).
     pytest.importorskip("mkdocs")
+    pytest.importorskip("pymdownx")
     p = subprocess.run(
         [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
         cwd=ROOT, capture_output=True, text=True, timeout=300,
     )
     assert p.returncode == 0, p.stderr[-3000:]
-    for page in ("index.html", "cli/index.html", "api/index.html", "examples/index.html", "model-format/index.html"):
-        assert (tmp_path / "site" / page).is_file(), page
-    assert "planardyn inverse" in (tmp_path / "site" / "cli" / "index.html").read_text()
+    site = tmp_path / "site"
+    for page in ("index.html", "cli/index.html", "api/index.html", "examples/index.html", "model-format/index.html",
+                 "benchmarks/index.html", "repo/schema/planardyn-model.schema.json",
+                 "repo/examples/models/library/four-bar.yaml"):
+        assert (site / page).is_file(), page
+    assert "planardyn inverse" in (site / "cli" / "index.html").read_text()
+    home = (site / "index.html").read_text()
+    assert 'href="benchmarks/"' in home  # in the navigation (issue 26)
+    assert 'href="../repo/examples/models/library/four-bar.yaml"' in (site / "library" / "index.html").read_text()
+    # The formulas: KaTeX from the site itself, no CDN; every one parses.
+    assert (site / "assets" / "katex" / "katex.min.js").is_file() and (site / "assets" / "katex" / "LICENSE").is_file()
+    assert list((site / "assets" / "katex" / "fonts").glob("*.woff2"))
+    pages = [f.read_text() for f in site.rglob("*.html")]
+    assert not [m for text in pages for m in re.findall(r'(?:src|href)="(https?://[^"]*)"', text)
+                if re.search(r"\.(js|css)\b", m)]
+    formulation = (site / "formulation" / "index.html").read_text()
+    formulas = [html.unescape(f).strip() for f in
+                re.findall(r'<(?:span|div) class="arithmatex">(.*?)</(?:span|div)>', formulation, re.S)]
+    assert len(formulas) >= 50 and "katex.min.js" in formulation
+    assert_katex_parses(formulas)
+
+
+def assert_katex_parses(formulas: list[str]) -> None:
+    """Each \\(...\\) or \\[...\\] formula through KaTeX (node, the npm package the site ships)."""
+    node = shutil.which("node")
+    katex = ROOT / "node_modules" / "katex"
+    if node is None or not katex.is_dir():
+        pytest.skip("node or node_modules/katex missing")
+    script = ("const k=require(process.argv[1]);let bad=[];"
+              "for(const t of JSON.parse(require('fs').readFileSync(0,'utf8'))){"
+              "try{k.renderToString(t.slice(2,-2),{displayMode:t.startsWith('\\\\['),throwOnError:true})}"
+              "catch(e){bad.push(t+': '+e.message)}}console.log(JSON.stringify(bad))")
+    p = subprocess.run([node, "-e", script, str(katex)], input=json.dumps(formulas), capture_output=True, text=True,
+                       timeout=60)
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout) == []
+
+
+#: The alias the pages, examples and docstrings use for planardyn (issue 26, first hour 2):
+#: `pd` is pandas' by convention, and a page using both could not tell them apart.
+ALIAS = "pdy"
+
+
+def test_planardyn_is_never_imported_as_pandas_alias():
+    texts = [*PAGES, *sorted((ROOT / "examples").glob("*.py")), *sorted((ROOT / "python" / "planardyn").rglob("*.py")),
+             ROOT / "tests" / "wheel_smoke.py"]
+    clash = re.compile(r"import planardyn as pd\b|\bpd\.(load|load_example|from_result|read_results|models)\b")
+    found = [f"{p.relative_to(ROOT)}:{n}: {line.strip()}" for p in texts
+             for n, line in enumerate(p.read_text().splitlines(), 1) if clash.search(line)]
+    assert not found, "\n".join(found)
+    # One alias everywhere, and the README, the home page and the API page use it.
+    aliases = {a for p in texts for a in re.findall(r"import planardyn as (\w+)", p.read_text())}
+    assert aliases == {ALIAS}, aliases
+    assert all(f"import planardyn as {ALIAS}\n" in (DOCS / name).read_text() for name in ("index.md", "api.md"))
+    assert f"import planardyn as {ALIAS}\n" in (ROOT / "README.md").read_text()

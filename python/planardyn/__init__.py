@@ -1,11 +1,11 @@
 """planardyn: exact minimal-coordinate dynamics of planar closed-chain mechanisms.
 
 A mechanism is described as it is drawn, in a model file (YAML or JSON, see
-``docs/model-format.md``), and validated once into an immutable :class:`Mechanism`::
+``planardyn docs model-format``), and validated once into an immutable :class:`Mechanism`::
 
-    import planardyn as pd
+    import planardyn as pdy
 
-    mech = pd.load("examples/models/five-bar.yaml")   # or pd.load_example("five-bar")
+    mech = pdy.load_example("five-bar")   # a shipped model; pdy.load("my-linkage.yaml") for a file
     res = mech.simulate(t_end=1.0)
     res.q          # (N, m) coordinates, rad or m
     res.to_csv("five-bar.csv")

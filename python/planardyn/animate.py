@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import extras
 from .playback import auto_speed
 from .plot import draw_mechanism, trace_points
 from .viewer import write_viewer
@@ -130,8 +131,8 @@ def write_mp4(frames, path: Path, fps: float, size: tuple[int, int]) -> int:
     """Encode RGB frames as H.264 MP4 with imageio-ffmpeg's ffmpeg. Returns the frame count."""
     try:
         import imageio_ffmpeg
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("MP4 needs imageio-ffmpeg: pip install imageio-ffmpeg") from e
+    except ImportError as e:
+        raise extras.missing("mp4", "an MP4 animation", e) from e
     writer = imageio_ffmpeg.write_frames(
         str(path), size, fps=fps, codec="libx264", pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
         macro_block_size=16, output_params=["-movflags", "+faststart"], ffmpeg_log_level="error",

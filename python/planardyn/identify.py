@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._core import PlanardynError
 from .arguments import array, count, data_error, error, finite_rates, limits, positive, rates_overflow, samples, times
 from .mechanism import Mechanism
+from .notebook import Summarized
 
 FloatArray = NDArray[np.float64]
 
@@ -61,7 +62,7 @@ MIN_FILTER_ROWS = 3 * (2 * (FILTER_ORDER // 2) + 1) + 1
 MIN_CUTOFF_RATIO = 1e-6
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class BaseParameters:
     """The identifiable combinations of the inertial parameters.
 
@@ -84,6 +85,10 @@ class BaseParameters:
     @property
     def rank(self) -> int:
         return len(self.independent)
+
+    def __repr__(self) -> str:
+        return (f"BaseParameters({self.rank} of {len(self.parameters)} parameters identifiable, condition "
+                f"{self.condition:.3g}, from {self.samples} samples)")
 
     @property
     def names(self) -> list[str]:
@@ -174,8 +179,8 @@ def base_parameters(mech: Mechanism, samples: int = 200, seed: int = 0) -> BaseP
     return BaseParameters(names, independent.tolist(), dependent.tolist(), K, samples, condition)
 
 
-@dataclass(frozen=True)
-class Identification:
+@dataclass(frozen=True, repr=False)
+class Identification(Summarized):
     """Base parameters estimated from a measured motion (:func:`identify`).
 
     ``beta`` with ``std_error`` (one standard deviation, from the residuals' variance per
@@ -192,6 +197,21 @@ class Identification:
     #: RMS of the efforts' residual per coordinate (N m or N), and the samples used.
     residual_rms: FloatArray
     samples: int
+
+    def __repr__(self) -> str:
+        rms = ", ".join(f"{v:.3g}" for v in self.residual_rms)
+        return (f"Identification({self.base.rank} base parameters from {self.samples} samples, "
+                f"residual RMS per coordinate [{rms}])")
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        return [("samples", f"{self.samples}"), ("base parameters", f"{self.base.rank} of {len(self.base.parameters)}"),
+                ("condition", f"{self.base.condition:.3g}"),
+                ("residual RMS", ", ".join(f"{v:.3g}" for v in self.residual_rms) + " (N m or N, per coordinate)")]
+
+    def _summary_tables(self) -> list[tuple[list[str], list[list[str]]]]:
+        rows = [[e, f"{b:.6g}", f"{s:.3g}", f"{p:.6g}"]
+                for e, b, s, p in zip(self.base.expressions, self.beta, self.std_error, self.prior)]
+        return [(["base parameter", "identified", "std error", "prior"], rows)]
 
     def report(self) -> str:
         """A table: each base parameter, identified ± standard error, and the prior."""
@@ -400,7 +420,7 @@ def lowpass(t: ArrayLike, v: ArrayLike, cutoff: float) -> FloatArray:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Excitation:
     """A periodic motion of the coordinates for identification (:func:`excitation`):
     q_k(t) = q0_k + sum_l a_kl (sin(l w t)) + b_kl (cos(l w t) - 1), w = 2 pi / period.
@@ -415,6 +435,10 @@ class Excitation:
     b: FloatArray
     condition: float
     start_condition: float
+
+    def __repr__(self) -> str:
+        return (f"Excitation(period {self.period:g} s, {self.a.shape[1]} harmonics on {len(self.q0)} coordinates, "
+                f"condition {self.condition:.3g} (the simple sine's {self.start_condition:.3g}))")
 
     def sample(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, qd, qdd (N, m) at times t (N,) (s)."""

@@ -576,7 +576,7 @@ class Mechanism:
     def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:
         if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
             raise error("result", "the result is not a run of this mechanism (its bodies differ); "
-                                  "use pd.from_result(res) for the mechanism it was made with")
+                                  "use pdy.from_result(res) for the mechanism it was made with")
         return self._native.along(res.t, res.x, res.q, res.qd, res.tau, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:

@@ -23,6 +23,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from . import extras
+
 FloatArray = NDArray[np.float64]
 
 FORMAT = "planardyn-results"
@@ -30,6 +32,10 @@ FORMAT = "planardyn-results"
 #: 3: a model with actuators adds the motor torques ``tau_motor``.
 FORMAT_VERSION = 3
 EXTENSIONS = (".csv", ".parquet", ".npz")
+#: What a CSV results file's metadata file adds to its name: ``run.csv`` -> ``run.csv.json``.
+#: (Before, the metadata were ``# `` lines at the head of the CSV, which spreadsheets do not
+#: read; such files are still read.)
+METADATA_SUFFIX = ".json"
 #: Rows formatted (CSV) or checksummed at a time: bounds the memory a long run's file needs.
 CSV_BLOCK = 4096
 
@@ -61,6 +67,12 @@ def columns(names: list[str], bodies: list[str], motor: bool = False) -> list[tu
         ("x", body_cols),
         ("xd", [c.replace("_", "d_", 1) for c in body_cols]),
     ] + ([("tau_motor", [f"tau_motor_{n}" for n in names])] if motor else [])
+
+
+def metadata_path(path: str | os.PathLike[str]) -> Path:
+    """The metadata file beside a CSV results file: ``run.csv`` -> ``run.csv.json``."""
+    path = Path(path)
+    return path.with_name(path.name + METADATA_SUFFIX)
 
 
 def table(groups: dict[str, Any], layout: list[tuple[str, int]], n_t: int) -> FloatArray:
@@ -96,8 +108,8 @@ def pyarrow() -> tuple[Any, Any]:
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("Parquet results files need pyarrow: pip install pyarrow") from e
+    except ImportError as e:
+        raise extras.missing("parquet", "a Parquet results file", e) from e
     return pa, pq
 
 
@@ -185,7 +197,10 @@ def write(path: str | os.PathLike[str], meta: dict[str, Any], groups: dict[str, 
           layout: list[tuple[str, list[str]]], ext: str | None = None) -> Path:
     """Write a results file: ``meta`` (JSON-plain metadata, without ``rows`` and
     ``checksum``, which are added), the arrays ``groups`` in ``layout`` order. The form is
-    ``ext`` or the name's extension. The file is written whole or not at all."""
+    ``ext`` or the name's extension. The file is written whole or not at all; a CSV's metadata
+    go to :func:`metadata_path` beside it (a plain table a spreadsheet opens, and its JSON),
+    written after the table: the checksum the JSON records refuses a table it was not
+    written with."""
     path = Path(path)
     ext = (ext or path.suffix).lower()
     if ext not in EXTENSIONS:
@@ -209,10 +224,11 @@ def write(path: str | os.PathLike[str], meta: dict[str, Any], groups: dict[str, 
                 {"planardyn": json.dumps(meta)}), tmp)
         else:
             with open(tmp, "w", newline="") as f:
-                for line in json.dumps(meta, indent=1).splitlines():
-                    f.write(f"# {line}\n")
                 w = csv.writer(f)
                 w.writerow(names)
                 for start in range(0, n_t, CSV_BLOCK):
                     w.writerows([repr(v) for v in row] for row in tab[start:start + CSV_BLOCK].tolist())
+    if ext == ".csv":
+        with replacing(metadata_path(path)) as tmp, open(tmp, "w", encoding="utf-8") as f:
+            f.write(json.dumps(meta, indent=1) + "\n")
     return path

@@ -6,9 +6,11 @@ the solver settings (keyword arguments of ``Mechanism.simulate``), the planardyn
 the status and counters. The format is chosen by the file name's extension:
 
 ``.csv``
-    The metadata as JSON on leading ``# `` comment lines, then a header row and one row per
-    output time; numbers are written with ``repr`` (the shortest string that reads back to
-    the same double, at most 17 significant digits), so they round-trip exactly.
+    A plain table that a spreadsheet opens: a header row and one row per output time; numbers
+    are written with ``repr`` (the shortest string that reads back to the same double, at most
+    17 significant digits), so they round-trip exactly. The metadata, as JSON, are in a file
+    beside it named after it: ``run.csv.json`` (keep the two together; files written before
+    it, with the metadata on leading ``# `` lines of the CSV, are read too).
 ``.parquet``
     One column per channel (pyarrow), the metadata under the file-level key ``planardyn``.
 ``.npz``
@@ -44,7 +46,7 @@ from .arguments import data_error, finite_rates, rates_overflow, samples, times
 from .mechanism import Mechanism, attach_metadata
 from .result import Energy, SimulationResult
 from .results_format import FORMAT
-from .results_read import Damaged, csv_blocks, csv_head, read
+from .results_read import Damaged, csv_blocks, csv_head, csv_metadata, read
 
 FloatArray = NDArray[np.float64]
 
@@ -190,11 +192,12 @@ def _check_finite(path: Path, columns: dict[str, FloatArray]) -> None:
 
 
 def _is_results_csv(path: Path) -> bool:
-    """Whether a CSV file holds a planardyn results file's metadata (read from its head only)."""
+    """Whether a CSV file is a planardyn results file: its metadata file beside it, or its
+    head (files written before the metadata file was)."""
     try:
         with open(path, encoding="utf-8") as f:
-            meta, _ = csv_head(f)
-    except (OSError, UnicodeDecodeError):
+            meta = csv_metadata(path, csv_head(f)[0])
+    except (OSError, UnicodeDecodeError, Damaged):
         return False
     return isinstance(meta, dict) and meta.get("format") == FORMAT
 

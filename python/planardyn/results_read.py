@@ -25,7 +25,15 @@ from numpy.typing import NDArray
 
 from .arguments import data_error
 from .result import ChangePoint, Energy, SimulationResult
-from .results_format import CSV_BLOCK, EXTENSIONS, FORMAT, FORMAT_VERSION, checksum_rows, checksum_start
+from .results_format import (
+    CSV_BLOCK,
+    EXTENSIONS,
+    FORMAT,
+    FORMAT_VERSION,
+    checksum_rows,
+    checksum_start,
+    metadata_path,
+)
 from .results_format import columns as _columns
 from .results_format import pyarrow as _pyarrow
 
@@ -371,10 +379,27 @@ def _parse_lines(block: list[str], header: list[str], usecols: list[int] | None,
     return out
 
 
+def csv_metadata(path: Path, head: Any) -> Any:
+    """A CSV results file's metadata: its JSON file beside it (``run.csv.json``), else the
+    ``# `` lines at its head (``head``, from :func:`csv_head`: files written before the JSON
+    file was), else None."""
+    beside = metadata_path(path)
+    if not beside.is_file():
+        return head
+    try:
+        return json.loads(beside.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError) as e:
+        raise Damaged(f"its metadata file {beside.name} is not JSON ({e})") from None
+
+
 def _read_csv(path: Path) -> tuple[dict[str, Any], dict[str, FloatArray]]:
     try:
         with open(path, encoding="utf-8") as f:
-            found, header = csv_head(f)
+            head, header = csv_head(f)
+            found = csv_metadata(path, head)
+            if found is None:
+                raise Damaged(f"not a planardyn results file: no metadata file {metadata_path(path).name} "
+                              "beside it (copy it with the table) and none at its head")
             meta = check_meta(found)
             _check_header(meta, header)
             width = len(header)

@@ -37,6 +37,7 @@ from . import batch
 from ._core import AssemblyError, ModelError, PlanardynError, SimulationError, SingularityError
 from .arguments import error
 from .mechanism import Mechanism
+from .notebook import Summarized
 
 __all__ = ["Sensitivity", "efforts", "objective", "peak_effort", "rms_effort", "trajectory", "DEFAULT_REL_STEP"]
 
@@ -51,8 +52,8 @@ Design = Mechanism | Mapping[str, Any] | Callable[..., Mechanism | Mapping[str, 
 DEFAULT_REL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
 
 
-@dataclass(frozen=True)
-class Sensitivity:
+@dataclass(frozen=True, repr=False)
+class Sensitivity(Summarized):
     """Derivatives of a quantity (shape S) with respect to p named parameters.
 
     ``value`` (S) at the nominal design; ``derivative`` and ``error`` (p, *S): the central
@@ -71,6 +72,24 @@ class Sensitivity:
     def __getitem__(self, name: str) -> FloatArray:
         """The derivative with respect to one parameter (shape S)."""
         return self.derivative[self.names.index(name)]
+
+    def __repr__(self) -> str:
+        return (f"Sensitivity(d{list(self.value.shape) if self.value.ndim else ' value'} / d({', '.join(self.names)}), "
+                f"largest error estimate {float(np.max(self.error, initial=0.0)):.2g})")
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        return [("quantity", f"shape {self.value.shape}" if self.value.ndim else f"{float(self.value):.6g}"),
+                ("parameters", ", ".join(self.names))]
+
+    def _summary_tables(self) -> list[tuple[list[str], list[list[str]]]]:
+        rows = []
+        for k, name in enumerate(self.names):
+            d, e = self.derivative[k], self.error[k]
+            big = int(np.argmax(np.abs(d))) if d.ndim else 0
+            rows.append([name, f"{self.values[k]:.6g}", f"{self.steps[k]:.3g}", f"{np.ravel(d)[big]:.6g}",
+                         f"{np.ravel(e)[big]:.2g}"])
+        entry = "derivative" if self.value.ndim == 0 else "derivative (largest entry)"
+        return [(["parameter", "value", "step", entry, "error"], rows)]
 
     def __str__(self) -> str:
         rows = [f"{'parameter':>32} {'value':>12} {'step':>10} {'derivative':>14} {'error':>10}"]

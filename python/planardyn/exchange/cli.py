@@ -31,7 +31,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     e = sub.add_parser("export", help="write a model as MJCF (MuJoCo), URDF (ROS) or SDF (Gazebo)",
                        description="Write a model for MuJoCo (.xml, .mjcf), ROS (.urdf) or Gazebo (.sdf), by the\n"
                                    "extension of -o. What the format cannot carry is listed in a comment at the top\n"
-                                   "of the file; docs/exchange.md has the mapping.",
+                                   "of the file; `planardyn docs exchange` has the mapping.",
                        epilog="examples:\n  planardyn export four-bar-gravity -o four-bar.xml\n"
                               "  planardyn export five-bar -o five-bar.urdf", formatter_class=formatter)
     e.add_argument("model", type=Path, help="model file, or a shipped model by name (five-bar)")

@@ -160,7 +160,7 @@ def from_urdf(data: str, source: str = "<string>", coordinates: list[str] | None
         name = child.get("link", "") if child is not None else ""
         if name in parent_of:
             raise doc.error(j, f"link {name!r} has a second parent: URDF is a tree; close loops with an SDF joint "
-                               "inside <gazebo> (docs/exchange.md)")
+                               "inside <gazebo> (see `planardyn docs exchange`)")
         parent_of[name] = j
     roots = [n for n in links if n not in parent_of]
     if len(roots) != 1:

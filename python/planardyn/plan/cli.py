@@ -26,6 +26,7 @@ import sys
 
 import numpy as np
 
+from .. import extras
 from .._core import AssemblyError, ModelError, SingularityError
 from ..mechanism import load
 from ..models import UnknownModelError, resolve
@@ -41,8 +42,19 @@ OPTIONS = {"effort": "--effort", "speed": "--speed", "spacing": "--spacing", "n_
            "duration": "--duration", "n_intervals": "--intervals", "sigma_min": "--sigma-min", "X": "--line"}
 
 
-def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="planardyn plan", description="Time-optimal timing of an end-effector line, or optimal motion between its ends.")
+DESCRIPTION = ("Time-optimal timing of an end-effector line (TOPP, toppra) within effort limits (--effort) or\n"
+               "the motors' torque-speed envelopes (--actuators), or with --collocate the optimal motion\n"
+               "between the line's ends (minimum time, or minimum effort in --duration; collocation, IPOPT).\n"
+               "Needs the 'plan' extra: pip install toppra casadi.")
+EXAMPLES = ("examples:\n"
+            "  planardyn plan library/five-bar-5r --line -0.08 0.28 0.08 0.36 --effort 3 3 --speed 12 12 -o timed.csv\n"
+            "  planardyn plan library/five-bar-5r --line -0.08 0.28 0.08 0.36 --effort 3 3 --collocate time\n"
+            "\nExit status: 0 done; 1 no timing or motion within the limits, or IPOPT did not converge\n"
+            "(nothing written); 2 a usage or model error (the message names the option).")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``planardyn plan`` on parser ``p``."""
     p.add_argument("model", help="model file (.yaml/.json), or a shipped model by name")
     p.add_argument("--point", default="P", help="end-effector point (default P)")
     p.add_argument("--line", nargs=4, type=number(unit="m"), required=True, metavar=("X0", "Y0", "X1", "Y1"), help="m")
@@ -64,7 +76,14 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--sigma-min", type=number(0.0, 1.0, open_low=True), default=None,
                    help="type II singularity margin for --collocate, in (0, 1)")
     p.add_argument("-o", "--output", default=None, help="write the timed motion (CSV)")
-    return p
+
+
+def register(sub: argparse._SubParsersAction, help: str) -> None:
+    """Add ``plan`` to the planardyn command's subparsers (it sets ``run``), listed with ``help``."""
+    p = sub.add_parser("plan", help=help,
+                       description=DESCRIPTION, epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(p)
+    p.set_defaults(run=run)
 
 
 def write_csv(plan: PlannedMotion, path: str) -> None:
@@ -76,12 +95,8 @@ def write_csv(plan: PlannedMotion, path: str) -> None:
     np.savetxt(path, table, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
 
 
-def plan_cli(argv: list[str] | None = None) -> int:
-    """Run ``planardyn plan`` with ``argv`` (without the program and command names)."""
-    try:
-        args = _parser().parse_args(argv)
-    except SystemExit as exc:
-        return 0 if exc.code == 0 else 2
+def run(args: argparse.Namespace) -> int:
+    """``planardyn plan`` on parsed arguments; the exit status."""
     try:
         if args.output:
             check_writable(args.output)
@@ -127,6 +142,10 @@ def plan_cli(argv: list[str] | None = None) -> int:
     except (SingularityError, AssemblyError) as exc:
         print(f"planardyn plan: refused: {exc}", file=sys.stderr)
         return 1
+    except ImportError as exc:  # casadi is imported by --collocate only
+        if extras.is_missing("plan", exc):
+            raise extras.missing("plan", "planardyn plan", exc) from exc
+        raise
     peak = np.abs(plan.tau).max(axis=0)
     print(f"{mech.name}: {plan.duration:.6g} s {what}; peak |tau| {np.round(peak, 4).tolist()}; limits used to "
           f"{plan.limit_ratio:.10g} on the dense check")

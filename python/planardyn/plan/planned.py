@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import ArgumentError
 from ..mechanism import Mechanism
+from ..notebook import Summarized, peak_rows
 from ..result import SimulationResult
 
 FloatArray = NDArray[np.float64]
@@ -30,7 +31,7 @@ class InfeasiblePlan(PlanError):
 
 
 @dataclass(repr=False)
-class PlannedMotion:
+class PlannedMotion(Summarized):
     """A motion from rest to rest with the efforts that run it.
 
     It holds ``mech``, the grid times ``t`` (N,) (s), and ``q``, ``qd``, ``qdd``, ``tau``
@@ -56,6 +57,11 @@ class PlannedMotion:
 
     def _summary(self) -> str:
         return f"{len(self.t)} grid points"
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        return [("model", self.mech.name), ("duration", f"{self.duration:.6g} s"),
+                ("limits used", f"{self.limit_ratio:.6g} of the largest (dense check)"),
+                *peak_rows(self.mech, self.tau, self.qd), ("solution", self._summary())]
 
     @property
     def duration(self) -> float:

@@ -58,7 +58,7 @@ def capability_at(ee: EndEffector, q: ArrayLike, tau_max: ArrayLike, n_dir: int 
     return float(r[k]), float(ts[k])
 
 
-@dataclass
+@dataclass(repr=False)
 class CapabilityMap:
     """Guaranteed end-effector acceleration at rest on a grid.
 
@@ -77,6 +77,12 @@ class CapabilityMap:
     holding: FloatArray
     tau_max: FloatArray
     grid: TaskGrid
+
+    def __repr__(self) -> str:
+        inside = self.accel[np.isfinite(self.accel)]
+        span = f"{inside.min():.4g} .. {inside.max():.4g} m/s^2" if inside.size else "no reachable cell"
+        return (f"CapabilityMap({self.effector.point} of {self.effector.mech.name}: {len(self.y)} x {len(self.x)} "
+                f"cells, guaranteed acceleration {span}, |tau| <= {np.round(self.tau_max, 6).tolist()})")
 
 
 def capability_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float, float],

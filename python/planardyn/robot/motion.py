@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
 from ..arguments import count, error, positive
+from ..notebook import Summarized, peak_rows
 from .effector import EndEffector
 from .paths import TaskPath
 from .tolerances import SINGULAR_TOL
@@ -48,7 +49,7 @@ KIND_TEXT = {
 
 
 @dataclass
-class TaskMotion:
+class TaskMotion(Summarized):
     """A task-space motion solved for the inputs, time-major arrays.
 
     ``t`` (N,) s; ``X``, ``Xd``, ``Xdd`` (N, k) prescribed task coordinates and their rates
@@ -80,6 +81,13 @@ class TaskMotion:
     def __repr__(self) -> str:
         return (f"TaskMotion({self.label}; {len(self.t)} samples, min sigma_I {self.sigma_I.min():.3g}, "
                 f"min sigma_II {self.sigma_II.min():.3g}, peak |tau| {np.abs(self.tau).max(axis=0).round(4).tolist()})")
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        return [("model", self.mech.name), ("path", f"{self.label} of {self.effector.point}"),
+                ("samples", f"{len(self.t)}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s"),
+                *peak_rows(self.mech, self.tau, self.qd),
+                ("min sigma_I, sigma_II", f"{self.sigma_I.min():.3g}, {self.sigma_II.min():.3g}"),
+                *[("note", n) for n in self.notes]]
 
     def drives(self) -> DriveFunction:
         """The drive efforts as a callable ``f(t, q, qd)`` for :meth:`Mechanism.simulate`: a

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..mechanism import Mechanism, from_dict
+from ..notebook import Summarized
 from .effector import EndEffector
 from .motion import TaskMotion, _sample_times, solve_motion
 from .paths import TaskPath
@@ -120,6 +121,11 @@ class MotorSizing:
         """Whether every given limit holds (True when none is given)."""
         return all(c.passed for c in self.checks)
 
+    def __repr__(self) -> str:
+        return (f"MotorSizing({self.name}: peak {self.peak_torque:.4g} N m, RMS {self.rms_torque:.4g} N m, "
+                f"speed {self.peak_speed:.4g} rad/s, power {self.peak_power:.4g} W, "
+                f"{'pass' if self.passed else 'FAIL'} on {len(self.checks)} limits)")
+
 
 @dataclass
 class DriveSizing:
@@ -137,9 +143,14 @@ class DriveSizing:
     envelope_effort: FloatArray
     motor: MotorSizing | None = None
 
+    def __repr__(self) -> str:
+        return (f"DriveSizing({self.name}: peak {self.peak_effort:.4g} {self.effort_unit}, RMS {self.rms_effort:.4g} "
+                f"{self.effort_unit}, speed {self.peak_speed:.4g} {self.speed_unit}, power {self.peak_power:.4g} W"
+                + ("" if self.motor is None else f", motor {self.motor.name}") + ")")
+
 
 @dataclass
-class SizingReport:
+class SizingReport(Summarized):
     """Actuator requirements of a task-space motion; ``drives`` one :class:`DriveSizing` each.
 
     ``min_sigma_I``/``min_sigma_II`` (dimensionless) with the time (s) and end-effector
@@ -172,6 +183,33 @@ class SizingReport:
             lines.append(f"nearest type {kind} singularity: sigma_{kind} = {s:.3g} at t = {t:.3f} s, "
                          f"end effector at ({X[0]:.4f}, {X[1]:.4f}) m")
         return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        m = self.motion
+        peaks = ", ".join(f"{d.name} {d.peak_effort:.4g} {d.effort_unit}" for d in self.drives)
+        motors = [d.motor for d in self.drives if d.motor is not None]
+        verdict = "" if not motors else f", motors {'pass' if all(mo.passed for mo in motors) else 'FAIL'}"
+        return (f"SizingReport({m.mech.name} on {m.label}: peak efforts {peaks}{verdict}; "
+                f"min sigma_II {self.min_sigma_II[0]:.3g})")
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        m = self.motion
+        rows = [("model", m.mech.name), ("path", m.label), ("payload", f"{self.payload:g} kg"),
+                ("samples", f"{len(m.t)}, t = {m.t[0]:.6g} .. {m.t[-1]:.6g} s")]
+        for kind, (s, t, X) in (("I", self.min_sigma_I), ("II", self.min_sigma_II)):
+            rows.append((f"nearest type {kind} singularity",
+                         f"sigma_{kind} = {s:.3g} at t = {t:.3f} s, end effector at ({X[0]:.4f}, {X[1]:.4f}) m"))
+        return rows
+
+    def _summary_tables(self) -> list[tuple[list[str], list[list[str]]]]:
+        drives = (["drive", "peak effort", "RMS effort", "peak speed", "peak power"],
+                  [[d.name, f"{d.peak_effort:.4g} {d.effort_unit}", f"{d.rms_effort:.4g} {d.effort_unit}",
+                    f"{d.peak_speed:.4g} {d.speed_unit}", f"{d.peak_power:.4g} W"] for d in self.drives])
+        checks = [[d.name, d.motor.name, c.quantity, f"{c.demand:.4g} {c.unit}", f"{c.limit:.4g} {c.unit}",
+                   f"{100 * c.margin:.2f} %", "pass" if c.passed else "FAIL"]
+                  for d in self.drives if d.motor is not None for c in d.motor.checks]
+        header = ["drive", "motor", "limit", "demand", "limit value", "margin", ""]
+        return [drives] + ([(header, checks)] if checks else [])
 
     def to_dict(self) -> dict[str, Any]:
         """Plain numbers (for JSON): per drive the peaks and RMS, and the singularity margins."""

@@ -51,7 +51,7 @@ impl Input<'_> {
 
     /// The message in plain words and its fix; a missing field goes onto the path.
     fn explain(&self, message: &str, field: &mut String) -> (String, String) {
-        let docs = "see docs/model-format.md";
+        let docs = "see `planardyn docs model-format`";
         if let Some(name) = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
             push_field(field, name);
             return (format!("missing field `{name}`"), format!("add it ({docs})"));
