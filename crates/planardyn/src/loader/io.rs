@@ -4,9 +4,15 @@
 
 use super::parse_errors::Input;
 use super::{nesting, tags, Format};
+use crate::model::construct;
+use crate::model::spec::{PointSpec, ValueSpec};
 use crate::model::{Mechanism, MechanismSpec};
+use crate::units;
 use crate::ModelError;
 use std::path::Path;
+
+/// A model file as written.
+type FileSpec = MechanismSpec<PointSpec, ValueSpec>;
 
 /// Load a model file (`.yaml`, `.yml` or `.json`).
 pub fn load(path: impl AsRef<Path>) -> Result<Mechanism, ModelError> {
@@ -33,8 +39,15 @@ pub fn loads(text: &str, format: Format, source: &str) -> Result<Mechanism, Mode
     super::build(spec, source)
 }
 
-/// Parse model text into its specification without validating it.
+/// Parse model text into its specification without validating it: quantities with units
+/// in SI, the points given by construction placed and the coordinates' values given as
+/// measures of the drawing measured (`model::construct`).
 pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismSpec, ModelError> {
+    construct::resolve(parse_file(text, format, source)?, source)
+}
+
+/// The model text as written: points and coordinate values also by construction.
+fn parse_file(text: &str, format: Format, source: &str) -> Result<FileSpec, ModelError> {
     let input = Input { text, format, source };
     match format {
         Format::Json => {
@@ -58,7 +71,7 @@ pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismS
             }
             tags::refuse(text, source)?;
             let de = serde_yaml_ng::Deserializer::from_str(text);
-            serde_path_to_error::deserialize(de).map_err(|e| {
+            units::reading_yaml(|| serde_path_to_error::deserialize(de)).map_err(|e| {
                 let at = e.inner().location().map(|l| (l.line(), l.column()));
                 input.error(e.path(), &e.inner().to_string(), at)
             })

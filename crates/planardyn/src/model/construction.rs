@@ -2,11 +2,10 @@
 //! them: from a point at a length and an angle, where two circles meet, along a line, where
 //! a line meets a circle; and a coordinate's drawn value as a measure of the drawing (the
 //! angle or the distance between two points). Lengths and angles take units
-//! ([`crate::units`]). The loader resolves them into coordinates (`loader::construct`);
-//! a [`MechanismSpec`](super::MechanismSpec) then holds coordinates only, and keeps the
-//! constructions in `constructions` for the reports.
+//! ([`crate::units`]). [`super::construct`] resolves them into coordinates when a file is
+//! read: a [`MechanismSpec`](super::MechanismSpec) then holds coordinates only.
 
-use crate::units;
+use crate::units::{self, Motion, Quantity};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use std::fmt;
@@ -56,19 +55,13 @@ pub enum Crossing {
     Second,
 }
 
-/// A constructed point as the loader resolved it: its name, its construction and where it is.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Constructed {
-    pub point: String,
-    pub how: Construction,
-    pub at: [f64; 2],
-}
-
 /// A coordinate's drawn value in a model file: a number (rad or m, or with its unit), or a
 /// measure of the drawing.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ValueSpec {
-    Number(f64),
+    /// A number (SI), and whether its unit, if one was written, is an angle's or a length's
+    /// (checked against the pair: `"30 mm"` is no value of a revolute pair).
+    Number(f64, Option<Motion>),
     /// `{angle: [P, Q]}`: the angle of the line P -> Q from the x axis (rad, in (-pi, pi]).
     Angle([String; 2]),
     /// `{distance: [P, Q]}`: |PQ| (m).
@@ -103,8 +96,20 @@ pub const FORMS: &str = "{from: A, length: L, angle: a} (optionally relative_to:
 
 impl Fields {
     fn construction<E: de::Error>(self) -> Result<Construction, E> {
-        let Fields { from, length, angle, relative_to, circles, side, along, distance, fraction, line, circle, crossing } =
-            self;
+        let Fields {
+            from,
+            length,
+            angle,
+            relative_to,
+            circles,
+            side,
+            along,
+            distance,
+            fraction,
+            line,
+            circle,
+            crossing,
+        } = self;
         // Which forms the fields given belong to.
         let forms = [
             from.is_some() || length.is_some() || angle.is_some() || relative_to.is_some(),
@@ -166,10 +171,10 @@ impl<'de> Deserialize<'de> for PointSpec {
 impl<'de> Deserialize<'de> for ValueSpec {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         #[derive(Deserialize)]
-        #[serde(rename_all = "lowercase", deny_unknown_fields)]
-        enum Measure {
-            Angle([String; 2]),
-            Distance([String; 2]),
+        #[serde(deny_unknown_fields)]
+        struct Measure {
+            angle: Option<[String; 2]>,
+            distance: Option<[String; 2]>,
         }
         struct ValueVisitor;
         impl<'de> Visitor<'de> for ValueVisitor {
@@ -178,22 +183,34 @@ impl<'de> Deserialize<'de> for ValueSpec {
                 f.write_str("a number (rad or m), a number with a unit (\"30 deg\", \"120 mm\"), or a measure of the drawing: {angle: [P, Q]} or {distance: [P, Q]}")
             }
             fn visit_f64<E>(self, v: f64) -> Result<ValueSpec, E> {
-                Ok(ValueSpec::Number(v))
+                Ok(ValueSpec::Number(v, None))
             }
             fn visit_i64<E>(self, v: i64) -> Result<ValueSpec, E> {
-                Ok(ValueSpec::Number(v as f64))
+                Ok(ValueSpec::Number(v as f64, None))
             }
             fn visit_u64<E>(self, v: u64) -> Result<ValueSpec, E> {
-                Ok(ValueSpec::Number(v as f64))
+                Ok(ValueSpec::Number(v as f64, None))
             }
-            fn visit_str<E: de::Error>(self, v: &str) -> Result<ValueSpec, E> {
-                units::position(de::value::StrDeserializer::<E>::new(v)).map(ValueSpec::Number)
+            fn visit_str<E: de::Error>(self, text: &str) -> Result<ValueSpec, E> {
+                let si: f64 = units::position(de::value::StrDeserializer::<E>::new(text))?;
+                // The kind of the unit written (Position's kinds: an angle, then a length).
+                let motion = units::read(text, units::Position::KINDS).ok().and_then(|r| r.kind).map(|k| {
+                    if k == 0 {
+                        Motion::Rotation
+                    } else {
+                        Motion::Translation
+                    }
+                });
+                Ok(ValueSpec::Number(si, motion))
             }
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ValueSpec, A::Error> {
-                Ok(match Measure::deserialize(de::value::MapAccessDeserializer::new(map))? {
-                    Measure::Angle(p) => ValueSpec::Angle(p),
-                    Measure::Distance(p) => ValueSpec::Distance(p),
-                })
+                match Measure::deserialize(de::value::MapAccessDeserializer::new(map))? {
+                    Measure { angle: Some(p), distance: None } => Ok(ValueSpec::Angle(p)),
+                    Measure { angle: None, distance: Some(p) } => Ok(ValueSpec::Distance(p)),
+                    _ => Err(de::Error::custom(
+                        "a measure of the drawing is one of {angle: [P, Q]} (rad) and {distance: [P, Q]} (m)",
+                    )),
+                }
             }
         }
         deserializer.deserialize_any(ValueVisitor)

@@ -9,9 +9,10 @@
 //! The ground is not part of `x`; its local frame is the global frame.
 
 pub mod actuators;
-pub mod construction;
 pub(crate) mod build;
 pub(crate) mod checks;
+pub mod construct;
+pub mod construction;
 pub(crate) mod diameter;
 pub mod loads;
 mod motion;

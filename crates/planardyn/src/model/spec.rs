@@ -9,9 +9,9 @@
 //! ([`MechanismSpec<PointSpec, ValueSpec>`], the form the loader reads and resolves into
 //! this one).
 
-pub use super::construction::{Circle, Constructed, Construction, Crossing, PointSpec, Side, ValueSpec};
+pub use super::construction::{Circle, Construction, Crossing, PointSpec, Side, ValueSpec};
 pub use super::loads::LoadSpec;
-use crate::units;
+use crate::units::{self, Motion};
 use indexmap::IndexMap;
 use serde::de::{Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
@@ -44,6 +44,7 @@ pub struct MechanismSpec<P = [f64; 2], V = f64> {
     /// The mobile bodies, by name, in the order their coordinates are stored.
     pub bodies: NamedMap<BodySpec>,
     /// Kinematic pairs (joints).
+    #[serde(deserialize_with = "units::tagged")]
     pub pairs: Vec<PairSpec>,
     /// Generalized coordinates: the input pairs, one per degree of freedom.
     pub coordinates: Vec<CoordinateSpec<V>>,
@@ -51,7 +52,7 @@ pub struct MechanismSpec<P = [f64; 2], V = f64> {
     #[serde(default)]
     pub drives: Vec<DriveSpec>,
     /// External loads and force elements (one kind a file: `model::loads`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::tagged")]
     pub loads: Vec<LoadSpec>,
     /// Motors with their transmissions, one per driven coordinate (docs/actuators.md).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -59,10 +60,6 @@ pub struct MechanismSpec<P = [f64; 2], V = f64> {
     /// Default simulation settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulate: Option<SimulateSpec>,
-    /// The points the file gave by construction, as the loader resolved them, in the order
-    /// it did (for the reports; not part of the file).
-    #[serde(skip)]
-    pub constructions: Vec<Constructed>,
 }
 
 /// A mobile body. Its inertia is given either directly (`mass`, `inertia`, `com`), as a
@@ -202,6 +199,27 @@ pub enum PairSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         along: Option<[String; 2]>,
     },
+}
+
+impl PairSpec {
+    /// The name the file gave the pair, if any.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            PairSpec::Revolute { name, .. }
+            | PairSpec::Prismatic { name, .. }
+            | PairSpec::Gear { name, .. }
+            | PairSpec::Slot { name, .. } => name.as_deref(),
+        }
+    }
+
+    /// Whether the pair's coordinate is an angle or a displacement (a gear pair has none).
+    pub fn motion(&self) -> Option<Motion> {
+        match self {
+            PairSpec::Revolute { .. } => Some(Motion::Rotation),
+            PairSpec::Prismatic { .. } | PairSpec::Slot { .. } => Some(Motion::Translation),
+            PairSpec::Gear { .. } => None,
+        }
+    }
 }
 
 /// A generalized coordinate: the relative angle (rad) of a revolute pair or the displacement

@@ -9,8 +9,9 @@ use std::fmt;
 use std::marker::PhantomData;
 
 /// Starts the message of a text that is not a quantity of its field, to tell it from the
-/// parsers' own errors (`loader::parse_errors` takes it off).
+/// parsers' own errors (`loader::parse_errors` takes it off), and parts its fix from it.
 pub const MARK: &str = "quantity: ";
+pub const FIX: &str = " / fix: ";
 
 thread_local! {
     static YAML_SCALARS: Cell<bool> = const { Cell::new(false) };
@@ -22,14 +23,26 @@ thread_local! {
 /// the text tells them apart. (JSON has no such forms, and there `deserialize_any` gives
 /// numbers and strings as they are.)
 pub fn reading_yaml<T>(f: impl FnOnce() -> T) -> T {
-    struct Restore(bool);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            YAML_SCALARS.set(self.0);
-        }
-    }
     let _restore = Restore(YAML_SCALARS.replace(true));
     f()
+}
+
+/// Puts the thread's YAML switch back as it was, also on unwinding.
+struct Restore(bool);
+
+impl Drop for Restore {
+    fn drop(&mut self) {
+        YAML_SCALARS.set(self.0);
+    }
+}
+
+/// `deserialize_with` of a list of entries tagged by their `type` (pairs, loads): serde
+/// buffers each entry to read its tag first, and the buffer holds the YAML parser's numbers,
+/// not its scalars' text, so the entries are read as JSON is (a hexadecimal integer there
+/// is the integer, as it was before units).
+pub fn tagged<'de, D: Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<T, D::Error> {
+    let _restore = Restore(YAML_SCALARS.replace(false));
+    T::deserialize(deserializer)
 }
 
 /// A quantity of kind Q read from a model file, in SI.
@@ -38,7 +51,11 @@ struct Si<Q>(f64, PhantomData<Q>);
 impl<'de, Q: Quantity> Deserialize<'de> for Si<Q> {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let visitor = SiVisitor::<Q>(PhantomData);
-        let si = if YAML_SCALARS.get() { deserializer.deserialize_str(visitor) } else { deserializer.deserialize_any(visitor) }?;
+        let si = if YAML_SCALARS.get() {
+            deserializer.deserialize_str(visitor)
+        } else {
+            deserializer.deserialize_any(visitor)
+        }?;
         Ok(Si(si, PhantomData))
     }
 }
@@ -69,7 +86,10 @@ impl<'de, Q: Quantity> Visitor<'de> for SiVisitor<Q> {
             Ok(reading) => Ok(reading.si),
             // The loader explains a number beyond a double's range from this form.
             Err(UnitError::Overflow) => Err(E::invalid_type(Unexpected::Str(text), &self)),
-            Err(e) => Err(E::custom(format!("{MARK}{}", e.message(text, Q::KINDS)))),
+            Err(e) => {
+                let (what, fix) = e.message(text, Q::KINDS);
+                Err(E::custom(format!("{MARK}{what}{FIX}{fix}")))
+            }
         }
     }
 }

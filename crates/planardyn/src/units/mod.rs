@@ -95,22 +95,22 @@ impl Kind {
 }
 
 impl UnitError {
-    /// The message for `text` in a field of `kinds`: what is wrong, and the units accepted.
-    pub fn message(&self, text: &str, kinds: &[&Kind]) -> String {
+    /// What is wrong with `text` in a field of `kinds`, and the fix (the units accepted).
+    pub fn message(&self, text: &str, kinds: &[&Kind]) -> (String, String) {
         let accepted = kinds
             .iter()
-            .map(|k| format!("{} ({}; a number alone is in {})", k.name, k.unit_list(), k.si))
+            .map(|k| format!("{} ({}, or a number alone in {})", k.name, k.unit_list(), k.si))
             .collect::<Vec<_>>()
             .join(" or ");
-        let example = example(kinds[0]);
+        let fix = format!("write e.g. \"{}\"", example(kinds[0]));
         match self {
-            UnitError::NoNumber | UnitError::Overflow => format!(
-                "\"{text}\" is not a number with a unit; this field takes {accepted}: write e.g. \"{example}\""
-            ),
+            UnitError::NoNumber | UnitError::Overflow => {
+                (format!("\"{text}\" is not a number with a unit; this field takes {accepted}"), fix)
+            }
             UnitError::Unknown { unit } => {
                 let other = KINDS.iter().find(|k| k.factor(unit).is_some() && !kinds.contains(k));
                 let is = other.map_or(String::new(), |k| format!(" ('{unit}' is a unit of {})", k.name));
-                format!("\"{text}\": '{unit}' is not a unit of {accepted}{is}; write e.g. \"{example}\"")
+                (format!("\"{text}\": '{unit}' is not a unit of {accepted}{is}"), fix)
             }
         }
     }
