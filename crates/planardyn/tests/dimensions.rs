@@ -143,7 +143,8 @@ fn circles_that_do_not_meet_name_the_point_and_the_gap() {
         msg,
         format!(
             "m.yaml: points.B: the circles of radius 0.5 m about A and 0.3 m about D do not meet: their centres are \
-             {d} m apart, more than the sum of the radii 0.8 by {:.6e} m; change a radius by at least that, or move a centre",
+             0.866025403784 m apart, more than the sum of the radii 0.8 by {:.6e} m; change a radius by at least that, \
+             or move a centre",
             d - 0.8
         )
     );

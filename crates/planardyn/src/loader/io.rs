@@ -46,6 +46,19 @@ pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismS
     construct::resolve(parse_file(text, format, source)?, source)
 }
 
+/// [`parse_spec`], and the names of the points the text gives by construction (for the
+/// reports of what the loader derived).
+pub fn parse_spec_constructed(
+    text: &str,
+    format: Format,
+    source: &str,
+) -> Result<(MechanismSpec, Vec<String>), ModelError> {
+    let file = parse_file(text, format, source)?;
+    let constructed =
+        file.points.0.iter().filter(|(_, p)| matches!(p, PointSpec::By(_))).map(|(n, _)| n.clone()).collect();
+    Ok((construct::resolve(file, source)?, constructed))
+}
+
 /// The model text as written: points and coordinate values also by construction.
 fn parse_file(text: &str, format: Format, source: &str) -> Result<FileSpec, ModelError> {
     let input = Input { text, format, source };

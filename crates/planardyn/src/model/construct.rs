@@ -154,8 +154,9 @@ fn construct(how: &Construction, xy: &[[f64; 2]]) -> Result<[f64; 2], String> {
             if disc < 0.0 {
                 let miss = (w[0] * u[1] - w[1] * u[0]).abs() - r;
                 return Err(format!(
-                    "the line {p} -> {q} misses the circle of radius {r} m about {}: it passes {miss:.6e} m outside it; \
+                    "the line {p} -> {q} misses the circle of radius {} m about {}: it passes {miss:.6e} m outside it; \
                      lengthen the radius by at least that or move the line",
+                    short(r),
                     circle.0
                 ));
             }
@@ -171,26 +172,34 @@ fn construct(how: &Construction, xy: &[[f64; 2]]) -> Result<[f64; 2], String> {
 fn circles(ca: &Circle, cb: &Circle, a: [f64; 2], b: [f64; 2], side: Side) -> Result<[f64; 2], String> {
     let (ra, rb) = (radius(ca)?, radius(cb)?);
     let (d, _) = direction(a, b, &format!("the centres {} and {}", ca.0, cb.0))?;
+    let (ra_, rb_, d_) = (short(ra), short(rb), short(d));
     let meet = |gap: f64, how: &str| {
         format!(
-            "the circles of radius {ra} m about {} and {rb} m about {} do not meet: their centres are {d} m apart, \
-             {how} by {gap:.6e} m; change a radius by at least that, or move a centre",
+            "the circles of radius {ra_} m about {} and {rb_} m about {} do not meet: their centres are {d_} m \
+             apart, {how} by {gap:.6e} m; change a radius by at least that, or move a centre",
             ca.0, cb.0
         )
     };
     if d > ra + rb {
-        return Err(meet(d - (ra + rb), &format!("more than the sum of the radii {}", ra + rb)));
+        return Err(meet(d - (ra + rb), &format!("more than the sum of the radii {}", short(ra + rb))));
     }
     if d < (ra - rb).abs() {
+        let difference = short((ra - rb).abs());
         return Err(meet(
             (ra - rb).abs() - d,
-            &format!("one lies inside the other: less than the difference of the radii {}", (ra - rb).abs()),
+            &format!("one lies inside the other: less than the difference of the radii {difference}"),
         ));
     }
     let e = [(b[0] - a[0]) / d, (b[1] - a[1]) / d];
     let along = (d * d + ra * ra - rb * rb) / (2.0 * d);
     let h = (ra * ra - along * along).max(0.0).sqrt() * if side == Side::Left { 1.0 } else { -1.0 };
     Ok([a[0] + along * e[0] - h * e[1], a[1] + along * e[1] + h * e[0]])
+}
+
+/// A number for a message: rounded to 12 significant digits, so that the round-off of the
+/// drawing's arithmetic (0.1 + 0.05 = 0.15000000000000002) does not show.
+fn short(v: f64) -> f64 {
+    format!("{v:.11e}").parse().unwrap_or(v)
 }
 
 /// The length (m) and angle (rad) of the line p -> q; an error naming `what` when p = q.
