@@ -1,24 +1,33 @@
 """Mechanisms written by their dimensions (issue 26 item 1): the Hoeken linkage, a quick-return
-shaper and a 3-RPR robot, each as a model file by its dimensions (tests/data/dimensions/) and
-with :class:`planardyn.Builder`, give the mechanisms of their coordinate versions; the Hoeken
-coupler point's straight line; units; the check's report; SVG and DXF drawings read back."""
+shaper and a 3-RPR robot, each as a model file by its dimensions and with
+:class:`planardyn.Builder`, give the mechanisms of their coordinate versions; the Hoeken
+coupler point's straight line; units; the check's report; SVG and DXF drawings read back.
+
+The Hoeken file and the three builders are docs/dimensions.md's own (its Python blocks run
+here, in a folder of their own, as the reader runs them); the shaper's and the 3-RPR's files
+and the coordinate versions are in tests/data/dimensions/."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import math
+import os
 import xml.etree.ElementTree as ET
 
 import jsonschema
 import numpy as np
 import pytest
 from conftest import ROOT
+from wheel_smoke import snippets
 
 import planardyn as pdy
 from planardyn import cli, library
 from planardyn.drawing import MM_PER_M, write_drawing
 
 DATA = ROOT / "tests" / "data" / "dimensions"
+PAGE = ROOT / "docs" / "dimensions.md"
 SCHEMA = json.loads((ROOT / "schema" / "planardyn-model.schema.json").read_text())
 
 #: Round-off of the constructions (a few products, square roots and atan2 of numbers near
@@ -46,35 +55,42 @@ def assert_same_mechanism(a: pdy.Mechanism, b: pdy.Mechanism, inputs: list[np.nd
     np.testing.assert_allclose(a.inertias, b.inertias, rtol=1e-13)
 
 
+@pytest.fixture(scope="module")
+def page(tmp_path_factory) -> dict:
+    """The namespace of docs/dimensions.md's Python blocks, run in order in an empty folder
+    (which then holds the files they wrote: hoeken.yaml, shaper.yaml...)."""
+    folder = tmp_path_factory.mktemp("dimensions")
+    namespace: dict = {"__name__": "dimensions_page"}
+    cwd = os.getcwd()
+    os.chdir(folder)
+    try:
+        for kind, code in snippets(PAGE.read_text()):
+            if kind == "python":
+                with contextlib.redirect_stdout(io.StringIO()):
+                    exec(compile(code, str(PAGE), "exec"), namespace)
+    finally:
+        os.chdir(cwd)
+    namespace["folder"] = folder
+    return namespace
+
+
 # ----------------------------------------------------------------------------- Hoeken
-
-
-def hoeken_builder() -> pdy.Builder:
-    """Hoeken's linkage with the builder: ground 100 mm, crank 50 mm, coupler and rocker 125 mm."""
-    b = pdy.Builder("Hoeken straight-line linkage", gravity=(0, "-9.81 m/s^2"))
-    b.point("O2", (0, 0))
-    b.point("O4", ("100 mm", 0))
-    b.crank("crank", "O2", "A", "50 mm", "180 deg", mass="100 g", coordinate="theta")
-    b.dyad(("coupler", "rocker"), "B", "A", "125 mm", "O4", "125 mm", "left", ends=("crank", "ground"),
-           masses=("500 g", "250 g"))
-    b.along("P", "A", "B", distance="250 mm")
-    b.bar("coupler", ["A", "P", "B"], mass="500 g")  # the coupler is the bar A-P, carrying B
-    return b
 
 
 HOEKEN_INPUTS = [np.array([t]) for t in (math.pi / 2, 2.5, 4.0, 3 * math.pi / 2)]
 
 
-def test_hoeken_by_dimensions_is_hoeken_by_coordinates():
+def test_hoeken_by_dimensions_is_hoeken_by_coordinates(page):
     coords = pdy.load(DATA / "hoeken-coordinates.yaml")
-    assert_same_mechanism(pdy.load(DATA / "hoeken.yaml"), coords, HOEKEN_INPUTS)
-    assert_same_mechanism(hoeken_builder().build(), coords, HOEKEN_INPUTS)
+    assert_same_mechanism(pdy.load(page["folder"] / "hoeken.yaml"), coords, HOEKEN_INPUTS)
+    assert_same_mechanism(page["built"], coords, HOEKEN_INPUTS)
+    assert_same_mechanism(pdy.load(page["folder"] / "hoeken-built.yaml"), coords, HOEKEN_INPUTS)
 
 
-def test_hoeken_coupler_point_runs_on_its_straight_line():
+def test_hoeken_coupler_point_runs_on_its_straight_line(page):
     # Analytic: at theta = 90, 180, 270 deg the coupler and rocker circles meet at B with
     # 3-4-5 triangles, and P = A + 2 (B - A) is (200, 200), (100, 200), (0, 200) mm exactly.
-    mech = pdy.load(DATA / "hoeken.yaml")
+    mech = pdy.load(page["folder"] / "hoeken.yaml")
     for theta, expected in ((math.pi / 2, (0.2, 0.2)), (math.pi, (0.1, 0.2)), (3 * math.pi / 2, (0.0, 0.2))):
         p = points(mech, mech.assemble([theta]))["P"]
         np.testing.assert_allclose(p, expected, rtol=0, atol=SAME_DRAWING)
@@ -99,87 +115,39 @@ def shaper_coordinates() -> pdy.Mechanism:
     return pdy.from_dict(model)
 
 
-def shaper_builder() -> pdy.Builder:
-    b = pdy.Builder("quick-return shaper")
-    b.point("O1", (0, 0), ground=True)
-    b.point("G", (0, "500 mm"), ground=True)
-    b.point("H", ("1 m", "500 mm"), ground=True)
-    b.point("O2", (0, "200 mm"))
-    b.crank("crank", "O2", "A", "100 mm", "0 deg", mass="500 g", coordinate="theta")
-    b.along("B", "O1", "A", distance="500 mm")
-    b.bar("lever", ["O1", "B"], mass="2 kg")
-    b.revolute("lever_pivot", "O1", "ground", "lever")
-    b.slot("crank_pin", "A", "lever", "crank", along=("O1", "B"))
-    b.line_circle("C", ("G", "H"), "B", "150 mm", "second")
-    b.polar("T", "C", "250 mm", 0)
-    b.bar("link", ["B", "C"], mass="500 g")
-    b.bar("ram", ["C", "T"], mass="5 kg")
-    b.revolute("lever_top", "B", "lever", "link")
-    b.revolute("ram_pin", "C", "link", "ram")
-    b.prismatic("ram_guide", "C", "ground", "ram", along=("G", "H"))
-    return b
-
-
 SHAPER_INPUTS = [np.array([t]) for t in (0.5, 1.5, 3.0, 5.0)]
 
 
-def test_shaper_by_dimensions_is_the_shaper_by_coordinates():
+def test_shaper_by_dimensions_is_the_shaper_by_coordinates(page):
     coords = shaper_coordinates()
     assert_same_mechanism(pdy.load(DATA / "shaper.yaml"), coords, SHAPER_INPUTS)
-    assert_same_mechanism(shaper_builder().build(), coords, SHAPER_INPUTS)
+    assert_same_mechanism(page["shaper"], coords, SHAPER_INPUTS)
 
 
 # ----------------------------------------------------------------------------- 3-RPR
 
 
-def three_rpr_builder() -> pdy.Builder:
-    """library.three_rpr at its defaults, by its dimensions."""
-    b = pdy.Builder("3-RPR")
-    b.point("P", (0, 0))
-    for i, angle in enumerate(("90 deg", "210 deg", "330 deg"), start=1):
-        b.polar(f"A{i}", "P", "500 mm", angle, ground=True)
-        b.polar(f"C{i}", "P", "100 mm", 0.5, relative_to=("P", f"A{i}"))
-    for i in (1, 2, 3):
-        b.along(f"E{i}", f"A{i}", f"C{i}", distance="300 mm")
-        b.along(f"K{i}", f"C{i}", f"A{i}", distance="300 mm")
-    for i in (1, 2, 3):
-        b.bar(f"barrel{i}", [f"A{i}", f"E{i}"], rho=1.0)
-        b.bar(f"rod{i}", [f"K{i}", f"C{i}"], rho=1.0)
-    b.polygon("platform", ["P", "C1", "C2", "C3"], ["C1", "C2", "C3"], rho=1.0)
-    for i in (1, 2, 3):
-        b.revolute(f"base{i}", f"A{i}", "ground", f"barrel{i}")
-        b.prismatic(f"leg{i}", f"K{i}", f"barrel{i}", f"rod{i}", along=(f"A{i}", f"C{i}"))
-        b.revolute(f"wrist{i}", f"C{i}", f"rod{i}", "platform")
-    for i in (1, 2, 3):
-        b.coordinate(f"L{i}", f"leg{i}", {"distance": [f"A{i}", f"C{i}"]})
-    return b
-
-
-def test_three_rpr_by_dimensions_is_the_librarys():
+def test_three_rpr_by_dimensions_is_the_librarys(page):
     coords = library.three_rpr()
     inputs = [coords.drawn_q + d for d in (np.array([0.02, -0.01, 0.0]), np.array([-0.03, 0.02, 0.01]))]
     assert_same_mechanism(pdy.load(DATA / "3-rpr.yaml"), coords, inputs)
-    assert_same_mechanism(three_rpr_builder().build(), coords, inputs)
+    assert_same_mechanism(page["robot"], coords, inputs)
 
 
 # ----------------------------------------------------------------------------- files, units, errors
 
 
-@pytest.mark.parametrize("name", ["hoeken.yaml", "shaper.yaml", "3-rpr.yaml"])
-def test_files_by_dimensions_validate_against_the_schema(name):
+@pytest.mark.parametrize("path", [DATA / "shaper.yaml", DATA / "3-rpr.yaml", "hoeken.yaml", "hoeken-built.yaml",
+                                  "shaper.yaml"])
+def test_files_by_dimensions_validate_against_the_schema(path, page):
     import yaml
 
-    jsonschema.Draft202012Validator(SCHEMA).validate(yaml.safe_load((DATA / name).read_text()))
+    jsonschema.Draft202012Validator(SCHEMA).validate(yaml.safe_load((page["folder"] / path).read_text()))
 
 
-def test_the_builders_model_is_a_file_by_dimensions(tmp_path):
-    b = hoeken_builder()
-    assert b.model["points"]["B"] == {"circles": [["A", "125 mm"], ["O4", "125 mm"]], "side": "left"}
-    jsonschema.Draft202012Validator(SCHEMA).validate(b.model)
-    for suffix in (".yaml", ".json"):
-        path = tmp_path / f"hoeken{suffix}"
-        b.write(path)
-        assert_same_mechanism(pdy.load(path), b.build(), HOEKEN_INPUTS[:1])
+def test_the_builder_writes_json_too(page, tmp_path):
+    page["b"].write(tmp_path / "robot.json")
+    assert_same_mechanism(pdy.load(tmp_path / "robot.json"), page["robot"], [])
 
 
 def test_units_convert_by_their_definitions():
@@ -192,22 +160,22 @@ def test_units_convert_by_their_definitions():
     assert mech.drawn_q[0] == pytest.approx(math.pi, rel=1e-16)
 
 
-def test_errors_name_the_field_and_the_fix():
-    text = (DATA / "hoeken.yaml").read_text()
+def test_errors_name_the_field_and_the_fix(page):
+    text = (page["folder"] / "hoeken.yaml").read_text()
     with pytest.raises(pdy.ModelError) as e:
         pdy.loads(text.replace('"180 deg"', '"180 degs"'), source="hoeken.yaml")
     assert str(e.value) == ("hoeken.yaml: points.A.angle: \"180 degs\": 'degs' is not a unit of an angle (rad, deg, "
-                            "rev, or a number alone in rad) (line 9 column 44); write e.g. \"30 deg\"")
+                            "rev, or a number alone in rad) (line 6 column 41); write e.g. \"30 deg\"")
     # |A O4| = 150 mm at the drawing, 125 + 20 = 145 mm: 5 mm short.
     with pytest.raises(pdy.ModelError) as e:
         pdy.loads(text.replace('[O4, "125 mm"]', '[O4, "20 mm"]'), source="hoeken.yaml")
     assert str(e.value).startswith("hoeken.yaml: points.B: the circles of radius 0.125 m about A and 0.02 m about O4 "
                                    "do not meet: their centres are 0.15 m apart, more than the sum of the radii 0.145 "
-                                   "by 5.000000e-03 m")
+                                   "by 5.000000e-3 m; change a radius by at least that, or move a centre")
 
 
-def test_check_prints_the_derived_dimensions(capsys):
-    assert cli.main(["check", str(DATA / "hoeken.yaml")]) == 0
+def test_check_prints_the_derived_dimensions(page, capsys):
+    assert cli.main(["check", str(page["folder"] / "hoeken.yaml")]) == 0
     out = capsys.readouterr().out
     assert "  crank: O2-A 0.05; O2->A at 180 deg\n" in out
     assert "  coupler: A-P 0.25, A-B 0.125; A->P at 53.1301 deg\n" in out  # atan(4/3)
@@ -239,8 +207,8 @@ def test_dxf_drawing_reads_back_in_millimetres(tmp_path):
     assert len(msp.query('LWPOLYLINE[layer=="GROUND"]')) == 2
 
 
-def test_svg_drawing_parses_with_its_labels(tmp_path):
-    mech = pdy.load(DATA / "hoeken.yaml")
+def test_svg_drawing_parses_with_its_labels(page, tmp_path):
+    mech = pdy.load(page["folder"] / "hoeken.yaml")
     path = write_drawing(mech, tmp_path / "hoeken.svg")
     root = ET.parse(path).getroot()
     assert root.tag == "{http://www.w3.org/2000/svg}svg"
@@ -252,7 +220,7 @@ def test_svg_drawing_parses_with_its_labels(tmp_path):
 def test_draw_command_writes_both_and_refuses_other_suffixes(tmp_path, capsys):
     for suffix in (".svg", ".dxf"):
         out = tmp_path / f"d{suffix}"
-        assert cli.main(["draw", str(DATA / "hoeken.yaml"), "-o", str(out)]) == 0
+        assert cli.main(["draw", str(DATA / "shaper.yaml"), "-o", str(out)]) == 0
         assert out.stat().st_size > 0
-    assert cli.main(["draw", str(DATA / "hoeken.yaml"), "-o", str(tmp_path / "d.png")]) == 2
+    assert cli.main(["draw", str(DATA / "shaper.yaml"), "-o", str(tmp_path / "d.png")]) == 2
     assert "give a file ending in .svg or .dxf" in capsys.readouterr().err
