@@ -18,13 +18,12 @@ import xml.etree.ElementTree as ET
 
 import jsonschema
 import numpy as np
+import planardyn as pdy
 import pytest
 from conftest import ROOT
-from wheel_smoke import snippets
-
-import planardyn as pdy
 from planardyn import cli, library
 from planardyn.drawing import MM_PER_M, write_drawing
+from wheel_smoke import snippets
 
 DATA = ROOT / "tests" / "data" / "dimensions"
 PAGE = ROOT / "docs" / "dimensions.md"
@@ -179,7 +178,7 @@ def test_check_prints_the_derived_dimensions(page, capsys):
     out = capsys.readouterr().out
     assert "  crank: O2-A 0.05; O2->A at 180 deg\n" in out
     assert "  coupler: A-P 0.25, A-B 0.125; A->P at 53.1301 deg\n" in out  # atan(4/3)
-    assert "points by construction:\n  A = (-0.05, 6.12323400e-18)\n  B = (0.025, 0.1)\n  P = (0.1, 0.2)\n" in out
+    assert "points by construction:\n  A = (-0.05, 0)\n  B = (0.025, 0.1)\n  P = (0.1, 0.2)\n" in out
 
 
 # ----------------------------------------------------------------------------- drawings

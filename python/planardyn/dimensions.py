@@ -15,6 +15,10 @@ from .mechanism import Mechanism
 
 __all__ = ["constructed_points", "report"]
 
+#: A coordinate below this fraction of the mechanism's size is printed as 0: the round-off of a
+#: construction (sin 180 deg = 1.2e-16, not 0), not a dimension.
+ROUND_OFF = 1e-12
+
 
 def constructed_points(path: str | os.PathLike[str]) -> list[str]:
     """The names of the points the model file ``path`` gives by construction."""
@@ -46,7 +50,10 @@ def report(mech: Mechanism, constructed: Sequence[str] = ()) -> str:
             lines.append(f"  {label} ({pair['type']}): guide {a}->{b} at {_angle(where[a], where[b]):.6g} deg")
     if constructed:
         lines.append("points by construction:")
-        lines += [f"  {n} = ({where[n][0]:.9g}, {where[n][1]:.9g})" for n in constructed]
+        tiny = ROUND_OFF * mech.scale
+        for n in constructed:
+            x, y = (0.0 if abs(v) < tiny else v for v in where[n])
+            lines.append(f"  {n} = ({x:.9g}, {y:.9g})")
     return "\n".join(lines)
 
 

@@ -54,39 +54,29 @@ fn units_convert_to_si_by_their_definitions() {
 }
 
 /// The four-bar of `common::FOUR_BAR` by its dimensions: crank 0.5 m at 60 deg, coupler
-/// 1.2 m, rocker 1.0 m, B above the line A -> D.
-const FOUR_BAR_BY_DIMENSIONS: &str = r#"
-name: four-bar under gravity
-gravity: [0.0, "-9810 mm/s^2"]
-points:
-  O: [0, 0]
-  D: ["1000 mm", 0]
-  A: {from: O, length: "500 mm", angle: "60 deg"}
-  B: {circles: [[A, "1.2 m"], [D, "1 m"]], side: left}
-ground: [O, D]
-bodies:
-  crank: {points: [O, A], mass: "500 g", inertia: 0.010416666666666666, com: [0.125, 0.21650635094610965]}
-  coupler: {points: [A, B], mass: 1.2, inertia: 0.144, com: [0.793463242511288, 0.6872718296322415]}
-  rocker: {points: [D, B], mass: 1.0, inertia: 0.08333333333333333, com: [1.168463242511288, 0.47076547868613194]}
-pairs:
-  - {type: revolute, name: O, at: O, bodies: [ground, crank]}
-  - {type: revolute, at: A, bodies: [crank, coupler]}
-  - {type: revolute, at: B, bodies: [coupler, rocker]}
-  - {type: revolute, at: D, bodies: [ground, rocker]}
-coordinates:
-  - {name: theta1, pair: O, value: {angle: [O, A]}}
-"#;
+/// 1.2 m, rocker 1.0 m, B above the line A -> D; gravity and the crank's mass with units.
+fn four_bar_by_dimensions() -> String {
+    let drawn = "  D: [1.0, 0.0]\n  A: [0.25, 0.4330127018922193]\n  B: [1.336926485022576, 0.9415309573722639]";
+    let by_dimensions = "  D: [\"1000 mm\", 0]\n  A: {from: O, length: \"500 mm\", angle: \"60 deg\"}\n  \
+                         B: {circles: [[A, \"1.2 m\"], [D, \"1 m\"]], side: left}";
+    assert!(FOUR_BAR.contains(drawn));
+    FOUR_BAR
+        .replace(drawn, by_dimensions)
+        .replace("gravity: [0.0, -9.81]", "gravity: [0.0, \"-9810 mm/s^2\"]")
+        .replace("mass: 0.5,", "mass: \"500 g\",")
+        .replace("value: 1.0471975511965976}", "value: {angle: [O, A]}}")
+}
 
 #[test]
 fn a_four_bar_by_its_dimensions_is_the_four_bar_by_coordinates() {
-    let (by_dims, by_coords) = (load(FOUR_BAR_BY_DIMENSIONS), load(FOUR_BAR));
+    let (by_dims, by_coords) = (load(&four_bar_by_dimensions()), load(FOUR_BAR));
     let d = max_diff(&by_dims.x0, &by_coords.x0);
     assert!(d < CONSTRUCTED_TOL, "x0 differs by {d:e}");
     assert!((by_dims.spec.coordinates[0].value - PI / 3.0).abs() < CONSTRUCTED_TOL);
     assert_eq!(by_dims.spec.gravity, [0.0, -9.81]);
     assert!((by_dims.spec.bodies.0["crank"].mass.unwrap() - 0.5).abs() < CONSTRUCTED_TOL);
     // The other assembly: B mirrored in the line A -> D.
-    let right = load(&FOUR_BAR_BY_DIMENSIONS.replace("side: left", "side: right"));
+    let right = load(&four_bar_by_dimensions().replace("side: left", "side: right"));
     let p = |m: &Mechanism, n: &str| m.spec.points.0[n];
     let (a, dd, bl, br) = (p(&right, "A"), p(&right, "D"), p(&by_dims, "B"), p(&right, "B"));
     let cross = |q: [f64; 2]| (dd[0] - a[0]) * (q[1] - a[1]) - (dd[1] - a[1]) * (q[0] - a[0]);
@@ -95,7 +85,7 @@ fn a_four_bar_by_its_dimensions_is_the_four_bar_by_coordinates() {
 
 #[test]
 fn points_along_a_line_and_where_a_line_meets_a_circle() {
-    let text = FOUR_BAR_BY_DIMENSIONS.replace(
+    let text = four_bar_by_dimensions().replace(
         "ground: [O, D]",
         "  M: {along: [O, D], fraction: 0.5}\n  E: {along: [O, A], distance: \"250 mm\"}\n  \
          F: {line: [O, D], circle: [A, 0.5], crossing: second}\n  \
@@ -116,14 +106,14 @@ fn points_along_a_line_and_where_a_line_meets_a_circle() {
 
 #[test]
 fn an_unknown_unit_names_the_field_the_line_and_the_units() {
-    let msg = refused(&FOUR_BAR_BY_DIMENSIONS.replace("\"60 deg\"", "\"60 degs\""), Format::Yaml);
+    let msg = refused(&four_bar_by_dimensions().replace("\"60 deg\"", "\"60 degs\""), Format::Yaml);
     assert_eq!(
         msg,
         "m.yaml: points.A.angle: \"60 degs\": 'degs' is not a unit of an angle (rad, deg, rev, or a number alone \
          in rad) (line 7 column 41); write e.g. \"30 deg\""
     );
     // A unit of another kind says which kind it is.
-    let msg = refused(&FOUR_BAR_BY_DIMENSIONS.replace("\"500 mm\"", "\"500 kg\""), Format::Yaml);
+    let msg = refused(&four_bar_by_dimensions().replace("\"500 mm\"", "\"500 kg\""), Format::Yaml);
     assert!(msg.contains("points.A.length: \"500 kg\": 'kg' is not a unit of a length (m, mm, cm, um, in, ft, or a number alone in m) ('kg' is a unit of a mass)"), "{msg}");
     // JSON too.
     let json = r#"{"name": "x", "points": {"O": ["1 mx", 0]}, "bodies": {}, "pairs": [], "coordinates": []}"#;
@@ -135,7 +125,7 @@ fn an_unknown_unit_names_the_field_the_line_and_the_units() {
 fn circles_that_do_not_meet_name_the_point_and_the_gap() {
     // |AD| = 0.9539 m at the drawing; radii 0.5 + 0.3 = 0.8 m: 0.1539 m short.
     let msg = refused(
-        &FOUR_BAR_BY_DIMENSIONS.replace("[[A, \"1.2 m\"], [D, \"1 m\"]]", "[[A, 0.5], [D, 0.3]]"),
+        &four_bar_by_dimensions().replace("[[A, \"1.2 m\"], [D, \"1 m\"]]", "[[A, 0.5], [D, 0.3]]"),
         Format::Yaml,
     );
     let d = (1.0f64 - 0.25).hypot(0.5 * (PI / 3.0).sin());
@@ -148,19 +138,21 @@ fn circles_that_do_not_meet_name_the_point_and_the_gap() {
             d - 0.8
         )
     );
-    let msg =
-        refused(&FOUR_BAR_BY_DIMENSIONS.replace("[[A, \"1.2 m\"], [D, \"1 m\"]]", "[[A, 3], [D, 0.3]]"), Format::Yaml);
+    let msg = refused(
+        &four_bar_by_dimensions().replace("[[A, \"1.2 m\"], [D, \"1 m\"]]", "[[A, 3], [D, 0.3]]"),
+        Format::Yaml,
+    );
     assert!(msg.contains("one lies inside the other"), "{msg}");
 }
 
 #[test]
 fn constructions_refer_to_points_that_exist_and_do_not_go_round() {
-    let msg = refused(&FOUR_BAR_BY_DIMENSIONS.replace("from: O,", "from: Q,"), Format::Yaml);
+    let msg = refused(&four_bar_by_dimensions().replace("from: O,", "from: Q,"), Format::Yaml);
     assert!(msg.starts_with("m.yaml: points.A: unknown point 'Q'; points are: O, D, A, B"), "{msg}");
-    let msg = refused(&FOUR_BAR_BY_DIMENSIONS.replace("from: O,", "from: B,"), Format::Yaml);
+    let msg = refused(&four_bar_by_dimensions().replace("from: O,", "from: B,"), Format::Yaml);
     assert!(msg.contains("points.A: 'A' is constructed from B, which cannot be placed before it"), "{msg}");
     // A construction missing its side says so.
-    let msg = refused(&FOUR_BAR_BY_DIMENSIONS.replace(", side: left", ""), Format::Yaml);
+    let msg = refused(&four_bar_by_dimensions().replace(", side: left", ""), Format::Yaml);
     assert!(
         msg.contains("points.B: a point where two circles meet needs the side it lies on, side: left or right"),
         "{msg}"
@@ -169,11 +161,11 @@ fn constructions_refer_to_points_that_exist_and_do_not_go_round() {
 
 #[test]
 fn a_value_in_a_unit_of_the_wrong_motion_is_refused() {
-    let msg = refused(&FOUR_BAR_BY_DIMENSIONS.replace("{angle: [O, A]}", "\"60 mm\""), Format::Yaml);
+    let msg = refused(&four_bar_by_dimensions().replace("{angle: [O, A]}", "\"60 mm\""), Format::Yaml);
     assert_eq!(
         msg,
         "m.yaml: coordinates[0].value: the pair 'O' turns, so its value is an angle; give it in rad or deg"
     );
-    let m = load(&FOUR_BAR_BY_DIMENSIONS.replace("{angle: [O, A]}", "\"60 deg\""));
+    let m = load(&four_bar_by_dimensions().replace("{angle: [O, A]}", "\"60 deg\""));
     assert!((m.spec.coordinates[0].value - PI / 3.0).abs() < CONSTRUCTED_TOL);
 }
