@@ -293,6 +293,10 @@ def _mass(mass: Quantity | None, rho: float | None, length: Callable[[], float],
 
 
 def _guide(axis: Sequence[float] | None, along: tuple[str, str] | None) -> dict[str, Any]:
+    """A guide's direction as the dict holds it: ``axis`` as a unit vector, or ``along``."""
     if axis is not None:
-        return {"axis": [float(axis[0]), float(axis[1])]}
+        n = math.hypot(float(axis[0]), float(axis[1]))
+        if not (n > 0.0 and math.isfinite(n)):
+            raise error("axis", f"a guide's direction must be a finite non-zero vector, got {list(axis)!r}")
+        return {"axis": [float(axis[0]) / n, float(axis[1]) / n]}
     return {"along": list(along)} if along is not None else {}
