@@ -16,6 +16,7 @@ __all__ = [
     "Mechanism",
     "load",
     "loads",
+    "resolve_model",
     "PlanardynError",
     "ModelError",
     "ArgumentError",

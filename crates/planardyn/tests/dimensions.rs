@@ -169,3 +169,20 @@ fn a_value_in_a_unit_of_the_wrong_motion_is_refused() {
     let m = load(&four_bar_by_dimensions().replace("{angle: [O, A]}", "\"60 deg\""));
     assert!((m.spec.coordinates[0].value - PI / 3.0).abs() < CONSTRUCTED_TOL);
 }
+
+#[test]
+fn units_inside_pairs_and_loads_are_read_in_yaml_and_json() {
+    use planardyn::loader::parse_spec;
+    use planardyn::model::spec::LoadSpec;
+    // serde buffers these entries to read their `type` first (`units::tagged`).
+    let yaml = four_bar_by_dimensions()
+        .replace("coordinates:", "loads:\n  - {type: torque, body: crank, value: \"500 N mm\"}\ncoordinates:");
+    let spec = parse_spec(&yaml, Format::Yaml, "m.yaml").unwrap();
+    let LoadSpec::Torque(t) = &spec.loads[0] else { panic!("{:?}", spec.loads) };
+    assert!((t.value - 0.5).abs() < 1e-15);
+    let json = r#"{"name": "x", "points": {"O": [0, 0]}, "bodies": {}, "coordinates": [],
+        "pairs": [{"type": "gear", "bodies": ["a", "b"], "centers": ["O"], "radii": ["20 mm"], "rack": ["O", "O"]}]}"#;
+    let spec = parse_spec(json, Format::Json, "m.json").unwrap();
+    let planardyn::model::spec::PairSpec::Gear { radii, .. } = &spec.pairs[0] else { panic!() };
+    assert!((radii[0] - 0.02).abs() < 1e-15);
+}

@@ -17,7 +17,10 @@ fn spelling(unit: &str) -> String {
             out.push_str(r"[\s*·⋅]+");
         }
         let f = factor.replace('^', r"\^").replace(r"\^2", r"(\^2|²)").replace('/', r"\s*/\s*");
-        let f = if f.starts_with('u') { format!("[uµμ]{}", &f[1..]) } else { f };
+        let f = match f.strip_prefix('u') {
+            Some(rest) => format!("[uµμ]{rest}"),
+            None => f,
+        };
         out.push_str(&f.replace("deg", "(deg|°)"));
     }
     out
