@@ -133,6 +133,35 @@ def test_three_rpr_by_dimensions_is_the_librarys(page):
     assert_same_mechanism(page["robot"], coords, inputs)
 
 
+# ----------------------------------------------------------------------------- gears
+
+
+def test_a_gear_train_by_its_dimensions_is_the_shipped_one():
+    # The centres from the pitch radii: O2 at 20 + 60 mm from O1 (external), O3 at 45 - 25 mm
+    # from O2 (inside the ring); a mark on each gear at its pitch radius, straight up.
+    b = pdy.Builder("gear train", gravity=(0, 0))
+    b.point("O1", (0, 0), ground=True)
+    b.polar("T1", "O1", "20 mm", "90 deg")
+    b.polar("O2", "O1", "80 mm", 0, ground=True)
+    b.polar("T2", "O2", "60 mm", "90 deg")
+    b.polar("O3", "O2", "20 mm", 0, ground=True)
+    b.polar("T3", "O3", "45 mm", "90 deg")
+    b.point("R1", ("-100 mm", "-20 mm"))
+    b.point("R2", ("100 mm", "-20 mm"))
+    for gear, centre, mark, mass, inertia in (("pinion", "O1", "T1", "200 g", 4.0e-5), ("wheel", "O2", "T2", "600 g", 0.00108),
+                                              ("ring", "O3", "T3", "400 g", 0.00081)):
+        b.block(gear, centre, mass, inertia)
+        b.carry(gear, mark)
+        b.revolute(f"{gear}_shaft", centre, "ground", gear)
+    b.bar("rack", ["R1", "R2"], mass="300 g")
+    b.prismatic("rack_guide", "R1", "ground", "rack", axis=(1, 0))
+    b.gear("mesh1", "pinion", "wheel", ["O1", "O2"], ["20 mm", "60 mm"])
+    b.gear("mesh2", "wheel", "ring", ["O2", "O3"], ["25 mm", "45 mm"], internal=True)
+    b.gear("rack_mesh", "pinion", "rack", ["O1"], ["20 mm"], rack=("R1", "R2"))
+    b.coordinate("theta", "pinion_shaft", 0)
+    assert_same_mechanism(b.build(), pdy.load_example("gear-train"), [np.array([0.3]), np.array([-1.0])])
+
+
 # ----------------------------------------------------------------------------- files, units, errors
 
 
