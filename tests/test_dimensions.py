@@ -40,14 +40,15 @@ def points(mech: pdy.Mechanism, x: np.ndarray | None = None) -> dict[str, np.nda
     return dict(zip(mech.point_names, mech.point_positions(mech.x0 if x is None else x)))
 
 
-def assert_same_mechanism(a: pdy.Mechanism, b: pdy.Mechanism, inputs: list[np.ndarray]) -> None:
-    """The same points where drawn and at each input q, the same masses and inertias."""
-    assert sorted(a.point_names) == sorted(b.point_names)
+def assert_same_mechanism(a: pdy.Mechanism, b: pdy.Mechanism, inputs: list[np.ndarray], guides: tuple = ()) -> None:
+    """The same points where drawn and at each input q, the same masses and inertias (``a``
+    may have the ground points ``guides`` more, drawn only to construct others)."""
+    assert sorted(a.point_names) == sorted([*b.point_names, *guides])
     for qa in [None, *inputs]:
         xa = None if qa is None else a.assemble(qa)
         xb = None if qa is None else b.assemble(qa)
         pa, pb = points(a, xa), points(b, xb)
-        gap = max(float(np.max(np.abs(pa[n] - pb[n]))) for n in pa)
+        gap = max(float(np.max(np.abs(pa[n] - pb[n]))) for n in pb)
         assert gap < SAME_DRAWING, f"at q = {qa}: points differ by {gap:.3e} m"
     np.testing.assert_allclose(a.drawn_q, b.drawn_q, rtol=0, atol=SAME_DRAWING)
     np.testing.assert_allclose(a.masses, b.masses, rtol=1e-15)
@@ -160,6 +161,27 @@ def test_a_gear_train_by_its_dimensions_is_the_shipped_one():
     b.gear("rack_mesh", "pinion", "rack", ["O1"], ["20 mm"], rack=("R1", "R2"))
     b.coordinate("theta", "pinion_shaft", 0)
     assert_same_mechanism(b.build(), pdy.load_example("gear-train"), [np.array([0.3]), np.array([-1.0])])
+
+
+# ----------------------------------------------------------------------------- slider-crank
+
+
+def test_a_slider_crank_by_its_dimensions_is_the_librarys():
+    # library.slider_crank at its defaults: crank 0.1 m at 60 deg, rod 0.3 m, the slider on y = 0
+    # ahead of the crank pin; the guide's line by its ends G, H (ground points of this drawing only).
+    b = pdy.Builder("slider-crank")
+    b.point("O", (0, 0))
+    b.point("G", (0, 0), ground=True)
+    b.point("H", ("1 m", 0), ground=True)
+    b.crank("crank", "O", "A", "100 mm", "60 deg", rho=1.0, coordinate="theta")
+    b.line_circle("B", ("G", "H"), "A", "300 mm", "second")
+    b.bar("rod", ["A", "B"], rho=1.0)
+    b.revolute("crank_pin", "A", "crank", "rod")
+    b.slider("slider", "B", 0.5, 1.0e-3, axis=(1, 0))
+    b.revolute("wrist_pin", "B", "rod", "slider")
+    built = b.build()
+    assert built.pair_names == ["ground_crank", "crank_pin", "ground_slider", "wrist_pin"]
+    assert_same_mechanism(built, library.slider_crank(), [np.array([1.0]), np.array([3.0])], guides=("G", "H"))
 
 
 # ----------------------------------------------------------------------------- files, units, errors
