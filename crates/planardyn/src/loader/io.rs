@@ -43,7 +43,7 @@ pub fn loads(text: &str, format: Format, source: &str) -> Result<Mechanism, Mode
 /// in SI, the points given by construction placed and the coordinates' values given as
 /// measures of the drawing measured (`model::construct`).
 pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismSpec, ModelError> {
-    construct::resolve(parse_file(text, format, source)?, source)
+    parse_spec_constructed(text, format, source).map(|(spec, _)| spec)
 }
 
 /// [`parse_spec`], and the names of the points the text gives by construction (for the
@@ -56,7 +56,35 @@ pub fn parse_spec_constructed(
     let file = parse_file(text, format, source)?;
     let constructed =
         file.points.0.iter().filter(|(_, p)| matches!(p, PointSpec::By(_))).map(|(n, _)| n.clone()).collect();
-    Ok((construct::resolve(file, source)?, constructed))
+    let spec = construct::resolve(file, source).map_err(|e| with_line(e, text, format))?;
+    Ok((spec, constructed))
+}
+
+/// A construction's error with the line of its point in the text: `points.B: ... (line 8); fix`.
+fn with_line(e: ModelError, text: &str, format: Format) -> ModelError {
+    let ModelError::Invalid { source_name, path, message } = e else { return e };
+    let line = path.strip_prefix("points.").and_then(|name| point_line(text, format, name));
+    let message = match (line, message.split_once("; ")) {
+        (Some(line), Some((what, fix))) => format!("{what} (line {line}); {fix}"),
+        (Some(line), None) => format!("{message} (line {line})"),
+        (None, _) => message,
+    };
+    ModelError::Invalid { source_name, path, message }
+}
+
+/// The 1-based line where the point `name` is given: its key, the first after the `points`
+/// key (an entry `B: {...}` in YAML, `"B": {...}` in JSON, where several may share a line).
+fn point_line(text: &str, format: Format, name: &str) -> Option<usize> {
+    let lines: Vec<&str> = text.lines().collect();
+    let is_key = |line: &str, key: &str| {
+        let l = line.trim_start().trim_start_matches(['{', ',', ' ']);
+        [format!("{key}:"), format!("\"{key}\":"), format!("'{key}':")].iter().any(|k| l.starts_with(k.as_str()))
+    };
+    let start = lines.iter().position(|l| is_key(l, "points") || is_key(l, "points_at_t0"))?;
+    let json_key = format!("\"{name}\":");
+    let found =
+        lines[start..].iter().position(|l| is_key(l, name) || (format == Format::Json && l.contains(&json_key)))?;
+    Some(start + found + 1)
 }
 
 /// The model text as written: points and coordinate values also by construction.
