@@ -7,7 +7,7 @@
 //! parser knows only its own unit abbreviations; `dimensioned` and `measurements` likewise
 //! model arithmetic, not parsing. A model file needs a table per quantity kind, an error
 //! that lists the units accepted, and the same table in the JSON Schema (`schema/`, checked
-//! against [`KINDS`] by `tests/units.rs`).
+//! against [`KINDS`] by `tests/units_schema.rs`).
 
 mod de;
 mod table;
@@ -38,8 +38,8 @@ pub enum Motion {
 }
 
 /// What a field of a model file holds: one kind, or the two kinds of a pair's motion
-/// (rotation first, translation second), which the pair decides (the loader checks a unit
-/// against the pair, `loader::pair_units`).
+/// (rotation first, translation second), which the pair decides (a coordinate's drawn value
+/// is checked against its pair, `model::construct`; the other pair quantities take either).
 pub trait Quantity {
     const KINDS: &'static [&'static Kind];
 }
