@@ -43,7 +43,7 @@ def write_drawing(mech: Mechanism, path: str | os.PathLike[str], x: ArrayLike | 
 
 def to_svg(mech: Mechanism, path: str | os.PathLike[str], x: ArrayLike | None = None) -> Path:
     """The drawing as SVG (the figure of :func:`~planardyn.plot.draw_mechanism`, its labels as
-    ``<text>`` elements). Returns the path."""
+    ``<text>`` elements; no date and fixed ids, so that one drawing gives one file). Returns the path."""
     import matplotlib
     from matplotlib.figure import Figure
 
@@ -54,7 +54,7 @@ def to_svg(mech: Mechanism, path: str | os.PathLike[str], x: ArrayLike | None = 
     ax.set_ylabel("y (m)")
     ax.set_title(mech.name)
     with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "planardyn"}):
-        fig.savefig(path, format="svg", bbox_inches="tight")
+        fig.savefig(path, format="svg", bbox_inches="tight", metadata={"Date": None})
     return Path(path)
 
 
