@@ -265,6 +265,11 @@ def test_svg_drawing_parses_with_its_labels(page, tmp_path):
     texts = {"".join(t.itertext()).strip() for t in root.iter("{http://www.w3.org/2000/svg}text")}
     assert set(mech.point_names) <= texts
     assert "Hoeken straight-line linkage" in texts
+    # No date, fixed ids: the same drawing gives the same file (docs/img/hoeken.svg is this one).
+    assert write_drawing(mech, tmp_path / "again.svg").read_bytes() == path.read_bytes()
+    assert path.read_bytes() == (ROOT / "docs" / "img" / "hoeken.svg").read_bytes(), (
+        "docs/img/hoeken.svg is not what `planardyn draw hoeken.yaml -o hoeken.svg` writes (with docs/dimensions.md's "
+        "hoeken.yaml): write it again")
 
 
 def test_draw_command_writes_both_and_refuses_other_suffixes(tmp_path, capsys):
