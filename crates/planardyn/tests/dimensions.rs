@@ -174,6 +174,12 @@ fn a_value_in_a_unit_of_the_wrong_motion_is_refused() {
     );
     let m = load(&four_bar_by_dimensions().replace("{angle: [O, A]}", "\"60 deg\""));
     assert!((m.spec.coordinates[0].value - PI / 3.0).abs() < CONSTRUCTED_TOL);
+    // The start q0 too.
+    let msg =
+        refused(&four_bar_by_dimensions().replace("{angle: [O, A]}}", "{angle: [O, A]}, q0: \"1 in\"}"), Format::Yaml);
+    assert!(msg.starts_with("m.yaml: coordinates[0].q0: the pair 'O' turns, so its value is an angle"), "{msg}");
+    let m = load(&four_bar_by_dimensions().replace("{angle: [O, A]}}", "{angle: [O, A]}, q0: \"90 deg\"}"));
+    assert!((m.spec.coordinates[0].q0.unwrap() - PI / 2.0).abs() < CONSTRUCTED_TOL);
 }
 
 #[test]

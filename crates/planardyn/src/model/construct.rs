@@ -21,9 +21,12 @@ pub fn resolve(spec: MechanismSpec<PointSpec, ValueSpec>, source: &str) -> R<Mec
         .into_iter()
         .enumerate()
         .map(|(i, c)| {
-            let path = format!("coordinates[{i}].value");
-            let value = drawn_value(&c.value, &c.pair, &spec.pairs, &points, &path, &err)?;
-            Ok(CoordinateSpec { name: c.name, pair: c.pair, value, q0: c.q0, qd0: c.qd0, about: c.about })
+            let drawn = |v: &ValueSpec, field: &str| {
+                drawn_value(v, &c.pair, &spec.pairs, &points, &format!("coordinates[{i}].{field}"), &err)
+            };
+            let value = drawn(&c.value, "value")?;
+            let q0 = c.q0.as_ref().map(|v| drawn(v, "q0")).transpose()?;
+            Ok(CoordinateSpec { name: c.name, pair: c.pair, value, q0, qd0: c.qd0, about: c.about })
         })
         .collect::<R<Vec<_>>>()?;
     Ok(MechanismSpec {

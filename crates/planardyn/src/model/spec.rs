@@ -233,9 +233,10 @@ pub struct CoordinateSpec<V = f64> {
     pub pair: String,
     /// The coordinate's value in the drawing (e.g. the absolute angle of a crank line).
     pub value: V,
-    /// Start the simulation here instead of at the drawing.
-    #[serde(default, deserialize_with = "units::position", skip_serializing_if = "Option::is_none")]
-    pub q0: Option<f64>,
+    /// Start the simulation here instead of at the drawing (as `value`: a number, with its unit,
+    /// or a measure of the drawing in a file).
+    #[serde(default = "Option::default", skip_serializing_if = "Option::is_none")]
+    pub q0: Option<V>,
     /// Initial rate (rad/s or m/s), default 0.
     #[serde(default, deserialize_with = "units::rate")]
     pub qd0: f64,
