@@ -232,6 +232,22 @@ def test_check_prints_the_derived_dimensions(page, capsys):
     assert "points by construction:\n  A = (-0.05, 0)\n  B = (0.025, 0.1)\n  P = (0.1, 0.2)\n" in out
 
 
+def test_the_builder_names_what_it_lacks():
+    b = pdy.Builder("x")
+    b.point("O", (0, 0))
+    b.polar("A", "O", "10 mm", "30 deg")
+    np.testing.assert_allclose(b.xy("A"), (0.01 * math.cos(math.pi / 6), 0.005), rtol=0, atol=1e-15)
+    with pytest.raises(pdy.ArgumentError, match=r"unknown point 'B'; the points so far: O, A \(add it first\)"):
+        b.xy("B")
+    with pytest.raises(pdy.ArgumentError, match="unknown body 'crank'"):
+        b.carry("crank", "A")
+    with pytest.raises(pdy.ArgumentError, match="give one of mass"):
+        b.bar("crank", ["O", "A"])
+    b.polar("C", "Q", 1, 0)
+    with pytest.raises(pdy.ModelError, match=r"points.C: unknown point 'Q'"):
+        b.xy("C")
+
+
 # ----------------------------------------------------------------------------- drawings
 
 

@@ -100,7 +100,7 @@ class Builder:
 
     def xy(self, name: str) -> Vec:
         """Where a point is (m), its construction placed by the loader."""
-        spec = self._d["points"][name]
+        spec = self._known("point", name, self._d["points"])
         if isinstance(spec, list) and all(isinstance(v, float) for v in spec):
             return (spec[0], spec[1])
         if self._placed is None:
@@ -121,6 +121,8 @@ class Builder:
             about: str | None = None) -> str:
         """A uniform bar between its first two points, carrying all ``points``: of ``mass``
         (kg, or with a unit), or of ``rho`` kg per metre of its drawn length."""
+        if len(points) < 2:
+            raise error("points", f"bar {name!r}: a bar carries at least two points, got {list(points)!r}")
         p, q = points[0], points[1]
         body = self._body(name, points, about)
         body["uniform_bar"] = [p, q]
@@ -148,7 +150,7 @@ class Builder:
 
     def carry(self, body: str, *points: str) -> None:
         """``body`` carries these points too (a coupler point, a pin of a later pair)."""
-        have = self._d["bodies"][body]["points"]
+        have = self._known("body", body, self._d["bodies"])["points"]
         have += [p for p in points if p not in have]
 
     # ------------------------------------------------------------------ pairs
@@ -266,6 +268,12 @@ class Builder:
         if ground:
             self.ground(name)
         return name
+
+    def _known(self, kind: str, name: str, entries: dict[str, Any]) -> Any:
+        if name not in entries:
+            raise error(kind, f"unknown {kind} {name!r}; the {kind}s so far: {', '.join(entries) or 'none'} "
+                              f"(add it first)")
+        return entries[name]
 
     def _body(self, name: str, points: Sequence[str], about: str | None) -> dict[str, Any]:
         body: dict[str, Any] = {"points": list(points)}
