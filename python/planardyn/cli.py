@@ -45,6 +45,8 @@ from . import (
     SimulationError,
     SingularityError,
     __version__,
+    dimensions,
+    drawing,
     extras,
     from_result,
     guide,
@@ -71,7 +73,8 @@ class UsageError(Exception):
 
 
 #: What writing a file of this extension needs beyond the dependencies: (extra, what it writes).
-OPTIONAL_WRITERS = {".parquet": ("parquet", "a .parquet file"), ".mp4": ("mp4", "an .mp4 file")}
+OPTIONAL_WRITERS = {".parquet": ("parquet", "a .parquet file"), ".mp4": ("mp4", "an .mp4 file"),
+                    ".dxf": ("cad", "a .dxf drawing")}
 #: Integration methods without error control, whose step must be given (--dt).
 FIXED_STEP_METHODS = ("rk4",)
 
@@ -221,6 +224,14 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
              "  planardyn check five-bar\n"
              "  planardyn check my-linkage.yaml")
     c.add_argument("model", type=Path, help=MODEL_HELP)
+
+    d = _sub(sub, "draw", "write a model's drawing for CAD or a document (.svg, .dxf)",
+             "Write the mechanism as drawn: SVG (the plot's drawing) or DXF in millimetres on the\n"
+             "layers BODIES, PAIRS, GROUND and LABELS (DXF needs the 'cad' extra, ezdxf).",
+             "  planardyn draw five-bar -o five-bar.svg\n"
+             "  planardyn draw my-linkage.yaml -o my-linkage.dxf")
+    d.add_argument("model", type=Path, help=MODEL_HELP)
+    d.add_argument("-o", "--output", type=Path, required=True, help="the drawing: .svg or .dxf")
 
     s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
              "Integrate the equations of motion from the model's start state. Options left out take\n"
@@ -400,6 +411,7 @@ def _check(args: argparse.Namespace) -> int:
     print(f"bodies: {n}")
     for b, mass, inertia in zip(mech.body_names, mech.masses, mech.inertias):
         print(f"  {b}: mass {mass:.6g} kg, inertia {inertia:.6g} kg m^2")
+    print(dimensions.report(mech, dimensions.constructed_points(args.model)))
     kinds: dict[str, list[str]] = {}
     for pr in pairs:
         kinds.setdefault(pr["kind"], []).append(pr["name"])
@@ -419,6 +431,15 @@ def _check(args: argparse.Namespace) -> int:
     except SingularityError as e:
         print(f"singularity measures at the start: singular ({e})")
     print(structure.report(s))
+    return EXIT_OK
+
+
+def _draw(args: argparse.Namespace) -> int:
+    if args.output.suffix.lower() not in (".svg", ".dxf"):
+        raise UsageError(f"-o {args.output}: a drawing is written as SVG or DXF; give a file ending in .svg or .dxf")
+    require_writer(args.output)
+    mech = load(args.model)
+    print(f"wrote {drawing.write_drawing(mech, args.output)}")
     return EXIT_OK
 
 
@@ -752,6 +773,7 @@ def _docs(args: argparse.Namespace) -> int:
 
 COMMANDS = {
     "check": _check,
+    "draw": _draw,
     "simulate": _simulate,
     "inverse": _inverse,
     "identify": _identify,
