@@ -8,7 +8,8 @@ use std::ops::ControlFlow::{self, Break, Continue};
 
 use super::charts::{chart_sigma, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
 use super::crossing::{
-    cross, stepped_over, user_state, Approach, Landing, Path, Quintic, APPROACH_FRACTION, CROSS_BELOW, WATCH_BELOW,
+    cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Passed, Path,
+    APPROACH_BELOW, APPROACH_FRACTION, CHANGE_POINT_RATIO, CROSS_START, WATCH_BELOW,
 };
 use super::dense::{self, DenseOutput};
 use super::events::Watch;
@@ -18,7 +19,7 @@ use super::stop::{Near, Stop, PROGRESS_MARGIN};
 use super::trajectory::Trajectory;
 use super::{Observe, Settings};
 use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
-use crate::integrate::{Options, Stepper};
+use crate::integrate::{Options, Stats, Stepper};
 use crate::kinematics::{passive_sigma_min, Chart};
 use crate::model::Mechanism;
 use crate::Error;
@@ -30,6 +31,14 @@ const PROGRESS_MIN_STEPS: usize = 10_000;
 /// The progress callback: called with t after each accepted step, false stops the run.
 pub type Progress<'p> = Option<&'p mut dyn FnMut(f64) -> bool>;
 
+/// What a crossing did: landed past the change point, reached t_end inside it, or found none
+/// (the passive measure only dipped).
+enum Crossed {
+    Past,
+    AtEnd,
+    NoPoint,
+}
+
 /// A run: the mechanism in its chart, the integrator, the trajectory written so far, and what
 /// the stages keep between steps.
 pub struct Run<'a, 's, 'e> {
@@ -40,8 +49,18 @@ pub struct Run<'a, 's, 'e> {
     /// The output grid, and the index of the next output time in it.
     t_eval: Option<&'s [f64]>,
     next: usize,
-    /// The accepted points near a change point, and the energy balance across it.
+    /// The accepted points near a change point, and the energy balance across it; where the
+    /// next step must end at the latest (t_end, or before a change point ahead).
     approach: Approach,
+    t_stop: f64,
+    grid: Option<Grid>,
+    limit: Option<f64>,
+    /// Whether the measure now heading to 0 is the passive one (asked once an approach).
+    heading: Option<bool>,
+    /// The integrator's options without dense output (for a crossing's integration past its
+    /// landing), and the counters of those integrations.
+    options: Options,
+    crossing_stats: Stats,
     /// (2m + 1) The state accepted last, and an interpolated one.
     y: Vec<f64>,
     yi: Vec<f64>,
@@ -72,7 +91,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // Dense output is only needed to interpolate at requested times, and for events and the
         // kept interpolant (DOP853 pays 3 extra evaluations in each step that uses it).
         let (observing, keep_dense) = (!observe.is_empty(), observe.dense_output);
-        let options = Options { dense_output: settings.t_eval.is_some() || observing, ..settings.options.clone() };
+        // DOP853 evaluates them only when a step is interpolated (outputs, events, a crossing's
+        // nodes): a step without pays nothing.
+        let options = Options { dense_output: true, ..settings.options.clone() };
         let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
         if let Err(error) = stepper.reset(&mut ode, settings.t0, &y) {
             return Ok(Break(Stop::Step { error, crossing: None }));
@@ -85,6 +106,12 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             t_eval: settings.t_eval.as_deref(),
             next: 0,
             approach: Approach::default(),
+            t_stop: settings.t_end,
+            grid: None,
+            limit: None,
+            heading: None,
+            options: Options { dense_output: false, ..settings.options.clone() },
+            crossing_stats: Stats::default(),
             y,
             yi: vec![0.0; 2 * m + 1],
             dense: observing.then(|| DenseOutput::new(m, settings.method.dense_order())),
@@ -95,7 +122,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // The start counts in the least measures, so that a run of no step reports its start's.
         let first = measure(&mut run.ode);
         (run.traj.stats.min_sigma, run.traj.stats.min_passive_sigma) = (first.sigma, first.passive);
-        run.approach.keep(&run.ode, settings.t0, first.passive, run.y[2 * m]);
+        run.approach.keep(&run.ode, settings.t0, first.passive);
         if run.t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
             run.traj.record(&run.ode, settings.t0, run.y[2 * m], first.sigma);
             run.next = 1;
@@ -124,10 +151,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// One step, as `mj_step`: integrate, observe, output, accept; then what the accepted
     /// point asks for.
     fn step(&mut self, progress: &mut Progress) -> ControlFlow<Stop> {
-        if let Err(error) = self.stepper.step(&mut self.ode, self.settings.t_end) {
+        if let Err(error) = self.stepper.step(&mut self.ode, self.t_stop) {
             return self.cross_from_last(error);
         }
         let t = self.stepper.t();
+        if self.overshot(t) {
+            return self.retake();
+        }
         self.y.copy_from_slice(self.stepper.y());
         if self.ode.ws.chart != Chart::Inputs {
             self.traj.stats.partition_steps += 1;
@@ -137,14 +167,16 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if let Some((t_star, index)) = terminal {
             return self.end_at_event(t_star, index);
         }
+        self.fill_approach(t)?;
         let meas = self.accept(t)?;
         if self.change_points(t, &meas)? {
             return Continue(());
         }
-        self.energy(t, &meas)?;
+        self.approach.keep(&self.ode, t, meas.passive);
         self.passive(t, &meas)?;
         self.progress_rate()?;
         self.chart(t, &meas)?;
+        self.aim(t, &meas);
         self.report(t, progress)
     }
 
@@ -171,8 +203,12 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return Break(Stop::Step { error, crossing: None });
         };
         match self.cross_change_point((t, meas.sigma, meas.passive, y[2 * m])) {
-            Ok(false) => Continue(()),
-            Ok(true) => Break(Stop::Reached { t_end: self.settings.t_end }),
+            Ok(Crossed::Past) => Continue(()),
+            Ok(Crossed::AtEnd) => Break(Stop::Reached { t_end: self.settings.t_end }),
+            Ok(Crossed::NoPoint) => {
+                let why = "Phi_x keeps its rank on the path ahead: no change point to cross".to_string();
+                Break(Stop::Step { error, crossing: Some(why) })
+            }
             Err(why) => Break(Stop::Step { error, crossing: Some(why) }),
         }
     }
@@ -256,35 +292,35 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn change_points(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop, bool> {
         let falling = self.approach.last().is_some_and(|p| meas.passive < p.passive);
         let over = stepped_over(&self.ode, &self.approach, t, meas.passive);
-        if over.is_none() && meas.passive < CROSS_BELOW && falling && self.ode.motion.is_none() {
+        let watched = self.heading != Some(false) && self.ode.motion.is_none();
+        if over.is_none() && meas.passive < CROSS_START && falling && watched {
             let work = self.y[self.y.len() - 1];
             return match self.cross_change_point((t, meas.sigma, meas.passive, work)) {
-                Ok(false) => Continue(true),
-                Ok(true) => Break(Stop::Reached { t_end: self.settings.t_end }),
+                Ok(Crossed::Past) => Continue(true),
+                Ok(Crossed::AtEnd) => Break(Stop::Reached { t_end: self.settings.t_end }),
+                // A dip, not a change point: on with the step's other stages, unwatched.
+                Ok(Crossed::NoPoint) => {
+                    self.heading = Some(false);
+                    Continue(false)
+                }
                 Err(why) => Break(Stop::NoCrossing { t, passive: meas.passive, why }),
             };
         }
         if let Some(point) = over {
-            self.traj.change_points.push(point);
+            self.passed_point(point);
             // The points kept are on the other side of it.
             self.approach.clear();
         }
         Continue(false)
     }
 
-    /// Restore the energy balance from before the change point last crossed, once clear of it,
-    /// and keep the point for the next crossing.
-    fn energy(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
-        let m = self.ode.m();
-        if let Some(scale) = self.approach.restore(&self.ode, meas.passive, self.y[2 * m]) {
-            self.y[m..2 * m].iter_mut().for_each(|v| *v *= scale);
-            let restored = self.stepper.reset(&mut self.ode, t, &self.y).map_err(|e| e.to_string());
-            if let Err(error) = restored.and_then(|()| self.ode.accept(t, &self.y).map_err(|e| e.to_string())) {
-                return Break(Stop::Restore { t, error });
-            }
-        }
-        self.approach.keep(&self.ode, t, meas.passive, self.y[2 * m]);
-        Continue(())
+    /// Report a change point the run went through: in the trajectory's list, and in the least
+    /// passive measure seen (the path passes through it, the accepted points do not).
+    fn passed_point(&mut self, point: ChangePoint) {
+        let passive = passive_sigma_min(self.ode.mech, &point.x);
+        let stats = &mut self.traj.stats;
+        stats.min_passive_sigma = stats.min_passive_sigma.min(passive);
+        self.traj.change_points.push(point);
     }
 
     /// Stop where the passive mechanism itself is singular.
@@ -338,6 +374,90 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         Continue(())
     }
 
+    /// With a change point ahead, the crossing's grid before it ([`Approach::grid`]) and where
+    /// the next step should end at the latest ([`Approach::step_limit`]): below
+    /// [`APPROACH_BELOW`] the next step ends there, above only if it would otherwise end past
+    /// the crossing's start ([`Run::retake`]).
+    fn aim(&mut self, t: f64, meas: &Measures) {
+        let grid = self.approach.grid(t, meas.passive).filter(|_| self.ode.motion.is_none());
+        if grid.is_none() {
+            self.heading = None;
+        }
+        let ahead = grid.is_some() && self.change_point_ahead(meas);
+        self.grid = grid.filter(|_| ahead);
+        self.limit = self.approach.step_limit(t, meas.passive).filter(|_| ahead).map(|l| l.min(self.settings.t_end));
+        self.t_stop = self.settings.t_end;
+    }
+
+    /// Whether the measure heading to 0 at the point in `ode.ws` is the passive one. Above
+    /// [`APPROACH_BELOW`] it is the user's chart's type II measure, which bounds the passive
+    /// one from below: asked once an approach (the passive measure, an SVD of Phi_x), which is
+    /// A02's (the same) and not the 3-RRR's (2.3 times it, where its type II measure dips).
+    fn change_point_ahead(&mut self, meas: &Measures) -> bool {
+        if meas.passive < APPROACH_BELOW {
+            return true;
+        }
+        *self
+            .heading
+            .get_or_insert_with(|| passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CHANGE_POINT_RATIO * meas.passive)
+    }
+
+    /// Whether the step just taken to t, not limited by the approach, went past the start of
+    /// the crossing ahead (as seen from its start) and near or over a change point. Above
+    /// [`APPROACH_BELOW`] the measure is the user's chart's: one heading to 0 there may only
+    /// dip (the 3-RRR's, the five-bar's), so the step's end and its path are asked (the true
+    /// passive measure there; Phi_x's rank along the quintic through its ends).
+    fn overshot(&mut self, t: f64) -> bool {
+        let unlimited = self.t_stop == self.settings.t_end;
+        if !(unlimited && self.grid.is_some_and(|g| t > g.t_star - g.tau)) {
+            return false;
+        }
+        let Some(last) = self.approach.last() else { return false };
+        let saved = self.ode.save();
+        let near = self.ode.evaluate(t, self.stepper.y()).map(|()| {
+            passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CROSS_START || inside_step(&self.ode, last, t)
+        });
+        self.ode.restore(saved);
+        near.unwrap_or(true)
+    }
+
+    /// Take the step again from its start, ending at the approach's limit: a step from above
+    /// [`APPROACH_BELOW`] that went past the crossing's start (or over the point: A02 at
+    /// rtol 1e-8 stepped from 0.06 to past it in the user's chart) would leave the crossing no
+    /// nodes before it. `self.y` still holds the step's start.
+    fn retake(&mut self) -> ControlFlow<Stop> {
+        let t_prev = self.stepper.t_prev();
+        self.ode.restart_from_anchor();
+        if let Err(error) = self.stepper.reset(&mut self.ode, t_prev, &self.y) {
+            return Break(Stop::Step { error, crossing: None });
+        }
+        self.t_stop = self.limit.unwrap_or(self.settings.t_end);
+        Continue(())
+    }
+
+    /// The crossing's nodes that the step just taken went over (its grid as seen from the
+    /// step's start): evaluated on the step's interpolant, as the outputs are, and kept for the
+    /// crossing ([`Approach::fill`]).
+    fn fill_approach(&mut self, t: f64) -> ControlFlow<Stop> {
+        let Some(grid) = self.grid else { return Continue(()) };
+        let t_prev = self.stepper.t_prev();
+        let mut times: Vec<f64> = grid.nodes().filter(|&s| s > t_prev + grid.h / 4.0 && s < t - grid.h / 4.0).collect();
+        if times.is_empty() {
+            return Continue(());
+        }
+        times.reverse();
+        let saved = self.ode.save();
+        self.ode.restart_from_anchor();
+        for s in times {
+            if let Err(error) = evaluate_output(&mut self.ode, &mut self.stepper, s, &mut self.yi) {
+                return Break(Stop::Output { t: s, error });
+            }
+            self.approach.fill(Passed::of(&self.ode, s, f64::NAN));
+        }
+        self.ode.restore(saved);
+        Continue(())
+    }
+
     /// The caller's progress callback, which may stop the run.
     fn report(&mut self, t: f64, progress: &mut Progress) -> ControlFlow<Stop> {
         let stop = progress.as_mut().is_some_and(|cb| !cb(t));
@@ -348,32 +468,31 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     }
 
     /// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
-    /// passive measures `sigma`, `passive`, work `work`), `approach` the points before it, and
-    /// restart the stepper past it. Outputs inside the crossing come from the quintic through
-    /// its ends (from its Taylor step if t_end is inside it); without a grid the point past it
-    /// is recorded. Returns whether t_end was reached inside the crossing; Err says why the
-    /// motion cannot be continued.
-    fn cross_change_point(&mut self, (t, sigma, passive, work): (f64, f64, f64, f64)) -> Result<bool, String> {
+    /// passive measures `sigma`, `passive`, work `work`) and restart the stepper past it.
+    /// Outputs inside the crossing come from the path it followed; without a grid the point
+    /// past it is recorded. Err says why the motion cannot be continued.
+    fn cross_change_point(&mut self, (t, sigma, passive, work): (f64, f64, f64, f64)) -> Result<Crossed, String> {
         let t_end = self.settings.t_end;
-        let landing: Landing = cross(&mut self.ode, t, passive, work, &self.approach)?;
-        self.traj.change_points.push(landing.point.clone());
+        let integration = Integration { method: self.settings.method, options: &self.options };
+        let at = (t, passive, work);
+        let Some(landing) = cross(&mut self.ode, at, &self.approach, &integration, &mut self.crossing_stats)? else {
+            return Ok(Crossed::NoPoint);
+        };
+        self.passed_point(landing.point.clone());
+        (self.t_stop, self.grid, self.heading) = (t_end, None, None);
         let inside = |s: f64, end: f64| s < end || s == t_end && end >= t_end;
         if landing.t >= t_end {
-            // Ends inside the crossing: the rest from its Taylor step.
             let rows: Vec<f64> = match self.t_eval {
                 Some(te) => te[self.next..].iter().copied().take_while(|&s| inside(s, t_end)).collect(),
                 None => vec![t_end],
             };
             for s in rows {
-                path_row(&mut self.ode, &mut self.traj, &landing.path, s, work, sigma);
+                path_row(&mut self.ode, &mut self.traj, &landing.path, s, sigma);
             }
             self.next = self.t_eval.map_or(0, <[f64]>::len);
-            return Ok(true);
+            return Ok(Crossed::AtEnd);
         }
         let ode = &mut self.ode;
-        ode.ws.x.copy_from_slice(&landing.x);
-        ode.set_chart(landing.chart.clone(), landing.t, &landing.y)
-            .map_err(|e| format!("past the change point: {e}"))?;
         self.stepper.reset(ode, landing.t, &landing.y).map_err(|e| format!("restarting past the change point: {e}"))?;
         self.traj.stats.chart_switches += 1;
         let meas = measure(ode);
@@ -381,22 +500,18 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         ode.limit_correction(own);
         let work_past = landing.y[landing.y.len() - 1];
         self.approach.clear();
-        self.approach.keep(ode, landing.t, meas.passive, work_past);
+        self.approach.keep(ode, landing.t, meas.passive);
         match self.t_eval {
             None => self.traj.record(ode, landing.t, work_past, meas.sigma),
             Some(te) => {
-                // Outputs inside the crossing: the quintic through its two ends (x, xd, xdd), an
-                // interpolation, where the Taylor step's own error grows towards its end.
-                let ws = &ode.ws;
-                let path = Quintic::new(&landing.start, (&ws.x, &ws.xd, &ws.xdd), landing.t);
                 while self.next < te.len() && inside(te[self.next], landing.t) {
-                    path_row(ode, &mut self.traj, &path, te[self.next], work, sigma);
+                    path_row(ode, &mut self.traj, &landing.path, te[self.next], sigma);
                     self.next += 1;
                 }
                 ode.restart_from_anchor();
             }
         }
-        Ok(false)
+        Ok(Crossed::Past)
     }
 
     /// The trajectory with the run's counters, its events and dense output, and the status and
@@ -407,7 +522,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             keep_last_state(&mut self.ode, &self.stepper, &mut self.traj);
         }
         let mut traj = self.traj;
-        traj.stats.integrator = self.stepper.stats();
+        let (run, crossings) = (self.stepper.stats(), self.crossing_stats);
+        traj.stats.integrator = Stats {
+            nfev: run.nfev + crossings.nfev,
+            naccept: run.naccept + crossings.naccept,
+            nreject: run.nreject + crossings.nreject,
+            ..run
+        };
         traj.stats.failed_evaluations = self.ode.failed_evaluations;
         traj.events = self.watch.records;
         // Events alone need the dense output only while the run lasts.
@@ -485,10 +606,10 @@ fn sample_step(
     Ok(())
 }
 
-/// Record the row at time s inside a crossing, from `path`.
-fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &dyn Path, s: f64, work: f64, sigma: f64) {
+/// Record the row at time s inside a crossing, from the path it followed.
+fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &Bridge, s: f64, sigma: f64) {
     let ws = &mut ode.ws;
     path.at(s, &mut ws.x, &mut ws.xd, &mut ws.xdd);
     user_state(ode);
-    traj.record(ode, s, work, sigma);
+    traj.record(ode, s, path.work(s), sigma);
 }

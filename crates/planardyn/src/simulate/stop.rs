@@ -33,8 +33,6 @@ pub enum Stop {
     Accept { t: f64, error: Error },
     /// A change point ahead of the point at t (passive measure `passive`) could not be crossed.
     NoCrossing { t: f64, passive: f64, why: String },
-    /// The energy balance could not be restored at t.
-    Restore { t: f64, error: String },
     /// The passive mechanism is singular at t.
     PassiveSingular { t: f64, passive: f64 },
     /// The run cannot reach t_end at its rate of progress (see `Run::progress_rate`): at t,
@@ -123,9 +121,6 @@ impl Stop {
                 Status::PassiveSingularity,
                 format!("the passive mechanism is singular at t = {t} s (scaled measure {passive:.2e}) and {why}"),
             ),
-            Stop::Restore { t, error } => {
-                (Status::AssemblyFailed, format!("restoring the energy at t = {t} s: {error}"))
-            }
             Stop::PassiveSingular { t, passive } => (
                 Status::PassiveSingularity,
                 format!(
