@@ -5,21 +5,23 @@ repository root with the peers' venv::
 
     PYTHONPATH=python benchmarks/.venv-peers/bin/python benchmarks/bench.py [--quick] [--only four-bar andrews]
 
-For each mechanism of ``mechanisms.py`` (four-bar, five-bar, 3-RRR, Andrews' squeezer):
-each tool's wall time and accuracy (energy drift or balance, loop gap, error against a
-tight planardyn reference) over a sweep of its step size or tolerance, and the cheapest
-setting of each that meets the mechanism's stated accuracy. On the four-bar also the
-performance targets: planardyn's cheapest for drift < 1e-6 J against the fastest peer at 1e-3 J, and
-``simulate`` from Python against the same run from Rust. Also runs the Rust criterion bench
-of one forward-dynamics evaluation. Writes ``benchmarks/results/`` (results.json,
-results.md, one work-precision plot per mechanism) and the generated part of
-``docs/benchmarks.md``.
+For each mechanism of ``mechanisms.py`` (four-bar, five-bar, 3-RRR, Andrews' squeezer) and each
+method of each tool (``variants`` of its module in peers/): the cheapest setting that meets the
+mechanism's stated accuracy (energy drift or balance, loop gap), and the cheapest that meets its
+stated error (with the gap), each found by ``cheapest.cheapest`` (a 1.1x scan, bisection to the
+adjacent failing setting, a check of the neighbours) on the method's number of steps or tolerance.
+Those settings are then timed side by side, interleaved, by ``timing.measure``; each tool's winner
+is its method with the least median CPU time at the target, and its ratio to planardyn's winner is
+taken round by round (``winners.py``). On the four-bar also the performance targets: planardyn's cheapest for
+drift < 1e-6 J against the fastest peer at 1e-3 J, and ``simulate`` from Python against the same
+run from Rust. Also runs the Rust criterion bench of one forward-dynamics evaluation. Writes
+``benchmarks/results/`` (results.json, results.md, one work-precision plot per mechanism) and the
+generated part of ``docs/benchmarks.md``.
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import importlib
 import json
 import os
@@ -33,12 +35,16 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+import cheapest  # noqa: E402
 import common  # noqa: E402
 import mechanisms  # noqa: E402
 import numpy as np  # noqa: E402
 import overhead as overhead_mod  # noqa: E402
 import report  # noqa: E402
-from common import Run  # noqa: E402
+import timing  # noqa: E402
+import winners  # noqa: E402
+from common import Run, Variant  # noqa: E402
+from winners import CLOCKED, PLANARDYN_DRIFT_TARGET, PRE_ROUNDS, PREFILTER  # noqa: E402
 
 PEERS = ["planardyn_peer", "mujoco_peer", "pinocchio_peer", "exudyn_peer"]
 RESULTS = HERE / "results"
@@ -47,10 +53,8 @@ DOCS_PAGE = mechanisms.ROOT / "docs" / "benchmarks.md"
 #: Criterion targets for one forward-dynamics evaluation (s), from the closed-form groups item of the
 #: engine issue (docs/benchmarks.md, *Closed-form groups*).
 FD_TARGETS = {"four-bar-gravity": 0.25e-6, "five-bar": 0.4e-6, "3-rrr": 1.5e-6, "andrews-squeezer": 1e-6}
-#: Target on the four-bar: planardyn at this drift (J) in at most 1/RATIO_TARGET of the
-#: wall time of the fastest peer meeting the four-bar's drift and gap targets.
-PLANARDYN_DRIFT_TARGET = 1e-6
-RATIO_TARGET = 20.0
+#: Timing rounds under --quick.
+QUICK_ROUNDS = 5
 
 
 def say(msg: str) -> None:
@@ -69,66 +73,70 @@ def tools() -> tuple[dict, dict]:
     return ok, missing
 
 
-def sweep(mod, bm, d, ref, quick: bool) -> list[Run]:
-    settings = mod.SWEEPS.get(bm.key)
-    if not settings:
-        return [Run(mod.TOOL, "—", "—", bm.key).fail(f"{bm.key} is not modelled for {mod.TOOL} (no sweep)")]
-    runs = []
-    for s in settings[::2] if quick else settings:
-        try:
-            r = mod.run(bm, d, s, ref)
-        except Exception as e:  # a tool that cannot model or run this: reported, not dropped
-            r = Run(mod.TOOL, "?", repr(s)).fail(f"{type(e).__name__}: {e}")
-        r.mechanism = bm.key
-        flag = "ok " if r.ok else "FAIL"
-        say(f"  {flag} {r.tool:9s} {r.method:40s} {r.setting:12s} wall {r.wall * 1e3:9.2f} ms  "
-            f"drift {r.drift:9.2e} J  gap {r.gap:9.2e} m  error {r.error:9.2e} rad {r.note}")
-        runs.append(r)
-    return runs
+
+def targets_for(bm, tool: str) -> dict[str, dict]:
+    """The targets a tool's methods are searched for: the mechanism's stated accuracy and its stated
+    error (each with the gap), and on the four-bar planardyn's performance target as well."""
+    t = {"accuracy": {"drift": bm.drift_target, "gap": bm.gap_target},
+         "error": {"error": bm.error_target, "gap": bm.gap_target}}
+    if bm.key == mechanisms.FOUR_BAR.key and tool == "planardyn":
+        t["tight"] = {"drift": PLANARDYN_DRIFT_TARGET, "gap": bm.gap_target}
+    return t
 
 
-def cheapest(runs: list[Run], **targets) -> Run | None:
-    good = [r for r in runs if r.meets(**targets)]
-    return min(good, key=lambda r: r.wall) if good else None
+def misses(r: Run, target: dict) -> str:
+    """What a run misses of a target, e.g. 'drift 1.20e-03 J'."""
+    if not r.ok:
+        return "failed: " + r.note
+    unit = {"drift": "J", "gap": "m", "error": "rad"}
+    return ", ".join(f"{k} {getattr(r, k):.5g} {unit[k]} (limit {lim:g})" for k, lim in target.items()
+                     if not getattr(r, k) < lim)
 
 
-def summarise(bm, runs: list[Run], tools: list[str]) -> dict:
-    """Per tool: the cheapest run at the stated accuracy (drift and gap), the cheapest at the
-    stated trajectory error (and gap), and the wall-time ratios to planardyn's."""
-    def per_tool(**targets):
-        return {t: cheapest([r for r in runs if r.tool == t], **targets) for t in tools}
+def search(mod, bm, d, v: Variant, ref, verbose: bool) -> tuple[dict[int, Run], dict]:
+    """One method's cheapest passing setting for each of its targets: (every run made, by setting;
+    per target what cheapest.py found, JSON-ready)."""
+    runs: dict[int, Run] = {}
 
-    s = {}
-    for name, best in (("accuracy", per_tool(drift=bm.drift_target, gap=bm.gap_target)),
-                       ("error", per_tool(error=bm.error_target, gap=bm.gap_target))):
-        s[f"best_at_{name}"] = {t: dataclasses.asdict(r) if r else None for t, r in best.items()}
-        pd = best.get("planardyn")
-        s[f"ratio_at_{name}"] = {t: r.wall / pd.wall for t, r in best.items() if r and pd and t != "planardyn"}
-        # A peer whose own dynamics calls were clocked: the ratio against those calls alone.
-        s[f"dynamics_ratio_at_{name}"] = {t: r.wall * r.extra["dynamics_share"] / pd.wall for t, r in best.items()
-                                          if r and pd and "dynamics_share" in r.extra}
-    e0 = {t: [r.e0 for r in runs if r.tool == t and r.ok] for t in tools}
-    s["start_energy"] = {t: v[0] for t, v in e0.items() if v}
-    if "planardyn" in s["start_energy"]:
-        pd0 = s["start_energy"]["planardyn"]
-        s["start_energy_max_deviation"] = max(abs(x - pd0) for v in e0.values() for x in v)
-    s["failed"] = {t: sum(not r.ok for r in runs if r.tool == t) for t in tools}
-    return s
+    def evaluate(s: int) -> Run:
+        if s not in runs:
+            try:
+                r = mod.run(bm, d, v, s, ref)
+            except common.ReferenceFailed:
+                raise
+            except Exception as e:  # a tool that cannot model or run this: reported, not dropped
+                r = Run(mod.TOOL, v.method, v.label(bm.t_end, s), value=s).fail(f"{type(e).__name__}: {e}")
+            r.mechanism = bm.key
+            runs[s] = r
+            if verbose:
+                say(f"      {'ok ' if r.ok else 'FAIL'} {r.setting:26s} one call {r.wall * 1e3:9.2f} ms  drift "
+                    f"{r.drift:9.2e} J  gap {r.gap:9.2e} m  error {r.error:9.2e} rad {r.note}")
+        return runs[s]
 
+    grid = v.grid()
+    out = {}
+    for name, target in targets_for(bm, mod.TOOL).items():
+        def passes(s: int, target: dict = target) -> bool:
+            return evaluate(s).meets(**target)
 
-def four_bar_target(runs: list[Run], summary: dict) -> dict:
-    """The four-bar target: planardyn at drift < 1e-6 J against the fastest peer meeting the four-bar's
-    stated accuracy (drift < 1e-3 J, gap < 1e-6 m)."""
-    bm = mechanisms.FOUR_BAR
-    tight = cheapest([r for r in runs if r.tool == "planardyn"], drift=PLANARDYN_DRIFT_TARGET, gap=bm.gap_target)
-    peers = [r for t, r in summary["best_at_accuracy"].items() if r and t != "planardyn"]
-    fastest = min(peers, key=lambda r: r["wall"], default=None)
-    out = {"planardyn": dataclasses.asdict(tight) if tight else None, "fastest_peer": fastest,
-           "drift_target_J": PLANARDYN_DRIFT_TARGET, "ratio_target": RATIO_TARGET}
-    if tight and fastest:
-        out["ratio"] = fastest["wall"] / tight.wall
-        out["meets"] = out["ratio"] >= RATIO_TARGET
-    return out
+        if passes(grid[-1]):
+            f = cheapest.cheapest(passes, grid)
+        else:  # no scan below a dearest setting that fails (loops that stay open at any step)
+            f = cheapest.Found(None, None, tried={grid[-1]: False},
+                               note=f"fails at the dearest setting searched, {v.label(bm.t_end, grid[-1])}: "
+                                    f"{misses(runs[grid[-1]], target)}")
+        res = {"setting": f.setting, "label": None if f.setting is None else v.label(bm.t_end, f.setting),
+               "evaluated": len(f.tried), "note": f.note, "isolated": [v.label(bm.t_end, s) for s in f.isolated],
+               "below": None if f.below is None else v.label(bm.t_end, f.below),
+               "below_misses": None if f.below is None else misses(runs[f.below], target)}
+        out[name] = res
+        what = (f"{res['label']} (one call {runs[f.setting].wall * 1e3:.3g} ms); {res['below']} misses: "
+                f"{res['below_misses']}" if f.setting is not None else "none")
+        say(f"  {mod.TOOL:9s} {v.method:42s} {name:8s} {what}; {len(f.tried)} settings evaluated"
+            + (f"; isolated passes ignored: {', '.join(res['isolated'])}" if f.isolated else "")
+            + (f" [{f.note}]" if f.note else ""))
+    return runs, out
+
 
 
 def criterion(quick: bool) -> dict:
@@ -164,32 +172,78 @@ def python_overhead(setting: list) -> dict:
     return json.loads(p.stdout)
 
 
-def bench_mechanism(bm, found: dict, quick: bool) -> dict:
+def bench_mechanism(bm, found: dict, rounds: int, verbose: bool) -> dict:
     say(f"== {bm.key}: {bm.title} ({bm.model_rel})")
     load_start = os.getloadavg()  # other work on the machine skews every wall time
     date = time.strftime("%Y-%m-%d %H:%M:%S %Z")
     d = common.load_drawing(bm.spec)
-    pd_mod = found["planardyn"][0]
-    say("reference: planardyn DOP853 rtol = atol = 1e-13")
-    ref = pd_mod.reference(bm)
-    reference = {"q_end": ref[-1].tolist()}
+    ref = found["planardyn"][0].Reference(bm)
+    say(f"reference: planardyn DOP853 rtol = atol = {ref.RTOL:g}")
+    reference = {"q_end": ref.grid()[-1].tolist()}
     if bm.published_end:
         i, value, source = bm.published_end
-        reference["published"] = {"coordinate": i, "value": value, "source": source,
-                                  "difference": float(ref[-1, i] - value)}
-        say(f"  reference at t_end {float(ref[-1, i])!r} against {value!r} ({source}): {ref[-1, i] - value:+.2e}")
+        end = float(reference["q_end"][i])
+        reference["published"] = {"coordinate": i, "value": value, "source": source, "difference": end - value}
+        say(f"  reference at t_end {end!r} against {value!r} ({source}): {end - value:+.2e}")
+    say("search: each method's cheapest setting per target; '<setting> misses' is the next cheaper one")
     runs: list[Run] = []
+    methods, cands = [], {}
     for mod, _ in found.values():
-        runs += sweep(mod, bm, d, ref, quick)
-    measured = {"date": date, "quick": quick,
-                "load_average_at_start": load_start, "load_average_at_end": os.getloadavg()}
+        for v in mod.variants(bm):
+            vruns, res = search(mod, bm, d, v, ref, verbose)
+            runs += vruns.values()
+            methods.append({"tool": mod.TOOL, "method": v.method, "axis": "steps" if v.steps else "tolerance",
+                            "range": v.label(bm.t_end, v.grid()[0]) + " to " + v.label(bm.t_end, v.grid()[-1]),
+                            "targets": res, "run_columns": RUN_COLUMNS, "runs": run_rows(list(vruns.values()))})
+            winners.candidates_of(mod, v, vruns, res, cands)
+    load_search = os.getloadavg()
+    cands_all = list(cands.values())
+    calls = {}
+    for c in cands_all:
+        calls[c.key] = c.mod.timed(bm, d, c.variant, c.run.value)
+        if hasattr(c.mod, "clocked"):
+            calls[c.key + CLOCKED] = c.mod.clocked(bm, d, c.variant, c.run.value)
+    say(f"timing the {len(cands_all)} cheapest settings side by side, {PRE_ROUNDS} rounds")
+    pre = timing.measure({c.key: calls[c.key] for c in cands_all}, PRE_ROUNDS, say)
+    median = {k: winners.cost(e) for k, e in pre["entries"].items()}
+    keep, skipped = winners.prefilter(cands_all, median)
+    say(f"timing the {len(keep)} within {PREFILTER:g}x of their tool's cheapest (CPU time), {rounds} rounds")
+    timed = timing.measure({k: f for k, f in calls.items() if k.removesuffix(CLOCKED) in {c.key for c in keep}},
+                           rounds, say)
+    for r in runs:
+        r.mechanism = bm.key
+    measured = {"date": date, "rounds": rounds, "load_average_at_start": load_start,
+                "load_average_after_search": load_search, "load_average_at_end": os.getloadavg()}
     return {"key": bm.key, "title": bm.title, "measured": measured,
             "driven": any(c.effort for c in d.coordinates), "model": bm.model_rel, "scenario": bm.scenario,
             "changed": bm.changed, "t_end_s": bm.t_end, "grid_dt_s": bm.grid_dt,
             "coordinates": [c.name for c in d.coordinates],
             "targets": {"drift_J": bm.drift_target, "gap_m": bm.gap_target, "error_rad": bm.error_target},
-            "reference": reference, "runs": [dataclasses.asdict(r) for r in runs],
-            "summary": summarise(bm, runs, list(found)), "_runs": runs}
+            "reference": reference, "methods": methods,
+            "not_timed": [{"key": c.key, "targets": c.targets, "pre_median_cpu": median[c.key]} for c in skipped],
+            "timing": timed, "summary": winners.summarise(runs, cands_all, timed, list(found)), "_candidates": cands_all}
+
+
+#: The fields of every run of a method's search kept in results.json (the winners keep all of theirs).
+RUN_COLUMNS = ("value", "ok", "note", "wall", "steps", "drift", "gap", "error")
+
+
+def run_rows(runs: list[Run]) -> list[list]:
+    """A method's runs as rows of RUN_COLUMNS (thousands in all), by setting, the floats to 6 digits."""
+    def cell(v):
+        return float(f"{v:.6g}") if isinstance(v, float) else v
+
+    return [[cell(getattr(r, c)) for c in RUN_COLUMNS] for r in sorted(runs, key=lambda r: r.value)]
+
+
+def dumps(result: dict) -> str:
+    """results.json, indented, but each list of plain values on one line (the thousands of runs of
+    the searches, the timing samples). JSON strings hold no raw line breaks, so only the layout
+    changes."""
+    def one_line(m: re.Match) -> str:
+        return re.sub(r"\[\s+", "[", re.sub(r"\s+\]", "]", re.sub(r",\n\s*", ", ", m.group(0))))
+
+    return re.sub(r"\[[^\[\]{}]*\]", one_line, json.dumps(result, indent=1, default=_json))
 
 
 def merge_previous(result: dict, path: Path) -> dict:
@@ -212,7 +266,10 @@ def merge_previous(result: dict, path: Path) -> dict:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--quick", action="store_true", help="every other setting, shorter criterion run")
+    ap.add_argument("--quick", action="store_true",
+                    help=f"{QUICK_ROUNDS} timing rounds instead of {timing.ROUNDS}, shorter criterion run "
+                         "(the search is the same)")
+    ap.add_argument("--verbose", action="store_true", help="print every run of the search")
     ap.add_argument("--only", nargs="+", choices=list(mechanisms.BY_KEY), metavar="MECHANISM",
                     help="only these mechanisms (" + ", ".join(mechanisms.BY_KEY) + ")")
     ap.add_argument("--no-criterion", action="store_true", help="skip cargo bench")
@@ -229,18 +286,19 @@ def main() -> int:
         say("planardyn itself does not import: run ./dev setup (or benchmarks/run.sh)")
         return 2
     benches = [mechanisms.BY_KEY[k] for k in a.only] if a.only else mechanisms.ALL
-    mechs = {bm.key: bench_mechanism(bm, found, a.quick) for bm in benches}
+    rounds = QUICK_ROUNDS if a.quick else timing.ROUNDS
+    mechs = {bm.key: bench_mechanism(bm, found, rounds, a.verbose) for bm in benches}
 
     four_bar, overhead = None, {"ok": False, "why": "the four-bar was not run (--only)"}
     if "four-bar" in mechs:
         m = mechs["four-bar"]
-        four_bar = four_bar_target(m["_runs"], m["summary"])
+        four_bar = winners.four_bar_target(m)
         say("Python overhead: simulate from Python against the same run from Rust")
         overhead = (python_overhead(four_bar["planardyn"]["extra"]["setting"]) if four_bar["planardyn"]
                     else {"ok": False, "why": f"no planardyn setting met {PLANARDYN_DRIFT_TARGET:g} J"})
         overhead["date"] = four_bar["date"] = m["measured"]["date"]
     for m in mechs.values():
-        del m["_runs"]
+        del m["_candidates"]
     crit = {"ok": False, "error": "skipped (--no-criterion)"} if a.no_criterion else criterion(a.quick)
 
     if not a.no_criterion:
@@ -253,7 +311,7 @@ def main() -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     if a.only or a.no_criterion:
         result = merge_previous(result, a.out / "results.json")
-    (a.out / "results.json").write_text(json.dumps(result, indent=1, default=_json))
+    (a.out / "results.json").write_text(dumps(result))
     report.write(result, a.out, None if str(a.docs) == "-" else a.docs)
     say(report.summary_text(result))
     say(f"wrote {a.out}/results.json, results.md and the plots in {result['bench_seconds']:.0f} s")

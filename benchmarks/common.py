@@ -18,7 +18,8 @@ Accuracy, the same for every tool:
   as carried by its two bodies (for a tree joint it is round-off: it matters for the pairs
   that close loops);
 - error: max over the grid times and the coordinates of |q(t) - q_ref(t)| (rad), against
-  planardyn with DOP853 at rtol = atol = 1e-13.
+  planardyn with DOP853 at rtol = atol = 1e-13; a run of n fixed steps is sampled at its steps
+  nearest the grid times and the reference at the same times (``Benchmark.sample_indices``).
 """
 
 from __future__ import annotations
@@ -27,8 +28,9 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
+import cheapest
 import numpy as np
 
 
@@ -223,19 +225,58 @@ def loop_gap(d: Drawing, poses: dict[str, np.ndarray]) -> np.ndarray:
     return np.max(np.broadcast_arrays(*gaps), axis=0)
 
 
-def best_time(fn: Callable[[], Any], *, budget: float = 1.0, max_repeats: int = 5) -> tuple[float, Any]:
-    """Run fn at least twice (one warm-up if it is quick), up to max_repeats or until budget
-    seconds have gone; return the best wall time (s) and the last result."""
-    times = []
-    out = None
-    start = time.perf_counter()
-    while True:
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-        if len(times) >= max_repeats or (len(times) >= 2 and time.perf_counter() - start > budget):
-            break
-    return min(times), out
+@dataclass(frozen=True)
+class Variant:
+    """One method of one tool (an integrator with its constraint handling and gains), whose cost
+    is swept along one integer setting by ``cheapest.cheapest``: the number of fixed steps n over
+    the run (dt = t_end / n), or for an adaptive integrator the tolerance index k
+    (rtol = atol = ``cheapest.rtol(k)``)."""
+
+    tool: str
+    method: str  # for the tables
+    params: tuple  # the tool's own parameters of the method
+    #: (cheapest, dearest) number of steps over the run to search; None: a tolerance index instead.
+    steps: tuple[int, int] | None
+
+    def grid(self) -> list[int]:
+        """The settings to scan, cheapest first, each within cheapest.SCAN_RATIO of the one before."""
+        if self.steps is None:
+            return cheapest.tolerance_grid(*TOLERANCE_RANGE)
+        return cheapest.steps_grid(*self.steps)
+
+    def label(self, t_end: float, s: int) -> str:
+        """The setting as a user would write it: rtol, or the number of steps and dt."""
+        if self.steps is None:
+            return f"rtol={cheapest.rtol(s):.3g}"
+        return f"n={s} (dt={t_end / s:.4g} s)"
+
+
+#: The loosest and the tightest rtol (= atol) an adaptive method is searched over.
+TOLERANCE_RANGE = (1.0, 1e-12)
+
+
+def one_shot(fn: Callable[[], Any]) -> tuple[float, Any]:
+    """The wall time (s) of one call of fn and its result: the search's own runs, which only
+    place a setting on the work-precision plot (timing.py measures the winners properly)."""
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+class ReferenceFailed(RuntimeError):
+    """The reference run failed: a fault of the benchmark, never of the tool being measured."""
+
+
+class Reference(Protocol):
+    """The reference coordinates (K, m) in rad at the times a run is sampled at (planardyn_peer's)."""
+
+    def grid(self) -> np.ndarray:
+        """At the grid times ``Benchmark.grid_times``."""
+        ...
+
+    def steps(self, n: int) -> np.ndarray:
+        """At the steps of a run of n fixed steps nearest the grid times (``Benchmark.sample_times``)."""
+        ...
 
 
 @dataclass
@@ -243,12 +284,13 @@ class Run:
     """One setting of one tool on one mechanism: what it cost and how accurate it was."""
 
     tool: str
-    method: str  # integrator and constraint handling, for the table
-    setting: str  # the swept parameter(s), for the table
+    method: str  # integrator and constraint handling, for the table (Variant.method)
+    setting: str  # the swept setting, for the table (Variant.label)
+    value: int = 0  # the setting as cheapest.py searches it: steps, or tolerance index
     mechanism: str = ""  # Benchmark.key, set by bench.py
     ok: bool = True
     note: str = ""
-    wall: float = math.nan  # s, best of the repeats
+    wall: float = math.nan  # s, one call (the search's run; timing.py times the winners)
     steps: int = 0
     drift: float = math.nan  # J
     gap: float = math.nan  # m

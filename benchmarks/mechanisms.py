@@ -25,7 +25,7 @@ class Benchmark:
     title: str
     model: Path
     t_end: float  # s
-    grid_dt: float  # s: spacing of the error samples; every fixed step swept divides it
+    grid_dt: float  # s: spacing of the error samples (a fixed-step run samples its nearest steps)
     #: The stated accuracy at which tools are compared: energy drift (or balance) in J and
     #: loop gap in m; trajectory error in rad (max over the grid and the coordinates).
     drift_target: float
@@ -56,16 +56,17 @@ class Benchmark:
         n = int(round(self.t_end / self.grid_dt))
         return np.arange(n + 1) * self.grid_dt
 
-    def grid_indices(self, dt: float) -> np.ndarray:
-        """Step indices of the grid times for a fixed step dt that divides grid_dt."""
-        k = self.grid_dt / dt
-        assert abs(k - round(k)) < 1e-6, f"{self.key}: dt = {dt} does not divide {self.grid_dt}"
-        return np.arange(len(self.grid_times())) * int(round(k))
+    def sample_indices(self, n: int) -> np.ndarray:
+        """Step indices of a run of n fixed steps nearest the grid times (the grid times themselves
+        when dt = t_end / n divides grid_dt): the error is taken there, against the reference at
+        the same times (``sample_times``), so any n can be compared exactly."""
+        k = np.arange(len(self.grid_times()))
+        return np.rint(k * n / k[-1]).astype(int)
 
-    def steps(self, dt: float) -> int:
-        n = self.t_end / dt
-        assert abs(n - round(n)) < 1e-6, f"{self.key}: dt = {dt} does not divide t_end = {self.t_end}"
-        return int(round(n))
+    def sample_times(self, n: int) -> np.ndarray:
+        """(K,) s: the times of ``sample_indices(n)``; the last is t_end (t_end * n / n can round off it)."""
+        i = self.sample_indices(n)
+        return np.where(i == n, self.t_end, self.t_end * i / n)
 
 
 FOUR_BAR = Benchmark(

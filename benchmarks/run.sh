@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # One command for the whole benchmark suite (docs/benchmarks.md):
 #
-#   benchmarks/run.sh [--quick] [--only four-bar five-bar 3-rrr andrews] [--no-criterion]
+#   benchmarks/run.sh [--quick] [--only four-bar five-bar 3-rrr andrews] [--no-criterion] [--verbose]
 #
 # --only runs some mechanisms and keeps the others' results (each with its own date) in
-# results.json, results.md and docs/benchmarks.md; --quick takes every other setting.
+# results.json, results.md and docs/benchmarks.md; --quick times the winners in fewer rounds (the
+# search for each method's cheapest setting is the same); --verbose prints every run of the search.
 #
 # 1. ./dev setup: builds planardyn's extension from the current sources into python/.
 # 2. benchmarks/.venv-peers: a venv of its own with the other tools from PyPI (mujoco, pin,
@@ -12,7 +13,9 @@
 #    whose install fails is left out and reported by bench.py as not available, never hidden.
 # 3. benchmarks/rust-sim: the same simulate call from Rust, for the Python-overhead figure.
 # 4. bench.py: every measurement in one run; writes benchmarks/results/ and the generated
-#    section of docs/benchmarks.md.
+#    section of docs/benchmarks.md. It prints, per mechanism, each method's cheapest passing
+#    setting, the winners' times and ratios, and the load average; the machine's load is printed
+#    here before and after as well (wall times on a shared machine follow it).
 set -euo pipefail
 
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -52,6 +55,7 @@ say "building benchmarks/rust-sim (release)"
 cp "$ROOT/Cargo.lock" "$HERE/rust-sim/Cargo.lock"
 CARGO_TARGET_DIR="$HERE/.target" cargo build --release --quiet --manifest-path "$HERE/rust-sim/Cargo.toml"
 
-say "running bench.py"
+say "running bench.py on $(nproc) CPUs; load: $(uptime)"
 cd "$ROOT"
 PYTHONPATH="$ROOT/python${PYTHONPATH:+:$PYTHONPATH}" "$PY" "$HERE/bench.py" "$@"
+say "done; load: $(uptime)"

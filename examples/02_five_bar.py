@@ -12,13 +12,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from planardyn.plot import draw_mechanism, plot_coordinates, plot_efforts
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "out"
 
-mech = pd.load(ROOT / "examples" / "models" / "five-bar.yaml")
+mech = pdy.load(ROOT / "examples" / "models" / "five-bar.yaml")
 print(mech)
 res = mech.simulate()
 print(res)

@@ -21,7 +21,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from matplotlib.figure import Figure
 from planardyn import robot
 
@@ -49,7 +49,7 @@ def circle_check(ee, path, label):
 
 
 # ------------------------------------------------------------------ the five-bar
-five = pd.load(ROOT / "examples" / "models" / "five-bar.yaml")
+five = pdy.load(ROOT / "examples" / "models" / "five-bar.yaml")
 ee5 = robot.EndEffector(five, "P")
 home = ee5.home()
 motion5 = circle_check(ee5, robot.circle(home + [0.0, 0.06], 0.06, duration=1.0), "five-bar")
@@ -78,12 +78,12 @@ save(fig, "five-bar-workspace")
 
 try:
     robot.solve_motion(ee5, robot.point_to_point(home, (home[0], 0.1), duration=1.0))
-except pd.SingularityError as exc:
+except pdy.SingularityError as exc:
     print(f"refused: {exc}")
     assert exc.kind == "II" and len(exc.partial.t) > 0
 
 # ------------------------------------------------------------------ the 3-RRR
-rrr = pd.load(ROOT / "examples" / "models" / "3-rrr.yaml")
+rrr = pdy.load(ROOT / "examples" / "models" / "3-rrr.yaml")
 ee3 = robot.EndEffector(rrr, "P")  # the platform pose [x, y, psi]
 motion3 = circle_check(ee3, robot.circle((0.0, 0.05), 0.05, duration=1.0, angle=(0.0, 0.2)), "3-RRR")
 fig = Figure(figsize=(11, 7))

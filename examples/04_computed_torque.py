@@ -23,7 +23,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from planardyn import robot
 from scipy.interpolate import CubicHermiteSpline
 
@@ -48,8 +48,8 @@ def scale_masses(model: dict, factor: float) -> dict:
     return model
 
 
-plant = pd.load(ROOT / "examples" / "models" / "five-bar.yaml")
-model = pd.from_dict(scale_masses(plant.to_dict(), MASS_ERROR))
+plant = pdy.load(ROOT / "examples" / "models" / "five-bar.yaml")
+model = pdy.from_dict(scale_masses(plant.to_dict(), MASS_ERROR))
 ee = robot.EndEffector(plant, "P")
 home = ee.home()
 circle = robot.circle(home + [0.0, 0.05], 0.05, duration=T_END, turns=2.0)

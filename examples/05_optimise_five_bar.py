@@ -26,7 +26,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from matplotlib.figure import Figure
 from planardyn import batch, library, robot
 from planardyn import sensitivity as sens
@@ -66,7 +66,7 @@ def evaluate(lengths):
     if key not in cache:
         try:
             cache[key] = sens.objective(design, dict(zip(NAMES, lengths)), PATH, measures, dt=DT)
-        except (pd.SingularityError, pd.AssemblyError, ValueError):  # ValueError: no drawing
+        except (pdy.SingularityError, pdy.AssemblyError, ValueError):  # ValueError: no drawing
             cache[key] = None
     return cache[key]
 

@@ -18,7 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from planardyn import library, robot
 from planardyn.plan import task_waypoints, time_optimal
 
@@ -29,7 +29,7 @@ TAU_MAX, SPEED_MAX = np.array([3.0, 3.0]), np.array([12.0, 12.0])  # N m, rad/s
 PAYLOADS = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]  # kg
 
 
-def with_payload(mass: float) -> pd.Mechanism:
+def with_payload(mass: float) -> pdy.Mechanism:
     """The 5R with a point mass at P on distal1: mass, centre of mass and inertia combined
     (parallel axes)."""
     model = library.five_bar_model()
@@ -40,7 +40,7 @@ def with_payload(mass: float) -> pd.Mechanism:
     com = (bar * (b + p) / 2 + mass * p) / total
     inertia = bar * length**2 / 12 + bar * np.sum(((b + p) / 2 - com) ** 2) + mass * np.sum((p - com) ** 2)
     model["bodies"]["distal1"] = {"points": ["B1", "P"], "mass": total, "inertia": float(inertia), "com": com.tolist()}
-    return pd.from_dict(model)
+    return pdy.from_dict(model)
 
 
 def main() -> None:

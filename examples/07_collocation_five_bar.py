@@ -22,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-import planardyn as pd
+import planardyn as pdy
 from planardyn import robot
 from planardyn.plan import collocate, task_waypoints, time_optimal
 
@@ -43,7 +43,7 @@ def effort_integral(plan, T: float) -> float:
 
 def main() -> None:
     start = time.perf_counter()
-    mech = pd.load(ROOT / "examples" / "models" / "library" / "five-bar-5r.yaml")
+    mech = pdy.load(ROOT / "examples" / "models" / "library" / "five-bar-5r.yaml")
     ee = robot.EndEffector(mech, "P")
     qa = ee.inverse(PICK).q
     qb = ee.inverse(PLACE, qa).q

@@ -177,7 +177,7 @@ def test_a_yaml_tag_is_refused_with_its_line_and_column():
     assert e.path == "line 1 column 1"
     assert str(e) == (
         "m.yaml: line 1 column 1: the YAML tag `!model` is not part of the model format; "
-        "remove it and write the value alone (see docs/model-format.md)"
+        "remove it and write the value alone (see `planardyn docs model-format`)"
     )
 
 
@@ -639,3 +639,43 @@ def test_singularity_error_carries_its_kind_and_no_made_up_sigma():
     assert info.value.kind == "type_ii"
     assert info.value.sigma_min is None
     assert "singular value" not in str(info.value)
+
+
+# ---------------------------------------------------------------- issue 23 finding 6: NaN, inf and zero refused by name
+
+def _three_legged_geared():
+    from test_fuzz_api import GEARED
+
+    return GEARED
+
+
+@pytest.mark.parametrize(("call", "argument", "says"), [
+    # Before: NaN efforts, infinite efforts.
+    (lambda m: m.distribute_efforts(m.q0, [0, 0], [0, 0], method="preload", preload=[float("nan")]),
+     "preload", "preload[0] = nan is not a finite number"),
+    (lambda m: m.distribute_efforts(m.q0, [0, 0], [0, 0], method="preload", preload=[float("inf")]),
+     "preload", "preload[0] = inf is not a finite number"),
+    # Before: OverflowError (can't convert negative int to unsigned).
+    (lambda m: m.available_torque(-1, [0.0]), "coordinate", "coordinate = -1 must be an integer from 0 to 2"),
+    (lambda m: m.available_torque(3, [0.0]), "coordinate", "coordinate = 3 must be an integer from 0 to 2"),
+], ids=["preload-nan", "preload-inf", "available-torque--1", "available-torque-3"])
+def test_actuator_arguments_are_refused_by_name(call, argument, says):
+    with pytest.raises(pd.ArgumentError) as info:
+        call(_three_legged_geared())
+    assert info.value.argument == argument and says in str(info.value), str(info.value)
+
+
+@pytest.mark.parametrize(("kw", "says"), [
+    ({"period": float("nan")}, "period = nan must be a finite number > 0 (s)"),  # before: NaN motion
+    ({"period": float("inf")}, "period = inf must be a finite number > 0 (s)"),  # before: NaN motion
+    ({"period": 0.0}, "period = 0.0 must be a finite number > 0 (s)"),  # before: ZeroDivisionError
+    ({"amplitude": float("nan")}, "amplitude = nan must be a finite number > 0"),  # before: NaN motion
+    ({"harmonics": 0}, "harmonics = 0 must be an integer from 1 to 50"),  # before: slice step cannot be zero
+])
+def test_excitation_arguments_are_refused_by_name(kw, says):
+    from planardyn import identify
+
+    mech = pd.load_example("five-bar")
+    with pytest.raises(pd.ArgumentError) as info:
+        identify.excitation(mech, base=identify.base_parameters(mech, samples=20), max_evaluations=3, **kw)
+    assert info.value.argument == next(iter(kw)) and str(info.value).startswith(says), str(info.value)

@@ -180,13 +180,13 @@ def test_inverse_dynamics_failures_in_place(five_bar, designs, circle):
     got = inverse_dynamics(mixed, circle, dt=ID_DT)
     assert isinstance(got[1], BatchError) and got[1].type == "ModelError" and "mass" in got[1].message
     assert got[2].type == "SingularityError" and "type II" in got[2].message and got[2].index == 2
-    assert got[3].type == "ValueError" and got[3].message.startswith('point: expected one of the points A1, ')
+    assert got[3].type == "ArgumentError" and got[3].message.startswith('point: expected one of the points A1, ')
     assert got[3].message.endswith('got "Q"')
     with pytest.raises(pd.SingularityError):
         robot.solve_motion(robot.EndEffector(five_bar, "P"), through_singularity)
     assert_same_efforts([got[0], got[4]], serial_inverse([designs[0], five_bar], circle))
     (no_motion,) = inverse_dynamics([five_bar])
-    assert no_motion.type == "ValueError" and "needs a path" in no_motion.message
+    assert no_motion.type == "ArgumentError" and "needs a path" in no_motion.message
 
 
 def test_inverse_dynamics_on_a_thread_pool_executor(designs, circle):

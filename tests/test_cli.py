@@ -16,7 +16,7 @@ import numpy as np
 import planardyn as pd
 import pytest
 import yaml
-from conftest import MODELS, four_bar_dict
+from conftest import MODELS, ROOT, cli_run, four_bar_dict
 from PIL import Image
 from planardyn.results_io import read_results
 
@@ -35,7 +35,7 @@ def write_model(tmp_path, d: dict, name="model.json"):
 
 
 def csv_rows(path):
-    return list(csv.reader(line for line in path.open() if not line.startswith("#")))
+    return list(csv.reader(path.open()))
 
 
 def test_simulate_writes_csv(tmp_path):
@@ -51,7 +51,7 @@ def test_simulate_writes_csv(tmp_path):
     assert len(rows) == 1 + 21  # t = 0, 0.01, ..., 0.2
     assert float(rows[-1][0]) == pytest.approx(0.2)
     assert float(rows[1][1]) == pytest.approx(four_bar_dict()["coordinates"][0]["value"], abs=1e-12)
-    meta = json.loads("".join(line[2:] for line in out.open() if line.startswith("# ")))
+    meta = json.loads(out.with_name(out.name + ".json").read_text())
     assert meta["settings"]["t_end"] == 0.2 and meta["settings"]["output_dt"] == 0.01
     assert meta["model"]["name"] == "crank-rocker four-bar"
 
@@ -79,7 +79,9 @@ def test_simulate_with_method_and_progress(tmp_path):
     model = write_model(tmp_path, four_bar_dict())
     p = run("simulate", model, "--t-end", "0.1", "--method", "rk4", "--dt", "0.001", "--progress")
     assert p.returncode == 0, p.stderr
-    assert "100.0%" in p.stderr  # the bar ends full
+    # tqdm's bar ends full, once (issue 26: the old bar printed 100 % twice), with the run's
+    # span and the elapsed time < time left.
+    assert p.stderr.count("100%") == 1 and p.stderr.rstrip().endswith("0.1/0.1 s [00:00<00:00]"), p.stderr
 
 
 def test_bad_model_exit_2_names_file_and_field(tmp_path):
@@ -256,3 +258,152 @@ def test_plot_and_animate_errors(tmp_path):
     assert p.returncode == 2 and "was not computed with" in p.stderr
     p = run("animate", FIVE_BAR, sim, "-o", tmp_path / "a.avi")
     assert p.returncode == 2 and ".gif, .mp4 or .html" in p.stderr and "Traceback" not in p.stderr
+
+
+# ---------------------------------------------------------------- issue 23 finding 9: output errors in words
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    """A short five-bar run written as a results file (the input of plot, animate, inverse)
+    and a four-bar as MJCF (the input of import)."""
+    path = tmp_path_factory.mktemp("run") / "run.csv"
+    pd.load(MODELS / "five-bar.yaml").simulate(0.05, output_dt=0.01).save(path)
+    # An MJCF file beside it, the input of planardyn import.
+    assert run("export", "four-bar-gravity", "-o", path.with_name("four-bar.xml")).returncode == 0
+    return path
+
+
+def writing_commands(run_file, out):
+    """Every command that writes, with ``out`` as its output (demo: its folder)."""
+    five = MODELS / "five-bar.yaml"
+    return {
+        "simulate": ["simulate", five, "--t-end", "0.01", "-o", out.with_suffix(".csv")],
+        "inverse": ["inverse", five, "--motion", run_file, "-o", out.with_suffix(".npz")],
+        "identify": ["identify", five, run_file, "-o", out.with_suffix(".json")],
+        "plot": ["plot", run_file, "-o", out.with_suffix(".png")],
+        "animate": ["animate", run_file, "-o", out.with_suffix(".html")],
+        "demo": ["demo", "--out", out],
+        "export": ["export", five, "-o", out.with_suffix(".urdf")],
+        "import": ["import", run_file.with_name("four-bar.xml"), "-o", out.with_suffix(".yaml")],
+        "size": ["size", "five-bar", "--circle", "0.014", "0.5097", "0.06", "--json", out.with_suffix(".json")],
+        "plan": ["plan", "library/five-bar-5r", "--line", "-0.08", "0.28", "0.08", "0.36", "--effort", "5", "5",
+                 "-o", out.with_suffix(".csv")],
+    }
+
+
+def prefix(command):
+    """How a command's errors start (size and plan name themselves)."""
+    return f"planardyn {command}: " if command in ("size", "plan") else "planardyn: "
+
+
+@pytest.mark.parametrize("command", ["simulate", "inverse", "identify", "plot", "animate", "demo", "export",
+                                     "import", "size", "plan"])
+def test_an_output_under_a_file_is_named_with_its_cause(short_run, tmp_path, command):
+    """Before: 'planardyn: [Errno 17] File exists: ...' (simulate after the whole run)."""
+    from conftest import cli_run
+
+    blocker = tmp_path / "file.csv"
+    blocker.write_text("x")
+    argv = writing_commands(short_run, blocker / "x")[command]
+    code, err = cli_run(*argv)
+    out = argv[-1]
+    assert (code, err) == (2, f"{prefix(command)}cannot write {out}: {blocker} is a file, not a directory\n")
+
+
+def test_an_output_where_no_file_can_be_made_names_the_path_asked_for(short_run):
+    """Before: 'planardyn: [Errno 2] No such file or directory: '/proc/.o.csv.123.part'."""
+    from conftest import cli_run
+
+    for command, argv in writing_commands(short_run, __import__("pathlib").Path("/proc/o")).items():
+        code, err = cli_run(*argv)
+        assert (code, err) == (2, f"{prefix(command)}cannot write {argv[-1]}: /proc does not take new files\n"), command
+
+
+@pytest.mark.parametrize("errno_, cause", [
+    (13, "permission denied"), (30, "the file system is read-only"), (28, "the disk is full")])
+def test_a_failed_write_says_why_in_words(short_run, tmp_path, monkeypatch, errno_, cause):
+    """The causes root cannot meet in a test (it may write anywhere, the disk is not full):
+    the results writer raises them, as the file system would, after the whole run."""
+    from conftest import cli_run
+    from planardyn import results_format
+
+    def refused(*args, **kwargs):
+        raise OSError(errno_, "from the OS")
+
+    monkeypatch.setattr(results_format.np, "savez_compressed", refused)
+    out = tmp_path / "run.npz"
+    code, err = cli_run("simulate", MODELS / "five-bar.yaml", "--t-end", "0.01", "-o", out)
+    assert (code, err) == (2, f"planardyn: cannot write {out}: {cause}\n")
+    assert list(tmp_path.iterdir()) == []  # no temporary file left
+
+
+# ---------------------------------------------------------------- issue 26, the first hour
+
+
+def test_every_command_is_in_the_help_with_shipped_model_names():
+    # Issue 26: plan was missing from --help, size only in the epilog (both dispatched outside
+    # argparse); the examples named examples/models/five-bar.yaml, which a wheel user lacks.
+    p = run("--help")
+    listed = re.findall(r"^    (\w+) ", p.stdout, re.M)
+    assert listed == ["check", "simulate", "inverse", "identify", "plot", "animate", "demo", "size", "plan",
+                      "export", "import", "docs"]
+    for command in listed:
+        help_text = run(command, "--help").stdout
+        assert help_text.startswith(f"usage: planardyn {command} "), command
+        assert "examples/models" not in help_text, command
+    assert "examples/models" not in p.stdout
+    for name in re.findall(r"planardyn \w+ ([\w/-]+)(?= )", p.stdout):
+        assert name in pd.models.names() or name.endswith((".csv", ".npz")) or name == "model-format", name
+
+
+def test_size_and_plan_as_subcommands_keep_their_exit_codes():
+    code, err = cli_run("size", FIVE_BAR, "--circle", "0.014", "0.5097", "0")  # R > 0
+    assert code == 2 and "argument --circle: the radius R must be > 0 m, got 0" in err
+    code, err = cli_run("plan", "library/five-bar-5r", "--line", "-0.08", "0.28", "0.08", "0.36")
+    assert code == 2 and "one of the arguments --effort --actuators is required" in err
+    # Limits no timing keeps: exit 1 (InfeasiblePlan), as before.
+    code, err = cli_run("plan", "library/five-bar-5r", "--line", "-0.08", "0.28", "0.08", "0.36", "--effort",
+                        "1e-6", "1e-6")
+    assert code == 1 and err.startswith("planardyn plan: "), err
+
+
+def test_docs_lists_and_prints_the_installed_pages():
+    p = run("docs")
+    assert p.returncode == 0 and "model-format     The planardyn model file" in p.stdout
+    page = run("docs", "model-format")
+    assert page.stdout == (ROOT / "docs" / "model-format.md").read_text()
+    assert run("docs", "docs/cli.md", "--path").stdout.strip().endswith("docs/cli.md")
+    bad = run("docs", "tutorial")
+    assert bad.returncode == 2 and bad.stderr.startswith("planardyn: no page of the guide is named 'tutorial'; the pages are: index, ")
+
+
+def test_model_errors_point_at_the_installed_page(tmp_path):
+    # Issue 26: "see docs/model-format.md" (not in the wheel) is now the command that prints it.
+    path = tmp_path / "m.yaml"
+    path.write_text("points: {}\n")
+    p = run("check", str(path))
+    assert p.returncode == 2 and "(see `planardyn docs model-format`)" in p.stderr
+    assert run("docs", "model-format").returncode == 0
+
+
+def test_plot_points_draws_and_prints_a_points_motion(tmp_path):
+    # The crank pin A of the slider-crank turns on a circle of radius 0.08 m (the model file's
+    # crank): its x and y each travel 0.16 m over a turn, and its speed is 0.08 |theta'|.
+    out = tmp_path / "run.csv"
+    assert run("simulate", "slider-crank", "--t-end", "1", "--output-dt", "0.001", "-o", str(out)).returncode == 0
+    p = run("plot", str(out), "--points", "A", "-o", str(tmp_path / "a.png"))
+    assert p.returncode == 0, p.stderr
+    res = read_results(out)
+    lines = p.stdout.splitlines()
+    numbers = [float(v) for v in re.findall(r"-?\d+\.?\d*(?:e[-+]\d+)?", lines[0])]
+    assert re.fullmatch(r"A: x \S+ \.\. \S+ m \(travel \S+ m\), y \S+ \.\. \S+ m \(travel \S+ m\); "
+                        r"peak speed \S+ m/s, peak acceleration \S+ m/s\^2", lines[0]), lines[0]
+    # Sampled every 1 ms at up to 65 rad/s: the extremes are within 0.08 (1 - cos(0.0325)) = 4e-5 m.
+    np.testing.assert_allclose(numbers[:6], [-0.08, 0.08, 0.16, -0.08, 0.08, 0.16], atol=1e-4)
+    assert numbers[6] == pytest.approx(0.08 * np.abs(res.qd[:, 0]).max(), rel=1e-3)  # 4 digits printed
+    assert lines[-1] == f"wrote {tmp_path / 'a.png'}" and Image.open(tmp_path / "a.png").size == (1080, 960)
+    # B is the slider's point and the ground's (its guide): refused with the fix.
+    p = run("plot", str(out), "--points", "B")
+    assert p.returncode == 2 and "the ground carries B as well as rod and slider" in p.stderr
+    p = run("plot", str(out), "--points", "Z")
+    assert p.returncode == 2 and "--points: the model has no point Z; its points are O, A, B, W" in p.stderr

@@ -15,6 +15,7 @@ tests/test_cli_fuzz.py`` runs a longer one (default 150 inputs, seed 11).
 from __future__ import annotations
 
 import io
+import itertools
 import json
 import os
 import zipfile
@@ -48,7 +49,24 @@ def originals(tmp_path_factory) -> dict[str, bytes]:
     for ext in FORMATS:
         p = pd.results_io.write_results(res, d / f"run{ext}", mechanism=mech)
         out[ext] = p.read_bytes()
+    # A CSV's metadata are in run.csv.json beside it: fuzzed as one text, the metadata's lines
+    # first as '# ' lines (write_input puts them back beside the table).
+    meta = (d / "run.csv.json").read_text().splitlines()
+    out[".csv"] = "".join(f"# {ln}\n" for ln in meta).encode() + out[".csv"]
     return out
+
+
+def write_input(path: Path, data: bytes) -> None:
+    """A results file from (damaged) bytes: a CSV's leading '# ' lines to its metadata file."""
+    beside = path.with_name(path.name + ".json")
+    beside.unlink(missing_ok=True)
+    if path.suffix != ".csv" or not data.startswith(b"# "):
+        path.write_bytes(data)
+        return
+    lines = data.splitlines(keepends=True)
+    head = [ln for ln in itertools.takewhile(lambda ln: ln.startswith(b"#"), lines)]
+    beside.write_bytes(b"".join(ln[2:] if ln.startswith(b"# ") else ln[1:] for ln in head))
+    path.write_bytes(b"".join(lines[len(head):]))
 
 
 def random_value(rng: np.random.Generator) -> Any:
@@ -212,7 +230,7 @@ def test_cli_fuzz(originals, tmp_path):
     failures: list[str] = []
     written = {}
     for ext in FORMATS:
-        (tmp_path / f"written{ext}").write_bytes(originals[ext])
+        write_input(tmp_path / f"written{ext}", originals[ext])
         written[ext] = pd.read_results(tmp_path / f"written{ext}")
     outcomes: Counter[tuple[str, int]] = Counter()
     for k in range(N_INPUTS):
@@ -223,7 +241,7 @@ def test_cli_fuzz(originals, tmp_path):
             data, how = damage(ext, originals[ext], rng, tmp_path)
         else:
             data, how = originals[ext], "intact"
-        path.write_bytes(data)
+        write_input(path, data)
         argv = command(rng, path, tmp_path)
         # Harmless: the final newline cut off, or the metadata's checksum itself dropped.
         harmless = data.rstrip() == originals[ext].rstrip() or (how == "meta" and b'"checksum"' not in data)
@@ -258,3 +276,74 @@ def test_npz_needing_pickle_is_refused_with_its_name(tmp_path):
     assert code == 2 and str(p) in err and "allow_pickle" not in err, err
     with zipfile.ZipFile(p) as z:
         assert z.namelist() == ["metadata.npy"]
+
+
+# ---------------------------------------------------------------- the options issues 12-16 added (issue 23)
+
+#: Every option issues 12-16 added to the commands of cli.py, with where its value goes
+#: ({} is the hostile word). ``planardyn size --distribution/--preload`` and ``planardyn plan``
+#: are the planning helper's (its fuzz test lists them).
+NEW_OPTIONS = [
+    ("simulate", "--speed", "theta1={}"),  # issue 12: prescribed motion
+    ("simulate", "--speed", "{}=1rev/s"),
+    ("simulate", "--stop-when", "theta1>{}"),  # issue 12: events
+    ("simulate", "--stop-when", "{}=1"),
+    ("animate", "--trace", "{}"),  # issue 12: point traces, viewer channels
+    ("animate", "--channel", "{}"),
+    ("identify", "--cutoff", "{}"),  # issue 15: identification
+    ("identify", "--validate", "{}.csv"),
+    ("demo", "--model", "{}"),  # issue 12: the demo
+]
+
+
+@pytest.fixture(scope="module")
+def measured(tmp_path_factory) -> Path:
+    """A measured motion of the five-bar (t, q, tau at 200 Hz over 2 s) along a two-tone
+    motion of both cranks, which identifies every base parameter."""
+    import csv
+
+    mech = pd.load(MODEL)
+    t = np.arange(0.0, 2.0, 0.005)
+    w = 2 * np.pi * np.array([[1.0, 3.0], [2.0, 1.0]])
+    q = mech.q0 + 0.15 * np.sin(t[:, None, None] * w).sum(axis=2)
+    qd = 0.15 * (np.cos(t[:, None, None] * w) * w).sum(axis=2)
+    qdd = -0.15 * (np.sin(t[:, None, None] * w) * w**2).sum(axis=2)
+    path = tmp_path_factory.mktemp("measured") / "measured.csv"
+    with open(path, "w", newline="") as f:
+        out = csv.writer(f)
+        out.writerow(["t", "theta1", "theta2", "tau_theta1", "tau_theta2"])
+        out.writerows(np.column_stack([t, q, mech.inverse_dynamics(q, qd, qdd)]).tolist())
+    return path
+
+
+def option_command(command: str, option: str, value: str, run: Path, measured: Path, out: Path) -> list[str]:
+    """The command line trying ``option value``, kept cheap to run."""
+    if command == "simulate":
+        return ["simulate", str(MODEL), "--t-end", "0.01", "--max-steps", "300", "--no-progress", option, value]
+    if command == "animate":
+        return ["animate", str(run), "-o", str(out / "view.html"), option, value]
+    if command == "identify":
+        cutoff = [] if option == "--cutoff" else ["--cutoff", "10"]
+        return ["identify", str(MODEL), str(measured), *cutoff, option, value]
+    return ["demo", "--out", str(out / "demo"), option, value]
+
+
+@pytest.mark.parametrize(("command", "option", "form"), NEW_OPTIONS, ids=lambda v: str(v))
+def test_new_options_take_any_value_and_name_themselves(originals, measured, tmp_path, command, option, form):
+    """Each option with every hostile word: exit 0 or 1, or exit 2 with one message naming the
+    option (or the value given), never a traceback or a library's words."""
+    run = tmp_path / "run.npz"
+    run.write_bytes(originals[".npz"])
+    failures = []
+    for word in WORDS:
+        value = form.format(word)
+        argv = option_command(command, option, value, run, measured, tmp_path)
+        code, err = cli_run(*argv)
+        where = f"planardyn {' '.join(argv)}: exit {code}: {err.strip()[:300]}"
+        ok = code in (0, 1, 2) and "Traceback" not in err and "unexpected" not in err
+        ok = ok and len([ln for ln in err.splitlines() if ln.startswith("planardyn")]) <= 2
+        if code == 2:
+            ok = ok and (option in err or (value.strip() and value.strip() in err))
+        if not ok:
+            failures.append(where)
+    assert not failures, "\n".join(failures)

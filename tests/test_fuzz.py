@@ -197,7 +197,7 @@ def test_fuzz_corpus_replays(path):
 # ----------------------------------------------------------------------------- located errors
 
 MAPPING_FIX = ("a model file must be a mapping with the keys name, points, ground, bodies, pairs and coordinates: "
-               "see docs/model-format.md")
+               "see `planardyn docs model-format`")
 YAML_FIX = "the text is not valid YAML: check the indentation, brackets, quotes and colons there"
 
 
@@ -226,7 +226,7 @@ def test_a_missing_top_level_field_is_its_own_path():
     e = refused(lambda: pd.from_dict(model))
     assert e.path == "name"
     assert str(e).startswith("<dict>: name: missing field `name` (line 1 column ")
-    assert str(e).endswith("); add it (see docs/model-format.md)")
+    assert str(e).endswith("); add it (see `planardyn docs model-format`)")
     del model["coordinates"][0]["value"]
     model["name"] = "x"
     assert refused(lambda: pd.from_dict(model)).path == "coordinates[0].value"

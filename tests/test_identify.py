@@ -259,3 +259,82 @@ def test_identify_command(experiment, tmp_path):
     bare.write_text("t,theta1,theta2\n0,2.0,1.0\n0.01,2.0,1.0\n")
     code, err = cli_run("identify", "five-bar", bare, "--cutoff", "10")
     assert code == 2 and "tau_theta1, tau_theta2" in err
+
+
+# ---------------------------------------------------------------- issue 23 finding 7: data that cannot identify
+
+def held_still(mech, n):
+    """n rows of the mechanism held still at its start, with the efforts that hold it."""
+    q = np.tile(mech.q0, (n, 1))
+    z = np.zeros_like(q)
+    return q, z, z, mech.inverse_dynamics(q, z, z)
+
+
+def test_a_robot_held_still_names_the_parameters_it_cannot_identify():
+    """Before: numpy's 'LinAlgError: Singular matrix'. Held still at one configuration the
+    efforts are the two gravity torques there: 2 of the five-bar's 11 base parameters
+    (combinations of the first moments) can be told, the 9 others not."""
+    mech = pd.load_example("five-bar")
+    base = base_parameters(mech)
+    with pytest.raises(pd.DataError) as info:
+        pd.identify.identify(mech, *held_still(mech, 50), base=base)
+    msg = str(info.value)
+    assert msg.startswith("these 50 rows cannot identify 9 of the 11 base parameters")
+    # Every inertia about a pivot is among them (no acceleration, no speed: no inertia).
+    assert all(e in msg for e in base.expressions if e.startswith("I_"))
+    assert "identify.excitation" in msg and info.value.path is None
+
+
+def test_too_few_rows_give_the_least_number():
+    mech = pd.load_example("five-bar")
+    q, qd, qdd, tau = (a[:3] for a in held_still(mech, 3))
+    # 11 base parameters need more than 11 equations: 6 rows of 2 efforts.
+    with pytest.raises(pd.DataError, match=r"^3 rows of 2 efforts cannot determine 11 base parameters .* "
+                                           r"give at least 6 rows$"):
+        pd.identify.identify(mech, q, qd, qdd, tau)
+
+
+def test_a_nan_effort_is_named_by_row_and_column_before_lapack_runs(capfd):
+    """Before: 'LinAlgError: SVD did not converge', and LAPACK's DLASCL lines on stdout."""
+    mech = pd.load_example("five-bar")
+    q, qd, qdd, tau = held_still(mech, 50)
+    tau[7, 1] = np.nan
+    with pytest.raises(pd.ArgumentError, match=r"^tau\[7, 1\] \(row 7, column 'tau_theta2'\) = nan is not a "
+                                               r"finite number: remove the row or give its value$") as info:
+        pd.identify.identify(mech, q, qd, qdd, tau)
+    assert info.value.argument == "tau"
+    assert capfd.readouterr().out == ""
+
+
+def test_the_identify_command_names_the_file_and_the_cause(tmp_path):
+    """Before: 'planardyn: Singular matrix', scipy's 'The length of the input vector x must be
+    greater than padlen, which is 15.', and a NaN named by its row only."""
+    import csv
+
+    from conftest import cli_run
+
+    mech = pd.load_example("five-bar")
+    q, _, _, tau = held_still(mech, 50)
+
+    def table(name, rows, nan_at=None):
+        path = tmp_path / name
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["t", "theta1", "theta2", "tau_theta1", "tau_theta2"])
+            for i in range(rows):
+                w.writerow([0.01 * i, *q[i], *(tau[i] if i != nan_at else (1.0, float("nan")))])
+        return path
+
+    still, nan, short = table("still.csv", 50), table("nan.csv", 50, nan_at=7), table("short.csv", 10)
+    code, err = cli_run("identify", "five-bar", still, "--cutoff", "20")
+    assert code == 2 and err.startswith(f"planardyn: {still}: these 30 rows cannot identify 9 of the 11 base "
+                                        "parameters"), err
+    code, err = cli_run("identify", "five-bar", nan, "--cutoff", "20")
+    assert (code, err) == (2, f"planardyn: {nan}: data row 8 has nan in column 'tau_theta2': give finite numbers "
+                              "(remove the row, or fill it in)\n")
+    code, err = cli_run("identify", "five-bar", short, "--cutoff", "20")
+    assert (code, err) == (2, f"planardyn: {short}: t has 10 times: give at least 16 (the zero-phase filter's "
+                              "padding at both ends needs them)\n")
+    code, err = cli_run("identify", "five-bar", still, "--cutoff", "60")
+    assert (code, err) == (2, f"planardyn: {still}: --cutoff = 60 Hz must be below half the sampling rate (50 Hz): "
+                              "a lower cutoff, or a record sampled faster\n")

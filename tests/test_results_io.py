@@ -15,7 +15,7 @@ import json
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import MODELS, four_bar_dict
+from conftest import MODELS, ROOT, four_bar_dict
 from planardyn.results_io import (
     attach_metadata,
     inverse_from_file,
@@ -85,14 +85,19 @@ def test_results_file_reproduces_the_run(five_bar_run, tmp_path):
     np.testing.assert_array_equal(again.tau, res.tau)
 
 
-def test_csv_layout_metadata_in_comments(five_bar_run, tmp_path):
+def test_csv_is_a_plain_table_with_its_metadata_beside(five_bar_run, tmp_path):
+    # Issue 26 (first hour 7): the CSV began with 304 lines of '#' JSON that spreadsheets
+    # choke on. Now its first line is the header and every line the same number of fields
+    # (what a spreadsheet, or pandas.read_csv without options, takes); the metadata are in
+    # run.csv.json beside it, and read_results finds them.
     _, _, res = five_bar_run
     path = write_results(res, tmp_path / "run.csv")
     lines = path.read_text().splitlines()
-    comments = [ln[2:] for ln in lines if ln.startswith("# ")]
-    meta = json.loads("\n".join(comments))
+    assert not any(ln.startswith("#") for ln in lines)
+    meta = json.loads((tmp_path / "run.csv.json").read_text())
     assert meta["format"] == "planardyn-results" and meta["model"]["name"] == "five-bar 5R robot, driven"
-    rows = list(csv.reader(ln for ln in lines if not ln.startswith("#")))
+    rows = list(csv.reader(lines))
+    assert {len(r) for r in rows} == {len(rows[0])}
     assert rows[0][:9] == ["t", "theta1", "theta2", "qd_theta1", "qd_theta2", "qdd_theta1", "qdd_theta2",
                            "tau_theta1", "tau_theta2"]
     assert rows[0][-6:] == ["Xd_distal_left", "Yd_distal_left", "phid_distal_left",
@@ -102,6 +107,41 @@ def test_csv_layout_metadata_in_comments(five_bar_run, tmp_path):
     v = rows[5][1]
     assert len(v.replace(".", "").replace("-", "").lstrip("0").split("e")[0]) <= 17
     assert float(v) == res.q[4, 0]
+    pandas = pytest.importorskip("pandas")
+    table = pandas.read_csv(path)
+    assert list(table.columns) == rows[0] and all(k == "f" for k in table.dtypes.map(lambda d: d.kind))
+    np.testing.assert_array_equal(table["theta1"].to_numpy(), res.q[:, 0])
+    back = read_results(path)
+    np.testing.assert_array_equal(back.q, res.q)
+    assert back.metadata["model"] == meta["model"]
+
+
+def test_csv_without_its_metadata_file_is_refused_by_name(five_bar_run, tmp_path):
+    _, _, res = five_bar_run
+    path = write_results(res, tmp_path / "run.csv")
+    (tmp_path / "run.csv.json").unlink()
+    with pytest.raises(pd.DataError, match=r"run\.csv: not a planardyn results file: no metadata file run\.csv\.json"):
+        read_results(path)
+    # ... and a table with t and the coordinates is still a motion (planardyn inverse takes it).
+    mech = pd.from_result(res)
+    motion = read_motion(path, mech.coordinate_names)
+    assert not motion["from_results"]
+    np.testing.assert_array_equal(motion["qdd"], res.qdd)
+
+
+def test_csv_written_before_the_metadata_file_is_read(tmp_path):
+    # tests/data/four-bar-v3-comment-metadata.csv: written by planardyn at d746b24 (format 3,
+    # the metadata on 217 leading '#' lines); read as it was, every number and the model.
+    old = ROOT / "tests" / "data" / "four-bar-v3-comment-metadata.csv"
+    res = read_results(old)
+    assert res.success and len(res.t) == 6 and res.metadata["model"]["name"] == "four-bar under gravity (passive)"
+    again = pd.from_result(res).simulate(**res.metadata["settings"])
+    # The same run by the same integrator: the file's numbers to the last bit of their repr.
+    np.testing.assert_allclose(again.q, res.q, rtol=0, atol=1e-12)
+    # Written again, it is the new form and reads back equal.
+    back = read_results(res.save(tmp_path / "again.csv"))
+    np.testing.assert_array_equal(back.q, res.q)
+    assert (tmp_path / "again.csv.json").is_file()
 
 
 def test_failed_run_round_trip(four_bar, tmp_path):

@@ -90,8 +90,10 @@ def test_failed_write_leaves_the_old_file_and_no_partial_one(run_5bar, tmp_path,
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(results_io.np, "savez_compressed", disk_full)
-    with pytest.raises(OSError, match="No space left"):
+    # The cause in words and the path asked for (issue 23 finding 9), not the temporary file.
+    with pytest.raises(OSError, match=r"^cannot write .*/r\.npz: the disk is full$") as info:
         write_results(res, path)
+    assert info.value.errno == 28
     assert path.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.npz"]
 
@@ -214,17 +216,16 @@ def test_damaged_integrity_key_does_not_switch_the_check_off(run_5bar, tmp_path)
     'checksum' of a Parquet file read as a file without a checksum."""
     mech, res = run_5bar
     path = write_results(res, tmp_path / "r.csv", mechanism=mech)
-    text = path.read_text()
-    path.write_text(text.replace('"checksum"', '"cZecksum"'))
+    beside = tmp_path / "r.csv.json"  # a CSV's metadata
+    text = beside.read_text()
+    beside.write_text(text.replace('"checksum"', '"cZecksum"'))
     with pytest.raises(ValueError, match=r"r\.csv: metadata has no field 'checksum'"):
         read_results(path)
     # A version 1 file (written before rows and checksum were recorded) is still read.
-    lines = text.splitlines(keepends=True)
-    meta = json.loads("".join(ln[2:] for ln in lines if ln.startswith("#")))
+    meta = json.loads(text)
     del meta["rows"], meta["checksum"]
     meta["format_version"] = 1
-    head = "".join(f"# {ln}\n" for ln in json.dumps(meta, indent=1).splitlines())
-    path.write_text(head + "".join(ln for ln in lines if not ln.startswith("#")))
+    beside.write_text(json.dumps(meta, indent=1))
     assert np.array_equal(read_results(path).q, res.q)
 
 
@@ -238,3 +239,78 @@ def test_api_run_that_cannot_fit_is_refused_up_front(monkeypatch):
     with pytest.raises(ValueError, match="fewer t_eval"):
         mech.simulate(t_end=1.0, t_eval=np.linspace(0.0, 1.0, 10_000))
     assert mech.simulate(t_end=0.01, output_dt=1e-5).success
+
+
+# ---------------------------------------------------------------- issue 23 finding 8: bounded memory when reading
+
+#: Rows of the long file: the finding's 1e5.
+LONG_ROWS = 100_000
+#: Peak memory of a read over the bytes of the numbers the file holds. The reader keeps the
+#: result's arrays (1), the energy's total and balance and one temporary (3 columns of the
+#: five-bar's 39: 0.08), and one block of 4096 rows in up to three copies while it is parsed
+#: and checksummed (0.12 of 1e5 rows): 1.2, measured 1.13-1.25 (npz, parquet, csv). The
+#: issue asks for about 2; before, a CSV took 24 times its numbers (754 MB for 31 MB), a
+#: Parquet file 4.9 times (its library's copies included), an NPZ 2.1.
+READ_PEAK_RATIO = 1.5
+
+PEAK_SCRIPT = """
+import json, sys, tracemalloc
+import pyarrow as pa, pyarrow.parquet  # imported before the count: module objects are not data
+from planardyn.results_io import read_results
+pool = pa.default_memory_pool()
+tracemalloc.start()
+try:
+    res = read_results(sys.argv[1])
+    rows, error = len(res.t), None
+except ValueError as e:
+    rows, error = None, str(e)
+peak = tracemalloc.get_traced_memory()[1]
+print(json.dumps({"peak": peak + pool.max_memory(), "rows": rows, "error": error}))
+"""
+
+
+def read_peak(path) -> dict:
+    """Peak memory of reading ``path`` back in a fresh process: tracemalloc's peak (numpy's
+    arrays are traced) plus pyarrow's own pool (which tracemalloc does not see)."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", PEAK_SCRIPT, str(path)], capture_output=True, text=True,
+                         check=True, timeout=300)
+    return json.loads(out.stdout)
+
+
+@pytest.fixture(scope="module")
+def long_run(run_5bar):
+    """A five-bar result of 1e5 rows (the 21 rows of run_5bar over and over), as a run
+    interrupted by Ctrl-C would leave it: status 'cancelled'."""
+    import dataclasses
+
+    mech, res = run_5bar
+    long = res.take(np.arange(LONG_ROWS) % len(res.t))
+    return mech, dataclasses.replace(long, status="cancelled", success=False,
+                                     message="interrupted (Ctrl-C) at t = 0.2 s: the trajectory so far is kept")
+
+
+@pytest.mark.parametrize("ext", [".csv", ".npz", ".parquet"])
+def test_reading_a_long_file_needs_about_the_memory_of_its_numbers(long_run, tmp_path, ext):
+    """Before: 8 KB a row for a CSV (24 times its numbers), 4.9 times for Parquet."""
+    mech, res = long_run
+    path = write_results(res, tmp_path / f"long{ext}", mechanism=mech)
+    numbers = LONG_ROWS * 39 * 8  # t, 4 x 2 coordinates, 6 energies and measures, 6 x 4 bodies
+    got = read_peak(path)
+    assert got["rows"] == LONG_ROWS, got
+    assert got["peak"] / numbers <= READ_PEAK_RATIO, f"peak {got['peak'] / 1e6:.1f} MB for {numbers / 1e6:.1f} MB"
+    back = read_results(path)  # the interrupted run reads back whole, as it was written
+    assert back.status == "cancelled" and np.array_equal(back.q, res.q) and np.array_equal(back.x, res.x)
+
+
+def test_a_long_csv_cut_in_its_last_line_is_refused_in_bounded_memory(long_run, tmp_path):
+    """A copy cut short inside its last row: refused by name and row, in the same memory."""
+    mech, res = long_run
+    path = write_results(res, tmp_path / "long.csv", mechanism=mech)
+    data = path.read_bytes()
+    path.write_bytes(data[: data.rstrip().rfind(b",")])  # the last row's last number lost
+    got = read_peak(path)
+    assert got["error"] == f"{path}: data row {LONG_ROWS} is not 39 numbers (38 fields): truncated or damaged"
+    assert got["peak"] / (LONG_ROWS * 39 * 8) <= READ_PEAK_RATIO

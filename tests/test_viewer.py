@@ -22,7 +22,7 @@ import planardyn as pd
 import pytest
 from conftest import MODELS
 from PIL import Image
-from planardyn.notebook import mechanism_html, mechanism_svg, register_display, result_html, viewer
+from planardyn.notebook import mechanism_html, mechanism_svg, point_motion_html, register_display, result_html, viewer
 from planardyn.results_io import attach_metadata
 from planardyn.viewer import DIGITS, viewer_data, viewer_html, write_viewer
 
@@ -198,7 +198,8 @@ def test_register_display_hands_both_views_to_ipython(five_bar):
 
     shell = types.SimpleNamespace(display_formatter=types.SimpleNamespace(formatters={"text/html": Formatter()}))
     assert register_display(shell)
-    assert printers == {pd.Mechanism: mechanism_html, pd.SimulationResult: result_html}
+    assert printers == {pd.Mechanism: mechanism_html, pd.SimulationResult: result_html,
+                        pd.PointMotion: point_motion_html}
     assert printers[type(mech)](mech).startswith('<div style="display:flex')
     assert register_display() is False  # no running IPython shell under pytest: nothing to do
 

@@ -25,10 +25,10 @@ def test_snippets_are_found_in_page_order():
 def test_readme_snippets_need_no_repository_file():
     # Run from an installed wheel in an empty folder: models by name, not by repository path.
     code = snippets(README)
-    assert [kind for kind, _ in code] == ["python"] + ["planardyn"] * 7
+    assert [kind for kind, _ in code] == ["python"] + ["planardyn"] * 9
     for _, text in code:
         assert "examples/" not in text, text
-    assert 'pd.load_example("five-bar")' in code[0][1]
+    assert 'pdy.load_example("five-bar")' in code[0][1]
     assert code[1][1] == "planardyn check five-bar"
 
 

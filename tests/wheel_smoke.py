@@ -4,8 +4,8 @@ wheel and its dependencies, from a folder outside the repository.
     python wheel_smoke.py README.md
 
 Checks that planardyn is imported from the installed wheel, not a source tree; that the wheel
-holds the licence and every shipped model file, each of which loads; that `planardyn --version`
-prints the installed version; and that every snippet of README.md runs in page order, the
+holds the licence and every shipped model file, each of which loads, and the guide's pages
+(`planardyn docs`); that `planardyn --version` prints the installed version; and that every snippet of README.md runs in page order, the
 ```python blocks in one namespace, the `planardyn` lines of its ```bash blocks as commands (as
 tests/test_docs.py runs every page in the repository). Needs nothing but the wheel.
 """
@@ -47,20 +47,33 @@ def snippets(markdown: str) -> list[tuple[str, str]]:
 
 
 def check_installed() -> None:
-    import planardyn as pd
+    import planardyn as pdy
 
-    where = Path(pd.__file__).resolve()
+    where = Path(pdy.__file__).resolve()
     assert "site-packages" in where.parts, f"planardyn is imported from {where}, not from an installed wheel"
     files = [str(f) for f in importlib.metadata.distribution("planardyn").files or []]
     assert any(f.endswith("licenses/LICENSE") for f in files), "the wheel holds no LICENSE"
     shipped = sorted(f.removeprefix("planardyn/models/").removesuffix(".yaml") for f in files
                      if f.startswith("planardyn/models/") and f.endswith(".yaml"))
-    assert shipped and shipped == sorted(pd.models.names()), (shipped, pd.models.names())
+    assert shipped and shipped == sorted(pdy.models.names()), (shipped, pdy.models.names())
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pd.PlanardynWarning)  # e.g. the library's redundant double parallelogram
+        warnings.simplefilter("ignore", pdy.PlanardynWarning)  # e.g. the library's redundant double parallelogram
         for name in shipped:
-            pd.load_example(name)
+            pdy.load_example(name)
     print(f"wheel: {where.parent}: LICENSE, {len(shipped)} model files, each loads")
+
+
+def check_guide(readme: Path) -> None:
+    """The guide's pages are in the wheel (planardyn/docs/*.md), the repository's, and
+    `planardyn docs PAGE` prints them: the address model errors cite."""
+    files = [str(f) for f in importlib.metadata.distribution("planardyn").files or []]
+    shipped = sorted(f.removeprefix("planardyn/docs/") for f in files if f.startswith("planardyn/docs/"))
+    pages = sorted(p.name for p in (readme.parent / "docs").glob("*.md"))
+    assert shipped == pages, (shipped, pages)
+    command = Path(sys.executable).parent / "planardyn"
+    out = subprocess.run([str(command), "docs", "model-format"], capture_output=True, text=True, check=True).stdout
+    assert out == (readme.parent / "docs" / "model-format.md").read_text(), out[:200]
+    print(f"wheel: the guide's {len(shipped)} pages, planardyn docs prints them")
 
 
 def check_version() -> None:
@@ -92,4 +105,5 @@ def run_readme(readme: Path) -> None:
 if __name__ == "__main__":
     check_installed()
     check_version()
+    check_guide(Path(sys.argv[1]))
     run_readme(Path(sys.argv[1]))

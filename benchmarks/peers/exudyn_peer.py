@@ -5,9 +5,9 @@ algebraic constraint: no tree needed), gravity by ``Gravity`` loads, springs by
 Exudyn's implicit generalized-alpha solver with index-3 constraints (its default), Newton to
 relative 1e-8.
 
-Swept: the number of steps, at spectral radius 0.9. (On the four-bar at spectral radius 1,
-no numerical damping, Newton diverges around t = 2.55 s at every step size tried; the
-index-2 Newmark variant and one run at spectral radius 1 are included, for the record.)
+Variants, each searched on its number of steps: generalized-alpha with index-3 constraints at
+spectral radius 0.8, 0.9, 0.95 and 1 (no numerical damping; on the four-bar Newton then diverges
+around t = 2.55 s at every step size tried), and Newmark with index-2 constraints.
 
 Timed: ``mbs.SolveDynamic`` (the C++ loop) with node sensors storing position, angle and
 their rates at every step. Energy and loop gap come afterwards from the sensors (untimed).
@@ -16,28 +16,25 @@ their rates at every step. Energy and loop gap come afterwards from the sensors 
 from __future__ import annotations
 
 import io
+from collections.abc import Callable
 from contextlib import redirect_stdout
 
 import numpy as np
-from common import Drawing, Run, best_time, coordinates, energy, loop_gap
+from common import Drawing, Reference, Run, Variant, coordinates, energy, loop_gap, one_shot
 from mechanisms import Benchmark
 
 TOOL = "Exudyn"
 PACKAGE = "exudyn"
 
+#: (spectral radius, index-2 Newmark?)
+METHODS = [(0.8, False), (0.9, False), (0.95, False), (1.0, False), (1.0, True)]
+#: (cheapest, dearest) number of steps over the run.
+STEPS = {"four-bar": (50, 80000), "five-bar": (10, 100000), "3-rrr": (4, 8000), "andrews": (30, 40000)}
 
-def _sweep(dts: tuple, records: list[tuple] = ()) -> list[tuple]:
-    """(dt in s, spectral radius, index-2 Newmark?)"""
-    return [(dt, 0.9, False) for dt in dts] + list(records)
 
-
-SWEEPS = {
-    "four-bar": _sweep((0.01, 0.005, 0.0025, 0.00125, 0.001, 0.0008, 0.0005, 0.00025),
-                       [(0.001, 1.0, True), (0.005, 1.0, False)]),
-    "five-bar": _sweep((0.001, 0.0005, 0.0002, 0.0001, 0.00005, 0.00002), [(0.0005, 1.0, True), (0.0005, 1.0, False)]),
-    "3-rrr": _sweep((0.01, 0.005, 0.002, 0.001, 0.0005), [(0.001, 1.0, True), (0.001, 1.0, False)]),
-    "andrews": _sweep((2e-5, 1e-5, 5e-6, 2e-6), [(5e-6, 1.0, True), (5e-6, 1.0, False)]),
-}
+def variants(bm: Benchmark) -> list[Variant]:
+    return [Variant(TOOL, "Newmark, index 2" if index2 else f"gen.-alpha index 3, rho={rho:g}", (rho, index2),
+                    STEPS[bm.key]) for rho, index2 in METHODS]
 
 
 def version() -> str:
@@ -111,15 +108,13 @@ def settings(exu, n: int, t_end: float, rho: float, index2: bool):
     return s
 
 
-def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
-    dt, rho, index2 = setting
-    r = Run(TOOL, "Newmark, index 2" if index2 else f"gen.-alpha index 3, rho={rho:g}", f"dt={dt:g}")
+def run(bm: Benchmark, d: Drawing, v: Variant, n: int, ref: Reference) -> Run:
+    r = Run(TOOL, v.method, v.label(bm.t_end, n), value=n, steps=n)
     exu, mbs, sensors = build(d)
-    n = r.steps = bm.steps(dt)
-    s = settings(exu, n, bm.t_end, rho, index2)
+    s = settings(exu, n, bm.t_end, *v.params)
     try:
         with redirect_stdout(io.StringIO()):
-            r.wall, _ = best_time(lambda: mbs.SolveDynamic(s), max_repeats=3)
+            r.wall, _ = one_shot(lambda: mbs.SolveDynamic(s))
     except Exception as e:  # Exudyn raises SolverError when Newton fails for good
         return r.fail(f"solver failed: {e}")
     poses, rates = {}, {}
@@ -131,5 +126,16 @@ def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
     rows = len(next(iter(poses.values())))
     if rows != n + 1:
         return r.fail(f"{rows} sensor rows for {n} steps")
-    q = coordinates(d, poses)[bm.grid_indices(dt)]
-    return r.finish(energy(d, poses, rates), loop_gap(d, poses), q, ref_grid)
+    q = coordinates(d, poses)[bm.sample_indices(n)]
+    return r.finish(energy(d, poses, rates), loop_gap(d, poses), q, ref.steps(n))
+
+
+def timed(bm: Benchmark, d: Drawing, v: Variant, n: int) -> Callable[[], object]:
+    exu, mbs, _ = build(d)
+    s = settings(exu, n, bm.t_end, *v.params)
+
+    def call() -> None:
+        with redirect_stdout(io.StringIO()):
+            mbs.SolveDynamic(s)
+
+    return call

@@ -6,36 +6,40 @@ stabilisation with Kp = w^2, Kd = 2 w (critical), and classic RK4 written in Pyt
 Drive torques enter as joint torques; a spring's force enters as J^T f through the frame
 Jacobians of its two ends (the way a Pinocchio user adds a force element).
 
+Variants: the Baumgarte gain w on a half-decade grid (w = 0: no stabilisation), each searched
+on its number of steps.
+
 Timed: the RK4 loop, storing q and v at every step. Energy, loop gap and coordinates are
-computed afterwards from the stored states (untimed). One more run, untimed as a whole, clocks
-each ``constraintDynamics`` call inside the loop: its share of that run's time is the part of
-Pinocchio's cost that is its C++ dynamics (the rest is the Python loop, the RK4 arithmetic on
-numpy arrays and the springs' Jacobians), in ``Run.extra['dynamics_share']``.
+computed afterwards from the stored states (untimed). A second timed call (``clocked``) clocks
+each ``constraintDynamics`` call inside the loop: the sum is the part of Pinocchio's cost that
+is its C++ dynamics (the rest is the Python loop, the RK4 arithmetic on numpy arrays and the
+springs' Jacobians).
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
-from common import Drawing, Run, best_time, coordinates, energy, loop_gap
+from common import Drawing, Reference, Run, Variant, coordinates, energy, loop_gap, one_shot
 from mechanisms import Benchmark
 
 TOOL = "Pinocchio"
 PACKAGE = "pin"
 
+#: Baumgarte gains w (1/s) per mechanism: Kp = w^2, Kd = 2 w.
+GAINS = {"four-bar": (0.0, 1.0, 3.0, 10.0, 30.0, 100.0), "five-bar": (0.0, 3.0, 10.0, 30.0, 100.0, 300.0),
+         "3-rrr": (0.0, 3.0, 10.0, 30.0, 100.0, 300.0),
+         "andrews": (0.0, 100.0, 300.0, 1e3, 3e3, 1e4, 3e4)}
+#: (cheapest, dearest) number of RK4 steps over the run.
+STEPS = {"four-bar": (20, 20000), "five-bar": (10, 10000), "3-rrr": (4, 2000), "andrews": (30, 6000)}
 
-def _sweep(dts: tuple, ws: tuple) -> list[tuple]:
-    """(dt in s, Baumgarte w in 1/s): w = 0 is no stabilisation."""
-    return [(dt, w) for w in ws for dt in dts]
 
+def variants(bm: Benchmark) -> list[Variant]:
+    return [Variant(TOOL, "RK4 + constraintDynamics" + (f", Baumgarte w={w:g}" if w else ""), (w,), STEPS[bm.key])
+            for w in GAINS[bm.key]]
 
-SWEEPS = {
-    "four-bar": _sweep((0.01, 0.005, 0.004, 0.0025, 0.002, 0.001), (0.0, 10.0, 30.0)),
-    "five-bar": _sweep((0.005, 0.002, 0.001, 0.0005, 0.0002), (0.0, 30.0, 100.0)),
-    "3-rrr": _sweep((0.04, 0.02, 0.01, 0.005, 0.002), (0.0, 30.0, 100.0)),
-    "andrews": _sweep((3e-4, 1.5e-4, 1e-4, 5e-5, 2e-5), (0.0, 1e3, 1e4)),
-}
 
 #: Proximal solver settings: absolute and relative accuracy, mu, iterations.
 PROX = (1e-12, 1e-12, 1e-8, 20)
@@ -152,39 +156,64 @@ class Model:
         return Q, V
 
     def body_states(self, Q: np.ndarray, V: np.ndarray) -> tuple[dict, dict]:
-        """Per-body (N, 3) CoM poses (phi from the drawing) and rates, from Pinocchio's
-        forward kinematics."""
-        pin, model, data = self.pin, self.model, self.data
-        bodies = self.d.bodies
-        poses = {k: np.empty((len(Q), 3)) for k in bodies}
-        rates = {k: np.empty((len(Q), 3)) for k in bodies}
-        for i in range(len(Q)):
-            pin.forwardKinematics(model, data, Q[i], V[i])
-            for name in bodies:
-                j = self.jid[name]
-                M, vel = data.oMi[j], data.v[j]  # vel: joint frame, local coordinates
-                c = v3(bodies[name].com - self.origin[name])
-                R = M.rotation
-                poses[name][i, :2] = (M.translation + R @ c)[:2]
-                poses[name][i, 2] = np.arctan2(R[1, 0], R[0, 0])
-                rates[name][i, :2] = (R @ (vel.linear + np.cross(vel.angular, c)))[:2]
-                rates[name][i, 2] = vel.angular[2]
-        for p in poses.values():
-            p[:, 2] = np.unwrap(p[:, 2])
-        return poses, rates
+        """Per-body (N, 3) CoM poses (phi from the drawing) and rates from the stored q and v, down
+        the tree as the model chains it (each joint at its drawn offset in its parent's frame,
+        every frame world-aligned in the drawing), vectorised over the states: Pinocchio's forward
+        kinematics state by state from Python took five times the simulation itself
+        (test_common.py checks the two agree)."""
+        def turn(phi: np.ndarray, r: np.ndarray) -> np.ndarray:  # (N, 2): r (2,) turned by phi (N,)
+            c, s = np.cos(phi), np.sin(phi)
+            return np.c_[c * r[0] - s * r[1], s * r[0] + c * r[1]]
+
+        def cross(w: np.ndarray, r: np.ndarray) -> np.ndarray:  # (N, 2): w e_z x r
+            return w[:, None] * np.c_[-r[:, 1], r[:, 0]]
+
+        n = len(Q)
+        phi, w = {"ground": np.zeros(n)}, {"ground": np.zeros(n)}
+        o, vo = {"ground": np.zeros((n, 2))}, {"ground": np.zeros((n, 2))}  # joint origins and their rates
+        poses, rates = {}, {}
+        for p in self.d.tree()[0]:  # depth-first: every parent before its children
+            a, b, joint = p.a, p.b, self.model.joints[self.jid[p.b]]
+            r = turn(phi[a], self.origin[b] - self.origin[a])
+            o[b], vo[b] = o[a] + r, vo[a] + cross(w[a], r)
+            phi[b], w[b] = phi[a] + Q[:, joint.idx_q], w[a] + V[:, joint.idx_v]
+            c = turn(phi[b], self.d.bodies[b].com - self.origin[b])
+            poses[b] = np.c_[o[b] + c, phi[b]]
+            rates[b] = np.c_[vo[b] + cross(w[b], c), w[b]]
+        return {k: poses[k] for k in self.d.bodies}, {k: rates[k] for k in self.d.bodies}
 
 
-def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
-    dt, w = setting
-    r = Run(TOOL, "RK4 + constraintDynamics" + (f", Baumgarte w={w:g}" if w else ""), f"dt={dt:g}")
-    n = r.steps = bm.steps(dt)
-    m = Model(d, w)
+_models: dict = {}
+
+
+def model(bm: Benchmark, d: Drawing, w: float) -> Model:
+    if (bm.key, w) not in _models:
+        _models[bm.key, w] = Model(d, w)
+    return _models[bm.key, w]
+
+
+def run(bm: Benchmark, d: Drawing, v: Variant, n: int, ref: Reference) -> Run:
+    r = Run(TOOL, v.method, v.label(bm.t_end, n), value=n, steps=n)
+    m = model(bm, d, *v.params)
     with np.errstate(all="ignore"):
-        r.wall, (Q, V) = best_time(lambda: m.simulate(dt, n))
-        clock = [0.0]
-        t0 = time.perf_counter()
-        m.simulate(dt, n, clock)
-        r.extra["dynamics_share"] = clock[0] / (time.perf_counter() - t0)
+        r.wall, (Q, V) = one_shot(lambda: m.simulate(bm.t_end / n, n))
         poses, rates = m.body_states(Q, V)
-        q = coordinates(d, poses)[bm.grid_indices(dt)]
-        return r.finish(energy(d, poses, rates), loop_gap(d, poses), q, ref_grid)
+        q = coordinates(d, poses)[bm.sample_indices(n)]
+        return r.finish(energy(d, poses, rates), loop_gap(d, poses), q, ref.steps(n))
+
+
+def timed(bm: Benchmark, d: Drawing, v: Variant, n: int) -> Callable[[], object]:
+    m, dt = model(bm, d, *v.params), bm.t_end / n
+    return lambda: m.simulate(dt, n)
+
+
+def clocked(bm: Benchmark, d: Drawing, v: Variant, n: int) -> Callable[[], float]:
+    """The same run, returning the seconds spent inside ``constraintDynamics``."""
+    m, dt = model(bm, d, *v.params), bm.t_end / n
+
+    def call() -> float:
+        clock = [0.0]
+        m.simulate(dt, n, clock)
+        return clock[0]
+
+    return call

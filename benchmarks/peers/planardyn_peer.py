@@ -1,6 +1,9 @@
 """planardyn: the model file (with the benchmark's overrides), integrated in its minimal
 coordinates.
 
+Variants: DOP853 and DOPRI5 (Radau IIA too on Andrews' squeezer) searched on their tolerance
+(rtol = atol, the state being of order 1 rad and rad/s), and fixed-step RK4 on its number of steps.
+
 Timed: ``Mechanism.simulate`` with outputs at the error grid (each with energies, body poses
 and the loop residual). Energy drift and loop gap are then taken from a second, untimed run
 of the same settings that outputs every accepted step, so they are measured at every step
@@ -9,34 +12,34 @@ as for the peers.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+import cheapest
+import common
 import numpy as np
-from common import Drawing, Run, best_time, energy, loop_gap
+from common import Drawing, Run, Variant, energy, loop_gap, one_shot
 from mechanisms import Benchmark
 
 TOOL = "planardyn"
 PACKAGE = "planardyn (this repository)"
 
-_RTOLS_DOP853 = (1e-5, 1e-6, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 1e-10, 1e-11)
-_RTOLS_DOPRI5 = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)
-
-
-def _sweep(rk4_dts: tuple, extra: list | None = None, loose: int = 0) -> list[tuple]:
-    """(method, rtol, dt): DOP853 and DOPRI5 over a range of tolerances (atol = rtol, the
-    state being of order 1 rad and rad/s), starting ``loose`` decades looser, and fixed-step RK4."""
-    def rtols(tight):
-        return [tight[0] * 10.0 ** k for k in range(loose, 0, -1)] + list(tight)
-
-    return ([("dop853", r, None) for r in rtols(_RTOLS_DOP853)] + [("dopri5", r, None) for r in rtols(_RTOLS_DOPRI5)]
-            + [("rk4", None, dt) for dt in rk4_dts] + (extra or []))
-
-
-SWEEPS = {
-    "four-bar": _sweep((0.01, 0.005, 0.0025, 0.001)),
-    "five-bar": _sweep((0.002, 0.001, 0.0005, 0.0002)),
-    "3-rrr": _sweep((0.04, 0.02, 0.01, 0.005), loose=1),
-    "andrews": _sweep((1e-4, 5e-5, 2e-5, 1e-5), [("radau5", r, None) for r in (1e-5, 1e-7, 1e-9)]),
-}
 METHODS = {"dop853": "DOP853 8(5,3)", "dopri5": "DOPRI5 5(4)", "rk4": "RK4 fixed step", "radau5": "Radau IIA 5"}
+#: The adaptive methods searched on each mechanism (default: the explicit pair).
+ADAPTIVE = {"andrews": ("dop853", "dopri5", "radau5")}
+#: Fixed-step RK4: (cheapest, dearest) number of steps over the run.
+RK4_STEPS = {"four-bar": (20, 40000), "five-bar": (10, 20000), "3-rrr": (4, 2000), "andrews": (30, 30000)}
+
+
+def variants(bm: Benchmark) -> list[Variant]:
+    return ([Variant(TOOL, METHODS[m], (m,), None) for m in ADAPTIVE.get(bm.key, ("dop853", "dopri5"))]
+            + [Variant(TOOL, METHODS["rk4"], ("rk4",), RK4_STEPS[bm.key])])
+
+
+def setting(bm: Benchmark, v: Variant, s: int) -> tuple[str, float | None, float | None]:
+    """(method, rtol, dt) of setting s of variant v: the form results.json and overhead.py keep."""
+    (method,) = v.params
+    return (method, None, bm.t_end / s) if v.steps else (method, cheapest.rtol(s), None)
+
 
 _mechs: dict = {}
 
@@ -67,11 +70,40 @@ def label(method: str, rtol: float | None, dt: float | None) -> str:
     return f"dt={dt:g}" if method == "rk4" else f"rtol={rtol:g}"
 
 
-def reference(bm: Benchmark, rtol: float = 1e-13) -> np.ndarray:
-    """(K, m) coordinates at the grid times from DOP853 at rtol = atol = 1e-13."""
-    res = mechanism(bm).simulate(bm.t_end, method="dop853", rtol=rtol, atol=rtol, t_eval=bm.grid_times())
-    assert res.success, res.message
-    return res.q.copy()
+class Reference(common.Reference):
+    """planardyn with DOP853 at rtol = atol = RTOL at the times a run is sampled at: the grid, or
+    for a run of n fixed steps its steps nearest the grid (``Benchmark.sample_times``)."""
+
+    #: The reference's tolerance: at the grid times it agrees with DOP853 at 3e-14 and DOPRI5 at
+    #: 1e-13 to 1.7e-11, 1.3e-9, 6e-14 and 2.6e-12 rad (four-bar, five-bar, 3-RRR, Andrews'
+    #: squeezer; 2026-11-25), far below the stated errors of 1e-4 rad.
+    RTOL = 1e-13
+
+    def __init__(self, bm: Benchmark):
+        self.bm = bm
+        self._at: dict[bytes, np.ndarray] = {}
+
+    def at(self, times: np.ndarray) -> np.ndarray:
+        """(K, m) coordinates (rad) at the times (s)."""
+        key = times.tobytes()
+        if key not in self._at:
+            # A run of fewer steps than grid intervals samples a step more than once.
+            t, back = np.unique(times, return_inverse=True)
+            try:
+                res = mechanism(self.bm).simulate(self.bm.t_end, method="dop853", rtol=self.RTOL, atol=self.RTOL,
+                                                  t_eval=t)
+            except Exception as e:
+                raise common.ReferenceFailed(f"{self.bm.key}: {type(e).__name__}: {e}") from e
+            if not res.success:
+                raise common.ReferenceFailed(f"{self.bm.key}: {res.message}")
+            self._at[key] = res.q[back]
+        return self._at[key]
+
+    def grid(self) -> np.ndarray:
+        return self.at(self.bm.grid_times())
+
+    def steps(self, n: int) -> np.ndarray:
+        return self.at(self.bm.sample_times(n))
 
 
 def split(mech, x: np.ndarray, xd: np.ndarray) -> tuple[dict, dict]:
@@ -85,14 +117,14 @@ def split(mech, x: np.ndarray, xd: np.ndarray) -> tuple[dict, dict]:
     return poses, rates
 
 
-def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
-    method, rtol, dt = setting
+def run(bm: Benchmark, d: Drawing, v: Variant, s: int, ref: Reference) -> Run:
+    method, rtol, dt = setting(bm, v, s)
     mech = mechanism(bm)
     opts = options(method, rtol, dt)
-    r = Run(TOOL, METHODS[method], label(method, rtol, dt))
-    wall, res = best_time(lambda: mech.simulate(bm.t_end, t_eval=bm.grid_times(), **opts))
+    r = Run(TOOL, v.method, v.label(bm.t_end, s), value=s)
+    r.wall, res = one_shot(lambda: mech.simulate(bm.t_end, t_eval=bm.grid_times(), **opts))
     every = mech.simulate(bm.t_end, **opts)  # untimed: every accepted step, for drift and gap
-    r.wall, r.steps = wall, int(res.stats["naccept"])
+    r.steps = int(res.stats["naccept"])
     r.extra = {"setting": [method, rtol, dt], "nfev": int(res.stats["nfev"]),
                "max_residual_scaled": float(every.stats["max_residual"])}
     if not (res.success and every.success):
@@ -101,4 +133,10 @@ def run(bm: Benchmark, d: Drawing, setting: tuple, ref_grid: np.ndarray) -> Run:
     gp, gr = split(mech, res.x, res.xd)
     e = np.concatenate([energy(d, poses, rates), energy(d, gp, gr)])
     gap = np.concatenate([loop_gap(d, poses), loop_gap(d, gp)])
-    return r.finish(e, gap, res.q, ref_grid)
+    return r.finish(e, gap, res.q, ref.grid())
+
+
+def timed(bm: Benchmark, d: Drawing, v: Variant, s: int) -> Callable[[], object]:
+    """The call timing.py times: the run with outputs at the error grid."""
+    mech, t, opts = mechanism(bm), bm.grid_times(), options(*setting(bm, v, s))
+    return lambda: mech.simulate(bm.t_end, t_eval=t, **opts)

@@ -1,26 +1,30 @@
 """planardyn: exact minimal-coordinate dynamics of planar closed-chain mechanisms.
 
 A mechanism is described as it is drawn, in a model file (YAML or JSON, see
-``docs/model-format.md``), and validated once into an immutable :class:`Mechanism`::
+``planardyn docs model-format``), and validated once into an immutable :class:`Mechanism`::
 
-    import planardyn as pd
+    import planardyn as pdy
 
-    mech = pd.load("examples/models/five-bar.yaml")   # or pd.load_example("five-bar")
+    mech = pdy.load_example("five-bar")   # a shipped model; pdy.load("my-linkage.yaml") for a file
     res = mech.simulate(t_end=1.0)
     res.q          # (N, m) coordinates, rad or m
     res.to_csv("five-bar.csv")
 
 Units are SI throughout (m, kg, s, rad, N, N m); arrays are float64 and time-major.
 Errors raise subclasses of :class:`PlanardynError`: :class:`ModelError` (also a
-``ValueError``) for a model that cannot be built, :class:`AssemblyError`,
-:class:`SingularityError` and :class:`SimulationError`.
+``ValueError``) for a model that cannot be built, :class:`ArgumentError` (also a
+``ValueError``) for an argument of the wrong shape or value, :class:`DataError` (also a
+``ValueError``) for a data file or measured motion that cannot be used,
+:class:`AssemblyError`, :class:`SingularityError` and :class:`SimulationError`.
 """
 
 from __future__ import annotations
 
 from . import batch, models, notebook, sensitivity
 from ._core import (
+    ArgumentError,
     AssemblyError,
+    DataError,
     ModelError,
     PlanardynError,
     SimulationError,
@@ -33,9 +37,11 @@ from .result import ChangePoint, Energy, PointMotion, SimulationInterrupted, Sim
 from .results_io import read_results
 
 __all__ = [
+    "ArgumentError",
     "AssemblyError",
     "ChangePoint",
     "Crossing",
+    "DataError",
     "Energy",
     "Mechanism",
     "ModelError",

@@ -18,6 +18,8 @@ __all__ = [
     "loads",
     "PlanardynError",
     "ModelError",
+    "ArgumentError",
+    "DataError",
     "AssemblyError",
     "SingularityError",
     "SimulationError",
@@ -41,6 +43,12 @@ class PlanardynError(Exception): ...
 class ModelError(PlanardynError, ValueError):
     source: str
     path: str
+
+class ArgumentError(PlanardynError, ValueError):
+    argument: str | None
+
+class DataError(PlanardynError, ValueError):
+    path: str | None
 
 class AssemblyError(PlanardynError):
     residual: float

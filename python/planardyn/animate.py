@@ -15,8 +15,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import extras
 from .playback import auto_speed
-from .plot import default_trace_points, draw_mechanism
+from .plot import draw_mechanism, trace_points
 from .viewer import write_viewer
 
 if TYPE_CHECKING:
@@ -84,7 +85,7 @@ def render_frames(
     ax = fig.add_axes((0.08, 0.08, 0.9, 0.84))
     pos = mech.point_positions(result.x)  # (N, P, 2)
     x0, x1, y0, y1 = _bounds(mech, pos)
-    traces = default_trace_points(mech) if traces is None else list(traces)
+    traces = trace_points(mech, traces)
     trace_idx = [mech.point_names.index(n) for n in traces]
     colors = [f"C{(j + 6) % 10}" for j in range(len(trace_idx))]
     for j, i in enumerate(trace_idx):  # the whole paths, faint, drawn once
@@ -130,8 +131,8 @@ def write_mp4(frames, path: Path, fps: float, size: tuple[int, int]) -> int:
     """Encode RGB frames as H.264 MP4 with imageio-ffmpeg's ffmpeg. Returns the frame count."""
     try:
         import imageio_ffmpeg
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("MP4 needs imageio-ffmpeg: pip install imageio-ffmpeg") from e
+    except ImportError as e:
+        raise extras.missing("mp4", "an MP4 animation", e) from e
     writer = imageio_ffmpeg.write_frames(
         str(path), size, fps=fps, codec="libx264", pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
         macro_block_size=16, output_params=["-movflags", "+faststart"], ffmpeg_log_level="error",
@@ -184,10 +185,6 @@ def animate(
     ext = path.suffix.lower()
     if ext not in FORMATS:
         raise ValueError(f"{path}: unknown animation format {ext!r} (use .gif, .mp4 or .html)")
-    if traces is not None:
-        unknown = [p for p in traces if p not in mech.point_names]
-        if unknown:
-            raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
     if ext in (".html", ".htm"):
         return write_viewer(mech, result, path, traces=traces, **viewer_kw)
     if ext == ".mp4" and (size[0] % 16 or size[1] % 16):

@@ -31,9 +31,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import inverse_batch, simulate_batch
+from .arguments import count, error
 from .mechanism import Mechanism, attach_metadata, from_dict, native_motion
 from .result import SimulationResult
-from .settings import MAX_THREADS, check_settings, count
+from .settings import MAX_THREADS, check_settings
 
 if TYPE_CHECKING:
     from .robot import TaskMotion, TaskPath
@@ -87,8 +88,8 @@ def _settings(common: Mapping[str, Any], own: Mapping[str, Any], mech: Mechanism
     result's metadata (``_motion``)."""
     unknown = set(own) - set(_SETTINGS) - {"motion"}
     if unknown:
-        raise ValueError(f"unknown simulation settings {sorted(unknown)}; expected some of "
-                         f"{', '.join(_SETTINGS)}, motion")
+        raise error("settings", f"unknown simulation settings {sorted(unknown)}; expected some of "
+                                f"{', '.join(_SETTINGS)}, motion")
     given = {k: v for k, v in {**common, **own}.items() if v is not None}
     motion = given.pop("motion", None)
     out = check_settings(**given)
@@ -142,14 +143,14 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
     """Cut the prepared variants into chunks, run them here or on the executor, and put each
     raw result (``finish``-ed) or BatchError in its variant's place."""
     if threads is not None:
-        threads = count("threads", threads, MAX_THREADS)
+        threads = count("threads", threads, 1, MAX_THREADS)
     out, todo, items = _prepare(variants, own_args)
     n = len(items)
     if chunk_size is None:
         parts = 16 if executor is not None else (20 if progress is not None else 1)
         chunk_size = max(1, math.ceil(n / parts))
     if chunk_size < 1:
-        raise ValueError(f"chunk_size = {chunk_size} must be at least 1")
+        raise error("chunk_size", f"chunk_size = {chunk_size} must be at least 1")
     starts = range(0, n, chunk_size)
     futures: list[Any] = []
     if executor is None:
@@ -335,12 +336,12 @@ def _motion(mech: Mechanism, common: Mapping[str, Any], own: Mapping[str, Any]) 
 
     unknown = set(own) - set(_MOTION)
     if unknown:
-        raise ValueError(f"unknown motion arguments {sorted(unknown)}; expected some of {', '.join(_MOTION)}")
+        raise error("motion", f"unknown motion arguments {sorted(unknown)}; expected some of {', '.join(_MOTION)}")
     a = {k: v for k, v in {**common, **own}.items() if v is not None}
     flat = lambda x: np.asarray(x, dtype=np.float64).ravel().tolist()  # noqa: E731 - exact for float64
     if "path" not in a:
         if not {"q", "qd", "qdd"} <= set(a):
-            raise ValueError("inverse_dynamics needs a path, or q, qd and qdd (N, m) rows")
+            raise error("path", "inverse_dynamics needs a path, or q, qd and qdd (N, m) rows")
         return {k: flat(a[k]) for k in ("q", "qd", "qdd")}
     path = a["path"].with_dim(mech.dof)
     t = _sample_times(path.duration, a.get("n"), a.get("dt"))

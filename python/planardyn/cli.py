@@ -5,11 +5,13 @@
                              [--output-dt H] [--max-steps N] [-o results.csv|.parquet|.npz]
     planardyn inverse MODEL --motion FILE [-o results.csv|.parquet|.npz]
     planardyn identify MODEL DATA [--cutoff HZ] [--validate DATA] [-o FILE.json]
-    planardyn plot RESULTS [-o FILE.png] [--torque-speed]
+    planardyn plot RESULTS [-o FILE.png] [--torque-speed | --points P [P ...]]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
     planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V ...] [--collocate time|effort] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
+    planardyn export MODEL -o FILE.xml|.urdf|.sdf;  planardyn import FILE -o MODEL.yaml
+    planardyn docs [PAGE]
     planardyn --version
 
 MODEL is a model file, or a shipped model by name (``five-bar``: planardyn.models.resolve).
@@ -22,32 +24,41 @@ usage, file or model error. Errors are one message on stderr, never a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
-import importlib.util
+import importlib
 import json
 import os
 import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
 from . import (
+    ArgumentError,
     AssemblyError,
+    DataError,
     Mechanism,
     PlanardynError,
     SimulationError,
     SingularityError,
     __version__,
+    extras,
     from_result,
+    guide,
     load,
     models,
     structure,
 )
 from .events import Crossing, parse_crossing
+from .exchange.cli import register as exchange_commands
 from .guard import RunGuard, available_memory, rows_message
 from .result import SimulationResult
+from .results_format import check_writable, writing
+from .robot.cli import register as size_command
+from .robot.cli_options import number
 from .settings import check_settings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -59,23 +70,26 @@ class UsageError(Exception):
     """A command line that cannot be carried out as given (exit 2)."""
 
 
-#: What writing a file of this extension needs beyond the dependencies: (module, package, extra).
-OPTIONAL_WRITERS = {
-    ".parquet": ("pyarrow", "pyarrow", "parquet"),
-    ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg", "mp4"),
-}
+#: What writing a file of this extension needs beyond the dependencies: (extra, what it writes).
+OPTIONAL_WRITERS = {".parquet": ("parquet", "a .parquet file"), ".mp4": ("mp4", "an .mp4 file")}
 #: Integration methods without error control, whose step must be given (--dt).
 FIXED_STEP_METHODS = ("rk4",)
 
 
 def require_writer(path: Path | None) -> None:
-    """Refuse, before any computation, an output file whose optional package is missing."""
-    if path is None or path.suffix.lower() not in OPTIONAL_WRITERS:
+    """Refuse, before any computation, an output file that cannot be written (its directory
+    made, the cause in words) or whose optional package is missing."""
+    if path is None:
         return
-    module, package, extra = OPTIONAL_WRITERS[path.suffix.lower()]
-    if importlib.util.find_spec(module) is None:
-        raise UsageError(f"{path}: writing {path.suffix} files needs {package}, which is not installed: "
-                         f"pip install {package} (or pip install 'planardyn[{extra}]')")
+    check_writable(path)
+    if path.suffix.lower() not in OPTIONAL_WRITERS:
+        return
+    extra, what = OPTIONAL_WRITERS[path.suffix.lower()]
+    for module in extras.MODULES[extra]:
+        try:
+            importlib.import_module(module)
+        except ImportError as e:
+            raise UsageError(f"{path}: {extras.missing(extra, what, e)}") from None
 
 
 def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
@@ -84,26 +98,25 @@ def _warning_line(message: Warning | str, category: type[Warning], *_: Any, **__
 
 
 class ProgressBar:
-    """A one-line text bar on a stream, redrawn from a progress callback: ``bar(t)`` for t
-    from 0 to ``t_end``; ``unit`` formats t after the percentage (default: the simulated time)."""
+    """A progress bar on a stream (tqdm's: percentage, elapsed time, time left), moved to a
+    position: ``bar(t)`` for a run's time t from 0 to ``total`` s, ``bar(done)`` of ``total``
+    frames. The end is drawn once, by :meth:`close` (tqdm would draw it again there)."""
 
-    WIDTH = 30
+    def __init__(self, total: float, unit: str = "s", stream: TextIO | None = None) -> None:
+        from tqdm import tqdm
 
-    def __init__(self, t_end: float, stream: TextIO | None = None, unit: str = "t = {:.4g} s") -> None:
-        self.t_end, self.unit, self.start = t_end, unit, time.monotonic()
-        self.stream = sys.stderr if stream is None else stream
+        self.total, self.position = float(total), 0.0
+        self.bar = tqdm(total=self.total, file=sys.stderr if stream is None else stream, leave=True,
+                        bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} " + unit + " [{elapsed}<{remaining}]")
 
-    def __call__(self, t: float) -> None:
-        frac = min(max(t / self.t_end, 0.0), 1.0) if self.t_end > 0 else 1.0
-        filled = int(round(frac * self.WIDTH))
-        bar = "#" * filled + "." * (self.WIDTH - filled)
-        elapsed = time.monotonic() - self.start
-        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  {self.unit.format(t)}  ({elapsed:.1f} s)")
-        self.stream.flush()
+    def __call__(self, position: float) -> None:
+        self.position = min(max(float(position), self.position), self.total)
+        if self.position < self.total:
+            self.bar.update(self.position - self.bar.n)
 
     def close(self) -> None:
-        self.stream.write("\n")
-        self.stream.flush()
+        self.bar.n = self.position
+        self.bar.close()
 
 
 def _crossing(text: str) -> Crossing:
@@ -132,7 +145,7 @@ def summary(res: SimulationResult) -> str:
 
 MODEL_HELP = "model file (.yaml, .yml or .json), or a shipped model by name (five-bar; see planardyn.models.names())"
 EPILOG = "Exit status: 0 ok, 1 the computation failed, 2 usage or model error."
-SIZE_NOTE = "Also: planardyn size MODEL ...: actuator sizing for an end-effector motion (see planardyn size --help)."
+PLAN_HELP = "time-optimal timing of an end-effector line, or the optimal motion between its ends (the 'plan' extra)"
 
 
 def _sub(sub, name: str, help: str, description: str, examples: str) -> argparse.ArgumentParser:
@@ -171,40 +184,30 @@ def _setting(name: str) -> Callable[[str], float | int]:
     return parse
 
 
-def _within(low: float, high: float) -> Callable[[str], float]:
-    """An argparse type for a number in [low, high] (a finite one: nan and inf are refused)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{text} must be from {low:g} to {high:g}")
-        return value
-
-    return parse
-
-
 #: A frame rate or a playback speed given as 0 < value <= this is taken; beyond, refused.
 MAX_FPS = 240.0
 #: Resolution of plot images (dots per inch): 600 makes an 11 x 7 in figure about 100 MB.
 DPI_RANGE = (10.0, 600.0)
 
 
-def _parser() -> argparse.ArgumentParser:
+def _parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The command's parser. ``command``: the one to be run, whose own parser is built in
+    full (``plan``'s imports toppra and casadi, a second and more: built only when it runs)."""
     p = argparse.ArgumentParser(
         prog="planardyn",
         description="Exact dynamics of planar closed-chain mechanisms, from model files.",
         epilog=(
             "examples:\n"
-            "  planardyn check examples/models/five-bar.yaml\n"
-            "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
+            "  planardyn check five-bar                 # a shipped model by name, or a model file\n"
+            "  planardyn simulate five-bar -o five-bar.csv\n"
             "  planardyn plot five-bar.csv -o five-bar.png\n"
+            "  planardyn plot five-bar.csv --points P -o p.png\n"
             "  planardyn animate five-bar.csv -o five-bar.html\n"
-            "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
+            "  planardyn inverse five-bar --motion five-bar.csv -o torques.csv\n"
+            "  planardyn size five-bar --circle 0.014 0.5097 0.06 --payload 0.5\n"
+            "  planardyn docs model-format             # the guide's page on model files\n"
             "  planardyn demo\n\n"
-            "Run 'planardyn COMMAND --help' for a command's options. " + SIZE_NOTE + "\n" + EPILOG
+            "Run 'planardyn COMMAND --help' for a command's options, 'planardyn docs' for the guide.\n" + EPILOG
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -215,8 +218,8 @@ def _parser() -> argparse.ArgumentParser:
              "Load and validate a model file and describe it: bodies, pairs by kind, the coordinates\n"
              "with their units and drawn values, the Grubler mobility 3n - 2p, and the singularity\n"
              "measures at the start configuration.",
-             "  planardyn check examples/models/five-bar.yaml\n"
-             "  planardyn check my-linkage.json")
+             "  planardyn check five-bar\n"
+             "  planardyn check my-linkage.yaml")
     c.add_argument("model", type=Path, help=MODEL_HELP)
 
     s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
@@ -224,9 +227,10 @@ def _parser() -> argparse.ArgumentParser:
              "the model file's 'simulate' values, else the defaults shown. The results file holds\n"
              "the model, the settings and the planardyn version, so it can be re-plotted and the\n"
              "run reproduced.",
-             "  planardyn simulate examples/models/five-bar.yaml -o five-bar.csv\n"
-             "  planardyn simulate examples/models/slider-crank.yaml --t-end 2 --method radau5 -o run.npz\n"
-             "  planardyn simulate model.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
+             "  planardyn simulate five-bar -o five-bar.csv\n"
+             "  planardyn simulate slider-crank --t-end 2 --method radau5 -o run.npz\n"
+             "  planardyn simulate slider-crank --speed theta=1rev/s -o crank-torque.csv\n"
+             "  planardyn simulate my-linkage.yaml --method rk4 --dt 1e-3 --output-dt 0.01 -o run.parquet")
     s.add_argument("model", type=Path, help=MODEL_HELP)
     s.add_argument("--t-end", type=_setting("t_end"), help="end time (s); default: the model's, else 1")
     s.add_argument("--method", help="dop853 (default), dopri5, radau5 or rk4 (needs --dt)")
@@ -255,8 +259,8 @@ def _parser() -> argparse.ArgumentParser:
              "with a column t (s) and one per coordinate (rad or m); rates and accelerations come\n"
              "from cubic splines of q unless columns qd_<name> and qdd_<name> give them. A\n"
              "planardyn results file is also accepted (its q, qd, qdd are used).",
-             "  planardyn inverse examples/models/five-bar.yaml --motion motion.csv -o torques.csv\n"
-             "  planardyn inverse examples/models/five-bar.yaml --motion five-bar.npz -o check.npz\n"
+             "  planardyn inverse five-bar --motion motion.csv -o torques.csv\n"
+             "  planardyn inverse five-bar --motion five-bar.npz -o check.npz\n"
              "\n"
              "motion.csv:\n"
              "  t,theta1,theta2\n"
@@ -282,20 +286,26 @@ def _parser() -> argparse.ArgumentParser:
                "  planardyn identify five-bar run.npz --validate other.npz -o identified.json")
     idf.add_argument("model", type=Path, help=MODEL_HELP)
     idf.add_argument("data", type=Path, help="measured motion: CSV table or results file")
-    idf.add_argument("--cutoff", type=_within(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
+    idf.add_argument("--cutoff", type=number(1e-6, 1e9), help="low-pass cutoff (Hz) to differentiate positions")
     idf.add_argument("--validate", type=Path, help="another measured motion: RMS effort error, identified vs model")
     idf.add_argument("-o", "--output", type=Path, help="write the identification as JSON")
 
-    pl = _sub(sub, "plot", "plot a results file: coordinates, rates, drive efforts, energy",
+    pl = _sub(sub, "plot", "plot a results file: coordinates, rates, drive efforts, energy; or points' motions",
               "Plot the time histories of a results file (coordinates, rates, drive efforts and\n"
-              "energy on one figure), or with --torque-speed each drive's effort against its speed.",
+              "energy on one figure), or with --torque-speed each drive's effort against its speed,\n"
+              "or with --points the position, velocity and acceleration of named points (a ram's\n"
+              "stroke, an end effector's path) against time, each point's range printed.",
               "  planardyn plot five-bar.csv                 # writes five-bar.png\n"
               "  planardyn plot five-bar.npz -o histories.png\n"
-              "  planardyn plot five-bar.csv --torque-speed -o torque-speed.png")
+              "  planardyn plot five-bar.csv --torque-speed -o torque-speed.png\n"
+              "  planardyn plot slider-crank.csv --points B -o stroke.png")
     pl.add_argument("results", type=Path, help="results file (.csv, .parquet or .npz) written by planardyn")
     pl.add_argument("-o", "--output", type=Path, help="image to write (.png, .pdf, .svg); default RESULTS with .png")
-    pl.add_argument("--torque-speed", action="store_true", help="plot drive effort against speed instead")
-    pl.add_argument("--dpi", type=_within(*DPI_RANGE), default=120,
+    what = pl.add_mutually_exclusive_group()
+    what.add_argument("--torque-speed", action="store_true", help="plot drive effort against speed instead")
+    what.add_argument("--points", nargs="+", metavar="POINT",
+                      help="plot these points' position, velocity and acceleration (m, m/s, m/s^2) against time instead")
+    pl.add_argument("--dpi", type=number(*DPI_RANGE), default=120,
                     help=f"resolution of raster images, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} (default 120)")
 
     a = _sub(sub, "animate", "animate a result: GIF, MP4 or an interactive HTML viewer",
@@ -309,9 +319,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="results file (.csv, .parquet or .npz), after the model it was computed with when "
                         "the file does not hold its model (files planardyn writes do)")
     a.add_argument("-o", "--output", type=Path, required=True, help="FILE.gif, FILE.mp4 or FILE.html")
-    a.add_argument("--fps", type=_within(1e-3, MAX_FPS), default=20.0,
+    a.add_argument("--fps", type=number(1e-3, MAX_FPS), default=20.0,
                    help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
-    a.add_argument("--speed", type=_within(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
+    a.add_argument("--speed", type=number(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
     a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
@@ -321,10 +331,47 @@ def _parser() -> argparse.ArgumentParser:
              "mechanism (a four-bar under gravity) simulated, plotted and animated; and both in the\n"
              "interactive viewer (HTML, open it in a browser). One line per file says what it is.",
              "  planardyn demo\n"
-             "  planardyn demo --out /tmp/demo --model examples/models/slider-crank.yaml")
+             "  planardyn demo --out /tmp/demo --model slider-crank")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
+    size_command(sub)
+    _plan_command(sub, full=command == "plan")
+    exchange_commands(sub)
+    g = _sub(sub, "docs", "the user guide, installed with planardyn: list its pages, or print one",
+             "Without PAGE, list the guide's pages with their titles and the folder they are installed\n"
+             "in; with PAGE, print that page (Markdown). The same pages as the docs/ folder of the\n"
+             "repository and the site built from it.",
+             "  planardyn docs\n"
+             "  planardyn docs model-format | less\n"
+             "  planardyn docs cli --path               # where the file is, to open it in an editor")
+    g.add_argument("page", nargs="?", help="a page's name: model-format, cli, api, robot, ...")
+    g.add_argument("--path", action="store_true", help="print the page's file name instead of its text")
+    g.set_defaults(run=_docs)
     return p
+
+
+def _plan_command(sub: argparse._SubParsersAction, full: bool) -> None:
+    """``plan``: in full (its options, from planardyn.plan.cli) when it is the command to run,
+    else its line in the listing; without the 'plan' extra, a command that says how to get it."""
+    cause = None
+    if full:
+        try:
+            from .plan.cli import register
+        except ImportError as e:
+            if not extras.is_missing("plan", e):
+                raise
+            cause = e
+        else:
+            register(sub, PLAN_HELP)
+            return
+    # Every argument is taken ('-' is no option prefix here): the run says what to install.
+    stub = sub.add_parser("plan", help=PLAN_HELP, add_help=False, prefix_chars="\x00")
+    stub.add_argument("arguments", nargs="*")
+    stub.set_defaults(run=_plan_missing, cause=cause)
+
+
+def _plan_missing(args: argparse.Namespace) -> int:
+    raise extras.missing("plan", "planardyn plan", args.cause)
 
 
 # ------------------------------------------------------------------ commands
@@ -334,7 +381,8 @@ def _check(args: argparse.Namespace) -> int:
     mech = load(args.model)
     n, pairs = mech.n_bodies, mech.pairs
     s = structure.analyse(mech)
-    print(f"model: {mech.name}  ({mech.source})")
+    shipped = Path(args.given) != args.model  # a name: the file's path would be the package's
+    print(f"model: {mech.name}  ({f'shipped model {args.given}' if shipped else mech.source})")
     print(f"bodies: {n}")
     for b, mass, inertia in zip(mech.body_names, mech.masses, mech.inertias):
         print(f"  {b}: mass {mass:.6g} kg, inertia {inertia:.6g} kg m^2")
@@ -373,6 +421,10 @@ def _simulate(args: argparse.Namespace) -> int:
                          "or dt in the model file's simulate section), or choose an adaptive method (--method dopri5)")
     require_writer(args.output)
     motion = _speeds(args.speed, mech)
+    for c in args.stop_when:
+        if c.coordinate not in mech.coordinate_names:
+            raise UsageError(f"--stop-when {c.coordinate}...: give NAME=VALUE with NAME one of "
+                             f"{', '.join(mech.coordinate_names)}")
     t_end = settings["t_end"] or 1.0
     if settings["output_dt"] is not None:
         refused = rows_message(t_end / settings["output_dt"] + 1, mech.dof, mech.n_bodies, available_memory())
@@ -393,8 +445,8 @@ def _simulate(args: argparse.Namespace) -> int:
     stops = {"events": [dataclasses.asdict(c) for c in args.stop_when]} if args.stop_when else {}
     res = attach_metadata(res, mech, dict(settings, motion=motion, **stops))
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        write_results(res, args.output)
+        with writing(args.output):
+            write_results(res, args.output)
     line = summary(res) + (f" -> {args.output}" if args.output is not None else "")
     print(line)
     if not res.success:
@@ -428,8 +480,8 @@ def _inverse(args: argparse.Namespace) -> int:
     mech = load(args.model)
     res = inverse_from_file(mech, args.motion)
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        write_results(res, args.output)
+        with writing(args.output):
+            write_results(res, args.output)
     peaks = ", ".join(
         f"|tau_{n}| <= {v:.4g} {u}" for n, v, u in zip(mech.coordinate_names, np.abs(res.tau).max(axis=0), mech.effort_units)
     )
@@ -459,12 +511,40 @@ def _measured(mech: Any, path: Path, cutoff: float | None) -> tuple[Any, ...]:
         return m["q"], m["qd"], m["qdd"], tau, m["x"]
     if cutoff is None:
         raise UsageError(f"{path}: no qd_/qdd_ columns: give --cutoff (Hz) to differentiate the positions")
-    q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
-    keep = inside(m["t"], cutoff)
-    if not keep.any():
-        raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at --cutoff "
-                         f"{cutoff:g} Hz: record longer or raise --cutoff")
-    return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
+    with _about(path):
+        q, qd, qdd = differentiate(m["t"], m["q"], cutoff)
+        keep = inside(m["t"], cutoff)
+        if not keep.any():
+            raise UsageError(f"{path}: a record of {m['t'][-1] - m['t'][0]:g} s is all filter transient at "
+                             f"--cutoff {cutoff:g} Hz: record longer or raise --cutoff")
+        return q[keep], qd[keep], qdd[keep], lowpass(m["t"], tau, cutoff)[keep], None
+
+
+@contextlib.contextmanager
+def _about(path: Path) -> Iterator[None]:
+    """The errors of computing on a data file (its data, or an argument from an option) as
+    usage errors naming the file; the one option that reaches the computation, ``--cutoff``,
+    named as the user wrote it."""
+    try:
+        yield
+    except DataError as e:
+        raise UsageError(str(e) if getattr(e, "path", None) else f"{path}: {e}") from None
+    except ArgumentError as e:
+        text = f"--{e}" if getattr(e, "argument", None) == "cutoff" else str(e)
+        raise UsageError(f"{path}: {text}") from None
+
+
+@contextlib.contextmanager
+def _options(options: dict[str, str]) -> Iterator[None]:
+    """An ArgumentError of an API argument that an option gave, as a usage error naming the
+    option (``options``: argument name -> option)."""
+    try:
+        yield
+    except ArgumentError as e:
+        option = options.get(getattr(e, "argument", None) or "")
+        if option is None:
+            raise
+        raise UsageError(f"{option}: {e}") from None
 
 
 def _identify(args: argparse.Namespace) -> int:
@@ -472,12 +552,18 @@ def _identify(args: argparse.Namespace) -> int:
 
     from .identify import identify
 
+    require_writer(args.output)
     mech = load(args.model)
-    found = identify(mech, *_measured(mech, args.data, args.cutoff))
+    measured = _measured(mech, args.data, args.cutoff)
+    # Both records read before the identification: a bad --validate is refused at once.
+    validation = None if args.validate is None else _measured(mech, args.validate, args.cutoff)
+    with _about(args.data):
+        found = identify(mech, *measured)
     print(found.report())
-    if args.validate is not None:
-        q, qd, qdd, tau, x = _measured(mech, args.validate, args.cutoff)
-        Y, tau_o = mech.regressor(q, qd, qdd, x=x)
+    if validation is not None:
+        q, qd, qdd, tau, x = validation
+        with _about(args.validate):
+            Y, tau_o = mech.regressor(q, qd, qdd, x=x)
         rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
         ident = rms(Y[..., found.base.independent] @ found.beta + tau_o - tau)
         prior = rms(Y @ np.array(list(mech.regressor_parameters.values())) + tau_o - tau)
@@ -487,8 +573,8 @@ def _identify(args: argparse.Namespace) -> int:
                "std_error": found.std_error.tolist(), "model": found.prior.tolist(),
                "parameters": {k: float(v) for k, v in found.pi.items()},
                "residual_rms": found.residual_rms.tolist(), "samples": found.samples}
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        args.output.write_text(json.dumps(out, indent=1))
+        with writing(args.output):
+            args.output.write_text(json.dumps(out, indent=1))
         print(f"wrote {args.output}")
     return EXIT_OK
 
@@ -497,12 +583,21 @@ def _plot(args: argparse.Namespace) -> int:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .plot import plot_results, plot_torque_speed
+    from .plot import plot_point_motion, plot_results, plot_torque_speed
     from .results_io import read_results
 
-    res = read_results(args.results)
     out = args.output or args.results.with_suffix(".png")
-    if args.torque_speed:
+    require_writer(out)
+    res = read_results(args.results)
+    if args.points:
+        motion = _point_motion(res, args.results, args.points)
+        fig = Figure(figsize=(9, 8))
+        FigureCanvasAgg(fig)
+        with _options({"points": "--points"}):
+            plot_point_motion(motion, args.points, fig=fig)
+        for name in args.points:
+            print(motion.describe(name))
+    elif args.torque_speed:
         fig = Figure(figsize=(7, 5))
         FigureCanvasAgg(fig)
         ax = fig.add_subplot()
@@ -514,13 +609,35 @@ def _plot(args: argparse.Namespace) -> int:
         fig = Figure(figsize=(11, 7))
         FigureCanvasAgg(fig)
         plot_results(res, fig=fig)
-    out.parent.mkdir(parents=True, exist_ok=True)
     try:
-        fig.savefig(out, dpi=args.dpi)
+        with writing(out):
+            fig.savefig(out, dpi=args.dpi)
     except ValueError as e:  # matplotlib: an image format it does not write
         raise UsageError(f"{out}: {e}") from None
     print(f"wrote {out}")
     return EXIT_OK
+
+
+def _point_motion(res: SimulationResult, path: Path, points: list[str]) -> Any:
+    """The motion of the named points along a results file's run (its model from the file)."""
+    if res.metadata.get("model") is None:
+        raise UsageError(f"{path} does not hold its model, which --points needs: simulate it again with "
+                         "planardyn simulate (its results files hold the model)")
+    mech = from_result(res)
+    motion = mech.point_motion(res)
+    unknown = [p for p in points if p not in motion.names]
+    if unknown:
+        raise UsageError(f"--points: the model has no point {', '.join(unknown)}; its points are "
+                         f"{', '.join(motion.names)}")
+    # A point the ground carries is reported as the ground's, at rest, even where a moving
+    # body carries it too (a slider's point on its guide): refused rather than drawn still.
+    shared = [p for p in points if p in mech.ground_points and any(p in [n for n, _ in b] for b in mech.body_points)]
+    if shared:
+        bodies = [mech.body_names[k] for k, b in enumerate(mech.body_points) if shared[0] in [n for n, _ in b]]
+        raise UsageError(f"--points {shared[0]}: the ground carries {shared[0]} as well as {' and '.join(bodies)}, "
+                         "and a point's motion is its ground copy's, at rest: give a point the ground does not carry "
+                         f"(add one at the same place to the points of {' or '.join(bodies)} in the model file)")
+    return motion
 
 
 def _animate(args: argparse.Namespace) -> int:
@@ -546,16 +663,21 @@ def _animate(args: argparse.Namespace) -> int:
                          f"planardyn animate MODEL {results} -o {args.output}")
     else:
         mech = from_result(res)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
         raise UsageError("--channel is for the HTML viewer only")
-    bar = ProgressBar(1.0, unit="of the frames drawn") if not kw and sys.stderr.isatty() else None
-    if bar is not None:  # GIF and MP4 take seconds
-        kw["progress"] = lambda done, total, bar=bar: bar(done / total)
+    bar: ProgressBar | None = None
+    if not kw and sys.stderr.isatty():  # GIF and MP4 take seconds: a bar over the frames, made at the first
+        def frames(done: int, total: int) -> None:
+            nonlocal bar
+            bar = bar or ProgressBar(total, unit="frames")
+            bar(done)
+
+        kw["progress"] = frames
     start = time.monotonic()
     try:
-        animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
+        with writing(args.output), _options({"traces": "--trace", "channels": "--channel"}):
+            animate(mech, res, args.output, fps=args.fps, speed=args.speed, traces=args.trace, **kw)
     finally:
         if bar is not None:
             bar.close()
@@ -568,10 +690,31 @@ def _demo(args: argparse.Namespace) -> int:
     from .demo import run
 
     out: Path = args.out
+    if args.model is not None and not Path(args.model).is_file():
+        raise UsageError(f"--model {args.model}: not a model file (a file, or a shipped model's name)")
     print(f"planardyn demo: writing into {out}/")
-    demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
+    with writing(out):
+        demo = run(out, args.model, echo=lambda line: print("  " + line, flush=True))
     print(f"open {out / 'robot.html'} and {out / 'passive.html'} in a browser to play the motions")
     return EXIT_OK if demo.success else EXIT_FAILED
+
+
+def _docs(args: argparse.Namespace) -> int:
+    if args.page is None:
+        if args.path:
+            print(guide.directory())
+            return EXIT_OK
+        print(f"The planardyn guide, {len(guide.pages())} pages in {guide.directory()}; "
+              "read one with 'planardyn docs PAGE':")
+        for name in guide.pages():
+            print(f"  {name:<16} {guide.title(name)}")
+        return EXIT_OK
+    path = guide.page(args.page)
+    if args.path:
+        print(path)
+    else:
+        sys.stdout.write(path.read_text(encoding="utf-8"))
+    return EXIT_OK
 
 
 COMMANDS = {
@@ -593,20 +736,18 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: list[str]) -> int:
     try:
-        if argv[:1] == ["size"]:
-            # Actuator sizing has its own parser in planardyn.robot (planardyn size --help).
-            from .robot import size_cli
-
-            return size_cli(argv[1:])
-        if argv[:1] == ["plan"]:
-            # Time-optimal timing has its own parser in planardyn.plan (planardyn plan --help).
-            from .plan.cli import plan_cli
-
-            return plan_cli(argv[1:])
-        args = _parser().parse_args(argv)
+        try:
+            args = _parser(argv[0] if argv else None).parse_args(argv)
+        except SystemExit as e:  # argparse: --help, --version (0) or a usage error (2), already printed
+            return e.code if isinstance(e.code, int) else EXIT_OK if e.code is None else EXIT_USAGE
         if getattr(args, "model", None) is not None:
-            args.model = models.resolve(args.model)
-        code = COMMANDS[args.command](args)
+            args.given = str(args.model)
+            try:
+                args.model = models.resolve(args.model)
+            except models.UnknownModelError as e:  # demo's model is an option, the others' an argument
+                raise UsageError(f"--model {e}" if args.command == "demo" else str(e)) from None
+        code = getattr(args, "run", None) or COMMANDS[args.command]
+        code = code(args)
         sys.stdout.flush()
         return code
     except BrokenPipeError:
@@ -616,7 +757,8 @@ def _main(argv: list[str]) -> int:
     except (AssemblyError, SingularityError) as e:
         # The start state (or a row of a motion) could not be computed: the computation failed.
         return _fail(str(e), EXIT_FAILED)
-    except (PlanardynError, UsageError, ValueError, OSError, ImportError, models.UnknownModelError) as e:
+    except (PlanardynError, UsageError, ValueError, OSError, ImportError, models.UnknownModelError,
+            guide.UnknownPageError) as e:
         return _fail(str(e), EXIT_USAGE)
     except MemoryError:
         return _fail("out of memory: ask for fewer outputs (--output-dt, --t-end) or a smaller image", EXIT_FAILED)

@@ -117,7 +117,7 @@ def passive_outputs(out: Path, model: str | os.PathLike[str] | None = None) -> t
     q = ", ".join(f"{n} {lo:.3g}..{hi:.3g}" for n, lo, hi in zip(mech.coordinate_names, res.q.min(0), res.q.max(0)))
     written.append((out / "passive.csv",
                     f"{mech.name}: {res.status} to t = {res.t[-1]:.3g} s, {q} "
-                    f"(results file: planardyn plot / animate read it)"))
+                    f"(results file, its metadata in passive.csv.json: planardyn plot / animate read it)"))
 
     fig = _figure((11, 7))
     plot_results(res, fig=fig)

@@ -10,12 +10,15 @@ which the core evaluates without calling Python (an end stop, a crank angle reac
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from .arguments import error, number
 
 #: g(t, q, qd) -> float.
 EventFunction = Callable[[float, NDArray[np.float64], NDArray[np.float64]], float]
@@ -41,11 +44,13 @@ def parse_crossing(text: str) -> Crossing:
         name, sep, value = text.partition(op)
         if sep and name.strip():
             try:
-                return Crossing(name.strip(), float(value), terminal=True, direction=direction)
+                if math.isfinite(float(value)):
+                    return Crossing(name.strip(), float(value), terminal=True, direction=direction)
             except ValueError:
-                break
+                pass
+            break
     raise ValueError(f"--stop-when {text!r}: write NAME=VALUE, NAME>VALUE (rising) or NAME<VALUE (falling), "
-                     "a coordinate's name and a number in rad or m, e.g. theta=1.5")
+                     "a coordinate's name and a finite number in rad or m, e.g. theta=1.5")
 
 
 def native_events(events: Sequence[Event | Mapping[str, Any]] | None, names: list[str]) -> list[tuple[Any, ...]]:
@@ -57,10 +62,12 @@ def native_events(events: Sequence[Event | Mapping[str, Any]] | None, names: lis
             e = Crossing(**e)
         if isinstance(e, Crossing):
             if e.coordinate not in names:
-                raise ValueError(f"event: unknown coordinate {e.coordinate!r}; coordinates are: {', '.join(names)}")
-            out.append((names.index(e.coordinate), float(e.value), bool(e.terminal), float(e.direction)))
+                raise error("events", f"event: unknown coordinate {e.coordinate!r}; coordinates are: {', '.join(names)}")
+            value = number("event's value", e.value, "rad or m")
+            out.append((names.index(e.coordinate), value, bool(e.terminal), number("event's direction", e.direction)))
         elif callable(e):
-            out.append((e, bool(getattr(e, "terminal", False)), float(getattr(e, "direction", 0.0))))
+            out.append((e, bool(getattr(e, "terminal", False)),
+                        number("event's direction", getattr(e, "direction", 0.0))))
         else:
             raise TypeError(f"an event is a function g(t, q, qd) -> float or a planardyn.Crossing, "
                             f"got {type(e).__name__}")

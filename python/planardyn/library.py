@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from . import models
+from .arguments import array, error, positive
 from .mechanism import Mechanism, from_dict, load_example
 
 Vec = tuple[float, float]
@@ -109,25 +110,31 @@ def _rotate(v: Vec, angle: float) -> Vec:
 def _unit(v: Vec) -> Vec:
     n = math.hypot(*v)
     if n == 0.0:
-        raise ValueError("a direction of zero length")
+        raise error("direction", "a direction of zero length: give two distinct points")
     return (v[0] / n, v[1] / n)
 
 
 def circle_intersection(c1: Sequence[float], r1: float, c2: Sequence[float], r2: float, mode: int) -> Vec:
     """The point at distance r1 from c1 and r2 from c2 (m), on the left of c1 -> c2 for
-    ``mode=+1``, on the right for ``mode=-1``. ``ValueError`` when the circles do not meet."""
+    ``mode=+1``, on the right for ``mode=-1``. :class:`~planardyn.ArgumentError` (a
+    ``ValueError``) when the circles do not meet, or an argument is not finite."""
     _check_mode(mode)
-    c1, c2 = (float(c1[0]), float(c1[1])), (float(c2[0]), float(c2[1]))
+    p1, p2 = (tuple(array(n, c, shape=(2,), what="a point (x, y), m")) for n, c in (("c1", c1), ("c2", c2)))
+    r1, r2 = positive("r1", r1, "m"), positive("r2", r2, "m")
+    c1, c2 = (p1[0], p1[1]), (p2[0], p2[1])
     d = _dist(c1, c2)
     if d == 0.0 or d > r1 + r2 or d < abs(r1 - r2):
-        raise ValueError(
-            f"cannot assemble: circles of radii {r1:g} and {r2:g} m with centres {d:g} m apart do not "
-            f"meet (need |r1 - r2| <= d <= r1 + r2): change the lengths or the input values"
-        )
+        raise error(None, f"cannot assemble: circles of radii r1 = {r1:g} and r2 = {r2:g} m with centres c1, c2 "
+                          f"{d:g} m apart do not meet (need |r1 - r2| <= d <= r1 + r2): change the lengths or the "
+                          "input values")
     a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
     h = math.sqrt(max(r1 * r1 - a * a, 0.0))
     e = ((c2[0] - c1[0]) / d, (c2[1] - c1[1]) / d)
-    return (c1[0] + a * e[0] - mode * h * e[1], c1[1] + a * e[1] + mode * h * e[0])
+    point = (c1[0] + a * e[0] - mode * h * e[1], c1[1] + a * e[1] + mode * h * e[0])
+    if not all(math.isfinite(v) for v in point):
+        raise error(None, f"circles of radii r1 = {r1:g} and r2 = {r2:g} m about c1, c2 are too large to intersect "
+                          "in floating point (overflow): give lengths in metres of a drawable size")
+    return point
 
 
 def _line_circle(origin: Vec, direction: Vec, centre: Vec, r: float, mode: int) -> float:
@@ -140,16 +147,14 @@ def _line_circle(origin: Vec, direction: Vec, centre: Vec, r: float, mode: int) 
     c = w[0] ** 2 + w[1] ** 2 - r * r
     disc = b * b - c
     if disc < 0.0:
-        raise ValueError(
-            f"cannot assemble: the rail through {origin} does not reach the circle of radius {r:g} m "
-            f"about {centre}: lengthen the link or move the rail"
-        )
+        raise error(None, f"cannot assemble: the rail through {origin} does not reach the circle of radius {r:g} m "
+                          f"about {centre}: lengthen the link or move the rail")
     return -b + mode * math.sqrt(disc)
 
 
 def _check_mode(mode: int) -> None:
-    if mode not in (1, -1):
-        raise ValueError(f"mode must be +1 or -1, got {mode!r}")
+    if isinstance(mode, bool) or mode not in (1, -1):
+        raise error("mode", f"mode must be +1 or -1 (the assembly branch), got {mode!r}")
 
 
 def grashof(ground: float, crank: float, coupler: float, rocker: float) -> bool:
@@ -320,7 +325,7 @@ def slider_crank_model(
     A = _polar(crank, theta)
     dy = offset - A[1]
     if abs(dy) > rod:
-        raise ValueError(f"cannot assemble: the rod ({rod:g} m) does not reach the guide {abs(dy):g} m from the crank pin")
+        raise error("rod", f"cannot assemble: the rod ({rod:g} m) does not reach the guide {abs(dy):g} m from the crank pin")
     B = (A[0] + mode * math.sqrt(rod * rod - dy * dy), float(offset))
     m = _Model("slider-crank (crank input)", "Slider-crank with a horizontal guide, crank angle input (planardyn.library.slider_crank).", gravity)
     _slider_crank(m, A, B, rho, slider_mass, slider_inertia)
@@ -507,7 +512,7 @@ def three_rpr_model(
         A, C = m.xy(f"A{i}"), m.xy(f"C{i}")
         L = _dist(A, C)
         if not L - rod < barrel:
-            raise ValueError(f"leg {i}: length {L:g} m leaves the rod's end outside the barrel (rod + barrel = {rod + barrel:g} m)")
+            raise error("rod", f"leg {i}: length {L:g} m leaves the rod's end outside the barrel (rod + barrel = {rod + barrel:g} m)")
         u = _unit(_sub(C, A))
         m.point(f"E{i}", _add(A, (barrel * u[0], barrel * u[1])))
         m.point(f"K{i}", _add(A, ((L - rod) * u[0], (L - rod) * u[1])))
@@ -738,7 +743,7 @@ def _scalar(v: Any) -> str:
         return str(v)
     if isinstance(v, float):
         if not math.isfinite(v):
-            raise ValueError(f"a model value must be finite, got {v!r}")
+            raise error(None, f"a model value must be finite, got {v!r}")
         text = repr(v)
         # YAML 1.1 readers want a dot and a signed exponent: 1e-06 -> 1.0e-06.
         if "e" in text and "." not in text:

@@ -17,12 +17,14 @@ from typing import Any, Generic, Literal, TypeVar, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._core import ArgumentError, __version__
 from ._core import Mechanism as NativeMechanism
-from ._core import __version__
 from ._core import load as native_load
 from ._core import loads as native_loads
+from .arguments import array, error, index, number
 from .events import Crossing, Event, native_events
 from .guard import available_memory, rows_message
+from .models import UnknownModelError
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
 from .results_format import plain
@@ -180,7 +182,7 @@ class Mechanism:
         ------
         AssemblyError
             The mechanism cannot be assembled at q (or not on its drawn branch).
-        ValueError
+        ArgumentError
             q has the wrong shape or a non-finite value.
         """
         return self._native.assemble(q, x_start)
@@ -241,7 +243,7 @@ class Mechanism:
         Raises
         ------
         AssemblyError, SingularityError (the analogues are undefined where sigma_min = 0);
-        ValueError (attribute ``quantity``) where rates so large make xd or c overflow.
+        ArgumentError (attribute ``quantity``) where rates so large make xd or c overflow.
         """
         return self._native.kinematics(q, qd, x_start)
 
@@ -300,11 +302,11 @@ class Mechanism:
         SingularityError
             Below the type II threshold, as for :meth:`mass_matrix`, unless
             ``allow_singular=True``.
-        ValueError
+        ArgumentError
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
         """
-        return self._native.forward_dynamics(q, qd, float(t), tau, allow_singular)
+        return self._native.forward_dynamics(q, qd, number("t", t, "s"), tau, allow_singular)
 
     def inverse_dynamics(
         self,
@@ -336,7 +338,7 @@ class Mechanism:
             qd moves those by eps/sigma, and the efforts with them (2.5e-8 N m at sigma
             8.6e-4 on the free-falling five-bar). Rows whose xd are not the rates of their qd
             (J xd = [0; qd] within ``planardyn::batch::RATES_TOL``, 1e-10 relative) raise
-            ``ValueError`` naming the row.
+            ``ArgumentError`` naming the row.
 
         Returns
         -------
@@ -350,7 +352,7 @@ class Mechanism:
         SingularityError
             Below the type II threshold, as for :meth:`mass_matrix`, unless
             ``allow_singular=True`` (then every row is computed).
-        ValueError
+        ArgumentError
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
         """
@@ -382,7 +384,7 @@ class Mechanism:
         qd: ArrayLike,
         qdd: ArrayLike,
         method: Literal["min_norm", "min_max", "preload"] = "min_norm",
-        preload: list[float] | None = None,
+        preload: ArrayLike | None = None,
         x_start: ArrayLike | None = None,
     ) -> dict[str, FloatArray]:
         """Inverse dynamics with redundant actuators: every actuator's effort for (q, qd, qdd),
@@ -393,19 +395,21 @@ class Mechanism:
         orthonormal basis of the internal forces (B v = 0). The efforts are joint-side, a
         motor's rotor torque n^2 J qdd kept on its own coordinate (:meth:`motor_torques`
         gives the coordinates' motor torques)."""
-        return self._native.distribute_efforts(q, qd, qdd, method, preload, x_start)
+        lam = None if preload is None else array("preload", preload, ndim=(0, 1), what="N m or N").ravel().tolist()
+        return self._native.distribute_efforts(q, qd, qdd, method, lam, x_start)
 
     def forward_dynamics_actuated(self, q: ArrayLike, qd: ArrayLike, efforts: ArrayLike, t: float = 0.0) -> FloatArray:
         """Accelerations qdd (m,) at (q, qd) under every actuator's effort (n_a,, in
         :attr:`actuator_names` order): on a coordinate with a motor its motor torque (N m), as
         in :meth:`forward_dynamics`; the model's drive laws are not evaluated."""
-        return self._native.forward_dynamics_actuated(q, qd, efforts, float(t))
+        return self._native.forward_dynamics_actuated(q, qd, efforts, number("t", t, "s"))
 
     def available_torque(self, coordinate: int, speed: ArrayLike) -> FloatArray | None:
         """The torque (N m) the motor of actuator ``coordinate`` (an index: the coordinates, then the
         pair actuators) can give at motor speeds ``speed`` (rad/s, any shape): its torque-speed
         envelope, else its peak torque; None when it has no motor or no torque limit."""
-        return self._native.available_torque(int(coordinate), speed)
+        k = index("coordinate", coordinate, len(self.actuator_names), "actuators")
+        return self._native.available_torque(k, speed)
 
     def dissipated_power(
         self,
@@ -502,7 +506,7 @@ class Mechanism:
 
         Raises
         ------
-        SingularityError, ValueError
+        SingularityError, ArgumentError
             As for :meth:`forward_dynamics`; along a result, with attributes ``row`` and
             ``t`` of the row.
         """
@@ -512,7 +516,7 @@ class Mechanism:
             return self._along(q, allow_singular)["reactions"]
         if qd is None:
             raise TypeError("reactions(q, qd, ...) needs qd (or give a SimulationResult alone)")
-        return self._native.reactions(q, qd, float(t), tau, allow_singular)
+        return self._native.reactions(q, qd, number("t", t, "s"), tau, allow_singular)
 
     def point_motion(self, res: SimulationResult, allow_singular: bool = False) -> PointMotion:
         """Positions, velocities and accelerations of the named points (those a body or the
@@ -571,8 +575,8 @@ class Mechanism:
 
     def _along(self, res: SimulationResult, allow_singular: bool) -> dict[str, FloatArray]:
         if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
-            raise ValueError("the result is not a run of this mechanism (its bodies differ); "
-                             "use pd.from_result(res) for the mechanism it was made with")
+            raise error("result", "the result is not a run of this mechanism (its bodies differ); "
+                                  "use pdy.from_result(res) for the mechanism it was made with")
         return self._native.along(res.t, res.x, res.q, res.qd, res.tau, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
@@ -581,7 +585,7 @@ class Mechanism:
         drawing.
 
         V counts gravity (zero at y = 0) and the elastic energy of springs. Rates so large that
-        T overflows raise ``ValueError`` (attribute ``quantity``).
+        T overflows raise ``ArgumentError`` (attribute ``quantity``).
         """
         return self._native.energy(q, qd, x_start)
 
@@ -680,7 +684,7 @@ class Mechanism:
             far, status ``'cancelled'``.
         AssemblyError, SingularityError
             The start state cannot be assembled, or is singular.
-        ValueError
+        ArgumentError
             An argument with the wrong shape or a non-finite value.
         """
         checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
@@ -736,7 +740,7 @@ class Mechanism:
             return
         refused = rows_message(rows, self.dof, self.n_bodies, available_memory())
         if refused:
-            raise ValueError(f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
+            raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
 
 
 def native_motion(
@@ -751,14 +755,13 @@ def native_motion(
     out: list[tuple[int, Any]] = []
     for name, m in motion.items():
         if name not in names:
-            raise ValueError(f"motion: unknown coordinate {name!r}; coordinates are: {', '.join(names)}")
+            raise error("motion", f"motion: unknown coordinate {name!r}; coordinates are: {', '.join(names)}")
         k = names.index(name)
         if isinstance(m, Mapping):
             if set(m) != {"t", "q"}:
-                raise ValueError(f"motion of {name!r}: a table is {{'t': times, 'q': positions}}, got keys {sorted(m)}")
-            t, q = (np.asarray(m[key], dtype=float) for key in ("t", "q"))
-            if t.ndim != 1 or q.ndim != 1:
-                raise ValueError(f"motion table of {name!r}: t and q must be 1-D, got shapes {t.shape} and {q.shape}")
+                raise error("motion", f"motion of {name!r}: a table is {{'t': times, 'q': positions}}, "
+                                      f"got keys {sorted(m)}")
+            t, q = (array(f"motion[{name!r}][{key!r}]", m[key], ndim=1) for key in ("t", "q"))
             out.append((k, (t.tolist(), q.tolist())))
         elif callable(m):
             out.append((k, m))
@@ -782,15 +785,29 @@ def load(path: str | os.PathLike[str]) -> Mechanism:
     return Mechanism(native_load(os.fspath(path)))
 
 
+class _UnknownExample(UnknownModelError, ArgumentError):
+    """No shipped model has the name given to :func:`load_example`: a
+    ``models.UnknownModelError`` (a ``KeyError``) and an ``ArgumentError`` (argument ``name``)."""
+
+
 def load_example(name: str) -> Mechanism:
     """Load a model file shipped with planardyn by name (``"five-bar"``; see ``planardyn.models.names()``).
 
     Raises
     ------
     planardyn.models.UnknownModelError
-        (a ``KeyError``) No shipped model has that name; the message lists the names there are.
+        (a ``KeyError``, and an :class:`ArgumentError`) No shipped model has that name; the
+        message lists the names there are.
     """
-    return load(model_path(name))
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a shipped model's name (a string), not {type(name).__name__}")
+    try:
+        path = model_path(name)
+    except UnknownModelError as e:
+        err = _UnknownExample(str(e))
+        err.argument = "name"
+        raise err from None
+    return load(path)
 
 
 def loads(text: str, format: Literal["yaml", "json"] = "yaml", source: str = "<string>") -> Mechanism:
@@ -822,13 +839,13 @@ def from_result(result: SimulationResult) -> Mechanism:
 
     Raises
     ------
-    ValueError
+    ArgumentError
         The result does not carry its model (attach it with :func:`attach_metadata`).
     """
     model = result.metadata.get("model")
     if not model:
-        raise ValueError("the result does not carry its model (metadata['model']): "
-                         "pass the mechanism, or attach it with planardyn.results_io.attach_metadata")
+        raise error("result", "the result does not carry its model (metadata['model']): "
+                              "pass the mechanism, or attach it with planardyn.results_io.attach_metadata")
     return from_dict(model, source=result.metadata.get("source") or "<results>")
 
 

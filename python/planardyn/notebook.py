@@ -3,8 +3,11 @@ a result as a summary table (with a drawing of its last configuration when it kn
 model), and :func:`viewer` embeds the interactive HTML viewer.
 
 Everything here returns HTML strings; nothing needs IPython. :func:`register_display` hands
-:func:`mechanism_html` and :func:`result_html` to IPython's HTML formatter (``import
-planardyn`` does it inside IPython), so the model classes need not know about notebooks.
+:func:`mechanism_html`, :func:`result_html` and :func:`point_motion_html` to IPython's HTML
+formatter (``import planardyn`` does it inside IPython), so the model classes need not know
+about notebooks. The result classes of the layers above (planned motions, sizing reports,
+identifications...) show themselves: their ``_repr_html_`` is :class:`Summarized`'s, a table
+of the rows they give, and their ``__repr__`` one line, never an array's contents.
 """
 
 from __future__ import annotations
@@ -18,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .mechanism import Mechanism, from_result
-from .plot import default_trace_points
-from .result import SimulationResult
+from .plot import default_trace_points, pivot_points
+from .result import PointMotion, SimulationResult
 from .viewer import viewer_html
 
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
@@ -66,7 +69,7 @@ def mechanism_svg(
             d = " ".join(f"{X(px)},{Y(py)}" for px, py in np.asarray(paths)[:, j] if np.isfinite(px))
             out.append(f'<polyline points="{d}" fill="none" stroke="{COLORS[(j + 6) % 10]}" stroke-width="1.2" '
                        f'stroke-dasharray="3 2" opacity="0.8"/>')
-    for name in mech.ground_points:
+    for name in pivot_points(mech):
         gx, gy = where[name]
         h = 0.04 * L
         tri = f"{X(gx)},{Y(gy)} {X(gx - h)},{Y(gy - 1.6 * h)} {X(gx + h)},{Y(gy - 1.6 * h)}"
@@ -104,6 +107,7 @@ def mechanism_svg(
 
 
 def _table(rows: list[tuple[str, str]]) -> str:
+    """Rows of (field, HTML) as a two-column table."""
     cells = "".join(
         f'<tr><th style="text-align:left;padding-right:12px">{html.escape(k)}</th><td style="text-align:left">{v}</td></tr>'
         for k, v in rows
@@ -180,6 +184,54 @@ def result_html(result: SimulationResult) -> str:
     )
 
 
+def grid(header: list[str], rows: list[list[str]]) -> str:
+    """A table with a header row; every cell is text (escaped here)."""
+    cell = 'style="text-align:right;padding:0 8px"'
+    head = "".join(f"<th {cell}>{html.escape(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td {cell}>{html.escape(v)}</td>" for v in r) + "</tr>" for r in rows)
+    return f'<table style="border-collapse:collapse;font-size:13px;margin-top:6px"><tr>{head}</tr>{body}</table>'
+
+
+def per_coordinate(names: list[str], values: Any, units: list[str]) -> str:
+    """``"theta1 1.23 N m, theta2 0.456 N m"``: a value (4 digits) and its unit per name."""
+    return ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(names, np.ravel(values), units))
+
+
+def peak_rows(mech: Mechanism, tau: Any, qd: Any) -> list[tuple[str, str]]:
+    """The rows "peak |tau|" and "peak |qd|" of a motion's efforts and rates (N, m), each
+    coordinate's largest magnitude in its unit."""
+    names = mech.coordinate_names
+    return [("peak |tau|", per_coordinate(names, np.abs(tau).max(axis=0), mech.effort_units)),
+            ("peak |qd|", per_coordinate(names, np.abs(qd).max(axis=0), [f"{u}/s" for u in mech.coordinate_units]))]
+
+
+class Summarized:
+    """What the result classes share for a notebook: ``_repr_html_`` shows the class's name
+    over a table of the rows :meth:`_summary_rows` gives ((field, text), escaped here) and the
+    tables :meth:`_summary_tables` gives (a header and rows of texts). Their ``__repr__`` is
+    their own: one line, no array's contents."""
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        raise NotImplementedError
+
+    def _summary_tables(self) -> list[tuple[list[str], list[list[str]]]]:
+        return []
+
+    def _repr_html_(self) -> str:
+        rows = [(k, html.escape(v)) for k, v in self._summary_rows()]
+        tables = "".join(grid(header, body) for header, body in self._summary_tables())
+        return f"<div><b>{html.escape(type(self).__name__)}</b>{_table(rows)}{tables}</div>"
+
+
+def point_motion_html(motion: PointMotion) -> str:
+    """A point motion's notebook view: its span, and per point its travel in x and y and its
+    largest speed and acceleration (:meth:`PointMotion.describe`)."""
+    n = len(motion.t)
+    rows = [("outputs", f"{n}" + (f", t = {motion.t[0]:.6g} .. {motion.t[-1]:.6g} s" if n else ""))]
+    rows += [(name, html.escape(motion.describe(name).removeprefix(f"{name}: "))) for name in motion.names]
+    return f"<div><b>PointMotion</b>{_table(rows)}</div>"
+
+
 class Viewer:
     """The interactive viewer in a notebook cell (an iframe whose page is inline)."""
 
@@ -208,8 +260,9 @@ def viewer(mech: Mechanism | None, result: SimulationResult, height: int = 640, 
 
 
 def register_display(shell: Any = None) -> bool:
-    """Show every :class:`~planardyn.Mechanism` and :class:`~planardyn.SimulationResult` as
-    HTML (:func:`mechanism_html`, :func:`result_html`) in an IPython shell (default: the
+    """Show every :class:`~planardyn.Mechanism`, :class:`~planardyn.SimulationResult` and
+    :class:`~planardyn.PointMotion` as HTML (:func:`mechanism_html`, :func:`result_html`,
+    :func:`point_motion_html`) in an IPython shell (default: the
     running one, if any). Returns whether there was a shell to register with."""
     if shell is None:
         ipython = sys.modules.get("IPython")  # not imported here: only a running shell matters
@@ -219,4 +272,5 @@ def register_display(shell: Any = None) -> bool:
     formatter = shell.display_formatter.formatters["text/html"]
     formatter.for_type(Mechanism, mechanism_html)
     formatter.for_type(SimulationResult, result_html)
+    formatter.for_type(PointMotion, point_motion_html)
     return True

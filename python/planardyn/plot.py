@@ -4,19 +4,39 @@ returns the artists it drew. Nothing here changes rcParams or calls ``plt.show()
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .units import group_unit
+from .arguments import error
 
 if TYPE_CHECKING:
     from matplotlib.artist import Artist
     from matplotlib.axes import Axes
 
     from .mechanism import Mechanism
-    from .result import SimulationResult
+    from .result import PointMotion, SimulationResult
+
+#: Units of a coordinate's quantities by its kind: value, rate, acceleration, drive effort.
+UNITS = {
+    "angle": {"q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "tau": "N m"},
+    "displacement": {"q": "m", "qd": "m/s", "qdd": "m/s^2", "tau": "N"},
+}
+
+
+def units(result: SimulationResult, quantity: str) -> list[str]:
+    """The unit of ``quantity`` (``'q'``, ``'qd'``, ``'qdd'``, ``'tau'``) of each coordinate."""
+    return [UNITS[kind][quantity] for kind in result.coordinate_kinds]
+
+
+def axis_label(what: str, names: Sequence[str], unit_of: Sequence[str]) -> str:
+    """An axis label with each coordinate's unit: ``"drive effort (N m)"`` when all share one,
+    else ``"drive effort: theta (N m), s (N)"``."""
+    if len(set(unit_of)) <= 1:
+        return f"{what} ({unit_of[0]})" if unit_of else what
+    return f"{what}: " + ", ".join(f"{n} ({u})" for n, u in zip(names, unit_of))
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -39,14 +59,12 @@ def plot_coordinates(
     if which not in ("q", "qd", "qdd"):
         raise ValueError(f"which must be 'q', 'qd' or 'qdd', got {which!r}")
     data = getattr(result, which)
-    suffix = {"q": "", "qd": "/s", "qdd": "/s^2"}[which]
     lines: list[Artist] = []
-    for k, name in enumerate(result.coordinate_names):
-        label = name if which == "q" else f"{which}_{name}"
+    labels = [name if which == "q" else f"{which}_{name}" for name in result.coordinate_names]
+    for k, label in enumerate(labels):
         lines += ax.plot(result.t, data[:, k], label=label, **line_kw)
-    unit = group_unit(result.coordinate_kinds, "rad", "m")
     ax.set_xlabel("t (s)")
-    ax.set_ylabel(f"{which} ({unit}{suffix if unit != 'mixed units' else ''})")
+    ax.set_ylabel(axis_label(which, labels, units(result, which)))
     ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
     return lines
@@ -59,7 +77,7 @@ def plot_efforts(result: SimulationResult, ax: Axes | None = None, **line_kw: An
     for k, name in enumerate(result.coordinate_names):
         lines += ax.plot(result.t, result.tau[:, k], label=f"tau_{name}", **line_kw)
     ax.set_xlabel("t (s)")
-    ax.set_ylabel(f"drive effort ({group_unit(result.coordinate_kinds, 'N m', 'N')})")
+    ax.set_ylabel(axis_label("drive effort", [f"tau_{n}" for n in result.coordinate_names], units(result, "tau")))
     ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
     return lines
@@ -96,7 +114,10 @@ def plot_energy(result: SimulationResult, ax: Axes | None = None, balance: bool 
             ax2.set_ylabel("energy balance (J)")
         lines += bal
         handles += bal
-    ax.legend(handles=handles, loc="best", fontsize="small")
+    # Below the axes: a legend inside would cover a curve, and matplotlib's loc="best" only
+    # avoids the lines of the axes it belongs to, not the balance on the twin axes.
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3, fontsize="small",
+              frameon=False)
     return lines
 
 
@@ -134,7 +155,7 @@ def draw_mechanism(
             artists.append(poly)
         artists += ax.plot(xy[:, 0], xy[:, 1], "-", color=colors[b], linewidth=3, alpha=alpha, solid_capstyle="round")
     scale = mech.scale
-    for name in mech.ground_points:
+    for name in pivot_points(mech):
         px, py = where[name]
         s = 0.04 * scale
         tri = Polygon(
@@ -161,6 +182,22 @@ def draw_mechanism(
                 artists.append(ax.annotate(name, (px, py), textcoords="offset points", xytext=(5, 5), fontsize=8, alpha=alpha))
     ax.set_aspect("equal")
     return artists
+
+
+def pivot_points(mech: Mechanism) -> list[str]:
+    """The ground points drawn with the ground mark: where a body is held to the ground, by a
+    pair (a pin, a gear's axle) or a load's end (a spring's anchor). A point the ground carries
+    only to lay a guide (a prismatic or slot pair's point or the ends of its ``along``) or as
+    a reference of the drawing is not a pivot: the guide is drawn as its line."""
+    model = mech.to_dict()
+    held: set[str] = set()
+    for pair in model.get("pairs", []):
+        if "ground" not in pair.get("bodies", ()) or pair.get("type") in ("prismatic", "slot"):
+            continue
+        held.update([pair["at"]] if "at" in pair else pair.get("centers", []))
+    for load in model.get("loads", []):
+        held.update(point for body, point in load.get("between", []) if body == "ground")
+    return [p for p in mech.ground_points if p in held]
 
 
 def _nearest(t: np.ndarray, time: float) -> int:
@@ -192,6 +229,16 @@ def default_trace_points(mech: Mechanism) -> list[str]:
     return chosen or [n for n in mech.point_names if n not in ground]
 
 
+def trace_points(mech: Mechanism, points: Sequence[str] | None) -> list[str]:
+    """The points whose paths to draw: ``points`` (default :func:`default_trace_points`),
+    each a named point of the model, else an ArgumentError (argument ``traces``) listing them."""
+    points = default_trace_points(mech) if points is None else list(points)
+    unknown = [p for p in points if p not in mech.point_names]
+    if unknown:
+        raise error("traces", f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
+    return points
+
+
 def plot_point_paths(
     mech: Mechanism,
     result: SimulationResult,
@@ -204,10 +251,7 @@ def plot_point_paths(
     ``points``: names (default :func:`default_trace_points`). Returns the lines, one a point.
     """
     ax = _axes(ax)
-    points = default_trace_points(mech) if points is None else list(points)
-    unknown = [p for p in points if p not in mech.point_names]
-    if unknown:
-        raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(mech.point_names)}")
+    points = trace_points(mech, points)
     pos = mech.point_positions(result.x)  # (N, P, 2)
     lines: list[Artist] = []
     for name in points:
@@ -217,6 +261,7 @@ def plot_point_paths(
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_aspect("equal")
+    ax.legend(loc="best", fontsize="small")
     return lines
 
 
@@ -252,7 +297,7 @@ def plot_reaction(mech: Mechanism, result: SimulationResult, pair: str, fig: Any
     ``fig`` is a matplotlib figure to draw in (a new one when None). Returns the artists.
     """
     if pair not in mech.pair_names:
-        raise ValueError(f"no pair {pair!r}; the pairs are {', '.join(mech.pair_names)}")
+        raise error("pair", f"no pair {pair!r}; the pairs are {', '.join(mech.pair_names)}")
     k = mech.pair_names.index(pair)
     force = mech.reactions(result)[:, k, :2]
     second = mech.pairs[k]["bodies"][1]
@@ -282,12 +327,41 @@ def plot_torque_speed(result: SimulationResult, ax: Axes | None = None, **line_k
         lines.append(line)
         if len(result.t):
             lines += ax.plot(result.qd[:1, k], result.tau[:1, k], "o", color=line.get_color())
-    ax.set_xlabel(f"speed ({group_unit(result.coordinate_kinds, 'rad/s', 'm/s')})")
-    ax.set_ylabel(f"drive effort ({group_unit(result.coordinate_kinds, 'N m', 'N')})")
+    ax.set_xlabel(axis_label("speed", result.coordinate_names, units(result, "qd")))
+    ax.set_ylabel(axis_label("drive effort", result.coordinate_names, units(result, "tau")))
     ax.axhline(0, color="0.6", linewidth=0.6)
     ax.axvline(0, color="0.6", linewidth=0.6)
     ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
+    return lines
+
+
+def plot_point_motion(motion: PointMotion, points: Sequence[str] | None = None, fig: Any = None) -> list[Artist]:
+    """Position, velocity and acceleration of named points against time (m, m/s, m/s^2), on
+    three axes sharing t: x solid, y dashed, one colour a point (a ram's stroke, an end
+    effector's path). ``points``: names of ``motion.names`` (default: all). ``fig``: a
+    matplotlib Figure (default a new one, 9 x 8 in). Returns the lines."""
+    names = list(motion.names) if points is None else list(points)
+    unknown = [p for p in names if p not in motion.names]
+    if unknown:
+        raise error("points", f"no point {', '.join(unknown)} in the motion; its points are {', '.join(motion.names)}")
+    if fig is None:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(9, 8))
+    axes = fig.subplots(3, 1, sharex=True)
+    lines: list[Artist] = []
+    for ax, (what, unit) in zip(axes, (("position", "m"), ("velocity", "m/s"), ("acceleration", "m/s^2"))):
+        for c, name in enumerate(names):
+            value = getattr(motion, what)[:, motion.names.index(name)]
+            for j, (axis, style) in enumerate((("x", "-"), ("y", "--"))):
+                lines += ax.plot(motion.t, value[:, j], style, color=f"C{c % 10}", label=f"{name} {axis}")
+        ax.set_ylabel(f"{what} ({unit})")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize="small")
+    axes[-1].set_xlabel("t (s)")
+    fig.suptitle(f"motion of {', '.join(names)}")
+    fig.tight_layout()
     return lines
 
 

@@ -12,8 +12,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import results_format
+from . import extras, results_format
 from ._core import DenseOutput, __version__
+from .arguments import error
 
 if TYPE_CHECKING:
     import pandas
@@ -56,12 +57,12 @@ def _dataframe(cols: Mapping[str, FloatArray]) -> pandas.DataFrame:
     """``cols`` as a DataFrame indexed by its ``t`` column (needs pandas)."""
     try:
         import pandas as pd
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+    except ImportError as e:
+        raise extras.missing("pandas", "to_dataframe()", e) from e
     return pd.DataFrame(cols).set_index("t")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class PointMotion:
     """Positions, velocities and accelerations of named points along a trajectory
     (``Mechanism.point_motion``); each array (N, P, 2), points in the order of ``names``."""
@@ -78,6 +79,22 @@ class PointMotion:
             raise KeyError(f"no point {name!r}; the points carried by a link are {', '.join(self.names)}")
         k = self.names.index(name)
         return self.position[:, k], self.velocity[:, k], self.acceleration[:, k]
+
+    def describe(self, name: str) -> str:
+        """One line on point ``name``: its range in x and in y (m; the travel, e.g. a ram's
+        stroke, is max - min), its largest speed (m/s) and acceleration (m/s^2)."""
+        position, velocity, acceleration = self[name]
+        if not len(self.t):
+            return f"{name}: no output"
+        lo, hi = position.min(axis=0), position.max(axis=0)
+        travel = ", ".join(f"{axis} {lo[j]:.6g} .. {hi[j]:.6g} m (travel {hi[j] - lo[j]:.4g} m)"
+                           for j, axis in enumerate("xy"))
+        speed, accel = np.hypot(*velocity.T).max(), np.hypot(*acceleration.T).max()
+        return f"{name}: {travel}; peak speed {speed:.4g} m/s, peak acceleration {accel:.4g} m/s^2"
+
+    def __repr__(self) -> str:
+        span = f"t = {self.t[0]:.6g}..{self.t[-1]:.6g} s" if len(self.t) else "no output"
+        return f"PointMotion(N={len(self.t)}, {span}, points=({', '.join(self.names)}))"
 
     def to_dataframe(self) -> pandas.DataFrame:
         """Indexed by ``t``: per point ``<name>_x``, ``<name>_y``, ``<name>_vx``, ``<name>_vy``,
@@ -253,7 +270,19 @@ class SimulationResult:
         """The result at some of its rows: indices or a boolean mask, e.g. every tenth row
         ``res.take(np.arange(0, len(res), 10))``. The energy balance keeps its reference
         (the first output of the whole run)."""
-        k = np.arange(len(self.t))[np.asarray(rows)]
+        try:
+            r = np.asarray(rows)
+        except ValueError:  # a ragged list
+            raise TypeError("rows must be integer indices or a boolean mask, not a ragged list") from None
+        n = len(self.t)
+        if r.dtype.kind not in "biu":
+            raise TypeError(f"rows must be integer indices or a boolean mask of the {n} rows, got {r.dtype}")
+        if r.dtype.kind == "b" and r.shape != (n,):
+            raise error("rows", f"rows as a boolean mask has one entry per row ({n},), got shape {r.shape}")
+        if r.dtype.kind != "b" and r.size and not (-n <= r.min() and r.max() < n):
+            raise error("rows", f"rows must be indices of the {n} rows (from -{n} to {n - 1}), got "
+                                f"{r.min() if r.min() < -n else r.max()}")
+        k = np.arange(n)[r]
 
         def rows_of(obj: Any) -> dict[str, Any]:  # every per-row array field, at rows k
             return {f.name: v[k] for f in dataclasses.fields(obj) if isinstance(v := getattr(obj, f.name), np.ndarray)}
@@ -298,8 +327,9 @@ class SimulationResult:
         return self._write(path, None)
 
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
-        """:meth:`save` in the CSV form whatever the name: the metadata on ``# `` lines, then
-        the file's columns (:mod:`planardyn.results_io`), full double precision."""
+        """:meth:`save` in the CSV form whatever the name: the file's columns, full double
+        precision, a table a spreadsheet opens; the metadata as JSON beside it, in the file
+        named ``<path>.json`` (:mod:`planardyn.results_io`)."""
         return self._write(path, ".csv")
 
     def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:

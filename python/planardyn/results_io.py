@@ -6,9 +6,11 @@ the solver settings (keyword arguments of ``Mechanism.simulate``), the planardyn
 the status and counters. The format is chosen by the file name's extension:
 
 ``.csv``
-    The metadata as JSON on leading ``# `` comment lines, then a header row and one row per
-    output time; numbers are written with ``repr`` (the shortest string that reads back to
-    the same double, at most 17 significant digits), so they round-trip exactly.
+    A plain table that a spreadsheet opens: a header row and one row per output time; numbers
+    are written with ``repr`` (the shortest string that reads back to the same double, at most
+    17 significant digits), so they round-trip exactly. The metadata, as JSON, are in a file
+    beside it named after it: ``run.csv.json`` (keep the two together; files written before
+    it, with the metadata on leading ``# `` lines of the CSV, are read too).
 ``.parquet``
     One column per channel (pyarrow), the metadata under the file-level key ``planardyn``.
 ``.npz``
@@ -32,13 +34,7 @@ named like another column.
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 import os
-import zipfile
-import zlib
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -46,20 +42,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._core import SingularityError
+from .arguments import data_error, finite_rates, rates_overflow, samples, times
 from .mechanism import Mechanism, attach_metadata
-from .result import ChangePoint, Energy, SimulationResult
-from .results_format import EXTENSIONS, FORMAT, FORMAT_VERSION
-from .results_format import checksum as _checksum
-from .results_format import columns as _columns
-from .results_format import pyarrow as _pyarrow
-from .results_format import table as _table
+from .result import Energy, SimulationResult
+from .results_format import FORMAT
+from .results_read import Damaged, csv_blocks, csv_head, csv_metadata, read
 
 FloatArray = NDArray[np.float64]
 
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
-#: Metadata a results file cannot be read without (the others may be absent or None).
-REQUIRED_FIELDS = ("coordinate_names", "coordinate_kinds", "body_names", "status", "success", "message", "layout")
 
 
 # ------------------------------------------------------------------ metadata
@@ -76,110 +68,6 @@ def simulate_settings(mech: Mechanism, **given: Any) -> dict[str, Any]:
         raise TypeError(f"unknown simulate settings: {', '.join(sorted(unknown))}")
     model = mech.simulate_defaults
     return {k: given[k] if given.get(k) is not None else model.get(k) for k in SETTING_NAMES}
-
-
-def _result(meta: dict[str, Any], table: FloatArray, path: Path) -> SimulationResult:
-    """Rebuild a result from its checked metadata and its (rows, columns) table."""
-    groups, col = {}, 0
-    for g, k in meta["layout"]:
-        groups[g] = np.ascontiguousarray(table[:, col : col + k])
-        col += k
-    n_t, n_b = len(table), len(meta["body_names"])
-    flat = lambda g: np.ascontiguousarray(groups[g].reshape(n_t))  # noqa: E731
-    own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
-           "coordinate_kinds", "body_names", "layout", "rows", "checksum", "events",
-           "change_points"}
-    m = len(meta["coordinate_names"])
-    events = meta.get("events") or {}
-    per_event = lambda key, shape: [np.asarray(v, dtype=float).reshape(shape) for v in events.get(key, [])]  # noqa: E731
-    return SimulationResult(
-        t=flat("t"), q=groups["q"], qd=groups["qd"], qdd=groups["qdd"], tau=groups["tau"],
-        x=groups["x"], xd=groups["xd"], poses=groups["x"].reshape(n_t, n_b, 3),
-        energy=Energy.from_arrays(flat("kinetic"), flat("potential"), flat("work")),
-        sigma=flat("sigma"), residual=flat("residual"), partitioned=flat("partitioned").astype(bool),
-        success=meta["success"], status=meta["status"], message=meta["message"],
-        stats=dict(meta.get("stats") or {}),
-        coordinate_names=list(meta["coordinate_names"]),
-        coordinate_kinds=list(meta["coordinate_kinds"]),
-        body_names=list(meta["body_names"]),
-        change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
-        metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
-        t_events=per_event("t", (-1,)), q_events=per_event("q", (-1, m)), qd_events=per_event("qd", (-1, m)),
-        tau_motor=groups.get("tau_motor"),
-    )
-
-
-class _Damaged(Exception):
-    """What is wrong with a results file (the reader adds the file's name)."""
-
-
-def _is_str_list(v: Any) -> bool:
-    return isinstance(v, list) and all(isinstance(s, str) for s in v)
-
-
-def _check_meta(meta: Any) -> dict[str, Any]:
-    """The metadata if it is a planardyn results file's, field by field, else _Damaged."""
-    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
-        raise _Damaged(f"not a planardyn results file (no '{FORMAT}' metadata)")
-    version = meta.get("format_version")
-    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        raise _Damaged(f"metadata field 'format_version' is {version!r}, not a version number")
-    if version > FORMAT_VERSION:
-        raise _Damaged(f"results format version {version} is newer than this planardyn reads "
-                       f"({FORMAT_VERSION}): upgrade planardyn")
-    fields: list[tuple[str, Callable[[Any], bool], str]] = [
-        ("coordinate_names", _is_str_list, "a list of names"),
-        ("coordinate_kinds", lambda v: isinstance(v, list) and all(k in ("angle", "displacement") for k in v),
-         "a list of 'angle'/'displacement'"),
-        ("body_names", _is_str_list, "a list of names"),
-        ("status", lambda v: isinstance(v, str), "a string"),
-        ("success", lambda v: isinstance(v, bool), "true or false"),
-        ("message", lambda v: isinstance(v, str), "a string"),
-        ("stats", lambda v: v is None or isinstance(v, dict), "a mapping"),
-        ("model", lambda v: v is None or isinstance(v, dict), "a model mapping"),
-        ("settings", lambda v: v is None or isinstance(v, dict), "a mapping"),
-        ("rows", lambda v: v is None or isinstance(v, int) and not isinstance(v, bool) and v >= 0,
-         "a number of rows"),
-        ("checksum", lambda v: v is None or isinstance(v, int) and not isinstance(v, bool), "a CRC-32"),
-    ]
-    # From version 2 the integrity fields are required: a damaged key must not switch the check off.
-    required = REQUIRED_FIELDS + (("rows", "checksum") if version >= 2 else ())
-    missing = [k for k in required if k not in meta]
-    if missing:
-        raise _Damaged(f"metadata has no field{'s' * (len(missing) > 1)} {', '.join(repr(k) for k in missing)}")
-    for name, ok, what in fields:
-        if not ok(meta.get(name)):
-            raise _Damaged(f"metadata field {name!r} is {_short(meta.get(name))}, not {what}")
-    if len(meta["coordinate_kinds"]) != len(meta["coordinate_names"]):
-        raise _Damaged("metadata fields 'coordinate_names' and 'coordinate_kinds' differ in length")
-    layout = [[g, len(c)] for g, c in _layout(meta)]
-    if meta["layout"] != layout:
-        raise _Damaged(f"metadata field 'layout' is {_short(meta['layout'])}, not the layout of its "
-                       f"coordinates and bodies {layout}")
-    return meta
-
-
-def _layout(meta: dict[str, Any]) -> list[tuple[str, list[str]]]:
-    """The columns of a file with this metadata: with the motor torques when its layout names them."""
-    motor = isinstance(meta["layout"], list) and ["tau_motor", len(meta["coordinate_names"])] in meta["layout"]
-    return _columns(meta["coordinate_names"], meta["body_names"], motor)
-
-
-def _short(v: Any) -> str:
-    text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _check_table(meta: dict[str, Any], table: FloatArray) -> FloatArray:
-    """The table if it has the rows and the checksum the metadata records, else _Damaged."""
-    rows = meta.get("rows")
-    if rows is not None and len(table) != rows:
-        raise _Damaged(f"truncated or damaged: {len(table)} rows where its metadata records {rows} "
-                       "(an interrupted copy or write?)")
-    if meta.get("checksum") is not None and _checksum(meta, table) != meta["checksum"]:
-        raise _Damaged("damaged: its contents do not match the checksum its metadata records "
-                       "(changed after it was written?)")
-    return table
 
 
 # ------------------------------------------------------------------ write / read
@@ -211,153 +99,16 @@ def read_results(path: str | os.PathLike[str]) -> SimulationResult:
     ------
     FileNotFoundError
         No such file.
-    ValueError
-        Not a planardyn results file, or a damaged one: truncated (fewer rows than its
-        metadata records), changed (its checksum), metadata missing or of the wrong type,
-        a file its format's library cannot read. The message starts with the file's name.
+    DataError
+        (a ``ValueError``) Not a planardyn results file, or a damaged one: truncated (fewer
+        rows than its metadata records), changed (its checksum), metadata missing or of the
+        wrong type, a file its format's library cannot read. The message starts with the
+        file's name.
+
+    The numbers go straight into the result's arrays a block of rows (or an array) at a
+    time: reading needs about the memory of the arrays themselves.
     """
-    path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in EXTENSIONS:
-        raise ValueError(f"{path}: unknown results format {ext!r} (use {', '.join(EXTENSIONS)})")
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such results file")
-    readers = {".npz": _read_npz, ".parquet": _read_parquet, ".csv": _read_csv_table}
-    try:
-        meta, table = readers[ext](path)
-        return _result(meta, _check_table(meta, table), path)
-    except _Damaged as e:
-        raise ValueError(f"{path}: {e}") from None
-    except MemoryError:
-        raise ValueError(f"{path}: damaged: it declares arrays larger than memory") from None
-    except _library_errors() as e:
-        raise ValueError(f"{path}: damaged or not a {ext} results file ({type(e).__name__}: {e})") from None
-
-
-def _library_errors() -> tuple[type[BaseException], ...]:
-    """What numpy, zipfile, zlib, json and pyarrow raise on a damaged file (zipfile: a
-    NotImplementedError for flags or a compression it does not know, a RuntimeError for an
-    encrypted member)."""
-    errors: tuple[type[BaseException], ...] = (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError,
-                                               NotImplementedError, RuntimeError)
-    try:
-        import pyarrow as pa
-    except ImportError:  # pragma: no cover - depends on the environment
-        return errors
-    return (*errors, pa.lib.ArrowException)
-
-
-def _read_npz(path: Path) -> tuple[dict[str, Any], FloatArray]:
-    if not zipfile.is_zipfile(path):
-        raise _Damaged("not an .npz archive (damaged, or another kind of file)")
-    with np.load(path, allow_pickle=False) as z:
-        if "metadata" not in z.files:
-            raise _Damaged("not a planardyn results file (no 'metadata' array)")
-        raw = _member(z, "metadata")
-        if raw.shape != () or raw.dtype.kind != "U":
-            raise _Damaged(f"array 'metadata' is {raw.dtype} of shape {raw.shape}, not one JSON string")
-        meta = _check_meta(_json(str(raw)))
-        layout = [(g, k) for g, k in meta["layout"]]
-        missing = [g for g, _ in layout if g not in z.files]
-        if missing:
-            raise _Damaged(f"no array {', '.join(repr(g) for g in missing)}")
-        groups = {g: _member(z, g) for g, _ in layout}
-    n_t = groups["t"].size
-    for g, k in layout:
-        a = groups[g]
-        if a.dtype.kind not in "fiub":
-            raise _Damaged(f"array {g!r} holds {a.dtype}, not numbers")
-        if a.size != n_t * k:
-            raise _Damaged(f"array {g!r} has {a.size} values where {n_t} rows of {k} need {n_t * k}")
-    return meta, _table(groups, layout, n_t)
-
-
-def _member(z: Any, name: str) -> np.ndarray:
-    """Array ``name`` of an open .npz; numpy's refusals as _Damaged."""
-    try:
-        return z[name]
-    except ValueError as e:
-        if "allow_pickle" in str(e):
-            raise _Damaged(f"array {name!r} holds Python objects, not numbers") from None
-        raise _Damaged(f"array {name!r} is damaged ({e})") from None
-
-
-def _read_parquet(path: Path) -> tuple[dict[str, Any], FloatArray]:
-    pa, pq = _pyarrow()
-    table = pq.read_table(path)
-    raw = (table.schema.metadata or {}).get(b"planardyn")
-    meta = _check_meta(_json(raw) if raw else None)
-    width = sum(k for _, k in meta["layout"])
-    _check_header(meta, table.column_names)
-    cols = [table.column(i).to_numpy().astype(np.float64) for i in range(table.num_columns)]
-    return meta, np.column_stack(cols).reshape(table.num_rows, width) if cols else np.empty((table.num_rows, 0))
-
-
-def _read_csv_table(path: Path) -> tuple[dict[str, Any], FloatArray]:
-    found, header, rows = _read_csv(path)
-    meta = _check_meta(found)
-    _check_header(meta, header)
-    width = len(header)
-    data = np.empty((len(rows), width))
-    for i, r in enumerate(rows):
-        try:
-            if len(r) != width:
-                raise ValueError(f"{len(r)} fields")
-            data[i] = [float(v) for v in r]
-        except ValueError as e:
-            raise _Damaged(f"data row {i + 1} is not {width} numbers ({e}): truncated or damaged") from None
-    return meta, data
-
-
-def _check_header(meta: dict[str, Any], header: list[str]) -> None:
-    names = [c for _, cols in _layout(meta) for c in cols]
-    if header != names:
-        wrong = next((k for k, (h, n) in enumerate(zip(header, names)) if h != n), min(len(header), len(names)))
-        raise _Damaged(f"{len(header)} columns where its metadata says {len(names)}: column {wrong + 1} is "
-                       f"{header[wrong] if wrong < len(header) else 'missing'!r}, expected "
-                       f"{names[wrong] if wrong < len(names) else 'none'!r}")
-
-
-def _json(text: Any) -> Any:
-    try:
-        return json.loads(text)
-    except (ValueError, TypeError) as e:
-        raise _Damaged(f"metadata is not JSON ({e})") from None
-
-
-def _read_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[list[str]]]:
-    """The JSON of the leading '# ' lines (None if there are none or it is not JSON), the
-    header, the data rows."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as e:
-        raise _Damaged(f"not text: byte {e.start} is not UTF-8 (damaged, or not a CSV file)") from None
-    comment: list[str] = []
-    lines = text.splitlines(keepends=True)
-    k = 0
-    while k < len(lines) and lines[k].startswith("#"):
-        comment.append(lines[k][2:] if lines[k].startswith("# ") else lines[k][1:])
-        k += 1
-    body = lines[k:]
-    try:
-        rows = [r for r in csv.reader(io.StringIO("".join(body))) if r]
-    except csv.Error as e:
-        raise _Damaged(f"not a CSV table ({e})") from None
-    meta = None
-    if comment:
-        try:
-            meta = json.loads("".join(comment))
-        except json.JSONDecodeError:
-            meta = None
-    return meta, [h.strip() for h in rows[0]] if rows else [], rows[1:]
-
-
-def _read_named_csv(path: Path) -> tuple[dict[str, Any] | None, list[str], list[list[str]]]:
-    """:func:`_read_csv`, its errors as ValueErrors that name the file."""
-    try:
-        return _read_csv(path)
-    except _Damaged as e:
-        raise ValueError(f"{path}: {e}") from None
+    return read(path)
 
 
 # ------------------------------------------------------------------ motions and inverse dynamics
@@ -382,55 +133,73 @@ def read_motion(path: str | os.PathLike[str], coordinate_names: list[str]) -> di
     per-coordinate lists ``qd_columns``/``qdd_columns`` (a (N,) array or None for each).
     """
     path = Path(path)
-    if path.suffix.lower() in (".npz", ".parquet") or (
-        path.suffix.lower() == ".csv" and path.is_file() and path.open("rb").read(1) == b"#"
-        and ((_read_named_csv(path)[0] or {}).get("format") == FORMAT)
-    ):
+    if path.suffix.lower() in (".npz", ".parquet") or (path.suffix.lower() == ".csv" and _is_results_csv(path)):
         res = read_results(path)
         if res.coordinate_names != list(coordinate_names):
-            raise ValueError(
-                f"{path}: the results' coordinates ({', '.join(res.coordinate_names)}) are not "
-                f"the model's ({', '.join(coordinate_names)})"
-            )
+            raise data_error(path, f"the results' coordinates ({', '.join(res.coordinate_names)}) are not "
+                                   f"the model's ({', '.join(coordinate_names)})")
+        groups = {"": res.q, "qd_": res.qd, "qdd_": res.qdd, "tau_": res.tau, "tau_motor_": res.tau_motor}
+        _check_finite(path, {f"{p}{n}": a[:, k] for p, a in groups.items() if a is not None
+                             for k, n in enumerate(coordinate_names)})
         return {"t": res.t, "q": res.q, "qd": res.qd, "qdd": res.qdd, "tau": res.tau, "tau_motor": res.tau_motor,
                 "from_results": True, "x": res.x, "xd": res.xd, "qd_columns": list(res.qd.T),
                 "qdd_columns": list(res.qdd.T)}
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such motion file")
-    _, header, rows = _read_named_csv(path)
-    need = ["t", *coordinate_names]
-    missing = [c for c in need if c not in header]
-    if missing:
-        raise ValueError(
-            f"{path}: motion table has no column {', '.join(repr(c) for c in missing)} "
-            f"(it needs t and the coordinates {', '.join(coordinate_names)}; found {', '.join(header)})"
-        )
-    col = {h: i for i, h in enumerate(header)}
-    used = need + [f"{p}_{n}" for p in ("qd", "qdd", "tau", "tau_motor") for n in coordinate_names
-                   if f"{p}_{n}" in col]
-    data = np.empty((len(rows), len(header)))
-    for i, r in enumerate(rows):
-        for h in used:
-            try:
-                data[i, col[h]] = float(r[col[h]])
-            except (ValueError, IndexError):
-                raise ValueError(f"{path}: row {i + 1} of the data has no number in column {h!r}") from None
-        if not all(np.isfinite(data[i, col[h]]) for h in used):
-            raise ValueError(f"{path}: row {i + 1} of the data has a non-finite value")
-    get = lambda h: data[:, col[h]] if h in col else None  # noqa: E731 - an optional column
-    t = data[:, col["t"]]
+    try:
+        with open(path, encoding="utf-8") as f:
+            _, header = csv_head(f)
+            need = ["t", *coordinate_names]
+            missing = [c for c in need if c not in header]
+            if missing:
+                raise Damaged(f"motion table has no column {', '.join(repr(c) for c in missing)} (it needs t and "
+                              f"the coordinates {', '.join(coordinate_names)}; found {', '.join(header)})")
+            used = need + [f"{p}_{n}" for p in ("qd", "qdd", "tau", "tau_motor") for n in coordinate_names
+                           if f"{p}_{n}" in header]
+            cols = [header.index(h) for h in used]
+            blocks = list(csv_blocks(f, header, cols))
+    except UnicodeDecodeError:
+        raise data_error(path, "not text: it holds bytes that are not UTF-8 (not a CSV table?)") from None
+    except Damaged as e:
+        raise data_error(path, str(e)) from None
+    data = np.concatenate(blocks) if blocks else np.empty((0, len(used)))
+    col = {h: data[:, k] for k, h in enumerate(used)}
+    _check_finite(path, col)
+    t = col["t"]
     if len(t) < 2:
-        raise ValueError(f"{path}: a motion needs at least 2 rows, found {len(t)}")
+        raise data_error(path, f"a motion needs at least 2 rows, found {len(t)}")
     if np.any(np.diff(t) <= 0):
-        raise ValueError(f"{path}: column t must increase strictly")
-    q = np.column_stack([data[:, col[n]] for n in coordinate_names])
-    qd_cols = [get(f"qd_{n}") for n in coordinate_names]
-    qdd_cols = [get(f"qdd_{n}") for n in coordinate_names]
-    both = lambda cols: None if any(c is None for c in cols) else np.column_stack(cols)  # noqa: E731
-    tau = both([get(f"tau_{n}") for n in coordinate_names])
-    tau_motor = both([get(f"tau_motor_{n}") for n in coordinate_names])
-    return {"t": t, "q": q, "qd": both(qd_cols), "qdd": both(qdd_cols), "tau": tau, "tau_motor": tau_motor,
-            "from_results": False, "x": None, "xd": None, "qd_columns": qd_cols, "qdd_columns": qdd_cols}
+        k = int(np.argmax(np.diff(t) <= 0))
+        raise data_error(path, f"column t must increase strictly: data row {k + 2} ({t[k + 1]!r} s) does not "
+                               f"come after row {k + 1} ({t[k]!r} s)")
+    both = lambda p: np.column_stack([col[f"{p}_{n}"] for n in coordinate_names]) if all(  # noqa: E731
+        f"{p}_{n}" in col for n in coordinate_names) else None
+    return {"t": t, "q": np.column_stack([col[n] for n in coordinate_names]), "qd": both("qd"), "qdd": both("qdd"),
+            "tau": both("tau"), "tau_motor": both("tau_motor"), "from_results": False, "x": None, "xd": None,
+            "qd_columns": [col.get(f"qd_{n}") for n in coordinate_names],
+            "qdd_columns": [col.get(f"qdd_{n}") for n in coordinate_names]}
+
+
+def _check_finite(path: Path, columns: dict[str, FloatArray]) -> None:
+    """Refuse a motion with a NaN or an infinity, naming the first data row that has one
+    (from 1) and its column."""
+    rows = {h: np.flatnonzero(~np.isfinite(c)) for h, c in columns.items()}
+    bad = [(int(r[0]), h) for h, r in rows.items() if len(r)]
+    if bad:
+        i, h = min(bad)
+        raise data_error(path, f"data row {i + 1} has {columns[h][i]} in column {h!r}: give finite numbers "
+                               "(remove the row, or fill it in)")
+
+
+def _is_results_csv(path: Path) -> bool:
+    """Whether a CSV file is a planardyn results file: its metadata file beside it, or its
+    head (files written before the metadata file was)."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            meta = csv_metadata(path, csv_head(f)[0])
+    except (OSError, UnicodeDecodeError, Damaged):
+        return False
+    return isinstance(meta, dict) and meta.get("format") == FORMAT
 
 
 def motion_derivatives(
@@ -446,21 +215,26 @@ def motion_derivatives(
     """
     from scipy.interpolate import CubicSpline
 
-    t = np.asarray(t, dtype=np.float64)
-    q = np.asarray(q, dtype=np.float64)
+    t = times("t", t)
+    q = samples("q", q, len(t), what="rad or m")
     m = q.shape[1]
+    finite_rates(q, t)
     qd_columns = qd_columns or [None] * m
     qdd_columns = qdd_columns or [None] * m
     qd, qdd = np.empty_like(q), np.empty_like(q)
     for k in range(m):
-        sq = CubicSpline(t, q[:, k])
-        if qd_columns[k] is not None:
-            qd[:, k] = qd_columns[k]
-            second = CubicSpline(t, qd[:, k])(t, 1)
-        else:
-            qd[:, k] = sq(t, 1)
-            second = sq(t, 2)
+        try:
+            sq = CubicSpline(t, q[:, k])
+            if qd_columns[k] is not None:
+                qd[:, k] = qd_columns[k]
+                second = CubicSpline(t, qd[:, k])(t, 1)
+            else:
+                qd[:, k] = sq(t, 1)
+                second = sq(t, 2)
+        except ValueError:  # scipy's refusal of its own overflow
+            raise rates_overflow(q, t) from None
         qdd[:, k] = qdd_columns[k] if qdd_columns[k] is not None else second
+    finite_rates(q, t, qd, qdd)
     return qd, qdd
 
 
@@ -505,16 +279,15 @@ def inverse_result(
         kinetic and potential energy; ``work`` the work of tau (J, trapezoidal rule);
         ``metadata["branch"]`` says which branch the rows were computed on.
     """
-    t = np.ascontiguousarray(t, dtype=np.float64)
-    q = np.ascontiguousarray(q, dtype=np.float64)
-    if q.ndim == 1:
-        q = q[:, None]
+    t = times("t", t)
+    m = mech.dof
+    q = samples("q", q, len(t), m, "rad or m")
     if qd is None or qdd is None:
         sd, sdd = motion_derivatives(t, q)
         qd = sd if qd is None else qd
         qdd = sdd if qdd is None else qdd
-    qd = np.ascontiguousarray(qd, dtype=np.float64).reshape(q.shape)
-    qdd = np.ascontiguousarray(qdd, dtype=np.float64).reshape(q.shape)
+    qd = samples("qd", qd, len(t), m, "rad/s or m/s")
+    qdd = samples("qdd", qdd, len(t), m, "rad/s^2 or m/s^2")
     given = None if x is None else np.asarray(x, dtype=np.float64)
     given_xd = None if xd is None else np.asarray(xd, dtype=np.float64)
     try:

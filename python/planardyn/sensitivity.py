@@ -35,7 +35,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import batch
 from ._core import AssemblyError, ModelError, PlanardynError, SimulationError, SingularityError
+from .arguments import error
 from .mechanism import Mechanism
+from .notebook import Summarized
 
 __all__ = ["Sensitivity", "efforts", "objective", "peak_effort", "rms_effort", "trajectory", "DEFAULT_REL_STEP"]
 
@@ -50,8 +52,8 @@ Design = Mechanism | Mapping[str, Any] | Callable[..., Mechanism | Mapping[str, 
 DEFAULT_REL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
 
 
-@dataclass(frozen=True)
-class Sensitivity:
+@dataclass(frozen=True, repr=False)
+class Sensitivity(Summarized):
     """Derivatives of a quantity (shape S) with respect to p named parameters.
 
     ``value`` (S) at the nominal design; ``derivative`` and ``error`` (p, *S): the central
@@ -71,6 +73,24 @@ class Sensitivity:
         """The derivative with respect to one parameter (shape S)."""
         return self.derivative[self.names.index(name)]
 
+    def __repr__(self) -> str:
+        return (f"Sensitivity(d{list(self.value.shape) if self.value.ndim else ' value'} / d({', '.join(self.names)}), "
+                f"largest error estimate {float(np.max(self.error, initial=0.0)):.2g})")
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        return [("quantity", f"shape {self.value.shape}" if self.value.ndim else f"{float(self.value):.6g}"),
+                ("parameters", ", ".join(self.names))]
+
+    def _summary_tables(self) -> list[tuple[list[str], list[list[str]]]]:
+        rows = []
+        for k, name in enumerate(self.names):
+            d, e = self.derivative[k], self.error[k]
+            big = int(np.argmax(np.abs(d))) if d.ndim else 0
+            rows.append([name, f"{self.values[k]:.6g}", f"{self.steps[k]:.3g}", f"{np.ravel(d)[big]:.6g}",
+                         f"{np.ravel(e)[big]:.2g}"])
+        entry = "derivative" if self.value.ndim == 0 else "derivative (largest entry)"
+        return [(["parameter", "value", "step", entry, "error"], rows)]
+
     def __str__(self) -> str:
         rows = [f"{'parameter':>32} {'value':>12} {'step':>10} {'derivative':>14} {'error':>10}"]
         for k, name in enumerate(self.names):
@@ -88,7 +108,7 @@ def _nominal(design: Design, params: Mapping[str, float] | Sequence[str]) -> tup
     if isinstance(params, Mapping):
         return list(params), np.array([float(v) for v in params.values()])
     if callable(design) and not isinstance(design, Mechanism):
-        raise ValueError("with a model constructor, give the parameters as a mapping {name: nominal value}")
+        raise error("params", "with a model constructor, give the parameters as a mapping {name: nominal value}")
     model = design.to_dict() if isinstance(design, Mechanism) else design
     return list(params), np.array([_read(model, p) for p in params])
 
@@ -98,7 +118,7 @@ def _read(model: Mapping[str, Any], path: str) -> float:
     for key in path.split("."):
         node = batch._child(node, key, path)
     if not isinstance(node, (int, float)):
-        raise ValueError(f"{path}: expected a number in the model, found {node!r}; give its value in params")
+        raise error("params", f"{path}: expected a number in the model, found {node!r}; give its value in params")
     return float(node)
 
 
@@ -125,7 +145,7 @@ def steps(values: ArrayLike, rel_step: float = DEFAULT_REL_STEP, typical: ArrayL
     bad = np.flatnonzero(~(h > 0) | ~np.isfinite(h))
     if len(bad):
         which = names[bad[0]] if names is not None else f"parameter {bad[0]}"
-        raise ValueError(f"{which} = {v[bad[0]]:g}: no step can be made from it; give typical= (a typical "
+        raise error("typical", f"{which} = {v[bad[0]]:g}: no step can be made from it; give typical= (a typical "
                          f"magnitude in its units, e.g. the mechanism's size for a coordinate that is 0)")
     return h
 

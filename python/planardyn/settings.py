@@ -7,19 +7,20 @@ because the error scale is ``atol + rtol * |y_i|``: a state component that passe
 end in "NaN or infinity" instead of an answer. ``rtol`` is also at least :data:`MIN_RTOL`
 (below it the error test asks for more than double precision holds). ``max_steps`` is an integer in 1..=:data:`MAX_STEPS`.
 
-A value that breaks its rule raises what ``Mechanism.simulate`` raises for it: ValueError
-for ``t_end`` (an argument), :class:`~planardyn.SimulationError` for a solver option,
-TypeError for something that is not a number.
+A value that breaks its rule raises what ``Mechanism.simulate`` raises for it:
+:class:`~planardyn.ArgumentError` (a ValueError) for ``t_end`` (an argument),
+:class:`~planardyn.SimulationError` for a solver option, TypeError for something that is not
+a number.
 """
 
 from __future__ import annotations
 
 import math
-import operator
 import sys
 from typing import Any
 
 from ._core import SimulationError
+from .arguments import count, error
 
 #: Settings that are finite numbers > 0 (s, or dimensionless for the tolerances).
 POSITIVE = ("t_end", "rtol", "atol", "dt", "output_dt")
@@ -33,7 +34,7 @@ MAX_THREADS = 256
 
 
 def _error(name: str, text: str) -> Exception:
-    return ValueError(text) if name == "t_end" else SimulationError(f"invalid option: {text}")
+    return error(name, text) if name == "t_end" else SimulationError(f"invalid option: {text}")
 
 
 def positive(name: str, value: Any) -> float:
@@ -47,19 +48,6 @@ def positive(name: str, value: Any) -> float:
     if not (math.isfinite(x) and x > 0.0):
         raise _error(name, f"{name} = {value!r} must be a finite number > 0")
     return x
-
-
-def count(name: str, value: Any, high: int) -> int:
-    """``value`` as an int if it is an integer in 1..=high, else TypeError/ValueError naming ``name``."""
-    if isinstance(value, bool):
-        raise TypeError(f"{name} = {value!r} must be an integer, not bool")
-    try:
-        n = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name} = {value!r} must be an integer, not {type(value).__name__}") from None
-    if not 1 <= n <= high:
-        raise ValueError(f"{name} = {n} must be an integer from 1 to {high}")
-    return n
 
 
 def check_settings(**settings: Any) -> dict[str, Any]:
@@ -76,7 +64,7 @@ def check_settings(**settings: Any) -> dict[str, Any]:
                                       f"cannot be met: use rtol >= {MIN_RTOL:.3g}")
         elif name == "max_steps":
             try:
-                out[name] = count(name, value, MAX_STEPS)
+                out[name] = count(name, value, 1, MAX_STEPS)
             except ValueError as e:
                 raise SimulationError(f"invalid option: {e}") from None
     return out

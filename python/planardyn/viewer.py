@@ -23,8 +23,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._core import PlanardynError, __version__
+from .arguments import error
 from .playback import auto_speed
-from .plot import default_trace_points
+from .plot import trace_points
 from .units import group_unit
 
 if TYPE_CHECKING:
@@ -123,8 +124,8 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
     chosen = default if selected is None else set(selected)
     unknown = chosen - {c["key"] for c in chans}
     if unknown:
-        raise ValueError(
-            f"unknown channel(s) {', '.join(sorted(unknown))}; the channels are "
+        raise error(
+            "channels", f"unknown channel(s) {', '.join(sorted(unknown))}; the channels are "
             f"{', '.join(c['key'] for c in chans)}"
         )
     for c in chans:
@@ -155,10 +156,7 @@ def viewer_data(
     L = mech.scale
     pad = 0.12 * L
     names = mech.point_names
-    traces = default_trace_points(mech) if traces is None else list(traces)
-    unknown = [p for p in traces if p not in names]
-    if unknown:
-        raise ValueError(f"unknown point(s) {', '.join(unknown)}; the model has {', '.join(names)}")
+    traces = trace_points(mech, traces)
     # Each pair's drawing per frame from the core: flat lists of pins [x, y], blocks [x, y],
     # lines [x0, y0, x1, y1] and circles [x, y, r].
     frames = [mech.pair_geometry(xk) for xk in result.x[keep]]

@@ -8,15 +8,13 @@
 //! native `Mechanism` and a motion dict, either coordinate rows (`q`, `qd`, `qdd`) or a
 //! sampled end-effector path (`t`, `X`, `Xd`, `Xdd`, `point`, ...), on the same pool.
 
-use crate::convert::arr2;
-use crate::effector::solution_dict;
-use crate::errors::{run, task_error, to_pyerr, Failure};
+use crate::convert::{arr2, solution_dict};
+use crate::errors::{argument_error, run, task_error, to_pyerr, Failure, PlanardynError};
 use crate::mechanism::PyMechanism;
 use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};
-use planardyn::batch::{map_many_until, Efforts, InverseVariant, Model, Motion, Overrides, Variant};
+use planardyn::batch::{map_many_until, Efforts, InverseVariant, Motion, Overrides, Variant};
 use planardyn::Mechanism;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -33,21 +31,21 @@ const MOTION_KEYS: [&str; 11] = ["q", "qd", "qdd", "t", "X", "Xd", "Xdd", "point
 fn get<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<Option<T>> {
     match d.get_item(k)? {
         Some(v) if !v.is_none() => {
-            Ok(Some(v.extract::<T>().map_err(|e| PyValueError::new_err(format!("{k}: {}", Into::<PyErr>::into(e))))?))
+            Ok(Some(v.extract::<T>().map_err(|e| argument_error(Some(k), format!("{k}: {}", Into::<PyErr>::into(e))))?))
         }
         _ => Ok(None),
     }
 }
 
 fn require<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<T> {
-    get(d, k)?.ok_or_else(|| PyValueError::new_err(format!("the motion needs {k:?}")))
+    get(d, k)?.ok_or_else(|| argument_error(Some(k), format!("the motion needs {k:?}")))
 }
 
 fn check_keys(d: &Bound<'_, PyDict>, keys: &[&str], what: &str) -> PyResult<()> {
     for k in d.keys() {
         let k: String = k.extract()?;
         if !keys.contains(&k.as_str()) {
-            return Err(PyValueError::new_err(format!("unknown {what} {k:?}; expected one of {}", keys.join(", "))));
+            return Err(argument_error(Some(&k), format!("unknown {what} {k:?}; expected one of {}", keys.join(", "))));
         }
     }
     Ok(())
@@ -60,7 +58,8 @@ fn overrides(mech: &Mechanism, d: &Bound<'_, PyDict>) -> PyResult<Overrides> {
         .into_iter()
         .map(|(k, entry)| match entry {
             MotionEntry::Law(law) => Ok((k, law)),
-            MotionEntry::Function(_) => Err(PyValueError::new_err(
+            MotionEntry::Function(_) => Err(argument_error(
+                Some("motion"),
                 "a batch's motions are speeds or tables; a Python function runs only in Mechanism.simulate",
             )),
         })
@@ -106,7 +105,7 @@ fn run_until_interrupt<T: Send>(
                     }
                     Err(mpsc::RecvTimeoutError::Timeout) => {}
                     Err(mpsc::RecvTimeoutError::Disconnected) => {
-                        return Err(PyValueError::new_err("the batch worker stopped without a result").into());
+                        return Err(PlanardynError::new_err("the batch worker stopped without a result").into());
                     }
                 }
             }
@@ -161,7 +160,7 @@ fn simulate_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(Variant { model: Model::Built(m.get().inner.clone()), overrides: overrides(&m.get().inner, d)? })
+        Ok(Variant { model: m.get().inner.clone(), overrides: overrides(&m.get().inner, d)? })
     };
     let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
     run_batch(py, &variants, threads, make, solve, |r, _| match r {
@@ -221,7 +220,7 @@ fn inverse_batch<'py>(
     threads: Option<usize>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(InverseVariant { model: Model::Built(m.get().inner.clone()), motion: motion(d)? })
+        Ok(InverseVariant { model: m.get().inner.clone(), motion: motion(d)? })
     };
     run_batch(
         py,

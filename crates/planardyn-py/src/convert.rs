@@ -1,10 +1,43 @@
 //! Conversions between numpy arrays (float64, C order, time-major) and the core's slices,
 //! with shape checks whose messages name the argument, the expected shape and its meaning.
 
+use crate::errors::{argument_error, PlanardynError};
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, IxDyn};
 use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use planardyn::dynamics::task::TaskSolution;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::ops::Deref;
+
+/// An array argument read as float64 (numpy's conversion of any array-like). Something numpy
+/// cannot read as numbers (a string, a ragged list) is a `TypeError`, as an argument of the
+/// wrong type is everywhere else, where numpy raises `ValueError`; pyo3 prefixes it with the
+/// argument's name.
+pub struct Floats<'py>(PyArrayLikeDyn<'py, f64, AllowTypeChange>);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Floats<'py> {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let py = ob.py();
+        <PyArrayLikeDyn<'py, f64, AllowTypeChange> as FromPyObject<'a, 'py>>::extract(ob).map(Floats).map_err(|e| {
+            if e.is_instance_of::<PyValueError>(py) {
+                PyTypeError::new_err(format!("an array of numbers is needed ({})", e.value(py)))
+            } else {
+                e
+            }
+        })
+    }
+}
+
+impl<'py> Deref for Floats<'py> {
+    type Target = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
 
 /// An argument read as float64 values in C order, with its shape.
 pub struct Values {
@@ -40,10 +73,10 @@ fn shape_str(shape: &[usize]) -> String {
 pub fn vector(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize, what: &str) -> PyResult<Vec<f64>> {
     let v = Values::read(a);
     if v.shape != [len] {
-        return Err(PyValueError::new_err(format!(
-            "{name} must have shape ({len},) ({what}), got shape {}",
-            shape_str(&v.shape)
-        )));
+        return Err(argument_error(
+            Some(name),
+            format!("{name} must have shape ({len},) ({what}), got shape {}", shape_str(&v.shape)),
+        ));
     }
     finite(name, &v.data)?;
     Ok(v.data)
@@ -58,10 +91,10 @@ pub fn rows(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize
         _ => false,
     };
     if !ok {
-        return Err(PyValueError::new_err(format!(
-            "{name} must have shape ({len},) or (N, {len}) ({what}), got shape {}",
-            shape_str(&v.shape)
-        )));
+        return Err(argument_error(
+            Some(name),
+            format!("{name} must have shape ({len},) or (N, {len}) ({what}), got shape {}", shape_str(&v.shape)),
+        ));
     }
     finite(name, &v.data)?;
     Ok(v)
@@ -69,7 +102,7 @@ pub fn rows(name: &str, a: &PyArrayLikeDyn<'_, f64, AllowTypeChange>, len: usize
 
 pub fn finite(name: &str, data: &[f64]) -> PyResult<()> {
     match data.iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(PyValueError::new_err(format!("{name}[{i}] = {} is not a finite number", data[i]))),
+        Some(i) => Err(argument_error(Some(name), format!("{name}[{i}] = {} is not a finite number", data[i]))),
         None => Ok(()),
     }
 }
@@ -80,20 +113,34 @@ pub fn arr1<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
 
 /// An (rows, cols) array from row-major data.
 pub fn arr2<'py>(py: Python<'py>, rows: usize, cols: usize, v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let a = Array2::from_shape_vec((rows, cols), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = Array2::from_shape_vec((rows, cols), v).map_err(|e| PlanardynError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any())
 }
 
 pub fn arr3<'py>(py: Python<'py>, shape: (usize, usize, usize), v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let a = Array3::from_shape_vec(shape, v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = Array3::from_shape_vec(shape, v).map_err(|e| PlanardynError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any())
 }
 
 pub fn arr_dyn<'py>(py: Python<'py>, shape: &[usize], v: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| PlanardynError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any())
 }
 
 pub fn bool1<'py>(py: Python<'py>, v: Vec<bool>) -> Bound<'py, PyAny> {
     Array1::from_vec(v).into_pyarray(py).into_any()
+}
+
+/// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
+/// `q`, `qd`, `qdd`, `tau` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
+pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let TaskSolution { q, qd, qdd, tau, sigma_i, sigma_ii, condition } = s;
+    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)] {
+        d.set_item(k, arr2(py, v.len() / m.max(1), m, v)?)?;
+    }
+    for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
+        d.set_item(k, arr1(py, v))?;
+    }
+    Ok(d)
 }

@@ -1,10 +1,9 @@
 //! `planardyn._core.DenseOutput`: a run's continuous solution (the core's
 //! `simulate::DenseOutput`), called with times to give q and qd there.
 
-use crate::convert::{arr1, arr2, Values};
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
+use crate::convert::{arr1, arr2, Floats, Values};
+use crate::errors::argument_error;
 use planardyn::simulate::DenseOutput;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 #[pyclass(frozen, module = "planardyn._core", name = "DenseOutput")]
@@ -15,24 +14,20 @@ pub struct PyDenseOutput {
 #[pymethods]
 impl PyDenseOutput {
     /// (q, qd) at time(s) t (s): (m,) each for a number, (K, m) each for (K,) times.
-    fn __call__<'py>(
-        &self,
-        py: Python<'py>,
-        t: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    fn __call__<'py>(&self, py: Python<'py>, t: Floats<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let v = Values::read(&t);
         if v.shape.len() > 1 {
-            return Err(PyValueError::new_err(format!(
-                "sol(t) takes a time or a 1-D array of times, got shape {:?}",
-                v.shape
-            )));
+            return Err(argument_error(
+                Some("t"),
+                format!("sol(t) takes a time or a 1-D array of times, got shape {:?}", v.shape),
+            ));
         }
         let m = self.inner.m;
         let (mut q, mut qd) = (vec![0.0; v.data.len() * m], vec![0.0; v.data.len() * m]);
         for (k, &tk) in v.data.iter().enumerate() {
             self.inner
                 .eval(tk, &mut q[k * m..(k + 1) * m], &mut qd[k * m..(k + 1) * m])
-                .map_err(|e| PyValueError::new_err(format!("sol(t): {e}")))?;
+                .map_err(|e| argument_error(Some("t"), format!("sol(t): {e}")))?;
         }
         if v.shape.is_empty() {
             return Ok((arr1(py, q), arr1(py, qd)));

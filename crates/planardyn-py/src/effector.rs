@@ -3,41 +3,25 @@
 //! its own `Workspace`, started at the body coordinates `x_start` when given, else at the
 //! drawing.
 
-use crate::convert::{arr1, arr2, finite, rows, vector, Values};
-use crate::errors::{effector_error, run, task_error, Failure};
+use crate::convert::{arr1, arr2, finite, rows, solution_dict, vector, Floats, Values};
+use crate::errors::{argument_error, effector_error, run, task_error, Failure};
 use crate::mechanism::PyMechanism;
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
-use planardyn::dynamics::task::{self, TaskPath, TaskSolution};
+use planardyn::dynamics::task::{self, TaskPath};
 use planardyn::kinematics::constraints::coordinates;
 use planardyn::kinematics::effector::{Effector, EffectorState};
 use planardyn::kinematics::{self as kin};
 use planardyn::{Mechanism, Workspace};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
 
-type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+type ArrayArg<'py> = Floats<'py>;
 
 /// A point of a body (k = 2) or its body's pose (k = 3) as task coordinates.
 #[pyclass(frozen, module = "planardyn._core", name = "Effector")]
 pub struct PyEffector {
     mech: Arc<Mechanism>,
     ee: Effector,
-}
-
-/// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
-/// `q`, `qd`, `qdd`, `tau` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
-pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let TaskSolution { q, qd, qdd, tau, sigma_i, sigma_ii, condition } = s;
-    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)] {
-        d.set_item(k, arr2(py, v.len() / m.max(1), m, v)?)?;
-    }
-    for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {
-        d.set_item(k, arr1(py, v))?;
-    }
-    Ok(d)
 }
 
 impl PyEffector {
@@ -94,7 +78,7 @@ impl PyEffector {
     #[pyo3(signature = (mech, point, body=None))]
     fn new(mech: &Bound<'_, PyMechanism>, point: &str, body: Option<&str>) -> PyResult<Self> {
         let mech = mech.get().inner.clone();
-        let ee = Effector::new(&mech, point, body).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let ee = Effector::new(&mech, point, body).map_err(|e| argument_error(Some("point"), e.to_string()))?;
         Ok(PyEffector { mech, ee })
     }
 
@@ -155,12 +139,10 @@ impl PyEffector {
     fn measures(&self, jt: ArrayArg<'_>) -> PyResult<(f64, f64)> {
         let v = Values::read(&jt);
         if v.shape != [self.ee.dim, self.m()] {
-            return Err(PyValueError::new_err(format!(
-                "J must have shape ({}, {}), got {:?}",
-                self.ee.dim,
-                self.m(),
-                v.shape
-            )));
+            return Err(argument_error(
+                Some("jt"),
+                format!("J must have shape ({}, {}), got {:?}", self.ee.dim, self.m(), v.shape),
+            ));
         }
         Ok(self.ee.measures(&v.data))
     }

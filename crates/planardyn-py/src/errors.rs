@@ -5,6 +5,8 @@
 //! ```text
 //! PlanardynError(Exception)
 //! ├── ModelError(PlanardynError, ValueError)   a model file or dict that is not a mechanism
+//! ├── ArgumentError(PlanardynError, ValueError) an argument of the wrong shape or value
+//! ├── DataError(PlanardynError, ValueError)    a data file or table that cannot be used
 //! ├── AssemblyError                            KinematicsError::AssemblyFailed
 //! ├── SingularityError                         KinematicsError::Singular, Error::BranchUndecided
 //! └── SimulationError                          Error::Options, Error::Drive
@@ -17,13 +19,17 @@
 //! the data of where the motion stopped as attributes. A failure at one row of a trajectory
 //! (`Error::Row`) is its row's error, with attributes `row` and `t` and the row in the message.
 //!
-//! Shape and value errors in the arguments are plain `ValueError`s (attribute `argument`
-//! where the core names it), and so are finite arguments whose results overflow
-//! (`KinematicsError::Overflow`, attribute `quantity`). A core error of a kind added later is a `PlanardynError`. A Rust panic never
+//! Shape and value errors in the arguments (`KinematicsError::BadArgument`, and the glue's own
+//! shape and finiteness checks) are `ArgumentError`s, attribute `argument` naming it (None where
+//! no one argument is at fault), and so are finite arguments whose results overflow
+//! (`KinematicsError::Overflow`, attribute `quantity`). Both classes are also `ValueError`s, as
+//! such errors were before they had their own class. `DataError` is raised by the Python side
+//! (results files, measured motions, data that cannot identify). A core error of a kind added
+//! later is a `PlanardynError`. A Rust panic never
 //! reaches Python as `PanicException`: [`run`] catches it and raises `PlanardynError` asking
 //! for a bug report.
 
-use crate::effector::solution_dict;
+use crate::convert::solution_dict;
 use planardyn::dynamics::task::{TaskError, TaskSolution};
 use planardyn::kinematics::EffectorError;
 use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
@@ -58,27 +64,65 @@ create_exception!(
     "Invalid simulation options, or a run that could not start."
 );
 
-/// `ModelError(PlanardynError, ValueError)`: two bases, so it is made with `type(...)`
-/// (`create_exception!` takes one base). Attributes `source` and `path`.
-static MODEL_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+/// The classes that are both a `PlanardynError` and a `ValueError`, made with `type(...)`
+/// (`create_exception!` takes one base): their name and docstring.
+const MODEL_ERROR_DOC: &str = "A model that cannot be built: malformed YAML/JSON, a wrong field, or a drawing \
+     that is not a mechanism. The message names the source and the field path; attributes `source` (file or \
+     '<string>') and `path` (e.g. 'bodies.crank.mass', or 'line 3 column 5' where no field can be named).";
+const ARGUMENT_ERROR_DOC: &str = "An argument planardyn cannot compute with: the wrong shape, a NaN or an infinity, \
+     a value out of its range (zero, negative, too large), or finite values whose result overflows. The message \
+     names the argument and says what it must be; attribute `argument` (its name, or None).";
+const DATA_ERROR_DOC: &str = "Data planardyn cannot use: a results file or motion table that is damaged or not \
+     one, a measured motion with a NaN, too few rows, or rows that cannot identify the parameters. The message \
+     names the file (or the argument) and says what to change; attribute `path` (the file, or None).";
 
+static MODEL_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static ARGUMENT_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static DATA_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+fn value_error_type<'py>(
+    py: Python<'py>,
+    cell: &'static PyOnceLock<Py<PyType>>,
+    name: &str,
+    doc: &str,
+) -> PyResult<&'py Bound<'py, PyType>> {
+    cell.get_or_try_init(py, || {
+        let bases = PyTuple::new(py, [py.get_type::<PlanardynError>(), py.get_type::<PyValueError>()])?;
+        let ns = PyDict::new(py);
+        ns.set_item("__module__", "planardyn")?;
+        ns.set_item("__doc__", doc)?;
+        let ty = py.get_type::<PyType>().call1((name, bases, ns))?;
+        Ok::<_, PyErr>(ty.cast_into::<PyType>()?.unbind())
+    })
+    .map(|t| t.bind(py))
+}
+
+/// `ModelError(PlanardynError, ValueError)`, attributes `source` and `path`.
 pub fn model_error_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
-    MODEL_ERROR
-        .get_or_try_init(py, || {
-            let bases = PyTuple::new(py, [py.get_type::<PlanardynError>(), py.get_type::<PyValueError>()])?;
-            let ns = PyDict::new(py);
-            ns.set_item("__module__", "planardyn")?;
-            ns.set_item(
-                "__doc__",
-                "A model that cannot be built: malformed YAML/JSON, a wrong field, or a drawing \
-                 that is not a mechanism. The message names the source and the field path; \
-                 attributes `source` (file or '<string>') and `path` (e.g. 'bodies.crank.mass', or \
-                 'line 3 column 5' where no field can be named).",
-            )?;
-            let ty = py.get_type::<PyType>().call1(("ModelError", bases, ns))?;
-            Ok::<_, PyErr>(ty.cast_into::<PyType>()?.unbind())
-        })
-        .map(|t| t.bind(py))
+    value_error_type(py, &MODEL_ERROR, "ModelError", MODEL_ERROR_DOC)
+}
+
+/// `ArgumentError(PlanardynError, ValueError)`, attribute `argument`.
+pub fn argument_error_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
+    value_error_type(py, &ARGUMENT_ERROR, "ArgumentError", ARGUMENT_ERROR_DOC)
+}
+
+/// `DataError(PlanardynError, ValueError)`, attribute `path`.
+pub fn data_error_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
+    value_error_type(py, &DATA_ERROR, "DataError", DATA_ERROR_DOC)
+}
+
+/// An `ArgumentError` for argument `name` (None: no one argument) with `message`.
+pub fn argument_error(name: Option<&str>, message: impl Into<String>) -> PyErr {
+    let message = message.into();
+    Python::attach(|py| {
+        let ty = match argument_error_type(py) {
+            Ok(t) => t.clone(),
+            Err(err) => return err,
+        };
+        let err = PyErr::from_type(ty, message);
+        set_attrs(py, err, vec![("argument", attr(py, name))])
+    })
 }
 
 /// Register the exception classes in the module.
@@ -86,6 +130,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("PlanardynError", py.get_type::<PlanardynError>())?;
     m.add("ModelError", model_error_type(py)?)?;
+    m.add("ArgumentError", argument_error_type(py)?)?;
+    m.add("DataError", data_error_type(py)?)?;
     m.add("AssemblyError", py.get_type::<AssemblyError>())?;
     m.add("SingularityError", py.get_type::<SingularityError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
@@ -136,12 +182,9 @@ pub fn kinematics_error(py: Python<'_>, e: &KinematicsError) -> PyErr {
         }
         KinematicsError::Overflow { what } => {
             let Ok(w) = what.into_pyobject(py);
-            with_attrs(py, PyValueError::new_err(e.to_string()), &[("quantity", w.into_any().unbind())])
+            with_attrs(py, argument_error(None, e.to_string()), &[("quantity", w.into_any().unbind())])
         }
-        KinematicsError::BadArgument { name, .. } => {
-            let Ok(n) = name.into_pyobject(py);
-            with_attrs(py, PyValueError::new_err(e.to_string()), &[("argument", n.into_any().unbind())])
-        }
+        KinematicsError::BadArgument { name, .. } => argument_error(Some(name), e.to_string()),
         KinematicsError::FrictionUnsettled { iterations, change } => {
             let Ok(i) = iterations.into_pyobject(py);
             let Ok(c) = change.into_pyobject(py);
@@ -180,7 +223,7 @@ pub fn effector_error(py: Python<'_>, e: &EffectorError) -> PyErr {
 
 /// A task motion that failed: `SingularityError` (attributes `kind` 'I' or 'II', `t` (s), `X`
 /// (k,), `q` (m,), `sigma`, `tol`) or `AssemblyError` (attribute `t`), both with `partial_rows`,
-/// the dict of the motion solved before the failure (see `effector::solution_dict`).
+/// the dict of the motion solved before the failure (see `convert::solution_dict`).
 pub fn task_error(py: Python<'_>, e: &TaskError) -> PyErr {
     let partial = |p: &TaskSolution, m: usize| solution_dict(py, p.clone(), m).ok().map(|d| d.into_any().unbind());
     match e {

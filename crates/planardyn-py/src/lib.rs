@@ -14,10 +14,9 @@ mod mechanism;
 mod simulate;
 mod structure;
 
-use errors::{model_error, PlanardynError};
+use errors::{argument_error, model_error, PlanardynError};
 use mechanism::PyMechanism;
 use planardyn::Format;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -48,7 +47,7 @@ fn loads(py: Python<'_>, text: &str, format: &str, source: &str) -> PyResult<PyM
     let format = match format.to_ascii_lowercase().as_str() {
         "yaml" | "yml" => Format::Yaml,
         "json" => Format::Json,
-        other => return Err(PyValueError::new_err(format!("format must be 'yaml' or 'json', got {other:?}"))),
+        other => return Err(argument_error(Some("format"), format!("format must be 'yaml' or 'json', got {other:?}"))),
     };
     let (text, source) = (text.to_owned(), source.to_owned());
     let r = py.detach(|| catch_unwind(AssertUnwindSafe(|| planardyn::loads(&text, format, &source))));

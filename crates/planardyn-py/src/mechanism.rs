@@ -4,22 +4,20 @@
 //! reproducible (positions come by continuation from the drawing) and thread-safe; the
 //! GIL is released while the core computes.
 
-use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Values};
-use crate::errors::{run, Failure};
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
+use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
+use crate::errors::{argument_error, kinematics_error, run, Failure, PlanardynError};
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
-use planardyn::kinematics::pairs::{self, pair_geometry, Relative};
 use planardyn::kinematics::{self as kin, Chart};
+use planardyn::model::pairs::{self, pair_geometry, Relative};
 use planardyn::model::{CoordinateKind, Link, PairId};
 use planardyn::{Error, Mechanism, Workspace};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
 
-type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+type ArrayArg<'py> = Floats<'py>;
 
 fn kind_name(kind: CoordinateKind) -> &'static str {
     match kind {
@@ -95,19 +93,22 @@ impl PyMechanism {
         if let Some(xd) = &xd {
             if x.as_ref().map(|x| &x.shape) != Some(&xd.shape) {
                 let x_shape = x.as_ref().map(|x| format!("{:?}", x.shape)).unwrap_or_else(|| "none".into());
-                return Err(PyValueError::new_err(format!(
-                    "xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}",
-                    xd.shape
-                )));
+                return Err(argument_error(
+                    Some("xd"),
+                    format!("xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}", xd.shape),
+                ));
             }
         }
         let (m, what) = (self.m(), self.coords_what());
         let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
         if qd.shape != q.shape || qdd.shape != q.shape {
-            return Err(PyValueError::new_err(format!(
-                "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
-                q.shape, qd.shape, qdd.shape
-            )));
+            return Err(argument_error(
+                None,
+                format!(
+                    "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
+                    q.shape, qd.shape, qdd.shape
+                ),
+            ));
         }
         Ok((q, qd, qdd, x, xd))
     }
@@ -599,24 +600,29 @@ impl PyMechanism {
         qd: ArrayArg<'py>,
         tau: ArrayArg<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        if qd.as_array().shape() != tau.as_array().shape() {
+            return Err(argument_error(
+                Some("tau"),
+                format!(
+                    "qd and tau must have the same shape, got {:?} and {:?}",
+                    qd.as_array().shape(),
+                    tau.as_array().shape()
+                ),
+            ));
+        }
+        let n_a = self.inner.n_actuators();
         let every = tau.as_array().shape().last() == Some(&n_a);
         let (m, what) = if every {
-            (n_a, format!("one per actuator: {}", dynamics::redundant::actuator_names(&self.inner).join(", ")))
+            (n_a, format!("one per actuator: {}", self.inner.actuator_names().join(", ")))
         } else {
             (self.m(), self.coords_what())
         };
         let (qd, tau) = (rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
-        if qd.shape != tau.shape {
-            return Err(PyValueError::new_err(format!(
-                "qd and tau must have the same shape, got {:?} and {:?}",
-                qd.shape, tau.shape
-            )));
-        }
         let mut out = vec![0.0; tau.data.len()];
         for ((o, qd), tau) in out.chunks_exact_mut(m).zip(qd.data.chunks_exact(m)).zip(tau.data.chunks_exact(m)) {
             dynamics::motor_torques(&self.inner, qd, tau, o);
         }
+        let out = dynamics::finite("motor torques", out).map_err(|e| kinematics_error(py, &e))?;
         arr_dyn(py, &tau.shape, out)
     }
 
@@ -659,10 +665,10 @@ impl PyMechanism {
         speed: ArrayArg<'py>,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
         let Some(slot) = dynamics::transmission::motors(&self.inner).nth(coordinate) else {
-            return Err(PyValueError::new_err(format!(
-                "actuator {coordinate} out of range: the model has {} actuators",
-                dynamics::redundant::n_actuators(&self.inner)
-            )));
+            return Err(argument_error(
+                Some("coordinate"),
+                format!("actuator {coordinate} out of range: the model has {} actuators", self.inner.n_actuators()),
+            ));
         };
         let Some(a) = slot else { return Ok(None) };
         let v = Values::read(&speed);
@@ -673,7 +679,7 @@ impl PyMechanism {
     /// The actuators' names: the coordinates', then the redundant actuators' on pairs.
     #[getter]
     fn actuator_names(&self) -> Vec<String> {
-        dynamics::redundant::actuator_names(&self.inner)
+        self.inner.actuator_names()
     }
 
     /// Every actuator's effort (n_a,) for (q, qd, qdd), each (m,), shared by `method`
@@ -699,10 +705,13 @@ impl PyMechanism {
             ("min_max", None) => Distribution::MinMax,
             ("preload", Some(p)) => Distribution::Preload(p),
             _ => {
-                return Err(PyValueError::new_err(format!(
-                    "method {method:?}: use \"min_norm\", \"min_max\", or \"preload\" with preload=[one value \
+                return Err(argument_error(
+                    Some("method"),
+                    format!(
+                        "method {method:?}: use \"min_norm\", \"min_max\", or \"preload\" with preload=[one value \
                      per internal force] (and preload only with it)"
-                )))
+                    ),
+                ))
             }
         };
         let mech = self.inner.clone();
@@ -730,7 +739,7 @@ impl PyMechanism {
         t: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
-        let n_a = dynamics::redundant::n_actuators(&self.inner);
+        let n_a = self.inner.n_actuators();
         let efforts = vector("efforts", &efforts, n_a, "one value per actuator (actuator_names)")?;
         check_time(t)?;
         let mech = self.inner.clone();
@@ -852,10 +861,13 @@ impl PyMechanism {
         let what = "body coordinates [X, Y, phi] per body";
         let (x, xd, xdd) = (rows("x", &x, nx, what)?, rows("xd", &xd, nx, what)?, rows("xdd", &xdd, nx, what)?);
         if xd.data.len() != x.data.len() || xdd.data.len() != x.data.len() {
-            return Err(PyValueError::new_err(format!(
-                "x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}",
-                x.shape, xd.shape, xdd.shape
-            )));
+            return Err(argument_error(
+                None,
+                format!(
+                    "x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}",
+                    x.shape, xd.shape, xdd.shape
+                ),
+            ));
         }
         let mech = &self.inner;
         let names: Vec<&str> =
@@ -922,10 +934,10 @@ impl PyMechanism {
             .map(|a| {
                 let v = Values::read(&a);
                 if v.shape.len() != 1 {
-                    return Err(PyValueError::new_err(format!(
-                        "t_eval must be 1-D (output times in s), got shape {:?}",
-                        v.shape
-                    )));
+                    return Err(argument_error(
+                        Some("t_eval"),
+                        format!("t_eval must be 1-D (output times in s), got shape {:?}", v.shape),
+                    ));
                 }
                 crate::convert::finite("t_eval", &v.data)?;
                 Ok(v.data)
@@ -975,12 +987,13 @@ fn check_time(t: f64) -> PyResult<()> {
     if t.is_finite() {
         Ok(())
     } else {
-        Err(PyValueError::new_err(format!("t = {t} must be a finite time (s)")))
+        Err(argument_error(Some("t"), format!("t = {t} must be a finite time (s)")))
     }
 }
 
 fn planardyn_spec_json(mech: &Mechanism) -> PyResult<String> {
-    serde_json::to_string(&mech.spec).map_err(|e| PyValueError::new_err(format!("cannot write the model as JSON: {e}")))
+    serde_json::to_string(&mech.spec)
+        .map_err(|e| PlanardynError::new_err(format!("cannot write the model as JSON: {e}")))
 }
 
 /// A motion's q, qd, qdd rows and the optional body coordinates x and rates xd of its rows.

@@ -4,13 +4,13 @@
 //! callbacks re-attach to the interpreter for the duration of each call.
 
 use crate::convert::{arr1, arr2, bool1, Values};
-use crate::errors::{run, Failure};
+use crate::errors::{argument_error, run, Failure};
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
 use planardyn::simulate::{Event, EventFn, Observe, Overrides, Settings, Trajectory};
 use planardyn::Mechanism;
-use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::sync::Mutex;
@@ -29,7 +29,9 @@ pub(crate) const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
 fn settings(mech: &Mechanism, a: &Overrides) -> Result<Settings, Failure> {
     if let Some(t_end) = a.t_end {
         if !(t_end.is_finite() && t_end > 0.0) {
-            return Err(PyValueError::new_err(format!("t_end = {t_end} must be a finite time after t0 = 0 s")).into());
+            return Err(
+                argument_error(Some("t_end"), format!("t_end = {t_end} must be a finite time after t0 = 0 s")).into()
+            );
         }
     }
     Ok(a.settings(mech)?)
@@ -170,14 +172,16 @@ pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) 
     motion
         .into_iter()
         .map(|(k, arg)| {
-            let name = names.get(k).ok_or_else(|| PyValueError::new_err(format!("motion: no coordinate {k}")))?;
+            let name =
+                names.get(k).ok_or_else(|| argument_error(Some("motion"), format!("motion: no coordinate {k}")))?;
             let entry = match arg {
                 MotionArg::Speed(w) if w.is_finite() => MotionEntry::Law(MotionLaw::Speed(w)),
                 MotionArg::Speed(w) => {
-                    return Err(PyValueError::new_err(format!("motion of '{name}': speed {w} must be finite")))
+                    return Err(argument_error(Some("motion"), format!("motion of '{name}': speed {w} must be finite")))
                 }
                 MotionArg::Table(t, q) => MotionEntry::Law(MotionLaw::Table(
-                    Spline::new(&t, &q).map_err(|e| PyValueError::new_err(format!("motion table of '{name}': {e}")))?,
+                    Spline::new(&t, &q)
+                        .map_err(|e| argument_error(Some("motion"), format!("motion table of '{name}': {e}")))?,
                 )),
                 MotionArg::Function(f) => MotionEntry::Function(PyMotion { f, name: name.to_string(), fatal: None }),
             };
@@ -249,7 +253,7 @@ pub fn simulate<'py>(
                 MotionEntry::Law(law) => Motion::Law(law.clone()),
                 MotionEntry::Function(f) => Motion::Function(f),
             };
-            prescribed.set(*k, motion).map_err(PyValueError::new_err)?;
+            prescribed.set(*k, motion).map_err(|e| argument_error(Some("motion"), e))?;
         }
         let observe = Observe { events: core_events(&events, &event_fatal), dense_output };
         Ok(planardyn::simulate::simulate_observed(mech, &s, d, &mut prescribed, observe, Some(&mut on_step))?)

@@ -1,18 +1,18 @@
 //! Structural analysis (`planardyn.structure`): the core's `planardyn::structure` results as
 //! Python dicts of names and numbers, and the pair-constraint Jacobian Phi_x.
 
-use crate::convert::{arr1, arr2, vector};
+use crate::convert::{arr1, arr2, vector, Floats};
 use crate::errors::{kinematics_error, model_error};
 use crate::mechanism::PyMechanism;
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
 use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x};
-use planardyn::model::{parse_spec, Link};
-use planardyn::structure::{analyse, analyse_spec, scaled_constraint_jacobian, Structure};
+use planardyn::loader::{analyse_spec, parse_spec};
+use planardyn::model::Link;
+use planardyn::structure::{analyse, scaled_constraint_jacobian, Structure};
 use planardyn::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-type ArrayArg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+type ArrayArg<'py> = Floats<'py>;
 
 /// The pair-constraint Jacobian Phi_x = dPhi/dx at body coordinates x: shape
 /// (`n_pair_rows`, 3n), every pair's rows in pair order, also the ones the core leaves out
@@ -56,7 +56,7 @@ pub fn structure<'py>(py: Python<'py>, mech: &PyMechanism, x: Option<ArrayArg<'p
 }
 
 /// The structural analysis of a model (JSON text) at its drawing, also of a model whose
-/// mobility differs from its coordinates (`planardyn::structure::analyse_spec`).
+/// mobility differs from its coordinates (`planardyn::loader::analyse_spec`).
 #[pyfunction]
 #[pyo3(signature = (text, source="<dict>"))]
 pub fn structure_of_model<'py>(py: Python<'py>, text: &str, source: &str) -> PyResult<Bound<'py, PyDict>> {

@@ -5,9 +5,9 @@
 //! [`Mechanism`] is immutable and `Send + Sync`, so variants may share one; every task makes
 //! its own [`crate::Workspace`] inside [`simulate`](crate::simulate::simulate). Each variant
 //! gets its own `Result`: a failing one (a start that cannot be assembled, invalid
-//! settings, a spec that is not a mechanism) leaves the others untouched. The outputs are in
-//! the order of the inputs and equal, bit for bit, those of a serial loop: a run does not
-//! depend on which thread it lands on.
+//! settings) leaves the others untouched. The outputs are in the order of the inputs and
+//! equal, bit for bit, those of a serial loop: a run does not depend on which thread it
+//! lands on.
 //!
 //! Inverse dynamics runs the same way ([`inverse_many`]): each variant a model and a motion,
 //! either in the coordinates (q, qd, qdd rows) or of an end effector along a sampled path
@@ -21,39 +21,23 @@ use crate::kinematics::{assemble_from, assemble_into, continue_to};
 use crate::simulate::charts::SWITCH_TO_PARTITION;
 pub use crate::simulate::Overrides;
 use crate::simulate::{simulate_prescribed, Trajectory};
-use crate::{Error, KinematicsError, Mechanism, MechanismSpec, Workspace};
+use crate::{Error, KinematicsError, Mechanism, Workspace};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use task::{TaskError, TaskPath, TaskSolution};
 
-/// The model of a variant: a built mechanism (shared, not copied) or a specification that
-/// is validated inside the task, so that building many edited models runs in parallel too.
-#[derive(Debug, Clone)]
-pub enum Model {
-    Built(Arc<Mechanism>),
-    Spec(Box<MechanismSpec>),
-}
-
-/// One variant: its model and its settings.
+/// One variant: its mechanism (shared, not copied) and its settings. Edited specifications
+/// are built by the loader first (`crate::build`, in parallel with [`map_many`]): the
+/// batch runs built mechanisms only, as the engine below the loader.
 #[derive(Debug, Clone)]
 pub struct Variant {
-    pub model: Model,
+    pub model: Arc<Mechanism>,
     pub overrides: Overrides,
 }
 
-impl Model {
-    /// Run `f` on the built mechanism (building a specification first, in this thread).
-    fn with<R, E: From<Error>>(&self, f: impl FnOnce(&Mechanism) -> Result<R, E>) -> Result<R, E> {
-        match self {
-            Model::Built(m) => f(m),
-            Model::Spec(spec) => f(&Mechanism::new((**spec).clone(), "<variant>").map_err(Error::from)?),
-        }
-    }
-}
-
 impl Variant {
-    /// Build (if needed), set up and simulate with the model's drives, in the caller's thread.
+    /// Set up and simulate with the model's drives, in the caller's thread.
     pub fn simulate(&self) -> Result<Trajectory, Error> {
         self.simulate_until(&AtomicBool::new(false))
     }
@@ -62,12 +46,11 @@ impl Variant {
     /// driven by them), stopping at the first step after `stop` is set (status
     /// `Cancelled`, the trajectory so far kept).
     pub fn simulate_until(&self, stop: &AtomicBool) -> Result<Trajectory, Error> {
-        self.model.with(|mech| {
-            let settings = self.overrides.settings(mech)?;
-            let mut motion = self.overrides.prescribed(mech)?;
-            let mut go_on = |_t: f64| !stop.load(Ordering::Relaxed);
-            simulate_prescribed(mech, &settings, &mut ModelDrives(mech), &mut motion, Some(&mut go_on))
-        })
+        let mech = &*self.model;
+        let settings = self.overrides.settings(mech)?;
+        let mut motion = self.overrides.prescribed(mech)?;
+        let mut go_on = |_t: f64| !stop.load(Ordering::Relaxed);
+        simulate_prescribed(mech, &settings, &mut ModelDrives(mech), &mut motion, Some(&mut go_on))
     }
 }
 
@@ -90,17 +73,18 @@ pub enum Efforts {
 /// One inverse-dynamics variant: its model and its motion.
 #[derive(Debug, Clone)]
 pub struct InverseVariant {
-    pub model: Model,
+    pub model: Arc<Mechanism>,
     pub motion: Motion,
 }
 
 impl InverseVariant {
-    /// Build (if needed) and solve, in the caller's thread.
+    /// Solve, in the caller's thread.
     pub fn solve(&self) -> Result<Efforts, TaskError> {
-        self.model.with(|mech| match &self.motion {
+        let mech = &*self.model;
+        match &self.motion {
             Motion::Coordinates { q, qd, qdd } => Ok(Efforts::Coordinates(inverse_rows(mech, q, qd, qdd)?)),
             Motion::Task(path) => Ok(Efforts::Task(task::solve(mech, path)?)),
-        })
+        }
     }
 }
 

@@ -10,6 +10,12 @@
 //! A mechanism is described as it is drawn (a model file, see `docs/model-format.md`),
 //! validated once into an immutable [`Mechanism`]; every computation runs in a
 //! [`Workspace`] of buffers sized once. SI units and radians throughout.
+//!
+//! The modules are layers, bottom to top, each using only those below it (declared in
+//! `crates/layers.toml`, checked by `tools/rust_layers.py` in `./dev test`): [`error`] and
+//! [`linalg`]; the [`model`], pure data with the pair and load kinds; [`topology`];
+//! [`kinematics`]; [`dynamics`]; the [`structure`] report; [`integrate`] (independent of the
+//! mechanics); [`simulate`]; [`batch`]; and the [`loader`] on top.
 
 // `!(x > 0.0)` is how the validators reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -20,12 +26,15 @@ pub mod error;
 pub mod integrate;
 pub mod kinematics;
 pub mod linalg;
+pub mod loader;
 pub mod model;
 pub mod simulate;
 pub mod structure;
+pub mod topology;
 pub mod workspace;
 
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};
-pub use model::{load, loads, Format, Mechanism, MechanismSpec};
+pub use loader::{analyse_spec, build, load, loads, Format};
+pub use model::{Mechanism, MechanismSpec};
 pub use structure::{analyse, Structure};
 pub use workspace::Workspace;

@@ -1,12 +1,13 @@
 //! Batch runs: a parallel batch equals a serial loop bit for bit, in input order; a failing
-//! variant reports its own error and leaves the others untouched; specs are built per task.
+//! variant reports its own error and leaves the others untouched; edited specs are built by
+//! the loader in parallel, then run.
 
 mod common;
 use common::*;
-use planardyn::batch::{simulate_many, Model, Overrides, Variant};
+use planardyn::batch::{map_many, simulate_many, Overrides, Variant};
 use planardyn::dynamics::ModelDrives;
 use planardyn::simulate::{simulate, Trajectory};
-use planardyn::{Error, KinematicsError};
+use planardyn::{Error, KinematicsError, ModelError};
 use std::sync::Arc;
 
 fn same(a: &Trajectory, b: &Trajectory) {
@@ -22,7 +23,7 @@ fn variants(mech: &Arc<planardyn::Mechanism>, n: usize) -> Vec<Variant> {
     let q0 = mech.initial_state().0[0];
     (0..n)
         .map(|k| Variant {
-            model: Model::Built(mech.clone()),
+            model: mech.clone(),
             overrides: Overrides { t_end: Some(0.3), q0: Some(vec![q0 + 0.02 * k as f64]), ..Overrides::default() },
         })
         .collect()
@@ -48,7 +49,7 @@ fn parallel_batch_equals_serial_loop_in_order() {
 fn a_failing_variant_does_not_stop_the_others() {
     let mech = Arc::new(shipped("five-bar.yaml"));
     let over = Overrides { t_end: Some(0.1), ..Overrides::default() };
-    let mut vs = vec![Variant { model: Model::Built(mech.clone()), overrides: over }; 5];
+    let mut vs = vec![Variant { model: mech.clone(), overrides: over }; 5];
     // Proximal links straight out (C1 C2 = 0.8 m > 2 x 0.35 m: the distal links cannot
     // meet), and a method that does not exist.
     vs[2].overrides.q0 = Some(vec![std::f64::consts::PI, 0.0]);
@@ -66,23 +67,22 @@ fn a_failing_variant_does_not_stop_the_others() {
 }
 
 #[test]
-fn spec_variants_are_built_in_the_task() {
+fn edited_specs_are_built_in_parallel_then_run() {
     let base = yaml(FOUR_BAR);
     let mut heavy = base.spec.clone();
     heavy.bodies.0.get_mut("coupler").unwrap().mass = Some(2.4);
     let mut broken = base.spec.clone();
     broken.bodies.0.get_mut("coupler").unwrap().mass = Some(-1.0);
+    let specs = [base.spec.clone(), heavy, broken];
+    let built = map_many(&specs, Some(2), |spec| planardyn::build(spec.clone(), "<variant>")).unwrap();
+    assert!(matches!(built[2], Err(ModelError::Invalid { .. })), "{:?}", built[2]);
     let over = Overrides { t_end: Some(0.2), ..Overrides::default() };
-    let vs: Vec<Variant> = [base.spec.clone(), heavy.clone(), broken]
-        .into_iter()
-        .map(|spec| Variant { model: Model::Spec(Box::new(spec)), overrides: over.clone() })
+    let vs: Vec<Variant> = built[..2]
+        .iter()
+        .map(|mech| Variant { model: Arc::new(mech.clone().unwrap()), overrides: over.clone() })
         .collect();
     let out = simulate_many(&vs, Some(2)).unwrap();
-    same(
-        out[0].as_ref().unwrap(),
-        &Variant { model: Model::Built(Arc::new(base)), overrides: over.clone() }.simulate().unwrap(),
-    );
-    assert!(matches!(out[2], Err(Error::Model(_))));
+    same(out[0].as_ref().unwrap(), &Variant { model: Arc::new(base), overrides: over.clone() }.simulate().unwrap());
     // The heavier coupler changes the motion.
     assert_ne!(out[0].as_ref().unwrap().q.last(), out[1].as_ref().unwrap().q.last());
 }
@@ -144,16 +144,16 @@ fn coordinate_motions_in_a_batch_equal_the_serial_rows_and_invert_the_forward_dy
     let four = Arc::new(yaml(FOUR_BAR));
     let vs = vec![
         InverseVariant {
-            model: Model::Built(mech.clone()),
+            model: mech.clone(),
             motion: Motion::Coordinates { q: tr.q.clone(), qd: tr.qd.clone(), qdd: tr.qdd.clone() },
         },
         InverseVariant {
-            model: Model::Built(four.clone()),
+            model: four.clone(),
             motion: Motion::Coordinates { q: runs[0].q.clone(), qd: runs[0].qd.clone(), qdd: runs[0].qdd.clone() },
         },
         // Rows of the wrong length: reported for this variant only.
         InverseVariant {
-            model: Model::Built(mech.clone()),
+            model: mech.clone(),
             motion: Motion::Coordinates { q: vec![1.0; 3], qd: vec![0.0; 3], qdd: vec![0.0; 3] },
         },
     ];
@@ -175,21 +175,24 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
     let circle = five_bar_path(&mech, Some(0.05), [0.0; 2]);
     let mut heavy = mech.spec.clone();
     heavy.bodies.0.get_mut("distal_right").unwrap().mass = Some(1.4);
-    let task = |model: Model, path: &TaskPath| InverseVariant { model, motion: Motion::Task(path.clone()) };
+    let task = |model: Arc<planardyn::Mechanism>, path: &TaskPath| InverseVariant {
+        model,
+        motion: Motion::Task(path.clone()),
+    };
     let mut wrong_point = circle.clone();
     wrong_point.point = "Q".into();
     let mut far = circle.clone();
     far.x.iter_mut().skip(1).step_by(2).for_each(|y| *y += 1.0);
     let vs = vec![
-        task(Model::Built(mech.clone()), &circle),
+        task(mech.clone(), &circle),
         // Straight down through the type II singularity (distal links aligned near y = 0.15 m).
-        task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 0.1])),
+        task(mech.clone(), &five_bar_path(&mech, None, [0.014, 0.1])),
         // Up to 1 m above the base: it stops at the edge of the workspace, a type I singularity.
-        task(Model::Built(mech.clone()), &five_bar_path(&mech, None, [0.014, 1.0])),
-        task(Model::Built(mech.clone()), &wrong_point),
-        task(Model::Spec(Box::new(heavy)), &circle),
+        task(mech.clone(), &five_bar_path(&mech, None, [0.014, 1.0])),
+        task(mech.clone(), &wrong_point),
+        task(Arc::new(planardyn::build(heavy, "<variant>").unwrap()), &circle),
         // The circle 1 m higher: its first point is out of reach.
-        task(Model::Built(mech.clone()), &far),
+        task(mech.clone(), &far),
     ];
     let out = inverse_many(&vs, Some(2)).unwrap();
     assert_eq!(out, inverse_many(&vs, Some(1)).unwrap());

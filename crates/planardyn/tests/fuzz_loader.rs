@@ -98,7 +98,7 @@ const FIX_WORDS: &[&str] = &[
     "bring",
     "convert",
     "join",
-    "see docs/",
+    "see `planardyn docs",
 ];
 /// Rust names that must not reach a user.
 const JARGON: &[&str] = &["Spec", "f64", "usize", "struct ", "enum "];

@@ -16,7 +16,7 @@ fn refused(text: &str, format: Format) -> (String, String) {
 }
 
 const MAPPING_FIX: &str =
-    "a model file must be a mapping with the keys name, points, ground, bodies, pairs and coordinates: see docs/model-format.md";
+    "a model file must be a mapping with the keys name, points, ground, bodies, pairs and coordinates: see `planardyn docs model-format`";
 
 #[test]
 fn a_document_that_is_not_a_mapping_says_what_a_model_is() {
@@ -33,7 +33,7 @@ fn a_document_that_is_not_a_mapping_says_what_a_model_is() {
 fn a_missing_top_level_field_is_the_path() {
     let (msg, path) = refused(&FOUR_BAR.replace("name: four-bar under gravity\n", ""), Format::Yaml);
     assert_eq!(path, "name");
-    assert_eq!(msg, "m.yaml: name: missing field `name` (line 2 column 1); add it (see docs/model-format.md)");
+    assert_eq!(msg, "m.yaml: name: missing field `name` (line 2 column 1); add it (see `planardyn docs model-format`)");
     // Nested: the missing field's own path, not its parent's.
     let (_, path) = refused(&FOUR_BAR.replace(", value: 1.0471975511965976}", "}"), Format::Yaml);
     assert_eq!(path, "coordinates[0].value");
@@ -61,7 +61,7 @@ fn yaml_syntax_errors_give_line_and_column_even_at_the_first_character() {
     assert_eq!(path, "line 3 column 1");
     let (msg, path) = refused("", Format::Json);
     assert_eq!(path, "line 1 column 1");
-    assert_eq!(msg, "m.yaml: line 1 column 1: EOF while parsing a value; the text is empty: write a model (see docs/model-format.md)");
+    assert_eq!(msg, "m.yaml: line 1 column 1: EOF while parsing a value; the text is empty: write a model (see `planardyn docs model-format`)");
 }
 
 #[test]
@@ -80,7 +80,7 @@ fn errors_inside_a_field_keep_its_path_and_add_the_line() {
     assert_eq!(
         msg,
         "m.yaml: bodies.crank.mass: invalid type: string \"heavy\", expected a number (line 11 column 33); \
-         give the form the field takes: see docs/model-format.md"
+         give the form the field takes: see `planardyn docs model-format`"
     );
     // An unknown field inside a pair (an entry tagged by `type`): the field itself.
     let (msg, path) = refused(
@@ -218,7 +218,7 @@ fn a_yaml_tag_is_refused_where_it_is() {
     assert_eq!(
         msg,
         "m.yaml: bodies.crank.mass: the YAML tag `!foo` is not part of the model format (line 11 column 33); \
-         remove it and write the value alone (see docs/model-format.md)"
+         remove it and write the value alone (see `planardyn docs model-format`)"
     );
     let (msg, path) = refused(&format!("!model\n{FOUR_BAR}"), Format::Yaml);
     assert_eq!(path, "line 1 column 1");

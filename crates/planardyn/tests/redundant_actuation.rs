@@ -380,3 +380,21 @@ fn a_geared_pair_actuator_keeps_its_rotor_and_its_losses() {
         assert!(balance.abs() <= 1e-12 * input.abs(), "{how:?}: {input} W in, {balance} W unbalanced");
     }
 }
+
+#[test]
+fn a_preload_that_is_not_finite_is_refused_naming_it() {
+    // Before (issue 23 finding 6): NaN efforts for a NaN preload, infinite ones for inf.
+    let mech = three_legs();
+    let (q, qd, qdd) = point(&mech);
+    let mut ws = Workspace::new(&mech);
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let err = inverse_redundant(&mech, &q, &qd, &qdd, &Distribution::Preload(vec![bad]), &mut ws).unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.starts_with(&format!(
+                "preload: expected finite values (N m or N), one per internal force, got preload[0] = {bad}"
+            )),
+            "{text}"
+        );
+    }
+}

@@ -74,7 +74,7 @@ fn with_losses(mech: &Mechanism, friction_law: &str) -> Mechanism {
         }
     }
     spec.loads.extend(friction);
-    Mechanism::new(spec, "with losses").unwrap_or_else(|e| panic!("{}: {e}", mech.name))
+    planardyn::build(spec, "with losses").unwrap_or_else(|e| panic!("{}: {e}", mech.name))
 }
 
 /// Y pi + tau_o against inverse dynamics at the model's pi, to `rtol` of the terms' size.
@@ -95,7 +95,7 @@ fn check_model(mech: &Mechanism, rtol: f64) {
 fn y_pi_is_inverse_dynamics_on_every_model() {
     // Exact in exact arithmetic; round-off of sums of a few dozen terms: 1e-12 of their size.
     for mech in every_model() {
-        let damper = |l: &Load| matches!(l, Load::PairSpring { stiffness, .. } if *stiffness == 0.0);
+        let damper = |l: &Load| matches!(l, Load::PairSpring(s) if s.stiffness == 0.0);
         if !mech.has_losses() && !mech.loads.iter().any(damper) {
             assert_eq!(n_parameters(&mech), BODY_PARAMETERS * mech.bodies.len(), "{}", mech.name);
         }
@@ -143,14 +143,14 @@ fn redundant_actuation_rows_are_the_generalized_efforts() {
     let mut spec =
         with_losses(&common::shipped("five-bar.yaml"), "type: torsional_spring, stiffness: 0.0, damping: 0.002").spec;
     spec.actuators = vec![serde_yaml_ng::from_str::<ActuatorSpec>("{pair: elbow1}").unwrap()];
-    let mech = Mechanism::new(spec.clone(), "redundant five-bar").unwrap();
+    let mech = planardyn::build(spec.clone(), "redundant five-bar").unwrap();
     assert_eq!(mech.pair_actuators.len(), 1);
     assert_eq!(n_parameters(&mech), 4 * 4 + 5, "bodies and the five pairs' damping");
     check_model(&mech, 1e-10);
     // With transmissions the motor torques are not rows of the coordinates: refused.
     let mut geared = spec;
     geared.actuators.push(serde_yaml_ng::from_str::<ActuatorSpec>("{coordinate: theta1, gear_ratio: 10}").unwrap());
-    let mech = Mechanism::new(geared, "redundant geared five-bar").unwrap();
+    let mech = planardyn::build(geared, "redundant geared five-bar").unwrap();
     let (q, qd, qdd) = state(&mech);
     let mut ws = Workspace::new(&mech);
     assemble_into(&mech, &q, &mut ws).unwrap();

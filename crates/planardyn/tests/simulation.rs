@@ -89,7 +89,7 @@ fn four_bar_in_frame(a: f64, shift: [f64; 2]) -> planardyn::Mechanism {
     let g = spec.gravity;
     spec.gravity = [c * g[0] - s * g[1], s * g[0] + c * g[1]];
     spec.coordinates[0].value += a;
-    planardyn::Mechanism::new(spec, "<rotated>").unwrap()
+    planardyn::build(spec, "<rotated>").unwrap()
 }
 
 #[test]

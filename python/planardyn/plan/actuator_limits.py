@@ -30,6 +30,10 @@ FloatArray = NDArray[np.float64]
 #: Relative step of the tangents' central differences in x = s'^2.
 TANGENT_STEP = 1e-6
 
+#: The rows are scaled by the half-width of the joint-side bounds, at least this fraction of
+#: its largest along the path (where a motor runs out of torque the bounds close).
+ROW_SCALE_MIN = 1e-6
+
 
 @dataclass
 class Drive:
@@ -98,9 +102,11 @@ def tangent_rows(mech: Mechanism, ds: list[Drive], a: FloatArray, b: FloatArray,
             lo_m, hi_m = _line_bounds(mech, d, t0, t1, p1, x0 - dx)
             dhi, dlo = (hi_p - hi_m) / (2 * dx), (lo_p - lo_m) / (2 * dx)
             k = d.k
-            rows_a += [a[:, k], -a[:, k]]
-            rows_b += [b[:, k] - dhi, dlo - b[:, k]]
-            rows_c += [c[:, k] - hi0 + dhi * x0, lo0 - dlo * x0 - c[:, k]]
+            # Scaled by the half-width of the bounds at x0, as effort limits' rows are.
+            half = np.maximum((hi0 - lo0) / 2, ROW_SCALE_MIN * max(float(np.abs(hi0 - lo0).max()), 1e-300))
+            rows_a += [a[:, k] / half, -a[:, k] / half]
+            rows_b += [(b[:, k] - dhi) / half, (dlo - b[:, k]) / half]
+            rows_c += [(c[:, k] - hi0 + dhi * x0) / half, (lo0 - dlo * x0 - c[:, k]) / half]
     return np.column_stack(rows_a), np.column_stack(rows_b), np.column_stack(rows_c)
 
 

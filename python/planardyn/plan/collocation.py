@@ -18,16 +18,24 @@ end, so the stated bound on q is the sum of eta_q,k + eta_qd,k (T - t_{k+1}) ove
 intervals; it neglects how the dynamics amplify an error, which over a short point-to-point
 motion is small (the tests compare with an open-loop replay).
 
+The limits hold between the nodes too. The efforts are linear between nodes, so within
+[lo, hi] wherever they are at the nodes. The rate between nodes is the interpolant's
+quadratic, whose Bernstein control points are qd_k, qd_k + h f_k / 2 and qd_{k+1}: it stays
+within their hull, so |qd_k + h f_k / 2| <= v (one more row per interval) keeps it within
+the speed limit everywhere. The singularity margin and the workspace box are imposed at the
+nodes. Each solution's ``limit_ratio`` is the largest fraction of an effort or speed limit
+used at :data:`CHECK_POINTS` points of every interval.
+
 f and its Jacobian are planardyn's (Mechanism.forward_dynamics and the exact
-forward_dynamics_derivatives), each node one casadi.Callback whose Jacobian is another
-Callback. IPOPT (through CasADi) solves the NLP with a limited-memory Hessian. The type II
-measure sigma_II's gradient (for the singularity margin) is by central differences of the
-kinematics, step SIGMA_STEP; the effector's task coordinates use its exact Jacobian.
+forward_dynamics_derivatives), handed to CasADi as callbacks (planardyn.plan.casadi_callbacks).
+IPOPT solves the NLP with a limited-memory Hessian, silently: its return status is the
+result's ``status``. The type II measure sigma_II's gradient (for the singularity margin) is
+by central differences of the kinematics, step SIGMA_STEP; the effector's task coordinates
+use its exact Jacobian.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -36,8 +44,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
 from ..mechanism import Mechanism
-from ..robot import EndEffector
-from .planned import PlanError, PlannedMotion, effort_bounds, speed_bounds
+from .casadi_callbacks import callback, or_nan
+from .collocation_problem import Problem, Workspace, check_ends, problem, sigma
+from .dense_check import CHECK_POINTS
+from .planned import InfeasiblePlan, PlanError, PlannedMotion
 from .topp import time_optimal
 
 FloatArray = NDArray[np.float64]
@@ -45,18 +55,14 @@ FloatArray = NDArray[np.float64]
 #: Central-difference step (rad or m) of the type II measure's gradient.
 SIGMA_STEP = 1e-6
 
+#: A minimum time within this fraction of the bounds put on T is taken as held by them.
+T_BOUND_TOL = 1e-6
 
-@dataclass
-class Workspace:
-    """A box the effector's task coordinates X (m, m[, rad]) stay in: lo <= X(q) <= hi at
-    every node (inf where unbounded)."""
-
-    effector: EndEffector
-    lo: ArrayLike
-    hi: ArrayLike
+#: IPOPT's final status when it converged.
+CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
-@dataclass
+@dataclass(repr=False)
 class CollocatedMotion(PlannedMotion):
     """The solution of :func:`collocate` and IPOPT's report on it.
 
@@ -67,7 +73,8 @@ class CollocatedMotion(PlannedMotion):
     ``iterations`` its iteration count, ``violation`` the largest constraint violation of the
     final point as IPOPT measured it, ``max_defect`` the largest trapezoidal defect
     (rad or m, and per s); ``error`` (m,) the stated accuracy of q (rad or m; see the module;
-    inf when the motion between nodes meets a singularity).
+    inf when the motion between nodes meets a singularity); ``limit_ratio`` the largest
+    fraction of an effort or speed limit used between the nodes (0 without limits).
     """
 
     objective: str
@@ -79,8 +86,12 @@ class CollocatedMotion(PlannedMotion):
     max_defect: float
     error: FloatArray
 
+    def _summary(self) -> str:
+        return (f"{len(self.t) - 1} intervals, minimum {self.objective}, IPOPT {self.status} in {self.iterations} "
+                f"iterations, stated accuracy of q {self.error.max():.2g}")
+
     def _interval(self, t: ArrayLike) -> tuple[Any, FloatArray, FloatArray]:
-        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.t[-1])
+        tt = self.times(t)
         i = np.clip(np.searchsorted(self.t, tt, side="right") - 1, 0, len(self.t) - 2)
         h = (self.t[i + 1] - self.t[i])[:, None]
         return i, (tt - self.t[i])[:, None], h
@@ -98,109 +109,39 @@ class CollocatedMotion(PlannedMotion):
         return self.tau[i] + s / h * (self.tau[i + 1] - self.tau[i])
 
 
-def _function(ca: Any, name: str, sizes: Sequence[int], n_out: int, value: Callable[..., FloatArray],
-              jacobian: Callable[..., Sequence[FloatArray]], keep: list[Any]) -> Any:
-    """A casadi.Callback y = value(*args) whose Jacobian is another Callback, jacobian(*args)
-    giving dy/d(each arg). ``keep`` holds both alive while the solver uses them."""
-    n_in = len(sizes)
-
-    class Jacobian(ca.Callback):
-        def __init__(self, jname: str, opts: dict[str, Any]) -> None:
-            ca.Callback.__init__(self)
-            self.construct(jname, opts)
-
-        def get_n_in(self) -> int:
-            return n_in + 1
-
-        def get_n_out(self) -> int:
-            return n_in
-
-        def get_sparsity_in(self, i: int) -> Any:
-            return ca.Sparsity.dense(sizes[i], 1) if i < n_in else ca.Sparsity(n_out, 1)
-
-        def get_sparsity_out(self, i: int) -> Any:
-            return ca.Sparsity.dense(n_out, sizes[i])
-
-        def eval(self, arg: list[Any]) -> list[Any]:
-            return [ca.DM(j) for j in jacobian(*(np.asarray(a, dtype=float).ravel() for a in arg[:n_in]))]
-
-    class Function(ca.Callback):
-        def __init__(self) -> None:
-            ca.Callback.__init__(self)
-            self.construct(name, {"enable_fd": False})
-
-        def get_n_in(self) -> int:
-            return n_in
-
-        def get_n_out(self) -> int:
-            return 1
-
-        def get_sparsity_in(self, i: int) -> Any:
-            return ca.Sparsity.dense(sizes[i], 1)
-
-        def get_sparsity_out(self, i: int) -> Any:
-            return ca.Sparsity.dense(n_out, 1)
-
-        def eval(self, arg: list[Any]) -> list[Any]:
-            return [ca.DM(value(*(np.asarray(a, dtype=float).ravel() for a in arg)))]
-
-        def has_jacobian(self) -> bool:
-            return True
-
-        def get_jacobian(self, jname: str, inames: Any, onames: Any, opts: dict[str, Any]) -> Any:
-            jac = Jacobian(jname, opts)
-            keep.append(jac)
-            return jac
-
-    f = Function()
-    keep.append(f)
-    return f
+def _straight(mech: Mechanism, p: Problem) -> tuple[PlannedMotion | None, PlanError | None]:
+    """The straight joint path timed by TOPP within the limits, or None and why not (no
+    limits, limits no timing keeps, or a model TOPP refuses: dampers)."""
+    effort = None if p.lo is None or p.hi is None else np.stack([p.lo, p.hi], axis=1)
+    if effort is None and not np.isfinite(p.v).any():
+        return None, PlanError("no limits to time the warm start with")
+    try:
+        return time_optimal(mech, [p.q0, p.q1], effort, None if not np.isfinite(p.v).any() else p.v,
+                            n_grid=max(2 * p.n, 50), rtol=None), None
+    except PlanError as exc:
+        return None, exc
 
 
-def _or_nan(shapes: Sequence[tuple[int, ...]]) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Evaluations where the kinematics fail (a singularity, out of reach) give NaN to IPOPT,
-    which then shortens its step; they never reach the result (checked there)."""
-
-    def wrap(fn: Callable[..., Any]) -> Callable[..., Any]:
-        def safe(*args: FloatArray) -> Any:
-            try:
-                return fn(*args)
-            except (SingularityError, AssemblyError):
-                nan = [np.full(s, np.nan) for s in shapes]
-                return nan[0] if len(nan) == 1 else nan
-
-        return safe
-
-    return wrap
-
-
-def _sigma(mech: Mechanism, q: FloatArray) -> float:
-    return float(mech.kinematics(q)["sigma_min"])
-
-
-def _warm_start(mech: Mechanism, q_start: FloatArray, q_end: FloatArray, lo: FloatArray | None, hi: FloatArray | None,
-                speed: FloatArray, duration: float | None, n: int, previous: PlannedMotion | None) -> tuple[Any, ...]:
-    """(T, q, qd, tau) at n + 1 nodes: a previous motion, or the straight joint path timed by
-    TOPP within the limits, stretched to ``duration`` when one is given (efforts by inverse
-    dynamics of the stretched motion); without limits, or for a model TOPP refuses (dampers),
-    the straight path in ``duration`` with the cubic timing s = 3 r^2 - 2 r^3, r = t / T (the
-    minimum-effort timing of a double integrator)."""
+def _warm_start(mech: Mechanism, p: Problem, duration: float | None, previous: PlannedMotion | None,
+                why: PlanError | None) -> tuple[Any, ...]:
+    """(T, q, qd, tau) at n + 1 nodes: a previous motion (by default the straight path's
+    fastest timing), stretched to ``duration`` when one is given (efforts by inverse dynamics
+    of the stretched motion); without one (``why`` says why), the straight path in
+    ``duration`` with the cubic timing s = 3 r^2 - 2 r^3, r = t / T (the minimum-effort
+    timing of a double integrator)."""
+    n = p.n
     if previous is None:
-        effort = None if lo is None or hi is None else np.stack([lo, hi], axis=1)
-        try:
-            if effort is None and not np.isfinite(speed).any():
-                raise PlanError("no limits to time the warm start with")
-            previous = time_optimal(mech, [q_start, q_end], effort, None if not np.isfinite(speed).any() else speed,
-                                    n_grid=max(2 * n, 50))
-        except PlanError as exc:
-            if duration is None:
-                raise PlanError(f"warm start: {exc}; give a first guess duration= (s) or warm_start=") from exc
-            r = np.linspace(0.0, 1.0, n + 1)[:, None]
-            dq = q_end - q_start
-            q = q_start + dq * (3 * r**2 - 2 * r**3)
-            qd = dq * (6 * r - 6 * r**2) / duration
-            qdd = dq * (6 - 12 * r) / duration**2
-            return duration, q, qd, np.asarray(mech.inverse_dynamics(q, qd, qdd))
+        if duration is None:
+            # Limits no timing of the straight path keeps stay the reason; else the start is missing.
+            kind, argument = (InfeasiblePlan, None) if isinstance(why, InfeasiblePlan) else (PlanError, "duration")
+            raise kind(f"duration: the straight path cannot be timed for a start ({why}); give a first guess "
+                       "duration= (s) or warm_start=", argument)
+        r = np.linspace(0.0, 1.0, n + 1)[:, None]
+        dq = p.q1 - p.q0
+        q = p.q0 + dq * (3 * r**2 - 2 * r**3)
+        qd = dq * (6 * r - 6 * r**2) / duration
+        qdd = dq * (6 - 12 * r) / duration**2
+        return duration, q, qd, np.asarray(mech.inverse_dynamics(q, qd, qdd))
     t_ref = previous.duration
     T = t_ref if duration is None else duration
     t = np.linspace(0.0, T, n + 1)
@@ -245,16 +186,16 @@ def collocate(
     speed : (m,) array_like, optional
         Speed limits |qd| (rad/s or m/s).
     sigma_min : float, optional
-        A type II singularity margin: sigma_II(q_k) >= sigma_min at every node.
+        A type II singularity margin in (0, 1): sigma_II(q_k) >= sigma_min at every node.
     workspace : Workspace, optional
         A box for the effector's task coordinates at every node.
     n_intervals : int
-        N, the collocation intervals (>= 2).
+        N, the collocation intervals (2 to 10000).
     warm_start : PlannedMotion, optional
         A motion to start from (e.g. a previous solution), stretched to ``duration``;
         default the straight joint path timed by :func:`time_optimal` within the limits.
     tol, max_iter
-        IPOPT's tolerance and iteration limit.
+        IPOPT's tolerance (> 0) and iteration limit (>= 1).
 
     Returns
     -------
@@ -264,112 +205,140 @@ def collocate(
     Raises
     ------
     PlanError
-        Bad arguments, or ends that break the margin or the workspace.
+        Bad arguments (the error's ``argument`` names which), ends that break the margin or
+        the workspace, or a minimum-effort duration shorter than the fastest motion within
+        the limits (found first by minimum time when the straight path's is longer).
     """
-    import casadi as ca
-
-    m = mech.dof
-    q0, q1 = (np.asarray(v, dtype=float) for v in (q_start, q_end))
-    if q0.shape != (m,) or q1.shape != (m,) or not (np.all(np.isfinite(q0)) and np.all(np.isfinite(q1))):
-        raise PlanError(f"q_start, q_end: expected ({m},) finite coordinates, got shapes {q0.shape}, {q1.shape}")
-    if objective not in ("time", "effort"):
-        raise PlanError(f"objective: 'time' or 'effort', got {objective!r}")
-    if objective == "effort" and (duration is None or not np.isfinite(duration) or duration <= 0):
-        raise PlanError(f"objective 'effort' needs a positive duration (s), got {duration}")
-    if objective == "time" and effort is None and speed is None:
-        raise PlanError("objective 'time' needs effort or speed limits")
-    if n_intervals < 2:
-        raise PlanError(f"n_intervals: need at least 2, got {n_intervals}")
-    if duration is not None and not (np.isfinite(duration) and duration > 0):
-        raise PlanError(f"duration: a positive time (s), got {duration}")
+    p = problem(mech, q_start, q_end, objective, duration, effort, speed, sigma_min, workspace, n_intervals,
+                 warm_start, tol, max_iter)
+    check_ends(mech, p)
     try:
-        mech.forward_dynamics_derivatives(q0, np.zeros(m), tau=np.zeros(m))
+        mech.forward_dynamics_derivatives(p.q0, np.zeros(mech.dof), tau=np.zeros(mech.dof))
     except ValueError as exc:
         raise PlanError(f"collocation needs the exact derivatives of forward dynamics: {exc}") from exc
-    n = n_intervals
-    lo, hi = effort_bounds(m, effort) if effort is not None else (None, None)
-    v = speed_bounds(m, speed)
-    for name, qe in (("q_start", q0), ("q_end", q1)):
-        if sigma_min is not None and _sigma(mech, qe) < sigma_min:
-            raise PlanError(f"{name}: sigma_II {_sigma(mech, qe):.3g} is below the margin {sigma_min}; move it or lower "
-                            "sigma_min")
-        if workspace is not None:
-            X = workspace.effector.state(qe).X
-            if np.any(X < np.asarray(workspace.lo, dtype=float)) or np.any(X > np.asarray(workspace.hi, dtype=float)):
-                raise PlanError(f"{name}: the effector at {np.round(X, 6).tolist()} is outside the workspace box")
+    why = None
+    if warm_start is None:
+        warm_start, why = _straight(mech, p)
+        if p.objective == "effort" and p.duration is not None and warm_start is not None \
+                and warm_start.duration > p.duration:
+            warm_start = _fastest(mech, p, warm_start)
+    return _solve(mech, p, p.objective, _warm_start(mech, p, p.duration, warm_start, why))
 
-    T0, q_w, qd_w, tau_w = _warm_start(mech, q0, q1, lo, hi, v, duration, n, warm_start)
 
+def _fastest(mech: Mechanism, p: Problem, line: PlannedMotion) -> PlannedMotion:
+    """The minimum-time motion, a start for minimum effort in a duration shorter than the
+    straight path's fastest timing ``line``; a duration no motion within the limits can
+    keep is refused."""
+    assert p.duration is not None
+    fastest = _solve(mech, p, "time", _warm_start(mech, p, None, line, None))
+    if not fastest.success:
+        raise InfeasiblePlan(f"duration: {p.duration:g} s is shorter than the straight path's fastest timing within "
+                             f"the limits ({line.duration:.6g} s), and the minimum-time motion that would say whether "
+                             f"any is that fast did not converge (IPOPT: {fastest.status}); give a longer duration")
+    if fastest.duration > p.duration:
+        raise InfeasiblePlan(f"duration: no motion within the limits takes {p.duration:g} s; the fastest takes "
+                             f"{fastest.duration:.6g} s (minimum time, {p.n} intervals): give at least that")
+    return fastest
+
+
+def _solve(mech: Mechanism, p: Problem, objective: str, start: tuple[Any, ...]) -> CollocatedMotion:
+    """IPOPT on the collocation NLP from the start (T, q, qd, tau) at the nodes."""
+    import casadi as ca
+
+    m, n = mech.dof, p.n
+    T0, q_w, qd_w, tau_w = start
     keep: list[Any] = []
-    fd = _function(
-        ca, "forward_dynamics", [m, m, m], m,
-        _or_nan([(m,)])(lambda q, qd, tau: mech.forward_dynamics(q, qd, tau=tau)),
-        _or_nan([(m, m)] * 3)(lambda q, qd, tau: [(d := mech.forward_dynamics_derivatives(q, qd, tau=tau))["dq"],
-                                                     d["dqd"], d["dtau"]]),
-        keep)
-
     w = ca.MX.sym("w", 3 * m * (n + 1) + 1)
     Q = ca.reshape(w[0:m * (n + 1)], m, n + 1)
     QD = ca.reshape(w[m * (n + 1):2 * m * (n + 1)], m, n + 1)
     U = ca.reshape(w[2 * m * (n + 1):3 * m * (n + 1)], m, n + 1)
     T = w[-1]
     h = T / n
+    g, lbg, ubg = _constraints(ca, mech, p, Q, QD, U, h, keep)
+    if objective == "time":
+        J = T
+    else:
+        Ua, Ub = U[:, :-1], U[:, 1:]
+        J = h / 3 * ca.sum1(ca.sum2(Ua**2 + Ua * Ub + Ub**2))
+    inf = np.inf
+    lbq, ubq = np.full((n + 1, m), -inf), np.full((n + 1, m), inf)
+    lbq[0] = ubq[0] = p.q0
+    lbq[-1] = ubq[-1] = p.q1
+    lbqd, ubqd = np.tile(-p.v, (n + 1, 1)), np.tile(p.v, (n + 1, 1))
+    lbqd[[0, -1]] = ubqd[[0, -1]] = 0.0
+    lbu = np.tile(p.lo if p.lo is not None else np.full(m, -inf), (n + 1, 1))
+    ubu = np.tile(p.hi if p.hi is not None else np.full(m, inf), (n + 1, 1))
+    lbT, ubT = (T0, T0) if objective == "effort" else (1e-3 * T0, 1e3 * T0)
+    # Columns of the casadi matrices are the nodes: (n + 1, m) row-major is their column-major.
+    lbx = np.concatenate([lbq.ravel(), lbqd.ravel(), lbu.ravel(), [lbT]])
+    ubx = np.concatenate([ubq.ravel(), ubqd.ravel(), ubu.ravel(), [ubT]])
+    x0 = np.concatenate([q_w.ravel(), qd_w.ravel(), np.clip(tau_w, lbu, ubu).ravel(), [T0]])
+    opts: dict[str, Any] = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": p.tol,
+                            "ipopt.max_iter": p.max_iter, "ipopt.print_level": 0, "print_time": False,
+                            "ipopt.sb": "yes", "ipopt.bound_relax_factor": 0.0, "show_eval_warnings": False}
+    solver = ca.nlpsol("collocation", "ipopt", {"x": w, "f": J, "g": ca.vertcat(*g)}, opts)
+    try:
+        sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+    except RuntimeError as exc:
+        last = str(exc).strip().splitlines()[-1]
+        raise PlanError(f"IPOPT (through CasADi) refused the problem: {last}") from exc
+    return _result(mech, p, objective, sol, solver.stats(), (lbT, ubT))
+
+
+def _constraints(ca: Any, mech: Mechanism, p: Problem, Q: Any, QD: Any, U: Any, h: Any,
+                 keep: list[Any]) -> tuple[list[Any], list[float], list[float]]:
+    """The defects, the speed limits between the nodes (see the module), the margin and the
+    box at the inner nodes: g with its bounds."""
+    m, n = mech.dof, p.n
+    fd = callback(
+        ca, "forward_dynamics", [m, m, m], m,
+        or_nan([(m,)])(lambda q, qd, tau: mech.forward_dynamics(q, qd, tau=tau)),
+        or_nan([(m, m)] * 3)(lambda q, qd, tau: [(d := mech.forward_dynamics_derivatives(q, qd, tau=tau))["dq"],
+                                                    d["dqd"], d["dtau"]]),
+        keep)
     F = [fd(Q[:, k], QD[:, k], U[:, k]) for k in range(n + 1)]
     g = []
     for k in range(n):
         g.append(Q[:, k + 1] - Q[:, k] - h / 2 * (QD[:, k] + QD[:, k + 1]))
         g.append(QD[:, k + 1] - QD[:, k] - h / 2 * (F[k] + F[k + 1]))
     lbg, ubg = [0.0] * (2 * m * n), [0.0] * (2 * m * n)
-    if sigma_min is not None:
+    limited = np.flatnonzero(np.isfinite(p.v)).tolist()
+    if limited:
+        g += [QD[limited, k] + h / 2 * F[k][limited] for k in range(n)]
+        lbg += list(-p.v[limited]) * n
+        ubg += list(p.v[limited]) * n
+    if p.sigma_min is not None:
         def sigma_grad(q: FloatArray) -> list[FloatArray]:
             e = SIGMA_STEP * np.eye(m)
-            return [np.array([[(_sigma(mech, q + ei) - _sigma(mech, q - ei)) / (2 * SIGMA_STEP) for ei in e]])]
+            return [np.array([[(sigma(mech, q + ei) - sigma(mech, q - ei)) / (2 * SIGMA_STEP) for ei in e]])]
 
-        sig = _function(ca, "sigma_II", [m], 1, _or_nan([(1,)])(lambda q: np.array([_sigma(mech, q)])),
-                        _or_nan([(1, m)])(sigma_grad), keep)
+        sig = callback(ca, "sigma_II", [m], 1, or_nan([(1,)])(lambda q: np.array([sigma(mech, q)])),
+                       or_nan([(1, m)])(sigma_grad), keep)
         g += [sig(Q[:, k]) for k in range(1, n)]
-        lbg += [sigma_min] * (n - 1)
+        lbg += [p.sigma_min] * (n - 1)
         ubg += [np.inf] * (n - 1)
-    if workspace is not None:
-        ee = workspace.effector
-        k_x = len(ee.names)
-        box_lo = np.broadcast_to(np.asarray(workspace.lo, dtype=float), (k_x,))
-        box_hi = np.broadcast_to(np.asarray(workspace.hi, dtype=float), (k_x,))
-        task = _function(ca, "task", [m], k_x, _or_nan([(k_x,)])(lambda q: ee.state(q).X),
-                         _or_nan([(k_x, m)])(lambda q: [ee.state(q).J]), keep)
+    if p.box is not None:
+        ee, box_lo, box_hi = p.box
+        k_x = len(box_lo)
+        task = callback(ca, "task", [m], k_x, or_nan([(k_x,)])(lambda q: ee.state(q).X),
+                        or_nan([(k_x, m)])(lambda q: [ee.state(q).J]), keep)
         g += [task(Q[:, k]) for k in range(1, n)]
         lbg += list(box_lo) * (n - 1)
         ubg += list(box_hi) * (n - 1)
+    return g, lbg, ubg
 
-    if objective == "time":
-        J = T
-    else:
-        Ua, Ub = U[:, :-1], U[:, 1:]
-        J = h / 3 * ca.sum1(ca.sum2(Ua**2 + Ua * Ub + Ub**2))
 
-    inf = np.inf
-    lbq, ubq = np.full((n + 1, m), -inf), np.full((n + 1, m), inf)
-    lbq[0] = ubq[0] = q0
-    lbq[-1] = ubq[-1] = q1
-    lbqd, ubqd = np.tile(-v, (n + 1, 1)), np.tile(v, (n + 1, 1))
-    lbqd[[0, -1]] = ubqd[[0, -1]] = 0.0
-    lbu = np.tile(lo if lo is not None else np.full(m, -inf), (n + 1, 1))
-    ubu = np.tile(hi if hi is not None else np.full(m, inf), (n + 1, 1))
-    lbT, ubT = (T0, T0) if objective == "effort" else (1e-3 * T0, 1e3 * T0)
-    # Columns of the casadi matrices are the nodes: (n + 1, m) row-major is their column-major.
-    lbx = np.concatenate([lbq.ravel(), lbqd.ravel(), lbu.ravel(), [lbT]])
-    ubx = np.concatenate([ubq.ravel(), ubqd.ravel(), ubu.ravel(), [ubT]])
-    x0 = np.concatenate([q_w.ravel(), qd_w.ravel(), np.clip(tau_w, lbu, ubu).ravel(), [T0]])
-
-    opts: dict[str, Any] = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.max_iter": max_iter,
-            "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-            "ipopt.bound_relax_factor": 0.0}
-    nlp: dict[str, Any] = {"x": w, "f": J, "g": ca.vertcat(*g)}
-    solver = ca.nlpsol("collocation", "ipopt", nlp, opts)
-    sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-    stats = solver.stats()
+def _result(mech: Mechanism, p: Problem, objective: str, sol: Any, stats: dict[str, Any],
+            t_bounds: tuple[float, float]) -> CollocatedMotion:
+    """The motion at IPOPT's final point, with its report, error estimate and dense check; a
+    minimum time at the bounds put on T (1e-3 and 1e3 times the start's) is no minimum."""
+    m, n = mech.dof, p.n
     status = str(stats.get("return_status", "unknown"))
     xs = np.asarray(sol["x"], dtype=float).ravel()
+    at_bound = objective == "time" and not t_bounds[0] * (1 + T_BOUND_TOL) < xs[-1] < t_bounds[1] * (1 - T_BOUND_TOL)
+    if at_bound:
+        status = (f"{status}; T = {xs[-1]:.6g} s is at its bound (1e-3 to 1e3 times the start's {t_bounds[0] * 1e3:.6g} "
+                  "s): give a first guess duration= nearer the minimum")
     if not np.all(np.isfinite(xs)):
         raise PlanError(f"IPOPT ended ({status}) at a point where the dynamics are undefined; start nearer (warm_start=) "
                         "or add a singularity margin (sigma_min=)")
@@ -378,21 +347,35 @@ def collocate(
     t = np.linspace(0.0, xs[-1], n + 1)
     try:
         qdd = np.array([mech.forward_dynamics(a, b, tau=c) for a, b, c in zip(q, qd, tau)])
-    except (SingularityError, AssemblyError) as exc:
-        raise PlanError(f"IPOPT ended ({status}) at a singular configuration: {exc}; add a margin (sigma_min=)") from exc
+    except (SingularityError, AssemblyError, ValueError) as exc:
+        raise PlanError(f"IPOPT ended ({status}) at a configuration where the dynamics are undefined: {exc}; add a "
+                        "margin (sigma_min=) or start nearer (warm_start=)") from exc
     hk = t[1] - t[0]
     defect = max(np.abs(np.diff(q, axis=0) - hk / 2 * (qd[:-1] + qd[1:])).max(),
                  np.abs(np.diff(qd, axis=0) - hk / 2 * (qdd[:-1] + qdd[1:])).max())
     iters = stats.get("iterations", {})
-    violation = float(iters["inf_pr"][-1]) if iters.get("inf_pr") else float("nan")
-    motion = CollocatedMotion(mech=mech, t=t, q=q, qd=qd, qdd=qdd, tau=tau, objective=objective,
+    # Without an iteration recorded the violation is unknown: no bound on it.
+    violation = float(iters["inf_pr"][-1]) if iters.get("inf_pr") else float("inf")
+    motion = CollocatedMotion(mech=mech, t=t, q=q, qd=qd, qdd=qdd, tau=tau, limit_ratio=np.nan, objective=objective,
                               cost=float(sol["f"]), status=status,
-                              success=bool(stats.get("success", False)) and status in ("Solve_Succeeded",
-                                                                                       "Solved_To_Acceptable_Level"),
+                              success=bool(stats.get("success", False)) and status in CONVERGED and not at_bound,
                               iterations=int(stats.get("iter_count", -1)), violation=violation,
                               max_defect=float(defect), error=np.zeros(m))
     motion.error = _error_estimate(motion)
+    motion.limit_ratio = _limit_ratio(motion, p)
     return motion
+
+
+def _limit_ratio(c: CollocatedMotion, p: Problem) -> float:
+    """The largest fraction of an effort or speed limit used at CHECK_POINTS points of every
+    interval (ends included): |tau - mid| / half of [lo, hi], |qd| / v; 0 without limits."""
+    f = np.linspace(0.0, 1.0, CHECK_POINTS)
+    t = (c.t[:-1, None] + np.diff(c.t)[:, None] * f).ravel()
+    used = [np.zeros(len(t))]
+    if p.lo is not None and p.hi is not None:
+        used.append(np.max(np.abs(c.efforts(t) - (p.lo + p.hi) / 2) / ((p.hi - p.lo) / 2), axis=1))
+    used.append(np.max(np.abs(c.state(t)[1]) / p.v, axis=1))
+    return float(np.max(used))
 
 
 def _error_estimate(c: CollocatedMotion) -> FloatArray:
@@ -404,7 +387,7 @@ def _error_estimate(c: CollocatedMotion) -> FloatArray:
     tau_m = c.efforts(mid)
     try:
         f_m = np.array([c.mech.forward_dynamics(a, b, tau=u) for a, b, u in zip(q_m, qd_m, tau_m)])
-    except (SingularityError, AssemblyError):
+    except (SingularityError, AssemblyError, ValueError):
         return np.full(c.q.shape[1], np.inf)
     eta_q = 2 * h / 3 * np.abs((c.qd[:-1] + c.qd[1:]) / 2 - qd_m)
     eta_qd = 2 * h / 3 * np.abs(qdd_m - f_m)

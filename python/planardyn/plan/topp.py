@@ -1,14 +1,26 @@
-"""Time-optimal path parameterisation (TOPP) of a closed-chain mechanism with toppra.
+"""Time-optimal path parameterisation (TOPP) of a closed-chain mechanism with toppra, within
+its limits along the whole timed path.
 
 Along a path q = p(s), s in [0, 1], the drive efforts are
 
     tau = a(s) s'' + b(s) s'^2 + c(s),   a = A p',  b = A p'' + (convective terms of p'),  c = gravity and springs,
 
-which planardyn's inverse dynamics gives exactly at every grid point of s, continuing the
-assembly branch from one point to the next: c = ID(p, 0, 0), a = ID(p, 0, p') - c,
-b = ID(p, p', p'') - c. toppra (reachability analysis, Pham and Pham 2018) then finds the
-fastest s'(s) within effort limits F tau <= g and speed limits on q'. Between grid points
-s'' is constant (toppra's discretisation), so the timing s(t) is piecewise quadratic in t.
+which planardyn's inverse dynamics gives exactly at any s, continuing the assembly branch
+along the path (planardyn.plan.path_limits). toppra (reachability analysis, Pham and Pham
+2018) finds the fastest s'(s) on a grid of s with s'' constant on each interval, so the timing
+s(t) is piecewise quadratic in t and s'^2 linear in s between grid points.
+
+The limits hold between the grid points too, not only at them: each stage's linear program
+takes the limits at both ends of its interval (toppra's interpolation scheme), and the timing
+is then checked at ten times the grid's density (planardyn.plan.dense_check); an interval
+where a limit is still exceeded gets the limit at its worst point as one more row, and toppra
+is solved again, until no limit is exceeded by more than :data:`RATIO_TOL` of itself. A
+timing that keeps every limit everywhere is a feasible timing of the path, so the duration is
+never shorter than the optimum. It is longer by O(grid spacing) (first order: a constant s''
+per interval must meet the limits at the interval's worst point, where the optimum's s''
+varies across it); with ``rtol`` the grid is doubled until the duration changes by less
+than rtol of itself, and that change, the first-order estimate of the remaining excess, is
+reported (``TimedPath.time_error``).
 
 Dampers add efforts linear in s', which this form cannot hold: such a model is refused.
 """
@@ -21,39 +33,81 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from toppra.constants import MAXU, MAXX
 
+from .._core import AssemblyError, PlanardynError, SingularityError
 from ..mechanism import Mechanism
 from ..robot import EndEffector
-from .actuator_limits import drives, exact_bounds, tangent_rows
-from .planned import PlanError, PlannedMotion, effort_bounds, speed_bounds
+from .actuator_limits import drives, exact_bounds
+from .dense_check import check
+from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
+from .planned import (
+    MAX_COORDINATE,
+    MAX_DURATION,
+    InfeasiblePlan,
+    PlanError,
+    PlannedMotion,
+    effort_bounds,
+    positive_int,
+    positive_number,
+    speed_bounds,
+)
 
 FloatArray = NDArray[np.float64]
 
 #: effort="actuators": the rounds of tangents stop when the time changes by less than this
-#: fraction, and fail after ACTUATOR_ROUNDS rounds.
+#: fraction.
 ACTUATOR_TOL = 1e-7
-ACTUATOR_ROUNDS = 60
 
-#: Relative size of the s'-linear part of the efforts beyond which a model is refused.
-LINEAR_TOL = 1e-9
+#: Rounds of toppra on one grid (with new cuts, and new tangents for motor envelopes) before
+#: the plan is given up: the cuts settle in a few rounds, the tangents in ten to twenty.
+MAX_ROUNDS = 60
+
+#: A timing is accepted when its dense check finds no limit exceeded by more than this fraction
+#: of itself: toppra's linear programs hold their rows to about 1e-12 of the row's scale.
+RATIO_TOL = 1e-10
+
+#: Default ``rtol`` of :func:`time_optimal`: the duration within about 0.1 % of the optimum.
+RTOL = 1e-3
+
+#: toppra bounds s'^2 by MAXX and |s''| by MAXU (1e4 each) and decides with absolute
+#: tolerances of 1e-8 and more on them, so the path parameter's span S is fitted to the
+#: duration T: s' ~ S / T and s'' ~ S / T^2 must stay within FAST_FRACTION of the bounds and
+#: far above the tolerances (see _span). A timing that meets a bound is timed again with S
+#: fitted to it (it is then too slow, so S shrinks), at most SPAN_ROUNDS times; a motion
+#: faster than MIN_DURATION is refused.
+FAST_FRACTION = 0.25
+SPAN_ROUNDS = 8
+MIN_DURATION = 1e-4
+
+#: task_waypoints solves inverse kinematics at most this many times (a few seconds).
+MAX_WAYPOINTS = 100_000
+
+#: Grid refinement stops at this many grid points (the status then says the tolerance was not
+#: reached).
+MAX_GRID = 12801
 
 #: An effort limit that may depend on the coordinates: ``f(q) -> (lo, hi)``, each (m,) in
 #: N m or N. Limits that depend on the speed: ``effort="actuators"``.
-EffortLimit = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
+EffortFunction = Callable[[FloatArray], tuple[ArrayLike, ArrayLike]]
 
 
-@dataclass
+@dataclass(repr=False)
 class TimedPath(PlannedMotion):
     """A path with its time-optimal timing.
 
-    ``s`` (N,) the grid of the path parameter (dimensionless, 0 to 1); ``sd`` (N,) s' at the
+    ``s`` (N,) the grid of the path parameter (dimensionless, 0 to S: S is 1, or 1e-2, 1e-4 ...
+    for a path so fast that s' would pass toppra's bound, see FAST_SPAN); ``sd`` (N,) s' at the
     grid points (1/s); ``sdd`` (N - 1,) the constant s'' on each interval (1/s^2); ``t`` (N,)
     the times the grid points are reached (s); ``x`` (N, 3n) the body coordinates there (the
     branch, continued from the drawing); ``q``, ``qd``, ``qdd`` (N, m) the coordinates,
     rates and accelerations at the grid points (rad or m, per s, per s^2), ``tau`` (N, m) the
     efforts there (N m or N; with s'' of the interval that starts there, the last with the
     last interval's); ``lo``, ``hi`` (N, m) the effort limits, ``speed`` (m,) the speed limits
-    (inf where none); ``status`` toppra's.
+    (inf where none); ``limit_ratio`` the largest fraction of a limit used on the dense check
+    (planardyn.plan.dense_check); ``time_error`` the estimated excess of the duration over
+    the optimum (s: the change over the last doubling of the grid; None without refinement);
+    ``status`` toppra's, with the rounds and grids.
     """
 
     path: Any
@@ -64,11 +118,16 @@ class TimedPath(PlannedMotion):
     lo: FloatArray
     hi: FloatArray
     speed: FloatArray
+    time_error: float | None
     status: str
+
+    def _summary(self) -> str:
+        error = "not estimated" if self.time_error is None else f"{self.time_error:.2g} s"
+        return f"{len(self.s)} grid points, time error {error}, {self.status}"
 
     def timing(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """s, s', s'' at times t (s), from the piecewise-quadratic s(t)."""
-        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.t[-1])
+        tt = self.times(t)
         i = np.clip(np.searchsorted(self.t, tt, side="right") - 1, 0, len(self.sdd) - 1)
         tau = tt - self.t[i]
         u = self.sdd[i]
@@ -76,31 +135,59 @@ class TimedPath(PlannedMotion):
 
     def state(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, qd, qdd (N, m) at times t (N,) (s): q = p(s), qd = p' s', qdd = p' s'' + p'' s'^2."""
-        s, sd, sdd = self.timing(np.atleast_1d(t))
+        s, sd, sdd = self.timing(t)
         p1, p2 = self.path(s, 1), self.path(s, 2)
         return self.path(s), p1 * sd[:, None], p1 * sdd[:, None] + p2 * (sd**2)[:, None]
 
     def efforts(self, t: ArrayLike) -> FloatArray:
         """The efforts (N, m) that run the timed path at times t (N,) (s, ascending), by
         inverse dynamics on the plan's branch."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        t = self.times(t)
         q, qd, qdd = self.state(t)
         i = int(np.clip(np.searchsorted(self.t, t[0]), 0, len(self.t) - 1))
         return np.asarray(self.mech.inverse_dynamics(q, qd, qdd, x=self.x[i]))
 
 
-def _limits(mech: Mechanism, effort: ArrayLike | EffortLimit, q: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _effort_limit(mech: Mechanism, effort: ArrayLike | EffortFunction) -> EffortLimit:
     m = mech.dof
-    if callable(effort):
-        pairs = [effort(qi) for qi in q]
-        lo = np.array([np.broadcast_to(np.asarray(p[0], dtype=float), (m,)) for p in pairs])
-        hi = np.array([np.broadcast_to(np.asarray(p[1], dtype=float), (m,)) for p in pairs])
-    else:
+    if not callable(effort):
         lo1, hi1 = effort_bounds(m, effort)
-        lo, hi = np.tile(lo1, (len(q), 1)), np.tile(hi1, (len(q), 1))
-    if not (np.all(lo < hi) and np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
-        raise PlanError("effort limits: need finite lo < hi for every coordinate")
-    return lo, hi
+        return EffortLimit(lambda q: (np.tile(lo1, (len(q), 1)), np.tile(hi1, (len(q), 1))))
+
+    def bounds(q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        pairs = [effort(qi) for qi in q]
+        try:
+            lo = np.array([np.broadcast_to(np.asarray(p[0], dtype=float), (m,)) for p in pairs])
+            hi = np.array([np.broadcast_to(np.asarray(p[1], dtype=float), (m,)) for p in pairs])
+        except (TypeError, ValueError, IndexError) as exc:
+            raise PlanError(f"effort: the function must return (lo, hi), each ({m},) N m or N: {exc}") from exc
+        bad = ~(np.isfinite(lo) & np.isfinite(hi) & (lo < hi)).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise PlanError(f"effort: the function gives lo = {lo[k]}, hi = {hi[k]} at q = {q[k]}; it must give "
+                            "finite lo < hi for every coordinate")
+        return lo, hi
+
+    return EffortLimit(bounds)
+
+
+def _limits(mech: Mechanism, effort: ArrayLike | EffortFunction | str | None,
+            speed: ArrayLike | None) -> tuple[list[Limit], MotorLimit | None, FloatArray]:
+    """The limits, the motor limits among them (effort="actuators") and the speed limits (m,)."""
+    v = speed_bounds(mech.dof, speed)
+    if isinstance(effort, str):
+        if effort != "actuators":
+            raise PlanError(f"effort: limits, a function of q, 'actuators' or None, got {effort!r}")
+        ds = drives(mech)
+        v = np.minimum(v, [d.max_speed / d.ratio for d in ds])
+        motor = MotorLimit(mech, ds)
+        return [motor, *([SpeedLimit(v)] if np.isfinite(v).any() else [])], motor, v
+    limits: list[Limit] = [] if effort is None else [_effort_limit(mech, effort)]
+    if np.isfinite(v).any():
+        limits.append(SpeedLimit(v))
+    if not limits:
+        raise PlanError("effort, speed: no limits: give effort limits, speed limits or both", "effort")
+    return limits, None, v
 
 
 def branch(mech: Mechanism, q: FloatArray) -> FloatArray:
@@ -112,35 +199,17 @@ def branch(mech: Mechanism, q: FloatArray) -> FloatArray:
     return np.array(x)
 
 
-def _coefficients(mech: Mechanism, path: Any, s: FloatArray,
-                  x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """a(s), b(s), c(s) (N, m) by inverse dynamics along the grid, on the branch x (N, 3n)."""
-    p, p1, p2 = path(s), path(s, 1), path(s, 2)
-    zero = np.zeros_like(p)
-
-    def inverse(qd: FloatArray, qdd: FloatArray) -> FloatArray:
-        return np.asarray(mech.inverse_dynamics(p, qd, qdd, x=x))
-
-    c = inverse(zero, zero)
-    a = inverse(zero, p1) - c
-    b = inverse(p1, p2) - c
-    # Quadratic in s' only if no effort is linear in the rates: tau(2 p', 4 p'') = 4 b + c.
-    b4 = inverse(2 * p1, 4 * p2) - c
-    scale = max(float(np.abs(b).max()), float(np.abs(a).max()), float(np.abs(c).max()), 1e-300)
-    if np.abs(b4 - 4 * b).max() > LINEAR_TOL * scale:
-        raise PlanError(f"{mech.name}: efforts linear in the rates (dampers or viscous friction) are not of "
-                        "TOPP's form a s'' + b s'^2 + c; plan on a copy of the model without them")
-    return a, b, c
-
-
 def time_optimal(
     mech: Mechanism,
     waypoints: ArrayLike,
-    effort: ArrayLike | EffortLimit | str | None,
+    effort: ArrayLike | EffortFunction | str | None,
     speed: ArrayLike | None = None,
     n_grid: int = 200,
+    *,
+    rtol: float | None = RTOL,
 ) -> TimedPath:
-    """The fastest timing of a joint-space path within effort and speed limits.
+    """The fastest timing of a joint-space path within effort and speed limits, everywhere
+    along it (see the module).
 
     Parameters
     ----------
@@ -148,119 +217,204 @@ def time_optimal(
         The model; its drives are not used, the efforts are the plan's.
     waypoints : (K, m) array_like
         Coordinates (rad or m) the path passes through, K >= 2, joined by a C2 cubic spline
-        in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, 1]. For
+        in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, S]. For
         a task-space path, :func:`task_waypoints`.
     effort : (m,) or (m, 2) array_like, or callable ``f(q) -> (lo, hi)``, "actuators", or None
         Effort limits (N m or N): symmetric magnitudes, [lo, hi] per coordinate, or a function
-        of the coordinates (see :data:`EffortLimit`); "actuators": every coordinate's motor
+        of the coordinates (see :data:`EffortFunction`); "actuators": every coordinate's motor
         torque within the torque its envelope offers at its speed, through its transmission
         (planardyn.plan.actuator_limits says how; the motors' top speeds become speed limits);
         None: none (then ``speed`` is needed).
     speed : (m,) array_like, optional
         Speed limits |qd| (rad/s or m/s); none by default.
     n_grid : int
-        Grid points in s (toppra's stages + 1).
+        Grid points in s to start with (toppra's stages + 1), >= 3.
+    rtol : float or None
+        Double the grid until the duration changes by less than this fraction of itself
+        (default 1e-3: within about 0.1 % of the optimum); None: keep ``n_grid``.
 
     Returns
     -------
     TimedPath
-        Starting and ending at rest.
+        Starting and ending at rest, within every limit along the whole path (its
+        ``limit_ratio`` <= 1 + :data:`RATIO_TOL`).
 
     Raises
     ------
     PlanError
         Bad arguments, a model with dampers, or a path no timing can follow within the limits.
     """
+
+    m = mech.dof
+    try:
+        q_w = np.atleast_2d(np.asarray(waypoints, dtype=float))
+    except (TypeError, ValueError) as exc:
+        raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) coordinates: {exc}") from exc
+    if q_w.ndim != 2 or q_w.shape[1] != m or len(q_w) < 2 or not np.all(np.abs(q_w) <= MAX_COORDINATE):
+        raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) finite coordinates within {MAX_COORDINATE:g} (rad "
+                        f"or m), got shape {q_w.shape}", "waypoints")
+    n_grid = positive_int("n_grid", n_grid, 3)
+    if rtol is not None:
+        rtol = positive_number("rtol", rtol)
+    chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q_w, axis=0), axis=1))])
+    if not np.isfinite(chord[-1]) or np.any(np.diff(chord) == 0.0):
+        raise PlanError("waypoints: consecutive waypoints must differ (and their distances be finite)")
+    limits, motor, v = _limits(mech, effort, speed)
+    try:
+        return _time_optimal(mech, q_w, chord, limits, motor, v, n_grid, rtol)
+    except ValueError as exc:  # the core's refusal of a coordinate (far from the drawing)
+        if isinstance(exc, PlanardynError):
+            raise
+        raise PlanError(f"waypoints: the path cannot be followed: {exc}", "waypoints") from exc
+
+
+def _time_optimal(mech: Mechanism, q_w: FloatArray, chord: FloatArray, limits: list[Limit], motor: MotorLimit | None,
+                  v: FloatArray, n_grid: int, rtol: float | None) -> TimedPath:
+    """time_optimal on checked arguments: the span fitted, then the grid refined."""
     import toppra
 
-    q_w = np.atleast_2d(np.asarray(waypoints, dtype=float))
     m = mech.dof
-    if q_w.ndim != 2 or q_w.shape[1] != m or len(q_w) < 2 or not np.all(np.isfinite(q_w)):
-        raise PlanError(f"waypoints: expected (K, m) = (K >= 2, {m}) finite coordinates, got shape {q_w.shape}")
-    if n_grid < 3:
-        raise PlanError(f"n_grid: need at least 3 grid points, got {n_grid}")
-    chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q_w, axis=0), axis=1))])
-    if chord[-1] == 0.0 or np.any(np.diff(chord) == 0.0):
-        raise PlanError("waypoints: consecutive waypoints must differ")
-    path = toppra.SplineInterpolator(chord / chord[-1], q_w)
-    s = np.linspace(0.0, 1.0, n_grid)
-    v = speed_bounds(m, speed)
-    if effort is None and not np.isfinite(v).any():
-        raise PlanError("no limits: give effort limits, speed limits or both")
-    x = branch(mech, path(s))
-    a, b, c = _coefficients(mech, path, s, x)
-    p1 = path(s, 1)
-    if isinstance(effort, str):
-        if effort != "actuators":
-            raise PlanError(f"effort: limits, a function of q, 'actuators' or None, got {effort!r}")
-        ds = drives(mech)
-        v = np.minimum(v, [d.max_speed / d.ratio for d in ds])
-        # The speed limits' s'^2 bound (a quarter of it) as the first tangent point.
-        with np.errstate(divide="ignore"):
-            x_v = np.min((v / np.abs(p1)) ** 2, axis=1)
-        x0 = np.minimum(np.where(np.isfinite(x_v), x_v / 4, 1.0), 1e6)
-        duration, rounds = np.inf, 0
-        while True:
-            rounds += 1
-            sdd, sd, status = _toppra(path, s, tangent_rows(mech, ds, a, b, c, p1, x0), v)
-            t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
-            if abs(duration - t_new) <= ACTUATOR_TOL * t_new:
-                break
-            if rounds == ACTUATOR_ROUNDS:
-                raise PlanError(f"effort='actuators': the time did not settle in {rounds} rounds of tangents "
-                                f"({duration:.9g} s, then {t_new:.9g} s); use a finer n_grid")
-            duration, x0 = t_new, sd**2
-        status = f"{status}; {rounds} rounds of tangents"
-        lo, hi = exact_bounds(mech, p1 * sd[:, None])
+    span = 1.0
+    for _ in range(SPAN_ROUNDS):
+        path = toppra.SplineInterpolator(chord / chord[-1] * span, q_w)
+        s = np.linspace(0.0, span, n_grid)
+        plan = _time_on_grid(mech, path, s, limits, motor is not None)
+        capped = plan.sd.max() ** 2 >= FAST_FRACTION * MAXX or np.abs(plan.sdd).max() >= FAST_FRACTION * MAXU
+        if plan.duration < MIN_DURATION:
+            raise InfeasiblePlan(f"the limits let this path run in {plan.duration:.3g} s or less, faster than toppra "
+                                 f"can time (its s' and s'' are bounded): give limits of a motion of {MIN_DURATION:g} s "
+                                 "or more", "effort")
+        if plan.duration > MAX_DURATION:
+            raise InfeasiblePlan(f"the limits make this path take {plan.duration:.3g} s, more than {MAX_DURATION:g} s: "
+                                 "give limits of a shorter motion")
+        want = _span(plan.duration)
+        if not capped and 0.1 < span / want < 10:
+            break
+        span = want
+    grids = [len(s)]
+    time_error: float | None = None
+    while rtol is not None:
+        s = np.sort(np.concatenate([s, (s[:-1] + s[1:]) / 2]))
+        finer = _time_on_grid(mech, path, s, limits, motor is not None)
+        grids.append(len(s))
+        time_error = abs(plan.duration - finer.duration)
+        plan = finer
+        if time_error <= rtol * plan.duration or len(s) >= MAX_GRID:
+            break
+    note = f"grids {'-'.join(map(str, grids))}" if len(grids) > 1 else f"grid {grids[0]}"
+    if rtol is not None and time_error is not None and time_error > rtol * plan.duration:
+        note += f"; rtol {rtol:g} not reached within {MAX_GRID} grid points"
+    if motor is not None:
+        lo, hi = exact_bounds(mech, plan.qd)
+    elif isinstance(limits[0], EffortLimit):
+        lo, hi = limits[0].bounds(plan.q)
     else:
-        if effort is None:
-            lo, hi = np.full((n_grid, m), -np.inf), np.full((n_grid, m), np.inf)
-        else:
-            lo, hi = _limits(mech, effort, path(s))
-        rows = (np.hstack([a, -a]), np.hstack([b, -b]), np.hstack([c - hi, lo - c]))
-        sdd, sd, status = _toppra(path, s, None if effort is None else rows, v)
+        lo, hi = np.full((len(s), m), -np.inf), np.full((len(s), m), np.inf)
+    plan.lo, plan.hi, plan.speed, plan.time_error = lo, hi, v, time_error
+    plan.status = f"{plan.status}; {note}"
+    return plan
+
+
+def _span(duration: float) -> float:
+    """The path parameter's span for a motion of about this duration (s): S = T (s' ~ 1,
+    s'' ~ 1 / T) down to 10 ms, then S = 100 T^2 (s'' ~ 100, s'^2 ~ 1e4 T^2, 1e-4 at the
+    shortest motion timed, MIN_DURATION)."""
+    return float(duration if duration >= 1e-2 else 100 * duration**2)
+
+
+def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit], tangents: bool) -> TimedPath:
+    """toppra's timing on the grid s within the limits at both ends of every interval, cut
+    where the dense check still finds a limit exceeded (see the module); with tangents (motor
+    envelopes) the rows are linearised at the previous timing until the time settles."""
+    n = len(s)
+    x = branch(mech, path(s))
+    grid = path_points(mech, path, s, x, linear_check=True)
+    # Each stage i < n - 1 holds its interval's start (d = 0) and end (d = s_i+1 - s_i).
+    pts = _take(grid, np.concatenate([np.arange(n), np.arange(1, n)]))
+    stage = np.concatenate([np.arange(n), np.arange(n - 1)])
+    d = np.concatenate([np.zeros(n), np.diff(s)])
+    x0 = _first_speeds(limits, pts)
+    duration, rounds = np.inf, 0
+    while True:
+        rounds += 1
+        rows = stage_rows(stage, d, rows_at(limits, pts, x0), n)
+        sdd, sd, status = _toppra(path, s, rows)
+        with np.errstate(divide="ignore"):
+            t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
+        if not np.isfinite(t_new):
+            raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}, but at rest "
+                                 "somewhere along it): raise the limits or move the path")
+        found = check(mech, path, s, x, sd, sdd, limits)
+        settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
+        if found.ratio <= 1 + RATIO_TOL and settled:
+            break
+        if rounds == MAX_ROUNDS:
+            raise PlanError(f"the timing did not settle in {rounds} rounds ({duration:.9g} s, then {t_new:.9g} s, "
+                            f"limits used to {found.ratio:.9g}); use a finer n_grid")
+        bad = np.flatnonzero(found.worst > 1 + RATIO_TOL)
+        if len(bad):
+            cut = path_points(mech, path, found.at[bad], x[bad])
+            pts = _join(pts, cut)
+            stage = np.concatenate([stage, bad])
+            d = np.concatenate([d, found.at[bad] - s[bad]])
+        duration = t_new
+        x0 = sd[stage] ** 2 + 2 * d * np.append(sdd, 0.0)[stage]
+    status = f"{status}; {rounds} rounds" + (" of tangents" if tangents else "")
     sd2 = sd**2
     dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
-    t = np.concatenate([[0.0], np.cumsum(dt)])
     u = np.append(sdd, sdd[-1])
-    p2 = path(s, 2)
-    tau = a * u[:, None] + b * sd2[:, None] + c
-    return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=t, x=x, q=path(s), qd=p1 * sd[:, None],
-                     qdd=p1 * u[:, None] + p2 * sd2[:, None], tau=tau, lo=lo, hi=hi, speed=v, status=status)
+    return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=np.concatenate([[0.0], np.cumsum(dt)]), x=x,
+                     q=grid.q, qd=grid.p1 * sd[:, None], qdd=grid.p1 * u[:, None] + grid.p2 * sd2[:, None],
+                     tau=grid.efforts(u, sd2), limit_ratio=found.ratio, lo=grid.a * np.nan, hi=grid.a * np.nan,
+                     speed=np.full(mech.dof, np.inf), time_error=None, status=status)
 
 
-def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray] | None,
-            v: FloatArray) -> tuple[FloatArray, FloatArray, str]:
-    """toppra's timing (s'' per interval, s' at the grid) within rows (N, R) A u + B x + C <= 0
-    (u = s'', x = s'^2) and speed limits v."""
+def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
+    """The s'^2 at which the first tangents of motor envelopes are taken: a quarter of the
+    speed limits' bound (1 where none; at most 1e6)."""
+    bound = np.full(len(pts.s), np.inf)
+    for lim in limits:
+        if isinstance(lim, SpeedLimit):
+            with np.errstate(divide="ignore", over="ignore"):  # no bound: inf
+                bound = np.minimum(bound, np.min((lim.v / np.abs(pts.p1)) ** 2, axis=1))
+    return np.minimum(np.where(np.isfinite(bound), bound / 4, 1.0), 1e6)
+
+
+def _take(p: PathPoints, i: NDArray[np.intp]) -> PathPoints:
+    return PathPoints(p.s[i], p.q[i], p.p1[i], p.p2[i], p.a[i], p.b[i], p.c[i])
+
+
+def _join(p: PathPoints, r: PathPoints) -> PathPoints:
+    return PathPoints(*(np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b", "c")))
+
+
+def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray]) -> tuple[FloatArray, FloatArray, str]:
+    """toppra's timing (s'' per interval, s' at the grid) within the stages' rows (N, R)
+    A u + B x + C <= 0 (u = s'', x = s'^2)."""
     import toppra.algorithm as algo
     import toppra.constraint as constraint
 
+    r = rows[0].shape[1]
+
     class _Rows(constraint.SecondOrderConstraint):
+        def __init__(self) -> None:
+            super().__init__(None, lambda q: np.eye(r), lambda q: np.zeros(r), len(s))
+            self.identical = True
+
         def compute_constraint_params(self, _path: Any, gridpoints: FloatArray) -> tuple[Any, ...]:
             if not np.array_equal(gridpoints, s):
-                raise PlanError("toppra asked for efforts off the planned grid")
-            assert rows is not None
-            r = rows[0].shape[1]
-            return rows[0], rows[1], rows[2], np.tile(np.eye(r), (len(s), 1, 1)), np.zeros((len(s), r)), None, None
+                raise PlanError("toppra asked for limits off the planned grid")
+            return rows[0], rows[1], rows[2], np.eye(r), np.zeros(r), None, None
 
-    constraints: list[Any] = []
-    m = len(v)
-    if rows is not None:
-        r = rows[0].shape[1]
-        constraints.append(_Rows(None, lambda q: np.eye(r), lambda q: np.zeros(r), m))
-    if np.isfinite(v).any():
-        vmax = np.where(np.isfinite(v), v, 1e300)
-        constraints.append(constraint.JointVelocityConstraint(np.stack([-vmax, vmax], axis=1)))
-    instance = algo.TOPPRA(constraints, path, gridpoints=s, parametrizer="ParametrizeConstAccel")
+    instance = algo.TOPPRA([_Rows()], path, gridpoints=s, parametrizer="ParametrizeConstAccel")
     sdd, sd, _, status = _solve(instance)
     if sd is None:
-        from .stage_lp import HighsWrapper
+        from .stage_lp import VertexWrapper
 
-        instance.solver_wrapper = HighsWrapper(instance.constraints, instance.path, instance.gridpoints)
+        instance.solver_wrapper = VertexWrapper(instance.constraints, instance.path, instance.gridpoints)
         sdd, sd, _, status = _solve(instance)
     if sd is None:
-        raise PlanError(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
+        raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}); the efforts at rest "
                         "(gravity, springs) may exceed them somewhere: raise the limits or move the path")
     return sdd, sd, status
 
@@ -275,22 +429,37 @@ def _solve(instance: Any) -> tuple[Any, Any, Any, str]:
 def task_waypoints(effector: EndEffector, X: ArrayLike, spacing: float) -> FloatArray:
     """Coordinates (K, m) along a task-space polyline, for :func:`time_optimal`.
 
-    Each segment between the rows of ``X`` ((J, k) task coordinates: m, m[, rad]) is cut into
-    pieces no longer than ``spacing`` (m) and solved by inverse kinematics, continued from
-    the drawing through the first point (on the drawing's working mode). The joint-space
-    spline through them leaves the task path by O(spacing^4) between them: check with
+    Each segment between the rows of ``X`` ((J, k) task coordinates, J >= 2: m, m[, rad], k
+    the effector's) is cut into pieces no longer than ``spacing`` (m, > 0; at most
+    MAX_WAYPOINTS pieces in all) and solved by inverse kinematics, continued from the drawing
+    through the first point (on the drawing's working mode). The joint-space spline through
+    them leaves the task path by O(spacing^4) between them: check with
     ``effector.state(q).X`` along the plan's ``q``.
     """
-    X = np.atleast_2d(np.asarray(X, dtype=float))
-    if len(X) < 2 or spacing <= 0:
-        raise PlanError(f"task path: need >= 2 points and a positive spacing, got {len(X)} points, {spacing}")
+    if not isinstance(effector, EndEffector):
+        raise PlanError(f"effector: expected an EndEffector, got {type(effector).__name__}", "effector")
+    k = len(effector.names)
+    try:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+    except (TypeError, ValueError):
+        X = np.full((0, 0), np.nan)
+    if X.ndim != 2 or X.shape[1] != k or len(X) < 2 or not np.all(np.isfinite(X)):
+        raise PlanError(f"X: expected (J, {k}) finite task coordinates ({', '.join(effector.names)}), J >= 2, got "
+                        f"shape {X.shape}", "X")
+    spacing = positive_number("spacing", spacing, "m")
+    pieces = np.ceil(np.linalg.norm(np.diff(X[:, :2], axis=0), axis=1) / spacing)
+    if pieces.sum() > MAX_WAYPOINTS:
+        raise PlanError(f"spacing: {spacing:g} m cuts the path into {pieces.sum():.3g} pieces, more than "
+                        f"{MAX_WAYPOINTS}; give a larger spacing", "spacing")
     points = [X[0]]
-    for a, b in zip(X[:-1], X[1:]):
-        n = max(1, int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / spacing)))
-        points.extend(a + (b - a) * f for f in np.linspace(0.0, 1.0, n + 1)[1:])
-    state = effector.inverse(points[0])
-    q = [state.q]
-    for Xi in points[1:]:
-        state = effector.solve(Xi, state.q, state.kin["x"])
-        q.append(state.q)
+    for a, b, n in zip(X[:-1], X[1:], pieces.astype(int)):
+        points.extend(a + (b - a) * f for f in np.linspace(0.0, 1.0, max(1, n) + 1)[1:])
+    try:
+        state = effector.inverse(points[0])
+        q = [state.q]
+        for Xi in points[1:]:
+            state = effector.solve(Xi, state.q, state.kin["x"])
+            q.append(state.q)
+    except (AssemblyError, SingularityError) as exc:
+        raise PlanError(f"X: the effector cannot follow the polyline on its working mode: {exc}", "X") from exc
     return np.array(q)

@@ -20,11 +20,14 @@ from .modes import Mode, assembly_modes, working_modes
 from .motion import TaskMotion, singularity_message, solve_motion
 from .paths import TaskPath, circle, from_functions, line, point_to_point, table, time_law
 from .plots import plot_capability, plot_modes, plot_motion, plot_singularity_map, plot_sizing, plot_workspace
+from .sampling import SamplingError, SizingError
 from .sizing import DriveSizing, LimitCheck, MotorSizing, SizingReport, envelope, motor_sizing, size, with_payload
 from .tolerances import SINGULAR_TOL
 
 __all__ = [
     "SINGULAR_TOL",
+    "SamplingError",
+    "SizingError",
     "DriveSizing",
     "SizingReport",
     "TaskGrid",

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..arguments import error
 from .effector import EndEffector
 from .maps import TaskGrid, flood, grid_size
 
@@ -48,7 +49,7 @@ def capability_at(ee: EndEffector, q: ArrayLike, tau_max: ArrayLike, n_dir: int 
     tau_max = np.broadcast_to(np.asarray(tau_max, dtype=float), (mech.dof,))
     J = ee.state(q).J[:2]
     if ee.dim != 2:
-        raise ValueError("the capability map is for a point end effector (m = 2)")
+        raise error("ee", "the capability map is for a point end effector (m = 2)")
     M = mech.mass_matrix(q) @ np.linalg.inv(J)
     g = mech.inverse_dynamics(q, np.zeros(mech.dof), np.zeros(mech.dof))
     ts = np.linspace(0.0, 2 * np.pi, n_dir, endpoint=False)
@@ -57,7 +58,7 @@ def capability_at(ee: EndEffector, q: ArrayLike, tau_max: ArrayLike, n_dir: int 
     return float(r[k]), float(ts[k])
 
 
-@dataclass
+@dataclass(repr=False)
 class CapabilityMap:
     """Guaranteed end-effector acceleration at rest on a grid.
 
@@ -76,6 +77,12 @@ class CapabilityMap:
     holding: FloatArray
     tau_max: FloatArray
     grid: TaskGrid
+
+    def __repr__(self) -> str:
+        inside = self.accel[np.isfinite(self.accel)]
+        span = f"{inside.min():.4g} .. {inside.max():.4g} m/s^2" if inside.size else "no reachable cell"
+        return (f"CapabilityMap({self.effector.point} of {self.effector.mech.name}: {len(self.y)} x {len(self.x)} "
+                f"cells, guaranteed acceleration {span}, |tau| <= {np.round(self.tau_max, 6).tolist()})")
 
 
 def capability_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float, float],

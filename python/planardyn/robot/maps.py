@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from ..arguments import error
 from .effector import EffectorState, EndEffector
 from .tolerances import EDGE_TOL, JUMP_TOL, QUAD_JUMP, SINGULAR_TOL
 
@@ -24,7 +25,7 @@ FloatArray = NDArray[np.float64]
 MAX_ATTEMPTS = 4
 
 
-@dataclass
+@dataclass(repr=False)
 class TaskGrid:
     """Measures on a grid of end-effector positions (orientation psi fixed for a pose).
 
@@ -44,6 +45,11 @@ class TaskGrid:
     @property
     def reachable(self) -> NDArray[np.bool_]:
         return np.isfinite(self.sigma_I)
+
+    def __repr__(self) -> str:
+        return (f"TaskGrid({self.effector.point} of {self.effector.mech.name}: {len(self.y)} x {len(self.x)} cells, "
+                f"x {self.x[0]:.4g} .. {self.x[-1]:.4g} m, y {self.y[0]:.4g} .. {self.y[-1]:.4g} m, "
+                f"{int(self.reachable.sum())} reachable)")
 
     @property
     def area(self) -> float:
@@ -135,7 +141,7 @@ def singularity_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[floa
     return flood(ee, np.linspace(*xlim, nx), np.linspace(*ylim, ny), psi, q_start)
 
 
-@dataclass
+@dataclass(repr=False)
 class Workspace:
     """Reachable positions of an end-effector point.
 
@@ -153,6 +159,10 @@ class Workspace:
     dexterity: FloatArray
     area: float
     method: str
+
+    def __repr__(self) -> str:
+        return (f"Workspace({self.effector.point} of {self.effector.mech.name}: area {self.area:.4g} m^2, "
+                f"{len(self.points)} positions, {len(self.y)} x {len(self.x)} cells; {self.method})")
 
     def boundary(self) -> list[FloatArray]:
         """The boundary as closed polylines ((K, 2) m each): the occupancy's 0.5 contour."""
@@ -235,7 +245,7 @@ def workspace(ee: EndEffector, ranges: ArrayLike | None = None, n: int = 80, cel
         ranges = np.column_stack([q0 - half, q0 + half])
     ranges = np.asarray(ranges, dtype=float)
     if ranges.shape != (mech.dof, 2) or np.any(ranges[:, 1] <= ranges[:, 0]):
-        raise ValueError(f"ranges must be (m, 2) = ({mech.dof}, 2) with low < high, got {ranges.tolist()}")
+        raise error("ranges", f"ranges must be (m, 2) = ({mech.dof}, 2) with low < high, got {ranges.tolist()}")
     if ee.dim == 3:
         return _workspace_pose(ee, ranges, cells, psi)
     a1, a2 = (np.linspace(lo, hi, n) for lo, hi in ranges)

@@ -20,6 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
+from ..arguments import count, error, positive
+from ..notebook import Summarized, peak_rows
 from .effector import EndEffector
 from .paths import TaskPath
 from .tolerances import SINGULAR_TOL
@@ -32,6 +34,8 @@ FloatArray = NDArray[np.float64]
 
 # Default spacing of the samples of a path (s).
 DEFAULT_DT = 1e-3
+#: Most samples of a task motion: 1e7 rows of q, qd, qdd, tau and the poses take gigabytes.
+MAX_SAMPLES = 10**7
 # Tolerances of the open-loop check run (TaskMotion.simulate): its integration error must stay
 # far below the 1e-6 m to which the efforts are required to reproduce the path.
 CHECK_RTOL, CHECK_ATOL = 1e-10, 1e-12
@@ -45,7 +49,7 @@ KIND_TEXT = {
 
 
 @dataclass
-class TaskMotion:
+class TaskMotion(Summarized):
     """A task-space motion solved for the inputs, time-major arrays.
 
     ``t`` (N,) s; ``X``, ``Xd``, ``Xdd`` (N, k) prescribed task coordinates and their rates
@@ -78,6 +82,13 @@ class TaskMotion:
         return (f"TaskMotion({self.label}; {len(self.t)} samples, min sigma_I {self.sigma_I.min():.3g}, "
                 f"min sigma_II {self.sigma_II.min():.3g}, peak |tau| {np.abs(self.tau).max(axis=0).round(4).tolist()})")
 
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        return [("model", self.mech.name), ("path", f"{self.label} of {self.effector.point}"),
+                ("samples", f"{len(self.t)}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s"),
+                *peak_rows(self.mech, self.tau, self.qd),
+                ("min sigma_I, sigma_II", f"{self.sigma_I.min():.3g}, {self.sigma_II.min():.3g}"),
+                *[("note", n) for n in self.notes]]
+
     def drives(self) -> DriveFunction:
         """The drive efforts as a callable ``f(t, q, qd)`` for :meth:`Mechanism.simulate`: a
         cubic spline of ``tau`` in t (open loop: q and qd are not used)."""
@@ -106,11 +117,14 @@ class TaskMotion:
 
 
 def _sample_times(duration: float, n: int | None, dt: float | None) -> FloatArray:
-    if n is None:
-        n = int(np.ceil(duration / (dt or DEFAULT_DT))) + 1
-    if n < 2:
-        raise ValueError(f"a motion needs at least 2 samples, got n = {n}")
-    return np.linspace(0.0, duration, n)
+    """``n`` sample times over [0, duration] (s), or as many as a spacing ``dt`` (s) gives."""
+    if n is not None:
+        return np.linspace(0.0, duration, count("n", n, 2, MAX_SAMPLES))
+    step = DEFAULT_DT if dt is None else positive("dt", dt, "s")
+    if duration / step >= MAX_SAMPLES:
+        raise error("dt", f"dt = {step:g} s cuts the {duration:g} s motion into more than {MAX_SAMPLES} samples: "
+                          "give a larger dt")
+    return np.linspace(0.0, duration, max(int(np.ceil(duration / step)) + 1, 2))
 
 
 def _where(ee: EndEffector, X: FloatArray) -> str:

@@ -16,6 +16,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..arguments import array, choice, error, number, positive, times
+
 FloatArray = NDArray[np.float64]
 Profile = Literal["quintic", "trapezoid", "constant"]
 Sampler = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
@@ -32,7 +34,7 @@ def time_law(kind: Profile, tau: FloatArray) -> tuple[FloatArray, FloatArray, Fl
     ends. ``'trapezoid'``: constant acceleration, cruise, constant deceleration (speed
     continuous, acceleration steps). ``'constant'``: s = tau (constant speed).
     """
-    tau = np.clip(np.asarray(tau, dtype=float), 0.0, 1.0)
+    tau = np.clip(array("tau", tau, ndim=(0, 1), what="normalised times"), 0.0, 1.0)
     if kind == "quintic":
         s = tau**3 * (10 - 15 * tau + 6 * tau**2)
         sd = 30 * tau**2 * (1 - tau) ** 2
@@ -48,7 +50,7 @@ def time_law(kind: Profile, tau: FloatArray) -> tuple[FloatArray, FloatArray, Fl
     elif kind == "constant":
         s, sd, sdd = tau, np.ones_like(tau), np.zeros_like(tau)
     else:
-        raise ValueError(f"profile must be 'quintic', 'trapezoid' or 'constant', got {kind!r}")
+        raise error("profile", f"profile must be 'quintic', 'trapezoid' or 'constant', got {kind!r}")
     return s, sd, sdd
 
 
@@ -65,8 +67,16 @@ class TaskPath:
     _sample: Sampler
 
     def sample(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        return self._sample(t)
+        """X, Xd, Xdd (N, k) at times t (N,) (s) within [0, duration]."""
+        t = np.atleast_1d(array("t", t, ndim=(0, 1), what="times in s"))
+        if np.any((t < 0.0) | (t > self.duration)):
+            k = int(np.argmax((t < 0.0) | (t > self.duration)))
+            raise error("t", f"t[{k}] = {t[k]!r} s is outside the path's [0, {self.duration:g}] s")
+        out = self._sample(t)
+        if not all(np.isfinite(a).all() for a in out):
+            raise error("path", f"{self.label}: its speed or acceleration overflows (not finite): give a longer "
+                                "duration or a smaller path")
+        return out
 
     def with_dim(self, k: int) -> TaskPath:
         """The same path with k task coordinates: psi = 0 (drawn orientation) appended for
@@ -79,20 +89,20 @@ class TaskPath:
                 return tuple(np.hstack([a, z]) for a in self._sample(t))  # type: ignore[return-value]
 
             return TaskPath(self.duration, 3, self.label, sample3)
-        raise ValueError(f"the path has {self.dim} task coordinates, the end effector {k}")
+        raise error("path", f"the path has {self.dim} task coordinates, the end effector {k}: give a path of {k}")
 
 
 def _check_duration(duration: float) -> float:
-    duration = float(duration)
-    if not np.isfinite(duration) or duration <= 0:
-        raise ValueError(f"duration must be > 0 s, got {duration}")
-    return duration
+    return positive("duration", duration, "s")
 
 
 def _angles(angle: float | tuple[float, float] | None) -> tuple[float, float] | None:
     if angle is None:
         return None
-    a0, a1 = np.broadcast_to(np.asarray(angle, dtype=float), (2,))  # psi, or (psi0, psi1)
+    a = array("angle", angle, ndim=(0, 1), what="psi, or (psi0, psi1), rad")
+    if a.size not in (1, 2):
+        raise error("angle", f"angle must be psi or (psi0, psi1) (rad), got {a.size} values")
+    a0, a1 = np.broadcast_to(a, (2,))
     return float(a0), float(a1)
 
 
@@ -122,7 +132,8 @@ def line(
     interpolated with the same profile.
     """
     T = _check_duration(duration)
-    p0, p1 = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    choice("profile", profile, ("quintic", "trapezoid", "constant"))
+    p0, p1 = (array(n, p, shape=(2,), what="a point (x, y), m") for n, p in (("start", start), ("end", end)))
     d = p1 - p0
     angles = _angles(angle)
 
@@ -144,7 +155,8 @@ def point_to_point(
 ) -> TaskPath:
     """Rest-to-rest move along a straight line (see :func:`line`)."""
     if profile not in ("quintic", "trapezoid"):
-        raise ValueError(f"a point-to-point move starts and ends at rest: use 'quintic' or 'trapezoid', got {profile!r}")
+        raise error("profile", f"a point-to-point move starts and ends at rest: use 'quintic' or 'trapezoid', "
+                               f"got {profile!r}")
     return line(start, end, duration, profile, angle)
 
 
@@ -162,11 +174,11 @@ def circle(
     follows the time profile (``'quintic'``: from rest to rest; ``'constant'``: uniform speed).
     """
     T = _check_duration(duration)
-    c = np.asarray(center, dtype=float)
-    r = float(radius)
-    if not r > 0:
-        raise ValueError(f"radius must be > 0 m, got {radius}")
-    sweep = 2 * np.pi * float(turns)
+    choice("profile", profile, ("quintic", "trapezoid", "constant"))
+    c = array("center", center, shape=(2,), what="a point (x, y), m")
+    r = positive("radius", radius, "m")
+    sweep = 2 * np.pi * number("turns", turns)
+    start_angle = number("start_angle", start_angle, "rad")
     angles = _angles(angle)
 
     def sample(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -210,10 +222,10 @@ def from_functions(
         out = tuple(np.asarray(f(t), dtype=float) for f in (X, Xd, Xdd))
         for name, a in zip(("X", "Xd", "Xdd"), out):
             if a.shape not in ((len(t), 2), (len(t), 3)):
-                raise ValueError(f"{name}(t) must return shape (N, 2) or (N, 3) for t of shape (N,); "
-                                 f"got {a.shape} for N = {len(t)}")
+                raise error(name, f"{name}(t) must return shape (N, 2) or (N, 3) for t of shape (N,); "
+                                  f"got {a.shape} for N = {len(t)}")
             if not np.isfinite(a).all():
-                raise ValueError(f"{name}(t) returned a NaN or an infinity")
+                raise error(name, f"{name}(t) returned a NaN or an infinity")
         return out  # type: ignore[return-value]
 
     t = duration * np.array([0.1, 0.37, 0.5, 0.73, 0.9])
@@ -223,9 +235,14 @@ def from_functions(
         scale = np.abs(want).max() + np.abs(x0).max() / duration ** (1 if name == "Xd" else 2)
         err = np.abs(got - want).max()
         if err > DERIVATIVE_CHECK_RTOL * scale:
-            raise ValueError(f"{name}(t) is not the time derivative of the path: it differs from a central "
-                             f"difference by {err:.3g} (scale {scale:.3g}); check signs and chain-rule factors")
+            raise error(name, f"{name}(t) is not the time derivative of the path: at 0.1 to 0.9 of the duration it "
+                              f"differs from a central difference (step {h:.3g} s, 1e-4 of the duration) by "
+                              f"{err:.3g} (scale {scale:.3g}); check signs and chain-rule factors")
     return TaskPath(duration, x0.shape[1], label, sample)
+
+
+#: The end conditions of :func:`table` (scipy's CubicSpline names).
+BC_TYPES = ("not-a-knot", "clamped", "natural", "periodic")
 
 
 def table(t: ArrayLike, X: ArrayLike, bc_type: str = "not-a-knot") -> TaskPath:
@@ -245,13 +262,21 @@ def table(t: ArrayLike, X: ArrayLike, bc_type: str = "not-a-knot") -> TaskPath:
     """
     from scipy.interpolate import CubicSpline
 
-    t = np.asarray(t, dtype=float)
-    X = np.asarray(X, dtype=float)
-    if t.ndim != 1 or X.ndim != 2 or X.shape[0] != t.shape[0] or X.shape[1] not in (2, 3):
-        raise ValueError(f"table needs t (K,) and X (K, 2 or 3); got {t.shape} and {X.shape}")
-    if t[0] != 0.0 or np.any(np.diff(t) <= 0):
-        raise ValueError("table times must start at 0 s and increase")
-    spline = CubicSpline(t, X, bc_type=bc_type)
+    t = times("t", t)
+    X = array("X", X, ndim=2, what="positions (m), with psi (rad) as a third column for a pose")
+    if X.shape[0] != t.shape[0] or X.shape[1] not in (2, 3):
+        raise error("X", f"table needs X (K, 2 or 3) for t (K,) = ({len(t)},); got {X.shape}")
+    if t[0] != 0.0:
+        raise error("t", f"table times start at 0 s, got t[0] = {t[0]!r}")
+    choice("bc_type", bc_type, BC_TYPES)
+    if bc_type == "periodic" and not np.array_equal(X[0], X[-1]):
+        raise error("bc_type", "bc_type = 'periodic' needs a table whose last row X[-1] is its first X[0]")
+    with np.errstate(all="ignore"):  # the slopes and the spline's coefficients must be finite
+        finite = bool(np.isfinite(np.diff(X, axis=0) / np.diff(t)[:, None]).all())
+        spline = CubicSpline(t, X, bc_type=bc_type) if finite else None
+    if spline is None or not all(np.isfinite(c).all() for c in (spline.c, spline(t[-1], 1), spline(t[-1], 2))):
+        raise error("X", "X: the table's spline overflows (its positions too far apart, or its times too close, for "
+                         "floating point): give positions in metres and times in seconds of a drawable motion")
     d1, d2 = spline.derivative(1), spline.derivative(2)
 
     def sample(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..plot import draw_mechanism
+from ..plot import axis_label, draw_mechanism
 from .tolerances import SINGULAR_TOL
 
 if TYPE_CHECKING:
@@ -60,8 +60,9 @@ def plot_motion(motion: TaskMotion, fig: Any = None) -> list[Any]:
     for k, name in enumerate(mech.coordinate_names):
         out += ax[0, 1].plot(motion.t, motion.q[:, k], label=name)
         out += ax[1, 0].plot(motion.t, motion.tau[:, k], label=f"tau_{name}")
-    ax[0, 1].set_ylabel("inputs q (rad or m)")
-    ax[1, 0].set_ylabel("drive efforts (N m or N)")
+    names = mech.coordinate_names
+    ax[0, 1].set_ylabel(axis_label("inputs q", names, mech.coordinate_units))
+    ax[1, 0].set_ylabel(axis_label("drive efforts", [f"tau_{n}" for n in names], mech.effort_units))
     for a in (ax[0, 1], ax[1, 0]):
         a.set_xlabel("t (s)")
         a.legend(loc="best", fontsize="small")
@@ -93,9 +94,14 @@ def plot_sizing(report: SizingReport, fig: Any = None) -> list[Any]:
             out += ax[0, 1].plot(mo.envelope_speed, mo.envelope_torque, color=c,
                                  label=f"{d.name} motor {mo.name} ({'pass' if mo.passed else 'FAIL'})")
         out += ax[1, 0].plot(m.t, m.tau[:, k] * m.qd[:, k], color=c, label=f"{d.name} (peak {d.peak_power:.3g} W)")
-    ax[0, 0].set(xlabel="t (s)", ylabel="effort (N m or N)", title="efforts (dashed: RMS)")
+    names = [d.name for d in report.drives]
+    ax[0, 0].set(xlabel="t (s)", ylabel=axis_label("effort", names, [d.effort_unit for d in report.drives]),
+                 title="efforts (dashed: RMS)")
     motors = any(d.motor is not None for d in report.drives)
-    ax[0, 1].set(xlabel="|speed| (rad/s or m/s)", ylabel="|effort| (N m or N)",
+    # The motor side where a drive has a motor (N m, rad/s), else the joint side.
+    side = [("N m", "rad/s") if d.motor is not None else (d.effort_unit, d.speed_unit) for d in report.drives]
+    ax[0, 1].set(xlabel=axis_label("|speed|", names, [v for _, v in side]),
+                 ylabel=axis_label("|effort|", names, [e for e, _ in side]),
                  title="torque-speed: motor side and motor envelope" if motors else "torque-speed envelope")
     ax[1, 0].set(xlabel="t (s)", ylabel="power tau qd (W)", title="mechanical power")
     for a in (ax[0, 0], ax[0, 1], ax[1, 0]):

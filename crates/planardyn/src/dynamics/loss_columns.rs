@@ -91,7 +91,7 @@ impl LossLayout {
 /// The damping of `load` if it is a viscous damper on pair `id`.
 fn damper(load: &Load, id: PairId) -> Option<f64> {
     match load {
-        Load::PairSpring { pair, stiffness, damping, .. } if *pair == id && *stiffness == 0.0 => Some(*damping),
+        Load::PairSpring(s) if s.pair == id && s.stiffness == 0.0 => Some(s.damping),
         _ => None,
     }
 }

@@ -2,7 +2,6 @@
 //! set [`Prescribed`] evaluates q_p, qd_p, qdd_p of the driven coordinates at a time; the
 //! efforts they need come from `dynamics::prescribed`.
 
-use super::prescribed::Scratch;
 use crate::model::{Mechanism, MotionLaw};
 
 /// A motion given by the caller as a function of time (a Python callable, a closed form).
@@ -138,6 +137,35 @@ impl<'a> Prescribed<'a> {
         for (i, &k) in self.p.iter().enumerate() {
             y[k] = self.q[i];
             y[m + k] = self.qd[i];
+        }
+    }
+}
+
+/// Buffers of `dynamics::prescribed::forward_prescribed`, held by the set ([`Prescribed`]) so
+/// that a run allocates them once: sized for m coordinates, m_p of them prescribed, and 3n
+/// body coordinates.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    /// (m_p x 3n) the prescribed coordinates' gradients D_p,x.
+    pub(super) grad: Vec<f64>,
+    /// (m_p x m) G = D_p,x U, then (m x m_p, column-major) A^-1 G^T.
+    pub(super) g: Vec<f64>,
+    pub(super) ainv_gt: Vec<f64>,
+    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) the rows' h, and h - G A^-1 b, then tau_p.
+    pub(super) s: Vec<f64>,
+    pub(super) h0: Vec<f64>,
+    pub(super) h: Vec<f64>,
+}
+
+impl Scratch {
+    pub fn new(m: usize, mp: usize, nx: usize) -> Scratch {
+        Scratch {
+            grad: vec![0.0; mp * nx],
+            g: vec![0.0; mp * m],
+            ainv_gt: vec![0.0; m * mp],
+            s: vec![0.0; mp * mp],
+            h0: vec![0.0; mp],
+            h: vec![0.0; mp],
         }
     }
 }

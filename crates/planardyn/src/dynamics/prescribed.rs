@@ -12,7 +12,7 @@
 use super::forces::{applied_forces, Drives};
 use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
 use super::losses::forward_with_losses_by;
-use super::motion::Prescribed;
+use super::motion::{Prescribed, Scratch};
 use super::transmission;
 use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
@@ -23,34 +23,6 @@ use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 use nalgebra::DMatrix;
-
-/// Buffers of [`forward_prescribed`] (held by [`Prescribed`]), sized for m coordinates, m_p of them prescribed, and
-/// 3n body coordinates.
-#[derive(Debug, Clone, Default)]
-pub struct Scratch {
-    /// (m_p x 3n) the prescribed coordinates' gradients D_p,x.
-    grad: Vec<f64>,
-    /// (m_p x m) G = D_p,x U, then (m x m_p, column-major) A^-1 G^T.
-    g: Vec<f64>,
-    ainv_gt: Vec<f64>,
-    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) the rows' h, and h - G A^-1 b, then tau_p.
-    s: Vec<f64>,
-    h0: Vec<f64>,
-    h: Vec<f64>,
-}
-
-impl Scratch {
-    pub fn new(m: usize, mp: usize, nx: usize) -> Scratch {
-        Scratch {
-            grad: vec![0.0; mp * nx],
-            g: vec![0.0; mp * m],
-            ainv_gt: vec![0.0; m * mp],
-            s: vec![0.0; mp * mp],
-            h0: vec![0.0; mp],
-            h: vec![0.0; mp],
-        }
-    }
-}
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()

@@ -2,7 +2,7 @@
 //! M xdd = f + Phi_x^T mu, solved as J^T lambda = M xdd - f in the current chart (the chart
 //! rows carry no force, so their multipliers vanish up to round-off; docs/formulation.md).
 
-use crate::kinematics::pairs;
+use crate::model::pairs;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 
@@ -10,7 +10,7 @@ use crate::workspace::Workspace;
 /// exerts on body b (the pair's first and second body), after a forward evaluation in `ws`.
 /// The force is reduced to b's copy of the pair point (where a slider touches its guide, a
 /// gear's centre); a revolute pair transmits no couple; a prismatic pair's force is normal
-/// to its guide; each kind's is described in its module of `kinematics::pairs`.
+/// to its guide; each kind's is described in its module of `model::pairs`.
 pub fn reactions(mech: &Mechanism, ws: &mut Workspace) -> Vec<[f64; 3]> {
     let (mut lambda, mut out) = (vec![0.0; ws.x.len()], vec![[0.0; 3]; mech.pairs.len()]);
     reactions_into(mech, ws, &mut lambda, &mut out);

@@ -48,17 +48,6 @@ pub struct Actuation {
     l: Vec<f64>,
 }
 
-/// Number of actuators n_a: the coordinates, then the pair actuators.
-pub fn n_actuators(mech: &Mechanism) -> usize {
-    mech.dof() + mech.pair_actuators.len()
-}
-
-/// The actuators' names: the coordinates', then the pair actuators'.
-pub fn actuator_names(mech: &Mechanism) -> Vec<String> {
-    let coords = mech.coordinates.iter().map(|c| c.name.clone());
-    coords.chain(mech.pair_actuators.iter().map(|a| a.name.clone())).collect()
-}
-
 fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f64]) {
     grad.fill(0.0);
     pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
@@ -87,7 +76,7 @@ fn orthogonalise(v: &mut [f64], basis: &[Vec<f64>]) -> f64 {
 impl Actuation {
     /// The actuation at the point in `ws` (after the kinematic stages, in its chart).
     pub fn at(mech: &Mechanism, ws: &Workspace) -> Result<Self, KinematicsError> {
-        let (m, n_a, n) = (mech.dof(), n_actuators(mech), ws.x.len());
+        let (m, n_a, n) = (mech.dof(), mech.n_actuators(), ws.x.len());
         let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
         let mut b = vec![0.0; m * n_a];
         let mut grad = vec![0.0; n];
@@ -152,13 +141,23 @@ impl Actuation {
                     got: format!("{}", lambda.len()),
                 })
             }
-            Distribution::Preload(lambda) => lambda.clone(),
+            Distribution::Preload(lambda) => match lambda.iter().position(|l| !l.is_finite()) {
+                Some(i) => {
+                    return Err(KinematicsError::bad_argument(
+                        "preload",
+                        "finite values (N m or N), one per internal force",
+                        format!("preload[{i}] = {}", lambda[i]),
+                    ))
+                }
+                None => lambda.clone(),
+            },
             Distribution::MinMax => min_max_lambda(&out, &self.internal)?,
         };
         for (l, v) in lambda.iter().zip(&self.internal) {
             out.iter_mut().zip(v).for_each(|(o, v)| *o += l * v);
         }
-        Ok(out)
+        // Finite preloads near the floating-point range can still overflow when added.
+        super::regular::finite("efforts", out)
     }
 }
 

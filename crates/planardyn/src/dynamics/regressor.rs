@@ -17,7 +17,7 @@
 use super::forces::applied_forces;
 use super::inverse::inverse_at_rates;
 use super::loss_columns::{self, LossLayout};
-use crate::kinematics::pairs::frames::rotate;
+use crate::model::pairs::frames::rotate;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::KinematicsError;

@@ -27,7 +27,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::control::{all_finite, explicit_step, Core, ExplicitPair, Failure};
-use super::{OdeSystem, Options, StepError};
+use super::{Integrator, OdeSystem, Options, StepError};
 
 /// Stages of the step (the FSAL stage excluded).
 const N_STAGES: usize = 12;
@@ -256,8 +256,16 @@ pub struct Dop853 {
     dense_ready: bool,
 }
 
-impl Dop853 {
-    pub fn new(opts: &Options, n: usize) -> Self {
+impl Integrator for Dop853 {
+    const NAME: &'static str = "dop853";
+    const ALIASES: &'static [&'static str] = &[];
+    const ORDER: usize = 8;
+    /// Degree 7 (with `Options::dense_output`; cubic Hermite without).
+    const DENSE_ORDER: usize = 7;
+    const ADAPTIVE: bool = true;
+    const IMPLICIT: bool = false;
+
+    fn new(opts: &Options, n: usize) -> Self {
         Dop853 {
             core: Core::new(opts, n),
             k: vec![0.0; N_EXT * n],
@@ -270,21 +278,11 @@ impl Dop853 {
         }
     }
 
-    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
-        self.fd.fill(0.0);
-        self.dense_ready = true;
-        self.core.reset(sys, t, y)
-    }
-
-    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
-        explicit_step(self, sys, t_stop)
-    }
-
     /// 7th-order dense output on the last accepted step (HNW I, II.6; scipy
     /// `Dop853DenseOutput`): with `s = (t - t_prev)/h`,
     /// `y = y_prev + s (F0 + (1-s) (F1 + s (F2 + (1-s) (F3 + s (F4 + (1-s) (F5 + s F6))))))`.
     /// The first call within a step evaluates its 3 extra stages with `sys`.
-    pub fn interpolate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
+    fn interpolate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
         if !self.dense_ready {
             self.dense_coefficients(sys);
         }
@@ -300,6 +298,18 @@ impl Dop853 {
             }
             out[i] = c.y_prev[i] + acc;
         }
+    }
+}
+
+impl Dop853 {
+    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
+        self.fd.fill(0.0);
+        self.dense_ready = true;
+        self.core.reset(sys, t, y)
+    }
+
+    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
+        explicit_step(self, sys, t_stop)
     }
 
     /// Rows 3..6 of the dense output of the last accepted step, from its stages and the 3

@@ -26,7 +26,7 @@
 //! computed at each accepted step (`4 x n` values, no `rhs` call).
 
 use super::control::{all_finite, error_norm, explicit_step, Core, ExplicitPair, Failure};
-use super::{OdeSystem, Options, StepError};
+use super::{Integrator, OdeSystem, Options, StepError};
 
 const C: [f64; 6] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0];
 
@@ -71,8 +71,16 @@ pub struct Dopri5 {
     h: f64,
 }
 
-impl Dopri5 {
-    pub fn new(opts: &Options, n: usize) -> Self {
+impl Integrator for Dopri5 {
+    const NAME: &'static str = "dopri5";
+    const ALIASES: &'static [&'static str] = &["rk45"];
+    const ORDER: usize = 5;
+    /// Quartic.
+    const DENSE_ORDER: usize = 4;
+    const ADAPTIVE: bool = true;
+    const IMPLICIT: bool = false;
+
+    fn new(opts: &Options, n: usize) -> Self {
         Dopri5 {
             core: Core::new(opts, n),
             k: vec![0.0; 7 * n],
@@ -85,17 +93,8 @@ impl Dopri5 {
         }
     }
 
-    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
-        self.q.fill(0.0);
-        self.core.reset(sys, t, y)
-    }
-
-    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
-        explicit_step(self, sys, t_stop)
-    }
-
     /// 4th-order dense output on the last accepted step.
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
+    fn interpolate<S: OdeSystem>(&mut self, _sys: &mut S, t: f64, out: &mut [f64]) {
         let c = &self.core;
         let n = c.n;
         let h = c.t - c.t_prev;
@@ -108,6 +107,17 @@ impl Dopri5 {
             }
             out[i] = c.y_prev[i] + acc * s;
         }
+    }
+}
+
+impl Dopri5 {
+    pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
+        self.q.fill(0.0);
+        self.core.reset(sys, t, y)
+    }
+
+    pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
+        explicit_step(self, sys, t_stop)
     }
 }
 

@@ -11,6 +11,8 @@
 //!
 //! The shared pieces (error norm, initial step, step-size controller, the
 //! explicit-pair step loop) live in `control`; Radau5's LU is `crate::linalg`'s.
+//! Each file declares its integrator's name, orders and kind ([`Integrator`]); adding a
+//! method is a file and a line of the registration table (`integrators!`).
 //!
 //! # Why hand-written
 //!
@@ -76,61 +78,135 @@ pub trait OdeSystem {
     }
 }
 
-/// The integration method, chosen at run time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Method {
+/// What an integrator declares in its own file: its names, orders and kind, how it is made
+/// and how it interpolates. The registration table (`integrators!` below) lists the
+/// integrators; [`Method`] and [`Stepper`] read everything else from here.
+pub trait Integrator: Sized {
+    /// The canonical lower-case name (as `FromStr` and a model's `simulate.method` accept
+    /// it, case-insensitive), and the other names accepted.
+    const NAME: &'static str;
+    const ALIASES: &'static [&'static str];
+    /// Classical order of the propagated solution (global error `O(h^ORDER)`).
+    const ORDER: usize;
+    /// Order of the dense output: its local error is `O(h^(DENSE_ORDER + 1))`.
+    const DENSE_ORDER: usize;
+    /// With local error control (false: a fixed step, [`Options::dt`]).
+    const ADAPTIVE: bool;
+    /// Implicit (stiffly accurate).
+    const IMPLICIT: bool;
+    /// A stepper for systems of dimension `dim`, all buffers allocated here.
+    fn new(opts: &Options, dim: usize) -> Self;
+    /// The solution at t in [t_prev, t] of the last accepted step into `out`; `sys` for a
+    /// dense output that evaluates stages of its own (Dop853's, once a step).
+    fn interpolate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]);
+}
+
+/// The registration table's macro: from each method's doc, variant and integrator type it
+/// makes [`Method`] (with `Method::ALL`), [`Stepper`], and the macros `registry!` (a method
+/// to its integrator type) and `dispatch!` (a stepper to its integrator). `$d` is a `$`
+/// passed in, which the macros it defines need.
+macro_rules! integrators {
+    ($d:tt $($(#[$doc:meta])* $variant:ident => $module:ident::$ty:ident,)*) => {
+        /// The integration method, chosen at run time.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Method {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl Method {
+            /// All methods, in declaration order.
+            pub const ALL: [Method; [$(Method::$variant),*].len()] = [$(Method::$variant),*];
+        }
+
+        /// One integrator, chosen at run time (enum dispatch, so generic `step<S>` works
+        /// without trait objects).
+        ///
+        /// Created once per simulation, so the variants' different sizes do not matter.
+        #[allow(clippy::large_enum_variant)]
+        pub enum Stepper {
+            $($variant($module::$ty),)*
+        }
+
+        /// Evaluate `$body` with `$T` the integrator type of a method.
+        macro_rules! registry {
+            ($d method:expr, $d T:ident => $d body:expr) => {
+                match $d method {
+                    $(Method::$variant => {
+                        type $d T = $module::$ty;
+                        $d body
+                    })*
+                }
+            };
+        }
+
+        /// Evaluate `$body` with `$s` the integrator of a stepper.
+        macro_rules! dispatch {
+            ($d stepper:expr, $d s:ident => $d body:expr) => {
+                match $d stepper {
+                    $(Stepper::$variant($d s) => $d body,)*
+                }
+            };
+        }
+
+        impl Stepper {
+            /// The method of this stepper.
+            pub fn method(&self) -> Method {
+                match self {
+                    $(Stepper::$variant(_) => Method::$variant,)*
+                }
+            }
+
+            /// A stepper of `method` for valid options.
+            fn of(method: Method, opts: &Options, dim: usize) -> Stepper {
+                match method {
+                    $(Method::$variant => Stepper::$variant(<$module::$ty as Integrator>::new(opts, dim)),)*
+                }
+            }
+        }
+    };
+}
+
+// The registration table: each integrator's file declares the rest (`Integrator`).
+integrators! { $
     /// Classic fixed-step Runge-Kutta of order 4 (needs [`Options::dt`]).
-    Rk4,
+    Rk4 => rk4::Rk4,
     /// Dormand-Prince 5(4), adaptive, FSAL.
-    Dopri5,
+    Dopri5 => dopri5::Dopri5,
     /// Dormand-Prince 8(5,3), adaptive, for tight tolerances.
-    Dop853,
+    Dop853 => dop853::Dop853,
     /// Radau IIA of order 5, implicit, for stiff systems (stiff springs, dampers).
-    Radau5,
+    Radau5 => radau5::Radau5,
 }
 
 impl Method {
-    /// All methods, in declaration order.
-    pub const ALL: [Method; 4] = [Method::Rk4, Method::Dopri5, Method::Dop853, Method::Radau5];
-
     /// Classical order of the propagated solution (global error `O(h^order)`).
     pub fn order(self) -> usize {
-        match self {
-            Method::Rk4 => 4,
-            Method::Dopri5 => 5,
-            Method::Dop853 => 8,
-            Method::Radau5 => 5,
-        }
+        registry!(self, T => T::ORDER)
     }
 
     /// Order of the dense output: its local error is `O(h^(dense_order + 1))`.
     pub fn dense_order(self) -> usize {
-        match self {
-            Method::Rk4 => 3,
-            Method::Dopri5 => 4,
-            Method::Dop853 => 7,
-            Method::Radau5 => 3,
-        }
+        registry!(self, T => T::DENSE_ORDER)
     }
 
     /// True for the methods with local error control (all but `Rk4`).
     pub fn is_adaptive(self) -> bool {
-        !matches!(self, Method::Rk4)
+        registry!(self, T => T::ADAPTIVE)
     }
 
     /// True for the implicit (stiffly accurate) methods.
     pub fn is_implicit(self) -> bool {
-        matches!(self, Method::Radau5)
+        registry!(self, T => T::IMPLICIT)
     }
 
     /// The canonical lower-case name, as accepted by `FromStr`.
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Rk4 => "rk4",
-            Method::Dopri5 => "dopri5",
-            Method::Dop853 => "dop853",
-            Method::Radau5 => "radau5",
-        }
+        registry!(self, T => T::NAME)
+    }
+
+    /// The other names `FromStr` accepts.
+    fn aliases(self) -> &'static [&'static str] {
+        registry!(self, T => T::ALIASES)
     }
 }
 
@@ -143,18 +219,19 @@ impl fmt::Display for Method {
 impl FromStr for Method {
     type Err = String;
 
-    /// Case-insensitive: "rk4", "dopri5" (or "rk45"), "dop853", "radau5" (or "radau").
+    /// Case-insensitive: a method's name or one of its aliases ("rk4", "dopri5" or "rk45",
+    /// "dop853", "radau5" or "radau").
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "rk4" => Ok(Method::Rk4),
-            "dopri5" | "rk45" => Ok(Method::Dopri5),
-            "dop853" => Ok(Method::Dop853),
-            "radau5" | "radau" => Ok(Method::Radau5),
-            _ => Err(format!(
-                "unknown integration method {s:?}: use one of \"rk4\", \"dopri5\" (\"rk45\"), \
-                 \"dop853\", \"radau5\" (\"radau\")"
-            )),
-        }
+        let name = s.trim().to_ascii_lowercase();
+        let known = |m: &Method| m.name() == name || m.aliases().contains(&name.as_str());
+        Method::ALL.into_iter().find(known).ok_or_else(|| {
+            let quoted = |names: &[&str]| names.iter().map(|n| format!("{n:?}")).collect::<Vec<_>>().join(", ");
+            let each = Method::ALL.map(|m| match m.aliases() {
+                [] => quoted(&[m.name()]),
+                aliases => format!("{} ({})", quoted(&[m.name()]), quoted(aliases)),
+            });
+            format!("unknown integration method {s:?}: use one of {}", each.join(", "))
+        })
     }
 }
 
@@ -252,10 +329,11 @@ impl Options {
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(format!("dt = {dt} must be finite and > 0"));
             }
-        } else if method == Method::Rk4 {
-            return Err("rk4 is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
-                        or choose an adaptive method such as dopri5"
-                .to_string());
+        } else if !method.is_adaptive() {
+            return Err(format!(
+                "{method} is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
+                 or choose an adaptive method such as dopri5"
+            ));
         }
         if self.max_steps == 0 {
             return Err("max_steps = 0 must be >= 1 (default 10000000)".to_string());
@@ -319,17 +397,6 @@ pub struct Stats {
     pub nlu: usize,
 }
 
-/// One integrator, chosen at run time (enum dispatch, so generic `step<S>` works without trait objects).
-///
-/// Created once per simulation, so the variants' different sizes do not matter.
-#[allow(clippy::large_enum_variant)]
-pub enum Stepper {
-    Rk4(rk4::Rk4),
-    Dopri5(dopri5::Dopri5),
-    Dop853(dop853::Dop853),
-    Radau5(radau5::Radau5),
-}
-
 impl fmt::Debug for Stepper {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Stepper")
@@ -342,28 +409,12 @@ impl fmt::Debug for Stepper {
     }
 }
 
-macro_rules! dispatch {
-    ($self:expr, $s:ident => $body:expr) => {
-        match $self {
-            Stepper::Rk4($s) => $body,
-            Stepper::Dopri5($s) => $body,
-            Stepper::Dop853($s) => $body,
-            Stepper::Radau5($s) => $body,
-        }
-    };
-}
-
 impl Stepper {
     /// A stepper for systems of dimension `dim`, all buffers allocated here.
     /// Err for invalid options, with the fix in the message.
     pub fn new(method: Method, opts: &Options, dim: usize) -> Result<Self, String> {
         opts.validate(method)?;
-        Ok(match method {
-            Method::Rk4 => Stepper::Rk4(rk4::Rk4::new(opts, dim)),
-            Method::Dopri5 => Stepper::Dopri5(dopri5::Dopri5::new(opts, dim)),
-            Method::Dop853 => Stepper::Dop853(dop853::Dop853::new(opts, dim)),
-            Method::Radau5 => Stepper::Radau5(radau5::Radau5::new(opts, dim)),
-        })
+        Ok(Stepper::of(method, opts, dim))
     }
 
     /// Start, or restart after a discontinuity / change of coordinates, at (t, y). Evaluates f(t, y).
@@ -410,27 +461,12 @@ impl Stepper {
     /// evaluates its 3 dense-output stages on the first call within a step (so steps with no
     /// output time in them do not pay for them); call it before the next `step`.
     pub fn interpolate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
-        match self {
-            Stepper::Dop853(s) => s.interpolate(sys, t, out),
-            Stepper::Rk4(s) => s.interpolate(t, out),
-            Stepper::Dopri5(s) => s.interpolate(t, out),
-            Stepper::Radau5(s) => s.interpolate(t, out),
-        }
+        dispatch!(self, s => Integrator::interpolate(s, sys, t, out))
     }
 
     /// Work counters since `new`.
     pub fn stats(&self) -> Stats {
         dispatch!(self, s => s.core.stats)
-    }
-
-    /// The method of this stepper.
-    pub fn method(&self) -> Method {
-        match self {
-            Stepper::Rk4(_) => Method::Rk4,
-            Stepper::Dopri5(_) => Method::Dopri5,
-            Stepper::Dop853(_) => Method::Dop853,
-            Stepper::Radau5(_) => Method::Radau5,
-        }
     }
 
     /// The step size the next `step` will try first (s), 0 before the first step after a reset.

@@ -43,7 +43,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::control::{all_finite, initial_step, stretch, Core, Failure, FAIL_FACTOR, MAX_FACTOR, MIN_FACTOR};
-use super::{OdeSystem, Options, StepError};
+use super::{Integrator, OdeSystem, Options, StepError};
 use crate::linalg::{lu_factor, lu_solve, LuError};
 use nalgebra::Complex;
 
@@ -140,8 +140,16 @@ pub struct Radau5 {
     err_old: Option<f64>,
 }
 
-impl Radau5 {
-    pub fn new(opts: &Options, n: usize) -> Self {
+impl Integrator for Radau5 {
+    const NAME: &'static str = "radau5";
+    const ALIASES: &'static [&'static str] = &["radau"];
+    const ORDER: usize = 5;
+    /// The collocation cubic.
+    const DENSE_ORDER: usize = 3;
+    const ADAPTIVE: bool = true;
+    const IMPLICIT: bool = true;
+
+    fn new(opts: &Options, n: usize) -> Self {
         let eps = f64::EPSILON;
         Radau5 {
             core: Core::new(opts, n),
@@ -171,6 +179,16 @@ impl Radau5 {
         }
     }
 
+    /// Collocation-polynomial dense output on the last accepted step.
+    fn interpolate<S: OdeSystem>(&mut self, _sys: &mut S, t: f64, out: &mut [f64]) {
+        let c = &self.core;
+        let h = c.t - c.t_prev;
+        let s = if h == 0.0 { 0.0 } else { (t - c.t_prev) / h };
+        eval_dense(&self.q, &c.y_prev, s, out);
+    }
+}
+
+impl Radau5 {
     pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         self.jac_valid = false;
         self.jac_current = false;
@@ -180,14 +198,6 @@ impl Radau5 {
         self.h_old = None;
         self.err_old = None;
         self.core.reset(sys, t, y)
-    }
-
-    /// Collocation-polynomial dense output on the last accepted step.
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let c = &self.core;
-        let h = c.t - c.t_prev;
-        let s = if h == 0.0 { 0.0 } else { (t - c.t_prev) / h };
-        eval_dense(&self.q, &c.y_prev, s, out);
     }
 
     /// The Jacobian at the current point: exact, or by forward differences (module doc).

@@ -25,7 +25,7 @@
 //! after a shortened one is `dt` again.
 
 use super::control::{explicit_step, Core, ExplicitPair, Failure};
-use super::{OdeSystem, Options, StepError};
+use super::{Integrator, OdeSystem, Options, StepError};
 
 /// Fixed-step RK4 with cubic Hermite dense output. All buffers allocated in `new`.
 pub struct Rk4 {
@@ -37,8 +37,16 @@ pub struct Rk4 {
     f_new: Vec<f64>,
 }
 
-impl Rk4 {
-    pub fn new(opts: &Options, n: usize) -> Self {
+impl Integrator for Rk4 {
+    const NAME: &'static str = "rk4";
+    const ALIASES: &'static [&'static str] = &[];
+    const ORDER: usize = 4;
+    /// Cubic Hermite.
+    const DENSE_ORDER: usize = 3;
+    const ADAPTIVE: bool = false;
+    const IMPLICIT: bool = false;
+
+    fn new(opts: &Options, n: usize) -> Self {
         Rk4 {
             core: Core::new(opts, n),
             k: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
@@ -48,17 +56,19 @@ impl Rk4 {
         }
     }
 
+    /// Cubic Hermite interpolation on the last step (see the module doc).
+    fn interpolate<S: OdeSystem>(&mut self, _sys: &mut S, t: f64, out: &mut [f64]) {
+        hermite(&self.core, t, out);
+    }
+}
+
+impl Rk4 {
     pub fn reset<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<(), StepError<S::Error>> {
         self.core.reset(sys, t, y)
     }
 
     pub fn step<S: OdeSystem>(&mut self, sys: &mut S, t_stop: f64) -> Result<(), StepError<S::Error>> {
         explicit_step(self, sys, t_stop)
-    }
-
-    /// Cubic Hermite interpolation on the last step (see the module doc).
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        hermite(&self.core, t, out);
     }
 }
 

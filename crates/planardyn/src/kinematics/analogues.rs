@@ -4,7 +4,6 @@
 //!   J U = [0; I_m],   J w_jk = -gamma(u_j, u_k),   J c = -gamma(xd, xd) with xd = U zd.
 
 use super::constraints::gamma;
-use super::position::chart_singularity;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 use crate::KinematicsError;
@@ -16,7 +15,7 @@ use crate::KinematicsError;
 pub fn velocity_analogues(ws: &mut Workspace) -> Result<(), KinematicsError> {
     if !ws.sys.is_factored() {
         // The analogues are undefined where J is singular (no factorisation of it).
-        return Err(KinematicsError::singular(chart_singularity(&ws.chart)));
+        return Err(KinematicsError::singular(ws.chart.singularity()));
     }
     if ws.u_zeros_for != ws.sys.supports_id() {
         ws.u.fill(0.0);

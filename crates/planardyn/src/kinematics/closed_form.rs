@@ -30,7 +30,7 @@ use super::dyads::triad::Triad;
 use super::dyads::Joint;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
-use crate::structure::assur::{self, AssurGroup};
+use crate::topology::assur::{self, AssurGroup};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
 

@@ -1,21 +1,22 @@
 //! The position equations F(x) = [Phi(x); D(x) - z] = 0 and their derivatives.
 //!
 //! The first rows are the independent pair constraints Phi (each pair kind has its own rows,
-//! `kinematics::pairs`; `Mechanism::row_slot` places them); the last m rows fix the chart's
+//! `model::pairs`; `Mechanism::row_slot` places them); the last m rows fix the chart's
 //! coordinates z: the user's generalized coordinates D(x) (relative angles and displacements
 //! of the input pairs), or m chosen components of x (generalized coordinate partitioning).
 //! Per row we need the value, the gradient (a row of J) and the second derivative as a
 //! bilinear form gamma(a, b) = sum_ij d2F/dx_i dx_j a_i b_j, which gives the convective term
 //! (gamma(xd, xd)) and the acceleration analogues (gamma(u_j, u_k)).
 
-pub use super::pairs::frames::{perp, rotate};
-use super::pairs::{self, frames::link_state, frames::part};
-pub use super::pairs::{
+pub use crate::linalg::{Dense, Sink};
+use crate::model::pairs;
+pub use crate::model::pairs::frames::{perp, point_acceleration, point_velocity, rotate, world_point};
+pub use crate::model::pairs::{
     coordinate as pair_coordinate, coordinate_gamma as pair_coordinate_gamma, coordinate_grad as pair_coordinate_grad,
     coordinate_rate as pair_coordinate_rate,
 };
-pub use crate::linalg::{Dense, Sink};
-use crate::model::{Link, Mechanism};
+use crate::model::{CoordinateKind, Mechanism};
+use crate::SingularityKind;
 
 /// Which m functions of x are the independent coordinates.
 #[derive(Debug, PartialEq, Eq)]
@@ -25,6 +26,17 @@ pub enum Chart {
     /// Components of x (indices into the 3n body coordinates), chosen near a singularity
     /// of the actuated mechanism.
     Partition(Vec<usize>),
+}
+
+impl Chart {
+    /// What a singular J means in this chart: a type II singularity in the generalized
+    /// coordinates, a rank loss of the pair constraints in a partition chart.
+    pub(crate) fn singularity(&self) -> SingularityKind {
+        match self {
+            Chart::Inputs => SingularityKind::TypeII,
+            Chart::Partition(_) => SingularityKind::Passive,
+        }
+    }
 }
 
 // By hand for `clone_from`: the factorisation records its chart at every evaluation, and a
@@ -169,25 +181,26 @@ pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &
     }
 }
 
-/// World position of a point of a link.
-pub fn world_point(link: Link, s: [f64; 2], x: &[f64]) -> [f64; 2] {
-    link_state(link, x).point(s)
+/// 1/L for rows measured in metres, 1 for rows measured in radians.
+pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
+    fill_row_scale(mech, chart, 1.0 / mech.scale, rs)
 }
 
-/// Velocity of a point of a link for body rates xd.
-pub fn point_velocity(link: Link, s: [f64; 2], x: &[f64], xd: &[f64]) -> [f64; 2] {
-    let l = link_state(link, x);
-    let (v, w) = part(&l, xd);
-    let t = perp(l.rot(s));
-    [v[0] + w * t[0], v[1] + w * t[1]]
-}
-
-/// Acceleration of a point of a link for body rates xd and accelerations xdd.
-pub fn point_acceleration(link: Link, s: [f64; 2], x: &[f64], xd: &[f64], xdd: &[f64]) -> [f64; 2] {
-    let l = link_state(link, x);
-    let (_, w) = part(&l, xd);
-    let (a, al) = part(&l, xdd);
-    let p = l.rot(s);
-    let t = perp(p);
-    [a[0] + al * t[0] - w * w * p[0], a[1] + al * t[1] - w * w * p[1]]
+/// `inv` for rows measured in metres, 1 for rows measured in radians.
+pub fn fill_row_scale(mech: &Mechanism, chart: &Chart, inv: f64, rs: &mut [f64]) {
+    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
+        for (slot, scale) in slots.iter().zip(pairs::row_scales(pair, inv)) {
+            if let Some(i) = *slot {
+                rs[i] = scale;
+            }
+        }
+    }
+    let nc = mech.n_constraints;
+    for (k, r) in rs[nc..].iter_mut().enumerate() {
+        let angle = match chart {
+            Chart::Inputs => mech.coordinates[k].kind == CoordinateKind::Angle,
+            Chart::Partition(idx) => idx[k] % 3 == 2,
+        };
+        *r = if angle { 1.0 } else { inv };
+    }
 }

@@ -20,11 +20,10 @@
 //! factors already in hand (2 s^2 flops an iteration for a block of s rows); the exact measure
 //! takes the SVD of each block (s^3), never of the whole J.
 
-use super::constraints::Chart;
-use super::pairs::frames::perp;
-use super::system::fill_row_scale;
+use super::constraints::{fill_row_scale, Chart};
 use crate::linalg::BlockLu;
 use crate::model::diameter::diameter;
+use crate::model::pairs::frames::perp;
 use crate::model::Mechanism;
 use nalgebra::DMatrix;
 

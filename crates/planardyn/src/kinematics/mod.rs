@@ -8,8 +8,8 @@ pub mod constraints;
 pub mod dyads;
 pub mod effector;
 pub mod group_sigma;
-pub mod pairs;
 pub mod position;
+pub mod rank;
 pub mod singularity;
 pub mod system;
 pub mod third;
@@ -18,7 +18,6 @@ pub use analogues::{acceleration_analogues, add_u_times, convective, velocity_an
 pub use closed_form::ClosedForm;
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
-pub use pairs::{pair_geometry, PairGeometry};
 pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, scaled_distances, solve_position,
     MAX_CORRECTION, POSITION_TOL,

@@ -2,11 +2,10 @@
 //! in the coordinates for larger moves (it stays on the branch the mechanism is drawn in).
 
 use super::analogues::velocity_analogues;
-use super::constraints::{body_trig, residual, Chart};
-use super::system::set_row_scale;
-use crate::model::{CoordinateKind, Mechanism};
+use super::constraints::{body_trig, residual, set_row_scale, Chart};
+use crate::model::{CoordinateKind, Mechanism, MAX_CONTINUATION_DISTANCE};
 use crate::workspace::Workspace;
-use crate::{KinematicsError, SingularityKind};
+use crate::KinematicsError;
 
 /// Convergence test of Newton's method: the largest residual, lengths divided by the
 /// characteristic length L and angles in radians, below 1e-14 (about 50 ulp of O(1) values).
@@ -107,16 +106,7 @@ fn converged(mech: &Mechanism, ws: &mut Workspace, norm: f64, iterations: usize)
 
 fn factor(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
     let chart = &ws.chart;
-    ws.sys.factor(mech, chart, &ws.x, &ws.trig).map_err(|_| KinematicsError::singular(chart_singularity(chart)))
-}
-
-/// What a singular J means in `chart`: a type II singularity in the generalized coordinates,
-/// a rank loss of the pair constraints in a partition chart.
-pub(crate) fn chart_singularity(chart: &Chart) -> SingularityKind {
-    match chart {
-        Chart::Inputs => SingularityKind::TypeII,
-        Chart::Partition(_) => SingularityKind::Passive,
-    }
+    ws.sys.factor(mech, chart, &ws.x, &ws.trig).map_err(|_| KinematicsError::singular(chart.singularity()))
 }
 
 /// Smallest continuation step, as a fraction of the whole move, before giving up.
@@ -129,11 +119,6 @@ const MAX_CONTINUATION_MOVE: f64 = 0.1;
 /// may have left the branch it started on (another assembly mode is O(1) away): the step is
 /// refused and cut, by continuation here and by the integrator in a simulation.
 pub const MAX_CORRECTION: f64 = 0.1;
-/// Largest move one continuation may make (rad, or lengths L for a displacement), for the
-/// loader's `q0` and every API call alike: with steps of [`MAX_CONTINUATION_MOVE`] it bounds
-/// a call to ~10^4 position solves (well under a second), where an unbounded target such as
-/// 1e15 rad would never return. A longer way is a sequence of calls, each from the last.
-pub const MAX_CONTINUATION_DISTANCE: f64 = 1e3;
 
 /// Largest scaled difference between two body-coordinate vectors.
 pub fn scaled_distance(a: &[f64], b: &[f64], col_scale: &[f64]) -> f64 {

@@ -8,11 +8,10 @@
 //! (`linalg::BlockLu`): input links and Assur groups are eliminated one after another, with
 //! the blocks found once per chart from the pattern of J.
 
-use super::constraints::{jacobian, jacobian_into, jacobian_pattern, Chart};
+use super::constraints::{jacobian, jacobian_into, jacobian_pattern, set_row_scale, Chart};
 use super::group_sigma::GroupScales;
-use super::pairs;
 use crate::linalg::{BlockLu, MAX_COLUMNS};
-use crate::model::{CoordinateKind, Mechanism};
+use crate::model::Mechanism;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
@@ -253,29 +252,5 @@ pub fn scaled_jacobian(
         for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(cs) {
             *v *= rs[r] * c;
         }
-    }
-}
-
-/// 1/L for rows measured in metres, 1 for rows measured in radians.
-pub fn set_row_scale(mech: &Mechanism, chart: &Chart, rs: &mut [f64]) {
-    fill_row_scale(mech, chart, 1.0 / mech.scale, rs)
-}
-
-/// `inv` for rows measured in metres, 1 for rows measured in radians.
-pub fn fill_row_scale(mech: &Mechanism, chart: &Chart, inv: f64, rs: &mut [f64]) {
-    for (pair, slots) in mech.pairs.iter().zip(&mech.pair_slots) {
-        for (slot, scale) in slots.iter().zip(pairs::row_scales(pair, inv)) {
-            if let Some(i) = *slot {
-                rs[i] = scale;
-            }
-        }
-    }
-    let nc = mech.n_constraints;
-    for (k, r) in rs[nc..].iter_mut().enumerate() {
-        let angle = match chart {
-            Chart::Inputs => mech.coordinates[k].kind == CoordinateKind::Angle,
-            Chart::Partition(idx) => idx[k] % 3 == 2,
-        };
-        *r = if angle { 1.0 } else { inv };
     }
 }

@@ -7,7 +7,7 @@
 //! one more right-hand side for the factorised J per coordinate.
 
 use super::constraints::{gamma, Chart};
-use super::pairs;
+use crate::model::pairs;
 use crate::model::Mechanism;
 use crate::workspace::Workspace;
 

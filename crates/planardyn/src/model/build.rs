@@ -1,104 +1,29 @@
-//! Validation of a [`MechanismSpec`] into a [`Mechanism`]: every name resolves, masses and
-//! inertias are positive, the mobility equals the number of coordinates, the constraints are
-//! independent in the drawing, and the mechanism assembles at its start coordinates.
+//! The checks of a [`MechanismSpec`] that need no mechanics, into the [`Mechanism`] as drawn:
+//! every name resolves, masses and inertias are positive, numbers are finite and in range,
+//! each pair, coordinate, drive, load and actuator is well formed. The loader adds the checks
+//! that need kinematics (the mobility, the assembly at q0) and the simulation settings
+//! (`crate::loader`).
 
-use super::spec::{BodySpec, DriveSpec, LoadSpec, Location, MotionSpec, PairSpec, PartSpec, SimulateSpec};
+use super::checks::{pair_id, Ctx, R};
+use super::loads;
+use super::pairs::frames::rotate;
+use super::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
+use super::spec::{BodySpec, CoordinateSpec, DriveSpec, Location, MotionSpec, PairSpec, PartSpec};
 use super::*;
-use crate::kinematics::assemble;
-use crate::kinematics::constraints::rotate;
-use crate::kinematics::pairs::{self, gear::Gear, gear::Mesh, slot::Slot};
-use crate::kinematics::position::MAX_CONTINUATION_DISTANCE;
-use crate::structure::constraint_rank;
-use crate::ModelError;
 
 mod actuators;
-
-/// Collects the context for error messages: the source name.
-struct Ctx<'a> {
-    source: &'a str,
-    spec: &'a MechanismSpec,
-}
-
-type R<T> = Result<T, ModelError>;
 
 /// Largest drawn coordinate accepted (m): beyond it squared lengths overflow and the
 /// numbers cannot describe a machine.
 const MAX_COORDINATE: f64 = 1e9;
-/// Largest magnitude of any other number (SI): products of a few model numbers (m u^2,
-/// qd^2 L, tau / A) then stay far from overflowing a double (1.8e308).
-const MAX_MAGNITUDE: f64 = 1e30;
 /// Smallest total mass (kg) and inertia (kg m^2) of a body: with efforts up to
 /// MAX_MAGNITUDE the accelerations stay finite (the fuzz found NaN with 1e308 kg).
 const MIN_MASS: f64 = 1e-30;
 
-impl Ctx<'_> {
-    fn err(&self, path: impl Into<String>, message: impl Into<String>) -> ModelError {
-        ModelError::Invalid { source_name: self.source.to_string(), path: path.into(), message: message.into() }
-    }
-    fn point(&self, path: &str, name: &str) -> R<PointId> {
-        self.spec.points.0.get_index_of(name).map(PointId).ok_or_else(|| {
-            let known: Vec<&str> = self.spec.points.0.keys().map(String::as_str).collect();
-            self.err(
-                path,
-                format!(
-                    "unknown point '{name}'; points are: {} (use one of them, or add it to `points`)",
-                    known.join(", ")
-                ),
-            )
-        })
-    }
-    fn xy(&self, path: &str, name: &str) -> R<[f64; 2]> {
-        self.point(path, name).map(|p| self.spec.points.0[p.0])
-    }
-    fn link(&self, path: &str, name: &str) -> R<Link> {
-        if name == "ground" {
-            return Ok(Link::Ground);
-        }
-        self.spec.bodies.0.get_index_of(name).map(|i| Link::Body(BodyId(i))).ok_or_else(|| {
-            let known: Vec<&str> = self.spec.bodies.0.keys().map(String::as_str).collect();
-            self.err(
-                path,
-                format!(
-                    "unknown body '{name}'; bodies are: ground, {} (use one of them, or add it to `bodies`)",
-                    known.join(", ")
-                ),
-            )
-        })
-    }
-    /// A finite number of magnitude at most MAX_MAGNITUDE.
-    fn finite(&self, path: &str, v: f64) -> R<f64> {
-        if !v.is_finite() {
-            return Err(self.err(path, format!("{v} is not a finite number; give a finite one")));
-        }
-        if v.abs() > MAX_MAGNITUDE {
-            return Err(self.err(
-                path,
-                format!("{v:e} is beyond the largest magnitude accepted, {MAX_MAGNITUDE:e}: check the units (SI)"),
-            ));
-        }
-        Ok(v)
-    }
-    fn non_negative(&self, path: &str, v: f64) -> R<f64> {
-        if self.finite(path, v)? < 0.0 {
-            return Err(self.err(path, format!("{v} is negative; it must be >= 0")));
-        }
-        Ok(v)
-    }
-}
-
-pub(super) fn build(spec: MechanismSpec, source: &str) -> R<Mechanism> {
-    let mut mech = drawing(spec, source)?;
-    let spec = mech.spec.clone();
-    let ctx = Ctx { source, spec: &spec };
-    check_mobility(&ctx, &mut mech)?;
-    check_assembly(&ctx, &mech)?;
-    Ok(mech)
-}
-
-/// Every check but the mobility and the assembly: the mechanism as drawn, all its pair rows
-/// kept, which the structural analysis of a model the loader refuses reads.
+/// Every check that needs no mechanics: the mechanism as drawn, all its pair rows kept
+/// (the loader leaves out the redundant ones), without simulation defaults (the loader's).
 pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
-    let ctx = Ctx { source, spec: &spec };
+    let ctx = context(source, &spec);
     if let Some(units) = &spec.units {
         if units != "SI" {
             return Err(ctx.err("units", format!("'{units}' is not supported; use SI (m, kg, s, rad)")));
@@ -172,19 +97,15 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.n_constraints = mech.n_pair_rows();
     mech.row_slot = (0..mech.n_constraints).map(Some).collect();
     mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
-    build_coordinates(&ctx, &mut mech)?;
+    build_coordinates(&ctx, &mut mech, &spec.coordinates)?;
     warn_degree_like_angles(&mut mech);
     (mech.drives, mech.motions) = build_drives(&ctx, &mech, &spec.drives)?;
-    mech.loads = spec
-        .loads
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| !mesh_coulomb_only(&ctx, &mech, l))
-        .map(|(k, l)| build_load(&ctx, &mech, k, l))
-        .collect::<R<_>>()?;
-    mech.friction = actuators::build_friction(&ctx, &mech, &spec.loads)?;
+    let path = |k: usize| format!("loads[{k}]");
+    let entries = || spec.loads.iter().enumerate();
+    mech.loads = entries().filter_map(|(k, l)| loads::build(l, &ctx, &mech, &path(k)).transpose()).collect::<R<_>>()?;
+    mech.friction =
+        entries().filter_map(|(k, l)| loads::friction(l, &ctx, &mech, &path(k)).transpose()).collect::<R<_>>()?;
     (mech.actuators, mech.pair_actuators) = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
-    mech.simulate = build_simulate(&ctx, spec.simulate.as_ref())?;
     Ok(mech)
 }
 
@@ -326,7 +247,7 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec, scale: f64) -> R<Body> {
         }
         ids.push(id);
     }
-    let xy = |id: PointId| ctx.spec.points.0[id.0];
+    let xy = |id: PointId| ctx.points[id.0];
     check_com_near(ctx, name, b, &parts, ids.iter().map(|&id| xy(id)), scale)?;
     let angle0 = match ids.as_slice() {
         [p0, p1, ..] => {
@@ -579,26 +500,14 @@ fn local_coords(mech: &Mechanism, link: Link, p: [f64; 2]) -> [f64; 2] {
     }
 }
 
-/// A pair referenced by the `name` it was given: the name made up for an unnamed pair
-/// (`a-b@at`) is for messages and results only, and changes when the file is edited.
-fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
-    let id = mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
-        ctx.err(
-            path,
-            format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")),
-        )
-    })?;
-    if pair_name(&ctx.spec.pairs[id.0]).is_none() {
-        return Err(ctx.err(
-            path,
-            format!(
-                "'{name}' is the name made up for the unnamed pairs[{}], which a model may not refer to; \
-                 give that pair a `name:` and refer to it by that name",
-                id.0
-            ),
-        ));
+/// The context of the checks of `spec`; `source` names it in messages.
+pub(crate) fn context<'a>(source: &'a str, spec: &'a MechanismSpec) -> Ctx<'a> {
+    Ctx {
+        source,
+        points: &spec.points.0,
+        bodies: spec.bodies.0.keys().map(String::as_str).collect(),
+        named_pairs: spec.pairs.iter().map(|p| pair_name(p).is_some()).collect(),
     }
-    Ok(id)
 }
 
 fn pair_name(p: &PairSpec) -> &Option<String> {
@@ -610,30 +519,8 @@ fn pair_name(p: &PairSpec) -> &Option<String> {
     }
 }
 
-/// A `friction` load on a gear pair without `viscous`: all of it is the mesh's Coulomb
-/// friction (`mech.friction`), with no damper on a relative coordinate it lacks.
-fn mesh_coulomb_only(ctx: &Ctx, mech: &Mechanism, l: &LoadSpec) -> bool {
-    let LoadSpec::Friction { pair, viscous: None, .. } = l else { return false };
-    pair_id(ctx, mech, "", pair).is_ok_and(|id| pairs::relative(&mech.pairs[id.0]).is_none())
-}
-
-/// A pair with a relative motion of its own (for a pair spring or friction).
-fn relative_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
-    let id = pair_id(ctx, mech, path, name)?;
-    match pairs::relative(&mech.pairs[id.0]) {
-        Some(_) => Ok(id),
-        None => Err(ctx.err(
-            path,
-            format!(
-                "'{name}' is a {} pair, which has no relative motion of its own; put the spring or viscous friction on the revolute pair of one of its gears",
-                pairs::kind_name(&mech.pairs[id.0])
-            ),
-        )),
-    }
-}
-
-fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
-    for (k, c) in ctx.spec.coordinates.iter().enumerate() {
+fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism, coordinates: &[CoordinateSpec]) -> R<()> {
+    for (k, c) in coordinates.iter().enumerate() {
         let path = format!("coordinates[{k}]");
         if mech.coordinates.iter().any(|d| d.name == c.name) || c.name.is_empty() {
             return Err(ctx.err(
@@ -777,168 +664,6 @@ fn build_motion(ctx: &Ctx, path: &str, m: &MotionSpec) -> R<MotionLaw> {
             "give exactly one of `speed` (rad/s or m/s, from the start value) or `table: {t, q}` (s; rad or m)",
         )),
     }
-}
-
-fn body_point(ctx: &Ctx, mech: &Mechanism, path: &str, body: &str, point: &str) -> R<Attachment> {
-    let link = ctx.link(&format!("{path}.body"), body)?;
-    let id = ctx.point(&format!("{path}.at"), point)?;
-    mech.attachment(link, id)
-        .ok_or_else(|| ctx.err(path, format!("body '{body}' does not carry point '{point}'; add it to its points")))
-}
-
-fn build_load(ctx: &Ctx, mech: &Mechanism, k: usize, l: &LoadSpec) -> R<Load> {
-    let path = format!("loads[{k}]");
-    let mobile = |name: &str| match ctx.link(&format!("{path}.body"), name)? {
-        Link::Body(b) => Ok(b),
-        Link::Ground => Err(ctx.err(format!("{path}.body"), "a load on the ground does nothing; name a mobile body")),
-    };
-    Ok(match l {
-        LoadSpec::Force { body, at, value } => {
-            mobile(body)?;
-            Load::Force {
-                at: body_point(ctx, mech, &path, body, at)?,
-                value: [
-                    ctx.finite(&format!("{path}.value"), value[0])?,
-                    ctx.finite(&format!("{path}.value"), value[1])?,
-                ],
-            }
-        }
-        LoadSpec::Torque { body, value } => {
-            Load::Torque { body: mobile(body)?, value: ctx.finite(&format!("{path}.value"), *value)? }
-        }
-        LoadSpec::Spring { between, stiffness, damping, rest_length } => {
-            let e0 = body_point(ctx, mech, &format!("{path}.between[0]"), &between[0][0], &between[0][1])?;
-            let e1 = body_point(ctx, mech, &format!("{path}.between[1]"), &between[1][0], &between[1][1])?;
-            let (p0, p1) = (ctx.xy(&path, &between[0][1])?, ctx.xy(&path, &between[1][1])?);
-            let drawn = (p1[0] - p0[0]).hypot(p1[1] - p0[1]);
-            Load::Spring {
-                ends: [e0, e1],
-                stiffness: ctx.non_negative(&format!("{path}.stiffness"), *stiffness)?,
-                damping: ctx.non_negative(&format!("{path}.damping"), *damping)?,
-                rest_length: ctx.non_negative(&format!("{path}.rest_length"), rest_length.unwrap_or(drawn))?,
-            }
-        }
-        LoadSpec::TorsionalSpring { pair, stiffness, damping, rest } => Load::PairSpring {
-            pair: relative_pair(ctx, mech, &format!("{path}.pair"), pair)?,
-            stiffness: ctx.non_negative(&format!("{path}.stiffness"), *stiffness)?,
-            damping: ctx.non_negative(&format!("{path}.damping"), *damping)?,
-            rest: ctx.finite(&format!("{path}.rest"), *rest)?,
-        },
-        LoadSpec::Friction { pair, viscous, .. } => Load::PairSpring {
-            pair: relative_pair(ctx, mech, &format!("{path}.pair"), pair)?,
-            stiffness: 0.0,
-            damping: ctx.non_negative(&format!("{path}.viscous"), viscous.unwrap_or(0.0))?,
-            rest: 0.0,
-        },
-    })
-}
-
-fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
-    let Some(s) = s else { return Ok(SimulateDefaults::default()) };
-    let positive = |field: &str, v: Option<f64>| -> R<Option<f64>> {
-        match v {
-            Some(x) if !(x > 0.0 && x.is_finite()) => {
-                Err(ctx.err(format!("simulate.{field}"), format!("{x} must be a positive number")))
-            }
-            _ => Ok(v),
-        }
-    };
-    if let Some(m) = &s.method {
-        m.parse::<crate::integrate::Method>().map_err(|e| ctx.err("simulate.method", e))?;
-    }
-    Ok(SimulateDefaults {
-        t_end: positive("t_end", s.t_end)?,
-        method: s.method.clone(),
-        rtol: positive("rtol", s.rtol)?,
-        atol: positive("atol", s.atol)?,
-        dt: positive("dt", s.dt)?,
-        output_dt: positive("output_dt", s.output_dt)?,
-    })
-}
-
-/// The mobility, 3n minus the rank of the pair constraints in the drawing, must equal the
-/// number of coordinates; the Chebyshev-Grubler count 3n - (sum of the pairs' rows)
-/// explains a mismatch. Redundant constraints (rank below the row count with the right
-/// mobility, as in a parallelogram) are left out of the position equations and reported
-/// in `warnings`.
-fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
-    let (n, rows, m) = (mech.n_bodies() as i64, mech.n_pair_rows(), mech.dof() as i64);
-    let cr = constraint_rank(mech, &mech.x0);
-    let (grubler, mobility) = (3 * n - rows as i64, 3 * n - cr.rank as i64);
-    // The count written out: 2 rows for each revolute and prismatic pair, 1 for each gear or slot.
-    let p1 = mech.pairs.iter().filter(|p| pairs::n_rows(&p.kind) == 1).count();
-    let p2 = mech.pairs.len() - p1;
-    let count =
-        if p1 == 0 { format!("3n - 2p = 3*{n} - 2*{p2}") } else { format!("3n - 2p - p1 = 3*{n} - 2*{p2} - {p1}") };
-    // Whatever the coordinates, a drawing whose constraints have full rank cannot move.
-    if mobility == 0 {
-        let why = if n == 0 {
-            "the model has no mobile body".to_string()
-        } else {
-            format!(
-                "its {rows} pair constraints have rank {} = 3n in the drawing (Chebyshev-Grubler: {count} = {grubler})",
-                cr.rank
-            )
-        };
-        return Err(ctx.err(
-            "coordinates",
-            format!(
-                "the drawing is a structure (mobility 0): {why}, so nothing can move, and planardyn moves \
-                 mechanisms only; remove a pair or a body (or add a body) until the mobility is at least 1, \
-                 or check the drawing, then give one coordinate per degree of freedom"
-            ),
-        ));
-    }
-    if m == 0 {
-        return Err(ctx.err(
-            "coordinates",
-            format!(
-                "no generalized coordinates, but the mechanism has mobility 3n - rank = {mobility}; \
-                 name {mobility} input pair(s) under `coordinates`"
-            ),
-        ));
-    }
-    if mobility != m {
-        let message = if mobility == grubler {
-            format!(
-                "the mechanism has mobility {count} = {mobility} but {m} coordinate(s) are given; \
-                 give exactly {mobility} coordinate(s), or check the pairs (a revolute or prismatic pair removes 2 freedoms, \
-                 a gear or slot pair 1)"
-            )
-        } else {
-            format!(
-                "the {rows} pair constraints have rank {} in the drawing, so it has mobility 3n - rank = {mobility} \
-                 (Chebyshev-Grubler: {count} = {grubler}), but {m} coordinate(s) are given: the drawing is at a \
-                 singular (folded) configuration, or has redundant constraints; draw it away from singular positions",
-                cr.rank
-            )
-        };
-        return Err(ctx.err("coordinates", message));
-    }
-    if cr.rank < rows {
-        mech.row_slot = vec![None; rows];
-        for (slot, &row) in cr.independent_rows.iter().enumerate() {
-            mech.row_slot[row] = Some(slot);
-        }
-        mech.n_constraints = cr.rank;
-        mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
-        for stress in &cr.self_stresses {
-            let names: Vec<&str> = stress.pairs.iter().map(|&k| mech.pairs[k.0].name.as_str()).collect();
-            mech.warnings.push(format!(
-                "redundant constraints among pairs {}: one of their constraint equations is implied by the others \
-                 and left out (Chebyshev-Grubler counts {grubler} degree(s) of freedom, the rank shows {mobility}); \
-                 the reactions shared by these pairs are statically indeterminate",
-                names.join(", ")
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// The mechanism must assemble at its start coordinates (the drawing, or `q0`).
-fn check_assembly(ctx: &Ctx, mech: &Mechanism) -> R<()> {
-    let (q0, _) = mech.initial_state();
-    assemble(mech, &q0).map(|_| ()).map_err(|e| ctx.err("coordinates", format!("cannot start at q0 = {q0:?}: {e}")))
 }
 
 fn characteristic_length(points: &[(String, [f64; 2])]) -> f64 {

@@ -1,21 +1,24 @@
-//! The mechanism model: immutable once built and validated from a [`MechanismSpec`].
+//! The mechanism model, pure data: the bodies, the pairs with their kinds ([`pairs`], one file
+//! a kind), coordinates, drives, loads with their kinds ([`loads`], one file a kind) and
+//! actuators; immutable once built from a
+//! [`MechanismSpec`]. The checks that need no mechanics are here (`build`); the loader
+//! (`crate::loader`) reads model files and adds the checks that need kinematics.
 //!
 //! Bodies carry their points in a local frame with origin at the centre of mass, rotated by
 //! the body's drawn angle, so that a world point is `r + R(phi) s` with `x_i = [X, Y, phi]`.
 //! The ground is not part of `x`; its local frame is the global frame.
 
 pub mod actuators;
-mod build;
+pub(crate) mod build;
+pub(crate) mod checks;
 pub(crate) mod diameter;
-mod io;
+pub mod loads;
 mod motion;
-mod nesting;
-mod parse_errors;
+pub mod pairs;
 pub mod spec;
-mod tags;
 
 pub use actuators::{Actuator, JointFriction, Limits, PairActuator};
-pub use io::{load, loads, parse_spec, Format};
+pub use loads::Load;
 pub use motion::{MotionLaw, Spline};
 pub use spec::MechanismSpec;
 
@@ -62,10 +65,10 @@ pub enum PairKind {
         /// Unit direction of the guide in a's frame.
         axis: [f64; 2],
     },
-    /// Gears (or a pinion and a rack) rolling without slip: `kinematics::pairs::gear`.
-    Gear(crate::kinematics::pairs::gear::Gear),
-    /// A pin of b in a slot of a: `kinematics::pairs::slot`.
-    Slot(crate::kinematics::pairs::slot::Slot),
+    /// Gears (or a pinion and a rack) rolling without slip: [`pairs::gear`].
+    Gear(pairs::gear::Gear),
+    /// A pin of b in a slot of a: [`pairs::slot`].
+    Slot(pairs::slot::Slot),
 }
 
 /// A kinematic pair between links `a` and `b` at a point both carry (a gear pair: at the
@@ -108,6 +111,13 @@ pub struct Coordinate {
     pub qd0: f64,
 }
 
+/// Largest move one continuation of the position analysis may make (rad, or lengths L for
+/// a displacement), for the model's `q0` and every API call alike: with its steps of at most
+/// 0.1 (`kinematics::position`) it bounds a call to ~10^4 position solves (well under a
+/// second), where an unbounded target such as 1e15 rad would never return. A longer way is
+/// a sequence of calls, each from the last.
+pub const MAX_CONTINUATION_DISTANCE: f64 = 1e3;
+
 /// A drive effort law on one coordinate (N m for an angle, N for a displacement).
 #[derive(Debug, Clone, PartialEq)]
 pub enum DriveLaw {
@@ -145,20 +155,6 @@ impl DriveLaw {
 pub struct Attachment {
     pub link: Link,
     pub s: [f64; 2],
-}
-
-/// An external load or force element.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Load {
-    /// Constant global force (N) at a point of a body.
-    Force { at: Attachment, value: [f64; 2] },
-    /// Constant torque (N m) on a body.
-    Torque { body: BodyId, value: f64 },
-    /// Linear spring-damper between two points: tension k (L - rest_length) + c L'.
-    Spring { ends: [Attachment; 2], stiffness: f64, damping: f64, rest_length: f64 },
-    /// Spring-damper on the relative motion of a pair (angle or displacement from the
-    /// drawing): generalized effort -k (theta - rest) - c theta'. Viscous friction has k = 0.
-    PairSpring { pair: PairId, stiffness: f64, damping: f64, rest: f64 },
 }
 
 /// Default simulation settings read from the model file.
@@ -224,12 +220,8 @@ pub struct Mechanism {
 }
 
 impl Mechanism {
-    /// Validate a specification and build the mechanism; `source` names it in messages.
-    pub fn new(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
-        build::build(spec, source)
-    }
-    /// The mechanism as drawn without the mobility and assembly checks (for the structural
-    /// analysis of a model the loader refuses; not for kinematics).
+    /// The mechanism as drawn, with every check that needs no mechanics (the loader's
+    /// `build` adds the mobility, the assembly and the simulation defaults).
     pub(crate) fn drawing(spec: MechanismSpec, source: &str) -> Result<Self, crate::ModelError> {
         build::drawing(spec, source)
     }
@@ -243,6 +235,15 @@ impl Mechanism {
         !self.friction.is_empty()
             || self.actuators.iter().any(Option::is_some)
             || self.pair_actuators.iter().any(|a| a.drive.is_some())
+    }
+    /// Number of actuators n_a: the coordinates, then the pair actuators.
+    pub fn n_actuators(&self) -> usize {
+        self.dof() + self.pair_actuators.len()
+    }
+    /// The actuators' names: the coordinates', then the pair actuators'.
+    pub fn actuator_names(&self) -> Vec<String> {
+        let coords = self.coordinates.iter().map(|c| c.name.clone());
+        coords.chain(self.pair_actuators.iter().map(|a| a.name.clone())).collect()
     }
     /// Number of mobile bodies n.
     pub fn n_bodies(&self) -> usize {

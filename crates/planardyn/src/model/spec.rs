@@ -1,10 +1,11 @@
 //! The model file: a mechanism described as it is drawn (YAML or JSON, one schema).
 //!
 //! These plain structs are what a file deserialises to and what a Rust user fills in to
-//! describe a mechanism in code; [`crate::Mechanism::new`] validates them. The schema is
+//! describe a mechanism in code; [`crate::build`] validates them. The schema is
 //! documented field by field in `docs/model-format.md` and `schema/planardyn-model.schema.json`.
 //! Units are SI throughout: m, kg, kg m^2, s, rad, N, N m.
 
+pub use super::loads::LoadSpec;
 use indexmap::IndexMap;
 use serde::de::{Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
@@ -41,7 +42,7 @@ pub struct MechanismSpec {
     /// Drive efforts on the coordinates (torque for an angle, force for a displacement).
     #[serde(default)]
     pub drives: Vec<DriveSpec>,
-    /// External loads and force elements.
+    /// External loads and force elements (one kind a file: `model::loads`).
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
     /// Motors with their transmissions, one per driven coordinate (docs/actuators.md).
@@ -221,67 +222,6 @@ pub struct MotionTableSpec {
 pub struct TableSpec {
     pub t: Vec<f64>,
     pub effort: Vec<f64>,
-}
-
-/// An external load or a force element.
-#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub enum LoadSpec {
-    /// A constant force [F_x, F_y] (N, global frame) at a point of a body.
-    Force { body: String, at: String, value: [f64; 2] },
-    /// A constant torque (N m) on a body.
-    Torque { body: String, value: f64 },
-    /// A linear spring-damper between two body points, each given as [body, point]:
-    /// tension k (L - rest_length) + c dL/dt. `rest_length` defaults to the drawn length.
-    Spring {
-        between: [[String; 2]; 2],
-        stiffness: f64,
-        #[serde(default)]
-        damping: f64,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        rest_length: Option<f64>,
-    },
-    /// A torsional spring-damper at a revolute pair (or a linear one along a prismatic pair),
-    /// acting on the pair's relative motion from the drawing: torque -k (theta - rest) - c theta'.
-    TorsionalSpring {
-        pair: String,
-        stiffness: f64,
-        #[serde(default)]
-        damping: f64,
-        /// Relative rotation (rad) or displacement (m) from the drawing at which it is unloaded.
-        #[serde(default)]
-        rest: f64,
-    },
-    /// Friction at a pair: viscous, -c times the relative rate (N m s/rad or N s/m), and
-    /// Coulomb friction from the pair's load (docs/actuators.md, *Friction from the joint
-    /// loads*): torque mu r |F| at a revolute pair of pin radius r, force mu max(|N|, 2|M|/L)
-    /// along a prismatic pair of length L, mu |N| along a slot.
-    Friction {
-        pair: String,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        viscous: Option<f64>,
-        /// Sliding (kinetic) friction coefficient.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        mu: Option<f64>,
-        /// Static coefficient (Stribeck peak at low speed); default `mu`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        mu_static: Option<f64>,
-        /// Pin radius of a revolute pair (m): the friction arm.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pin_radius: Option<f64>,
-        /// Length of a prismatic pair's slider (m): the arm over which it carries a couple.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        length: Option<f64>,
-        /// Slip speed (m/s) below which the regularised law lets the pair creep (default 1e-4).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        stiction_speed: Option<f64>,
-        /// Slip speed (m/s) over which the coefficient falls from `mu_static` to `mu` (default 1e-2).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        stribeck_speed: Option<f64>,
-        /// Pressure angle of a gear pair's teeth (rad, default 20 degrees): normal load F_t / cos.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pressure_angle: Option<f64>,
-    },
 }
 
 /// A motor driving a coordinate through a transmission of ratio n (motor angle = n q): the

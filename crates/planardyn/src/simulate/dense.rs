@@ -75,7 +75,9 @@ impl DenseOutput {
         let (mut num, mut den) = (vec![0.0; 2 * m], 0.0);
         for j in 0..n {
             let d = theta - node(j, n);
-            if d == 0.0 {
+            // Within a rounding unit of a node (theta is of order 1) the node's value is the
+            // polynomial's to round-off; 1/d would overflow for a subnormal d (t = 5e-324).
+            if d.abs() < f64::EPSILON {
                 q.copy_from_slice(&rows[j * 2 * m..j * 2 * m + m]);
                 qd.copy_from_slice(&rows[j * 2 * m + m..(j + 1) * 2 * m]);
                 return;

@@ -14,18 +14,13 @@
 //! - **Assur groups**: the blocks of the block-triangular form of the position Jacobian with
 //!   the inputs locked, see [`AssurGroup`].
 
-pub(crate) mod assur;
-mod loops;
-mod rank;
+pub use crate::kinematics::rank::{scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRESS_TOL};
+pub use crate::topology::{AssurGroup, Loop};
 
-pub use assur::AssurGroup;
-pub use loops::Loop;
-pub use rank::{scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRESS_TOL};
-
-pub(crate) use rank::constraint_rank;
-
-use crate::model::{BodyId, Mechanism, MechanismSpec, PairId};
-use crate::{KinematicsError, ModelError};
+use crate::kinematics::rank::constraint_rank;
+use crate::model::{BodyId, Mechanism, PairId};
+use crate::topology::{assur, loops};
+use crate::KinematicsError;
 
 /// The structural analysis of a mechanism at a configuration.
 #[derive(Debug, Clone, PartialEq)]
@@ -104,17 +99,8 @@ pub fn analyse(mech: &Mechanism, x: &[f64]) -> Result<Structure, KinematicsError
     Ok(structure(mech, x))
 }
 
-/// The structural analysis of a model at its drawing, also when it does not build because
-/// its mobility differs from its number of coordinates or it does not assemble at `q0`
-/// (what a structural analysis is for). Every other check of the loader applies; its errors
-/// are returned as they are.
-pub fn analyse_spec(spec: MechanismSpec, source: &str) -> Result<Structure, ModelError> {
-    let mech = Mechanism::drawing(spec, source)?;
-    Ok(structure(&mech, &mech.x0))
-}
-
 /// The analysis at a finite x of the right length.
-fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
+pub(crate) fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
     let (n, rows) = (mech.n_bodies(), mech.n_pair_rows());
     let Rank { rank, singular_values, independent_rows, self_stresses } = constraint_rank(mech, x);
     let (loops, connected) = loops::loops(mech);
@@ -130,7 +116,7 @@ fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
         mobility: 3 * n - rank,
         redundant: rows - rank,
         self_stresses,
-        actuation: crate::dynamics::redundant::n_actuators(mech),
+        actuation: mech.n_actuators(),
         loops,
         connected,
         input_links: a.input_links,

@@ -3,7 +3,7 @@
 //! sign (q_k + offset), sign +1 when the body is the pair's b.
 
 use super::{put_acceleration, put_rate};
-use crate::kinematics::pairs::frames::rot;
+use crate::model::pairs::frames::rot;
 
 #[derive(Debug, Clone)]
 pub struct Crank {

@@ -8,7 +8,7 @@
 
 use super::rate;
 use crate::kinematics::group_sigma::Block;
-use crate::kinematics::pairs::frames::{dot, perp, rot};
+use crate::model::pairs::frames::{dot, perp, rot};
 use crate::model::{BodyId, Link, Mechanism};
 
 #[derive(Debug, Clone)]

@@ -9,9 +9,9 @@
 //! from any start is exact ([`Local::affine`]): the angles from their rows, then the positions
 //! from the rest. Other groups place their bodies by their own closed form ([`Local::store`]).
 
-use crate::kinematics::pairs;
-use crate::kinematics::pairs::gear::Mesh;
 use crate::linalg::{BlockLu, Dense};
+use crate::model::pairs;
+use crate::model::pairs::gear::Mesh;
 use crate::model::{BodyId, Link, Mechanism, Pair, PairId, PairKind};
 use crate::{KinematicsError, SingularityKind};
 use nalgebra::{Matrix3, Matrix4, Matrix5, Matrix6};

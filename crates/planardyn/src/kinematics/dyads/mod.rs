@@ -23,7 +23,7 @@ pub mod rrr;
 pub mod slider;
 pub mod triad;
 
-use super::pairs::frames::rot;
+use crate::model::pairs::frames::rot;
 use crate::model::Link;
 use std::f64::consts::{PI, TAU};
 

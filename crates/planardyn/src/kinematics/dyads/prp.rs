@@ -6,7 +6,7 @@
 
 use super::local::Local;
 use crate::model::{Mechanism, PairKind};
-use crate::structure::assur::AssurGroup;
+use crate::topology::AssurGroup;
 
 /// The PRP dyad `g`: two one-body links, two outer prismatic pairs and an inner revolute one.
 pub fn prp(mech: &Mechanism, g: &AssurGroup) -> Option<Local> {

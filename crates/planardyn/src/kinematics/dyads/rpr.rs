@@ -9,7 +9,7 @@
 
 use super::local::Local;
 use super::{rotation, Joint};
-use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
+use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{Mechanism, Pair, PairId, PairKind};
 use crate::{KinematicsError, SingularityKind};
 use std::f64::consts::TAU;

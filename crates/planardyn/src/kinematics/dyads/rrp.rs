@@ -8,7 +8,7 @@
 
 use super::{pose, put_acceleration, put_rate, rate, rotation, Joint};
 use crate::kinematics::group_sigma::rrp_sigma;
-use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
+use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
 use crate::{KinematicsError, SingularityKind};
 use std::f64::consts::TAU;

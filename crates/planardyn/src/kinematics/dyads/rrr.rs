@@ -7,7 +7,7 @@
 
 use super::{put_acceleration, put_rate, rotation, Joint};
 use crate::kinematics::group_sigma::dyad_sigma;
-use crate::kinematics::pairs::frames::{dot, link_state, perp, rot, sub};
+use crate::model::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
 use crate::{KinematicsError, SingularityKind};
 use std::f64::consts::TAU;

@@ -3,7 +3,7 @@
 //! G the pair point on the ground and u the guide's direction.
 
 use super::put_rate;
-use crate::kinematics::pairs::frames::rot;
+use crate::model::pairs::frames::rot;
 
 #[derive(Debug, Clone)]
 pub struct Slider {

@@ -16,8 +16,8 @@
 use super::extension::Arm;
 use super::{put_acceleration, put_rate, Joint};
 use crate::kinematics::group_sigma::{triad_sigma, Block};
-use crate::kinematics::pairs::frames::{dot, perp, rot, sub};
 use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
+use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::{KinematicsError, SingularityKind};
 
 #[inline]

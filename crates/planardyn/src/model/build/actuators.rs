@@ -1,19 +1,13 @@
-//! Validation of the actuators and of the Coulomb friction of the pairs.
+//! Validation of the actuators (the pairs' Coulomb friction is a load kind: `model::loads::friction`).
 
-use super::{coordinate_index, pair_id, relative_pair, Ctx, R};
-use crate::kinematics::pairs::{self, Relative};
-use crate::model::actuators::{Actuator, JointFriction, Limits, PairActuator};
-use crate::model::spec::{ActuatorSpec, LimitsSpec, LoadSpec};
-use crate::model::{Mechanism, PairKind};
+use super::coordinate_index;
+use crate::model::actuators::{Actuator, Limits, PairActuator};
+use crate::model::checks::{relative_pair, Ctx, R};
+use crate::model::spec::{ActuatorSpec, LimitsSpec};
+use crate::model::Mechanism;
 
-/// Default regularisation speeds: a motor's (rad/s) and a pair's slip (m/s).
+/// Default regularisation speed of a motor (rad/s).
 const MOTOR_STICTION_SPEED: f64 = 1e-2;
-const PAIR_STICTION_SPEED: f64 = 1e-4;
-const STRIBECK_SPEED: f64 = 1e-2;
-/// Default pressure angle of a gear mesh: the standard involute tooth's 20 degrees.
-const PRESSURE_ANGLE: f64 = 20.0 * std::f64::consts::PI / 180.0;
-/// Largest pressure angle accepted (rad, 45 degrees): beyond, N = F_t / cos(alpha) is no tooth's.
-const MAX_PRESSURE_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
 
 /// One actuator slot per coordinate (`None`: an ideal effort source), and the redundant
 /// actuators on pairs.
@@ -159,104 +153,4 @@ fn build_limits(ctx: &Ctx, path: &str, l: Option<&LimitsSpec>) -> R<Limits> {
         (None, None) => {}
     }
     Ok(Limits { peak_torque, continuous_torque: opt("continuous_torque", l.continuous_torque)?, max_speed, envelope })
-}
-
-/// The Coulomb friction of the `friction` loads that give a coefficient `mu`.
-pub(in crate::model) fn build_friction(ctx: &Ctx, mech: &Mechanism, loads: &[LoadSpec]) -> R<Vec<JointFriction>> {
-    let mut out = Vec::new();
-    for (k, l) in loads.iter().enumerate() {
-        let LoadSpec::Friction {
-            pair,
-            viscous,
-            mu,
-            mu_static,
-            pin_radius,
-            length,
-            stiction_speed,
-            stribeck_speed,
-            pressure_angle,
-        } = l
-        else {
-            continue;
-        };
-        let path = format!("loads[{k}]");
-        if mu.is_none() && viscous.is_none() {
-            return Err(ctx.err(&path, "give `viscous` (N m s/rad or N s/m), Coulomb friction `mu`, or both"));
-        }
-        let Some(mu) = mu else {
-            if mu_static.is_some() || pin_radius.is_some() || length.is_some() || pressure_angle.is_some() {
-                return Err(ctx.err(format!("{path}.mu"), "Coulomb friction needs its sliding coefficient `mu`"));
-            }
-            continue;
-        };
-        let id = friction_pair(ctx, mech, &format!("{path}.pair"), pair)?;
-        let mu = ctx.non_negative(&format!("{path}.mu"), *mu)?;
-        let mu_static = ctx.non_negative(&format!("{path}.mu_static"), mu_static.unwrap_or(mu))?;
-        let speed = |field: &str, v: Option<f64>, default: f64| -> R<f64> {
-            let p = format!("{path}.{field}");
-            let v = v.unwrap_or(default);
-            if ctx.finite(&p, v)? <= 0.0 {
-                return Err(ctx.err(p, format!("{v} must be > 0")));
-            }
-            Ok(v)
-        };
-        let p = &mech.pairs[id.0];
-        let revolute = pairs::relative(p) == Some(Relative::Angle);
-        // A field given where it does not apply (or missing where it must be), and the fix.
-        let refuse = |field: &str, fix: String| -> R<f64> { Err(ctx.err(format!("{path}.{field}"), fix)) };
-        let arm = match (revolute, pin_radius) {
-            (true, Some(r)) => speed("pin_radius", Some(*r), 0.0)?,
-            (true, None) => refuse(
-                "pin_radius",
-                format!("'{pair}' turns: give its pin radius (m), the arm of the friction force mu |F|"),
-            )?,
-            (false, Some(_)) => refuse("pin_radius", format!("'{pair}' does not turn on a pin: remove `pin_radius`"))?,
-            (false, None) => 1.0,
-        };
-        let length = match (&p.kind, length) {
-            (PairKind::Prismatic { .. }, Some(l)) => speed("length", Some(*l), 0.0)?,
-            (_, Some(_)) => {
-                refuse("length", format!("'{pair}' carries no couple: `length` applies to a prismatic pair only"))?
-            }
-            (_, None) => 0.0,
-        };
-        let pressure_angle = match (&p.kind, pressure_angle) {
-            (PairKind::Gear(_), a) => {
-                let a = a.unwrap_or(PRESSURE_ANGLE);
-                if !(0.0..=MAX_PRESSURE_ANGLE).contains(&ctx.finite(&format!("{path}.pressure_angle"), a)?) {
-                    refuse(
-                        "pressure_angle",
-                        format!("{a} rad is not a tooth's pressure angle: give one in [0, {MAX_PRESSURE_ANGLE}] rad"),
-                    )?;
-                }
-                a
-            }
-            (_, Some(_)) => refuse(
-                "pressure_angle",
-                format!("'{pair}' has no teeth: `pressure_angle` applies to a gear pair only"),
-            )?,
-            (_, None) => 0.0,
-        };
-        out.push(JointFriction {
-            pair: id,
-            mu,
-            mu_static,
-            arm,
-            length,
-            stiction_speed: speed("stiction_speed", *stiction_speed, PAIR_STICTION_SPEED)?,
-            stribeck_speed: speed("stribeck_speed", *stribeck_speed, STRIBECK_SPEED)?,
-            pressure_angle,
-        });
-    }
-    Ok(out)
-}
-
-/// The pair a Coulomb friction load acts on: one with a relative motion, or a gear mesh
-/// (whose lever is the pitch-line travel).
-fn friction_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<crate::model::PairId> {
-    let id = pair_id(ctx, mech, path, name)?;
-    match mech.pairs[id.0].kind {
-        PairKind::Gear(_) => Ok(id),
-        _ => relative_pair(ctx, mech, path, name),
-    }
 }

@@ -12,8 +12,8 @@
 //! inner pairs, or (without a contour) the largest number of inner pairs on one of its links,
 //! 2 for a dyad; its order is its number of outer pairs (Artobolevsky).
 
-use crate::kinematics::pairs::letter;
 use crate::linalg::BlockLu;
+use crate::model::pairs::letter;
 use crate::model::{BodyId, Link, Mechanism, PairId};
 use petgraph::algo::tarjan_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
@@ -38,7 +38,7 @@ pub struct AssurGroup {
     pub description: String,
 }
 
-/// What the decomposition finds (see [`super::Structure`]).
+/// What the decomposition finds (the structure report shows it: `crate::Structure`).
 pub(crate) struct Assur {
     pub input_links: Vec<BodyId>,
     pub relative_inputs: Vec<PairId>,

@@ -4,6 +4,7 @@
 //! a location (the field path, or `line L column C` where no field is known) and a fix.
 
 use super::Format;
+use crate::model::spec::LoadSpec;
 use crate::ModelError;
 use serde_path_to_error::{Path, Segment};
 
@@ -50,7 +51,7 @@ impl Input<'_> {
 
     /// The message in plain words and its fix; a missing field goes onto the path.
     fn explain(&self, message: &str, field: &mut String) -> (String, String) {
-        let docs = "see docs/model-format.md";
+        let docs = "see `planardyn docs model-format`";
         if let Some(name) = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
             push_field(field, name);
             return (format!("missing field `{name}`"), format!("add it ({docs})"));
@@ -210,10 +211,6 @@ fn plain(message: &str) -> String {
         ("struct MotionTableSpec", "a motion table (a mapping: t, q)"),
         ("struct SimulateSpec", "simulation settings (a mapping: t_end, method...)"),
         ("internally tagged enum PairSpec", "a pair (a mapping with type: revolute or prismatic)"),
-        (
-            "internally tagged enum LoadSpec",
-            "a load (a mapping with type: force, torque, spring, torsional_spring or friction)",
-        ),
         ("a map from names to entries", "a mapping from names to entries"),
         ("sequence", "list"),
         ("an array of length 2", "a list of 2 items"),
@@ -221,6 +218,11 @@ fn plain(message: &str) -> String {
         ("field identifier", "a field name"),
     ];
     let mut out = WORDS.iter().fold(message.to_string(), |m, (rust, words)| m.replace(rust, words));
+    if out.contains("internally tagged enum LoadSpec") {
+        let [kinds @ .., last] = LoadSpec::NAMES;
+        let load = format!("a load (a mapping with type: {} or {last})", kinds.join(", "));
+        out = out.replace("internally tagged enum LoadSpec", &load);
+    }
     // A pair or load written as a list: "expected struct variant PairSpec::Revolute with 3 elements".
     while let Some(i) = out.find("struct variant ") {
         let end = out[i..].find(" elements").map_or(out.len(), |j| i + j + " elements".len());
@@ -256,6 +258,12 @@ mod tests {
         assert_eq!(
             plain("invalid length 1, expected struct variant PairSpec::Revolute with 3 elements"),
             "invalid length 1, expected a mapping with the fields of its `type`"
+        );
+        // The load kinds by name, from `LoadSpec::NAMES`.
+        assert_eq!(
+            plain("invalid type: integer `5`, expected internally tagged enum LoadSpec"),
+            "invalid type: integer `5`, expected a load (a mapping with type: force, torque, spring, \
+             torsional_spring or friction)"
         );
     }
 }

@@ -1,10 +1,10 @@
 //! The scaled pair-constraint Jacobian Phi_x and what its singular value decomposition
 //! tells: numerical rank, a maximal set of independent rows, and the self-stresses.
 
-use crate::kinematics::constraints::{body_trig, constraint_jacobian};
-use crate::kinematics::pairs::row_scales;
-use crate::kinematics::system::col_scales;
+use super::constraints::{body_trig, constraint_jacobian};
+use super::system::col_scales;
 use crate::linalg::pivot_columns;
+use crate::model::pairs::row_scales;
 use crate::model::{Mechanism, PairId};
 use nalgebra::DMatrix;
 

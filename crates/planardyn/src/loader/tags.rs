@@ -90,7 +90,7 @@ pub(super) fn refuse(text: &str, source: &str) -> Result<(), crate::ModelError> 
         source_name: source.to_string(),
         path,
         message: format!(
-            "the YAML tag {tag} is not part of the model format{at}; remove it and write the value alone (see docs/model-format.md)"
+            "the YAML tag {tag} is not part of the model format{at}; remove it and write the value alone (see `planardyn docs model-format`)"
         ),
     })
 }

@@ -31,7 +31,7 @@ fn node(link: Link) -> NodeIndex {
 
 /// A loop basis (pairs - links + components loops) and whether every link is connected to
 /// the ground.
-pub(super) fn loops(mech: &Mechanism) -> (Vec<Loop>, bool) {
+pub(crate) fn loops(mech: &Mechanism) -> (Vec<Loop>, bool) {
     let mut graph = UnGraph::<(), PairId>::with_capacity(mech.n_bodies() + 1, mech.pairs.len());
     for _ in 0..=mech.n_bodies() {
         graph.add_node(());

@@ -56,6 +56,29 @@ pub fn link_state(link: Link, x: &[f64]) -> LinkState {
     }
 }
 
+/// World position of a point of a link.
+pub fn world_point(link: Link, s: [f64; 2], x: &[f64]) -> [f64; 2] {
+    link_state(link, x).point(s)
+}
+
+/// Velocity of a point of a link for body rates xd.
+pub fn point_velocity(link: Link, s: [f64; 2], x: &[f64], xd: &[f64]) -> [f64; 2] {
+    let l = link_state(link, x);
+    let (v, w) = part(&l, xd);
+    let t = perp(l.rot(s));
+    [v[0] + w * t[0], v[1] + w * t[1]]
+}
+
+/// Acceleration of a point of a link for body rates xd and accelerations xdd.
+pub fn point_acceleration(link: Link, s: [f64; 2], x: &[f64], xd: &[f64], xdd: &[f64]) -> [f64; 2] {
+    let l = link_state(link, x);
+    let (_, w) = part(&l, xd);
+    let (a, al) = part(&l, xdd);
+    let p = l.rot(s);
+    let t = perp(p);
+    [a[0] + al * t[0] - w * w * p[0], a[1] + al * t[1] - w * w * p[1]]
+}
+
 /// R(phi) s.
 #[inline]
 pub fn rotate(phi: f64, s: [f64; 2]) -> [f64; 2] {

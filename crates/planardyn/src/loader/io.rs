@@ -3,27 +3,10 @@
 //! put in plain words by [`super::parse_errors`].
 
 use super::parse_errors::Input;
-use super::{nesting, tags};
-use super::{Mechanism, MechanismSpec};
+use super::{nesting, tags, Format};
+use crate::model::{Mechanism, MechanismSpec};
 use crate::ModelError;
 use std::path::Path;
-
-/// The text format of a model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    Yaml,
-    Json,
-}
-
-impl Format {
-    /// The format a file name implies: `.json` is JSON, anything else YAML (a superset).
-    pub fn from_path(path: &Path) -> Format {
-        match path.extension().and_then(|e| e.to_str()) {
-            Some(e) if e.eq_ignore_ascii_case("json") => Format::Json,
-            _ => Format::Yaml,
-        }
-    }
-}
 
 /// Load a model file (`.yaml`, `.yml` or `.json`).
 pub fn load(path: impl AsRef<Path>) -> Result<Mechanism, ModelError> {
@@ -47,7 +30,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<Mechanism, ModelError> {
 /// Parse model text; `source` names it in error messages.
 pub fn loads(text: &str, format: Format, source: &str) -> Result<Mechanism, ModelError> {
     let spec = parse_spec(text, format, source)?;
-    Mechanism::new(spec, source)
+    super::build(spec, source)
 }
 
 /// Parse model text into its specification without validating it.

@@ -1,0 +1,77 @@
+//! A spring-damper on the relative motion of a pair: `type: torsional_spring` (an angle at a
+//! revolute pair, a displacement along a prismatic or slot pair, from the drawing), effort
+//! -k (theta - rest) - c theta' on the pair's relative coordinate. It stores
+//! 1/2 k (theta - rest)^2; its damper's power is -c theta'^2. A `friction` load's viscous
+//! part is one with k = 0 (`friction`).
+
+use super::apply::{add_pair_effort, pair_effort_rate};
+use super::{Load, LoadSpecType, LoadType};
+use crate::model::checks::{relative_pair, Ctx, R};
+use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_rate};
+use crate::model::{Mechanism, PairId};
+use serde::{Deserialize, Serialize};
+
+/// A torsional spring-damper at a revolute pair (or a linear one along a prismatic pair),
+/// acting on the pair's relative motion from the drawing: torque -k (theta - rest) - c theta'.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+// `expecting`: as `force::ForceSpec`'s.
+#[serde(deny_unknown_fields, expecting = "struct variant LoadSpec::TorsionalSpring")]
+pub struct TorsionalSpringSpec {
+    pub pair: String,
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    /// Relative rotation (rad) or displacement (m) from the drawing at which it is unloaded.
+    #[serde(default)]
+    pub rest: f64,
+}
+
+/// Spring-damper on the relative motion of a pair (angle or displacement from the drawing):
+/// generalized effort -k (theta - rest) - c theta'. Viscous friction has k = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairSpring {
+    pub pair: PairId,
+    pub stiffness: f64,
+    pub damping: f64,
+    pub rest: f64,
+}
+
+impl LoadSpecType for TorsionalSpringSpec {
+    fn build(&self, ctx: &Ctx, mech: &Mechanism, path: &str) -> R<Option<Load>> {
+        Ok(Some(Load::PairSpring(PairSpring {
+            pair: relative_pair(ctx, mech, &format!("{path}.pair"), &self.pair)?,
+            stiffness: ctx.non_negative(&format!("{path}.stiffness"), self.stiffness)?,
+            damping: ctx.non_negative(&format!("{path}.damping"), self.damping)?,
+            rest: ctx.finite(&format!("{path}.rest"), self.rest)?,
+        })))
+    }
+}
+
+impl LoadType for PairSpring {
+    #[inline]
+    fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
+        let p = &mech.pairs[self.pair.0];
+        let rate = coordinate_rate(p, x, xd);
+        let effort = -self.stiffness * (coordinate(p, x) - self.rest) - self.damping * rate;
+        add_pair_effort(mech, self.pair.0, effort, x, f);
+        -(self.damping * rate * rate)
+    }
+
+    fn add_force_dx(&self, mech: &Mechanism, x: &[f64], xd: &[f64], t: &[f64], df: &mut [f64], scratch: &mut [f64]) {
+        let p = &mech.pairs[self.pair.0];
+        let (k, c) = (self.stiffness, self.damping);
+        let rate = coordinate_rate(p, x, xd);
+        let effort = -k * (coordinate(p, x) - self.rest) - c * rate;
+        let deffort = -k * coordinate_rate(p, x, t) - c * coordinate_gamma(p, x, xd, t);
+        pair_effort_rate(mech, self.pair.0, effort, deffort, x, t, df, scratch);
+    }
+
+    fn power_dx(&self, mech: &Mechanism, x: &[f64], xd: &[f64], t: &[f64]) -> f64 {
+        let p = &mech.pairs[self.pair.0];
+        -(2.0 * self.damping * coordinate_rate(p, x, xd) * coordinate_gamma(p, x, xd, t))
+    }
+
+    fn potential(&self, mech: &Mechanism, x: &[f64]) -> f64 {
+        0.5 * self.stiffness * (coordinate(&mech.pairs[self.pair.0], x) - self.rest).powi(2)
+    }
+}
