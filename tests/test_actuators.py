@@ -9,7 +9,7 @@ import json
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import MODELS
+from conftest import MODELS, cli_run
 from planardyn import robot, structure
 from scipy.integrate import solve_ivp
 
@@ -103,26 +103,25 @@ def sized(mech: pd.Mechanism) -> robot.SizingReport:
 
 def test_motor_side_of_the_sizing_report():
     rep = sized(five_bar_with_motors())
-    n, eta = GEARED["gear_ratio"], GEARED["efficiency"]
+    n, eta, j = GEARED["gear_ratio"], GEARED["efficiency"], GEARED["rotor_inertia"]
     m = rep.motion
     fine = robot.solve_motion(m.effector, robot.circle(m.X[0] + [0.0, 0.03], 0.03, 0.5), dt=2e-5)
     for k, d in enumerate(rep.drives):
         mo = d.motor
         assert mo is not None and mo.checks == []
-        # Motor speed n qd; motor torque tau / (n eta) + friction while motoring, tau eta / n +
-        # friction while generating (the transmission's definition, docs/actuators.md).
+        # Motor speed n qd; motor torque J n qdd (the rotor, on the ground, before the gear)
+        # + friction + tau / (n eta) while motoring, tau eta / n while back-driven (the
+        # transmission's definition, docs/actuators.md).
         w = n * m.qd[:, k]
         fr = GEARED["viscous"] * w + GEARED["coulomb"] * np.tanh(w / 1e-2)
         gear = np.where(m.tau[:, k] * m.qd[:, k] >= 0, m.tau[:, k] / (n * eta), m.tau[:, k] * eta / n)
-        np.testing.assert_allclose(mo.torque, gear + fr, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(mo.torque, j * n * m.qdd[:, k] + gear + fr, rtol=1e-12, atol=1e-15)
         # The peak between the samples (the sizing resamples around it): the motion's, 100
         # times finer, to 1e-6.
         assert mo.peak_speed == pytest.approx(n * np.abs(fine.qd[:, k]).max(), rel=1e-6)
-    # The rotors' reflected inertia n^2 J is in the joint efforts: inverse dynamics with and
-    # without it differ by n^2 J qdd.
+    # The rotors are their motors': the joint-side efforts are the bare five-bar's.
     bare = pd.load(MODELS / "five-bar.yaml")
-    tau0 = bare.inverse_dynamics(m.q, m.qd, m.qdd)
-    np.testing.assert_allclose(m.tau - tau0, n * n * GEARED["rotor_inertia"] * m.qdd, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(m.tau, bare.inverse_dynamics(m.q, m.qd, m.qdd), rtol=1e-12, atol=1e-12)
 
 
 @pytest.mark.parametrize("quantity", ["peak torque", "RMS torque", "speed", "torque-speed"])
@@ -248,18 +247,19 @@ def test_a_geared_pair_actuator_motor_torque_reproduces_the_motion():
     q, qd, qdd = mech.q0 + [0.05, -0.04], [1.2, -0.7], [3.0, 5.0]
     out = mech.distribute_efforts(q, qd, qdd)
     rates = out["B"].T @ qd
-    t_m = mech.motor_torques(rates, out["efforts"])
-    # Closed form without motor friction: tau / (n eta) motoring, tau eta / n generating; the
-    # ideal drives' torques are their efforts.
-    e3, p3 = out["efforts"][2], out["efforts"][2] * rates[2]
-    assert t_m[2] == pytest.approx(e3 / (15.0 * 0.85) if p3 >= 0 else e3 * 0.85 / 15.0, rel=1e-14)
-    np.testing.assert_array_equal(t_m[:2], out["efforts"][:2])
+    t_m = mech.motor_torques(q, qd, qdd, out["efforts"])
+    np.testing.assert_array_equal(t_m, out["motor_torques"])
+    np.testing.assert_array_equal(t_m[:2], out["efforts"][:2])  # the ideal drives' torques are their efforts
     np.testing.assert_allclose(mech.forward_dynamics_actuated(q, qd, t_m), qdd, rtol=1e-10)
-    # The rotor's torque n^2 J qdd_3 (qdd_3 = B_3 . qdd + the pair's own convective part, the
-    # difference of the two models' shares) stays on motor3: the shares differ by it alone.
+    # The rotor turns before its gear: the shares are the ideal model's, and motor3's torque is
+    # its gear's input, tau / (n eta) motoring or tau eta / n back-driven (no motor friction),
+    # plus the rotor's own J n qdd_3 (qdd_3 the pair's acceleration), which forward dynamics
+    # above takes back.
     e0 = ideal.distribute_efforts(q, qd, qdd)["efforts"]
-    np.testing.assert_allclose(out["efforts"][:2], e0[:2], rtol=1e-12, atol=1e-12)
-    assert out["efforts"][2] - e0[2] != pytest.approx(0.0, abs=1e-4)
+    np.testing.assert_allclose(out["efforts"], e0, rtol=1e-12, atol=1e-12)
+    e3, p3 = out["efforts"][2], out["efforts"][2] * rates[2]
+    rotor = t_m[2] - (e3 / (15.0 * 0.85) if p3 >= 0 else e3 * 0.85 / 15.0)
+    assert abs(rotor) > 1e-3 * abs(t_m[2])
 
 
 def test_sizing_sizes_a_geared_pair_actuators_motor():
@@ -272,8 +272,9 @@ def test_sizing_sizes_a_geared_pair_actuators_motor():
     # The peaks between the samples (the sizing resamples around them): the motion's, 100
     # times finer, to 1e-6.
     m = robot.solve_motion(ee, robot.circle(home[:2] + [0.0, 0.02], 0.02, 0.5), dt=5e-5)
-    efforts, rates = robot.sizing.distributed_efforts(mech, m)
-    t_m = mech.motor_torques(rates, efforts)[:, 2]
+    efforts, rates, torques = robot.sizing.distributed_efforts(mech, m)
+    t_m = torques[:, 2]
+    np.testing.assert_allclose(t_m, mech.motor_torques(m.q, m.qd, m.qdd, efforts)[:, 2], rtol=1e-12, atol=1e-15)
     assert drive.motor.peak_torque == pytest.approx(np.abs(t_m).max(), rel=1e-6)
     assert drive.motor.peak_speed == pytest.approx(15.0 * np.abs(rates[:, 2]).max(), rel=1e-6)
     assert [c.quantity for c in drive.motor.checks] == ["peak torque"]
@@ -326,3 +327,46 @@ def test_gear_mesh_friction_costs_its_dissipated_power_and_keeps_the_energy_bala
     assert np.max(np.abs(run.energy.balance - run.energy.balance[0])) <= 1e-9
     # The meshes took energy: the train ends slower than without them (0.1625 J frictionless).
     assert run.energy.kinetic[-1] < 0.95 * frictionless.simulate().energy.kinetic[-1]
+
+
+def with_pin_friction(name: str, pair: str, mu: float) -> pd.Mechanism:
+    """A shipped model with Coulomb friction mu at `pair`: the slider-crank's crank pin
+    (radius 8 mm) or the Scotch yoke's slot pin."""
+    model = pd.load_example(name).to_dict()
+    load = {"type": "friction", "pair": pair, "mu": mu} | ({"pin_radius": 0.008} if pair == "crank_pin" else {})
+    model["loads"] = model.get("loads", []) + [load]
+    return pd.from_dict(model)
+
+
+@pytest.mark.parametrize(("name", "pair"), [("slider-crank", "crank_pin"), ("scotch-yoke", "pin")])
+def test_self_locking_friction_is_refused_at_any_mu(name, pair, tmp_path):
+    # Issue 23, finding 4: from mu ~ 1e4 (slider-crank) and 3e3 (Scotch yoke) the fixed point
+    # overflowed and forward_dynamics returned -1.1e297, a run kept a row of it. Both
+    # self-lock at their start states for every mu here: forward dynamics, simulate, a batch
+    # and the CLI must say so and never give a number.
+    for mu in (1e2, 1e3, 1e4, 1e6, 1e10, 1e15, 1e20):
+        mech = with_pin_friction(name, pair, mu)
+        with pytest.raises(pd.PlanardynError, match="self-locks") as e:
+            mech.forward_dynamics(mech.q0, mech.qd0)
+        assert e.value.iterations <= 100 and np.isfinite(e.value.change)
+        with pytest.raises(pd.PlanardynError, match="self-locks"):
+            mech.simulate(0.2)
+        (out,) = pd.batch.simulate([(mech, {})], t_end=0.2)
+        assert isinstance(out, pd.batch.BatchError) and "self-locks" in out.message
+    # Once, from the shell: an error naming the cause, no results file.
+    model = tmp_path / "locked.json"
+    model.write_text(json.dumps(with_pin_friction(name, pair, 1e15).to_dict()))
+    code, err = cli_run("simulate", model, "--t-end", "0.2", "-o", tmp_path / "out.csv")
+    assert code != 0 and "self-locks" in err and not (tmp_path / "out.csv").exists()
+
+
+def test_a_run_that_self_locks_on_the_way_stops_with_finite_rows(tmp_path):
+    # mu = 6 on the slider-crank's crank pin settles at the start and locks at t = 0.40 s, as
+    # the crank nears its dead centre: the run stops there with the reason, every row kept
+    # finite (its largest |qdd| 1.24e3 rad/s^2), and so does its results file.
+    mech = with_pin_friction("slider-crank", "crank_pin", 6.0)
+    res = mech.simulate(1.0)
+    assert not res.success and "self-locks" in res.message and 0.3 < res.t[-1] < 0.5
+    assert np.isfinite(res.qdd).all() and np.abs(res.qdd).max() < 1e4
+    back = pd.read_results(res.save(tmp_path / "run.csv"))
+    assert np.isfinite(back.qdd).all() and np.isfinite(back.tau).all()

@@ -345,7 +345,8 @@ def test_every_command_is_in_the_help_with_shipped_model_names():
     # argparse); the examples named examples/models/five-bar.yaml, which a wheel user lacks.
     p = run("--help")
     listed = re.findall(r"^    (\w+)(?: |$)", p.stdout, re.M)  # a long name has its help on the next line
-    assert listed == ["check", "simulate", "inverse", "identify", "plot", "animate", "demo", "size", "stiffness", "modes", "plan",
+    assert listed == ["check", "draw", "simulate", "inverse", "identify", "plot", "animate", "demo", "app", "size",
+                      "stiffness", "modes", "plan",
                       "export", "import", "docs"]
     for command in listed:
         help_text = run(command, "--help").stdout

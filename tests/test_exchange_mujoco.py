@@ -1,7 +1,7 @@
 """Every shipped model that MJCF can express runs in MuJoCo as exported and follows planardyn.
 
 Each model in its lossless form (docs/exchange.md: no Coulomb pair friction, every actuator
-of efficiency 1) is exported by ``planardyn.exchange.to_mjcf``, loaded by MuJoCo at its
+of efficiency 1 both ways) is exported by ``planardyn.exchange.to_mjcf``, loaded by MuJoCo at its
 keyframe ``start`` and stepped with RK4 to t_cmp = min(0.5 s, the model's t_end, its first
 singularity crossing); planardyn integrates the same model with DOP853 at tight tolerances.
 At t_cmp every body angle (and every displacement coordinate, relative to the mechanism's
@@ -24,6 +24,7 @@ import pytest
 from planardyn import models
 from planardyn.exchange import ExchangeError, to_mjcf
 from planardyn.exchange.tree import GROUND, drawing
+from test_exchange import lossless
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -45,15 +46,6 @@ SIGMA_CROSS = 0.03
 OUTPUT_DT = 1e-3
 #: The models MJCF cannot express, with the reason (docs/exchange.md lists them too).
 CANNOT: dict[str, str] = {}
-
-
-def lossless(mech: pdn.Mechanism) -> pdn.Mechanism:
-    """The model without what MuJoCo cannot carry: Coulomb pair friction, actuator efficiency."""
-    spec = mech.to_dict()
-    spec["loads"] = [ld for ld in spec.get("loads", []) if not (ld["type"] == "friction" and ld.get("mu"))]
-    for a in spec.get("actuators", []):
-        a["efficiency"] = 1.0
-    return pdn.from_dict(spec)
 
 
 def compare_time(mech: pdn.Mechanism) -> float:

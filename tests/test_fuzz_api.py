@@ -225,7 +225,7 @@ CASES: list[Case] = [
     Case("load_example", pd.load_example, {"name": Arg("five-bar", "name")}),
     # issue 13: actuators, redundant actuation, losses
     Case("Mechanism.motor_torques", GEARED.motor_torques,
-         {"qd": Arg([1.0, -0.5, 0.3], "array"), "tau": Arg([0.2, 0.1, 0.4], "array")}),
+         {"q": Arg(Q, "array"), "qd": Arg(QD, "array"), "qdd": Arg(QDD, "array"), "tau": Arg([0.2, 0.1, 0.4], "array")}),
     Case("Mechanism.distribute_efforts", GEARED.distribute_efforts,
          {"q": Arg(Q, "array"), "qd": Arg(QD, "array"), "qdd": Arg(QDD, "array"),
           "method": Arg("preload", "name"), "preload": Arg([3.0], "array")}),

@@ -49,7 +49,7 @@ def experiment():
     for name, T in (("fit", 2.0), ("long", 8.0), ("validation", 2.0)):
         t = np.arange(0.0, T, 1.0 / RATE)
         q, qd, qdd = two_tone(prior.q0, tones["validation" if name == "validation" else "fit"], t)
-        tau = real.motor_torques(qd, real.inverse_dynamics(q, qd, qdd))
+        tau = real.motor_torques(q, qd, qdd)
         runs[name] = (q, qd, qdd, tau)
     base = base_parameters(prior)
     return prior, real, runs, base, base.of(real.regressor_parameters)

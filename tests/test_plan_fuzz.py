@@ -163,11 +163,12 @@ def test_size_and_its_helpers(five, capfd) -> None:
                           NUMBERS, capfd)
     failures += probe(lambda v: robot.with_payload(five.mech, v, 0.5), "point", ["nowhere", None], capfd)
     m = robot.solve_motion(five, path, dt=5e-3)
-    arrays = {"t": m.t, "qd": m.qd, "tau": m.tau}
+    arrays = {"t": m.t, "qd": m.qd, "torques": m.tau_motor}
     for name in arrays:
         failures += probe(lambda v, n=name: robot.motor_sizing(five.mech, 0, **{**arrays, n: v}), name,
                           NUMBERS + ARRAYS, capfd)
-    failures += probe(lambda v: robot.motor_sizing(five.mech, v, m.t, m.qd, m.tau), "k", [-1, 2, 2.5, NAN, "x"], capfd)
+    failures += probe(lambda v: robot.motor_sizing(five.mech, v, m.t, m.qd, m.tau_motor), "k", [-1, 2, 2.5, NAN, "x"],
+                      capfd)
     failures += probe(lambda v: robot.envelope(v, m.tau[:, 0]), "speed", NUMBERS + ARRAYS, capfd)
     failures += probe(lambda v: robot.envelope(m.qd[:, 0], v), "effort", NUMBERS + ARRAYS, capfd)
     failures += probe(lambda v: robot.LimitCheck("speed", 1.0, v, "rad/s"), "limit", NUMBERS, capfd)

@@ -83,6 +83,33 @@ def test_eigenvalues_match_an_independent_redundant_coordinate_model():
     np.testing.assert_allclose(ours, expected, rtol=EIG_TOL)
 
 
+
+def test_compliance_quantities_take_units():
+    # The same compliances in SI and with units (issue 26's "120 mm" for the compliance
+    # section): each conversion is one multiplication by the unit's SI value (one rounding),
+    # amplified by the eigenproblem's conditioning (~1e3), so 1e-12 relative.
+    def model(k1: str, k2: str, c1: str, kp: str, ea: str, rect: str) -> str:
+        return FIVE_BAR + f"""
+compliance:
+  drives:
+    - {{actuator: theta1, stiffness: {k1}, damping: {c1}}}
+    - {{actuator: theta2, stiffness: {k2}}}
+  pairs:
+    - {{pair: effector, stiffness: {kp}}}
+  links:
+    - {{body: distal_left, EA: {ea}, EI: 20.0}}
+    - {{body: distal_right, E: 7.0e10, section: {{rectangle: {rect}}}}}
+"""
+    si = st.modes(pd.loads(model("2000", str(3 / np.deg2rad(1)), "0.5", "5.0e5", "1.0e6", "[0.01, 0.02]")))
+    units = st.modes(pd.loads(model('"2000 N m/rad"', '"3 N m/deg"', '"500 N mm s/rad"', '"500 N/mm"',
+                                    '"1000 kN"', '["10 mm", "20 mm"]')))
+    np.testing.assert_allclose(units.omega2, si.omega2, rtol=1e-12)
+    np.testing.assert_allclose(units.damping_ratio, si.damping_ratio, rtol=1e-12,
+                               atol=1e-12 * si.damping_ratio.max())  # modes the damper misses: 0
+    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].stiffness.*N/m"):
+        pd.loads(FIVE_BAR + '\ncompliance:\n  pairs: [{pair: effector, stiffness: "5 N m/rad"}]\n')
+
+
 def _period(res: pd.SimulationResult, q_eq: float) -> float:
     """Mean period between the upward zero crossings of q - q_eq (a cubic spline's roots)."""
     spline = CubicSpline(res.t, res.q[:, 0] - q_eq)

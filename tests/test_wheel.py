@@ -42,3 +42,13 @@ def test_extras_and_licence():
     assert set(extras) == {"pandas", "parquet", "mp4", "dask", "plan", "all"}
     assert meta["license"] == {"text": "MIT"}
     assert (ROOT / "LICENSE").read_text().startswith("MIT License\n")
+
+
+def test_the_app_is_included_in_the_wheel():
+    # maturin's walk of python/planardyn skips the git-ignored built app: an include rule
+    # names it, at the path planardyn.app reads (tests/wheel_smoke.py checks the wheel itself).
+    from planardyn.app import APP_FILE
+
+    include = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["maturin"]["include"]
+    assert {"path": f"python/planardyn/{APP_FILE.rsplit('/', 1)[0]}/*.html", "format": "wheel"} in include
+    assert APP_FILE.endswith(".html")

@@ -265,7 +265,7 @@ def simulate(
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
     result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
                                        coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names,
-                                       tau_motor=mech._result_motor_torques(raw["qd"], raw["tau"]))
+                                       tau_motor=mech._result_motor_torques(raw))
     # The metadata's settings rerun the variant: mech.simulate(**settings), motions by name.
     rerun = {k: v for k, v in settings.items() if k not in ("motion", "_motion")}
     if "_motion" in settings:
@@ -363,7 +363,7 @@ def _efforts(raw: dict[str, Any], mech: Mechanism, motion: dict[str, Any]) -> Ta
     k = mech.dof
     X, Xd, Xdd = (np.asarray(motion[key]).reshape(-1, k) for key in ("X", "Xd", "Xdd"))
     return TaskMotion(ee, motion["_label"], np.asarray(motion["t"]), X, Xd, Xdd, raw["q"], raw["qd"], raw["qdd"],
-                      raw["tau"], raw["sigma_I"], raw["sigma_II"], raw["condition"])
+                      raw["tau"], raw["sigma_I"], raw["sigma_II"], raw["condition"], tau_motor=raw["tau_motor"])
 
 
 # ---------------------------------------------------------------------- making variants

@@ -242,10 +242,12 @@ def identify(
     (m cy)^2 > 0, i.e. a positive inertia about the centre of mass; rotor inertias and
     friction coefficients >= 0).
 
-    With actuators the measured efforts of their coordinates are the motor torques (as a
-    simulation's ``tau`` and ``Mechanism.motor_torques``). Two terms are taken from the model
-    (docs/identification.md, *Losses*): a transmission's branch (motoring or generating, when
-    its efficiency is below 1) and the pin friction's load, the reaction, which the ``mu_``
+    With actuators the measured efforts of their coordinates are the motor torques (a
+    simulation's ``tau_motor``, ``Mechanism.motor_torques``): the rotor's torque J omega_r'
+    (its ``J_`` column) and the motor friction before the gear, the joint-side row through it.
+    Two terms are taken from the model (docs/identification.md, *Losses*): a transmission's
+    branch (motoring or back-driven, when its efficiencies are below 1) and the pin friction's
+    load, the reaction, which the ``mu_``
     columns multiply. Both are exact when the model is near the robot; where the robot's
     loads differ from the model's by d, the pin friction is off by d of itself. The loads
     are not re-evaluated from the estimate: they depend on parameters the efforts do not

@@ -344,8 +344,9 @@ class Mechanism:
         -------
         tau : ndarray of the same shape
             Efforts (N m on angles, N on displacements), the model's drives not included;
-            joint-side: with the pairs' Coulomb friction and the rotors' n^2 J qdd
-            (:meth:`motor_torques` gives the motor side).
+            joint-side: with the pairs' Coulomb friction; on a coordinate with a motor its
+            gear's output, the rotor (before the gear) not included (:meth:`motor_torques`
+            gives the motor side).
 
         Raises
         ------
@@ -358,20 +359,36 @@ class Mechanism:
         """
         return self._native.inverse_dynamics(q, qd, qdd, x, xd, allow_singular)
 
-    def motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray:
-        """Motor torques (N m, motor side) that give the joint-side efforts ``tau`` (N m or N)
-        at rates ``qd``, each (m,) or (N, m) — or (n_a,) or (N, n_a): every actuator's, at its
-        rate B^T qd: t_m = tau / (n eta) + motor friction while motoring (tau qd >= 0),
-        tau eta / n + motor friction while generating; on an actuator without a motor, the
-        effort itself (docs/actuators.md)."""
-        return self._native.motor_torques(qd, tau)
+    def motor_torques(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        tau: ArrayLike | None = None,
+        x: ArrayLike | None = None,
+        xd: ArrayLike | None = None,
+        allow_singular: bool = False,
+    ) -> FloatArray:
+        """Motor torques (N m, motor side) along a motion (q, qd, qdd; arguments, branch and
+        errors as :meth:`inverse_dynamics`): of the joint-side efforts ``tau`` ((m,) or (N, m),
+        e.g. a result's; or every actuator's, (n_a,) or (N, n_a), e.g. shared efforts), or of
+        the motion's own inverse dynamics when ``tau`` is None. Each motor's rotor (inertia J)
+        turns before its gear, at its housing's rate plus n qd: t_m = J omega_r' + motor
+        friction + t, t the gear's input, tau / (n eta) while motoring (tau qd >= 0),
+        tau eta_b / n while back-driven (docs/actuators.md); on an actuator without a motor, the
+        effort itself."""
+        return self._native.motor_torques(q, qd, qdd, tau, x, xd, allow_singular)
 
-    def _result_motor_torques(self, qd: ArrayLike, tau: ArrayLike) -> FloatArray | None:
-        """A result's ``tau_motor``: :meth:`motor_torques` of its rows (N, m) when the model has
-        an actuator, else None."""
+    def _result_motor_torques(self, raw: Mapping[str, Any]) -> FloatArray | None:
+        """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
+        tau, x, xd, each (N, ...)) when the model has an actuator, else None."""
         if all(a is None for a in self.actuators):
             return None
-        return np.asarray(self.motor_torques(qd, tau), dtype=np.float64).reshape(np.shape(tau))
+        tau = np.asarray(raw["tau"], dtype=np.float64)
+        if len(tau) == 0:
+            return tau.copy()
+        return np.asarray(self.motor_torques(raw["q"], raw["qd"], raw["qdd"], tau, x=raw["x"], xd=raw["xd"],
+                                             allow_singular=True), dtype=np.float64).reshape(np.shape(tau))
 
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
@@ -392,9 +409,10 @@ class Mechanism:
         largest magnitude, any number of internal forces: a linear program), or ``"preload"`` with ``preload`` one value
         (N m or N) per internal force added to the minimum-norm efforts. Returns ``efforts``
         (n_a,), ``B`` (m, n_a) the generalized force per unit effort, ``internal`` (r, n_a) an
-        orthonormal basis of the internal forces (B v = 0). The efforts are joint-side, a
-        motor's rotor torque n^2 J qdd kept on its own coordinate (:meth:`motor_torques`
-        gives the coordinates' motor torques)."""
+        orthonormal basis of the internal forces (B v = 0), ``motor_torques`` (n_a,) every
+        actuator's motor torque (N m; the effort itself without a motor). The efforts are
+        joint-side, the gears' outputs, shared as the mechanism's linear B allows; each motor
+        then adds its rotor's and its friction's torque before its gear (docs/actuators.md)."""
         lam = None if preload is None else array("preload", preload, ndim=(0, 1), what="N m or N").ravel().tolist()
         return self._native.distribute_efforts(q, qd, qdd, method, lam, x_start)
 
@@ -496,7 +514,8 @@ class Mechanism:
             As for :meth:`forward_dynamics`.
         q : SimulationResult
             A run of this mechanism (qd, t, tau not given): every row on its own branch
-            (``res.x``) under the efforts the run applied (``res.tau``).
+            (``res.x``) under the efforts the run applied (``res.tau``; with motors their
+            torques, ``res.tau_motor``).
 
         Returns
         -------
@@ -577,7 +596,9 @@ class Mechanism:
         if list(res.body_names) != self.body_names or res.x.shape[1:] != (3 * len(self.body_names),):
             raise error("result", "the result is not a run of this mechanism (its bodies differ); "
                                   "use pdy.from_result(res) for the mechanism it was made with")
-        return self._native.along(res.t, res.x, res.q, res.qd, res.tau, allow_singular)
+        # The run's drives: the motor torques where the model has motors (res.tau is joint-side).
+        drives = res.tau if res.tau_motor is None else res.tau_motor
+        return self._native.along(res.t, res.x, res.q, res.qd, drives, allow_singular)
 
     def energy(self, q: ArrayLike, qd: ArrayLike, x_start: ArrayLike | None = None) -> tuple[float, float]:
         """Kinetic and potential energy (J) at (q, qd): ``(T, V)``, the position reached from
@@ -711,7 +732,7 @@ class Mechanism:
             coordinate_names=self.coordinate_names,
             coordinate_kinds=self.coordinate_kinds,
             body_names=self.body_names,
-            tau_motor=self._result_motor_torques(raw["qd"], raw["tau"]),
+            tau_motor=self._result_motor_torques(raw),
         )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,

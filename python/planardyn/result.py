@@ -200,7 +200,8 @@ class SimulationResult:
     #: (which keeps the events).
     sol: DenseOutput | None = None
     #: (N, m) motor torques (N m) of a model with actuators, what its drives measure
-    #: (``Mechanism.motor_torques(qd, tau)``; tau itself on a coordinate without one); None
+    #: (``Mechanism.motor_torques(q, qd, qdd, tau, x=x, xd=xd)``; tau itself on a coordinate
+    #: without one); None
     #: for a model without actuators. What identification reads from a results file.
     tau_motor: FloatArray | None = None
 

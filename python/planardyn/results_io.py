@@ -27,7 +27,7 @@ Columns, in order: ``t``; the coordinate names (q); ``qd_<name>``; ``qdd_<name>`
 ``tau_<name>``; ``kinetic``, ``potential``, ``work`` (J); ``sigma``; ``residual``;
 ``partitioned`` (0/1); ``X_<body>``, ``Y_<body>``, ``phi_<body>`` (x) and ``Xd_<body>``,
 ``Yd_<body>``, ``phid_<body>`` (xd); for a model with actuators, ``tau_motor_<name>`` (the
-motor torques, N m: ``Mechanism.motor_torques(qd, tau)``, what identification reads).
+motor torques, N m: ``Mechanism.motor_torques`` of the rows, what identification reads).
 Readers split the table by position (the layout is in the metadata), so a coordinate may be
 named like another column.
 """
@@ -323,7 +323,7 @@ def inverse_result(
         coordinate_names=list(mech.coordinate_names),
         coordinate_kinds=list(mech.coordinate_kinds),
         body_names=list(mech.body_names),
-        tau_motor=mech._result_motor_torques(qd, tau),
+        tau_motor=mech._result_motor_torques({"q": q, "qd": qd, "qdd": qdd, "tau": tau, "x": x, "xd": xd}),
     )
     if given is not None and given.ndim == 2:
         branch = "each row's body coordinates"

@@ -132,11 +132,11 @@ pub fn bool1<'py>(py: Python<'py>, v: Vec<bool>) -> Bound<'py, PyAny> {
 }
 
 /// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
-/// `q`, `qd`, `qdd`, `tau` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
+/// `q`, `qd`, `qdd`, `tau`, `tau_motor` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
 pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let TaskSolution { q, qd, qdd, tau, sigma_i, sigma_ii, condition } = s;
-    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)] {
+    let TaskSolution { q, qd, qdd, tau, tau_motor, sigma_i, sigma_ii, condition } = s;
+    for (k, v) in [("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("tau_motor", tau_motor)] {
         d.set_item(k, arr2(py, v.len() / m.max(1), m, v)?)?;
     }
     for (k, v) in [("sigma_I", sigma_i), ("sigma_II", sigma_ii), ("condition", condition)] {

@@ -5,8 +5,8 @@
 //! GIL is released while the core computes.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
-use crate::errors::{argument_error, kinematics_error, run, Failure, PlanardynError};
-use planardyn::batch::{dissipation_rows, inverse_rows_checked, regressor_rows, Branch};
+use crate::errors::{argument_error, run, Failure, PlanardynError};
+use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};
 use planardyn::kinematics::{self as kin, Chart};
@@ -591,44 +591,61 @@ impl PyMechanism {
         Ok(arr1(py, p))
     }
 
-    /// Motor torques (N m, motor side) giving the joint-side efforts `tau` at rates `qd`,
-    /// each (m,) or (N, m) — or (n_a,) or (N, n_a): every actuator's, at its rate B^T qd;
-    /// on an actuator without a motor, the effort itself.
+    /// Motor torques (N m, motor side) along (q, qd, qdd), each (m,) or (N, m), on the branch
+    /// of x (and with the rates xd) as `inverse_dynamics`: of the joint-side efforts `tau`,
+    /// (m,) / (N, m) or every actuator's (n_a,) / (N, n_a), or of the motion's own inverse
+    /// dynamics without `tau`; on an actuator without a motor, the effort itself.
+    #[pyo3(signature = (q, qd, qdd, tau=None, x=None, xd=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
     fn motor_torques<'py>(
         &self,
         py: Python<'py>,
+        q: ArrayArg<'py>,
         qd: ArrayArg<'py>,
-        tau: ArrayArg<'py>,
+        qdd: ArrayArg<'py>,
+        tau: Option<ArrayArg<'py>>,
+        x: Option<ArrayArg<'py>>,
+        xd: Option<ArrayArg<'py>>,
+        allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        if qd.as_array().shape() != tau.as_array().shape() {
-            return Err(argument_error(
-                Some("tau"),
-                format!(
-                    "qd and tau must have the same shape, got {:?} and {:?}",
-                    qd.as_array().shape(),
-                    tau.as_array().shape()
-                ),
-            ));
-        }
+        let (q, qd, qdd, x, xd) = self.motion_rows(&q, &qd, &qdd, x.as_ref(), xd.as_ref())?;
         let n_a = self.inner.n_actuators();
-        let every = tau.as_array().shape().last() == Some(&n_a);
-        let (m, what) = if every {
-            (n_a, format!("one per actuator: {}", self.inner.actuator_names().join(", ")))
-        } else {
-            (self.m(), self.coords_what())
+        let tau = match &tau {
+            Some(tau) => {
+                let (w, what) = if tau.as_array().shape().last() == Some(&n_a) {
+                    (n_a, format!("one per actuator: {}", self.inner.actuator_names().join(", ")))
+                } else {
+                    (self.m(), self.coords_what())
+                };
+                let tau = rows("tau", tau, w, &what)?;
+                if tau.shape[..tau.shape.len() - 1] != q.shape[..q.shape.len() - 1] {
+                    return Err(argument_error(
+                        Some("tau"),
+                        format!("tau must have q's rows, got tau {:?} and q {:?}", tau.shape, q.shape),
+                    ));
+                }
+                Some((tau, w))
+            }
+            None => None,
         };
-        let (qd, tau) = (rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
-        let mut out = vec![0.0; tau.data.len()];
-        for ((o, qd), tau) in out.chunks_exact_mut(m).zip(qd.data.chunks_exact(m)).zip(tau.data.chunks_exact(m)) {
-            dynamics::motor_torques(&self.inner, qd, tau, o);
+        let mut shape = q.shape.clone();
+        if let Some((_, w)) = &tau {
+            *shape.last_mut().expect("rows have a last axis") = *w;
         }
-        let out = dynamics::finite("motor torques", out).map_err(|e| kinematics_error(py, &e))?;
-        arr_dyn(py, &tau.shape, out)
+        let mech = self.inner.clone();
+        let t_m = run(py, move || {
+            let branch = branch_of(x.as_ref(), xd.as_ref());
+            let given = tau.as_ref().map(|(t, w)| (&t.data[..], *w));
+            let t_m = motor_torque_rows(&mech, branch, &q.data, &qd.data, &qdd.data, given, allow_singular)?;
+            Ok(dynamics::finite("motor torques", t_m)?)
+        })?;
+        arr_dyn(py, &shape, t_m)
     }
 
     /// The actuators, one entry per actuator (the coordinates', then the pair actuators';
     /// None: an ideal effort source): dicts of
-    /// name, gear_ratio, efficiency, rotor_inertia (kg m^2), viscous, coulomb, stiction_speed
+    /// name, gear_ratio, efficiency, backdrive_efficiency, rotor_inertia (kg m^2), viscous,
+    /// coulomb, stiction_speed
     /// and the limits peak_torque, continuous_torque (N m), max_speed (rad/s) (None when not
     /// given) and envelope ((k, 2) [speed, torque] points).
     #[getter]
@@ -640,6 +657,7 @@ impl PyMechanism {
                     d.set_item("name", &a.name)?;
                     d.set_item("gear_ratio", a.ratio)?;
                     d.set_item("efficiency", a.efficiency)?;
+                    d.set_item("backdrive_efficiency", a.backdrive_efficiency)?;
                     d.set_item("rotor_inertia", a.rotor_inertia)?;
                     d.set_item("viscous", a.viscous)?;
                     d.set_item("coulomb", a.coulomb)?;
@@ -715,12 +733,16 @@ impl PyMechanism {
             }
         };
         let mech = self.inner.clone();
-        let (act, efforts) = run(py, move || {
+        let (act, efforts, t_m) = run(py, move || {
             let mut ws = Self::assembled(&mech, &q, x_start.as_deref())?;
-            Ok(inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws)?)
+            let (act, efforts) = inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws)?;
+            let mut t_m = vec![0.0; efforts.len()];
+            dynamics::motor_torques(&mech, &ws, &efforts, &mut t_m);
+            Ok((act, efforts, dynamics::finite("motor torques", t_m)?))
         })?;
         let d = PyDict::new(py);
         d.set_item("efforts", arr1(py, efforts))?;
+        d.set_item("motor_torques", arr1(py, t_m))?;
         d.set_item("B", arr2(py, act.m, act.n_a, act.b.clone())?)?;
         d.set_item("internal", arr2(py, act.internal.len(), act.n_a, act.internal.concat())?)?;
         Ok(d)

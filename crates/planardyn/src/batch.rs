@@ -152,6 +152,32 @@ pub fn inverse_rows_checked(
     Ok(tau)
 }
 
+/// Motor torques (N x w, N m) along rows of a motion on `branch` (as
+/// [`inverse_rows_checked`]): of the joint-side efforts `tau` (N x w: the first w actuators'
+/// efforts, the coordinates' then the pair actuators', e.g. a run's tau or shared efforts),
+/// or of the motion's own inverse dynamics (w = m) when `tau` is `None`; at each row's rates
+/// and accelerations (`dynamics::motor_torques`: a rotor takes its own torque before its gear).
+#[allow(clippy::too_many_arguments)]
+pub fn motor_torque_rows(
+    mech: &Mechanism,
+    branch: Branch<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    tau: Option<(&[f64], usize)>,
+    allow_singular: bool,
+) -> Result<Vec<f64>, Error> {
+    let w = tau.map_or(mech.dof(), |(_, w)| w);
+    let mut out = Vec::with_capacity(q.len() / mech.dof().max(1) * w);
+    let mut row = vec![0.0; w];
+    inverse_walk(mech, branch, q, qd, qdd, allow_singular, |ws| {
+        let given = tau.map_or(&ws.tau[..], |(tau, w)| &tau[out.len()..out.len() + w]);
+        dynamics::motor_torques(mech, ws, given, &mut row);
+        out.extend_from_slice(&row);
+    })?;
+    Ok(out)
+}
+
 /// Inverse dynamics at every row of a motion on `branch` (as [`inverse_rows_checked`]),
 /// `keep` taking what it needs from each row's workspace.
 fn inverse_walk(

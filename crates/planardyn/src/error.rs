@@ -109,6 +109,14 @@ pub enum KinematicsError {
          the mechanism self-locks under its pair friction here; lower mu or the pin radii"
     )]
     FrictionUnsettled { iterations: usize, change: f64 },
+    /// No choice of the gears' branches (motoring, back-driven, stuck) is consistent: a motor
+    /// on a moving link whose housing turns against its rotor, with a lossy gear (Painleve's
+    /// paradox of friction; docs/actuators.md).
+    #[error(
+        "the gears of {actuators} admit no consistent motion here (their efficiencies against the \
+         housings' rotation: friction's paradox); raise the efficiencies or mount the motors elsewhere"
+    )]
+    GearsJammed { actuators: String },
     /// The linear program of min-max effort sharing found no optimum (`message`: the solver's).
     #[error("the min-max sharing of the efforts failed: {message}; share them by minimum norm or a preload")]
     EffortSharing { message: String },

@@ -32,6 +32,7 @@ pub mod model;
 pub mod simulate;
 pub mod structure;
 pub mod topology;
+pub mod units;
 pub mod workspace;
 
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};

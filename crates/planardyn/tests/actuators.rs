@@ -6,7 +6,9 @@ mod common;
 use common::{run, yaml};
 use planardyn::dynamics::{forward, inverse, motor_torques, ModelDrives};
 use planardyn::kinematics::{assemble_into, velocity_analogues, Chart};
-use planardyn::{Mechanism, Workspace};
+use planardyn::model::loads::friction::FrictionSpec;
+use planardyn::model::spec::LoadSpec;
+use planardyn::{KinematicsError, Mechanism, Workspace};
 
 const G: f64 = 9.81;
 
@@ -51,24 +53,26 @@ fn reflected_rotor_inertia_adds_n2_j() {
 
 #[test]
 fn efficiency_and_motor_friction_follow_the_power_flow() {
-    // Motoring (qd > 0): tau = n eta (T - c n qd - T_c); generating (qd < 0 against T > 0):
-    // tau = n (T - c n qd + T_c) / eta. Stiction speed 1e-2 rad/s against n qd = 100 rad/s:
-    // tanh(1e4) = 1 exactly.
+    // The rotor sits before the gear: with c = T - c n qd - T_c sgn(qd) the motor's net torque
+    // and t = c - J n qdd what it hands to the gear, I_O qdd = n eta t while motoring (qd > 0:
+    // (I_O + eta n^2 J) qdd = eta n c) and I_O qdd = n t / eta back-driven (qd < 0 against
+    // T > 0: (I_O + n^2 J / eta) qdd = n c / eta). Stiction speed 1e-2 rad/s against
+    // n qd = 100 rad/s: tanh(1e4) = 1 exactly.
     let (n, eta, j, c, tc, t) = (50.0, 0.8, 1e-4, 2e-4, 0.01, 0.3);
     let mech =
         crank(&format!("gear_ratio: {n}, efficiency: {eta}, rotor_inertia: {j}, viscous: {c}, coulomb: {tc}"), t);
-    let a = I_O + n * n * j;
-    let motoring = n * eta * (t - c * n * 2.0 - tc) / a;
-    let generating = n * (t + c * n * 2.0 + tc) / eta / a;
+    let motoring = eta * n * (t - c * n * 2.0 - tc) / (I_O + eta * n * n * j);
+    let generating = n * (t + c * n * 2.0 + tc) / eta / (I_O + n * n * j / eta);
     for (qd, expected) in [(2.0, motoring), (-2.0, generating)] {
         let (qdd, _) = qdd_at(&mech, 0.1, qd);
         assert!((qdd - expected).abs() <= 1e-13 * expected.abs(), "qd {qd}: {qdd} vs {expected}");
-        // Inverse dynamics gives back the motor torque of the forward evaluation.
+        // Inverse dynamics gives the joint side I_O qdd (the rotor is the motor's), and the
+        // motor torque of the forward evaluation back.
         let mut ws = Workspace::new(&mech);
         inverse(&mech, &[0.1], &[qd], &[qdd], &mut ws).unwrap();
-        assert!((ws.tau[0] - (I_O + n * n * j) * qdd).abs() <= 1e-13 * ws.tau[0].abs());
+        assert!((ws.tau[0] - I_O * qdd).abs() <= 1e-13 * ws.tau[0].abs());
         let mut t_m = [0.0];
-        motor_torques(&mech, &[qd], &ws.tau, &mut t_m);
+        motor_torques(&mech, &ws, &ws.tau, &mut t_m);
         assert!((t_m[0] - t).abs() <= 1e-14, "motor torque {} vs {t}", t_m[0]);
     }
 }
@@ -233,7 +237,7 @@ fn forward_with_losses_inverts_and_holds_in_a_partition_chart() {
     let mut inv = assembled();
     inverse(&mech, &q, &qd, &[qdd], &mut inv).unwrap();
     let mut t_m = [0.0];
-    motor_torques(&mech, &qd, &inv.tau, &mut t_m);
+    motor_torques(&mech, &inv, &inv.tau, &mut t_m);
     assert!((t_m[0] - 0.4).abs() <= 1e-12, "motor torque {} vs 0.4 N m", t_m[0]);
     assert!((inv.dissipated - ws.dissipated).abs() <= 1e-12 * ws.dissipated);
 
@@ -247,4 +251,47 @@ fn forward_with_losses_inverts_and_holds_in_a_partition_chart() {
     forward(&mech, 0.0, &z, &zd, &mut ModelDrives(&mech), &mut part).unwrap();
     assert!((part.qdd[0] - qdd).abs() <= 1e-9 * qdd.abs(), "partition chart {} vs {qdd}", part.qdd[0]);
     assert!((part.dissipated - ws.dissipated).abs() <= 1e-9 * ws.dissipated);
+}
+
+/// A shipped model with Coulomb friction `mu` at `pair` (a pin of radius `radius`, or a slot).
+fn shipped_with_friction(name: &str, pair: &str, mu: f64, radius: Option<f64>) -> Mechanism {
+    let mut spec = common::shipped(name).spec.clone();
+    spec.loads.push(LoadSpec::Friction(FrictionSpec {
+        pair: pair.into(),
+        viscous: None,
+        mu: Some(mu),
+        mu_static: None,
+        pin_radius: radius,
+        length: None,
+        stiction_speed: None,
+        stribeck_speed: None,
+        pressure_angle: None,
+    }));
+    planardyn::build(spec, name).unwrap()
+}
+
+#[test]
+fn self_locking_friction_is_reported_at_any_mu() {
+    // Issue 23, finding 4: the slider-crank's crank pin (r = 8 mm) and the Scotch yoke's slot
+    // pin self-lock for mu >= 1e2 at their start states (moving: 5 and 2 rad/s); up to
+    // mu ~ 3e3 the fixed point wandered for 100 iterations, beyond it overflowed and forward
+    // dynamics returned -1.1e297 (mu 1e15 on the crank pin). Every mu must now give the
+    // self-lock error, never a number; a small mu still settles.
+    for (model, pair, radius) in [("slider-crank.yaml", "crank_pin", Some(0.008)), ("scotch-yoke.yaml", "pin", None)] {
+        let settles = shipped_with_friction(model, pair, 0.1, radius);
+        let (q, qd) = settles.initial_state();
+        let mut ws = Workspace::new(&settles);
+        forward(&settles, 0.0, &q, &qd, &mut ModelDrives(&settles), &mut ws).unwrap();
+        assert!(ws.qdd.iter().all(|v| v.is_finite() && v.abs() < 1e4) && ws.dissipated > 0.0, "{model}: {:?}", ws.qdd);
+        for mu in [1e2, 3e2, 1e3, 3e3, 1e4, 1e5, 1e6, 1e8, 1e10, 1e12, 1e15, 1e18, 1e20] {
+            let mech = shipped_with_friction(model, pair, mu, radius);
+            let mut ws = Workspace::new(&mech);
+            match forward(&mech, 0.0, &q, &qd, &mut ModelDrives(&mech), &mut ws) {
+                Err(planardyn::Error::Kinematics(KinematicsError::FrictionUnsettled { iterations, change })) => {
+                    assert!(iterations <= 100 && change.is_finite(), "{model} mu {mu}: {iterations} {change}");
+                }
+                other => panic!("{model} mu {mu}: {other:?}, qdd {:?}", ws.qdd),
+            }
+        }
+    }
 }

@@ -106,10 +106,11 @@ fn shipped_models_with_closed_forms() {
 /// with a gear or slot pair (1R1G, 1P1G, 1P1S), RRR and RRP dyads and 6R triads only, the RRR
 /// dyads' links and the triads' legs possibly cylinders (two bodies and a relative prismatic
 /// input: the hydraulic boom, the 3-RPR).
-const CLOSED: [&str; 20] = [
+const CLOSED: [&str; 21] = [
     "3-rrr",
     "andrews-squeezer",
     "five-bar-free-fall",
+    "five-bar-robot",
     "five-bar",
     "four-bar-gravity",
     "gear-train",
@@ -148,6 +149,12 @@ fn both(
     cf.set_reference(&general.x);
     let mut closed = Workspace::new(mech);
     cf.kinematic_stages(q, qd, &mut closed).unwrap();
+    if !mech.friction.is_empty() {
+        // The pairs' friction needs the reactions, solved with J at this point (as the
+        // simulation's closed-form evaluations factor it: simulate::ode).
+        let ws = &mut closed;
+        ws.sys.factor(mech, &ws.chart, &ws.x, &ws.trig).unwrap();
+    }
     dynamic_stages(mech, 0.0, &mut drives, &mut closed).unwrap();
     for ws in [&mut general, &mut closed] {
         mass_matrix(mech, ws);

@@ -58,13 +58,15 @@ fn relative_error(
     err / if scale < 1e-12 { 1.0 } else { scale }
 }
 
-/// Every shipped model, and Andrews' squeezer with its spring damped (no shipped model has
-/// a damped spring between two moving bodies).
+/// Every shipped model without losses (exact derivatives cover ideal joints and drives; one
+/// with transmissions or pin friction, the geared five-bar robot, is refused), and Andrews'
+/// squeezer with its spring damped (no shipped model has a damped spring between two moving
+/// bodies).
 fn models() -> Vec<Mechanism> {
     let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(path).unwrap();
     assert!(text.contains("damping: 0.0"));
-    let mut all = every_model();
+    let mut all: Vec<Mechanism> = every_model().into_iter().filter(|m| !m.has_losses()).collect();
     all.push(yaml(&text.replace("damping: 0.0", "damping: 40.0")));
     all
 }

@@ -1,10 +1,11 @@
 //! Prescribed motion with the pairs' Coulomb friction and a geared motor: the drive effort
 //! against inverse dynamics with losses, the power balance drive = frictionless + dissipated,
-//! the run's energy balance with the friction's work, and a geared crank against n^2 J.
+//! the run's energy balance with the friction's work, and a geared crank whose rotor is its
+//! motor's.
 
 mod common;
 use common::*;
-use planardyn::dynamics::{inverse, ModelDrives};
+use planardyn::dynamics::{inverse, motor_torques, ModelDrives};
 use planardyn::simulate::{simulate, Settings, Trajectory};
 use planardyn::{Mechanism, Workspace};
 
@@ -105,9 +106,10 @@ drives:
 
 /// A balanced crank (centre of mass on its pivot, I_O = 0.002 kg m^2) behind a motor of ratio
 /// n = 10 and rotor J = 1e-4 kg m^2, following q = 2 t^2 - t^3 (a table motion the
-/// not-a-knot spline reproduces): tau = (I_O + n^2 J) qdd exactly, qdd = 4 - 6 t.
+/// not-a-knot spline reproduces): the joint-side effort is tau = I_O qdd exactly, qdd = 4 - 6 t,
+/// and the motor's torque t_m = J n qdd + tau / n (the rotor before the gear).
 #[test]
-fn geared_crank_torque_is_the_inertia_plus_n_squared_j() {
+fn geared_crank_torque_is_its_inertia_and_its_motor_turns_the_rotor() {
     let times: Vec<f64> = (0..=8).map(|k| k as f64 / 8.0).collect();
     let q = |t: f64| 2.0 * t * t - t.powi(3);
     let tt: Vec<String> = times.iter().map(|t| t.to_string()).collect();
@@ -133,11 +135,17 @@ drives:
         qq.join(", ")
     ));
     let tr = run(&mech, 1.0);
+    let mut ws = Workspace::new(&mech);
     for k in 0..tr.len() {
-        let expected = (0.002 + 100.0 * 1e-4) * (4.0 - 6.0 * tr.t[k]);
-        assert!((tr.tau[k] - expected).abs() <= 1e-9, "t = {}: {} vs {expected} N m", tr.t[k], tr.tau[k]);
+        let qdd = 4.0 - 6.0 * tr.t[k];
+        assert!((tr.tau[k] - 0.002 * qdd).abs() <= 1e-9, "t = {}: {} vs {} N m", tr.t[k], tr.tau[k], 0.002 * qdd);
+        inverse(&mech, &tr.q[k..=k], &tr.qd[k..=k], &tr.qdd[k..=k], &mut ws).unwrap();
+        let mut t_m = [0.0];
+        motor_torques(&mech, &ws, &tr.tau[k..=k], &mut t_m);
+        let expected = (1e-4 * 10.0 + 0.002 / 10.0) * qdd;
+        assert!((t_m[0] - expected).abs() <= 1e-10, "t = {}: motor {} vs {expected} N m", tr.t[k], t_m[0]);
     }
-    // The rotor's kinetic energy is outside T: its power is counted in the work, so the
-    // balance still closes.
+    // The rotor's kinetic energy is outside T and its motor's: the work counts the gear's
+    // power into the crank, so the balance closes.
     assert!(tr.stats.energy_drift < 1e-9, "energy balance {} J", tr.stats.energy_drift);
 }

@@ -36,7 +36,7 @@ fn both(
     assemble_into(model, q, &mut ws).unwrap();
     inverse(model, q, qd, qdd, &mut ws).unwrap();
     let mut t_m = vec![0.0; m];
-    motor_torques(model, qd, &ws.tau, &mut t_m);
+    motor_torques(model, &ws, &ws.tau, &mut t_m);
     (linear, t_m, scale)
 }
 

@@ -375,6 +375,9 @@ def not_carried(d: Drawing) -> list[str]:
         if float(a.get("efficiency", 1.0)) != 1.0:
             lost.append(f"the efficiency {a['efficiency']!r} of actuator {name!r}: a loss that changes with the "
                         "direction of the power flow")
+        if float(a.get("backdrive_efficiency", 1.0)) != 1.0:
+            lost.append(f"the back-drive efficiency {a['backdrive_efficiency']!r} of actuator {name!r} (the gear's "
+                        "efficiency while the load drives the motor)")
         limits = a.get("limits") or {}
         for key in ("continuous_torque", "max_speed", "torque_speed", "corner_speed"):
             if limits.get(key) is not None:

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..mechanism import Mechanism
-from .actuator_limits import Drive, tangent_rows
+from .actuator_limits import Drive, MotorMap, tangent_rows
 from .planned import PlanError
 
 FloatArray = NDArray[np.float64]
@@ -50,8 +50,9 @@ LINEAR_TOL = 1e-9
 
 @dataclass
 class PathPoints:
-    """Points s (P,) of a path (dimensionless), with q = p(s), p'(s), p''(s) (P, m) and the
-    efforts' coefficients a, b, c (P, m) (N m or N) there."""
+    """Points s (P,) of a path (dimensionless), with q = p(s), p'(s), p''(s) (P, m), the
+    efforts' coefficients a, b, c (P, m) (N m or N) there, and the branch's body coordinates
+    x (P, 3n) they were computed on (a motor's torque needs its rotor's acceleration)."""
 
     s: FloatArray
     q: FloatArray
@@ -60,6 +61,9 @@ class PathPoints:
     a: FloatArray
     b: FloatArray
     c: FloatArray
+    x: FloatArray
+    #: The motors' torque map at the points (planardyn.plan.actuator_limits), made once.
+    motors: MotorMap | None = None
 
     def efforts(self, u: FloatArray, x: FloatArray) -> FloatArray:
         """tau (P, m) at s'' = u and s'^2 = x (P,)."""
@@ -85,13 +89,13 @@ def path_points(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, linear
     a = inverse(zero, p1) - c
     b = inverse(p1, p2) - c
     if not linear_check:
-        return PathPoints(s, p, p1, p2, a, b, c)
+        return PathPoints(s, p, p1, p2, a, b, c, x)
     b4 = inverse(2 * p1, 4 * p2) - c
     scale = max(float(np.abs(b).max()), float(np.abs(a).max()), float(np.abs(c).max()), 1e-300)
     if np.abs(b4 - 4 * b).max() > LINEAR_TOL * scale:
         raise PlanError(f"{mech.name}: efforts linear in the rates (dampers or viscous friction) are not of "
                         "TOPP's form a s'' + b s'^2 + c; plan on a copy of the model without them")
-    return PathPoints(s, p, p1, p2, a, b, c)
+    return PathPoints(s, p, p1, p2, a, b, c, x)
 
 
 class Limit(Protocol):
@@ -144,20 +148,26 @@ class SpeedLimit:
 @dataclass
 class MotorLimit:
     """Every drive's motor torque within its torque-speed envelope at its speed: the tangents
-    of planardyn.plan.actuator_limits at x0; the ratio is |t_m| / the available torque. At
-    rest (s' = 0: the path's ends) t_m is its limit from the side the path moves on (braking
-    into the end generates, as just before it), by rates along p' of size X_REST."""
+    of planardyn.plan.actuator_limits at x0; the ratio is |t_m| / the available torque, t_m on
+    the gear's branch of the path's direction (as the rows: at rest, s' = 0 at the path's
+    ends, its limit from the side the path moves on; braking into the end back-drives the
+    gear, as just before it), the available torque at rates along p' of size X_REST."""
 
     mech: Mechanism
     drives: list[Drive]
 
+    def _map(self, pts: PathPoints) -> MotorMap:
+        if pts.motors is None:
+            pts.motors = MotorMap.along(self.mech, pts.q, pts.p1, pts.p2, pts.x)
+        return pts.motors
+
     def rows(self, pts: PathPoints, x0: FloatArray) -> Rows:
-        a, b, c = tangent_rows(self.mech, self.drives, pts.a, pts.b, pts.c, pts.p1, x0)
+        a, b, c = tangent_rows(self._map(pts), self.drives, pts.a, pts.b, pts.c, x0)
         return a, b, c + ROW_MARGIN
 
     def ratio(self, pts: PathPoints, u: FloatArray, x: FloatArray) -> FloatArray:
         qd = pts.rates(np.maximum(x, X_REST))
-        t_m = np.asarray(self.mech.motor_torques(qd, pts.efforts(u, x)))
+        t_m = self._map(pts).torques(pts.efforts(u, x), u, x)
         out = np.zeros(len(x))
         for d in self.drives:
             avail = np.asarray(self.mech.available_torque(d.k, d.ratio * qd[:, d.k]), dtype=float)

@@ -38,7 +38,7 @@ from toppra.constants import MAXU, MAXX
 from .._core import AssemblyError, PlanardynError, SingularityError
 from ..mechanism import Mechanism
 from ..robot import EndEffector
-from .actuator_limits import drives, exact_bounds
+from .actuator_limits import MotorMap, drives, exact_bounds
 from .dense_check import check
 from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
 from .planned import (
@@ -305,7 +305,8 @@ def _time_optimal(mech: Mechanism, q_w: FloatArray, chord: FloatArray, limits: l
     if rtol is not None and time_error is not None and time_error > rtol * plan.duration:
         note += f"; rtol {rtol:g} not reached within {MAX_GRID} grid points"
     if motor is not None:
-        lo, hi = exact_bounds(mech, plan.qd)
+        motors = MotorMap.along(mech, plan.q, path(plan.s, 1), path(plan.s, 2), plan.x)
+        lo, hi = exact_bounds(mech, motors, np.append(plan.sdd, plan.sdd[-1]), plan.sd**2)
     elif isinstance(limits[0], EffortLimit):
         lo, hi = limits[0].bounds(plan.q)
     else:
@@ -381,11 +382,13 @@ def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
 
 
 def _take(p: PathPoints, i: NDArray[np.intp]) -> PathPoints:
-    return PathPoints(p.s[i], p.q[i], p.p1[i], p.p2[i], p.a[i], p.b[i], p.c[i])
+    return PathPoints(p.s[i], p.q[i], p.p1[i], p.p2[i], p.a[i], p.b[i], p.c[i], p.x[i])
 
 
 def _join(p: PathPoints, r: PathPoints) -> PathPoints:
-    return PathPoints(*(np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b", "c")))
+    s, q, p1, p2, a, b, c, x = (np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b",
+                                                                                          "c", "x"))
+    return PathPoints(s, q, p1, p2, a, b, c, x)
 
 
 def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray]) -> tuple[FloatArray, FloatArray, str]:

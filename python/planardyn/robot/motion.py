@@ -56,7 +56,9 @@ class TaskMotion(Summarized):
     (m, m/s, m/s^2; rad... for psi); ``q``, ``qd``, ``qdd`` (N, m) inputs (rad or m, per s,
     per s^2); ``tau`` (N, m) drive efforts (N m or N; the model's loads included, its drives
     not); ``sigma_I``, ``sigma_II`` (N,) the singularity measures (dimensionless, 0 at the
-    singularity); ``condition`` (N,) condition number of the scaled J.
+    singularity); ``condition`` (N,) condition number of the scaled J; ``tau_motor`` (N, m) the
+    motor torques (N m) the efforts need (``Mechanism.motor_torques``; tau itself on a
+    coordinate without a motor).
     """
 
     effector: EndEffector
@@ -73,6 +75,7 @@ class TaskMotion(Summarized):
     sigma_II: FloatArray
     condition: FloatArray
     notes: list[str] = field(default_factory=list)
+    tau_motor: FloatArray | None = None
 
     @property
     def mech(self) -> Any:
@@ -91,10 +94,11 @@ class TaskMotion(Summarized):
 
     def drives(self) -> DriveFunction:
         """The drive efforts as a callable ``f(t, q, qd)`` for :meth:`Mechanism.simulate`: a
-        cubic spline of ``tau`` in t (open loop: q and qd are not used)."""
+        cubic spline of ``tau_motor`` (the drives' efforts: a motor's torque, else tau) in t
+        (open loop: q and qd are not used)."""
         from scipy.interpolate import CubicSpline
 
-        spline = CubicSpline(self.t, self.tau, axis=0)
+        spline = CubicSpline(self.t, self.tau if self.tau_motor is None else self.tau_motor, axis=0)
         return lambda t, q, qd: spline(t)
 
     def simulate(self, **options: Any) -> SimulationResult:
@@ -113,6 +117,8 @@ class TaskMotion(Summarized):
     def _head(self, n: int) -> TaskMotion:
         cut = {k: getattr(self, k)[:n] for k in ("t", "X", "Xd", "Xdd", "q", "qd", "qdd", "tau",
                                                   "sigma_I", "sigma_II", "condition")}
+        if self.tau_motor is not None:
+            cut["tau_motor"] = self.tau_motor[:n]
         return replace(self, **cut)
 
 
@@ -183,7 +189,8 @@ def solve_motion(
     def motion(rows: dict[str, FloatArray]) -> TaskMotion:
         k = len(rows["sigma_I"])
         return TaskMotion(ee, path.label, t[:k].copy(), X[:k].copy(), Xd[:k].copy(), Xdd[:k].copy(), rows["q"],
-                          rows["qd"], rows["qdd"], rows["tau"], rows["sigma_I"], rows["sigma_II"], rows["condition"])
+                          rows["qd"], rows["qdd"], rows["tau"], rows["sigma_I"], rows["sigma_II"], rows["condition"],
+                          tau_motor=rows["tau_motor"])
 
     try:
         rows = ee._core.motion(t, X, Xd, Xdd, q_start, singular_tol)

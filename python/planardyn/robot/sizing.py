@@ -230,25 +230,25 @@ def _motor_dict(mo: MotorSizing) -> dict[str, Any]:
                         "margin": c.margin, "passed": c.passed} for c in mo.checks]}
 
 
-def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, tau: FloatArray,
+def motor_sizing(mech: Mechanism, k: int, t: FloatArray, qd: FloatArray, torques: FloatArray,
                  dense: tuple[FloatArray, FloatArray] | None = None) -> MotorSizing | None:
     """The motor side of actuator ``k``'s drive along samples at times ``t`` (s) with the
-    actuators' rates ``qd`` and joint-side efforts ``tau`` (N, m; or N, n_a with the pair
-    actuators); None without a motor. ``dense``: the rates and efforts (M, m or n_a) at more
-    samples (the resampling around peaks), from which the peaks are taken too (the RMS is
-    the samples' integral)."""
+    actuators' rates ``qd`` and motor torques ``torques`` (N m; N, m; or N, n_a with the pair
+    actuators: :meth:`Mechanism.motor_torques`, a solved motion's ``tau_motor``); None
+    without a motor. ``dense``: the rates and motor torques (M, m or n_a) at more samples (the
+    resampling around peaks), from which the peaks are taken too (the RMS is the samples'
+    integral)."""
     names = mech.actuator_names
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < len(names):
         raise SizingError(f"k: an actuator index from 0 to {len(names) - 1} ({', '.join(names)}), got {k!r}", "k")
-    t, qd, tau = _samples_of(t, qd, tau, len(names) if np.shape(tau)[-1:] == (len(names),) else mech.dof)
+    t, qd, torques = _samples_of(t, qd, torques, len(names) if np.shape(torques)[-1:] == (len(names),) else mech.dof)
     if dense is not None:
         dense = (_finite("dense", dense[0], qd.shape[1]), _finite("dense", dense[1], qd.shape[1]))
     act = mech.actuators[k]
     if act is None:
         return None
-    t_m = mech.motor_torques(qd, tau)[:, k]
-    qd_all, tau_all = (qd, tau) if dense is None else (np.vstack([qd, dense[0]]), np.vstack([tau, dense[1]]))
-    tm_all = mech.motor_torques(qd_all, tau_all)[:, k]
+    t_m = torques[:, k]
+    qd_all, tm_all = (qd, t_m) if dense is None else (np.vstack([qd, dense[0]]), np.concatenate([t_m, dense[1][:, k]]))
     w = act["gear_ratio"] * qd_all[:, k]
     peak_t, rms_t, peak_w = float(np.abs(tm_all).max()), _rms(t, t_m), float(np.abs(w).max())
     checks = []
@@ -287,12 +287,12 @@ def _finite(name: str, value: Any, width: int | None = None) -> FloatArray:
     return a
 
 
-def _samples_of(t: Any, qd: Any, tau: Any, width: int) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """t (N,) increasing, qd and tau (N, width), all finite, or a SizingError."""
-    tt, rates, efforts = _finite("t", t), _finite("qd", qd, width), _finite("tau", tau, width)
+def _samples_of(t: Any, qd: Any, torques: Any, width: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """t (N,) increasing, qd and torques (N, width), all finite, or a SizingError."""
+    tt, rates, efforts = _finite("t", t), _finite("qd", qd, width), _finite("torques", torques, width)
     if np.any(np.diff(tt) <= 0):
         raise SizingError("t: expected increasing times (s)", "t")
-    for name, rows in (("qd", rates), ("tau", efforts)):
+    for name, rows in (("qd", rates), ("torques", efforts)):
         if len(rows) != len(tt):
             raise SizingError(f"{name}: one row per time, got {len(rows)} rows for {len(tt)} times", name)
     return tt, rates, efforts
@@ -328,12 +328,14 @@ def _rms(t: FloatArray, y: FloatArray) -> float:
 
 @dataclass
 class _Samples:
-    """What a sizing reads at samples of a motion: times (N,) (s), every actuator's effort
-    and rate (N, n_a), the singularity measures (N,) and the task coordinates (N, k)."""
+    """What a sizing reads at samples of a motion: times (N,) (s), every actuator's effort,
+    rate and motor torque (N, n_a; the effort itself without a motor), the singularity
+    measures (N,) and the task coordinates (N, k)."""
 
     t: FloatArray
     efforts: FloatArray
     rates: FloatArray
+    torques: FloatArray
     sigma_I: FloatArray
     sigma_II: FloatArray
     X: FloatArray
@@ -341,14 +343,14 @@ class _Samples:
     def join(self, other: _Samples) -> _Samples:
         order = np.argsort(np.concatenate([self.t, other.t]), kind="stable")
         return _Samples(*(np.concatenate([getattr(self, f), getattr(other, f)])[order]
-                          for f in ("t", "efforts", "rates", "sigma_I", "sigma_II", "X")))
+                          for f in ("t", "efforts", "rates", "torques", "sigma_I", "sigma_II", "X")))
 
     def peaks(self, mech: Mechanism) -> list[FloatArray]:
         """The quantities whose largest a sizing reports: |effort|, |rate|, |power| and the
         motor torques per actuator, 1 / sigma for the singularity margins."""
         out = [np.abs(self.efforts), np.abs(self.rates), np.abs(self.efforts * self.rates)]
         if any(a is not None for a in mech.actuators):
-            out.append(np.abs(np.asarray(mech.motor_torques(self.rates, self.efforts))))
+            out.append(np.abs(self.torques))
         cols = [c for block in out for c in block.T]
         with np.errstate(divide="ignore"):
             return [*cols, 1 / self.sigma_I, 1 / self.sigma_II]
@@ -357,10 +359,12 @@ class _Samples:
 def _samples(motion: TaskMotion, distribution: str, preload: list[float] | None) -> _Samples:
     mech = motion.mech
     if len(mech.actuator_names) > len(mech.coordinate_names):
-        efforts, rates = distributed_efforts(mech, motion, distribution, preload)
+        efforts, rates, torques = distributed_efforts(mech, motion, distribution, preload)
     else:
         efforts, rates = motion.tau, motion.qd
-    return _Samples(motion.t, efforts, rates, motion.sigma_I, motion.sigma_II, motion.X)
+        torques = (np.asarray(mech.motor_torques(motion.q, motion.qd, motion.qdd, motion.tau, allow_singular=True))
+                   if motion.tau_motor is None else motion.tau_motor)
+    return _Samples(motion.t, efforts, rates, torques, motion.sigma_I, motion.sigma_II, motion.X)
 
 
 def _window(ee: EndEffector, path: TaskPath, motion: TaskMotion, k: int, options: dict[str, Any]) -> TaskMotion:
@@ -376,17 +380,18 @@ def _window(ee: EndEffector, path: TaskPath, motion: TaskMotion, k: int, options
 
 
 def distributed_efforts(mech: Mechanism, motion: TaskMotion, distribution: str = "min_norm",
-                        preload: list[float] | None = None) -> tuple[FloatArray, FloatArray]:
+                        preload: list[float] | None = None) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Every actuator's effort (N, n_a) along a motion of a redundantly actuated mechanism,
-    shared by ``distribution`` (:meth:`Mechanism.distribute_efforts`), and each actuator's
-    rate (N, n_a): B^T qd (rad/s or m/s on its pair)."""
+    shared by ``distribution`` (:meth:`Mechanism.distribute_efforts`), each actuator's rate
+    (N, n_a): B^T qd (rad/s or m/s on its pair), and its motor torque (N, n_a)."""
     preload = _check_arguments(0.0, distribution, preload, {})[1]
-    efforts, rates = [], []
+    efforts, rates, torques = [], [], []
     for q, qd, qdd in zip(motion.q, motion.qd, motion.qdd):
         out = mech.distribute_efforts(q, qd, qdd, distribution, preload)  # type: ignore[arg-type]
         efforts.append(out["efforts"])
         rates.append(out["B"].T @ qd)
-    return np.array(efforts), np.array(rates)
+        torques.append(out["motor_torques"])
+    return np.array(efforts), np.array(rates), np.array(torques)
 
 
 def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payload: float = 0.0,
@@ -448,7 +453,7 @@ def size(motion: TaskMotion | EndEffector, path: TaskPath | None = None, *, payl
     else:
         raise SizingError(f"motion: a TaskMotion or an EndEffector, got {type(motion).__name__}", "motion")
     mech = motion.mech
-    check_rms(base.t, np.hstack([base.efforts, np.asarray(mech.motor_torques(base.rates, base.efforts))]))
+    check_rms(base.t, np.hstack([base.efforts, base.torques]))
     return _report(motion, payload, base, dense)
 
 
@@ -463,7 +468,7 @@ def _report(motion: TaskMotion, payload: float, base: _Samples, dense: _Samples)
         drives.append(DriveSizing(name, "N m" if angle else "N", "rad/s" if angle else "m/s", float(np.abs(tau).max()),
                                   _rms(base.t, base.efforts[:, k]), float(np.abs(qd).max()),
                                   float(np.abs(tau * qd).max()), ev, ee_,
-                                  motor_sizing(mech, k, base.t, base.rates, base.efforts, (dense.rates, dense.efforts))))
+                                  motor_sizing(mech, k, base.t, base.rates, base.torques, (dense.rates, dense.torques))))
     iI, iII = int(np.argmin(dense.sigma_I)), int(np.argmin(dense.sigma_II))
     return SizingReport(motion, float(payload), drives,
                         (float(dense.sigma_I[iI]), float(dense.t[iI]), dense.X[iI]),

@@ -4,7 +4,7 @@
 
 use super::forces::{applied_forces, Drives};
 use super::losses::forward_with_losses;
-use super::{redundant, transmission};
+use super::redundant;
 use crate::kinematics::constraints::{coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_rate};
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart};
 use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
@@ -36,10 +36,9 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     let m = ws.b.len();
     let id = ws.sys.supports_id();
-    // With losses the rotors' inertia is added to A outside the supports' pattern.
-    if mech.has_losses() || ws.a_zeros_for != id {
+    if ws.a_zeros_for != id {
         ws.a.fill(0.0);
-        ws.a_zeros_for = if mech.has_losses() { 0 } else { id };
+        ws.a_zeros_for = id;
     } else {
         for &(k, j) in ws.sys.a_fill_in() {
             ws.a[k * m + j] = 0.0;
@@ -121,7 +120,7 @@ pub fn forward(
 /// A, b, zdd, xdd and the user's accelerations.
 pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
-    transmission::to_joint_efforts(mech, ws);
+    ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     ws.power += redundant::apply_pair_efforts(mech, ws);
     mass_matrix(mech, ws);
@@ -162,11 +161,19 @@ pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsErr
 
 /// zdd = A^-1 b in `ws.b`, with the factor from [`factor_mass_matrix`].
 pub(crate) fn solve_mass_matrix(ws: &mut Workspace) {
-    let m = ws.b.len();
+    let mut b = std::mem::take(&mut ws.b);
+    solve_factored(ws, &mut b);
+    ws.b = b;
+}
+
+/// A^-1 rhs in place, with the factor from [`factor_mass_matrix`] (over its envelope when it
+/// kept one).
+pub(crate) fn solve_factored(ws: &Workspace, rhs: &mut [f64]) {
+    let m = rhs.len();
     if ws.a_zeros_for == ws.sys.supports_id() {
-        cholesky_solve_envelope(&ws.a, m, ws.sys.a_first(), &mut ws.b);
+        cholesky_solve_envelope(&ws.a, m, ws.sys.a_first(), rhs);
     } else {
-        cholesky_solve(&ws.a, m, &mut ws.b);
+        cholesky_solve(&ws.a, m, rhs);
     }
 }
 

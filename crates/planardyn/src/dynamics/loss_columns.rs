@@ -3,7 +3,9 @@
 //!
 //! - per actuator (coordinate order) `J_<actuator>` (rotor inertia, kg m^2), `fv_<actuator>`
 //!   (motor viscous, N m s/rad), `fc_<actuator>` (motor Coulomb, N m): the rotor's torque
-//!   n^2 J qdd is joint-side, the motor friction c n qd + T_c tanh(n qd / v_m) motor-side;
+//!   J omega_r' (omega_r = omega_housing + n qd) and the motor friction
+//!   c n qd + T_c tanh(n qd / v_m) are motor-side, before the gear; a rotor on a moving link
+//!   also loads the joints through its housing's reaction -J omega_r' (joint-side, e its row);
 //! - per pair with a viscous damper (a pair spring-damper of zero stiffness: the viscous
 //!   part of a `friction` load) `fvp_<pair>`: the summed damping c of those loads, whose
 //!   effort on the pair's relative coordinate is -c rate (a spring's own damping, like a
@@ -14,8 +16,8 @@
 //!
 //! A pair's effort e enters the joint-side efforts as -e U^T grad (its lever, as
 //! `dynamics::losses` forms it). On a coordinate with an actuator the row is the motor
-//! torque: the joint-side row times 1 / (n eta) while motoring, eta / n while generating,
-//! plus the motor friction's columns.
+//! torque: the joint-side row times 1 / (n eta) while motoring, eta_b / n while back-driven,
+//! plus the rotor's and the motor friction's columns.
 //!
 //! Two terms are not linear in pi and are evaluated at the model's own parameters:
 //! - the pin friction's load N is the pair's reaction, which depends on pi: the `mu` column
@@ -23,12 +25,12 @@
 //!   coefficient's share arm N mu_s E tanh(...) (E = exp(-(arm rate / v_str)^2)) goes to
 //!   tau_o; Y pi + tau_o is exact at the model's pi (identification keeps the model's
 //!   reactions: they depend on parameters the efforts do not determine);
-//! - the transmission's branch (motoring or generating) is that of the model's joint-side
-//!   effort times qd.
+//! - the transmission's branch (motoring or back-driven) is that of the model's joint-side
+//!   effort, its power tau qd (at rest tau qdd: `transmission::motoring`).
 
 use super::friction;
 use super::losses::pair_lever;
-use super::transmission::smooth_sign;
+use super::transmission::{gear_input, motoring, smooth_sign};
 use crate::model::{Actuator, JointFriction, Load, Mechanism, PairId};
 use crate::workspace::Workspace;
 use crate::KinematicsError;
@@ -135,10 +137,13 @@ pub(crate) fn fill(
         row[start..].fill(0.0);
     }
     let (mut grad, mut gu) = (vec![0.0; n], vec![0.0; m]);
-    // Joint-side columns: rotors, dampers, pin friction.
+    // Joint-side columns: the rotors' reactions on their housings, dampers, pin friction.
+    let gears = ws.losses.gears();
     let mut col = start;
-    for (k, a) in actuated(mech) {
-        y[k * p + col] = a.ratio * a.ratio * qdd[k];
+    for (_, e, rotor) in gears.each(m) {
+        for (j, e) in e.iter().enumerate() {
+            y[j * p + col] = rotor.rotor_acc * e;
+        }
         col += ACTUATOR_PARAMETERS;
     }
     for &id in &layout.damped {
@@ -155,15 +160,16 @@ pub(crate) fn fill(
         add_lever(&gu, col + 1, law(fr, 1.0, 1.0, s), 0.0, y, tau_o);
         col += FRICTION_PARAMETERS;
     }
-    // Motor side: the joint-side row through the transmission, then the motor friction.
+    // Motor side: the joint-side row through the gear, then the rotor and the motor friction.
     let mut col = start;
-    for (k, a) in actuated(mech) {
-        let gear = if tau_model[k] * qd[k] >= 0.0 { 1.0 / (a.ratio * a.efficiency) } else { a.efficiency / a.ratio };
+    for ((k, a), rotor) in actuated(mech).zip(gears.each(m).map(|(_, _, r)| r)) {
+        let gear = gear_input(a, 1.0, motoring(a, tau_model[k], qd[k], qdd[k]));
         for v in &mut y[k * p..(k + 1) * p] {
             *v *= gear;
         }
         tau_o[k] *= gear;
         let w = a.ratio * qd[k];
+        y[k * p + col] += rotor.rotor_acc;
         y[k * p + col + 1] = w;
         y[k * p + col + 2] = smooth_sign(w, a.stiction_speed);
         col += ACTUATOR_PARAMETERS;

@@ -151,10 +151,12 @@ pub struct Scratch {
     /// (m_p x m) G = D_p,x U, then (m x m_p, column-major) A^-1 G^T.
     pub(super) g: Vec<f64>,
     pub(super) ainv_gt: Vec<f64>,
-    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) the rows' h, and h - G A^-1 b, then tau_p.
+    /// (m_p x m_p) G A^-1 G^T and its factor; (m_p) the rows' h, and h - G A^-1 b, then tau_p;
+    /// the same of a homogeneous solve (h = 0).
     pub(super) s: Vec<f64>,
     pub(super) h0: Vec<f64>,
     pub(super) h: Vec<f64>,
+    pub(super) t: Vec<f64>,
 }
 
 impl Scratch {
@@ -166,6 +168,7 @@ impl Scratch {
             s: vec![0.0; mp * mp],
             h0: vec![0.0; mp],
             h: vec![0.0; mp],
+            t: vec![0.0; mp],
         }
     }
 }

@@ -11,9 +11,8 @@
 
 use super::forces::{applied_forces, Drives};
 use super::forward::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
-use super::losses::forward_with_losses_by;
+use super::losses::{forward_with_losses_by, Solve};
 use super::motion::{Prescribed, Scratch};
-use super::transmission;
 use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
 use crate::kinematics::system::{col_scales, scaled_jacobian};
@@ -51,10 +50,10 @@ fn prescribed_rows(mech: &Mechanism, p: &[usize], qdd_p: &[f64], ws: &Workspace,
 
 /// One evaluation at time t (s) and chart state (z, zd) with the coordinates of `motion`
 /// (evaluated at t) driven by it: fills every buffer of `ws` as `forward` does, with the
-/// prescribed efforts in `ws.tau` (joint-side, a rotor's n^2 J qdd included; the drives'
-/// values there are replaced) and their power in `ws.power`. With the actuators'
+/// prescribed efforts in `ws.tau` (joint-side: a motor's gear output, its rotor not included;
+/// the drives' values there are replaced) and their power in `ws.power`. With the actuators'
 /// transmissions or Coulomb pair friction, the prescribed efforts are the multipliers of each
-/// fixed-point step of `dynamics::losses`, so the friction, the reactions, the free
+/// fixed-point step of `dynamics::losses`, so the friction, the gears, the reactions, the free
 /// coordinates' accelerations and the prescribed efforts settle together.
 pub fn forward_prescribed(
     mech: &Mechanism,
@@ -67,18 +66,23 @@ pub fn forward_prescribed(
 ) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
     drive_efforts(t, drives, ws)?;
-    transmission::to_joint_efforts(mech, ws);
+    ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
     let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;
     p.iter().for_each(|&k| ws.tau[k] = 0.0);
     ws.power = applied_forces(mech, &ws.x, &ws.xd, &ws.tau, &mut ws.f);
     mass_matrix(mech, ws);
     bias(mech, ws);
     prescribed_rows(mech, p, qdd_p, ws, w);
+    let mut solver = Held { p, w };
     if mech.has_losses() {
-        forward_with_losses_by(mech, ws, &mut |ws| solve_prescribed(p, w, ws))?;
+        forward_with_losses_by(mech, ws, &mut solver)?;
     } else {
         factor_mass_matrix(ws)?;
-        solve_prescribed(p, w, ws)?;
+        let mut zdd = std::mem::take(&mut ws.b);
+        let solved = solver.solve(ws, &mut zdd, false);
+        ws.b = zdd;
+        solved?;
+        solver.add_efforts(ws);
         accelerations(mech, ws);
     }
     for (&k, &tau) in p.iter().zip(&w.h) {
@@ -88,38 +92,58 @@ pub fn forward_prescribed(
     Ok(())
 }
 
-/// With A factored in `ws.a`: zdd into `ws.b` and the prescribed efforts tau_p into `w.h`
-/// (from the rows' `w.h0`), their forces added to `ws.f`.
-fn solve_prescribed(p: &[usize], w: &mut Scratch, ws: &mut Workspace) -> Result<(), KinematicsError> {
-    let (m, mp, nx) = (ws.b.len(), p.len(), ws.x.len());
-    cholesky_solve(&ws.a, m, &mut ws.b);
-    for i in 0..mp {
-        let col = &mut w.ainv_gt[i * m..(i + 1) * m];
-        col.copy_from_slice(&w.g[i * m..(i + 1) * m]);
-        cholesky_solve(&ws.a, m, col);
+/// A zdd = rhs + G^T tau_p with the prescribed rows G zdd = h held: the solver of
+/// `dynamics::losses` for a motion with prescribed coordinates (A factored in `ws.a`).
+struct Held<'a> {
+    p: &'a [usize],
+    w: &'a mut Scratch,
+}
+
+impl Solve for Held<'_> {
+    /// zdd of `rhs` in place, with the efforts tau_p into `w.h` (from the rows' `w.h0`, or 0 when
+    /// `homogeneous`, then into `w.t`).
+    fn solve(&mut self, ws: &Workspace, rhs: &mut [f64], homogeneous: bool) -> Result<(), KinematicsError> {
+        let (m, mp) = (rhs.len(), self.p.len());
+        let w = &mut *self.w;
+        cholesky_solve(&ws.a, m, rhs);
+        for i in 0..mp {
+            let col = &mut w.ainv_gt[i * m..(i + 1) * m];
+            col.copy_from_slice(&w.g[i * m..(i + 1) * m]);
+            cholesky_solve(&ws.a, m, col);
+        }
+        let tau = if homogeneous { &mut w.t } else { &mut w.h };
+        for (i, (tau, g)) in tau.iter_mut().zip(w.g.chunks_exact(m)).enumerate() {
+            *tau = if homogeneous { 0.0 } else { w.h0[i] } - dot(g, rhs);
+            for k in 0..mp {
+                w.s[i * mp + k] = dot(&w.g[i * m..(i + 1) * m], &w.ainv_gt[k * m..(k + 1) * m]);
+            }
+        }
+        // G A^-1 G^T is positive definite unless the prescribed coordinates are dependent where
+        // the motion takes them (a type II singularity of their own drives).
+        if !cholesky_in_place(&mut w.s, mp) {
+            return Err(KinematicsError::singular(SingularityKind::TypeII));
+        }
+        cholesky_solve(&w.s, mp, tau);
+        for (i, &t) in tau.iter().enumerate() {
+            for (zdd, a) in rhs.iter_mut().zip(&w.ainv_gt[i * m..(i + 1) * m]) {
+                *zdd += a * t;
+            }
+        }
+        Ok(())
     }
-    for i in 0..mp {
-        w.h[i] = w.h0[i] - dot(&w.g[i * m..(i + 1) * m], &ws.b);
-        for k in 0..mp {
-            w.s[i * mp + k] = dot(&w.g[i * m..(i + 1) * m], &w.ainv_gt[k * m..(k + 1) * m]);
+
+    fn prescribed(&self, k: usize) -> bool {
+        self.p.contains(&k)
+    }
+
+    fn add_efforts(&mut self, ws: &mut Workspace) {
+        let nx = ws.x.len();
+        for (i, &tau) in self.w.h.iter().enumerate() {
+            for (f, g) in ws.f.iter_mut().zip(&self.w.grad[i * nx..(i + 1) * nx]) {
+                *f += tau * g;
+            }
         }
     }
-    // G A^-1 G^T is positive definite unless the prescribed coordinates are dependent where
-    // the motion takes them (a type II singularity of their own drives).
-    if !cholesky_in_place(&mut w.s, mp) {
-        return Err(KinematicsError::singular(SingularityKind::TypeII));
-    }
-    cholesky_solve(&w.s, mp, &mut w.h);
-    for i in 0..mp {
-        let tau = w.h[i];
-        for (zdd, a) in ws.b.iter_mut().zip(&w.ainv_gt[i * m..(i + 1) * m]) {
-            *zdd += a * tau;
-        }
-        for (f, g) in ws.f.iter_mut().zip(&w.grad[i * nx..(i + 1) * nx]) {
-            *f += tau * g;
-        }
-    }
-    Ok(())
 }
 
 /// Smallest singular value of the scaled [Phi_x; D_p,x] at x: the pair constraints with the

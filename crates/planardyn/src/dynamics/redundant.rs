@@ -8,7 +8,6 @@
 
 use super::forward::forward;
 use super::inverse::inverse;
-use super::transmission::joint_effort;
 use super::Drives;
 use crate::kinematics::constraints::{pair_coordinate_grad, pair_coordinate_rate, Dense};
 use crate::model::{Mechanism, PairId};
@@ -192,13 +191,12 @@ fn min_max_lambda(t: &[f64], internal: &[Vec<f64>]) -> Result<Vec<f64>, Kinemati
 
 /// Inverse dynamics with redundant actuators: the joint-side efforts (n_a) of every actuator
 /// for coordinates q, rates qd, accelerations qdd, shared as `how` says; `ws` is left with the
-/// point's kinematics (and `ws.tau` the generalized efforts they produce). The sharing is of
-/// the joint-side efforts: B and its internal forces are the mechanism's, linear, where a
-/// motor's torque is not (its efficiency changes with the sign of its power, its Coulomb
-/// friction with that of its speed). A rotor's torque r_a = n^2 J qdd_a is its own motor's:
-/// the efforts B tau_a = tau - B r are shared, then r_a is added to actuator a's share.
-/// [`super::transmission::motor_torques`] gives the motor torques (the actuators' rates are
-/// B^T qd).
+/// point's motion (and `ws.tau` the generalized efforts they produce). The sharing is of
+/// the joint-side efforts, the gears' outputs: B and its internal forces are the mechanism's,
+/// linear, where a motor's torque is not (its gear's efficiency changes with the direction of
+/// the power, its Coulomb friction with that of its speed). Each rotor is its own motor's
+/// (before its gear); its reaction on a moving housing is part of the generalized efforts.
+/// [`super::motor_torques`] with `ws` gives the motor torques.
 pub fn inverse_redundant(
     mech: &Mechanism,
     q: &[f64],
@@ -209,11 +207,7 @@ pub fn inverse_redundant(
 ) -> Result<(Actuation, Vec<f64>), KinematicsError> {
     inverse(mech, q, qd, qdd, ws)?;
     let act = Actuation::at(mech, ws)?;
-    let mut rotor = ws.losses.rotor_torques().to_vec();
-    rotor.resize(act.n_a, 0.0);
-    let shared: Vec<f64> = ws.tau.iter().zip(act.b.chunks_exact(act.n_a)).map(|(t, b)| t - dot(b, &rotor)).collect();
-    let mut efforts = act.distribute(&shared, how)?;
-    efforts.iter_mut().zip(&rotor).for_each(|(e, r)| *e += r);
+    let efforts = act.distribute(&ws.tau, how)?;
     Ok((act, efforts))
 }
 
@@ -246,14 +240,13 @@ pub fn forward_redundant(
     result
 }
 
-/// Add the pair actuators' joint-side efforts to `ws.f` (`ws.pair_tau`: motor torques where
-/// a pair actuator has a motor); returns their power (W).
+/// Add the efforts of the pair actuators without a motor (`ws.pair_tau`) to `ws.f`; returns
+/// their power (W). A motor's torque goes through its gear (`dynamics::gears`).
 pub(crate) fn apply_pair_efforts(mech: &Mechanism, ws: &mut Workspace) -> f64 {
     let mut power = 0.0;
-    for (a, &t) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
-        if t != 0.0 || a.drive.is_some() {
+    for (a, &e) in mech.pair_actuators.iter().zip(&ws.pair_tau) {
+        if e != 0.0 && a.drive.is_none() {
             let rate = pair_coordinate_rate(&mech.pairs[a.pair.0], &ws.x, &ws.xd);
-            let e = a.drive.as_ref().map_or(t, |d| joint_effort(d, t, rate));
             pair_grad(mech, a.pair, &ws.x, &mut ws.tmp);
             ws.f.iter_mut().zip(&ws.tmp).for_each(|(f, g)| *f += e * g);
             power += e * rate;

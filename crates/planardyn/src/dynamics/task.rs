@@ -53,14 +53,17 @@ pub struct TaskPath {
 }
 
 /// A solved motion, time-major (N x m): inputs (rad or m), their rates and accelerations,
-/// drive efforts (N m or N; the model's loads included, its drives not), the two singularity
-/// measures and the condition number of the scaled J_t (N each).
+/// drive efforts (N m or N; the model's loads included, its drives not; joint-side) and the
+/// motor torques they need (N m; the effort itself on a coordinate without a motor:
+/// [`super::motor_torques`]), the two singularity measures and the condition number of the
+/// scaled J_t (N each).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TaskSolution {
     pub q: Vec<f64>,
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
     pub tau: Vec<f64>,
+    pub tau_motor: Vec<f64>,
     pub sigma_i: Vec<f64>,
     pub sigma_ii: Vec<f64>,
     pub condition: Vec<f64>,
@@ -73,7 +76,8 @@ impl TaskSolution {
             q: rows.clone(),
             qd: rows.clone(),
             qdd: rows.clone(),
-            tau: rows,
+            tau: rows.clone(),
+            tau_motor: rows,
             sigma_i: vec![0.0; n],
             sigma_ii: vec![0.0; n],
             condition: vec![0.0; n],
@@ -88,6 +92,7 @@ impl TaskSolution {
             qd: rows(&self.qd),
             qdd: rows(&self.qdd),
             tau: rows(&self.tau),
+            tau_motor: rows(&self.tau_motor),
             sigma_i: self.sigma_i[..n].to_vec(),
             sigma_ii: self.sigma_ii[..n].to_vec(),
             condition: self.condition[..n].to_vec(),
@@ -271,6 +276,9 @@ pub fn solve(mech: &Mechanism, path: &TaskPath) -> Result<TaskSolution, TaskErro
         let (qd, qdd) = rates.unwrap_or_default();
         dynamics::inverse(mech, &st.q, &qd, &qdd, &mut tr.ws).map_err(Error::from)?;
         out.tau[i * m..(i + 1) * m].copy_from_slice(&tr.ws.tau);
+        let t_m = &mut out.tau_motor[i * m..(i + 1) * m];
+        dynamics::motor_torques(mech, &tr.ws, &tr.ws.tau, t_m);
+        dynamics::finite("motor torques", t_m).map_err(Error::from)?;
         out.q[i * m..(i + 1) * m].copy_from_slice(&st.q);
         out.qd[i * m..(i + 1) * m].copy_from_slice(&qd);
         out.qdd[i * m..(i + 1) * m].copy_from_slice(&qdd);

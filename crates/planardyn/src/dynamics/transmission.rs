@@ -1,18 +1,20 @@
 //! Motors and their transmissions (docs/actuators.md): the motor torque t_m (N m, motor side)
-//! and the joint-side effort tau (N m or N on the coordinate) of a transmission of ratio n
-//! and efficiency eta, with motor-side viscous and regularised Coulomb friction:
+//! of a drive whose gear of ratio n delivers the joint-side effort tau (N m or N on its pair's
+//! coordinate q). The rotor (inertia J) sits before the gear, turning at
+//! omega_r = omega_h + n qd (omega_h its housing's rate: the pair's first body for an angle,
+//! 0 for a sliding pair, whose screw turns about an axis in the plane). With the motor's own
+//! friction f(n qd) = c n qd + T_c tanh(n qd / v_m), the torque the rotor hands to the gear is
 //!
-//!   tau = n eta^s (t_m - c n qd - T_c sgn_v(n qd)),
+//!   t = t_m - f - J omega_r',
 //!
-//! s = +1 while motoring (the torque the motor hands to the gears does positive work,
-//! (t_m - losses) qd >= 0; at rest too), s = -1 while generating (the load drives the motor).
-//! The rotor's inertia J adds n^2 J to A on the driven coordinate; its torque n^2 J qdd is
-//! part of the joint-side effort (the efficiency is applied to the whole gear torque except
-//! that of the rotor, which keeps A linear: docs/actuators.md states it).
+//! and the gear passes it on with its efficiency in the direction the power flows: motoring
+//! (the gear's input power t qd >= 0) tau = n eta t; back-driven (the load drives the rotor)
+//! eta_b tau = n t, eta_b the back-drive efficiency (0: a self-locking gear, t = 0, which holds
+//! any load). Forward dynamics solves these with the accelerations (`dynamics::gears`); here
+//! the motor torque of a known motion (`dynamics::motor_torques` reads the last evaluation's).
 
-use crate::kinematics::constraints::pair_coordinate_gamma;
-use crate::model::{Actuator, Mechanism, PairId};
-use crate::workspace::Workspace;
+use crate::model::pairs::{self, Relative};
+use crate::model::{Actuator, Link, Mechanism, PairId};
 
 /// tanh(v / v_s): the sign function regularised over speed v_s > 0.
 #[inline]
@@ -20,33 +22,63 @@ pub fn smooth_sign(v: f64, v_s: f64) -> f64 {
     (v / v_s).tanh()
 }
 
-/// The motor's own friction torque (N m, motor side) at coordinate rate qd.
-fn motor_friction(a: &Actuator, qd: f64) -> f64 {
+/// The motor's own friction torque f (N m, motor side) at coordinate rate qd.
+pub(crate) fn motor_friction(a: &Actuator, qd: f64) -> f64 {
     let w = a.ratio * qd;
     a.viscous * w + a.coulomb * smooth_sign(w, a.stiction_speed)
 }
 
-/// The joint-side effort (N m or N) of motor torque `t_m` (N m) at coordinate rate qd.
-pub fn joint_effort(a: &Actuator, t_m: f64, qd: f64) -> f64 {
-    let gear = t_m - motor_friction(a, qd);
-    if gear * qd >= 0.0 {
-        a.ratio * a.efficiency * gear
+/// A stuck gear whose coordinate still turns within its at-rest band ([`at_rest`]) comes to
+/// rest with this time constant (s): qdd = -qd / T. It then creeps at most v_m T / n
+/// (3.3e-6 rad behind a 30:1 gear at the default v_m = 1e-2 rad/s), and the decay rate
+/// 1 / T = 100 /s is far below what an explicit integrator's steps resolve anyway.
+pub(crate) const STUCK_DECAY: f64 = 1e-2;
+
+/// Whether actuator `a`'s gear counts as at rest at coordinate rate qd: its motor turns slower
+/// than its stiction speed v_m, the band where its Coulomb torque fades too. At rest a gear
+/// can stick (`dynamics::gears`), where an exact qd = 0 would make an integrator chatter
+/// across it (a sliding mode).
+pub(crate) fn at_rest(a: &Actuator, qd: f64) -> bool {
+    (a.ratio * qd).abs() <= a.stiction_speed
+}
+
+/// The direction of actuator `a`'s relative motion that decides its gear's branch: qd; at rest
+/// ([`at_rest`]) the way it slips from sticking, qdd - (-qd / T) ([`STUCK_DECAY`]): qdd at
+/// qd = 0, and positive, zero or negative as the gear slips forward, sticks or slips back.
+pub(crate) fn direction(a: &Actuator, qd: f64, qdd: f64) -> f64 {
+    if at_rest(a, qd) {
+        qdd + qd / STUCK_DECAY
     } else {
-        a.ratio * gear / a.efficiency
+        qd
     }
 }
 
-/// The rotor's inertia reflected to the driven coordinate, n^2 J (kg m^2, or kg on a
-/// sliding coordinate).
-pub fn reflected_inertia(a: &Actuator) -> f64 {
-    a.ratio * a.ratio * a.rotor_inertia
+/// Whether the gear of actuator `a` whose output effort is `tau` moves power from the motor
+/// to the load: tau along the [`direction`] of the motion. Held still (at rest, qdd = 0) it
+/// counts as motoring: the motor torque that holds a load is then any between the two
+/// branches' values, and the motoring one, which would start to move the load along tau, is
+/// the one reported.
+pub(crate) fn motoring(a: &Actuator, tau: f64, qd: f64, qdd: f64) -> bool {
+    let d = direction(a, qd, qdd);
+    tau * if d == 0.0 { tau } else { d } >= 0.0
 }
 
-/// The motor torque (N m) that gives joint-side effort `tau` at rate qd: the inverse of
-/// [`joint_effort`].
-pub fn motor_torque(a: &Actuator, tau: f64, qd: f64) -> f64 {
-    let gear = if tau * qd >= 0.0 { tau / (a.ratio * a.efficiency) } else { tau * a.efficiency / a.ratio };
-    gear + motor_friction(a, qd)
+/// The gear's input torque t (N m, motor side) for its output effort `tau`: tau / (n eta)
+/// motoring, tau eta_b / n back-driven.
+pub(crate) fn gear_input(a: &Actuator, tau: f64, motoring: bool) -> f64 {
+    if motoring {
+        tau / (a.ratio * a.efficiency)
+    } else {
+        tau * a.backdrive_efficiency / a.ratio
+    }
+}
+
+/// The motor torque (N m) that gives joint-side effort `tau` (N m or N) at coordinate rate qd
+/// and acceleration qdd (of the actuator's pair), its rotor accelerating at `rotor_acc`
+/// (rad/s^2, absolute): t_m = J omega_r' + f + t, t the gear's input ([`gear_input`] on the
+/// branch [`motoring`] gives).
+pub fn motor_torque(a: &Actuator, tau: f64, qd: f64, qdd: f64, rotor_acc: f64) -> f64 {
+    a.rotor_inertia * rotor_acc + motor_friction(a, qd) + gear_input(a, tau, motoring(a, tau, qd, qdd))
 }
 
 /// Every actuator's motor, in actuator order: the coordinates', then the pair actuators'
@@ -65,53 +97,12 @@ pub(crate) fn actuator_pair(mech: &Mechanism, k: usize) -> PairId {
     }
 }
 
-/// Each actuator's n^2 J (0 without a rotor), in actuator order.
-pub(crate) fn rotor_inertias(mech: &Mechanism) -> Vec<f64> {
-    motors(mech).map(|a| a.map_or(0.0, reflected_inertia)).collect()
-}
-
-/// Motor torques (N m; the joint effort where an actuator has no motor) into `t_m` for
-/// joint-side efforts `tau` at rates `qd`: the first `tau.len()` actuators (the coordinates',
-/// then the pair actuators', whose rates are B^T qd).
-pub fn motor_torques(mech: &Mechanism, qd: &[f64], tau: &[f64], t_m: &mut [f64]) {
-    for (k, (slot, (&tau, &qd))) in motors(mech).zip(tau.iter().zip(qd)).enumerate() {
-        t_m[k] = slot.map_or(tau, |a| motor_torque(a, tau, qd));
-    }
-}
-
-/// `ws.tau` from motor torques to joint-side efforts, at the rates `ws.qd`.
-pub(crate) fn to_joint_efforts(mech: &Mechanism, ws: &mut Workspace) {
-    for (a, (tau, &qd)) in mech.actuators.iter().zip(ws.tau.iter_mut().zip(&ws.qd)) {
-        if let Some(a) = a {
-            *tau = joint_effort(a, *tau, qd);
-        }
-    }
-}
-
-/// h_k = grad_k . c + gamma_k(xd, xd) of every actuator k with a rotor (`inertia[k]` > 0),
-/// so that qdd_k = g_k . zdd + h_k; `grad` holds the actuators' pair gradients (n_a x 3n).
-pub(crate) fn rotor_terms(mech: &Mechanism, ws: &Workspace, inertia: &[f64], grad: &[f64], h: &mut [f64]) {
-    let n = ws.x.len();
-    for (k, ((h, g), &j)) in h.iter_mut().zip(grad.chunks_exact(n)).zip(inertia).enumerate() {
-        if j > 0.0 {
-            let pair = &mech.pairs[actuator_pair(mech, k).0];
-            *h = g.iter().zip(&ws.c).map(|(a, b)| a * b).sum::<f64>()
-                + pair_coordinate_gamma(pair, &ws.x, &ws.xd, &ws.xd);
-        }
-    }
-}
-
-/// A += n^2 J g_k g_k^T and b -= n^2 J h_k g_k for every actuator k (`inertia[k]` = n^2 J,
-/// 0 without a rotor; `g` n_a x m, row k = dq_k/dz, q_k the actuator's pair coordinate): the
-/// rotors' kinetic energy 1/2 n^2 J qd_k^2.
-pub(crate) fn add_rotor_inertia(inertia: &[f64], g: &[f64], h: &[f64], a: &mut [f64], b: &mut [f64]) {
-    let m = b.len();
-    for ((&j, g), &h) in inertia.iter().zip(g.chunks_exact(m)).zip(h).filter(|((j, _), _)| **j > 0.0) {
-        for r in 0..m {
-            b[r] -= j * h * g[r];
-            for c in 0..m {
-                a[r * m + c] += j * g[r] * g[c];
-            }
-        }
+/// The body (index) whose rate the rotor of actuator `k` turns with: the first body of an
+/// angle pair when it is not the ground; `None` for the ground and for sliding pairs.
+pub(crate) fn housing(mech: &Mechanism, k: usize) -> Option<usize> {
+    let pair = &mech.pairs[actuator_pair(mech, k).0];
+    match (pairs::relative(pair), pair.a) {
+        (Some(Relative::Angle), Link::Body(b)) => Some(b.0),
+        _ => None,
     }
 }

@@ -4,15 +4,19 @@
 
 use super::PairId;
 
-/// A motor driving actuator `coordinate`'s relative coordinate q through a transmission of
-/// ratio n: motor angle n q (rad), motor speed n qd (rad/s).
+/// A motor driving an actuator's relative coordinate q through a transmission of ratio n:
+/// motor angle n q (rad) relative to its housing, motor speed n qd (rad/s). The housing is
+/// the pair's first body (for a sliding pair the rotor's axis lies in the plane).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Actuator {
     pub name: String,
     /// Transmission ratio n (> 0).
     pub ratio: f64,
-    /// Transmission efficiency eta in (0, 1].
+    /// Transmission efficiency eta in (0, 1] while motoring (the rotor drives the load).
     pub efficiency: f64,
+    /// Back-drive efficiency eta_b in [0, 1], while the load drives the rotor (default eta);
+    /// 0: a self-locking gear (a worm drive), which holds its load.
+    pub backdrive_efficiency: f64,
     /// Rotor inertia J (kg m^2, motor side).
     pub rotor_inertia: f64,
     /// Motor-side viscous friction (N m s/rad).

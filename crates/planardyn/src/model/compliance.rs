@@ -11,10 +11,13 @@
 //!   the section and the material).
 //!
 //! The mechanics that use them are in `crate::elastic`. Units SI: N m/rad, N/m, N m s/rad,
-//! N s/m, N, N m^2, m^2, m^4, Pa.
+//! N s/m, N, N m^2, m^2, m^4, Pa. The stiffnesses, dampings, EA and a rectangle's sides may be
+//! written with a unit (`"20 kN m/rad"`, `"30 mm"`: `crate::units`); EI, E, area and
+//! second_moment have no unit table and are numbers in SI.
 
 use super::checks::{pair_id, Ctx, R};
 use super::{BodyId, Mechanism, PairId, PairKind, PointId};
+use crate::units;
 use serde::{Deserialize, Serialize};
 
 /// The `compliance:` section of a model file.
@@ -50,9 +53,10 @@ pub enum Side {
 pub struct DriveComplianceSpec {
     pub actuator: String,
     /// k (N m/rad, or N/m on a sliding coordinate), > 0.
+    #[serde(deserialize_with = "units::pair_stiffness")]
     pub stiffness: f64,
     /// c (N m s/rad or N s/m), >= 0.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::pair_damping")]
     pub damping: f64,
     #[serde(default)]
     pub side: Side,
@@ -63,8 +67,9 @@ pub struct DriveComplianceSpec {
 #[serde(deny_unknown_fields)]
 pub struct PairComplianceSpec {
     pub pair: String,
+    #[serde(deserialize_with = "units::stiffness")]
     pub stiffness: f64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::damping")]
     pub damping: f64,
 }
 
@@ -73,7 +78,7 @@ pub struct PairComplianceSpec {
 #[serde(deny_unknown_fields)]
 pub struct LinkComplianceSpec {
     pub body: String,
-    #[serde(default, rename = "EA", skip_serializing_if = "Option::is_none")]
+    #[serde(default, rename = "EA", deserialize_with = "units::force", skip_serializing_if = "Option::is_none")]
     pub ea: Option<f64>,
     #[serde(default, rename = "EI", skip_serializing_if = "Option::is_none")]
     pub ei: Option<f64>,
@@ -94,7 +99,7 @@ pub struct SectionSpec {
     pub area: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub second_moment: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::length", skip_serializing_if = "Option::is_none")]
     pub rectangle: Option<[f64; 2]>,
 }
 

@@ -12,6 +12,8 @@ pub mod actuators;
 pub(crate) mod build;
 pub(crate) mod checks;
 pub mod compliance;
+pub mod construct;
+pub mod construction;
 pub(crate) mod diameter;
 pub mod loads;
 mod motion;

@@ -56,16 +56,38 @@ fn motor(ctx: &Ctx, path: &str, a: &ActuatorSpec, default_name: &str) -> R<Actua
             format!("{efficiency} is above 1; give the fraction of the power transmitted, in (0, 1]"),
         ));
     }
+    let rotor_inertia = ctx.non_negative(&format!("{path}.rotor_inertia"), a.rotor_inertia)?;
+    let backdrive_efficiency = backdrive(ctx, path, a.backdrive_efficiency, efficiency, rotor_inertia)?;
     Ok(Actuator {
         name: a.name.clone().unwrap_or_else(|| default_name.to_string()),
         ratio: positive("gear_ratio", a.gear_ratio)?,
         efficiency,
-        rotor_inertia: ctx.non_negative(&format!("{path}.rotor_inertia"), a.rotor_inertia)?,
+        backdrive_efficiency,
+        rotor_inertia,
         viscous: ctx.non_negative(&format!("{path}.viscous"), a.viscous)?,
         coulomb: ctx.non_negative(&format!("{path}.coulomb"), a.coulomb)?,
         stiction_speed: positive("stiction_speed", a.stiction_speed.unwrap_or(MOTOR_STICTION_SPEED))?,
         limits: build_limits(ctx, &format!("{path}.limits"), a.limits.as_ref())?,
     })
+}
+
+/// The back-drive efficiency eta_b in [0, 1] (default: the forward one). A self-locking gear
+/// (0) needs a rotor: while the load would back-drive it, its output follows the rotor,
+/// which its motor alone accelerates (docs/actuators.md).
+fn backdrive(ctx: &Ctx, path: &str, given: Option<f64>, efficiency: f64, rotor_inertia: f64) -> R<f64> {
+    let Some(v) = given else { return Ok(efficiency) };
+    let p = format!("{path}.backdrive_efficiency");
+    if !(0.0..=1.0).contains(&ctx.finite(&p, v)?) {
+        return Err(ctx.err(p, format!("{v} is not an efficiency: give the fraction of the load's power that reaches the rotor, in [0, 1] (0: self-locking)")));
+    }
+    if v == 0.0 && rotor_inertia == 0.0 {
+        return Err(ctx.err(
+            format!("{path}.rotor_inertia"),
+            "a self-locking gear (backdrive_efficiency 0) needs the rotor's inertia J > 0: while the load would \
+             back-drive it the joint follows the rotor, which only its motor accelerates",
+        ));
+    }
+    Ok(v)
 }
 
 /// A redundant actuator: a pair with a relative coordinate, not a coordinate's, driven by a
@@ -97,6 +119,7 @@ fn pair_actuator(
     }
     let ideal = a.gear_ratio == 1.0
         && a.efficiency == 1.0
+        && a.backdrive_efficiency.is_none()
         && a.rotor_inertia == 0.0
         && a.viscous == 0.0
         && a.coulomb == 0.0
