@@ -81,7 +81,7 @@ def test_motor_torques_stay_within_the_envelopes_between_the_grid_and_a_limit_bi
     assert use.max() >= 1 - 1e-6  # a limit reached (to toppra's stage tolerance and ROW_MARGIN)
     # Time-optimal to its rtol: the same path run faster by rtol breaks a limit somewhere.
     faster = usage(plan.mech, *states(plan, 1 / (1 - RTOL)))[:-1]
-    assert faster.max() > 1 + 1e-4
+    assert faster.max() > 1 + 1e-3  # measured 1.00777: the inertial torques grow by (1 - rtol)^-2
 
 
 def test_the_pins_friction_efforts_balance_their_dissipated_power(planned) -> None:

@@ -81,7 +81,7 @@ def planning_model(mech: Mechanism) -> PlanningModel:
             raise PlanError(f"{mech.name}: loads[{i}] ({ld['type']} {where}) damps with {viscous:g}: its effort c s' is "
                             "not of TOPP's form a s'' + b s'^2 + c; plan on a copy with its "
                             f"{'damping' if ld['type'] in SPRING_TYPES else 'viscous'} set to 0 (or, if it is a "
-                            "drive's servo, give its coordinate a drive: then planning replaces it)", "effort")
+                            "drive's servo, give its coordinate a drive: then planning replaces it)")
         kept.append(ld)
     if model.get("drives"):
         ignored.insert(0, "drives: the planned efforts are the drives")

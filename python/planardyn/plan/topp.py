@@ -46,7 +46,6 @@ from .actuator_limits import MotorMap, drives, exact_bounds
 from .dense_check import check
 from .friction_rows import variants
 from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
-from .planning_model import PlanningModel, planning_model
 from .planned import (
     MAX_COORDINATE,
     MAX_DURATION,
@@ -58,6 +57,7 @@ from .planned import (
     positive_number,
     speed_bounds,
 )
+from .planning_model import PlanningModel, planning_model
 
 FloatArray = NDArray[np.float64]
 
