@@ -90,16 +90,14 @@ def _coefficients(mech: Mechanism, pts: PathPoints) -> PathPoints:
 
 
 def _with_motors(model: PlanningModel, pts: PathPoints, motors: MotorMap, theta: float) -> PathPoints:
-    ratio = np.array([float((a or {}).get("gear_ratio", 1.0)) for a in model.mech.actuators])
-    shift = CoulombShift(theta, model.coulomb, model.stiction, ratio, pts.p1)
+    shift = CoulombShift(theta, model.coulomb, model.stiction, model.ratio, pts.p1)
     return replace(pts, motors=motors.with_coulomb(shift))
 
 
 def _in_band(model: PlanningModel, pts: PathPoints, u0: FloatArray, x0: FloatArray, moving: PathPoints) -> NDArray[np.bool_]:
     """Points (P,) where some friction at s'' = u0, s'^2 = x0 is below its full value by more
     than BAND_TOL of it: a motor's tanh, or a pin's torque (the core's against the sharp one)."""
-    ratio = np.array([float((a or {}).get("gear_ratio", 1.0)) for a in model.mech.actuators])
-    speed = ratio * np.abs(pts.p1) * np.sqrt(np.maximum(x0, 0.0))[:, None] / model.stiction
+    speed = model.ratio * np.abs(pts.p1) * np.sqrt(np.maximum(x0, 0.0))[:, None] / model.stiction
     band = np.any((model.coulomb > 0) & (1.0 - np.tanh(speed) > BAND_TOL), axis=1)
     if model.bare is None:
         return np.asarray(band)

@@ -45,14 +45,16 @@ class PlanningModel:
     """The model planned (``mech``: the user's without its servos), the sharp copy its rows
     of theta = 1 come from (``sharp``), the copy without the pins' Coulomb friction
     (``bare``; None when it has none: then ``sharp`` is ``mech``), the motors' Coulomb
-    torques ``coulomb`` (m,) (N m, 0 without one) and regularising speeds ``stiction`` (m,)
-    (rad/s), and what was left out (``ignored``, one sentence each)."""
+    torques ``coulomb`` (m,) (N m, 0 without one), regularising speeds ``stiction`` (m,)
+    (rad/s) and gear ratios ``ratio`` (m,), and what was left out (``ignored``, one sentence
+    each)."""
 
     mech: Mechanism
     sharp: Mechanism
     bare: Mechanism | None
     coulomb: FloatArray
     stiction: FloatArray
+    ratio: FloatArray
     ignored: list[str]
 
     @property
@@ -90,10 +92,11 @@ def planning_model(mech: Mechanism) -> PlanningModel:
     acts = [a or {} for a in planned.actuators]
     coulomb = np.array([float(a.get("coulomb", 0.0) or 0.0) for a in acts])
     stiction = np.array([float(a.get("stiction_speed", 1.0) or 1.0) for a in acts])
+    ratio = np.array([float(a.get("gear_ratio", 1.0) or 1.0) for a in acts])
     pins = [ld for ld in kept if ld["type"] == "friction" and float(ld.get("mu", 0.0) or 0.0) > 0]
     if not pins:
-        return PlanningModel(planned, planned, None, coulomb, stiction, ignored)
+        return PlanningModel(planned, planned, None, coulomb, stiction, ratio, ignored)
     sharp, bare = dict(model), dict(model)
     sharp["loads"] = [{**ld, "stiction_speed": SHARP} if ld in pins else ld for ld in kept]
     bare["loads"] = [ld for ld in kept if ld not in pins]
-    return PlanningModel(planned, from_dict(sharp), from_dict(bare), coulomb, stiction, ignored)
+    return PlanningModel(planned, from_dict(sharp), from_dict(bare), coulomb, stiction, ratio, ignored)
