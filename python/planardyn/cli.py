@@ -8,6 +8,8 @@
     planardyn plot RESULTS [-o FILE.png] [--torque-speed | --points P [P ...]]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
+    planardyn stiffness MODEL --body B [--point P] [--at Q ...] [--load FX FY M] [--map X0 X1 Y0 Y1]
+    planardyn modes MODEL [--at Q ...] [--free-rotors | --passive]
     planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V ...] [--collocate time|effort] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn export MODEL -o FILE.xml|.urdf|.sdf;  planardyn import FILE -o MODEL.yaml
@@ -62,6 +64,7 @@ from .results_format import check_writable, writing
 from .robot.cli import register as size_command
 from .robot.cli_options import number
 from .settings import check_settings
+from .stiffness_cli import register as stiffness_commands
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -360,6 +363,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     w.add_argument("--results", type=_results_path, help="a results file of the model (.csv, .parquet, .npz) to play")
     w.set_defaults(run=_app)
     size_command(sub)
+    stiffness_commands(sub)
     _plan_command(sub, full=command == "plan")
     exchange_commands(sub)
     g = _sub(sub, "docs", "the user guide, installed with planardyn: list its pages, or print one",

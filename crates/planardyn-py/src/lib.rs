@@ -12,6 +12,7 @@ mod effector;
 mod errors;
 mod mechanism;
 mod simulate;
+mod stiffness;
 mod structure;
 
 use errors::{argument_error, model_error, PlanardynError};
@@ -83,5 +84,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     structure::register(m)?;
     batch::register(m)?;
     effector::register(m)?;
+    stiffness::register(m)?;
     Ok(())
 }

@@ -42,6 +42,7 @@ pub fn resolve(spec: MechanismSpec<PointSpec, ValueSpec>, source: &str) -> R<Mec
         drives: spec.drives,
         loads: spec.loads,
         actuators: spec.actuators,
+        compliance: spec.compliance,
         simulate: spec.simulate,
     })
 }

@@ -9,6 +9,7 @@
 //! ([`MechanismSpec<PointSpec, ValueSpec>`], the form the loader reads and resolves into
 //! this one).
 
+pub use super::compliance::ComplianceSpec;
 pub use super::construction::{Circle, Construction, Crossing, PointSpec, Side, ValueSpec};
 pub use super::loads::LoadSpec;
 use crate::units::{self, Motion};
@@ -57,6 +58,9 @@ pub struct MechanismSpec<P = [f64; 2], V = f64> {
     /// Motors with their transmissions, one per driven coordinate (docs/actuators.md).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub actuators: Vec<ActuatorSpec>,
+    /// Transmission, pair and link compliances (`model::compliance`, docs/stiffness.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<ComplianceSpec>,
     /// Default simulation settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulate: Option<SimulateSpec>,

@@ -143,6 +143,12 @@ impl<Q: Quantity> Shape<Q> for [f64; 2] {
     }
 }
 
+impl<Q: Quantity> Shape<Q> for Option<[f64; 2]> {
+    fn read<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        Option::<[Si<Q>; 2]>::deserialize(deserializer).map(|s| s.map(|[a, b]| [a.0, b.0]))
+    }
+}
+
 impl<Q: Quantity> Shape<Q> for Vec<f64> {
     fn read<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         Vec::<Si<Q>>::deserialize(deserializer).map(|v| v.into_iter().map(|s| s.0).collect())
