@@ -29,11 +29,16 @@ solve_ivp = pytest.importorskip("scipy.integrate").solve_ivp
 TIGHT = dict(method="dop853", rtol=1e-12, atol=1e-14)
 
 
-def reduction(n: int, t: np.ndarray) -> np.ndarray:
+def reduction_state(n: int, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """theta (rad) and theta' (rad/s) of the reduction at the times t (from 0, increasing)."""
     k = G * ((n + 1) / 2 + n) / ((n + 1) / 3 + n)
     sol = solve_ivp(lambda _, y: [y[1], -k * math.cos(y[0])], (0.0, t[-1]), [math.pi / 2, -1.0],
                     method="DOP853", rtol=1e-13, atol=1e-14, t_eval=t)
-    return sol.y[0]
+    return sol.y[0], sol.y[1]
+
+
+def reduction(n: int, t: np.ndarray) -> np.ndarray:
+    return reduction_state(n, t)[0]
 
 
 @pytest.fixture(scope="module")
@@ -81,6 +86,30 @@ def test_a02_n40_runs_its_official_20_s():
     assert np.abs(res.q[:, 0] - reduction(40, res.t)).max() < 1e-6
     assert len(res.change_points) == -math.floor(res.q[-1, 0] / math.pi)
     assert {c.rank_drop for c in res.change_points} == {40}
+
+
+#: Issue 23 item 2's bounds at rtol = atol = 1e-12 (measured: 3.6e-10 rad and 6.3e-10 rad/s at N = 2; before,
+#: at 2ac385e, 5.1e-7 rad and 8.5e-7 rad/s, and 2.7e-5 rad/s at atol 1e-14 between a crossing and its energy restore).
+ANGLE_BOUND, RATE_BOUND = 1e-8, 1e-7
+
+
+def test_a02_n2_at_1e_12_follows_the_reduction_in_angle_and_rate_at_every_output():
+    t = np.linspace(0.0, 20.0, 2001)
+    res = pd.from_dict(a02(2)).simulate(t_end=20.0, t_eval=t, method="dop853", rtol=1e-12, atol=1e-12)
+    assert res.status == "success", res.message
+    theta, rate = reduction_state(2, t)
+    assert np.abs(res.q[:, 0] - theta).max() < ANGLE_BOUND
+    assert np.abs(res.qd[:, 0] - rate).max() < RATE_BOUND
+
+
+@pytest.mark.parametrize("rtol, atol", [(1e-10, 1e-10), (1e-10, 1e-12), (1e-7, 1e-7)])
+def test_a02_n2_reports_all_20_crossings_where_one_went_missing(rtol, atol):
+    # Before (2ac385e): 19, 19 and 14 of the 20 the reduction makes in 20 s (theta passes -k pi).
+    t = np.linspace(0.0, 20.0, 2001)
+    res = pd.from_dict(a02(2)).simulate(t_end=20.0, t_eval=t, method="dop853", rtol=rtol, atol=atol)
+    assert res.status == "success", res.message
+    assert -math.floor(reduction(2, t)[-1] / math.pi) == 20
+    assert len(res.change_points) == 20
 
 
 def test_a_run_without_change_points_reports_none():

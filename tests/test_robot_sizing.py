@@ -14,6 +14,7 @@ import json
 import numpy as np
 import planardyn as pd
 import pytest
+import scipy.linalg
 from conftest import MODELS
 from planardyn import robot
 
@@ -101,3 +102,29 @@ def test_bad_arguments_name_themselves(ee) -> None:
         robot.with_payload(ee.mech, "P", np.nan)
     with pytest.raises(robot.SizingError, match="inertia"):
         robot.with_payload(ee.mech, "P", 0.5, inertia=-1.0)
+
+
+def test_the_report_states_the_first_natural_frequency_of_a_compliant_model() -> None:
+    # Issue 27 item 3. Drive springs only, rotors held, no load: the elastic potential is
+    # sum k_i (q_i - theta_i)^2 / 2 with theta held, so omega^2 = eig(diag(k), M(q)) at each
+    # sample exactly (M the rigid mass matrix in the coordinates); the lowest over the samples
+    # is the report's. Two exact computations (ours: the redundant-coordinate eigenproblem,
+    # condensed), rounding amplified by M's conditioning: 1e-9 relative.
+    k = np.array([2.0e3, 3.0e3])  # N m/rad
+    text = MODEL.read_text().split("\ndrives:")[0] + (
+        f"\ncompliance:\n  drives:\n    - {{actuator: theta1, stiffness: {k[0]}}}\n"
+        f"    - {{actuator: theta2, stiffness: {k[1]}}}\n")
+    mech = pd.loads(text)
+    report = robot.size(robot.EndEffector(mech, "P"), robot.circle(CENTER, RADIUS, duration=1.0))
+    m = report.motion
+    f = [np.sqrt(scipy.linalg.eigh(np.diag(k), mech.mass_matrix(q), eigvals_only=True)[0]) / (2 * np.pi) for q in m.q]
+    i = int(np.argmin(f))
+    assert report.first_frequency is not None
+    np.testing.assert_allclose(report.first_frequency[0], f[i], rtol=1e-9)
+    assert report.first_frequency[1] == m.t[i]
+    assert f"lowest first natural frequency: {f[i]:.4g} Hz" in str(report)
+    assert report.to_dict()["first_frequency_hz"]["value"] == report.first_frequency[0]
+    # A rigid model's report has none (and its text and JSON are as before).
+    rigid = robot.size(robot.EndEffector(pd.load(MODEL), "P"), robot.circle(CENTER, RADIUS, duration=1.0))
+    assert rigid.first_frequency is None and "natural frequency" not in str(rigid)
+    assert "first_frequency_hz" not in rigid.to_dict()

@@ -157,7 +157,7 @@ def test_a_module_outside_the_order_is_a_finding(tmp_path: Path) -> None:
     assert found == ["c: module `extra` is in no layer of the declared order"]
 
 
-@pytest.mark.parametrize("name", ["planardyn", "planardyn-py"])
+@pytest.mark.parametrize("name", ["planardyn", "planardyn-py", "planardyn-wasm"])
 def test_the_crates_keep_their_declared_layers(name: str) -> None:
     config = rust_layers.tomllib.loads((ROOT / "crates" / "layers.toml").read_text())
     found, _, _ = rust_layers.check(name, config[name], ROOT)

@@ -25,7 +25,7 @@ def test_snippets_are_found_in_page_order():
 def test_readme_snippets_need_no_repository_file():
     # Run from an installed wheel in an empty folder: models by name, not by repository path.
     code = snippets(README)
-    assert [kind for kind, _ in code] == ["python"] + ["planardyn"] * 9
+    assert [kind for kind, _ in code] == ["python"] + ["planardyn"] * 10
     for _, text in code:
         assert "examples/" not in text, text
     assert 'pdy.load_example("five-bar")' in code[0][1]
@@ -38,7 +38,18 @@ def test_extras_and_licence():
     assert extras["parquet"] == ["pyarrow>=14"] and extras["mp4"] == ["imageio-ffmpeg>=0.4"]
     assert extras["dask"] == ["dask[distributed]>=2023.1"]
     assert extras["plan"] == ["toppra>=0.6.10", "casadi>=3.6"]
-    assert extras["all"] == ["planardyn[pandas,parquet,mp4,dask,plan]"]
-    assert set(extras) == {"pandas", "parquet", "mp4", "dask", "plan", "all"}
+    assert extras["cad"] == ["ezdxf>=1.1"]
+    assert extras["all"] == ["planardyn[pandas,parquet,mp4,dask,plan,cad]"]
+    assert set(extras) == {"pandas", "parquet", "mp4", "dask", "plan", "cad", "all"}
     assert meta["license"] == {"text": "MIT"}
     assert (ROOT / "LICENSE").read_text().startswith("MIT License\n")
+
+
+def test_the_app_is_included_in_the_wheel():
+    # maturin's walk of python/planardyn skips the git-ignored built app: an include rule
+    # names it, at the path planardyn.app reads (tests/wheel_smoke.py checks the wheel itself).
+    from planardyn.app import APP_FILE
+
+    include = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["maturin"]["include"]
+    assert {"path": f"python/planardyn/{APP_FILE.rsplit('/', 1)[0]}/*.html", "format": "wheel"} in include
+    assert APP_FILE.endswith(".html")

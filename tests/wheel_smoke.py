@@ -76,6 +76,21 @@ def check_guide(readme: Path) -> None:
     print(f"wheel: the guide's {len(shipped)} pages, planardyn docs prints them")
 
 
+def check_app() -> None:
+    """The browser app is in the wheel (planardyn/app_build/app.html) and `planardyn app` writes
+    it with the model: one file holding the engine (its wasm, inlined as base64)."""
+    from planardyn.app import APP_FILE
+
+    files = [str(f) for f in importlib.metadata.distribution("planardyn").files or []]
+    assert f"planardyn/{APP_FILE}" in files, f"the wheel holds no planardyn/{APP_FILE}"
+    command = Path(sys.executable).parent / "planardyn"
+    subprocess.run([str(command), "app", "five-bar", "-o", "app.html"], capture_output=True, text=True, check=True)
+    page = Path("app.html").read_text()
+    # "AGFzbQ" is the base64 of the wasm magic number "\\0asm": the engine is inlined.
+    assert '"source": "five-bar.yaml"' in page and "AGFzbQ" in page, page[:200]
+    print(f"wheel: planardyn app wrote app.html ({len(page) / 1e6:.1f} MB, the engine inside)")
+
+
 def check_version() -> None:
     command = Path(sys.executable).parent / "planardyn"
     out = subprocess.run([str(command), "--version"], capture_output=True, text=True, check=True).stdout
@@ -106,4 +121,5 @@ if __name__ == "__main__":
     check_installed()
     check_version()
     check_guide(Path(sys.argv[1]))
+    check_app()
     run_readme(Path(sys.argv[1]))

@@ -31,6 +31,7 @@ from ._core import (
     SingularityError,
     __version__,
 )
+from .builder import Builder
 from .events import Crossing
 from .mechanism import Mechanism, PlanardynWarning, from_dict, from_result, load, load_example, loads
 from .result import ChangePoint, Energy, PointMotion, SimulationInterrupted, SimulationResult
@@ -39,6 +40,7 @@ from .results_io import read_results
 __all__ = [
     "ArgumentError",
     "AssemblyError",
+    "Builder",
     "ChangePoint",
     "Crossing",
     "DataError",

@@ -16,6 +16,7 @@ __all__ = [
     "Mechanism",
     "load",
     "loads",
+    "resolve_model",
     "PlanardynError",
     "ModelError",
     "ArgumentError",
@@ -32,6 +33,14 @@ __all__ = [
     "JUMP_TOL",
     "simulate_batch",
     "inverse_batch",
+    "stiffness",
+    "weakest_direction",
+    "deflection",
+    "modes",
+    "small_oscillations",
+    "equilibrium",
+    "state_space",
+    "simulate_flexible",
 ]
 
 __version__: str
@@ -63,8 +72,41 @@ class SimulationError(PlanardynError): ...
 def load(path: str | PathLike[str]) -> Mechanism: ...
 def constraint_jacobian(mech: Mechanism, x: ArrayLike, scaled: bool = False) -> NDArray[np.float64]: ...
 def loads(text: str, format: str = "yaml", source: str = "<string>") -> Mechanism: ...
+def resolve_model(text: str, format: str = "yaml", source: str = "<string>") -> tuple[str, list[str]]: ...
 def structure(mech: Mechanism, x: ArrayLike | None = None) -> dict[str, Any]: ...
 def structure_of_model(text: str, source: str = "<dict>") -> dict[str, Any]: ...
+def stiffness(
+    mech: Mechanism,
+    q: ArrayLike,
+    body: str,
+    point: str | None = None,
+    wrench: ArrayLike | None = None,
+    preload: dict[str, float] | None = None,
+) -> dict[str, Any]: ...
+def weakest_direction(compliance: ArrayLike, length: float) -> tuple[NDArray[np.float64], float]: ...
+def deflection(
+    mech: Mechanism,
+    q: ArrayLike,
+    body: str,
+    wrench: ArrayLike,
+    point: str | None = None,
+    steps: int = 10,
+    preload: dict[str, float] | None = None,
+) -> dict[str, Any]: ...
+def modes(mech: Mechanism, q: ArrayLike, free_rotors: bool = False) -> dict[str, Any]: ...
+def small_oscillations(mech: Mechanism, q: ArrayLike) -> dict[str, Any]: ...
+def equilibrium(mech: Mechanism, q_start: ArrayLike) -> NDArray[np.float64]: ...
+def simulate_flexible(
+    mech: Mechanism,
+    t_end: float,
+    output_dt: float,
+    method: str = "dop853",
+    rtol: float = 1e-09,
+    atol: float = 1e-12,
+) -> dict[str, NDArray[np.float64]]: ...
+def state_space(
+    mech: Mechanism, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, points: list[tuple[str, str]] = ...
+) -> dict[str, NDArray[np.float64]]: ...
 @final
 class Mechanism:
     @property

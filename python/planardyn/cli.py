@@ -8,6 +8,8 @@
     planardyn plot RESULTS [-o FILE.png] [--torque-speed | --points P [P ...]]
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
+    planardyn stiffness MODEL --body B [--point P] [--at Q ...] [--load FX FY M] [--map X0 X1 Y0 Y1]
+    planardyn modes MODEL [--at Q ...] [--free-rotors | --passive]
     planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V ...] [--collocate time|effort] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn export MODEL -o FILE.xml|.urdf|.sdf;  planardyn import FILE -o MODEL.yaml
@@ -45,6 +47,8 @@ from . import (
     SimulationError,
     SingularityError,
     __version__,
+    dimensions,
+    drawing,
     extras,
     from_result,
     guide,
@@ -60,6 +64,7 @@ from .results_format import check_writable, writing
 from .robot.cli import register as size_command
 from .robot.cli_options import number
 from .settings import check_settings
+from .stiffness_cli import register as stiffness_commands
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -71,7 +76,8 @@ class UsageError(Exception):
 
 
 #: What writing a file of this extension needs beyond the dependencies: (extra, what it writes).
-OPTIONAL_WRITERS = {".parquet": ("parquet", "a .parquet file"), ".mp4": ("mp4", "an .mp4 file")}
+OPTIONAL_WRITERS = {".parquet": ("parquet", "a .parquet file"), ".mp4": ("mp4", "an .mp4 file"),
+                    ".dxf": ("cad", "a .dxf drawing")}
 #: Integration methods without error control, whose step must be given (--dt).
 FIXED_STEP_METHODS = ("rk4",)
 
@@ -222,6 +228,14 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
              "  planardyn check my-linkage.yaml")
     c.add_argument("model", type=Path, help=MODEL_HELP)
 
+    d = _sub(sub, "draw", "write a model's drawing for CAD or a document (.svg, .dxf)",
+             "Write the mechanism as drawn: SVG (the plot's drawing) or DXF in millimetres on the\n"
+             "layers BODIES, PAIRS, GROUND and LABELS (DXF needs the 'cad' extra, ezdxf).",
+             "  planardyn draw five-bar -o five-bar.svg\n"
+             "  planardyn draw my-linkage.yaml -o my-linkage.dxf")
+    d.add_argument("model", type=Path, help=MODEL_HELP)
+    d.add_argument("-o", "--output", type=Path, required=True, help="the drawing: .svg or .dxf")
+
     s = _sub(sub, "simulate", "simulate a model file and write the trajectory (.csv, .parquet, .npz)",
              "Integrate the equations of motion from the model's start state. Options left out take\n"
              "the model file's 'simulate' values, else the defaults shown. The results file holds\n"
@@ -334,7 +348,22 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
              "  planardyn demo --out /tmp/demo --model slider-crank")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     d.add_argument("--model", type=Path, help="model file or shipped name for the passive part (default four-bar-gravity)")
+    w = _sub(sub, "app", "write the browser app: drag, edit and simulate a model in one offline HTML file",
+             "Write one HTML file holding planardyn's engine as WebAssembly and the model: open it in a\n"
+             "browser (no server, no network) to drag a point or a coordinate and see the drive\n"
+             "efforts, pair reactions, singularity measure and point paths follow; edit the model with\n"
+             "the loader's errors in place; simulate, play, chart every channel and export. With\n"
+             "--results, a run computed in Python is in the page too, ready to play.",
+             "  planardyn app five-bar -o five-bar.html\n"
+             "  planardyn app my-linkage.yaml -o app.html\n"
+             "  planardyn app four-bar-gravity --results run.csv -o run.html")
+    w.add_argument("model", nargs="?", type=Path, default=Path("five-bar"), help=MODEL_HELP + "; default five-bar")
+    w.add_argument("-o", "--output", "--out", type=Path, dest="output", default=Path("app.html"),
+                   help="the HTML file to write (default app.html)")
+    w.add_argument("--results", type=_results_path, help="a results file of the model (.csv, .parquet, .npz) to play")
+    w.set_defaults(run=_app)
     size_command(sub)
+    stiffness_commands(sub)
     _plan_command(sub, full=command == "plan")
     exchange_commands(sub)
     g = _sub(sub, "docs", "the user guide, installed with planardyn: list its pages, or print one",
@@ -386,6 +415,7 @@ def _check(args: argparse.Namespace) -> int:
     print(f"bodies: {n}")
     for b, mass, inertia in zip(mech.body_names, mech.masses, mech.inertias):
         print(f"  {b}: mass {mass:.6g} kg, inertia {inertia:.6g} kg m^2")
+    print(dimensions.report(mech, dimensions.constructed_points(args.model)))
     kinds: dict[str, list[str]] = {}
     for pr in pairs:
         kinds.setdefault(pr["kind"], []).append(pr["name"])
@@ -405,6 +435,15 @@ def _check(args: argparse.Namespace) -> int:
     except SingularityError as e:
         print(f"singularity measures at the start: singular ({e})")
     print(structure.report(s))
+    return EXIT_OK
+
+
+def _draw(args: argparse.Namespace) -> int:
+    if args.output.suffix.lower() not in (".svg", ".dxf"):
+        raise UsageError(f"-o {args.output}: a drawing is written as SVG or DXF; give a file ending in .svg or .dxf")
+    require_writer(args.output)
+    mech = load(args.model)
+    print(f"wrote {drawing.write_drawing(mech, args.output)}")
     return EXIT_OK
 
 
@@ -640,6 +679,25 @@ def _point_motion(res: SimulationResult, path: Path, points: list[str]) -> Any:
     return motion
 
 
+def _app(args: argparse.Namespace) -> int:
+    from .app import write_app
+    from .results_io import read_results
+
+    if args.output.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"{args.output}: the app is an .html file")
+    mech = load(args.model)
+    res = None
+    if args.results is not None:
+        res = read_results(args.results)
+        if res.coordinate_names != mech.coordinate_names or res.body_names != mech.body_names:
+            raise UsageError(f"{args.results} was not computed with {args.given}: its coordinates are "
+                             f"({', '.join(res.coordinate_names)}), the model's ({', '.join(mech.coordinate_names)})")
+    with writing(args.output):
+        out = write_app(args.output, args.model, res, mech)
+    print(f"{out}: the app for {mech.name} ({out.stat().st_size / 1e6:.1f} MB, one offline file; open it in a browser)")
+    return EXIT_OK
+
+
 def _animate(args: argparse.Namespace) -> int:
     from .animate import FORMATS, animate
     from .results_io import read_results
@@ -719,6 +777,7 @@ def _docs(args: argparse.Namespace) -> int:
 
 COMMANDS = {
     "check": _check,
+    "draw": _draw,
     "simulate": _simulate,
     "inverse": _inverse,
     "identify": _identify,

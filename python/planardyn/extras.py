@@ -18,6 +18,7 @@ EXTRAS = {
     "mp4": ("imageio-ffmpeg",),
     "dask": ("dask[distributed]",),
     "plan": ("toppra", "casadi"),
+    "cad": ("ezdxf",),
 }
 
 #: Extra -> the top-level modules of its packages (an ImportError names one when it is missing).
@@ -27,6 +28,7 @@ MODULES = {
     "mp4": ("imageio_ffmpeg",),
     "dask": ("dask", "distributed"),
     "plan": ("toppra", "casadi"),
+    "cad": ("ezdxf",),
 }
 
 

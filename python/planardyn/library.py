@@ -27,10 +27,8 @@ Conventions shared by every constructor:
 from __future__ import annotations
 
 import functools
-import json
 import math
 import os
-import re
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -38,7 +36,9 @@ from typing import Any
 
 from . import models
 from .arguments import array, error, positive
+from .builder import Builder
 from .mechanism import Mechanism, from_dict, load_example
+from .model_text import model_text
 
 Vec = tuple[float, float]
 GRAVITY: Vec = (0.0, -9.81)
@@ -163,88 +163,6 @@ def grashof(ground: float, crank: float, coupler: float, rocker: float) -> bool:
     return links[0] + links[3] <= links[1] + links[2]
 
 
-# ----------------------------------------------------------------------------- model builder
-
-
-class _Model:
-    """Collects points, bodies, pairs and coordinates into a model dict."""
-
-    def __init__(self, name: str, about: str, gravity: Sequence[float]) -> None:
-        self.d: dict[str, Any] = {
-            "name": name,
-            "about": about,
-            "gravity": [float(gravity[0]), float(gravity[1])],
-            "points": {},
-            "ground": [],
-            "bodies": {},
-            "pairs": [],
-            "coordinates": [],
-        }
-
-    def point(self, name: str, p: Vec) -> str:
-        self.d["points"][name] = [float(p[0]), float(p[1])]
-        return name
-
-    def xy(self, name: str) -> Vec:
-        p = self.d["points"][name]
-        return (p[0], p[1])
-
-    def ground(self, *names: str) -> None:
-        self.d["ground"] += list(names)
-
-    def bar(self, name: str, points: list[str], rho: float, about: str | None = None) -> None:
-        """A uniform bar between the first two points (rho kg/m)."""
-        p, q = points[0], points[1]
-        body: dict[str, Any] = {"points": points}
-        if about:
-            body["about"] = about
-        body["uniform_bar"] = [p, q]
-        body["mass"] = rho * _dist(self.xy(p), self.xy(q))
-        self.d["bodies"][name] = body
-
-    def bars(self, rho: float, **links: Sequence[str]) -> None:
-        """Uniform bars (rho kg/m), each named by its keyword and carrying the points given."""
-        for name, points in links.items():
-            self.bar(name, list(points), rho)
-
-    def polygon(self, name: str, points: list[str], outline: list[str], rho: float, about: str | None = None) -> None:
-        """A link made of uniform bars (rho kg/m) along the closed outline."""
-        parts = [
-            {"uniform_bar": [a, b], "mass": rho * _dist(self.xy(a), self.xy(b))}
-            for a, b in zip(outline, outline[1:] + outline[:1])
-        ]
-        body: dict[str, Any] = {"points": points}
-        if about:
-            body["about"] = about
-        body["parts"] = parts
-        self.d["bodies"][name] = body
-
-    def block(self, name: str, point: str, mass: float, inertia: float, about: str | None = None) -> None:
-        """A slider block: all its mass at one point, with its own inertia."""
-        body: dict[str, Any] = {"points": [point]}
-        if about:
-            body["about"] = about
-        body.update({"mass": float(mass), "inertia": float(inertia), "com": point})
-        self.d["bodies"][name] = body
-
-    def revolute(self, name: str, at: str, a: str, b: str) -> str:
-        self.d["pairs"].append({"type": "revolute", "name": name, "at": at, "bodies": [a, b]})
-        return name
-
-    def hinges(self, *joints: tuple[str, str, str]) -> None:
-        """Revolute pairs given as (at, a, b), each named ``a_b`` after the bodies it joins."""
-        for at, a, b in joints:
-            self.revolute(f"{a}_{b}", at, a, b)
-
-    def prismatic(self, name: str, at: str, a: str, b: str, axis: Vec) -> str:
-        u = _unit(axis)
-        self.d["pairs"].append({"type": "prismatic", "name": name, "at": at, "bodies": [a, b], "axis": [u[0], u[1]]})
-        return name
-
-    def coordinate(self, name: str, pair: str, value: float, about: str) -> None:
-        self.d["coordinates"].append({"name": name, "pair": pair, "value": float(value), "about": about})
-
-
 def _mechanism(model_fn: Callable[..., dict[str, Any]]) -> Callable[..., Mechanism]:
     """``f(...)`` = ``from_dict(f_model(...))``, with the model function's signature and doc."""
 
@@ -277,7 +195,7 @@ def four_bar_model(
     ``theta1``: the crank's absolute angle (rad). Defaults: the crank-rocker of
     ``four-bar-gravity.yaml``. Mobility 3*3 - 2*4 = 1.
     """
-    m = _Model("four-bar", "Four-bar linkage O-A-B-D, uniform bars, crank angle input (planardyn.library.four_bar).", gravity)
+    m = Builder("four-bar", "Four-bar linkage O-A-B-D, uniform bars, crank angle input (planardyn.library.four_bar).", gravity)
     O, D = m.point("O", (0.0, 0.0)), m.point("D", (ground, 0.0))
     A = m.point("A", _polar(crank, theta))
     m.point("B", circle_intersection(m.xy(A), coupler, m.xy(D), rocker, mode))
@@ -285,11 +203,11 @@ def four_bar_model(
     m.bars(rho, crank=("O", "A"), coupler=("A", "B"), rocker=("D", "B"))
     m.hinges(("O", "ground", "crank"), ("A", "crank", "coupler"), ("B", "coupler", "rocker"), ("D", "ground", "rocker"))
     m.coordinate("theta1", "ground_crank", theta, "absolute angle of O->A (rad)")
-    return m.d
+    return m.model
 
 
 def _slider_crank(
-    m: _Model, A: Vec, B: Vec, rho: float, slider_mass: float, slider_inertia: float
+    m: Builder, A: Vec, B: Vec, rho: float, slider_mass: float, slider_inertia: float
 ) -> None:
     m.point("O", (0.0, 0.0))
     m.point("A", A)
@@ -300,7 +218,7 @@ def _slider_crank(
     m.revolute("crank_pivot", "O", "ground", "crank")
     m.revolute("crank_pin", "A", "crank", "rod")
     m.revolute("wrist_pin", "B", "rod", "slider")
-    m.prismatic("guide", "B", "ground", "slider", (1.0, 0.0))
+    m.prismatic("guide", "B", "ground", "slider", axis=(1.0, 0.0))
 
 
 def slider_crank_model(
@@ -327,10 +245,10 @@ def slider_crank_model(
     if abs(dy) > rod:
         raise error("rod", f"cannot assemble: the rod ({rod:g} m) does not reach the guide {abs(dy):g} m from the crank pin")
     B = (A[0] + mode * math.sqrt(rod * rod - dy * dy), float(offset))
-    m = _Model("slider-crank (crank input)", "Slider-crank with a horizontal guide, crank angle input (planardyn.library.slider_crank).", gravity)
+    m = Builder("slider-crank (crank input)", "Slider-crank with a horizontal guide, crank angle input (planardyn.library.slider_crank).", gravity)
     _slider_crank(m, A, B, rho, slider_mass, slider_inertia)
     m.coordinate("theta", "crank_pivot", theta, "absolute angle of O->A (rad)")
-    return m.d
+    return m.model
 
 
 def slider_crank_slider_driven_model(
@@ -354,10 +272,10 @@ def slider_crank_slider_driven_model(
     """
     B = (float(s), float(offset))
     A = circle_intersection((0.0, 0.0), crank, B, rod, mode)
-    m = _Model("slider-crank (slider input)", "Slider-crank with a horizontal guide, slider position input (planardyn.library.slider_crank_slider_driven).", gravity)
+    m = Builder("slider-crank (slider input)", "Slider-crank with a horizontal guide, slider position input (planardyn.library.slider_crank_slider_driven).", gravity)
     _slider_crank(m, A, B, rho, slider_mass, slider_inertia)
     m.coordinate("s", "guide", s, "x of the slider pin B (m)")
-    return m.d
+    return m.model
 
 
 def five_bar_model(
@@ -377,7 +295,7 @@ def five_bar_model(
     B1 -> B2 for ``mode=+1`` (above, with B1 left of B2). Inputs ``theta1``, ``theta2``
     (rad). Mobility 3*4 - 2*5 = 2.
     """
-    m = _Model("five-bar 5R", "Five-bar 5R parallel robot, uniform bars, two base angle inputs (planardyn.library.five_bar).", gravity)
+    m = Builder("five-bar 5R", "Five-bar 5R parallel robot, uniform bars, two base angle inputs (planardyn.library.five_bar).", gravity)
     A1, A2 = m.point("A1", (-base / 2, 0.0)), m.point("A2", (base / 2, 0.0))
     m.point("B1", _add(m.xy(A1), _polar(proximal, theta1)))
     m.point("B2", _add(m.xy(A2), _polar(proximal, theta2)))
@@ -391,7 +309,7 @@ def five_bar_model(
     m.revolute("R2", "A2", "ground", "proximal2")
     m.coordinate("theta1", "R1", theta1, "absolute angle of A1->B1 (rad)")
     m.coordinate("theta2", "R2", theta2, "absolute angle of A2->B2 (rad)")
-    return m.d
+    return m.model
 
 
 def biglide_model(
@@ -414,27 +332,27 @@ def biglide_model(
     (B1 = B2: the bars then fold onto each other, a change point of the passive
     mechanism); the default 0.1 m keeps them apart. Mobility 3*4 - 2*5 = 2.
     """
-    m = _Model("biglide 2-PRR", "Biglide: two sliders on parallel horizontal rails, two bars to the end-effector (planardyn.library.biglide).", gravity)
+    m = Builder("biglide 2-PRR", "Biglide: two sliders on parallel horizontal rails, two bars to the end-effector (planardyn.library.biglide).", gravity)
     m.point("B1", (float(s1), 0.0))
     m.point("B2", (float(s2), float(rail_offset)))
     m.point("P", circle_intersection(m.xy("B1"), length, m.xy("B2"), length, mode))
     for i in (1, 2):
         m.block(f"slider{i}", f"B{i}", slider_mass, slider_inertia)
-        m.bar(f"bar{i}", [f"B{i}", "P"], rho)
-    m.prismatic("rail1", "B1", "ground", "slider1", (1.0, 0.0))
+        m.bar(f"bar{i}", [f"B{i}", "P"], rho=rho)
+    m.prismatic("rail1", "B1", "ground", "slider1", axis=(1.0, 0.0))
     m.revolute("hinge1", "B1", "slider1", "bar1")
     m.revolute("tip", "P", "bar1", "bar2")
     m.revolute("hinge2", "B2", "slider2", "bar2")
-    m.prismatic("rail2", "B2", "ground", "slider2", (1.0, 0.0))
+    m.prismatic("rail2", "B2", "ground", "slider2", axis=(1.0, 0.0))
     m.coordinate("s1", "rail1", s1, "x of slider 1 (m)")
     m.coordinate("s2", "rail2", s2, "x of slider 2 (m)")
-    return m.d
+    return m.model
 
 
 # ----------------------------------------------------------------------------- 3-DOF robots
 
 
-def _platform(m: _Model, base_radius: float, platform_radius: float, pose: Sequence[float], base_offset: float) -> None:
+def _platform(m: Builder, base_radius: float, platform_radius: float, pose: Sequence[float], base_offset: float) -> None:
     """Base points A_i on a circle (angles 90 + 120 i deg + base_offset), the platform's
     centre P and its pins C_i at angles 90 + 120 i deg + pose[2] about P."""
     x, y, phi = (float(v) for v in pose)
@@ -445,7 +363,7 @@ def _platform(m: _Model, base_radius: float, platform_radius: float, pose: Seque
         m.point(f"C{i}", _add((x, y), _polar(platform_radius, a + phi)))
 
 
-def _platform_body(m: _Model, rho: float) -> None:
+def _platform_body(m: Builder, rho: float) -> None:
     m.polygon("platform", ["P", "C1", "C2", "C3"], ["C1", "C2", "C3"], rho,
               about="triangle C1 C2 C3 of uniform bars, end-effector point P at its centre")
 
@@ -468,14 +386,14 @@ def three_rrr_model(
     from C_i, on the left of A_i -> C_i for ``modes[i] = +1`` (the working mode of leg i).
     Inputs ``theta1..3``: absolute angles of A_i -> B_i (rad). Mobility 3*7 - 2*9 = 3.
     """
-    m = _Model("3-RRR", "Symmetric 3-RRR planar parallel robot, uniform bars, three base angle inputs (planardyn.library.three_rrr).", gravity)
+    m = Builder("3-RRR", "Symmetric 3-RRR planar parallel robot, uniform bars, three base angle inputs (planardyn.library.three_rrr).", gravity)
     _platform(m, base_radius, platform_radius, pose, 0.0)
     for i in (1, 2, 3):
         m.point(f"B{i}", circle_intersection(m.xy(f"A{i}"), proximal, m.xy(f"C{i}"), distal, modes[i - 1]))
     m.ground("A1", "A2", "A3")
     for i in (1, 2, 3):
-        m.bar(f"proximal{i}", [f"A{i}", f"B{i}"], rho)
-        m.bar(f"distal{i}", [f"B{i}", f"C{i}"], rho)
+        m.bar(f"proximal{i}", [f"A{i}", f"B{i}"], rho=rho)
+        m.bar(f"distal{i}", [f"B{i}", f"C{i}"], rho=rho)
     _platform_body(m, rho)
     for i in (1, 2, 3):
         m.revolute(f"R{i}", f"A{i}", "ground", f"proximal{i}")
@@ -483,7 +401,7 @@ def three_rrr_model(
         m.revolute(f"wrist{i}", f"C{i}", f"distal{i}", "platform")
     for i in (1, 2, 3):
         m.coordinate(f"theta{i}", f"R{i}", _angle(m.xy(f"A{i}"), m.xy(f"B{i}")), f"absolute angle of A{i}->B{i} (rad)")
-    return m.d
+    return m.model
 
 
 def three_rpr_model(
@@ -505,7 +423,7 @@ def three_rpr_model(
     The default pose turns the platform by 0.5 rad so that the legs are not concurrent
     (a type II singularity). Mobility 3*7 - 2*9 = 3.
     """
-    m = _Model("3-RPR", "3-RPR planar parallel robot, legs are cylinders (barrel + rod) with a relative prismatic input (planardyn.library.three_rpr).", gravity)
+    m = Builder("3-RPR", "3-RPR planar parallel robot, legs are cylinders (barrel + rod) with a relative prismatic input (planardyn.library.three_rpr).", gravity)
     _platform(m, base_radius, platform_radius, pose, 0.0)
     lengths = []
     for i in (1, 2, 3):
@@ -519,16 +437,16 @@ def three_rpr_model(
         lengths.append((L, u))
     m.ground("A1", "A2", "A3")
     for i in (1, 2, 3):
-        m.bar(f"barrel{i}", [f"A{i}", f"E{i}"], rho, about=f"cylinder barrel of leg {i}")
-        m.bar(f"rod{i}", [f"K{i}", f"C{i}"], rho, about=f"piston rod of leg {i}, piston at K{i}")
+        m.bar(f"barrel{i}", [f"A{i}", f"E{i}"], rho=rho, about=f"cylinder barrel of leg {i}")
+        m.bar(f"rod{i}", [f"K{i}", f"C{i}"], rho=rho, about=f"piston rod of leg {i}, piston at K{i}")
     _platform_body(m, rho)
     for i, (_, u) in zip((1, 2, 3), lengths):
         m.revolute(f"base{i}", f"A{i}", "ground", f"barrel{i}")
-        m.prismatic(f"leg{i}", f"K{i}", f"barrel{i}", f"rod{i}", u)
+        m.prismatic(f"leg{i}", f"K{i}", f"barrel{i}", f"rod{i}", axis=u)
         m.revolute(f"wrist{i}", f"C{i}", f"rod{i}", "platform")
     for i, (L, _u) in zip((1, 2, 3), lengths):
         m.coordinate(f"L{i}", f"leg{i}", L, f"pin-to-pin length |A{i} C{i}| of leg {i} (m)")
-    return m.d
+    return m.model
 
 
 def three_prr_model(
@@ -551,7 +469,7 @@ def three_prr_model(
     larger s_i (further along t_i) for ``modes[i] = +1``. Inputs ``s1..3``: B_i's position
     along its rail from A_i (m). Mobility 3*7 - 2*9 = 3.
     """
-    m = _Model("3-PRR", "3-PRR planar parallel robot, sliders on three fixed rails (planardyn.library.three_prr).", gravity)
+    m = Builder("3-PRR", "3-PRR planar parallel robot, sliders on three fixed rails (planardyn.library.three_prr).", gravity)
     _platform(m, base_radius, platform_radius, pose, 0.0)
     s, t = [], []
     for i in (1, 2, 3):
@@ -564,15 +482,15 @@ def three_prr_model(
     m.ground("A1", "A2", "A3")
     for i in (1, 2, 3):
         m.block(f"slider{i}", f"B{i}", slider_mass, slider_inertia)
-        m.bar(f"distal{i}", [f"B{i}", f"C{i}"], rho)
+        m.bar(f"distal{i}", [f"B{i}", f"C{i}"], rho=rho)
     _platform_body(m, rho)
     for i in (1, 2, 3):
-        m.prismatic(f"rail{i}", f"B{i}", "ground", f"slider{i}", t[i - 1])
+        m.prismatic(f"rail{i}", f"B{i}", "ground", f"slider{i}", axis=t[i - 1])
         m.revolute(f"hinge{i}", f"B{i}", f"slider{i}", f"distal{i}")
         m.revolute(f"wrist{i}", f"C{i}", f"distal{i}", "platform")
     for i in (1, 2, 3):
         m.coordinate(f"s{i}", f"rail{i}", s[i - 1], f"position of slider {i} along rail {i} from A{i} (m)")
-    return m.d
+    return m.model
 
 
 # ----------------------------------------------------------------------------- six-bars
@@ -603,7 +521,7 @@ def watt_six_bar_model(
     ``theta1``: the crank's absolute angle (rad). The two ternary links (ground O1 O2 O3
     and the rocker) are joined at O2: Watt's chain. Mobility 3*5 - 2*7 = 1.
     """
-    m = _Model("Watt six-bar", "Watt six-bar (Watt II): four-bar O1-A-B-O2 driving four-bar O2-C-E-O3 through the ternary rocker O2-B-C (planardyn.library.watt_six_bar).", gravity)
+    m = Builder("Watt six-bar", "Watt six-bar (Watt II): four-bar O1-A-B-O2 driving four-bar O2-C-E-O3 through the ternary rocker O2-B-C (planardyn.library.watt_six_bar).", gravity)
     O1, O2, O3 = m.point("O1", (0.0, 0.0)), m.point("O2", (o2[0], o2[1])), m.point("O3", (o3[0], o3[1]))
     m.point("A", _polar(crank, theta))
     m.point("B", circle_intersection(m.xy("A"), coupler1, m.xy(O2), rocker, modes[0]))
@@ -617,7 +535,7 @@ def watt_six_bar_model(
              ("O2", "ground", "rocker"), ("C", "rocker", "coupler2"), ("E", "coupler2", "output"),
              ("O3", "ground", "output"))
     m.coordinate("theta1", "ground_crank", theta, "absolute angle of O1->A (rad)")
-    return m.d
+    return m.model
 
 
 def stephenson_six_bar_model(
@@ -642,7 +560,7 @@ def stephenson_six_bar_model(
     ``triangle`` the vertices J1 J2 J3 in its own frame (m), ``pose = (x, y, phi)`` where it
     is drawn (m, m, rad); the binary links' lengths follow. Mobility 3*5 - 2*7 = 1.
     """
-    m = _Model("Stephenson six-bar", "Stephenson six-bar: ground O1 O2 O3 and the triangle J1 J2 J3 are the ternary links; crank O3-D input; the triangle with links O1-J1, O2-J2, D-J3 is an Assur triad (planardyn.library.stephenson_six_bar).", gravity)
+    m = Builder("Stephenson six-bar", "Stephenson six-bar: ground O1 O2 O3 and the triangle J1 J2 J3 are the ternary links; crank O3-D input; the triangle with links O1-J1, O2-J2, D-J3 is an Assur triad (planardyn.library.stephenson_six_bar).", gravity)
     for name, p in (("O1", o1), ("O2", o2), ("O3", o3)):
         m.point(name, (float(p[0]), float(p[1])))
     m.point("D", _add(m.xy("O3"), _polar(crank, theta)))
@@ -655,7 +573,7 @@ def stephenson_six_bar_model(
     m.hinges(("O3", "ground", "crank"), ("D", "crank", "link3"), ("O1", "ground", "link1"), ("O2", "ground", "link2"),
              ("J1", "link1", "triangle"), ("J2", "link2", "triangle"), ("J3", "link3", "triangle"))
     m.coordinate("theta1", "ground_crank", theta, "absolute angle of O3->D (rad)")
-    return m.d
+    return m.model
 
 
 def double_parallelogram_model(
@@ -676,18 +594,18 @@ def double_parallelogram_model(
     hangs the cranks at -60 deg, so that the passive swing stays away from theta = 0 and pi
     where the parallelograms fold (a change point).
     """
-    m = _Model("double parallelogram", "Double parallelogram: three parallel cranks and one coupler; one redundant constraint (planardyn.library.double_parallelogram).", gravity)
+    m = Builder("double parallelogram", "Double parallelogram: three parallel cranks and one coupler; one redundant constraint (planardyn.library.double_parallelogram).", gravity)
     for i in (1, 2, 3):
         m.point(f"O{i}", ((i - 1) * spacing, 0.0))
         m.point(f"A{i}", _add(m.xy(f"O{i}"), _polar(crank, theta)))
     m.ground("O1", "O2", "O3")
     for i in (1, 2, 3):
-        m.bar(f"crank{i}", [f"O{i}", f"A{i}"], rho)
-    m.bar("coupler", ["A1", "A3", "A2"], rho)
+        m.bar(f"crank{i}", [f"O{i}", f"A{i}"], rho=rho)
+    m.bar("coupler", ["A1", "A3", "A2"], rho=rho)
     for i in (1, 2, 3):
         m.hinges((f"O{i}", "ground", f"crank{i}"), (f"A{i}", f"crank{i}", "coupler"))
     m.coordinate("theta1", "ground_crank1", theta, "absolute angle of O1->A1 (rad)")
-    return m.d
+    return m.model
 
 
 four_bar = _mechanism(four_bar_model)
@@ -731,57 +649,6 @@ LIBRARY: dict[str, Callable[..., dict[str, Any]]] = {
 
 
 # ----------------------------------------------------------------------------- writing files
-
-_PLAIN = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
-_YAML_WORDS = {"y", "n", "yes", "no", "on", "off", "true", "false", "null", "~"}
-
-
-def _scalar(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if not math.isfinite(v):
-            raise error(None, f"a model value must be finite, got {v!r}")
-        text = repr(v)
-        # YAML 1.1 readers want a dot and a signed exponent: 1e-06 -> 1.0e-06.
-        if "e" in text and "." not in text:
-            mant, exp = text.split("e")
-            text = f"{mant}.0e{exp}"
-        return text
-    if isinstance(v, str):
-        return v if _PLAIN.match(v) and v.lower() not in _YAML_WORDS else json.dumps(v)
-    if v is None:
-        return "null"
-    raise TypeError(f"{type(v).__name__} is not a model value")
-
-
-def _flow(v: Any) -> str:
-    if isinstance(v, Mapping):
-        return "{" + ", ".join(f"{_scalar(k)}: {_flow(x)}" for k, x in v.items()) + "}"
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_flow(x) for x in v) + "]"
-    return _scalar(v)
-
-
-def model_text(model: Mapping[str, Any], header: str | None = None) -> str:
-    """The model dict as YAML text: top-level sections in block style, one line per point,
-    body, pair, coordinate...; floats at full precision (``repr``). ``header`` (optional) is
-    written first as ``#`` comment lines. ``yaml.safe_load`` gives the dict back."""
-    lines = [f"# {h}".rstrip() for h in (header or "").splitlines()]
-    for key, value in model.items():
-        if isinstance(value, Mapping) and value:
-            lines.append(f"{key}:")
-            for k, v in value.items():
-                lines.append(f"  {_scalar(k)}: {_flow(v)}")
-        elif isinstance(value, list) and value and all(isinstance(x, Mapping) for x in value):
-            lines.append(f"{key}:")
-            lines += [f"  - {_flow(x)}" for x in value]
-        else:
-            lines.append(f"{key}: {_flow(value)}")
-    return "\n".join(lines) + "\n"
-
 
 def write_model(mech_or_model: Mechanism | Mapping[str, Any], path: str | os.PathLike[str], header: str | None = None) -> Path:
     """Write a mechanism (its :meth:`~planardyn.Mechanism.to_dict`) or a model dict as a

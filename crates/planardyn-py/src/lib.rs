@@ -12,6 +12,7 @@ mod effector;
 mod errors;
 mod mechanism;
 mod simulate;
+mod stiffness;
 mod structure;
 
 use errors::{argument_error, model_error, PlanardynError};
@@ -44,14 +45,31 @@ fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<PyMechanism> {
 #[pyfunction]
 #[pyo3(signature = (text, format="yaml", source="<string>"))]
 fn loads(py: Python<'_>, text: &str, format: &str, source: &str) -> PyResult<PyMechanism> {
-    let format = match format.to_ascii_lowercase().as_str() {
-        "yaml" | "yml" => Format::Yaml,
-        "json" => Format::Json,
-        other => return Err(argument_error(Some("format"), format!("format must be 'yaml' or 'json', got {other:?}"))),
-    };
+    let format = format_arg(format)?;
     let (text, source) = (text.to_owned(), source.to_owned());
     let r = py.detach(|| catch_unwind(AssertUnwindSafe(|| planardyn::loads(&text, format, &source))));
     built(py, r)
+}
+
+/// Model text as the model holds it, as JSON text, not validated (quantities in SI, the points
+/// given by construction at their coordinates, coordinate values as numbers), and the names
+/// of the points the text gives by construction.
+#[pyfunction]
+#[pyo3(signature = (text, format="yaml", source="<string>"))]
+fn resolve_model(py: Python<'_>, text: &str, format: &str, source: &str) -> PyResult<(String, Vec<String>)> {
+    let (spec, constructed) = planardyn::loader::parse_spec_constructed(text, format_arg(format)?, source)
+        .map_err(|e| model_error(py, &e))?;
+    let json = serde_json::to_string(&spec)
+        .map_err(|e| PlanardynError::new_err(format!("cannot write the model as JSON: {e}")))?;
+    Ok((json, constructed))
+}
+
+fn format_arg(format: &str) -> PyResult<Format> {
+    match format.to_ascii_lowercase().as_str() {
+        "yaml" | "yml" => Ok(Format::Yaml),
+        "json" => Ok(Format::Json),
+        other => Err(argument_error(Some("format"), format!("format must be 'yaml' or 'json', got {other:?}"))),
+    }
 }
 
 #[pymodule]
@@ -61,9 +79,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<dense::PyDenseOutput>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;
+    m.add_function(wrap_pyfunction!(resolve_model, m)?)?;
     errors::register(m)?;
     structure::register(m)?;
     batch::register(m)?;
     effector::register(m)?;
+    stiffness::register(m)?;
     Ok(())
 }

@@ -15,13 +15,14 @@
 //! `crates/layers.toml`, checked by `tools/rust_layers.py` in `./dev test`): [`error`] and
 //! [`linalg`]; the [`model`], pure data with the pair and load kinds; [`topology`];
 //! [`kinematics`]; [`dynamics`]; the [`structure`] report; [`integrate`] (independent of the
-//! mechanics); [`simulate`]; [`batch`]; and the [`loader`] on top.
+//! mechanics); [`simulate`]; [`elastic`] (stiffness, vibration, compliant drives); [`batch`]; and the [`loader`] on top.
 
 // `!(x > 0.0)` is how the validators reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod batch;
 pub mod dynamics;
+pub mod elastic;
 pub mod error;
 pub mod integrate;
 pub mod kinematics;
@@ -31,6 +32,7 @@ pub mod model;
 pub mod simulate;
 pub mod structure;
 pub mod topology;
+pub mod units;
 
 pub use dynamics::Workspace;
 pub use error::{Error, KinematicsError, ModelError, Result, SingularityKind};

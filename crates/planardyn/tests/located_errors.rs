@@ -79,8 +79,8 @@ fn errors_inside_a_field_keep_its_path_and_add_the_line() {
     assert_eq!(path, "bodies.crank.mass");
     assert_eq!(
         msg,
-        "m.yaml: bodies.crank.mass: invalid type: string \"heavy\", expected a number (line 11 column 33); \
-         give the form the field takes: see `planardyn docs model-format`"
+        "m.yaml: bodies.crank.mass: \"heavy\" is not a number with a unit; this field takes a mass (kg, g, lb, \
+         or a number alone in kg) (line 11 column 33); write e.g. \"30 g\""
     );
     // An unknown field inside a pair (an entry tagged by `type`): the field itself.
     let (msg, path) = refused(

@@ -28,7 +28,7 @@ hi hold them at its speeds and accelerations).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -96,6 +96,8 @@ class MotorMap:
     down: FloatArray
     r_a: FloatArray
     r_b: FloatArray
+    #: The motors' Coulomb torque at a fixed fraction of its band (None: the core's tanh).
+    shift: CoulombShift | None = None
 
     @classmethod
     def along(cls, mech: Mechanism, q: FloatArray, p1: FloatArray, p2: FloatArray, x: FloatArray) -> MotorMap:
@@ -116,7 +118,12 @@ class MotorMap:
         """F (N, m) at s'^2 = x (N,): the motors' friction and the rotors' convective torque."""
         qd = self.p1 * np.sqrt(np.maximum(x, 0.0))[:, None]
         zero = np.zeros_like(self.q)
-        return np.asarray(self.mech.motor_torques(self.q, qd, zero, zero, x=self.x, allow_singular=True))
+        f = np.asarray(self.mech.motor_torques(self.q, qd, zero, zero, x=self.x, allow_singular=True))
+        return f if self.shift is None else f + self.shift(qd)
+
+    def with_coulomb(self, shift: CoulombShift) -> MotorMap:
+        """The map with the motors' Coulomb torque at ``shift``'s fraction of its band."""
+        return replace(self, shift=shift)
 
     def rotor(self, u: FloatArray, x: FloatArray) -> FloatArray:
         """R = r_a u + r_b x + F (N, m) at s'' = u and s'^2 = x (N,): all of t_m but the gear's."""
@@ -126,6 +133,24 @@ class MotorMap:
         """t_m (N, m) of the joint-side efforts tau (N, m) at s'' = u and s'^2 = x (N,), on the
         gear's branch of the path's direction."""
         return np.asarray(np.where(tau >= 0, self.up, self.down) * tau + self.rotor(u, x))
+
+
+@dataclass
+class CoulombShift:
+    """Replaces the core's T_c tanh(n qd / v_s) by theta T_c sign(p') (the path's direction):
+    ``theta`` 1 as if moving beyond the band, 0 and -1 the band's other values
+    (planardyn.plan.planning_model); T_c ``coulomb``, v_s ``stiction``, n ``ratio``, each (m,),
+    the path's tangent ``p1`` (P, m)."""
+
+    theta: float
+    coulomb: FloatArray
+    stiction: FloatArray
+    ratio: FloatArray
+    p1: FloatArray
+
+    def __call__(self, qd: FloatArray) -> FloatArray:
+        """The change (P, m) of the motor torques at rates qd (P, m) (rad/s or m/s)."""
+        return np.asarray(self.coulomb * (self.theta * np.sign(self.p1) - np.tanh(self.ratio * qd / self.stiction)))
 
 
 def joint_bounds(motor: MotorMap, u: FloatArray, x: FloatArray, torque: FloatArray) -> tuple[FloatArray, FloatArray]:

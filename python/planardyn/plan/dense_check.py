@@ -39,14 +39,15 @@ class Check:
 
 
 def check(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, sd: FloatArray, sdd: FloatArray,
-          limits: list[Limit]) -> Check:
+          limits: list[Limit], exact: Mechanism | None = None) -> Check:
     """The check of the timing (s' (N,) at the grid s (N,), s'' (N - 1,) on its intervals)
-    on the branch x (N, 3n) at the grid points; see the module."""
+    on the branch x (N, 3n) at the grid points; see the module. With ``exact`` (a model with
+    Coulomb friction in its pins), its inverse dynamics gives the efforts."""
     n_int, k = len(s) - 1, CHECK_POINTS
     f = np.linspace(0.0, 1.0, k)
     delta = np.diff(s)
     sk = s[:-1, None] + delta[:, None] * f  # (I, K)
-    use = _ratios(mech, path, sk, s[:-1], x[:-1], sd, sdd, limits)
+    use = _ratios(mech, path, sk, s[:-1], x[:-1], sd, sdd, limits, exact)
     j = np.clip(np.argmax(use, axis=1), 1, k - 2)
     rows = np.arange(n_int)
     y0, y1, y2 = use[rows, j - 1], use[rows, j], use[rows, j + 1]
@@ -55,7 +56,7 @@ def check(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, sd: FloatArr
         shift = np.where(curv < 0, 0.5 * (y0 - y2) / curv, 0.0)
     shift = np.clip(np.nan_to_num(shift), -1.0, 1.0)
     s_v = s[:-1] + delta * (f[j] + shift * (f[1] - f[0]))
-    use_v = _ratios(mech, path, s_v[:, None], s[:-1], x[:-1], sd, sdd, limits)[:, 0]
+    use_v = _ratios(mech, path, s_v[:, None], s[:-1], x[:-1], sd, sdd, limits, exact)[:, 0]
     best = np.argmax(use, axis=1)
     worst = np.maximum(use[rows, best], use_v)
     at = np.where(use_v >= use[rows, best], s_v, sk[rows, best])
@@ -63,12 +64,12 @@ def check(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, sd: FloatArr
 
 
 def _ratios(mech: Mechanism, path: Any, sk: FloatArray, s: FloatArray, x: FloatArray, sd: FloatArray,
-            sdd: FloatArray, limits: list[Limit]) -> FloatArray:
+            sdd: FloatArray, limits: list[Limit], exact: Mechanism | None) -> FloatArray:
     """The largest fraction of a limit used (I, K) at points sk (I, K) of the intervals that
     start at s (I,), where x (I, 3n) is the branch, s' is sd and s'' is sdd."""
     n_int, k = sk.shape
     i = np.repeat(np.arange(n_int), k)
     flat = sk.ravel()
-    pts = path_points(mech, path, flat, np.repeat(x, k, axis=0))
+    pts = path_points(mech, path, flat, np.repeat(x, k, axis=0), exact=exact)
     u = sdd[i]
     return ratio_at(limits, pts, u, sd[i] ** 2 + 2 * (flat - s[i]) * u).reshape(n_int, k)

@@ -64,9 +64,14 @@ class PathPoints:
     x: FloatArray
     #: The motors' torque map at the points (planardyn.plan.actuator_limits), made once.
     motors: MotorMap | None = None
+    #: A model whose efforts are not linear in (s'', s'^2) (Coulomb friction in its pins):
+    #: :meth:`efforts` are then its inverse dynamics, and a, b, c only its rows' start.
+    exact: Mechanism | None = None
 
     def efforts(self, u: FloatArray, x: FloatArray) -> FloatArray:
         """tau (P, m) at s'' = u and s'^2 = x (P,)."""
+        if self.exact is not None:
+            return inverse_along(self.exact, self, u, x)
         return np.asarray(self.a * u[:, None] + self.b * x[:, None] + self.c)
 
     def rates(self, x: FloatArray) -> FloatArray:
@@ -74,11 +79,20 @@ class PathPoints:
         return np.asarray(self.p1 * np.sqrt(np.maximum(x, 0.0))[:, None])
 
 
-def path_points(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, linear_check: bool = False) -> PathPoints:
+def inverse_along(mech: Mechanism, pts: PathPoints, u: FloatArray, x: FloatArray, sign: float = 1.0) -> FloatArray:
+    """The efforts (P, m) of ``mech`` at the points at s'' = u and s'^2 = x (P,), moving along
+    the path (``sign`` -1: against it, at the same speed), by inverse dynamics."""
+    sd = sign * np.sqrt(np.maximum(x, 0.0))[:, None]
+    return np.asarray(mech.inverse_dynamics(pts.q, pts.p1 * sd, pts.p1 * u[:, None] + pts.p2 * x[:, None], x=pts.x))
+
+
+def path_points(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, linear_check: bool = False,
+                exact: Mechanism | None = None) -> PathPoints:
     """a(s), b(s), c(s) by inverse dynamics, each point assembled from the body coordinates
     x (P, 3n) of a nearby point of the branch: c = ID(p, 0, 0), a = ID(p, 0, p') - c,
     b = ID(p, p', p'') - c. With ``linear_check``, refuses efforts linear in the rates
-    (dampers), which are not of this form: then ID(p, 2 p', 4 p'') - c differs from 4 b."""
+    (dampers), which are not of this form: then ID(p, 2 p', 4 p'') - c differs from 4 b.
+    With ``exact``, the points' efforts are that model's (:attr:`PathPoints.exact`)."""
     p, p1, p2 = path(s), path(s, 1), path(s, 2)
     zero = np.zeros_like(p)
 
@@ -88,14 +102,13 @@ def path_points(mech: Mechanism, path: Any, s: FloatArray, x: FloatArray, linear
     c = inverse(zero, zero)
     a = inverse(zero, p1) - c
     b = inverse(p1, p2) - c
-    if not linear_check:
-        return PathPoints(s, p, p1, p2, a, b, c, x)
-    b4 = inverse(2 * p1, 4 * p2) - c
-    scale = max(float(np.abs(b).max()), float(np.abs(a).max()), float(np.abs(c).max()), 1e-300)
-    if np.abs(b4 - 4 * b).max() > LINEAR_TOL * scale:
-        raise PlanError(f"{mech.name}: efforts linear in the rates (dampers or viscous friction) are not of "
-                        "TOPP's form a s'' + b s'^2 + c; plan on a copy of the model without them")
-    return PathPoints(s, p, p1, p2, a, b, c, x)
+    if linear_check:
+        b4 = inverse(2 * p1, 4 * p2) - c
+        scale = max(float(np.abs(b).max()), float(np.abs(a).max()), float(np.abs(c).max()), 1e-300)
+        if np.abs(b4 - 4 * b).max() > LINEAR_TOL * scale:
+            raise PlanError(f"{mech.name}: efforts linear in the rates (dampers or viscous friction) are not of "
+                            "TOPP's form a s'' + b s'^2 + c; plan on a copy of the model without them")
+    return PathPoints(s, p, p1, p2, a, b, c, x, exact=exact)
 
 
 class Limit(Protocol):
@@ -178,9 +191,17 @@ class MotorLimit:
         return out
 
 
-def rows_at(limits: list[Limit], pts: PathPoints, x0: FloatArray) -> Rows:
-    """Every limit's rows (P, R) at the points."""
-    parts = [lim.rows(pts, x0) for lim in limits]
+def rows_at(limits: list[Limit], variants: list[tuple[PathPoints, NDArray[np.bool_] | None]], x0: FloatArray) -> Rows:
+    """Every limit's rows (P, R) at the points, for each of their variants (the linear rows of
+    the efforts, planardyn.plan.friction_rows): a variant held only where its mask is true
+    has rows 0 <= 1 elsewhere."""
+    parts = []
+    for pts, mask in variants:
+        for lim in limits:
+            A, B, C = lim.rows(pts, x0)
+            if mask is not None:
+                A, B, C = (np.where(mask[:, None], r, v) for r, v in ((A, 0.0), (B, 0.0), (C, -1.0)))
+            parts.append((A, B, C))
     return tuple(np.hstack([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
 
 

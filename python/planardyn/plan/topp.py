@@ -22,7 +22,11 @@ varies across it); with ``rtol`` the grid is doubled until the duration changes 
 than rtol of itself, and that change, the first-order estimate of the remaining excess, is
 reported (``TimedPath.time_error``).
 
-Dampers add efforts linear in s', which this form cannot hold: such a model is refused.
+The model planned is the user's with its drive laws replaced by the planned efforts: its
+drives and its drives' servos are left out (``TimedPath.ignored`` lists them), a damper that
+is not a servo is refused (its c s' is not of this form), and Coulomb friction (the pins'
+mu r |F|, the motors' T_c) is taken by tangent rows about the previous timing with the least
+favourable value of its band at rest (planardyn.plan.planning_model, friction_rows).
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from ..mechanism import Mechanism
 from ..robot import EndEffector
 from .actuator_limits import MotorMap, drives, exact_bounds
 from .dense_check import check
+from .friction_rows import variants
 from .path_limits import EffortLimit, Limit, MotorLimit, PathPoints, SpeedLimit, path_points, rows_at, stage_rows
 from .planned import (
     MAX_COORDINATE,
@@ -52,6 +57,7 @@ from .planned import (
     positive_number,
     speed_bounds,
 )
+from .planning_model import PlanningModel, planning_model
 
 FloatArray = NDArray[np.float64]
 
@@ -107,7 +113,9 @@ class TimedPath(PlannedMotion):
     (inf where none); ``limit_ratio`` the largest fraction of a limit used on the dense check
     (planardyn.plan.dense_check); ``time_error`` the estimated excess of the duration over
     the optimum (s: the change over the last doubling of the grid; None without refinement);
-    ``status`` toppra's, with the rounds and grids.
+    ``status`` toppra's, with the rounds and grids; ``ignored`` the parts of the model the
+    plan leaves out, and why (its drives and their servos: the planned efforts replace them;
+    ``mech`` is the model without them).
     """
 
     path: Any
@@ -120,6 +128,7 @@ class TimedPath(PlannedMotion):
     speed: FloatArray
     time_error: float | None
     status: str
+    ignored: list[str]
 
     def _summary(self) -> str:
         error = "not estimated" if self.time_error is None else f"{self.time_error:.2g} s"
@@ -214,7 +223,8 @@ def time_optimal(
     Parameters
     ----------
     mech : Mechanism
-        The model; its drives are not used, the efforts are the plan's.
+        The model; its drives and their servos (spring-dampers at a driven coordinate's pair)
+        are not used, the efforts are the plan's (see the module; ``TimedPath.ignored``).
     waypoints : (K, m) array_like
         Coordinates (rad or m) the path passes through, K >= 2, joined by a C2 cubic spline
         in s (not-a-knot; a straight line for K = 2), s spaced by chord length in [0, S]. For
@@ -242,7 +252,8 @@ def time_optimal(
     Raises
     ------
     PlanError
-        Bad arguments, a model with dampers, or a path no timing can follow within the limits.
+        Bad arguments, a model with dampers that are not servos, or a path no timing can
+        follow within the limits.
     """
 
     m = mech.dof
@@ -259,26 +270,28 @@ def time_optimal(
     chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q_w, axis=0), axis=1))])
     if not np.isfinite(chord[-1]) or np.any(np.diff(chord) == 0.0):
         raise PlanError("waypoints: consecutive waypoints must differ (and their distances be finite)")
-    limits, motor, v = _limits(mech, effort, speed)
+    model = planning_model(mech)
+    limits, motor, v = _limits(model.mech, effort, speed)
     try:
-        return _time_optimal(mech, q_w, chord, limits, motor, v, n_grid, rtol)
+        return _time_optimal(model, q_w, chord, limits, motor, v, n_grid, rtol)
     except ValueError as exc:  # the core's refusal of a coordinate (far from the drawing)
         if isinstance(exc, PlanardynError):
             raise
         raise PlanError(f"waypoints: the path cannot be followed: {exc}", "waypoints") from exc
 
 
-def _time_optimal(mech: Mechanism, q_w: FloatArray, chord: FloatArray, limits: list[Limit], motor: MotorLimit | None,
-                  v: FloatArray, n_grid: int, rtol: float | None) -> TimedPath:
+def _time_optimal(model: PlanningModel, q_w: FloatArray, chord: FloatArray, limits: list[Limit],
+                  motor: MotorLimit | None, v: FloatArray, n_grid: int, rtol: float | None) -> TimedPath:
     """time_optimal on checked arguments: the span fitted, then the grid refined."""
     import toppra
 
+    mech = model.mech
     m = mech.dof
     span = 1.0
     for _ in range(SPAN_ROUNDS):
         path = toppra.SplineInterpolator(chord / chord[-1] * span, q_w)
         s = np.linspace(0.0, span, n_grid)
-        plan = _time_on_grid(mech, path, s, limits, motor is not None)
+        plan = _time_on_grid(model, path, s, limits, motor is not None)
         capped = plan.sd.max() ** 2 >= FAST_FRACTION * MAXX or np.abs(plan.sdd).max() >= FAST_FRACTION * MAXU
         if plan.duration < MIN_DURATION:
             raise InfeasiblePlan(f"the limits let this path run in {plan.duration:.3g} s or less, faster than toppra "
@@ -295,7 +308,7 @@ def _time_optimal(mech: Mechanism, q_w: FloatArray, chord: FloatArray, limits: l
     time_error: float | None = None
     while rtol is not None:
         s = np.sort(np.concatenate([s, (s[:-1] + s[1:]) / 2]))
-        finer = _time_on_grid(mech, path, s, limits, motor is not None)
+        finer = _time_on_grid(model, path, s, limits, motor is not None)
         grids.append(len(s))
         time_error = abs(plan.duration - finer.duration)
         plan = finer
@@ -311,7 +324,7 @@ def _time_optimal(mech: Mechanism, q_w: FloatArray, chord: FloatArray, limits: l
         lo, hi = limits[0].bounds(plan.q)
     else:
         lo, hi = np.full((len(s), m), -np.inf), np.full((len(s), m), np.inf)
-    plan.lo, plan.hi, plan.speed, plan.time_error = lo, hi, v, time_error
+    plan.lo, plan.hi, plan.speed, plan.time_error, plan.ignored = lo, hi, v, time_error, model.ignored
     plan.status = f"{plan.status}; {note}"
     return plan
 
@@ -323,29 +336,35 @@ def _span(duration: float) -> float:
     return float(duration if duration >= 1e-2 else 100 * duration**2)
 
 
-def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit], tangents: bool) -> TimedPath:
+def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[Limit], envelopes: bool) -> TimedPath:
     """toppra's timing on the grid s within the limits at both ends of every interval, cut
     where the dense check still finds a limit exceeded (see the module); with tangents (motor
-    envelopes) the rows are linearised at the previous timing until the time settles."""
+    envelopes, Coulomb friction) the rows are linearised at the previous timing until the
+    time settles."""
     n = len(s)
+    mech = model.mech
+    exact = None if model.bare is None else mech
+    tangents = envelopes or model.has_coulomb
     x = branch(mech, path(s))
-    grid = path_points(mech, path, s, x, linear_check=True)
+    grid = path_points(model.bare or mech, path, s, x, linear_check=True, exact=exact)
     # Each stage i < n - 1 holds its interval's start (d = 0) and end (d = s_i+1 - s_i).
     pts = _take(grid, np.concatenate([np.arange(n), np.arange(1, n)]))
     stage = np.concatenate([np.arange(n), np.arange(n - 1)])
     d = np.concatenate([np.zeros(n), np.diff(s)])
     x0 = _first_speeds(limits, pts)
+    u0 = np.zeros_like(x0)
     duration, rounds = np.inf, 0
     while True:
         rounds += 1
-        rows = stage_rows(stage, d, rows_at(limits, pts, x0), n)
+        rows = stage_rows(stage, d, rows_at(limits, variants(model, pts, u0, x0) if model.has_coulomb else [(pts, None)],
+                                            x0), n)
         sdd, sd, status = _toppra(path, s, rows)
         with np.errstate(divide="ignore"):
             t_new = float(np.sum(2 * np.diff(s) / (sd[:-1] + sd[1:])))
         if not np.isfinite(t_new):
             raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}, but at rest "
                                  "somewhere along it): raise the limits or move the path")
-        found = check(mech, path, s, x, sd, sdd, limits)
+        found = check(mech, path, s, x, sd, sdd, limits, exact)
         settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
         if found.ratio <= 1 + RATIO_TOL and settled:
             break
@@ -354,12 +373,13 @@ def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit]
                             f"limits used to {found.ratio:.9g}); use a finer n_grid")
         bad = np.flatnonzero(found.worst > 1 + RATIO_TOL)
         if len(bad):
-            cut = path_points(mech, path, found.at[bad], x[bad])
+            cut = path_points(model.bare or mech, path, found.at[bad], x[bad], exact=exact)
             pts = _join(pts, cut)
             stage = np.concatenate([stage, bad])
             d = np.concatenate([d, found.at[bad] - s[bad]])
         duration = t_new
-        x0 = sd[stage] ** 2 + 2 * d * np.append(sdd, 0.0)[stage]
+        u0 = np.append(sdd, 0.0)[stage]
+        x0 = sd[stage] ** 2 + 2 * d * u0
     status = f"{status}; {rounds} rounds" + (" of tangents" if tangents else "")
     sd2 = sd**2
     dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
@@ -367,7 +387,7 @@ def _time_on_grid(mech: Mechanism, path: Any, s: FloatArray, limits: list[Limit]
     return TimedPath(mech=mech, path=path, s=s, sd=sd, sdd=sdd, t=np.concatenate([[0.0], np.cumsum(dt)]), x=x,
                      q=grid.q, qd=grid.p1 * sd[:, None], qdd=grid.p1 * u[:, None] + grid.p2 * sd2[:, None],
                      tau=grid.efforts(u, sd2), limit_ratio=found.ratio, lo=grid.a * np.nan, hi=grid.a * np.nan,
-                     speed=np.full(mech.dof, np.inf), time_error=None, status=status)
+                     speed=np.full(mech.dof, np.inf), time_error=None, status=status, ignored=[])
 
 
 def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
@@ -382,13 +402,13 @@ def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:
 
 
 def _take(p: PathPoints, i: NDArray[np.intp]) -> PathPoints:
-    return PathPoints(p.s[i], p.q[i], p.p1[i], p.p2[i], p.a[i], p.b[i], p.c[i], p.x[i])
+    return PathPoints(p.s[i], p.q[i], p.p1[i], p.p2[i], p.a[i], p.b[i], p.c[i], p.x[i], exact=p.exact)
 
 
 def _join(p: PathPoints, r: PathPoints) -> PathPoints:
     s, q, p1, p2, a, b, c, x = (np.concatenate([getattr(p, k), getattr(r, k)]) for k in ("s", "q", "p1", "p2", "a", "b",
                                                                                           "c", "x"))
-    return PathPoints(s, q, p1, p2, a, b, c, x)
+    return PathPoints(s, q, p1, p2, a, b, c, x, exact=p.exact)
 
 
 def _toppra(path: Any, s: FloatArray, rows: tuple[FloatArray, FloatArray, FloatArray]) -> tuple[FloatArray, FloatArray, str]:

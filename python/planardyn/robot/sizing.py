@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._core import modes as native_modes
 from ..mechanism import Mechanism, from_dict
 from ..notebook import Summarized
 from .effector import EndEffector
@@ -155,6 +156,9 @@ class SizingReport(Summarized):
 
     ``min_sigma_I``/``min_sigma_II`` (dimensionless) with the time (s) and end-effector
     position (m) where each is reached: the motion's nearest approach to each singularity.
+    ``first_frequency``: for a model with a ``compliance:`` section, the lowest first natural
+    frequency (Hz) over the motion's samples, rotors held (docs/stiffness.md), with its time
+    (s) and end-effector position (m); None for a rigid model.
     """
 
     motion: TaskMotion
@@ -162,6 +166,7 @@ class SizingReport(Summarized):
     drives: list[DriveSizing]
     min_sigma_I: tuple[float, float, FloatArray]
     min_sigma_II: tuple[float, float, FloatArray]
+    first_frequency: tuple[float, float, FloatArray] | None = None
 
     def __str__(self) -> str:
         m = self.motion
@@ -182,7 +187,15 @@ class SizingReport(Summarized):
         for kind, (s, t, X) in (("I", self.min_sigma_I), ("II", self.min_sigma_II)):
             lines.append(f"nearest type {kind} singularity: sigma_{kind} = {s:.3g} at t = {t:.3f} s, "
                          f"end effector at ({X[0]:.4f}, {X[1]:.4f}) m")
+        lines.extend(f"{name}: {value}" for name, value in self._frequency_rows())
         return "\n".join(lines)
+
+    def _frequency_rows(self) -> list[tuple[str, str]]:
+        if self.first_frequency is None:
+            return []
+        f, t, X = self.first_frequency
+        return [("lowest first natural frequency", f"{f:.4g} Hz at t = {t:.3f} s, end effector at "
+                                                   f"({X[0]:.4f}, {X[1]:.4f}) m")]
 
     def __repr__(self) -> str:
         m = self.motion
@@ -199,7 +212,7 @@ class SizingReport(Summarized):
         for kind, (s, t, X) in (("I", self.min_sigma_I), ("II", self.min_sigma_II)):
             rows.append((f"nearest type {kind} singularity",
                          f"sigma_{kind} = {s:.3g} at t = {t:.3f} s, end effector at ({X[0]:.4f}, {X[1]:.4f}) m"))
-        return rows
+        return rows + self._frequency_rows()
 
     def _summary_tables(self) -> list[tuple[list[str], list[list[str]]]]:
         drives = (["drive", "peak effort", "RMS effort", "peak speed", "peak power"],
@@ -220,7 +233,8 @@ class SizingReport(Summarized):
                        | ({} if d.motor is None else {"motor": _motor_dict(d.motor)}) for d in self.drives],
             "min_sigma_I": {"value": self.min_sigma_I[0], "t": self.min_sigma_I[1], "X": self.min_sigma_I[2].tolist()},
             "min_sigma_II": {"value": self.min_sigma_II[0], "t": self.min_sigma_II[1], "X": self.min_sigma_II[2].tolist()},
-        }
+        } | ({} if self.first_frequency is None else {"first_frequency_hz": {
+            "value": self.first_frequency[0], "t": self.first_frequency[1], "X": self.first_frequency[2].tolist()}})
 
 
 def _motor_dict(mo: MotorSizing) -> dict[str, Any]:
@@ -472,7 +486,19 @@ def _report(motion: TaskMotion, payload: float, base: _Samples, dense: _Samples)
     iI, iII = int(np.argmin(dense.sigma_I)), int(np.argmin(dense.sigma_II))
     return SizingReport(motion, float(payload), drives,
                         (float(dense.sigma_I[iI]), float(dense.t[iI]), dense.X[iI]),
-                        (float(dense.sigma_II[iII]), float(dense.t[iII]), dense.X[iII]))
+                        (float(dense.sigma_II[iII]), float(dense.t[iII]), dense.X[iII]), _first_frequency(motion))
+
+
+def _first_frequency(motion: TaskMotion) -> tuple[float, float, FloatArray] | None:
+    """The lowest first natural frequency (Hz) over the motion's samples (not resampled
+    between them, unlike the peaks: it varies with the pose only, slowly away from
+    singularities), its time and task position; None without a ``compliance:`` section."""
+    mech = motion.mech
+    if "compliance" not in mech.to_dict():
+        return None
+    f = np.array([native_modes(mech._native, q)["omega"][0] for q in motion.q]) / (2 * np.pi)
+    i = int(np.argmin(f))
+    return float(f[i]), float(motion.t[i]), motion.X[i]
 
 
 def _check_arguments(payload: Any, distribution: Any, preload: Any,

@@ -6,6 +6,7 @@
 pub mod along;
 pub mod derivatives;
 pub mod energy;
+pub mod evaluate;
 pub mod force_rates;
 pub mod forces;
 pub mod forward;
@@ -29,6 +30,7 @@ pub mod workspace;
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
 pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivatives, Jacobians, PowerRates};
 pub use energy::{kinetic_energy, potential_energy};
+pub use evaluate::{evaluate, sigma_rows, Evaluation, SigmaRows};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{dynamic_stages, forward};
 pub use inverse::{inverse, inverse_at_rates, rates_mismatch};

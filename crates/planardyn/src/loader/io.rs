@@ -4,9 +4,15 @@
 
 use super::parse_errors::Input;
 use super::{nesting, tags, Format};
+use crate::model::construct;
+use crate::model::spec::{PointSpec, ValueSpec};
 use crate::model::{Mechanism, MechanismSpec};
+use crate::units;
 use crate::ModelError;
 use std::path::Path;
+
+/// A model file as written.
+type FileSpec = MechanismSpec<PointSpec, ValueSpec>;
 
 /// Load a model file (`.yaml`, `.yml` or `.json`).
 pub fn load(path: impl AsRef<Path>) -> Result<Mechanism, ModelError> {
@@ -33,8 +39,56 @@ pub fn loads(text: &str, format: Format, source: &str) -> Result<Mechanism, Mode
     super::build(spec, source)
 }
 
-/// Parse model text into its specification without validating it.
+/// Parse model text into its specification without validating it: quantities with units
+/// in SI, the points given by construction placed and the coordinates' values given as
+/// measures of the drawing measured (`model::construct`).
 pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismSpec, ModelError> {
+    parse_spec_constructed(text, format, source).map(|(spec, _)| spec)
+}
+
+/// [`parse_spec`], and the names of the points the text gives by construction (for the
+/// reports of what the loader derived).
+pub fn parse_spec_constructed(
+    text: &str,
+    format: Format,
+    source: &str,
+) -> Result<(MechanismSpec, Vec<String>), ModelError> {
+    let file = parse_file(text, format, source)?;
+    let constructed =
+        file.points.0.iter().filter(|(_, p)| matches!(p, PointSpec::By(_))).map(|(n, _)| n.clone()).collect();
+    let spec = construct::resolve(file, source).map_err(|e| with_line(e, text, format))?;
+    Ok((spec, constructed))
+}
+
+/// A construction's error with the line of its point in the text: `points.B: ... (line 8); fix`.
+fn with_line(e: ModelError, text: &str, format: Format) -> ModelError {
+    let ModelError::Invalid { source_name, path, message } = e else { return e };
+    let line = path.strip_prefix("points.").and_then(|name| point_line(text, format, name));
+    let message = match (line, message.split_once("; ")) {
+        (Some(line), Some((what, fix))) => format!("{what} (line {line}); {fix}"),
+        (Some(line), None) => format!("{message} (line {line})"),
+        (None, _) => message,
+    };
+    ModelError::Invalid { source_name, path, message }
+}
+
+/// The 1-based line where the point `name` is given: its key, the first after the `points`
+/// key (an entry `B: {...}` in YAML, `"B": {...}` in JSON, where several may share a line).
+fn point_line(text: &str, format: Format, name: &str) -> Option<usize> {
+    let lines: Vec<&str> = text.lines().collect();
+    let is_key = |line: &str, key: &str| {
+        let l = line.trim_start().trim_start_matches(['{', ',', ' ']);
+        [format!("{key}:"), format!("\"{key}\":"), format!("'{key}':")].iter().any(|k| l.starts_with(k.as_str()))
+    };
+    let start = lines.iter().position(|l| is_key(l, "points") || is_key(l, "points_at_t0"))?;
+    let json_key = format!("\"{name}\":");
+    let found =
+        lines[start..].iter().position(|l| is_key(l, name) || (format == Format::Json && l.contains(&json_key)))?;
+    Some(start + found + 1)
+}
+
+/// The model text as written: points and coordinate values also by construction.
+fn parse_file(text: &str, format: Format, source: &str) -> Result<FileSpec, ModelError> {
     let input = Input { text, format, source };
     match format {
         Format::Json => {
@@ -58,7 +112,7 @@ pub fn parse_spec(text: &str, format: Format, source: &str) -> Result<MechanismS
             }
             tags::refuse(text, source)?;
             let de = serde_yaml_ng::Deserializer::from_str(text);
-            serde_path_to_error::deserialize(de).map_err(|e| {
+            units::reading_yaml(|| serde_path_to_error::deserialize(de)).map_err(|e| {
                 let at = e.inner().location().map(|l| (l.line(), l.column()));
                 input.error(e.path(), &e.inner().to_string(), at)
             })

@@ -10,7 +10,7 @@ mod parse_errors;
 mod tags;
 mod validate;
 
-pub use io::{load, loads, parse_spec};
+pub use io::{load, loads, parse_spec, parse_spec_constructed};
 pub use validate::build;
 
 use crate::model::MechanismSpec;

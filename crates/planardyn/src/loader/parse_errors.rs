@@ -5,6 +5,7 @@
 
 use super::Format;
 use crate::model::spec::LoadSpec;
+use crate::units;
 use crate::ModelError;
 use serde_path_to_error::{Path, Segment};
 
@@ -51,6 +52,12 @@ impl Input<'_> {
 
     /// The message in plain words and its fix; a missing field goes onto the path.
     fn explain(&self, message: &str, field: &mut String) -> (String, String) {
+        // A quantity's own message (`units::UnitError::message`): what is wrong; the fix.
+        if let Some(i) = message.find(units::MARK) {
+            let m = &message[i + units::MARK.len()..];
+            let (what, fix) = m.split_once(units::FIX).unwrap_or((m, "write a number with its unit"));
+            return (what.into(), fix.into());
+        }
         let docs = "see `planardyn docs model-format`";
         if let Some(name) = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
             push_field(field, name);

@@ -71,6 +71,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         actuators: Vec::new(),
         pair_actuators: Vec::new(),
         friction: Vec::new(),
+        compliance: Default::default(),
         simulate: SimulateDefaults::default(),
         x0: Vec::new(),
         scale: 1.0,
@@ -106,6 +107,7 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     mech.friction =
         entries().filter_map(|(k, l)| loads::friction(l, &ctx, &mech, &path(k)).transpose()).collect::<R<_>>()?;
     (mech.actuators, mech.pair_actuators) = actuators::build_actuators(&ctx, &mech, &spec.actuators)?;
+    mech.compliance = super::compliance::build(&ctx, &mech, spec.compliance.as_ref())?;
     Ok(mech)
 }
 

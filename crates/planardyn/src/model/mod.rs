@@ -11,6 +11,9 @@
 pub mod actuators;
 pub(crate) mod build;
 pub(crate) mod checks;
+pub mod compliance;
+pub mod construct;
+pub mod construction;
 pub(crate) mod diameter;
 pub mod loads;
 mod motion;
@@ -197,6 +200,8 @@ pub struct Mechanism {
     pub pair_actuators: Vec<PairActuator>,
     /// Coulomb friction from the pairs' loads.
     pub friction: Vec<JointFriction>,
+    /// Transmission, pair and link compliances (empty: rigid), for `crate::elastic`.
+    pub compliance: compliance::Compliance,
     pub simulate: SimulateDefaults,
     /// Body coordinates in the drawing, 3n values [X, Y, phi] per body.
     pub x0: Vec<f64>,

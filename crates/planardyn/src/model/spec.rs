@@ -3,19 +3,28 @@
 //! These plain structs are what a file deserialises to and what a Rust user fills in to
 //! describe a mechanism in code; [`crate::build`] validates them. The schema is
 //! documented field by field in `docs/model-format.md` and `schema/planardyn-model.schema.json`.
-//! Units are SI throughout: m, kg, kg m^2, s, rad, N, N m.
+//! Units are SI throughout: m, kg, kg m^2, s, rad, N, N m. A file may give a quantity as a
+//! number with its unit (`"120 mm"`, `"30 deg"`: the fields' `deserialize_with` read them,
+//! [`crate::units`]), and points and coordinate values by construction
+//! ([`MechanismSpec<PointSpec, ValueSpec>`], the form the loader reads and resolves into
+//! this one).
 
+pub use super::compliance::ComplianceSpec;
+pub use super::construction::{Circle, Construction, Crossing, PointSpec, Side, ValueSpec};
 pub use super::loads::LoadSpec;
+use crate::units::{self, Motion};
 use indexmap::IndexMap;
-use serde::de::{Deserializer, MapAccess, Visitor};
+use serde::de::{Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::marker::PhantomData;
 
-/// A whole mechanism.
+/// A whole mechanism: its points coordinates [x, y] (m) and its coordinates' drawn values
+/// numbers (rad or m). `MechanismSpec<PointSpec, ValueSpec>` is a model file as written,
+/// points and values also by construction, which the loader resolves into this.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
-pub struct MechanismSpec {
+pub struct MechanismSpec<P = [f64; 2], V = f64> {
     /// A human-readable name.
     pub name: String,
     /// Free text: where the data come from.
@@ -25,29 +34,33 @@ pub struct MechanismSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub units: Option<String>,
     /// Gravity vector [g_x, g_y] in m/s^2 (default none).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::acceleration")]
     pub gravity: [f64; 2],
     /// Named points and their global coordinates [x, y] (m) in the drawn configuration.
     #[serde(alias = "points_at_t0")]
-    pub points: NamedMap<[f64; 2]>,
+    pub points: NamedMap<P>,
     /// The points carried by the fixed body `ground`.
     #[serde(default, alias = "fixed_points")]
     pub ground: Vec<String>,
     /// The mobile bodies, by name, in the order their coordinates are stored.
     pub bodies: NamedMap<BodySpec>,
     /// Kinematic pairs (joints).
+    #[serde(deserialize_with = "units::tagged")]
     pub pairs: Vec<PairSpec>,
     /// Generalized coordinates: the input pairs, one per degree of freedom.
-    pub coordinates: Vec<CoordinateSpec>,
+    pub coordinates: Vec<CoordinateSpec<V>>,
     /// Drive efforts on the coordinates (torque for an angle, force for a displacement).
     #[serde(default)]
     pub drives: Vec<DriveSpec>,
     /// External loads and force elements (one kind a file: `model::loads`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::tagged")]
     pub loads: Vec<LoadSpec>,
     /// Motors with their transmissions, one per driven coordinate (docs/actuators.md).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub actuators: Vec<ActuatorSpec>,
+    /// Transmission, pair and link compliances (`model::compliance`, docs/stiffness.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<ComplianceSpec>,
     /// Default simulation settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulate: Option<SimulateSpec>,
@@ -61,10 +74,15 @@ pub struct BodySpec {
     /// The points this body carries. The body's angle is that of the line from its first to
     /// its second point (0 for a body with a single point).
     pub points: Vec<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::mass", skip_serializing_if = "Option::is_none")]
     pub mass: Option<f64>,
     /// Moment of inertia about the centre of mass (kg m^2).
-    #[serde(default, alias = "inertia_about_com", skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        alias = "inertia_about_com",
+        deserialize_with = "units::inertia",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub inertia: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub com: Option<Location>,
@@ -84,8 +102,14 @@ pub struct BodySpec {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PartSpec {
+    #[serde(deserialize_with = "units::mass")]
     pub mass: f64,
-    #[serde(default, alias = "inertia_about_com", skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        alias = "inertia_about_com",
+        deserialize_with = "units::inertia",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub inertia: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub com: Option<Location>,
@@ -96,11 +120,30 @@ pub struct PartSpec {
 }
 
 /// A location in the drawing: coordinates [x, y] (m) or the name of a point.
-#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Location {
     Coords([f64; 2]),
     Point(String),
+}
+
+impl<'de> Deserialize<'de> for Location {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct LocationVisitor;
+        impl<'de> Visitor<'de> for LocationVisitor {
+            type Value = Location;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a point name or coordinates [x, y] (m)")
+            }
+            fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Location, E> {
+                Ok(Location::Point(name.to_string()))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Location, A::Error> {
+                units::length(serde::de::value::SeqAccessDeserializer::new(seq)).map(Location::Coords)
+            }
+        }
+        deserializer.deserialize_any(LocationVisitor)
+    }
 }
 
 /// A kinematic pair between two bodies (`ground` is the fixed body).
@@ -137,6 +180,7 @@ pub enum PairSpec {
         name: Option<String>,
         bodies: [String; 2],
         centers: Vec<String>,
+        #[serde(deserialize_with = "units::length")]
         radii: Vec<f64>,
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         internal: bool,
@@ -161,22 +205,44 @@ pub enum PairSpec {
     },
 }
 
+impl PairSpec {
+    /// The name the file gave the pair, if any.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            PairSpec::Revolute { name, .. }
+            | PairSpec::Prismatic { name, .. }
+            | PairSpec::Gear { name, .. }
+            | PairSpec::Slot { name, .. } => name.as_deref(),
+        }
+    }
+
+    /// Whether the pair's coordinate is an angle or a displacement (a gear pair has none).
+    pub fn motion(&self) -> Option<Motion> {
+        match self {
+            PairSpec::Revolute { .. } => Some(Motion::Rotation),
+            PairSpec::Prismatic { .. } | PairSpec::Slot { .. } => Some(Motion::Translation),
+            PairSpec::Gear { .. } => None,
+        }
+    }
+}
+
 /// A generalized coordinate: the relative angle (rad) of a revolute pair or the displacement
 /// (m) of a prismatic or slot pair, of the second body relative to the first (a gear pair
 /// has none).
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
-pub struct CoordinateSpec {
+pub struct CoordinateSpec<V = f64> {
     pub name: String,
     /// The name of the input pair.
     pub pair: String,
     /// The coordinate's value in the drawing (e.g. the absolute angle of a crank line).
-    pub value: f64,
-    /// Start the simulation here instead of at the drawing.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub q0: Option<f64>,
+    pub value: V,
+    /// Start the simulation here instead of at the drawing (as `value`: a number, with its unit,
+    /// or a measure of the drawing in a file).
+    #[serde(default = "Option::default", skip_serializing_if = "Option::is_none")]
+    pub q0: Option<V>,
     /// Initial rate (rad/s or m/s), default 0.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::rate")]
     pub qd0: f64,
     /// Free text.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -189,7 +255,7 @@ pub struct CoordinateSpec {
 #[serde(deny_unknown_fields)]
 pub struct DriveSpec {
     pub coordinate: String,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::effort", skip_serializing_if = "Option::is_none")]
     pub effort: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table: Option<TableSpec>,
@@ -202,7 +268,7 @@ pub struct DriveSpec {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MotionSpec {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::rate", skip_serializing_if = "Option::is_none")]
     pub speed: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table: Option<MotionTableSpec>,
@@ -212,7 +278,9 @@ pub struct MotionSpec {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MotionTableSpec {
+    #[serde(deserialize_with = "units::time")]
     pub t: Vec<f64>,
+    #[serde(deserialize_with = "units::position")]
     pub q: Vec<f64>,
 }
 
@@ -220,7 +288,9 @@ pub struct MotionTableSpec {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TableSpec {
+    #[serde(deserialize_with = "units::time")]
     pub t: Vec<f64>,
+    #[serde(deserialize_with = "units::effort")]
     pub effort: Vec<f64>,
 }
 
@@ -252,16 +322,16 @@ pub struct ActuatorSpec {
     pub backdrive_efficiency: Option<f64>,
     /// Rotor (and gearbox input) inertia J (kg m^2, motor side), before the gear: its
     /// kinetic energy 1/2 J (omega_housing + n qd)^2.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::inertia")]
     pub rotor_inertia: f64,
     /// Motor-side viscous friction (N m s/rad).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::torsional_damping")]
     pub viscous: f64,
     /// Motor-side Coulomb friction torque (N m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::torque")]
     pub coulomb: f64,
     /// Motor speed (rad/s) below which the regularised Coulomb torque fades (default 1e-2).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::angular_speed", skip_serializing_if = "Option::is_none")]
     pub stiction_speed: Option<f64>,
     /// The motor's limits, for the sizing report.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -281,17 +351,17 @@ fn one() -> f64 {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::torque", skip_serializing_if = "Option::is_none")]
     pub peak_torque: Option<f64>,
     /// The RMS torque the motor carries without overheating.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::torque", skip_serializing_if = "Option::is_none")]
     pub continuous_torque: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::angular_speed", skip_serializing_if = "Option::is_none")]
     pub max_speed: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::angular_speed", skip_serializing_if = "Option::is_none")]
     pub corner_speed: Option<f64>,
     /// Points [speed, torque] of the envelope, speeds increasing from 0.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::speed_torque", skip_serializing_if = "Option::is_none")]
     pub torque_speed: Option<Vec<[f64; 2]>>,
 }
 
@@ -299,7 +369,7 @@ pub struct LimitsSpec {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SimulateSpec {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::time", skip_serializing_if = "Option::is_none")]
     pub t_end: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method: Option<String>,
@@ -308,10 +378,10 @@ pub struct SimulateSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub atol: Option<f64>,
     /// Step of the fixed-step method (s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::time", skip_serializing_if = "Option::is_none")]
     pub dt: Option<f64>,
     /// Spacing of the output times (s); default: every accepted step.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::time", skip_serializing_if = "Option::is_none")]
     pub output_dt: Option<f64>,
 }
 

@@ -335,7 +335,43 @@ impl<'a> MechanismOde<'a> {
     }
 }
 
+/// The evaluation a [`MechanismOde`] holds (its workspace and what the next evaluation's
+/// Newton start is predicted from), set aside while points off the integration are evaluated.
+pub struct Evaluation {
+    ws: Workspace,
+    eval_y: Vec<f64>,
+    last_t: f64,
+    last_y: Vec<f64>,
+    base_valid: bool,
+    closed: Option<ClosedForm>,
+    base_closed: bool,
+    stale_j: bool,
+}
+
 impl MechanismOde<'_> {
+    /// The evaluation held now, to be put back by [`MechanismOde::restore`]: evaluating other
+    /// points between (a crossing's nodes inside a step) then leaves the integration as it
+    /// would have been, to the bit.
+    pub fn save(&self) -> Evaluation {
+        Evaluation {
+            ws: self.ws.clone(),
+            eval_y: self.eval_y.clone(),
+            last_t: self.last_t,
+            last_y: self.last_y.clone(),
+            base_valid: self.base_valid,
+            closed: self.closed.clone(),
+            base_closed: self.base_closed,
+            stale_j: self.stale_j,
+        }
+    }
+
+    /// Put back an evaluation saved by [`MechanismOde::save`].
+    pub fn restore(&mut self, e: Evaluation) {
+        (self.ws, self.eval_y, self.last_t, self.last_y) = (e.ws, e.eval_y, e.last_t, e.last_y);
+        (self.base_valid, self.closed, self.base_closed, self.stale_j) =
+            (e.base_valid, e.closed, e.base_closed, e.stale_j);
+    }
+
     /// As [`MechanismOde::evaluate`], for a point that must be evaluated (an output, a dense
     /// output stage) rather than avoided by a shorter step: when refused, walk to it from the
     /// last accepted point in straight pieces of the chart coordinates (4, then 16, then 64),

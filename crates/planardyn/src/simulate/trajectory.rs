@@ -73,7 +73,8 @@ pub struct SimStats {
     pub max_residual: f64,
     /// Smallest type II measure seen at accepted steps (scaled singular value).
     pub min_sigma: f64,
-    /// Smallest passive measure seen (see `charts::Measures::passive`).
+    /// Smallest passive measure seen (see `charts::Measures::passive`) at the accepted steps
+    /// and at the change points crossed (about 0 there: the path goes through them).
     pub min_passive_sigma: f64,
     /// Largest |E(t) - E(0)| at the outputs with E = T + V - W (J): energy balance error.
     pub energy_drift: f64,

@@ -5,6 +5,7 @@ use super::apply::{add_point_force_rate, point_velocity_rate, Point};
 use super::{mobile_body, Load, LoadSpecType, LoadType};
 use crate::model::checks::{body_point, Ctx, R};
 use crate::model::{Attachment, Mechanism};
+use crate::units;
 use serde::{Deserialize, Serialize};
 
 /// A constant force [F_x, F_y] (N, global frame) at a point of a body.
@@ -15,6 +16,7 @@ use serde::{Deserialize, Serialize};
 pub struct ForceSpec {
     pub body: String,
     pub at: String,
+    #[serde(deserialize_with = "units::force")]
     pub value: [f64; 2],
 }
 

@@ -11,6 +11,7 @@ use crate::model::actuators::JointFriction;
 use crate::model::checks::{pair_id, relative_pair, Ctx, R};
 use crate::model::pairs::{self, Relative};
 use crate::model::{Mechanism, PairId, PairKind};
+use crate::units;
 use serde::{Deserialize, Serialize};
 
 /// Default regularisation speeds of a pair's slip (m/s): the stiction speed and the
@@ -31,7 +32,7 @@ const MAX_PRESSURE_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
 #[serde(deny_unknown_fields, expecting = "struct variant LoadSpec::Friction")]
 pub struct FrictionSpec {
     pub pair: String,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::pair_damping", skip_serializing_if = "Option::is_none")]
     pub viscous: Option<f64>,
     /// Sliding (kinetic) friction coefficient.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -40,19 +41,19 @@ pub struct FrictionSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mu_static: Option<f64>,
     /// Pin radius of a revolute pair (m): the friction arm.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::length", skip_serializing_if = "Option::is_none")]
     pub pin_radius: Option<f64>,
     /// Length of a prismatic pair's slider (m): the arm over which it carries a couple.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::length", skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
     /// Slip speed (m/s) below which the regularised law lets the pair creep (default 1e-4).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::speed", skip_serializing_if = "Option::is_none")]
     pub stiction_speed: Option<f64>,
     /// Slip speed (m/s) over which the coefficient falls from `mu_static` to `mu` (default 1e-2).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::speed", skip_serializing_if = "Option::is_none")]
     pub stribeck_speed: Option<f64>,
     /// Pressure angle of a gear pair's teeth (rad, default 20 degrees): normal load F_t / cos.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::angle", skip_serializing_if = "Option::is_none")]
     pub pressure_angle: Option<f64>,
 }
 

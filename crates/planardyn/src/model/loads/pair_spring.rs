@@ -9,6 +9,7 @@ use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
 use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_rate};
 use crate::model::{Mechanism, PairId};
+use crate::units;
 use serde::{Deserialize, Serialize};
 
 /// A torsional spring-damper at a revolute pair (or a linear one along a prismatic pair),
@@ -18,11 +19,12 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields, expecting = "struct variant LoadSpec::TorsionalSpring")]
 pub struct TorsionalSpringSpec {
     pub pair: String,
+    #[serde(deserialize_with = "units::pair_stiffness")]
     pub stiffness: f64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::pair_damping")]
     pub damping: f64,
     /// Relative rotation (rad) or displacement (m) from the drawing at which it is unloaded.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::position")]
     pub rest: f64,
 }
 

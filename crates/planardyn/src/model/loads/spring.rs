@@ -8,6 +8,7 @@ use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{body_point, Ctx, R};
 use crate::model::pairs::frames::{point_velocity, world_point};
 use crate::model::{Attachment, Mechanism};
+use crate::units;
 use serde::{Deserialize, Serialize};
 
 /// A linear spring-damper between two body points, each given as [body, point]:
@@ -17,10 +18,11 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields, expecting = "struct variant LoadSpec::Spring")]
 pub struct SpringSpec {
     pub between: [[String; 2]; 2],
+    #[serde(deserialize_with = "units::stiffness")]
     pub stiffness: f64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "units::damping")]
     pub damping: f64,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "units::length", skip_serializing_if = "Option::is_none")]
     pub rest_length: Option<f64>,
 }
 

@@ -4,6 +4,7 @@
 use super::{mobile_body, Load, LoadSpecType, LoadType};
 use crate::model::checks::{Ctx, R};
 use crate::model::{BodyId, Mechanism};
+use crate::units;
 use serde::{Deserialize, Serialize};
 
 /// A constant torque (N m) on a body.
@@ -12,6 +13,7 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields, expecting = "struct variant LoadSpec::Torque")]
 pub struct TorqueSpec {
     pub body: String,
+    #[serde(deserialize_with = "units::torque")]
     pub value: f64,
 }
 

@@ -1,0 +1,148 @@
+"""The browser app's engine (planardyn as WebAssembly, in headless chromium) against the native
+extension (the same Rust through the Python API), measured in one run on this machine:
+
+- a 10 s passive four-bar run (four-bar-gravity, the model's settings: DOP853, rtol 1e-9);
+- a 3-RRR's drive efforts and pair reactions for one frame (planardyn::dynamics::evaluate in
+  the page; native: inverse_dynamics then reactions through the Python API, so the native
+  figure includes two Python calls);
+- a 5R's 100 x 100 singularity map over its two coordinates by continuation (the page's
+  map, web/src/map.js over planardyn::dynamics::sigma_rows; native: the same loop in Python
+  over Mechanism.kinematics, which also computes the analogues u and w: the Python API has no
+  call for the map, so the native figure is the Python user's);
+- the engine's size (wasm, the page, gzipped) and the page's load time to its first drawing.
+
+Each figure is the best of REPEAT rounds (timing noise on a shared machine only adds).
+
+    .venv/bin/python benchmarks/app_browser.py            # needs ./dev setup (builds the app) and chromium
+"""
+
+from __future__ import annotations
+
+import gzip
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import planardyn as pdy
+from planardyn.app import app_html, app_template, model_payload
+from playwright.sync_api import sync_playwright
+
+ROOT = Path(__file__).resolve().parents[1]
+WASM = ROOT / "target" / "app" / "pkg" / "planardyn_wasm_bg.wasm"
+REPEAT = 15
+FRAMES = 200
+MAP_N = 100
+
+
+def best(f, repeat: int = REPEAT) -> float:
+    """Least wall time (s) of `repeat` calls of f."""
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        f()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def native() -> dict[str, float]:
+    four = pdy.load(pdy.models.path("four-bar-gravity"))
+    out = {"sim": best(lambda: four.simulate(t_end=10.0))}
+    rrr = pdy.load(pdy.models.path("3-rrr"))
+    q0 = rrr.q0
+    qs = [q0 + 0.05 * np.sin(0.1 * k) for k in range(FRAMES)]
+    qd, qdd = np.full(rrr.dof, 0.2), np.full(rrr.dof, 0.5)
+
+    def frames() -> None:
+        for q in qs:
+            tau = rrr.inverse_dynamics(q, qd, qdd)
+            rrr.reactions(q, qd, tau=tau)
+
+    out["frame"] = best(frames) / FRAMES
+    five = pdy.load(pdy.models.path("five-bar"))
+    out["map"] = best(lambda: python_map(five), repeat=1)
+    return out
+
+
+def python_map(mech: pdy.Mechanism) -> np.ndarray:
+    """The page's map (web/src/map.js) through the Python API: a serpentine over the grid,
+    each cell continued from the last."""
+    q0 = mech.q0
+    lo, hi = q0 - np.pi, q0 + np.pi
+    axis = [lo[k] + (hi[k] - lo[k]) * (np.arange(MAP_N) + 0.5) / MAP_N for k in range(2)]
+    sigma = np.full((MAP_N, MAP_N), np.nan)
+    x = row_start = mech.assemble(q0)
+    for j in range(MAP_N):
+        for i in range(MAP_N):
+            ii = MAP_N - 1 - i if j % 2 else i
+            try:
+                k = mech.kinematics([axis[0][ii], axis[1][j]], x_start=x)
+                x, sigma[j, ii] = k["x"], k["sigma_min"]
+                if i == 0:
+                    row_start = x
+            except pdy.PlanardynError:
+                x = row_start
+    return sigma
+
+
+PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
+  const a = window.planardyn, pd = a.pd;
+  const best = (f, n = repeat) => { let b = Infinity; for (let i = 0; i < n; i++) { const t = performance.now(); f(); b = Math.min(b, performance.now() - t); } return b / 1000; };
+  const fm = pd.load(four, "yaml", "four-bar-gravity.yaml");
+  const sim = best(() => fm.simulate({t_end: 10}));
+  const m = pd.load(rrr, "yaml", "3-rrr.yaml"), info = m.info(), q0 = info.q0, n = info.dof;
+  const qs = [...Array(frames).keys()].map((k) => q0.map((v) => v + 0.05 * Math.sin(0.1 * k)));
+  const qd = new Float64Array(n).fill(0.2), qdd = new Float64Array(n).fill(0.5);
+  const frame = best(() => { let x; for (const q of qs) x = m.evaluate(q, qd, qdd, x).x; }) / frames;
+  const five = a.mech;
+  const { mapRanges, mapper } = a.mapTools;
+  const map = best(() => mapper(five, mapRanges(a.info, a.info.q0), mapN, five.assemble(a.info.q0), a.info.q0).step(Infinity), 1);
+  return { sim, frame, map, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000 };
+}"""
+
+
+def browser() -> dict[str, float]:
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if chromium is None:
+        sys.exit("chromium is needed (./dev installs Debian's as root)")
+    with tempfile.TemporaryDirectory() as tmp, sync_playwright() as p:
+        page_file = Path(tmp) / "app.html"
+        page_file.write_text(app_html(model_payload(pdy.models.path("five-bar"))), encoding="utf-8")
+        b = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
+        loads = []
+        for _ in range(REPEAT):
+            page = b.new_page()
+            page.goto(page_file.as_uri())
+            page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+            loads.append(page.evaluate("window.planardyn.timings"))
+            page.close()
+        page = b.new_page()
+        page.goto(page_file.as_uri())
+        page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+        texts = [pdy.models.path(n).read_text() for n in ("four-bar-gravity", "3-rrr")]
+        out = page.evaluate(PAGE_BENCH, [*texts, FRAMES, MAP_N, REPEAT])
+        b.close()
+    out["load"] = min(t["readyMs"] for t in loads) / 1000
+    out["engine"] = min(t["engineMs"] for t in loads) / 1000
+    return out
+
+
+def main() -> None:
+    page = app_template().encode()
+    wasm = WASM.read_bytes() if WASM.exists() else b""
+    nat, web = native(), browser()
+    print(f"engine: {len(wasm) / 1e6:.2f} MB wasm ({len(gzip.compress(wasm)) / 1e6:.2f} MB gzipped); "
+          f"the app page {len(page) / 1e6:.2f} MB ({len(gzip.compress(page)) / 1e6:.2f} MB gzipped)")
+    print(f"page load to the first drawing: {web['load'] * 1e3:.0f} ms (the engine's instantiation {web['engine'] * 1e3:.0f} ms)")
+    print(f"{'':44s} {'browser':>10s} {'native':>10s} {'ratio':>7s}")
+    rows = [("10 s passive four-bar run", "sim", 1e3, "ms"),
+            ("3-RRR efforts + reactions, one frame", "frame", 1e6, "us"),
+            (f"5R singularity map {MAP_N} x {MAP_N}", "map", 1e3, "ms")]
+    for label, key, scale, unit in rows:
+        print(f"{label + f' ({unit})':44s} {web[key] * scale:10.3g} {nat[key] * scale:10.3g} {web[key] / nat[key]:7.2f}")
+
+
+if __name__ == "__main__":
+    main()

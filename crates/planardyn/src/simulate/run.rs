@@ -1,0 +1,615 @@
+//! One run of a simulation as named stages, in the order of MuJoCo's `mj_step`: integrate a
+//! step, observe it (dense output, events), write the outputs it passed, accept its end, then
+//! the change points, the energy, the passive measure, the rate of progress, the chart and the
+//! caller's progress callback. Each stage returns `ControlFlow<Stop>`; [`Stop`] says why the
+//! run ended and is turned into the trajectory's status and message once, in `stop.rs`.
+
+use std::ops::ControlFlow::{self, Break, Continue};
+
+use super::charts::{chart_sigma, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
+use super::crossing::{
+    cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Passed, Path,
+    APPROACH_BELOW, APPROACH_FRACTION, CHANGE_POINT_RATIO, CROSS_START, WATCH_BELOW,
+};
+use super::dense::{self, DenseOutput};
+use super::events::Watch;
+use super::ode::MechanismOde;
+use super::start;
+use super::stop::{Near, Stop, PROGRESS_MARGIN};
+use super::trajectory::Trajectory;
+use super::{Observe, Settings};
+use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
+use crate::integrate::{Options, Stats, Stepper};
+use crate::kinematics::{passive_sigma_min, Chart};
+use crate::model::Mechanism;
+use crate::Error;
+
+/// Step attempts before a run's rate of progress is judged: an early transient of small
+/// steps (a stiff start, a chart switch) must not stop a run that would finish.
+const PROGRESS_MIN_STEPS: usize = 10_000;
+
+/// The progress callback: called with t after each accepted step, false stops the run.
+pub type Progress<'p> = Option<&'p mut dyn FnMut(f64) -> bool>;
+
+/// What a crossing did: landed past the change point, reached t_end inside it, or found none
+/// (the passive measure only dipped).
+enum Crossed {
+    Past,
+    AtEnd,
+    NoPoint,
+}
+
+/// A run: the mechanism in its chart, the integrator, the trajectory written so far, and what
+/// the stages keep between steps.
+pub struct Run<'a, 's, 'e> {
+    settings: &'s Settings,
+    ode: MechanismOde<'a>,
+    stepper: Stepper,
+    traj: Trajectory,
+    /// The output grid, and the index of the next output time in it.
+    t_eval: Option<&'s [f64]>,
+    next: usize,
+    /// The accepted points near a change point, and the energy balance across it; where the
+    /// next step must end at the latest (t_end, or before a change point ahead).
+    approach: Approach,
+    t_stop: f64,
+    grid: Option<Grid>,
+    limit: Option<f64>,
+    /// Whether the measure now heading to 0 is the passive one (asked once an approach).
+    heading: Option<bool>,
+    /// The integrator's options without dense output (for a crossing's integration past its
+    /// landing), and the counters of those integrations.
+    options: Options,
+    crossing_stats: Stats,
+    /// (2m + 1) The state accepted last, and an interpolated one.
+    y: Vec<f64>,
+    yi: Vec<f64>,
+    /// The dense output (for the events and the kept interpolant), and one step's rows of it.
+    dense: Option<DenseOutput>,
+    rows: Vec<f64>,
+    watch: Watch<'e>,
+    keep_dense: bool,
+}
+
+impl<'a, 's, 'e> Run<'a, 's, 'e> {
+    /// The run at t0, its start row written; `Break` if it stopped before its first step (a
+    /// drive or the integrator failing at the start). Errors in the start itself return Err.
+    pub fn start(
+        mech: &'a Mechanism,
+        settings: &'s Settings,
+        drives: &'a mut dyn Drives,
+        motion: &'a mut Prescribed<'a>,
+        observe: Observe<'e>,
+    ) -> Result<ControlFlow<Stop, Self>, Error> {
+        let (mut ode, y) = match start::start(mech, settings, drives, motion) {
+            Ok(started) => started,
+            // A drive that fails at once is a failed run, not bad input: say so in the status.
+            Err(e @ Error::Drive { .. }) => return Ok(Break(Stop::StartDrive(e))),
+            Err(e) => return Err(e),
+        };
+        let m = mech.dof();
+        // Dense output is only needed to interpolate at requested times, and for events and the
+        // kept interpolant (DOP853 pays 3 extra evaluations in each step that uses it).
+        let (observing, keep_dense) = (!observe.is_empty(), observe.dense_output);
+        // DOP853 evaluates them only when a step is interpolated (outputs, events, a crossing's
+        // nodes): a step without pays nothing.
+        let options = Options { dense_output: true, ..settings.options.clone() };
+        let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
+        if let Err(error) = stepper.reset(&mut ode, settings.t0, &y) {
+            return Ok(Break(Stop::Step { error, crossing: None }));
+        }
+        let mut run = Run {
+            settings,
+            ode,
+            stepper,
+            traj: Trajectory::new(m, mech.n_x()),
+            t_eval: settings.t_eval.as_deref(),
+            next: 0,
+            approach: Approach::default(),
+            t_stop: settings.t_end,
+            grid: None,
+            limit: None,
+            heading: None,
+            options: Options { dense_output: false, ..settings.options.clone() },
+            crossing_stats: Stats::default(),
+            y,
+            yi: vec![0.0; 2 * m + 1],
+            dense: observing.then(|| DenseOutput::new(m, settings.method.dense_order())),
+            rows: Vec::new(),
+            watch: Watch::new(observe.events, m),
+            keep_dense,
+        };
+        // The start counts in the least measures, so that a run of no step reports its start's.
+        let first = measure(&mut run.ode);
+        (run.traj.stats.min_sigma, run.traj.stats.min_passive_sigma) = (first.sigma, first.passive);
+        run.approach.keep(&run.ode, settings.t0, first.passive);
+        if run.t_eval.is_none_or(|te| te.first() == Some(&settings.t0)) {
+            run.traj.record(&run.ode, settings.t0, run.y[2 * m], first.sigma);
+            run.next = 1;
+        }
+        Ok(Continue(run))
+    }
+
+    /// Step until t_end or a stop; the trajectory with its status.
+    pub fn run(mut self, mut progress: Progress) -> Trajectory {
+        let stop = match self.stages(&mut progress) {
+            Break(stop) => stop,
+            Continue(()) => Stop::Reached { t_end: self.settings.t_end },
+        };
+        self.finish(stop)
+    }
+
+    /// The driver: the events' start values, then one step after another.
+    fn stages(&mut self, progress: &mut Progress) -> ControlFlow<Stop> {
+        self.start_events()?;
+        while self.stepper.t() < self.settings.t_end {
+            self.step(progress)?;
+        }
+        Continue(())
+    }
+
+    /// One step, as `mj_step`: integrate, observe, output, accept; then what the accepted
+    /// point asks for.
+    fn step(&mut self, progress: &mut Progress) -> ControlFlow<Stop> {
+        if let Err(error) = self.stepper.step(&mut self.ode, self.t_stop) {
+            return self.cross_from_last(error);
+        }
+        let t = self.stepper.t();
+        if self.overshot(t) {
+            return self.retake();
+        }
+        self.y.copy_from_slice(self.stepper.y());
+        if self.ode.ws.chart != Chart::Inputs {
+            self.traj.stats.partition_steps += 1;
+        }
+        let terminal = self.observe(t)?;
+        self.outputs(terminal.map_or(t, |(t_star, _)| t_star))?;
+        if let Some((t_star, index)) = terminal {
+            return self.end_at_event(t_star, index);
+        }
+        self.fill_approach(t)?;
+        let meas = self.accept(t)?;
+        if self.change_points(t, &meas)? {
+            return Continue(());
+        }
+        self.approach.keep(&self.ode, t, meas.passive);
+        self.passive(t, &meas)?;
+        self.progress_rate()?;
+        self.chart(t, &meas)?;
+        self.aim(t, &meas);
+        self.report(t, progress)
+    }
+
+    /// The events' values at the start.
+    fn start_events(&mut self) -> ControlFlow<Stop> {
+        let t = self.settings.t0;
+        match self.watch.start(t, &self.ode.ws.q, &self.ode.ws.qd) {
+            Ok(()) => Continue(()),
+            Err(error) => Break(Stop::EventAtStart { t, error }),
+        }
+    }
+
+    /// A failed step: steps that shrink to nothing before a change point cross it from the
+    /// last accepted point when it is near enough; otherwise the run stops.
+    fn cross_from_last(&mut self, error: crate::integrate::StepError<Error>) -> ControlFlow<Stop> {
+        let (t, y) = (self.stepper.t(), self.stepper.y().to_vec());
+        let m = self.ode.m();
+        self.ode.restart_from_anchor();
+        let ode = &mut self.ode;
+        let at_last =
+            ode.motion.is_none() && self.approach.last().is_some_and(|p| p.t == t) && ode.accept(t, &y).is_ok();
+        let meas = if at_last { Some(measure(ode)) } else { None };
+        let Some(meas) = meas.filter(|meas| meas.passive < NEAR_PASSIVE_SINGULAR) else {
+            return Break(Stop::Step { error, crossing: None });
+        };
+        match self.cross_change_point((t, meas.sigma, meas.passive, y[2 * m])) {
+            Ok(Crossed::Past) => Continue(()),
+            Ok(Crossed::AtEnd) => Break(Stop::Reached { t_end: self.settings.t_end }),
+            Ok(Crossed::NoPoint) => {
+                let why = "Phi_x keeps its rank on the path ahead: no change point to cross".to_string();
+                Break(Stop::Step { error, crossing: Some(why) })
+            }
+            Err(why) => Break(Stop::Step { error, crossing: Some(why) }),
+        }
+    }
+
+    /// The step's dense output and its events; the first terminal event's time and index.
+    fn observe(&mut self, t: f64) -> ControlFlow<Stop, Option<(f64, usize)>> {
+        let Some(dense) = self.dense.as_mut() else { return Continue(None) };
+        if let Err(error) = sample_step(&mut self.ode, &mut self.stepper, dense, &mut self.yi, &mut self.rows) {
+            return Break(Stop::DenseOutput { t, error });
+        }
+        match self.watch.step(dense) {
+            Ok(found) => Continue(found),
+            Err(error) => Break(Stop::EventInStep { t, error }),
+        }
+    }
+
+    /// The rows of the output grid up to `t_last` (the step's end, or a terminal event's time).
+    fn outputs(&mut self, t_last: f64) -> ControlFlow<Stop> {
+        let Some(te) = self.t_eval else { return Continue(()) };
+        if self.next < te.len() && te[self.next] <= t_last {
+            // DOP853's dense-output stages (at 0.1, 0.2 and 7/9 of the step, evaluated by
+            // the first interpolation) are predicted from the step's start, not its end.
+            self.ode.restart_from_anchor();
+        }
+        while self.next < te.len() && te[self.next] <= t_last {
+            let t = te[self.next];
+            if let Err(error) = evaluate_output(&mut self.ode, &mut self.stepper, t, &mut self.yi) {
+                return Break(Stop::Output { t, error });
+            }
+            let sigma = measure(&mut self.ode).sigma;
+            self.traj.record(&self.ode, t, self.yi[self.yi.len() - 1], sigma);
+            self.next += 1;
+        }
+        Continue(())
+    }
+
+    /// The last row of a run ended by terminal event `index` at `t_star`, within the step just
+    /// taken (unless the outputs already hold it).
+    fn end_at_event(&mut self, t_star: f64, index: usize) -> ControlFlow<Stop> {
+        if self.traj.t.last() != Some(&t_star) {
+            self.ode.restart_from_anchor();
+            if let Err(error) = evaluate_output(&mut self.ode, &mut self.stepper, t_star, &mut self.yi) {
+                return Break(Stop::EventState { index, t: t_star, error });
+            }
+            let sigma = measure(&mut self.ode).sigma;
+            self.traj.record(&self.ode, t_star, self.yi[self.yi.len() - 1], sigma);
+        }
+        if let Some(d) = self.dense.as_mut() {
+            d.truncate(t_star);
+        }
+        Break(Stop::TerminalEvent { index, t: t_star })
+    }
+
+    /// Make the step's end the predictor's anchor and measure it; without a grid, its row.
+    fn accept(&mut self, t: f64) -> ControlFlow<Stop, Measures> {
+        // Outputs and the dense output moved the evaluation away from the step's end; if going
+        // straight back is refused, come back along the interpolant as they did.
+        let (ode, y) = (&mut self.ode, &self.y);
+        let accepted = ode.accept(t, y).or_else(|e| {
+            if self.t_eval.is_none() && self.dense.is_none() {
+                return Err(e);
+            }
+            evaluate_output(ode, &mut self.stepper, t, &mut self.yi)?;
+            ode.accept(t, y)
+        });
+        if let Err(error) = accepted {
+            return Break(Stop::Accept { t, error });
+        }
+        let meas = measure(&mut self.ode);
+        if self.t_eval.is_none() {
+            self.traj.record(&self.ode, t, self.y[self.y.len() - 1], meas.sigma);
+        }
+        let stats = &mut self.traj.stats;
+        stats.min_sigma = stats.min_sigma.min(meas.sigma);
+        stats.min_passive_sigma = stats.min_passive_sigma.min(meas.passive);
+        Continue(meas)
+    }
+
+    /// Cross the change point ahead, or record one the step went over. Continue(true): crossed,
+    /// the stepper restarted past it (the step's other stages are skipped).
+    fn change_points(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop, bool> {
+        let falling = self.approach.last().is_some_and(|p| meas.passive < p.passive);
+        let over = stepped_over(&self.ode, &self.approach, t, meas.passive);
+        let watched = self.heading != Some(false) && self.ode.motion.is_none();
+        if over.is_none() && meas.passive < CROSS_START && falling && watched {
+            let work = self.y[self.y.len() - 1];
+            return match self.cross_change_point((t, meas.sigma, meas.passive, work)) {
+                Ok(Crossed::Past) => Continue(true),
+                Ok(Crossed::AtEnd) => Break(Stop::Reached { t_end: self.settings.t_end }),
+                // A dip, not a change point: on with the step's other stages, unwatched.
+                Ok(Crossed::NoPoint) => {
+                    self.heading = Some(false);
+                    Continue(false)
+                }
+                Err(why) => Break(Stop::NoCrossing { t, passive: meas.passive, why }),
+            };
+        }
+        if let Some(point) = over {
+            self.passed_point(point);
+            // The points kept are on the other side of it.
+            self.approach.clear();
+        }
+        Continue(false)
+    }
+
+    /// Report a change point the run went through: in the trajectory's list, and in the least
+    /// passive measure seen (the path passes through it, the accepted points do not).
+    fn passed_point(&mut self, point: ChangePoint) {
+        let passive = passive_sigma_min(self.ode.mech, &point.x);
+        let stats = &mut self.traj.stats;
+        stats.min_passive_sigma = stats.min_passive_sigma.min(passive);
+        self.traj.change_points.push(point);
+    }
+
+    /// Stop where the passive mechanism itself is singular.
+    fn passive(&self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
+        if meas.passive < PASSIVE_SINGULAR {
+            return Break(Stop::PassiveSingular { t, passive: meas.passive });
+        }
+        Continue(())
+    }
+
+    /// Stop a run that cannot reach t_end at its present rate: after [`PROGRESS_MIN_STEPS`]
+    /// attempts, its mean step is below `(t_end - t0) / (PROGRESS_MARGIN max_steps)`. The steps
+    /// of such runs shrink as they go (efforts of 1e12 N m on the five-bar: 10 million steps for
+    /// 0.35 % of 1 s), so waiting for `max_steps` only wastes the work.
+    fn progress_rate(&self) -> ControlFlow<Stop> {
+        let stats = self.stepper.stats();
+        let attempts = stats.naccept + stats.nreject;
+        let (t0, t, t_end) = (self.settings.t0, self.stepper.t(), self.settings.t_end);
+        let max_steps = self.settings.options.max_steps;
+        let floor = (t_end - t0) / (PROGRESS_MARGIN * max_steps as f64);
+        let mean = (t - t0) / attempts as f64;
+        if attempts < PROGRESS_MIN_STEPS || mean >= floor {
+            return Continue(());
+        }
+        let last = t - self.stepper.t_prev();
+        Break(Stop::Hopeless { t, attempts, mean, last, floor, t_end, max_steps })
+    }
+
+    /// Change the chart if the measures ask for it, and bound the next step's moves by the
+    /// chart's distance to its singularities (and to a change point being approached).
+    fn chart(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
+        let m = self.ode.m();
+        let mut own = chart_sigma(&mut self.ode, meas.sigma);
+        if let Some(chart) = next_chart(&self.ode, meas, own) {
+            state_in(&self.ode, &chart, self.y[2 * m], &mut self.y);
+            self.traj.stats.chart_switches += 1;
+            let switched = self.ode.set_chart(chart, t, &self.y).map_err(|e| e.to_string());
+            if let Err(error) =
+                switched.and_then(|_| self.stepper.reset(&mut self.ode, t, &self.y).map_err(|e| e.to_string()))
+            {
+                return Break(Stop::ChartChange { t, error });
+            }
+            own = chart_sigma(&mut self.ode, meas.sigma);
+        }
+        self.ode.limit_correction(own);
+        // In the user's chart the passive measure is only bounded by sigma_II (it is
+        // measured in a partition, which the integrator takes below 0.05).
+        if meas.passive < WATCH_BELOW && self.ode.motion.is_none() && self.ode.ws.chart != Chart::Inputs {
+            self.ode.limit_move(APPROACH_FRACTION * meas.passive);
+        }
+        Continue(())
+    }
+
+    /// With a change point ahead, the crossing's grid before it ([`Approach::grid`]) and where
+    /// the next step should end at the latest ([`Approach::step_limit`]): below
+    /// [`APPROACH_BELOW`] the next step ends there, above only if it would otherwise end past
+    /// the crossing's start ([`Run::retake`]).
+    fn aim(&mut self, t: f64, meas: &Measures) {
+        let grid = self.approach.grid(t, meas.passive).filter(|_| self.ode.motion.is_none());
+        if grid.is_none() {
+            self.heading = None;
+        }
+        let ahead = grid.is_some() && self.change_point_ahead(meas);
+        self.grid = grid.filter(|_| ahead);
+        self.limit = self.approach.step_limit(t, meas.passive).filter(|_| ahead).map(|l| l.min(self.settings.t_end));
+        self.t_stop = self.settings.t_end;
+    }
+
+    /// Whether the measure heading to 0 at the point in `ode.ws` is the passive one. Above
+    /// [`APPROACH_BELOW`] it is the user's chart's type II measure, which bounds the passive
+    /// one from below: asked once an approach (the passive measure, an SVD of Phi_x), which is
+    /// A02's (the same) and not the 3-RRR's (2.3 times it, where its type II measure dips).
+    fn change_point_ahead(&mut self, meas: &Measures) -> bool {
+        if meas.passive < APPROACH_BELOW {
+            return true;
+        }
+        *self
+            .heading
+            .get_or_insert_with(|| passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CHANGE_POINT_RATIO * meas.passive)
+    }
+
+    /// Whether the step just taken to t, not limited by the approach, went past the start of
+    /// the crossing ahead (as seen from its start) and near or over a change point. Above
+    /// [`APPROACH_BELOW`] the measure is the user's chart's: one heading to 0 there may only
+    /// dip (the 3-RRR's, the five-bar's), so the step's end and its path are asked (the true
+    /// passive measure there; Phi_x's rank along the quintic through its ends).
+    fn overshot(&mut self, t: f64) -> bool {
+        let unlimited = self.t_stop == self.settings.t_end;
+        if !(unlimited && self.grid.is_some_and(|g| t > g.t_star - g.tau)) {
+            return false;
+        }
+        let Some(last) = self.approach.last() else { return false };
+        let saved = self.ode.save();
+        let near = self.ode.evaluate(t, self.stepper.y()).map(|()| {
+            passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CROSS_START || inside_step(&self.ode, last, t)
+        });
+        self.ode.restore(saved);
+        near.unwrap_or(true)
+    }
+
+    /// Take the step again from its start, ending at the approach's limit: a step from above
+    /// [`APPROACH_BELOW`] that went past the crossing's start (or over the point: A02 at
+    /// rtol 1e-8 stepped from 0.06 to past it in the user's chart) would leave the crossing no
+    /// nodes before it. `self.y` still holds the step's start.
+    fn retake(&mut self) -> ControlFlow<Stop> {
+        let t_prev = self.stepper.t_prev();
+        self.ode.restart_from_anchor();
+        if let Err(error) = self.stepper.reset(&mut self.ode, t_prev, &self.y) {
+            return Break(Stop::Step { error, crossing: None });
+        }
+        self.t_stop = self.limit.unwrap_or(self.settings.t_end);
+        Continue(())
+    }
+
+    /// The crossing's nodes that the step just taken went over (its grid as seen from the
+    /// step's start): evaluated on the step's interpolant, as the outputs are, and kept for the
+    /// crossing ([`Approach::fill`]).
+    fn fill_approach(&mut self, t: f64) -> ControlFlow<Stop> {
+        let Some(grid) = self.grid else { return Continue(()) };
+        let t_prev = self.stepper.t_prev();
+        let mut times: Vec<f64> = grid.nodes().filter(|&s| s > t_prev + grid.h / 4.0 && s < t - grid.h / 4.0).collect();
+        if times.is_empty() {
+            return Continue(());
+        }
+        times.reverse();
+        let saved = self.ode.save();
+        self.ode.restart_from_anchor();
+        for s in times {
+            if let Err(error) = evaluate_output(&mut self.ode, &mut self.stepper, s, &mut self.yi) {
+                return Break(Stop::Output { t: s, error });
+            }
+            self.approach.fill(Passed::of(&self.ode, s, f64::NAN));
+        }
+        self.ode.restore(saved);
+        Continue(())
+    }
+
+    /// The caller's progress callback, which may stop the run.
+    fn report(&mut self, t: f64, progress: &mut Progress) -> ControlFlow<Stop> {
+        let stop = progress.as_mut().is_some_and(|cb| !cb(t));
+        if stop {
+            return Break(Stop::Cancelled { t });
+        }
+        Continue(())
+    }
+
+    /// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
+    /// passive measures `sigma`, `passive`, work `work`) and restart the stepper past it.
+    /// Outputs inside the crossing come from the path it followed; without a grid the point
+    /// past it is recorded. Err says why the motion cannot be continued.
+    fn cross_change_point(&mut self, (t, sigma, passive, work): (f64, f64, f64, f64)) -> Result<Crossed, String> {
+        let t_end = self.settings.t_end;
+        let integration = Integration { method: self.settings.method, options: &self.options };
+        let at = (t, passive, work);
+        let Some(landing) = cross(&mut self.ode, at, &self.approach, &integration, &mut self.crossing_stats)? else {
+            return Ok(Crossed::NoPoint);
+        };
+        self.passed_point(landing.point.clone());
+        (self.t_stop, self.grid, self.heading) = (t_end, None, None);
+        let inside = |s: f64, end: f64| s < end || s == t_end && end >= t_end;
+        if landing.t >= t_end {
+            let rows: Vec<f64> = match self.t_eval {
+                Some(te) => te[self.next..].iter().copied().take_while(|&s| inside(s, t_end)).collect(),
+                None => vec![t_end],
+            };
+            for s in rows {
+                path_row(&mut self.ode, &mut self.traj, &landing.path, s, sigma);
+            }
+            self.next = self.t_eval.map_or(0, <[f64]>::len);
+            return Ok(Crossed::AtEnd);
+        }
+        let ode = &mut self.ode;
+        self.stepper.reset(ode, landing.t, &landing.y).map_err(|e| format!("restarting past the change point: {e}"))?;
+        self.traj.stats.chart_switches += 1;
+        let meas = measure(ode);
+        let own = chart_sigma(ode, meas.sigma);
+        ode.limit_correction(own);
+        let work_past = landing.y[landing.y.len() - 1];
+        self.approach.clear();
+        self.approach.keep(ode, landing.t, meas.passive);
+        match self.t_eval {
+            None => self.traj.record(ode, landing.t, work_past, meas.sigma),
+            Some(te) => {
+                while self.next < te.len() && inside(te[self.next], landing.t) {
+                    path_row(ode, &mut self.traj, &landing.path, te[self.next], sigma);
+                    self.next += 1;
+                }
+                ode.restart_from_anchor();
+            }
+        }
+        Ok(Crossed::Past)
+    }
+
+    /// The trajectory with the run's counters, its events and dense output, and the status and
+    /// message of `stop`. A run stopped between two accepted steps keeps the last one as its
+    /// final row when the output grid did not reach it.
+    fn finish(mut self, stop: Stop) -> Trajectory {
+        if stop.keeps_last() && self.traj.t.last().is_none_or(|&t| t < self.stepper.t()) {
+            keep_last_state(&mut self.ode, &self.stepper, &mut self.traj);
+        }
+        let mut traj = self.traj;
+        let (run, crossings) = (self.stepper.stats(), self.crossing_stats);
+        traj.stats.integrator = Stats {
+            nfev: run.nfev + crossings.nfev,
+            naccept: run.naccept + crossings.naccept,
+            nreject: run.nreject + crossings.nreject,
+            ..run
+        };
+        traj.stats.failed_evaluations = self.ode.failed_evaluations;
+        traj.events = self.watch.records;
+        // Events alone need the dense output only while the run lasts.
+        traj.dense = self.dense.filter(|_| self.keep_dense);
+        let (mech, ode) = (self.ode.mech, &self.ode);
+        (traj.status, traj.message) = stop.describe(|| Near {
+            passive: passive_sigma_min(mech, ode.anchor_x()),
+            driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
+        });
+        traj
+    }
+}
+
+/// The trajectory of a run that stopped before its first step: no row, its status.
+pub fn stopped_at_start(mech: &Mechanism, stop: Stop) -> Trajectory {
+    let mut traj = Trajectory::new(mech.dof(), mech.n_x());
+    (traj.status, traj.message) = stop.describe(|| Near { passive: f64::INFINITY, driven: f64::INFINITY });
+    traj
+}
+
+/// Record the stepper's last accepted state as the final row (a stopped run keeps it when
+/// the output grid did not reach it). Evaluated from its own anchor, so Newton starts at the
+/// answer; if even that fails, the rows already recorded stand.
+fn keep_last_state(ode: &mut MechanismOde, stepper: &Stepper, traj: &mut Trajectory) {
+    let (t, y) = (stepper.t(), stepper.y());
+    ode.restart_from_anchor();
+    if ode.accept(t, y).is_ok() {
+        let sigma = measure(ode).sigma;
+        traj.record(ode, t, y[y.len() - 1], sigma);
+    }
+}
+
+/// Evaluate the dense output of the step just taken at `t_out` into `yi` (walking there
+/// from the step's start if a direct evaluation is refused).
+fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi: &mut [f64]) -> Result<(), Error> {
+    stepper.interpolate(ode, t_out, yi);
+    ode.evaluate_walking(t_out, yi)
+}
+
+/// Append the step just taken to `dense`: the user's q and qd at its nodes, from the step's
+/// interpolant. In the user's chart that is the interpolant itself, the coordinates driven by
+/// motion following it; in a partition chart, the point assembled at the interpolated chart
+/// values (the interpolant of q through those points is then as accurate as the step's own).
+fn sample_step(
+    ode: &mut MechanismOde,
+    stepper: &mut Stepper,
+    dense: &mut DenseOutput,
+    yi: &mut [f64],
+    rows: &mut Vec<f64>,
+) -> Result<(), Error> {
+    let m = ode.m();
+    let (t0, t1) = (stepper.t_prev(), stepper.t());
+    rows.clear();
+    ode.restart_from_anchor();
+    for j in 0..dense.nodes {
+        let t = t0 + dense::node(j, dense.nodes) * (t1 - t0);
+        if j + 1 == dense.nodes {
+            yi.copy_from_slice(stepper.y());
+        } else {
+            stepper.interpolate(ode, t, yi);
+        }
+        if ode.ws.chart == Chart::Inputs {
+            if let Some(motion) = ode.motion.as_deref_mut() {
+                motion.eval(t).map_err(|message| Error::Drive { t, message })?;
+                motion.overwrite(m, yi);
+            }
+            rows.extend_from_slice(&yi[..2 * m]);
+        } else {
+            ode.evaluate_walking(t, yi)?;
+            rows.extend_from_slice(&ode.ws.q);
+            rows.extend_from_slice(&ode.ws.qd);
+        }
+    }
+    dense.push(t0, t1, rows);
+    Ok(())
+}
+
+/// Record the row at time s inside a crossing, from the path it followed.
+fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &Bridge, s: f64, sigma: f64) {
+    let ws = &mut ode.ws;
+    path.at(s, &mut ws.frame.x, &mut ws.frame.xd, &mut ws.xdd);
+    user_state(ode);
+    traj.record(ode, s, path.work(s), sigma);
+}

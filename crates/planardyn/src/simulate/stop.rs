@@ -1,0 +1,169 @@
+//! Why a run stopped, with the data its message needs: every stage of [`super::run::Run`]
+//! returns `ControlFlow<Stop>`, and this file alone turns a [`Stop`] into the trajectory's
+//! [`Status`] and message.
+
+use super::charts::NEAR_PASSIVE_SINGULAR;
+use super::trajectory::Status;
+use crate::integrate::StepError;
+use crate::Error;
+
+/// Why a run stopped. Times in s.
+#[derive(Debug)]
+pub enum Stop {
+    /// t_end was reached (also inside a change point's crossing).
+    Reached { t_end: f64 },
+    /// A drive failed at the start.
+    StartDrive(Error),
+    /// A step could not be completed, even with the smallest step size; `crossing` says why
+    /// no change point could be crossed from the last accepted point, when one was near.
+    Step { error: StepError<Error>, crossing: Option<String> },
+    /// An event function failed at the start.
+    EventAtStart { t: f64, error: String },
+    /// The dense output of the step to t could not be evaluated.
+    DenseOutput { t: f64, error: Error },
+    /// An event function failed in the step to t.
+    EventInStep { t: f64, error: String },
+    /// The output at t could not be evaluated.
+    Output { t: f64, error: Error },
+    /// Terminal event `index` occurred at t.
+    TerminalEvent { index: usize, t: f64 },
+    /// The state at terminal event `index` (time t) could not be evaluated.
+    EventState { index: usize, t: f64, error: Error },
+    /// The end of the step at t could not be made the predictor's anchor.
+    Accept { t: f64, error: Error },
+    /// A change point ahead of the point at t (passive measure `passive`) could not be crossed.
+    NoCrossing { t: f64, passive: f64, why: String },
+    /// The passive mechanism is singular at t.
+    PassiveSingular { t: f64, passive: f64 },
+    /// The run cannot reach t_end at its rate of progress (see `Run::progress_rate`): at t,
+    /// after `attempts` steps of mean `mean` (last `last`), below `floor`.
+    Hopeless { t: f64, attempts: usize, mean: f64, last: f64, floor: f64, t_end: f64, max_steps: usize },
+    /// Changing the chart at t failed.
+    ChartChange { t: f64, error: String },
+    /// The progress callback asked to stop at t.
+    Cancelled { t: f64 },
+}
+
+/// The passive and the prescribed coordinates' measures at the last accepted point, for a
+/// failure's message (`passive_sigma_min`, `prescribed_sigma_min`).
+pub struct Near {
+    pub passive: f64,
+    pub driven: f64,
+}
+
+impl Stop {
+    /// Whether the last accepted state is kept as the final row when the outputs did not
+    /// reach it: the run stopped between two of its accepted steps.
+    pub fn keeps_last(&self) -> bool {
+        matches!(
+            self,
+            Stop::Step { .. }
+                | Stop::DenseOutput { .. }
+                | Stop::EventInStep { .. }
+                | Stop::Hopeless { .. }
+                | Stop::Cancelled { .. }
+        )
+    }
+
+    /// The trajectory's status and message. A failure that usually means a change point (steps
+    /// that shrink to nothing, a position that does not assemble) asks `near` for the measures
+    /// at the last accepted point and says when one of them is near-singular.
+    pub fn describe(self, near: impl FnOnce() -> Near) -> (Status, String) {
+        let (status, message) = self.status_message();
+        if !matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
+            return (status, message);
+        }
+        let Near { passive, driven } = near();
+        if passive < NEAR_PASSIVE_SINGULAR {
+            let message = format!(
+                "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
+                 a change point where its motion is not determined"
+            );
+            (Status::PassiveSingularity, message)
+        } else if driven < NEAR_PASSIVE_SINGULAR {
+            let message = format!(
+                "{message}; the coordinates driven by motion are near a singularity of their own there (scaled \
+                 measure {driven:.2e}): they stop determining their part of the mechanism, and the efforts their \
+                 motion needs grow without bound. Change the motion so that it avoids this configuration"
+            );
+            (status, message)
+        } else {
+            (status, message)
+        }
+    }
+
+    /// Status and message, before the diagnosis of [`Stop::describe`].
+    fn status_message(self) -> (Status, String) {
+        match self {
+            Stop::Reached { t_end } => (Status::Success, format!("reached t_end = {t_end} s")),
+            Stop::StartDrive(e) => (Status::DriveFailed, e.to_string()),
+            Stop::Step { error, crossing } => {
+                let (status, message) = step_failure(&error);
+                match crossing {
+                    Some(why) => (status, format!("{message}; {why}")),
+                    None => (status, message),
+                }
+            }
+            Stop::EventAtStart { t, error } => (Status::EventFailed, format!("at t = {t} s: {error}")),
+            Stop::DenseOutput { t, error } => {
+                let kind =
+                    if matches!(error, Error::Drive { .. }) { Status::DriveFailed } else { Status::AssemblyFailed };
+                (kind, format!("dense output of the step to t = {t} s: {error}"))
+            }
+            Stop::EventInStep { t, error } => (Status::EventFailed, format!("in the step to t = {t} s: {error}")),
+            Stop::Output { t, error } => (Status::AssemblyFailed, format!("output at t = {t}: {error}")),
+            Stop::TerminalEvent { index, t } => (Status::Event, format!("terminal event {index} at t = {t} s")),
+            Stop::EventState { index, t, error } => {
+                (Status::AssemblyFailed, format!("the state at terminal event {index}, t = {t} s: {error}"))
+            }
+            Stop::Accept { t, error } => (Status::AssemblyFailed, format!("at t = {t}: {error}")),
+            Stop::NoCrossing { t, passive, why } => (
+                Status::PassiveSingularity,
+                format!("the passive mechanism is singular at t = {t} s (scaled measure {passive:.2e}) and {why}"),
+            ),
+            Stop::PassiveSingular { t, passive } => (
+                Status::PassiveSingularity,
+                format!(
+                    "the passive mechanism is singular at t = {t} s (scaled measure {passive:.2e}): its pair \
+                     constraints lose rank and the motion is not determined beyond"
+                ),
+            ),
+            Stop::Hopeless { t, attempts, mean, last, floor, t_end, max_steps } => (
+                Status::StepSizeTooSmall,
+                format!(
+                    "step size too small at t = {t:e} s: after {attempts} steps the mean step is {mean:.2e} s \
+                     (last {last:.2e} s), below (t_end - t0) / ({PROGRESS_MARGIN} max_steps) = {floor:.2e} s, so \
+                     the run cannot make progress to t_end = {t_end} s within max_steps = {max_steps}. The efforts \
+                     are too large for the model or the tolerances too tight: lower the efforts, loosen rtol/atol, \
+                     shorten t_end, or raise max_steps"
+                ),
+            ),
+            Stop::ChartChange { t, error } => {
+                (Status::AssemblyFailed, format!("changing coordinates at t = {t} s: {error}"))
+            }
+            Stop::Cancelled { t } => {
+                (Status::Cancelled, format!("cancelled at t = {t} s: the progress callback asked to stop"))
+            }
+        }
+    }
+}
+
+/// A run whose mean step so far would need this many times its step budget to reach t_end
+/// is stopped: it cannot finish, and waiting for the budget costs this many times more work.
+pub const PROGRESS_MARGIN: f64 = 10.0;
+
+/// Status and message for a failed step.
+fn step_failure(e: &StepError<Error>) -> (Status, String) {
+    let status = match e {
+        StepError::StepSizeUnderflow { .. } => Status::StepSizeUnderflow,
+        StepError::NonFinite { .. } => Status::NonFinite,
+        StepError::TooManySteps { .. } => Status::TooManySteps,
+        StepError::Rhs { error: Error::Drive { .. }, .. } => Status::DriveFailed,
+        StepError::Rhs { .. } => Status::AssemblyFailed,
+    };
+    let message = match e {
+        StepError::Rhs { t, error } => format!("at t = {t} s, even with the smallest step: {error}"),
+        other => other.to_string(),
+    };
+    (status, message)
+}

@@ -1,0 +1,123 @@
+// Charts of the chosen channels with uPlot: one chart per unit (so every axis has one unit
+// and nice-number ticks), sharing the x axis and the cursor, with a marker at the current
+// state; a click moves the state there. The chooser lists every channel by group.
+import uPlot from "uplot";
+import { GROUPS } from "./channels.js";
+
+const COLORS = ["#1f6fb2", "#d9730d", "#2e8540", "#8e44ad", "#b3261e", "#0f7c80", "#7a5c00", "#c2185b"];
+/** Height of one chart (px): the charts share the area, scrolling below this. */
+const MIN_HEIGHT = 150;
+const MAX_HEIGHT = 320;
+/** The legend's line under each chart (px). */
+const LEGEND_HEIGHT = 26;
+
+/** uPlot's range with a margin, never below zero for a channel that never is (|F|, speeds). */
+function range(u, min, max) {
+  if (min === max) return [min - 1, max + 1];
+  const [a, b] = uPlot.rangeNum(min, max, 0.1, true);
+  return [min >= 0 ? Math.max(0, a) : a, b];
+}
+
+export class Charts {
+  constructor(chooser, area, onPick) {
+    this.chooser = chooser;
+    this.area = area;
+    this.onPick = onPick;
+    this.plots = [];
+    this.chans = [];
+    this.on = new Set();
+    this.x = new Float64Array(0);
+    this.xLabel = "";
+    this.marker = null;
+  }
+
+  /** Show channels `chans` over `x` (label with unit), keeping the user's choice where
+   * it still names channels, else `defaults`. */
+  set(x, xLabel, chans, defaults) {
+    const keys = new Set(chans.map((c) => c.key));
+    const kept = [...this.on].filter((k) => keys.has(k));
+    this.on = kept.length ? new Set(kept) : defaults;
+    Object.assign(this, { x, xLabel, chans });
+    this.renderChooser();
+    this.render();
+  }
+
+  renderChooser() {
+    this.chooser.replaceChildren();
+    for (const [g, label] of GROUPS) {
+      const members = this.chans.filter((c) => c.group === g);
+      if (!members.length) continue;
+      const box = document.createElement("details");
+      box.open = members.some((c) => this.on.has(c.key));
+      const sum = document.createElement("summary");
+      sum.textContent = `${label} (${members[0].unit})`;
+      box.append(sum);
+      for (const c of members) {
+        const row = document.createElement("label");
+        const input = document.createElement("input");
+        input.type = "checkbox";
+        input.checked = this.on.has(c.key);
+        input.dataset.key = c.key;
+        input.addEventListener("change", () => {
+          input.checked ? this.on.add(c.key) : this.on.delete(c.key);
+          this.render();
+        });
+        row.append(input, ` ${c.label}`);
+        box.append(row);
+      }
+      this.chooser.append(box);
+    }
+  }
+
+  render() {
+    for (const p of this.plots) p.destroy();
+    this.plots = [];
+    this.area.replaceChildren();
+    const chosen = this.chans.filter((c) => this.on.has(c.key));
+    const units = [...new Set(chosen.map((c) => c.unit))];
+    const width = Math.max(200, this.area.clientWidth - 12);
+    const height = Math.min(MAX_HEIGHT, Math.max(MIN_HEIGHT, (this.area.clientHeight - 8) / Math.max(1, units.length) - LEGEND_HEIGHT));
+    const sync = uPlot.sync("planardyn");
+    units.forEach((unit, u) => {
+      const members = chosen.filter((c) => c.unit === unit);
+      const opts = {
+        width, height,
+        scales: { x: { time: false }, y: { range } },
+        axes: [{ label: u === units.length - 1 ? this.xLabel : "" }, { label: unit, size: 60 }],
+        series: [{ label: this.xLabel }, ...members.map((c, i) => ({ label: c.label, stroke: COLORS[i % COLORS.length], width: 1.5 }))],
+        cursor: { sync: { key: sync.key } },
+        legend: { live: true },
+        hooks: { draw: [(p) => this.drawMarker(p)], ready: [(p) => p.over.addEventListener("click", () => this.pick(p))] },
+      };
+      const plot = new uPlot(opts, [this.x, ...members.map((c) => c.values)], this.area);
+      plot.root.dataset.unit = unit;
+      this.plots.push(plot);
+    });
+  }
+
+  /** Move the state to the point under the cursor. */
+  pick(p) {
+    const i = p.cursor.idx;
+    if (i != null && this.onPick) this.onPick(i);
+  }
+
+  /** Put the marker at x value `x` (the current state) on every chart. */
+  mark(x) {
+    this.marker = x;
+    for (const p of this.plots) p.redraw(false, false);
+  }
+
+  drawMarker(p) {
+    if (this.marker == null || !Number.isFinite(this.marker)) return;
+    const ctx = p.ctx;
+    const px = p.valToPos(this.marker, "x", true);
+    ctx.save();
+    ctx.strokeStyle = "#b3261e";
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    ctx.moveTo(px, p.bbox.top);
+    ctx.lineTo(px, p.bbox.top + p.bbox.height);
+    ctx.stroke();
+    ctx.restore();
+  }
+}

@@ -1,0 +1,89 @@
+// The singularity map of a two-coordinate mechanism (a 5R, a two-input robot): over a grid
+// of (q1, q2), the type II measure sigma of the branch reached by continuation from the
+// current state, cell after cell along a serpentine (each cell starts Newton from its
+// neighbour; the engine's `sigmaRows`). Computed progressively, coarse grids first, in slices
+// that leave the page responsive; cells that do not assemble are grey.
+
+/** Grids of the progressive refinement; the last is the map's resolution. */
+export const LEVELS = [25, 50, 100];
+/** Work per slice before the page gets the main thread back (ms). */
+const SLICE_MS = 12;
+/** Rows per call of the engine: a 100-wide row takes about a millisecond. */
+const ROWS_PER_CALL = 4;
+
+/** The grid's ranges: an angle q0 +- pi, a displacement q0 +- L. */
+export function mapRanges(info, q) {
+  return [0, 1].map((k) => {
+    const half = info.coordinateKinds[k] === "angle" ? Math.PI : info.scale;
+    return [q[k] - half, q[k] + half];
+  });
+}
+
+/** sigma on an n x n grid over `ranges` (row j: q2, column i: q1), NaN where it does not
+ * assemble, computed by the engine a few rows a call (`Mechanism.sigmaRows`: one workspace,
+ * continuation outwards from the current state q, whose body coordinates are x0: its row
+ * first, then the rows above it, then those below). `coarse`, a finished coarser grid, fills
+ * the cells not yet computed, so that the map refines in place. */
+export function mapper(mech, ranges, n, x0, q, coarse = null) {
+  const sigma = new Float64Array(n * n).fill(NaN);
+  if (coarse) {
+    const c = coarse.n;
+    for (let j = 0; j < n; j++) for (let i = 0; i < n; i++) sigma[j * n + i] = coarse.sigma[Math.floor((j * c) / n) * c + Math.floor((i * c) / n)];
+  }
+  const axes = ranges.map((r) => Float64Array.from({ length: n }, (_, i) => r[0] + ((r[1] - r[0]) * (i + 0.5)) / n));
+  const j0 = Math.floor(n / 2);
+  const order = [...Array(n - j0).keys()].map((d) => j0 + d).concat([...Array(j0).keys()].map((d) => j0 - 1 - d));
+  let [done, x, xMiddle] = [0, x0, null];
+  return {
+    sigma, n,
+    /** Work for `budget` ms (all at once when Infinity); true when the grid is done. */
+    step(budget = SLICE_MS) {
+      const end = performance.now() + budget;
+      while (done < n && performance.now() < end) {
+        // The rows below the middle continue from the middle row, not from the top one.
+        if (done === n - j0) x = xMiddle;
+        const count = done === 0 ? 1 : Math.min(ROWS_PER_CALL, (done < n - j0 ? n - j0 : n) - done);
+        const rows = Uint32Array.from(order.slice(done, done + count));
+        const out = mech.sigmaRows(q, 0, 1, axes[0], axes[1], j0, rows, x);
+        rows.forEach((j, r) => sigma.set(out.sigma.subarray(r * n, (r + 1) * n), j * n));
+        x = out.x;
+        if (done === 0) xMiddle = out.x;
+        done += count;
+      }
+      return done >= n;
+    },
+  };
+}
+
+/** A colour for sigma (log scale from 1e-3 to 1: dark red at a singularity to pale). */
+function colour(s) {
+  if (!Number.isFinite(s)) return [210, 214, 218];
+  const t = Math.max(0, Math.min(1, (Math.log10(Math.max(s, 1e-3)) + 3) / 3));
+  return [Math.round(120 + 135 * t), Math.round(20 + 215 * t), Math.round(30 + 190 * t)];
+}
+
+/** Paint a finished or partial grid on the canvas, with the current state's cross. */
+export function paintMap(canvas, grid, ranges, q) {
+  const ctx = canvas.getContext("2d");
+  const { n, sigma } = grid;
+  const img = ctx.createImageData(n, n);
+  for (let j = 0; j < n; j++) {
+    for (let i = 0; i < n; i++) {
+      const [r, g, b] = colour(sigma[j * n + i]);
+      const o = ((n - 1 - j) * n + i) * 4;
+      [img.data[o], img.data[o + 1], img.data[o + 2], img.data[o + 3]] = [r, g, b, 255];
+    }
+  }
+  const off = new OffscreenCanvas(n, n);
+  off.getContext("2d").putImageData(img, 0, 0);
+  ctx.imageSmoothingEnabled = false;
+  ctx.drawImage(off, 0, 0, canvas.width, canvas.height);
+  const px = ((q[0] - ranges[0][0]) / (ranges[0][1] - ranges[0][0])) * canvas.width;
+  const py = (1 - (q[1] - ranges[1][0]) / (ranges[1][1] - ranges[1][0])) * canvas.height;
+  ctx.strokeStyle = "#000";
+  ctx.lineWidth = 2;
+  ctx.beginPath();
+  ctx.moveTo(px - 7, py); ctx.lineTo(px + 7, py);
+  ctx.moveTo(px, py - 7); ctx.lineTo(px, py + 7);
+  ctx.stroke();
+}
