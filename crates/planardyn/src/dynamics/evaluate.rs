@@ -6,7 +6,7 @@
 //! that redraws it as the design changes ([`sigma_rows`]).
 
 use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives};
-use crate::kinematics::{assemble_from, assemble_into, passive_sigma_min, sigma_min, sigma_min_with, Chart};
+use crate::kinematics::{assemble_from, assemble_into, passive_sigma_min, sigma_min, sigma_min_with, Chart, Frame};
 use crate::model::Mechanism;
 use crate::Workspace;
 use crate::{Error, KinematicsError};
@@ -93,7 +93,7 @@ pub struct SigmaRows {
     pub x: Vec<f64>,
 }
 
-/// See [`SigmaRows`]. One workspace for all the cells (no allocation per cell).
+/// See [`SigmaRows`]. One kinematic frame for all the cells (no allocation per cell).
 pub fn sigma_rows(
     mech: &Mechanism,
     q: &[f64],
@@ -119,29 +119,31 @@ pub fn sigma_rows(
             KinematicsError::bad_argument("x_start", format!("{} finite body coordinates", mech.n_x()), got).into()
         );
     }
-    let mut ws = Workspace::new(mech);
+    let mut frame = Frame::new(mech);
     let mut q = q.to_vec();
     let (mut start, mut sigma) = (x_start.to_vec(), Vec::with_capacity(rows.len() * n));
-    let cell = |q: &[f64], from: &[f64], ws: &mut Workspace| {
-        assemble_from(mech, from, q, ws).ok().map(|()| sigma_min_with(&mut ws.frame.sys, mech, &Chart::Inputs, &ws.frame.x))
+    let cell = |q: &[f64], from: &[f64], frame: &mut Frame| {
+        assemble_from(mech, from, q, frame)
+            .ok()
+            .map(|()| sigma_min_with(&mut frame.sys, mech, &Chart::Inputs, &frame.x))
     };
     for &j in rows {
         let mut row = vec![f64::NAN; n];
         q[k[1]] = axes[1][j];
         q[k[0]] = axes[0][i0];
-        if let Some(s) = cell(&q, &start, &mut ws) {
+        if let Some(s) = cell(&q, &start, &mut frame) {
             row[i0] = s;
-            start.copy_from_slice(&ws.x);
+            start.copy_from_slice(&frame.x);
         }
         let (right, left) = ((i0 + 1..n).collect::<Vec<_>>(), (0..i0).rev().collect::<Vec<_>>());
         for side in [right, left] {
             let mut last = start.clone();
             for i in side {
                 q[k[0]] = axes[0][i];
-                match cell(&q, &last, &mut ws) {
+                match cell(&q, &last, &mut frame) {
                     Some(s) => {
                         row[i] = s;
-                        last.copy_from_slice(&ws.x);
+                        last.copy_from_slice(&frame.x);
                     }
                     None => last.copy_from_slice(&start),
                 }

@@ -11,8 +11,8 @@ use crate::kinematics::assemble_into;
 use crate::model::pairs::frames::rotate;
 use crate::model::BodyId;
 use crate::model::Mechanism;
-use crate::Workspace;
 use crate::Error;
+use crate::Workspace;
 
 /// A, B, C, D row-major: A (2m x 2m), B (2m x m), C (p x 2m), D (p x m), p = m + 2 per point.
 #[derive(Debug, Clone, PartialEq)]

@@ -14,8 +14,8 @@ use super::stiffness::{elastic_at, elastic_stiffness, null_basis};
 use crate::dynamics::{inverse, inverse_derivatives, mass_matrix};
 use crate::kinematics::assemble_into;
 use crate::model::{CoordinateKind, Mechanism};
-use crate::Workspace;
 use crate::KinematicsError;
+use crate::Workspace;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 /// A mass eigenvalue below this fraction of the largest is a direction without mass (the

@@ -17,8 +17,8 @@
 use super::model::{ElasticModel, Output};
 use crate::kinematics::assemble_into;
 use crate::model::Mechanism;
-use crate::Workspace;
 use crate::KinematicsError;
+use crate::Workspace;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 /// A singular value of the scaled rigid rows below this fraction of the largest is taken as
