@@ -93,6 +93,7 @@ def test_a_method_given_to_a_lower_type_from_above_is_an_upward_reference(tmp_pa
         "c: model.rs -> loader.rs: upward: model (layer 0) -> loader (layer 2) "
         "(its `Mechanism` gets methods there: make them functions of `loader`)",
         "c: file cycle (2): loader.rs, model.rs",
+        "c: module cycle (2): loader, model",
     ]
 
 
@@ -110,6 +111,27 @@ def test_a_cycle_between_two_files_of_one_layer_is_found(tmp_path: Path) -> None
     }
     found, _ = run(tmp_path, files)
     assert found == ["c: file cycle (2): kinematics/analogues.rs, kinematics/position.rs"]
+
+
+def test_a_cycle_between_two_modules_through_different_files_is_found(tmp_path: Path) -> None:
+    # model.rs -> kinematics/x.rs and kinematics/y.rs -> model.rs: no file cycle (x and y are
+    # different files), but the modules model and kinematics reference each other. The upward
+    # reference is a finding of the order; allowed, the module cycle it closes still is one.
+    files = {
+        "kinematics/mod.rs": "pub mod x;\npub mod y;\n",
+        "kinematics/x.rs": "pub fn count() -> usize { 1 }\n",
+        "kinematics/y.rs": "use crate::model::Mechanism;\n",
+        "model.rs": "pub struct Mechanism;\npub fn f() -> usize { crate::kinematics::x::count() }\n",
+    }
+    found, _ = run(tmp_path, files)
+    assert found == [
+        "c: model.rs -> kinematics/x.rs: upward: model (layer 0) -> kinematics (layer 1)",
+        "c: module cycle (2): kinematics, model",
+    ]
+    known = {"from": "model.rs", "to": "kinematics/x.rs", "why": "w", "until": "phase 9"}
+    found, allowed = run(tmp_path, files, allow=[known])
+    assert found == ["c: module cycle (2): kinematics, model"]
+    assert len(allowed) == 1
 
 
 def test_the_allow_list_lets_known_violations_pass_and_only_shrinks(tmp_path: Path) -> None:

@@ -6,6 +6,10 @@ and fails (exit 1) on
 - a reference from a module to one of a higher layer, or between two independent modules
   of one layer (``a | b``), or from an independent module to one it may not use;
 - a cycle between two files (a strongly connected component of the file graph);
+- a cycle between two top-level modules (a folder or file of ``src``: ``dynamics``,
+  ``kinematics``...) through any of their files, e.g. ``a.rs -> b/x.rs`` and ``b/y.rs -> a.rs``.
+  The declared order already forbids one (it needs a reference upward or between independent
+  modules), but an allowed reference could close one: a module cycle is never allowed;
 - an allow-list entry that no longer matches anything (so the list can only shrink);
 
 except the violations the allow-list names, each with its reason and the phase that removes it.
@@ -287,6 +291,25 @@ def reason(entry: dict) -> str:
     return f"  [allowed: {entry['why']}; until {entry['until']}]"
 
 
+def module_graph(graph: dict[Module, set[Module]]) -> dict[Module, set[Module]]:
+    """The graph of the top-level modules: an edge wherever one of a module's files references
+    a file of another (lib.rs, the crate's facade of re-exports, left out)."""
+    modules: dict[Module, set[Module]] = {(top(m),): set() for m in graph if m}
+    for mod, targets in graph.items():
+        for target in targets:
+            if mod and target and top(mod) != top(target):
+                modules[(top(mod),)].add((top(target),))
+    return modules
+
+
+def module_cycle_findings(name: str, graph: dict[Module, set[Module]]) -> list[str]:
+    """The cycles between top-level modules, each a finding (no allow-list entry excuses one)."""
+    return [
+        f"{name}: module cycle ({len(comp)}): {', '.join(m[0] for m in comp)}"
+        for comp in cycles(module_graph(graph))
+    ]
+
+
 def layer_findings(name: str, crate: Crate, graph: dict, layers: Layers, allow: list[dict]) -> tuple[list, list, list]:
     """(violations, allowed lines, allow entries used) of the references between layers."""
     by_edge = {(a["from"], a["to"]): a for a in allow}
@@ -331,7 +354,7 @@ def cycle_findings(name: str, crate: Crate, graph: dict, allow: list[dict]) -> t
 
 
 def check(name: str, cfg: dict, root: Path = ROOT) -> tuple[list[str], list[str], int]:
-    """(violations, allowed lines, number of file cycles) of one crate against its
+    """(violations, allowed lines, number of file and module cycles) of one crate against its
     declared order and allow-list."""
     crate = Crate.read(root / cfg["src"])
     layers = Layers.parse(cfg["layers"], cfg.get("may_use", {}))
@@ -349,8 +372,9 @@ def check(name: str, cfg: dict, root: Path = ROOT) -> tuple[list[str], list[str]
         if id(entry) not in used:
             what = ", ".join(entry["cycle"]) if "cycle" in entry else f"{entry['from']} -> {entry['to']}"
             found.append(f"{name}: allow-list entry matches nothing now, remove it: {what}")
+    modules = module_cycle_findings(name, graph)
     n_cycles = sum(line.startswith(f"{name}: file cycle") for line in edges[1] + loops[0] + loops[1])
-    return edges[0] + loops[0] + found, edges[1] + loops[1], n_cycles
+    return edges[0] + loops[0] + modules + found, edges[1] + loops[1], n_cycles + len(modules)
 
 
 def main(argv: list[str]) -> int:
@@ -360,7 +384,7 @@ def main(argv: list[str]) -> int:
     for name, cfg in crates.items():
         found, allowed, n_cycles = check(name, cfg, config.resolve().parents[1])
         print("\n".join(allowed + found) or f"{name}: no violation")
-        print(f"{name}: {n_cycles} file cycle(s), {len(allowed)} allowed, {len(found)} violation(s)")
+        print(f"{name}: {n_cycles} file or module cycle(s), {len(allowed)} allowed, {len(found)} violation(s)")
         failed |= bool(found)
     return 1 if failed else 0
 
