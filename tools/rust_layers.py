@@ -305,8 +305,7 @@ def module_graph(graph: dict[Module, set[Module]]) -> dict[Module, set[Module]]:
 def module_cycle_findings(name: str, graph: dict[Module, set[Module]]) -> list[str]:
     """The cycles between top-level modules, each a finding (no allow-list entry excuses one)."""
     return [
-        f"{name}: module cycle ({len(comp)}): {', '.join(m[0] for m in comp)}"
-        for comp in cycles(module_graph(graph))
+        f"{name}: module cycle ({len(comp)}): {', '.join(m[0] for m in comp)}" for comp in cycles(module_graph(graph))
     ]
 
 
