@@ -9,7 +9,8 @@
 //! sampled end-effector path (`t`, `X`, `Xd`, `Xdd`, `point`, ...), on the same pool.
 
 use crate::convert::{arr2, solution_dict};
-use crate::errors::{argument_error, run, task_error, to_pyerr, Failure, PlanardynError};
+use crate::errors::{run, task_error, to_pyerr, Failure};
+use crate::exceptions::{argument_error, PlanardynError};
 use crate::mechanism::PyMechanism;
 use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};

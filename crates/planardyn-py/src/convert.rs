@@ -1,7 +1,7 @@
 //! Conversions between numpy arrays (float64, C order, time-major) and the core's slices,
 //! with shape checks whose messages name the argument, the expected shape and its meaning.
 
-use crate::errors::{argument_error, PlanardynError};
+use crate::exceptions::{argument_error, PlanardynError};
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, IxDyn};
 use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
 use planardyn::dynamics::task::TaskSolution;

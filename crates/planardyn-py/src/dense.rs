@@ -2,7 +2,7 @@
 //! `simulate::DenseOutput`), called with times to give q and qd there.
 
 use crate::convert::{arr1, arr2, Floats, Values};
-use crate::errors::argument_error;
+use crate::exceptions::argument_error;
 use planardyn::simulate::DenseOutput;
 use pyo3::prelude::*;
 

@@ -4,7 +4,8 @@
 //! drawing.
 
 use crate::convert::{arr1, arr2, finite, rows, solution_dict, vector, Floats, Values};
-use crate::errors::{argument_error, effector_error, run, task_error, Failure};
+use crate::errors::{effector_error, run, task_error, Failure};
+use crate::exceptions::argument_error;
 use crate::mechanism::PyMechanism;
 use planardyn::dynamics::task::{self, TaskPath};
 use planardyn::kinematics::constraints::coordinates;

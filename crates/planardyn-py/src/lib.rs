@@ -1,5 +1,6 @@
 //! PyO3 glue for planardyn: the native module `planardyn._core`. Conversions live in
-//! `convert.rs`, the mapping of errors to Python exceptions in `errors.rs` (the only place),
+//! `convert.rs`, the mapping of errors to Python exceptions in `errors.rs` (the only place; the
+//! exception classes in `exceptions.rs`),
 //! the `Mechanism` class in `mechanism.rs`, the end effector and task-space motions in
 //! `effector.rs`, and the simulation entry point in `simulate.rs` (its dense output in `dense.rs`).
 //! The typed Python face is the package `python/planardyn`; its stub `_core.pyi` mirrors
@@ -10,12 +11,14 @@ mod convert;
 mod dense;
 mod effector;
 mod errors;
+mod exceptions;
 mod mechanism;
 mod simulate;
 mod stiffness;
 mod structure;
 
-use errors::{argument_error, model_error, PlanardynError};
+use errors::model_error;
+use exceptions::{argument_error, PlanardynError};
 use mechanism::PyMechanism;
 use planardyn::Format;
 use pyo3::prelude::*;
@@ -80,7 +83,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;
     m.add_function(wrap_pyfunction!(resolve_model, m)?)?;
-    errors::register(m)?;
+    exceptions::register(m)?;
     structure::register(m)?;
     batch::register(m)?;
     effector::register(m)?;

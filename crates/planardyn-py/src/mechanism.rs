@@ -5,7 +5,8 @@
 //! GIL is released while the core computes.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
-use crate::errors::{argument_error, run, Failure, PlanardynError};
+use crate::errors::{run, Failure};
+use crate::exceptions::{argument_error, PlanardynError};
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
 use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
 use planardyn::kinematics::constraints::{point_velocity, world_point};

@@ -4,7 +4,8 @@
 //! callbacks re-attach to the interpreter for the duration of each call.
 
 use crate::convert::{arr1, arr2, bool1, Values};
-use crate::errors::{argument_error, run, Failure};
+use crate::errors::{run, Failure};
+use crate::exceptions::argument_error;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};

@@ -2,7 +2,8 @@
 //! as dicts of numpy arrays; names (bodies, points, actuators) resolved to the core's ids.
 
 use crate::convert::{arr1, arr2, vector, Floats};
-use crate::errors::{argument_error, run, Failure};
+use crate::errors::{run, Failure};
+use crate::exceptions::argument_error;
 use crate::mechanism::PyMechanism;
 use planardyn::elastic::{self, CartesianStiffness, Load, Modes, Output};
 use planardyn::integrate::{Method, Options};
