@@ -78,7 +78,7 @@ def test_time_optimal(capfd) -> None:
 
 def test_task_waypoints(five, capfd) -> None:
     base = dict(effector=five, X=[PICK, PLACE], spacing=0.01)
-    extra = {"X": [[PICK], [PICK, [NAN, 0.3]], [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]], "spacing": [1e-300]}
+    extra = {"X": [[PICK], [PICK, [NAN, 0.3]], [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]], "spacing": [1e-300, 5e-324]}  # 5e-324: the pieces overflowed
     failures = []
     for name in base:
         values = HOSTILE + ARRAYS + extra.get(name, [])
