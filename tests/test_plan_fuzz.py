@@ -27,8 +27,8 @@ from planardyn.plan import InfeasiblePlan, collocate, task_waypoints, time_optim
 
 #: The numbers tried on every argument: NaN, the infinities, zero, negative, huge; a string
 #: and None too (the plan functions take no TypeError for an answer: they refuse these with a
-#: PlanardynError naming the argument). Not yet all of tests/fuzzing.py's NUMBERS: a
-#: subnormal spacing (5e-324) still makes task_waypoints warn of an overflow (s8-revpy notes).
+#: PlanardynError naming the argument). Not yet all of tests/fuzzing.py's NUMBERS: collocate
+#: with a first-guess duration of 5e-324 s still warns (its warm start's rates overflow).
 HOSTILE = [NAN, INF, -INF, 0.0, -1.0, 1e300, -1e300, "x", None]
 
 FIVE_BAR = MODELS / "library" / "five-bar-5r.yaml"
@@ -115,7 +115,7 @@ def test_a_planned_motion_s_methods(capfd) -> None:
 def test_size_and_its_helpers(five, capfd) -> None:
     path = robot.circle([0.014, 0.3], 0.02, duration=0.5)
     base = dict(payload=0.0, distribution="min_norm", preload=None, dt=5e-3)
-    extra = {"distribution": ["fair"], "dt": [10.0, 1e-300]}
+    extra = {"distribution": ["fair"], "dt": [10.0, 1e-300, 2**70]}  # 2**70: np.isfinite refused the int
     failures = []
     for name in base:
         values = HOSTILE + ARRAYS + extra.get(name, [])
