@@ -145,3 +145,29 @@ fn evaluation_with_losses_does_not_allocate() {
     let vary = |y: &mut [f64], step: usize| y[0] += 1e-6 * step as f64;
     assert_eq!(allocations(&mut ode, Chart::Partition(idx), &z, &zd, vary), 0, "in a partition chart");
 }
+
+/// The flexible-joint model's evaluation (`elastic::FlexibleOde`: the mechanism without its
+/// rotors, the springs' efforts as its drives, the rotors' equations) on the four-bar, whose
+/// positions need Newton.
+#[test]
+fn flexible_joint_evaluation_does_not_allocate() {
+    use planardyn::elastic::FlexibleOde;
+    let mech = yaml(&format!(
+        "{FOUR_BAR}drives:\n  - {{coordinate: theta1, effort: 0.02}}\n\
+         actuators: [{{coordinate: theta1, gear_ratio: 20, rotor_inertia: 5.0e-5}}]\n\
+         compliance:\n  drives: [{{actuator: theta1, stiffness: 1.0e3, damping: 0.5}}]\n"
+    ));
+    let (mut ode, mut y) = FlexibleOde::new(&mech).unwrap();
+    let mut dy = vec![0.0; y.len()];
+    ode.rhs(0.0, &y, &mut dy).unwrap();
+    let before = ALLOCATIONS.with(Cell::get);
+    for step in 0..10 {
+        // Coupler and rotor apart: the spring works, and Newton moves the loop.
+        y[0] += 1e-3;
+        y[2] -= 2e-3 * step as f64;
+        ode.rhs(1e-3 * step as f64, &y, &mut dy).unwrap();
+    }
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0, "allocations in the flexible-joint rhs");
+    assert!(dy.iter().all(|v| v.is_finite()), "{dy:?}");
+}
+

@@ -16,7 +16,7 @@ mod model;
 pub mod modes;
 pub mod stiffness;
 
-pub use flexible::{simulate_flexible, FlexibleRun};
+pub use flexible::{simulate_flexible, FlexibleOde, FlexibleRun};
 pub use linearize::{linearize, StateSpace};
 pub use model::Output;
 pub use modes::{equilibrium, modes, small_oscillations, Modes};
