@@ -171,3 +171,39 @@ fn flexible_joint_evaluation_does_not_allocate() {
     assert!(dy.iter().all(|v| v.is_finite()), "{dy:?}");
 }
 
+/// The approach to a change point, at each accepted step (`simulate::crossing::Approach`):
+/// keeping the point and the nodes filled inside the step, the time left and the step limit.
+/// Once its queues are full their oldest buffers are reused.
+#[test]
+fn approach_bookkeeping_does_not_allocate() {
+    use planardyn::simulate::crossing::Approach;
+    let mech = yaml(FOUR_BAR);
+    let (q, qd) = test_state(&mech);
+    let mut drives = ModelDrives(&mech);
+    let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives);
+    let y: Vec<f64> = q.iter().chain(&qd).copied().chain([0.0]).collect();
+    ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
+    let mut approach = Approach::default();
+    // A measure falling linearly to 0 at t = 1 s: a change point ahead, the grid defined.
+    let step = |approach: &mut Approach, k: usize| {
+        let t = 1e-2 * k as f64;
+        approach.fill(&ode, t - 5e-3);
+        approach.keep(&ode, t, 0.1 * (1.0 - t));
+        approach.step_limit(t, 0.1 * (1.0 - t))
+    };
+    // Past the queues' length (a few dozen): from here on each point reuses the oldest's buffers.
+    for k in 0..64 {
+        step(&mut approach, k);
+    }
+    let mut limits = Vec::with_capacity(10);
+    let before = ALLOCATIONS.with(Cell::get);
+    for k in 64..74 {
+        limits.push(step(&mut approach, k));
+    }
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0, "allocations in the approach's bookkeeping");
+    // The limit is ahead of each step and before the point at 1 s.
+    for (k, limit) in (64..74).zip(&limits) {
+        let t = 1e-2 * k as f64;
+        assert!(limit.is_some_and(|l| l > t && l < 1.0), "step {k}: {limit:?}");
+    }
+}
