@@ -146,6 +146,27 @@ fn evaluation_with_losses_does_not_allocate() {
     assert_eq!(allocations(&mut ode, Chart::Partition(idx), &z, &zd, vary), 0, "in a partition chart");
 }
 
+/// Two geared motors with rotors on the five-bar (a 2 x 2 motor system, `dynamics::gears`):
+/// at rest (each gear's candidates motoring, back-driven and stuck, tried in turn until one is
+/// consistent) and moving, in the input chart.
+#[test]
+fn geared_motors_branch_solves_do_not_allocate() {
+    let motor = "gear_ratio: 30, efficiency: 0.7, backdrive_efficiency: 0.4, rotor_inertia: 2.0e-5, coulomb: 0.01";
+    let mech = yaml(&format!(
+        "{FIVE_BAR_FALL}drives:\n  - {{coordinate: theta1, effort: 0.3}}\n  - {{coordinate: theta2, effort: -0.2}}\n\
+         actuators:\n  - {{coordinate: theta1, {motor}}}\n  - {{coordinate: theta2, {motor}}}\n"
+    ));
+    let (q, qd) = test_state(&mech);
+    let m = mech.dof();
+    for (qd, what) in [(vec![0.0; m], "at rest"), (qd, "moving")] {
+        let mut drives = ModelDrives(&mech);
+        let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives);
+        // Positions only: at rest the rates stay 0, so every evaluation searches the modes.
+        let vary = |y: &mut [f64], step: usize| y[0] += 1e-5 * step as f64;
+        assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "allocations with geared motors {what}");
+    }
+}
+
 /// The flexible-joint model's evaluation (`elastic::FlexibleOde`: the mechanism without its
 /// rotors, the springs' efforts as its drives, the rotors' equations) on the four-bar, whose
 /// positions need Newton.
