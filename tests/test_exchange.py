@@ -194,6 +194,12 @@ def test_cli_export_and_import(tmp_path, capsys):
     np.testing.assert_allclose(back.mass_matrix(orig.q0), orig.mass_matrix(orig.q0), rtol=ROUND_OFF)
     assert main(["export", "four-bar-gravity", "-o", str(tmp_path / "x.txt")]) == 2
     assert "the extension must be one of .xml, .mjcf, .urdf, .sdf" in capsys.readouterr().err
+    # A timestep MuJoCo cannot step by: refused, no file written (before: timestep="nan" in it).
+    for bad in ("nan", "inf", "0", "-1e-3"):
+        assert main(["export", "four-bar-gravity", "-o", str(tmp_path / "bad.xml"), "--timestep", bad]) == 2
+        assert "timestep" in capsys.readouterr().err and not (tmp_path / "bad.xml").exists()
+    with pytest.raises(pdn.ArgumentError, match=r"timestep = nan must be a finite number > 0 \(s\)"):
+        to_mjcf(_load("four-bar-gravity"), timestep=float("nan"))
 
 
 @pytest.mark.parametrize("name", sorted(LOSSY))

@@ -2,16 +2,13 @@
 
 Every function below (:data:`CASES`, listed by name) is called with valid arguments except
 one, which is NaN, an infinity, zero, negative, huge, tiny, of the wrong shape, or of the
-wrong type. The outcome must be one of:
-
-- a result with no NaN or infinity in it (the documented NaN of unreachable map cells is in
-  no function listed here);
-- a :class:`~planardyn.PlanardynError` (an :class:`~planardyn.ArgumentError` names the
-  argument), never an internal error;
-- a ``TypeError`` for a value of the wrong type (not a number, not an array of numbers).
-
-Anything else (a ``ValueError`` of numpy or scipy, ``ZeroDivisionError``, ``OverflowError``,
-``LinAlgError``, ``IndexError``...) is a library error leaked to the user: a failure.
+wrong type. The outcome is judged by tests/fuzzing.py's oracle, shared with the planning
+fuzz test: a result with no NaN or infinity in it (the documented NaN of unreachable map
+cells is in no function listed here), a :class:`~planardyn.PlanardynError` naming the
+argument (never an internal error), or a ``TypeError`` for a value of the wrong type (not a
+number, not an array of numbers). Anything else (a ``ValueError`` of numpy or scipy,
+``ZeroDivisionError``, ``OverflowError``, ``LinAlgError``, ``IndexError``...) is a library
+error leaked to the user: a failure.
 
 Two passes, as tests/test_fuzz.py: every argument of every case with every value of the
 fixed hostile lists (:func:`test_every_argument_with_every_hostile_value`), then hypothesis'
@@ -20,18 +17,15 @@ random values (``PLANARDYN_FUZZ_EXAMPLES``, default 300; a longer campaign:
 ``python tests/test_fuzz_api.py 20000`` which prints its counts). The command-line options
 those issues added are fuzzed in tests/test_cli_fuzz.py.
 
-Not listed here (the planning helper's fuzz test has them): ``planardyn.plan`` and
+Not listed here (tests/test_plan_fuzz.py has them): ``planardyn.plan`` and
 ``robot.size``/``motor_sizing``/``envelope`` (robot/sizing.py).
 """
 
 from __future__ import annotations
 
 import copy
-import dataclasses
-import math
 import os
 import sys
-import warnings
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -41,6 +35,7 @@ import numpy as np
 import planardyn as pd
 import pytest
 from conftest import pendulum_dict
+from fuzzing import NUMBERS, WRONG_TYPES, failures_of, judge
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from planardyn import identify, library, robot
@@ -48,12 +43,6 @@ from planardyn.results_io import inverse_result, motion_derivatives
 from test_actuators import three_legged
 
 FUZZ_EXAMPLES = int(os.environ.get("PLANARDYN_FUZZ_EXAMPLES", "300"))
-
-#: Numbers no argument should turn into a NaN, an overflow or a library's error.
-NUMBERS: list[Any] = [math.nan, math.inf, -math.inf, 0.0, -0.0, -1.0, -1e-300, 5e-324, 1e-300, 1e300, 1e308,
-                      -1e308, 2**70, -(2**70)]
-#: Values of the wrong type: a TypeError (or a PlanardynError) is the answer.
-WRONG_TYPES: list[Any] = ["x", b"1", object(), {"a": 1}, [1.0, "a"], [[1.0], [1.0, 2.0]]]
 
 
 # ------------------------------------------------------------------ argument kinds
@@ -83,7 +72,7 @@ def spoiled(arg: Arg) -> list[Any]:
     if arg.kind == "array":
         a = np.asarray(arg.value, dtype=float)
         out: list[Any] = []
-        for v in NUMBERS[:11]:
+        for v in [v for v in NUMBERS if isinstance(v, float)]:  # big integers are tried as numbers
             b = a.copy()
             b.flat[b.size // 2] = v
             out.append(b)
@@ -270,55 +259,15 @@ CASES: list[Case] = [
 ]
 
 
-# ------------------------------------------------------------------ the oracle
-
-
-def non_finite(out: Any, where: str = "result") -> str | None:
-    """Where the first NaN or infinity in a result is (None: none), walking its arrays,
-    numbers, containers and dataclasses."""
-    if isinstance(out, (float, np.floating)):
-        return None if math.isfinite(out) else where
-    if isinstance(out, np.ndarray):
-        if out.dtype.kind in "fc" and not np.all(np.isfinite(out)):
-            return where
-        return None
-    if isinstance(out, dict):
-        items = list(out.items())
-    elif isinstance(out, (list, tuple)):
-        items = list(enumerate(out))
-    elif dataclasses.is_dataclass(out) and not isinstance(out, type):
-        items = [(f.name, getattr(out, f.name)) for f in dataclasses.fields(out) if f.name != "effector"]
-    else:
-        return None
-    return next((w for k, v in items if (w := non_finite(v, f"{where}[{k!r}]"))), None)
+# ------------------------------------------------------------------ the oracle (tests/fuzzing.py)
 
 
 def outcome(case: Case, arg: str | None, value: Any) -> str:
     """Run ``case`` with ``arg`` set to ``value``: 'ok', 'refused' or 'TypeError'; an
-    AssertionError for a leaked error or a NaN result."""
-    where = f"{case.name} with {arg} = {value!r:.80}"
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            out = case.run({} if arg is None else {arg: value})
-        except pd.PlanardynError as e:
-            msg = str(e)
-            assert "internal error" not in msg, f"{where}: {msg}"
-            overflow = getattr(e, "quantity", None) is not None  # finite arguments whose result overflows
-            kind = case.args[arg].kind if arg is not None else ""
-            if isinstance(e, pd.ArgumentError) and arg is not None and not is_wrong_type(value, kind) and not overflow:
-                names = (arg, *case.aliases.get(arg, ()))
-                assert any(n in msg for n in names), f"{where}: the message does not name {arg}: {msg}"
-            return "refused"
-        except TypeError as e:
-            assert arg is not None and is_wrong_type(value, case.args[arg].kind), (
-                f"{where}: TypeError for a value of the right type: {e}")
-            return "TypeError"
-        except Exception as e:  # noqa: BLE001 - what the test is for
-            raise AssertionError(f"{where}: leaked {type(e).__module__}.{type(e).__name__}: {e}") from None
-    bad = non_finite(out)
-    assert bad is None, f"{where}: a NaN or infinity in {bad}"
-    return "ok"
+    AssertionError for a leaked error or a NaN or infinity in the result."""
+    kind = case.args[arg].kind if arg is not None else ""
+    return judge(lambda: case.run({} if arg is None else {arg: value}), arg, value, what=case.name,
+                 wrong_type=arg is not None and is_wrong_type(value, kind), names=case.aliases.get(arg or "", ()))
 
 
 # ------------------------------------------------------------------ the tests
@@ -333,14 +282,9 @@ def test_valid_arguments_give_a_finite_result(case):
 def test_every_argument_with_every_hostile_value(case):
     """The fixed lists: each argument of the case spoiled in turn by every hostile value
     and every wrong type. Every failure is listed, not only the first."""
-    failures = []
-    for arg, a in case.args.items():
-        for value in spoiled(a) + (WRONG_TYPES if a.types else []):
-            try:
-                outcome(case, arg, value)
-            except AssertionError as e:
-                failures.append(str(e))
-    assert not failures, "\n".join(failures)
+    found = [f for arg, a in case.args.items()
+             for f in failures_of(lambda v, arg=arg: outcome(case, arg, v), spoiled(a) + (WRONG_TYPES if a.types else []))]
+    assert not found, "\n".join(found)
 
 
 def random_value(arg: Arg) -> st.SearchStrategy[Any]:

@@ -5,7 +5,8 @@ Each argument, one at a time, gets NaN, +-inf, 0, a negative, a huge value, an e
 arrays of the wrong shape and a string, the others valid. Expected: every call either
 returns a result holding no NaN (nor a warning, nor anything printed: IPOPT's output is
 silenced) or raises a planardyn error (PlanardynError) whose message starts with the
-argument's name; nothing else (no numpy, scipy, toppra or CasADi error). Every CLI option with
+argument's name; nothing else (no numpy, scipy, toppra or CasADi error): tests/fuzzing.py's
+oracle, shared with tests/test_fuzz_api.py. Every CLI option with
 a bad value exits 2 with a message naming the option. At 2ac385e, among others:
 task_waypoints with NaN raised "cannot convert float NaN to integer", size with preload NaN
 blamed tau[0], collocate with sigma_min NaN ended in CasADi's "Ill-posed problem", minimum
@@ -14,24 +15,21 @@ effort in 1e-6 s ran 55 s of NaN warnings.
 
 from __future__ import annotations
 
-import dataclasses
-import math
-import warnings
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
 import planardyn as pd
 import pytest
 from conftest import MODELS
+from fuzzing import ARRAYS, INF, NAN, ONE, failures_of, judge
 from planardyn import PlanardynError, robot
 from planardyn.plan import InfeasiblePlan, collocate, task_waypoints, time_optimal
 
-NAN, INF = math.nan, math.inf
-NUMBERS = [NAN, INF, -INF, 0.0, -1.0, 1e300, -1e300, "x", None]
-ARRAYS = [[], [NAN], [INF], [[1.0, 2.0], [3.0, 4.0]], [[[0.0]]], "abc"]
-#: Values of the right shape for one coordinate: huge, tiny, zero, negative.
-ONE = [[1e300], [1e-300], [0.0], [-1.0], [-1e300]]
+#: The numbers tried on every argument: NaN, the infinities, zero, negative, huge; a string
+#: and None too (the plan functions take no TypeError for an answer: they refuse these with a
+#: PlanardynError naming the argument). Not yet all of tests/fuzzing.py's NUMBERS: collocate
+#: with a first-guess duration of 5e-324 s still warns (its warm start's rates overflow).
+HOSTILE = [NAN, INF, -INF, 0.0, -1.0, 1e300, -1e300, "x", None]
 
 FIVE_BAR = MODELS / "library" / "five-bar-5r.yaml"
 PICK, PLACE = [-0.08, 0.28], [0.08, 0.36]
@@ -48,49 +46,16 @@ def crank() -> pd.Mechanism:
     })
 
 
-def nan_in(value: Any, seen: set[int] | None = None) -> list[str]:
-    """Where a result holds a NaN: its arrays and floats, through dataclasses, lists, dicts."""
-    seen = set() if seen is None else seen
-    if id(value) in seen or isinstance(value, (pd.Mechanism, robot.EndEffector)) or callable(value):
-        return []
-    seen.add(id(value))
-    if isinstance(value, float):
-        return ["value"] if math.isnan(value) else []
-    if isinstance(value, np.ndarray) and value.dtype.kind == "f":
-        return ["array"] if np.isnan(value).any() else []
-    if dataclasses.is_dataclass(value):
-        return [f"{f.name}.{w}" for f in dataclasses.fields(value) for w in nan_in(getattr(value, f.name), seen)]
-    if isinstance(value, dict):
-        return [f"{k}.{w}" for k, v in value.items() for w in nan_in(v, seen)]
-    if isinstance(value, (list, tuple)):
-        return [w for v in value for w in nan_in(v, seen)]
-    return []
-
-
 def probe(call: Callable[..., Any], name: str, values: list[Any], capfd) -> list[str]:
-    """Call ``call(value)`` for each value; the failures of the rules above."""
-    failures = []
-    for value in values:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            try:
-                out = call(value)
-            except InfeasiblePlan:
-                continue  # limits no motion keeps: the reason, not an argument, is the message
-            except PlanardynError as exc:
-                if not str(exc).startswith(name) and getattr(exc, "argument", None) != name:
-                    failures.append(f"{name}={value!r}: the error does not name {name}: {exc}")
-                continue
-            except Exception as exc:  # noqa: BLE001 - what the test is about
-                failures.append(f"{name}={value!r}: {type(exc).__name__}: {exc}")
-                continue
-        where = nan_in(out)
-        if where:
-            failures.append(f"{name}={value!r}: NaN in the result at {where[:3]}")
+    """Call ``call(value)`` for each value; the failures of the oracle (tests/fuzzing.py: no
+    warning, every other error naming the argument, InfeasiblePlan an answer, infinities allowed: a plan's limits and stated accuracy
+    are infinite where there are none), and any output printed (IPOPT's is silenced)."""
+    found = failures_of(lambda v: judge(lambda: call(v), name, v, naming=PlanardynError, start=True,
+                                        answers=(InfeasiblePlan,), inf=True, quiet=True), values)
     printed = capfd.readouterr()
     if printed.out or printed.err:
-        failures.append(f"{name}: printed {(printed.out + printed.err)[:200]!r}")
-    return failures
+        found.append(f"{name}: printed {(printed.out + printed.err)[:200]!r}")
+    return found
 
 
 @pytest.fixture(scope="module")
@@ -106,17 +71,17 @@ def test_time_optimal(capfd) -> None:
              "n_grid": [2, 2.5, 10**9], "rtol": [1e-300]}
     failures = []
     for name in base:
-        values = NUMBERS + ARRAYS + ONE + extra.get(name, [])
+        values = HOSTILE + ARRAYS + ONE + extra.get(name, [])
         failures += probe(lambda v, n=name: time_optimal(mech, **{**base, n: v}), name, values, capfd)
     assert not failures, "\n".join(failures)
 
 
 def test_task_waypoints(five, capfd) -> None:
     base = dict(effector=five, X=[PICK, PLACE], spacing=0.01)
-    extra = {"X": [[PICK], [PICK, [NAN, 0.3]], [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]], "spacing": [1e-300]}
+    extra = {"X": [[PICK], [PICK, [NAN, 0.3]], [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]], "spacing": [1e-300, 5e-324]}  # 5e-324: the pieces overflowed
     failures = []
     for name in base:
-        values = NUMBERS + ARRAYS + extra.get(name, [])
+        values = HOSTILE + ARRAYS + extra.get(name, [])
         failures += probe(lambda v, n=name: task_waypoints(**{**base, n: v}), name, values, capfd)
     assert not failures, "\n".join(failures)
 
@@ -129,7 +94,7 @@ def test_collocate(capfd) -> None:
              "warm_start": ["plan", 1.0], "sigma_min": [1.0, 2.0]}
     failures = []
     for name in base:
-        values = NUMBERS + ARRAYS + ONE + extra.get(name, [])
+        values = HOSTILE + ARRAYS + ONE + extra.get(name, [])
         failures += probe(lambda v, n=name: collocate(mech, **{**base, n: v}), name, values, capfd)
     # Minimum effort in a duration no motion within the limits keeps: refused at once with
     # the fastest time (at 2ac385e, 55 s of NaN warnings for --duration 1e-6).
@@ -150,28 +115,28 @@ def test_a_planned_motion_s_methods(capfd) -> None:
 def test_size_and_its_helpers(five, capfd) -> None:
     path = robot.circle([0.014, 0.3], 0.02, duration=0.5)
     base = dict(payload=0.0, distribution="min_norm", preload=None, dt=5e-3)
-    extra = {"distribution": ["fair"], "dt": [10.0, 1e-300]}
+    extra = {"distribution": ["fair"], "dt": [10.0, 1e-300, 2**70]}  # 2**70: np.isfinite refused the int
     failures = []
     for name in base:
-        values = NUMBERS + ARRAYS + extra.get(name, [])
+        values = HOSTILE + ARRAYS + extra.get(name, [])
         failures += probe(lambda v, n=name: robot.size(five, path, **{**base, n: v}), name, values, capfd)
     failures += probe(lambda v: robot.size(five, v), "path", [None, 1.0, "x"], capfd)
     failures += probe(lambda v: robot.size(v), "motion", [None, 1.0, "x"], capfd)
     payload = {"mass": 0.5, "inertia": 0.0}
     for name in payload:
         failures += probe(lambda v, n=name: robot.with_payload(five.mech, "P", **{**payload, n: v}), name,
-                          NUMBERS, capfd)
+                          HOSTILE, capfd)
     failures += probe(lambda v: robot.with_payload(five.mech, v, 0.5), "point", ["nowhere", None], capfd)
     m = robot.solve_motion(five, path, dt=5e-3)
     arrays = {"t": m.t, "qd": m.qd, "torques": m.tau_motor}
     for name in arrays:
         failures += probe(lambda v, n=name: robot.motor_sizing(five.mech, 0, **{**arrays, n: v}), name,
-                          NUMBERS + ARRAYS, capfd)
+                          HOSTILE + ARRAYS, capfd)
     failures += probe(lambda v: robot.motor_sizing(five.mech, v, m.t, m.qd, m.tau_motor), "k", [-1, 2, 2.5, NAN, "x"],
                       capfd)
-    failures += probe(lambda v: robot.envelope(v, m.tau[:, 0]), "speed", NUMBERS + ARRAYS, capfd)
-    failures += probe(lambda v: robot.envelope(m.qd[:, 0], v), "effort", NUMBERS + ARRAYS, capfd)
-    failures += probe(lambda v: robot.LimitCheck("speed", 1.0, v, "rad/s"), "limit", NUMBERS, capfd)
+    failures += probe(lambda v: robot.envelope(v, m.tau[:, 0]), "speed", HOSTILE + ARRAYS, capfd)
+    failures += probe(lambda v: robot.envelope(m.qd[:, 0], v), "effort", HOSTILE + ARRAYS, capfd)
+    failures += probe(lambda v: robot.LimitCheck("speed", 1.0, v, "rad/s"), "limit", HOSTILE, capfd)
     failures += probe(lambda v: robot.LimitCheck("speed", v, 1.0, "rad/s"), "demand", [NAN, -1.0], capfd)
     assert not failures, "\n".join(failures)
 

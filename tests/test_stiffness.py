@@ -190,6 +190,16 @@ def test_cli_stiffness_and_modes(tmp_path):
     assert code == 2 and "compliance:" in err, err
     code, err = cli_run("modes", model, "--at", 1.0)
     assert code == 2 and "--at: give 2 values" in err, err
+    # Refused before any work, naming the option (before: the report printed, then an
+    # unnamed "the characteristic length must be > 0"; a grid of 0 points leaked numpy's
+    # "attempt to get argmin of an empty sequence").
+    for length in ("nan", "0", "-1"):
+        code, err = cli_run("stiffness", model, "--body", "distal_left", "--length", length)
+        assert code == 2 and "--length" in err, err
+    for n in (0, -5):
+        code, err = cli_run("stiffness", model, "--body", "distal_left", "--point", "P", "--map", -0.05, 0.05, 0.4,
+                            0.5, "--n", n)
+        assert code == 2 and f"n = {n} must be an integer from 1" in err, err
 
 
 def test_flexible_run_from_python_and_its_refusals():

@@ -58,6 +58,15 @@ def _matrix(m: Any) -> str:
     return "[" + "; ".join(" ".join(f"{v:.4g}" for v in row) for row in np.atleast_2d(m)) + "]"
 
 
+def _wrench(w: FloatArray) -> str:
+    return f"F_x {w[0]:.4g} N, F_y {w[1]:.4g} N, M {w[2]:.4g} N m"
+
+
+def _span(values: FloatArray, unit: str) -> str:
+    """The range of ``values`` over the cells or poses that have one (NaN: unreachable)."""
+    return f"{np.nanmin(values):.6g} .. {np.nanmax(values):.6g} {unit}"
+
+
 class _Report(Summarized):
     """A report printed as its summary rows, one "field: value" a line."""
 
@@ -113,7 +122,7 @@ class StiffnessReport(_Report):
     def _summary_rows(self) -> list[tuple[str, str]]:
         rows = [("output", f"{self.point or 'centre of mass'} of {self.body}"),
                 ("pose", f"x {self.pose[0]:.6g} m, y {self.pose[1]:.6g} m, phi {self.pose[2]:.6g} rad"),
-                ("wrench", f"F_x {self.wrench[0]:.4g} N, F_y {self.wrench[1]:.4g} N, M {self.wrench[2]:.4g} N m"),
+                ("wrench", _wrench(self.wrench)),
                 ("compliance C", _matrix(self.compliance)),
                 ("stiffness K", _matrix(self.stiffness) if self.stiffness is not None
                  else f"none: the point moves in {self.freedoms} direction(s)"),
@@ -156,7 +165,7 @@ class DeflectionReport(_Report):
         def fmt(d: FloatArray) -> str:
             return f"dx {d[0]:.6g} m, dy {d[1]:.6g} m, dphi {d[2]:.6g} rad"
 
-        return [("wrench", f"F_x {self.wrench[0]:.4g} N, F_y {self.wrench[1]:.4g} N, M {self.wrench[2]:.4g} N m"),
+        return [("wrench", _wrench(self.wrench)),
                 ("linear", fmt(self.linear)), ("non-linear", fmt(self.nonlinear)),
                 ("tangent weakest", f"{self.tangent.weakest_stiffness:.6g} N/m")]
 
@@ -257,9 +266,7 @@ class StiffnessMap(_Report):
 
     def _summary_rows(self) -> list[tuple[str, str]]:
         return [("cells", f"{len(self.y)} x {len(self.x)}, {int(np.isfinite(self.weakest).sum())} reachable"),
-                ("weakest stiffness", f"{np.nanmin(self.weakest):.6g} .. {np.nanmax(self.weakest):.6g} N/m"),
-                ("first frequency", f"{np.nanmin(self.first_frequency):.6g} .. "
-                                    f"{np.nanmax(self.first_frequency):.6g} Hz")]
+                ("weakest stiffness", _span(self.weakest, "N/m")), ("first frequency", _span(self.first_frequency, "Hz"))]
 
 
 def stiffness_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float, float],
@@ -295,8 +302,7 @@ class PathStiffness(_Report):
 
     def _summary_rows(self) -> list[tuple[str, str]]:
         return [("poses", str(len(self.weakest))),
-                ("weakest stiffness", f"{self.weakest.min():.6g} .. {self.weakest.max():.6g} N/m"),
-                ("first frequency", f"{self.first_frequency.min():.6g} .. {self.first_frequency.max():.6g} Hz")]
+                ("weakest stiffness", _span(self.weakest, "N/m")), ("first frequency", _span(self.first_frequency, "Hz"))]
 
 
 def along_path(mech: Mechanism, q: ArrayLike, *, body: str, point: str | None = None) -> PathStiffness:

@@ -20,6 +20,7 @@ import numpy as np
 from ._core import ArgumentError, AssemblyError, ModelError, SingularityError
 from .mechanism import Mechanism, load
 from .models import UnknownModelError, resolve
+from .robot.cli_options import positive
 from .robot.effector import EndEffector
 from .stiffness import modes, small_oscillations, stiffness, stiffness_map
 from .stiffness_plots import plot_stiffness_map
@@ -51,7 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--point", help="the point (default the body's centre of mass)")
     s.add_argument("--at", type=float, nargs="+", metavar="Q", help="coordinates (rad or m; default the start)")
     s.add_argument("--load", type=float, nargs=3, metavar=("FX", "FY", "M"), help="wrench at the point, N N N m")
-    s.add_argument("--length", type=float, help="characteristic length (m) for the weakest direction with rotation")
+    s.add_argument("--length", type=positive("m"), help="characteristic length (m) for the weakest direction with rotation")
     s.add_argument("--map", type=float, nargs=4, metavar=("X0", "X1", "Y0", "Y1"), help="map this region, m")
     s.add_argument("--n", type=int, default=20, help="grid points per side of --map (default 20)")
     s.add_argument("--plot", help="--map: write the figure (PNG, PDF...)")

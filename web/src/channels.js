@@ -18,6 +18,9 @@ const UNITS = {
   displacement: { q: "m", qd: "m/s", qdd: "m/s²", tau: "N" },
 };
 
+/** The unit of `quantity` (q, qd, qdd, tau) of coordinate k. */
+export const unitOf = (info, k, quantity) => UNITS[info.coordinateKinds[k]][quantity];
+
 /** Column k of an N x width row-major array. */
 function column(a, width, k) {
   const n = a.length / width;
@@ -41,9 +44,8 @@ export function seriesChannels(info, s) {
   const m = info.dof;
   const chans = [];
   info.coordinateNames.forEach((name, k) => {
-    const units = UNITS[info.coordinateKinds[k]];
     for (const [g, prefix] of [["q", ""], ["qd", "qd_"], ["qdd", "qdd_"], ["tau", "tau_"]]) {
-      if (s[g]) chans.push({ key: `${prefix}${name}`, label: `${prefix}${name}`, group: g, unit: units[g], values: column(s[g], m, k) });
+      if (s[g]) chans.push({ key: `${prefix}${name}`, label: `${prefix}${name}`, group: g, unit: unitOf(info, k, g), values: column(s[g], m, k) });
     }
   });
   const energy = [["kinetic", "T", s.kinetic], ["potential", "V", s.potential]];

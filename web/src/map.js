@@ -11,12 +11,16 @@ const SLICE_MS = 12;
 /** Rows per call of the engine: a 100-wide row takes about a millisecond. */
 const ROWS_PER_CALL = 4;
 
-/** The grid's ranges: an angle q0 +- pi, a displacement q0 +- L. */
+/** The range of coordinate k about its value qk (a slider's, a map axis'): an angle qk +- pi,
+ * a displacement qk +- L. */
+export function coordinateRange(info, k, qk) {
+  const half = info.coordinateKinds[k] === "angle" ? Math.PI : info.scale;
+  return [qk - half, qk + half];
+}
+
+/** The grid's ranges: each coordinate's range about q. */
 export function mapRanges(info, q) {
-  return [0, 1].map((k) => {
-    const half = info.coordinateKinds[k] === "angle" ? Math.PI : info.scale;
-    return [q[k] - half, q[k] + half];
-  });
+  return [0, 1].map((k) => coordinateRange(info, k, q[k]));
 }
 
 /** sigma on an n x n grid over `ranges` (row j: q2, column i: q1), NaN where it does not

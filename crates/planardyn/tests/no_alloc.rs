@@ -145,3 +145,86 @@ fn evaluation_with_losses_does_not_allocate() {
     let vary = |y: &mut [f64], step: usize| y[0] += 1e-6 * step as f64;
     assert_eq!(allocations(&mut ode, Chart::Partition(idx), &z, &zd, vary), 0, "in a partition chart");
 }
+
+/// Two geared motors with rotors on the five-bar (a 2 x 2 motor system, `dynamics::gears`):
+/// at rest (each gear's candidates motoring, back-driven and stuck, tried in turn until one is
+/// consistent) and moving, in the input chart.
+#[test]
+fn geared_motors_branch_solves_do_not_allocate() {
+    let motor = "gear_ratio: 30, efficiency: 0.7, backdrive_efficiency: 0.4, rotor_inertia: 2.0e-5, coulomb: 0.01";
+    let mech = yaml(&format!(
+        "{FIVE_BAR_FALL}drives:\n  - {{coordinate: theta1, effort: 0.3}}\n  - {{coordinate: theta2, effort: -0.2}}\n\
+         actuators:\n  - {{coordinate: theta1, {motor}}}\n  - {{coordinate: theta2, {motor}}}\n"
+    ));
+    let (q, qd) = test_state(&mech);
+    let m = mech.dof();
+    for (qd, what) in [(vec![0.0; m], "at rest"), (qd, "moving")] {
+        let mut drives = ModelDrives(&mech);
+        let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives);
+        // Positions only: at rest the rates stay 0, so every evaluation searches the modes.
+        let vary = |y: &mut [f64], step: usize| y[0] += 1e-5 * step as f64;
+        assert_eq!(allocations(&mut ode, Chart::Inputs, &q, &qd, vary), 0, "allocations with geared motors {what}");
+    }
+}
+
+/// The flexible-joint model's evaluation (`elastic::FlexibleOde`: the mechanism without its
+/// rotors, the springs' efforts as its drives, the rotors' equations) on the four-bar, whose
+/// positions need Newton.
+#[test]
+fn flexible_joint_evaluation_does_not_allocate() {
+    use planardyn::elastic::FlexibleOde;
+    let mech = yaml(&format!(
+        "{FOUR_BAR}drives:\n  - {{coordinate: theta1, effort: 0.02}}\n\
+         actuators: [{{coordinate: theta1, gear_ratio: 20, rotor_inertia: 5.0e-5}}]\n\
+         compliance:\n  drives: [{{actuator: theta1, stiffness: 1.0e3, damping: 0.5}}]\n"
+    ));
+    let (mut ode, mut y) = FlexibleOde::new(&mech).unwrap();
+    let mut dy = vec![0.0; y.len()];
+    ode.rhs(0.0, &y, &mut dy).unwrap();
+    let before = ALLOCATIONS.with(Cell::get);
+    for step in 0..10 {
+        // Coupler and rotor apart: the spring works, and Newton moves the loop.
+        y[0] += 1e-3;
+        y[2] -= 2e-3 * step as f64;
+        ode.rhs(1e-3 * step as f64, &y, &mut dy).unwrap();
+    }
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0, "allocations in the flexible-joint rhs");
+    assert!(dy.iter().all(|v| v.is_finite()), "{dy:?}");
+}
+
+/// The approach to a change point, at each accepted step (`simulate::crossing::Approach`):
+/// keeping the point and the nodes filled inside the step, the time left and the step limit.
+/// Once its queues are full their oldest buffers are reused.
+#[test]
+fn approach_bookkeeping_does_not_allocate() {
+    use planardyn::simulate::crossing::Approach;
+    let mech = yaml(FOUR_BAR);
+    let (q, qd) = test_state(&mech);
+    let mut drives = ModelDrives(&mech);
+    let mut ode = MechanismOde::new(&mech, assembled(&mech, &q), &mut drives);
+    let y: Vec<f64> = q.iter().chain(&qd).copied().chain([0.0]).collect();
+    ode.set_chart(Chart::Inputs, 0.0, &y).unwrap();
+    let mut approach = Approach::default();
+    // A measure falling linearly to 0 at t = 1 s: a change point ahead, the grid defined.
+    let step = |approach: &mut Approach, k: usize| {
+        let t = 1e-2 * k as f64;
+        approach.fill(&ode, t - 5e-3);
+        approach.keep(&ode, t, 0.1 * (1.0 - t));
+        approach.step_limit(t, 0.1 * (1.0 - t))
+    };
+    // Past the queues' length (a few dozen): from here on each point reuses the oldest's buffers.
+    for k in 0..64 {
+        step(&mut approach, k);
+    }
+    let mut limits = Vec::with_capacity(10);
+    let before = ALLOCATIONS.with(Cell::get);
+    for k in 64..74 {
+        limits.push(step(&mut approach, k));
+    }
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0, "allocations in the approach's bookkeeping");
+    // The limit is ahead of each step and before the point at 1 s.
+    for (k, limit) in (64..74).zip(&limits) {
+        let t = 1e-2 * k as f64;
+        assert!(limit.is_some_and(|l| l > t && l < 1.0), "step {k}: {limit:?}");
+    }
+}

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..arguments import positive
 from ..mechanism import Mechanism
 from .planar import SAME_POINT, Builder
 from .tree import GROUND, Drawing, Edge, Vec, actuated, drawing, joint_state, not_carried, pair_loads
@@ -57,9 +58,12 @@ def to_mjcf(mech: Mechanism, timestep: float = TIMESTEP) -> str:
 
     Raises
     ------
+    ArgumentError
+        A timestep that is not a finite number > 0.
     ExchangeError
         A loop closed by prismatic or slot pairs only, or a gear whose shaft closes a loop.
     """
+    timestep = positive("timestep", timestep, "s")
     d = drawing(mech)
     root = ET.Element("mujoco", model=d.name)
     lost = not_carried(d)

@@ -55,15 +55,12 @@ def joint(name: str, kind: str, parent: str, child: str, pose: np.ndarray, axis:
     return j
 
 
-def edge_joints(d: Drawing, e: Edge) -> list[tuple[str, str, str, str, np.ndarray]]:
+def edge_joints(e: Edge) -> list[tuple[str, str, str, str, np.ndarray]]:
     """The one-axis joints of a tree edge as (name, 'hinge' | 'slide', parent link, child
     link, axis (3,)), with a slot's carriage link between its two joints."""
     names = [f"{e.pair.name}.{k}" for k in e.joints] if e.pair.kind == "slot" else [e.pair.name]
     links = [e.parent, carriage(e.pair), e.child] if e.pair.kind == "slot" else [e.parent, e.child]
-    out = []
-    for k, (name, kind) in enumerate(zip(names, e.joints)):
-        out.append((name, kind, links[k], links[k + 1], e.axis(kind)))
-    return out
+    return [(name, kind, links[k], links[k + 1], e.axis(kind)) for k, (name, kind) in enumerate(zip(names, e.joints))]
 
 
 def closing_joint(d: Drawing, p: Pair) -> ET.Element:
@@ -103,7 +100,7 @@ def to_sdf(mech: Mechanism) -> str:
         if e.pair.kind == "slot":
             small = CARRIAGE_FRACTION * lightest
             _link(model, carriage(e.pair), d.points[e.pair.point], np.zeros(2), small, small * mech.scale**2)
-        for name, kind, parent, child, axis in edge_joints(d, e):
+        for name, kind, parent, child, axis in edge_joints(e):
             own = kind == ("hinge" if e.pair.kind == "revolute" else "slide")
             joints[name] = joint(name, "revolute" if kind == "hinge" else "prismatic", parent, child, np.zeros(2), axis,
                                  loads.get(e.pair.name) if own else None)

@@ -72,7 +72,7 @@ def to_urdf(mech: Mechanism) -> str:
     for e in d.edges:
         if e.pair.kind == "slot":
             ET.SubElement(robot, "link", name=carriage(e.pair))
-        for k, (name, kind, parent, child, axis) in enumerate(edge_joints(d, e)):
+        for k, (name, kind, parent, child, axis) in enumerate(edge_joints(e)):
             j = ET.SubElement(robot, "joint", name=name, type="continuous" if kind == "hinge" else "prismatic")
             ET.SubElement(j, "parent", link=link_name(parent))
             ET.SubElement(j, "child", link=child)

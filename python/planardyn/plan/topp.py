@@ -470,7 +470,8 @@ def task_waypoints(effector: EndEffector, X: ArrayLike, spacing: float) -> Float
         raise PlanError(f"X: expected (J, {k}) finite task coordinates ({', '.join(effector.names)}), J >= 2, got "
                         f"shape {X.shape}", "X")
     spacing = positive_number("spacing", spacing, "m")
-    pieces = np.ceil(np.linalg.norm(np.diff(X[:, :2], axis=0), axis=1) / spacing)
+    with np.errstate(over="ignore"):  # a subnormal spacing: infinitely many pieces, refused below
+        pieces = np.ceil(np.linalg.norm(np.diff(X[:, :2], axis=0), axis=1) / spacing)
     if pieces.sum() > MAX_WAYPOINTS:
         raise PlanError(f"spacing: {spacing:g} m cuts the path into {pieces.sum():.3g} pieces, more than "
                         f"{MAX_WAYPOINTS}; give a larger spacing", "spacing")

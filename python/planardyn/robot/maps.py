@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._core import AssemblyError, SingularityError
-from ..arguments import error
+from ..arguments import count, error
 from .effector import EffectorState, EndEffector
 from .tolerances import EDGE_TOL, JUMP_TOL, QUAD_JUMP, SINGULAR_TOL
 
@@ -58,9 +58,11 @@ class TaskGrid:
 
 
 def grid_size(n: int | tuple[int, int]) -> tuple[int, int]:
-    """(nx, ny): ``n`` points per side, or the (nx, ny) given."""
-    nx, ny = np.broadcast_to(np.asarray(n, dtype=int), (2,))
-    return int(nx), int(ny)
+    """(nx, ny): ``n`` points per side, or the (nx, ny) given, each an integer >= 1."""
+    sides = tuple(n) if np.ndim(n) == 1 else (n, n)  # type: ignore[arg-type]  # ndim 1: iterable
+    if len(sides) != 2:
+        raise error("n", f"n = {n!r} must be one integer or two, (nx, ny)")
+    return count("n", sides[0]), count("n", sides[1])
 
 
 def _neighbours(j: int, i: int, ny: int, nx: int) -> list[tuple[int, int]]:

@@ -285,7 +285,10 @@ def _number(value: Any) -> float:
     """A real number as a float; NaN for anything else (a bool, a string, None)."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         return np.nan
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an integer beyond the float range
+        return np.inf
 
 
 def _finite(name: str, value: Any, width: int | None = None) -> FloatArray:
@@ -523,8 +526,7 @@ def _check_arguments(payload: Any, distribution: Any, preload: Any,
                           sorted(unknown)[0])
     for name in ("dt", "singular_tol"):
         value = options.get(name)
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float, np.floating))
-                                  or not (np.isfinite(value) and value > 0)):
+        if value is not None and not (np.isfinite(x := _number(value)) and x > 0):
             raise SizingError(f"{name}: a finite number > 0{' (s)' if name == 'dt' else ''}, got {value!r}", name)
     n = options.get("n")
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 2 <= n <= MAX_SAMPLES):

@@ -31,9 +31,10 @@
 //! band is the vertical segment where the slip is zero. So
 //! A zdd - b - sum_i g_i tau_i(g_i . zdd) = 0 is the optimality condition of the strictly
 //! convex function 1/2 zdd^T A zdd - b^T zdd plus sum_i Phi_i(g_i . zdd) (Phi_i' = -tau_i,
-//! convex): exactly one zdd, whatever the number of motors; for one motor both branch matrices, A + eta n^2 J g g^T and A + n^2 J g g^T / eta_b,
-//! are positive definite. A housing on a moving link adds J e_i w_i^T, which is not symmetric
-//! when eta < 1: for one motor each branch stays invertible with the same orientation while
+//! convex): exactly one zdd, whatever the number of motors; for one motor both branch
+//! matrices, A + eta n^2 J g g^T and A + n^2 J g g^T / eta_b, are positive definite. A
+//! housing on a moving link adds J e_i w_i^T, which is not symmetric when eta < 1: for one
+//! motor each branch stays invertible with the same orientation while
 //! 1 + J w^T A^-1 (eps n g + e) > 0 for eps = eta and 1 / eta_b, which fails only where the
 //! housing turns against its rotor at nearly n times the joint's rate. Where no choice is
 //! consistent (Painleve's paradox of friction), the evaluation is refused

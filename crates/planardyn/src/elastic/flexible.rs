@@ -12,7 +12,7 @@
 //! E = T + V + sum 1/2 n^2 J thetad^2 + 1/2 k (theta - q)^2 changes only by the motors' work
 //! and the dampers'. As k grows the run tends to the rigid model's, whose A holds n^2 J.
 
-use crate::dynamics::{forward, kinetic_energy, potential_energy, Drives, ModelDrives};
+use crate::dynamics::{forward, kinetic_energy, potential_energy, Drives, FixedDrives, ModelDrives};
 use crate::integrate::{Method, OdeSystem, Options, Stepper};
 use crate::kinematics::assemble_into;
 use crate::model::compliance::DriveCompliance;
@@ -35,26 +35,53 @@ pub struct FlexibleRun {
     pub energy: Vec<f64>,
 }
 
-/// The flexible-joint system: the mechanism without its rotors, and the elastic drives.
-struct Flexible<'m> {
+/// The flexible-joint model as an ODE in y = [q, qd, theta, thetad] (2 (m + r), r elastic
+/// drives): the mechanism without its rotors, the elastic drives, and the buffers of an
+/// evaluation (none is allocated in one).
+pub struct FlexibleOde<'m> {
     rigid: Mechanism,
     model: &'m Mechanism,
     drives: Vec<DriveCompliance>,
     ratios: Vec<f64>,
     ws: Workspace,
+    /// (m) The springs' and dampers' efforts on the coordinates (joint side), and the model's
+    /// drives (the motor torques, motor side).
+    spring: Vec<f64>,
+    motor: Vec<f64>,
 }
 
-impl Flexible<'_> {
-    /// The springs' and dampers' efforts on the coordinates (joint side).
-    fn spring_efforts(&self, q: &[f64], qd: &[f64], th: &[f64], thd: &[f64]) -> Vec<f64> {
-        let mut tau = vec![0.0; q.len()];
-        for (i, d) in self.drives.iter().enumerate() {
-            let k = d.actuator;
-            tau[k] += d.stiffness * (th[i] - q[k]) + d.damping * (thd[i] - qd[k]);
+impl<'m> FlexibleOde<'m> {
+    /// The model's flexible-joint system and its start y0 (the model's start, rotors at their
+    /// joints' angles and rates: springs relaxed). Every elastic drive must be on a
+    /// coordinate, with a rotor (J > 0).
+    pub fn new(mech: &'m Mechanism) -> Result<(Self, Vec<f64>), Error> {
+        let drives = mech.compliance.drives.clone();
+        if drives.is_empty() {
+            return Err(refuse("a model with `compliance.drives` (docs/stiffness.md)", "no elastic drive".into()));
         }
-        tau
+        if let Some(d) = drives.iter().find(|d| d.actuator >= mech.dof() || d.rotor_inertia <= 0.0) {
+            let name = mech.actuator_names()[d.actuator].clone();
+            return Err(refuse(
+                "elastic drives on coordinates with a rotor (`actuators`: `rotor_inertia` > 0)",
+                format!("actuator '{name}' without one"),
+            ));
+        }
+        let mut rigid = mech.clone();
+        // The rotors are coordinates of their own: out of A, and the drives are the springs.
+        rigid.actuators = vec![None; mech.dof()];
+        let ratios = drives.iter().map(|d| mech.actuators[d.actuator].as_ref().map_or(1.0, |a| a.ratio)).collect();
+        let mut ws = Workspace::new(&rigid);
+        let (q0, qd0) = mech.initial_state();
+        assemble_into(&rigid, &q0, &mut ws)?;
+        let m = mech.dof();
+        let mut y: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
+        y.extend(drives.iter().map(|d| q0[d.actuator]));
+        y.extend(drives.iter().map(|d| qd0[d.actuator]));
+        let ode = FlexibleOde { rigid, model: mech, drives, ratios, ws, spring: vec![0.0; m], motor: vec![0.0; m] };
+        Ok((ode, y))
     }
 
+    /// The energy E (J) at y.
     fn energy(&mut self, y: &[f64]) -> Result<f64, KinematicsError> {
         let (m, r) = (self.rigid.dof(), self.drives.len());
         let (q, qd) = (&y[..m], &y[m..2 * m]);
@@ -69,7 +96,7 @@ impl Flexible<'_> {
     }
 }
 
-impl OdeSystem for Flexible<'_> {
+impl OdeSystem for FlexibleOde<'_> {
     type Error = Error;
     fn dim(&self) -> usize {
         2 * (self.rigid.dof() + self.drives.len())
@@ -78,18 +105,22 @@ impl OdeSystem for Flexible<'_> {
         let (m, r) = (self.rigid.dof(), self.drives.len());
         let (q, qd) = (&y[..m], &y[m..2 * m]);
         let (th, thd) = (&y[2 * m..2 * m + r], &y[2 * m + r..]);
-        let spring = self.spring_efforts(q, qd, th, thd);
-        let mut motor = vec![0.0; m];
-        ModelDrives(self.model).efforts(t, q, qd, &mut motor).map_err(|message| Error::Drive { t, message })?;
-        let mut fixed = crate::dynamics::FixedDrives(&spring);
-        forward(&self.rigid, t, q, qd, &mut fixed, &mut self.ws)?;
+        // Each spring's effort: on its coordinate, and against its rotor (the motor's added below).
+        self.spring.fill(0.0);
+        for (i, d) in self.drives.iter().enumerate() {
+            let k = d.actuator;
+            let own = d.stiffness * (th[i] - q[k]) + d.damping * (thd[i] - qd[k]);
+            self.spring[k] += own;
+            dy[2 * m + r + i] = -own;
+        }
+        ModelDrives(self.model).efforts(t, q, qd, &mut self.motor).map_err(|message| Error::Drive { t, message })?;
+        forward(&self.rigid, t, q, qd, &mut FixedDrives(&self.spring), &mut self.ws)?;
         dy[..m].copy_from_slice(qd);
         dy[m..2 * m].copy_from_slice(&self.ws.qdd);
         dy[2 * m..2 * m + r].copy_from_slice(thd);
         for (i, d) in self.drives.iter().enumerate() {
-            let k = d.actuator;
-            let own = d.stiffness * (th[i] - q[k]) + d.damping * (thd[i] - qd[k]);
-            dy[2 * m + r + i] = (self.ratios[i] * motor[k] - own) / d.rotor_inertia;
+            let rotor = &mut dy[2 * m + r + i];
+            *rotor = (self.ratios[i] * self.motor[d.actuator] + *rotor) / d.rotor_inertia;
         }
         Ok(())
     }
@@ -99,9 +130,10 @@ fn refuse(expected: &str, got: String) -> Error {
     KinematicsError::BadArgument { name: "mechanism", expected: expected.into(), got }.into()
 }
 
-/// Simulate the flexible-joint model from the model's start (rotors at their joints' angles,
-/// springs relaxed) to `t_end` (s) with `method` at tolerances `options`, output every
-/// `output_dt` (s). Every elastic drive must be on a coordinate, with a rotor (J > 0).
+/// Simulate the flexible-joint model ([`FlexibleOde`]) from the model's start (rotors at their
+/// joints' angles, springs relaxed) to `t_end` (s) with `method` at tolerances `options`,
+/// output every `output_dt` (s). Every elastic drive must be on a coordinate, with a rotor
+/// (J > 0).
 pub fn simulate_flexible(
     mech: &Mechanism,
     t_end: f64,
@@ -109,45 +141,24 @@ pub fn simulate_flexible(
     method: Method,
     options: &Options,
 ) -> Result<FlexibleRun, Error> {
-    let drives = mech.compliance.drives.clone();
-    if drives.is_empty() {
-        return Err(refuse("a model with `compliance.drives` (docs/stiffness.md)", "no elastic drive".into()));
-    }
-    if let Some(d) = drives.iter().find(|d| d.actuator >= mech.dof() || d.rotor_inertia <= 0.0) {
-        let name = mech.actuator_names()[d.actuator].clone();
-        return Err(refuse(
-            "elastic drives on coordinates with a rotor (`actuators`: `rotor_inertia` > 0)",
-            format!("actuator '{name}' without one"),
-        ));
-    }
+    let (mut sys, y) = FlexibleOde::new(mech)?;
     if !(t_end > 0.0 && t_end.is_finite() && output_dt > 0.0 && t_end / output_dt <= MAX_OUTPUTS) {
         return Err(refuse(
             "t_end > 0 and output_dt > 0 (s), at most 1e7 outputs",
             format!("t_end {t_end}, output_dt {output_dt}"),
         ));
     }
-    let mut rigid = mech.clone();
-    // The rotors are coordinates of their own: out of A, and the drives are the springs.
-    rigid.actuators = vec![None; mech.dof()];
-    let ratios = drives.iter().map(|d| mech.actuators[d.actuator].as_ref().map_or(1.0, |a| a.ratio)).collect();
-    let mut ws = Workspace::new(&rigid);
-    let (q0, qd0) = mech.initial_state();
-    assemble_into(&rigid, &q0, &mut ws)?;
-    let mut sys = Flexible { rigid, model: mech, drives, ratios, ws };
-    let mut y: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
-    y.extend(sys.drives.iter().map(|d| q0[d.actuator]));
-    y.extend(sys.drives.iter().map(|d| qd0[d.actuator]));
     let mut stepper = Stepper::new(method, options, y.len()).map_err(Error::Options)?;
-    stepper.reset(&mut sys, 0.0, &y).map_err(|e| Error::Options(format!("{e:?}")))?;
+    stepper
+        .reset(&mut sys, 0.0, &y)
+        .map_err(|e| Error::Options(format!("the flexible-joint run failed at its start: {e}")))?;
     let mut run = FlexibleRun { t: vec![], q: vec![], qd: vec![], theta: vec![], thetad: vec![], energy: vec![] };
     let n_out = (t_end / output_dt).floor() as usize;
     let mut out = vec![0.0; y.len()];
     for j in 0..=n_out {
         let t = (j as f64 * output_dt).min(t_end);
         while stepper.t() < t {
-            stepper
-                .step(&mut sys, t_end)
-                .map_err(|e| Error::Options(format!("the flexible-joint run failed: {e:?}")))?;
+            stepper.step(&mut sys, t_end).map_err(|e| Error::Options(format!("the flexible-joint run failed: {e}")))?;
         }
         stepper.interpolate(&mut sys, t, &mut out);
         let (m, r) = (mech.dof(), sys.drives.len());

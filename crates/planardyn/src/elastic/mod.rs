@@ -2,9 +2,10 @@
 //! docs/stiffness.md): the compliant mechanism in redundant coordinates (`model`), its
 //! elastostatics at a pose (`stiffness`), natural and small-oscillation modes (`modes`), the
 //! linearised state-space model of the rigid mechanism (`linearize`), and the simulation with
-//! compliant drives (`flexible`). A layer above the
-//! dynamics, the structure report, the integrators and the simulation: it uses the kinematics (assembly, analogues), the pair
-//! kinds' exact first and second derivatives, the dynamics' exact derivatives, and the integrators.
+//! compliant drives (`flexible`). A layer above the dynamics, the structure report, the
+//! integrators and the simulation: it uses the kinematics (assembly, analogues), the pair
+//! kinds' exact first and second derivatives, the dynamics' exact derivatives, and the
+//! integrators.
 //!
 //! nalgebra's dense decompositions (SVD, symmetric eigen, Cholesky) are used throughout: these
 //! are analyses at a pose, on matrices of a few dozen columns, where allocating is of no
@@ -16,7 +17,7 @@ mod model;
 pub mod modes;
 pub mod stiffness;
 
-pub use flexible::{simulate_flexible, FlexibleRun};
+pub use flexible::{simulate_flexible, FlexibleOde, FlexibleRun};
 pub use linearize::{linearize, StateSpace};
 pub use model::Output;
 pub use modes::{equilibrium, modes, small_oscillations, Modes};

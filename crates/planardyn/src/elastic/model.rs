@@ -12,6 +12,7 @@
 //! kinds' own, `model::pairs`; the beam's below), so that the tangent stiffness
 //! sum B^T K B + sum_r sigma_r d2delta_r - sum_r lambda_r d2g_r - W . d2p is exact.
 
+use crate::dynamics::transmission::actuator_pair;
 use crate::kinematics::constraints::body_trig;
 use crate::linalg::Dense;
 use crate::model::compliance::LinkCompliance;
@@ -130,7 +131,7 @@ impl<'m> ElasticModel<'m> {
             }
         }
         for a in 0..mech.n_actuators() {
-            let pair = actuator_pair(mech, a);
+            let pair = actuator_pair(mech, a).0;
             let at = coordinate(&model.pairs[pair], &z0);
             match c.drives.iter().find(|d| d.actuator == a) {
                 Some(d) => {
@@ -345,17 +346,7 @@ impl<'m> ElasticModel<'m> {
 
 /// Whether actuator `a`'s coordinate is an angle.
 fn actuator_is_angle(mech: &Mechanism, a: usize) -> bool {
-    pairs::coordinate_kind(&mech.pairs[actuator_pair(mech, a)]) == Some(CoordinateKind::Angle)
-}
-
-/// The pair actuator `a` drives: a coordinate's, then a pair actuator's.
-fn actuator_pair(mech: &Mechanism, a: usize) -> usize {
-    let m = mech.dof();
-    if a < m {
-        mech.coordinates[a].pair.0
-    } else {
-        mech.pair_actuators[a - m].pair.0
-    }
+    pairs::coordinate_kind(&mech.pairs[actuator_pair(mech, a).0]) == Some(CoordinateKind::Angle)
 }
 
 /// The stiffness of a cantilever's tip in its frame (axial, transverse, rotation), the

@@ -8,7 +8,7 @@ use std::ops::ControlFlow::{self, Break, Continue};
 
 use super::charts::{chart_sigma, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
 use super::crossing::{
-    cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Passed, Path,
+    cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
     APPROACH_BELOW, APPROACH_FRACTION, CHANGE_POINT_RATIO, CROSS_START, WATCH_BELOW,
 };
 use super::dense::{self, DenseOutput};
@@ -441,18 +441,18 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn fill_approach(&mut self, t: f64) -> ControlFlow<Stop> {
         let Some(grid) = self.grid else { return Continue(()) };
         let t_prev = self.stepper.t_prev();
-        let mut times: Vec<f64> = grid.nodes().filter(|&s| s > t_prev + grid.h / 4.0 && s < t - grid.h / 4.0).collect();
-        if times.is_empty() {
+        let inside = |s: &f64| *s > t_prev + grid.h / 4.0 && *s < t - grid.h / 4.0;
+        if !grid.nodes().any(|s| inside(&s)) {
             return Continue(());
         }
-        times.reverse();
         let saved = self.ode.save();
         self.ode.restart_from_anchor();
-        for s in times {
+        // Earliest first, as the outputs are walked.
+        for s in grid.nodes().rev().filter(inside) {
             if let Err(error) = evaluate_output(&mut self.ode, &mut self.stepper, s, &mut self.yi) {
                 return Break(Stop::Output { t: s, error });
             }
-            self.approach.fill(Passed::of(&self.ode, s, f64::NAN));
+            self.approach.fill(&self.ode, s);
         }
         self.ode.restore(saved);
         Continue(())

@@ -51,7 +51,7 @@ pub struct Grid {
 
 impl Grid {
     /// The node times j = 1 .. NODES, latest first.
-    pub fn nodes(&self) -> impl Iterator<Item = f64> + '_ {
+    pub fn nodes(&self) -> impl DoubleEndedIterator<Item = f64> + '_ {
         (1..=NODES).map(|j| self.t_star - self.tau - j as f64 * self.h)
     }
 }
@@ -59,26 +59,13 @@ impl Grid {
 impl Approach {
     /// Remember the point held by `ode.ws`, accepted at t with passive measure `passive`.
     pub fn keep(&mut self, ode: &MechanismOde, t: f64, passive: f64) {
-        let ws = &ode.ws;
-        let recycled = if self.passed.len() >= KEPT { self.passed.pop_front() } else { None };
-        match recycled {
-            Some(mut p) => {
-                (p.t, p.passive, p.power) = (t, passive, ws.power);
-                p.x.copy_from_slice(&ws.x);
-                p.xd.copy_from_slice(&ws.xd);
-                p.xdd.copy_from_slice(&ws.xdd);
-                self.passed.push_back(p);
-            }
-            None => self.passed.push_back(Passed::of(ode, t, passive)),
-        }
+        push(&mut self.passed, ode, t, passive);
     }
 
-    /// Add a point evaluated inside the step just accepted (before the point kept next).
-    pub fn fill(&mut self, p: Passed) {
-        if self.filled.len() >= KEPT {
-            self.filled.pop_front();
-        }
-        self.filled.push_back(p);
+    /// Add the point held by `ode.ws`, evaluated at t inside the step just accepted (before
+    /// the point kept next; its passive measure is not asked for).
+    pub fn fill(&mut self, ode: &MechanismOde, t: f64) {
+        push(&mut self.filled, ode, t, f64::NAN);
     }
 
     /// Forget the way (after a crossing: the points before it are on the other side).
@@ -160,5 +147,22 @@ impl Approach {
         } else {
             t + to_point - tau - (away - 0.5).floor().max(0.0) * h
         })
+    }
+}
+
+/// Append the point held by `ode.ws` (at t, passive measure `passive`) to `points`, the
+/// oldest's buffers reused once [`KEPT`] are held (no allocation then).
+fn push(points: &mut VecDeque<Passed>, ode: &MechanismOde, t: f64, passive: f64) {
+    let ws = &ode.ws;
+    let recycled = if points.len() >= KEPT { points.pop_front() } else { None };
+    match recycled {
+        Some(mut p) => {
+            (p.t, p.passive, p.power) = (t, passive, ws.power);
+            p.x.copy_from_slice(&ws.x);
+            p.xd.copy_from_slice(&ws.xd);
+            p.xdd.copy_from_slice(&ws.xdd);
+            points.push_back(p);
+        }
+        None => points.push_back(Passed::of(ode, t, passive)),
     }
 }

@@ -61,20 +61,28 @@ pub fn stepped_over(ode: &MechanismOde, approach: &Approach, t: f64, passive: f6
     } else if passive >= WATCH_BELOW {
         return None;
     }
-    let ws = &ode.ws;
-    let path = Quintic::new(last, (&ws.x, &ws.xd, &ws.xdd), t);
-    let point = located(ode.mech, &path, last.t, t);
-    (near || inside_step(ode, last, t)).then_some(point)
+    let point = located_in_step(ode, last, t);
+    (near || strictly_inside(&point, last.t, t)).then_some(point)
 }
 
 /// Whether Phi_x loses rank on the quintic from the point `last` to the point held by `ode.ws`
 /// at `t` (strictly inside: a point located at the step's end is still ahead).
 pub fn inside_step(ode: &MechanismOde, last: &Passed, t: f64) -> bool {
+    strictly_inside(&located_in_step(ode, last, t), last.t, t)
+}
+
+/// The change point located on the quintic from the point `last` to the point held by
+/// `ode.ws` at `t`.
+fn located_in_step(ode: &MechanismOde, last: &Passed, t: f64) -> ChangePoint {
     let ws = &ode.ws;
     let path = Quintic::new(last, (&ws.x, &ws.xd, &ws.xdd), t);
-    let point = located(ode.mech, &path, last.t, t);
+    located(ode.mech, &path, last.t, t)
+}
+
+/// Whether `point`, located in the step from t0 to t, lost rank strictly inside it.
+fn strictly_inside(point: &ChangePoint, t0: f64, t: f64) -> bool {
     // Golden section ends within 0.618^40 of an end where the pivot only falls.
-    point.rank_drop > 0 && point.t < t - 1e-6 * (t - last.t)
+    point.rank_drop > 0 && point.t < t - 1e-6 * (t - t0)
 }
 
 /// The scaled pivots of complete pivoting on Phi_x at x, in pivot order (fewer than its

@@ -1,0 +1,86 @@
+// The model: built from text (a file, the page's data, the editor), its loader errors shown
+// in place under the editor, the last good model kept meanwhile.
+import { $, app, status } from "./state.js";
+import { describe } from "./engine.js";
+import { moveTo } from "./view.js";
+import { setMode } from "./timeline.js";
+import { buildSliders, sweep } from "./design.js";
+import { buildRunModes } from "./run.js";
+import { startMap } from "./map_tab.js";
+
+/** Build the model from text; on an error, show it in place and keep the last model. */
+export function setModel(text, format, source, { fromEditor = false } = {}) {
+  let mech;
+  try {
+    mech = app.pd.load(text, format, source);
+  } catch (err) {
+    showModelError(err, text);
+    return false;
+  }
+  showModelError(null);
+  const keep = app.info && app.info.dof === mech.info().dof && fromEditor;
+  if (app.mech) app.mech.free();
+  Object.assign(app, { mech, info: mech.info(), text, format, source, x: null, run: null, replay: null, mode: "design" });
+  if (!fromEditor) $("editor").value = text;
+  $("title").textContent = app.info.name;
+  const starts = keep ? [app.q, app.info.q0, app.info.drawnQ] : [app.info.q0, app.info.drawnQ];
+  if (!starts.some((q) => moveTo(Float64Array.from(q), null))) {
+    status("the model does not assemble at q0 nor as drawn", true);
+    return false;
+  }
+  app.active = Math.min(app.active, app.info.dof - 1);
+  buildSliders();
+  buildRunModes();
+  sweep();
+  setMode("design");
+  startMap();
+  status(`${app.info.name}: ${app.info.dof} coordinates, ${app.info.bodyNames.length} bodies; drag a point or a slider` +
+    (app.info.warnings.length ? ` — ${app.info.warnings.join("; ")}` : ""));
+  return true;
+}
+
+/** The loader's error under the editor, with its line selected on a click. */
+function showModelError(err, text) {
+  const box = $("model-error");
+  $("editor").classList.toggle("bad", !!err);
+  box.hidden = !err;
+  if (!err) return;
+  const line = err.line ?? lineOfField(text, err.field);
+  box.dataset.line = line ?? "";
+  box.textContent = (line ? `line ${line}: ` : "") + describe(err);
+  status(`the model has an error (${err.field || err.name})`, true);
+}
+
+/** The line where the last key of a field path (`bodies.crank.mass`) is written, if found. */
+function lineOfField(text, field) {
+  const key = (field || "").split(/[.[\]]/).filter((s) => s && !/^\d+$/.test(s)).pop();
+  if (!key) return null;
+  const re = new RegExp(`^\\s*(- )?"?${key.replace(/[^\w]/g, "\\$&")}"?\\s*:`);
+  const i = text.split("\n").findIndex((l) => re.test(l));
+  return i >= 0 ? i + 1 : null;
+}
+
+/** The side panel: the editor (the model rebuilt as it is typed, its error's line selected
+ * on a click) and the tabs. */
+export function installEditor() {
+  let timer = 0;
+  $("editor").addEventListener("input", () => {
+    clearTimeout(timer);
+    timer = setTimeout(() => setModel($("editor").value, app.format, app.source || "<editor>", { fromEditor: true }), 250);
+  });
+  $("model-error").addEventListener("click", () => {
+    const line = +$("model-error").dataset.line;
+    if (!line) return;
+    const ed = $("editor");
+    const lines = ed.value.split("\n");
+    const start = lines.slice(0, line - 1).reduce((n, l) => n + l.length + 1, 0);
+    ed.focus();
+    ed.setSelectionRange(start, start + (lines[line - 1] || "").length);
+  });
+  document.querySelectorAll("#side nav button").forEach((b) => b.addEventListener("click", () => {
+    document.querySelectorAll("#side nav button, .tab").forEach((el) => el.classList.remove("on"));
+    b.classList.add("on");
+    $(`tab-${b.dataset.tab}`).classList.add("on");
+    if (b.dataset.tab === "map") startMap();
+  }));
+}

@@ -1,0 +1,125 @@
+// The current state on the page: evaluated at q (design), or a frame of a run or of a
+// Python run (replay); drawn on the canvas (or as SVG) and listed in the values table.
+import { $, app, fmt, status, zeros } from "./state.js";
+import { describe } from "./engine.js";
+import { canvasPen, drawScene, svgPen, transform } from "./draw.js";
+import { unitOf } from "./channels.js";
+import { replayScene } from "./replay.js";
+
+/** Evaluate at q (continuing from app.x); near a type II singularity, where the dynamics is
+ * not defined, the positions and measures alone. False if q does not assemble. */
+export function moveTo(q, xStart = app.x) {
+  const z = zeros();
+  try {
+    app.ev = app.mech.evaluate(q, z, z, xStart ?? undefined);
+  } catch (err) {
+    try {
+      const x = app.mech.assemble(q, xStart ?? undefined);
+      const m = app.mech.measures(x);
+      app.ev = { x, points: app.mech.points(x), sigma: m.sigma, sigmaPassive: m.sigmaPassive, note: describe(err) };
+    } catch (err2) {
+      status(describe(err2), true);
+      return false;
+    }
+  }
+  app.q = q;
+  app.x = app.ev.x;
+  return true;
+}
+
+function arrowsOf(reactions, x) {
+  if (!reactions) return null;
+  const geom = app.mech.pairGeometry(x);
+  const items = geom.map((g, j) => {
+    const at = g.pins.length ? g.pins : g.blocks;
+    return { x: at[0], y: at[1], fx: reactions[3 * j], fy: reactions[3 * j + 1] };
+  }).filter((a) => Number.isFinite(a.x));
+  return { ref: app.arrowRef, items };
+}
+
+/** The scene of the current state (design) or frame (run). */
+function scene() {
+  if (app.mode === "replay") return replayScene(app.replay, app.frame);
+  const x = app.ev.x;
+  return {
+    points: app.ev.points, bodies: bodyIndices(), ground: groundIndices(),
+    geometry: app.mech.pairGeometry(x), arrows: arrowsOf(app.ev.reactions, x),
+    paths: app.mode === "design" ? app.paths : [], scale: app.info.scale,
+  };
+}
+
+const bodyIndices = () => app.info.bodies.map((b) => b.map((n) => app.info.points.indexOf(n)).filter((i) => i >= 0));
+export const groundIndices = () => app.info.groundPoints.map((n) => app.info.points.indexOf(n)).filter((i) => i >= 0);
+
+function draw() {
+  const c = $("drawing");
+  const dpr = window.devicePixelRatio || 1;
+  const [w, h] = [c.clientWidth, c.clientHeight];
+  if (c.width !== Math.round(w * dpr) || c.height !== Math.round(h * dpr)) [c.width, c.height] = [Math.round(w * dpr), Math.round(h * dpr)];
+  const ctx = c.getContext("2d");
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  drawScene(canvasPen(ctx), scene(), transform(app.bounds, w, h), w, h);
+}
+
+/** The drawing as SVG, at the canvas's size. */
+export function drawingSvg() {
+  const c = $("drawing");
+  const [w, h] = [c.clientWidth, c.clientHeight];
+  const pen = svgPen();
+  drawScene(pen, scene(), transform(app.bounds, w, h), w, h);
+  return pen.svg(w, h);
+}
+
+export function showState() {
+  draw();
+  renderValues();
+  const k = app.active;
+  if (app.mode === "design") app.charts.mark(app.q[k]);
+  else app.charts.mark(app.mode === "run" ? app.run.t[app.frame] : app.replay.t[app.frame]);
+  document.querySelectorAll("#sliders input").forEach((s, j) => {
+    s.value = app.q[j];
+    $(`q-out-${j}`).textContent = fmt(app.q[j]);
+  });
+  document.body.dataset.q = Array.from(app.q ?? []).join(",");
+}
+
+function renderValues() {
+  const rows = [];
+  const head = (t) => rows.push(`<tr><th colspan="3">${t}</th></tr>`);
+  const row = (a, v, u) => rows.push(`<tr><td>${a}</td><td class="num">${fmt(v)}</td><td>${u}</td></tr>`);
+  if (app.mode === "replay") {
+    head(`t = ${fmt(app.replay.t[app.frame])} s`);
+    for (const c of app.replay.chans) row(c.label, c.values[app.frame], c.unit);
+    $("values").innerHTML = rows.join("");
+    return;
+  }
+  const ev = app.mode === "run" ? runState() : app.ev;
+  head(app.mode === "run" ? `t = ${fmt(app.run.t[app.frame])} s` : "coordinates and efforts (at rest)");
+  app.info.coordinateNames.forEach((n, k) => {
+    row(n, app.q[k], unitOf(app.info, k, "q"));
+    if (ev.tau) row(`τ ${n}`, ev.tau[k], unitOf(app.info, k, "tau"));
+  });
+  head("singularity measures");
+  row("σ (type II)", ev.sigma, "");
+  if (ev.sigmaPassive !== undefined) row("σ passive", ev.sigmaPassive, "");
+  if (ev.note) rows.push(`<tr><td colspan="3" class="note">${ev.note}</td></tr>`);
+  if (ev.kinetic !== undefined) {
+    head("energies");
+    row("T", ev.kinetic, "J");
+    row("V", ev.potential, "J");
+  }
+  if (ev.reactions) {
+    head("pair reactions |F| (a on b)");
+    app.info.pairs.forEach((p, j) => row(p.name, Math.hypot(ev.reactions[3 * j], ev.reactions[3 * j + 1]), "N"));
+  }
+  $("values").innerHTML = rows.join("");
+}
+
+/** The efforts, measure, energies and reactions of the run's current frame. */
+export function runState() {
+  const r = app.run, i = app.frame, m = app.info.dof, p = app.info.pairs.length;
+  return {
+    tau: r.tau.subarray(i * m, (i + 1) * m), sigma: r.sigma[i], kinetic: r.kinetic[i], potential: r.potential[i],
+    reactions: r.reactions ? r.reactions.subarray(i * 3 * p, (i + 1) * 3 * p) : null,
+  };
+}
