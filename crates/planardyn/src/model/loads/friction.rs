@@ -9,8 +9,8 @@ use super::pair_spring::PairSpring;
 use super::{Load, LoadSpecType};
 use crate::model::actuators::JointFriction;
 use crate::model::checks::{pair_id, relative_pair, Ctx, R};
-use crate::model::pairs::{self, Relative};
-use crate::model::{Mechanism, PairId, PairKind};
+use crate::model::pairs::{self, FrictionField, Relative};
+use crate::model::{Mechanism, PairId};
 use crate::units;
 use serde::{Deserialize, Serialize};
 
@@ -119,15 +119,16 @@ impl LoadSpecType for FrictionSpec {
             (false, Some(_)) => refuse("pin_radius", format!("'{pair}' does not turn on a pin: remove `pin_radius`"))?,
             (false, None) => 1.0,
         };
-        let length = match (&p.kind, length) {
-            (PairKind::Prismatic { .. }, Some(l)) => speed("length", Some(*l), 0.0)?,
-            (_, Some(_)) => {
+        let field = pairs::friction_field(&p.kind);
+        let length = match (field, length) {
+            (FrictionField::Length, Some(l)) => speed("length", Some(*l), 0.0)?,
+            (FrictionField::None | FrictionField::PressureAngle, Some(_)) => {
                 refuse("length", format!("'{pair}' carries no couple: `length` applies to a prismatic pair only"))?
             }
             (_, None) => 0.0,
         };
-        let pressure_angle = match (&p.kind, pressure_angle) {
-            (PairKind::Gear(_), a) => {
+        let pressure_angle = match (field, pressure_angle) {
+            (FrictionField::PressureAngle, a) => {
                 let a = a.unwrap_or(PRESSURE_ANGLE);
                 if !(0.0..=MAX_PRESSURE_ANGLE).contains(&ctx.finite(&format!("{path}.pressure_angle"), a)?) {
                     refuse(
@@ -137,7 +138,7 @@ impl LoadSpecType for FrictionSpec {
                 }
                 a
             }
-            (_, Some(_)) => refuse(
+            (FrictionField::None | FrictionField::Length, Some(_)) => refuse(
                 "pressure_angle",
                 format!("'{pair}' has no teeth: `pressure_angle` applies to a gear pair only"),
             )?,
@@ -160,8 +161,8 @@ impl LoadSpecType for FrictionSpec {
 /// (whose lever is the pitch-line travel).
 fn friction_pair(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
     let id = pair_id(ctx, mech, path, name)?;
-    match mech.pairs[id.0].kind {
-        PairKind::Gear(_) => Ok(id),
-        _ => relative_pair(ctx, mech, path, name),
+    match pairs::friction_field(&mech.pairs[id.0].kind) {
+        FrictionField::PressureAngle => Ok(id),
+        FrictionField::None | FrictionField::Length => relative_pair(ctx, mech, path, name),
     }
 }

@@ -22,7 +22,7 @@
 //! force: the physical bearing load of b is its revolute reaction plus this force.
 
 use super::frames::{add_grad, angle, dot, link_columns, link_state, link_state_t, part, perp, Projection};
-use super::{reaction_force, PairGeometry, PairType, Relative, Rows};
+use super::{reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Link, Pair};
 
@@ -127,6 +127,7 @@ impl PairType for Gear {
     const NAME: &'static str = "gear";
     const ROWS: usize = 1;
     const LETTER: char = 'G';
+    const FRICTION_FIELD: FrictionField = FrictionField::PressureAngle;
 
     #[inline]
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {

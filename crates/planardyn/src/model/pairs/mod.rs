@@ -56,6 +56,20 @@ impl PairGeometry {
     }
 }
 
+/// The field of its own a Coulomb friction entry takes on a pair kind, beside `mu` (and the
+/// pin radius of a pair that turns).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrictionField {
+    /// None: the contact load is the reaction force.
+    None,
+    /// `length` (m): the guide's bearing length, over which the pair's couple presses the
+    /// block's ends.
+    Length,
+    /// `pressure_angle` (rad): the teeth's, the mesh's normal load being its force over the
+    /// angle's cosine. The friction's lever is the pitch-line travel, not a relative coordinate.
+    PressureAngle,
+}
+
 /// What a pair kind provides. `x` holds the body coordinates, `trig` their [cos, sin]
 /// (`constraints::body_trig`), `rows` where each of the kind's rows goes in F (None: a
 /// redundant row, left out).
@@ -67,6 +81,9 @@ pub trait PairType {
     /// Its letter in the type of an Assur group (`RRP`...): R and P for the lower pairs, G
     /// (gear) and S (pin-in-slot) for the one-row higher pairs.
     const LETTER: char;
+    /// The field of its own a Coulomb friction entry on the kind takes (checked where the
+    /// entry is read, model/loads/friction.rs; used by `contact_load`).
+    const FRICTION_FIELD: FrictionField;
     /// Residual of the rows.
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows;
     /// Gradients of the rows, added into `j`.
@@ -166,6 +183,14 @@ pub fn letter(kind: &PairKind) -> char {
         T::LETTER
     }
     dispatch!(kind, t => letter(&t))
+}
+
+/// The friction entry's field of its own on a pair kind.
+pub fn friction_field(kind: &PairKind) -> FrictionField {
+    fn field<T: PairType>(_: &T) -> FrictionField {
+        T::FRICTION_FIELD
+    }
+    dispatch!(kind, t => field(&t))
 }
 
 /// Number of constraint rows of a pair.

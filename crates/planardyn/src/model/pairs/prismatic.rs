@@ -5,7 +5,7 @@
 use super::frames::{add_grad, angle, link_state, link_state_t, perp, Projection};
 use super::gear::Side;
 use super::revolute::both_links;
-use super::{coordinate_lever, guide, reaction_force, PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, guide, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -18,6 +18,7 @@ impl PairType for Prismatic {
     const NAME: &'static str = "prismatic";
     const ROWS: usize = 2;
     const LETTER: char = 'P';
+    const FRICTION_FIELD: FrictionField = FrictionField::Length;
 
     #[inline]
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {

@@ -3,7 +3,7 @@
 
 use super::frames::{add_grad, link_columns, link_state, link_state_t, part, perp};
 use super::gear::Side;
-use super::{coordinate_lever, reaction_force, PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -13,6 +13,7 @@ impl PairType for Revolute {
     const NAME: &'static str = "revolute";
     const ROWS: usize = 2;
     const LETTER: char = 'R';
+    const FRICTION_FIELD: FrictionField = FrictionField::None;
 
     #[inline]
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {

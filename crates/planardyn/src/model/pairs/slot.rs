@@ -6,7 +6,7 @@
 use super::frames::{link_state, perp, Projection};
 use super::gear::Side;
 use super::revolute::both_links;
-use super::{coordinate_lever, reaction_force, PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -22,6 +22,7 @@ impl PairType for Slot {
     const NAME: &'static str = "slot";
     const ROWS: usize = 1;
     const LETTER: char = 'S';
+    const FRICTION_FIELD: FrictionField = FrictionField::None;
 
     #[inline]
     fn residual(&self, pair: &Pair, x: &[f64], trig: &[[f64; 2]]) -> Rows {
