@@ -1,4 +1,4 @@
-"""The fuzz harness of tests/test_fuzz_api.py and tests/test_plan_fuzz.py (issue 23, finding 6):
+"""The fuzz harness of tests/test_api_fuzz.py and tests/test_plan_fuzz.py (issue 23, finding 6):
 the hostile values, the walk that finds a NaN or an infinity in a result, and the oracle that
 judges one call with one spoilt argument.
 

@@ -644,7 +644,7 @@ def test_singularity_error_carries_its_kind_and_no_made_up_sigma():
 # ---------------------------------------------------------------- issue 23 finding 6: NaN, inf and zero refused by name
 
 def _three_legged_geared():
-    from test_fuzz_api import GEARED
+    from test_api_fuzz import GEARED
 
     return GEARED
 

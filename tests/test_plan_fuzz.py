@@ -6,7 +6,7 @@ arrays of the wrong shape and a string, the others valid. Expected: every call e
 returns a result holding no NaN (nor a warning, nor anything printed: IPOPT's output is
 silenced) or raises a planardyn error (PlanardynError) whose message starts with the
 argument's name; nothing else (no numpy, scipy, toppra or CasADi error): tests/fuzzing.py's
-oracle, shared with tests/test_fuzz_api.py. Every CLI option with
+oracle, shared with tests/test_api_fuzz.py. Every CLI option with
 a bad value exits 2 with a message naming the option. At 2ac385e, among others:
 task_waypoints with NaN raised "cannot convert float NaN to integer", size with preload NaN
 blamed tau[0], collocate with sigma_min NaN ended in CasADi's "Ill-posed problem", minimum

@@ -72,7 +72,7 @@ def test_regressor_takes_a_results_body_rates_near_a_type_ii_singularity():
     # The free-falling five-bar passes a type II singularity (sigma 8.6e-4 at its worst row):
     # with the run's xd the regressor's efforts are inverse dynamics' to round-off (measured
     # 3.0e-14 N m), and both are the passive run's 0 within the 1e-8 N m bound that
-    # tests/test_branch_true_inverse.py keeps (measured 7.4e-11 N m). With the rates solved
+    # tests/test_dynamics.py keeps (measured 7.4e-11 N m). With the rates solved
     # from qd instead (x alone) one rounding unit of qd gives 2.5e-8 N m there.
     mech = pd.load_example("five-bar-free-fall")
     res = mech.simulate(t_end=1.0, method="dop853", rtol=1e-10, atol=1e-12)

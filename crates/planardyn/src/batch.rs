@@ -113,7 +113,7 @@ pub const BRANCH_SIGMA: f64 = SWITCH_TO_PARTITION;
 /// The largest relative mismatch of given body rates xd with a row's qd,
 /// [`dynamics::rates_mismatch`], accepted: round-off leaves a few eps, whatever J's
 /// conditioning; rates of another state are off by O(1) (one body's rate 1e-6 rad/s off,
-/// about 1e-7 relative, is refused in tests/test_branch_true_inverse.py).
+/// about 1e-7 relative, is refused in tests/test_dynamics.py).
 pub const RATES_TOL: f64 = 1e-10;
 
 /// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each) on the drawn branch;

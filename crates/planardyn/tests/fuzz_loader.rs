@@ -2,7 +2,7 @@
 //! structurally (fields deleted, duplicated, retyped, renamed, names swapped, extreme numbers,
 //! NaN and inf, empty lists, wrong mobility) and as text (lines cut, moved, doubled, tokens
 //! inserted), random texts, and the corpus kept in `tests/fuzz_corpus/` (shared with the
-//! Python fuzz, `tests/test_fuzz.py`).
+//! Python fuzz, `tests/test_loader_fuzz.py`).
 //!
 //! Every input must, within [`TIME_LIMIT`] and without a panic, give `Ok(Mechanism)` or a
 //! `ModelError` naming the file, a location (a field path, or line and column) and a fix. A

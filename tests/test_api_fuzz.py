@@ -10,11 +10,11 @@ number, not an array of numbers). Anything else (a ``ValueError`` of numpy or sc
 ``ZeroDivisionError``, ``OverflowError``, ``LinAlgError``, ``IndexError``...) is a library
 error leaked to the user: a failure.
 
-Two passes, as tests/test_fuzz.py: every argument of every case with every value of the
+Two passes, as tests/test_loader_fuzz.py: every argument of every case with every value of the
 fixed hostile lists (:func:`test_every_argument_with_every_hostile_value`), then hypothesis'
 random values (``PLANARDYN_FUZZ_EXAMPLES``, default 300; a longer campaign:
-``PLANARDYN_FUZZ_EXAMPLES=20000 pytest tests/test_fuzz_api.py``, or
-``python tests/test_fuzz_api.py 20000`` which prints its counts). The command-line options
+``PLANARDYN_FUZZ_EXAMPLES=20000 pytest tests/test_api_fuzz.py``, or
+``python tests/test_api_fuzz.py 20000`` which prints its counts). The command-line options
 those issues added are fuzzed in tests/test_cli_fuzz.py.
 
 Not listed here (tests/test_plan_fuzz.py has them): ``planardyn.plan`` and

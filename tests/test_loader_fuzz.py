@@ -5,7 +5,7 @@
    text must either load or raise ``ModelError``/``PlanardynError`` whose message names the
    source and a field -- never another exception, never an internal error (a Rust panic is
    turned into ``PlanardynError('internal error ...')``: that is a bug here).
-   ``PLANARDYN_FUZZ_EXAMPLES=20000 pytest tests/test_fuzz.py -k fuzz`` runs a longer
+   ``PLANARDYN_FUZZ_EXAMPLES=20000 pytest tests/test_loader_fuzz.py -k fuzz`` runs a longer
    campaign; inputs worth keeping are in ``tests/fuzz_corpus/`` and replayed every run.
 2. Random four-bars and five-bars from the library constructors (Grashof crank-rockers,
    assemblable five-bars): the drawing closes, energy is conserved over 1 s of passive

@@ -1,0 +1,192 @@
+"""The dynamics calls: no finite garbage and no NaN/inf (below), and inverse dynamics on the
+branch the motion took (its section at the end).
+
+Near the slider-driven slider-crank's dead centre (slider at r + l = 0.4 m) the analogues grow
+as 1/sigma and the results lost every digit while looking like numbers (inverse dynamics 9.8e25
+at sigma 5.7e-8); below ``planardyn::dynamics::SINGULAR_SIGMA`` = 1e-6 the four dynamics calls
+raise ``SingularityError`` (kind 'type_ii', ``sigma_min``), or compute with
+``allow_singular=True``. Finite inputs whose results overflow raise ``ValueError`` naming the
+quantity, never return NaN or inf.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import planardyn as pd
+import pytest
+from planardyn.results_io import inverse_from_file, write_results
+
+SINGULAR_SIGMA = 1e-6
+DEAD_CENTRE = 0.4  # m: crank 0.1 m + rod 0.3 m, guide through the crank pivot
+
+
+@pytest.fixture(scope="module")
+def slider():
+    return pd.load_example("library/slider-crank-slider-driven")
+
+
+def near(mech, d):
+    q = np.array([DEAD_CENTRE - d])
+    return q, mech.kinematics(q)["sigma_min"]
+
+
+CALLS = {
+    "mass_matrix": lambda m, q, **kw: m.mass_matrix(q, **kw),
+    "forward_dynamics": lambda m, q, **kw: m.forward_dynamics(q, [0.0], tau=[0.0], **kw),
+    "inverse_dynamics": lambda m, q, **kw: m.inverse_dynamics(q, [0.1], [1.0], **kw),
+    "reactions": lambda m, q, **kw: m.reactions(q, [0.0], tau=[0.0], **kw),
+}
+
+
+@pytest.mark.parametrize("name", list(CALLS))
+def test_at_the_dead_centre_each_call_is_refused_with_the_measure(slider, name):
+    q, sigma = near(slider, 1e-14)
+    assert sigma < SINGULAR_SIGMA
+    with pytest.raises(pd.SingularityError, match="type II") as err:
+        CALLS[name](slider, q)
+    assert err.value.kind == "type_ii"
+    # The core's estimate of the measure stops within its SIGMA_RTOL (2e-3) of the SVD.
+    assert err.value.sigma_min == pytest.approx(sigma, rel=2e-3)
+    # On request the value is computed (and is finite) instead.
+    assert np.all(np.isfinite(CALLS[name](slider, q, allow_singular=True)))
+
+
+def test_just_above_the_threshold_forward_and_inverse_agree(slider):
+    q, sigma = near(slider, 1e-10)
+    assert SINGULAR_SIGMA < sigma < 100 * SINGULAR_SIGMA
+    tau = slider.inverse_dynamics(q, [0.1], [1.0])
+    qdd = slider.forward_dynamics(q, [0.1], tau=tau)
+    # Round-off grows as the measure falls (test dynamics_guards.rs measures it): 1e-3 is the
+    # accuracy the threshold keeps.
+    assert qdd[0] == pytest.approx(1.0, rel=1e-3)
+
+
+def test_huge_efforts_are_an_overflow_error():
+    mech = pd.load_example("five-bar-free-fall")
+    with pytest.raises(ValueError, match="accelerations qdd overflow") as err:
+        mech.forward_dynamics(mech.q0, [0.0, 0.0], tau=[1e308, 1e308])
+    assert err.value.quantity == "accelerations qdd"
+
+
+@pytest.mark.parametrize(
+    ("call", "quantity"),
+    [
+        (lambda m, q, v: m.forward_dynamics(q, v), "accelerations qdd"),
+        (lambda m, q, v: m.reactions(q, v), "accelerations qdd"),
+        (lambda m, q, v: m.inverse_dynamics(q, v, [0.0, 0.0]), "efforts tau"),
+        (lambda m, q, v: m.kinematics(q, v), "convective accelerations c"),
+        (lambda m, q, v: m.energy(q, v), "energies"),
+    ],
+)
+def test_huge_rates_are_an_overflow_error(call, quantity):
+    mech = pd.load_example("five-bar-free-fall")
+    with pytest.raises(ValueError, match="try smaller efforts") as err:
+        call(mech, mech.q0, [1e155, 1e155])
+    assert err.value.quantity == quantity
+
+
+def test_a_run_of_no_step_reports_the_start_measure_not_inf():
+    # A drive that fails after the start: the first step is never accepted.
+    def drives(t, q, qd):
+        if t > 0.0:
+            raise RuntimeError("no effort after the start")
+        return np.zeros(2)
+
+    mech = pd.load_example("five-bar-free-fall")
+    res = mech.simulate(t_end=1.0, drives=drives)
+    assert res.status == "drive_failed" and res.stats["naccept"] == 0
+    sigma0 = mech.kinematics(mech.q0)["sigma_min"]
+    # The integrator's estimate of the measure, within its SIGMA_RTOL (2e-3) of the SVD.
+    assert res.stats["min_sigma"] == pytest.approx(sigma0, rel=2e-3)
+
+
+# ---------------------------------------------------------------- inverse dynamics on the motion's branch
+# Inverse dynamics follows the branch the motion took.
+#
+# A motion that passes through a type II singularity may leave it on the other assembly
+# branch: the free-falling five-bar does, and a slider-crank pushed through its dead centre.
+# Their efforts are known exactly: the five-bar is passive (the truth is 0), the slider-crank
+# ran under its model's drives (the truth is the run's own ``tau``). With the body coordinates
+# of every row (a result's ``x``, which results files carry) the efforts match; from q alone
+# the rows after the singularity are refused, naming the row, instead of being computed on
+# the drawn branch (they were off by up to 2.28e3 N m).
+
+TIGHT = dict(method="dop853", rtol=1e-10, atol=1e-12)
+
+
+@pytest.fixture(scope="module")
+def free_fall():
+    mech = pd.load_example("five-bar-free-fall")
+    res = mech.simulate(t_end=1.0, **TIGHT)
+    # The run itself goes through a type II singularity (it switches to body coordinates).
+    assert res.success and res.partitioned.any()
+    return mech, res
+
+
+def test_free_fall_efforts_are_zero_from_the_result(free_fall):
+    mech, res = free_fall
+    # With the run's body rates: at its most singular row (sigma 8.6e-4) one rounding unit of
+    # qd moves the rates solved from it, and the efforts by ~2e-8 N m (2.5e-8 measured from
+    # x alone); xd holds the integrator's state.
+    tau = mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x, xd=res.xd)
+    # Passive: 0 exactly; 1e-8 N m is the issue's bound, ~1e4 times the round-off of A qdd - b.
+    assert np.abs(tau).max() < 1e-8
+
+
+def test_free_fall_efforts_are_zero_from_its_results_file(free_fall, tmp_path):
+    mech, res = free_fall
+    path = tmp_path / "free-fall.npz"
+    write_results(res, path)
+    # The file's xd are passed with its x (see the test above for why).
+    inv = inverse_from_file(mech, path)
+    assert np.abs(inv.tau).max() < 1e-8
+    assert np.array_equal(inv.xd, res.xd)
+    assert inv.metadata["branch"] == "each row's body coordinates"
+    assert np.allclose(inv.x, res.x, atol=1e-9)
+
+
+def test_body_rates_that_are_not_qd_s_are_refused_naming_the_row(free_fall):
+    mech, res = free_fall
+    xd = res.xd.copy()
+    # Another state's rates: one body's angular rate off by 1e-6 rad/s, far above the
+    # round-off (relative 1e-10 accepted) and far below the rates themselves (~1-10 rad/s).
+    xd[7, 2] += 1e-6
+    with pytest.raises(ValueError, match="row 7"):
+        mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x, xd=xd)
+    with pytest.raises(ValueError, match="xd needs x"):
+        mech.inverse_dynamics(res.q, res.qd, res.qdd, xd=res.xd)
+
+
+def test_free_fall_from_q_alone_is_refused_at_the_singularity(free_fall):
+    mech, res = free_fall
+    with pytest.raises(pd.SingularityError, match="cannot be decided") as err:
+        mech.inverse_dynamics(res.q, res.qd, res.qdd)
+    row = err.value.row
+    # Refused before the run entered the partition chart's region far behind: at a row where
+    # the drawn branch is within 0.05 of the singularity, and before the motion left it.
+    assert err.value.sigma_min < 0.05
+    assert 0 < row < np.argmax(res.partitioned)
+
+
+@pytest.mark.parametrize("v0", [-3.0, 3.0])
+def test_slider_crank_through_its_dead_centre(v0):
+    mech = pd.load_example("library/slider-crank-slider-driven")
+    res = mech.simulate(t_end=1.0, qd0=[v0], **TIGHT)
+    assert res.success and res.partitioned.any()
+    tau = mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x)
+    # Near the dead centre (sigma ~1e-4) round-off in the efforts grows as 1/sigma: 1e-6 N
+    # is ~1e2 times the measured 3e-8 N and 1e-6 of the gravity loads.
+    assert np.abs(tau - res.tau).max() < 1e-6
+    with pytest.raises(pd.SingularityError) as err:
+        mech.inverse_dynamics(res.q, res.qd, res.qdd)
+    assert err.value.row < np.argmax(res.partitioned)
+
+
+def test_a_single_row_near_a_singularity_is_not_refused(free_fall):
+    # One row has no "after": nothing to decide. At the run's most singular row (sigma
+    # 8.6e-4) the passive efforts are still 0 to round-off amplified by 1/sigma, given the
+    # row's body rates (from qd's rounding alone they are 2.5e-8 N m off).
+    mech, res = free_fall
+    i = int(np.argmin(res.sigma))
+    tau = mech.inverse_dynamics(res.q[i], res.qd[i], res.qdd[i], x=res.x[i], xd=res.xd[i])
+    assert np.abs(tau).max() < 1e-8
