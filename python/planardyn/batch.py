@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._core import inverse_batch, simulate_batch
 from .arguments import count, error
-from .mechanism import Mechanism, attach_metadata, from_dict, native_motion
+from .mechanism import Mechanism, from_dict, native_motion, run_metadata
 from .result import SimulationResult
 from .settings import MAX_THREADS, check_settings
 
@@ -263,14 +263,13 @@ def simulate(
 
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
-    result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
-                                       coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names,
-                                       tau_motor=mech._result_motor_torques(raw))
     # The metadata's settings rerun the variant: mech.simulate(**settings), motions by name.
     rerun = {k: v for k, v in settings.items() if k not in ("motion", "_motion")}
     if "_motion" in settings:
         rerun["motion"] = settings["_motion"]
-    return attach_metadata(result, mech, rerun)
+    return SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
+                                     coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names,
+                                     metadata=run_metadata({}, mech, rerun), tau_motor=mech._result_motor_torques(raw))
 
 
 def inverse_dynamics(

@@ -23,7 +23,7 @@ from ._core import load as native_load
 from ._core import loads as native_loads
 from .arguments import array, error, index, number
 from .events import Crossing, Event, native_events
-from .guard import available_memory, rows_message
+from .guard import ALWAYS_FITS, available_memory, needed_bytes, rows_message
 from .models import UnknownModelError
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
@@ -75,12 +75,14 @@ class Mechanism:
     the mechanism is drawn in. Methods release the GIL and may be called from threads.
     """
 
-    __slots__ = ("_native",)
+    __slots__ = ("_native", "_model")
 
     def __init__(self, native: NativeMechanism) -> None:
         if not isinstance(native, NativeMechanism):
             raise TypeError("use planardyn.load(), loads() or from_dict() to make a Mechanism")
         self._native = native
+        #: The model dict the results' metadata share, parsed at the first run (`_shared_model`).
+        self._model: dict[str, Any] | None = None
         for message in native.warnings:
             warnings.warn(f"{native.source}: {message}", PlanardynWarning, stacklevel=3)
 
@@ -143,6 +145,13 @@ class Mechanism:
     def to_dict(self) -> dict[str, Any]:
         """The model as a dict in the model-file schema; ``from_dict`` gives it back."""
         return json.loads(self._native.spec_json())
+
+    def _shared_model(self) -> dict[str, Any]:
+        """:meth:`to_dict` parsed once and shared by the metadata of every result of this
+        mechanism: parsing it at each run was most of a short run's fixed cost in Python."""
+        if self._model is None:
+            self._model = self.to_dict()
+        return self._model
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mechanism):
@@ -727,13 +736,6 @@ class Mechanism:
             events=native_events(events, self.coordinate_names),
             dense_output=bool(dense_output),
         )
-        result = SimulationResult.from_raw(
-            raw,
-            coordinate_names=self.coordinate_names,
-            coordinate_kinds=self.coordinate_kinds,
-            body_names=self.body_names,
-            tau_motor=self._result_motor_torques(raw),
-        )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
                         t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
@@ -743,14 +745,22 @@ class Mechanism:
                         **({} if events is None else {"events": [
                             dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
                         **({"dense_output": True} if dense_output else {}))
-        result = attach_metadata(result, self, settings)
+        result = SimulationResult.from_raw(
+            raw,
+            coordinate_names=self.coordinate_names,
+            coordinate_kinds=self.coordinate_kinds,
+            body_names=self.body_names,
+            metadata=run_metadata({}, self, settings),
+            tau_motor=self._result_motor_torques(raw),
+        )
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
 
     def _check_rows_fit(self, checked: dict[str, Any], t_eval: ArrayLike | None) -> None:
         """Refuse up front a run whose output rows cannot fit in the memory available (a run
-        that outputs every step has no count known up front)."""
+        that outputs every step has no count known up front). The memory is not read for a run
+        whose rows always fit (``guard.ALWAYS_FITS``)."""
         defaults = self.simulate_defaults
         output_dt = checked.get("output_dt") or defaults.get("output_dt")
         if t_eval is not None:
@@ -759,7 +769,10 @@ class Mechanism:
             rows = (checked.get("t_end") or defaults.get("t_end") or 1.0) / output_dt + 1
         else:
             return
-        refused = rows_message(rows, self.dof, self.n_bodies, available_memory())
+        m, n = self.dof, self.n_bodies
+        if needed_bytes(rows, m, n) <= ALWAYS_FITS:
+            return
+        refused = rows_message(rows, m, n, available_memory())
         if refused:
             raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
 
@@ -880,13 +893,24 @@ def attach_metadata(
 
     Values already in ``result.metadata`` are kept unless given again here.
     """
-    meta = dict(result.metadata)
+    return dataclasses.replace(result, metadata=run_metadata(result.metadata, mechanism, settings, **extra))
+
+
+def run_metadata(
+    metadata: Mapping[str, Any],
+    mechanism: Mechanism | None = None,
+    settings: dict[str, Any] | None = None,
+    **extra: Any,
+) -> dict[str, Any]:
+    """``metadata`` with the model, settings and version of a run recorded (as
+    :func:`attach_metadata`); the model dict is the one all results of ``mechanism`` share."""
+    meta = dict(metadata)
     meta.setdefault("kind", "simulation")
     meta["planardyn_version"] = meta.get("planardyn_version") or __version__
     if mechanism is not None:
-        meta["model"] = mechanism.to_dict()
+        meta["model"] = mechanism._shared_model()
         meta["source"] = mechanism.source
     if settings is not None:
         meta["settings"] = {k: plain(v) for k, v in settings.items()}
     meta.update(extra)
-    return dataclasses.replace(result, metadata=meta)
+    return meta

@@ -185,7 +185,8 @@ class SimulationResult:
     #: The change points crossed, in time order (see :meth:`change_points_frame`).
     change_points: list[ChangePoint] = field(default_factory=list)
     #: Where the result came from, for reproducing and re-plotting it: ``model`` (the model
-    #: as a dict, ``Mechanism.to_dict()``), ``settings`` (keyword arguments of
+    #: as a dict, ``Mechanism.to_dict()``, one dict shared by the results of a mechanism: edit a
+    #: ``to_dict()`` copy), ``settings`` (keyword arguments of
     #: ``Mechanism.simulate``), ``planardyn_version``, ``kind`` ('simulation' or 'inverse').
     #: Empty unless attached (:func:`planardyn.results_io.attach_metadata`) or read from a file.
     metadata: dict[str, Any] = field(default_factory=dict)
