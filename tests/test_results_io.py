@@ -88,6 +88,15 @@ def test_metadata_model_is_parsed_once_and_to_dict_is_a_copy(five_bar_run):
     assert mech.to_dict()["name"] != "edited" and res.metadata["model"]["name"] != "edited"
 
 
+def test_from_raw_sets_every_field(five_bar_run):
+    """from_raw sets the fields without the dataclass's __init__ (issue 25 item 4): every field
+    is there, and the dataclass's own machinery (replace) still takes them all."""
+    _, _, res = five_bar_run
+    assert set(vars(res)) == {f.name for f in dataclasses.fields(res)}
+    again = dataclasses.replace(res, status="cancelled")
+    assert again.status == "cancelled" and again.q is res.q and again.metadata == res.metadata
+
+
 def test_results_file_reproduces_the_run(five_bar_run, tmp_path):
     # The model and settings in the file are enough to compute the same trajectory again.
     _, _, res = five_bar_run

@@ -12,7 +12,7 @@ import json
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Generic, Literal, TypeVar, overload
+from typing import Any, Generic, Literal, NamedTuple, TypeVar, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -66,6 +66,24 @@ class _Native(Generic[T]):
         raise AttributeError(f"Mechanism.{self.name} is read-only: a Mechanism is immutable")
 
 
+class _RunFacts(NamedTuple):
+    """What every run of a mechanism reads from it, read once: parsing the model dict and the
+    native reads at each run were most of a short run's fixed cost in Python."""
+
+    #: :meth:`Mechanism.to_dict`, the one dict the metadata of all its results share.
+    model: dict[str, Any]
+    source: str
+    coordinate_names: list[str]
+    coordinate_kinds: list[str]
+    body_names: list[str]
+    has_actuators: bool
+    dof: int
+    n_bodies: int
+    #: The model file's ``simulate`` output_dt and t_end (s), None where not given.
+    output_dt: float | None
+    t_end: float | None
+
+
 class Mechanism:
     """An immutable, validated planar mechanism.
 
@@ -75,14 +93,14 @@ class Mechanism:
     the mechanism is drawn in. Methods release the GIL and may be called from threads.
     """
 
-    __slots__ = ("_native", "_model")
+    __slots__ = ("_native", "_facts")
 
     def __init__(self, native: NativeMechanism) -> None:
         if not isinstance(native, NativeMechanism):
             raise TypeError("use planardyn.load(), loads() or from_dict() to make a Mechanism")
         self._native = native
-        #: The model dict the results' metadata share, parsed at the first run (`_shared_model`).
-        self._model: dict[str, Any] | None = None
+        #: Read at the first run (`_run_facts`).
+        self._facts: _RunFacts | None = None
         for message in native.warnings:
             warnings.warn(f"{native.source}: {message}", PlanardynWarning, stacklevel=3)
 
@@ -146,12 +164,21 @@ class Mechanism:
         """The model as a dict in the model-file schema; ``from_dict`` gives it back."""
         return json.loads(self._native.spec_json())
 
-    def _shared_model(self) -> dict[str, Any]:
-        """:meth:`to_dict` parsed once and shared by the metadata of every result of this
-        mechanism: parsing it at each run was most of a short run's fixed cost in Python."""
-        if self._model is None:
-            self._model = self.to_dict()
-        return self._model
+    def _run_facts(self) -> _RunFacts:
+        """What every run reads from this mechanism, read at the first run."""
+        if self._facts is None:
+            defaults = self.simulate_defaults
+            self._facts = _RunFacts(self.to_dict(), self.source, self.coordinate_names, self.coordinate_kinds, self.body_names,
+                                    any(a is not None for a in self.actuators), self.dof, self.n_bodies,
+                                    defaults.get("output_dt"), defaults.get("t_end"))
+        return self._facts
+
+    def _result(self, raw: dict[str, Any], settings: dict[str, Any]) -> SimulationResult:
+        """The result of a run from the native dict, its metadata recording ``settings``."""
+        f = self._run_facts()
+        return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
+                                         body_names=f.body_names, metadata=run_metadata({}, self, settings),
+                                         tau_motor=self._result_motor_torques(raw))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mechanism):
@@ -391,7 +418,7 @@ class Mechanism:
     def _result_motor_torques(self, raw: Mapping[str, Any]) -> FloatArray | None:
         """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
         tau, x, xd, each (N, ...)) when the model has an actuator, else None."""
-        if all(a is None for a in self.actuators):
+        if not self._run_facts().has_actuators:
             return None
         tau = np.asarray(raw["tau"], dtype=np.float64)
         if len(tau) == 0:
@@ -745,14 +772,7 @@ class Mechanism:
                         **({} if events is None else {"events": [
                             dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
                         **({"dense_output": True} if dense_output else {}))
-        result = SimulationResult.from_raw(
-            raw,
-            coordinate_names=self.coordinate_names,
-            coordinate_kinds=self.coordinate_kinds,
-            body_names=self.body_names,
-            metadata=run_metadata({}, self, settings),
-            tau_motor=self._result_motor_torques(raw),
-        )
+        result = self._result(raw, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
@@ -761,18 +781,17 @@ class Mechanism:
         """Refuse up front a run whose output rows cannot fit in the memory available (a run
         that outputs every step has no count known up front). The memory is not read for a run
         whose rows always fit (``guard.ALWAYS_FITS``)."""
-        defaults = self.simulate_defaults
-        output_dt = checked.get("output_dt") or defaults.get("output_dt")
+        f = self._run_facts()
+        output_dt = checked.get("output_dt") or f.output_dt
         if t_eval is not None:
             rows = float(np.size(t_eval))
         elif output_dt is not None:
-            rows = (checked.get("t_end") or defaults.get("t_end") or 1.0) / output_dt + 1
+            rows = (checked.get("t_end") or f.t_end or 1.0) / output_dt + 1
         else:
             return
-        m, n = self.dof, self.n_bodies
-        if needed_bytes(rows, m, n) <= ALWAYS_FITS:
+        if needed_bytes(rows, f.dof, f.n_bodies) <= ALWAYS_FITS:
             return
-        refused = rows_message(rows, m, n, available_memory())
+        refused = rows_message(rows, f.dof, f.n_bodies, available_memory())
         if refused:
             raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
 
@@ -908,8 +927,8 @@ def run_metadata(
     meta.setdefault("kind", "simulation")
     meta["planardyn_version"] = meta.get("planardyn_version") or __version__
     if mechanism is not None:
-        meta["model"] = mechanism._shared_model()
-        meta["source"] = mechanism.source
+        facts = mechanism._run_facts()
+        meta["model"], meta["source"] = facts.model, facts.source
     if settings is not None:
         meta["settings"] = {k: plain(v) for k, v in settings.items()}
     meta.update(extra)
