@@ -746,6 +746,7 @@ class Mechanism:
         """
         checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
         self._check_rows_fit(checked, t_eval)
+        names = self._run_facts().coordinate_names
         raw = self._native.simulate(
             t_end=checked["t_end"],
             method=method,
@@ -759,8 +760,8 @@ class Mechanism:
             drives=drives,
             progress=progress,
             max_steps=checked["max_steps"],
-            motion=native_motion(motion, self.coordinate_names),
-            events=native_events(events, self.coordinate_names),
+            motion=native_motion(motion, names),
+            events=native_events(events, names),
             dense_output=bool(dense_output),
         )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
