@@ -63,6 +63,27 @@ def test_native_threads_equal_a_serial_loop(variants):
     assert not np.array_equal(got[0].q, got[2].q)
 
 
+def test_results_are_finished_in_the_native_threads(five_bar):
+    """Each run's result is converted and finished by the worker that ran it, not by the
+    calling thread (issue 25 item 4: that serial work capped two threads at about 1.6x);
+    a failed variant's (type, message) pair reaches finish as it is."""
+    from planardyn._core import simulate_batch
+
+    caller = threading.get_ident()
+    seen = []
+
+    def finish(k, raw):
+        seen.append((k, threading.get_ident(), type(raw).__name__))
+        return k
+
+    native = [(five_bar._native, {"q0": list(five_bar.q0 + [0.01 * k, 0.0]), "t_end": T_END}) for k in range(4)]
+    native[2] = (five_bar._native, {"q0": IMPOSSIBLE_Q0, "t_end": T_END})
+    assert simulate_batch(native, 2, finish) == [0, 1, 2, 3]
+    assert sorted(k for k, _, _ in seen) == [0, 1, 2, 3]
+    assert all(ident != caller for _, ident, _ in seen)
+    assert {k: kind for k, _, kind in seen} == {0: "dict", 1: "dict", 2: "tuple", 3: "dict"}
+
+
 def test_a_failing_variant_is_reported_in_its_place(five_bar, variants):
     bad_model = five_bar.to_dict()
     bad_model["bodies"]["proximal_left"]["mass"] = -1.0

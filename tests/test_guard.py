@@ -74,3 +74,15 @@ def test_api_run_that_cannot_fit_is_refused_up_front(monkeypatch):
     with pytest.raises(ValueError, match="fewer t_eval"):
         mech.simulate(t_end=1.0, t_eval=np.linspace(0.0, 1.0, 10_000))
     assert mech.simulate(t_end=0.01, output_dt=1e-5).success
+
+
+def test_api_small_run_does_not_read_the_memory(monkeypatch):
+    """A run whose rows always fit (11 rows of 305 B, 4 times over: 13 kB, under
+    guard.ALWAYS_FITS = 1 MiB) runs without reading /proc/meminfo; 1001 rows (1.2 MB) do read it."""
+    mech = pd.load(FIVE_BAR)
+    reads = []
+    monkeypatch.setattr(pd.mechanism, "available_memory", lambda: reads.append(1) or 10 * 2**20)
+    assert mech.simulate(t_end=0.01, output_dt=1e-3).success
+    assert reads == []
+    assert mech.simulate(t_end=0.01, output_dt=1e-5).success
+    assert reads == [1]

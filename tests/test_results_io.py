@@ -77,6 +77,27 @@ def test_round_trip_every_array_equal(five_bar_run, tmp_path, ext):
     np.testing.assert_array_equal(df["tau_theta2"].to_numpy(), res.tau[:, 1])
 
 
+def test_metadata_model_is_parsed_once_and_to_dict_is_a_copy(five_bar_run):
+    """The results of one mechanism share its model dict (parsed at the first run, not at
+    each: issue 25 item 4); to_dict() still gives a fresh copy to edit."""
+    mech, _, res = five_bar_run
+    again = mech.simulate(0.01)
+    assert again.metadata["model"] is res.metadata["model"]
+    assert res.metadata["model"] == mech.to_dict()
+    edited = mech.to_dict()
+    edited["name"] = "edited"
+    assert mech.to_dict()["name"] != "edited" and res.metadata["model"]["name"] != "edited"
+
+
+def test_from_raw_sets_every_field(five_bar_run):
+    """from_raw sets the fields without the dataclass's __init__ (issue 25 item 4): every field
+    is there, and the dataclass's own machinery (replace) still takes them all."""
+    _, _, res = five_bar_run
+    assert set(vars(res)) == {f.name for f in dataclasses.fields(res)}
+    again = dataclasses.replace(res, status="cancelled")
+    assert again.status == "cancelled" and again.q is res.q and again.metadata == res.metadata
+
+
 def test_results_file_reproduces_the_run(five_bar_run, tmp_path):
     # The model and settings in the file are enough to compute the same trajectory again.
     _, _, res = five_bar_run

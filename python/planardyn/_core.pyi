@@ -311,8 +311,12 @@ class Effector:
     ) -> dict[str, Any]: ...
 
 def simulate_batch(
-    variants: list[tuple[Mechanism, dict[str, Any]]], threads: int | None = None
-) -> list[dict[str, Any] | tuple[str, str]]: ...
+    variants: list[tuple[Mechanism, dict[str, Any]]],
+    threads: int | None = None,
+    finish: Callable[[int, dict[str, Any]], Any] | None = None,
+) -> list[Any]: ...
 def inverse_batch(
-    variants: list[tuple[Mechanism, dict[str, Any]]], threads: int | None = None
-) -> list[dict[str, Any] | tuple[str, str]]: ...
+    variants: list[tuple[Mechanism, dict[str, Any]]],
+    threads: int | None = None,
+    finish: Callable[[int, dict[str, Any]], Any] | None = None,
+) -> list[Any]: ...

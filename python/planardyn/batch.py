@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._core import inverse_batch, simulate_batch
 from .arguments import count, error
-from .mechanism import Mechanism, attach_metadata, from_dict, native_motion
+from .mechanism import Mechanism, from_dict, native_motion
 from .result import SimulationResult
 from .settings import MAX_THREADS, check_settings
 
@@ -108,12 +108,18 @@ def _settings(common: Mapping[str, Any], own: Mapping[str, Any], mech: Mechanism
     return out
 
 
-def _run_chunk(kind: str, items: list[tuple[Mechanism, dict[str, Any]]], threads: int | None) -> list[Any]:
+def _run_chunk(kind: str, items: list[tuple[Mechanism, dict[str, Any]]], threads: int | None,
+               finish: Callable[[Any, Mechanism, dict[str, Any]], Any] | None = None) -> list[Any]:
     """One native batch (``kind`` 'simulate' or 'inverse'): a picklable call that runs on a
-    worker (or here)."""
+    worker (or here). Given ``finish``, the native threads apply it to each raw result as they
+    finish it (the calling thread only collects them; a failed variant's pair (type, message)
+    is kept); else the raw results come back."""
     native = simulate_batch if kind == "simulate" else inverse_batch
     # Keys with a leading underscore stay in Python (the path's label, for the result).
-    return native([(m._native, {k: v for k, v in s.items() if not k.startswith("_")}) for m, s in items], threads)
+    variants = [(m._native, {k: v for k, v in s.items() if not k.startswith("_")}) for m, s in items]
+    if finish is None:
+        return native(variants, threads)
+    return native(variants, threads, lambda k, raw: raw if isinstance(raw, tuple) else finish(raw, *items[k]))
 
 
 def _is_dask(executor: Any) -> bool:
@@ -154,7 +160,7 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
     starts = range(0, n, chunk_size)
     futures: list[Any] = []
     if executor is None:
-        pending = [lambda s=s: _run_chunk(kind, items[s:s + chunk_size], threads) for s in starts]
+        pending = [lambda s=s: _run_chunk(kind, items[s:s + chunk_size], threads, finish) for s in starts]
     else:
         kw = {"pure": False} if _is_dask(executor) else {}
         futures = [executor.submit(_run_chunk, kind, items[s:s + chunk_size], threads, **kw) for s in starts]
@@ -176,7 +182,10 @@ def _run(kind: str, variants: Sequence[VariantLike], own_args: Callable[[Mechani
             raws = [(type(e).__name__, f"the chunk with this variant failed: {e}")] * len(chunk)
         for k, ((mech, args), raw) in enumerate(zip(chunk, raws)):
             i = todo[s + k]
-            out[i] = finish(raw, mech, args) if isinstance(raw, dict) else BatchError(i, *raw)
+            if isinstance(raw, tuple):
+                out[i] = BatchError(i, *raw)
+            else:  # finished here by the native threads, or come back raw from the executor
+                out[i] = raw if executor is None else finish(raw, mech, args)
         done += len(chunk)
         if progress is not None and stopped is None:
             stopped = _progress_stop(progress, done, n)
@@ -263,14 +272,11 @@ def simulate(
 
 
 def _result(raw: dict[str, Any], mech: Mechanism, settings: dict[str, Any]) -> SimulationResult:
-    result = SimulationResult.from_raw(raw, coordinate_names=mech.coordinate_names,
-                                       coordinate_kinds=mech.coordinate_kinds, body_names=mech.body_names,
-                                       tau_motor=mech._result_motor_torques(raw))
     # The metadata's settings rerun the variant: mech.simulate(**settings), motions by name.
     rerun = {k: v for k, v in settings.items() if k not in ("motion", "_motion")}
     if "_motion" in settings:
         rerun["motion"] = settings["_motion"]
-    return attach_metadata(result, mech, rerun)
+    return mech._result(raw, rerun)
 
 
 def inverse_dynamics(

@@ -22,6 +22,11 @@ from typing import Any
 PEAK_FACTOR = 4
 #: Share of the memory available at the start a run may grow by before it is stopped.
 GROWTH_SHARE = 0.5
+#: Output rows that need at most this many bytes at their peak are never refused, and the
+#: memory is not read for them: reading /proc/meminfo (about 10 us) cost more than a short
+#: run's whole fixed cost in Python, and a process that cannot get 1 MiB more fails at its
+#: next allocation whatever the guard says.
+ALWAYS_FITS = 2**20
 
 
 def available_memory() -> int | None:
@@ -55,10 +60,15 @@ def row_bytes(m: int, n_bodies: int) -> int:
     return 8 * (1 + 4 * m + 3 + 2 + 6 * n_bodies) + 1
 
 
+def needed_bytes(rows: float, m: int, n_bodies: int) -> float:
+    """Peak bytes of a run with ``rows`` output rows."""
+    return rows * row_bytes(m, n_bodies) * PEAK_FACTOR
+
+
 def rows_message(rows: float, m: int, n_bodies: int, available: int | None) -> str | None:
     """Why ``rows`` output rows cannot be held in ``available`` bytes, or None if they can
     (or nothing is known of the memory)."""
-    need = rows * row_bytes(m, n_bodies) * PEAK_FACTOR
+    need = needed_bytes(rows, m, n_bodies)
     if available is None or need <= available:
         return None
     return (f"{rows:.4g} output rows need about {need / 2**30:.3g} GiB, more than the "

@@ -12,7 +12,7 @@ import json
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Generic, Literal, TypeVar, overload
+from typing import Any, Generic, Literal, NamedTuple, TypeVar, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,7 +23,7 @@ from ._core import load as native_load
 from ._core import loads as native_loads
 from .arguments import array, error, index, number
 from .events import Crossing, Event, native_events
-from .guard import available_memory, rows_message
+from .guard import ALWAYS_FITS, available_memory, needed_bytes, rows_message
 from .models import UnknownModelError
 from .models import path as model_path
 from .result import PointMotion, SimulationInterrupted, SimulationResult
@@ -66,6 +66,24 @@ class _Native(Generic[T]):
         raise AttributeError(f"Mechanism.{self.name} is read-only: a Mechanism is immutable")
 
 
+class _RunFacts(NamedTuple):
+    """What every run of a mechanism reads from it, read once: parsing the model dict and the
+    native reads at each run were most of a short run's fixed cost in Python."""
+
+    #: :meth:`Mechanism.to_dict`, the one dict the metadata of all its results share.
+    model: dict[str, Any]
+    source: str
+    coordinate_names: list[str]
+    coordinate_kinds: list[str]
+    body_names: list[str]
+    has_actuators: bool
+    dof: int
+    n_bodies: int
+    #: The model file's ``simulate`` output_dt and t_end (s), None where not given.
+    output_dt: float | None
+    t_end: float | None
+
+
 class Mechanism:
     """An immutable, validated planar mechanism.
 
@@ -75,12 +93,14 @@ class Mechanism:
     the mechanism is drawn in. Methods release the GIL and may be called from threads.
     """
 
-    __slots__ = ("_native",)
+    __slots__ = ("_native", "_facts")
 
     def __init__(self, native: NativeMechanism) -> None:
         if not isinstance(native, NativeMechanism):
             raise TypeError("use planardyn.load(), loads() or from_dict() to make a Mechanism")
         self._native = native
+        #: Read at the first run (`_run_facts`).
+        self._facts: _RunFacts | None = None
         for message in native.warnings:
             warnings.warn(f"{native.source}: {message}", PlanardynWarning, stacklevel=3)
 
@@ -143,6 +163,22 @@ class Mechanism:
     def to_dict(self) -> dict[str, Any]:
         """The model as a dict in the model-file schema; ``from_dict`` gives it back."""
         return json.loads(self._native.spec_json())
+
+    def _run_facts(self) -> _RunFacts:
+        """What every run reads from this mechanism, read at the first run."""
+        if self._facts is None:
+            defaults = self.simulate_defaults
+            self._facts = _RunFacts(self.to_dict(), self.source, self.coordinate_names, self.coordinate_kinds, self.body_names,
+                                    any(a is not None for a in self.actuators), self.dof, self.n_bodies,
+                                    defaults.get("output_dt"), defaults.get("t_end"))
+        return self._facts
+
+    def _result(self, raw: dict[str, Any], settings: dict[str, Any]) -> SimulationResult:
+        """The result of a run from the native dict, its metadata recording ``settings``."""
+        f = self._run_facts()
+        return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
+                                         body_names=f.body_names, metadata=run_metadata({}, self, settings),
+                                         tau_motor=self._result_motor_torques(raw))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mechanism):
@@ -382,7 +418,7 @@ class Mechanism:
     def _result_motor_torques(self, raw: Mapping[str, Any]) -> FloatArray | None:
         """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
         tau, x, xd, each (N, ...)) when the model has an actuator, else None."""
-        if all(a is None for a in self.actuators):
+        if not self._run_facts().has_actuators:
             return None
         tau = np.asarray(raw["tau"], dtype=np.float64)
         if len(tau) == 0:
@@ -710,6 +746,7 @@ class Mechanism:
         """
         checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
         self._check_rows_fit(checked, t_eval)
+        names = self._run_facts().coordinate_names
         raw = self._native.simulate(
             t_end=checked["t_end"],
             method=method,
@@ -723,16 +760,9 @@ class Mechanism:
             drives=drives,
             progress=progress,
             max_steps=checked["max_steps"],
-            motion=native_motion(motion, self.coordinate_names),
-            events=native_events(events, self.coordinate_names),
+            motion=native_motion(motion, names),
+            events=native_events(events, names),
             dense_output=bool(dense_output),
-        )
-        result = SimulationResult.from_raw(
-            raw,
-            coordinate_names=self.coordinate_names,
-            coordinate_kinds=self.coordinate_kinds,
-            body_names=self.body_names,
-            tau_motor=self._result_motor_torques(raw),
         )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun.
         settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
@@ -743,23 +773,26 @@ class Mechanism:
                         **({} if events is None else {"events": [
                             dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
                         **({"dense_output": True} if dense_output else {}))
-        result = attach_metadata(result, self, settings)
+        result = self._result(raw, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
 
     def _check_rows_fit(self, checked: dict[str, Any], t_eval: ArrayLike | None) -> None:
         """Refuse up front a run whose output rows cannot fit in the memory available (a run
-        that outputs every step has no count known up front)."""
-        defaults = self.simulate_defaults
-        output_dt = checked.get("output_dt") or defaults.get("output_dt")
+        that outputs every step has no count known up front). The memory is not read for a run
+        whose rows always fit (``guard.ALWAYS_FITS``)."""
+        f = self._run_facts()
+        output_dt = checked.get("output_dt") or f.output_dt
         if t_eval is not None:
             rows = float(np.size(t_eval))
         elif output_dt is not None:
-            rows = (checked.get("t_end") or defaults.get("t_end") or 1.0) / output_dt + 1
+            rows = (checked.get("t_end") or f.t_end or 1.0) / output_dt + 1
         else:
             return
-        refused = rows_message(rows, self.dof, self.n_bodies, available_memory())
+        if needed_bytes(rows, f.dof, f.n_bodies) <= ALWAYS_FITS:
+            return
+        refused = rows_message(rows, f.dof, f.n_bodies, available_memory())
         if refused:
             raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
 
@@ -880,13 +913,24 @@ def attach_metadata(
 
     Values already in ``result.metadata`` are kept unless given again here.
     """
-    meta = dict(result.metadata)
+    return dataclasses.replace(result, metadata=run_metadata(result.metadata, mechanism, settings, **extra))
+
+
+def run_metadata(
+    metadata: Mapping[str, Any],
+    mechanism: Mechanism | None = None,
+    settings: dict[str, Any] | None = None,
+    **extra: Any,
+) -> dict[str, Any]:
+    """``metadata`` with the model, settings and version of a run recorded (as
+    :func:`attach_metadata`); the model dict is the one all results of ``mechanism`` share."""
+    meta = dict(metadata)
     meta.setdefault("kind", "simulation")
     meta["planardyn_version"] = meta.get("planardyn_version") or __version__
     if mechanism is not None:
-        meta["model"] = mechanism.to_dict()
-        meta["source"] = mechanism.source
+        facts = mechanism._run_facts()
+        meta["model"], meta["source"] = facts.model, facts.source
     if settings is not None:
         meta["settings"] = {k: plain(v) for k, v in settings.items()}
     meta.update(extra)
-    return dataclasses.replace(result, metadata=meta)
+    return meta

@@ -40,8 +40,9 @@ class Energy:
     @classmethod
     def from_arrays(cls, kinetic: FloatArray, potential: FloatArray, work: FloatArray) -> Energy:
         total = kinetic + potential
-        raw = total - work
-        balance = raw - raw[0] if len(raw) else raw
+        balance = total - work
+        if len(balance):
+            balance -= balance[0]  # in place: one temporary fewer on a short run's path
         return cls(kinetic, potential, work, total, balance)
 
     @property
@@ -185,7 +186,8 @@ class SimulationResult:
     #: The change points crossed, in time order (see :meth:`change_points_frame`).
     change_points: list[ChangePoint] = field(default_factory=list)
     #: Where the result came from, for reproducing and re-plotting it: ``model`` (the model
-    #: as a dict, ``Mechanism.to_dict()``), ``settings`` (keyword arguments of
+    #: as a dict, ``Mechanism.to_dict()``, one dict shared by the results of a mechanism: edit a
+    #: ``to_dict()`` copy), ``settings`` (keyword arguments of
     #: ``Mechanism.simulate``), ``planardyn_version``, ``kind`` ('simulation' or 'inverse').
     #: Empty unless attached (:func:`planardyn.results_io.attach_metadata`) or read from a file.
     metadata: dict[str, Any] = field(default_factory=dict)
@@ -218,7 +220,7 @@ class SimulationResult:
     ) -> SimulationResult:
         """Wrap the dict returned by the native ``Mechanism.simulate``."""
         x = raw["x"]
-        return cls(
+        fields = dict(
             t=raw["t"],
             q=raw["q"],
             qd=raw["qd"],
@@ -246,6 +248,12 @@ class SimulationResult:
             sol=raw.get("sol"),
             tau_motor=tau_motor,
         )
+        # Every field is given: set them at once. The frozen dataclass's __init__ sets them one
+        # by one through object.__setattr__, about 5 us a result, a fifth of a short run's
+        # fixed cost in Python (issue 25 item 4).
+        result = object.__new__(cls)
+        result.__dict__.update(fields)
+        return result
 
     def change_points_frame(self) -> pandas.DataFrame:
         """The change points as a DataFrame: ``t``, ``rank_drop`` and the coordinates (needs

@@ -2,7 +2,13 @@
 //! threads with the GIL released (no Python in the loop). Each variant is a native
 //! `Mechanism` and a dict of overrides; each result is a trajectory dict (as
 //! `Mechanism.simulate` returns) or, for a variant that failed, the pair
-//! (exception type name, message) that `Mechanism.simulate` would have raised.
+//! (exception type name, message) that `Mechanism.simulate` would have raised. Given a
+//! callable `finish(k, outcome)`, its return value takes the place of variant k's outcome.
+//!
+//! Each worker converts its own outcome (and calls `finish`), holding the GIL only for that:
+//! the conversion of one run overlaps the next runs on the other threads, and the calling
+//! thread only collects the results (it did every conversion, a quarter of a short batch's
+//! CPU time, while the workers waited).
 //!
 //! `planardyn._core.inverse_batch` does the same for inverse dynamics: each variant a
 //! native `Mechanism` and a motion dict, either coordinate rows (`q`, `qd`, `qdd`) or a
@@ -116,26 +122,36 @@ fn run_until_interrupt<T: Send>(
 }
 
 /// The native variants (`make` from each pair), solved by `solve` on the batch pool with
-/// the GIL released; each outcome turned into a Python object by `out`, in input order.
+/// the GIL released; each outcome turned into a Python object by `out`, then by `finish`
+/// (called with the variant's index and that object) when given, in the worker that solved
+/// it; in input order. The first error `out` or `finish` raised, in input order, is raised.
 /// On Ctrl-C the KeyboardInterrupt is raised with the list as its attribute `partial`: the
 /// variants finished, those stopped on the way (`solve` sees the stop flag), and
 /// ("Cancelled", reason) for the rest.
-fn run_batch<'py, V: Sync, R: Send>(
+fn run_batch<'py, V: Sync, R>(
     py: Python<'py>,
     variants: &[(Bound<'py, PyMechanism>, Bound<'py, PyDict>)],
     threads: Option<usize>,
+    finish: Option<Py<PyAny>>,
     make: impl Fn(&Bound<'py, PyMechanism>, &Bound<'py, PyDict>) -> PyResult<V>,
     solve: impl Fn(&V, &AtomicBool) -> R + Sync + Send,
-    out: impl Fn(R, &Bound<'py, PyMechanism>) -> PyResult<Bound<'py, PyAny>>,
+    out: impl Fn(Python<'_>, R, &V) -> PyResult<Py<PyAny>> + Sync + Send,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let vs = variants.iter().map(|(m, d)| make(m, d)).collect::<PyResult<Vec<_>>>()?;
+    let items: Vec<(usize, V)> = vs.into_iter().enumerate().collect();
+    let one = |(k, v): &(usize, V), stop: &AtomicBool| {
+        let r = solve(v, stop);
+        Python::attach(|py| match &finish {
+            Some(f) => Ok(f.bind(py).call1((*k, out(py, r, v)?))?.unbind()),
+            None => out(py, r, v),
+        })
+    };
     let (done, interrupt) =
-        run_until_interrupt(py, |stop| map_many_until(&vs, threads, stop, solve).map_err(Failure::from))?;
+        run_until_interrupt(py, |stop| map_many_until(&items, threads, stop, one).map_err(Failure::from))?;
     let results = done
         .into_iter()
-        .zip(variants)
-        .map(|(r, (m, _))| match r {
-            Some(r) => out(r, m),
+        .map(|r| match r {
+            Some(r) => r.map(|o| o.into_bound(py)),
             None => Ok(PyTuple::new(py, ["Cancelled", INTERRUPTED])?.into_any()),
         })
         .collect::<PyResult<Vec<_>>>()?;
@@ -152,21 +168,24 @@ fn run_batch<'py, V: Sync, R: Send>(
 const INTERRUPTED: &str = "not run: interrupted (Ctrl-C)";
 
 /// Simulate `(mechanism, overrides)` pairs on `threads` threads (None: all cores); results
-/// in input order.
+/// (or `finish(k, outcome)`) in input order.
 #[pyfunction]
-#[pyo3(signature = (variants, threads=None))]
+#[pyo3(signature = (variants, threads=None, finish=None))]
 fn simulate_batch<'py>(
     py: Python<'py>,
     variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>,
     threads: Option<usize>,
+    finish: Option<Py<PyAny>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
         Ok(Variant { model: m.get().inner.clone(), overrides: overrides(&m.get().inner, d)? })
     };
     let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
-    run_batch(py, &variants, threads, make, solve, |r, _| match r {
+    run_batch(py, &variants, threads, finish, make, solve, |py, r, _| match r {
         // A batch's runs are cancelled only by Ctrl-C.
-        Ok(traj) => Ok(crate::simulate::to_dict(py, traj, Some("interrupted (Ctrl-C)".to_string()))?.into_any()),
+        Ok(traj) => {
+            Ok(crate::simulate::to_dict(py, traj, Some("interrupted (Ctrl-C)".to_string()))?.into_any().unbind())
+        }
         Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
     })
 }
@@ -201,24 +220,25 @@ fn efforts_dict<'py>(py: Python<'py>, e: Efforts, m: usize) -> PyResult<Bound<'p
 }
 
 /// (exception type name, message) of a failed variant, as the serial call would raise.
-fn failure<'py>(py: Python<'py>, e: &TaskError) -> PyResult<Bound<'py, PyAny>> {
+fn failure(py: Python<'_>, e: &TaskError) -> PyResult<Py<PyAny>> {
     error_pair(py, task_error(py, e), e.to_string())
 }
 
 /// The pair (exception type name, message) that reports a failed variant.
-fn error_pair<'py>(py: Python<'py>, err: PyErr, message: String) -> PyResult<Bound<'py, PyAny>> {
+fn error_pair(py: Python<'_>, err: PyErr, message: String) -> PyResult<Py<PyAny>> {
     let name = err.get_type(py).name()?.to_string();
-    Ok(PyTuple::new(py, [name, message])?.into_any())
+    Ok(PyTuple::new(py, [name, message])?.into_any().unbind())
 }
 
 /// Inverse dynamics of `(mechanism, motion)` pairs on `threads` threads (None: all cores);
-/// results (dicts of arrays) in input order.
+/// results (dicts of arrays, or `finish(k, outcome)`) in input order.
 #[pyfunction]
-#[pyo3(signature = (variants, threads=None))]
+#[pyo3(signature = (variants, threads=None, finish=None))]
 fn inverse_batch<'py>(
     py: Python<'py>,
     variants: Vec<(Bound<'py, PyMechanism>, Bound<'py, PyDict>)>,
     threads: Option<usize>,
+    finish: Option<Py<PyAny>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
         Ok(InverseVariant { model: m.get().inner.clone(), motion: motion(d)? })
@@ -227,10 +247,11 @@ fn inverse_batch<'py>(
         py,
         &variants,
         threads,
+        finish,
         make,
         |v, _| v.solve(),
-        |r, m| match r {
-            Ok(e) => efforts_dict(py, e, m.get().inner.dof()),
+        |py, r, v| match r {
+            Ok(e) => Ok(efforts_dict(py, e, v.model.dof())?.unbind()),
             Err(e) => failure(py, &e),
         },
     )
