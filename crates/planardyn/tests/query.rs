@@ -82,6 +82,7 @@ fn the_pendulums_dynamics_are_its_closed_form() {
     let id = query::inverse_derivatives(&mech, &[Q], &[QD], &[QDD], false).unwrap();
     let tau = I_O * QDD + gravity_torque(Q);
     close(&id.value, &[tau], TOL, "tau");
+    close(&query::inverse_dynamics(&mech, &[Q], &[QD], &[QDD], None).unwrap(), &[tau], TOL, "inverse dynamics");
     let j = &id.jacobians;
     close(&[j.dq[0], j.dqd[0], j.dthird[0]], &[-M * G * L / 2.0 * Q.sin(), 0.0, I_O], TOL, "dtau");
     // One actuator: its share is the whole effort, B = [1], no internal force, no motor.

@@ -1,6 +1,6 @@
 //! What a binding, or a Rust user, asks of a mechanism at one state, each as one call with a
 //! typed result: the assembly, a kinematics report, the mass matrix, forward dynamics (and its
-//! reactions), the derivatives of forward and inverse dynamics, redundant actuation both ways,
+//! reactions), inverse dynamics, the derivatives of forward and inverse dynamics, redundant actuation both ways,
 //! the energies. Every call makes its own buffers (a [`Frame`] or a [`Workspace`], sized once
 //! per call), so calls are reproducible and thread-safe: positions come by continuation from
 //! the drawing, or from the body coordinates `x_start` of a neighbouring state on the wanted
@@ -13,7 +13,9 @@
 
 use super::derivatives::{self, Jacobians};
 use super::redundant::{forward_redundant, inverse_redundant, Actuation, Distribution};
-use super::{finite, forward, kinetic_energy, potential_energy, type_ii_measure, Drives, FixedDrives, ModelDrives};
+use super::{
+    finite, forward, inverse, kinetic_energy, potential_energy, type_ii_measure, Drives, FixedDrives, ModelDrives,
+};
 use super::{motor_torques, Workspace};
 use crate::kinematics::constraints::{point_velocity, world_point};
 use crate::kinematics::{
@@ -201,6 +203,21 @@ pub fn reactions(
     let r = super::reactions(mech, &mut ws);
     finite("reactions", r.as_flattened())?;
     Ok(r)
+}
+
+/// Drive efforts tau (m; N m or N, joint side) for (q, qd, qdd), on the branch of `x_start`
+/// (else the drawn one): inverse dynamics at one state ([`super::inverse`]; along rows,
+/// `crate::batch::inverse_rows_checked`).
+pub fn inverse_dynamics(
+    mech: &Mechanism,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    x_start: Option<&[f64]>,
+) -> Result<Vec<f64>, Error> {
+    let mut ws = assembled(mech, q, x_start)?;
+    inverse(mech, q, qd, qdd, &mut ws)?;
+    Ok(ws.tau)
 }
 
 /// A value of a dynamics map with its three Jacobians.
