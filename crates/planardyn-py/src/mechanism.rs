@@ -9,7 +9,7 @@ use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
 use crate::errors::run;
 use crate::exceptions::{argument_error, PlanardynError};
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
-use planardyn::dynamics::query::{self, Derivatives};
+use planardyn::dynamics::query::{self, Derivatives, ForwardState};
 use planardyn::dynamics::{self, Rows};
 use planardyn::model::pairs::{self, pair_geometry, Relative};
 use planardyn::model::{CoordinateKind, PairId};
@@ -372,7 +372,9 @@ impl PyMechanism {
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
         let mech = &*self.inner;
-        let qdd = run(py, || Ok(query::forward_dynamics(mech, &q, &qd, t, tau.as_deref(), allow_singular)?))?;
+        let qdd = run(py, || {
+            Ok(query::forward_dynamics(mech, ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular })?)
+        })?;
         Ok(arr1(py, qdd))
     }
 
@@ -393,7 +395,12 @@ impl PyMechanism {
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
         let mech = &*self.inner;
-        let d = run(py, || Ok(query::forward_derivatives(mech, &q, &qd, t, tau.as_deref(), allow_singular)?))?;
+        let d = run(py, || {
+            Ok(query::forward_derivatives(
+                mech,
+                ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular },
+            )?)
+        })?;
         self.jacobians(py, d, ["qdd", "dtau"])
     }
 
@@ -698,7 +705,9 @@ impl PyMechanism {
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
         let mech = self.inner.clone();
-        let r = run(py, || Ok(query::reactions(&mech, &q, &qd, t, tau.as_deref(), allow_singular)?))?;
+        let r = run(py, || {
+            Ok(query::reactions(&mech, ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular })?)
+        })?;
         arr2(py, r.len(), 3, r.concat())
     }
 

@@ -36,6 +36,11 @@ fn close(got: &[f64], want: &[f64], tol: f64, what: &str) {
     }
 }
 
+/// The pendulum at (Q, QD), t = 0, under `tau` (or its drives, none).
+fn at(tau: Option<&[f64]>) -> query::ForwardState<'_> {
+    query::ForwardState { q: &[Q], qd: &[QD], t: 0.0, tau, allow_singular: false }
+}
+
 /// The gravity torque about O (N m) at angle q.
 fn gravity_torque(q: f64) -> f64 {
     M * G * L / 2.0 * q.cos()
@@ -68,13 +73,13 @@ fn the_pendulums_dynamics_are_its_closed_form() {
     close(&query::mass_matrix(&mech, &[Q], false).unwrap(), &[I_O], TOL, "A");
     // I_O qdd = tau - m g (l/2) cos q.
     let qdd = (TAU - gravity_torque(Q)) / I_O;
-    close(&query::forward_dynamics(&mech, &[Q], &[QD], 0.0, Some(&[TAU]), false).unwrap(), &[qdd], TOL, "qdd");
+    close(&query::forward_dynamics(&mech, at(Some(&[TAU]))).unwrap(), &[qdd], TOL, "qdd");
     close(&query::forward_actuated(&mech, &[Q], &[QD], &[TAU], 0.0).unwrap(), &[qdd], TOL, "qdd actuated");
     // The pendulum has no drives: the model's efforts are zero.
-    let free = query::forward_dynamics(&mech, &[Q], &[QD], 0.0, None, false).unwrap();
+    let free = query::forward_dynamics(&mech, at(None)).unwrap();
     close(&free, &[-gravity_torque(Q) / I_O], TOL, "qdd without drives");
     // dqdd/dq = m g (l/2) sin q / I_O, dqdd/dqd = 0, dqdd/dtau = 1 / I_O.
-    let fd = query::forward_derivatives(&mech, &[Q], &[QD], 0.0, Some(&[TAU]), false).unwrap();
+    let fd = query::forward_derivatives(&mech, at(Some(&[TAU]))).unwrap();
     close(&fd.value, &[qdd], TOL, "qdd of the derivatives");
     let j = &fd.jacobians;
     close(&[j.dq[0], j.dqd[0], j.dthird[0]], &[M * G * L / 2.0 * Q.sin() / I_O, 0.0, 1.0 / I_O], TOL, "dqdd");
@@ -102,7 +107,7 @@ fn the_pendulums_hinge_carries_mass_times_the_centres_acceleration_less_gravity(
     let (s, c, h) = (Q.sin(), Q.cos(), L / 2.0);
     let qdd = (TAU - gravity_torque(Q)) / I_O;
     let a_g = [-h * s * qdd - h * c * QD * QD, h * c * qdd - h * s * QD * QD];
-    let r = query::reactions(&mech, &[Q], &[QD], 0.0, Some(&[TAU]), false).unwrap();
+    let r = query::reactions(&mech, at(Some(&[TAU]))).unwrap();
     assert_eq!(r.len(), 1);
     close(&r[0][..2], &[M * a_g[0], M * (a_g[1] + G)], TOL, "hinge force (ground on bar)");
 }

@@ -159,17 +159,23 @@ fn with_drives<R>(mech: &Mechanism, tau: Option<&[f64]>, f: impl FnOnce(&mut dyn
     }
 }
 
-/// A forward evaluation at (q, qd), time t (s), under efforts `tau` (m) or the model's
-/// drives, on the drawn branch: every buffer of the returned workspace filled. Refused near a
-/// type II singularity unless `allow_singular`, and where the accelerations are not finite.
-pub fn forward_at(
-    mech: &Mechanism,
-    q: &[f64],
-    qd: &[f64],
-    t: f64,
-    tau: Option<&[f64]>,
-    allow_singular: bool,
-) -> Result<Workspace, Error> {
+/// Where forward dynamics is asked: coordinates q and rates qd (m each), time t (s), and the
+/// efforts (m; N m or N, motor torques where a motor is) `tau`, or the model's drives if None.
+/// The positions are those of the drawn branch; a state near a type II singularity is
+/// refused (`Singular`) unless `allow_singular`.
+#[derive(Debug, Clone, Copy)]
+pub struct ForwardState<'a> {
+    pub q: &'a [f64],
+    pub qd: &'a [f64],
+    pub t: f64,
+    pub tau: Option<&'a [f64]>,
+    pub allow_singular: bool,
+}
+
+/// A forward evaluation at `at`: every buffer of the returned workspace filled. Refused also
+/// where the accelerations are not finite.
+pub fn forward_at(mech: &Mechanism, at: ForwardState<'_>) -> Result<Workspace, Error> {
+    let ForwardState { q, qd, t, tau, allow_singular } = at;
     let mut ws = assembled(mech, q, None)?;
     with_drives(mech, tau, |drives| forward(mech, t, q, qd, drives, &mut ws))?;
     type_ii_measure(mech, &mut ws, allow_singular)?;
@@ -178,28 +184,14 @@ pub fn forward_at(
 }
 
 /// Accelerations qdd (m; rad/s^2 or m/s^2) of [`forward_at`].
-pub fn forward_dynamics(
-    mech: &Mechanism,
-    q: &[f64],
-    qd: &[f64],
-    t: f64,
-    tau: Option<&[f64]>,
-    allow_singular: bool,
-) -> Result<Vec<f64>, Error> {
-    Ok(forward_at(mech, q, qd, t, tau, allow_singular)?.qdd)
+pub fn forward_dynamics(mech: &Mechanism, at: ForwardState<'_>) -> Result<Vec<f64>, Error> {
+    Ok(forward_at(mech, at)?.qdd)
 }
 
 /// Pair reactions (p, each [F_x, F_y, M] that body a exerts on body b; N, N m) of
 /// [`forward_at`].
-pub fn reactions(
-    mech: &Mechanism,
-    q: &[f64],
-    qd: &[f64],
-    t: f64,
-    tau: Option<&[f64]>,
-    allow_singular: bool,
-) -> Result<Vec<[f64; 3]>, Error> {
-    let mut ws = forward_at(mech, q, qd, t, tau, allow_singular)?;
+pub fn reactions(mech: &Mechanism, at: ForwardState<'_>) -> Result<Vec<[f64; 3]>, Error> {
+    let mut ws = forward_at(mech, at)?;
     let r = super::reactions(mech, &mut ws);
     finite("reactions", r.as_flattened())?;
     Ok(r)
@@ -229,18 +221,10 @@ pub struct Derivatives {
     pub jacobians: Jacobians,
 }
 
-/// Exact first derivatives of forward dynamics at (q, qd), time t (s), with efforts `tau` (m)
-/// or the model's drives held fixed, on the drawn branch
-/// ([`derivatives::forward_derivatives`]); refused near a type II singularity unless
-/// `allow_singular`.
-pub fn forward_derivatives(
-    mech: &Mechanism,
-    q: &[f64],
-    qd: &[f64],
-    t: f64,
-    tau: Option<&[f64]>,
-    allow_singular: bool,
-) -> Result<Derivatives, Error> {
+/// Exact first derivatives of forward dynamics at `at`, with its efforts held fixed
+/// ([`derivatives::forward_derivatives`]).
+pub fn forward_derivatives(mech: &Mechanism, at: ForwardState<'_>) -> Result<Derivatives, Error> {
+    let ForwardState { q, qd, t, tau, allow_singular } = at;
     let mut ws = assembled(mech, q, None)?;
     let mut efforts = vec![0.0; q.len()];
     with_drives(mech, tau, |drives| drives.efforts(t, q, qd, &mut efforts))
