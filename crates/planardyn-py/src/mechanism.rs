@@ -1,19 +1,19 @@
 //! `planardyn._core.Mechanism`: an immutable, validated mechanism (an `Arc` of the core's)
-//! and its kinematics and dynamics at given coordinates. Every call makes its own
-//! `Workspace` (buffers sized once per call, no shared mutable state), so calls are
-//! reproducible (positions come by continuation from the drawing) and thread-safe; the
-//! GIL is released while the core computes.
+//! and its kinematics and dynamics at given coordinates. The methods check and convert their
+//! arguments, call the core's queries (`planardyn::dynamics::query` at one state,
+//! `planardyn::batch`'s rows along a motion), and convert the typed results; each query makes
+//! its own buffers, so calls are reproducible (positions come by continuation from the
+//! drawing) and thread-safe; the GIL is released while the core computes.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
-use crate::errors::{run, Failure};
+use crate::errors::run;
 use crate::exceptions::{argument_error, PlanardynError};
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
-use planardyn::dynamics::{self, Drives, FixedDrives, ModelDrives, Rows};
-use planardyn::kinematics::constraints::{point_velocity, world_point};
-use planardyn::kinematics::{self as kin, Chart};
+use planardyn::dynamics::query::{self, Derivatives, ForwardState};
+use planardyn::dynamics::{self, Rows};
 use planardyn::model::pairs::{self, pair_geometry, Relative};
-use planardyn::model::{CoordinateKind, Link, PairId};
-use planardyn::{Error, Mechanism, Workspace};
+use planardyn::model::{CoordinateKind, PairId};
+use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
@@ -31,16 +31,11 @@ fn kind_name(kind: CoordinateKind) -> &'static str {
 #[pyclass(frozen, module = "planardyn._core", name = "Mechanism")]
 pub struct PyMechanism {
     pub inner: Arc<Mechanism>,
-    /// For each named point, the link that carries it first (ground before bodies) and its
-    /// coordinates in that link's frame (m); `None` for a point no link carries.
-    carriers: Vec<Option<(Link, [f64; 2])>>,
 }
 
 impl PyMechanism {
     pub fn new(mech: Mechanism) -> Self {
-        let carriers =
-            (0..mech.points.len()).map(|p| mech.carrier(planardyn::model::PointId(p)).map(|a| (a.link, a.s))).collect();
-        PyMechanism { inner: Arc::new(mech), carriers }
+        PyMechanism { inner: Arc::new(mech) }
     }
 
     fn m(&self) -> usize {
@@ -58,25 +53,6 @@ impl PyMechanism {
     /// Body coordinates (3n,) given as a continuation start.
     fn x_arg(&self, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
         vector("x_start", a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")
-    }
-
-    /// `f(link, s)` of every named point, appended to `out` (P x 2, row-major); NaN for a
-    /// point no link carries.
-    fn per_point(&self, out: &mut Vec<f64>, f: impl Fn(Link, [f64; 2]) -> [f64; 2]) {
-        for c in &self.carriers {
-            out.extend_from_slice(&c.map_or([f64::NAN; 2], |(link, s)| f(link, s)));
-        }
-    }
-
-    /// World positions (P x 2, row-major) of every named point for body coordinates x.
-    fn points_at(&self, x: &[f64], out: &mut Vec<f64>) {
-        self.per_point(out, |link, s| world_point(link, s, x));
-    }
-
-    fn point_velocities(&self, x: &[f64], xd: &[f64]) -> Vec<f64> {
-        let mut out = Vec::with_capacity(2 * self.carriers.len());
-        self.per_point(&mut out, |link, s| point_velocity(link, s, x, xd));
-        out
     }
 
     /// q, qd, qdd of one shape, (m,) or (N, m), and the branch's body coordinates x, (3n,)
@@ -114,66 +90,15 @@ impl PyMechanism {
         Ok((q, qd, qdd, x, xd))
     }
 
-    /// Drive efforts: the given tau, or the model's drives.
-    fn drives_for(&self, tau: Option<Vec<f64>>) -> Box<dyn Drives + Send + '_> {
-        match tau {
-            Some(t) => Box::new(FixedDrives(t)),
-            None => Box::new(ModelDrives(&self.inner)),
-        }
-    }
-
-    /// Assembled at q: a workspace in the input chart, by continuation from `x_start` if
-    /// given, else from the drawing.
-    fn assembled(mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, Failure> {
-        let mut ws = Workspace::new(mech);
-        match x_start {
-            Some(x) => kin::assemble_from(mech, x, q, &mut ws)?,
-            None => kin::assemble_into(mech, q, &mut ws)?,
-        }
-        Ok(ws)
-    }
-
-    /// Assembled and analysed (positions, U) at q; see [`Self::assembled`].
-    fn analysed(mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, Failure> {
-        let mut ws = Self::assembled(mech, q, x_start)?;
-        kin::velocity_analogues(&mut ws)?;
-        Ok(ws)
-    }
-
-    /// Forward dynamics at (q, qd), refused near a type II singularity unless `allow_singular`.
-    fn forward_ws(
-        &self,
-        q: &[f64],
-        qd: &[f64],
-        t: f64,
-        tau: Option<Vec<f64>>,
-        allow_singular: bool,
-    ) -> Result<Workspace, Failure> {
-        let mech = &*self.inner;
-        let mut ws = Workspace::new(mech);
-        kin::assemble_into(mech, q, &mut ws)?;
-        let mut drives = self.drives_for(tau);
-        dynamics::forward(mech, t, q, qd, drives.as_mut(), &mut ws)?;
-        dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
-        dynamics::finite("accelerations qdd", &ws.qdd)?;
-        Ok(ws)
-    }
     /// A dict of the named value and the three Jacobians, the third under `third`.
-    fn jacobians<'py>(
-        &self,
-        py: Python<'py>,
-        value: [(&str, Vec<f64>); 1],
-        jac: dynamics::Jacobians,
-        third: &str,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        let m = self.m();
-        let d = PyDict::new(py);
-        let [(name, v)] = value;
-        d.set_item(name, arr1(py, v))?;
-        d.set_item("dq", arr2(py, m, m, jac.dq)?)?;
-        d.set_item("dqd", arr2(py, m, m, jac.dqd)?)?;
-        d.set_item(third, arr2(py, m, m, jac.dthird)?)?;
-        Ok(d)
+    fn jacobians<'py>(&self, py: Python<'py>, d: Derivatives, names: [&str; 2]) -> PyResult<Bound<'py, PyDict>> {
+        let (m, jac) = (self.m(), d.jacobians);
+        let out = PyDict::new(py);
+        out.set_item(names[0], arr1(py, d.value))?;
+        out.set_item("dq", arr2(py, m, m, jac.dq)?)?;
+        out.set_item("dqd", arr2(py, m, m, jac.dqd)?)?;
+        out.set_item(names[1], arr2(py, m, m, jac.dthird)?)?;
+        Ok(out)
     }
 }
 
@@ -370,7 +295,7 @@ impl PyMechanism {
         let q = self.q_arg("q", &q)?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
-        let x = run(py, move || Ok(Self::assembled(&mech, &q, x_start.as_deref())?.frame.x))?;
+        let x = run(py, move || Ok(query::assemble(&mech, &q, x_start.as_deref())?))?;
         Ok(arr1(py, x))
     }
 
@@ -378,10 +303,10 @@ impl PyMechanism {
     fn point_positions<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
         let nx = self.inner.n_x();
         let v = rows("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
-        let p = self.carriers.len();
+        let p = self.inner.points.len();
         let mut out = Vec::with_capacity(v.rows() * p * 2);
         for k in 0..v.rows() {
-            self.points_at(v.row(k, nx), &mut out);
+            out.extend(query::point_positions(&self.inner, v.row(k, nx)));
         }
         if v.shape.len() == 1 {
             arr2(py, p, 2, out)
@@ -403,55 +328,22 @@ impl PyMechanism {
         let qd = qd.map(|a| self.q_arg("qd", &a)).transpose()?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
-        let (n, m) = (mech.n_bodies(), mech.dof());
-        let nx = 3 * n;
-        let (ws, w, sigma, passive) = run(py, {
-            let qd = qd.clone();
-            move || {
-                let mut ws = Self::analysed(&mech, &q, x_start.as_deref())?;
-                let w = kin::acceleration_analogues(&mech, &mut ws);
-                if let Some(qd) = &qd {
-                    kin::convective(&mech, qd, &mut ws);
-                    dynamics::finite("body velocities xd", &ws.xd)?;
-                    dynamics::finite("convective accelerations c", &ws.c)?;
-                }
-                let sigma = kin::sigma_min(&mech, &Chart::Inputs, &ws.x);
-                let passive = kin::passive_sigma_min(&mech, &ws.x);
-                Ok((ws, w, sigma, passive))
-            }
-        })?;
-        // u: (n, 3, m) from columns u_j; w: (n, 3, m, m).
-        let mut u = vec![0.0; nx * m];
-        for j in 0..m {
-            for i in 0..nx {
-                u[i * m + j] = ws.u[j * nx + i];
-            }
-        }
-        let mut wo = vec![0.0; nx * m * m];
-        for j in 0..m {
-            for k in 0..m {
-                for i in 0..nx {
-                    wo[(i * m + j) * m + k] = w[(j * m + k) * nx + i];
-                }
-            }
-        }
+        let (n, m, p) = (mech.n_bodies(), mech.dof(), mech.points.len());
+        let k = run(py, move || Ok(query::kinematics(&mech, &q, qd.as_deref(), x_start.as_deref())?))?;
         let d = PyDict::new(py);
-        d.set_item("x", arr1(py, ws.x.clone()))?;
-        d.set_item("poses", arr2(py, n, 3, ws.x.clone())?)?;
-        d.set_item("u", arr_dyn(py, &[n, 3, m], u)?)?;
-        d.set_item("w", arr_dyn(py, &[n, 3, m, m], wo)?)?;
-        let mut pts = Vec::new();
-        self.points_at(&ws.x, &mut pts);
-        let p = self.carriers.len();
-        d.set_item("points", arr2(py, p, 2, pts)?)?;
-        if qd.is_some() {
-            d.set_item("xd", arr1(py, ws.xd.clone()))?;
-            d.set_item("c", arr1(py, ws.c.clone()))?;
-            d.set_item("point_velocities", arr2(py, p, 2, self.point_velocities(&ws.x, &ws.xd))?)?;
+        d.set_item("x", arr1(py, k.x.clone()))?;
+        d.set_item("poses", arr2(py, n, 3, k.x)?)?;
+        d.set_item("u", arr_dyn(py, &[n, 3, m], k.u)?)?;
+        d.set_item("w", arr_dyn(py, &[n, 3, m, m], k.w)?)?;
+        d.set_item("points", arr2(py, p, 2, k.points)?)?;
+        if let Some(r) = k.rates {
+            d.set_item("xd", arr1(py, r.xd))?;
+            d.set_item("c", arr1(py, r.c))?;
+            d.set_item("point_velocities", arr2(py, p, 2, r.point_velocities)?)?;
         }
-        d.set_item("sigma_min", sigma)?;
-        d.set_item("sigma_passive", passive)?;
-        d.set_item("residual", ws.residual)?;
+        d.set_item("sigma_min", k.sigma_min)?;
+        d.set_item("sigma_passive", k.sigma_passive)?;
+        d.set_item("residual", k.residual)?;
         Ok(d)
     }
 
@@ -461,12 +353,7 @@ impl PyMechanism {
         let q = self.q_arg("q", &q)?;
         let mech = self.inner.clone();
         let m = mech.dof();
-        let a = run(py, move || {
-            let mut ws = Self::analysed(&mech, &q, None)?;
-            dynamics::type_ii_measure(&mech, &mut ws, allow_singular)?;
-            dynamics::mass_matrix(&mech, &mut ws);
-            Ok(ws.a)
-        })?;
+        let a = run(py, move || Ok(query::mass_matrix(&mech, &q, allow_singular)?))?;
         arr2(py, m, m, a)
     }
 
@@ -484,8 +371,11 @@ impl PyMechanism {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
-        let ws = run(py, || self.forward_ws(&q, &qd, t, tau, allow_singular))?;
-        Ok(arr1(py, ws.qdd))
+        let mech = &*self.inner;
+        let qdd = run(py, || {
+            Ok(query::forward_dynamics(mech, ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular })?)
+        })?;
+        Ok(arr1(py, qdd))
     }
 
     /// Exact first derivatives of forward dynamics at (q, qd), time t (s), with efforts tau
@@ -505,15 +395,13 @@ impl PyMechanism {
         let tau = tau.map(|a| self.q_arg("tau", &a)).transpose()?;
         check_time(t)?;
         let mech = &*self.inner;
-        let (qdd, jac) = run(py, || {
-            let mut ws = Self::assembled(mech, &q, None)?;
-            let mut efforts = vec![0.0; q.len()];
-            self.drives_for(tau).efforts(t, &q, &qd, &mut efforts).map_err(|message| Error::Drive { t, message })?;
-            let out = dynamics::forward_derivatives(mech, &q, &qd, &efforts, &mut ws)?;
-            dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
-            Ok(out)
+        let d = run(py, || {
+            Ok(query::forward_derivatives(
+                mech,
+                ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular },
+            )?)
         })?;
-        self.jacobians(py, [("qdd", qdd)], jac, "dtau")
+        self.jacobians(py, d, ["qdd", "dtau"])
     }
 
     /// Exact first derivatives of inverse dynamics at (q, qd, qdd), each (m,): a dict of
@@ -529,13 +417,8 @@ impl PyMechanism {
     ) -> PyResult<Bound<'py, PyDict>> {
         let (q, qd, qdd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?, self.q_arg("qdd", &qdd)?);
         let mech = &*self.inner;
-        let (tau, jac) = run(py, || {
-            let mut ws = Self::assembled(mech, &q, None)?;
-            let jac = dynamics::inverse_derivatives(mech, &q, &qd, &qdd, &mut ws)?;
-            dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
-            Ok((ws.tau, jac))
-        })?;
-        self.jacobians(py, [("tau", tau)], jac, "dqdd")
+        let d = run(py, || Ok(query::inverse_derivatives(mech, &q, &qd, &qdd, allow_singular)?))?;
+        self.jacobians(py, d, ["tau", "dqdd"])
     }
 
     /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
@@ -716,7 +599,7 @@ impl PyMechanism {
         preload: Option<Vec<f64>>,
         x_start: Option<ArrayArg<'py>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        use dynamics::redundant::{inverse_redundant, Distribution};
+        use dynamics::redundant::Distribution;
         let (q, qd, qdd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?, self.q_arg("qdd", &qdd)?);
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let how = match (method, preload) {
@@ -734,16 +617,11 @@ impl PyMechanism {
             }
         };
         let mech = self.inner.clone();
-        let (act, efforts, t_m) = run(py, move || {
-            let mut ws = Self::assembled(&mech, &q, x_start.as_deref())?;
-            let (act, efforts) = inverse_redundant(&mech, &q, &qd, &qdd, &how, &mut ws)?;
-            let mut t_m = vec![0.0; efforts.len()];
-            dynamics::motor_torques(&mech, &ws, &efforts, &mut t_m);
-            Ok((act, efforts, dynamics::finite("motor torques", t_m)?))
-        })?;
+        let s = run(py, move || Ok(query::distribute_efforts(&mech, &q, &qd, &qdd, &how, x_start.as_deref())?))?;
+        let act = &s.actuation;
         let d = PyDict::new(py);
-        d.set_item("efforts", arr1(py, efforts))?;
-        d.set_item("motor_torques", arr1(py, t_m))?;
+        d.set_item("efforts", arr1(py, s.efforts))?;
+        d.set_item("motor_torques", arr1(py, s.motor_torques))?;
         d.set_item("B", arr2(py, act.m, act.n_a, act.b.clone())?)?;
         d.set_item("internal", arr2(py, act.internal.len(), act.n_a, act.internal.concat())?)?;
         Ok(d)
@@ -766,12 +644,7 @@ impl PyMechanism {
         let efforts = vector("efforts", &efforts, n_a, "one value per actuator (actuator_names)")?;
         check_time(t)?;
         let mech = self.inner.clone();
-        let qdd = run(py, move || {
-            let mut ws = Self::assembled(&mech, &q, None)?;
-            dynamics::redundant::forward_redundant(&mech, t, &q, &qd, &efforts, &mut ws)?;
-            dynamics::finite("accelerations qdd", &ws.qdd)?;
-            Ok(ws.qdd)
-        })?;
+        let qdd = run(py, move || Ok(query::forward_actuated(&mech, &q, &qd, &efforts, t)?))?;
         Ok(arr1(py, qdd))
     }
 
@@ -833,11 +706,9 @@ impl PyMechanism {
         check_time(t)?;
         let mech = self.inner.clone();
         let r = run(py, || {
-            let mut ws = self.forward_ws(&q, &qd, t, tau, allow_singular)?;
-            let r = dynamics::reactions(&mech, &mut ws);
-            Ok(dynamics::finite("reactions", r.as_flattened())?.to_vec())
+            Ok(query::reactions(&mech, ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular })?)
         })?;
-        arr2(py, r.len() / 3, 3, r)
+        arr2(py, r.len(), 3, r.concat())
     }
 
     /// Body accelerations (N, 3n) and pair reactions (N, p, 3) along a trajectory's rows, each
@@ -917,18 +788,8 @@ impl PyMechanism {
         let (q, qd) = (self.q_arg("q", &q)?, self.q_arg("qd", &qd)?);
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
         let mech = self.inner.clone();
-        run(py, move || {
-            let mut ws = Self::assembled(&mech, &q, x_start.as_deref())?;
-            if qd.iter().any(|&v| v != 0.0) {
-                kin::velocity_analogues(&mut ws)?;
-                kin::convective(&mech, &qd, &mut ws);
-            } else {
-                ws.xd.fill(0.0);
-            }
-            let energies = [dynamics::kinetic_energy(&mech, &ws.xd), dynamics::potential_energy(&mech, &ws.x)];
-            let [t, v] = dynamics::finite("energies", energies)?;
-            Ok((t, v))
-        })
+        let e = run(py, move || Ok(query::energy(&mech, &q, &qd, x_start.as_deref())?))?;
+        Ok((e.kinetic, e.potential))
     }
 
     /// Simulate; see `planardyn.Mechanism.simulate` for the arguments.

@@ -4,10 +4,9 @@
 use crate::convert::{arr1, arr2, vector, Floats};
 use crate::errors::{kinematics_error, model_error};
 use crate::mechanism::PyMechanism;
-use planardyn::kinematics::constraints::{body_trig, constraint_jacobian as phi_x};
 use planardyn::loader::{analyse_spec, parse_spec};
 use planardyn::model::Link;
-use planardyn::structure::{analyse, scaled_constraint_jacobian, Structure};
+use planardyn::structure::{analyse, pair_constraint_jacobian, scaled_constraint_jacobian, Structure};
 use planardyn::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -29,16 +28,7 @@ pub fn constraint_jacobian<'py>(
     let m = &*mech.inner;
     let x = vector("x", &x, m.n_x(), "body coordinates [X, Y, phi] per body")?;
     let (rows, cols) = (m.n_pair_rows(), m.n_x());
-    let j = if scaled {
-        scaled_constraint_jacobian(m, &x)
-    } else {
-        let mut trig = vec![[0.0; 2]; m.n_bodies()];
-        body_trig(&x, &mut trig);
-        let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
-        let mut j = vec![0.0; rows * cols];
-        phi_x(m, &x, &trig, &all, &mut j);
-        j
-    };
+    let j = if scaled { scaled_constraint_jacobian(m, &x) } else { pair_constraint_jacobian(m, &x) };
     arr2(py, rows, cols, j)
 }
 

@@ -1,16 +1,19 @@
 //! `Mechanism` in JavaScript: an immutable, validated mechanism (the core's) and its
-//! kinematics and dynamics at given coordinates. Every call makes its own `Workspace`, as the
-//! Python glue's do, so calls are reproducible: positions come by continuation from the
-//! drawing, or from the body coordinates `xStart` of a neighbouring state on the wanted branch.
+//! kinematics and dynamics at given coordinates. Every call checks its arguments and calls
+//! one of the core's queries (`planardyn::dynamics::query`, `evaluate`, `along`), as the
+//! Python glue's do; each makes its own buffers, so calls are reproducible: positions come by
+//! continuation from the drawing, or from the body coordinates `xStart` of a neighbouring
+//! state on the wanted branch.
 
 use crate::convert::{array, rows, strings, vector, Obj};
 use crate::errors::{argument_error, js};
 use crate::simulate::{run, SimulateOptions};
-use planardyn::dynamics::{self, carried_points, FixedDrives, ModelDrives, Rows};
+use planardyn::dynamics::query::{self, ForwardState};
+use planardyn::dynamics::{self, carried_points, Rows};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
 use planardyn::model::{CoordinateKind, PairId};
-use planardyn::{Mechanism, Workspace};
+use planardyn::Mechanism;
 use wasm_bindgen::prelude::*;
 
 /// A validated planar mechanism (immutable). Made by `load`.
@@ -36,18 +39,10 @@ impl WasmMechanism {
         vector(name, v, self.inner.n_x(), "body coordinates [X, Y, phi] per body")
     }
 
-    /// A workspace assembled at q from `x_start`, else from the drawing.
-    fn assembled(&self, q: &[f64], x_start: Option<&[f64]>) -> Result<Workspace, JsValue> {
+    /// The arguments of an assembly checked: q (m), and `x_start` (3n) when given.
+    fn start_args(&self, q: &[f64], x_start: Option<&[f64]>) -> Result<(), JsValue> {
         self.q_arg("q", q)?;
-        let mut ws = Workspace::new(&self.inner);
-        match x_start {
-            Some(x) => {
-                self.x_arg("xStart", x)?;
-                js(kin::assemble_from(&self.inner, x, q, &mut ws))?
-            }
-            None => js(kin::assemble_into(&self.inner, q, &mut ws))?,
-        }
-        Ok(ws)
+        x_start.map_or(Ok(()), |x| self.x_arg("xStart", x))
     }
 
     /// Positions, velocities, accelerations (rows of P x 2) of the carried points.
@@ -127,7 +122,8 @@ impl WasmMechanism {
 
     /// Body coordinates x (3n; m, rad) at coordinates q (m; rad or m).
     pub fn assemble(&self, q: &[f64], x_start: Option<Vec<f64>>) -> Result<Vec<f64>, JsValue> {
-        Ok(self.assembled(q, x_start.as_deref())?.frame.x)
+        self.start_args(q, x_start.as_deref())?;
+        js(query::assemble(&self.inner, q, x_start.as_deref()))
     }
 
     /// Rows of carried-point positions (P x 2 each; m) for rows of body coordinates x (3n).
@@ -228,24 +224,24 @@ impl WasmMechanism {
     ) -> Result<Vec<f64>, JsValue> {
         self.q_arg("qd", qd)?;
         self.q_arg("qdd", qdd)?;
-        let mut ws = self.assembled(q, x_start.as_deref())?;
-        js(dynamics::inverse(&self.inner, q, qd, qdd, &mut ws))?;
-        Ok(ws.tau)
+        self.start_args(q, x_start.as_deref())?;
+        js(query::inverse_dynamics(&self.inner, q, qd, qdd, x_start.as_deref()))
     }
 
     /// Accelerations qdd (m) at (q, qd) and time t (s) under efforts `tau` (m), else the
     /// model's drives; refused at a type II singularity.
     #[wasm_bindgen(js_name = forwardDynamics)]
     pub fn forward_dynamics(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Vec<f64>, JsValue> {
-        Ok(self.forward_ws(q, qd, t, tau)?.qdd)
+        self.forward_args(q, qd, t, tau.as_deref())?;
+        js(query::forward_dynamics(&self.inner, ForwardState { q, qd, t, tau: tau.as_deref(), allow_singular: false }))
     }
 
     /// Pair reactions (p x 3: F_x, F_y, M that body a exerts on b; N, N m) at (q, qd), time t
     /// (s), under efforts `tau` (m), else the model's drives.
     pub fn reactions(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Vec<f64>, JsValue> {
-        let mut ws = self.forward_ws(q, qd, t, tau)?;
-        let r = dynamics::reactions(&self.inner, &mut ws);
-        Ok(js(dynamics::finite("reactions", r.as_flattened()))?.to_vec())
+        self.forward_args(q, qd, t, tau.as_deref())?;
+        Ok(js(query::reactions(&self.inner, ForwardState { q, qd, t, tau: tau.as_deref(), allow_singular: false }))?
+            .concat())
     }
 
     /// Body accelerations and pair reactions along rows of a run (t (N), x and xd (N x 3n),
@@ -289,21 +285,13 @@ impl WasmMechanism {
 }
 
 impl WasmMechanism {
-    fn forward_ws(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Workspace, JsValue> {
+    /// The arguments of a forward evaluation checked: q, qd and tau (m each), a finite t.
+    fn forward_args(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<&[f64]>) -> Result<(), JsValue> {
         self.q_arg("qd", qd)?;
         if !t.is_finite() {
             return Err(argument_error(Some("t"), format!("t = {t} must be a finite time (s)")));
         }
-        let mut ws = self.assembled(q, None)?;
-        let mech = &self.inner;
-        match tau {
-            Some(tau) => {
-                self.q_arg("tau", &tau)?;
-                js(dynamics::forward(mech, t, q, qd, &mut FixedDrives(tau), &mut ws))?
-            }
-            None => js(dynamics::forward(mech, t, q, qd, &mut ModelDrives(mech), &mut ws))?,
-        }
-        js(dynamics::type_ii_measure(mech, &mut ws, false))?;
-        Ok(ws)
+        self.q_arg("q", q)?;
+        tau.map_or(Ok(()), |tau| self.q_arg("tau", tau))
     }
 }

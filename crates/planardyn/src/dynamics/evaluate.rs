@@ -5,10 +5,10 @@
 //! the pipeline itself. And the rows of a singularity map over two coordinates, for a view
 //! that redraws it as the design changes ([`sigma_rows`]).
 
+use super::query::assembled;
 use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives};
-use crate::kinematics::{assemble_from, assemble_into, passive_sigma_min, sigma_min, sigma_min_with, Chart, Frame};
+use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, Chart, Frame};
 use crate::model::Mechanism;
-use crate::Workspace;
 use crate::{Error, KinematicsError};
 
 /// One state's quantities; shapes with n bodies, m coordinates, p pairs.
@@ -48,11 +48,7 @@ pub fn evaluate(
     qdd: &[f64],
     x_start: Option<&[f64]>,
 ) -> Result<Evaluation, Error> {
-    let mut ws = Workspace::new(mech);
-    match x_start {
-        Some(x) => assemble_from(mech, x, q, &mut ws)?,
-        None => assemble_into(mech, q, &mut ws)?,
-    }
+    let mut ws = assembled(mech, q, x_start)?;
     inverse(mech, q, qd, qdd, &mut ws)?;
     let tau = ws.tau.clone();
     let mut motor = vec![0.0; tau.len()];

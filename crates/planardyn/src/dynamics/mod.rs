@@ -18,6 +18,7 @@ mod loss_columns;
 mod losses;
 pub mod motion;
 pub mod prescribed;
+pub mod query;
 pub mod reactions;
 pub mod redundant;
 pub mod regressor;

@@ -46,17 +46,24 @@ pub struct Rank {
     pub self_stresses: Vec<SelfStress>,
 }
 
-/// Phi_x at body coordinates x (3n values): all `n_pair_rows()` rows, redundant ones
-/// included, by 3n columns, row-major, scaled as the solver's J (`kinematics::system`):
-/// rows in metres divided by the characteristic length L, translation columns multiplied by
-/// L, so that the entries are dimensionless.
-pub fn scaled_constraint_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
-    let (rows, n) = (mech.n_pair_rows(), mech.n_x());
+/// Phi_x = dPhi/dx at body coordinates x (3n values): all `n_pair_rows()` rows, redundant
+/// ones included, by 3n columns (X, Y in m, phi in rad), row-major.
+pub fn pair_constraint_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
+    let rows = mech.n_pair_rows();
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
     let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
-    let mut j = vec![0.0; rows * n];
+    let mut j = vec![0.0; rows * mech.n_x()];
     constraint_jacobian(mech, x, &trig, &all, &mut j);
+    j
+}
+
+/// [`pair_constraint_jacobian`] scaled as the solver's J (`kinematics::system`): rows in
+/// metres divided by the characteristic length L, translation columns multiplied by L, so
+/// that the entries are dimensionless.
+pub fn scaled_constraint_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
+    let (rows, n) = (mech.n_pair_rows(), mech.n_x());
+    let mut j = pair_constraint_jacobian(mech, x);
     let mut rs = vec![1.0; rows];
     for (k, pair) in mech.pairs.iter().enumerate() {
         for (r, s) in mech.pair_rows(PairId(k)).zip(row_scales(pair, 1.0 / mech.scale)) {

@@ -14,7 +14,9 @@
 //! - **Assur groups**: the blocks of the block-triangular form of the position Jacobian with
 //!   the inputs locked, see [`AssurGroup`].
 
-pub use crate::kinematics::rank::{scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRESS_TOL};
+pub use crate::kinematics::rank::{
+    pair_constraint_jacobian, scaled_constraint_jacobian, Rank, SelfStress, RANK_TOL, SELF_STRESS_TOL,
+};
 pub use crate::topology::{AssurGroup, Loop};
 
 use crate::kinematics::rank::constraint_rank;
