@@ -38,6 +38,18 @@ fn settings(mech: &Mechanism, a: &Overrides) -> Result<Settings, Failure> {
     Ok(a.settings(mech)?)
 }
 
+/// What a Python callback's exception becomes, the one rule for drives, motions, events and
+/// progress: its repr, for the run's message; and a BaseException that is not an Exception
+/// (KeyboardInterrupt, SystemExit) kept in `fatal`, so that the run stops at once and it is
+/// raised again at the end.
+fn callback_error(py: Python<'_>, e: PyErr, fatal: &mut Option<PyErr>) -> String {
+    let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
+    if !e.is_instance_of::<PyException>(py) {
+        *fatal = Some(e);
+    }
+    text
+}
+
 /// A Python callable `f(t, q, qd) -> (m,)` as drive efforts.
 struct PyDrives {
     f: Py<PyAny>,
@@ -67,13 +79,7 @@ impl Drives for PyDrives {
                     "the drive function returned shape {:?}; expected ({},), one effort per coordinate",
                     v.shape, self.m
                 )),
-                Err(e) => {
-                    let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
-                    if !e.is_instance_of::<PyException>(py) {
-                        self.fatal = Some(e);
-                    }
-                    Err(format!("the drive function raised {text}"))
-                }
+                Err(e) => Err(format!("the drive function raised {}", callback_error(py, e, &mut self.fatal))),
             }
         })
     }
@@ -103,16 +109,11 @@ impl MotionFunction for PyMotion {
         }
         Python::attach(|py| match self.f.bind(py).call1((t,)).and_then(|r| r.extract::<(f64, f64, f64)>()) {
             Ok((q, qd, qdd)) => Ok([q, qd, qdd]),
-            Err(e) => {
-                let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
-                if !e.is_instance_of::<PyException>(py) {
-                    self.fatal = Some(e);
-                }
-                Err(format!(
-                    "the motion function of '{}' must return (q, qd, qdd), three numbers; it raised {text}",
-                    self.name
-                ))
-            }
+            Err(e) => Err(format!(
+                "the motion function of '{}' must return (q, qd, qdd), three numbers; it raised {}",
+                self.name,
+                callback_error(py, e, &mut self.fatal)
+            )),
         })
     }
 }
@@ -151,11 +152,7 @@ fn call_event(f: &Py<PyAny>, fatal: &Mutex<Option<PyErr>>, t: f64, q: &[f64], qd
         match f.bind(py).call1(args).and_then(|r| r.extract::<f64>()) {
             Ok(g) => Ok(g),
             Err(e) => {
-                let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
-                if !e.is_instance_of::<PyException>(py) {
-                    *fatal = Some(e);
-                }
-                Err(format!("the event function must return a number; it raised {text}"))
+                Err(format!("the event function must return a number; it raised {}", callback_error(py, e, &mut fatal)))
             }
         }
     })
@@ -233,11 +230,8 @@ pub fn simulate<'py>(
                 match cb.bind(py).call1((t,)) {
                     Ok(r) => r.is_none() || r.is_truthy().unwrap_or(true),
                     Err(e) => {
-                        let text = e.value(py).repr().map(|r| r.to_string()).unwrap_or_else(|_| e.to_string());
+                        let text = callback_error(py, e, &mut fatal);
                         cancel_reason = Some(format!("the progress callback raised {text} at t = {t} s"));
-                        if !e.is_instance_of::<PyException>(py) {
-                            fatal = Some(e);
-                        }
                         false
                     }
                 }
