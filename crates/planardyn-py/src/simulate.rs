@@ -4,12 +4,12 @@
 //! callbacks re-attach to the interpreter for the duration of each call.
 
 use crate::convert::{arr1, arr2, bool1, Values};
-use crate::errors::{run, Failure};
+use crate::errors::run;
 use crate::exceptions::argument_error;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
-use planardyn::simulate::{Event, EventFn, Observe, Overrides, Settings, Trajectory};
+use planardyn::simulate::{Event, EventFn, Observe, Overrides, Trajectory};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
@@ -24,19 +24,6 @@ const PROGRESS_FRACTION: f64 = 0.01;
 /// Ctrl-C is also checked at least this often in wall time, so a slow run answers it at once
 /// whatever its progress in t.
 pub(crate) const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
-
-/// The model's simulation settings with the caller's overrides; a bad `t_end` is a
-/// ValueError (an argument), everything else the core's option error.
-fn settings(mech: &Mechanism, a: &Overrides) -> Result<Settings, Failure> {
-    if let Some(t_end) = a.t_end {
-        if !(t_end.is_finite() && t_end > 0.0) {
-            return Err(
-                argument_error(Some("t_end"), format!("t_end = {t_end} must be a finite time after t0 = 0 s")).into()
-            );
-        }
-    }
-    Ok(a.settings(mech)?)
-}
 
 /// What a Python callback's exception becomes, the one rule for drives, motions, events and
 /// progress: its repr, for the run's message; and a BaseException that is not an Exception
@@ -207,7 +194,7 @@ pub fn simulate<'py>(
     let mut fatal: Option<PyErr> = None;
     let mut cancel_reason: Option<String> = None;
     let traj = run(py, || {
-        let s = settings(mech, &args)?;
+        let s = args.settings(mech)?;
         let step = PROGRESS_FRACTION * (s.t_end - s.t0);
         let mut next = s.t0 + step;
         let mut last_check = Instant::now();

@@ -237,3 +237,20 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
     }
     assert_ne!(heavier.tau, sol.tau);
 }
+
+/// The one rule of t_end (finite, after t0), in the core for every caller: an argument error
+/// that names it (the Python glue maps it to ArgumentError with `argument = 't_end'`).
+#[test]
+fn a_bad_t_end_is_an_argument_error_naming_it() {
+    let mech = shipped("five-bar.yaml");
+    for t_end in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
+        let over = Overrides { t_end: Some(t_end), ..Overrides::default() };
+        match over.settings(&mech) {
+            Err(Error::Kinematics(KinematicsError::BadArgument { name, expected, got })) => {
+                assert_eq!((name, expected.as_str()), ("t_end", "a finite time after t0 = 0 s"));
+                assert_eq!(got, t_end.to_string());
+            }
+            other => panic!("t_end = {t_end}: {other:?}"),
+        }
+    }
+}

@@ -5,7 +5,7 @@ use super::{grid, Settings};
 use crate::dynamics::{Motion, Prescribed};
 use crate::integrate::Method;
 use crate::model::{Mechanism, MotionLaw};
-use crate::Error;
+use crate::{Error, KinematicsError};
 
 /// Most output times an `output_dt` may ask for (a guard against output_dt = 1e-12).
 const MAX_OUTPUTS: f64 = 1e8;
@@ -37,7 +37,9 @@ impl Overrides {
         let mut s = Settings::for_model(mech)?;
         if let Some(t_end) = self.t_end {
             if !(t_end.is_finite() && t_end > s.t0) {
-                return Err(Error::Options(format!("t_end = {t_end} must be a finite time after t0 = {} s", s.t0)));
+                // An argument error naming `t_end` (every caller's argument), as for q0 and qd0.
+                let expected = format!("a finite time after t0 = {} s", s.t0);
+                return Err(KinematicsError::bad_argument("t_end", expected, t_end.to_string()).into());
             }
             s.t_end = t_end;
         }
