@@ -20,13 +20,6 @@ use std::sync::Arc;
 
 type ArrayArg<'py> = Floats<'py>;
 
-fn kind_name(kind: CoordinateKind) -> &'static str {
-    match kind {
-        CoordinateKind::Angle => "angle",
-        CoordinateKind::Displacement => "displacement",
-    }
-}
-
 /// A validated planar mechanism (immutable). Made by `load`/`loads`.
 #[pyclass(frozen, module = "planardyn._core", name = "Mechanism")]
 pub struct PyMechanism {
@@ -137,14 +130,14 @@ impl PyMechanism {
     /// 'angle' (rad) or 'displacement' (m) for each coordinate.
     #[getter]
     fn coordinate_kinds(&self) -> Vec<&'static str> {
-        self.inner.coordinates.iter().map(|c| kind_name(c.kind)).collect()
+        self.inner.coordinates.iter().map(|c| c.kind.name()).collect()
     }
     /// "angle" or "displacement" per actuator (`actuator_names`): what its effort turns.
     #[getter]
     fn actuator_kinds(&self) -> Vec<&'static str> {
         let mech = &self.inner;
         let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
-        pairs.map(|p| pairs::coordinate_kind(&mech.pairs[p.0]).map_or("displacement", kind_name)).collect()
+        pairs.map(|p| pairs::coordinate_kind(&mech.pairs[p.0]).map_or("displacement", CoordinateKind::name)).collect()
     }
     #[getter]
     fn body_names(&self) -> Vec<String> {

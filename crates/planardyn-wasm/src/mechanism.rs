@@ -12,7 +12,7 @@ use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::dynamics::{self, carried_points, Rows};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
-use planardyn::model::{CoordinateKind, PairId};
+use planardyn::model::PairId;
 use planardyn::Mechanism;
 use wasm_bindgen::prelude::*;
 
@@ -52,13 +52,6 @@ impl WasmMechanism {
     }
 }
 
-fn kind_name(kind: CoordinateKind) -> &'static str {
-    match kind {
-        CoordinateKind::Angle => "angle",
-        CoordinateKind::Displacement => "displacement",
-    }
-}
-
 #[wasm_bindgen(js_class = Mechanism)]
 impl WasmMechanism {
     /// What the page needs to know of the model: names, kinds, sizes, the drawing, the
@@ -93,7 +86,7 @@ impl WasmMechanism {
             .set("warnings", strings(&m.warnings))
             .set("dof", m.dof() as f64)
             .set("coordinateNames", strings(m.coordinate_names()))
-            .set("coordinateKinds", strings(m.coordinates.iter().map(|c| kind_name(c.kind))))
+            .set("coordinateKinds", strings(m.coordinates.iter().map(|c| c.kind.name())))
             .set("driven", array(m.drives.iter().map(|d| d.is_some().into())))
             .set("prescribed", array(m.motions.iter().map(|d| d.is_some().into())))
             .set("bodyNames", strings(m.body_names()))

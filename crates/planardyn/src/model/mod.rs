@@ -99,6 +99,16 @@ pub enum CoordinateKind {
     Displacement,
 }
 
+impl CoordinateKind {
+    /// Its name where a binding shows it: `angle` or `displacement`.
+    pub fn name(self) -> &'static str {
+        match self {
+            CoordinateKind::Angle => "angle",
+            CoordinateKind::Displacement => "displacement",
+        }
+    }
+}
+
 /// A generalized coordinate `q_k`: the relative motion of an input pair, offset to equal
 /// `value` in the drawing.
 #[derive(Debug, Clone, PartialEq)]
