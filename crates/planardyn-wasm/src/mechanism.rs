@@ -10,6 +10,7 @@ use crate::errors::{argument_error, js};
 use crate::simulate::{run, SimulateOptions};
 use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::dynamics::{self, carried_points, Rows};
+use planardyn::elastic;
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
 use planardyn::model::PairId;
@@ -101,6 +102,7 @@ impl WasmMechanism {
             .f64s("masses", &m.bodies.iter().map(|b| b.mass).collect::<Vec<_>>())
             .f64s("gravity", &m.gravity)
             .set("scale", m.scale)
+            .set("compliant", !m.compliance.is_empty())
             .set("simulate", defaults.build())
             .build()
     }
@@ -204,6 +206,24 @@ impl WasmMechanism {
         let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
         let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
         Ok(Obj::new().f64s("sigma", &out.sigma).f64s("x", &out.x).build())
+    }
+
+    /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
+    /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
+    /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
+    /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
+    /// increasing frequency. A model without a `compliance:` section throws an ArgumentError.
+    pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
+        self.start_args(q, x_start.as_deref())?;
+        let mut ws = js(query::assembled(&self.inner, q, x_start.as_deref()))?;
+        let modes = js(elastic::modes(&self.inner, q, free_rotors, &mut ws))?;
+        Ok(Obj::new()
+            .f64s("omega", &modes.omega())
+            .f64s("omega2", &modes.omega2)
+            .f64s("dampingRatio", &modes.damping_ratio)
+            .f64s("shapes", &modes.shapes.concat())
+            .f64s("x", &ws.x)
+            .build())
     }
 
     /// Drive efforts tau (m; N m or N) for (q, qd, qdd).
