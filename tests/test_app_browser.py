@@ -187,3 +187,74 @@ def test_simulate_button_plays_and_charts(page):
     assert units and all(units)
     page.screenshot(path=str(ARTEFACTS / "app-five-bar.png"))
     assert (ARTEFACTS / "app-five-bar.png").stat().st_size > 10_000
+
+
+# ------------------------------------------------------------------ the app in a notebook
+
+#: How Jupyter shows an HTML output (JupyterLab's renderer, classic Notebook, VS Code): the
+#: HTML set as a cell's output, then each of its scripts re-created so that it runs, in order.
+NOTEBOOK_PAGE = """<!doctype html><html><body><script type="application/json" id="outputs">__OUTPUTS__</script><script>
+const outputs = JSON.parse(document.getElementById("outputs").textContent);
+for (const html of outputs) {
+  const cell = document.createElement("div");
+  cell.className = "output";
+  cell.innerHTML = html;
+  document.body.append(cell);
+  for (const old of cell.querySelectorAll("script")) {
+    const s = document.createElement("script");
+    for (const a of old.attributes) s.setAttribute(a.name, a.value);
+    s.textContent = old.textContent;
+    old.replaceWith(s);
+  }
+}
+</script></body></html>"""
+
+
+def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
+    # A mechanism and a result displayed in a notebook, as Jupyter renders them: the engine is
+    # in the first output only, and both become apps: the mechanism's state is the Python API's
+    # at q0 (to 1e-9, as test_state_equals_the_python_api), the result's frames are its run's
+    # positions (rounded to 6 digits of L in the page: planardyn.replay.DIGITS).
+    import json
+
+    from planardyn import notebook
+
+    monkeypatch.setattr(notebook, "_engine_shown", False)
+    mech = five_bar()
+    res = mech.simulate(t_end=0.5, output_dt=0.01)
+    outputs = [notebook.mechanism_html(mech), notebook.result_html(res)]
+    page_file = tmp_path / "notebook.html"
+    page_file.write_text(NOTEBOOK_PAGE.replace("__OUTPUTS__", json.dumps(outputs).replace("<", "\\u003c")))
+    pg = browser.new_page(viewport={"width": 1200, "height": 1600})
+    errors = []
+    pg.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(page_file.as_uri())
+    pg.wait_for_function("document.querySelectorAll('iframe').length === 2", timeout=20_000)
+    frames = [f for f in pg.frames if f != pg.main_frame]
+    for f in frames:
+        f.wait_for_selector("body[data-ready='1']", timeout=20_000)
+    by_mode = {f.evaluate("window.planardyn.mode"): f for f in frames}
+    assert set(by_mode) == {"design", "replay"}
+    # The summaries' drawings gave way to the apps; their tables stay.
+    assert pg.evaluate("document.querySelectorAll('.planardyn-summary svg').length") == 0
+    assert pg.evaluate("document.querySelectorAll('.planardyn-summary table').length") == 2
+
+    got = by_mode["design"].evaluate("({q: Array.from(window.planardyn.q), names: window.planardyn.info.points,"
+                                     " points: Array.from(window.planardyn.ev.points)})")
+    kin = mech.kinematics(got["q"])
+    carried = [mech.point_names.index(n) for n in got["names"]]
+    np.testing.assert_allclose(got["q"], mech.q0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.reshape(got["points"], (-1, 2)), kin["points"][carried], rtol=STATE_RTOL,
+                               atol=STATE_RTOL * mech.scale)
+
+    replay = by_mode["replay"]
+    replay.evaluate("window.planardyn.setFrame(25)")
+    frame = replay.evaluate("Array.from(window.planardyn.replay.data.P[25])")
+    np.testing.assert_allclose(np.reshape(frame, (-1, 2)), mech.point_positions(res.x[25]), rtol=0,
+                               atol=1e-6 * mech.scale)
+    assert replay.evaluate("document.body.dataset.frame") == "25"
+    ARTEFACTS.mkdir(parents=True, exist_ok=True)
+    pg.screenshot(path=str(ARTEFACTS / "notebook.png"), full_page=True)
+    assert errors == []
+    pg.close()
