@@ -7,6 +7,7 @@ import { dragTowards } from "./drag.js";
 import { coordinateRange } from "./map.js";
 import { groundIndices, moveTo, showState } from "./view.js";
 import { setMode } from "./timeline.js";
+import { listModes } from "./modes.js";
 
 /** States of a sweep of one coordinate (the quasi-static charts and the point paths). */
 const SWEEP_STEPS = 180;
@@ -82,6 +83,7 @@ export function sweep() {
   const name = app.info.coordinateNames[k];
   app.sweepX = series.q.filter((_, i) => i % app.info.dof === k);
   app.charts.set(app.sweepX, `${name} (${unitOf(app.info, k, "q")}), at rest`, chans, defaultChannels(chans));
+  listModes();
 }
 
 /** The force (N) drawn ARROW_FRACTION of L long: the upper quartile of the states' largest

@@ -1,29 +1,40 @@
-// The side panel's singularity map tab (the map itself: map.js).
-import { $, app } from "./state.js";
-import { LEVELS, mapRanges, mapper, paintMap } from "./map.js";
+// The side panel's map tab (the maps themselves: map.js): the singularity map, or for a
+// compliant model the first natural frequency's.
+import { $, app, fmt } from "./state.js";
+import { LEVELS, frequencyRows, frequencyScale, mapRanges, mapper, paintMap, sigmaRows, sigmaScale } from "./map.js";
 
-/** The singularity map of a two-coordinate model, refined level by level while the page stays
- * responsive (only while its tab is open). */
+const KINDS = {
+  sigma: { rows: sigmaRows, scale: () => sigmaScale(), what: "σ (type II)",
+    legend: () => "pale: far from a singularity; dark red: at one" },
+  frequency: { rows: frequencyRows, scale: (g) => frequencyScale(g.sigma), what: "the first natural frequency (Hz; motors held)",
+    legend: (g) => { const f = g.sigma.filter(Number.isFinite); return `${fmt(Math.min(...f))} Hz dark red to ${fmt(Math.max(...f))} Hz pale`; } },
+};
+
+/** The map of a two-coordinate model, refined level by level while the page stays responsive
+ * (only while its tab is open). */
 export function startMap() {
   const note = $("map-note");
   if (app.mapJob) cancelAnimationFrame(app.mapJob);
+  $("map-kind-box").hidden = !(app.info && app.info.compliant);
   if (!app.info || app.info.dof !== 2) {
-    note.textContent = "The singularity map is drawn for mechanisms of two coordinates (a 5R, a two-input robot).";
+    note.textContent = "The maps are drawn for mechanisms of two coordinates (a 5R, a two-input robot).";
     return;
   }
   if (!$("tab-map").classList.contains("on")) return;
+  const kind = KINDS[app.info.compliant ? $("map-kind").value : "sigma"];
   const ranges = mapRanges(app.info, app.q);
   const [q, x0] = [Float64Array.from(app.q), app.x];
+  const rows = kind.rows(app.mech);
   let level = 0;
-  let grid = mapper(app.mech, ranges, LEVELS[0], x0, q);
+  let grid = mapper(rows, ranges, LEVELS[0], x0, q);
   const t0 = performance.now();
   const names = app.info.coordinateNames;
   const work = () => {
     const done = grid.step();
-    paintMap($("map"), grid, ranges, q);
-    if (done && level + 1 < LEVELS.length) grid = mapper(app.mech, ranges, LEVELS[++level], x0, q, grid);
+    paintMap($("map"), grid, ranges, q, kind.scale(grid));
+    if (done && level + 1 < LEVELS.length) grid = mapper(rows, ranges, LEVELS[++level], x0, q, grid);
     else if (done) {
-      note.textContent = `σ (type II) over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms (pale: far from a singularity; dark red: at one; grey: does not assemble on this branch)`;
+      note.textContent = `${kind.what} over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms (${kind.legend(grid)}; grey: does not assemble on this branch)`;
       app.mapGrid = grid;
       return;
     }

@@ -7,6 +7,7 @@ import { setMode } from "./timeline.js";
 import { buildSliders, sweep } from "./design.js";
 import { buildRunModes } from "./run.js";
 import { startMap } from "./map_tab.js";
+import { listModes } from "./modes.js";
 
 /** Build the model from text; on an error, show it in place and keep the last model. */
 export function setModel(text, format, source, { fromEditor = false } = {}) {
@@ -82,5 +83,7 @@ export function installEditor() {
     b.classList.add("on");
     $(`tab-${b.dataset.tab}`).classList.add("on");
     if (b.dataset.tab === "map") startMap();
+    if (b.dataset.tab === "modes") listModes();
   }));
+  $("map-kind").addEventListener("change", startMap);
 }
