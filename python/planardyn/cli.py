@@ -344,7 +344,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
              "Write, into one folder and in seconds, from the shipped models: the 5R robot tracing a\n"
              "circle with its drive torques, actuator sizing report and singularity map; a passive\n"
              "mechanism (a four-bar under gravity) simulated, plotted and animated; and both in the\n"
-             "interactive viewer (HTML, open it in a browser). One line per file says what it is.",
+             "browser app (HTML, open it in a browser). One line per file says what it is.",
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model slider-crank")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")

@@ -3,10 +3,12 @@
 import { $, app, fmt } from "./state.js";
 import { LEVELS, frequencyRows, frequencyScale, mapRanges, mapper, paintMap, sigmaRows, sigmaScale } from "./map.js";
 
+/** The maps: each its rows, its colour scale, its grids (a first frequency costs about a
+ * millisecond a cell, an eigenproblem, so its map stops at 50 x 50: about 3 s) and legend. */
 const KINDS = {
-  sigma: { rows: sigmaRows, scale: () => sigmaScale(), what: "σ (type II)",
+  sigma: { rows: sigmaRows, scale: () => sigmaScale(), levels: LEVELS, what: "σ (type II)",
     legend: () => "pale: far from a singularity; dark red: at one" },
-  frequency: { rows: frequencyRows, scale: (g) => frequencyScale(g.sigma), what: "the first natural frequency (Hz; motors held)",
+  frequency: { rows: frequencyRows, scale: (g) => frequencyScale(g.sigma), levels: LEVELS.slice(0, 2), what: "the first natural frequency (Hz; motors held)",
     legend: (g) => { const f = g.sigma.filter(Number.isFinite); return `${fmt(Math.min(...f))} Hz dark red to ${fmt(Math.max(...f))} Hz pale`; } },
 };
 
@@ -26,13 +28,13 @@ export function startMap() {
   const [q, x0] = [Float64Array.from(app.q), app.x];
   const rows = kind.rows(app.mech);
   let level = 0;
-  let grid = mapper(rows, ranges, LEVELS[0], x0, q);
+  let grid = mapper(rows, ranges, kind.levels[0], x0, q);
   const t0 = performance.now();
   const names = app.info.coordinateNames;
   const work = () => {
     const done = grid.step();
     paintMap($("map"), grid, ranges, q, kind.scale(grid));
-    if (done && level + 1 < LEVELS.length) grid = mapper(rows, ranges, LEVELS[++level], x0, q, grid);
+    if (done && level + 1 < kind.levels.length) grid = mapper(rows, ranges, kind.levels[++level], x0, q, grid);
     else if (done) {
       note.textContent = `${kind.what} over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms (${kind.legend(grid)}; grey: does not assemble on this branch)`;
       app.mapGrid = grid;
