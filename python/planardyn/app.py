@@ -80,7 +80,7 @@ def page_data(model: dict[str, str] | None = None, run: dict[str, Any] | None = 
         data["model"] = model
     if run is not None:
         data["run"] = run
-    return json.dumps(data, allow_nan=False).replace("<", "\\u003c")
+    return json.dumps(data, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c")
 
 
 def app_html(model: dict[str, str] | None = None, run: dict[str, Any] | None = None) -> str:
