@@ -346,3 +346,40 @@ def test_first_frequency_map_equals_the_python_api(page):
     assert "first natural frequency" in page.text_content("#map-note")
     ARTEFACTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(ARTEFACTS / "app-frequency-map.png"))
+
+
+def test_shift_dragging_a_point_edits_the_models_drawing(page):
+    # Shift + drag the end effector P 40 px right, in 5 px moves: the model file now draws P
+    # 40 px further right (40 / scale m, written to 1e-4 L: 0.1 mm here), the page's model is
+    # Python's model of that text (its state at the drawn pose equal to 1e-9), and the distal
+    # links, drawn from C1 and C2 to P, changed length.
+    mech = five_bar()
+    where = page.evaluate(
+        """() => {
+            const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
+            const k = a.info.points.indexOf('P'), b = a.bounds, w = r.width, h = r.height;
+            const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
+            const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
+            return {x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1], s};
+        }"""
+    )
+    page.keyboard.down("Shift")
+    page.mouse.move(where["x"], where["y"])
+    page.mouse.down()
+    for i in range(1, 9):
+        page.mouse.move(where["x"] + 5 * i, where["y"])
+        page.wait_for_timeout(50)
+    page.mouse.up()
+    page.keyboard.up("Shift")
+    page.wait_for_timeout(200)
+    text = page.input_value("#editor")
+    edited = pdy.loads(text)
+    drawn = dict(zip(mech.point_names, mech.point_positions(mech.x0)))
+    now = dict(zip(edited.point_names, edited.point_positions(edited.x0)))
+    snap = 1e-4 * mech.scale  # edit_drag.js SNAP_FRACTION, rounded to a decimal place: 0.1 mm here
+    np.testing.assert_allclose(now["P"], drawn["P"] + [40 / where["s"], 0.0], rtol=0, atol=snap)
+    np.testing.assert_allclose(now["C1"], drawn["C1"], rtol=0, atol=1e-15)
+    assert abs(np.hypot(*(now["P"] - now["C1"])) - np.hypot(*(drawn["P"] - drawn["C1"]))) > 0.01
+    got = page.evaluate("({q: Array.from(window.planardyn.q), x: Array.from(window.planardyn.x)})")
+    np.testing.assert_allclose(got["q"], edited.drawn_q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got["x"], edited.kinematics(got["q"])["x"], rtol=STATE_RTOL, atol=STATE_RTOL * mech.scale)

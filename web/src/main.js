@@ -8,7 +8,8 @@
 // state drawn and listed), timeline.js (modes, frames, playing), design.js (sliders, drag,
 // sweep), run.js (runs here and Python's), model.js (the model from text, the editor),
 // map_tab.js (the map tab: singularity or first frequency), modes.js (natural modes, shown
-// animated), files.js (open, drop, export).
+// animated), edit_drag.js (Shift + drag: a point of the model's drawing moved), files.js
+// (open, drop, export).
 import { $, app, status } from "./state.js";
 import { engine } from "./engine.js";
 import { Charts } from "./charts.js";
@@ -16,6 +17,7 @@ import { frequencyRows, mapRanges, mapper, sigmaRows } from "./map.js";
 import { drawingSvg, moveTo, showState } from "./view.js";
 import { play, setFrame } from "./timeline.js";
 import { installDrag, sweep } from "./design.js";
+import { installEditDrag } from "./edit_drag.js";
 import { backToDesign, showReplay, simulate } from "./run.js";
 import { installEditor, setModel } from "./model.js";
 import { startMap } from "./map_tab.js";
@@ -39,6 +41,7 @@ function start() {
     } else setFrame(i);
   });
   installDrag();
+  installEditDrag();
   installFiles();
   installEditor();
   $("simulate").onclick = simulate;
