@@ -310,13 +310,12 @@ def _app(summary: str, model: dict[str, str], run: dict[str, Any] | None, height
     )
 
 
-class AppView(Html):
-    """The app with a model (and a run) in a notebook cell; :meth:`save` writes it as one
-    offline page (as ``planardyn app`` does)."""
+class AppView:
+    """The app with a model (and a run) in a notebook cell, made when shown (the first shown
+    carries the engine); :meth:`save` writes it as one offline page (as ``planardyn app`` does)."""
 
     def __init__(self, summary: str, model: dict[str, str], run: dict[str, Any] | None, height: int) -> None:
         self.model, self.run, self.height, self.summary = model, run, height, summary
-        super().__init__("")
 
     def _repr_html_(self) -> str:
         return _app(self.summary, self.model, self.run, self.height)
