@@ -383,3 +383,41 @@ def test_shift_dragging_a_point_edits_the_models_drawing(page):
     got = page.evaluate("({q: Array.from(window.planardyn.q), x: Array.from(window.planardyn.x)})")
     np.testing.assert_allclose(got["q"], edited.drawn_q, rtol=0, atol=1e-12)
     np.testing.assert_allclose(got["x"], edited.kinematics(got["q"])["x"], rtol=STATE_RTOL, atol=STATE_RTOL * mech.scale)
+
+
+def test_stiffness_map_equals_the_python_api(page):
+    # The weakest translational stiffness of P (on distal_left, the first body that carries it)
+    # over a 7 x 7 grid: the middle cells that assemble equal planardyn.stiffness's to 1e-9
+    # (MODES_RTOL's reasons: the same Rust, an SVD and a symmetric eigenproblem of the
+    # compliant model); the map tab draws it for the point chosen.
+    from planardyn import stiffness as st
+
+    mech = compliant(page)
+    n = 7
+    got = page.evaluate(
+        """(n) => {
+            const a = window.planardyn, { mapRanges, mapper, stiffnessRows } = a.mapTools;
+            const ranges = mapRanges(a.info, a.q);
+            const grid = mapper(stiffnessRows(a.mech, "P"), ranges, n, a.x, Float64Array.from(a.q));
+            grid.step(Infinity);
+            return { ranges, k: Array.from(grid.sigma) };
+        }""",
+        n,
+    )
+    k = np.reshape(got["k"], (n, n))
+    axes = [lo + (hi - lo) * (np.arange(n) + 0.5) / n for lo, hi in got["ranges"]]
+    compared = 0
+    for j in range(2, 5):
+        for i in range(2, 5):
+            if np.isfinite(k[j, i]):
+                want = st.stiffness(mech, [axes[0][i], axes[1][j]], body="distal_left", point="P").weakest_stiffness
+                np.testing.assert_allclose(k[j, i], want, rtol=MODES_RTOL)
+                compared += 1
+    assert compared >= 7  # as the frequency map's: two cells are past the workspace's edge
+    with pytest.raises(playwright.Error, match="no body carries a point 'nope'"):
+        page.evaluate("window.planardyn.mech.stiffness(window.planardyn.q, 'nope')")
+    page.click("nav button[data-tab='map']")
+    page.select_option("#map-kind", "stiffness")
+    assert page.input_value("#map-point") == "P"
+    page.wait_for_function("document.getElementById('map-note').textContent.includes('50 × 50, in')", timeout=120_000)
+    assert "the weakest stiffness of P (N/m)" in page.text_content("#map-note")

@@ -13,7 +13,7 @@
 import { $, app, status } from "./state.js";
 import { engine } from "./engine.js";
 import { Charts } from "./charts.js";
-import { frequencyRows, mapRanges, mapper, sigmaRows } from "./map.js";
+import { frequencyRows, mapRanges, mapper, sigmaRows, stiffnessRows } from "./map.js";
 import { drawingSvg, moveTo, showState } from "./view.js";
 import { play, setFrame } from "./timeline.js";
 import { installDrag, sweep } from "./design.js";
@@ -49,7 +49,7 @@ function start() {
   $("design").onclick = backToDesign;
   $("scrub").addEventListener("input", () => { play(false); setFrame(+$("scrub").value); });
   window.addEventListener("resize", () => { if (app.info || app.replay) { app.charts.render(); showState(); } });
-  Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper, sigmaRows, frequencyRows }, listModes, showMode });
+  Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper, sigmaRows, frequencyRows, stiffnessRows }, listModes, showMode });
   const data = JSON.parse($("planardyn-data").textContent);
   if (data.model) setModel(data.model.text, data.model.format, data.model.source);
   if (data.run) showReplay(data.run);

@@ -1,7 +1,8 @@
 // The maps of a two-coordinate mechanism (a 5R, a two-input robot): over a grid of (q1, q2),
 // on the branch reached by continuation from the current state (each cell starts Newton from
 // its neighbour), the type II measure sigma (the engine's `sigmaRows`) or, for a compliant
-// model, the first natural frequency (the engine's `modes` a cell). Computed progressively,
+// model, the first natural frequency or a point's weakest stiffness (the engine's `modes` or
+// `stiffness` a cell). Computed progressively,
 // coarse grids first, in slices that leave the page responsive; cells that do not assemble
 // are grey.
 
@@ -29,10 +30,11 @@ export function mapRanges(info, q) {
  * continue)}`. */
 export const sigmaRows = (mech) => (q, axes, i0, rows, x) => mech.sigmaRows(q, 0, 1, axes[0], axes[1], i0, rows, x);
 
-/** The first natural frequency's rows (Hz), as `sigmaRows` walks them: each cell the
- * engine's `modes` at the cell's q from its neighbour's body coordinates; NaN where it does not
- * assemble or has no modes (the next cell then starts from the last that did). */
-export const frequencyRows = (mech) => (q, axes, i0, rows, xStart) => {
+/** Rows of a value computed a cell at a time by `cell(qCell, x)` -> {value, x} (one engine
+ * call at the cell's q from its neighbour's body coordinates x), walked as `sigmaRows` walks
+ * them; NaN where the call throws (it does not assemble there, or has no value), the next
+ * cell then starting from the last that did. */
+const cellRows = (cell) => (q, axes, i0, rows, xStart) => {
   const n = axes[0].length;
   const out = new Float64Array(rows.length * n).fill(NaN);
   let xRow = xStart;
@@ -44,17 +46,29 @@ export const frequencyRows = (mech) => (q, axes, i0, rows, xStart) => {
         const qc = Float64Array.from(q);
         [qc[0], qc[1]] = [axes[0][i], axes[1][j]];
         try {
-          const m = mech.modes(qc, false, x);
-          out[r * n + i] = m.omega[0] / (2 * Math.PI);
-          x = m.x;
-          if (i === i0) xNext = m.x;
-        } catch { /* not assembled here: NaN */ }
+          const c = cell(qc, x);
+          out[r * n + i] = c.value;
+          x = c.x;
+          if (i === i0) xNext = c.x;
+        } catch { /* not computed here: NaN */ }
       }
     }
     if (xNext) xRow = xNext;
   });
   return { sigma: out, x: xRow };
 };
+
+/** The first natural frequency's rows (Hz; the engine's `modes`, motors held). */
+export const frequencyRows = (mech) => cellRows((q, x) => {
+  const m = mech.modes(q, false, x);
+  return { value: m.omega[0] / (2 * Math.PI), x: m.x };
+});
+
+/** The rows of the weakest translational stiffness (N/m) of `point` (the engine's `stiffness`). */
+export const stiffnessRows = (mech, point) => cellRows((q, x) => {
+  const s = mech.stiffness(q, point, x);
+  return { value: s.weakest, x: s.x };
+});
 
 /** A map on an n x n grid over `ranges` (row j: q2, column i: q1), NaN where it does not
  * assemble, computed a few rows a call of `rowsOf` (`sigmaRows` or `frequencyRows` of the
@@ -95,8 +109,9 @@ export function mapper(rowsOf, ranges, n, x0, q, coarse = null) {
 /** Where sigma lies between 1e-3 and 1, log scale (0 at a singularity). */
 export const sigmaScale = () => (s) => (Math.log10(Math.max(s, 1e-3)) + 3) / 3;
 
-/** Where a frequency lies between the lowest and highest of the grid, log scale. */
-export function frequencyScale(values) {
+/** Where a value (a frequency, a stiffness) lies between the lowest and highest of the grid,
+ * log scale. */
+export function spanScale(values) {
   const finite = values.filter((v) => Number.isFinite(v) && v > 0);
   const [lo, hi] = [Math.log10(Math.min(...finite)), Math.log10(Math.max(...finite))];
   return (f) => (hi > lo ? (Math.log10(f) - lo) / (hi - lo) : 1);

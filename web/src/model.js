@@ -88,4 +88,5 @@ export function installEditor() {
     if (b.dataset.tab === "modes") listModes();
   }));
   $("map-kind").addEventListener("change", startMap);
+  $("map-point").addEventListener("change", startMap);
 }

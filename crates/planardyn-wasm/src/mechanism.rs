@@ -13,7 +13,7 @@ use planardyn::dynamics::{self, carried_points, Rows};
 use planardyn::elastic;
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
-use planardyn::model::PairId;
+use planardyn::model::{BodyId, Link, PairId, PointId};
 use planardyn::Mechanism;
 use wasm_bindgen::prelude::*;
 
@@ -61,7 +61,7 @@ impl WasmMechanism {
     pub fn info(&self) -> JsValue {
         let m = &self.inner;
         let (q0, qd0) = m.initial_state();
-        let point = |p: planardyn::model::PointId| m.points[p.0].0.as_str();
+        let point = |p: PointId| m.points[p.0].0.as_str();
         let bodies = m.bodies.iter().map(|b| strings(b.points.iter().map(|(p, _)| point(*p))).into());
         let pair_list = m.pairs.iter().enumerate().map(|(k, p)| {
             let rows = m.pair_rows(PairId(k));
@@ -222,6 +222,37 @@ impl WasmMechanism {
             .f64s("omega2", &modes.omega2)
             .f64s("dampingRatio", &modes.damping_ratio)
             .f64s("shapes", &modes.shapes.concat())
+            .f64s("x", &ws.x)
+            .build())
+    }
+
+    /// The stiffness of the point `point` (on the first body that carries it) at
+    /// coordinates q (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`
+    /// unloaded): `{weakest (N/m: the translational stiffness in its weakest direction), direction
+    /// ([d_x, d_y], unit), compliance (3 x 3 of [x, y, phi]; m/N, m/(N m), rad/N, rad/(N m)),
+    /// x (3n: the pose)}`. A model without a `compliance:` section throws an ArgumentError.
+    pub fn stiffness(&self, q: &[f64], point: &str, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
+        self.start_args(q, x_start.as_deref())?;
+        let m = &self.inner;
+        let on_body = |id: PointId| (0..m.n_bodies()).map(BodyId).find(|&b| m.attachment(Link::Body(b), id).is_some());
+        let Some((id, body)) = m.point_id(point).and_then(|id| on_body(id).map(|b| (id, b))) else {
+            let names: Vec<&str> = (0..m.points.len())
+                .filter(|&p| on_body(PointId(p)).is_some())
+                .map(|p| m.points[p].0.as_str())
+                .collect();
+            return Err(argument_error(
+                Some("point"),
+                format!("no body carries a point '{point}'; the bodies' points are: {}", names.join(", ")),
+            ));
+        };
+        let mut ws = js(query::assembled(m, q, x_start.as_deref()))?;
+        let out = elastic::Output { body, point: Some(id) };
+        let c = js(elastic::stiffness(m, q, out, &elastic::Load::default(), &mut ws))?;
+        let w = elastic::weakest_direction(&c, None);
+        Ok(Obj::new()
+            .set("weakest", w.stiffness)
+            .f64s("direction", &w.direction[..2])
+            .f64s("compliance", c.compliance.as_flattened())
             .f64s("x", &ws.x)
             .build())
     }
