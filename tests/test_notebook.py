@@ -206,7 +206,7 @@ def notebook_size(cells: list[str]) -> int:
 
 def test_a_notebook_with_five_apps_stays_light(five_bar, monkeypatch):
     # Five displays of the mechanism weigh the engine once and five models: the notebook of
-    # five is less than 4 % larger than the notebook of one (measured: 1.32 MB and 1.35 MB).
+    # five is less than 4 % larger than the notebook of one (measured: 1.35 MB and 1.38 MB).
     sizes = {}
     for n in (1, 5):
         monkeypatch.setattr(notebook, "_engine_shown", False)

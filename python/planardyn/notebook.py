@@ -2,7 +2,7 @@
 drag, edit, simulate) above a summary table, a result as the app with its run loaded (when it
 knows its model) above its summary; :func:`app_view` shows either where a cell ends.
 
-The app's engine (about 1.3 MB, gzipped) is embedded once per notebook session: the first app
+The app's engine (about 1.35 MB, gzipped) is embedded once per notebook session: the first app
 shown defines it in the notebook's page (``window.planardynApp``, a promise of the app's page),
 and every app, that one included, is an iframe whose page is written from it with its own
 model and run (a few kB to a few hundred kB). Where scripts do not run (a notebook rendered on
@@ -248,7 +248,7 @@ APP_HEIGHT = 640
 #: Whether this session's notebook page holds the engine (the first app shown defines it).
 _engine_shown = False
 #: Defines ``window.planardynApp`` in the notebook's page: a promise of the app's page, which
-#: ships gzipped and base64-encoded (2.7 MB -> about 1.3 MB; the browser's DecompressionStream
+#: ships gzipped and base64-encoded (2.8 MB -> about 1.35 MB; the browser's DecompressionStream
 #: inflates it), and tells the apps waiting for it.
 ENGINE_SCRIPT = (
     '<script>window.planardynApp=(async()=>{{const b=atob("{b64}"),u=new Uint8Array(b.length);'
