@@ -311,34 +311,39 @@ def test_modes_equal_the_python_api_and_are_animated(page):
     assert page.evaluate("window.planardyn.modeX") is None
 
 
+def check_map_middle(page, rows: str, want) -> None:
+    """A 7 x 7 map computed in the page by `mapTools.mapper` with the rows `rows` (JS, of `a`,
+    the app) over its ranges about the current state: each cell of the middle 3 x 3 that
+    assembles equals want(q of the cell) to MODES_RTOL. Python assembles from the drawing, the
+    same branch near q0; 7 of the 9 assemble (measured: the other two are past the workspace's
+    edge, NaN in the page's singularity map too)."""
+    n = 7
+    got = page.evaluate(
+        f"""(n) => {{
+            const a = window.planardyn, {{ mapRanges, mapper }} = a.mapTools;
+            const ranges = mapRanges(a.info, a.q);
+            const grid = mapper({rows}, ranges, n, a.x, Float64Array.from(a.q));
+            grid.step(Infinity);
+            return {{ ranges, v: Array.from(grid.sigma) }};
+        }}""",
+        n,
+    )
+    v = np.reshape(got["v"], (n, n))
+    axes = [lo + (hi - lo) * (np.arange(n) + 0.5) / n for lo, hi in got["ranges"]]
+    compared = 0
+    for j in range(2, 5):
+        for i in range(2, 5):
+            if np.isfinite(v[j, i]):
+                np.testing.assert_allclose(v[j, i], want([axes[0][i], axes[1][j]]), rtol=MODES_RTOL)
+                compared += 1
+    assert compared >= 7
+
+
 def test_first_frequency_map_equals_the_python_api(page):
     from planardyn import stiffness as st
 
     mech = compliant(page)
-    n = 7
-    got = page.evaluate(
-        """(n) => {
-            const a = window.planardyn, { mapRanges, mapper, frequencyRows } = a.mapTools;
-            const ranges = mapRanges(a.info, a.q);
-            const grid = mapper(frequencyRows(a.mech), ranges, n, a.x, Float64Array.from(a.q));
-            grid.step(Infinity);
-            return { ranges, f: Array.from(grid.sigma) };
-        }""",
-        n,
-    )
-    f = np.reshape(got["f"], (n, n))
-    axes = [lo + (hi - lo) * (np.arange(n) + 0.5) / n for lo, hi in got["ranges"]]
-    # Python's modes at each cell of the middle 3 x 3 the page reached (Python assembles from the
-    # drawing: the same branch near q0; 7 of the 9 assemble, measured: the other two are past
-    # the workspace's edge, NaN in the page's singularity map too).
-    compared = 0
-    for j in range(2, 5):
-        for i in range(2, 5):
-            if np.isfinite(f[j, i]):
-                want = st.modes(mech, [axes[0][i], axes[1][j]]).frequency[0]
-                np.testing.assert_allclose(f[j, i], want, rtol=MODES_RTOL)
-                compared += 1
-    assert compared >= 7
+    check_map_middle(page, "a.mapTools.frequencyRows(a.mech)", lambda q: st.modes(mech, q).frequency[0])
     # The map tab draws it for a compliant model (its kind chosen in the tab).
     page.click("nav button[data-tab='map']")
     page.select_option("#map-kind", "frequency")
@@ -386,34 +391,15 @@ def test_shift_dragging_a_point_edits_the_models_drawing(page):
 
 
 def test_stiffness_map_equals_the_python_api(page):
-    # The weakest translational stiffness of P (on distal_left, the first body that carries it)
-    # over a 7 x 7 grid: the middle cells that assemble equal planardyn.stiffness's to 1e-9
-    # (MODES_RTOL's reasons: the same Rust, an SVD and a symmetric eigenproblem of the
-    # compliant model); the map tab draws it for the point chosen.
+    # The weakest translational stiffness of P (on distal_left, the first body that carries it):
+    # the map's cells equal planardyn.stiffness's to 1e-9 (MODES_RTOL's reasons: the same Rust,
+    # an SVD and a symmetric eigenproblem of the compliant model); the map tab draws it for the
+    # point chosen.
     from planardyn import stiffness as st
 
     mech = compliant(page)
-    n = 7
-    got = page.evaluate(
-        """(n) => {
-            const a = window.planardyn, { mapRanges, mapper, stiffnessRows } = a.mapTools;
-            const ranges = mapRanges(a.info, a.q);
-            const grid = mapper(stiffnessRows(a.mech, "P"), ranges, n, a.x, Float64Array.from(a.q));
-            grid.step(Infinity);
-            return { ranges, k: Array.from(grid.sigma) };
-        }""",
-        n,
-    )
-    k = np.reshape(got["k"], (n, n))
-    axes = [lo + (hi - lo) * (np.arange(n) + 0.5) / n for lo, hi in got["ranges"]]
-    compared = 0
-    for j in range(2, 5):
-        for i in range(2, 5):
-            if np.isfinite(k[j, i]):
-                want = st.stiffness(mech, [axes[0][i], axes[1][j]], body="distal_left", point="P").weakest_stiffness
-                np.testing.assert_allclose(k[j, i], want, rtol=MODES_RTOL)
-                compared += 1
-    assert compared >= 7  # as the frequency map's: two cells are past the workspace's edge
+    check_map_middle(page, 'a.mapTools.stiffnessRows(a.mech, "P")',
+                     lambda q: st.stiffness(mech, q, body="distal_left", point="P").weakest_stiffness)
     with pytest.raises(playwright.Error, match="no body carries a point 'nope'"):
         page.evaluate("window.planardyn.mech.stiffness(window.planardyn.q, 'nope')")
     page.click("nav button[data-tab='map']")
