@@ -97,8 +97,8 @@ PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
   const qd = new Float64Array(n).fill(0.2), qdd = new Float64Array(n).fill(0.5);
   const frame = best(() => { let x; for (const q of qs) x = m.evaluate(q, qd, qdd, x).x; }) / frames;
   const five = a.mech;
-  const { mapRanges, mapper } = a.mapTools;
-  const map = best(() => mapper(five, mapRanges(a.info, a.info.q0), mapN, five.assemble(a.info.q0), a.info.q0).step(Infinity), 1);
+  const { mapRanges, mapper, sigmaRows } = a.mapTools;
+  const map = best(() => mapper(sigmaRows(five), mapRanges(a.info, a.info.q0), mapN, five.assemble(a.info.q0), a.info.q0).step(Infinity), 1);
   return { sim, frame, map, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000 };
 }"""
 

@@ -187,3 +187,223 @@ def test_simulate_button_plays_and_charts(page):
     assert units and all(units)
     page.screenshot(path=str(ARTEFACTS / "app-five-bar.png"))
     assert (ARTEFACTS / "app-five-bar.png").stat().st_size > 10_000
+
+
+# ------------------------------------------------------------------ the app in a notebook
+
+#: How Jupyter shows an HTML output (JupyterLab's renderer, classic Notebook, VS Code): the
+#: HTML set as a cell's output, then each of its scripts re-created so that it runs, in order.
+NOTEBOOK_PAGE = """<!doctype html><html><body><script type="application/json" id="outputs">__OUTPUTS__</script><script>
+const outputs = JSON.parse(document.getElementById("outputs").textContent);
+for (const html of outputs) {
+  const cell = document.createElement("div");
+  cell.className = "output";
+  cell.innerHTML = html;
+  document.body.append(cell);
+  for (const old of cell.querySelectorAll("script")) {
+    const s = document.createElement("script");
+    for (const a of old.attributes) s.setAttribute(a.name, a.value);
+    s.textContent = old.textContent;
+    old.replaceWith(s);
+  }
+}
+</script></body></html>"""
+
+
+def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
+    # A mechanism and a result displayed in a notebook, as Jupyter renders them: the engine is
+    # in the first output only, and both become apps: the mechanism's state is the Python API's
+    # at q0 (to 1e-9, as test_state_equals_the_python_api), the result's frames are its run's
+    # positions (rounded to 6 digits of L in the page: planardyn.replay.DIGITS).
+    import json
+
+    from planardyn import notebook
+
+    monkeypatch.setattr(notebook, "_engine_shown", False)
+    mech = five_bar()
+    res = mech.simulate(t_end=0.5, output_dt=0.01)
+    outputs = [notebook.mechanism_html(mech), notebook.result_html(res)]
+    page_file = tmp_path / "notebook.html"
+    page_file.write_text(NOTEBOOK_PAGE.replace("__OUTPUTS__", json.dumps(outputs).replace("<", "\\u003c")))
+    pg = browser.new_page(viewport={"width": 1200, "height": 1600})
+    errors = []
+    pg.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(page_file.as_uri())
+    pg.wait_for_function("document.querySelectorAll('iframe').length === 2", timeout=20_000)
+    frames = [f for f in pg.frames if f != pg.main_frame]
+    for f in frames:
+        f.wait_for_selector("body[data-ready='1']", timeout=20_000)
+    by_mode = {f.evaluate("window.planardyn.mode"): f for f in frames}
+    assert set(by_mode) == {"design", "replay"}
+    # The summaries' drawings gave way to the apps; their tables stay.
+    assert pg.evaluate("document.querySelectorAll('.planardyn-summary svg').length") == 0
+    assert pg.evaluate("document.querySelectorAll('.planardyn-summary table').length") == 2
+
+    got = by_mode["design"].evaluate("({q: Array.from(window.planardyn.q), names: window.planardyn.info.points,"
+                                     " points: Array.from(window.planardyn.ev.points)})")
+    kin = mech.kinematics(got["q"])
+    carried = [mech.point_names.index(n) for n in got["names"]]
+    np.testing.assert_allclose(got["q"], mech.q0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.reshape(got["points"], (-1, 2)), kin["points"][carried], rtol=STATE_RTOL,
+                               atol=STATE_RTOL * mech.scale)
+
+    # Frame 25 shown (the run plays on: read in the same turn of the page's loop).
+    shown = by_mode["replay"].evaluate("""() => { const a = window.planardyn; a.setFrame(25);
+        return {frame: document.body.dataset.frame, P: Array.from(a.replay.data.P[a.frame])}; }""")
+    assert shown["frame"] == "25"
+    np.testing.assert_allclose(np.reshape(shown["P"], (-1, 2)), mech.point_positions(res.x[25]), rtol=0,
+                               atol=1e-6 * mech.scale)
+    ARTEFACTS.mkdir(parents=True, exist_ok=True)
+    pg.screenshot(path=str(ARTEFACTS / "notebook.png"), full_page=True)
+    assert errors == []
+    pg.close()
+
+
+# ------------------------------------------------------------------ stiffness and vibration
+
+#: The five-bar with elastic motors and an elastic end-effector pin (tests/test_stiffness.py's).
+COMPLIANT_FIVE_BAR = (ROOT / "examples/models/five-bar.yaml").read_text().split("\ndrives:")[0] + """
+compliance:
+  drives:
+    - {actuator: theta1, stiffness: 2.0e3}
+    - {actuator: theta2, stiffness: 3.0e3}
+  pairs:
+    - {pair: effector, stiffness: 5.0e5}
+"""
+#: The modes in the page against Python's: the same Rust (SVD null space, symmetric eigen) in
+#: WebAssembly and natively, differing by the math library's rounding of the assembly's
+#: sin/cos (1 ulp), amplified by the eigenproblem's conditioning (frequencies 1e1..1e3 Hz apart
+#: by more than 10 %): 1e-9 relative, as the issue asks of every quantity at one state.
+MODES_RTOL = 1e-9
+
+
+def compliant(page):
+    page.evaluate("(text) => window.planardyn.setModel(text, 'yaml', 'compliant.yaml')", COMPLIANT_FIVE_BAR)
+    return pdy.loads(COMPLIANT_FIVE_BAR)
+
+
+def test_modes_equal_the_python_api_and_are_animated(page):
+    from planardyn import stiffness as st
+
+    mech = compliant(page)
+    page.click("nav button[data-tab='modes']")
+    got = page.evaluate("({q: Array.from(window.planardyn.q), omega: Array.from(window.planardyn.modes.omega),"
+                        " shapes: Array.from(window.planardyn.modes.shapes), rows: document.querySelectorAll('#modes tr[data-mode]').length})")
+    want = st.modes(mech, got["q"])
+    assert got["rows"] == len(want.omega) > 0
+    np.testing.assert_allclose(got["omega"], want.omega, rtol=MODES_RTOL)
+    shapes = np.reshape(got["shapes"], want.shapes.shape)
+    for k in range(len(want.omega)):  # a mode's shape is defined up to its sign
+        sign = np.sign(shapes[k] @ want.shapes[k])
+        np.testing.assert_allclose(sign * shapes[k], want.shapes[k], rtol=0,
+                                   atol=MODES_RTOL * np.abs(want.shapes[k]).max())
+    # Mode 1 clicked: the drawing is the pose displaced along mode 1's shape (x + c y_1, c
+    # changing with time), not at rest, until the state changes.
+    page.click("#modes tr[data-mode='0']")
+    page.wait_for_function("window.planardyn.modeX && Math.abs(window.planardyn.modeX[2] - window.planardyn.x[2]) > 1e-6")
+    assert page.evaluate("document.body.dataset.modeShown") == "1"
+    dx = np.subtract(page.evaluate("Array.from(window.planardyn.modeX)"), page.evaluate("Array.from(window.planardyn.x)"))
+    y = want.shapes[0]
+    c = dx @ y / (y @ y)
+    np.testing.assert_allclose(dx, c * y, rtol=0, atol=1e-12 * np.abs(dx).max())
+    page.evaluate("window.planardyn.moveTo(Float64Array.from(window.planardyn.q)); window.planardyn.showState()")
+    assert page.evaluate("window.planardyn.modeX") is None
+
+
+def check_map_middle(page, rows: str, want) -> None:
+    """A 7 x 7 map computed in the page by `mapTools.mapper` with the rows `rows` (JS, of `a`,
+    the app) over its ranges about the current state: each cell of the middle 3 x 3 that
+    assembles equals want(q of the cell) to MODES_RTOL. Python assembles from the drawing, the
+    same branch near q0; 7 of the 9 assemble (measured: the other two are past the workspace's
+    edge, NaN in the page's singularity map too)."""
+    n = 7
+    got = page.evaluate(
+        f"""(n) => {{
+            const a = window.planardyn, {{ mapRanges, mapper }} = a.mapTools;
+            const ranges = mapRanges(a.info, a.q);
+            const grid = mapper({rows}, ranges, n, a.x, Float64Array.from(a.q));
+            grid.step(Infinity);
+            return {{ ranges, v: Array.from(grid.sigma) }};
+        }}""",
+        n,
+    )
+    v = np.reshape(got["v"], (n, n))
+    axes = [lo + (hi - lo) * (np.arange(n) + 0.5) / n for lo, hi in got["ranges"]]
+    compared = 0
+    for j in range(2, 5):
+        for i in range(2, 5):
+            if np.isfinite(v[j, i]):
+                np.testing.assert_allclose(v[j, i], want([axes[0][i], axes[1][j]]), rtol=MODES_RTOL)
+                compared += 1
+    assert compared >= 7
+
+
+def test_first_frequency_map_equals_the_python_api(page):
+    from planardyn import stiffness as st
+
+    mech = compliant(page)
+    check_map_middle(page, "a.mapTools.frequencyRows(a.mech)", lambda q: st.modes(mech, q).frequency[0])
+    # The map tab draws it for a compliant model (its kind chosen in the tab).
+    page.click("nav button[data-tab='map']")
+    page.select_option("#map-kind", "frequency")
+    page.wait_for_function("document.getElementById('map-note').textContent.includes('50 × 50, in')", timeout=120_000)
+    assert "first natural frequency" in page.text_content("#map-note")
+    ARTEFACTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(ARTEFACTS / "app-frequency-map.png"))
+
+
+def test_shift_dragging_a_point_edits_the_models_drawing(page):
+    # Shift + drag the end effector P 40 px right, in 5 px moves: the model file now draws P
+    # 40 px further right (40 / scale m, written to 1e-4 L: 0.1 mm here), the page's model is
+    # Python's model of that text (its state at the drawn pose equal to 1e-9), and the distal
+    # links, drawn from C1 and C2 to P, changed length.
+    mech = five_bar()
+    where = page.evaluate(
+        """() => {
+            const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
+            const k = a.info.points.indexOf('P'), b = a.bounds, w = r.width, h = r.height;
+            const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
+            const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
+            return {x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1], s};
+        }"""
+    )
+    page.keyboard.down("Shift")
+    page.mouse.move(where["x"], where["y"])
+    page.mouse.down()
+    for i in range(1, 9):
+        page.mouse.move(where["x"] + 5 * i, where["y"])
+        page.wait_for_timeout(50)
+    page.mouse.up()
+    page.keyboard.up("Shift")
+    page.wait_for_timeout(200)
+    text = page.input_value("#editor")
+    edited = pdy.loads(text)
+    drawn = dict(zip(mech.point_names, mech.point_positions(mech.x0)))
+    now = dict(zip(edited.point_names, edited.point_positions(edited.x0)))
+    snap = 1e-4 * mech.scale  # edit_drag.js SNAP_FRACTION, rounded to a decimal place: 0.1 mm here
+    np.testing.assert_allclose(now["P"], drawn["P"] + [40 / where["s"], 0.0], rtol=0, atol=snap)
+    np.testing.assert_allclose(now["C1"], drawn["C1"], rtol=0, atol=1e-15)
+    assert abs(np.hypot(*(now["P"] - now["C1"])) - np.hypot(*(drawn["P"] - drawn["C1"]))) > 0.01
+    got = page.evaluate("({q: Array.from(window.planardyn.q), x: Array.from(window.planardyn.x)})")
+    np.testing.assert_allclose(got["q"], edited.drawn_q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got["x"], edited.kinematics(got["q"])["x"], rtol=STATE_RTOL, atol=STATE_RTOL * mech.scale)
+
+
+def test_stiffness_map_equals_the_python_api(page):
+    # The weakest translational stiffness of P (on distal_left, the first body that carries it):
+    # the map's cells equal planardyn.stiffness's to 1e-9 (MODES_RTOL's reasons: the same Rust,
+    # an SVD and a symmetric eigenproblem of the compliant model); the map tab draws it for the
+    # point chosen.
+    from planardyn import stiffness as st
+
+    mech = compliant(page)
+    check_map_middle(page, 'a.mapTools.stiffnessRows(a.mech, "P")',
+                     lambda q: st.stiffness(mech, q, body="distal_left", point="P").weakest_stiffness)
+    with pytest.raises(playwright.Error, match="no body carries a point 'nope'"):
+        page.evaluate("window.planardyn.mech.stiffness(window.planardyn.q, 'nope')")
+    page.click("nav button[data-tab='map']")
+    page.select_option("#map-kind", "stiffness")
+    assert page.input_value("#map-point") == "P"
+    page.wait_for_function("document.getElementById('map-note').textContent.includes('50 × 50, in')", timeout=120_000)
+    assert "the weakest stiffness of P (N/m)" in page.text_content("#map-note")

@@ -5,8 +5,11 @@ a ``TimedPath`` and a sizing report printed about 200 lines of raw arrays."""
 
 from __future__ import annotations
 
+import dataclasses
 import html
+import json
 import re
+import types
 
 import numpy as np
 import planardyn as pdy
@@ -14,6 +17,7 @@ import pytest
 from conftest import MODELS
 from planardyn import notebook, robot
 from planardyn.identify import Excitation, identify
+from planardyn.results_io import attach_metadata
 from planardyn.sensitivity import trajectory
 
 #: A repr is one line, at most this long (a console's width, twice): no array's contents.
@@ -125,3 +129,102 @@ def test_maps(five_bar):
     cmap = robot.capability_map(ee, (-0.05, 0.05), (0.45, 0.52), n=6, tau_max=[5, 5])
     text = check_repr(cmap, "6 x 6 cells", "m/s^2")
     assert re.search(r"\|tau\| <= \[5\.0, 5\.0\]", text)
+
+
+# ------------------------------------------------------------------ the app in a notebook
+
+
+@pytest.fixture
+def fresh_session(monkeypatch):
+    """A notebook session whose page holds no engine yet."""
+    monkeypatch.setattr(notebook, "_engine_shown", False)
+
+
+def test_mechanism_summary_svg(five_bar):
+    svg = notebook.mechanism_svg(five_bar)
+    assert svg.startswith("<svg") and svg.endswith("</svg>")
+    assert svg.count("<polyline") == five_bar.n_bodies  # four bars
+    assert svg.count("<circle") == len(five_bar.pairs)
+    assert all(f">{n}</text>" in svg for n in five_bar.point_names)
+    page = notebook.mechanism_summary(five_bar)
+    assert "five-bar 5R robot, driven" in page and "theta1 = 2.00713 rad" in page
+    assert "2 (3n - 2p = 2)" in page
+
+
+def test_result_summary(five_bar):
+    res = five_bar.simulate()
+    # Without its model (simulate attaches it): the summary alone, no app.
+    plain = notebook.result_html(dataclasses.replace(res, metadata={}))
+    assert "success" in plain and "301" in plain and "<svg" not in plain and "<iframe" not in plain
+    assert "tau 2.41 .. 2.41" not in plain and "tau -2.41 .. -2.41 N m" in plain
+    rich = notebook.result_summary(attach_metadata(res, five_bar, {}))
+    assert "<svg" in rich and rich.count("<polyline") == five_bar.n_bodies + 3  # bars and 3 paths
+    with pytest.raises(ValueError, match="does not carry its model"):
+        notebook.app_view(dataclasses.replace(res, metadata={}))
+
+
+def app_data(page: str) -> dict:
+    found = re.findall(r'<script type="application/json" id="planardyn-[0-9a-f]+-data">(.*?)</script>', page, re.S)
+    assert len(found) == 1
+    return json.loads(found[0])
+
+
+def test_displays_are_the_app_with_the_engine_once(five_bar, fresh_session):
+    # The first display holds the engine (the app's page, gzipped and base64-encoded: about
+    # 1.3 MB); the next ones only their model (a few kB) or their run.
+    first, second = notebook.mechanism_html(five_bar), notebook.mechanism_html(five_bar)
+    assert first.count("window.planardynApp=(async") == 1 and "window.planardynApp=(async" not in second
+    assert len(second) < 20_000 < 1_000_000 < len(first)
+    model = app_data(second)["model"]
+    assert pdy.loads(model["text"]) == five_bar and model["format"] == "yaml"
+    res = five_bar.simulate(t_end=0.5, output_dt=0.01)
+    run = app_data(notebook.result_html(res))["run"]
+    np.testing.assert_allclose(np.reshape(run["P"], (51, -1, 2)), five_bar.point_positions(res.x), rtol=0,
+                               atol=1e-6 * five_bar.scale)  # rounded to 6 digits of L (replay.DIGITS)
+    # engine() puts it back in a later cell (its first output cleared); save() writes the app.
+    assert "window.planardynApp=(async" in notebook.engine()._repr_html_()
+
+
+def test_app_view_saves_the_offline_app(five_bar, fresh_session, tmp_path):
+    view = notebook.app_view(five_bar, five_bar.simulate(t_end=0.2, output_dt=0.05))
+    view.save(tmp_path / "app.html")
+    page = (tmp_path / "app.html").read_text()
+    data = json.loads(re.search(r'id="planardyn-data">(.*?)</script>', page, re.S).group(1))
+    assert data["run"]["t"] == pytest.approx([0.0, 0.05, 0.1, 0.15, 0.2])
+
+
+def notebook_size(cells: list[str]) -> int:
+    """Bytes of an .ipynb (nbformat 4, as Jupyter writes it: indent 1) whose code cells have
+    these HTML outputs."""
+    nb = {"nbformat": 4, "nbformat_minor": 5, "metadata": {}, "cells": [
+        {"cell_type": "code", "execution_count": k + 1, "id": f"c{k}", "metadata": {}, "source": ["m"],
+         "outputs": [{"output_type": "execute_result", "execution_count": k + 1, "metadata": {},
+                      "data": {"text/html": html_text.splitlines(keepends=True), "text/plain": ["<Mechanism>"]}}]}
+        for k, html_text in enumerate(cells)]}
+    return len(json.dumps(nb, indent=1, ensure_ascii=False).encode("utf-8"))
+
+
+def test_a_notebook_with_five_apps_stays_light(five_bar, monkeypatch):
+    # Five displays of the mechanism weigh the engine once and five models: the notebook of
+    # five is less than 4 % larger than the notebook of one (measured: 1.35 MB and 1.38 MB).
+    sizes = {}
+    for n in (1, 5):
+        monkeypatch.setattr(notebook, "_engine_shown", False)
+        sizes[n] = notebook_size([notebook.mechanism_html(five_bar) for _ in range(n)])
+    assert sizes[5] < 1.04 * sizes[1]
+
+
+def test_register_display_hands_the_views_to_ipython(five_bar, fresh_session):
+    # A stand-in for IPython's shell: display_formatter.formatters["text/html"].for_type(cls, f).
+    printers = {}
+
+    class Formatter:
+        def for_type(self, cls, printer):
+            printers[cls] = printer
+
+    shell = types.SimpleNamespace(display_formatter=types.SimpleNamespace(formatters={"text/html": Formatter()}))
+    assert notebook.register_display(shell)
+    assert printers == {pdy.Mechanism: notebook.mechanism_html, pdy.SimulationResult: notebook.result_html,
+                        pdy.PointMotion: notebook.point_motion_html}
+    assert "planardyn-summary" in printers[type(five_bar)](five_bar)
+    assert notebook.register_display() is False  # no running IPython shell under pytest: nothing to do

@@ -1,5 +1,5 @@
 """Animations of a result: GIF (Pillow's encoder), MP4 (H.264 by the ffmpeg binary that the
-imageio-ffmpeg package ships) and the self-contained HTML viewer (:mod:`planardyn.viewer`).
+imageio-ffmpeg package ships) and HTML: the browser app with the run loaded (:mod:`planardyn.app`).
 
 Frames are drawn with matplotlib on its own Agg canvas (no pyplot, no global state): the
 mechanism as :func:`planardyn.plot.draw_mechanism` draws it, the paths of the traced points,
@@ -16,9 +16,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import extras
+from .app import write_app
 from .playback import auto_speed
 from .plot import draw_mechanism, trace_points
-from .viewer import write_viewer
 
 if TYPE_CHECKING:
     from .mechanism import Mechanism
@@ -160,10 +160,11 @@ def animate(
     labels: bool = True,
     max_frames: int = MAX_FRAMES,
     progress: Callable[[int, int], Any] | None = None,
-    **viewer_kw: Any,
+    **run_kw: Any,
 ) -> Path:
-    """Write an animation of ``result``: ``.gif``, ``.mp4`` or ``.html`` (the interactive
-    viewer, :func:`planardyn.viewer.write_viewer`; ``viewer_kw`` go to it), by extension.
+    """Write an animation of ``result``: ``.gif``, ``.mp4`` or ``.html`` (the browser app with
+    the model and the run, :func:`planardyn.app.write_app`; ``run_kw`` go to it: ``channels``,
+    ``max_frames``, ``title``), by extension.
 
     Parameters
     ----------
@@ -186,7 +187,7 @@ def animate(
     if ext not in FORMATS:
         raise ValueError(f"{path}: unknown animation format {ext!r} (use .gif, .mp4 or .html)")
     if ext in (".html", ".htm"):
-        return write_viewer(mech, result, path, traces=traces, **viewer_kw)
+        return write_app(path, mech, result, traces=traces, **run_kw)
     if ext == ".mp4" and (size[0] % 16 or size[1] % 16):
         raise ValueError(f"MP4 frame size must be multiples of 16 pixels, got {size[0]} x {size[1]}")
     frames = render_frames(

@@ -1,11 +1,12 @@
 """The browser app: one offline HTML file that holds planardyn's engine as WebAssembly, so a
 mechanism can be dragged, edited, simulated and plotted in any current browser with no server
-and no network (``planardyn app MODEL -o app.html``; the docs page ``app``).
+and no network (``planardyn app MODEL -o app.html``, ``planardyn animate ... -o run.html``;
+the docs page ``app``).
 
 The page is built from ``web/`` and ``crates/planardyn-wasm`` by ``./dev app`` and shipped in
 the wheel as ``planardyn/app_build/app.html``; this module only fills its data element with
-the model (its text, as written) and, optionally, a run computed in Python in the data format
-of the HTML viewer (played without the engine)::
+the model (its text) and, optionally, a run computed in Python (:func:`planardyn.replay.run_data`,
+played without the engine)::
 
     >>> import planardyn
     >>> from planardyn.app import write_app
@@ -18,14 +19,12 @@ import json
 import os
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from .mechanism import load
-from .viewer import viewer_data
-
-if TYPE_CHECKING:
-    from .mechanism import Mechanism
-    from .result import SimulationResult
+from .mechanism import Mechanism, load
+from .model_text import model_text
+from .replay import run_data
+from .result import SimulationResult
 
 #: The built page inside the package.
 APP_FILE = "app_build/app.html"
@@ -51,7 +50,10 @@ def app_template() -> str:
             f"the browser app is not in this installation (planardyn/{APP_FILE}): in a checkout of the "
             "repository run ./dev app (or ./dev setup) to build it; a planardyn wheel ships it built"
         )
-    return page.read_text(encoding="utf-8")
+    page_text = page.read_text(encoding="utf-8")
+    if DATA_ELEMENT not in page_text:
+        raise AppNotBuiltError(f"planardyn/{APP_FILE} has no data element: rebuild it with ./dev app")
+    return page_text
 
 
 def model_payload(path: str | os.PathLike[str]) -> dict[str, str]:
@@ -62,33 +64,58 @@ def model_payload(path: str | os.PathLike[str]) -> dict[str, str]:
     return {"text": p.read_text(encoding="utf-8"), "format": fmt, "source": p.name}
 
 
-def app_html(model: dict[str, str] | None = None, run: dict[str, Any] | None = None) -> str:
-    """The page with ``model`` (:func:`model_payload`) and ``run`` (:func:`planardyn.viewer.viewer_data`)
-    inline. The JSON is escaped so that no ``</script>`` can end its element."""
+def mechanism_payload(mech: Mechanism) -> dict[str, str]:
+    """A built mechanism as the page takes it: its specification as YAML model text
+    (:func:`planardyn.model_text.model_text`; loading it gives the same mechanism back)."""
+    header = f"{mech.name}: the model as planardyn built it from {mech.source}"
+    return {"text": model_text(mech.to_dict(), header), "format": "yaml", "source": Path(mech.source).name}
+
+
+def page_data(model: dict[str, str] | None = None, run: dict[str, Any] | None = None) -> str:
+    """The JSON of the page's data element: ``model`` (:func:`model_payload`) and ``run``
+    (:func:`planardyn.replay.run_data`), every ``<`` escaped (``\\u003c``, the same string
+    once parsed) so that nothing in it can end the element."""
     data: dict[str, Any] = {}
     if model is not None:
         data["model"] = model
     if run is not None:
         data["run"] = run
-    text = json.dumps(data, allow_nan=False).replace("</", "<\\/")
-    page = app_template()
-    if DATA_ELEMENT not in page:
-        raise AppNotBuiltError(f"planardyn/{APP_FILE} has no data element: rebuild it with ./dev app")
-    return page.replace(DATA_ELEMENT, DATA_ELEMENT.replace("{}", text), 1)
+    return json.dumps(data, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c")
+
+
+def app_html(model: dict[str, str] | None = None, run: dict[str, Any] | None = None) -> str:
+    """The page with ``model`` and ``run`` inline (:func:`page_data`)."""
+    return app_template().replace(DATA_ELEMENT, DATA_ELEMENT.replace("{}", page_data(model, run)), 1)
+
+
+def payloads(
+    model: str | os.PathLike[str] | Mechanism,
+    result: SimulationResult | None = None,
+    mechanism: Mechanism | None = None,
+    **run_kw: Any,
+) -> tuple[dict[str, str], dict[str, Any] | None]:
+    """(model, run) for the page: ``model`` a model file (its text as written) or a built
+    mechanism; the run of ``result`` (``run_kw`` go to :func:`planardyn.replay.run_data`).
+    A model file is loaded first (unless ``mechanism`` is it, built), so a model that does not
+    build raises here (:class:`~planardyn.ModelError`) rather than in the page."""
+    if isinstance(model, Mechanism):
+        mech, payload = model, mechanism_payload(model)
+    else:
+        mech, payload = (mechanism if mechanism is not None else load(model)), model_payload(model)
+    return payload, None if result is None else run_data(mech, result, **run_kw)
 
 
 def write_app(
     path: str | os.PathLike[str],
-    model: str | os.PathLike[str],
+    model: str | os.PathLike[str] | Mechanism,
     result: SimulationResult | None = None,
     mechanism: Mechanism | None = None,
+    **run_kw: Any,
 ) -> Path:
-    """Write the app for the model file ``model`` to ``path`` (.html); with ``result`` (a run of
-    that model), the run too, ready to play. The model is loaded first, so a model that does
-    not build raises here (:class:`~planardyn.ModelError`) rather than in the page.
-    Returns the path written."""
-    mech = mechanism if mechanism is not None else load(model)
-    run = None if result is None else viewer_data(mech, result)
+    """Write the app for ``model`` (a model file, or a built :class:`~planardyn.Mechanism`) to
+    ``path`` (.html); with ``result`` (a run of that model), the run too, ready to play
+    (``run_kw``: ``channels``, ``traces``, ``max_frames``, ``title`` of
+    :func:`planardyn.replay.run_data`). Returns the path written."""
     out = Path(path)
-    out.write_text(app_html(model_payload(model), run), encoding="utf-8")
+    out.write_text(app_html(*payloads(model, result, mechanism, **run_kw)), encoding="utf-8")
     return out

@@ -322,10 +322,11 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     pl.add_argument("--dpi", type=number(*DPI_RANGE), default=120,
                     help=f"resolution of raster images, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} (default 120)")
 
-    a = _sub(sub, "animate", "animate a result: GIF, MP4 or an interactive HTML viewer",
+    a = _sub(sub, "animate", "animate a result: GIF, MP4 or the browser app with the run loaded",
              "Animate the mechanism along a results file. .gif and .mp4 are videos (MP4 needs\n"
-             "imageio-ffmpeg); .html is a self-contained viewer (play, pause, speed, time slider,\n"
-             "point paths, linked plots) that works offline in any browser.",
+             "imageio-ffmpeg); .html is the browser app (as planardyn app --results writes it) with\n"
+             "the run ready to play, scrub and chart, and the model to drag, edit and simulate: one\n"
+             "offline file for any browser.",
              "  planardyn animate five-bar.csv -o five-bar.gif       # the model from the file\n"
              "  planardyn animate five-bar five-bar.csv -o five-bar.html\n"
              "  planardyn animate five-bar.npz -o five-bar.mp4 --fps 30 --speed 0.5")
@@ -337,13 +338,13 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
                    help=f"frames per second of playback, up to {MAX_FPS:g} (default 20)")
     a.add_argument("--speed", type=number(1e-12, 1e12), help="simulated seconds per second of playback (default: the run lasts 3-10 s)")
     a.add_argument("--trace", action="append", metavar="POINT", help="trace this point's path (repeat; default: the loop's moving joints)")
-    a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel plotted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
+    a.add_argument("--channel", action="append", metavar="NAME", help="HTML: channel charted at first (repeat; e.g. theta1, tau_theta1, kinetic)")
 
     d = _sub(sub, "demo", "show what planardyn does: a robot's path, torques, sizing, singularities; a mechanism moving",
              "Write, into one folder and in seconds, from the shipped models: the 5R robot tracing a\n"
              "circle with its drive torques, actuator sizing report and singularity map; a passive\n"
              "mechanism (a four-bar under gravity) simulated, plotted and animated; and both in the\n"
-             "interactive viewer (HTML, open it in a browser). One line per file says what it is.",
+             "browser app (HTML, open it in a browser). One line per file says what it is.",
              "  planardyn demo\n"
              "  planardyn demo --out /tmp/demo --model slider-crank")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
@@ -723,7 +724,7 @@ def _animate(args: argparse.Namespace) -> int:
         mech = from_result(res)
     kw = {"channels": args.channel} if args.output.suffix.lower() in (".html", ".htm") else {}
     if args.channel and not kw:
-        raise UsageError("--channel is for the HTML viewer only")
+        raise UsageError("--channel is for the HTML app only")
     bar: ProgressBar | None = None
     if not kw and sys.stderr.isatty():  # GIF and MP4 take seconds: a bar over the frames, made at the first
         def frames(done: int, total: int) -> None:

@@ -5,9 +5,9 @@ Two shipped models, nothing from the repository:
 - the 5R robot (``five-bar``) with 0.5 kg at its end effector P tracing a circle: inverse
   kinematics and dynamics along the path, the drive torques, the actuator sizing report, its
   singularity map, and a forward simulation under those torques (the check that they produce
-  the motion) in the HTML viewer;
+  the motion) in the browser app;
 - a passive mechanism (``four-bar-gravity``: the crank swings from +60 deg to about -233 deg
-  under gravity) simulated, plotted, animated (GIF) and in the viewer.
+  under gravity) simulated, plotted, animated (GIF) and in the browser app.
 
     from planardyn.demo import run
     demo = run("out/demo", echo=print)    # one line per file: its path, what it is
@@ -67,7 +67,7 @@ def _save(fig: Figure, path: Path) -> Path:
 
 
 def robot_outputs(out: Path) -> tuple[Written, bool]:
-    """The 5R robot on its circle: motion, sizing, singularity map, viewer; and whether the
+    """The 5R robot on its circle: motion, sizing, singularity map, the app; and whether the
     open-loop check ran to its end."""
     ee = robot.EndEffector(load_example(ROBOT_MODEL), ROBOT_POINT)
     path = robot.circle(center=ee.home() + [0.0, RADIUS], radius=RADIUS, duration=DURATION)
@@ -100,13 +100,13 @@ def robot_outputs(out: Path) -> tuple[Written, bool]:
     err = float(np.abs(motion.task_of(res.q) - motion.X).max())
     animate(motion.mech, res, out / "robot.html", traces=[ROBOT_POINT])
     written.append((out / "robot.html",
-                    f"viewer: the robot driven by those torques alone (open loop) retraces the circle to {err:.1g} m; "
+                    f"the browser app: the robot driven by those torques alone (open loop) retraces the circle to {err:.1g} m; "
                     "open it in a browser"))
     return written, res.success
 
 
 def passive_outputs(out: Path, model: str | os.PathLike[str] | None = None) -> tuple[Written, bool]:
-    """A passive mechanism moving under its loads: results, plots, snapshots, GIF, viewer;
+    """A passive mechanism moving under its loads: results, plots, snapshots, GIF, the app;
     and whether its simulation reached its end time."""
     mech = load_example(PASSIVE_MODEL) if model is None else load(model)
     settings = simulate_settings(mech, t_end=PASSIVE_T_END if model is None else None, output_dt=OUTPUT_DT)
@@ -133,7 +133,7 @@ def passive_outputs(out: Path, model: str | os.PathLike[str] | None = None) -> t
     animate(mech, res, out / "passive.gif")
     written.append((out / "passive.gif", "its animation (GIF)"))
     animate(mech, res, out / "passive.html")
-    written.append((out / "passive.html", "viewer: play, pause, slider, point paths, linked plots; open it in a browser"))
+    written.append((out / "passive.html", "the browser app with the run: play, scrub, chart, or drag and edit the model; open it in a browser"))
     return written, res.success
 
 

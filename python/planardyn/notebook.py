@@ -1,6 +1,12 @@
-"""Rich display in Jupyter: a mechanism shows itself as an inline SVG drawing with a summary,
-a result as a summary table (with a drawing of its last configuration when it knows its
-model), and :func:`viewer` embeds the interactive HTML viewer.
+"""Rich display in Jupyter: a mechanism shows itself as the browser app (:mod:`planardyn.app`:
+drag, edit, simulate) above a summary table, a result as the app with its run loaded (when it
+knows its model) above its summary; :func:`app_view` shows either where a cell ends.
+
+The app's engine (about 1.35 MB, gzipped) is embedded once per notebook session: the first app
+shown defines it in the notebook's page (``window.planardynApp``, a promise of the app's page),
+and every app, that one included, is an iframe whose page is written from it with its own
+model and run (a few kB to a few hundred kB). Where scripts do not run (a notebook rendered on
+a web site, an untrusted notebook), the summary's SVG drawing stays in the app's place.
 
 Everything here returns HTML strings; nothing needs IPython. :func:`register_display` hands
 :func:`mechanism_html`, :func:`result_html` and :func:`point_motion_html` to IPython's HTML
@@ -12,18 +18,22 @@ of the rows they give, and their ``__repr__`` one line, never an array's content
 
 from __future__ import annotations
 
+import base64
+import gzip
 import html
+import json
 import math
 import sys
+import uuid
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .app import DATA_ELEMENT, AppNotBuiltError, app_html, app_template, page_data, payloads
 from .mechanism import Mechanism, from_result
 from .plot import default_trace_points, pivot_points
 from .result import PointMotion, SimulationResult
-from .viewer import viewer_html
 
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
 
@@ -122,8 +132,9 @@ def _grubler(mech: Mechanism) -> str:
     return f"{form} = {3 * mech.n_bodies - rows}"
 
 
-def mechanism_html(mech: Mechanism) -> str:
-    """The mechanism's notebook view: the drawing (SVG) beside a summary table."""
+def mechanism_summary(mech: Mechanism) -> str:
+    """The mechanism's summary: the drawing (SVG) beside a table of its bodies, pairs, mobility,
+    coordinates, mass and gravity."""
     coords = ", ".join(
         f"{html.escape(n)} = {v:.6g} {u}" for n, v, u in zip(mech.coordinate_names, mech.drawn_q, mech.coordinate_units)
     )
@@ -146,10 +157,10 @@ def mechanism_html(mech: Mechanism) -> str:
     )
 
 
-def result_html(result: SimulationResult) -> str:
-    """The result's notebook view: status, span, counters and the range of every coordinate
-    and drive effort; with the drawing of the last configuration and the point paths when
-    the result knows its model (``result.metadata['model']``)."""
+def result_summary(result: SimulationResult) -> str:
+    """The result's summary: status, span, counters and the range of every coordinate and
+    drive effort; with the drawing of the last configuration and the point paths when the
+    result knows its model (``result.metadata['model']``)."""
     n = len(result.t)
     st = result.stats
     ok = "#1a7f37" if result.success else "#cf222e"
@@ -232,31 +243,115 @@ def point_motion_html(motion: PointMotion) -> str:
     return f"<div><b>PointMotion</b>{_table(rows)}</div>"
 
 
-class Viewer:
-    """The interactive viewer in a notebook cell (an iframe whose page is inline)."""
+#: The app's height in a notebook (px): the drawing, its sliders and the charts in one view.
+APP_HEIGHT = 640
+#: Whether this session's notebook page holds the engine (the first app shown defines it).
+_engine_shown = False
+#: Defines ``window.planardynApp`` in the notebook's page: a promise of the app's page, which
+#: ships gzipped and base64-encoded (2.8 MB -> about 1.35 MB; the browser's DecompressionStream
+#: inflates it), and tells the apps waiting for it.
+ENGINE_SCRIPT = (
+    '<script>window.planardynApp=(async()=>{{const b=atob("{b64}"),u=new Uint8Array(b.length);'
+    "for(let i=0;i<b.length;i++)u[i]=b.charCodeAt(i);"
+    'return await new Response(new Blob([u]).stream().pipeThrough(new DecompressionStream("gzip"))).text()}})();'
+    'window.dispatchEvent(new Event("planardyn-app"));</script>'
+)
+#: Mounts one app: an iframe (scripts and downloads allowed, nothing else of the notebook's
+#: page reachable) whose page is the engine's with this display's data; the summary's drawing
+#: goes, its table stays. Without the engine after 10 s, a note says how to get it.
+MOUNT_SCRIPT = (
+    '<script>(()=>{{const id="{id}",root=document.getElementById(id),data=document.getElementById(id+"-data").textContent;'
+    "const mount=(page)=>{{const f=document.createElement(\"iframe\");"
+    'f.setAttribute("sandbox","allow-scripts allow-downloads");f.title="planardyn app";'
+    'f.style.cssText="width:100%;height:{height}px;border:1px solid #dde";'
+    "f.srcdoc=page.replace({empty},()=>{empty}.replace(\"{{}}\",data));root.prepend(f);"
+    'const s=root.querySelector(".planardyn-summary svg");if(s)s.remove()}};'
+    "const go=()=>window.planardynApp.then(mount);"
+    'if(window.planardynApp)go();else{{window.addEventListener("planardyn-app",go,{{once:true}});'
+    'setTimeout(()=>{{if(!window.planardynApp)root.querySelector(".planardyn-note").hidden=false}},10000)}}}})();</script>'
+)
+NO_ENGINE = (
+    '<p class="planardyn-note" hidden>The app\'s engine is not in this page: the first planardyn app of '
+    "the session holds it. Show <code>planardyn.notebook.engine()</code> in a cell, then run this one again.</p>"
+)
 
-    def __init__(self, page: str, height: int = 640) -> None:
-        self.page, self.height = page, height
+
+class Html:
+    """HTML for a notebook cell: shown by Jupyter (``_repr_html_``)."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
 
     def _repr_html_(self) -> str:
-        return (
-            f'<iframe srcdoc="{html.escape(self.page, quote=True)}" '
-            f'style="width:100%;height:{self.height}px;border:0" sandbox="allow-scripts"></iframe>'
-        )
+        return self.text
+
+
+def engine() -> Html:
+    """The app's engine for the notebook's page, as a cell's output: every app shown after it
+    in this session uses it (needed only when the output that held it was cleared)."""
+    global _engine_shown
+    _engine_shown = True
+    page = gzip.compress(app_template().encode("utf-8"), mtime=0)
+    return Html(ENGINE_SCRIPT.format(b64=base64.b64encode(page).decode("ascii")))
+
+
+def _app(summary: str, model: dict[str, str], run: dict[str, Any] | None, height: int) -> str:
+    """An app above ``summary``, with the engine before it if the page has none yet; the
+    summary alone when this installation has no built app."""
+    try:
+        first = "" if _engine_shown else engine().text
+    except AppNotBuiltError:
+        return summary
+    id_ = f"planardyn-{uuid.uuid4().hex[:12]}"
+    return (
+        f'<div id="{id_}"><div class="planardyn-summary">{summary}</div>{NO_ENGINE}</div>{first}'
+        f'<script type="application/json" id="{id_}-data">{page_data(model, run)}</script>'
+        + MOUNT_SCRIPT.format(id=id_, height=height, empty=_js_string(DATA_ELEMENT))
+    )
+
+
+class AppView:
+    """The app with a model (and a run) in a notebook cell, made when shown (the first shown
+    carries the engine); :meth:`save` writes it as one offline page (as ``planardyn app`` does)."""
+
+    def __init__(self, summary: str, model: dict[str, str], run: dict[str, Any] | None, height: int) -> None:
+        self.model, self.run, self.height, self.summary = model, run, height, summary
+
+    def _repr_html_(self) -> str:
+        return _app(self.summary, self.model, self.run, self.height)
 
     def save(self, path: Any) -> None:
-        """Write the page to a file."""
+        """Write the app as one HTML file."""
         with open(path, "w", encoding="utf-8") as f:
-            f.write(self.page)
+            f.write(app_html(self.model, self.run))
 
 
-def viewer(mech: Mechanism | None, result: SimulationResult, height: int = 640, **kw: Any) -> Viewer:
-    """The HTML viewer for a notebook cell: ``planardyn.notebook.viewer(mech, res)`` as the
-    cell's last line. ``mech`` None: the result's own model. ``kw`` go to
-    :func:`planardyn.viewer.viewer_html`."""
-    if mech is None:
-        mech = from_result(result)
-    return Viewer(viewer_html(mech, result, **kw), height)
+def app_view(model: Mechanism | SimulationResult, result: SimulationResult | None = None, *,
+             height: int = APP_HEIGHT, **run_kw: Any) -> AppView:
+    """The app in a notebook cell (its last line): ``app_view(mech)``, ``app_view(mech, res)``,
+    or ``app_view(res)`` for a result that carries its model. ``run_kw`` go to
+    :func:`planardyn.replay.run_data` (``channels``, ``traces``, ``max_frames``, ``title``)."""
+    mech, run = (from_result(model), model) if isinstance(model, SimulationResult) else (model, result)
+    summary = mechanism_summary(mech) if run is None else result_summary(run)
+    return AppView(summary, *payloads(mech, run, **run_kw), height)
+
+
+def mechanism_html(mech: Mechanism) -> str:
+    """The mechanism's notebook view: the app above its summary (:func:`mechanism_summary`)."""
+    return app_view(mech)._repr_html_()
+
+
+def result_html(result: SimulationResult) -> str:
+    """The result's notebook view: the app with the run above its summary when the result
+    carries its model (:func:`result_summary`), else the summary."""
+    if not (len(result.t) and result.metadata.get("model")):
+        return result_summary(result)
+    return app_view(result)._repr_html_()
+
+
+def _js_string(text: str) -> str:
+    """``text`` as a JavaScript string literal safe inside a script element."""
+    return json.dumps(text).replace("<", "\\u003c")
 
 
 def register_display(shell: Any = None) -> bool:

@@ -1,11 +1,11 @@
-"""How fast a result plays back, shared by the animations and the HTML viewer."""
+"""How fast a result plays back, shared by the animations and the browser app's runs (planardyn.replay)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 #: Shortest and longest playback (s) of the default speed: a short run is not over before it
-#: is seen, a long one does not keep the viewer waiting.
+#: is seen, a long one does not keep the user waiting.
 MIN_PLAYBACK, MAX_PLAYBACK = 3.0, 10.0
 
 

@@ -7,6 +7,7 @@ import { dragTowards } from "./drag.js";
 import { coordinateRange } from "./map.js";
 import { groundIndices, moveTo, showState } from "./view.js";
 import { setMode } from "./timeline.js";
+import { listModes } from "./modes.js";
 
 /** States of a sweep of one coordinate (the quasi-static charts and the point paths). */
 const SWEEP_STEPS = 180;
@@ -82,6 +83,7 @@ export function sweep() {
   const name = app.info.coordinateNames[k];
   app.sweepX = series.q.filter((_, i) => i % app.info.dof === k);
   app.charts.set(app.sweepX, `${name} (${unitOf(app.info, k, "q")}), at rest`, chans, defaultChannels(chans));
+  listModes();
 }
 
 /** The force (N) drawn ARROW_FRACTION of L long: the upper quartile of the states' largest
@@ -97,35 +99,44 @@ export function arrowScale(reactions, p) {
   return big[Math.floor(0.75 * (n - 1))] || 0;
 }
 
+/** The pointer of event `e` in world coordinates (m) on the drawing: [x, y]. */
+export function pointerWorld(e) {
+  const r = $("drawing").getBoundingClientRect();
+  const tr = transform(app.bounds, r.width, r.height);
+  return [tr.wx(e.clientX - r.left), tr.wy(e.clientY - r.top)];
+}
+
+/** The carried point (its index) drawn within GRAB_PX of the pointer, nearest first; ground
+ * points only when `ground`. Null if none. */
+export function nearestPoint(e, ground = false) {
+  const r = $("drawing").getBoundingClientRect();
+  const tr = transform(app.bounds, r.width, r.height);
+  const fixed = new Set(ground ? [] : groundIndices());
+  let best = null;
+  app.info.points.forEach((_, i) => {
+    if (fixed.has(i)) return;
+    const d = Math.hypot(tr.px(app.ev.points[2 * i]) - (e.clientX - r.left), tr.py(app.ev.points[2 * i + 1]) - (e.clientY - r.top));
+    if (d < GRAB_PX && (!best || d < best.d)) best = { i, d };
+  });
+  return best ? best.i : null;
+}
+
 export function installDrag() {
   const c = $("drawing");
   let grabbed = null;
-  const world = (e) => {
-    const r = c.getBoundingClientRect();
-    const tr = transform(app.bounds, r.width, r.height);
-    return [tr.wx(e.clientX - r.left), tr.wy(e.clientY - r.top), tr];
-  };
   c.addEventListener("pointerdown", (e) => {
-    if (app.mode === "replay") return;
+    // Shift + drag edits the model's drawing (edit_drag.js).
+    if (app.mode === "replay" || e.shiftKey) return;
     if (app.mode === "run") setMode("design");
-    const [, , tr] = world(e);
-    const r = c.getBoundingClientRect();
-    const ground = new Set(groundIndices());
-    let best = null;
-    app.info.points.forEach((_, i) => {
-      if (ground.has(i)) return;
-      const d = Math.hypot(tr.px(app.ev.points[2 * i]) - (e.clientX - r.left), tr.py(app.ev.points[2 * i + 1]) - (e.clientY - r.top));
-      if (d < GRAB_PX && (!best || d < best.d)) best = { i, d };
-    });
-    if (!best) return;
-    grabbed = best.i;
+    grabbed = nearestPoint(e);
+    if (grabbed === null) return;
     c.setPointerCapture(e.pointerId);
     c.classList.add("dragging");
     document.body.dataset.grabbed = app.info.points[grabbed];
   });
   c.addEventListener("pointermove", (e) => {
     if (grabbed === null) return;
-    const [wx, wy] = world(e);
+    const [wx, wy] = pointerWorld(e);
     const next = dragTowards(app.mech, app.info, app.q, app.x, grabbed, [wx, wy]);
     if (next && moveTo(next.q, next.x)) status(statusLine());
     showState();

@@ -7,17 +7,21 @@
 // The parts, each a module: state.js (the state and small helpers), view.js (the current
 // state drawn and listed), timeline.js (modes, frames, playing), design.js (sliders, drag,
 // sweep), run.js (runs here and Python's), model.js (the model from text, the editor),
-// map_tab.js (the singularity map's tab), files.js (open, drop, export).
+// map_tab.js (the map tab: singularity or first frequency), modes.js (natural modes, shown
+// animated), edit_drag.js (Shift + drag: a point of the model's drawing moved), files.js
+// (open, drop, export).
 import { $, app, status } from "./state.js";
 import { engine } from "./engine.js";
 import { Charts } from "./charts.js";
-import { mapRanges, mapper } from "./map.js";
+import { frequencyRows, mapRanges, mapper, sigmaRows, stiffnessRows } from "./map.js";
 import { drawingSvg, moveTo, showState } from "./view.js";
 import { play, setFrame } from "./timeline.js";
 import { installDrag, sweep } from "./design.js";
+import { installEditDrag } from "./edit_drag.js";
 import { backToDesign, showReplay, simulate } from "./run.js";
 import { installEditor, setModel } from "./model.js";
 import { startMap } from "./map_tab.js";
+import { listModes, showMode } from "./modes.js";
 import { installFiles } from "./files.js";
 
 window.planardyn = app;
@@ -37,6 +41,7 @@ function start() {
     } else setFrame(i);
   });
   installDrag();
+  installEditDrag();
   installFiles();
   installEditor();
   $("simulate").onclick = simulate;
@@ -44,7 +49,7 @@ function start() {
   $("design").onclick = backToDesign;
   $("scrub").addEventListener("input", () => { play(false); setFrame(+$("scrub").value); });
   window.addEventListener("resize", () => { if (app.info || app.replay) { app.charts.render(); showState(); } });
-  Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper } });
+  Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper, sigmaRows, frequencyRows, stiffnessRows }, listModes, showMode });
   const data = JSON.parse($("planardyn-data").textContent);
   if (data.model) setModel(data.model.text, data.model.format, data.model.source);
   if (data.run) showReplay(data.run);

@@ -7,9 +7,12 @@ import { setMode } from "./timeline.js";
 import { buildSliders, sweep } from "./design.js";
 import { buildRunModes } from "./run.js";
 import { startMap } from "./map_tab.js";
+import { listModes } from "./modes.js";
 
-/** Build the model from text; on an error, show it in place and keep the last model. */
-export function setModel(text, format, source, { fromEditor = false } = {}) {
+/** Build the model from text; on an error, show it in place and keep the last model. The
+ * model is shown at its initial state (q0, else as drawn), at the last state when only its
+ * numbers were edited (`fromEditor`), or as drawn (`drawn`: its drawing is being edited). */
+export function setModel(text, format, source, { fromEditor = false, drawn = false } = {}) {
   let mech;
   try {
     mech = app.pd.load(text, format, source);
@@ -23,7 +26,7 @@ export function setModel(text, format, source, { fromEditor = false } = {}) {
   Object.assign(app, { mech, info: mech.info(), text, format, source, x: null, run: null, replay: null, mode: "design" });
   if (!fromEditor) $("editor").value = text;
   $("title").textContent = app.info.name;
-  const starts = keep ? [app.q, app.info.q0, app.info.drawnQ] : [app.info.q0, app.info.drawnQ];
+  const starts = drawn ? [app.info.drawnQ] : keep ? [app.q, app.info.q0, app.info.drawnQ] : [app.info.q0, app.info.drawnQ];
   if (!starts.some((q) => moveTo(Float64Array.from(q), null))) {
     status("the model does not assemble at q0 nor as drawn", true);
     return false;
@@ -82,5 +85,8 @@ export function installEditor() {
     b.classList.add("on");
     $(`tab-${b.dataset.tab}`).classList.add("on");
     if (b.dataset.tab === "map") startMap();
+    if (b.dataset.tab === "modes") listModes();
   }));
+  $("map-kind").addEventListener("change", startMap);
+  $("map-point").addEventListener("change", startMap);
 }

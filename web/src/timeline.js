@@ -1,7 +1,7 @@
 // The page's modes (design: dragging; run: a run made here; replay: a Python run) and the
 // timeline of the timed ones: the scrubber, the frame shown, playing.
 import { $, app } from "./state.js";
-import { runState, showState } from "./view.js";
+import { runState, showState, stopMode } from "./view.js";
 
 /** Show frame i of the run (or of a loaded Python run). */
 export function setFrame(i) {
@@ -20,6 +20,7 @@ export function setFrame(i) {
 }
 
 export function setMode(mode) {
+  stopMode();
   app.mode = mode;
   const timed = mode !== "design";
   const src = mode === "replay" ? app.replay : app.run;

@@ -9,6 +9,7 @@ import { replayScene } from "./replay.js";
 /** Evaluate at q (continuing from app.x); near a type II singularity, where the dynamics is
  * not defined, the positions and measures alone. False if q does not assemble. */
 export function moveTo(q, xStart = app.x) {
+  stopMode();
   const z = zeros();
   try {
     app.ev = app.mech.evaluate(q, z, z, xStart ?? undefined);
@@ -37,13 +38,21 @@ function arrowsOf(reactions, x) {
   return { ref: app.arrowRef, items };
 }
 
-/** The scene of the current state (design) or frame (run). */
+/** Stop showing a natural mode (modes.js): the drawing is the state's again. */
+export function stopMode() {
+  app.modeAnim = null;
+  app.modeX = null;
+  delete document.body.dataset.modeShown;
+}
+
+/** The scene of the current state (design), displaced along a natural mode while one is
+ * shown, or of a run's frame. */
 function scene() {
   if (app.mode === "replay") return replayScene(app.replay, app.frame);
-  const x = app.ev.x;
+  const x = app.modeX ?? app.ev.x;
   return {
-    points: app.ev.points, bodies: bodyIndices(), ground: groundIndices(),
-    geometry: app.mech.pairGeometry(x), arrows: arrowsOf(app.ev.reactions, x),
+    points: app.modeX ? app.mech.points(x) : app.ev.points, bodies: bodyIndices(), ground: groundIndices(),
+    geometry: app.mech.pairGeometry(x), arrows: app.modeX ? null : arrowsOf(app.ev.reactions, x),
     paths: app.mode === "design" ? app.paths : [], scale: app.info.scale,
   };
 }
@@ -51,7 +60,8 @@ function scene() {
 const bodyIndices = () => app.info.bodies.map((b) => b.map((n) => app.info.points.indexOf(n)).filter((i) => i >= 0));
 export const groundIndices = () => app.info.groundPoints.map((n) => app.info.points.indexOf(n)).filter((i) => i >= 0);
 
-function draw() {
+/** Draw the scene on the canvas. */
+export function redraw() {
   const c = $("drawing");
   const dpr = window.devicePixelRatio || 1;
   const [w, h] = [c.clientWidth, c.clientHeight];
@@ -71,7 +81,7 @@ export function drawingSvg() {
 }
 
 export function showState() {
-  draw();
+  redraw();
   renderValues();
   const k = app.active;
   if (app.mode === "design") app.charts.mark(app.q[k]);

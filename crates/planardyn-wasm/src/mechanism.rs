@@ -10,9 +10,10 @@ use crate::errors::{argument_error, js};
 use crate::simulate::{run, SimulateOptions};
 use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::dynamics::{self, carried_points, Rows};
+use planardyn::elastic;
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
-use planardyn::model::PairId;
+use planardyn::model::{BodyId, Link, PairId, PointId};
 use planardyn::Mechanism;
 use wasm_bindgen::prelude::*;
 
@@ -60,7 +61,7 @@ impl WasmMechanism {
     pub fn info(&self) -> JsValue {
         let m = &self.inner;
         let (q0, qd0) = m.initial_state();
-        let point = |p: planardyn::model::PointId| m.points[p.0].0.as_str();
+        let point = |p: PointId| m.points[p.0].0.as_str();
         let bodies = m.bodies.iter().map(|b| strings(b.points.iter().map(|(p, _)| point(*p))).into());
         let pair_list = m.pairs.iter().enumerate().map(|(k, p)| {
             let rows = m.pair_rows(PairId(k));
@@ -101,6 +102,7 @@ impl WasmMechanism {
             .f64s("masses", &m.bodies.iter().map(|b| b.mass).collect::<Vec<_>>())
             .f64s("gravity", &m.gravity)
             .set("scale", m.scale)
+            .set("compliant", !m.compliance.is_empty())
             .set("simulate", defaults.build())
             .build()
     }
@@ -204,6 +206,55 @@ impl WasmMechanism {
         let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
         let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
         Ok(Obj::new().f64s("sigma", &out.sigma).f64s("x", &out.x).build())
+    }
+
+    /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
+    /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
+    /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
+    /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
+    /// increasing frequency. A model without a `compliance:` section throws an ArgumentError.
+    pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
+        self.start_args(q, x_start.as_deref())?;
+        let mut ws = js(query::assembled(&self.inner, q, x_start.as_deref()))?;
+        let modes = js(elastic::modes(&self.inner, q, free_rotors, &mut ws))?;
+        Ok(Obj::new()
+            .f64s("omega", &modes.omega())
+            .f64s("omega2", &modes.omega2)
+            .f64s("dampingRatio", &modes.damping_ratio)
+            .f64s("shapes", &modes.shapes.concat())
+            .f64s("x", &ws.x)
+            .build())
+    }
+
+    /// The stiffness of the point `point` (on the first body that carries it) at
+    /// coordinates q (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`
+    /// unloaded): `{weakest (N/m: the translational stiffness in its weakest direction), direction
+    /// ([d_x, d_y], unit), compliance (3 x 3 of [x, y, phi]; m/N, m/(N m), rad/N, rad/(N m)),
+    /// x (3n: the pose)}`. A model without a `compliance:` section throws an ArgumentError.
+    pub fn stiffness(&self, q: &[f64], point: &str, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
+        self.start_args(q, x_start.as_deref())?;
+        let m = &self.inner;
+        let on_body = |id: PointId| (0..m.n_bodies()).map(BodyId).find(|&b| m.attachment(Link::Body(b), id).is_some());
+        let Some((id, body)) = m.point_id(point).and_then(|id| on_body(id).map(|b| (id, b))) else {
+            let names: Vec<&str> = (0..m.points.len())
+                .filter(|&p| on_body(PointId(p)).is_some())
+                .map(|p| m.points[p].0.as_str())
+                .collect();
+            return Err(argument_error(
+                Some("point"),
+                format!("no body carries a point '{point}'; the bodies' points are: {}", names.join(", ")),
+            ));
+        };
+        let mut ws = js(query::assembled(m, q, x_start.as_deref()))?;
+        let out = elastic::Output { body, point: Some(id) };
+        let c = js(elastic::stiffness(m, q, out, &elastic::Load::default(), &mut ws))?;
+        let w = elastic::weakest_direction(&c, None);
+        Ok(Obj::new()
+            .set("weakest", w.stiffness)
+            .f64s("direction", &w.direction[..2])
+            .f64s("compliance", c.compliance.as_flattened())
+            .f64s("x", &ws.x)
+            .build())
     }
 
     /// Drive efforts tau (m; N m or N) for (q, qd, qdd).

@@ -1,23 +1,14 @@
-"""A self-contained HTML viewer of a result: the mechanism animated on a canvas (play, pause,
-speed, a time slider, the point paths) and linked plots of chosen channels (a cursor follows
-the time; clicking a plot goes to that time).
-
-One file, no network: the page's JavaScript is hand-written and inline
-(``viewer_template.html`` next to this module) and the data is inline JSON. It works offline
-in any current browser. The page reports its state for tests and scripts: ``<body
-data-frame="K" data-drawn="N" data-ready="1">`` and ``document.title`` ending in
-``frame K/N-1``; an uncaught error sets ``data-error``. The address may set the start:
-``viewer.html#t=0.75&paused&speed=0.25``.
+"""A run computed in Python as the browser app plays it (:mod:`planardyn.app`): per frame the
+carried points' positions and each pair's drawing, and every channel a user may plot
+(coordinates, rates, accelerations, efforts, energies, the singularity measure, pair forces,
+points' speeds and accelerations) with its unit, rounded to ``DIGITS`` significant digits so
+that the page stays small. The page plays it without its engine (web/src/replay.js); the same
+JSON opened or dropped on the app plays too.
 """
 
 from __future__ import annotations
 
-import html
-import json
 import math
-import os
-from importlib import resources
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -136,7 +127,7 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
     return groups, chans
 
 
-def viewer_data(
+def run_data(
     mech: Mechanism,
     result: SimulationResult,
     *,
@@ -145,7 +136,26 @@ def viewer_data(
     max_frames: int = MAX_FRAMES,
     title: str | None = None,
 ) -> dict[str, Any]:
-    """The JSON-ready data of the page (see :func:`viewer_html` for the arguments)."""
+    """The JSON-ready data of the run for the app.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The model the result was computed with.
+    result : SimulationResult
+        The trajectory (``result.x`` gives the positions).
+    channels : list of str, optional
+        Channels plotted at first (the page has a checkbox for every one): coordinate names,
+        ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``, ``kinetic``, ``potential``, ``total``,
+        ``work``, ``balance``, ``sigma``, ``F_<pair>``, ``v_<point>``, ``a_<point>``. Default:
+        the coordinates and the drive efforts.
+    traces : list of str, optional
+        Points whose paths are drawn (default :func:`planardyn.plot.default_trace_points`).
+    max_frames : int
+        Outputs kept at most (uniformly subsampled beyond).
+    title : str, optional
+        The run's title (default the model's name).
+    """
     n = len(result.t)
     if n == 0:
         raise ValueError("the result has no output to show")
@@ -192,52 +202,3 @@ def viewer_data(
         "groups": groups,
         "channels": chans,
     }
-
-
-def _template() -> str:
-    return resources.files("planardyn").joinpath("viewer_template.html").read_text(encoding="utf-8")
-
-
-def viewer_html(
-    mech: Mechanism,
-    result: SimulationResult,
-    *,
-    channels: list[str] | None = None,
-    traces: list[str] | None = None,
-    max_frames: int = MAX_FRAMES,
-    title: str | None = None,
-) -> str:
-    """The viewer page as one HTML string.
-
-    Parameters
-    ----------
-    mech : Mechanism
-        The model the result was computed with.
-    result : SimulationResult
-        The trajectory (``result.x`` gives the positions).
-    channels : list of str, optional
-        Channels plotted at first (the page has a checkbox for every one): coordinate names,
-        ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``, ``kinetic``, ``potential``, ``total``,
-        ``work``, ``balance``, ``sigma``. Default: the coordinates and the drive efforts.
-    traces : list of str, optional
-        Points whose paths are drawn (default :func:`planardyn.plot.default_trace_points`).
-    max_frames : int
-        Outputs kept at most (uniformly subsampled beyond).
-    title : str, optional
-        Page title (default the model's name).
-    """
-    data = viewer_data(mech, result, channels=channels, traces=traces, max_frames=max_frames, title=title)
-    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
-    # Inside <script>: no '<' or '&' may end the element early.
-    payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
-    page = _template()
-    page = page.replace("__TITLE__", html.escape(data["title"]))
-    page = page.replace("__VERSION__", html.escape(__version__))
-    return page.replace("__DATA__", payload)
-
-
-def write_viewer(mech: Mechanism, result: SimulationResult, path: str | os.PathLike[str], **kw: Any) -> Path:
-    """Write :func:`viewer_html` to ``path`` (UTF-8). Returns the path."""
-    path = Path(path)
-    path.write_text(viewer_html(mech, result, **kw), encoding="utf-8")
-    return path
