@@ -1,4 +1,4 @@
-"""What planardyn does, in one folder and under 30 s: ``planardyn demo`` and ``./dev demo``.
+"""What planardyn does, in one folder, in about half a minute: ``planardyn demo`` and ``./dev demo``.
 
 Two shipped models, nothing from the repository:
 
