@@ -279,6 +279,31 @@ impl<'m> ElasticModel<'m> {
         (values, g)
     }
 
+    /// The model's gravity as a generalized force on z: m g on each body's centre of mass
+    /// (whose coordinates z holds, so that its potential is linear in z: no curvature of its
+    /// own; its geometric term comes through the forces that carry it). Zero on the nodes
+    /// (massless) and the rotors (turning about their fixed axes).
+    pub fn gravity_force(&self) -> DVector<f64> {
+        let g = self.mech.gravity;
+        let mut f = DVector::zeros(self.n_cols());
+        for (i, b) in self.mech.bodies.iter().enumerate() {
+            f[3 * i] = b.mass * g[0];
+            f[3 * i + 1] = b.mass * g[1];
+        }
+        f
+    }
+
+    /// The columns of the free rotors.
+    pub fn rotor_columns(&self) -> impl Iterator<Item = usize> + '_ {
+        self.elements.iter().flat_map(|e| &e.rows).filter_map(|r| {
+            if let Row::Coordinate { rotor: Some((c, _)), .. } = r {
+                Some(*c)
+            } else {
+                None
+            }
+        })
+    }
+
     /// Strains delta_e and their gradients B_e of every element at z.
     pub fn strains(&self, z: &[f64]) -> Vec<(DVector<f64>, DMatrix<f64>)> {
         self.elements.iter().map(|e| self.rows(&e.rows, z)).collect()

@@ -10,7 +10,7 @@
 //! eigenvalues. The damping ratios are modal, zeta_i = y_i^T D y_i / (2 omega_i) for
 //! mass-normalised y_i (exact for damping proportional to K and M, first order otherwise).
 
-use super::stiffness::{elastic_at, elastic_stiffness, null_basis};
+use super::stiffness::{elastic_at, loaded_stiffness, null_basis, Applied};
 use crate::dynamics::{inverse, inverse_derivatives, mass_matrix};
 use crate::kinematics::assemble_into;
 use crate::model::{CoordinateKind, Mechanism};
@@ -95,13 +95,21 @@ pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) 
 
 /// The natural modes of the compliant mechanism about coordinates q (its rigid pose): with
 /// each elastic drive's rotor held (`free_rotors` false: a stiff position loop) or free (a
-/// torque-driven motor, its rotor inertia n^2 J a coordinate of its own). The model's own
-/// loads (gravity) are left out: the stiffness is the elements'.
-pub fn modes(mech: &Mechanism, q: &[f64], free_rotors: bool, ws: &mut Workspace) -> Result<Modes, KinematicsError> {
+/// torque-driven motor, its rotor inertia n^2 J a coordinate of its own, held by a constant
+/// torque). With `gravity`, the pose is the equilibrium under the model's gravity (the
+/// elements carry it there) and the stiffness holds its geometric term (an inverted pendulum
+/// on a spring k: omega^2 = (k - m g l) / I_O); without, the elements' stiffness alone.
+pub fn modes(
+    mech: &Mechanism,
+    q: &[f64],
+    free_rotors: bool,
+    gravity: bool,
+    ws: &mut Workspace,
+) -> Result<Modes, KinematicsError> {
     let model = elastic_at(mech, q, free_rotors, ws)?;
     let z = model.z0.clone();
     let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
-    let k = elastic_stiffness(&model, &z, &n);
+    let k = loaded_stiffness(&model, &z, Applied::gravity(gravity), &[], &n)?;
     let mass = DMatrix::from_diagonal(&DVector::from_column_slice(&model.mass));
     let m = n.transpose() * mass * &n;
     let mut damping = DMatrix::zeros(n.ncols(), n.ncols());
