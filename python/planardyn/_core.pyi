@@ -40,6 +40,7 @@ __all__ = [
     "small_oscillations",
     "equilibrium",
     "state_space",
+    "compliant_state_space",
     "simulate_flexible",
 ]
 
@@ -108,6 +109,9 @@ def simulate_flexible(
 ) -> dict[str, NDArray[np.float64]]: ...
 def state_space(
     mech: Mechanism, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, points: list[tuple[str, str]] = ...
+) -> dict[str, NDArray[np.float64]]: ...
+def compliant_state_space(
+    mech: Mechanism, q: ArrayLike, points: list[tuple[str, str]] = ..., gravity: bool = False
 ) -> dict[str, NDArray[np.float64]]: ...
 @final
 class Mechanism:

@@ -229,18 +229,44 @@ pub fn state_space<'py>(
         pts.push((out.body, s));
     }
     let ss = run(py, || Ok::<_, Failure>(elastic::linearize(m, &q, &qd, &tau, &pts, &mut Workspace::new(m))?))?;
-    let n = q.len();
+    state_space_dict(py, ss)
+}
+
+fn state_space_dict(py: Python<'_>, ss: elastic::StateSpace) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("A", arr2(py, 2 * n, 2 * n, ss.a)?)?;
-    d.set_item("B", arr2(py, 2 * n, n, ss.b)?)?;
-    d.set_item("C", arr2(py, ss.n_outputs, 2 * n, ss.c)?)?;
-    d.set_item("D", arr2(py, ss.n_outputs, n, ss.d)?)?;
+    d.set_item("A", arr2(py, ss.n_states, ss.n_states, ss.a)?)?;
+    d.set_item("B", arr2(py, ss.n_states, ss.n_inputs, ss.b)?)?;
+    d.set_item("C", arr2(py, ss.n_outputs, ss.n_states, ss.c)?)?;
+    d.set_item("D", arr2(py, ss.n_outputs, ss.n_inputs, ss.d)?)?;
     Ok(d)
+}
+
+/// The linearised state-space model (A, B, C, D) of the compliant mechanism with its rotors
+/// free about q as its equilibrium (under the model's gravity with `gravity`): inputs the
+/// motor torques of the elastic drives with a rotor; outputs the coordinates, then each
+/// (body, point)'s [x, y].
+#[pyfunction]
+#[pyo3(signature = (mech, q, points=Vec::new(), gravity=false))]
+pub fn compliant_state_space<'py>(
+    py: Python<'py>,
+    mech: &PyMechanism,
+    q: ArrayArg<'py>,
+    points: Vec<(String, String)>,
+    gravity: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &*mech.inner;
+    let q = coords(m, "q", &q)?;
+    let outs = points.iter().map(|(b, p)| output(m, b, Some(p))).collect::<PyResult<Vec<_>>>()?;
+    let ss = run(py, || {
+        Ok::<_, Failure>(elastic::linearize_compliant(m, &q, gravity, &outs, &mut Workspace::new(m))?)
+    })?;
+    state_space_dict(py, ss)
 }
 
 /// The flexible-joint simulation (elastic drives' rotors as coordinates of their own) from the
 /// model's start to `t_end` (s), output every `output_dt` (s): `t` (N,), `q`, `qd` (N, m),
-/// `theta`, `thetad` (N, r) the rotors joint side, `energy` (N,) J.
+/// `theta`, `thetad` (N, r) the rotors joint side, `energy`, `work` (the motors'),
+/// `dissipated` (the transmission dampers') (N,) J.
 #[pyfunction]
 #[pyo3(signature = (mech, t_end, output_dt, method="dop853", rtol=1e-9, atol=1e-12))]
 pub fn simulate_flexible<'py>(
@@ -265,6 +291,8 @@ pub fn simulate_flexible<'py>(
     d.set_item("thetad", arr2(py, n, width(&run.thetad), run.thetad.concat())?)?;
     d.set_item("t", arr1(py, run.t))?;
     d.set_item("energy", arr1(py, run.energy))?;
+    d.set_item("work", arr1(py, run.work))?;
+    d.set_item("dissipated", arr1(py, run.dissipated))?;
     Ok(d)
 }
 
@@ -276,5 +304,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(modes, m)?)?;
     m.add_function(wrap_pyfunction!(small_oscillations, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium, m)?)?;
-    m.add_function(wrap_pyfunction!(state_space, m)?)
+    m.add_function(wrap_pyfunction!(state_space, m)?)?;
+    m.add_function(wrap_pyfunction!(compliant_state_space, m)?)
 }

@@ -392,13 +392,20 @@ fn a_rigid_model_is_refused_with_the_fix() {
 /// its rotor (J = 5e-5 kg m^2 behind n = 20) joined to it by a transmission spring k; no
 /// motor torque.
 fn flexible_pendulum(k: f64) -> Mechanism {
+    driven_flexible_pendulum(k, 0.0, 0.0)
+}
+
+/// The same with a damper c (N m s/rad) beside the spring and a constant motor torque t_m
+/// (N m, motor side).
+fn driven_flexible_pendulum(k: f64, c: f64, t_m: f64) -> Mechanism {
     yaml(&format!(
         "name: flexible pendulum\ngravity: [0, -9.81]\npoints: {{O: [0, 0], A: [0.5, 0]}}\nground: [O]\n\
          bodies:\n  bar: {{points: [O, A], uniform_bar: [O, A], mass: 1.2}}\n\
          pairs:\n  - {{type: revolute, name: O, at: O, bodies: [ground, bar]}}\n\
          coordinates:\n  - {{name: q, pair: O, value: 0.0, q0: -1.2}}\n\
          actuators: [{{coordinate: q, gear_ratio: 20, rotor_inertia: 5.0e-5}}]\n\
-         compliance:\n  drives: [{{actuator: q, stiffness: {k}}}]\n"
+         drives: [{{coordinate: q, effort: {t_m}}}]\n\
+         compliance:\n  drives: [{{actuator: q, stiffness: {k}, damping: {c}}}]\n"
     ))
 }
 
@@ -423,6 +430,23 @@ fn flexible_joint_run_conserves_its_energy() {
 }
 
 #[test]
+fn flexible_joint_energy_balance_counts_the_motors_work_and_the_dampers_loss() {
+    // A constant motor torque 0.05 N m (n = 20: 1 N m at the joint) and a transmission damper
+    // 0.5 N m s/rad: E(t) - E(0) = W(t) - D(t) with W and D integrated along the run; dop853 at
+    // rtol 1e-12 over 2 s keeps it to ~1e-11 J; the usual bound of the energy checks is 1e-9 J.
+    // Both terms are far above it (the balance sees them).
+    let options = planardyn::integrate::Options::tol(1e-12, 1e-14);
+    let mech = driven_flexible_pendulum(1.0e3, 0.5, 0.05);
+    let run = elastic::simulate_flexible(&mech, 2.0, 0.01, planardyn::integrate::Method::Dop853, &options).unwrap();
+    let residual = (0..run.t.len())
+        .map(|i| (run.energy[i] - run.energy[0] - run.work[i] + run.dissipated[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(residual < 1e-9, "energy balance {residual:e} J");
+    let (w, d) = (run.work.last().unwrap(), run.dissipated.last().unwrap());
+    assert!(w.abs() > 1e-3 && *d > 1e-6, "work {w} J, loss {d} J");
+}
+
+#[test]
 fn flexible_joint_run_tends_to_the_rigid_one_like_one_over_k() {
     // The rigid model's A holds n^2 J on the coordinate (`dynamics::transmission`); the
     // flexible run differs by the spring's deflection and its fast oscillation, both ~1/k:
@@ -440,4 +464,56 @@ fn flexible_joint_run_tends_to_the_rigid_one_like_one_over_k() {
         .collect();
     assert!(diffs[0] < 1e-1, "{diffs:?}");
     assert!(diffs[1] < diffs[0] / 6.7 && diffs[2] < diffs[1] / 6.7, "{diffs:?}");
+}
+
+/// C (s I - A)^-1 B + D of a state-space model at a real s (outputs x inputs).
+fn transfer(ss: &elastic::StateSpace, s: f64) -> DMatrix<f64> {
+    let (n, nu, p) = (ss.n_states, ss.n_inputs, ss.n_outputs);
+    let a = DMatrix::from_row_slice(n, n, &ss.a);
+    let b = DMatrix::from_row_slice(n, nu, &ss.b);
+    let c = DMatrix::from_row_slice(p, n, &ss.c);
+    let x = (DMatrix::identity(n, n) * s - a).lu().solve(&b).unwrap();
+    c * x + DMatrix::from_row_slice(p, nu, &ss.d)
+}
+
+#[test]
+fn compliant_state_space_is_the_flexible_joint_pendulums() {
+    // Spong's flexible joint linearised about the bar at rest at q under gravity (the motor
+    // holding it): I q'' + V'' q + k (q - th) + c (q' - th') = 0 and
+    // n^2 J th'' + k (th - q) + c (th' - q') = n t_m, V'' = -m g l sin q. Laplace: with
+    // kc = k + c s, q / t_m = n kc / ((I s^2 + kc + V'') (n^2 J s^2 + kc) - kc^2), and the tip A
+    // at L moves by L (-sin q, cos q) dq. The model's transfer function C (sI - A)^-1 B at
+    // s = 0 (the static gain), 3 and 40 1/s must equal it, and its undamped A's eigenvalues be
+    // +-i omega of `modes` (free rotors, gravity). All exact: CLOSED_FORM_TOL.
+    let (m, len, g, n, j) = (1.2_f64, 0.5_f64, 9.81_f64, 20.0_f64, 5.0e-5_f64);
+    let (i, l, nj) = (m * len * len / 3.0, len / 2.0, n * n * j);
+    let (k, c, q) = (1.0e3, 0.3, -1.2_f64);
+    let v2 = -m * g * l * q.sin();
+    let mech = driven_flexible_pendulum(k, c, 0.0);
+    let mut ws = Workspace::new(&mech);
+    let tip = Output { body: BodyId(0), point: mech.point_id("A") };
+    let ss = elastic::linearize_compliant(&mech, &[q], true, &[tip], &mut ws).unwrap();
+    assert_eq!((ss.n_states, ss.n_inputs, ss.n_outputs), (4, 1, 3));
+    for s in [0.0, 3.0, 40.0] {
+        let kc = k + c * s;
+        let gq = n * kc / ((i * s * s + kc + v2) * (nj * s * s + kc) - kc * kc);
+        let tf = transfer(&ss, s);
+        let expected = [gq, -len * q.sin() * gq, len * q.cos() * gq];
+        for (r, e) in expected.iter().enumerate() {
+            assert!((tf[(r, 0)] - e).abs() < CLOSED_FORM_TOL * gq.abs().max(len * gq.abs()), "s {s}: {tf} vs {e}");
+        }
+    }
+    let undamped = flexible_pendulum(k);
+    let ss = elastic::linearize_compliant(&undamped, &[q], true, &[], &mut ws).unwrap();
+    let a = DMatrix::from_row_slice(4, 4, &ss.a);
+    let mut eig: Vec<f64> = a.complex_eigenvalues().iter().map(|e| e.im.abs()).collect();
+    eig.sort_by(f64::total_cmp);
+    let omega = elastic::modes(&undamped, &[q], true, true, &mut ws).unwrap().omega();
+    for (pair, w) in eig.chunks(2).zip(&omega) {
+        for e in pair {
+            assert!(rel(*e, *w) < CLOSED_FORM_TOL, "eigenvalues {eig:?} vs omega {omega:?}");
+        }
+    }
+    let err = elastic::linearize_compliant(&spring_pendulum(0.3), &[0.3], false, &[], &mut ws).unwrap_err();
+    assert!(err.to_string().contains("rotor_inertia"), "{err}");
 }

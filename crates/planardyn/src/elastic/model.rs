@@ -293,15 +293,26 @@ impl<'m> ElasticModel<'m> {
         f
     }
 
-    /// The columns of the free rotors.
-    pub fn rotor_columns(&self) -> impl Iterator<Item = usize> + '_ {
-        self.elements.iter().flat_map(|e| &e.rows).filter_map(|r| {
-            if let Row::Coordinate { rotor: Some((c, _)), .. } = r {
-                Some(*c)
-            } else {
-                None
+    /// The free rotors: each one's column and its drive's actuator.
+    pub fn rotors(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for e in &self.elements {
+            for r in &e.rows {
+                if let (Row::Coordinate { rotor: Some((c, _)), .. }, Some(a)) = (r, e.actuator) {
+                    out.push((*c, a));
+                }
             }
-        })
+        }
+        out
+    }
+
+    /// The gradient (one entry a column) of the mechanism's coordinate `k` (its pair's
+    /// relative coordinate) at z.
+    pub fn coordinate_gradient(&self, k: usize, z: &[f64]) -> Vec<f64> {
+        let pair = self.mech.coordinates[k].pair.0;
+        let mut out = vec![0.0; self.n_cols()];
+        self.grad(Row::Coordinate { pair, at: 0.0, rotor: None }, z, &self.trig(z), &mut out);
+        out
     }
 
     /// Strains delta_e and their gradients B_e of every element at z.

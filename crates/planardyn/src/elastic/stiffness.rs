@@ -183,7 +183,7 @@ fn balance(
     let strains = model.strains(z);
     let (_, r) = model.rigid_rows(z);
     let n_e: usize = strains.iter().map(|(v, _)| v.len()).sum();
-    let rotors: Vec<usize> = model.rotor_columns().collect();
+    let rotors: Vec<usize> = model.rotors().iter().map(|&(c, _)| c).collect();
     let mut a = DMatrix::zeros(model.n_cols(), n_e + r.nrows() + rotors.len());
     let mut rhs = applied.force(model, z);
     let mut fixed = vec![None; n_e];
