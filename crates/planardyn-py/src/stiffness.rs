@@ -257,9 +257,8 @@ pub fn compliant_state_space<'py>(
     let m = &*mech.inner;
     let q = coords(m, "q", &q)?;
     let outs = points.iter().map(|(b, p)| output(m, b, Some(p))).collect::<PyResult<Vec<_>>>()?;
-    let ss = run(py, || {
-        Ok::<_, Failure>(elastic::linearize_compliant(m, &q, gravity, &outs, &mut Workspace::new(m))?)
-    })?;
+    let ss =
+        run(py, || Ok::<_, Failure>(elastic::linearize_compliant(m, &q, gravity, &outs, &mut Workspace::new(m))?))?;
     state_space_dict(py, ss)
 }
 

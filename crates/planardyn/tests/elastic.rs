@@ -340,7 +340,10 @@ fn gravity_on_a_spring_pendulum_is_its_closed_form() {
         for i in 0..2 {
             for j in 0..2 {
                 let scale = len * len / k;
-                assert!((c[i][j] - expected[i][j]).abs() < CLOSED_FORM_TOL * scale, "C[{i}][{j}] {c:?} vs {expected:?}");
+                assert!(
+                    (c[i][j] - expected[i][j]).abs() < CLOSED_FORM_TOL * scale,
+                    "C[{i}][{j}] {c:?} vs {expected:?}"
+                );
             }
         }
     };
