@@ -1,7 +1,7 @@
 """Stiffness and vibration of a mechanism with its compliances (docs/stiffness.md).
 
 The model file's ``compliance:`` section gives the elastic elements (drive transmissions,
-revolute pairs, slender links); the core (``planardyn::elastic``) computes, exactly from the
+revolute and prismatic pairs, slender links); the core (``planardyn::elastic``) computes, exactly from the
 pair kinds' first and second derivatives:
 
 - :func:`stiffness`: the Cartesian compliance C and stiffness K of a body's point, pose

@@ -520,3 +520,54 @@ fn compliant_state_space_is_the_flexible_joint_pendulums() {
     let err = elastic::linearize_compliant(&spring_pendulum(0.3), &[0.3], false, &[], &mut ws).unwrap_err();
     assert!(err.to_string().contains("rotor_inertia"), "{err}");
 }
+
+/// A slider on a compliant prismatic guide along x (lateral stiffness k_l at the pair point K,
+/// tilt stiffness k_t), its slide held (the coordinate without a drive spring), carrying P at d
+/// along the guide from K; `pairs` the compliance entry.
+fn compliant_slider(pairs: &str) -> Mechanism {
+    yaml(&slider_text(pairs))
+}
+
+fn slider_text(pairs: &str) -> String {
+    format!(
+        "name: slider\npoints: {{K: [0, 0], G: [1, 0], P: [0.4, 0]}}\nground: [K, G]\n\
+         bodies:\n  slider: {{points: [K, P], mass: 2.0, inertia: 0.03, com: P}}\n\
+         pairs:\n  - {{type: prismatic, name: guide, at: K, bodies: [ground, slider], along: [K, G]}}\n\
+         coordinates:\n  - {{name: s, pair: guide, value: 0.0}}\n\
+         compliance:\n  pairs: [{pairs}]\n"
+    )
+}
+
+#[test]
+fn a_compliant_prismatic_pair_is_a_lateral_and_a_tilt_spring() {
+    // The slider's copy of K is offset from the guide by F / k_l under a lateral force at K,
+    // and a moment turns it by M / k_t about K (the offset is measured at K, so the two do not
+    // couple there); at P, d along the guide: C_yy = 1/k_l + d^2/k_t, C_yphi = d/k_t,
+    // C_phiphi = 1/k_t, and nothing along the held slide (x).
+    let (kl, kt, d) = (2.0e5_f64, 3.0e3_f64, 0.4_f64);
+    let mech = compliant_slider(&format!("{{pair: guide, stiffness: {kl}, tilt_stiffness: {kt}}}"));
+    let mut ws = Workspace::new(&mech);
+    let at_p = Output { body: BodyId(0), point: mech.point_id("P") };
+    let s = elastic::stiffness(&mech, &[0.0], at_p, &Load::default(), &mut ws).unwrap();
+    let expected = [[0.0, 0.0, 0.0], [0.0, 1.0 / kl + d * d / kt, d / kt], [0.0, d / kt, 1.0 / kt]];
+    for i in 0..3 {
+        for j in 0..3 {
+            let err = (s.compliance[i][j] - expected[i][j]).abs();
+            assert!(err < CLOSED_FORM_TOL * (1.0 / kt), "C[{i}][{j}] {:?} vs {expected:?}", s.compliance);
+        }
+    }
+    assert_eq!((s.freedoms, s.stiffness.is_none()), (2, true));
+    let at_k = Output { body: BodyId(0), point: mech.point_id("K") };
+    let c = elastic::stiffness(&mech, &[0.0], at_k, &Load::default(), &mut ws).unwrap().compliance;
+    assert!(rel(c[1][1], 1.0 / kl) < CLOSED_FORM_TOL && c[1][2].abs() < CLOSED_FORM_TOL / kt, "{c:?}");
+}
+
+#[test]
+fn pair_compliance_errors_name_the_field_and_the_fix() {
+    let err = |text: &str| planardyn::loads(text, planardyn::Format::Yaml, "<test>").unwrap_err().to_string();
+    let e = err(&slider_text("{pair: guide, stiffness: 1.0e5}"));
+    assert!(e.contains("compliance.pairs[0].tilt_stiffness") && e.contains("N m/rad"), "{e}");
+    let revolute = "compliance:\n  pairs: [{pair: O, stiffness: 1.0e5, tilt_stiffness: 1.0}]\ncoordinates:";
+    let e = err(&common::PENDULUM.replace("coordinates:", revolute));
+    assert!(e.contains("compliance.pairs[0].tilt_stiffness") && e.contains("turns freely"), "{e}");
+}

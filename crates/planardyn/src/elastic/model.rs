@@ -120,8 +120,8 @@ impl<'m> ElasticModel<'m> {
             match released {
                 Some(pc) => model.elements.push(Element {
                     rows,
-                    stiffness: DMatrix::identity(2, 2) * pc.stiffness,
-                    damping: DMatrix::identity(2, 2) * pc.damping,
+                    stiffness: DMatrix::from_diagonal(&DVector::from_column_slice(&pc.stiffness)),
+                    damping: DMatrix::from_diagonal(&DVector::from_column_slice(&pc.damping)),
                     actuator: None,
                 }),
                 None => {
