@@ -264,6 +264,37 @@ compliance:
     np.testing.assert_allclose(static, expected, atol=FD_TOL * np.abs(expected).max())
 
 
+SLIDER = """name: slider
+points: {K: [0, 0], G: [1, 0], P: [0.4, 0]}
+ground: [K, G]
+bodies:
+  slider: {points: [K, P], mass: 2.0, inertia: 0.03, com: P}
+pairs:
+  - {type: prismatic, name: guide, at: K, bodies: [ground, slider], along: [K, G]}
+coordinates:
+  - {name: s, pair: guide, value: 0.0}
+compliance:
+"""
+
+
+def test_prismatic_pair_compliance_takes_units_and_names_its_fields():
+    # The closed form (lateral and tilt springs) is in crates/planardyn/tests/elastic.rs; here
+    # the same springs in SI and with units give the same compliance (one multiplication by
+    # the unit's value each: 1e-12), and a prismatic pair without tilt_stiffness, a revolute
+    # pair with one and a wrong unit are refused naming the field.
+    si = pd.loads(SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: 3.0e3}]\n")
+    units = pd.loads(SLIDER + '  pairs: [{pair: guide, stiffness: "200 N/mm", tilt_stiffness: "3e6 N mm/rad"}]\n')
+    c_si = st.stiffness(si, body="slider", point="P").compliance
+    np.testing.assert_allclose(st.stiffness(units, body="slider", point="P").compliance, c_si,
+                               rtol=1e-12, atol=1e-12 * np.abs(c_si).max())
+    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].tilt_stiffness.*N m/rad"):
+        pd.loads(SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5}]\n")
+    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].tilt_stiffness"):
+        pd.loads(SLIDER + '  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: "3 N/m"}]\n')
+    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].tilt_stiffness.*turns freely"):
+        pd.loads(FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: 1.0e5, tilt_stiffness: 1.0}]\n")
+
+
 def test_model_file_compliance_errors_name_the_field():
     with pytest.raises(pd.ModelError, match=r"compliance.drives\[0\].actuator.*theta1, theta2"):
         pd.loads(FIVE_BAR + "\ncompliance:\n  drives: [{actuator: nope, stiffness: 1}]\n")
