@@ -277,33 +277,31 @@ compliance:
 """
 
 
-def test_prismatic_pair_compliance_takes_units_and_names_its_fields():
+def test_prismatic_pair_compliance_takes_units():
     # The closed form (lateral and tilt springs) is in crates/planardyn/tests/elastic.rs; here
     # the same springs in SI and with units give the same compliance (one multiplication by
-    # the unit's value each: 1e-12), and a prismatic pair without tilt_stiffness, a revolute
-    # pair with one and a wrong unit are refused naming the field.
+    # the unit's value each: 1e-12); the refusals are in the next test.
     si = pd.loads(SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: 3.0e3}]\n")
     units = pd.loads(SLIDER + '  pairs: [{pair: guide, stiffness: "200 N/mm", tilt_stiffness: "3e6 N mm/rad"}]\n')
     c_si = st.stiffness(si, body="slider", point="P").compliance
     np.testing.assert_allclose(st.stiffness(units, body="slider", point="P").compliance, c_si,
                                rtol=1e-12, atol=1e-12 * np.abs(c_si).max())
-    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].tilt_stiffness.*N m/rad"):
-        pd.loads(SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].tilt_stiffness"):
-        pd.loads(SLIDER + '  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: "3 N/m"}]\n')
-    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].tilt_stiffness.*turns freely"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: 1.0e5, tilt_stiffness: 1.0}]\n")
 
 
-def test_model_file_compliance_errors_name_the_field():
-    with pytest.raises(pd.ModelError, match=r"compliance.drives\[0\].actuator.*theta1, theta2"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  drives: [{actuator: nope, stiffness: 1}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.drives\[0\].side"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  drives: [{actuator: theta1, stiffness: 1, side: motor}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.links\[0\]"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  links: [{body: distal_left, EA: 1.0}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].stiffness"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: -1}]\n")
+@pytest.mark.parametrize(("text", "message"), [
+    (FIVE_BAR + "\ncompliance:\n  drives: [{actuator: nope, stiffness: 1}]\n",
+     r"compliance.drives\[0\].actuator.*theta1, theta2"),
+    (FIVE_BAR + "\ncompliance:\n  drives: [{actuator: theta1, stiffness: 1, side: motor}]\n", r"compliance.drives\[0\].side"),
+    (FIVE_BAR + "\ncompliance:\n  links: [{body: distal_left, EA: 1.0}]\n", r"compliance.links\[0\]"),
+    (FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: -1}]\n", r"compliance.pairs\[0\].stiffness"),
+    (SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5}]\n", r"compliance.pairs\[0\].tilt_stiffness.*N m/rad"),
+    (SLIDER + '  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: "3 N/m"}]\n', r"compliance.pairs\[0\].tilt_stiffness"),
+    (FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: 1.0e5, tilt_stiffness: 1.0}]\n",
+     r"compliance.pairs\[0\].tilt_stiffness.*turns freely"),
+])
+def test_model_file_compliance_errors_name_the_field(text: str, message: str):
+    with pytest.raises(pd.ModelError, match=message):
+        pd.loads(text)
 
 
 def test_cli_stiffness_and_modes(tmp_path):
