@@ -351,7 +351,7 @@ def test_every_command_is_in_the_help_with_shipped_model_names():
     p = run("--help")
     listed = re.findall(r"^    (\w+)(?: |$)", p.stdout, re.M)  # a long name has its help on the next line
     assert listed == ["check", "draw", "simulate", "inverse", "identify", "plot", "animate", "demo", "app", "size",
-                      "stiffness", "modes", "plan",
+                      "stiffness", "modes", "flexible", "plan",
                       "export", "import", "docs"]
     for command in listed:
         help_text = run(command, "--help").stdout

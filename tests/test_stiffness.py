@@ -4,6 +4,7 @@ geometric term against finite differences) are in crates/planardyn/tests/elastic
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -82,6 +83,58 @@ def test_eigenvalues_match_an_independent_redundant_coordinate_model():
     ours = st.modes(mech).omega2
     np.testing.assert_allclose(ours, expected, rtol=EIG_TOL)
 
+
+def test_modes_under_gravity_are_the_small_oscillations_of_the_rigid_model_on_springs():
+    # Independent computation: the rigid 5R with torsional springs K1, K2 at its motors (model
+    # `loads`), their rest angles set so that the drawing is their equilibrium under gravity
+    # (k rest = the holding torque), swings about it with K = d tau/dq from the dynamics'
+    # exact derivatives and A = U^T M U (`small_oscillations`). The compliant model with the
+    # same drive springs under its gravity (`modes(gravity=True)`: balance, multipliers and
+    # the rows' second derivatives) must give the same omega^2; both exact, so EIG_TOL. And
+    # gravity's geometric term moves them far more than that.
+    rigid = pd.loads(FIVE_BAR)
+    hold = rigid.inverse_dynamics(rigid.q0, [0.0, 0.0], [0.0, 0.0])
+    springs = "".join(f"\n  - {{type: torsional_spring, pair: {pair}, stiffness: {k}, rest: {float(h / k)!r}}}"
+                      for pair, k, h in (("motor1", K1, hold[0]), ("motor2", K2, hold[1])))
+    sprung = pd.loads(FIVE_BAR + "\nloads:" + springs + "\n")
+    np.testing.assert_allclose(sprung.inverse_dynamics(sprung.q0, [0.0, 0.0], [0.0, 0.0]), 0.0, atol=1e-12)
+    expected = st.small_oscillations(sprung, equilibrium=False).omega2
+    compliant = pd.loads(FIVE_BAR + f"\ncompliance:\n  drives:\n    - {{actuator: theta1, stiffness: {K1}}}\n"
+                         f"    - {{actuator: theta2, stiffness: {K2}}}\n")
+    ours = st.modes(compliant, gravity=True).omega2
+    np.testing.assert_allclose(ours, expected, rtol=EIG_TOL)
+    without = st.modes(compliant).omega2
+    assert np.abs(without / expected - 1).max() > 1e3 * EIG_TOL, (without, expected)
+
+
+def _first_frequency_at(mech: pd.Mechanism, q: np.ndarray) -> float:
+    """Drive springs only, rotors held: omega^2 = eig(diag(k), M(q)) exactly (M the rigid mass
+    matrix in the coordinates), by scipy."""
+    w2 = scipy.linalg.eigh(np.diag([K1, K2]), mech.mass_matrix(q), eigvals_only=True)[0]
+    return float(np.sqrt(w2) / (2 * np.pi))
+
+
+def test_topp_and_collocation_reports_state_the_first_natural_frequency():
+    # Issue 27 item 3: the planned motion's report gives the lowest first natural frequency
+    # over its grid and the time; at that time it equals scipy's eigenvalue of the pose
+    # there (two exact computations: 1e-9 relative, as the sizing report's test), and no grid
+    # point is lower. A rigid model's report has no such line.
+    from planardyn.plan import collocate, time_optimal
+
+    mech = pd.loads(FIVE_BAR + f"\ncompliance:\n  drives:\n    - {{actuator: theta1, stiffness: {K1}}}\n"
+                    f"    - {{actuator: theta2, stiffness: {K2}}}\n")
+    q0 = np.asarray(mech.q0)
+    plans = [time_optimal(mech, [q0, q0 + [0.3, 0.2]], effort=[10.0, 10.0], n_grid=40, rtol=None),
+             collocate(mech, q0, q0 + [0.3, 0.2], effort=[10.0, 10.0], n_intervals=12)]
+    for plan in plans:
+        assert plan.first_frequency is not None
+        f, t = plan.first_frequency
+        q_at = plan.state([t])[0][0]
+        np.testing.assert_allclose(f, _first_frequency_at(mech, q_at), rtol=1e-9)
+        assert min(_first_frequency_at(mech, q) for q in plan.q) >= f * (1 - 1e-9)
+        assert dict(plan._summary_rows())["lowest first natural frequency"] == f"{f:.4g} Hz at t = {t:.4g} s"
+    rigid = time_optimal(pd.loads(FIVE_BAR), [q0, q0 + [0.3, 0.2]], effort=[10.0, 10.0], n_grid=40, rtol=None)
+    assert rigid.first_frequency is None and not rigid.frequency_rows()
 
 
 def test_compliance_quantities_take_units():
@@ -165,15 +218,90 @@ def test_state_space_matches_the_forward_dynamics_derivatives():
     np.testing.assert_allclose(np.abs(np.linalg.eigvals(A).imag), omega, rtol=1e-9)
 
 
-def test_model_file_compliance_errors_name_the_field():
-    with pytest.raises(pd.ModelError, match=r"compliance.drives\[0\].actuator.*theta1, theta2"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  drives: [{actuator: nope, stiffness: 1}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.drives\[0\].side"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  drives: [{actuator: theta1, stiffness: 1, side: motor}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.links\[0\]"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  links: [{body: distal_left, EA: 1.0}]\n")
-    with pytest.raises(pd.ModelError, match=r"compliance.pairs\[0\].stiffness"):
-        pd.loads(FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: -1}]\n")
+def test_compliant_state_space_has_the_modes_and_the_static_gain_of_finite_differences():
+    # The 5R with geared motors (n = 10, 20) behind its drive springs, rotors free, under its
+    # gravity at the drawing. (1) A's eigenvalues lambda are +-i omega of the modes
+    # (lambda^2 = -omega^2; two exact computations: EIG_TOL). (2) The static gain -C A^-1 B:
+    # at rest each spring passes its motor's torque to its joint, so tau_hold(q) = n t_m and
+    # dq/dt_m = (d tau_hold/dq)^-1 diag(n) whatever k; the point P moves by (dr_P/dq) dq.
+    # Both derivatives by central differences of the rigid model (inverse dynamics, point
+    # positions), h = 1e-5: truncation ~h^2 = 1e-10, rounding ~1e-16/h = 1e-11 of the
+    # entries; 1e-7 relative bounds both.
+    FD_TOL = 1e-7
+    ratios = (10.0, 20.0)
+
+    def geared(damping: float) -> pd.Mechanism:
+        return pd.loads(FIVE_BAR + f"""
+actuators:
+  - {{coordinate: theta1, gear_ratio: {ratios[0]}, rotor_inertia: 2.0e-5}}
+  - {{coordinate: theta2, gear_ratio: {ratios[1]}, rotor_inertia: 1.0e-5}}
+compliance:
+  drives:
+    - {{actuator: theta1, stiffness: {K1}, damping: {damping}}}
+    - {{actuator: theta2, stiffness: {K2}}}
+""")
+
+    mech = geared(0.2)
+    A, B, C, D = st.compliant_state_space(mech, points=[("distal_left", "P")], gravity=True)
+    assert A.shape == (8, 8) and B.shape == (8, 2) and C.shape == (4, 8) and D.shape == (4, 2)
+    undamped_A = st.compliant_state_space(geared(0.0), gravity=True)[0]
+    lam2 = np.sort(-(np.linalg.eigvals(undamped_A) ** 2).real)
+    omega2 = st.modes(mech, free_rotors=True, gravity=True).omega2
+    np.testing.assert_allclose(lam2[::2], omega2, rtol=EIG_TOL)
+    np.testing.assert_allclose(lam2[1::2], omega2, rtol=EIG_TOL)
+    rigid = pd.loads(FIVE_BAR)
+    q0, h, zero = np.asarray(rigid.q0), 1e-5, np.zeros(2)
+    p = rigid.point_names.index("P")
+
+    def diff(f):
+        return np.column_stack([(f(q0 + h * e) - f(q0 - h * e)) / (2 * h) for e in np.eye(2)])
+
+    dtau = diff(lambda q: np.asarray(rigid.inverse_dynamics(q, zero, zero)))
+    dr = diff(lambda q: rigid.point_positions(rigid.assemble(q))[p])
+    dq = np.linalg.solve(dtau, np.diag(ratios))
+    expected = np.vstack([dq, dr @ dq])
+    static = -C @ np.linalg.solve(A, B) + D
+    np.testing.assert_allclose(static, expected, atol=FD_TOL * np.abs(expected).max())
+
+
+SLIDER = """name: slider
+points: {K: [0, 0], G: [1, 0], P: [0.4, 0]}
+ground: [K, G]
+bodies:
+  slider: {points: [K, P], mass: 2.0, inertia: 0.03, com: P}
+pairs:
+  - {type: prismatic, name: guide, at: K, bodies: [ground, slider], along: [K, G]}
+coordinates:
+  - {name: s, pair: guide, value: 0.0}
+compliance:
+"""
+
+
+def test_prismatic_pair_compliance_takes_units():
+    # The closed form (lateral and tilt springs) is in crates/planardyn/tests/elastic.rs; here
+    # the same springs in SI and with units give the same compliance (one multiplication by
+    # the unit's value each: 1e-12); the refusals are in the next test.
+    si = pd.loads(SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: 3.0e3}]\n")
+    units = pd.loads(SLIDER + '  pairs: [{pair: guide, stiffness: "200 N/mm", tilt_stiffness: "3e6 N mm/rad"}]\n')
+    c_si = st.stiffness(si, body="slider", point="P").compliance
+    np.testing.assert_allclose(st.stiffness(units, body="slider", point="P").compliance, c_si,
+                               rtol=1e-12, atol=1e-12 * np.abs(c_si).max())
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    (FIVE_BAR + "\ncompliance:\n  drives: [{actuator: nope, stiffness: 1}]\n",
+     r"compliance.drives\[0\].actuator.*theta1, theta2"),
+    (FIVE_BAR + "\ncompliance:\n  drives: [{actuator: theta1, stiffness: 1, side: motor}]\n", r"compliance.drives\[0\].side"),
+    (FIVE_BAR + "\ncompliance:\n  links: [{body: distal_left, EA: 1.0}]\n", r"compliance.links\[0\]"),
+    (FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: -1}]\n", r"compliance.pairs\[0\].stiffness"),
+    (SLIDER + "  pairs: [{pair: guide, stiffness: 2.0e5}]\n", r"compliance.pairs\[0\].tilt_stiffness.*N m/rad"),
+    (SLIDER + '  pairs: [{pair: guide, stiffness: 2.0e5, tilt_stiffness: "3 N/m"}]\n', r"compliance.pairs\[0\].tilt_stiffness"),
+    (FIVE_BAR + "\ncompliance:\n  pairs: [{pair: effector, stiffness: 1.0e5, tilt_stiffness: 1.0}]\n",
+     r"compliance.pairs\[0\].tilt_stiffness.*turns freely"),
+])
+def test_model_file_compliance_errors_name_the_field(text: str, message: str):
+    with pytest.raises(pd.ModelError, match=message):
+        pd.loads(text)
 
 
 def test_cli_stiffness_and_modes(tmp_path):
@@ -182,6 +310,10 @@ def test_cli_stiffness_and_modes(tmp_path):
     assert cli_run("stiffness", model, "--body", "distal_left", "--point", "P", "--load", 0, -50, 0,
                    "--length", 0.1) == (0, "")
     assert cli_run("modes", model, "--free-rotors") == (0, "")
+    assert cli_run("modes", model, "--gravity") == (0, "")
+    assert cli_run("stiffness", model, "--body", "distal_left", "--point", "P", "--gravity") == (0, "")
+    code, err = cli_run("modes", model, "--passive", "--gravity")
+    assert code == 2 and "--gravity" in err, err
     plot = tmp_path / "map.png"
     assert cli_run("stiffness", model, "--body", "distal_left", "--point", "P", "--map", -0.05, 0.05, 0.4, 0.5,
                    "--n", 3, "--plot", plot) == (0, "")
@@ -217,3 +349,31 @@ def test_flexible_run_from_python_and_its_refusals():
         st.simulate_flexible(pd.loads(COMPLIANT_FIVE_BAR), 0.2)
     with pytest.raises(pd.ArgumentError, match="method"):
         st.simulate_flexible(flex, 0.2, method="euler")
+    # The energy balance E(t) - E(0) = W - D (W the motors' work, D the transmission dampers'
+    # loss, both integrated with the run): this model's own servo dampers (its `loads`) also
+    # dissipate, so the balance shows what they took; without them it closes to ~1e-11 J
+    # (crates/planardyn/tests/elastic.rs).
+    assert run["work"].shape == run["dissipated"].shape == (21,)
+
+
+def test_cli_flexible_prints_the_energy_balance(tmp_path, capsys):
+    # A passive, undamped flexible-joint five-bar (no drives, no servos): W = D = 0 and the
+    # energy is conserved; dop853 at rtol 1e-12 over 0.1 s keeps it to ~1e-12 J (the usual
+    # 1e-9 J bound of the energy checks).
+    model = tmp_path / "flexible.yaml"
+    model.write_text(FIVE_BAR + "\nactuators:\n  - {coordinate: theta1, rotor_inertia: 2.0e-3}\n"
+                     "  - {coordinate: theta2, rotor_inertia: 2.0e-3}\n"
+                     f"compliance:\n  drives:\n    - {{actuator: theta1, stiffness: {K1}}}\n"
+                     f"    - {{actuator: theta2, stiffness: {K2}}}\n")
+    out = tmp_path / "run.csv"
+    from planardyn.cli import main
+
+    assert main(["flexible", str(model), "--t-end", "0.1", "--rtol", "1e-12", "--atol", "1e-14", "-o", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    balance = float(re.search(r"largest \|E\(t\) - E\(0\) - W \+ D\| (\S+) J", stdout).group(1))
+    assert balance < 1e-9, stdout
+    assert "motors' work W 0 J" in stdout, stdout
+    table = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert table.shape == (101, 1 + 2 + 2 + 3)
+    code, err = cli_run("flexible", pd.models.resolve("five-bar"))
+    assert code == 2 and "compliance.drives" in err, err

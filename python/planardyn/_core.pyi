@@ -40,6 +40,7 @@ __all__ = [
     "small_oscillations",
     "equilibrium",
     "state_space",
+    "compliant_state_space",
     "simulate_flexible",
 ]
 
@@ -82,6 +83,7 @@ def stiffness(
     point: str | None = None,
     wrench: ArrayLike | None = None,
     preload: dict[str, float] | None = None,
+    gravity: bool = False,
 ) -> dict[str, Any]: ...
 def weakest_direction(compliance: ArrayLike, length: float) -> tuple[NDArray[np.float64], float]: ...
 def deflection(
@@ -92,8 +94,9 @@ def deflection(
     point: str | None = None,
     steps: int = 10,
     preload: dict[str, float] | None = None,
+    gravity: bool = False,
 ) -> dict[str, Any]: ...
-def modes(mech: Mechanism, q: ArrayLike, free_rotors: bool = False) -> dict[str, Any]: ...
+def modes(mech: Mechanism, q: ArrayLike, free_rotors: bool = False, gravity: bool = False) -> dict[str, Any]: ...
 def small_oscillations(mech: Mechanism, q: ArrayLike) -> dict[str, Any]: ...
 def equilibrium(mech: Mechanism, q_start: ArrayLike) -> NDArray[np.float64]: ...
 def simulate_flexible(
@@ -106,6 +109,9 @@ def simulate_flexible(
 ) -> dict[str, NDArray[np.float64]]: ...
 def state_space(
     mech: Mechanism, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, points: list[tuple[str, str]] = ...
+) -> dict[str, NDArray[np.float64]]: ...
+def compliant_state_space(
+    mech: Mechanism, q: ArrayLike, points: list[tuple[str, str]] = ..., gravity: bool = False
 ) -> dict[str, NDArray[np.float64]]: ...
 @final
 class Mechanism:

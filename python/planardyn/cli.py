@@ -9,7 +9,8 @@
     planardyn animate [MODEL] RESULTS -o FILE.gif|FILE.mp4|FILE.html
     planardyn size MODEL (--circle CX CY R | --line X0 Y0 X1 Y1) [--payload KG] ...
     planardyn stiffness MODEL --body B [--point P] [--at Q ...] [--load FX FY M] [--map X0 X1 Y0 Y1]
-    planardyn modes MODEL [--at Q ...] [--free-rotors | --passive]
+    planardyn modes MODEL [--at Q ...] [--free-rotors | --passive] [--gravity]
+    planardyn flexible MODEL [--t-end T] [--output-dt H] [-o FILE.csv]
     planardyn plan MODEL --line X0 Y0 X1 Y1 (--effort T [T ...] | --actuators) [--speed V ...] [--collocate time|effort] [-o FILE.csv]
     planardyn demo [--out DIR] [--model MODEL]
     planardyn export MODEL -o FILE.xml|.urdf|.sdf;  planardyn import FILE -o MODEL.yaml

@@ -1,17 +1,21 @@
 """Stiffness and vibration of a mechanism with its compliances (docs/stiffness.md).
 
 The model file's ``compliance:`` section gives the elastic elements (drive transmissions,
-revolute pairs, slender links); the core (``planardyn::elastic``) computes, exactly from the
+revolute and prismatic pairs, slender links); the core (``planardyn::elastic``) computes, exactly from the
 pair kinds' first and second derivatives:
 
 - :func:`stiffness`: the Cartesian compliance C and stiffness K of a body's point, pose
-  p = [x, y, phi] (m, m, rad), in equilibrium with a wrench W = [F_x, F_y, M] (N, N, N m)
-  and a preload of elastic drives (their geometric terms included); the weakest direction;
-- :func:`deflection`: the point's deflection under W, linear and non-linear by continuation;
-- :func:`modes`: natural frequencies, mode shapes and damping ratios about a pose;
+  p = [x, y, phi] (m, m, rad), in equilibrium with a wrench W = [F_x, F_y, M] (N, N, N m),
+  a preload of elastic drives and (``gravity=True``) the model's own gravity (their geometric
+  terms included); the weakest direction;
+- :func:`deflection`: the point's deflection under W (and gravity), linear and non-linear by
+  continuation;
+- :func:`modes`: natural frequencies, mode shapes and damping ratios about a pose (with
+  ``gravity=True``: the pose as the equilibrium under the model's gravity);
 - :func:`small_oscillations`: the modes of a passive mechanism about its equilibrium;
 - :func:`state_space`: the linearised model (A, B, C, D) of the rigid mechanism, in
-  ``scipy.signal.StateSpace``'s conventions;
+  ``scipy.signal.StateSpace``'s conventions; :func:`compliant_state_space` that of the
+  compliant mechanism with its rotors free (the flexible-joint model);
 - :func:`simulate_flexible`: a run with compliant drives (the flexible-joint model);
 - :func:`stiffness_map` and :func:`along_path`: the weakest stiffness and the first natural
   frequency over a grid of end-effector positions, and along a path (compliance ellipses).
@@ -29,6 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._core import compliant_state_space as native_compliant_state_space
 from ._core import deflection as native_deflection
 from ._core import equilibrium as native_equilibrium
 from ._core import modes as native_modes
@@ -46,7 +51,8 @@ FloatArray = NDArray[np.float64]
 
 __all__ = [
     "DeflectionReport", "ModesReport", "PathStiffness", "StiffnessMap", "StiffnessReport", "along_path",
-    "deflection", "modes", "simulate_flexible", "small_oscillations", "state_space", "stiffness", "stiffness_map",
+    "compliant_state_space", "deflection", "modes", "simulate_flexible", "small_oscillations", "state_space",
+    "stiffness", "stiffness_map",
 ]
 
 
@@ -134,14 +140,17 @@ class StiffnessReport(_Report):
 
 
 def stiffness(mech: Mechanism, q: ArrayLike | None = None, *, body: str, point: str | None = None,
-              wrench: ArrayLike | None = None, preload: Mapping[str, float] | None = None) -> StiffnessReport:
+              wrench: ArrayLike | None = None, preload: Mapping[str, float] | None = None,
+              gravity: bool = False) -> StiffnessReport:
     """The Cartesian stiffness of ``point`` of ``body`` (default its centre of mass) at
     coordinates ``q`` (m,) (default the start), in equilibrium with ``wrench`` [F_x, F_y, M]
-    (N, N, N m) at the point and ``preload`` efforts (N m or N) of elastic drives by actuator
-    name. Raises ``ArgumentError`` naming the argument (an unknown body, a rigid model...)."""
+    (N, N, N m) at the point, ``preload`` efforts (N m or N) of elastic drives by actuator
+    name and, with ``gravity``, the model's gravity on its bodies: the elements carry the load
+    at that pose. Raises ``ArgumentError`` naming the argument (an unknown body, a rigid
+    model...)."""
     qq = _q(mech, q)
     w = np.zeros(3) if wrench is None else np.asarray(wrench, dtype=float)
-    d = native_stiffness(mech._native, qq, body, point, w, dict(preload) if preload else None)
+    d = native_stiffness(mech._native, qq, body, point, w, dict(preload) if preload else None, bool(gravity))
     return StiffnessReport._from(d, body, point, qq, w)
 
 
@@ -172,12 +181,13 @@ class DeflectionReport(_Report):
 
 def deflection(mech: Mechanism, q: ArrayLike | None = None, *, body: str, wrench: ArrayLike,
                point: str | None = None, steps: int = 10,
-               preload: Mapping[str, float] | None = None) -> DeflectionReport:
-    """The deflection of ``point`` of ``body`` under ``wrench`` (N, N, N m), linear and
+               preload: Mapping[str, float] | None = None, gravity: bool = False) -> DeflectionReport:
+    """The deflection of ``point`` of ``body`` under ``wrench`` (N, N, N m) and, with
+    ``gravity``, the model's gravity (the sag), from the pose ``q`` unstrained: linear and
     non-linear (the equilibrium followed in ``steps`` load increments)."""
     qq = _q(mech, q)
     w = np.asarray(wrench, dtype=float)
-    d = native_deflection(mech._native, qq, body, w, point, steps, dict(preload) if preload else None)
+    d = native_deflection(mech._native, qq, body, w, point, steps, dict(preload) if preload else None, bool(gravity))
     tangent = StiffnessReport._from(d["tangent"], body, point, qq, w)
     return DeflectionReport(w, d["linear"], d["nonlinear"], tangent, d["x"])
 
@@ -219,11 +229,14 @@ def _modes(d: dict[str, Any], q: FloatArray) -> ModesReport:
     return ModesReport(d["omega"], d["omega2"], d["damping_ratio"], d["shapes"], q)
 
 
-def modes(mech: Mechanism, q: ArrayLike | None = None, *, free_rotors: bool = False) -> ModesReport:
+def modes(mech: Mechanism, q: ArrayLike | None = None, *, free_rotors: bool = False,
+          gravity: bool = False) -> ModesReport:
     """The natural modes of the compliant mechanism about coordinates ``q`` (its rigid pose):
-    each elastic drive's rotor held (a stiff position loop) or free (a torque-driven motor)."""
+    each elastic drive's rotor held (a stiff position loop) or free (a torque-driven motor);
+    with ``gravity``, about ``q`` as the equilibrium under the model's gravity (its geometric
+    stiffness included: a hanging link stiffens, a standing one softens)."""
     qq = _q(mech, q)
-    return _modes(native_modes(mech._native, qq, free_rotors), qq)
+    return _modes(native_modes(mech._native, qq, free_rotors, bool(gravity)), qq)
 
 
 def small_oscillations(mech: Mechanism, q: ArrayLike | None = None, *, equilibrium: bool = True) -> ModesReport:
@@ -249,6 +262,22 @@ def state_space(mech: Mechanism, q: ArrayLike | None = None, qd: ArrayLike | Non
     return d["A"], d["B"], d["C"], d["D"]
 
 
+def compliant_state_space(mech: Mechanism, q: ArrayLike | None = None, *, points: Sequence[tuple[str, str]] = (),
+                          gravity: bool = False) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """(A, B, C, D) of the compliant mechanism with every elastic drive's rotor free (the
+    flexible-joint model of :func:`simulate_flexible`) linearised about coordinates ``q`` as
+    its equilibrium (with ``gravity``: under the model's gravity, the motors holding it), for
+    ``scipy.signal.StateSpace(A, B, C, D)``. State [xi; dxi/dt] (2h): xi the mass-normalised
+    coordinates of its h massive free motions (the eigenvalues of A are +-i omega of
+    :func:`modes` with ``free_rotors=True`` when undamped); input the motor torques (motor
+    side, N m or N) of the elastic drives with a rotor, in the order of the actuators;
+    outputs the coordinates' increments (rad or m, measured at their pairs), then each
+    (body, point)'s [dx, dy] (m)."""
+    qq = _q(mech, q)
+    d = native_compliant_state_space(mech._native, qq, list(points), bool(gravity))
+    return d["A"], d["B"], d["C"], d["D"]
+
+
 @dataclass(repr=False)
 class StiffnessMap(_Report):
     """The weakest translational stiffness ``weakest`` (N/m) and the first natural frequency
@@ -270,17 +299,17 @@ class StiffnessMap(_Report):
 
 
 def stiffness_map(ee: EndEffector, xlim: tuple[float, float], ylim: tuple[float, float],
-                  n: int | tuple[int, int] = 30, psi: float = 0.0) -> StiffnessMap:
+                  n: int | tuple[int, int] = 30, psi: float = 0.0, gravity: bool = False) -> StiffnessMap:
     """The weakest stiffness of the end-effector point and the first natural frequency over a
     grid of its positions (inverse kinematics by continuation as the singularity maps:
-    :func:`planardyn.robot.maps.singularity_map`)."""
+    :func:`planardyn.robot.maps.singularity_map`); with ``gravity``, under the model's gravity."""
     grid = singularity_map(ee, xlim, ylim, n, psi)
     weakest = np.full(grid.sigma_I.shape, np.nan)
     first = np.full(grid.sigma_I.shape, np.nan)
     for j, i in zip(*np.nonzero(grid.reachable)):
         q = grid.q[j, i]
-        weakest[j, i] = stiffness(ee.mech, q, body=ee.body, point=ee.point).weakest_stiffness
-        first[j, i] = modes(ee.mech, q).frequency[0]
+        weakest[j, i] = stiffness(ee.mech, q, body=ee.body, point=ee.point, gravity=gravity).weakest_stiffness
+        first[j, i] = modes(ee.mech, q, gravity=gravity).frequency[0]
     return StiffnessMap(grid.x, grid.y, weakest, first)
 
 
@@ -305,14 +334,16 @@ class PathStiffness(_Report):
                 ("weakest stiffness", _span(self.weakest, "N/m")), ("first frequency", _span(self.first_frequency, "Hz"))]
 
 
-def along_path(mech: Mechanism, q: ArrayLike, *, body: str, point: str | None = None) -> PathStiffness:
-    """Compliance ellipses, weakest stiffness and first frequency at each row of ``q`` (N, m)."""
+def along_path(mech: Mechanism, q: ArrayLike, *, body: str, point: str | None = None,
+               gravity: bool = False) -> PathStiffness:
+    """Compliance ellipses, weakest stiffness and first frequency at each row of ``q`` (N, m);
+    with ``gravity``, under the model's gravity."""
     rows = np.atleast_2d(np.asarray(q, dtype=float))
-    reports = [stiffness(mech, r, body=body, point=point) for r in rows]
+    reports = [stiffness(mech, r, body=body, point=point, gravity=gravity) for r in rows]
     ellipses = [r.ellipse() for r in reports]
     return PathStiffness(np.array([r.pose[:2] for r in reports]), np.array([e[0] for e in ellipses]),
                          np.array([e[1] for e in ellipses]), np.array([r.weakest_stiffness for r in reports]),
-                         np.array([modes(mech, r).frequency[0] for r in rows]))
+                         np.array([modes(mech, r, gravity=gravity).frequency[0] for r in rows]))
 
 
 def simulate_flexible(mech: Mechanism, t_end: float, output_dt: float = 1e-3, *, method: str = "dop853",

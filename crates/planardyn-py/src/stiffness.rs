@@ -45,13 +45,18 @@ fn output(mech: &Mechanism, body_name: &str, point: Option<&str>) -> PyResult<Ou
     Ok(Output { body: b, point })
 }
 
-fn load(mech: &Mechanism, wrench: Option<ArrayArg<'_>>, preload: Option<HashMap<String, f64>>) -> PyResult<Load> {
+fn load(
+    mech: &Mechanism,
+    wrench: Option<ArrayArg<'_>>,
+    preload: Option<HashMap<String, f64>>,
+    gravity: bool,
+) -> PyResult<Load> {
     let wrench = match wrench {
         Some(w) => vector("wrench", &w, 3, "[F_x, F_y, M] in N, N, N m")?,
         None => vec![0.0; 3],
     };
     let names = mech.actuator_names();
-    let mut out = Load { wrench: [wrench[0], wrench[1], wrench[2]], preload: Vec::new() };
+    let mut out = Load { wrench: [wrench[0], wrench[1], wrench[2]], preload: Vec::new(), gravity };
     for (name, tau) in preload.unwrap_or_default() {
         let k = names.iter().position(|n| *n == name).ok_or_else(|| {
             argument_error(Some("preload"), format!("unknown actuator '{name}'; actuators are: {}", names.join(", ")))
@@ -81,9 +86,11 @@ fn cartesian<'py>(py: Python<'py>, s: &CartesianStiffness) -> PyResult<Bound<'py
 
 /// The Cartesian compliance and stiffness of `body`'s `point` (default its centre of mass) at
 /// coordinates q, in equilibrium with `wrench` [F_x, F_y, M] (N, N, N m) at the point and the
-/// `preload` efforts of elastic drives by actuator name (geometric terms included).
+/// `preload` efforts of elastic drives by actuator name, and (`gravity`) the model's gravity
+/// (geometric terms included).
 #[pyfunction]
-#[pyo3(signature = (mech, q, body, point=None, wrench=None, preload=None))]
+#[pyo3(signature = (mech, q, body, point=None, wrench=None, preload=None, gravity=false))]
+#[allow(clippy::too_many_arguments)]
 pub fn stiffness<'py>(
     py: Python<'py>,
     mech: &PyMechanism,
@@ -92,9 +99,10 @@ pub fn stiffness<'py>(
     point: Option<&str>,
     wrench: Option<ArrayArg<'py>>,
     preload: Option<HashMap<String, f64>>,
+    gravity: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &*mech.inner;
-    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(m, wrench, preload)?);
+    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(m, wrench, preload, gravity)?);
     let s = run(py, || Ok::<_, Failure>(elastic::stiffness(m, &q, out, &load, &mut Workspace::new(m))?))?;
     cartesian(py, &s)
 }
@@ -122,10 +130,11 @@ pub fn weakest_direction<'py>(
     Ok((arr1(py, w.direction.to_vec()), w.stiffness))
 }
 
-/// The deflection of `body`'s `point` under `wrench`, linear and non-linear (in `steps` load
-/// increments), with the tangent compliance at the loaded equilibrium.
+/// The deflection of `body`'s `point` under `wrench` and (`gravity`) the model's gravity,
+/// linear and non-linear (in `steps` load increments), with the tangent compliance at the
+/// loaded equilibrium.
 #[pyfunction]
-#[pyo3(signature = (mech, q, body, wrench, point=None, steps=10, preload=None))]
+#[pyo3(signature = (mech, q, body, wrench, point=None, steps=10, preload=None, gravity=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn deflection<'py>(
     py: Python<'py>,
@@ -136,9 +145,10 @@ pub fn deflection<'py>(
     point: Option<&str>,
     steps: usize,
     preload: Option<HashMap<String, f64>>,
+    gravity: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &*mech.inner;
-    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(m, Some(wrench), preload)?);
+    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(m, Some(wrench), preload, gravity)?);
     if !(1..=10_000).contains(&steps) {
         return Err(argument_error(Some("steps"), format!("steps must be 1 to 10000, got {steps}")));
     }
@@ -162,18 +172,20 @@ fn modes_dict<'py>(py: Python<'py>, modes: Modes, width: usize) -> PyResult<Boun
 }
 
 /// Natural modes of the compliant mechanism about q: `omega` (rad/s), `omega2`,
-/// `damping_ratio`, `shapes` (k, 3n) body displacements; rotors held or free.
+/// `damping_ratio`, `shapes` (k, 3n) body displacements; rotors held or free; with `gravity`
+/// about the pose as the equilibrium under the model's gravity.
 #[pyfunction]
-#[pyo3(signature = (mech, q, free_rotors=false))]
+#[pyo3(signature = (mech, q, free_rotors=false, gravity=false))]
 pub fn modes<'py>(
     py: Python<'py>,
     mech: &PyMechanism,
     q: ArrayArg<'py>,
     free_rotors: bool,
+    gravity: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &*mech.inner;
     let q = coords(m, "q", &q)?;
-    let modes = run(py, || Ok::<_, Failure>(elastic::modes(m, &q, free_rotors, &mut Workspace::new(m))?))?;
+    let modes = run(py, || Ok::<_, Failure>(elastic::modes(m, &q, free_rotors, gravity, &mut Workspace::new(m))?))?;
     modes_dict(py, modes, m.n_x())
 }
 
@@ -217,18 +229,43 @@ pub fn state_space<'py>(
         pts.push((out.body, s));
     }
     let ss = run(py, || Ok::<_, Failure>(elastic::linearize(m, &q, &qd, &tau, &pts, &mut Workspace::new(m))?))?;
-    let n = q.len();
+    state_space_dict(py, ss)
+}
+
+fn state_space_dict(py: Python<'_>, ss: elastic::StateSpace) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("A", arr2(py, 2 * n, 2 * n, ss.a)?)?;
-    d.set_item("B", arr2(py, 2 * n, n, ss.b)?)?;
-    d.set_item("C", arr2(py, ss.n_outputs, 2 * n, ss.c)?)?;
-    d.set_item("D", arr2(py, ss.n_outputs, n, ss.d)?)?;
+    d.set_item("A", arr2(py, ss.n_states, ss.n_states, ss.a)?)?;
+    d.set_item("B", arr2(py, ss.n_states, ss.n_inputs, ss.b)?)?;
+    d.set_item("C", arr2(py, ss.n_outputs, ss.n_states, ss.c)?)?;
+    d.set_item("D", arr2(py, ss.n_outputs, ss.n_inputs, ss.d)?)?;
     Ok(d)
+}
+
+/// The linearised state-space model (A, B, C, D) of the compliant mechanism with its rotors
+/// free about q as its equilibrium (under the model's gravity with `gravity`): inputs the
+/// motor torques of the elastic drives with a rotor; outputs the coordinates, then each
+/// (body, point)'s [x, y].
+#[pyfunction]
+#[pyo3(signature = (mech, q, points=Vec::new(), gravity=false))]
+pub fn compliant_state_space<'py>(
+    py: Python<'py>,
+    mech: &PyMechanism,
+    q: ArrayArg<'py>,
+    points: Vec<(String, String)>,
+    gravity: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &*mech.inner;
+    let q = coords(m, "q", &q)?;
+    let outs = points.iter().map(|(b, p)| output(m, b, Some(p))).collect::<PyResult<Vec<_>>>()?;
+    let ss =
+        run(py, || Ok::<_, Failure>(elastic::linearize_compliant(m, &q, gravity, &outs, &mut Workspace::new(m))?))?;
+    state_space_dict(py, ss)
 }
 
 /// The flexible-joint simulation (elastic drives' rotors as coordinates of their own) from the
 /// model's start to `t_end` (s), output every `output_dt` (s): `t` (N,), `q`, `qd` (N, m),
-/// `theta`, `thetad` (N, r) the rotors joint side, `energy` (N,) J.
+/// `theta`, `thetad` (N, r) the rotors joint side, `energy`, `work` (the motors'),
+/// `dissipated` (the transmission dampers') (N,) J.
 #[pyfunction]
 #[pyo3(signature = (mech, t_end, output_dt, method="dop853", rtol=1e-9, atol=1e-12))]
 pub fn simulate_flexible<'py>(
@@ -253,6 +290,8 @@ pub fn simulate_flexible<'py>(
     d.set_item("thetad", arr2(py, n, width(&run.thetad), run.thetad.concat())?)?;
     d.set_item("t", arr1(py, run.t))?;
     d.set_item("energy", arr1(py, run.energy))?;
+    d.set_item("work", arr1(py, run.work))?;
+    d.set_item("dissipated", arr1(py, run.dissipated))?;
     Ok(d)
 }
 
@@ -264,5 +303,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(modes, m)?)?;
     m.add_function(wrap_pyfunction!(small_oscillations, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium, m)?)?;
-    m.add_function(wrap_pyfunction!(state_space, m)?)
+    m.add_function(wrap_pyfunction!(state_space, m)?)?;
+    m.add_function(wrap_pyfunction!(compliant_state_space, m)?)
 }

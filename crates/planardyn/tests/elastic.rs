@@ -111,7 +111,7 @@ fn three_rpr_frequencies_with_massless_legs_are_eig_k_m_platform() {
     const MASSLESS_LEG_TOL: f64 = 1e-7;
     let mech = three_rpr(1e-9, &leg_compliance());
     let mut ws = Workspace::new(&mech);
-    let modes = elastic::modes(&mech, &mech.drawn_q(), false, &mut ws).unwrap();
+    let modes = elastic::modes(&mech, &mech.drawn_q(), false, false, &mut ws).unwrap();
     let j = gosselin_jacobian(&mech);
     let k = j.transpose() * DMatrix::from_diagonal(&DVector::from_column_slice(&LEG_STIFFNESS)) * &j;
     // M_platform = diag(m, m, I) about P, the centre of mass: whitened by its square root.
@@ -150,12 +150,12 @@ fn cantilever_tip_deflection_is_pl3_over_3ei_and_pl_over_ea() {
         let mut ws = Workspace::new(&mech);
         let tip = Output { body: BodyId(0), point: mech.point_id("B") };
         let (c, s) = (f64::cos(angle), f64::sin(angle));
-        let transverse = Load { wrench: [-s * p, c * p, 0.0], preload: vec![] };
+        let transverse = Load { wrench: [-s * p, c * p, 0.0], preload: vec![], gravity: false };
         let d = elastic::deflection(&mech, &[angle], tip, &transverse, 1, &mut ws).unwrap();
         let along = -s * d.linear[0] + c * d.linear[1];
         assert!(rel(along, p * len.powi(3) / (3.0 * ei)) < CLOSED_FORM_TOL, "transverse {along}");
         assert!(rel(d.linear[2], p * len * len / (2.0 * ei)) < CLOSED_FORM_TOL, "rotation {}", d.linear[2]);
-        let axial = Load { wrench: [c * p, s * p, 0.0], preload: vec![] };
+        let axial = Load { wrench: [c * p, s * p, 0.0], preload: vec![], gravity: false };
         let d = elastic::deflection(&mech, &[angle], tip, &axial, 1, &mut ws).unwrap();
         let stretch = c * d.linear[0] + s * d.linear[1];
         assert!(rel(stretch, p * len / ea) < CLOSED_FORM_TOL, "axial {stretch}");
@@ -181,18 +181,18 @@ fn compliant_drive_frequencies() {
     let (k, i, n, j) = (800.0_f64, 0.05, 10.0, 2e-4);
     let rigid = compliant_drive(&format!("compliance:\n  drives: [{{actuator: q, stiffness: {k}}}]\n"));
     let mut ws = Workspace::new(&rigid);
-    let held = elastic::modes(&rigid, &[0.0], false, &mut ws).unwrap();
+    let held = elastic::modes(&rigid, &[0.0], false, false, &mut ws).unwrap();
     assert!(rel(held.omega()[0], (k / i).sqrt()) < CLOSED_FORM_TOL);
     let geared = compliant_drive(&format!(
         "actuators: [{{coordinate: q, gear_ratio: {n}, rotor_inertia: {j}}}]\n\
          compliance:\n  drives: [{{actuator: q, stiffness: {k}, damping: 0.4}}]\n"
     ));
-    let held = elastic::modes(&geared, &[0.0], false, &mut ws).unwrap();
+    let held = elastic::modes(&geared, &[0.0], false, false, &mut ws).unwrap();
     assert_eq!(held.omega2.len(), 1);
     assert!(rel(held.omega()[0], (k / i).sqrt()) < CLOSED_FORM_TOL, "motor held: {:?}", held.omega());
     // Modal damping ratio c / (2 sqrt(k I)) of the single mode.
     assert!(rel(held.damping_ratio[0], 0.4 / (2.0 * (k * i).sqrt())) < CLOSED_FORM_TOL);
-    let free = elastic::modes(&geared, &[0.0], true, &mut ws).unwrap();
+    let free = elastic::modes(&geared, &[0.0], true, false, &mut ws).unwrap();
     let nj = n * n * j;
     let expected = (k * (i + nj) / (i * nj)).sqrt();
     assert_eq!(free.omega2.len(), 2);
@@ -244,14 +244,14 @@ fn five_bar(actuators: &str, drives: &str) -> Mechanism {
 /// non-linear deflection in the load: truncation (h/W)^2 ~ 1e-10 and rounding
 /// 1e-16 L / (h C) ~ 1e-9 relative; and the load changes the compliance by far more than
 /// that, so that the test sees the geometric terms.
-fn check_tangent_against_differences(mech: &Mechanism, preload: Vec<(usize, f64)>) {
+fn check_tangent_against_differences(mech: &Mechanism, preload: Vec<(usize, f64)>, gravity: bool) {
     const FD_TOL: f64 = 1e-7;
     let mut ws = Workspace::new(mech);
     let q = mech.drawn_q();
     let out = Output { body: mech.body_id("distal_left").unwrap(), point: mech.point_id("P") };
     let w = [40.0, -60.0, 0.0];
     let mut at = |w: [f64; 3]| {
-        elastic::deflection(mech, &q, out, &Load { wrench: w, preload: preload.clone() }, 4, &mut ws).unwrap()
+        elastic::deflection(mech, &q, out, &Load { wrench: w, preload: preload.clone(), gravity }, 4, &mut ws).unwrap()
     };
     let c = at(w).tangent.compliance;
     let unloaded = at([0.0; 3]).tangent.compliance;
@@ -272,7 +272,97 @@ fn check_tangent_against_differences(mech: &Mechanism, preload: Vec<(usize, f64)
 
 #[test]
 fn tangent_compliance_is_the_derivative_of_the_loaded_equilibrium() {
-    check_tangent_against_differences(&five_bar("", ""), vec![]);
+    check_tangent_against_differences(&five_bar("", ""), vec![], false);
+}
+
+#[test]
+fn gravity_enters_the_tangent_of_the_loaded_equilibrium() {
+    // The 5R's own gravity (its model's 9.81 m/s^2 on 1.7 kg of links and end effector) added
+    // to the wrench: the tangent compliance at the equilibrium under both is again the
+    // derivative of that equilibrium in the wrench, and gravity changes it by far more than
+    // the differences' error (the test sees its geometric term).
+    let mech = five_bar("", "");
+    check_tangent_against_differences(&mech, vec![], true);
+    let mut ws = Workspace::new(&mech);
+    let q = mech.drawn_q();
+    let out = Output { body: mech.body_id("distal_left").unwrap(), point: mech.point_id("P") };
+    let at = |gravity, ws: &mut Workspace| {
+        let load = Load { wrench: [0.0; 3], preload: vec![], gravity };
+        elastic::stiffness(&mech, &q, out, &load, ws).unwrap().compliance
+    };
+    let (with, without) = (at(true, &mut ws), at(false, &mut ws));
+    let change = (with[1][1] - without[1][1]).abs() / without[1][1];
+    assert!(change > 1e-4, "gravity's geometric term: {change:e}");
+}
+
+/// A uniform bar (m, length L: centre of mass at l = L/2, I_O = m L^2/3) on a hinge O under
+/// gravity g, drawn at `angle` from the x axis, its coordinate turned through a drive spring k.
+fn spring_pendulum(angle: f64) -> Mechanism {
+    let (len, c, s) = (0.5, angle.cos(), angle.sin());
+    yaml(&format!(
+        "name: spring pendulum\ngravity: [0, -9.81]\npoints: {{O: [0, 0], A: [{}, {}]}}\nground: [O]\n\
+         bodies:\n  bar: {{points: [O, A], uniform_bar: [O, A], mass: 1.2}}\n\
+         pairs:\n  - {{type: revolute, name: O, at: O, bodies: [ground, bar]}}\n\
+         coordinates:\n  - {{name: q, pair: O, value: {angle}}}\n\
+         compliance:\n  drives: [{{actuator: q, stiffness: 30.0}}]\n",
+        len * c,
+        len * s
+    ))
+}
+
+#[test]
+fn gravity_on_a_spring_pendulum_is_its_closed_form() {
+    // V(th) = m g l sin th + 1/2 k (th - q)^2 (th from the x axis, gravity along -y): at a
+    // pose q taken as the loaded equilibrium the stiffness is V'' = k - m g l sin q, so
+    // omega^2 = (k - m g l sin q) / I_O (at q = pi/2 the inverted pendulum on a torsional
+    // spring, (k - m g l) / I_O, stable for k > m g l) and the tip A at L gives
+    // C = L^2 t t^T / V'' along t = (-sin q, cos q). From the spring unstrained at q, gravity
+    // sags it to th* with k (th* - q) + m g l cos th* = 0 (solved here by scalar Newton), and
+    // linearly by -m g l cos q / k.
+    let (m, len, k, g) = (1.2_f64, 0.5_f64, 30.0_f64, 9.81_f64);
+    let (l, i_o) = (len / 2.0, m * len * len / 3.0);
+    let q = 0.6;
+    let mech = spring_pendulum(q);
+    let mut ws = Workspace::new(&mech);
+    for th in [q, std::f64::consts::FRAC_PI_2, -std::f64::consts::FRAC_PI_2] {
+        let w2 = elastic::modes(&mech, &[th], false, true, &mut ws).unwrap().omega2[0];
+        assert!(rel(w2, (k - m * g * l * th.sin()) / i_o) < CLOSED_FORM_TOL, "at {th}: {w2}");
+    }
+    let plain = elastic::modes(&mech, &[q], false, false, &mut ws).unwrap().omega2[0];
+    assert!(rel(plain, k / i_o) < CLOSED_FORM_TOL, "without gravity: {plain}");
+    let tip = Output { body: BodyId(0), point: mech.point_id("A") };
+    let compliance_at = |th: f64| {
+        let t = [-th.sin(), th.cos()];
+        let v2 = k - m * g * l * th.sin();
+        std::array::from_fn::<_, 2, _>(|i| std::array::from_fn::<_, 2, _>(|j| len * len * t[i] * t[j] / v2))
+    };
+    let check = |c: &[[f64; 3]; 3], expected: [[f64; 2]; 2]| {
+        for i in 0..2 {
+            for j in 0..2 {
+                let scale = len * len / k;
+                assert!(
+                    (c[i][j] - expected[i][j]).abs() < CLOSED_FORM_TOL * scale,
+                    "C[{i}][{j}] {c:?} vs {expected:?}"
+                );
+            }
+        }
+    };
+    let gravity = Load { wrench: [0.0; 3], preload: vec![], gravity: true };
+    check(&elastic::stiffness(&mech, &[q], tip, &gravity, &mut ws).unwrap().compliance, compliance_at(q));
+    let mut th = q;
+    for _ in 0..50 {
+        th -= (k * (th - q) + m * g * l * th.cos()) / (k - m * g * l * th.sin());
+    }
+    let d = elastic::deflection(&mech, &[q], tip, &gravity, 10, &mut ws).unwrap();
+    let sag = [len * (th.cos() - q.cos()), len * (th.sin() - q.sin())];
+    let linear = -m * g * l * q.cos() / k;
+    for i in 0..2 {
+        assert!((d.nonlinear[i] - sag[i]).abs() < CLOSED_FORM_TOL * len, "sag {:?} vs {sag:?}", d.nonlinear);
+        let lin = len * linear * [-q.sin(), q.cos()][i];
+        assert!((d.linear[i] - lin).abs() < CLOSED_FORM_TOL * len, "linear sag {:?} vs {lin}", d.linear);
+    }
+    assert!((d.nonlinear[2] - (th - q)).abs() < CLOSED_FORM_TOL, "rotation {} vs {}", d.nonlinear[2], th - q);
+    check(&d.tangent.compliance, compliance_at(th));
 }
 
 #[test]
@@ -282,12 +372,12 @@ fn preload_of_a_redundant_drive_enters_the_tangent_and_the_stiffness() {
     // (its geometric term) and the tangent along the loaded equilibria.
     let mech = five_bar("actuators: [{pair: elbow1}]\n", "    - {actuator: elbow1, stiffness: 1.5e3}\n");
     let elbow = mech.n_actuators() - 1;
-    check_tangent_against_differences(&mech, vec![(elbow, 50.0)]);
+    check_tangent_against_differences(&mech, vec![(elbow, 50.0)], false);
     let mut ws = Workspace::new(&mech);
     let out = Output { body: mech.body_id("distal_left").unwrap(), point: mech.point_id("P") };
     let q = mech.drawn_q();
     let plain = elastic::stiffness(&mech, &q, out, &Load::default(), &mut ws).unwrap();
-    let loaded = Load { wrench: [0.0; 3], preload: vec![(elbow, 50.0)] };
+    let loaded = Load { wrench: [0.0; 3], preload: vec![(elbow, 50.0)], gravity: false };
     let preloaded = elastic::stiffness(&mech, &q, out, &loaded, &mut ws).unwrap();
     let change = (preloaded.compliance[1][1] - plain.compliance[1][1]).abs() / plain.compliance[1][1];
     assert!(change > 1e-4, "the preload's geometric term: {change:e}");
@@ -297,7 +387,7 @@ fn preload_of_a_redundant_drive_enters_the_tangent_and_the_stiffness() {
 fn a_rigid_model_is_refused_with_the_fix() {
     let mech = yaml(common::PENDULUM);
     let mut ws = Workspace::new(&mech);
-    let err = elastic::modes(&mech, &[0.0], false, &mut ws).unwrap_err().to_string();
+    let err = elastic::modes(&mech, &[0.0], false, false, &mut ws).unwrap_err().to_string();
     assert!(err.contains("compliance:"), "{err}");
 }
 
@@ -305,13 +395,20 @@ fn a_rigid_model_is_refused_with_the_fix() {
 /// its rotor (J = 5e-5 kg m^2 behind n = 20) joined to it by a transmission spring k; no
 /// motor torque.
 fn flexible_pendulum(k: f64) -> Mechanism {
+    driven_flexible_pendulum(k, 0.0, 0.0)
+}
+
+/// The same with a damper c (N m s/rad) beside the spring and a constant motor torque t_m
+/// (N m, motor side).
+fn driven_flexible_pendulum(k: f64, c: f64, t_m: f64) -> Mechanism {
     yaml(&format!(
         "name: flexible pendulum\ngravity: [0, -9.81]\npoints: {{O: [0, 0], A: [0.5, 0]}}\nground: [O]\n\
          bodies:\n  bar: {{points: [O, A], uniform_bar: [O, A], mass: 1.2}}\n\
          pairs:\n  - {{type: revolute, name: O, at: O, bodies: [ground, bar]}}\n\
          coordinates:\n  - {{name: q, pair: O, value: 0.0, q0: -1.2}}\n\
          actuators: [{{coordinate: q, gear_ratio: 20, rotor_inertia: 5.0e-5}}]\n\
-         compliance:\n  drives: [{{actuator: q, stiffness: {k}}}]\n"
+         drives: [{{coordinate: q, effort: {t_m}}}]\n\
+         compliance:\n  drives: [{{actuator: q, stiffness: {k}, damping: {c}}}]\n"
     ))
 }
 
@@ -336,6 +433,23 @@ fn flexible_joint_run_conserves_its_energy() {
 }
 
 #[test]
+fn flexible_joint_energy_balance_counts_the_motors_work_and_the_dampers_loss() {
+    // A constant motor torque 0.05 N m (n = 20: 1 N m at the joint) and a transmission damper
+    // 0.5 N m s/rad: E(t) - E(0) = W(t) - D(t) with W and D integrated along the run; dop853 at
+    // rtol 1e-12 over 2 s keeps it to ~1e-11 J; the usual bound of the energy checks is 1e-9 J.
+    // Both terms are far above it (the balance sees them).
+    let options = planardyn::integrate::Options::tol(1e-12, 1e-14);
+    let mech = driven_flexible_pendulum(1.0e3, 0.5, 0.05);
+    let run = elastic::simulate_flexible(&mech, 2.0, 0.01, planardyn::integrate::Method::Dop853, &options).unwrap();
+    let residual = (0..run.t.len())
+        .map(|i| (run.energy[i] - run.energy[0] - run.work[i] + run.dissipated[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(residual < 1e-9, "energy balance {residual:e} J");
+    let (w, d) = (run.work.last().unwrap(), run.dissipated.last().unwrap());
+    assert!(w.abs() > 1e-3 && *d > 1e-6, "work {w} J, loss {d} J");
+}
+
+#[test]
 fn flexible_joint_run_tends_to_the_rigid_one_like_one_over_k() {
     // The rigid model's A holds n^2 J on the coordinate (`dynamics::transmission`); the
     // flexible run differs by the spring's deflection and its fast oscillation, both ~1/k:
@@ -353,4 +467,107 @@ fn flexible_joint_run_tends_to_the_rigid_one_like_one_over_k() {
         .collect();
     assert!(diffs[0] < 1e-1, "{diffs:?}");
     assert!(diffs[1] < diffs[0] / 6.7 && diffs[2] < diffs[1] / 6.7, "{diffs:?}");
+}
+
+/// C (s I - A)^-1 B + D of a state-space model at a real s (outputs x inputs).
+fn transfer(ss: &elastic::StateSpace, s: f64) -> DMatrix<f64> {
+    let (n, nu, p) = (ss.n_states, ss.n_inputs, ss.n_outputs);
+    let a = DMatrix::from_row_slice(n, n, &ss.a);
+    let b = DMatrix::from_row_slice(n, nu, &ss.b);
+    let c = DMatrix::from_row_slice(p, n, &ss.c);
+    let x = (DMatrix::identity(n, n) * s - a).lu().solve(&b).unwrap();
+    c * x + DMatrix::from_row_slice(p, nu, &ss.d)
+}
+
+#[test]
+fn compliant_state_space_is_the_flexible_joint_pendulums() {
+    // Spong's flexible joint linearised about the bar at rest at q under gravity (the motor
+    // holding it): I q'' + V'' q + k (q - th) + c (q' - th') = 0 and
+    // n^2 J th'' + k (th - q) + c (th' - q') = n t_m, V'' = -m g l sin q. Laplace: with
+    // kc = k + c s, q / t_m = n kc / ((I s^2 + kc + V'') (n^2 J s^2 + kc) - kc^2), and the tip A
+    // at L moves by L (-sin q, cos q) dq. The model's transfer function C (sI - A)^-1 B at
+    // s = 0 (the static gain), 3 and 40 1/s must equal it, and its undamped A's eigenvalues be
+    // +-i omega of `modes` (free rotors, gravity). All exact: CLOSED_FORM_TOL.
+    let (m, len, g, n, j) = (1.2_f64, 0.5_f64, 9.81_f64, 20.0_f64, 5.0e-5_f64);
+    let (i, l, nj) = (m * len * len / 3.0, len / 2.0, n * n * j);
+    let (k, c, q) = (1.0e3, 0.3, -1.2_f64);
+    let v2 = -m * g * l * q.sin();
+    let mech = driven_flexible_pendulum(k, c, 0.0);
+    let mut ws = Workspace::new(&mech);
+    let tip = Output { body: BodyId(0), point: mech.point_id("A") };
+    let ss = elastic::linearize_compliant(&mech, &[q], true, &[tip], &mut ws).unwrap();
+    assert_eq!((ss.n_states, ss.n_inputs, ss.n_outputs), (4, 1, 3));
+    for s in [0.0, 3.0, 40.0] {
+        let kc = k + c * s;
+        let gq = n * kc / ((i * s * s + kc + v2) * (nj * s * s + kc) - kc * kc);
+        let tf = transfer(&ss, s);
+        let expected = [gq, -len * q.sin() * gq, len * q.cos() * gq];
+        for (r, e) in expected.iter().enumerate() {
+            assert!((tf[(r, 0)] - e).abs() < CLOSED_FORM_TOL * gq.abs().max(len * gq.abs()), "s {s}: {tf} vs {e}");
+        }
+    }
+    let undamped = flexible_pendulum(k);
+    let ss = elastic::linearize_compliant(&undamped, &[q], true, &[], &mut ws).unwrap();
+    let a = DMatrix::from_row_slice(4, 4, &ss.a);
+    let mut eig: Vec<f64> = a.complex_eigenvalues().iter().map(|e| e.im.abs()).collect();
+    eig.sort_by(f64::total_cmp);
+    let omega = elastic::modes(&undamped, &[q], true, true, &mut ws).unwrap().omega();
+    for (pair, w) in eig.chunks(2).zip(&omega) {
+        for e in pair {
+            assert!(rel(*e, *w) < CLOSED_FORM_TOL, "eigenvalues {eig:?} vs omega {omega:?}");
+        }
+    }
+    let err = elastic::linearize_compliant(&spring_pendulum(0.3), &[0.3], false, &[], &mut ws).unwrap_err();
+    assert!(err.to_string().contains("rotor_inertia"), "{err}");
+}
+
+/// A slider on a compliant prismatic guide along x (lateral stiffness k_l at the pair point K,
+/// tilt stiffness k_t), its slide held (the coordinate without a drive spring), carrying P at d
+/// along the guide from K; `pairs` the compliance entry.
+fn compliant_slider(pairs: &str) -> Mechanism {
+    yaml(&slider_text(pairs))
+}
+
+fn slider_text(pairs: &str) -> String {
+    format!(
+        "name: slider\npoints: {{K: [0, 0], G: [1, 0], P: [0.4, 0]}}\nground: [K, G]\n\
+         bodies:\n  slider: {{points: [K, P], mass: 2.0, inertia: 0.03, com: P}}\n\
+         pairs:\n  - {{type: prismatic, name: guide, at: K, bodies: [ground, slider], along: [K, G]}}\n\
+         coordinates:\n  - {{name: s, pair: guide, value: 0.0}}\n\
+         compliance:\n  pairs: [{pairs}]\n"
+    )
+}
+
+#[test]
+fn a_compliant_prismatic_pair_is_a_lateral_and_a_tilt_spring() {
+    // The slider's copy of K is offset from the guide by F / k_l under a lateral force at K,
+    // and a moment turns it by M / k_t about K (the offset is measured at K, so the two do not
+    // couple there); at P, d along the guide: C_yy = 1/k_l + d^2/k_t, C_yphi = d/k_t,
+    // C_phiphi = 1/k_t, and nothing along the held slide (x).
+    let (kl, kt, d) = (2.0e5_f64, 3.0e3_f64, 0.4_f64);
+    let mech = compliant_slider(&format!("{{pair: guide, stiffness: {kl}, tilt_stiffness: {kt}}}"));
+    let mut ws = Workspace::new(&mech);
+    let at_p = Output { body: BodyId(0), point: mech.point_id("P") };
+    let s = elastic::stiffness(&mech, &[0.0], at_p, &Load::default(), &mut ws).unwrap();
+    let expected = [[0.0, 0.0, 0.0], [0.0, 1.0 / kl + d * d / kt, d / kt], [0.0, d / kt, 1.0 / kt]];
+    for i in 0..3 {
+        for j in 0..3 {
+            let err = (s.compliance[i][j] - expected[i][j]).abs();
+            assert!(err < CLOSED_FORM_TOL * (1.0 / kt), "C[{i}][{j}] {:?} vs {expected:?}", s.compliance);
+        }
+    }
+    assert_eq!((s.freedoms, s.stiffness.is_none()), (2, true));
+    let at_k = Output { body: BodyId(0), point: mech.point_id("K") };
+    let c = elastic::stiffness(&mech, &[0.0], at_k, &Load::default(), &mut ws).unwrap().compliance;
+    assert!(rel(c[1][1], 1.0 / kl) < CLOSED_FORM_TOL && c[1][2].abs() < CLOSED_FORM_TOL / kt, "{c:?}");
+}
+
+#[test]
+fn pair_compliance_errors_name_the_field_and_the_fix() {
+    let err = |text: &str| planardyn::loads(text, planardyn::Format::Yaml, "<test>").unwrap_err().to_string();
+    let e = err(&slider_text("{pair: guide, stiffness: 1.0e5}"));
+    assert!(e.contains("compliance.pairs[0].tilt_stiffness") && e.contains("N m/rad"), "{e}");
+    let revolute = "compliance:\n  pairs: [{pair: O, stiffness: 1.0e5, tilt_stiffness: 1.0}]\ncoordinates:";
+    let e = err(&common::PENDULUM.replace("coordinates:", revolute));
+    assert!(e.contains("compliance.pairs[0].tilt_stiffness") && e.contains("turns freely"), "{e}");
 }

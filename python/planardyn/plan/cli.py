@@ -149,6 +149,8 @@ def run(args: argparse.Namespace) -> int:
     peak = np.abs(plan.tau).max(axis=0)
     print(f"{mech.name}: {plan.duration:.6g} s {what}; peak |tau| {np.round(peak, 4).tolist()}; limits used to "
           f"{plan.limit_ratio:.10g} on the dense check")
+    for name, value in plan.frequency_rows():
+        print(f"  {name}: {value}")
     for part in getattr(plan, "ignored", []):
         print(f"  not planned with: {part}")
     if args.output:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -13,6 +14,7 @@ from .._core import ArgumentError
 from ..mechanism import Mechanism
 from ..notebook import Summarized, peak_rows
 from ..result import SimulationResult
+from ..robot.sizing import lowest_first_frequency
 
 FloatArray = NDArray[np.float64]
 
@@ -38,7 +40,9 @@ class PlannedMotion(Summarized):
     (N, m) there, and ``limit_ratio``: the largest fraction of an effort, motor torque or
     speed limit the motion uses on a dense check of its own path between the grid points
     (1: a limit reached; each subclass says how it checks); subclasses give :meth:`state`
-    and :meth:`efforts` between the grid points.
+    and :meth:`efforts` between the grid points. ``first_frequency``: for a model with a
+    ``compliance:`` section, the lowest first natural frequency (Hz) at the grid points,
+    rotors held (docs/stiffness.md), and the time (s) it is reached; None for a rigid model.
     ``motor_sizing(mech, k, plan.t, plan.qd[:, k], plan.tau[:, k])`` (planardyn.robot.sizing)
     sizes a drive on it.
     """
@@ -61,7 +65,20 @@ class PlannedMotion(Summarized):
     def _summary_rows(self) -> list[tuple[str, str]]:
         return [("model", self.mech.name), ("duration", f"{self.duration:.6g} s"),
                 ("limits used", f"{self.limit_ratio:.6g} of the largest (dense check)"),
-                *peak_rows(self.mech, self.tau, self.qd), ("solution", self._summary())]
+                *peak_rows(self.mech, self.tau, self.qd), ("solution", self._summary()), *self.frequency_rows()]
+
+    @cached_property
+    def first_frequency(self) -> tuple[float, float] | None:
+        """(f, t): the lowest first natural frequency (Hz) at the grid points and its time (s)."""
+        lowest = lowest_first_frequency(self.mech, self.t, self.q)
+        return None if lowest is None else lowest[:2]
+
+    def frequency_rows(self) -> list[tuple[str, str]]:
+        """The report's line on the first natural frequency (none for a rigid model)."""
+        if self.first_frequency is None:
+            return []
+        f, t = self.first_frequency
+        return [("lowest first natural frequency", f"{f:.4g} Hz at t = {t:.4g} s")]
 
     @property
     def duration(self) -> float:

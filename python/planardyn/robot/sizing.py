@@ -492,16 +492,26 @@ def _report(motion: TaskMotion, payload: float, base: _Samples, dense: _Samples)
                         (float(dense.sigma_II[iII]), float(dense.t[iII]), dense.X[iII]), _first_frequency(motion))
 
 
-def _first_frequency(motion: TaskMotion) -> tuple[float, float, FloatArray] | None:
-    """The lowest first natural frequency (Hz) over the motion's samples (not resampled
-    between them, unlike the peaks: it varies with the pose only, slowly away from
-    singularities), its time and task position; None without a ``compliance:`` section."""
-    mech = motion.mech
+def lowest_first_frequency(mech: Mechanism, t: FloatArray, q: FloatArray) -> tuple[float, float, int] | None:
+    """The lowest first natural frequency (Hz) of the model with its compliances, rotors held
+    (docs/stiffness.md), over the poses ``q`` (N, m) a motion reaches at times ``t`` (N,) (s),
+    with that time and the pose's row; None without a ``compliance:`` section. Not resampled
+    between the poses (it varies with the pose only, slowly away from singularities)."""
     if "compliance" not in mech.to_dict():
         return None
-    f = np.array([native_modes(mech._native, q)["omega"][0] for q in motion.q]) / (2 * np.pi)
+    f = np.array([native_modes(mech._native, row)["omega"][0] for row in q]) / (2 * np.pi)
     i = int(np.argmin(f))
-    return float(f[i]), float(motion.t[i]), motion.X[i]
+    return float(f[i]), float(t[i]), i
+
+
+def _first_frequency(motion: TaskMotion) -> tuple[float, float, FloatArray] | None:
+    """The lowest first natural frequency (Hz) over the motion's samples, its time and task
+    position; None without a ``compliance:`` section."""
+    lowest = lowest_first_frequency(motion.mech, motion.t, motion.q)
+    if lowest is None:
+        return None
+    f, t, i = lowest
+    return f, t, motion.X[i]
 
 
 def _check_arguments(payload: Any, distribution: Any, preload: Any,

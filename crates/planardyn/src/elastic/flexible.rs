@@ -10,7 +10,10 @@
 //! t_m the model's drive on the coordinate (the motor torque, N m, motor side; an ideal
 //! transmission: no efficiency or motor friction). The energy
 //! E = T + V + sum 1/2 n^2 J thetad^2 + 1/2 k (theta - q)^2 changes only by the motors' work
-//! and the dampers'. As k grows the run tends to the rigid model's, whose A holds n^2 J.
+//! W = int sum n t_m thetad dt, the transmission dampers' loss D = int sum c (thetad - qd)^2 dt
+//! (both integrated with the run, as two more states) and the model's own dampers and
+//! friction: E(t) - E(0) = W - D where the model has none. As k grows the run tends to the
+//! rigid model's, whose A holds n^2 J.
 
 use crate::dynamics::{forward, kinetic_energy, potential_energy, Drives, FixedDrives, ModelDrives};
 use crate::integrate::{Method, OdeSystem, Options, Stepper};
@@ -24,7 +27,8 @@ use crate::{Error, KinematicsError};
 const MAX_OUTPUTS: f64 = 1e7;
 
 /// A run: the output times (s), and per time the coordinates q, rates qd (m each), the rotors'
-/// angles theta and rates (one per elastic drive; rad or m, joint side) and the energy E (J).
+/// angles theta and rates (one per elastic drive; rad or m, joint side), the energy E, the
+/// motors' work W since the start and the transmission dampers' loss D (J).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlexibleRun {
     pub t: Vec<f64>,
@@ -33,11 +37,13 @@ pub struct FlexibleRun {
     pub theta: Vec<Vec<f64>>,
     pub thetad: Vec<Vec<f64>>,
     pub energy: Vec<f64>,
+    pub work: Vec<f64>,
+    pub dissipated: Vec<f64>,
 }
 
-/// The flexible-joint model as an ODE in y = [q, qd, theta, thetad] (2 (m + r), r elastic
-/// drives): the mechanism without its rotors, the elastic drives, and the buffers of an
-/// evaluation (none is allocated in one).
+/// The flexible-joint model as an ODE in y = [q, qd, theta, thetad, W, D] (2 (m + r) + 2, r
+/// elastic drives; W and D the motors' work and the dampers' loss): the mechanism without its
+/// rotors, the elastic drives, and the buffers of an evaluation (none is allocated in one).
 pub struct FlexibleOde<'m> {
     rigid: Mechanism,
     model: &'m Mechanism,
@@ -77,6 +83,7 @@ impl<'m> FlexibleOde<'m> {
         let mut y: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
         y.extend(drives.iter().map(|d| q0[d.actuator]));
         y.extend(drives.iter().map(|d| qd0[d.actuator]));
+        y.extend([0.0, 0.0]);
         let ode = FlexibleOde { rigid, model: mech, drives, ratios, ws, spring: vec![0.0; m], motor: vec![0.0; m] };
         Ok((ode, y))
     }
@@ -85,7 +92,7 @@ impl<'m> FlexibleOde<'m> {
     fn energy(&mut self, y: &[f64]) -> Result<f64, KinematicsError> {
         let (m, r) = (self.rigid.dof(), self.drives.len());
         let (q, qd) = (&y[..m], &y[m..2 * m]);
-        let (th, thd) = (&y[2 * m..2 * m + r], &y[2 * m + r..]);
+        let (th, thd) = (&y[2 * m..2 * m + r], &y[2 * m + r..2 * (m + r)]);
         crate::dynamics::kinematic_stages(&self.rigid, q, qd, &mut self.ws)?;
         let mut e = kinetic_energy(&self.rigid, &self.ws.xd) + potential_energy(&self.rigid, &self.ws.x);
         for (i, d) in self.drives.iter().enumerate() {
@@ -99,12 +106,12 @@ impl<'m> FlexibleOde<'m> {
 impl OdeSystem for FlexibleOde<'_> {
     type Error = Error;
     fn dim(&self) -> usize {
-        2 * (self.rigid.dof() + self.drives.len())
+        2 * (self.rigid.dof() + self.drives.len()) + 2
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         let (m, r) = (self.rigid.dof(), self.drives.len());
         let (q, qd) = (&y[..m], &y[m..2 * m]);
-        let (th, thd) = (&y[2 * m..2 * m + r], &y[2 * m + r..]);
+        let (th, thd) = (&y[2 * m..2 * m + r], &y[2 * m + r..2 * (m + r)]);
         // Each spring's effort: on its coordinate, and against its rotor (the motor's added below).
         self.spring.fill(0.0);
         for (i, d) in self.drives.iter().enumerate() {
@@ -118,10 +125,17 @@ impl OdeSystem for FlexibleOde<'_> {
         dy[..m].copy_from_slice(qd);
         dy[m..2 * m].copy_from_slice(&self.ws.qdd);
         dy[2 * m..2 * m + r].copy_from_slice(thd);
+        let (mut power, mut loss) = (0.0, 0.0);
         for (i, d) in self.drives.iter().enumerate() {
+            let torque = self.ratios[i] * self.motor[d.actuator];
             let rotor = &mut dy[2 * m + r + i];
-            *rotor = (self.ratios[i] * self.motor[d.actuator] + *rotor) / d.rotor_inertia;
+            *rotor = (torque + *rotor) / d.rotor_inertia;
+            power += torque * thd[i];
+            let slip = thd[i] - qd[d.actuator];
+            loss += d.damping * slip * slip;
         }
+        dy[2 * (m + r)] = power;
+        dy[2 * (m + r) + 1] = loss;
         Ok(())
     }
 }
@@ -152,7 +166,16 @@ pub fn simulate_flexible(
     stepper
         .reset(&mut sys, 0.0, &y)
         .map_err(|e| Error::Options(format!("the flexible-joint run failed at its start: {e}")))?;
-    let mut run = FlexibleRun { t: vec![], q: vec![], qd: vec![], theta: vec![], thetad: vec![], energy: vec![] };
+    let mut run = FlexibleRun {
+        t: vec![],
+        q: vec![],
+        qd: vec![],
+        theta: vec![],
+        thetad: vec![],
+        energy: vec![],
+        work: vec![],
+        dissipated: vec![],
+    };
     let n_out = (t_end / output_dt).floor() as usize;
     let mut out = vec![0.0; y.len()];
     for j in 0..=n_out {
@@ -166,8 +189,10 @@ pub fn simulate_flexible(
         run.q.push(out[..m].to_vec());
         run.qd.push(out[m..2 * m].to_vec());
         run.theta.push(out[2 * m..2 * m + r].to_vec());
-        run.thetad.push(out[2 * m + r..].to_vec());
+        run.thetad.push(out[2 * m + r..2 * (m + r)].to_vec());
         run.energy.push(sys.energy(&out)?);
+        run.work.push(out[2 * (m + r)]);
+        run.dissipated.push(out[2 * (m + r) + 1]);
     }
     Ok(run)
 }

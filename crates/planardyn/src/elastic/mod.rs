@@ -1,7 +1,7 @@
 //! Stiffness and vibration of the mechanism with its compliances (`model::compliance`;
 //! docs/stiffness.md): the compliant mechanism in redundant coordinates (`model`), its
 //! elastostatics at a pose (`stiffness`), natural and small-oscillation modes (`modes`), the
-//! linearised state-space model of the rigid mechanism (`linearize`), and the simulation with
+//! linearised state-space models of the rigid and the compliant mechanism (`linearize`), and the simulation with
 //! compliant drives (`flexible`). A layer above the dynamics, the structure report, the
 //! integrators and the simulation: it uses the kinematics (assembly, analogues), the pair
 //! kinds' exact first and second derivatives, the dynamics' exact derivatives, and the
@@ -18,7 +18,7 @@ pub mod modes;
 pub mod stiffness;
 
 pub use flexible::{simulate_flexible, FlexibleOde, FlexibleRun};
-pub use linearize::{linearize, StateSpace};
+pub use linearize::{linearize, linearize_compliant, StateSpace};
 pub use model::Output;
 pub use modes::{equilibrium, modes, small_oscillations, Modes};
 pub use stiffness::{deflection, stiffness, weakest_direction, CartesianStiffness, Deflection, Load, Weakest};

@@ -120,8 +120,8 @@ impl<'m> ElasticModel<'m> {
             match released {
                 Some(pc) => model.elements.push(Element {
                     rows,
-                    stiffness: DMatrix::identity(2, 2) * pc.stiffness,
-                    damping: DMatrix::identity(2, 2) * pc.damping,
+                    stiffness: DMatrix::from_diagonal(&DVector::from_column_slice(&pc.stiffness)),
+                    damping: DMatrix::from_diagonal(&DVector::from_column_slice(&pc.damping)),
                     actuator: None,
                 }),
                 None => {
@@ -277,6 +277,42 @@ impl<'m> ElasticModel<'m> {
             g.row_mut(i).copy_from_slice(&buf);
         }
         (values, g)
+    }
+
+    /// The model's gravity as a generalized force on z: m g on each body's centre of mass
+    /// (whose coordinates z holds, so that its potential is linear in z: no curvature of its
+    /// own; its geometric term comes through the forces that carry it). Zero on the nodes
+    /// (massless) and the rotors (turning about their fixed axes).
+    pub fn gravity_force(&self) -> DVector<f64> {
+        let g = self.mech.gravity;
+        let mut f = DVector::zeros(self.n_cols());
+        for (i, b) in self.mech.bodies.iter().enumerate() {
+            f[3 * i] = b.mass * g[0];
+            f[3 * i + 1] = b.mass * g[1];
+        }
+        f
+    }
+
+    /// The free rotors: each one's column and its drive's actuator.
+    pub fn rotors(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for e in &self.elements {
+            for r in &e.rows {
+                if let (Row::Coordinate { rotor: Some((c, _)), .. }, Some(a)) = (r, e.actuator) {
+                    out.push((*c, a));
+                }
+            }
+        }
+        out
+    }
+
+    /// The gradient (one entry a column) of the mechanism's coordinate `k` (its pair's
+    /// relative coordinate) at z.
+    pub fn coordinate_gradient(&self, k: usize, z: &[f64]) -> Vec<f64> {
+        let pair = self.mech.coordinates[k].pair.0;
+        let mut out = vec![0.0; self.n_cols()];
+        self.grad(Row::Coordinate { pair, at: 0.0, rotor: None }, z, &self.trig(z), &mut out);
+        out
     }
 
     /// Strains delta_e and their gradients B_e of every element at z.

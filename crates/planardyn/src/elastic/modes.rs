@@ -10,7 +10,8 @@
 //! eigenvalues. The damping ratios are modal, zeta_i = y_i^T D y_i / (2 omega_i) for
 //! mass-normalised y_i (exact for damping proportional to K and M, first order otherwise).
 
-use super::stiffness::{elastic_at, elastic_stiffness, null_basis};
+use super::model::ElasticModel;
+use super::stiffness::{elastic_at, loaded_stiffness, null_basis, Applied};
 use crate::dynamics::{inverse, inverse_derivatives, mass_matrix};
 use crate::kinematics::assemble_into;
 use crate::model::{CoordinateKind, Mechanism};
@@ -51,9 +52,10 @@ impl Modes {
     }
 }
 
-/// K y = omega^2 M y with damping D, over the columns of the given matrices; the shapes in
-/// those columns.
-pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) -> Modes {
+/// The coordinates of K y = omega^2 M y in which M is the identity: t (columns of K and M x
+/// the massive directions h) with t^T M t = I, the massless directions condensed statically
+/// (they follow the massive ones through K).
+pub(crate) fn condensation(k: &DMatrix<f64>, m: &DMatrix<f64>) -> DMatrix<f64> {
     let me = SymmetricEigen::new((m + m.transpose()) * 0.5);
     let top = me.eigenvalues.max();
     let (heavy, light): (Vec<usize>, Vec<usize>) =
@@ -75,11 +77,17 @@ pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) 
         true => DMatrix::zeros(0, heavy.len()),
         false => -(k_ll.pseudo_inverse(eps).expect("eps >= 0") * k_lh),
     };
-    let t = &th + &tl * follow;
+    &th + &tl * follow
+}
+
+/// K y = omega^2 M y with damping D, over the columns of the given matrices; the shapes in
+/// those columns.
+pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) -> Modes {
+    let t = condensation(k, m);
     let kc = t.transpose() * k * &t;
     let dc = t.transpose() * d * &t;
     let eig = SymmetricEigen::new((&kc + kc.transpose()) * 0.5);
-    let mut order: Vec<usize> = (0..heavy.len()).collect();
+    let mut order: Vec<usize> = (0..t.ncols()).collect();
     order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
     let mut modes = Modes { omega2: Vec::new(), damping_ratio: Vec::new(), shapes: Vec::new() };
     for i in order {
@@ -95,26 +103,39 @@ pub(crate) fn generalized(k: &DMatrix<f64>, m: &DMatrix<f64>, d: &DMatrix<f64>) 
 
 /// The natural modes of the compliant mechanism about coordinates q (its rigid pose): with
 /// each elastic drive's rotor held (`free_rotors` false: a stiff position loop) or free (a
-/// torque-driven motor, its rotor inertia n^2 J a coordinate of its own). The model's own
-/// loads (gravity) are left out: the stiffness is the elements'.
-pub fn modes(mech: &Mechanism, q: &[f64], free_rotors: bool, ws: &mut Workspace) -> Result<Modes, KinematicsError> {
+/// torque-driven motor, its rotor inertia n^2 J a coordinate of its own, held by a constant
+/// torque). With `gravity`, the pose is the equilibrium under the model's gravity (the
+/// elements carry it there) and the stiffness holds its geometric term (an inverted pendulum
+/// on a spring k: omega^2 = (k - m g l) / I_O); without, the elements' stiffness alone.
+pub fn modes(
+    mech: &Mechanism,
+    q: &[f64],
+    free_rotors: bool,
+    gravity: bool,
+    ws: &mut Workspace,
+) -> Result<Modes, KinematicsError> {
     let model = elastic_at(mech, q, free_rotors, ws)?;
     let z = model.z0.clone();
     let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
-    let k = elastic_stiffness(&model, &z, &n);
-    let mass = DMatrix::from_diagonal(&DVector::from_column_slice(&model.mass));
-    let m = n.transpose() * mass * &n;
-    let mut damping = DMatrix::zeros(n.ncols(), n.ncols());
-    for (e, (_, b)) in model.elements.iter().zip(model.strains(&z)) {
-        let bn = b * &n;
-        damping += bn.transpose() * &e.damping * bn;
-    }
+    let k = loaded_stiffness(&model, &z, Applied::gravity(gravity), &[], &n)?;
+    let (m, damping) = mass_and_damping(&model, &z, &n);
     let mut modes = generalized(&k, &m, &damping);
     for s in &mut modes.shapes {
         let full = &n * DVector::from_column_slice(s);
         *s = full.rows(0, mech.n_x()).iter().copied().collect();
     }
     Ok(modes)
+}
+
+/// The mass N^T M N and the elements' damping N^T (sum B^T D_e B) N over the basis n.
+pub(crate) fn mass_and_damping(model: &ElasticModel, z: &[f64], n: &DMatrix<f64>) -> (DMatrix<f64>, DMatrix<f64>) {
+    let mass = DMatrix::from_diagonal(&DVector::from_column_slice(&model.mass));
+    let mut damping = DMatrix::zeros(n.ncols(), n.ncols());
+    for (e, (_, b)) in model.elements.iter().zip(model.strains(z)) {
+        let bn = b * n;
+        damping += bn.transpose() * &e.damping * bn;
+    }
+    (n.transpose() * mass * n, damping)
 }
 
 /// A passive mechanism at rest at q: the efforts tau(q) = -U^T f that hold it there (gravity,

@@ -1,12 +1,12 @@
 //! Elastostatics at a pose (docs/stiffness.md): the Cartesian compliance and stiffness of a
-//! body's point, with the geometric (load-dependent) term of a wrench W and of a preload of
-//! elastic drives, the weakest direction, and the deflection under W, linear and non-linear
-//! by continuation in the load.
+//! body's point, with the geometric (load-dependent) term of a wrench W, of the model's own
+//! gravity and of a preload of elastic drives, the weakest direction, and the deflection under
+//! W and gravity, linear and non-linear by continuation in the load.
 //!
 //! With the rigid rows' gradient R (their null space N: the free motions of the compliant
 //! mechanism), the elements' gradients B_e, forces sigma_e and the rigid rows' multipliers
-//! lambda in equilibrium, B^T sigma - R^T lambda = S^T W (S = dp/dz), the tangent stiffness
-//! in the free motions is
+//! lambda in equilibrium, B^T sigma - R^T lambda = F = S^T W + f_g (S = dp/dz; f_g = m g on
+//! each body's centre of mass, linear in z), the tangent stiffness in the free motions is
 //!
 //!   H_N = N^T (sum_e B_e^T K_e B_e + sum_r sigma_r d2delta_r - sum_r lambda_r d2g_r - W . d2p) N,
 //!
@@ -19,7 +19,7 @@ use crate::kinematics::assemble_into;
 use crate::model::Mechanism;
 use crate::KinematicsError;
 use crate::Workspace;
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn, SymmetricEigen};
 
 /// A singular value of the scaled rigid rows below this fraction of the largest is taken as
 /// zero: a free motion of the compliant mechanism (rounding leaves ~1e-15 on the exact ones;
@@ -44,12 +44,55 @@ fn lstsq(a: DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>, &'static str
     svd.solve(b, eps)
 }
 
-/// A load on the output: the wrench W = [F_x, F_y, M] (N, N, N m) at the output point, and
-/// preload efforts (N m or N) of elastic drives by actuator index.
+/// A load on the output: the wrench W = [F_x, F_y, M] (N, N, N m) at the output point,
+/// preload efforts (N m or N) of elastic drives by actuator index, and the model's own gravity
+/// on the bodies' centres of mass when `gravity` is set.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Load {
     pub wrench: [f64; 3],
     pub preload: Vec<(usize, f64)>,
+    pub gravity: bool,
+}
+
+/// The applied loads of a load step: a wrench on an output (None: none) and the model's
+/// gravity times `gravity` (0 none, 1 all of it).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Applied {
+    wrench: Option<(Output, [f64; 3])>,
+    gravity: f64,
+}
+
+impl Applied {
+    fn of(out: Output, load: &Load) -> Self {
+        Applied { wrench: Some((out, load.wrench)), gravity: if load.gravity { 1.0 } else { 0.0 } }
+    }
+
+    /// The model's gravity alone (`on`), or nothing.
+    pub fn gravity(on: bool) -> Self {
+        Applied { wrench: None, gravity: if on { 1.0 } else { 0.0 } }
+    }
+
+    fn scaled(self, t: f64) -> Self {
+        Applied { wrench: self.wrench.map(|(o, w)| (o, w.map(|v| v * t))), gravity: self.gravity * t }
+    }
+
+    /// The generalized force F = S^T W + gravity f_g on z.
+    fn force(&self, model: &ElasticModel, z: &[f64]) -> DVector<f64> {
+        let mut f = model.gravity_force() * self.gravity;
+        if let Some((out, w)) = self.wrench {
+            f += model.output(out, z).1.transpose() * DVector::from_column_slice(&w);
+        }
+        f
+    }
+
+    /// W . d2p/dz2 over the basis: the wrench's own geometric term (gravity has none, being
+    /// linear in z).
+    fn curvature(&self, model: &ElasticModel, z: &[f64], basis: &DMatrix<f64>) -> DMatrix<f64> {
+        match self.wrench {
+            Some((out, w)) => model.output_curvature(out, z, &w, basis),
+            None => DMatrix::zeros(basis.ncols(), basis.ncols()),
+        }
+    }
 }
 
 /// The Cartesian compliance and stiffness of an output p = [x, y, phi] (m, m, rad).
@@ -128,25 +171,34 @@ pub(crate) fn null_basis(g: &DMatrix<f64>, col_scale: &[f64]) -> DMatrix<f64> {
 }
 
 /// The elements' forces sigma (stacked by element) and the rigid rows' multipliers lambda
-/// balancing the load at z: B^T sigma - R^T lambda = S^T W, the preloaded drives' sigma = -tau
-/// given; least squares (minimum norm) where redundant rows leave it open.
-fn balance(model: &ElasticModel, z: &[f64], out: Output, load: &Load) -> Result<(Vec<f64>, Vec<f64>), KinematicsError> {
+/// balancing the applied loads at z: B^T sigma - R^T lambda = F, the preloaded drives'
+/// sigma = -tau given, each free rotor held by its motor (a constant torque, of no stiffness);
+/// least squares (minimum norm) where redundant rows leave it open.
+fn balance(
+    model: &ElasticModel,
+    z: &[f64],
+    applied: Applied,
+    preload: &[(usize, f64)],
+) -> Result<(Vec<f64>, Vec<f64>), KinematicsError> {
     let strains = model.strains(z);
     let (_, r) = model.rigid_rows(z);
-    let (_, s) = model.output(out, z);
     let n_e: usize = strains.iter().map(|(v, _)| v.len()).sum();
-    let mut a = DMatrix::zeros(model.n_cols(), n_e + r.nrows());
-    let mut rhs = s.transpose() * DVector::from_column_slice(&load.wrench);
+    let rotors: Vec<usize> = model.rotors().iter().map(|&(c, _)| c).collect();
+    let mut a = DMatrix::zeros(model.n_cols(), n_e + r.nrows() + rotors.len());
+    let mut rhs = applied.force(model, z);
     let mut fixed = vec![None; n_e];
     let mut at = 0;
     for (e, (v, b)) in model.elements.iter().zip(&strains) {
         a.columns_mut(at, v.len()).copy_from(&b.transpose());
-        if let Some(&(_, tau)) = e.actuator.and_then(|k| load.preload.iter().find(|(a, _)| *a == k)) {
+        if let Some(&(_, tau)) = e.actuator.and_then(|k| preload.iter().find(|(a, _)| *a == k)) {
             fixed[at] = Some(-tau);
         }
         at += v.len();
     }
     a.columns_mut(n_e, r.nrows()).copy_from(&(-r.transpose()));
+    for (j, &c) in rotors.iter().enumerate() {
+        a[(c, n_e + r.nrows() + j)] = 1.0;
+    }
     for (j, f) in fixed.iter().enumerate() {
         if let Some(f) = f {
             rhs -= a.column(j) * *f;
@@ -168,7 +220,7 @@ fn balance(model: &ElasticModel, z: &[f64], out: Output, load: &Load) -> Result<
 }
 
 /// sum_e B_e^T K_e B_e projected on the basis.
-pub(crate) fn elastic_stiffness(model: &ElasticModel, z: &[f64], basis: &DMatrix<f64>) -> DMatrix<f64> {
+fn elastic_stiffness(model: &ElasticModel, z: &[f64], basis: &DMatrix<f64>) -> DMatrix<f64> {
     let mut k = DMatrix::zeros(basis.ncols(), basis.ncols());
     for (e, (_, b)) in model.elements.iter().zip(model.strains(z)) {
         let bn = b * basis;
@@ -177,31 +229,36 @@ pub(crate) fn elastic_stiffness(model: &ElasticModel, z: &[f64], basis: &DMatrix
     k
 }
 
-/// The tangent stiffness H_N (over `basis`) at z with forces (sigma, lambda) and wrench W.
-pub(crate) fn tangent(
+/// The tangent stiffness H_N (over `basis`) at z with forces (sigma, lambda) and the applied
+/// loads.
+fn tangent(
     model: &ElasticModel,
     z: &[f64],
-    out: Output,
     (sigma, lambda): (&[f64], &[f64]),
-    wrench: &[f64; 3],
+    applied: Applied,
     basis: &DMatrix<f64>,
 ) -> DMatrix<f64> {
     let minus_lambda: Vec<f64> = lambda.iter().map(|l| -l).collect();
     elastic_stiffness(model, z, basis) + model.curvature(z, &minus_lambda, sigma, basis)
-        - model.output_curvature(out, z, wrench, basis)
+        - applied.curvature(model, z, basis)
 }
 
-/// The compliance of the output from the tangent stiffness over the rigid rows' null space.
-fn cartesian(
+/// The tangent stiffness over `basis` at z taken as the equilibrium with the applied loads and
+/// the preload (the elements and rigid rows carrying them there, `balance`).
+pub(crate) fn loaded_stiffness(
     model: &ElasticModel,
     z: &[f64],
-    out: Output,
-    h: DMatrix<f64>,
-    n: &DMatrix<f64>,
-) -> Result<CartesianStiffness, KinematicsError> {
-    let (pose, s) = model.output(out, z);
-    let freedoms = n.ncols();
-    let chol = h.clone().cholesky().ok_or_else(|| {
+    applied: Applied,
+    preload: &[(usize, f64)],
+    basis: &DMatrix<f64>,
+) -> Result<DMatrix<f64>, KinematicsError> {
+    let (sigma, lambda) = balance(model, z, applied, preload)?;
+    Ok(tangent(model, z, (&sigma, &lambda), applied, basis))
+}
+
+/// The Cholesky factor of a tangent stiffness, or the error saying the pose is not stable.
+fn factor(h: DMatrix<f64>) -> Result<Cholesky<f64, Dyn>, KinematicsError> {
+    h.clone().cholesky().ok_or_else(|| {
         let lowest = SymmetricEigen::new(h).eigenvalues.min();
         KinematicsError::BadArgument {
             name: "q",
@@ -210,7 +267,20 @@ fn cartesian(
                 .into(),
             got: format!("a tangent stiffness with eigenvalue {lowest:.3e}"),
         }
-    })?;
+    })
+}
+
+/// The compliance of the output from the factored tangent stiffness over the rigid rows'
+/// null space n.
+fn cartesian(
+    model: &ElasticModel,
+    z: &[f64],
+    out: Output,
+    chol: &Cholesky<f64, Dyn>,
+    n: &DMatrix<f64>,
+) -> Result<CartesianStiffness, KinematicsError> {
+    let (pose, s) = model.output(out, z);
+    let freedoms = n.ncols();
     let sn = &s * n;
     let c = &sn * chol.solve(&sn.transpose());
     let c = (&c + c.transpose()) * 0.5;
@@ -239,7 +309,7 @@ fn scale_rotation(c: &DMatrix<f64>, length: f64) -> DMatrix<f64> {
 }
 
 /// The Cartesian stiffness of `out` at coordinates q, in equilibrium with `load` at that pose
-/// (its geometric term included); `ws` is left assembled at q.
+/// (the elements carry it there; its geometric term included); `ws` is left assembled at q.
 pub fn stiffness(
     mech: &Mechanism,
     q: &[f64],
@@ -250,10 +320,9 @@ pub fn stiffness(
     let model = elastic_at(mech, q, false, ws)?;
     check_preload(&model, load)?;
     let z = model.z0.clone();
-    let forces = balance(&model, &z, out, load)?;
     let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
-    let h = tangent(&model, &z, out, (&forces.0, &forces.1), &load.wrench, &n);
-    cartesian(&model, &z, out, h, &n)
+    let h = loaded_stiffness(&model, &z, Applied::of(out, load), &load.preload, &n)?;
+    cartesian(&model, &z, out, &factor(h)?, &n)
 }
 
 fn check_preload(model: &ElasticModel, load: &Load) -> Result<(), KinematicsError> {
@@ -286,9 +355,11 @@ pub fn weakest_direction(c: &CartesianStiffness, length: Option<f64>) -> Weakest
     Weakest { direction, stiffness: 1.0 / eig.eigenvalues[i] }
 }
 
-/// The deflection of `out` under `load.wrench`, linear (unloaded compliance) and non-linear
-/// (the equilibrium followed in `steps` equal load increments by Newton on the equilibrium
-/// and the rigid rows), with the tangent compliance at the loaded equilibrium.
+/// The deflection of `out` under `load.wrench` and (`load.gravity`) the model's gravity, from
+/// the pose q unstrained but for the preload: linear (the unloaded compliance,
+/// S N H_N^-1 N^T F) and non-linear (the equilibrium followed in `steps` equal load increments
+/// by Newton on the equilibrium and the rigid rows), with the tangent compliance at the loaded
+/// equilibrium.
 pub fn deflection(
     mech: &Mechanism,
     q: &[f64],
@@ -299,21 +370,22 @@ pub fn deflection(
 ) -> Result<Deflection, KinematicsError> {
     let model = elastic_at(mech, q, false, ws)?;
     check_preload(&model, load)?;
-    let unloaded = Load { wrench: [0.0; 3], preload: load.preload.clone() };
+    let applied = Applied::of(out, load);
+    let unloaded = applied.scaled(0.0);
     let mut z = model.z0.clone();
     let (_, r) = model.rigid_rows(&z);
     let mut lambda = vec![0.0; r.nrows()];
-    let sigma0 = balance(&model, &z, out, &unloaded)?.0;
-    equilibrium(&model, out, &sigma0, [0.0; 3], &mut z, &mut lambda)?;
+    let sigma0 = balance(&model, &z, unloaded, &load.preload)?.0;
+    equilibrium(&model, &sigma0, unloaded, &mut z, &mut lambda)?;
     let n0 = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
     let sigma_at = |z: &[f64]| stresses(&model, z, &sigma0);
-    let h0 = tangent(&model, &z, out, (&sigma_at(&z), &lambda), &[0.0; 3], &n0);
-    let c0 = cartesian(&model, &z, out, h0, &n0)?;
+    let chol0 = factor(tangent(&model, &z, (&sigma_at(&z), &lambda), unloaded, &n0))?;
+    let sn0 = model.output(out, &z).1 * &n0;
+    let linear = &sn0 * chol0.solve(&(n0.transpose() * applied.force(&model, &z)));
     let p0 = model.output(out, &z).0;
     for step in 1..=steps.max(1) {
         let t = step as f64 / steps.max(1) as f64;
-        let w = load.wrench.map(|v| v * t);
-        equilibrium(&model, out, &sigma0, w, &mut z, &mut lambda).map_err(|e| match e {
+        equilibrium(&model, &sigma0, applied.scaled(t), &mut z, &mut lambda).map_err(|e| match e {
             KinematicsError::AssemblyFailed { residual, iterations } => KinematicsError::BadArgument {
                 name: "load",
                 expected: "a load the compliant mechanism carries (no buckling or snap-through before it): \
@@ -328,12 +400,11 @@ pub fn deflection(
         })?;
     }
     let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
-    let h = tangent(&model, &z, out, (&sigma_at(&z), &lambda), &load.wrench, &n);
-    let tangent_c = cartesian(&model, &z, out, h, &n)?;
+    let h = tangent(&model, &z, (&sigma_at(&z), &lambda), applied, &n);
+    let tangent_c = cartesian(&model, &z, out, &factor(h)?, &n)?;
     let p = model.output(out, &z).0;
-    let linear = std::array::from_fn(|i| (0..3).map(|j| c0.compliance[i][j] * load.wrench[j]).sum());
     Ok(Deflection {
-        linear,
+        linear: std::array::from_fn(|i| linear[i]),
         nonlinear: std::array::from_fn(|i| p[i] - p0[i]),
         tangent: tangent_c,
         x: z[..mech.n_x()].to_vec(),
@@ -354,9 +425,8 @@ fn stresses(model: &ElasticModel, z: &[f64], sigma0: &[f64]) -> Vec<f64> {
 /// Lagrangian over all columns.
 fn equilibrium(
     model: &ElasticModel,
-    out: Output,
     sigma0: &[f64],
-    wrench: [f64; 3],
+    applied: Applied,
     z: &mut [f64],
     lambda: &mut [f64],
 ) -> Result<(), KinematicsError> {
@@ -366,15 +436,13 @@ fn equilibrium(
     for _ in 0..NEWTON_ITERATIONS {
         let sigma = stresses(model, z, sigma0);
         let (g, r) = model.rigid_rows(z);
-        let (_, s) = model.output(out, z);
-        let mut grad =
-            -(s.transpose() * DVector::from_column_slice(&wrench)) - r.transpose() * DVector::from_column_slice(lambda);
+        let mut grad = -applied.force(model, z) - r.transpose() * DVector::from_column_slice(lambda);
         let mut at = 0;
         for (v, b) in model.strains(z).iter() {
             grad += b.transpose() * DVector::from_column_slice(&sigma[at..at + v.len()]);
             at += v.len();
         }
-        let h = tangent(model, z, out, (&sigma, lambda), &wrench, &eye);
+        let h = tangent(model, z, (&sigma, lambda), applied, &eye);
         let nr = r.nrows();
         let mut kkt = DMatrix::zeros(nc + nr, nc + nr);
         kkt.view_mut((0, 0), (nc, nc)).copy_from(&h);

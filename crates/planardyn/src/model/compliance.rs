@@ -5,7 +5,8 @@
 //!   damper between the actuator's rotor and the driven pair, given at the joint side or the
 //!   motor side (reflected to the joint side with the transmission ratio n: k_joint = n^2 k_motor);
 //! - a revolute pair's radial compliance: an isotropic spring on the separation of the two
-//!   copies of the pin;
+//!   copies of the pin; a prismatic pair's: a lateral spring on the offset of the slider's
+//!   copy of the pair point from the guide and a tilt spring on their relative rotation;
 //! - a slender link (planar Euler-Bernoulli beam) between its two points, clamped at its first
 //!   point in the body frame, with axial stiffness EA and bending stiffness EI (given, or from
 //!   the section and the material).
@@ -27,7 +28,7 @@ pub struct ComplianceSpec {
     /// Transmission stiffness of actuators (coordinates or redundant pair actuators).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub drives: Vec<DriveComplianceSpec>,
-    /// Radial compliance of revolute pairs.
+    /// Compliance of revolute and prismatic pairs.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub pairs: Vec<PairComplianceSpec>,
     /// Slender links as planar beams.
@@ -62,7 +63,9 @@ pub struct DriveComplianceSpec {
     pub side: Side,
 }
 
-/// A revolute pair's radial stiffness k (N/m) and damping c (N s/m).
+/// A pair's stiffness k (N/m) and damping c (N s/m): radial for a revolute pair, lateral for a
+/// prismatic one, which also takes a tilt stiffness (N m/rad) and damping (N m s/rad) against
+/// the relative rotation of its two bodies.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PairComplianceSpec {
@@ -71,6 +74,10 @@ pub struct PairComplianceSpec {
     pub stiffness: f64,
     #[serde(default, deserialize_with = "units::damping")]
     pub damping: f64,
+    #[serde(default, deserialize_with = "units::torsional_stiffness", skip_serializing_if = "Option::is_none")]
+    pub tilt_stiffness: Option<f64>,
+    #[serde(default, deserialize_with = "units::torsional_damping", skip_serializing_if = "Option::is_none")]
+    pub tilt_damping: Option<f64>,
 }
 
 /// A slender link: EA (N) and EI (N m^2) directly, or a `section` and a `material`.
@@ -131,12 +138,14 @@ pub struct DriveCompliance {
     pub rotor_inertia: f64,
 }
 
-/// A revolute pair's isotropic radial spring (N/m) and damper (N s/m).
+/// A pair's springs and dampers, one a constraint row of its kind (`model::pairs`): a
+/// revolute pair's [x, y] separation both radial (N/m, N s/m), a prismatic pair's [relative
+/// rotation, lateral offset] tilt (N m/rad, N m s/rad) and lateral (N/m, N s/m).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PairCompliance {
     pub pair: PairId,
-    pub stiffness: f64,
-    pub damping: f64,
+    pub stiffness: [f64; 2],
+    pub damping: [f64; 2],
 }
 
 /// A beam from the body's first point (clamped) to its second point, the `tip`.
@@ -167,17 +176,50 @@ pub(crate) fn build(ctx: &Ctx, mech: &Mechanism, spec: Option<&ComplianceSpec>) 
     for (k, p) in spec.pairs.iter().enumerate() {
         let path = format!("compliance.pairs[{k}]");
         let id = pair_id(ctx, mech, &format!("{path}.pair"), &p.pair)?;
-        if mech.pairs[id.0].kind != PairKind::Revolute {
-            return Err(ctx.err(
-                format!("{path}.pair"),
-                format!("'{}' is not a revolute pair; pair compliance is modelled on revolute pairs", p.pair),
-            ));
-        }
         if out.pairs.iter().any(|o| o.pair == id) {
             return Err(ctx.err(format!("{path}.pair"), format!("pair '{}' is given twice; give it once", p.pair)));
         }
         let stiffness = positive(ctx, &format!("{path}.stiffness"), p.stiffness)?;
         let damping = ctx.non_negative(&format!("{path}.damping"), p.damping)?;
+        let (stiffness, damping) = match mech.pairs[id.0].kind {
+            PairKind::Revolute => {
+                if p.tilt_stiffness.is_some() || p.tilt_damping.is_some() {
+                    return Err(ctx.err(
+                        format!("{path}.tilt_stiffness"),
+                        format!(
+                            "'{}' is a revolute pair, which turns freely: drop tilt_stiffness and tilt_damping",
+                            p.pair
+                        ),
+                    ));
+                }
+                ([stiffness; 2], [damping; 2])
+            }
+            PairKind::Prismatic { .. } => {
+                let tilt = p.tilt_stiffness.ok_or_else(|| {
+                    ctx.err(
+                        format!("{path}.tilt_stiffness"),
+                        format!(
+                            "'{}' is a prismatic pair: give tilt_stiffness (N m/rad) against its bodies' relative \
+                             rotation, beside stiffness (N/m) against the lateral offset",
+                            p.pair
+                        ),
+                    )
+                })?;
+                let tilt = positive(ctx, &format!("{path}.tilt_stiffness"), tilt)?;
+                let tilt_damping = ctx.non_negative(&format!("{path}.tilt_damping"), p.tilt_damping.unwrap_or(0.0))?;
+                // The prismatic pair's rows: [relative rotation, lateral offset] (pairs::prismatic).
+                ([tilt, stiffness], [tilt_damping, damping])
+            }
+            PairKind::Gear(_) | PairKind::Slot(_) => {
+                return Err(ctx.err(
+                    format!("{path}.pair"),
+                    format!(
+                        "'{}' is a gear or slot pair; pair compliance is modelled on revolute and prismatic pairs",
+                        p.pair
+                    ),
+                ))
+            }
+        };
         out.pairs.push(PairCompliance { pair: id, stiffness, damping });
     }
     for (k, l) in spec.links.iter().enumerate() {

@@ -167,7 +167,7 @@ macro_rules! readers {
 readers! {
     length: Length, angle: Angle, mass: Mass, inertia: Inertia, force: Force, torque: Torque, time: Time,
     speed: Speed, angular_speed: AngularSpeed, acceleration: Acceleration, stiffness: Stiffness,
-    damping: Damping, torsional_damping: TorsionalDamping, position: Position, rate: Rate, effort: Effort,
+    damping: Damping, torsional_damping: TorsionalDamping, torsional_stiffness: TorsionalStiffness, position: Position, rate: Rate, effort: Effort,
     pair_stiffness: PairStiffness, pair_damping: PairDamping,
 }
 

@@ -147,6 +147,7 @@ quantities! {
     Stiffness = [STIFFNESS];
     Damping = [DAMPING];
     TorsionalDamping = [TORSIONAL_DAMPING];
+    TorsionalStiffness = [TORSIONAL_STIFFNESS];
     /// A pair's position: an angle (revolute) or a length (prismatic, slot).
     Position = [ANGLE, LENGTH];
     /// A pair's rate: rad/s or m/s.
