@@ -13,6 +13,7 @@ mod effector;
 mod errors;
 mod exceptions;
 mod mechanism;
+mod settings;
 mod simulate;
 mod stiffness;
 mod structure;
@@ -88,5 +89,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     batch::register(m)?;
     effector::register(m)?;
     stiffness::register(m)?;
+    settings::register(m)?;
     Ok(())
 }
