@@ -38,8 +38,8 @@ use crate::exceptions::{
     SingularityError,
 };
 use planardyn::dynamics::task::{TaskError, TaskSolution};
-use planardyn::kinematics::EffectorError;
 use planardyn::error::{Setting, SettingError};
+use planardyn::kinematics::EffectorError;
 use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};

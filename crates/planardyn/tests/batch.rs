@@ -6,8 +6,8 @@ mod common;
 use common::*;
 use planardyn::batch::{map_many, simulate_many, Overrides, Variant};
 use planardyn::dynamics::ModelDrives;
-use planardyn::simulate::{simulate, Trajectory};
 use planardyn::error::{Setting, MIN_RTOL};
+use planardyn::simulate::{simulate, Trajectory};
 use planardyn::{Error, KinematicsError, ModelError};
 use std::sync::Arc;
 

@@ -22,9 +22,9 @@ pub use trajectory::{SimStats, Status, Trajectory};
 use std::ops::ControlFlow;
 
 use crate::dynamics::{Drives, Prescribed};
+use crate::error::Setting;
 use crate::integrate::{Method, Options};
 use crate::model::Mechanism;
-use crate::error::Setting;
 use crate::Error;
 use run::{stopped_at_start, Run};
 

@@ -3,9 +3,9 @@
 
 use super::{check, grid, Settings};
 use crate::dynamics::{Motion, Prescribed};
+use crate::error::{Setting, SettingError};
 use crate::integrate::Method;
 use crate::model::{Mechanism, MotionLaw};
-use crate::error::{Setting, SettingError};
 use crate::Error;
 
 /// Most output times an `output_dt` may ask for (a guard against output_dt = 1e-12).

@@ -1,0 +1,264 @@
+//! `planardyn._core.Mechanism` along the rows of a motion: inverse dynamics, dissipated
+//! power, motor torques and the regressor on a branch (`planardyn::batch`'s rows), body
+//! accelerations and reactions along a trajectory (`planardyn::dynamics::along`), the named
+//! points' motion: the bodies of `Mechanism`'s methods of these names, which check the rows'
+//! shapes, call the core and shape its result.
+
+use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, Floats, Values};
+use crate::errors::run;
+use crate::exceptions::argument_error;
+use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
+use planardyn::dynamics::{self, Rows};
+use planardyn::Mechanism;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use std::sync::Arc;
+
+type ArrayArg<'py> = Floats<'py>;
+
+/// What each coordinate's entry is, for messages.
+fn coords_what(mech: &Mechanism) -> String {
+    format!("one value per coordinate: {}", mech.coordinate_names().join(", "))
+}
+
+/// q, qd, qdd of one shape, (m,) or (N, m), and the branch's body coordinates x, (3n,)
+/// or (N, 3n), if given.
+fn motion_rows(
+    mech: &Mechanism,
+    q: &ArrayArg<'_>,
+    qd: &ArrayArg<'_>,
+    qdd: &ArrayArg<'_>,
+    x: Option<&ArrayArg<'_>>,
+    xd: Option<&ArrayArg<'_>>,
+) -> PyResult<MotionRows> {
+    let x = x.map(|a| rows("x", a, mech.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
+    let xd = xd.map(|a| rows("xd", a, mech.n_x(), "body rates [Xd, Yd, phid] per body")).transpose()?;
+    if let Some(xd) = &xd {
+        if x.as_ref().map(|x| &x.shape) != Some(&xd.shape) {
+            let x_shape = x.as_ref().map(|x| format!("{:?}", x.shape)).unwrap_or_else(|| "none".into());
+            return Err(argument_error(
+                Some("xd"),
+                format!("xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}", xd.shape),
+            ));
+        }
+    }
+    let (m, what) = (mech.dof(), coords_what(mech));
+    let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
+    if qd.shape != q.shape || qdd.shape != q.shape {
+        return Err(argument_error(
+            None,
+            format!("q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}", q.shape, qd.shape, qdd.shape),
+        ));
+    }
+    Ok((q, qd, qdd, x, xd))
+}
+
+/// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
+/// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
+/// (`planardyn::batch::Branch`). `xd`, the body rates of x's rows, replaces the rates
+/// solved from qd.
+#[allow(clippy::too_many_arguments)]
+pub fn inverse_dynamics<'py>(
+    py: Python<'py>,
+    mech: &Arc<Mechanism>,
+    q: &ArrayArg<'py>,
+    qd: &ArrayArg<'py>,
+    qdd: &ArrayArg<'py>,
+    x: Option<&ArrayArg<'py>>,
+    xd: Option<&ArrayArg<'py>>,
+    allow_singular: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
+    let mech = mech.clone();
+    let shape = q.shape.clone();
+    let tau = run(py, move || {
+        let branch = branch_of(x.as_ref(), xd.as_ref());
+        Ok(inverse_rows_checked(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
+    })?;
+    arr_dyn(py, &shape, tau)
+}
+
+/// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
+/// (m,) or (N, m): a float or (N,), on the branch of x (and with the rates xd) as
+/// `inverse_dynamics`.
+#[allow(clippy::too_many_arguments)]
+pub fn dissipated_power<'py>(
+    py: Python<'py>,
+    mech: &Arc<Mechanism>,
+    q: &ArrayArg<'py>,
+    qd: &ArrayArg<'py>,
+    qdd: &ArrayArg<'py>,
+    x: Option<&ArrayArg<'py>>,
+    xd: Option<&ArrayArg<'py>>,
+    allow_singular: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
+    let mech = mech.clone();
+    let single = q.shape.len() == 1;
+    let p = run(py, move || {
+        let branch = branch_of(x.as_ref(), xd.as_ref());
+        Ok(dissipation_rows(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
+    })?;
+    if single {
+        return Ok(p[0].into_pyobject(py)?.into_any());
+    }
+    Ok(arr1(py, p))
+}
+
+/// Motor torques (N m, motor side) along (q, qd, qdd), each (m,) or (N, m), on the branch
+/// of x (and with the rates xd) as `inverse_dynamics`: of the joint-side efforts `tau`,
+/// (m,) / (N, m) or every actuator's (n_a,) / (N, n_a), or of the motion's own inverse
+/// dynamics without `tau`; on an actuator without a motor, the effort itself.
+#[allow(clippy::too_many_arguments)]
+pub fn motor_torques<'py>(
+    py: Python<'py>,
+    mech: &Arc<Mechanism>,
+    q: &ArrayArg<'py>,
+    qd: &ArrayArg<'py>,
+    qdd: &ArrayArg<'py>,
+    tau: Option<&ArrayArg<'py>>,
+    x: Option<&ArrayArg<'py>>,
+    xd: Option<&ArrayArg<'py>>,
+    allow_singular: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
+    let n_a = mech.n_actuators();
+    let tau = match &tau {
+        Some(tau) => {
+            let (w, what) = if tau.as_array().shape().last() == Some(&n_a) {
+                (n_a, format!("one per actuator: {}", mech.actuator_names().join(", ")))
+            } else {
+                (mech.dof(), coords_what(mech))
+            };
+            let tau = rows("tau", tau, w, &what)?;
+            if tau.shape[..tau.shape.len() - 1] != q.shape[..q.shape.len() - 1] {
+                return Err(argument_error(
+                    Some("tau"),
+                    format!("tau must have q's rows, got tau {:?} and q {:?}", tau.shape, q.shape),
+                ));
+            }
+            Some((tau, w))
+        }
+        None => None,
+    };
+    let mut shape = q.shape.clone();
+    if let Some((_, w)) = &tau {
+        *shape.last_mut().expect("rows have a last axis") = *w;
+    }
+    let mech = mech.clone();
+    let t_m = run(py, move || {
+        let branch = branch_of(x.as_ref(), xd.as_ref());
+        let given = tau.as_ref().map(|(t, w)| (&t.data[..], *w));
+        let t_m = motor_torque_rows(&mech, branch, &q.data, &qd.data, &qdd.data, given, allow_singular)?;
+        Ok(dynamics::finite("motor torques", t_m)?)
+    })?;
+    arr_dyn(py, &shape, t_m)
+}
+
+/// The regressor form along rows of a motion, on the branch of x (and with the body rates
+/// xd) as `inverse_dynamics`: `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with
+/// efforts = Y pi + tau_o.
+#[allow(clippy::too_many_arguments)]
+pub fn regressor<'py>(
+    py: Python<'py>,
+    mech: &Arc<Mechanism>,
+    q: &ArrayArg<'py>,
+    qd: &ArrayArg<'py>,
+    qdd: &ArrayArg<'py>,
+    x: Option<&ArrayArg<'py>>,
+    xd: Option<&ArrayArg<'py>>,
+    allow_singular: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
+    let mech = mech.clone();
+    let (m, p) = (mech.dof(), planardyn::dynamics::regressor::n_parameters(&mech));
+    let (y, tau_o) = run(py, || {
+        let branch = branch_of(x.as_ref(), xd.as_ref());
+        Ok(regressor_rows(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
+    })?;
+    let n = q.rows();
+    let d = PyDict::new(py);
+    if q.shape.len() == 1 {
+        d.set_item("Y", arr2(py, m, p, y)?)?;
+        d.set_item("tau_o", arr1(py, tau_o))?;
+    } else {
+        d.set_item("Y", arr3(py, (n, m, p), y)?)?;
+        d.set_item("tau_o", arr2(py, n, m, tau_o)?)?;
+    }
+    Ok(d)
+}
+
+/// Body accelerations (N, 3n) and pair reactions (N, p, 3) along a trajectory's rows, each
+/// on its own body coordinates x (`planardyn::dynamics::along`).
+#[allow(clippy::too_many_arguments)]
+pub fn along<'py>(
+    py: Python<'py>,
+    mech: &Arc<Mechanism>,
+    t: &ArrayArg<'py>,
+    x: &ArrayArg<'py>,
+    q: &ArrayArg<'py>,
+    qd: &ArrayArg<'py>,
+    tau: &ArrayArg<'py>,
+    allow_singular: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (m, nx, p) = (mech.dof(), mech.n_x(), mech.pairs.len());
+    let what = coords_what(mech);
+    let x = rows("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
+    let (q, qd, tau) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
+    let t = Values::read(&t);
+    let mech = mech.clone();
+    let out = run(py, || {
+        let r = Rows { t: &t.data, x: &x.data, q: &q.data, qd: &qd.data, tau: &tau.data };
+        Ok(dynamics::along(&mech, r, allow_singular)?)
+    })?;
+    let n = out.xdd.len() / nx;
+    let d = PyDict::new(py);
+    d.set_item("xdd", arr2(py, n, nx, out.xdd)?)?;
+    d.set_item("reactions", arr3(py, (n, p, 3), out.reactions)?)?;
+    Ok(d)
+}
+
+/// Positions, velocities and accelerations (N, P, 2) of the named points a link carries
+/// (`names`), for rows of x, xd, xdd (N, 3n).
+pub fn point_motion<'py>(
+    py: Python<'py>,
+    mech: &Arc<Mechanism>,
+    x: &ArrayArg<'py>,
+    xd: &ArrayArg<'py>,
+    xdd: &ArrayArg<'py>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let nx = mech.n_x();
+    let what = "body coordinates [X, Y, phi] per body";
+    let (x, xd, xdd) = (rows("x", &x, nx, what)?, rows("xd", &xd, nx, what)?, rows("xdd", &xdd, nx, what)?);
+    if xd.data.len() != x.data.len() || xdd.data.len() != x.data.len() {
+        return Err(argument_error(
+            None,
+            format!("x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}", x.shape, xd.shape, xdd.shape),
+        ));
+    }
+    let mech = &mech;
+    let names: Vec<&str> = dynamics::carried_points(mech).iter().map(|(p, _)| mech.points[p.0].0.as_str()).collect();
+    let [pos, vel, acc] = dynamics::point_motion(mech, &x.data, &xd.data, &xdd.data);
+    let shape = (x.rows(), names.len(), 2);
+    let d = PyDict::new(py);
+    d.set_item("names", names)?;
+    d.set_item("position", arr3(py, shape, pos)?)?;
+    d.set_item("velocity", arr3(py, shape, vel)?)?;
+    d.set_item("acceleration", arr3(py, shape, acc)?)?;
+    Ok(d)
+}
+
+/// A motion's q, qd, qdd rows and the optional body coordinates x and rates xd of its rows.
+type MotionRows = (Values, Values, Values, Option<Values>, Option<Values>);
+
+/// The branch of a motion: the drawn one, from the first row's body coordinates (3n,), or
+/// every row's (N, 3n); with body rates (x's shape, checked by `motion_rows`) every row's.
+fn branch_of<'a>(x: Option<&'a Values>, xd: Option<&'a Values>) -> Branch<'a> {
+    match (x, xd) {
+        (None, _) => Branch::Drawing,
+        (Some(x), Some(xd)) => Branch::Rows(&x.data, Some(&xd.data)),
+        (Some(x), None) if x.shape.len() == 1 => Branch::From(&x.data),
+        (Some(x), None) => Branch::Rows(&x.data, None),
+    }
+}
