@@ -6,7 +6,7 @@
 //! thread-safe. The bodies of the larger model getters are in `model.rs`, those of the methods
 //! along the rows of a motion in `rows.rs`.
 
-use crate::convert::{arr1, arr2, arr3, rows as row_args, vector, Floats, Values};
+use crate::convert::{arr1, arr2, vector, Floats, Values};
 use crate::errors::{run, Failure};
 use crate::exceptions::{argument_error, PlanardynError};
 use crate::query::{Named, ToPython};
@@ -264,18 +264,7 @@ impl PyMechanism {
 
     /// World positions of every named point: (P, 2) for x of shape (3n,), (N, P, 2) for (N, 3n).
     fn point_positions<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let nx = self.inner.n_x();
-        let v = row_args("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
-        let p = self.inner.points.len();
-        let mut out = Vec::with_capacity(v.rows() * p * 2);
-        for k in 0..v.rows() {
-            out.extend(query::point_positions(&self.inner, v.row(k, nx)));
-        }
-        if v.shape.len() == 1 {
-            arr2(py, p, 2, out)
-        } else {
-            arr3(py, (v.rows(), p, 2), out)
-        }
+        rows::point_positions(py, &self.inner, &x)
     }
 
     /// Positions and analogues at q (and velocities with qd); see the Python docstring.

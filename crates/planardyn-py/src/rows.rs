@@ -1,14 +1,14 @@
-//! `planardyn._core.Mechanism` along the rows of a motion: inverse dynamics, dissipated
-//! power, motor torques and the regressor on a branch (`planardyn::batch`'s rows), body
-//! accelerations and reactions along a trajectory (`planardyn::dynamics::along`), the named
-//! points' motion: the bodies of `Mechanism`'s methods of these names, which check the rows'
-//! shapes, call the core and shape its result.
+//! `planardyn._core.Mechanism` along the rows of a motion: the named points' positions;
+//! inverse dynamics, dissipated power, motor torques and the regressor on a branch
+//! (`planardyn::batch`'s rows); body accelerations and reactions along a trajectory
+//! (`planardyn::dynamics::along`); the named points' motion. The bodies of `Mechanism`'s
+//! methods of these names: they check the rows' shapes, call the core and shape its result.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, Floats, Values};
 use crate::errors::run;
 use crate::exceptions::argument_error;
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
-use planardyn::dynamics::{self, Rows};
+use planardyn::dynamics::{self, query, Rows};
 use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -52,6 +52,19 @@ fn motion_rows(
         ));
     }
     Ok((q, qd, qdd, x, xd))
+}
+
+/// World positions of every named point: (P, 2) for x of shape (3n,), (N, P, 2) for (N, 3n).
+pub fn point_positions<'py>(py: Python<'py>, mech: &Mechanism, x: &ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let nx = mech.n_x();
+    let v = rows("x", x, nx, "body coordinates [X, Y, phi] per body")?;
+    let p = mech.points.len();
+    let out: Vec<f64> = (0..v.rows()).flat_map(|k| query::point_positions(mech, v.row(k, nx))).collect();
+    if v.shape.len() == 1 {
+        arr2(py, p, 2, out)
+    } else {
+        arr3(py, (v.rows(), p, 2), out)
+    }
 }
 
 /// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
