@@ -217,9 +217,9 @@ pub fn along<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (m, nx, p) = (mech.dof(), mech.n_x(), mech.pairs.len());
     let what = coords_what(mech);
-    let x = rows("x", &x, nx, "body coordinates [X, Y, phi] per body")?;
-    let (q, qd, tau) = (rows("q", &q, m, &what)?, rows("qd", &qd, m, &what)?, rows("tau", &tau, m, &what)?);
-    let t = Values::read(&t);
+    let x = rows("x", x, nx, "body coordinates [X, Y, phi] per body")?;
+    let (q, qd, tau) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("tau", tau, m, &what)?);
+    let t = Values::read(t);
     let mech = mech.clone();
     let out = run(py, || {
         let r = Rows { t: &t.data, x: &x.data, q: &q.data, qd: &qd.data, tau: &tau.data };
@@ -243,7 +243,7 @@ pub fn point_motion<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let nx = mech.n_x();
     let what = "body coordinates [X, Y, phi] per body";
-    let (x, xd, xdd) = (rows("x", &x, nx, what)?, rows("xd", &xd, nx, what)?, rows("xdd", &xdd, nx, what)?);
+    let (x, xd, xdd) = (rows("x", x, nx, what)?, rows("xd", xd, nx, what)?, rows("xdd", xdd, nx, what)?);
     if xd.data.len() != x.data.len() || xdd.data.len() != x.data.len() {
         return Err(argument_error(
             None,
