@@ -34,25 +34,17 @@ impl PyMechanism {
         PyMechanism { inner: Arc::new(mech) }
     }
 
-    pub(crate) fn m(&self) -> usize {
+    fn m(&self) -> usize {
         self.inner.dof()
     }
 
-    pub(crate) fn coords_what(&self) -> String {
-        format!("one value per coordinate: {}", self.inner.coordinate_names().join(", "))
-    }
-
     fn q_arg(&self, name: &str, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
-        vector(name, a, self.m(), &self.coords_what())
+        vector(name, a, self.m(), &rows::coords_what(&self.inner))
     }
 
-    /// Body coordinates (3n,) given as a continuation start, or at which to draw.
-    pub(crate) fn x_arg(&self, name: &str, a: &ArrayArg<'_>) -> PyResult<Vec<f64>> {
-        vector(name, a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")
-    }
-
+    /// Body coordinates (3n,) on the wanted branch, where a continuation starts.
     fn x_start(&self, a: Option<ArrayArg<'_>>) -> PyResult<Option<Vec<f64>>> {
-        a.map(|a| self.x_arg("x_start", &a)).transpose()
+        a.map(|a| vector("x_start", &a, self.inner.n_x(), "body coordinates [X, Y, phi] per body")).transpose()
     }
 
     /// The arguments of a forward query, checked: q, qd, tau (m,), a finite time t (s).

@@ -18,7 +18,7 @@ use std::sync::Arc;
 type ArrayArg<'py> = Floats<'py>;
 
 /// What each coordinate's entry is, for messages.
-fn coords_what(mech: &Mechanism) -> String {
+pub fn coords_what(mech: &Mechanism) -> String {
     format!("one value per coordinate: {}", mech.coordinate_names().join(", "))
 }
 
