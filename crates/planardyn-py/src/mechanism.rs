@@ -9,8 +9,9 @@
 use crate::convert::{arr1, arr2, vector, Floats, Values};
 use crate::errors::{run, Failure};
 use crate::exceptions::{argument_error, PlanardynError};
+use crate::model;
 use crate::query::{Named, ToPython};
-use crate::{model, rows};
+use crate::rows::{self, MotionArgs};
 use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::dynamics::redundant::Distribution;
 use planardyn::Mechanism;
@@ -418,7 +419,8 @@ impl PyMechanism {
         xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        rows::inverse_dynamics(py, &self.inner, &q, &qd, &qdd, x.as_ref(), xd.as_ref(), allow_singular)
+        let motion = MotionArgs { q: &q, qd: &qd, qdd: &qdd, x: x.as_ref(), xd: xd.as_ref() };
+        rows::inverse_dynamics(py, &self.inner, motion, allow_singular)
     }
 
     /// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
@@ -436,7 +438,8 @@ impl PyMechanism {
         xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        rows::dissipated_power(py, &self.inner, &q, &qd, &qdd, x.as_ref(), xd.as_ref(), allow_singular)
+        let motion = MotionArgs { q: &q, qd: &qd, qdd: &qdd, x: x.as_ref(), xd: xd.as_ref() };
+        rows::dissipated_power(py, &self.inner, motion, allow_singular)
     }
 
     /// Motor torques (N m, motor side) along (q, qd, qdd), each (m,) or (N, m), on the branch
@@ -456,7 +459,8 @@ impl PyMechanism {
         xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        rows::motor_torques(py, &self.inner, &q, &qd, &qdd, tau.as_ref(), x.as_ref(), xd.as_ref(), allow_singular)
+        let motion = MotionArgs { q: &q, qd: &qd, qdd: &qdd, x: x.as_ref(), xd: xd.as_ref() };
+        rows::motor_torques(py, &self.inner, motion, tau.as_ref(), allow_singular)
     }
 
     /// The regressor form along rows of a motion, on the branch of x (and with the body rates
@@ -474,7 +478,8 @@ impl PyMechanism {
         xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        rows::regressor(py, &self.inner, &q, &qd, &qdd, x.as_ref(), xd.as_ref(), allow_singular)
+        let motion = MotionArgs { q: &q, qd: &qd, qdd: &qdd, x: x.as_ref(), xd: xd.as_ref() };
+        rows::regressor(py, &self.inner, motion, allow_singular)
     }
 
     /// Body accelerations (N, 3n) and pair reactions (N, p, 3) along a trajectory's rows, each

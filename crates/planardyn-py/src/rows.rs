@@ -9,11 +9,10 @@ use crate::errors::run;
 use crate::exceptions::argument_error;
 use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
 use planardyn::dynamics::{self, query, Rows};
+use planardyn::Error;
 use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-use std::sync::Arc;
 
 type ArrayArg<'py> = Floats<'py>;
 
@@ -22,36 +21,74 @@ pub fn coords_what(mech: &Mechanism) -> String {
     format!("one value per coordinate: {}", mech.coordinate_names().join(", "))
 }
 
-/// q, qd, qdd of one shape, (m,) or (N, m), and the branch's body coordinates x, (3n,)
-/// or (N, 3n), if given.
-fn motion_rows(
-    mech: &Mechanism,
-    q: &ArrayArg<'_>,
-    qd: &ArrayArg<'_>,
-    qdd: &ArrayArg<'_>,
-    x: Option<&ArrayArg<'_>>,
-    xd: Option<&ArrayArg<'_>>,
-) -> PyResult<MotionRows> {
-    let x = x.map(|a| rows("x", a, mech.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
-    let xd = xd.map(|a| rows("xd", a, mech.n_x(), "body rates [Xd, Yd, phid] per body")).transpose()?;
-    if let Some(xd) = &xd {
-        if x.as_ref().map(|x| &x.shape) != Some(&xd.shape) {
-            let x_shape = x.as_ref().map(|x| format!("{:?}", x.shape)).unwrap_or_else(|| "none".into());
+/// A motion as the rows methods take it: q, qd, qdd, each (m,) or (N, m), and the body
+/// coordinates x, (3n,) or (N, 3n), and rates xd, of its branch, if given.
+pub struct MotionArgs<'a, 'py> {
+    pub q: &'a ArrayArg<'py>,
+    pub qd: &'a ArrayArg<'py>,
+    pub qdd: &'a ArrayArg<'py>,
+    pub x: Option<&'a ArrayArg<'py>>,
+    pub xd: Option<&'a ArrayArg<'py>>,
+}
+
+/// A motion's rows, checked: q, qd, qdd of one shape, x and xd of one shape.
+struct Motion {
+    q: Values,
+    qd: Values,
+    qdd: Values,
+    x: Option<Values>,
+    xd: Option<Values>,
+}
+
+impl MotionArgs<'_, '_> {
+    fn checked(self, mech: &Mechanism) -> PyResult<Motion> {
+        let x = self.x.map(|a| rows("x", a, mech.n_x(), "body coordinates [X, Y, phi] per body")).transpose()?;
+        let xd = self.xd.map(|a| rows("xd", a, mech.n_x(), "body rates [Xd, Yd, phid] per body")).transpose()?;
+        if let Some(xd) = &xd {
+            if x.as_ref().map(|x| &x.shape) != Some(&xd.shape) {
+                let x_shape = x.as_ref().map(|x| format!("{:?}", x.shape)).unwrap_or_else(|| "none".into());
+                return Err(argument_error(
+                    Some("xd"),
+                    format!("xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}", xd.shape),
+                ));
+            }
+        }
+        let (m, what) = (mech.dof(), coords_what(mech));
+        let (q, qd, qdd) =
+            (rows("q", self.q, m, &what)?, rows("qd", self.qd, m, &what)?, rows("qdd", self.qdd, m, &what)?);
+        if qd.shape != q.shape || qdd.shape != q.shape {
             return Err(argument_error(
-                Some("xd"),
-                format!("xd needs x of the same rows (a result's x and xd), got xd {:?} and x {x_shape}", xd.shape),
+                None,
+                format!(
+                    "q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}",
+                    q.shape, qd.shape, qdd.shape
+                ),
             ));
         }
+        Ok(Motion { q, qd, qdd, x, xd })
     }
-    let (m, what) = (mech.dof(), coords_what(mech));
-    let (q, qd, qdd) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("qdd", qdd, m, &what)?);
-    if qd.shape != q.shape || qdd.shape != q.shape {
-        return Err(argument_error(
-            None,
-            format!("q, qd and qdd must have the same shape, got {:?}, {:?} and {:?}", q.shape, qd.shape, qdd.shape),
-        ));
+}
+
+impl Motion {
+    /// The branch: the drawn one, from the first row's body coordinates (3n,), or every
+    /// row's (N, 3n); with body rates (x's shape) every row's.
+    fn branch(&self) -> Branch<'_> {
+        match (&self.x, &self.xd) {
+            (None, _) => Branch::Drawing,
+            (Some(x), Some(xd)) => Branch::Rows(&x.data, Some(&xd.data)),
+            (Some(x), None) if x.shape.len() == 1 => Branch::From(&x.data),
+            (Some(x), None) => Branch::Rows(&x.data, None),
+        }
     }
-    Ok((q, qd, qdd, x, xd))
+
+    /// `f(branch, q, qd, qdd)`, a core computation along the rows, with the GIL released.
+    fn run<T: Send>(
+        &self,
+        py: Python<'_>,
+        f: impl FnOnce(Branch<'_>, &[f64], &[f64], &[f64]) -> Result<T, Error> + Send,
+    ) -> PyResult<T> {
+        run(py, || Ok(f(self.branch(), &self.q.data, &self.qd.data, &self.qdd.data)?))
+    }
 }
 
 /// World positions of every named point: (P, 2) for x of shape (3n,), (N, P, 2) for (N, 3n).
@@ -71,49 +108,29 @@ pub fn point_positions<'py>(py: Python<'py>, mech: &Mechanism, x: &ArrayArg<'py>
 /// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
 /// (`planardyn::batch::Branch`). `xd`, the body rates of x's rows, replaces the rates
 /// solved from qd.
-#[allow(clippy::too_many_arguments)]
 pub fn inverse_dynamics<'py>(
     py: Python<'py>,
-    mech: &Arc<Mechanism>,
-    q: &ArrayArg<'py>,
-    qd: &ArrayArg<'py>,
-    qdd: &ArrayArg<'py>,
-    x: Option<&ArrayArg<'py>>,
-    xd: Option<&ArrayArg<'py>>,
+    mech: &Mechanism,
+    motion: MotionArgs<'_, 'py>,
     allow_singular: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
-    let mech = mech.clone();
-    let shape = q.shape.clone();
-    let tau = run(py, move || {
-        let branch = branch_of(x.as_ref(), xd.as_ref());
-        Ok(inverse_rows_checked(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
-    })?;
-    arr_dyn(py, &shape, tau)
+    let motion = motion.checked(mech)?;
+    let tau = motion.run(py, |branch, q, qd, qdd| inverse_rows_checked(mech, branch, q, qd, qdd, allow_singular))?;
+    arr_dyn(py, &motion.q.shape, tau)
 }
 
 /// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
 /// (m,) or (N, m): a float or (N,), on the branch of x (and with the rates xd) as
 /// `inverse_dynamics`.
-#[allow(clippy::too_many_arguments)]
 pub fn dissipated_power<'py>(
     py: Python<'py>,
-    mech: &Arc<Mechanism>,
-    q: &ArrayArg<'py>,
-    qd: &ArrayArg<'py>,
-    qdd: &ArrayArg<'py>,
-    x: Option<&ArrayArg<'py>>,
-    xd: Option<&ArrayArg<'py>>,
+    mech: &Mechanism,
+    motion: MotionArgs<'_, 'py>,
     allow_singular: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
-    let mech = mech.clone();
-    let single = q.shape.len() == 1;
-    let p = run(py, move || {
-        let branch = branch_of(x.as_ref(), xd.as_ref());
-        Ok(dissipation_rows(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
-    })?;
-    if single {
+    let motion = motion.checked(mech)?;
+    let p = motion.run(py, |branch, q, qd, qdd| dissipation_rows(mech, branch, q, qd, qdd, allow_singular))?;
+    if motion.q.shape.len() == 1 {
         return Ok(p[0].into_pyobject(py)?.into_any());
     }
     Ok(arr1(py, p))
@@ -123,19 +140,15 @@ pub fn dissipated_power<'py>(
 /// of x (and with the rates xd) as `inverse_dynamics`: of the joint-side efforts `tau`,
 /// (m,) / (N, m) or every actuator's (n_a,) / (N, n_a), or of the motion's own inverse
 /// dynamics without `tau`; on an actuator without a motor, the effort itself.
-#[allow(clippy::too_many_arguments)]
 pub fn motor_torques<'py>(
     py: Python<'py>,
-    mech: &Arc<Mechanism>,
-    q: &ArrayArg<'py>,
-    qd: &ArrayArg<'py>,
-    qdd: &ArrayArg<'py>,
+    mech: &Mechanism,
+    motion: MotionArgs<'_, 'py>,
     tau: Option<&ArrayArg<'py>>,
-    x: Option<&ArrayArg<'py>>,
-    xd: Option<&ArrayArg<'py>>,
     allow_singular: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
+    let motion = motion.checked(mech)?;
+    let q = &motion.q;
     let n_a = mech.n_actuators();
     let tau = match &tau {
         Some(tau) => {
@@ -159,12 +172,10 @@ pub fn motor_torques<'py>(
     if let Some((_, w)) = &tau {
         *shape.last_mut().expect("rows have a last axis") = *w;
     }
-    let mech = mech.clone();
-    let t_m = run(py, move || {
-        let branch = branch_of(x.as_ref(), xd.as_ref());
+    let t_m = motion.run(py, |branch, q, qd, qdd| {
         let given = tau.as_ref().map(|(t, w)| (&t.data[..], *w));
-        let t_m = motor_torque_rows(&mech, branch, &q.data, &qd.data, &qdd.data, given, allow_singular)?;
-        Ok(dynamics::finite("motor torques", t_m)?)
+        dynamics::finite("motor torques", motor_torque_rows(mech, branch, q, qd, qdd, given, allow_singular)?)
+            .map_err(Error::from)
     })?;
     arr_dyn(py, &shape, t_m)
 }
@@ -172,24 +183,16 @@ pub fn motor_torques<'py>(
 /// The regressor form along rows of a motion, on the branch of x (and with the body rates
 /// xd) as `inverse_dynamics`: `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with
 /// efforts = Y pi + tau_o.
-#[allow(clippy::too_many_arguments)]
 pub fn regressor<'py>(
     py: Python<'py>,
-    mech: &Arc<Mechanism>,
-    q: &ArrayArg<'py>,
-    qd: &ArrayArg<'py>,
-    qdd: &ArrayArg<'py>,
-    x: Option<&ArrayArg<'py>>,
-    xd: Option<&ArrayArg<'py>>,
+    mech: &Mechanism,
+    motion: MotionArgs<'_, 'py>,
     allow_singular: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (q, qd, qdd, x, xd) = motion_rows(mech, q, qd, qdd, x, xd)?;
-    let mech = mech.clone();
-    let (m, p) = (mech.dof(), planardyn::dynamics::regressor::n_parameters(&mech));
-    let (y, tau_o) = run(py, || {
-        let branch = branch_of(x.as_ref(), xd.as_ref());
-        Ok(regressor_rows(&mech, branch, &q.data, &qd.data, &qdd.data, allow_singular)?)
-    })?;
+    let motion = motion.checked(mech)?;
+    let (m, p) = (mech.dof(), planardyn::dynamics::regressor::n_parameters(mech));
+    let (y, tau_o) = motion.run(py, |branch, q, qd, qdd| regressor_rows(mech, branch, q, qd, qdd, allow_singular))?;
+    let q = &motion.q;
     let n = q.rows();
     let d = PyDict::new(py);
     if q.shape.len() == 1 {
@@ -207,7 +210,7 @@ pub fn regressor<'py>(
 #[allow(clippy::too_many_arguments)]
 pub fn along<'py>(
     py: Python<'py>,
-    mech: &Arc<Mechanism>,
+    mech: &Mechanism,
     t: &ArrayArg<'py>,
     x: &ArrayArg<'py>,
     q: &ArrayArg<'py>,
@@ -220,10 +223,9 @@ pub fn along<'py>(
     let x = rows("x", x, nx, "body coordinates [X, Y, phi] per body")?;
     let (q, qd, tau) = (rows("q", q, m, &what)?, rows("qd", qd, m, &what)?, rows("tau", tau, m, &what)?);
     let t = Values::read(t);
-    let mech = mech.clone();
     let out = run(py, || {
         let r = Rows { t: &t.data, x: &x.data, q: &q.data, qd: &qd.data, tau: &tau.data };
-        Ok(dynamics::along(&mech, r, allow_singular)?)
+        Ok(dynamics::along(mech, r, allow_singular)?)
     })?;
     let n = out.xdd.len() / nx;
     let d = PyDict::new(py);
@@ -236,7 +238,7 @@ pub fn along<'py>(
 /// (`names`), for rows of x, xd, xdd (N, 3n).
 pub fn point_motion<'py>(
     py: Python<'py>,
-    mech: &Arc<Mechanism>,
+    mech: &Mechanism,
     x: &ArrayArg<'py>,
     xd: &ArrayArg<'py>,
     xdd: &ArrayArg<'py>,
@@ -250,7 +252,6 @@ pub fn point_motion<'py>(
             format!("x, xd and xdd must have the same shape, got {:?}, {:?} and {:?}", x.shape, xd.shape, xdd.shape),
         ));
     }
-    let mech = &mech;
     let names: Vec<&str> = dynamics::carried_points(mech).iter().map(|(p, _)| mech.points[p.0].0.as_str()).collect();
     let [pos, vel, acc] = dynamics::point_motion(mech, &x.data, &xd.data, &xdd.data);
     let shape = (x.rows(), names.len(), 2);
@@ -260,18 +261,4 @@ pub fn point_motion<'py>(
     d.set_item("velocity", arr3(py, shape, vel)?)?;
     d.set_item("acceleration", arr3(py, shape, acc)?)?;
     Ok(d)
-}
-
-/// A motion's q, qd, qdd rows and the optional body coordinates x and rates xd of its rows.
-type MotionRows = (Values, Values, Values, Option<Values>, Option<Values>);
-
-/// The branch of a motion: the drawn one, from the first row's body coordinates (3n,), or
-/// every row's (N, 3n); with body rates (x's shape, checked by `motion_rows`) every row's.
-fn branch_of<'a>(x: Option<&'a Values>, xd: Option<&'a Values>) -> Branch<'a> {
-    match (x, xd) {
-        (None, _) => Branch::Drawing,
-        (Some(x), Some(xd)) => Branch::Rows(&x.data, Some(&xd.data)),
-        (Some(x), None) if x.shape.len() == 1 => Branch::From(&x.data),
-        (Some(x), None) => Branch::Rows(&x.data, None),
-    }
 }
