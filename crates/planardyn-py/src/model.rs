@@ -13,14 +13,13 @@ use pyo3::types::PyDict;
 
 type ArrayArg<'py> = Floats<'py>;
 
-/// "angle" or "displacement" per actuator (`actuator_names`): what its effort turns.
+/// `Mechanism.actuator_kinds` (the getter's doc there).
 pub fn actuator_kinds(mech: &Mechanism) -> Vec<&'static str> {
     let pairs = mech.coordinates.iter().map(|c| c.pair).chain(mech.pair_actuators.iter().map(|a| a.pair));
     pairs.map(|p| pairs::coordinate_kind(&mech.pairs[p.0]).map_or("displacement", CoordinateKind::name)).collect()
 }
 
-/// For each body, its points as (name, (s_x, s_y)) in the body frame (m): origin at the
-/// centre of mass, rotated by the body angle phi.
+/// `Mechanism.body_points` (the getter's doc there).
 pub fn body_points(mech: &Mechanism) -> Vec<Vec<(String, (f64, f64))>> {
     mech.bodies
         .iter()
@@ -28,10 +27,7 @@ pub fn body_points(mech: &Mechanism) -> Vec<Vec<(String, (f64, f64))>> {
         .collect()
 }
 
-/// The pairs as dicts: name, kind ('revolute' | 'prismatic' | 'gear' | 'slot'), bodies
-/// (a, b) by name ('ground' for the fixed body), point (name; a gear's first centre),
-/// axis (the guide or slot direction in a's frame, or None), rows (start, stop): the
-/// pair's rows among the pair-constraint rows (`structure.constraint_jacobian`).
+/// `Mechanism.pairs` (the getter's doc there).
 pub fn pairs<'py>(py: Python<'py>, mech: &Mechanism) -> PyResult<Vec<Bound<'py, PyDict>>> {
     mech.pairs
         .iter()
@@ -54,10 +50,7 @@ pub fn pairs<'py>(py: Python<'py>, mech: &Mechanism) -> PyResult<Vec<Bound<'py, 
         .collect()
 }
 
-/// What the drawings show of each pair at body coordinates x (3n,), in world
-/// coordinates (m): a dict per pair with name, kind, pins [(x, y)] (pin joints),
-/// blocks [(x, y)] (sliding blocks), lines [((x, y), (x, y))] (guides, slots, rack pitch
-/// lines) and circles [((x, y), r)] (pitch circles).
+/// `Mechanism.pair_geometry` (the method's doc there).
 pub fn pair_geometry<'py>(py: Python<'py>, mech: &Mechanism, x: &ArrayArg<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let x = vector("x", x, mech.n_x(), "body coordinates [X, Y, phi] per body")?;
     let pt = |p: [f64; 2]| (p[0], p[1]);
@@ -77,7 +70,7 @@ pub fn pair_geometry<'py>(py: Python<'py>, mech: &Mechanism, x: &ArrayArg<'py>) 
         .collect()
 }
 
-/// The model file's `simulate` defaults (None where not given).
+/// `Mechanism.simulate_defaults` (the getter's doc there).
 pub fn simulate_defaults<'py>(py: Python<'py>, mech: &Mechanism) -> PyResult<Bound<'py, PyDict>> {
     let s = &mech.simulate;
     let d = PyDict::new(py);
@@ -90,12 +83,7 @@ pub fn simulate_defaults<'py>(py: Python<'py>, mech: &Mechanism) -> PyResult<Bou
     Ok(d)
 }
 
-/// The actuators, one entry per actuator (the coordinates', then the pair actuators';
-/// None: an ideal effort source): dicts of
-/// name, gear_ratio, efficiency, backdrive_efficiency, rotor_inertia (kg m^2), viscous,
-/// coulomb, stiction_speed
-/// and the limits peak_torque, continuous_torque (N m), max_speed (rad/s) (None when not
-/// given) and envelope ((k, 2) [speed, torque] points).
+/// `Mechanism.actuators` (the getter's doc there).
 pub fn actuators<'py>(py: Python<'py>, mech: &Mechanism) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
     dynamics::transmission::motors(mech)
         .map(|slot| {
@@ -121,8 +109,7 @@ pub fn actuators<'py>(py: Python<'py>, mech: &Mechanism) -> PyResult<Vec<Option<
         .collect()
 }
 
-/// The torque (N m) actuator `coordinate`'s motor can give at motor speeds `speed`
-/// (rad/s, any shape): its envelope, else its peak torque; None without limits.
+/// `Mechanism.available_torque` (the method's doc there).
 pub fn available_torque<'py>(
     py: Python<'py>,
     mech: &Mechanism,

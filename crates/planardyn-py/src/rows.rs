@@ -91,7 +91,7 @@ impl Motion {
     }
 }
 
-/// World positions of every named point: (P, 2) for x of shape (3n,), (N, P, 2) for (N, 3n).
+/// `Mechanism.point_positions` (the method's doc there).
 pub fn point_positions<'py>(py: Python<'py>, mech: &Mechanism, x: &ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
     let nx = mech.n_x();
     let v = rows("x", x, nx, "body coordinates [X, Y, phi] per body")?;
@@ -104,10 +104,7 @@ pub fn point_positions<'py>(py: Python<'py>, mech: &Mechanism, x: &ArrayArg<'py>
     }
 }
 
-/// Efforts tau for (q, qd, qdd), each (m,) or (N, m), on the branch of the body
-/// coordinates `x`: (3n,) at the first row, or (N, 3n) at every row; else the drawn one
-/// (`planardyn::batch::Branch`). `xd`, the body rates of x's rows, replaces the rates
-/// solved from qd.
+/// `Mechanism.inverse_dynamics` (the method's doc there).
 pub fn inverse_dynamics<'py>(
     py: Python<'py>,
     mech: &Mechanism,
@@ -119,9 +116,7 @@ pub fn inverse_dynamics<'py>(
     arr_dyn(py, &motion.q.shape, tau)
 }
 
-/// Power (W, >= 0) dissipated by the pairs' Coulomb friction along (q, qd, qdd), each
-/// (m,) or (N, m): a float or (N,), on the branch of x (and with the rates xd) as
-/// `inverse_dynamics`.
+/// `Mechanism.dissipated_power` (the method's doc there).
 pub fn dissipated_power<'py>(
     py: Python<'py>,
     mech: &Mechanism,
@@ -136,10 +131,7 @@ pub fn dissipated_power<'py>(
     Ok(arr1(py, p))
 }
 
-/// Motor torques (N m, motor side) along (q, qd, qdd), each (m,) or (N, m), on the branch
-/// of x (and with the rates xd) as `inverse_dynamics`: of the joint-side efforts `tau`,
-/// (m,) / (N, m) or every actuator's (n_a,) / (N, n_a), or of the motion's own inverse
-/// dynamics without `tau`; on an actuator without a motor, the effort itself.
+/// `Mechanism.motor_torques` (the method's doc there).
 pub fn motor_torques<'py>(
     py: Python<'py>,
     mech: &Mechanism,
@@ -180,9 +172,7 @@ pub fn motor_torques<'py>(
     arr_dyn(py, &shape, t_m)
 }
 
-/// The regressor form along rows of a motion, on the branch of x (and with the body rates
-/// xd) as `inverse_dynamics`: `Y` (m, p) or (N, m, p), `tau_o` (m,) or (N, m) with
-/// efforts = Y pi + tau_o.
+/// `Mechanism.regressor` (the method's doc there).
 pub fn regressor<'py>(
     py: Python<'py>,
     mech: &Mechanism,
@@ -205,8 +195,7 @@ pub fn regressor<'py>(
     Ok(d)
 }
 
-/// Body accelerations (N, 3n) and pair reactions (N, p, 3) along a trajectory's rows, each
-/// on its own body coordinates x (`planardyn::dynamics::along`).
+/// `Mechanism.along` (the method's doc there).
 #[allow(clippy::too_many_arguments)]
 pub fn along<'py>(
     py: Python<'py>,
@@ -234,8 +223,7 @@ pub fn along<'py>(
     Ok(d)
 }
 
-/// Positions, velocities and accelerations (N, P, 2) of the named points a link carries
-/// (`names`), for rows of x, xd, xdd (N, 3n).
+/// `Mechanism.point_motion` (the method's doc there).
 pub fn point_motion<'py>(
     py: Python<'py>,
     mech: &Mechanism,
