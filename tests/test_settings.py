@@ -94,7 +94,7 @@ def test_the_rules_are_the_cores():
             check_setting(name, float(value))
         assert str(core.value).removeprefix("invalid option: ").startswith(f"{name} = ")
     assert check_setting("rtol", MIN_RTOL) == MIN_RTOL
-    with pytest.raises(pd.ArgumentError, match="no setting 'tend': use one of t_end, rtol"):
+    with pytest.raises(pd.ArgumentError, match='no setting "tend": use one of t_end, rtol'):
         check_setting("tend", 1.0)
 
 
