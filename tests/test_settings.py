@@ -11,7 +11,8 @@ import pytest
 import yaml
 from conftest import MODELS, cli_run
 from planardyn import batch
-from planardyn.settings import MAX_THREADS, MIN_RTOL
+from planardyn._core import check_setting
+from planardyn.settings import MAX_STEPS, MAX_THREADS, MIN_RTOL
 
 FIVE_BAR = MODELS / "five-bar.yaml"
 
@@ -45,6 +46,56 @@ def test_positive_tolerances_are_taken():
     assert MIN_RTOL == pytest.approx(2.22e-14, rel=1e-3)  # 100 * 2.220446e-16
     with pytest.raises(pd.SimulationError, match="below 100 machine epsilons"):
         pd.load(FIVE_BAR).simulate(0.01, rtol=MIN_RTOL / 2)
+
+
+# One bad value of each rule (planardyn::error::Setting::check): t_end an argument, the
+# others solver options.
+BAD_SETTINGS = [
+    ("t_end", 0.0, pd.ArgumentError),
+    ("t_end", math.nan, pd.ArgumentError),
+    ("rtol", -1e-9, pd.SimulationError),
+    ("rtol", MIN_RTOL / 2, pd.SimulationError),
+    ("atol", 0.0, pd.SimulationError),
+    ("dt", math.inf, pd.SimulationError),
+    ("output_dt", -1.0, pd.SimulationError),
+    ("max_steps", 0, pd.SimulationError),
+    ("max_steps", MAX_STEPS + 1, pd.SimulationError),
+]
+
+
+@pytest.mark.parametrize("name, value, error", BAD_SETTINGS)
+def test_each_bad_setting_is_refused_alike_naming_it(name, value, error):
+    """The API, the batch runner (its common settings and a variant's own) and the CLI refuse
+    a bad setting with one rule, the core's: the same class and message, which starts with
+    the setting's name and value."""
+    mech = pd.load(FIVE_BAR)
+    settings = {"t_end": 0.01, name: value}
+    with pytest.raises(error) as api:
+        mech.simulate(**settings)
+    message = str(api.value).removeprefix("invalid option: ")
+    assert message.startswith(f"{name} = "), message
+    assert error is not pd.ArgumentError or api.value.argument == name
+    with pytest.raises(error) as common:
+        batch.simulate([mech], **settings)
+    assert str(common.value) == str(api.value)
+    (own,) = batch.simulate([(mech, {name: value})], 0.01)
+    assert isinstance(own, batch.BatchError) and (own.type, own.message) == (error.__name__, str(api.value))
+    option = "--" + name.replace("_", "-")
+    code, err = cli_run("simulate", FIVE_BAR, "--t-end=0.01", f"{option}={value!r}")
+    assert code == 2 and f"argument {option}: {message}" in err, err
+
+
+def test_the_rules_are_the_cores():
+    """settings.py keeps no rule of its own: its bounds are the core's, and what it refuses
+    the core's check refuses with the same message."""
+    assert MAX_STEPS == 10**12 and MIN_RTOL == 100 * np.finfo(float).eps
+    for name, value, error in BAD_SETTINGS:
+        with pytest.raises(error) as core:
+            check_setting(name, float(value))
+        assert str(core.value).removeprefix("invalid option: ").startswith(f"{name} = ")
+    assert check_setting("rtol", MIN_RTOL) == MIN_RTOL
+    with pytest.raises(pd.ArgumentError, match='no setting "tend": use one of t_end, rtol'):
+        check_setting("tend", 1.0)
 
 
 @pytest.mark.parametrize("value, error", [(-1, pd.SimulationError), (0, pd.SimulationError),

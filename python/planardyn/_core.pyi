@@ -31,6 +31,9 @@ __all__ = [
     "DenseOutput",
     "SINGULAR_TOL",
     "JUMP_TOL",
+    "MIN_RTOL",
+    "MAX_STEPS",
+    "check_setting",
     "simulate_batch",
     "inverse_batch",
     "stiffness",
@@ -47,6 +50,8 @@ __all__ = [
 __version__: str
 SINGULAR_TOL: float
 JUMP_TOL: float
+MIN_RTOL: float
+MAX_STEPS: int
 
 class PlanardynError(Exception): ...
 
@@ -70,6 +75,7 @@ class SingularityError(PlanardynError):
 
 class SimulationError(PlanardynError): ...
 
+def check_setting(name: str, value: float) -> float: ...
 def load(path: str | PathLike[str]) -> Mechanism: ...
 def constraint_jacobian(mech: Mechanism, x: ArrayLike, scaled: bool = False) -> NDArray[np.float64]: ...
 def loads(text: str, format: str = "yaml", source: str = "<string>") -> Mechanism: ...

@@ -1,53 +1,58 @@
-"""The rule of each simulation setting, in one place for the API, the batch runner and the CLI.
+"""The rule of each simulation setting, the same for the API, the batch runner and the CLI.
 
-Times and tolerances (``t_end``, ``rtol``, ``atol``, ``dt``, ``output_dt``) are finite numbers
-> 0, the rule the model loader and the integrator's own check apply. ``atol = 0`` is refused
-because the error scale is ``atol + rtol * |y_i|``: a state component that passes through 0
-(an angle, a rate at rest) would have a zero scale, the step size would collapse and the run
-end in "NaN or infinity" instead of an answer. ``rtol`` is also at least :data:`MIN_RTOL`
-(below it the error test asks for more than double precision holds). ``max_steps`` is an integer in 1..=:data:`MAX_STEPS`.
+The rules are the core's (``planardyn::error::Setting``, through ``_core.check_setting``), the
+ones a run applies whoever made its settings: times and tolerances (``t_end``, ``rtol``,
+``atol``, ``dt``, ``output_dt``) are finite numbers > 0; ``atol = 0`` is refused because the
+error scale is ``atol + rtol * |y_i|``: a state component that passes through 0 (an angle, a
+rate at rest) would have a zero scale, the step size would collapse and the run end in "NaN or
+infinity" instead of an answer. ``rtol`` is also at least :data:`MIN_RTOL` (below it the error
+test asks for more than double precision holds). ``max_steps`` is an integer in
+1..=:data:`MAX_STEPS`.
 
 A value that breaks its rule raises what ``Mechanism.simulate`` raises for it:
 :class:`~planardyn.ArgumentError` (a ValueError) for ``t_end`` (an argument),
-:class:`~planardyn.SimulationError` for a solver option, TypeError for something that is not
-a number.
+:class:`~planardyn.SimulationError` for a solver option. What stays here is what cannot reach
+the core: a value that is not a number (or for ``max_steps`` not an integer) is a TypeError
+before it is converted.
 """
 
 from __future__ import annotations
 
 import math
-import sys
+import operator
 from typing import Any
 
-from ._core import SimulationError
-from .arguments import count, error
+from ._core import MAX_STEPS, MIN_RTOL, check_setting
 
-#: Settings that are finite numbers > 0 (s, or dimensionless for the tolerances).
-POSITIVE = ("t_end", "rtol", "atol", "dt", "output_dt")
-#: Smallest relative tolerance: 100 machine epsilons.
-MIN_RTOL = 100 * sys.float_info.epsilon
-#: Most step attempts a run may be given: days of computing at a microsecond a step.
-MAX_STEPS = 10**12
+__all__ = ["MAX_STEPS", "MAX_THREADS", "MIN_RTOL", "NUMBERS", "check_settings"]
+
+#: Settings that are numbers (s, or dimensionless for the tolerances).
+NUMBERS = ("t_end", "rtol", "atol", "dt", "output_dt")
 #: Most native threads of a batch: far more than any machine's cores, far fewer than
 #: would exhaust the system's thread table.
 MAX_THREADS = 256
 
 
-def _error(name: str, text: str) -> Exception:
-    return error(name, text) if name == "t_end" else SimulationError(f"invalid option: {text}")
-
-
-def positive(name: str, value: Any) -> float:
-    """``value`` as a float if it is finite and > 0, else the error naming ``name``."""
+def _number(name: str, value: Any) -> float:
+    """``value`` as a float (an int too large for one is infinite), or the TypeError naming ``name``."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
         raise TypeError(f"{name} = {value!r} must be a number, not {type(value).__name__}")
     try:
-        x = float(value)
-    except (OverflowError, ValueError):
-        x = math.nan
-    if not (math.isfinite(x) and x > 0.0):
-        raise _error(name, f"{name} = {value!r} must be a finite number > 0")
-    return x
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+    except ValueError:
+        return math.nan
+
+
+def _integer(name: str, value: Any) -> int:
+    """``value`` as an int, or the TypeError naming ``name``."""
+    if isinstance(value, bool):
+        raise TypeError(f"{name} = {value!r} must be an integer, not bool")
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name} = {value!r} must be an integer, not {type(value).__name__}") from None
 
 
 def check_settings(**settings: Any) -> dict[str, Any]:
@@ -57,14 +62,10 @@ def check_settings(**settings: Any) -> dict[str, Any]:
     for name, value in settings.items():
         if value is None:
             continue
-        if name in POSITIVE:
-            out[name] = positive(name, value)
-            if name == "rtol" and out[name] < MIN_RTOL:
-                raise SimulationError(f"invalid option: rtol = {value!r} is below 100 machine epsilons and "
-                                      f"cannot be met: use rtol >= {MIN_RTOL:.3g}")
+        if name in NUMBERS:
+            out[name] = check_setting(name, _number(name, value))
         elif name == "max_steps":
-            try:
-                out[name] = count(name, value, 1, MAX_STEPS)
-            except ValueError as e:
-                raise SimulationError(f"invalid option: {e}") from None
+            n = _integer(name, value)
+            check_setting(name, float(n))
+            out[name] = n
     return out

@@ -1,15 +1,16 @@
 //! `planardyn._core.Effector`: the core's end effector (`kinematics::effector`) and its
-//! task-space inverse dynamics (`dynamics::task`) on a native `Mechanism`. Every call makes
-//! its own kinematic frame (`kinematics::Frame`), started at the body coordinates `x_start` when given, else at the
-//! drawing.
+//! task-space inverse dynamics (`dynamics::task`) on a native `Mechanism`. The methods check
+//! and convert their arguments, call the core (each call makes its own kinematic frame,
+//! started at the body coordinates `x_start` when given, else at the drawing) and convert
+//! the result.
 
 use crate::convert::{arr1, arr2, finite, rows, solution_dict, vector, Floats, Values};
-use crate::errors::{effector_error, run, task_error, Failure};
+use crate::errors::{effector_error, run, task_error};
 use crate::exceptions::argument_error;
 use crate::mechanism::PyMechanism;
+use crate::query::ToPython;
 use planardyn::dynamics::task::{self, TaskPath};
-use planardyn::kinematics::constraints::coordinates;
-use planardyn::kinematics::effector::{Effector, EffectorState};
+use planardyn::kinematics::effector::{Effector, EffectorError, Reached};
 use planardyn::kinematics::{self as kin};
 use planardyn::Mechanism;
 use pyo3::prelude::*;
@@ -42,34 +43,14 @@ impl PyEffector {
         vector("x", a, self.mech.n_x(), "body coordinates [X, Y, phi] per body")
     }
 
-    /// A kinematic frame at the body coordinates `x` (a closed configuration), or at the drawing.
-    fn frame(&self, x: Option<&[f64]>) -> kin::Frame {
-        let mut ws = kin::Frame::new(&self.mech);
-        if let Some(x) = x {
-            ws.x.copy_from_slice(x);
-        }
-        ws
-    }
-
-    /// A kinematic frame analysed at the body coordinates `x`, and the end effector there.
-    fn at(&self, x: &[f64]) -> Result<(kin::Frame, EffectorState), Failure> {
-        let mut ws = self.frame(Some(x));
-        let mut q = vec![0.0; self.m()];
-        coordinates(&self.mech, x, &mut q);
-        let st = self.ee.state(&self.mech, &q, &mut ws)?;
-        Ok((ws, st))
-    }
-
-    fn state_dict<'py>(&self, py: Python<'py>, st: EffectorState, x: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
-        let (k, m) = (self.ee.dim, self.m());
-        let d = PyDict::new(py);
-        d.set_item("q", arr1(py, st.q))?;
-        d.set_item("X", arr1(py, st.pose))?;
-        d.set_item("J", arr2(py, k, m, st.jt)?)?;
-        d.set_item("sigma_I", st.sigma_i)?;
-        d.set_item("condition", st.condition)?;
-        d.set_item("x", arr1(py, x))?;
-        Ok(d)
+    /// An inverse-kinematics solve run by the core, as its dict.
+    fn reached<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl FnOnce() -> Result<Reached, EffectorError> + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let r = run(py, || Ok(f()))?;
+        r.map_err(|e| effector_error(py, &e))?.to_python(py, &self.mech)
     }
 }
 
@@ -102,15 +83,11 @@ impl PyEffector {
         py: Python<'py>,
         q: ArrayArg<'py>,
         x_start: Option<ArrayArg<'py>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<Bound<'py, PyAny>> {
         let q = self.q_arg("q", &q)?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
-        let (st, x) = run(py, || {
-            let mut ws = self.frame(x_start.as_deref());
-            let st = self.ee.state(&self.mech, &q, &mut ws)?;
-            Ok((st, ws.x))
-        })?;
-        self.state_dict(py, st, x)
+        let r = run(py, || Ok(self.ee.state_from(&self.mech, &q, x_start.as_deref())?))?;
+        r.to_python(py, &self.mech)
     }
 
     /// Task coordinates (k,) at body coordinates x (3n,).
@@ -121,19 +98,14 @@ impl PyEffector {
     /// J_t (k, m) at body coordinates x (3n,).
     fn jacobian<'py>(&self, py: Python<'py>, x: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
         let x = self.x_arg(&x)?;
-        let st = run(py, || Ok(self.at(&x)?.1))?;
+        let (st, _) = run(py, || Ok(self.ee.state_at(&self.mech, &x)?))?;
         arr2(py, self.ee.dim, self.m(), st.jt)
     }
 
     /// J_t' qd (k,) at body coordinates x (3n,) and rates qd (m,).
     fn convective<'py>(&self, py: Python<'py>, x: ArrayArg<'py>, qd: ArrayArg<'py>) -> PyResult<Bound<'py, PyAny>> {
         let (x, qd) = (self.x_arg(&x)?, self.q_arg("qd", &qd)?);
-        let c = run(py, || {
-            let (mut ws, _) = self.at(&x)?;
-            kin::convective(&self.mech, &qd, &mut ws);
-            Ok(self.ee.convective(&ws))
-        })?;
-        Ok(arr1(py, c))
+        Ok(arr1(py, run(py, || Ok(self.ee.convective_at(&self.mech, &x, &qd)?))?))
     }
 
     /// (sigma_I, condition number) of a task Jacobian J (k, m), scaled dimensionless.
@@ -156,15 +128,10 @@ impl PyEffector {
         target: ArrayArg<'py>,
         q_guess: ArrayArg<'py>,
         x_start: Option<ArrayArg<'py>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (target, guess) = (self.task_arg("X", &target)?, self.q_arg("q_guess", &q_guess)?);
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
-        let r = run(py, || {
-            let mut ws = self.frame(x_start.as_deref());
-            Ok(self.ee.solve(&self.mech, &target, &guess, &mut ws).map(|st| (st, ws.x)))
-        })?;
-        let (st, x) = r.map_err(|e| effector_error(py, &e))?;
-        self.state_dict(py, st, x)
+        self.reached(py, || self.ee.solve_from(&self.mech, &target, &guess, x_start.as_deref()))
     }
 
     /// Inverse kinematics by continuation in task space from the end effector at `q_start`
@@ -176,19 +143,11 @@ impl PyEffector {
         target: ArrayArg<'py>,
         q_start: Option<ArrayArg<'py>>,
         x_start: Option<ArrayArg<'py>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<Bound<'py, PyAny>> {
         let target = self.task_arg("X", &target)?;
-        let q_start = match q_start {
-            Some(a) => self.q_arg("q_start", &a)?,
-            None => self.mech.drawn_q(),
-        };
+        let q_start = q_start.map(|a| self.q_arg("q_start", &a)).transpose()?;
         let x_start = x_start.map(|a| self.x_arg(&a)).transpose()?;
-        let r = run(py, || {
-            let mut ws = self.frame(x_start.as_deref());
-            Ok(self.ee.reach(&self.mech, &target, &q_start, &mut ws).map(|st| (st, ws.x)))
-        })?;
-        let (st, x) = r.map_err(|e| effector_error(py, &e))?;
-        self.state_dict(py, st, x)
+        self.reached(py, || self.ee.reach_from(&self.mech, &target, q_start.as_deref(), x_start.as_deref()))
     }
 
     /// Inputs and drive efforts along a sampled path: t (N,) s, X, Xd, Xdd (N, k).

@@ -9,7 +9,7 @@
 //! ├── DataError(PlanardynError, ValueError)    a data file or table that cannot be used
 //! ├── AssemblyError                            KinematicsError::AssemblyFailed
 //! ├── SingularityError                         KinematicsError::Singular, Error::BranchUndecided
-//! └── SimulationError                          Error::Options, Error::Drive
+//! └── SimulationError                          Error::Setting (but t_end's), Error::Options, Error::Drive
 //! ```
 //!
 //! Pair friction that does not settle (`KinematicsError::FrictionUnsettled`: the mechanism
@@ -18,6 +18,9 @@
 //! A task motion's failures (`TaskError`) are `SingularityError` and `AssemblyError` too, with
 //! the data of where the motion stopped as attributes. A failure at one row of a trajectory
 //! (`Error::Row`) is its row's error, with attributes `row` and `t` and the row in the message.
+//!
+//! A setting that breaks its rule (`Error::Setting`) is a `SimulationError` "invalid option:
+//! ...", but t_end's, an argument of every run, an `ArgumentError`.
 //!
 //! Shape and value errors in the arguments (`KinematicsError::BadArgument`, and the glue's own
 //! shape and finiteness checks) are `ArgumentError`s, attribute `argument` naming it (None where
@@ -35,6 +38,7 @@ use crate::exceptions::{
     SingularityError,
 };
 use planardyn::dynamics::task::{TaskError, TaskSolution};
+use planardyn::error::{Setting, SettingError};
 use planardyn::kinematics::EffectorError;
 use planardyn::{Error, KinematicsError, ModelError as CoreModelError};
 use pyo3::prelude::*;
@@ -133,11 +137,21 @@ pub fn task_error(py: Python<'_>, e: &TaskError) -> PyErr {
     }
 }
 
+/// A setting that breaks its rule: t_end (an argument of every run) an `ArgumentError`
+/// naming it, a solver option a `SimulationError` "invalid option: ...".
+pub fn setting_error(e: &SettingError) -> PyErr {
+    match e.setting {
+        Setting::TEnd => argument_error(Some(e.setting.name()), e.to_string()),
+        _ => SimulationError::new_err(Error::Setting(e.clone()).to_string()),
+    }
+}
+
 /// Any core error as a Python exception.
 pub fn to_pyerr(py: Python<'_>, e: &Error) -> PyErr {
     match e {
         Error::Model(m) => model_error(py, m),
         Error::Kinematics(k) => kinematics_error(py, k),
+        Error::Setting(s) => setting_error(s),
         Error::Options(_) | Error::Drive { .. } => SimulationError::new_err(e.to_string()),
         Error::BranchUndecided { row, sigma_min, .. } => {
             let attrs = vec![("kind", attr(py, "II")), ("row", attr(py, *row)), ("sigma_min", attr(py, *sigma_min))];

@@ -1,8 +1,10 @@
 //! PyO3 glue for planardyn: the native module `planardyn._core`. Conversions live in
 //! `convert.rs`, the mapping of errors to Python exceptions in `errors.rs` (the only place; the
 //! exception classes in `exceptions.rs`),
-//! the `Mechanism` class in `mechanism.rs`, the end effector and task-space motions in
-//! `effector.rs`, and the simulation entry point in `simulate.rs` (its dense output in `dense.rs`).
+//! the `Mechanism` class in `mechanism.rs` (its model data in `model.rs`, its methods along
+//! the rows of a motion in `rows.rs`; the core's typed query results converted in `query.rs`),
+//! the end effector and task-space motions in `effector.rs`, the simulation entry point in
+//! `simulate.rs` (its dense output in `dense.rs`) and the rule of each setting in `settings.rs`.
 //! The typed Python face is the package `python/planardyn`; its stub `_core.pyi` mirrors
 //! this module.
 
@@ -13,6 +15,10 @@ mod effector;
 mod errors;
 mod exceptions;
 mod mechanism;
+mod model;
+mod query;
+mod rows;
+mod settings;
 mod simulate;
 mod stiffness;
 mod structure;
@@ -88,5 +94,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     batch::register(m)?;
     effector::register(m)?;
     stiffness::register(m)?;
+    settings::register(m)?;
     Ok(())
 }

@@ -17,6 +17,7 @@
 //! reads with `lastPanic()` to report the bug, and then makes a new instance of the module.
 
 use js_sys::{Error as JsError, Reflect};
+use planardyn::error::Setting;
 use planardyn::{Error, KinematicsError, ModelError};
 use std::cell::RefCell;
 use wasm_bindgen::prelude::*;
@@ -100,7 +101,9 @@ pub fn core_error(e: &Error) -> JsValue {
     match e {
         Error::Model(m) => model_error(m),
         Error::Kinematics(k) => kinematics_error(k),
-        Error::Options(_) | Error::Drive { .. } => error("SimulationError", &e.to_string(), &[]),
+        // t_end is an argument of every run; the other settings are solver options.
+        Error::Setting(s) if s.setting == Setting::TEnd => argument_error(Some(s.setting.name()), s.to_string()),
+        Error::Setting(_) | Error::Options(_) | Error::Drive { .. } => error("SimulationError", &e.to_string(), &[]),
         Error::BranchUndecided { sigma_min, .. } => {
             error("SingularityError", &e.to_string(), &[("kind", "type_ii".into()), ("sigmaMin", (*sigma_min).into())])
         }

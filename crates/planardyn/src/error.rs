@@ -149,7 +149,12 @@ pub enum Error {
     Model(#[from] ModelError),
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
-    /// Options that cannot work together (a fixed-step method without `dt`, rtol <= 0...).
+    /// A setting of a run that breaks its rule ([`Setting::check`]): rtol <= 0, a
+    /// fixed-step method without `dt`...
+    #[error("invalid option: {0}")]
+    Setting(#[from] SettingError),
+    /// Other options that cannot work together (an unknown method name, an event's
+    /// coordinate that does not exist...).
     #[error("invalid option: {0}")]
     Options(String),
     /// A user-supplied drive function failed (its message is kept).
@@ -169,3 +174,149 @@ pub enum Error {
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Smallest relative tolerance: 100 machine epsilons (below it the error test asks for more
+/// than double precision holds).
+pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+/// Most step attempts a run may be given: days of computing at a microsecond a step.
+pub const MAX_STEPS: f64 = 1e12;
+
+/// A setting of a simulation given as a number: the run's times and the integrator's options.
+/// Each has one rule ([`Setting::check`]), the same for every caller: `Overrides` (the Python
+/// API, the batch runner, the CLI through the glue), a Rust user's `Settings`, and the
+/// integrator's `Options::validate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Setting {
+    /// End time of a run (s).
+    TEnd,
+    /// Relative tolerance (dimensionless).
+    Rtol,
+    /// Absolute tolerance (units of the state).
+    Atol,
+    /// Fixed step (s).
+    Dt,
+    /// Interval of the output times (s).
+    OutputDt,
+    /// Most step attempts, accepted plus rejected.
+    MaxSteps,
+    /// First trial step (s).
+    H0,
+    /// Largest step (s).
+    HMax,
+    /// Smallest step, relative to the time scale.
+    HMin,
+}
+
+impl Setting {
+    /// Every setting, in the order of the Python API's arguments.
+    pub const ALL: [Setting; 9] = [
+        Setting::TEnd,
+        Setting::Rtol,
+        Setting::Atol,
+        Setting::Dt,
+        Setting::OutputDt,
+        Setting::MaxSteps,
+        Setting::H0,
+        Setting::HMax,
+        Setting::HMin,
+    ];
+
+    /// Its name, as the Python API, the CLI and model files spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Setting::TEnd => "t_end",
+            Setting::Rtol => "rtol",
+            Setting::Atol => "atol",
+            Setting::Dt => "dt",
+            Setting::OutputDt => "output_dt",
+            Setting::MaxSteps => "max_steps",
+            Setting::H0 => "h0",
+            Setting::HMax => "h_max",
+            Setting::HMin => "h_min",
+        }
+    }
+
+    /// The setting called `name`.
+    pub fn from_name(name: &str) -> Option<Setting> {
+        Setting::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    /// `value` if it keeps this setting's rule, else the error naming the setting and the fix.
+    /// The times and tolerances are finite numbers > 0 (t_end after the start at 0 s): with
+    /// atol = 0 a state component passing through 0 has no error scale and the step
+    /// collapses; rtol is at least [`MIN_RTOL`]; max_steps an integer in 1..=[`MAX_STEPS`].
+    pub fn check(self, value: f64) -> Result<f64, SettingError> {
+        match self.broken(value) {
+            Some(rule) => Err(SettingError::new(self, value, rule)),
+            None => Ok(value),
+        }
+    }
+
+    /// t_end's rule for a run that starts at t0 (s): finite and after t0 ([`Setting::check`]
+    /// at the start 0 s that every run made from `Overrides` has).
+    pub fn check_end(t0: f64, t_end: f64) -> Result<f64, SettingError> {
+        if t0 == 0.0 {
+            return Setting::TEnd.check(t_end);
+        }
+        if t0.is_finite() && t_end.is_finite() && t_end > t0 {
+            return Ok(t_end);
+        }
+        Err(SettingError::new(Setting::TEnd, t_end, format!("must be a finite number > t0 = {t0} (the end time in s)")))
+    }
+
+    /// The rule `value` breaks, if any.
+    fn broken(self, v: f64) -> Option<&'static str> {
+        let positive = v.is_finite() && v > 0.0;
+        match self {
+            Setting::TEnd => (!positive).then_some("must be a finite number > 0 (the end time in s)"),
+            Setting::Rtol if !positive => Some("must be a finite number > 0 (try 1e-8)"),
+            Setting::Rtol => {
+                (v < MIN_RTOL).then_some("is below 100 machine epsilons and cannot be met: use rtol >= 2.3e-14")
+            }
+            Setting::Atol => (!positive).then_some(
+                "must be a finite number > 0 (try 1e-10): with 0, a component of the state passing through 0 \
+                 has no error scale and the step collapses",
+            ),
+            Setting::Dt => (!positive).then_some("must be a finite number > 0 (the fixed step in s)"),
+            Setting::OutputDt => (!positive).then_some("must be a finite number > 0 (the output interval in s)"),
+            Setting::MaxSteps => {
+                (!(v.fract() == 0.0 && (1.0..=MAX_STEPS).contains(&v))).then_some("must be an integer from 1 to 1e12")
+            }
+            Setting::H0 => (!positive).then_some("must be a finite number > 0, or None for automatic"),
+            Setting::HMax => (v.is_nan() || v <= 0.0).then_some("must be > 0 (use infinity for no limit)"),
+            Setting::HMin => (!(v.is_finite() && v >= 0.0)).then_some("must be finite and >= 0 (default 1e-14)"),
+        }
+    }
+}
+
+/// A setting whose value breaks its rule: `"{name} = {value} {rule}"`.
+#[derive(Debug, Clone, Error, PartialEq)]
+#[error("{} = {value} {rule}", .setting.name())]
+pub struct SettingError {
+    pub setting: Setting,
+    /// The value as given (integers without a decimal point; "none" for a missing one).
+    pub value: String,
+    /// What it must be, and how to mend it.
+    pub rule: String,
+}
+
+impl SettingError {
+    /// `setting` = `value` breaks `rule`.
+    pub fn new(setting: Setting, value: f64, rule: impl Into<String>) -> Self {
+        // Whole numbers as integers (0, -1, 10000), others by their shortest exact form
+        // (1e-9, NaN, inf): as a caller wrote them.
+        let value = if is_whole(value) { format!("{value:.0}") } else { format!("{value:?}") };
+        SettingError { setting, value, rule: rule.into() }
+    }
+
+    /// `setting` is missing where it is needed (`rule` says why and what to give).
+    pub fn missing(setting: Setting, rule: impl Into<String>) -> Self {
+        SettingError { setting, value: "none".to_string(), rule: rule.into() }
+    }
+}
+
+/// A whole number small enough to print exactly as an integer.
+fn is_whole(v: f64) -> bool {
+    v.fract() == 0.0 && v.abs() < 1e15
+}

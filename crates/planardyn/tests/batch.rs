@@ -6,6 +6,7 @@ mod common;
 use common::*;
 use planardyn::batch::{map_many, simulate_many, Overrides, Variant};
 use planardyn::dynamics::ModelDrives;
+use planardyn::error::{Setting, MIN_RTOL};
 use planardyn::simulate::{simulate, Trajectory};
 use planardyn::{Error, KinematicsError, ModelError};
 use std::sync::Arc;
@@ -238,19 +239,50 @@ fn task_paths_in_a_batch_follow_the_path_and_report_failures_in_place() {
     assert_ne!(heavier.tau, sol.tau);
 }
 
-/// The one rule of t_end (finite, after t0), in the core for every caller: an argument error
-/// that names it (the Python glue maps it to ArgumentError with `argument = 't_end'`).
+/// The one rule of each numeric setting, in the core for every caller (the Python API, the
+/// batch runner and the CLI check through it too): a bad value is an `Error::Setting` naming
+/// the setting, its value as given and the fix; the glues map t_end's to ArgumentError
+/// (`argument = 't_end'`), the others to SimulationError. A run made from the overrides and
+/// one made from hand-written settings are refused the same way.
 #[test]
-fn a_bad_t_end_is_an_argument_error_naming_it() {
+fn a_bad_setting_is_refused_naming_it() {
     let mech = shipped("five-bar.yaml");
-    for t_end in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
-        let over = Overrides { t_end: Some(t_end), ..Overrides::default() };
-        match over.settings(&mech) {
-            Err(Error::Kinematics(KinematicsError::BadArgument { name, expected, got })) => {
-                assert_eq!((name, expected.as_str()), ("t_end", "a finite time after t0 = 0 s"));
-                assert_eq!(got, t_end.to_string());
-            }
-            other => panic!("t_end = {t_end}: {other:?}"),
-        }
+    let bad = [f64::NAN, f64::INFINITY, 0.0, -1.0];
+    let cases: Vec<(Setting, Overrides)> = bad
+        .iter()
+        .flat_map(|&v| {
+            [
+                (Setting::TEnd, Overrides { t_end: Some(v), ..Overrides::default() }),
+                (Setting::Rtol, Overrides { rtol: Some(v), ..Overrides::default() }),
+                (Setting::Atol, Overrides { atol: Some(v), ..Overrides::default() }),
+                (Setting::Dt, Overrides { dt: Some(v), ..Overrides::default() }),
+                (Setting::OutputDt, Overrides { output_dt: Some(v), ..Overrides::default() }),
+            ]
+        })
+        .chain([
+            (Setting::MaxSteps, Overrides { max_steps: Some(0), ..Overrides::default() }),
+            (Setting::MaxSteps, Overrides { max_steps: Some(1_000_000_000_001), ..Overrides::default() }),
+            (Setting::Rtol, Overrides { rtol: Some(MIN_RTOL / 2.0), ..Overrides::default() }),
+            (Setting::Dt, Overrides { method: Some("rk4".into()), ..Overrides::default() }),
+        ])
+        .collect();
+    for (setting, over) in cases {
+        let e = over.settings(&mech).unwrap_err();
+        let Error::Setting(s) = &e else { panic!("{over:?}: {e:?}") };
+        assert_eq!(s.setting, setting, "{e}");
+        // The message names the setting and its value, and says what it must be.
+        let name = setting.name();
+        assert!(e.to_string().starts_with(&format!("invalid option: {name} = {} ", s.value)), "{e}");
+        assert!(s.rule.contains("must be") || s.rule.contains("use") || s.rule.contains("set"), "{e}");
     }
+    // As a caller wrote them: t_end = NaN, inf, 0, -1 (the Display of each f64).
+    for t_end in bad {
+        let e = Overrides { t_end: Some(t_end), ..Overrides::default() }.settings(&mech).unwrap_err();
+        assert!(matches!(&e, Error::Setting(s) if s.value == t_end.to_string()), "{e:?}");
+    }
+    // Hand-written settings are checked by the same rule.
+    let mut s = Overrides::default().settings(&mech).unwrap();
+    s.options.atol = 0.0;
+    let e = simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap_err();
+    assert!(matches!(&e, Error::Setting(s) if s.setting == Setting::Atol), "{e:?}");
 }

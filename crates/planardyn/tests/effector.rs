@@ -118,6 +118,35 @@ fn five_bar_inverse_kinematics_matches_the_circle_intersections() {
     }
 }
 
+/// The entry points that make their own frame (what a binding calls): `reach_from` and
+/// `solve_from` land on the closed form's inputs, the body coordinates they return put P on
+/// the target, and `state_at` / `convective_at` at those x give what a frame carried there gives.
+#[test]
+fn frame_free_entry_points_match_the_closed_form() {
+    let mech = five_bar();
+    let ee = Effector::new(&mech, "P", None).unwrap();
+    let target = [0.05, 0.40];
+    let exact = five_bar_closed_form(&mech, target);
+    let reached = ee.reach_from(&mech, &target, None, None).unwrap();
+    let guess: Vec<f64> = reached.state.q.iter().map(|v| v + 0.01).collect();
+    let solved = ee.solve_from(&mech, &target, &guess, Some(&reached.x)).unwrap();
+    for r in [&reached, &solved] {
+        for k in 0..2 {
+            assert!((r.state.q[k] - exact[k]).abs() < IK_Q_TOL, "q = {:?}, closed form {exact:?}", r.state.q);
+        }
+        // IK_TOL: the scaled task residual at which Newton stops (L ~ 1 m here).
+        let p = ee.pose(&r.x);
+        assert!((p[0] - target[0]).abs() < 1e-11 && (p[1] - target[1]).abs() < 1e-11, "{p:?}");
+    }
+    // At the same body coordinates the same state, bit for bit: one code path.
+    let (at_x, mut frame) = ee.state_at(&mech, &reached.x).unwrap();
+    let from_q = ee.state_from(&mech, &at_x.q, Some(&reached.x)).unwrap();
+    assert_eq!((&at_x.jt, &at_x.pose), (&from_q.state.jt, &from_q.state.pose));
+    let qd = [0.5, -1.2];
+    convective(&mech, &qd, &mut frame);
+    assert_eq!(ee.convective_at(&mech, &reached.x, &qd).unwrap(), ee.convective(&frame));
+}
+
 struct Given(Vec<f64>);
 impl Drives for Given {
     fn efforts(&mut self, _t: f64, _q: &[f64], _qd: &[f64], tau: &mut [f64]) -> Result<(), String> {

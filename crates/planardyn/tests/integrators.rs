@@ -627,7 +627,8 @@ fn options_follow_the_loaders_rule() {
     let eps = f64::EPSILON;
     let refused = |opts: Options, name: &str| {
         let e = opts.validate(Method::Dopri5).unwrap_err();
-        assert!(e.starts_with(name), "{name}: {e}");
+        assert_eq!(e.setting.name(), name, "{e}");
+        assert!(e.to_string().starts_with(name), "{name}: {e}");
     };
     for atol in [0.0, -0.0, -1e-10, f64::NAN, f64::INFINITY] {
         refused(Options::tol(1e-8, atol), "atol");

@@ -53,6 +53,7 @@ pub mod dopri5;
 pub mod radau5;
 pub mod rk4;
 
+use crate::error::{Setting, SettingError};
 use std::fmt;
 use std::str::FromStr;
 
@@ -295,49 +296,33 @@ impl Options {
         Options { dt: Some(dt), ..Options::default() }
     }
 
-    /// Check the options for `method`; the message says what to change.
-    pub fn validate(&self, method: Method) -> Result<(), String> {
-        let eps = f64::EPSILON;
-        if !(self.rtol.is_finite() && self.rtol > 0.0) {
-            return Err(format!("rtol = {} must be finite and > 0 (try 1e-8)", self.rtol));
-        }
-        if self.rtol < 100.0 * eps {
-            return Err(format!(
-                "rtol = {:e} is below 100 machine epsilons and cannot be met: use rtol >= 2.3e-14",
-                self.rtol
-            ));
-        }
-        if !(self.atol.is_finite() && self.atol > 0.0) {
-            return Err(format!(
-                "atol = {} must be finite and > 0 (try 1e-10): with 0, a component of the state passing \
-                 through 0 has no error scale and the step collapses",
-                self.atol
-            ));
-        }
+    /// Check the options for `method` by each one's rule ([`Setting::check`]); the error
+    /// names the option and says what to change.
+    pub fn validate(&self, method: Method) -> Result<(), SettingError> {
+        Setting::Rtol.check(self.rtol)?;
+        Setting::Atol.check(self.atol)?;
         if let Some(h0) = self.h0 {
-            if !(h0.is_finite() && h0 > 0.0) {
-                return Err(format!("h0 = {h0} must be finite and > 0, or None for automatic"));
+            Setting::H0.check(h0)?;
+        }
+        Setting::HMax.check(self.h_max)?;
+        Setting::HMin.check(self.h_min)?;
+        match self.dt {
+            Some(dt) => {
+                Setting::Dt.check(dt)?;
             }
-        }
-        if self.h_max.is_nan() || self.h_max <= 0.0 {
-            return Err(format!("h_max = {} must be > 0 (use infinity for no limit)", self.h_max));
-        }
-        if !(self.h_min.is_finite() && self.h_min >= 0.0) {
-            return Err(format!("h_min = {} must be finite and >= 0 (default 1e-14)", self.h_min));
-        }
-        if let Some(dt) = self.dt {
-            if !(dt.is_finite() && dt > 0.0) {
-                return Err(format!("dt = {dt} must be finite and > 0"));
+            None if !method.is_adaptive() => {
+                return Err(SettingError::missing(
+                    Setting::Dt,
+                    format!(
+                        "is needed: {method} is a fixed-step method; set the step dt (e.g. Options::fixed(1e-3)), \
+                         or choose an adaptive method such as dopri5"
+                    ),
+                ))
             }
-        } else if !method.is_adaptive() {
-            return Err(format!(
-                "{method} is a fixed-step method: set the step dt (e.g. Options::fixed(1e-3)), \
-                 or choose an adaptive method such as dopri5"
-            ));
+            None => {}
         }
-        if self.max_steps == 0 {
-            return Err("max_steps = 0 must be >= 1 (default 10000000)".to_string());
-        }
+        // usize to f64 is exact up to 2^53, far above MAX_STEPS.
+        Setting::MaxSteps.check(self.max_steps as f64)?;
         Ok(())
     }
 }
@@ -413,7 +398,7 @@ impl Stepper {
     /// A stepper for systems of dimension `dim`, all buffers allocated here.
     /// Err for invalid options, with the fix in the message.
     pub fn new(method: Method, opts: &Options, dim: usize) -> Result<Self, String> {
-        opts.validate(method)?;
+        opts.validate(method).map_err(|e| e.to_string())?;
         Ok(Stepper::of(method, opts, dim))
     }
 

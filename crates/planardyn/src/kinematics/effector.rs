@@ -16,7 +16,7 @@
 //! continuation, so every solve stays on the branch it starts on and never returns to the
 //! drawing.
 
-use super::analogues::velocity_analogues;
+use super::analogues::{convective, velocity_analogues};
 use super::constraints::{coordinates, point_acceleration, point_velocity, world_point, Chart};
 use super::frame::Frame;
 use super::position::{continue_to, solve_position};
@@ -85,6 +85,24 @@ pub struct EffectorState {
     pub jt: Vec<f64>,
     pub sigma_i: f64,
     pub condition: f64,
+}
+
+/// The end effector reached at one configuration, with the body coordinates x (3n; m, rad)
+/// there: what the entry points that make their own frame return.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reached {
+    pub state: EffectorState,
+    pub x: Vec<f64>,
+}
+
+/// A kinematic frame started at the body coordinates `x_start` (a closed configuration on the
+/// wanted branch), else at the drawing.
+fn frame_from(mech: &Mechanism, x_start: Option<&[f64]>) -> Frame {
+    let mut ws = Frame::new(mech);
+    if let Some(x) = x_start {
+        ws.x.copy_from_slice(x);
+    }
+    ws
 }
 
 impl Effector {
@@ -223,6 +241,59 @@ impl Effector {
         self.jacobian(ws, &mut jt);
         let (sigma_i, condition) = self.measures(&jt);
         Ok(EffectorState { q: q.to_vec(), pose: self.pose(&ws.x), jt, sigma_i, condition })
+    }
+
+    /// [`Effector::state`] in a frame of its own, reached from the body coordinates `x_start`
+    /// (else the drawing).
+    pub fn state_from(&self, mech: &Mechanism, q: &[f64], x_start: Option<&[f64]>) -> Result<Reached, KinematicsError> {
+        let mut ws = frame_from(mech, x_start);
+        let state = self.state(mech, q, &mut ws)?;
+        Ok(Reached { state, x: ws.x })
+    }
+
+    /// The end effector at body coordinates x (3n, a closed configuration), and the frame
+    /// analysed there (positions and velocity analogues).
+    pub fn state_at(&self, mech: &Mechanism, x: &[f64]) -> Result<(EffectorState, Frame), KinematicsError> {
+        let mut ws = frame_from(mech, Some(x));
+        let mut q = vec![0.0; mech.dof()];
+        coordinates(mech, x, &mut q);
+        let state = self.state(mech, &q, &mut ws)?;
+        Ok((state, ws))
+    }
+
+    /// J_t' qd (k) at body coordinates x (3n) and rates qd (m) ([`Effector::convective`]).
+    pub fn convective_at(&self, mech: &Mechanism, x: &[f64], qd: &[f64]) -> Result<Vec<f64>, KinematicsError> {
+        let (_, mut ws) = self.state_at(mech, x)?;
+        convective(mech, qd, &mut ws);
+        Ok(self.convective(&ws))
+    }
+
+    /// [`Effector::solve`] from `guess` on the branch of `x_start` (else the drawing).
+    pub fn solve_from(
+        &self,
+        mech: &Mechanism,
+        target: &[f64],
+        guess: &[f64],
+        x_start: Option<&[f64]>,
+    ) -> Result<Reached, EffectorError> {
+        let mut ws = frame_from(mech, x_start);
+        let state = self.solve(mech, target, guess, &mut ws)?;
+        Ok(Reached { state, x: ws.x })
+    }
+
+    /// [`Effector::reach`] from the end effector at `q_start` (else the drawn coordinates),
+    /// reached from `x_start` (else the drawing).
+    pub fn reach_from(
+        &self,
+        mech: &Mechanism,
+        target: &[f64],
+        q_start: Option<&[f64]>,
+        x_start: Option<&[f64]>,
+    ) -> Result<Reached, EffectorError> {
+        let mut ws = frame_from(mech, x_start);
+        let q_start = q_start.map_or_else(|| mech.drawn_q(), <[f64]>::to_vec);
+        let state = self.reach(mech, target, &q_start, &mut ws)?;
+        Ok(Reached { state, x: ws.x })
     }
 
     /// Inverse kinematics: Newton on q for X(q) = `target` (k) from `guess` (m), on the branch

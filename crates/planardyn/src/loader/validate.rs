@@ -3,6 +3,7 @@
 //! assembly at the start coordinates. The model's own checks come first
 //! (`model::build`), so that a model with several errors reports the same one as ever.
 
+use crate::error::Setting;
 use crate::integrate::Method;
 use crate::kinematics::assemble;
 use crate::kinematics::rank::constraint_rank;
@@ -32,24 +33,21 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
 
 fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
     let Some(s) = s else { return Ok(SimulateDefaults::default()) };
-    let positive = |field: &str, v: Option<f64>| -> R<Option<f64>> {
-        match v {
-            Some(x) if !(x > 0.0 && x.is_finite()) => {
-                Err(ctx.err(format!("simulate.{field}"), format!("{x} must be a positive number")))
-            }
-            _ => Ok(v),
-        }
+    // Each setting by its one rule, the run's (`Setting::check`), the error at its field.
+    let checked = |setting: Setting, v: Option<f64>| -> R<Option<f64>> {
+        v.map(|x| setting.check(x).map_err(|e| ctx.err(format!("simulate.{}", setting.name()), e.to_string())))
+            .transpose()
     };
     if let Some(m) = &s.method {
         m.parse::<Method>().map_err(|e| ctx.err("simulate.method", e))?;
     }
     Ok(SimulateDefaults {
-        t_end: positive("t_end", s.t_end)?,
+        t_end: checked(Setting::TEnd, s.t_end)?,
         method: s.method.clone(),
-        rtol: positive("rtol", s.rtol)?,
-        atol: positive("atol", s.atol)?,
-        dt: positive("dt", s.dt)?,
-        output_dt: positive("output_dt", s.output_dt)?,
+        rtol: checked(Setting::Rtol, s.rtol)?,
+        atol: checked(Setting::Atol, s.atol)?,
+        dt: checked(Setting::Dt, s.dt)?,
+        output_dt: checked(Setting::OutputDt, s.output_dt)?,
     })
 }
 

@@ -22,6 +22,7 @@ pub use trajectory::{SimStats, Status, Trajectory};
 use std::ops::ControlFlow;
 
 use crate::dynamics::{Drives, Prescribed};
+use crate::error::Setting;
 use crate::integrate::{Method, Options};
 use crate::model::Mechanism;
 use crate::Error;
@@ -79,12 +80,13 @@ pub fn grid(t0: f64, t_end: f64, h: f64) -> Vec<f64> {
     t
 }
 
+/// The one check of a run's settings, whoever made them ([`Overrides::settings`] or a Rust
+/// user): each numeric setting by its rule ([`Setting::check`], an [`Error::Setting`] naming
+/// it), the start state's and output times' shapes.
 fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
     let bad = |m: String| Err(Error::Options(m));
-    if !(settings.t_end > settings.t0) || !settings.t_end.is_finite() || !settings.t0.is_finite() {
-        return bad(format!("t_end = {} must be finite and after t0 = {}", settings.t_end, settings.t0));
-    }
-    settings.options.validate(settings.method).map_err(Error::Options)?;
+    Setting::check_end(settings.t0, settings.t_end)?;
+    settings.options.validate(settings.method)?;
     for (name, v) in [("q0", &settings.q0), ("qd0", &settings.qd0)] {
         if let Some(v) = v {
             if v.len() != mech.dof() || v.iter().any(|x| !x.is_finite()) {

@@ -1,11 +1,12 @@
 //! A caller's changes to a model file's `simulate` defaults, applied the same way by the
 //! Python `Mechanism.simulate`, the batch runner and Rust users.
 
-use super::{grid, Settings};
+use super::{check, grid, Settings};
 use crate::dynamics::{Motion, Prescribed};
+use crate::error::{Setting, SettingError};
 use crate::integrate::Method;
 use crate::model::{Mechanism, MotionLaw};
-use crate::{Error, KinematicsError};
+use crate::Error;
 
 /// Most output times an `output_dt` may ask for (a guard against output_dt = 1e-12).
 const MAX_OUTPUTS: f64 = 1e8;
@@ -35,14 +36,7 @@ impl Overrides {
     /// changes, as `Mechanism.simulate` in Python makes them.
     pub fn settings(&self, mech: &Mechanism) -> Result<Settings, Error> {
         let mut s = Settings::for_model(mech)?;
-        if let Some(t_end) = self.t_end {
-            if !(t_end.is_finite() && t_end > s.t0) {
-                // An argument error naming `t_end` (every caller's argument), as for q0 and qd0.
-                let expected = format!("a finite time after t0 = {} s", s.t0);
-                return Err(KinematicsError::bad_argument("t_end", expected, t_end.to_string()).into());
-            }
-            s.t_end = t_end;
-        }
+        s.t_end = self.t_end.unwrap_or(s.t_end);
         if let Some(name) = &self.method {
             s.method = name.parse::<Method>().map_err(Error::Options)?;
             if s.method.is_adaptive() && self.dt.is_none() {
@@ -53,13 +47,14 @@ impl Overrides {
         s.options.atol = self.atol.unwrap_or(s.options.atol);
         s.options.dt = self.dt.or(s.options.dt);
         s.options.max_steps = self.max_steps.unwrap_or(s.options.max_steps);
-        s.t_eval = match (&self.t_eval, self.output_dt.or(mech.simulate.output_dt)) {
-            (Some(te), _) => Some(te.clone()),
-            (None, Some(h)) => Some(output_grid(s.t0, s.t_end, h)?),
-            (None, None) => None,
-        };
+        s.t_eval = self.t_eval.clone();
         s.q0 = self.q0.clone();
         s.qd0 = self.qd0.clone();
+        // The settings' one check (as `simulate` makes it), before t_end is used for the grid.
+        check(&s, mech)?;
+        if let (None, Some(h)) = (&s.t_eval, self.output_dt.or(mech.simulate.output_dt)) {
+            s.t_eval = Some(output_grid(s.t0, s.t_end, h)?);
+        }
         Ok(s)
     }
 
@@ -75,10 +70,10 @@ impl Overrides {
 
 /// Output times every h (s) from t0 to t_end, clamped to t_end without a duplicate end.
 fn output_grid(t0: f64, t_end: f64, h: f64) -> Result<Vec<f64>, Error> {
-    if !(h.is_finite() && h > 0.0) || (t_end - t0) / h > MAX_OUTPUTS {
-        return Err(Error::Options(format!(
-            "output_dt = {h} must be > 0 s and give at most {MAX_OUTPUTS:e} outputs over [{t0}, {t_end}] s"
-        )));
+    Setting::OutputDt.check(h)?;
+    if (t_end - t0) / h > MAX_OUTPUTS {
+        let rule = format!("gives more than {MAX_OUTPUTS:e} outputs over [{t0}, {t_end}] s: use a larger output_dt");
+        return Err(SettingError::new(Setting::OutputDt, h, rule).into());
     }
     let mut t = grid(t0, t_end, h);
     t.iter_mut().for_each(|v| *v = v.min(t_end));
