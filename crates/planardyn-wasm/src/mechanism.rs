@@ -212,11 +212,13 @@ impl WasmMechanism {
     /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
     /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
     /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
-    /// increasing frequency. A model without a `compliance:` section throws an ArgumentError.
+    /// increasing frequency, about the pose without gravity's load (as the Python API's
+    /// default: a drawn pose need not be an equilibrium). A model without a `compliance:`
+    /// section throws an ArgumentError.
     pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
         self.start_args(q, x_start.as_deref())?;
         let mut ws = js(query::assembled(&self.inner, q, x_start.as_deref()))?;
-        let modes = js(elastic::modes(&self.inner, q, free_rotors, &mut ws))?;
+        let modes = js(elastic::modes(&self.inner, q, free_rotors, false, &mut ws))?;
         Ok(Obj::new()
             .f64s("omega", &modes.omega())
             .f64s("omega2", &modes.omega2)
