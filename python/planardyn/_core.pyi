@@ -41,6 +41,7 @@ __all__ = [
     "equilibrium",
     "state_space",
     "simulate_flexible",
+    "output_columns",
 ]
 
 __version__: str
@@ -310,6 +311,7 @@ class Effector:
         singular_tol: float = ...,
     ) -> dict[str, Any]: ...
 
+def output_columns() -> list[tuple[str, str, str, str, str]]: ...
 def simulate_batch(
     variants: list[tuple[Mechanism, dict[str, Any]]],
     threads: int | None = None,
