@@ -314,7 +314,7 @@ def inverse_result(
         kinetic[i], potential[i] = mech.energy(q[i], qd[i], x_start=x[i])
     power = np.sum(tau * qd, axis=1)
     work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
-    columns = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": tau, "x": x, "xd": xd}
+    columns: dict[str, Any] = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": tau, "x": x, "xd": xd}
     columns |= {"kinetic": kinetic, "potential": potential, "work": work, "sigma": sigma, "residual": residual,
                 "partitioned": np.zeros(n_t, dtype=bool), "tau_motor": mech._result_motor_torques(columns)}
     res = SimulationResult(
