@@ -4,10 +4,10 @@
 
 use crate::convert::{array, f64s, Obj};
 use crate::errors::{argument_error, js};
+use js_sys::Uint8Array;
 use planardyn::dynamics::ModelDrives;
 use planardyn::model::spec::SimulateSpec;
 use planardyn::model::MotionLaw;
-use js_sys::Uint8Array;
 use planardyn::simulate::columns::{Values, COLUMNS};
 use planardyn::simulate::{simulate_observed, Event, Observe, Overrides, Trajectory};
 use planardyn::Mechanism;
@@ -112,7 +112,9 @@ fn trajectory(t: Trajectory) -> JsValue {
         .iter()
         .fold(Obj::new(), |obj, c| match (c.values)(&t) {
             Values::Numbers(v) => obj.f64s(c.name, v),
-            Values::Flags(v) => obj.set(c.name, Uint8Array::from(&v.iter().map(|&f| u8::from(f)).collect::<Vec<_>>()[..])),
+            Values::Flags(v) => {
+                obj.set(c.name, Uint8Array::from(&v.iter().map(|&f| u8::from(f)).collect::<Vec<_>>()[..]))
+            }
         })
         .set("tEvents", array(t.events.t.iter().map(|r| f64s(r).into())))
         .set("qEvents", array(t.events.q.iter().map(|r| f64s(r).into())))
