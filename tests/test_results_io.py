@@ -261,6 +261,8 @@ def test_every_column_round_trips_with_its_shape_and_headings(geared_run, tmp_pa
                                rtol=1e-12, atol=1e-15)
     again = mech.motor_torques(back.q, back.qd, back.qdd, back.tau, x=back.x, xd=back.xd, allow_singular=True)
     np.testing.assert_array_equal(back.tau_motor, again)
+    # Far from any singularity: no partition chart, loops closed (Newton stops at POSITION_TOL
+    # 1e-14, scaled; 1e-10 leaves room for its last step), a positive type II measure.
     assert not back.partitioned.any() and back.residual.max() < 1e-10 and back.sigma.min() > 0
 
 
