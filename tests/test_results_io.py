@@ -16,7 +16,9 @@ import numpy as np
 import planardyn as pd
 import pytest
 from conftest import MODELS, ROOT, four_bar_dict
-from planardyn import results_io
+from planardyn import _core, results_io
+from planardyn.result import ENERGY_COLUMNS, Energy
+from planardyn.results_format import COLUMNS, SHAPES
 from planardyn.results_io import (
     attach_metadata,
     inverse_from_file,
@@ -26,6 +28,7 @@ from planardyn.results_io import (
     simulate_settings,
     write_results,
 )
+from test_regressor_losses import geared_five_bar
 
 ARRAYS = ("t", "q", "qd", "qdd", "tau", "x", "xd", "poses", "sigma", "residual", "partitioned")
 ENERGIES = ("kinetic", "potential", "work", "total", "balance")
@@ -192,6 +195,75 @@ def test_read_errors(tmp_path):
         read_results(plain)
     with pytest.raises(ValueError, match="unknown results format '.txt'"):
         read_results(plain.rename(tmp_path / "plain.txt"))
+
+
+# ------------------------------------------------------------------ the output columns
+
+#: A column's array shape in a result by its shape per row, for N rows, m coordinates, n bodies.
+SHAPE_OF = {"scalar": lambda n, m, nb: (n,), "flag": lambda n, m, nb: (n,), "coordinates": lambda n, m, nb: (n, m),
+            "body_poses": lambda n, m, nb: (n, 3 * nb)}
+
+
+def column_of(res, name):
+    return getattr(res.energy if name in ENERGY_COLUMNS else res, name)
+
+
+def test_every_core_column_is_a_typed_field_and_documented():
+    """A column added to the core's table (crates/planardyn/src/simulate/columns.rs) without the
+    Python side knowing it fails here: each is a declared field of the result (or of its
+    energy) typed for its shape, and the docs of the result and of results files list it with
+    its shape and unit."""
+    core = _core.output_columns()
+    assert [c[0] for c in core] == [c.name for c in COLUMNS if not c.optional]
+    assert [c.name for c in COLUMNS if c.optional] == ["tau_motor"]
+    declared = {f.name: f.type for cls in (pd.SimulationResult, Energy) for f in dataclasses.fields(cls)}
+    for name, shape, unit, doc, heading in core:
+        assert shape in SHAPES and unit and doc and heading, name
+        assert declared.get(name) == ("NDArray[np.bool_]" if shape == "flag" else "FloatArray"), name
+        line = f"``{name}`` {SHAPES[shape]}: {doc} ({unit})"
+        assert line in pd.SimulationResult.__doc__ and line in results_io.__doc__, name
+    assert declared["tau_motor"] == "FloatArray | None"
+
+
+@pytest.fixture(scope="module")
+def geared_run():
+    # The geared five-bar (actuators: the motor torques too, every column) set going.
+    mech = geared_five_bar()
+    res = mech.simulate(t_end=0.05, output_dt=0.01, qd0=[1.0, -0.8])
+    assert res.success and res.tau_motor is not None, res.message
+    return mech, res
+
+
+@pytest.mark.parametrize("ext", [".csv", ".parquet", ".npz"])
+def test_every_column_round_trips_with_its_shape_and_headings(geared_run, tmp_path, ext):
+    mech, res = geared_run
+    n, m, nb = len(res), mech.dof, mech.n_bodies
+    assert (n, m, nb) == (6, 2, 4)  # t = 0, 0.01, ..., 0.05; theta1, theta2; four links
+    path = res.save(tmp_path / f"run{ext}")
+    back = read_results(path)
+    for c in COLUMNS:
+        a, b = column_of(res, c.name), column_of(back, c.name)
+        assert a.shape == b.shape == SHAPE_OF[c.shape](n, m, nb), c.name
+        assert a.dtype == b.dtype == (bool if c.shape == "flag" else np.float64), c.name
+        np.testing.assert_array_equal(a, b, err_msg=c.name)
+    headings = [h for c in COLUMNS for h in c.headings(res.coordinate_names, res.body_names)]
+    assert headings[:3] == ["t", "theta1", "theta2"] and headings[-2:] == ["tau_motor_theta1", "tau_motor_theta2"]
+    assert len(headings) == 1 + 4 * m + 6 + 2 * 3 * nb + m
+    if ext == ".csv":
+        assert path.read_text().splitlines()[0].split(",") == headings
+    # The values are the run's: its output grid and start state; the energies and the motor
+    # torques those of the rows (the same functions of the same numbers: equal to round-off).
+    np.testing.assert_allclose(back.t, np.linspace(0.0, 0.05, 6), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(back.qd[0], [1.0, -0.8])
+    np.testing.assert_allclose(back.x[0], mech.assemble(back.q[0]), rtol=0, atol=1e-12)
+    kinetic, potential = mech.energy(back.q[3], back.qd[3], x_start=back.x[3])
+    np.testing.assert_allclose([back.energy.kinetic[3], back.energy.potential[3]], [kinetic, potential],
+                               rtol=1e-12, atol=1e-15)
+    again = mech.motor_torques(back.q, back.qd, back.qdd, back.tau, x=back.x, xd=back.xd, allow_singular=True)
+    np.testing.assert_array_equal(back.tau_motor, again)
+    # Far from any singularity: no partition chart, loops closed (Newton stops at POSITION_TOL
+    # 1e-14, scaled; 1e-10 leaves room for its last step), a positive type II measure.
+    assert not back.partitioned.any() and back.residual.max() < 1e-10 and back.sigma.min() > 0
 
 
 def write_motion(path, t, q, names, extra=None):

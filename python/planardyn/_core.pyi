@@ -45,6 +45,7 @@ __all__ = [
     "state_space",
     "compliant_state_space",
     "simulate_flexible",
+    "output_columns",
 ]
 
 __version__: str
@@ -322,6 +323,7 @@ class Effector:
         singular_tol: float = ...,
     ) -> dict[str, Any]: ...
 
+def output_columns() -> list[tuple[str, str, str, str, str]]: ...
 def simulate_batch(
     variants: list[tuple[Mechanism, dict[str, Any]]],
     threads: int | None = None,

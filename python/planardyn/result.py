@@ -54,6 +54,22 @@ class Energy:
         return f"Energy(N={len(self.kinetic)}, drift={self.drift:.3g} J)"
 
 
+#: The output columns that are entries of :class:`Energy` (``result.energy.kinetic``, ...);
+#: every other column is the result's field of its name.
+ENERGY_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name in {f.name for f in dataclasses.fields(Energy)})
+
+
+def column_fields(values: Mapping[str, Any], body_names: list[str]) -> dict[str, Any]:
+    """A result's fields from its output columns by name (:data:`results_format.COLUMNS`, an
+    optional one None or absent): each column is the field of its name, but the energies make
+    ``energy``, and ``poses`` is ``x`` by body."""
+    fields = {c.name: values.get(c.name) for c in results_format.COLUMNS if c.name not in ENERGY_COLUMNS}
+    fields["energy"] = Energy.from_arrays(**{k: values[k] for k in ENERGY_COLUMNS})
+    x = values["x"]
+    fields["poses"] = x.reshape(x.shape[0], len(body_names), 3)
+    return fields
+
+
 def _dataframe(cols: Mapping[str, FloatArray]) -> pandas.DataFrame:
     """``cols`` as a DataFrame indexed by its ``t`` column (needs pandas)."""
     try:
@@ -145,28 +161,24 @@ class ChangePoint:
 class SimulationResult:
     """A trajectory, kept whole even when the run stopped early (see ``status``).
 
-    Shapes: N outputs, m coordinates, n bodies. Units: s, rad or m (per coordinate), N m or N.
+    Shapes: N outputs, m coordinates, n bodies. Its output columns, declared once in the core
+    (:data:`planardyn.results_format.COLUMNS`), each the field of its name, the energies
+    entries of ``energy``:
+
     """
 
-    #: (N,) output times (s).
     t: FloatArray
-    #: (N, m) coordinates (rad or m), rates, accelerations.
     q: FloatArray
     qd: FloatArray
     qdd: FloatArray
-    #: (N, m) drive efforts applied (N m or N), joint-side (after the transmissions).
     tau: FloatArray
-    #: (N, 3n) body coordinates [X, Y, phi] per body (m, m, rad) and their rates.
     x: FloatArray
     xd: FloatArray
     #: (N, n, 3) the same as x, one row per body.
     poses: FloatArray
     energy: Energy
-    #: (N,) type II singularity measure (smallest scaled singular value, dimensionless).
     sigma: FloatArray
-    #: (N,) scaled loop-closure residual of the position solve.
     residual: FloatArray
-    #: (N,) True where the point was integrated in body coordinates near a singularity.
     partitioned: NDArray[np.bool_]
     #: True when the run reached t_end or a terminal event.
     success: bool
@@ -201,10 +213,7 @@ class SimulationResult:
     #: sol.t_max]), from each step's own interpolant. None otherwise, and when read from a file
     #: (which keeps the events).
     sol: DenseOutput | None = None
-    #: (N, m) motor torques (N m) of a model with actuators, what its drives measure
-    #: (``Mechanism.motor_torques(q, qd, qdd, tau, x=x, xd=xd)``; tau itself on a coordinate
-    #: without one); None
-    #: for a model without actuators. What identification reads from a results file.
+    #: None for a model without actuators (the column ``tau_motor``, what identification reads).
     tau_motor: FloatArray | None = None
 
     @classmethod
@@ -219,20 +228,9 @@ class SimulationResult:
         tau_motor: FloatArray | None = None,
     ) -> SimulationResult:
         """Wrap the dict returned by the native ``Mechanism.simulate``."""
-        x = raw["x"]
+        columns = {c.name: raw[c.name] for c in results_format.COLUMNS if not c.optional}
         fields = dict(
-            t=raw["t"],
-            q=raw["q"],
-            qd=raw["qd"],
-            qdd=raw["qdd"],
-            tau=raw["tau"],
-            x=x,
-            xd=raw["xd"],
-            poses=x.reshape(x.shape[0], len(body_names), 3),
-            energy=Energy.from_arrays(raw["kinetic"], raw["potential"], raw["work"]),
-            sigma=raw["sigma"],
-            residual=raw["residual"],
-            partitioned=raw["partitioned"],
+            **column_fields(columns | {"tau_motor": tau_motor}, body_names),
             success=raw["status"] in ("success", "event"),
             status=raw["status"],
             message=raw["message"],
@@ -246,7 +244,6 @@ class SimulationResult:
             q_events=list(raw.get("q_events", [])),
             qd_events=list(raw.get("qd_events", [])),
             sol=raw.get("sol"),
-            tau_motor=tau_motor,
         )
         # Every field is given: set them at once. The frozen dataclass's __init__ sets them one
         # by one through object.__setattr__, about 5 us a result, a fifth of a short run's
@@ -342,15 +339,9 @@ class SimulationResult:
         return self._write(path, ".csv")
 
     def _write(self, path: str | os.PathLike[str], ext: str | None) -> Path:
-        layout = results_format.columns(self.coordinate_names, self.body_names, self.tau_motor is not None)
-        e = self.energy
-        groups = {
-            "t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau,
-            "kinetic": e.kinetic, "potential": e.potential, "work": e.work,
-            "sigma": self.sigma, "residual": self.residual, "partitioned": self.partitioned,
-            "x": self.x, "xd": self.xd,
-            **({"tau_motor": self.tau_motor} if self.tau_motor is not None else {}),
-        }
+        groups = {c.name: v for c in results_format.COLUMNS
+                  if (v := getattr(self.energy if c.name in ENERGY_COLUMNS else self, c.name)) is not None}
+        layout = results_format.columns(self.coordinate_names, self.body_names, groups)
         meta = {
             "format": results_format.FORMAT,
             "format_version": results_format.FORMAT_VERSION,
@@ -373,3 +364,6 @@ class SimulationResult:
             meta["events"] = {"t": [a.tolist() for a in self.t_events], "q": [a.tolist() for a in self.q_events],
                               "qd": [a.tolist() for a in self.qd_events]}
         return results_format.write(path, meta, groups, layout, ext)
+
+
+SimulationResult.__doc__ = f"{(SimulationResult.__doc__ or '').rstrip(' ')}{results_format.columns_doc('    ')}"

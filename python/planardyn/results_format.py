@@ -16,7 +16,8 @@ import errno
 import json
 import os
 import zlib
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import extras
+from ._core import output_columns
 
 FloatArray = NDArray[np.float64]
 
@@ -47,26 +49,71 @@ def plain(v: Any) -> Any:
     return v
 
 
-def columns(names: list[str], bodies: list[str], motor: bool = False) -> list[tuple[str, list[str]]]:
-    """(group, column names) in file order, for coordinates ``names`` and ``bodies``; groups
-    are result fields or energy entries. ``motor``: the motor torques ``tau_motor`` last (a
-    model with actuators), so the other columns keep their places."""
-    body_cols = [f"{c}_{b}" for b in bodies for c in ("X", "Y", "phi")]
-    return [
-        ("t", ["t"]),
-        ("q", list(names)),
-        ("qd", [f"qd_{n}" for n in names]),
-        ("qdd", [f"qdd_{n}" for n in names]),
-        ("tau", [f"tau_{n}" for n in names]),
-        ("kinetic", ["kinetic"]),
-        ("potential", ["potential"]),
-        ("work", ["work"]),
-        ("sigma", ["sigma"]),
-        ("residual", ["residual"]),
-        ("partitioned", ["partitioned"]),
-        ("x", body_cols),
-        ("xd", [c.replace("_", "d_", 1) for c in body_cols]),
-    ] + ([("tau_motor", [f"tau_motor_{n}" for n in names])] if motor else [])
+#: The axes of a body's pose, in the order of its body coordinates [X, Y, phi].
+POSE_AXES = ("X", "Y", "phi")
+#: A column's shape per output row, as a result holds it (N rows, m coordinates, n bodies).
+SHAPES = {"scalar": "(N,)", "flag": "(N,) bool", "coordinates": "(N, m)", "body_poses": "(N, 3n)"}
+
+
+@dataclass(frozen=True)
+class Column:
+    """An output column: ``name`` (the result's field, or the entry of its ``energy``; the
+    results file's group), ``shape`` per row (a key of :data:`SHAPES`), ``unit`` (SI; "rad or
+    m" by the coordinate's kind, "1" for a pure number), ``doc`` (one line), ``heading`` (its
+    columns' headings in a table: ``{coordinate}`` a coordinate's name, ``{axis}`` and
+    ``{body}`` a body's pose), and whether it is ``optional`` (None on a result without it)."""
+
+    name: str
+    shape: str
+    unit: str
+    doc: str
+    heading: str
+    optional: bool = False
+
+    def headings(self, coordinates: list[str], bodies: list[str]) -> list[str]:
+        """The headings of its columns in a table, for these coordinates and bodies."""
+        if self.shape == "coordinates":
+            return [self.heading.format(coordinate=n) for n in coordinates]
+        if self.shape == "body_poses":
+            return [self.heading.format(axis=a, body=b) for b in bodies for a in POSE_AXES]
+        if self.shape in ("scalar", "flag"):
+            return [self.heading]
+        raise ValueError(f"output column {self.name!r}: unknown shape {self.shape!r} (known: {', '.join(SHAPES)})")
+
+    def values(self, rows: FloatArray) -> NDArray[Any]:
+        """Its (N, k) block of a table as the result holds it: (N,) for a scalar, bool for a flag."""
+        if self.shape == "flag":
+            return rows.reshape(len(rows)).astype(bool)
+        return rows.reshape(len(rows)) if self.shape == "scalar" else rows
+
+    def describe(self) -> str:
+        """One line: name, shape, what it is and its unit."""
+        return f"``{self.name}`` {SHAPES[self.shape]}: {self.doc} ({self.unit})"
+
+
+#: The motor torques: computed in Python from a run (``Mechanism.motor_torques``), for a model
+#: with actuators only, last in a file so that the other columns keep their places.
+TAU_MOTOR = Column("tau_motor", "coordinates", "N m",
+                   "motor torques of a model with actuators, what its drives measure "
+                   "(``Mechanism.motor_torques`` of the rows; tau on a coordinate without one)",
+                   "tau_motor_{coordinate}", optional=True)
+#: Every output column, in a results file's order: the core's (``_core.output_columns()``,
+#: crates/planardyn/src/simulate/columns.rs), then the motor torques.
+COLUMNS = (*(Column(*c) for c in output_columns()), TAU_MOTOR)
+#: The columns by name.
+COLUMN = {c.name: c for c in COLUMNS}
+
+
+def columns(names: list[str], bodies: list[str], present: Collection[str] = ()) -> list[tuple[str, list[str]]]:
+    """(group, column names) in file order, for coordinates ``names`` and ``bodies``: every
+    column of :data:`COLUMNS`, an optional one (the motor torques) only when it is in
+    ``present``."""
+    return [(c.name, c.headings(names, bodies)) for c in COLUMNS if not c.optional or c.name in present]
+
+
+def columns_doc(indent: str = "") -> str:
+    """The columns of :data:`COLUMNS`, one line each, for the docs (each line after ``indent``)."""
+    return "".join(f"{indent}- {c.describe()}\n" for c in COLUMNS)
 
 
 def metadata_path(path: str | os.PathLike[str]) -> Path:
@@ -218,8 +265,8 @@ def write(path: str | os.PathLike[str], meta: dict[str, Any], groups: dict[str, 
                 np.savez_compressed(f, metadata=np.array(json.dumps(meta)), **arrays)
         elif ext == ".parquet":
             pa, pq = pyarrow()
-            pa_columns = [pa.array(tab[:, k].astype(bool) if n == "partitioned" else tab[:, k])
-                          for k, n in enumerate(names)]
+            flags = [COLUMN[g].shape == "flag" for g, cols in layout for _ in cols]
+            pa_columns = [pa.array(tab[:, k].astype(bool) if flag else tab[:, k]) for k, flag in enumerate(flags)]
             pq.write_table(pa.Table.from_arrays(pa_columns, names=names).replace_schema_metadata(
                 {"planardyn": json.dumps(meta)}), tmp)
         else:

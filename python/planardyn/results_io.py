@@ -23,13 +23,12 @@ numbers): a truncated or changed file is refused on reading, with its name and w
 wrong. Whether the run itself completed is its ``status`` (``'success'``, ``'cancelled'``
 for an interrupted run written as far as it got, ...).
 
-Columns, in order: ``t``; the coordinate names (q); ``qd_<name>``; ``qdd_<name>``;
-``tau_<name>``; ``kinetic``, ``potential``, ``work`` (J); ``sigma``; ``residual``;
-``partitioned`` (0/1); ``X_<body>``, ``Y_<body>``, ``phi_<body>`` (x) and ``Xd_<body>``,
-``Yd_<body>``, ``phid_<body>`` (xd); for a model with actuators, ``tau_motor_<name>`` (the
-motor torques, N m: ``Mechanism.motor_torques`` of the rows, what identification reads).
-Readers split the table by position (the layout is in the metadata), so a coordinate may be
-named like another column.
+The table's columns follow :data:`planardyn.results_format.COLUMNS`, listed below: a column of
+a result per coordinate has one per coordinate (``<name>`` for q, ``qd_<name>``, ...), a pose
+per body has three (``X_<body>``, ``Y_<body>``, ``phi_<body>`` for x, ``Xd_<body>``, ... for
+xd), a flag is 0/1; the motor torques only for a model with actuators. Readers split the table
+by position (the layout is in the metadata), so a coordinate may be named like another column.
+
 """
 
 from __future__ import annotations
@@ -44,11 +43,13 @@ from numpy.typing import ArrayLike, NDArray
 from ._core import SingularityError
 from .arguments import data_error, finite_rates, rates_overflow, samples, times
 from .mechanism import Mechanism, attach_metadata
-from .result import Energy, SimulationResult
-from .results_format import FORMAT
+from .result import SimulationResult, column_fields
+from .results_format import FORMAT, columns_doc
 from .results_read import Damaged, csv_blocks, csv_head, csv_metadata, read
 
 FloatArray = NDArray[np.float64]
+
+__doc__ = f"{__doc__}{columns_doc()}"
 
 #: The settings of ``Mechanism.simulate`` a results file records (None: the library default).
 SETTING_NAMES = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "max_steps")
@@ -313,17 +314,17 @@ def inverse_result(
         kinetic[i], potential[i] = mech.energy(q[i], qd[i], x_start=x[i])
     power = np.sum(tau * qd, axis=1)
     work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+    columns: dict[str, Any] = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": tau, "x": x, "xd": xd}
+    columns |= {"kinetic": kinetic, "potential": potential, "work": work, "sigma": sigma, "residual": residual,
+                "partitioned": np.zeros(n_t, dtype=bool), "tau_motor": mech._result_motor_torques(columns)}
     res = SimulationResult(
-        t=t, q=q, qd=qd, qdd=qdd, tau=tau, x=x, xd=xd, poses=x.reshape(n_t, n_b, 3),
-        energy=Energy.from_arrays(kinetic, potential, work),
-        sigma=sigma, residual=residual, partitioned=np.zeros(n_t, dtype=bool),
+        **column_fields(columns, mech.body_names),
         success=True, status="success", message="inverse dynamics of a prescribed motion",
         stats={"rows": n_t, "max_residual": float(residual.max()), "min_sigma": float(sigma.min()),
                "max_abs_tau": [float(v) for v in np.abs(tau).max(axis=0)]},
         coordinate_names=list(mech.coordinate_names),
         coordinate_kinds=list(mech.coordinate_kinds),
         body_names=list(mech.body_names),
-        tau_motor=mech._result_motor_torques({"q": q, "qd": qd, "qdd": qdd, "tau": tau, "x": x, "xd": xd}),
     )
     if given is not None and given.ndim == 2:
         branch = "each row's body coordinates"

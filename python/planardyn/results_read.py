@@ -24,8 +24,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .arguments import data_error
-from .result import ChangePoint, Energy, SimulationResult
+from .result import ChangePoint, SimulationResult, column_fields
 from .results_format import (
+    COLUMN,
+    COLUMNS,
     CSV_BLOCK,
     EXTENSIONS,
     FORMAT,
@@ -122,9 +124,11 @@ def check_meta(meta: Any) -> dict[str, Any]:
 
 
 def _layout(meta: dict[str, Any]) -> list[tuple[str, list[str]]]:
-    """The columns of a file with this metadata: with the motor torques when its layout names them."""
-    motor = isinstance(meta["layout"], list) and ["tau_motor", len(meta["coordinate_names"])] in meta["layout"]
-    return _columns(meta["coordinate_names"], meta["body_names"], motor)
+    """The columns of a file with this metadata: with an optional one (the motor torques) when
+    its layout names it."""
+    layout = meta["layout"] if isinstance(meta["layout"], list) else []
+    present = [c.name for c in COLUMNS if c.optional and any(isinstance(e, list) and e[:1] == [c.name] for e in layout)]
+    return _columns(meta["coordinate_names"], meta["body_names"], present)
 
 
 def _short(v: Any) -> str:
@@ -192,8 +196,6 @@ class _Arrays:
 
 def _result(meta: dict[str, Any], groups: dict[str, FloatArray], path: Path) -> SimulationResult:
     """Rebuild a result from its checked metadata and its arrays ((rows, k) per group)."""
-    n_t, n_b = len(groups["t"]), len(meta["body_names"])
-    flat = lambda g: groups[g].reshape(n_t)  # noqa: E731 - a view: the arrays are contiguous
     own = {"format", "format_version", "status", "success", "message", "stats", "coordinate_names",
            "coordinate_kinds", "body_names", "layout", "rows", "checksum", "events",
            "change_points"}
@@ -201,10 +203,7 @@ def _result(meta: dict[str, Any], groups: dict[str, FloatArray], path: Path) -> 
     events = meta.get("events") or {}
     per_event = lambda key, shape: [np.asarray(v, dtype=float).reshape(shape) for v in events.get(key, [])]  # noqa: E731
     return SimulationResult(
-        t=flat("t"), q=groups["q"], qd=groups["qd"], qdd=groups["qdd"], tau=groups["tau"],
-        x=groups["x"], xd=groups["xd"], poses=groups["x"].reshape(n_t, n_b, 3),
-        energy=Energy.from_arrays(flat("kinetic"), flat("potential"), flat("work")),
-        sigma=flat("sigma"), residual=flat("residual"), partitioned=flat("partitioned").astype(bool),
+        **column_fields({g: COLUMN[g].values(a) for g, a in groups.items()}, meta["body_names"]),
         success=meta["success"], status=meta["status"], message=meta["message"],
         stats=dict(meta.get("stats") or {}),
         coordinate_names=list(meta["coordinate_names"]),
@@ -213,7 +212,6 @@ def _result(meta: dict[str, Any], groups: dict[str, FloatArray], path: Path) -> 
         change_points=[ChangePoint.from_dict(c) for c in meta.get("change_points") or []],
         metadata={k: v for k, v in meta.items() if k not in own} | {"path": str(path)},
         t_events=per_event("t", (-1,)), q_events=per_event("q", (-1, m)), qd_events=per_event("qd", (-1, m)),
-        tau_motor=groups.get("tau_motor"),
     )
 
 

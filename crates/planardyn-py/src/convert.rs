@@ -127,10 +127,6 @@ pub fn arr_dyn<'py>(py: Python<'py>, shape: &[usize], v: Vec<f64>) -> PyResult<B
     Ok(a.into_pyarray(py).into_any())
 }
 
-pub fn bool1<'py>(py: Python<'py>, v: Vec<bool>) -> Bound<'py, PyAny> {
-    Array1::from_vec(v).into_pyarray(py).into_any()
-}
-
 /// A solved motion (or the part of one before a failure) as a dict of time-major arrays:
 /// `q`, `qd`, `qdd`, `tau`, `tau_motor` (N, m), `sigma_I`, `sigma_II`, `condition` (N,).
 pub fn solution_dict<'py>(py: Python<'py>, s: TaskSolution, m: usize) -> PyResult<Bound<'py, PyDict>> {

@@ -92,6 +92,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     exceptions::register(m)?;
     structure::register(m)?;
     batch::register(m)?;
+    simulate::register(m)?;
     effector::register(m)?;
     stiffness::register(m)?;
     settings::register(m)?;

@@ -3,12 +3,14 @@
 //! as a dict of time-major numpy arrays. The whole loop runs in Rust with the GIL released;
 //! callbacks re-attach to the interpreter for the duration of each call.
 
-use crate::convert::{arr1, arr2, bool1, Values};
+use crate::convert::{arr1, arr2, Values};
 use crate::errors::run;
-use crate::exceptions::argument_error;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
+use crate::exceptions::{argument_error, PlanardynError};
+use numpy::ndarray::{ArrayView1, ArrayView2};
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, ToPyArray};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
+use planardyn::simulate::columns::{self, Column, Shape, COLUMNS};
 use planardyn::simulate::{Event, EventFn, Observe, Overrides, Trajectory};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
@@ -267,21 +269,11 @@ pub fn simulate<'py>(
 /// The trajectory as the dict `Mechanism.simulate` returns (arrays time-major); a
 /// cancellation's reason, if given, replaces the message.
 pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<String>) -> PyResult<Bound<'_, PyDict>> {
-    let (n, m, nx) = (t.len(), t.m, t.nx);
+    let m = t.m;
     let d = PyDict::new(py);
-    d.set_item("t", arr1(py, t.t))?;
-    d.set_item("q", arr2(py, n, m, t.q)?)?;
-    d.set_item("qd", arr2(py, n, m, t.qd)?)?;
-    d.set_item("qdd", arr2(py, n, m, t.qdd)?)?;
-    d.set_item("tau", arr2(py, n, m, t.tau)?)?;
-    d.set_item("x", arr2(py, n, nx, t.x)?)?;
-    d.set_item("xd", arr2(py, n, nx, t.xd)?)?;
-    d.set_item("kinetic", arr1(py, t.kinetic))?;
-    d.set_item("potential", arr1(py, t.potential))?;
-    d.set_item("work", arr1(py, t.work))?;
-    d.set_item("sigma", arr1(py, t.sigma))?;
-    d.set_item("residual", arr1(py, t.residual))?;
-    d.set_item("partitioned", bool1(py, t.partitioned))?;
+    for c in COLUMNS {
+        d.set_item(c.name, column_array(py, c, &t)?)?;
+    }
     let event_rows = |rows: Vec<Vec<f64>>| -> PyResult<Vec<Bound<'_, PyAny>>> {
         rows.into_iter().map(|r| Ok(arr2(py, r.len() / m.max(1), m, r)?.into_any())).collect()
     };
@@ -323,4 +315,31 @@ pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<Strin
     stats.set_item("failed_evaluations", st.failed_evaluations)?;
     d.set_item("stats", stats)?;
     Ok(d)
+}
+
+/// Column `c` of `traj` as a numpy array (a copy): (N,) for a scalar, (N,) of bool for a flag,
+/// (N, width) for a row per output.
+fn column_array<'py>(py: Python<'py>, c: &Column, traj: &Trajectory) -> PyResult<Bound<'py, PyAny>> {
+    match ((c.values)(traj), c.shape) {
+        (columns::Values::Numbers(v), Shape::Coordinates | Shape::BodyPoses) => {
+            let shape = (traj.len(), c.shape.width(traj.m, traj.nx));
+            let rows = ArrayView2::from_shape(shape, v)
+                .map_err(|e| PlanardynError::new_err(format!("output column {}: {e}", c.name)))?;
+            Ok(rows.to_pyarray(py).into_any())
+        }
+        (columns::Values::Numbers(v), Shape::Scalar | Shape::Flag) => Ok(ArrayView1::from(v).to_pyarray(py).into_any()),
+        (columns::Values::Flags(v), _) => Ok(ArrayView1::from(v).to_pyarray(py).into_any()),
+    }
+}
+
+/// The output columns of a simulation, as the core declares them
+/// (`planardyn::simulate::columns::COLUMNS`), in a results file's order: (name, shape, unit,
+/// doc, heading) each; the Python package's result, results files and their reading follow it.
+#[pyfunction]
+fn output_columns() -> Vec<(&'static str, &'static str, &'static str, &'static str, &'static str)> {
+    COLUMNS.iter().map(|c| (c.name, c.shape.name(), c.unit, c.doc, c.heading)).collect()
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(output_columns, m)?)
 }

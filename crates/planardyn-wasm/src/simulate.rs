@@ -4,9 +4,11 @@
 
 use crate::convert::{array, f64s, Obj};
 use crate::errors::{argument_error, js};
+use js_sys::Uint8Array;
 use planardyn::dynamics::ModelDrives;
 use planardyn::model::spec::SimulateSpec;
 use planardyn::model::MotionLaw;
+use planardyn::simulate::columns::{Values, COLUMNS};
 use planardyn::simulate::{simulate_observed, Event, Observe, Overrides, Trajectory};
 use planardyn::Mechanism;
 use serde::Deserialize;
@@ -92,8 +94,10 @@ pub fn run(mech: &Mechanism, options: SimulateOptions) -> Result<JsValue, JsValu
     Ok(trajectory(traj))
 }
 
-/// The trajectory as `{t (N), q, qd, qdd, tau (N x m), x, xd (N x 3n), kinetic, potential,
-/// work, sigma, residual (N), tEvents, qEvents (per event), status, message, stats}`.
+/// The trajectory as `{<column> ..., tEvents, qEvents (per event), status, message, stats}`:
+/// every output column of `planardyn::simulate::columns::COLUMNS` by its name, row-major
+/// (t, kinetic, ... (N); q, qd, qdd, tau (N x m); x, xd (N x 3n)), a flag (partitioned) as 0/1
+/// bytes.
 fn trajectory(t: Trajectory) -> JsValue {
     let st = &t.stats;
     let stats = Obj::new()
@@ -104,22 +108,14 @@ fn trajectory(t: Trajectory) -> JsValue {
         .set("maxResidual", st.max_residual)
         .set("minSigma", st.min_sigma)
         .set("energyDrift", st.energy_drift);
-    let rows = [
-        ("t", &t.t),
-        ("q", &t.q),
-        ("qd", &t.qd),
-        ("qdd", &t.qdd),
-        ("tau", &t.tau),
-        ("x", &t.x),
-        ("xd", &t.xd),
-        ("kinetic", &t.kinetic),
-        ("potential", &t.potential),
-        ("work", &t.work),
-        ("sigma", &t.sigma),
-        ("residual", &t.residual),
-    ];
-    rows.into_iter()
-        .fold(Obj::new(), |obj, (k, v)| obj.f64s(k, v))
+    COLUMNS
+        .iter()
+        .fold(Obj::new(), |obj, c| match (c.values)(&t) {
+            Values::Numbers(v) => obj.f64s(c.name, v),
+            Values::Flags(v) => {
+                obj.set(c.name, Uint8Array::from(&v.iter().map(|&f| u8::from(f)).collect::<Vec<_>>()[..]))
+            }
+        })
         .set("tEvents", array(t.events.t.iter().map(|r| f64s(r).into())))
         .set("qEvents", array(t.events.q.iter().map(|r| f64s(r).into())))
         .set("status", t.status.name())

@@ -3,6 +3,7 @@
 //! computed so far with a status saying why it stopped.
 
 pub mod charts;
+pub mod columns;
 pub mod crossing;
 pub mod dense;
 pub mod events;

@@ -80,31 +80,27 @@ pub struct SimStats {
     pub energy_drift: f64,
 }
 
-/// Output arrays, time-major: row k belongs to `t[k]`.
+/// Output arrays, time-major: row k belongs to `t[k]`. The columns, from `t` to `partitioned`,
+/// are described (shape, unit, meaning) once, in [`super::columns::COLUMNS`], which the glues
+/// and the Python package convert them by: a new one is a field here, a row there and a line
+/// of [`Trajectory::record`].
 #[derive(Debug, Clone, Default)]
 pub struct Trajectory {
     /// Number of coordinates m and of body coordinates 3n (row lengths).
     pub m: usize,
     pub nx: usize,
-    /// Times (s).
     pub t: Vec<f64>,
-    /// (N x m) coordinates (rad or m), rates and accelerations.
     pub q: Vec<f64>,
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
-    /// (N x m) drive efforts applied (N m or N).
     pub tau: Vec<f64>,
-    /// (N x 3n) body poses [X, Y, phi] of each centre of mass (m, rad) and their rates.
     pub x: Vec<f64>,
     pub xd: Vec<f64>,
-    /// (N) kinetic and potential energy, work of non-conservative forces (J).
     pub kinetic: Vec<f64>,
     pub potential: Vec<f64>,
     pub work: Vec<f64>,
-    /// (N) type II singularity measure and loop-closure residual at each output.
     pub sigma: Vec<f64>,
     pub residual: Vec<f64>,
-    /// (N) whether the point was integrated in a partition chart.
     pub partitioned: Vec<bool>,
     /// The zeros of each event (see [`super::Observe`]): times and states.
     pub events: EventRecords,
