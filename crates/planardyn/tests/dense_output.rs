@@ -6,8 +6,9 @@ use common::*;
 use planardyn::simulate::{grid, simulate, Settings, Trajectory};
 
 /// rtol = atol = 10^-6.9: at this setting DOP853's step 0.6152 -> 0.6270 s of the five-bar's
-/// fall, in the user's chart, goes from sigma 0.07 to 0.018 past a point where the cranks'
-/// ends meet (sigma about 0.003), and its dense stage at 7/9 of the step falls right there.
+/// fall, in the user's chart, passes the type II singularity where the cranks' ends C1, C2
+/// meet (C1x - C2x from -59 to +14.6 mm), and its dense stage at 7/9 of the step falls right
+/// there (-0.6 mm).
 /// Before the fix (commit 0c75a35) that stage's qdd was (-116.9, 96.6) rad/s^2 where the path
 /// has (-107, 107), and the output at t = 0.62 s was 5.8e-5 J and 2.35e-2 rad/s off (below).
 const RTOL: f64 = 1.2589254117941673e-7;

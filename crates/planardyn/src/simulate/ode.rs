@@ -35,14 +35,14 @@ const CLOSED_FORM_SIGMA: f64 = 0.1;
 
 /// Smallest own measure of the chart at a dense-output stage, as a fraction of the measure at
 /// the step's start. In a chart the equations of motion are ill-conditioned like 1/sigma^2
-/// near its singularity, and a step may pass close to one between its stages, which then never
-/// see it: the five-bar at DOP853 rtol 1.26e-7 stepped in q from sigma 0.07 to 0.018 through a
-/// point where the cranks' ends meet (sigma about 0.003), and the dense stage at 7/9 of the
-/// step, right there, gave qdd = (-116.9, 96.6) rad/s^2 where the path has (-107, 107): its
-/// output at t = 0.62 s was 5.8e-5 J off, the steps 4.6e-7 J. A stage refused here leaves
-/// the step with its cubic Hermite interpolant, from the step's ends only. A step approaching
-/// the singularity at an even pace keeps its stages: its end, below them, is at 0.26 of its
-/// start there.
+/// near its singularity, and a step may pass through one between its stages, which then never
+/// see it: the five-bar at DOP853 rtol 1.26e-7 stepped in q (0.6152 -> 0.6270 s) while its
+/// cranks' ends C1, C2 passed each other (C1x - C2x from -59 to +14.6 mm; its stages at -9.4
+/// and +4.9 mm), and the dense stage at 7/9 of the step, at -0.6 mm, gave qdd = (-116.9, 96.6)
+/// rad/s^2 where the path has (-107, 107): its output at t = 0.62 s was 5.8e-5 J off, the steps
+/// 4.6e-7 J. A refused stage leaves the step's outputs to `Dop853::substep`. A step that only
+/// approaches the singularity has its stages above its end, which the monitor keeps near the
+/// switch threshold (0.05) or above.
 const DENSE_SIGMA_FRACTION: f64 = 0.1;
 
 /// A mechanism in one chart, with the state the Newton predictor starts from.
