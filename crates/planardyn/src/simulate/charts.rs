@@ -3,7 +3,7 @@
 //! singularity, and back again once past it. Decisions are taken between accepted steps.
 
 use super::ode::MechanismOde;
-use crate::kinematics::{passive_sigma_min, select_partition, sigma_min, sigma_min_with, Chart};
+use crate::kinematics::{passive_sigma_min, select_partition, sigma_min_with, Chart};
 
 /// Below this scaled type II measure the integrator leaves the user's coordinates. The scaled
 /// J has O(1) entries; at 0.05 the position solve still loses under 2 digits, and a step of
@@ -26,21 +26,16 @@ pub struct Measures {
     pub passive: f64,
 }
 
-/// Measure the point analysed in `ode.ws`. In the user's chart the type II measure comes
-/// from the closed forms where they gave the point (`ClosedForm::sigma`), else from the
-/// factorisation already in the workspace (inverse iteration, see
-/// `System::sigma_min_estimate`); near a singularity, where a partition is in use, it is exact
+/// Measure the point analysed in `ode.ws`. In the user's chart the type II measure is the
+/// chart's own ([`MechanismOde::own_sigma`]: from the closed forms or the factorisation in the
+/// workspace); near a singularity, where a partition is in use, it is exact
 /// (an SVD of each block of the user's chart, linear in the bodies), and the passive measure
 /// an SVD of the whole Phi_x (at the few steps near a type II singularity only).
 pub fn measure(ode: &mut MechanismOde) -> Measures {
-    let estimate = match ode.ws.chart {
-        Chart::Inputs => ode.closed_form_sigma().or_else(|| {
-            ode.factor_stale_j();
-            ode.ws.sys.sigma_min_estimate()
-        }),
-        Chart::Partition(_) => None,
+    let sigma = match ode.ws.chart {
+        Chart::Inputs => ode.own_sigma(),
+        Chart::Partition(_) => sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x),
     };
-    let sigma = estimate.unwrap_or_else(|| sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x));
     // Passive: the better of the user's chart and the partition in use (its factorisation is
     // in the workspace), else the partition complete pivoting would choose.
     let passive = if sigma >= SWITCH_TO_PARTITION {
@@ -61,9 +56,7 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
 pub fn chart_sigma(ode: &mut MechanismOde, sigma: f64) -> f64 {
     match &ode.ws.chart {
         Chart::Inputs => sigma,
-        Chart::Partition(_) => {
-            ode.ws.sys.sigma_min_estimate().unwrap_or_else(|| sigma_min(ode.mech, &ode.ws.chart, &ode.ws.x))
-        }
+        Chart::Partition(_) => ode.own_sigma(),
     }
 }
 
