@@ -130,9 +130,48 @@ pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsErr
         cholesky_in_place(&mut ws.a, m)
     };
     if !factored {
-        let type_ii = matches!(ws.chart, Chart::Inputs);
-        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }));
+        return Err(not_positive_definite(ws));
     }
+    Ok(())
+}
+
+/// The singularity that keeps A from being positive definite in the chart of `ws`.
+fn not_positive_definite(ws: &Workspace) -> KinematicsError {
+    let type_ii = matches!(ws.chart, Chart::Inputs);
+    KinematicsError::singular(SingularityKind::MassMatrix { type_ii })
+}
+
+/// The stages after the forces for one coordinate (m = 1), in one pass over U's one column u
+/// and no bookkeeping of A's pattern: A = u^T M u, b = u^T f - u^T M c, A's factor sqrt(A)
+/// (into `ws.a`, as [`factor_mass_matrix`] leaves it), zdd = (b / sqrt(A)) / sqrt(A), then
+/// xdd = u zdd + c and the user's qdd. The same operations in the same order as
+/// [`mass_matrix`], [`bias`], [`factor_mass_matrix`], [`solve_mass_matrix`] and
+/// [`accelerations`] (whose sums start at -0.0), so the same numbers to the bit.
+pub(crate) fn one_coordinate(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+    let (first, end) = ws.frame.sys.u_support()[0];
+    let span = 3 * first..3 * end.max(first);
+    let (u, c, f) = (&ws.frame.u[span.clone()], &ws.frame.c[span.clone()], &ws.f[span.clone()]);
+    let (mut a, mut uf, mut umc) = (-0.0, -0.0, -0.0);
+    let columns = u.chunks_exact(3).zip(c.chunks_exact(3)).zip(f.chunks_exact(3));
+    for (body, ((u, c), f)) in mech.bodies[first..end.max(first)].iter().zip(columns) {
+        a += body.mass * (u[0] * u[0] + u[1] * u[1]) + body.inertia * u[2] * u[2];
+        uf = uf + u[0] * f[0] + u[1] * f[1] + u[2] * f[2];
+        umc += body.mass * (u[0] * c[0] + u[1] * c[1]) + body.inertia * u[2] * c[2];
+    }
+    // An empty support leaves A = -0.0: not positive definite, as `mass_matrix` finds it.
+    if !(a > 0.0) {
+        return Err(not_positive_definite(ws));
+    }
+    let l = a.sqrt();
+    let b = uf - umc;
+    let zdd = b / l / l;
+    (ws.a[0], ws.b[0], ws.zdd[0]) = (l, b, zdd);
+    ws.a_zeros_for = ws.frame.sys.supports_id();
+    ws.xdd.copy_from_slice(&ws.frame.c);
+    for (x, u) in ws.xdd[span].iter_mut().zip(u) {
+        *x += u * zdd;
+    }
+    user_accelerations(mech, ws);
     Ok(())
 }
 

@@ -41,6 +41,12 @@ pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) ->
 /// Body velocities `ws.xd = U zd`, from `ws.u`.
 #[inline]
 pub(crate) fn body_rates(zd: &[f64], ws: &mut Frame) {
+    if let [r] = zd {
+        // One coordinate: U's one column (zero outside its support) times r in one pass; 0 + u r
+        // as the sum below, so a zero keeps its sign.
+        ws.xd.iter_mut().zip(&ws.u).for_each(|(v, u)| *v = 0.0 + u * r);
+        return;
+    }
     ws.xd.fill(0.0);
     add_u_times(&ws.u, ws.sys.u_support(), |j| zd[j], &mut ws.xd);
 }
