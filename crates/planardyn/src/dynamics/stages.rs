@@ -162,9 +162,9 @@ fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspa
             umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
         }
     }
-    for j in 0..M {
-        for k in j..M {
-            (ws.a[j * M + k], ws.a[k * M + j]) = (a[j][k], a[j][k]);
+    for (j, row) in a.iter().enumerate() {
+        for (k, &v) in row.iter().enumerate().skip(j) {
+            (ws.a[j * M + k], ws.a[k * M + j]) = (v, v);
         }
         ws.b[j] = uf[j] - umc[j];
     }
