@@ -163,13 +163,13 @@ impl Rrp {
         Branch { side: if psi.cos() >= 0.0 { 1.0 } else { -1.0 }, turns, rest: phi - turns }
     }
 
-    /// The bodies' poses (x and trig) on `branch`, the links before them solved, and their
-    /// geometry `g` (written in place: no copy of it between the stages).
+    /// The bodies' poses (x and trig) on `branch`, the links before them solved, and the
+    /// dyad's geometry there into `out` (in place: not returned and copied).
     #[inline(always)]
     pub fn position(
         &self,
         branch: &Branch,
-        g: &mut Geometry,
+        out: &mut Geometry,
         x: &mut [f64],
         trig: &mut [[f64; 2]],
     ) -> Result<(), KinematicsError> {
@@ -209,7 +209,7 @@ impl Rrp {
         x[3 * b2..3 * b2 + 3].copy_from_slice(&[p[0] - rp[0], p[1] - rp[1], phi_g + self.turn]);
         trig[b2] = c2;
         let inv_det = 1.0 / dot(n, perp(e));
-        *g = Geometry { known: [ra, rk], own, e, n, rw, rp, d: sub(sub(p, k), rw), inv_det };
+        *out = Geometry { known: [ra, rk], own, e, n, rw, rp, d: sub(sub(p, k), rw), inv_det };
         Ok(())
     }
 
