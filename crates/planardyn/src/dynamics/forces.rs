@@ -36,11 +36,9 @@ impl Drives for ModelDrives<'_> {
 /// Fill `f` (3n) with every applied force at (x, xd) and drive efforts `tau`. Returns the power of the non-conservative forces (drives, dampers, point
 /// forces and torques) in W; gravity and spring stiffness are counted in the potential.
 pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &mut [f64]) -> f64 {
-    f.fill(0.0);
     let g = mech.gravity;
-    for (i, body) in mech.bodies.iter().enumerate() {
-        f[3 * i] = body.mass * g[0];
-        f[3 * i + 1] = body.mass * g[1];
+    for (f, body) in f.chunks_exact_mut(3).zip(&mech.bodies) {
+        f.copy_from_slice(&[body.mass * g[0], body.mass * g[1], 0.0]);
     }
     let mut power = 0.0;
     for load in &mech.loads {

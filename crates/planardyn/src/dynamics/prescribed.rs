@@ -12,7 +12,7 @@
 use super::forces::{applied_forces, Drives};
 use super::losses::{forward_with_losses_by, Solve};
 use super::motion::{Prescribed, Scratch};
-use super::stages::{accelerations, bias, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix};
+use super::stages::{accelerations, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix_and_bias};
 use super::workspace::Workspace;
 use crate::kinematics::constraints::body_trig;
 use crate::kinematics::constraints::{pair_coordinate_gamma, pair_coordinate_grad, Dense};
@@ -70,8 +70,7 @@ pub fn forward_prescribed(
     let Prescribed { p, qdd: qdd_p, scratch: w, .. } = motion;
     p.iter().for_each(|&k| ws.tau[k] = 0.0);
     ws.power = applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
-    mass_matrix(mech, ws);
-    bias(mech, ws);
+    mass_matrix_and_bias(mech, ws);
     prescribed_rows(mech, p, qdd_p, ws, w);
     let mut solver = Held { p, w };
     if mech.has_losses() {

@@ -10,7 +10,7 @@ use super::workspace::Workspace;
 use crate::kinematics::constraints::{
     coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
 };
-use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame};
+use crate::kinematics::{add_u_times, convective, solve_position, velocity_analogues, Chart, Frame};
 use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
 use crate::model::{Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
@@ -120,6 +120,57 @@ pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
+/// A = U^T M U and b = U^T (f - M c) into `ws.a` and `ws.b`, as [`mass_matrix`] and [`bias`]
+/// give them; for up to [`FIXED_M`] coordinates in one pass over the bodies with fixed-size
+/// accumulators ([`fixed_mass_matrix_and_bias`]), beyond that over the supports of U.
+pub(crate) fn mass_matrix_and_bias(mech: &Mechanism, ws: &mut Workspace) {
+    match ws.b.len() {
+        1 => fixed_mass_matrix_and_bias::<1>(mech, ws),
+        2 => fixed_mass_matrix_and_bias::<2>(mech, ws),
+        3 => fixed_mass_matrix_and_bias::<3>(mech, ws),
+        FIXED_M => fixed_mass_matrix_and_bias::<FIXED_M>(mech, ws),
+        _ => {
+            mass_matrix(mech, ws);
+            bias(mech, ws);
+        }
+    }
+}
+
+/// The most coordinates the stages take with fixed-size loops (`mass_matrix_and_bias`, the
+/// Cholesky factor and solve): past a few, U's supports (which the fixed-size loops do not
+/// use) save more than the loops' bookkeeping costs.
+const FIXED_M: usize = 4;
+
+/// [`mass_matrix_and_bias`] for M coordinates: every entry of A's upper triangle and of b
+/// summed body by body over all bodies. U is zero outside its supports and a zero term leaves a
+/// non-zero sum's bits as they are, so the entries are [`mass_matrix`]'s and [`bias`]'s to the
+/// bit (an entry of zero terms only may differ in its zero's sign). A is written whole: its
+/// zeros outside the envelope are there (`a_zeros_for`).
+fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
+    let n = ws.x.len();
+    let u: [&[f64]; M] = std::array::from_fn(|j| &ws.frame.u[j * n..(j + 1) * n]);
+    // The sums of `m_dot` and `bias` start at -0.0 (f64's `Sum`).
+    let (mut a, mut uf, mut umc) = ([[-0.0; M]; M], [-0.0; M], [-0.0; M]);
+    let forces = ws.f.chunks_exact(3).zip(ws.frame.c.chunks_exact(3));
+    for (i, (body, (f, c))) in mech.bodies.iter().zip(forces).enumerate() {
+        let ui: [[f64; 3]; M] = std::array::from_fn(|j| [u[j][3 * i], u[j][3 * i + 1], u[j][3 * i + 2]]);
+        for (j, p) in ui.iter().enumerate() {
+            for (k, q) in ui.iter().enumerate().skip(j) {
+                a[j][k] += body.mass * (p[0] * q[0] + p[1] * q[1]) + body.inertia * p[2] * q[2];
+            }
+            uf[j] = uf[j] + p[0] * f[0] + p[1] * f[1] + p[2] * f[2];
+            umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
+        }
+    }
+    for (j, row) in a.iter().enumerate() {
+        for (k, &v) in row.iter().enumerate().skip(j) {
+            (ws.a[j * M + k], ws.a[k * M + j]) = (v, v);
+        }
+        ws.b[j] = uf[j] - umc[j];
+    }
+    ws.a_zeros_for = ws.frame.sys.supports_id();
+}
+
 /// `ws.a` into its Cholesky factor, or the singularity that keeps A from being positive definite.
 /// Over A's envelope from the supports of U when `mass_matrix` left A within it.
 pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsError> {
@@ -130,9 +181,34 @@ pub(crate) fn factor_mass_matrix(ws: &mut Workspace) -> Result<(), KinematicsErr
         cholesky_in_place(&mut ws.a, m)
     };
     if !factored {
-        let type_ii = matches!(ws.chart, Chart::Inputs);
-        return Err(KinematicsError::singular(SingularityKind::MassMatrix { type_ii }));
+        return Err(not_positive_definite(ws));
     }
+    Ok(())
+}
+
+/// The singularity that keeps A from being positive definite in the chart of `ws`.
+fn not_positive_definite(ws: &Workspace) -> KinematicsError {
+    let type_ii = matches!(ws.chart, Chart::Inputs);
+    KinematicsError::singular(SingularityKind::MassMatrix { type_ii })
+}
+
+/// The stages after [`mass_matrix_and_bias`] for one coordinate (m = 1) in one pass and no
+/// bookkeeping of A's pattern: A's factor sqrt(A) into `ws.a` (as [`factor_mass_matrix`] leaves
+/// it), zdd = (b / sqrt(A)) / sqrt(A), xdd = c + u zdd and the user's qdd; the operations of
+/// [`factor_mass_matrix`], [`solve_mass_matrix`] and [`accelerations`], so the same numbers (xdd
+/// but for the sign of a zero entry).
+pub(crate) fn one_coordinate_accelerations(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+    let a = ws.a[0];
+    if !(a > 0.0) {
+        return Err(not_positive_definite(ws));
+    }
+    let l = a.sqrt();
+    let zdd = ws.b[0] / l / l;
+    (ws.a[0], ws.zdd[0]) = (l, zdd);
+    for ((x, c), u) in ws.xdd.iter_mut().zip(&ws.frame.c).zip(&ws.frame.u) {
+        *x = c + u * zdd;
+    }
+    user_accelerations(mech, ws);
     Ok(())
 }
 
@@ -179,11 +255,6 @@ fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
 /// one column of 3n a coordinate), each column over the bodies of its `support`
 /// (`System::u_support`), where it may be non-zero.
 pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
-    let n = c.len();
     xdd.copy_from_slice(c);
-    for ((u, &a), &(first, end)) in u.chunks_exact(n).zip(zdd).zip(support) {
-        for (x, u) in xdd[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
-            *x += u * a;
-        }
-    }
+    add_u_times(u, support, |j| zdd[j], xdd);
 }

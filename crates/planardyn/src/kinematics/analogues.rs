@@ -30,10 +30,31 @@ pub fn velocity_analogues(ws: &mut Frame) -> Result<(), KinematicsError> {
 #[inline]
 pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) -> f64, out: &mut [f64]) {
     let n = out.len();
+    match supports.len() {
+        1 => return add_columns::<1>(u, std::array::from_fn(dz), out),
+        2 => return add_columns::<2>(u, std::array::from_fn(dz), out),
+        3 => return add_columns::<3>(u, std::array::from_fn(dz), out),
+        4 => return add_columns::<4>(u, std::array::from_fn(dz), out),
+        _ => {}
+    }
     for (j, (u, &(first, end))) in u.chunks_exact(n).zip(supports).enumerate() {
         let r = dz(j);
         for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
             *v += u * r;
+        }
+    }
+}
+
+/// [`add_u_times`] for M (a few) columns, over every row in one pass with no supports'
+/// bookkeeping: U is zero outside its supports, and adding a zero term leaves a non-zero sum's
+/// bits as they are, so `out` is the same but for the sign of a zero `out` entry.
+#[inline(always)]
+fn add_columns<const M: usize>(u: &[f64], dz: [f64; M], out: &mut [f64]) {
+    let n = out.len();
+    let u: [&[f64]; M] = std::array::from_fn(|j| &u[j * n..(j + 1) * n]);
+    for (i, v) in out.iter_mut().enumerate() {
+        for j in 0..M {
+            *v += u[j][i] * dz[j];
         }
     }
 }

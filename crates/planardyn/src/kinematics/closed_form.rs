@@ -96,8 +96,8 @@ impl Group {
     #[inline]
     fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         match self {
-            Group::Rrr(d, b, g) => *g = d.position(b, x, trig)?,
-            Group::Rrp(d, b, g) => *g = d.position(b, x, trig)?,
+            Group::Rrr(d, b, g) => d.position(b, g, x, trig)?,
+            Group::Rrp(d, b, g) => d.position(b, g, x, trig)?,
             Group::Affine(g) => g.affine(x, trig)?,
             Group::Rpr(d, b) => d.position(b, x, trig)?,
             Group::Extended(d) => d.position(z, x, trig)?,

@@ -12,11 +12,21 @@ pub fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
 /// As [`cholesky_in_place`] with the envelope given: `first[i]`, the first column of row i that
 /// may be non-zero (from the supports of U), so that no row is scanned for it.
 pub fn cholesky_envelope(a: &mut [f64], m: usize, first: &[usize]) -> bool {
-    factor(a, m, |_, i| first[i])
+    // m as a constant up to 4, so that the loops of `factor` (inlined) unroll: the mass matrix
+    // of a mechanism of a few coordinates, where their bookkeeping would cost more than the
+    // arithmetic.
+    match m {
+        1 => factor(a, 1, |_, i| first[i]),
+        2 => factor(a, 2, |_, i| first[i]),
+        3 => factor(a, 3, |_, i| first[i]),
+        4 => factor(a, 4, |_, i| first[i]),
+        _ => factor(a, m, |_, i| first[i]),
+    }
 }
 
 /// The factorisation, `first(a, i)` giving row i's first non-zero column (of A for the row being
 /// factorised, of L for one already done: L keeps the envelope).
+#[inline(always)]
 fn factor(a: &mut [f64], m: usize, first: impl Fn(&[f64], usize) -> usize) -> bool {
     for i in 0..m {
         let row = i * m;
@@ -49,11 +59,19 @@ pub fn cholesky_solve(l: &[f64], m: usize, b: &mut [f64]) {
 /// As [`cholesky_solve`] over the envelope `first` of [`cholesky_envelope`]: m plus the
 /// envelope's size, not m^2.
 pub fn cholesky_solve_envelope(l: &[f64], m: usize, first: &[usize], b: &mut [f64]) {
-    solve(l, m, b, |i| first[i])
+    // m as a constant up to 4 (as in `cholesky_envelope`).
+    match m {
+        1 => solve(l, 1, b, |i| first[i]),
+        2 => solve(l, 2, b, |i| first[i]),
+        3 => solve(l, 3, b, |i| first[i]),
+        4 => solve(l, 4, b, |i| first[i]),
+        _ => solve(l, m, b, |i| first[i]),
+    }
 }
 
 /// L y = b by rows, then L^T x = y by columns (row i of L is column i of L^T), each over the
 /// envelope.
+#[inline(always)]
 fn solve(l: &[f64], m: usize, b: &mut [f64], first: impl Fn(usize) -> usize) {
     for i in 0..m {
         let mut s = b[i];

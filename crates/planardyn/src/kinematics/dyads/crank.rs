@@ -25,9 +25,7 @@ impl Crank {
         let (sn, cs) = phi.sin_cos();
         let rs = rot([cs, sn], self.s);
         let b = 3 * self.body;
-        x[b] = self.pivot[0] - rs[0];
-        x[b + 1] = self.pivot[1] - rs[1];
-        x[b + 2] = phi;
+        x[b..b + 3].copy_from_slice(&[self.pivot[0] - rs[0], self.pivot[1] - rs[1], phi]);
         trig[self.body] = [cs, sn];
     }
 

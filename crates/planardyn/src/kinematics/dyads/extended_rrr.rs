@@ -55,7 +55,7 @@ impl ExtendedRrr {
     #[inline(never)]
     pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         self.set_arms(|a| a.ext.shift(z));
-        self.geometry = self.rrr.position(&self.branch, x, trig)?;
+        self.rrr.position(&self.branch, &mut self.geometry, x, trig)?;
         for a in self.extended.iter_mut().flatten() {
             a.ext.place(z, x, trig);
         }

@@ -50,26 +50,33 @@ pub struct Joint {
 }
 
 /// Pose (centre, [cos, sin]) of a link in x and trig; the ground's is the identity.
-#[inline]
+#[inline(always)]
 pub(crate) fn pose(link: Link, x: &[f64], trig: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
     match link {
         Link::Ground => ([0.0; 2], [1.0, 0.0]),
-        Link::Body(b) => ([x[3 * b.0], x[3 * b.0 + 1]], trig[b.0]),
+        Link::Body(b) => {
+            let r = &x[3 * b.0..3 * b.0 + 2];
+            ([r[0], r[1]], trig[b.0])
+        }
     }
 }
 
 /// (linear, angular) part of a rate vector for a link (zeros for the ground).
-#[inline]
+#[inline(always)]
 pub(crate) fn rate(link: Link, v: &[f64]) -> ([f64; 2], f64) {
     match link {
         Link::Ground => ([0.0; 2], 0.0),
-        Link::Body(b) => ([v[3 * b.0], v[3 * b.0 + 1]], v[3 * b.0 + 2]),
+        Link::Body(b) => {
+            // One bounds check for the three.
+            let r = &v[3 * b.0..3 * b.0 + 3];
+            ([r[0], r[1]], r[2])
+        }
     }
 }
 
 impl Joint {
     /// World position of the point, and R(phi) s.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn place(&self, x: &[f64], trig: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
         let (r, cs) = pose(self.link, x, trig);
         let p = rot(cs, self.s);
@@ -77,7 +84,7 @@ impl Joint {
     }
 
     /// Velocity of the point for rates v, given R s (`place`): r' + w E R s.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn velocity(&self, rs: [f64; 2], v: &[f64]) -> [f64; 2] {
         let (rd, w) = rate(self.link, v);
         [rd[0] - w * rs[1], rd[1] + w * rs[0]]
@@ -85,7 +92,7 @@ impl Joint {
 
     /// Acceleration of the point for rates v and accelerations a, given R s:
     /// r'' + al E R s - w^2 R s.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn acceleration(&self, rs: [f64; 2], v: &[f64], a: &[f64]) -> [f64; 2] {
         let (_, w) = rate(self.link, v);
         let (rdd, al) = rate(self.link, a);
@@ -95,18 +102,18 @@ impl Joint {
 
 /// Write a body's rates (centre velocity r' = v_p - w E R s from a point p = r + R s of
 /// velocity v_p, and w) into v.
-#[inline]
+#[inline(always)]
 pub(crate) fn put_rate(v: &mut [f64], body: usize, vp: [f64; 2], rs: [f64; 2], w: f64) {
-    v[3 * body] = vp[0] + w * rs[1];
-    v[3 * body + 1] = vp[1] - w * rs[0];
-    v[3 * body + 2] = w;
+    v[3 * body..3 * body + 3].copy_from_slice(&[vp[0] + w * rs[1], vp[1] - w * rs[0], w]);
 }
 
 /// Write a body's accelerations (r'' = a_p - al E R s + w^2 R s from a point p = r + R s of
 /// acceleration a_p, and al) into a.
-#[inline]
+#[inline(always)]
 pub(crate) fn put_acceleration(a: &mut [f64], body: usize, ap: [f64; 2], rs: [f64; 2], w: f64, al: f64) {
-    a[3 * body] = ap[0] + al * rs[1] + w * w * rs[0];
-    a[3 * body + 1] = ap[1] - al * rs[0] + w * w * rs[1];
-    a[3 * body + 2] = al;
+    a[3 * body..3 * body + 3].copy_from_slice(&[
+        ap[0] + al * rs[1] + w * w * rs[0],
+        ap[1] - al * rs[0] + w * w * rs[1],
+        al,
+    ]);
 }

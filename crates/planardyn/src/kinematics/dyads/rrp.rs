@@ -163,9 +163,16 @@ impl Rrp {
         Branch { side: if psi.cos() >= 0.0 { 1.0 } else { -1.0 }, turns, rest: phi - turns }
     }
 
-    /// The bodies' poses (x and trig) on `branch`, the links before them solved.
-    #[inline]
-    pub fn position(&self, branch: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
+    /// The bodies' poses (x and trig) on `branch`, the links before them solved, and the
+    /// dyad's geometry there into `out` (in place: not returned and copied).
+    #[inline(always)]
+    pub fn position(
+        &self,
+        branch: &Branch,
+        out: &mut Geometry,
+        x: &mut [f64],
+        trig: &mut [[f64; 2]],
+    ) -> Result<(), KinematicsError> {
         let (a, ra) = self.hinge.place(x, trig);
         let (k, rk) = self.slide.place(x, trig);
         let (_, cg) = pose(self.slide.link, x, trig);
@@ -195,18 +202,15 @@ impl Rrp {
         let (cs, turn) = rotation(c, s, branch.rest);
         let own = rot(cs, self.s_hinge);
         let [b1, b2] = self.bodies;
-        x[3 * b1] = a[0] - own[0];
-        x[3 * b1 + 1] = a[1] - own[1];
-        x[3 * b1 + 2] = branch.turns + branch.rest + turn;
+        x[3 * b1..3 * b1 + 3].copy_from_slice(&[a[0] - own[0], a[1] - own[1], branch.turns + branch.rest + turn]);
         trig[b1] = cs;
         // Body 2: g's angle, P at its point s_P.
         let rp = rot(c2, self.s_p);
-        x[3 * b2] = p[0] - rp[0];
-        x[3 * b2 + 1] = p[1] - rp[1];
-        x[3 * b2 + 2] = phi_g + self.turn;
+        x[3 * b2..3 * b2 + 3].copy_from_slice(&[p[0] - rp[0], p[1] - rp[1], phi_g + self.turn]);
         trig[b2] = c2;
         let inv_det = 1.0 / dot(n, perp(e));
-        Ok(Geometry { known: [ra, rk], own, e, n, rw, rp, d: sub(sub(p, k), rw), inv_det })
+        *out = Geometry { known: [ra, rk], own, e, n, rw, rp, d: sub(sub(p, k), rw), inv_det };
+        Ok(())
     }
 
     /// The bodies' rates, those of the links before them in v.

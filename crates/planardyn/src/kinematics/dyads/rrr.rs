@@ -104,9 +104,16 @@ impl Rrr {
         Branch { side: cross(sub(b, a), sub(p, a)).signum(), turns, rest: [phi[0] - turns[0], phi[1] - turns[1]] }
     }
 
-    /// The bodies' poses (x and trig) on `branch`, the links before them solved.
+    /// The bodies' poses (x and trig) on `branch`, the links before them solved, and their
+    /// geometry `g` (written in place: no copy of it between the stages).
     #[inline(always)]
-    pub fn position(&self, branch: &Branch, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<Geometry, KinematicsError> {
+    pub fn position(
+        &self,
+        branch: &Branch,
+        g: &mut Geometry,
+        x: &mut [f64],
+        trig: &mut [[f64; 2]],
+    ) -> Result<(), KinematicsError> {
         let (a, ra) = self.outer[0].place(x, trig);
         let (b, rb) = self.outer[1].place(x, trig);
         let [l1, l2] = self.arms2;
@@ -125,7 +132,7 @@ impl Rrr {
         let h = branch.side * h2.sqrt();
         let n = perp(d);
         let p = [a[0] + along * d[0] + h * n[0], a[1] + along * d[1] + h * n[1]];
-        let mut g = Geometry { known: [ra, rb], ..Geometry::default() };
+        g.known = [ra, rb];
         for (i, q) in [a, b].into_iter().enumerate() {
             // The rotation taking the arm in the body's frame to e = P - q in the world.
             let (arm, e) = (self.arms[i], sub(p, q));
@@ -133,15 +140,13 @@ impl Rrr {
             let (cs, turn) = rotation(c, s, branch.rest[i]);
             let rs = rot(cs, self.s_outer[i]);
             let k = 3 * self.bodies[i];
-            x[k] = q[0] - rs[0];
-            x[k + 1] = q[1] - rs[1];
-            x[k + 2] = branch.turns[i] + branch.rest[i] + turn;
+            x[k..k + 3].copy_from_slice(&[q[0] - rs[0], q[1] - rs[1], branch.turns[i] + branch.rest[i] + turn]);
             trig[self.bodies[i]] = cs;
             g.own[i] = rs;
             g.e[i] = e;
         }
         g.inv_det = 1.0 / cross(g.e[0], g.e[1]);
-        Ok(g)
+        Ok(())
     }
 
     /// The bodies' rates, those of the links before them in v; `slide` P's velocity relative to
