@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-
 import planardyn as pd
 
 #: rtol = atol = 10^(-4 - k / 5), k = 0..20: the benchmarks' sweep (5 per decade).
