@@ -36,8 +36,10 @@ def main() -> None:
             rows = mech.simulate(args.t_end, output_dt=args.output_dt, **run)
             steps = mech.simulate(args.t_end, **run)
             d_rows, d_steps = rows.stats["energy_drift"], steps.stats["energy_drift"]
-            print(f"{method} {rtol:.3g} {d_rows:.3e} {rows.stats['nfev']} {d_steps:.3e} {steps.stats['nfev']} "
-                  f"{d_rows / d_steps:.2f}")
+            print(
+                f"{method} {rtol:.3g} {d_rows:.3e} {rows.stats['nfev']} {d_steps:.3e} {steps.stats['nfev']} "
+                f"{d_rows / d_steps:.2f}"
+            )
 
 
 if __name__ == "__main__":
