@@ -94,8 +94,10 @@ pub struct SigmaRows {
 /// Where every group of the mechanism has a closed form (`ClosedForm`: a 5R, a two-input
 /// robot), a cell whose neighbour assembled is placed by the closed forms on the neighbour's
 /// branches instead of by Newton continuation from it (the same solution: continuation keeps
-/// the branch of its start over the step); a cell continued from a row's start after a gap,
-/// or the first from `x_start`, is continued as before.
+/// the branch of its start over the step). A row's cells beyond a gap are then not tried:
+/// the closed forms fail where a group cannot close on any branch, and the continuation from
+/// the row's start passes through that cell. A cell continued from another row's start, or
+/// the first from `x_start`, is continued as before.
 pub fn sigma_rows(
     mech: &Mechanism,
     q: &[f64],
@@ -138,11 +140,20 @@ pub fn sigma_rows(
             }
             None => start_adjacent = false,
         }
+        // Whether `start` is this row's own start cell: a cell beyond a gap then continues from
+        // it along the row, through the gap's cell.
+        let own_start = row[i0].is_finite();
         for side in [&mut (i0 + 1..n) as &mut dyn Iterator<Item = usize>, &mut (0..i0).rev()] {
             last.copy_from_slice(&start);
             let mut adjacent = start_adjacent;
             for i in side {
                 q[k[0]] = axes[0][i];
+                if !adjacent && own_start && cells.closed.is_some() {
+                    // The closed forms fail where a group cannot close on any branch (a dyad's
+                    // circles do not meet), so the continuation from the row's start, whose
+                    // path along the row passes through that cell, cannot reach this one.
+                    break;
+                }
                 match cells.sigma(&q, &last, adjacent) {
                     Some(s) => {
                         row[i] = s;
