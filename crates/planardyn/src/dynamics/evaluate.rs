@@ -91,9 +91,9 @@ pub struct SigmaRows {
 
 /// See [`SigmaRows`]. One kinematic frame for all the cells (no allocation per cell).
 ///
-/// Where every group of the mechanism has a closed form (`ClosedForm`: a 5R, a two-input
-/// robot), a cell whose neighbour assembled is placed by the closed forms on the neighbour's
-/// branches instead of by Newton continuation from it (the same solution: continuation keeps
+/// Where every group of the mechanism has a closed form without iteration
+/// (`ClosedForm::is_explicit`: a 5R, a two-input robot of dyads), a cell whose neighbour
+/// assembled is placed by the closed forms on the neighbour's branches instead of by Newton continuation from it (the same solution: continuation keeps
 /// the branch of its start over the step). A row's cells beyond a gap are then not tried:
 /// the closed forms fail where a group cannot close on any branch, and the continuation from
 /// the row's start passes through that cell. A cell continued from another row's start, or
@@ -123,7 +123,8 @@ pub fn sigma_rows(
             KinematicsError::bad_argument("x_start", format!("{} finite body coordinates", mech.n_x()), got).into()
         );
     }
-    let mut cells = Cells { mech, frame: Frame::new(mech), closed: ClosedForm::new(mech) };
+    let closed = ClosedForm::new(mech).filter(ClosedForm::is_explicit);
+    let mut cells = Cells { mech, frame: Frame::new(mech), closed };
     let mut q = q.to_vec();
     let (mut start, mut sigma) = (x_start.to_vec(), vec![f64::NAN; rows.len() * n]);
     let mut last = start.clone();
