@@ -8,6 +8,7 @@ use common::*;
 use planardyn::dynamics::{self, evaluate, FixedDrives};
 use planardyn::kinematics::assemble_into;
 use planardyn::Workspace;
+use std::f64::consts::PI;
 
 /// The five-bar's holding torques in its drawing, from its model file's comment: dV/dq by
 /// virtual work, central differences of the potential energy with the same numbers
@@ -81,4 +82,94 @@ fn the_map_rows_measure_each_cell_on_the_branch_followed_and_mark_what_does_not_
     let far = sigma_rows(&mech, &q, [0, 1], [&[std::f64::consts::PI], &[0.0]], 0, &[0], &out.x).unwrap();
     assert!(far.sigma[0].is_nan());
     assert_eq!(far.x, out.x);
+}
+
+/// The map's rows by Newton continuation alone, cell after cell as `sigma_rows` walks them
+/// (its walk before the closed forms placed the cells): the reference of the closed-form path.
+fn continued_rows(
+    mech: &planardyn::Mechanism,
+    axes: [&[f64]; 2],
+    i0: usize,
+    rows: &[usize],
+    x_start: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    use planardyn::kinematics::{assemble_from, sigma_min, Chart, Frame};
+    let n = axes[0].len();
+    let mut frame = Frame::new(mech);
+    let cell = |q: &[f64], from: &[f64], frame: &mut Frame| {
+        assemble_from(mech, from, q, frame).ok().map(|()| (sigma_min(mech, &Chart::Inputs, &frame.x), frame.x.clone()))
+    };
+    let (mut start, mut sigma) = (x_start.to_vec(), Vec::new());
+    for &j in rows {
+        let mut row = vec![f64::NAN; n];
+        if let Some((s, x)) = cell(&[axes[0][i0], axes[1][j]], &start, &mut frame) {
+            row[i0] = s;
+            start = x;
+        }
+        let sides: [Vec<usize>; 2] = [(i0 + 1..n).collect(), (0..i0).rev().collect()];
+        for side in sides {
+            let mut last = start.clone();
+            for i in side {
+                match cell(&[axes[0][i], axes[1][j]], &last, &mut frame) {
+                    Some((s, x)) => {
+                        row[i] = s;
+                        last = x;
+                    }
+                    None => last.clone_from(&start),
+                }
+            }
+        }
+        sigma.extend(row);
+    }
+    (sigma, start)
+}
+
+#[test]
+fn the_map_rows_by_closed_forms_are_those_of_continuation_on_the_five_bar() {
+    use planardyn::dynamics::sigma_rows;
+    use planardyn::kinematics::ClosedForm;
+    let mech = shipped("five-bar.yaml");
+    assert!(
+        ClosedForm::new(&mech).is_some_and(|c| c.is_explicit()),
+        "the 5R's dyad has a closed form without iteration: the fast path is the one tested"
+    );
+    let q = mech.drawn_q();
+    // The page's grid (web/src/map.js): 60 x 60 cell centres over q +- pi, the middle row
+    // first, then the rows above it, then those below from the middle row's start.
+    const N: usize = 60;
+    let axis = |k: usize| -> Vec<f64> { (0..N).map(|i| q[k] - PI + 2.0 * PI * (i as f64 + 0.5) / N as f64).collect() };
+    let (a0, a1) = (axis(0), axis(1));
+    let axes: [&[f64]; 2] = [&a0, &a1];
+    let (j0, i0) = (N / 2, N / 2);
+    let (up, down): (Vec<usize>, Vec<usize>) = ((j0..N).collect(), (0..j0).rev().collect());
+    let fast_up = sigma_rows(&mech, &q, [0, 1], axes, i0, &up[..1], &mech.x0).unwrap();
+    let fast_rest = sigma_rows(&mech, &q, [0, 1], axes, i0, &up[1..], &fast_up.x).unwrap();
+    let fast_down = sigma_rows(&mech, &q, [0, 1], axes, i0, &down, &fast_up.x).unwrap();
+    let (ref_up, x_mid) = continued_rows(&mech, axes, i0, &up[..1], &mech.x0);
+    let (ref_rest, x_top) = continued_rows(&mech, axes, i0, &up[1..], &x_mid);
+    let (ref_down, x_bottom) = continued_rows(&mech, axes, i0, &down, &x_mid);
+    // The same configurations to Newton's tolerance (the continuation's residual is at
+    // round-off after its last quadratic step): sigma to 1e-12 relative, and the same cells
+    // missing (where the followed branch does not assemble).
+    let (mut finite, mut missing) = (0, 0);
+    for (fast, reference) in [(&fast_up, &ref_up), (&fast_rest, &ref_rest), (&fast_down, &ref_down)] {
+        for (c, (a, b)) in fast.sigma.iter().zip(reference).enumerate() {
+            assert_eq!(a.is_nan(), b.is_nan(), "cell {c}: {a} vs {b}");
+            if a.is_nan() {
+                missing += 1;
+            } else {
+                assert!((a - b).abs() <= 1e-12 * b, "cell {c}: {a} vs {b}");
+                finite += 1;
+            }
+        }
+    }
+    // The grid crosses the folds (cells that do not assemble) and the rows restart after them.
+    assert!(finite > N * N / 4 && missing > N, "{finite} cells measured, {missing} missing");
+    // The branch: the rows' start cells (where the next rows continue) are the same
+    // configurations, elbows on the same sides, to 1e-12 m.
+    for (fast, reference) in [(&fast_up.x, &x_mid), (&fast_rest.x, &x_top), (&fast_down.x, &x_bottom)] {
+        for (a, b) in fast.iter().zip(reference) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+    }
 }

@@ -7,7 +7,7 @@
 
 use super::query::assembled;
 use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives};
-use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, Chart, Frame};
+use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, Chart, ClosedForm, Frame};
 use crate::model::Mechanism;
 use crate::{Error, KinematicsError};
 
@@ -90,6 +90,14 @@ pub struct SigmaRows {
 }
 
 /// See [`SigmaRows`]. One kinematic frame for all the cells (no allocation per cell).
+///
+/// Where every group of the mechanism has a closed form without iteration
+/// (`ClosedForm::is_explicit`: a 5R, a two-input robot of dyads), a cell whose neighbour
+/// assembled is placed by the closed forms on the neighbour's branches instead of by Newton continuation from it (the same solution: continuation keeps
+/// the branch of its start over the step). A row's cells beyond a gap are then not tried:
+/// the closed forms fail where a group cannot close on any branch, and the continuation from
+/// the row's start passes through that cell. A cell continued from another row's start, or
+/// the first from `x_start`, is continued as before.
 pub fn sigma_rows(
     mech: &Mechanism,
     q: &[f64],
@@ -115,37 +123,75 @@ pub fn sigma_rows(
             KinematicsError::bad_argument("x_start", format!("{} finite body coordinates", mech.n_x()), got).into()
         );
     }
-    let mut frame = Frame::new(mech);
+    let closed = ClosedForm::new(mech).filter(ClosedForm::is_explicit);
+    let mut cells = Cells { mech, frame: Frame::new(mech), closed };
     let mut q = q.to_vec();
-    let (mut start, mut sigma) = (x_start.to_vec(), Vec::with_capacity(rows.len() * n));
-    let cell = |q: &[f64], from: &[f64], frame: &mut Frame| {
-        assemble_from(mech, from, q, frame)
-            .ok()
-            .map(|()| sigma_min_with(&mut frame.sys, mech, &Chart::Inputs, &frame.x))
-    };
-    for &j in rows {
-        let mut row = vec![f64::NAN; n];
+    let (mut start, mut sigma) = (x_start.to_vec(), vec![f64::NAN; rows.len() * n]);
+    let mut last = start.clone();
+    // Whether `start` is the previous row's start cell (a neighbour) rather than `x_start`.
+    let mut start_adjacent = false;
+    for (&j, row) in rows.iter().zip(sigma.chunks_exact_mut(n)) {
         q[k[1]] = axes[1][j];
         q[k[0]] = axes[0][i0];
-        if let Some(s) = cell(&q, &start, &mut frame) {
-            row[i0] = s;
-            start.copy_from_slice(&frame.x);
+        match cells.sigma(&q, &start, start_adjacent) {
+            Some(s) => {
+                row[i0] = s;
+                start.copy_from_slice(&cells.frame.x);
+                start_adjacent = true;
+            }
+            None => start_adjacent = false,
         }
-        let (right, left) = ((i0 + 1..n).collect::<Vec<_>>(), (0..i0).rev().collect::<Vec<_>>());
-        for side in [right, left] {
-            let mut last = start.clone();
+        // Whether `start` is this row's own start cell: a cell beyond a gap then continues from
+        // it along the row, through the gap's cell.
+        let own_start = row[i0].is_finite();
+        for side in [&mut (i0 + 1..n) as &mut dyn Iterator<Item = usize>, &mut (0..i0).rev()] {
+            last.copy_from_slice(&start);
+            let mut adjacent = start_adjacent;
             for i in side {
                 q[k[0]] = axes[0][i];
-                match cell(&q, &last, &mut frame) {
+                if !adjacent && own_start && cells.closed.is_some() {
+                    // The closed forms fail where a group cannot close on any branch (a dyad's
+                    // circles do not meet), so the continuation from the row's start, whose
+                    // path along the row passes through that cell, cannot reach this one.
+                    break;
+                }
+                match cells.sigma(&q, &last, adjacent) {
                     Some(s) => {
                         row[i] = s;
-                        last.copy_from_slice(&frame.x);
+                        last.copy_from_slice(&cells.frame.x);
+                        adjacent = true;
                     }
-                    None => last.copy_from_slice(&start),
+                    None => {
+                        last.copy_from_slice(&start);
+                        adjacent = false;
+                    }
                 }
             }
         }
-        sigma.extend_from_slice(&row);
     }
     Ok(SigmaRows { sigma, x: start })
+}
+
+/// The map's cells, assembled in one frame.
+struct Cells<'a> {
+    mech: &'a Mechanism,
+    frame: Frame,
+    closed: Option<ClosedForm>,
+}
+
+impl Cells<'_> {
+    /// The type II measure at q, the configuration left in `frame.x`: by the closed forms on
+    /// the branches of `from` where it is the neighbouring cell's solution (`adjacent`) and the
+    /// mechanism has them, else by continuation from `from`. None where it does not assemble.
+    fn sigma(&mut self, q: &[f64], from: &[f64], adjacent: bool) -> Option<f64> {
+        let (mech, frame) = (self.mech, &mut self.frame);
+        let placed = match self.closed.as_mut().filter(|_| adjacent) {
+            Some(closed) => {
+                closed.set_reference(from);
+                closed.positions(q, frame)
+            }
+            None => assemble_from(mech, from, q, frame),
+        };
+        placed.ok().map(|()| sigma_min_with(&mut frame.sys, mech, &Chart::Inputs, &frame.x))
+    }
 }

@@ -371,6 +371,13 @@ impl ClosedForm {
         Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma })
     }
 
+    /// Whether every group is placed without iteration (no class III triad, whose Newton
+    /// solve can fail on one branch where a configuration exists): `positions` then fails
+    /// only where no configuration exists at those coordinates.
+    pub fn is_explicit(&self) -> bool {
+        !self.groups.iter().any(|g| matches!(g, Group::Triad(_)))
+    }
+
     /// Take the assembly branches from the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
         self.groups.iter_mut().for_each(|d| d.set_reference(x));
