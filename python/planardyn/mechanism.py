@@ -931,6 +931,6 @@ def run_metadata(
         facts = mechanism._run_facts()
         meta["model"], meta["source"] = facts.model, facts.source
     if settings is not None:
-        meta["settings"] = {k: plain(v) for k, v in settings.items()}
+        meta["settings"] = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
     meta.update(extra)
     return meta

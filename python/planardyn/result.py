@@ -43,7 +43,10 @@ class Energy:
         balance = total - work
         if len(balance):
             balance -= balance[0]  # in place: one temporary fewer on a short run's path
-        return cls(kinetic, potential, work, total, balance)
+        # Every field at once, as SimulationResult.from_raw (the frozen __init__ sets them one by one).
+        energy = object.__new__(cls)
+        energy.__dict__.update(kinetic=kinetic, potential=potential, work=work, total=total, balance=balance)
+        return energy
 
     @property
     def drift(self) -> float:
@@ -57,14 +60,17 @@ class Energy:
 #: The output columns that are entries of :class:`Energy` (``result.energy.kinetic``, ...);
 #: every other column is the result's field of its name.
 ENERGY_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name in {f.name for f in dataclasses.fields(Energy)})
+#: The other columns, each a result's field of its name; and those every run has (not optional).
+FIELD_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name not in ENERGY_COLUMNS)
+RUN_COLUMNS = tuple(c.name for c in results_format.COLUMNS if not c.optional)
 
 
 def column_fields(values: Mapping[str, Any], body_names: list[str]) -> dict[str, Any]:
     """A result's fields from its output columns by name (:data:`results_format.COLUMNS`, an
     optional one None or absent): each column is the field of its name, but the energies make
     ``energy``, and ``poses`` is ``x`` by body."""
-    fields = {c.name: values.get(c.name) for c in results_format.COLUMNS if c.name not in ENERGY_COLUMNS}
-    fields["energy"] = Energy.from_arrays(**{k: values[k] for k in ENERGY_COLUMNS})
+    fields = {name: values.get(name) for name in FIELD_COLUMNS}
+    fields["energy"] = Energy.from_arrays(values["kinetic"], values["potential"], values["work"])
     x = values["x"]
     fields["poses"] = x.reshape(x.shape[0], len(body_names), 3)
     return fields
@@ -228,9 +234,10 @@ class SimulationResult:
         tau_motor: FloatArray | None = None,
     ) -> SimulationResult:
         """Wrap the dict returned by the native ``Mechanism.simulate``."""
-        columns = {c.name: raw[c.name] for c in results_format.COLUMNS if not c.optional}
+        columns = {name: raw[name] for name in RUN_COLUMNS}
+        columns["tau_motor"] = tau_motor
         fields = dict(
-            **column_fields(columns | {"tau_motor": tau_motor}, body_names),
+            **column_fields(columns, body_names),
             success=raw["status"] in ("success", "event"),
             status=raw["status"],
             message=raw["message"],
