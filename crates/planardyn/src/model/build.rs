@@ -80,7 +80,6 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
         pair_slots: Vec::new(),
         n_constraints: 0,
         warnings: Vec::new(),
-        assur: Default::default(),
     };
     mech.x0 = mech.bodies.iter().flat_map(|b| [b.com0[0], b.com0[1], b.angle0]).collect();
     mech.scale = scale;

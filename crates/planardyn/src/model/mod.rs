@@ -232,10 +232,6 @@ pub struct Mechanism {
     pub n_constraints: usize,
     /// Things a user should know about the model (redundant constraints...).
     pub warnings: Vec<String>,
-    /// Its Assur decomposition, made at the first run and shared by every run after it
-    /// (and by clones): it reads only the pairs and coordinates, which do not change once
-    /// the drawing is built.
-    pub(crate) assur: crate::topology::assur::AssurCache,
 }
 
 impl Mechanism {

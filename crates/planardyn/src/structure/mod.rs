@@ -121,10 +121,10 @@ pub(crate) fn structure(mech: &Mechanism, x: &[f64]) -> Structure {
         actuation: mech.n_actuators(),
         loops,
         connected,
-        input_links: a.input_links.clone(),
-        relative_inputs: a.relative_inputs.clone(),
-        groups: a.groups.clone(),
-        left_over: a.left_over.clone(),
+        input_links: a.input_links,
+        relative_inputs: a.relative_inputs,
+        groups: a.groups,
+        left_over: a.left_over,
         left_over_mobility: a.left_over_mobility,
     }
 }

@@ -17,7 +17,6 @@ use crate::model::pairs::letter;
 use crate::model::{BodyId, Link, Mechanism, PairId};
 use petgraph::algo::tarjan_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
-use std::sync::{Arc, OnceLock};
 
 /// One Assur group: a set of links of zero mobility with the pairs joining them to each
 /// other and to the links solved before it.
@@ -40,7 +39,6 @@ pub struct AssurGroup {
 }
 
 /// What the decomposition finds (the structure report shows it: `crate::Structure`).
-#[derive(Debug)]
 pub(crate) struct Assur {
     pub input_links: Vec<BodyId>,
     pub relative_inputs: Vec<PairId>,
@@ -98,25 +96,7 @@ fn augment(r: usize, rows: &[Vec<usize>], col_row: &mut [Option<usize>], seen: &
     false
 }
 
-/// A mechanism's decomposition, made at its first use and kept with the model
-/// ([`Mechanism::assur`]): every run's set-up reads it (the closed forms' groups), and it
-/// depends only on the pairs and the coordinates, fixed once the drawing is built.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct AssurCache(OnceLock<Arc<Assur>>);
-
-impl PartialEq for AssurCache {
-    /// A cache is no part of the model's value: two models equal in their fields are equal.
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
-}
-
-/// `mech`'s decomposition, from its cache.
-pub(crate) fn assur(mech: &Mechanism) -> &Assur {
-    mech.assur.0.get_or_init(|| Arc::new(decompose(mech)))
-}
-
-fn decompose(mech: &Mechanism) -> Assur {
+pub(crate) fn assur(mech: &Mechanism) -> Assur {
     let (n, nx) = (mech.n_bodies(), mech.n_x());
     let mut input = vec![false; mech.pairs.len()];
     for c in &mech.coordinates {
