@@ -87,7 +87,8 @@ def check_app() -> None:
     subprocess.run([str(command), "app", "five-bar", "-o", "app.html"], capture_output=True, text=True, check=True)
     page = Path("app.html").read_text()
     # "AGFzbQ" is the base64 of the wasm magic number "\\0asm": the engine is inlined.
-    assert '"source": "five-bar.yaml"' in page and "AGFzbQ" in page, page[:200]
+    # The page's data is compact JSON (app.page_data): no space after the colon.
+    assert '"source":"five-bar.yaml"' in page and "AGFzbQ" in page, page[:200]
     print(f"wheel: planardyn app wrote app.html ({len(page) / 1e6:.1f} MB, the engine inside)")
 
 
