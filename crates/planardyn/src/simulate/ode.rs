@@ -380,7 +380,8 @@ impl<'a> MechanismOde<'a> {
 }
 
 /// The evaluation a [`MechanismOde`] holds (its workspace and what the next evaluation's
-/// Newton start is predicted from), set aside while points off the integration are evaluated.
+/// Newton start is predicted from), set aside while points off the integration are evaluated
+/// ([`MechanismOde::set_aside`], [`MechanismOde::save`]).
 pub struct Evaluation {
     ws: Workspace,
     eval_y: Vec<f64>,
@@ -440,7 +441,7 @@ impl MechanismOde<'_> {
     }
 
     /// The evaluation held now, to be put back by [`MechanismOde::restore`]: evaluating other
-    /// points between (a crossing's nodes inside a step) then leaves the integration as it
+    /// points between (the overshoot check's, `Run::overshot`) then leaves the integration as it
     /// would have been, to the bit.
     pub fn save(&self) -> Evaluation {
         Evaluation {
