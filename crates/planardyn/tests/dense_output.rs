@@ -17,6 +17,11 @@ const RTOL: f64 = 1.2589254117941673e-7;
 /// The benchmark's run (benchmarks/mechanisms.py): 1 s, DOP853, rtol = atol, outputs every
 /// 0.01 s or (None) at every step.
 fn fall(every: Option<f64>, rtol: f64) -> Trajectory {
+    fall_stepping(every, rtol).0
+}
+
+/// [`fall`], with the times of its accepted steps (from the progress callback).
+fn fall_stepping(every: Option<f64>, rtol: f64) -> (Trajectory, Vec<f64>) {
     let mech = shipped("five-bar-free-fall.yaml");
     let mut s = Settings::for_model(&mech).unwrap();
     s.method = "dop853".parse().unwrap();
@@ -27,9 +32,14 @@ fn fall(every: Option<f64>, rtol: f64) -> Trajectory {
         t.dedup();
         t
     });
-    let tr = simulate(&mech, &s, &mut planardyn::dynamics::ModelDrives(&mech), None).unwrap();
+    let mut steps = Vec::new();
+    let mut progress = |t: f64| {
+        steps.push(t);
+        true
+    };
+    let tr = simulate(&mech, &s, &mut planardyn::dynamics::ModelDrives(&mech), Some(&mut progress)).unwrap();
     assert!(tr.success(), "{:?} {}", tr.status, tr.message);
-    tr
+    (tr, steps)
 }
 
 /// Largest |qd1 + qd2| (rad/s) up to 0.7 s: the fall is symmetric about the y axis (the
@@ -56,8 +66,8 @@ fn five_bar_outputs_are_as_accurate_as_its_steps_past_a_singularity_between_stag
 }
 
 /// rtol = atol = 3.98e-8 (the sweep's 10^-7.4 rounded to 3 digits, as benchmarks/output_rows.py
-/// prints it; at 10^-7.4 itself the grid run's steps differ from the every-step run's, an open
-/// point of /work/notes/s10-rows.md): DOP853's first step after the five-bar's chart switch back to the
+/// prints it; at 10^-7.4 itself the grid run's steps differed from the every-step run's until
+/// the step's end was set aside from the outputs, see [`TRAJECTORY_RTOLS`]): DOP853's first step after the five-bar's chart switch back to the
 /// user's chart at 0.3371 s is 0.0473 s long (the starting guess's size; the steps before it
 /// in the partition were 8-13 ms) and passes the error test, its end 1.2e-7 J off the start's
 /// energy. Its degree-7 interpolant is of one order less than the step and its error is not
@@ -70,4 +80,24 @@ fn five_bar_outputs_are_as_accurate_as_its_steps_in_the_first_step_after_a_chart
     let (outputs, steps) = (fall(Some(0.01), FIRST_STEP_RTOL), fall(None, FIRST_STEP_RTOL));
     let (drift, bound) = (outputs.stats.energy_drift, OUTPUT_MARGIN * steps.stats.energy_drift);
     assert!(drift <= bound, "outputs' energy drift {drift:e} J > {bound:e} J (twice the steps')");
+}
+
+/// Settings of benchmarks/output_rows.py's sweep at which the outputs changed the five-bar's
+/// integration before the step's end was set aside from them (commit 522dfe5): the grid run's
+/// accepted step times differed from the every-step run's at all four. At 10^-7.4 exactly the
+/// grid run took 102 steps (22 in a partition chart) where the every-step run took 101 (20),
+/// and its rows were 6.9e-7 J off where the steps were 1.3e-7 J.
+const TRAJECTORY_RTOLS: [f64; 4] = [3.981071705534973e-8, 1e-6, 1e-8, 1e-4];
+
+/// The outputs leave the integration alone: the grid run takes the every-step run's steps,
+/// to the bit (the outputs are evaluated aside from the step's end, which the next step starts
+/// from; `MechanismOde::set_aside`), in the same charts.
+#[test]
+fn five_bar_outputs_do_not_change_the_steps() {
+    for rtol in TRAJECTORY_RTOLS {
+        let ((outputs, grid_steps), (steps, every_steps)) =
+            (fall_stepping(Some(0.01), rtol), fall_stepping(None, rtol));
+        assert_eq!(grid_steps, every_steps, "rtol {rtol:e}: accepted step times with and without the grid");
+        assert_eq!(outputs.stats.partition_steps, steps.stats.partition_steps, "rtol {rtol:e}: partition steps");
+    }
 }

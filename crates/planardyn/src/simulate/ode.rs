@@ -93,6 +93,9 @@ pub struct MechanismOde<'a> {
     /// The chart's own measure at the last accepted point (`limit_correction`), which the
     /// dense-output stages must keep within [`DENSE_SIGMA_FRACTION`] of.
     own_sigma: f64,
+    /// The evaluation not in use, of the current chart: the step's end while its outputs are
+    /// evaluated ([`MechanismOde::set_aside`]), their scratch otherwise.
+    spare: Evaluation,
 }
 
 impl<'a> MechanismOde<'a> {
@@ -103,6 +106,7 @@ impl<'a> MechanismOde<'a> {
         if let Some(c) = closed.as_mut() {
             c.set_reference(&ws.x);
         }
+        let spare = Evaluation::unused(&ws, &closed);
         MechanismOde {
             motion: None,
             eval_y: vec![0.0; 2 * m + 1],
@@ -125,6 +129,7 @@ impl<'a> MechanismOde<'a> {
             stale_j: false,
             clear_of_folds: true,
             own_sigma: 0.0,
+            spare,
             mech,
             ws,
             drives,
@@ -155,7 +160,8 @@ impl<'a> MechanismOde<'a> {
         self.anchor_u.copy_from_slice(&self.ws.u);
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
-        if let Some(c) = self.closed.as_mut() {
+        // The spare evaluates the outputs of the next step, from this point's branches.
+        for c in [self.closed.as_mut(), self.spare.closed.as_mut()].into_iter().flatten() {
             c.set_reference(&self.ws.x);
         }
         Ok(())
@@ -249,7 +255,11 @@ impl<'a> MechanismOde<'a> {
         self.anchor_z.copy_from_slice(&y[..m]);
         self.last_t = f64::NAN;
         self.base_valid = false;
-        self.accept(t, y)
+        self.accept(t, y)?;
+        // The spare's chart and its structure (`System`'s analysis, which the predictor from
+        // the anchor uses before Newton renews it) are the new chart's: a copy, once a switch.
+        self.spare = self.save();
+        Ok(())
     }
 
     /// Newton's start for chart values z: a second-order prediction
@@ -370,7 +380,8 @@ impl<'a> MechanismOde<'a> {
 }
 
 /// The evaluation a [`MechanismOde`] holds (its workspace and what the next evaluation's
-/// Newton start is predicted from), set aside while points off the integration are evaluated.
+/// Newton start is predicted from), set aside while points off the integration are evaluated
+/// ([`MechanismOde::set_aside`], [`MechanismOde::save`]).
 pub struct Evaluation {
     ws: Workspace,
     eval_y: Vec<f64>,
@@ -382,9 +393,55 @@ pub struct Evaluation {
     stale_j: bool,
 }
 
+impl Evaluation {
+    /// Buffers of the chart of `ws`, holding no evaluation.
+    fn unused(ws: &Workspace, closed: &Option<ClosedForm>) -> Self {
+        let n_y = 2 * ws.q.len() + 1;
+        Evaluation {
+            ws: ws.clone(),
+            eval_y: vec![0.0; n_y],
+            last_t: f64::NAN,
+            last_y: vec![f64::NAN; n_y],
+            base_valid: false,
+            closed: closed.clone(),
+            base_closed: false,
+            stale_j: false,
+        }
+    }
+}
+
 impl MechanismOde<'_> {
+    /// Set the evaluation held now (a step's end) aside, evaluations then starting from the
+    /// last accepted point in the spare buffers: a step's outputs (rows, dense output, events)
+    /// leave the point the next step starts from as the stepper left it, to the bit, and
+    /// [`MechanismOde::take_back`] returns it without evaluating it again. Re-evaluated, the
+    /// step's end differed from the stepper's in its last bits (Newton started from another
+    /// point), which changed the steps: the five-bar at DOP853 rtol 10^-7.4 took 102 steps with
+    /// a 0.01 s grid, 101 without. A swap: no allocation.
+    pub fn set_aside(&mut self) {
+        self.swap_spare();
+        self.restart_from_anchor();
+    }
+
+    /// Take back the evaluation set aside by [`MechanismOde::set_aside`].
+    pub fn take_back(&mut self) {
+        self.swap_spare();
+    }
+
+    fn swap_spare(&mut self) {
+        let e = &mut self.spare;
+        std::mem::swap(&mut self.ws, &mut e.ws);
+        std::mem::swap(&mut self.eval_y, &mut e.eval_y);
+        std::mem::swap(&mut self.last_t, &mut e.last_t);
+        std::mem::swap(&mut self.last_y, &mut e.last_y);
+        std::mem::swap(&mut self.base_valid, &mut e.base_valid);
+        std::mem::swap(&mut self.closed, &mut e.closed);
+        std::mem::swap(&mut self.base_closed, &mut e.base_closed);
+        std::mem::swap(&mut self.stale_j, &mut e.stale_j);
+    }
+
     /// The evaluation held now, to be put back by [`MechanismOde::restore`]: evaluating other
-    /// points between (a crossing's nodes inside a step) then leaves the integration as it
+    /// points between (the overshoot check's, `Run::overshot`) then leaves the integration as it
     /// would have been, to the bit.
     pub fn save(&self) -> Evaluation {
         Evaluation {

@@ -162,6 +162,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if self.ode.ws.chart != Chart::Inputs {
             self.traj.stats.partition_steps += 1;
         }
+        // The step's end as the stepper evaluated it, kept from its outputs until `accept`.
+        self.ode.set_aside();
         let terminal = self.observe(t)?;
         self.outputs(terminal.map_or(t, |(t_star, _)| t_star))?;
         if let Some((t_star, index)) = terminal {
@@ -264,8 +266,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
 
     /// Make the step's end the predictor's anchor and measure it; without a grid, its row.
     fn accept(&mut self, t: f64) -> ControlFlow<Stop, Measures> {
-        // Outputs and the dense output moved the evaluation away from the step's end; if going
-        // straight back is refused, come back along the interpolant as they did.
+        self.ode.take_back();
+        // The step's end is evaluated again only where the stepper's last evaluation was not
+        // there; if that is refused, come back along the interpolant as the outputs do.
         let (ode, y) = (&mut self.ode, &self.y);
         let accepted = ode.accept(t, y).or_else(|e| {
             if self.t_eval.is_none() && self.dense.is_none() {
@@ -445,7 +448,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if !grid.nodes().any(|s| inside(&s)) {
             return Continue(());
         }
-        let saved = self.ode.save();
+        // The step's end is set aside (`MechanismOde::set_aside`): these evaluations leave it.
         self.ode.restart_from_anchor();
         // Earliest first, as the outputs are walked.
         for s in grid.nodes().rev().filter(inside) {
@@ -454,7 +457,6 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             }
             self.approach.fill(&self.ode, s);
         }
-        self.ode.restore(saved);
         Continue(())
     }
 
@@ -504,11 +506,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         match self.t_eval {
             None => self.traj.record(ode, landing.t, work_past, meas.sigma),
             Some(te) => {
+                // In the spare buffers: the next step starts from the landing's evaluation.
+                ode.set_aside();
                 while self.next < te.len() && inside(te[self.next], landing.t) {
                     path_row(ode, &mut self.traj, &landing.path, te[self.next], sigma);
                     self.next += 1;
                 }
-                ode.restart_from_anchor();
+                ode.take_back();
             }
         }
         Ok(Crossed::Past)
