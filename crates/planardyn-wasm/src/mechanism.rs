@@ -188,7 +188,8 @@ impl WasmMechanism {
     /// Rows `rows` (in that order) of the type II measure over coordinates k1 (columns, values
     /// `axis1`) and k2 (rows, `axis2`), the others as in q, each row walked from column `i0`,
     /// by continuation from `xStart` (`planardyn::dynamics::sigma_rows`): `{sigma (rows x
-    /// axis1.length, NaN where it does not assemble), x (where the next rows continue)}`.
+    /// axis1.length, NaN where it does not assemble), x (where the next rows continue)}`; the
+    /// branch shown is `planardyn::dynamics::MapRows`'.
     #[wasm_bindgen(js_name = sigmaRows)]
     #[allow(clippy::too_many_arguments)]
     pub fn sigma_rows(
@@ -205,7 +206,7 @@ impl WasmMechanism {
         self.q_arg("q", q)?;
         let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
         let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
-        Ok(Obj::new().f64s("sigma", &out.sigma).f64s("x", &out.x).build())
+        Ok(Obj::new().f64s("sigma", &out.values).f64s("x", &out.x).build())
     }
 
     /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
