@@ -10,17 +10,16 @@ use crate::errors::{argument_error, js};
 use crate::simulate::{run, SimulateOptions};
 use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::dynamics::{self, carried_points, Rows};
-use planardyn::elastic;
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
-use planardyn::model::{BodyId, Link, PairId, PointId};
+use planardyn::model::{PairId, PointId};
 use planardyn::Mechanism;
 use wasm_bindgen::prelude::*;
 
 /// A validated planar mechanism (immutable). Made by `load`.
 #[wasm_bindgen(js_name = Mechanism)]
 pub struct WasmMechanism {
-    inner: Mechanism,
+    pub(crate) inner: Mechanism,
 }
 
 impl WasmMechanism {
@@ -41,7 +40,7 @@ impl WasmMechanism {
     }
 
     /// The arguments of an assembly checked: q (m), and `x_start` (3n) when given.
-    fn start_args(&self, q: &[f64], x_start: Option<&[f64]>) -> Result<(), JsValue> {
+    pub(crate) fn start_args(&self, q: &[f64], x_start: Option<&[f64]>) -> Result<(), JsValue> {
         self.q_arg("q", q)?;
         x_start.map_or(Ok(()), |x| self.x_arg("xStart", x))
     }
@@ -207,57 +206,6 @@ impl WasmMechanism {
         let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
         let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
         Ok(Obj::new().f64s("sigma", &out.values).f64s("x", &out.x).build())
-    }
-
-    /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
-    /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
-    /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
-    /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
-    /// increasing frequency, about the pose without gravity's load (as the Python API's
-    /// default: a drawn pose need not be an equilibrium). A model without a `compliance:`
-    /// section throws an ArgumentError.
-    pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
-        self.start_args(q, x_start.as_deref())?;
-        let mut ws = js(query::assembled(&self.inner, q, x_start.as_deref()))?;
-        let modes = js(elastic::modes(&self.inner, q, free_rotors, false, &mut ws))?;
-        Ok(Obj::new()
-            .f64s("omega", &modes.omega())
-            .f64s("omega2", &modes.omega2)
-            .f64s("dampingRatio", &modes.damping_ratio)
-            .f64s("shapes", &modes.shapes.concat())
-            .f64s("x", &ws.x)
-            .build())
-    }
-
-    /// The stiffness of the point `point` (on the first body that carries it) at
-    /// coordinates q (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`
-    /// unloaded): `{weakest (N/m: the translational stiffness in its weakest direction), direction
-    /// ([d_x, d_y], unit), compliance (3 x 3 of [x, y, phi]; m/N, m/(N m), rad/N, rad/(N m)),
-    /// x (3n: the pose)}`. A model without a `compliance:` section throws an ArgumentError.
-    pub fn stiffness(&self, q: &[f64], point: &str, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
-        self.start_args(q, x_start.as_deref())?;
-        let m = &self.inner;
-        let on_body = |id: PointId| (0..m.n_bodies()).map(BodyId).find(|&b| m.attachment(Link::Body(b), id).is_some());
-        let Some((id, body)) = m.point_id(point).and_then(|id| on_body(id).map(|b| (id, b))) else {
-            let names: Vec<&str> = (0..m.points.len())
-                .filter(|&p| on_body(PointId(p)).is_some())
-                .map(|p| m.points[p].0.as_str())
-                .collect();
-            return Err(argument_error(
-                Some("point"),
-                format!("no body carries a point '{point}'; the bodies' points are: {}", names.join(", ")),
-            ));
-        };
-        let mut ws = js(query::assembled(m, q, x_start.as_deref()))?;
-        let out = elastic::Output { body, point: Some(id) };
-        let c = js(elastic::stiffness(m, q, out, &elastic::Load::default(), &mut ws))?;
-        let w = elastic::weakest_direction(&c, None);
-        Ok(Obj::new()
-            .set("weakest", w.stiffness)
-            .f64s("direction", &w.direction[..2])
-            .f64s("compliance", c.compliance.as_flattened())
-            .f64s("x", &ws.x)
-            .build())
     }
 
     /// Drive efforts tau (m; N m or N) for (q, qd, qdd).

@@ -164,6 +164,11 @@ impl<'a> MapGrid<'a> {
         }
         Ok(MapGrid { k, axes, i0, rows, x_start })
     }
+
+    /// The branch's reference (3n).
+    pub fn x_start(&self) -> &'a [f64] {
+        self.x_start
+    }
 }
 
 /// The rows of `grid` (see [`MapRows`]): each cell placed in `ws` at its q on the branch
