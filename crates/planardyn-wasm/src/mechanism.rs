@@ -88,6 +88,7 @@ impl WasmMechanism {
             .set("coordinateNames", strings(m.coordinate_names()))
             .set("coordinateKinds", strings(m.coordinates.iter().map(|c| c.kind.name())))
             .set("driven", array(m.drives.iter().map(|d| d.is_some().into())))
+            .set("actuators", strings(m.actuator_names()))
             .set("prescribed", array(m.motions.iter().map(|d| d.is_some().into())))
             .set("bodyNames", strings(m.body_names()))
             .set("bodies", array(bodies))
