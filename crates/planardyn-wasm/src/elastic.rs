@@ -1,10 +1,10 @@
-//! The compliant mechanism's analyses in JavaScript (`planardyn::elastic`), methods of
-//! `Mechanism`: its natural modes, a point's stiffness under a load, and the maps of both over
-//! two coordinates (`planardyn::elastic::map_rows`, the singularity map's grid and branch).
+//! The compliant mechanism's analyses in JavaScript (`planardyn::elastic`), the bodies of
+//! `Mechanism`'s methods: its natural modes, a point's stiffness under a load, and the maps of
+//! both over two coordinates (`planardyn::elastic::map_rows`, the singularity map's grid and
+//! branch).
 
 use crate::convert::{from_js, Obj};
 use crate::errors::{argument_error, js};
-use crate::mechanism::WasmMechanism;
 use planardyn::dynamics::query;
 use planardyn::dynamics::MapGrid;
 use planardyn::elastic::{self, Load, MapValue, Output};
@@ -12,7 +12,7 @@ use planardyn::model::{BodyId, Link, PointId};
 use planardyn::Mechanism;
 use serde::Deserialize;
 use std::collections::BTreeMap;
-use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsValue;
 
 /// A load on a point (`stiffness`'s and the stiffness map's): `wrench` [F_x, F_y, M] (N, N,
 /// N m) at the point, `preload` efforts (N m or N) of elastic drives by actuator name, and
@@ -75,92 +75,53 @@ fn load(m: &Mechanism, option: LoadOption) -> Result<Load, JsValue> {
     Ok(out)
 }
 
-#[wasm_bindgen(js_class = Mechanism)]
-impl WasmMechanism {
-    /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
-    /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
-    /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
-    /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
-    /// increasing frequency, about the pose without gravity's load (as the Python API's
-    /// default: a drawn pose need not be an equilibrium). A model without a `compliance:`
-    /// section throws an ArgumentError.
-    pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
-        self.start_args(q, x_start.as_deref())?;
-        let mut ws = js(query::assembled(&self.inner, q, x_start.as_deref()))?;
-        let modes = js(elastic::modes(&self.inner, q, free_rotors, false, &mut ws))?;
-        Ok(Obj::new()
-            .f64s("omega", &modes.omega())
-            .f64s("omega2", &modes.omega2)
-            .f64s("dampingRatio", &modes.damping_ratio)
-            .f64s("shapes", &modes.shapes.concat())
-            .f64s("x", &ws.x)
-            .build())
-    }
+/// `Mechanism.modes` (see there): the modes about q on the branch of `x_start`.
+pub fn modes(m: &Mechanism, q: &[f64], free_rotors: bool, x_start: Option<&[f64]>) -> Result<JsValue, JsValue> {
+    let mut ws = js(query::assembled(m, q, x_start))?;
+    let modes = js(elastic::modes(m, q, free_rotors, false, &mut ws))?;
+    Ok(Obj::new()
+        .f64s("omega", &modes.omega())
+        .f64s("omega2", &modes.omega2)
+        .f64s("dampingRatio", &modes.damping_ratio)
+        .f64s("shapes", &modes.shapes.concat())
+        .f64s("x", &ws.x)
+        .build())
+}
 
-    /// The stiffness of the point `point` (on the first body that carries it) at coordinates q
-    /// (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`), in
-    /// equilibrium with `load` (`LoadOption`: a wrench at the point, preload efforts of elastic
-    /// drives by actuator name, gravity; none if absent) with its geometric term: `{weakest (N/m:
-    /// the translational stiffness in its weakest direction), direction ([d_x, d_y], unit),
-    /// compliance (3 x 3 of [x, y, phi]; m/N, m/(N m), rad/N, rad/(N m)), x (3n: the pose)}`,
-    /// as the Python API's `stiffness(mech, q, body=, point=, wrench=, preload=, gravity=)`. A
-    /// model without a `compliance:` section throws an ArgumentError.
-    pub fn stiffness(
-        &self,
-        q: &[f64],
-        point: &str,
-        x_start: Option<Vec<f64>>,
-        load_option: JsValue,
-    ) -> Result<JsValue, JsValue> {
-        self.start_args(q, x_start.as_deref())?;
-        let m = &self.inner;
-        let out = output(m, point)?;
-        let load = load(m, from_js("load", load_option)?)?;
-        let mut ws = js(query::assembled(m, q, x_start.as_deref()))?;
-        let c = js(elastic::stiffness(m, q, out, &load, &mut ws))?;
-        let w = elastic::weakest_direction(&c, None);
-        Ok(Obj::new()
-            .set("weakest", w.stiffness)
-            .f64s("direction", &w.direction[..2])
-            .f64s("compliance", c.compliance.as_flattened())
-            .f64s("x", &ws.x)
-            .build())
-    }
+/// `Mechanism.stiffness` (see there): `point`'s stiffness at q under `load_option`.
+pub fn stiffness(
+    m: &Mechanism,
+    q: &[f64],
+    point: &str,
+    x_start: Option<&[f64]>,
+    load_option: JsValue,
+) -> Result<JsValue, JsValue> {
+    let out = output(m, point)?;
+    let load = load(m, from_js("load", load_option)?)?;
+    let mut ws = js(query::assembled(m, q, x_start))?;
+    let c = js(elastic::stiffness(m, q, out, &load, &mut ws))?;
+    let w = elastic::weakest_direction(&c, None);
+    Ok(Obj::new()
+        .set("weakest", w.stiffness)
+        .f64s("direction", &w.direction[..2])
+        .f64s("compliance", c.compliance.as_flattened())
+        .f64s("x", &ws.x)
+        .build())
+}
 
-    /// Rows of an elastic map (`MapOption`: the first natural frequency, Hz, or a point's
-    /// weakest stiffness under a load, N/m) over coordinates k1 and k2 as `sigmaRows`' (same
-    /// grid, rows, branch; `planardyn::elastic::map_rows`): `{values (rows x axis1.length, NaN
-    /// where it does not assemble or has no value), x (where the next rows continue)}`.
-    #[wasm_bindgen(js_name = elasticRows)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn elastic_rows(
-        &self,
-        q: &[f64],
-        k1: usize,
-        k2: usize,
-        axis1: &[f64],
-        axis2: &[f64],
-        i0: usize,
-        rows: &[u32],
-        x_start: &[f64],
-        value: JsValue,
-    ) -> Result<JsValue, JsValue> {
-        self.start_args(q, None)?;
-        let m = &self.inner;
-        let option: MapOption = from_js("value", value)?;
-        let value = match (option.kind.as_str(), option.point) {
-            ("frequency", _) => MapValue::FirstFrequency { free_rotors: option.free_rotors },
-            ("stiffness", Some(point)) => {
-                MapValue::Weakest { out: output(m, &point)?, load: load(m, option.load.unwrap_or_default())? }
-            }
-            (kind, _) => {
-                let what = format!("value.kind {kind:?}: \"frequency\", or \"stiffness\" with a point");
-                return Err(argument_error(Some("value"), what));
-            }
-        };
-        let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
-        let grid = js(MapGrid::new(m, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
-        let out = js(elastic::map_rows(m, q, &grid, &value))?;
-        Ok(Obj::new().f64s("values", &out.values).f64s("x", &out.x).build())
-    }
+/// `Mechanism.elasticRows` (see there): the rows of the map `value` (a `MapOption`) over `grid`.
+pub fn elastic_rows(m: &Mechanism, q: &[f64], grid: &MapGrid<'_>, value: JsValue) -> Result<JsValue, JsValue> {
+    let option: MapOption = from_js("value", value)?;
+    let value = match (option.kind.as_str(), option.point) {
+        ("frequency", _) => MapValue::FirstFrequency { free_rotors: option.free_rotors },
+        ("stiffness", Some(point)) => {
+            MapValue::Weakest { out: output(m, &point)?, load: load(m, option.load.unwrap_or_default())? }
+        }
+        (kind, _) => {
+            let what = format!("value.kind {kind:?}: \"frequency\", or \"stiffness\" with a point");
+            return Err(argument_error(Some("value"), what));
+        }
+    };
+    let out = js(elastic::map_rows(m, q, grid, &value))?;
+    Ok(Obj::new().f64s("values", &out.values).f64s("x", &out.x).build())
 }

@@ -6,10 +6,11 @@
 //! state on the wanted branch.
 
 use crate::convert::{array, rows, strings, vector, Obj};
+use crate::elastic;
 use crate::errors::{argument_error, js};
 use crate::simulate::{run, SimulateOptions};
 use planardyn::dynamics::query::{self, ForwardState};
-use planardyn::dynamics::{self, carried_points, Rows};
+use planardyn::dynamics::{self, carried_points, MapGrid, Rows};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
 use planardyn::model::{PairId, PointId};
@@ -19,7 +20,7 @@ use wasm_bindgen::prelude::*;
 /// A validated planar mechanism (immutable). Made by `load`.
 #[wasm_bindgen(js_name = Mechanism)]
 pub struct WasmMechanism {
-    pub(crate) inner: Mechanism,
+    inner: Mechanism,
 }
 
 impl WasmMechanism {
@@ -40,7 +41,7 @@ impl WasmMechanism {
     }
 
     /// The arguments of an assembly checked: q (m), and `x_start` (3n) when given.
-    pub(crate) fn start_args(&self, q: &[f64], x_start: Option<&[f64]>) -> Result<(), JsValue> {
+    fn start_args(&self, q: &[f64], x_start: Option<&[f64]>) -> Result<(), JsValue> {
         self.q_arg("q", q)?;
         x_start.map_or(Ok(()), |x| self.x_arg("xStart", x))
     }
@@ -207,6 +208,64 @@ impl WasmMechanism {
         let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
         let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
         Ok(Obj::new().f64s("sigma", &out.values).f64s("x", &out.x).build())
+    }
+
+    /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
+    /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
+    /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
+    /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
+    /// increasing frequency, about the pose without gravity's load (as the Python API's
+    /// default: a drawn pose need not be an equilibrium). A model without a `compliance:`
+    /// section throws an ArgumentError.
+    pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
+        self.start_args(q, x_start.as_deref())?;
+        elastic::modes(&self.inner, q, free_rotors, x_start.as_deref())
+    }
+
+    /// The stiffness of the point `point` (on the first body that carries it) at coordinates q
+    /// (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`), in
+    /// equilibrium with `load` (`LoadOption`: `{wrench: [F_x, F_y, M] (N, N, N m) at the point,
+    /// preload: {actuator name: effort (N m or N)} of elastic drives, gravity}`, each absent for
+    /// none) with its geometric terms: `{weakest (N/m: the translational stiffness in its
+    /// weakest direction), direction ([d_x, d_y], unit), compliance (3 x 3 of [x, y, phi]; m/N,
+    /// m/(N m), rad/N, rad/(N m)), x (3n: the pose)}`, as the Python API's `stiffness(mech, q,
+    /// body=, point=, wrench=, preload=, gravity=)`. A model without a `compliance:` section
+    /// throws an ArgumentError.
+    pub fn stiffness(
+        &self,
+        q: &[f64],
+        point: &str,
+        x_start: Option<Vec<f64>>,
+        load: JsValue,
+    ) -> Result<JsValue, JsValue> {
+        self.start_args(q, x_start.as_deref())?;
+        elastic::stiffness(&self.inner, q, point, x_start.as_deref(), load)
+    }
+
+    /// Rows of an elastic map over coordinates k1 and k2 as `sigmaRows`' (the same grid, rows and
+    /// branch; `planardyn::elastic::map_rows`), `value` a `MapOption`: `{kind: "frequency"}`
+    /// (the first natural frequency, Hz; `freeRotors`) or `{kind: "stiffness", point, load}`
+    /// (the weakest translational stiffness of `point`, N/m, under `load` as `stiffness`'s):
+    /// `{values (rows x axis1.length, NaN where it does not assemble or has no value), x (where
+    /// the next rows continue)}`.
+    #[wasm_bindgen(js_name = elasticRows)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn elastic_rows(
+        &self,
+        q: &[f64],
+        k1: usize,
+        k2: usize,
+        axis1: &[f64],
+        axis2: &[f64],
+        i0: usize,
+        rows: &[u32],
+        x_start: &[f64],
+        value: JsValue,
+    ) -> Result<JsValue, JsValue> {
+        self.q_arg("q", q)?;
+        let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
+        let grid = js(MapGrid::new(&self.inner, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
+        elastic::elastic_rows(&self.inner, q, &grid, value)
     }
 
     /// Drive efforts tau (m; N m or N) for (q, qd, qdd).
