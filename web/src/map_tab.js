@@ -93,6 +93,7 @@ export function startMap() {
   let level = 0;
   let grid = mapper(rows, ranges, LEVELS[0], x0, q);
   const t0 = performance.now();
+  note.textContent = `computing ${grid.n} × ${grid.n}…`;  // not the last map's note meanwhile
   const names = app.info.coordinateNames;
   const work = () => {
     let done;
