@@ -61,10 +61,10 @@ fn the_elastic_maps_cells_are_the_per_pose_analyses() {
     let maps: Vec<_> = values.iter().map(|v| elastic::map_rows(&mech, &q, &grid, v).unwrap().values).collect();
     let sigma = sigma_rows(&mech, &q, [0, 1], [&a0, &a1], N / 2, &rows, &mech.x0).unwrap().values;
     let mut compared = 0;
-    for j in 0..N {
-        for i in 0..N {
+    for (j, &q1) in a1.iter().enumerate() {
+        for (i, &q0) in a0.iter().enumerate() {
             let c = j * N + i;
-            let qc = [a0[i], a1[j]];
+            let qc = [q0, q1];
             // The same cells as the singularity map's (the same placement).
             assert!(maps.iter().all(|m| m[c].is_finite() == sigma[c].is_finite()), "cell ({j}, {i})");
             if sigma[c].is_nan() {
