@@ -187,10 +187,10 @@ impl WasmMechanism {
     }
 
     /// Rows `rows` (in that order) of the type II measure over coordinates k1 (columns, values
-    /// `axis1`) and k2 (rows, `axis2`), the others as in q, each row walked from column `i0`,
-    /// by continuation from `xStart` (`planardyn::dynamics::sigma_rows`): `{sigma (rows x
-    /// axis1.length, NaN where it does not assemble), x (where the next rows continue)}`; the
-    /// branch shown is `planardyn::dynamics::MapRows`'.
+    /// `axis1`) and k2 (rows, `axis2`), the others as in q, on the branch of `xStart`
+    /// (`planardyn::dynamics::sigma_rows`; which branch: `planardyn::dynamics::MapRows`, rows
+    /// walked from column `i0` where it is by continuation): `{sigma (rows x axis1.length, NaN
+    /// where it does not assemble), x (where the next rows continue)}`.
     #[wasm_bindgen(js_name = sigmaRows)]
     #[allow(clippy::too_many_arguments)]
     pub fn sigma_rows(
