@@ -5,10 +5,14 @@ extension (the same Rust through the Python API), measured in one run on this ma
 - a 3-RRR's drive efforts and pair reactions for one frame (planardyn::dynamics::evaluate in
   the page; native: inverse_dynamics then reactions through the Python API, so the native
   figure includes two Python calls);
-- a 5R's 100 x 100 singularity map over its two coordinates by continuation (the page's
-  map, web/src/map.js over planardyn::dynamics::sigma_rows; native: the same loop in Python
-  over Mechanism.kinematics, which also computes the analogues u and w: the Python API has no
-  call for the map, so the native figure is the Python user's);
+- a 5R's 100 x 100 singularity map over its two coordinates (the page's map, web/src/map.js
+  over planardyn::dynamics::sigma_rows: each cell placed by the closed forms on the current
+  state's branch; native: a continuation loop in Python over Mechanism.kinematics, which also
+  computes the analogues u and w: the Python API has no call for the map, so the native
+  figure is the Python user's);
+- the compliant 5R's (elastic motors and end-effector pin, tests/test_app_browser.py's) 100 x 100
+  map of its first natural frequency (web/src/map.js over planardyn::elastic::map_rows; the
+  page's only: the Python API has no call for it);
 - the engine's size (wasm, the page, gzipped) and the page's load time to its first drawing.
 
 Each figure is the best of REPEAT rounds (timing noise on a shared machine only adds).
@@ -87,7 +91,7 @@ def python_map(mech: pdy.Mechanism) -> np.ndarray:
     return sigma
 
 
-PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
+PAGE_BENCH = """async ([four, rrr, compliant, frames, mapN, repeat]) => {
   const a = window.planardyn, pd = a.pd;
   const best = (f, n = repeat) => { let b = Infinity; for (let i = 0; i < n; i++) { const t = performance.now(); f(); b = Math.min(b, performance.now() - t); } return b / 1000; };
   const fm = pd.load(four, "yaml", "four-bar-gravity.yaml");
@@ -98,9 +102,25 @@ PAGE_BENCH = """async ([four, rrr, frames, mapN, repeat]) => {
   const frame = best(() => { let x; for (const q of qs) x = m.evaluate(q, qd, qdd, x).x; }) / frames;
   const five = a.mech;
   const { mapRanges, mapper, sigmaRows } = a.mapTools;
-  const map = best(() => mapper(sigmaRows(five), mapRanges(a.info, a.info.q0), mapN, five.assemble(a.info.q0), a.info.q0).step(Infinity), 1);
-  return { sim, frame, map, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000 };
+  const { frequencyRows } = a.mapTools;
+  const mapOf = (mech, rows) => {
+    const info = mech.info();
+    return best(() => mapper(rows(mech), mapRanges(info, info.q0), mapN, mech.assemble(info.q0), info.q0).step(Infinity), 1);
+  };
+  const map = mapOf(five, sigmaRows);
+  const frequencyMap = mapOf(pd.load(compliant, "yaml", "compliant.yaml"), frequencyRows);
+  return { sim, frame, map, frequencyMap, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000 };
 }"""
+
+#: The five-bar with elastic motors and an elastic end-effector pin (tests/test_app_browser.py's).
+COMPLIANT = (ROOT / "examples/models/five-bar.yaml").read_text().split("\ndrives:")[0] + """
+compliance:
+  drives:
+    - {actuator: theta1, stiffness: 2.0e3}
+    - {actuator: theta2, stiffness: 3.0e3}
+  pairs:
+    - {pair: effector, stiffness: 5.0e5}
+"""
 
 
 def browser() -> dict[str, float]:
@@ -122,7 +142,7 @@ def browser() -> dict[str, float]:
         page.goto(page_file.as_uri())
         page.wait_for_selector("body[data-ready='1']", timeout=30_000)
         texts = [pdy.models.path(n).read_text() for n in ("four-bar-gravity", "3-rrr")]
-        out = page.evaluate(PAGE_BENCH, [*texts, FRAMES, MAP_N, REPEAT])
+        out = page.evaluate(PAGE_BENCH, [*texts, COMPLIANT, FRAMES, MAP_N, REPEAT])
         b.close()
     out["load"] = min(t["readyMs"] for t in loads) / 1000
     out["engine"] = min(t["engineMs"] for t in loads) / 1000
@@ -142,6 +162,8 @@ def main() -> None:
             (f"5R singularity map {MAP_N} x {MAP_N}", "map", 1e3, "ms")]
     for label, key, scale, unit in rows:
         print(f"{label + f' ({unit})':44s} {web[key] * scale:10.3g} {nat[key] * scale:10.3g} {web[key] / nat[key]:7.2f}")
+    label = f"compliant 5R first-frequency map {MAP_N} x {MAP_N} (ms)"
+    print(f"{label:44s} {web['frequencyMap'] * 1e3:10.3g} {'-':>10s} {'-':>7s}")
 
 
 if __name__ == "__main__":

@@ -11,12 +11,14 @@ must be built (./dev setup builds it): a missing page fails.
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
 import numpy as np
 import planardyn as pdy
 import pytest
+import yaml
 from planardyn.cli import main
 
 playwright = pytest.importorskip("playwright.sync_api")
@@ -311,6 +313,10 @@ def test_modes_equal_the_python_api_and_are_animated(page):
     assert page.evaluate("window.planardyn.modeX") is None
 
 
+#: Whether the map tab's note says the map of its argument is done at 100 x 100.
+MAP_DONE = "(what) => { const t = document.getElementById('map-note').textContent; return t.startsWith(what + ' over') && t.includes('100 × 100, in'); }"
+
+
 def check_map_middle(page, rows: str, want) -> None:
     """A 7 x 7 map computed in the page by `mapTools.mapper` with the rows `rows` (JS, of `a`,
     the app) over its ranges about the current state: each cell of the middle 3 x 3 that
@@ -347,18 +353,13 @@ def test_first_frequency_map_equals_the_python_api(page):
     # The map tab draws it for a compliant model (its kind chosen in the tab).
     page.click("nav button[data-tab='map']")
     page.select_option("#map-kind", "frequency")
-    page.wait_for_function("document.getElementById('map-note').textContent.includes('50 × 50, in')", timeout=120_000)
-    assert "first natural frequency" in page.text_content("#map-note")
+    page.wait_for_function(MAP_DONE, arg="the first natural frequency (Hz; motors held)", timeout=120_000)
     ARTEFACTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(ARTEFACTS / "app-frequency-map.png"))
 
 
-def test_shift_dragging_a_point_edits_the_models_drawing(page):
-    # Shift + drag the end effector P 40 px right, in 5 px moves: the model file now draws P
-    # 40 px further right (40 / scale m, written to 1e-4 L: 0.1 mm here), the page's model is
-    # Python's model of that text (its state at the drawn pose equal to 1e-9), and the distal
-    # links, drawn from C1 and C2 to P, changed length.
-    mech = five_bar()
+def shift_drag_p(page, dx: int = 40) -> float:
+    """Shift + drag the end effector P dx px right, in 5 px moves; the drawing's scale (px/m)."""
     where = page.evaluate(
         """() => {
             const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
@@ -371,23 +372,53 @@ def test_shift_dragging_a_point_edits_the_models_drawing(page):
     page.keyboard.down("Shift")
     page.mouse.move(where["x"], where["y"])
     page.mouse.down()
-    for i in range(1, 9):
+    for i in range(1, dx // 5 + 1):
         page.mouse.move(where["x"] + 5 * i, where["y"])
         page.wait_for_timeout(50)
     page.mouse.up()
     page.keyboard.up("Shift")
     page.wait_for_timeout(200)
-    text = page.input_value("#editor")
-    edited = pdy.loads(text)
+    return where["s"]
+
+
+def check_p_moved(page, edited: pdy.Mechanism, scale: float) -> None:
+    """The edited model draws P 40 px further right than the five-bar (40 / scale m, written to
+    1e-4 L: 0.1 mm here), C1 where it was, so the distal link C1 P changed length; the page's
+    state at the drawn pose is Python's model of that text (1e-9)."""
+    mech = five_bar()
     drawn = dict(zip(mech.point_names, mech.point_positions(mech.x0)))
     now = dict(zip(edited.point_names, edited.point_positions(edited.x0)))
     snap = 1e-4 * mech.scale  # edit_drag.js SNAP_FRACTION, rounded to a decimal place: 0.1 mm here
-    np.testing.assert_allclose(now["P"], drawn["P"] + [40 / where["s"], 0.0], rtol=0, atol=snap)
+    np.testing.assert_allclose(now["P"], drawn["P"] + [40 / scale, 0.0], rtol=0, atol=snap)
     np.testing.assert_allclose(now["C1"], drawn["C1"], rtol=0, atol=1e-15)
     assert abs(np.hypot(*(now["P"] - now["C1"])) - np.hypot(*(drawn["P"] - drawn["C1"]))) > 0.01
     got = page.evaluate("({q: Array.from(window.planardyn.q), x: Array.from(window.planardyn.x)})")
     np.testing.assert_allclose(got["q"], edited.drawn_q, rtol=0, atol=1e-12)
     np.testing.assert_allclose(got["x"], edited.kinematics(got["q"])["x"], rtol=STATE_RTOL, atol=STATE_RTOL * mech.scale)
+
+
+def test_shift_dragging_a_point_edits_the_models_drawing(page):
+    # Shift + drag the end effector P 40 px right: the YAML text's `P: [x, y]` line moved.
+    scale = shift_drag_p(page)
+    check_p_moved(page, pdy.loads(page.input_value("#editor")), scale)
+
+
+def test_shift_dragging_a_point_edits_json_model_text(page):
+    # The five-bar as JSON text (2-space indented, as an editor writes it): the drag rewrites
+    # the top-level "points" object's "P" entry in place, every other line as written.
+    text = json.dumps(yaml.safe_load(pdy.models.path("five-bar").read_text()), indent=2)
+    page.evaluate("(t) => window.planardyn.setModel(t, 'json', 'five-bar.json')", text)
+    scale = shift_drag_p(page)
+    edited_text = page.input_value("#editor")
+    edited = json.loads(edited_text)
+    assert set(edited["points"]) == set(json.loads(text)["points"])
+    # json.dumps writes P's [x, y] on 4 lines (the only key "P": P is not a body's point in
+    # its own frame here); the drag writes it on one.
+    before, after = text.split("\n"), edited_text.split("\n")
+    i = before.index('    "P": [')
+    assert after[:i] + after[i + 1:] == before[:i] + before[i + 4:]
+    assert after[i].startswith('    "P": [') and after[i].endswith("]")
+    check_p_moved(page, pdy.loads(edited_text, format="json"), scale)
 
 
 def test_stiffness_map_equals_the_python_api(page):
@@ -402,8 +433,60 @@ def test_stiffness_map_equals_the_python_api(page):
                      lambda q: st.stiffness(mech, q, body="distal_left", point="P").weakest_stiffness)
     with pytest.raises(playwright.Error, match="no body carries a point 'nope'"):
         page.evaluate("window.planardyn.mech.stiffness(window.planardyn.q, 'nope')")
+    with pytest.raises(playwright.Error, match="unknown actuator 'nope'"):
+        page.evaluate("window.planardyn.mech.stiffness(window.planardyn.q, 'P', undefined, {preload: {nope: 1}})")
     page.click("nav button[data-tab='map']")
     page.select_option("#map-kind", "stiffness")
     assert page.input_value("#map-point") == "P"
-    page.wait_for_function("document.getElementById('map-note').textContent.includes('50 × 50, in')", timeout=120_000)
-    assert "the weakest stiffness of P (N/m)" in page.text_content("#map-note")
+    page.wait_for_function(MAP_DONE, arg="the weakest stiffness of P (N/m)", timeout=120_000)
+
+
+#: The compliant five-bar with redundant actuation: a third, elastic actuator at elbow 1 (the
+#: model of crates/planardyn/tests/elastic.rs's preload test).
+REDUNDANT_FIVE_BAR = (ROOT / "examples/models/five-bar.yaml").read_text().split("\ndrives:")[0] + """
+actuators: [{pair: elbow1}]
+compliance:
+  drives:
+    - {actuator: theta1, stiffness: 2.0e3}
+    - {actuator: theta2, stiffness: 3.0e3}
+    - {actuator: elbow1, stiffness: 1.5e3}
+  pairs:
+    - {pair: effector, stiffness: 5.0e5}
+"""
+
+
+def test_loaded_stiffness_equals_the_python_api(page):
+    # A wrench at P and a preload of the redundant elbow actuator, set in the map tab: the
+    # stiffness shown at the pose and the map's cells equal planardyn.stiffness's with the same
+    # load to 1e-9 (MODES_RTOL's reasons), and the load changes them (its geometric terms).
+    from planardyn import stiffness as st
+
+    page.evaluate("(text) => window.planardyn.setModel(text, 'yaml', 'redundant.yaml')", REDUNDANT_FIVE_BAR)
+    mech = pdy.loads(REDUNDANT_FIVE_BAR)
+    page.click("nav button[data-tab='map']")
+    page.select_option("#map-kind", "stiffness")
+    # A preload field per actuator: three actuators for two coordinates.
+    preloads = page.eval_on_selector_all("#load-preload input", "els => els.map(e => e.dataset.actuator)")
+    assert preloads == ["theta1", "theta2", "elbow1"]
+    wrench, preload = [3.0, -20.0, 0.5], {"elbow1": 50.0}
+    page.evaluate(
+        """([w, p]) => {
+            ["load-fx", "load-fy", "load-m"].forEach((id, k) => { document.getElementById(id).value = String(w[k]); });
+            document.querySelector("#load-preload input[data-actuator='elbow1']").value = String(p);
+            window.planardyn.startMap();
+        }""",
+        [wrench, preload["elbow1"]],
+    )
+    got = page.evaluate("({q: Array.from(window.planardyn.q), s: window.planardyn.stiffnessHere,"
+                        " c: Array.from(window.planardyn.stiffnessHere.compliance)})")
+    want = st.stiffness(mech, got["q"], body="distal_left", point="P", wrench=wrench, preload=preload)
+    np.testing.assert_allclose(got["s"]["weakest"], want.weakest_stiffness, rtol=MODES_RTOL)
+    np.testing.assert_allclose(np.reshape(got["c"], (3, 3)), want.compliance, rtol=0,
+                               atol=MODES_RTOL * np.abs(want.compliance).max())
+    unloaded = st.stiffness(mech, got["q"], body="distal_left", point="P").weakest_stiffness
+    assert abs(want.weakest_stiffness - unloaded) > 1e-6 * unloaded
+    assert "here: " in page.text_content("#stiffness-here")
+    check_map_middle(page, f'a.mapTools.stiffnessRows(a.mech, "P", {{wrench: {wrench}, preload: {{elbow1: 50}}}})',
+                     lambda q: st.stiffness(mech, q, body="distal_left", point="P", wrench=wrench,
+                                            preload=preload).weakest_stiffness)
+    page.wait_for_function(MAP_DONE, arg="the weakest stiffness of P (N/m, loaded)", timeout=120_000)

@@ -1,5 +1,6 @@
 // Editing the model's drawing on the page: Shift + drag a point (a ground point too) moves
-// where the model file draws it (its line under `points:` in YAML text), and the model is
+// where the model file draws it (its line under `points:` in YAML text, its entry of the
+// top-level "points" object in JSON text), and the model is
 // rebuilt as it moves (bodies' lengths, masses and inertias follow their points), shown as
 // drawn; an edit that breaks it shows the loader's error in place, the last good model kept.
 import { $, app, status } from "./state.js";
@@ -28,6 +29,55 @@ export function movePoint(text, name, [x, y], decimals) {
   return null;
 }
 
+/** Index just past the JSON string that opens at `i` (a quote). */
+function stringEnd(text, i) {
+  for (let k = i + 1; k < text.length; k++) {
+    if (text[k] === "\\") k++;
+    else if (text[k] === '"') return k + 1;
+  }
+  return text.length;
+}
+
+/** Where the value of the member at `path` (keys from the top-level object) begins in JSON
+ * text, or -1: a scan that tracks the keys of the enclosing objects (an array's items have
+ * none). */
+function memberStart(text, path) {
+  const stack = [], keys = [];
+  for (let i = 0; i < text.length;) {
+    const c = text[i];
+    if (c === '"') {
+      const end = stringEnd(text, i);
+      let k = end;
+      while (/\s/.test(text[k] || "")) k++;
+      const d = stack.length - 1;
+      if (text[k] !== ":" || stack[d] !== "{") { i = end; continue; }
+      const key = JSON.parse(text.slice(i, end));
+      const here = [...keys.slice(0, d), key];
+      for (i = k + 1; /\s/.test(text[i] || "");) i++;
+      if (here.length === path.length && here.every((s, j) => s === path[j])) return i;
+      keys[d] = key;
+      continue;
+    }
+    if (c === "{" || c === "[") { stack.push(c); keys[stack.length - 1] = c === "[" ? null : undefined; }
+    else if (c === "}" || c === "]") stack.pop();
+    i++;
+  }
+  return -1;
+}
+
+/** As `movePoint` for JSON text: the top-level "points" object's `name: [x, y]` rewritten in
+ * place (the rest of the text as written). Null where the point is not written so. */
+export function movePointJson(text, name, [x, y], decimals) {
+  let model;
+  try { model = JSON.parse(text); } catch { return null; }
+  const p = model && model.points && model.points[name];
+  if (!Array.isArray(p) || p.length !== 2 || !p.every((v) => typeof v === "number")) return null;
+  const start = memberStart(text, ["points", name]);
+  if (start < 0 || text[start] !== "[") return null;
+  const end = text.indexOf("]", start) + 1;
+  return `${text.slice(0, start)}[${x.toFixed(decimals)}, ${y.toFixed(decimals)}]${text.slice(end)}`;
+}
+
 export function installEditDrag() {
   const c = $("drawing");
   let edit = null, pending = null;
@@ -37,9 +87,11 @@ export function installEditDrag() {
     if (!edit || !at) return;
     const p = [edit.p0[0] + at[0] - edit.w0[0], edit.p0[1] + at[1] - edit.w0[1]];
     const decimals = Math.max(0, -Math.floor(Math.log10(SNAP_FRACTION * app.info.scale)));
-    const text = movePoint($("editor").value, edit.name, p, decimals);
+    const json = app.format === "json";
+    const text = (json ? movePointJson : movePoint)($("editor").value, edit.name, p, decimals);
     if (!text) {
-      status(`point ${edit.name} is not written as "${edit.name}: [x, y]" under points: in YAML model text, so it cannot be dragged; edit it in the Model tab`, true);
+      const where = json ? `"${edit.name}": [x, y] in the top-level "points" object` : `${edit.name}: [x, y] under points:`;
+      status(`point ${edit.name} is not written as ${where} in the model text, so it cannot be dragged; edit it in the Model tab`, true);
       return;
     }
     const bounds = app.bounds;

@@ -1,10 +1,10 @@
-// The maps of a two-coordinate mechanism (a 5R, a two-input robot): over a grid of (q1, q2),
-// on the branch reached by continuation from the current state (each cell starts Newton from
-// its neighbour), the type II measure sigma (the engine's `sigmaRows`) or, for a compliant
-// model, the first natural frequency or a point's weakest stiffness (the engine's `modes` or
-// `stiffness` a cell). Computed progressively,
-// coarse grids first, in slices that leave the page responsive; cells that do not assemble
-// are grey.
+// The maps of a two-coordinate mechanism (a 5R, a two-input robot) over a grid of (q1, q2):
+// the type II measure sigma (the engine's `sigmaRows`) or, for a compliant model, the first
+// natural frequency or a point's weakest stiffness under a load (`elasticRows`), on the branch
+// of the current state (planardyn::dynamics::MapRows: where every group has a closed form
+// without iteration, each cell in the assembly modes of the current state; else by
+// continuation from it, each cell from its neighbour). Computed progressively, coarse grids
+// first, in slices that leave the page responsive; cells that do not assemble are grey.
 
 /** Grids of the progressive refinement; the last is the map's resolution. */
 export const LEVELS = [25, 50, 100];
@@ -30,45 +30,19 @@ export function mapRanges(info, q) {
  * continue)}`. */
 export const sigmaRows = (mech) => (q, axes, i0, rows, x) => mech.sigmaRows(q, 0, 1, axes[0], axes[1], i0, rows, x);
 
-/** Rows of a value computed a cell at a time by `cell(qCell, x)` -> {value, x} (one engine
- * call at the cell's q from its neighbour's body coordinates x), walked as `sigmaRows` walks
- * them; NaN where the call throws (it does not assemble there, or has no value), the next
- * cell then starting from the last that did. */
-const cellRows = (cell) => (q, axes, i0, rows, xStart) => {
-  const n = axes[0].length;
-  const out = new Float64Array(rows.length * n).fill(NaN);
-  let xRow = xStart;
-  rows.forEach((j, r) => {
-    let xNext = null;
-    for (const dir of [1, -1]) {
-      let x = xRow;
-      for (let i = dir > 0 ? i0 : i0 - 1; i >= 0 && i < n; i += dir) {
-        const qc = Float64Array.from(q);
-        [qc[0], qc[1]] = [axes[0][i], axes[1][j]];
-        try {
-          const c = cell(qc, x);
-          out[r * n + i] = c.value;
-          x = c.x;
-          if (i === i0) xNext = c.x;
-        } catch { /* not computed here: NaN */ }
-      }
-    }
-    if (xNext) xRow = xNext;
-  });
-  return { sigma: out, x: xRow };
+/** The rows of an elastic map (`Mechanism.elasticRows`, the same grid, rows and branch as
+ * `sigmaRows`; `value` its `MapOption`), as `{sigma, x}`. */
+const elasticRows = (mech, value) => (q, axes, i0, rows, x) => {
+  const out = mech.elasticRows(q, 0, 1, axes[0], axes[1], i0, rows, x, value);
+  return { sigma: out.values, x: out.x };
 };
 
-/** The first natural frequency's rows (Hz; the engine's `modes`, motors held). */
-export const frequencyRows = (mech) => cellRows((q, x) => {
-  const m = mech.modes(q, false, x);
-  return { value: m.omega[0] / (2 * Math.PI), x: m.x };
-});
+/** The first natural frequency's rows (Hz; motors held). */
+export const frequencyRows = (mech) => elasticRows(mech, { kind: "frequency" });
 
-/** The rows of the weakest translational stiffness (N/m) of `point` (the engine's `stiffness`). */
-export const stiffnessRows = (mech, point) => cellRows((q, x) => {
-  const s = mech.stiffness(q, point, x);
-  return { value: s.weakest, x: s.x };
-});
+/** The rows of the weakest translational stiffness (N/m) of `point` under `load` (the
+ * engine's `LoadOption`: wrench at the point, preload by actuator name, gravity). */
+export const stiffnessRows = (mech, point, load = {}) => elasticRows(mech, { kind: "stiffness", point, load });
 
 /** A map on an n x n grid over `ranges` (row j: q2, column i: q1), NaN where it does not
  * assemble, computed a few rows a call of `rowsOf` (`sigmaRows` or `frequencyRows` of the

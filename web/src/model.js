@@ -89,4 +89,5 @@ export function installEditor() {
   }));
   $("map-kind").addEventListener("change", startMap);
   $("map-point").addEventListener("change", startMap);
+  for (const id of ["load-fx", "load-fy", "load-m"]) $(id).addEventListener("change", startMap);
 }

@@ -1,11 +1,12 @@
 //! planardyn as WebAssembly (wasm-bindgen glue only, as `planardyn-py` is for Python): the
 //! browser app's engine. Conversions live in `convert.rs`, the mapping of errors to JS errors
-//! in `errors.rs` (the only place), the `Mechanism` class in `mechanism.rs`, and runs in
-//! `simulate.rs`; the mechanics is the core's (`planardyn`). Built for
-//! `wasm32-unknown-unknown` by `./dev app`; on other targets it compiles (for clippy) but
+//! in `errors.rs` (the only place), the `Mechanism` class in `mechanism.rs`, and the bodies of
+//! its runs in `simulate.rs` and of its compliant analyses in `elastic.rs`; the mechanics is
+//! the core's (`planardyn`). Built for `wasm32-unknown-unknown` by `./dev app`; on other targets it compiles (for clippy) but
 //! exports nothing usable.
 
 mod convert;
+mod elastic;
 mod errors;
 mod mechanism;
 mod simulate;

@@ -6,14 +6,14 @@
 //! state on the wanted branch.
 
 use crate::convert::{array, rows, strings, vector, Obj};
+use crate::elastic;
 use crate::errors::{argument_error, js};
 use crate::simulate::{run, SimulateOptions};
 use planardyn::dynamics::query::{self, ForwardState};
-use planardyn::dynamics::{self, carried_points, Rows};
-use planardyn::elastic;
+use planardyn::dynamics::{self, carried_points, MapGrid, Rows};
 use planardyn::kinematics::{self as kin, Chart};
 use planardyn::model::pairs::{self, pair_geometry};
-use planardyn::model::{BodyId, Link, PairId, PointId};
+use planardyn::model::{PairId, PointId};
 use planardyn::Mechanism;
 use wasm_bindgen::prelude::*;
 
@@ -89,6 +89,7 @@ impl WasmMechanism {
             .set("coordinateNames", strings(m.coordinate_names()))
             .set("coordinateKinds", strings(m.coordinates.iter().map(|c| c.kind.name())))
             .set("driven", array(m.drives.iter().map(|d| d.is_some().into())))
+            .set("actuators", strings(m.actuator_names()))
             .set("prescribed", array(m.motions.iter().map(|d| d.is_some().into())))
             .set("bodyNames", strings(m.body_names()))
             .set("bodies", array(bodies))
@@ -186,9 +187,10 @@ impl WasmMechanism {
     }
 
     /// Rows `rows` (in that order) of the type II measure over coordinates k1 (columns, values
-    /// `axis1`) and k2 (rows, `axis2`), the others as in q, each row walked from column `i0`,
-    /// by continuation from `xStart` (`planardyn::dynamics::sigma_rows`): `{sigma (rows x
-    /// axis1.length, NaN where it does not assemble), x (where the next rows continue)}`.
+    /// `axis1`) and k2 (rows, `axis2`), the others as in q, on the branch of `xStart`
+    /// (`planardyn::dynamics::sigma_rows`; which branch: `planardyn::dynamics::MapRows`, rows
+    /// walked from column `i0` where it is by continuation): `{sigma (rows x axis1.length, NaN
+    /// where it does not assemble), x (where the next rows continue)}`.
     #[wasm_bindgen(js_name = sigmaRows)]
     #[allow(clippy::too_many_arguments)]
     pub fn sigma_rows(
@@ -205,7 +207,7 @@ impl WasmMechanism {
         self.q_arg("q", q)?;
         let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
         let out = js(dynamics::sigma_rows(&self.inner, q, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
-        Ok(Obj::new().f64s("sigma", &out.sigma).f64s("x", &out.x).build())
+        Ok(Obj::new().f64s("sigma", &out.values).f64s("x", &out.x).build())
     }
 
     /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
@@ -217,46 +219,53 @@ impl WasmMechanism {
     /// section throws an ArgumentError.
     pub fn modes(&self, q: &[f64], free_rotors: bool, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
         self.start_args(q, x_start.as_deref())?;
-        let mut ws = js(query::assembled(&self.inner, q, x_start.as_deref()))?;
-        let modes = js(elastic::modes(&self.inner, q, free_rotors, false, &mut ws))?;
-        Ok(Obj::new()
-            .f64s("omega", &modes.omega())
-            .f64s("omega2", &modes.omega2)
-            .f64s("dampingRatio", &modes.damping_ratio)
-            .f64s("shapes", &modes.shapes.concat())
-            .f64s("x", &ws.x)
-            .build())
+        elastic::modes(&self.inner, q, free_rotors, x_start.as_deref())
     }
 
-    /// The stiffness of the point `point` (on the first body that carries it) at
-    /// coordinates q (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`
-    /// unloaded): `{weakest (N/m: the translational stiffness in its weakest direction), direction
-    /// ([d_x, d_y], unit), compliance (3 x 3 of [x, y, phi]; m/N, m/(N m), rad/N, rad/(N m)),
-    /// x (3n: the pose)}`. A model without a `compliance:` section throws an ArgumentError.
-    pub fn stiffness(&self, q: &[f64], point: &str, x_start: Option<Vec<f64>>) -> Result<JsValue, JsValue> {
+    /// The stiffness of the point `point` (on the first body that carries it) at coordinates q
+    /// (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`), in
+    /// equilibrium with `load` (`LoadOption`: `{wrench: [F_x, F_y, M] (N, N, N m) at the point,
+    /// preload: {actuator name: effort (N m or N)} of elastic drives, gravity}`, each absent for
+    /// none) with its geometric terms: `{weakest (N/m: the translational stiffness in its
+    /// weakest direction), direction ([d_x, d_y], unit), compliance (3 x 3 of [x, y, phi]; m/N,
+    /// m/(N m), rad/N, rad/(N m)), x (3n: the pose)}`, as the Python API's `stiffness(mech, q,
+    /// body=, point=, wrench=, preload=, gravity=)`. A model without a `compliance:` section
+    /// throws an ArgumentError.
+    pub fn stiffness(
+        &self,
+        q: &[f64],
+        point: &str,
+        x_start: Option<Vec<f64>>,
+        load: JsValue,
+    ) -> Result<JsValue, JsValue> {
         self.start_args(q, x_start.as_deref())?;
-        let m = &self.inner;
-        let on_body = |id: PointId| (0..m.n_bodies()).map(BodyId).find(|&b| m.attachment(Link::Body(b), id).is_some());
-        let Some((id, body)) = m.point_id(point).and_then(|id| on_body(id).map(|b| (id, b))) else {
-            let names: Vec<&str> = (0..m.points.len())
-                .filter(|&p| on_body(PointId(p)).is_some())
-                .map(|p| m.points[p].0.as_str())
-                .collect();
-            return Err(argument_error(
-                Some("point"),
-                format!("no body carries a point '{point}'; the bodies' points are: {}", names.join(", ")),
-            ));
-        };
-        let mut ws = js(query::assembled(m, q, x_start.as_deref()))?;
-        let out = elastic::Output { body, point: Some(id) };
-        let c = js(elastic::stiffness(m, q, out, &elastic::Load::default(), &mut ws))?;
-        let w = elastic::weakest_direction(&c, None);
-        Ok(Obj::new()
-            .set("weakest", w.stiffness)
-            .f64s("direction", &w.direction[..2])
-            .f64s("compliance", c.compliance.as_flattened())
-            .f64s("x", &ws.x)
-            .build())
+        elastic::stiffness(&self.inner, q, point, x_start.as_deref(), load)
+    }
+
+    /// Rows of an elastic map over coordinates k1 and k2 as `sigmaRows`' (the same grid, rows and
+    /// branch; `planardyn::elastic::map_rows`), `value` a `MapOption`: `{kind: "frequency"}`
+    /// (the first natural frequency, Hz; `freeRotors`) or `{kind: "stiffness", point, load}`
+    /// (the weakest translational stiffness of `point`, N/m, under `load` as `stiffness`'s):
+    /// `{values (rows x axis1.length, NaN where it does not assemble or has no value), x (where
+    /// the next rows continue)}`.
+    #[wasm_bindgen(js_name = elasticRows)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn elastic_rows(
+        &self,
+        q: &[f64],
+        k1: usize,
+        k2: usize,
+        axis1: &[f64],
+        axis2: &[f64],
+        i0: usize,
+        rows: &[u32],
+        x_start: &[f64],
+        value: JsValue,
+    ) -> Result<JsValue, JsValue> {
+        self.q_arg("q", q)?;
+        let rows: Vec<usize> = rows.iter().map(|&j| j as usize).collect();
+        let grid = js(MapGrid::new(&self.inner, [k1, k2], [axis1, axis2], i0, &rows, x_start))?;
+        elastic::elastic_rows(&self.inner, q, &grid, value)
     }
 
     /// Drive efforts tau (m; N m or N) for (q, qd, qdd).

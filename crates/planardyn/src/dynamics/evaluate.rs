@@ -3,11 +3,11 @@
 //! singularity measures and the energies. The entry point of an interactive view (the browser
 //! app draws a frame from one [`evaluate`]), so that a binding converts and does not assemble
 //! the pipeline itself. And the rows of a singularity map over two coordinates, for a view
-//! that redraws it as the design changes ([`sigma_rows`]).
+//! that redraws it as the design changes ([`sigma_rows`], [`map_rows`]: which branch a map shows).
 
 use super::query::assembled;
-use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives};
-use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, Chart, ClosedForm, Frame};
+use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives, Workspace};
+use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, Chart, ClosedForm};
 use crate::model::Mechanism;
 use crate::{Error, KinematicsError};
 
@@ -72,32 +72,41 @@ pub fn evaluate(
     })
 }
 
-/// Rows of a map of the type II measure over two coordinates, as a design view draws it while
-/// a dimension changes: cell (j, i) is the mechanism at q with `q[k[0]] = axes[0][i]` and
-/// `q[k[1]] = axes[1][j]` (the other coordinates as in q). The map follows one branch by
-/// continuation from the current state outwards: each row in `rows` (in that order) starts at
-/// column `i0` from the previous row's start (from `x_start`, 3n, for the first), then walks
-/// right and left from there, each cell from its neighbour; a cell that does not assemble is
-/// NaN and the walk goes on from the row's start. A view computes the rows from the current
-/// state's row up, then down again from it, a few at a time (refining progressively), passing
-/// the returned `x` as the next call's `x_start`.
-pub struct SigmaRows {
-    /// sigma of the rows in the order given, row after row (axes[0].len() each), NaN where the
-    /// mechanism does not assemble on the branch followed.
-    pub sigma: Vec<f64>,
-    /// Body coordinates (3n) of the last row's start cell: where the next rows continue.
+/// Rows of a map over two coordinates, as a design view draws it while a dimension changes:
+/// cell (j, i) is the mechanism at q with `q[k[0]] = axes[0][i]` and `q[k[1]] = axes[1][j]`
+/// (the other coordinates as in q), and its value one number of the configuration placed
+/// there (the type II measure: [`sigma_rows`]; a natural frequency or a stiffness:
+/// `crate::elastic::map_rows`). A view asks for a few rows a call (refining progressively),
+/// passing the returned `x` as the next call's `x_start`.
+///
+/// Which branch a map shows (the configuration of a cell, where the coordinates admit several):
+/// - where every group has a closed form without iteration (`ClosedForm::is_explicit`: a 5R,
+///   a two-input robot of dyads), the branch of `x_start`: at each cell the configuration in
+///   which every group keeps the assembly mode it has in `x_start` (a dyad's elbow on the same
+///   side of the line through its outer joints). That is the branch continuation through
+///   assembled neighbours keeps (a group's side changes only where its circles touch, at the
+///   edge of the cells that assemble), and it needs no walk: each cell is placed on its own,
+///   in any order, and a cell is missing (NaN) exactly where no configuration exists at all
+///   (the group cannot close on any branch: its circles do not meet).
+/// - otherwise (a group solved by Newton's method, or none with a closed form), by
+///   continuation: each row in `rows` (in that order) starts at column `i0` from the previous
+///   row's start (from `x_start` for the first), then walks right and left from there, each
+///   cell from its neighbour; a cell that does not assemble is NaN and the walk goes on from
+///   the row's start. A view computes the rows from the current state's row up, then down
+///   again from it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapRows {
+    /// The value of the rows' cells in the order given, row after row (axes[0].len() each),
+    /// NaN where the mechanism does not assemble on the branch shown or has no value there.
+    pub values: Vec<f64>,
+    /// Body coordinates (3n) where the next rows continue: the last row's start cell (by
+    /// continuation), or `x_start` itself (the branch's reference, by the closed forms).
     pub x: Vec<f64>,
 }
 
-/// See [`SigmaRows`]. One kinematic frame for all the cells (no allocation per cell).
-///
-/// Where every group of the mechanism has a closed form without iteration
-/// (`ClosedForm::is_explicit`: a 5R, a two-input robot of dyads), a cell whose neighbour
-/// assembled is placed by the closed forms on the neighbour's branches instead of by Newton continuation from it (the same solution: continuation keeps
-/// the branch of its start over the step). A row's cells beyond a gap are then not tried:
-/// the closed forms fail where a group cannot close on any branch, and the continuation from
-/// the row's start passes through that cell. A cell continued from another row's start, or
-/// the first from `x_start`, is continued as before.
+/// The rows of the type II measure sigma (see [`MapRows`]), each cell's measured by the SVD of
+/// J's blocks (`sigma_min_with`, the measure of [`evaluate`]). One workspace for all the cells
+/// (no allocation per cell).
 pub fn sigma_rows(
     mech: &Mechanism,
     q: &[f64],
@@ -106,92 +115,112 @@ pub fn sigma_rows(
     i0: usize,
     rows: &[usize],
     x_start: &[f64],
-) -> Result<SigmaRows, Error> {
-    let m = mech.dof();
-    if k[0] == k[1] || k.iter().any(|&k| k >= m) {
-        let got = format!("{k:?} (the model has {m} coordinates)");
-        return Err(KinematicsError::bad_argument("k", "two different coordinate indices", got).into());
+) -> Result<MapRows, Error> {
+    let grid = MapGrid::new(mech, k, axes, i0, rows, x_start)?;
+    Ok(map_rows(mech, q, &grid, |_, ws| Some(sigma_min_with(&mut ws.frame.sys, mech, &Chart::Inputs, &ws.frame.x))))
+}
+
+/// A map's grid and rows, checked (see [`MapRows`]).
+#[derive(Debug, Clone, Copy)]
+pub struct MapGrid<'a> {
+    k: [usize; 2],
+    axes: [&'a [f64]; 2],
+    i0: usize,
+    rows: &'a [usize],
+    x_start: &'a [f64],
+}
+
+impl<'a> MapGrid<'a> {
+    /// The grid over coordinates k (two different indices) with cell centres `axes` (finite),
+    /// rows `rows` of axes[1] walked from column `i0` of axes[0], on the branch of `x_start`
+    /// (3n finite body coordinates).
+    pub fn new(
+        mech: &Mechanism,
+        k: [usize; 2],
+        axes: [&'a [f64]; 2],
+        i0: usize,
+        rows: &'a [usize],
+        x_start: &'a [f64],
+    ) -> Result<Self, Error> {
+        let m = mech.dof();
+        if k[0] == k[1] || k.iter().any(|&k| k >= m) {
+            let got = format!("{k:?} (the model has {m} coordinates)");
+            return Err(KinematicsError::bad_argument("k", "two different coordinate indices", got).into());
+        }
+        let n = axes[0].len();
+        if i0 >= n || rows.iter().any(|&j| j >= axes[1].len()) || axes.iter().any(|a| a.iter().any(|v| !v.is_finite()))
+        {
+            let got = format!("i0 {i0}, rows {rows:?} of axes of {n} and {} finite values", axes[1].len());
+            return Err(KinematicsError::bad_argument("axes", "finite axes, i0 and rows within them", got).into());
+        }
+        if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
+            let got = format!("{} values", x_start.len());
+            return Err(KinematicsError::bad_argument(
+                "x_start",
+                format!("{} finite body coordinates", mech.n_x()),
+                got,
+            )
+            .into());
+        }
+        Ok(MapGrid { k, axes, i0, rows, x_start })
     }
+
+    /// The branch's reference (3n).
+    pub fn x_start(&self) -> &'a [f64] {
+        self.x_start
+    }
+}
+
+/// The rows of `grid` (see [`MapRows`]): each cell placed in `ws` at its q on the branch
+/// shown, then `value(q, ws)` (None: no value there, NaN).
+pub fn map_rows(
+    mech: &Mechanism,
+    q: &[f64],
+    grid: &MapGrid<'_>,
+    mut value: impl FnMut(&[f64], &mut Workspace) -> Option<f64>,
+) -> MapRows {
+    let MapGrid { k, axes, i0, rows, x_start } = *grid;
     let n = axes[0].len();
-    if i0 >= n || rows.iter().any(|&j| j >= axes[1].len()) || axes.iter().any(|a| a.iter().any(|v| !v.is_finite())) {
-        let got = format!("i0 {i0}, rows {rows:?} of axes of {n} and {} finite values", axes[1].len());
-        return Err(KinematicsError::bad_argument("axes", "finite axes, i0 and rows within them", got).into());
-    }
-    if x_start.len() != mech.n_x() || x_start.iter().any(|v| !v.is_finite()) {
-        let got = format!("{} values", x_start.len());
-        return Err(
-            KinematicsError::bad_argument("x_start", format!("{} finite body coordinates", mech.n_x()), got).into()
-        );
-    }
-    let closed = ClosedForm::new(mech).filter(ClosedForm::is_explicit);
-    let mut cells = Cells { mech, frame: Frame::new(mech), closed };
+    let mut ws = Workspace::new(mech);
     let mut q = q.to_vec();
-    let (mut start, mut sigma) = (x_start.to_vec(), vec![f64::NAN; rows.len() * n]);
-    let mut last = start.clone();
-    // Whether `start` is the previous row's start cell (a neighbour) rather than `x_start`.
-    let mut start_adjacent = false;
-    for (&j, row) in rows.iter().zip(sigma.chunks_exact_mut(n)) {
+    let mut values = vec![f64::NAN; rows.len() * n];
+    if let Some(mut closed) = ClosedForm::new(mech).filter(ClosedForm::is_explicit) {
+        closed.set_reference(x_start);
+        for (&j, row) in rows.iter().zip(values.chunks_exact_mut(n)) {
+            q[k[1]] = axes[1][j];
+            for (i, cell) in row.iter_mut().enumerate() {
+                q[k[0]] = axes[0][i];
+                if closed.positions(&q, &mut ws.frame).is_ok() {
+                    *cell = value(&q, &mut ws).unwrap_or(f64::NAN);
+                }
+            }
+        }
+        return MapRows { values, x: x_start.to_vec() };
+    }
+    let mut cell = |q: &[f64], from: &[f64], ws: &mut Workspace| {
+        assemble_from(mech, from, q, ws).ok().map(|()| value(q, ws).unwrap_or(f64::NAN))
+    };
+    let (mut start, mut last) = (x_start.to_vec(), x_start.to_vec());
+    for (&j, row) in rows.iter().zip(values.chunks_exact_mut(n)) {
         q[k[1]] = axes[1][j];
         q[k[0]] = axes[0][i0];
-        match cells.sigma(&q, &start, start_adjacent) {
-            Some(s) => {
-                row[i0] = s;
-                start.copy_from_slice(&cells.frame.x);
-                start_adjacent = true;
-            }
-            None => start_adjacent = false,
+        if let Some(v) = cell(&q, &start, &mut ws) {
+            row[i0] = v;
+            start.copy_from_slice(&ws.frame.x);
         }
-        // Whether `start` is this row's own start cell: a cell beyond a gap then continues from
-        // it along the row, through the gap's cell.
-        let own_start = row[i0].is_finite();
         for side in [&mut (i0 + 1..n) as &mut dyn Iterator<Item = usize>, &mut (0..i0).rev()] {
             last.copy_from_slice(&start);
-            let mut adjacent = start_adjacent;
             for i in side {
                 q[k[0]] = axes[0][i];
-                if !adjacent && own_start && cells.closed.is_some() {
-                    // The closed forms fail where a group cannot close on any branch (a dyad's
-                    // circles do not meet), so the continuation from the row's start, whose
-                    // path along the row passes through that cell, cannot reach this one.
-                    break;
-                }
-                match cells.sigma(&q, &last, adjacent) {
-                    Some(s) => {
-                        row[i] = s;
-                        last.copy_from_slice(&cells.frame.x);
-                        adjacent = true;
+                match cell(&q, &last, &mut ws) {
+                    Some(v) => {
+                        row[i] = v;
+                        last.copy_from_slice(&ws.frame.x);
                     }
-                    None => {
-                        last.copy_from_slice(&start);
-                        adjacent = false;
-                    }
+                    None => last.copy_from_slice(&start),
                 }
             }
         }
     }
-    Ok(SigmaRows { sigma, x: start })
-}
-
-/// The map's cells, assembled in one frame.
-struct Cells<'a> {
-    mech: &'a Mechanism,
-    frame: Frame,
-    closed: Option<ClosedForm>,
-}
-
-impl Cells<'_> {
-    /// The type II measure at q, the configuration left in `frame.x`: by the closed forms on
-    /// the branches of `from` where it is the neighbouring cell's solution (`adjacent`) and the
-    /// mechanism has them, else by continuation from `from`. None where it does not assemble.
-    fn sigma(&mut self, q: &[f64], from: &[f64], adjacent: bool) -> Option<f64> {
-        let (mech, frame) = (self.mech, &mut self.frame);
-        let placed = match self.closed.as_mut().filter(|_| adjacent) {
-            Some(closed) => {
-                closed.set_reference(from);
-                closed.positions(q, frame)
-            }
-            None => assemble_from(mech, from, q, frame),
-        };
-        placed.ok().map(|()| sigma_min_with(&mut frame.sys, mech, &Chart::Inputs, &frame.x))
-    }
+    MapRows { values, x: start }
 }

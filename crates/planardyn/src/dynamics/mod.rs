@@ -31,7 +31,7 @@ pub mod workspace;
 pub use along::{along, carried_points, point_motion, Along, FixedDrives, Rows};
 pub use derivatives::{forward_derivatives, inverse_derivatives, motion_derivatives, Jacobians, PowerRates};
 pub use energy::{kinetic_energy, potential_energy};
-pub use evaluate::{evaluate, sigma_rows, Evaluation, SigmaRows};
+pub use evaluate::{evaluate, map_rows, sigma_rows, Evaluation, MapGrid, MapRows};
 pub use forces::{applied_forces, Drives, ModelDrives};
 pub use forward::{dynamic_stages, forward};
 pub use inverse::{inverse, inverse_at_rates, rates_mismatch};

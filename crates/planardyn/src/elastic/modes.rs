@@ -114,15 +114,19 @@ pub fn modes(
     gravity: bool,
     ws: &mut Workspace,
 ) -> Result<Modes, KinematicsError> {
-    let model = elastic_at(mech, q, free_rotors, ws)?;
+    modes_of(&elastic_at(mech, q, free_rotors, ws)?, gravity)
+}
+
+/// [`modes`] of the elastic model about its pose.
+pub(crate) fn modes_of(model: &ElasticModel, gravity: bool) -> Result<Modes, KinematicsError> {
     let z = model.z0.clone();
     let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
-    let k = loaded_stiffness(&model, &z, Applied::gravity(gravity), &[], &n)?;
-    let (m, damping) = mass_and_damping(&model, &z, &n);
+    let k = loaded_stiffness(model, &z, Applied::gravity(gravity), &[], &n)?;
+    let (m, damping) = mass_and_damping(model, &z, &n);
     let mut modes = generalized(&k, &m, &damping);
     for s in &mut modes.shapes {
         let full = &n * DVector::from_column_slice(s);
-        *s = full.rows(0, mech.n_x()).iter().copied().collect();
+        *s = full.rows(0, model.mech.n_x()).iter().copied().collect();
     }
     Ok(modes)
 }

@@ -149,7 +149,20 @@ pub(crate) fn elastic_at<'m>(
         return Err(no_compliance());
     }
     assemble_into(mech, q, ws)?;
-    Ok(ElasticModel::new(mech, &ws.x, free_rotors))
+    elastic_model(mech, &ws.x, free_rotors)
+}
+
+/// The elastic model about the rigid pose x (3n, assembled by the caller: a map's cell on its
+/// branch).
+pub(crate) fn elastic_model<'m>(
+    mech: &'m Mechanism,
+    x: &[f64],
+    free_rotors: bool,
+) -> Result<ElasticModel<'m>, KinematicsError> {
+    if mech.compliance.is_empty() {
+        return Err(no_compliance());
+    }
+    Ok(ElasticModel::new(mech, x, free_rotors))
 }
 
 /// A basis of the null space of the rigid rows' gradient (cols x d), from the SVD of the
@@ -317,15 +330,23 @@ pub fn stiffness(
     load: &Load,
     ws: &mut Workspace,
 ) -> Result<CartesianStiffness, KinematicsError> {
-    let model = elastic_at(mech, q, false, ws)?;
-    check_preload(&model, load)?;
-    let z = model.z0.clone();
-    let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
-    let h = loaded_stiffness(&model, &z, Applied::of(out, load), &load.preload, &n)?;
-    cartesian(&model, &z, out, &factor(h)?, &n)
+    stiffness_of(&elastic_at(mech, q, false, ws)?, out, load)
 }
 
-fn check_preload(model: &ElasticModel, load: &Load) -> Result<(), KinematicsError> {
+/// [`stiffness`] of the elastic model about its pose.
+pub(crate) fn stiffness_of(
+    model: &ElasticModel,
+    out: Output,
+    load: &Load,
+) -> Result<CartesianStiffness, KinematicsError> {
+    check_preload(model, load)?;
+    let z = model.z0.clone();
+    let n = null_basis(&model.rigid_rows(&z).1, &model.col_scale);
+    let h = loaded_stiffness(model, &z, Applied::of(out, load), &load.preload, &n)?;
+    cartesian(model, &z, out, &factor(h)?, &n)
+}
+
+pub(crate) fn check_preload(model: &ElasticModel, load: &Load) -> Result<(), KinematicsError> {
     for &(a, _) in &load.preload {
         if !model.elements.iter().any(|e| e.actuator == Some(a)) {
             return Err(KinematicsError::BadArgument {
