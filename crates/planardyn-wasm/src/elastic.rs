@@ -77,8 +77,8 @@ fn load(m: &Mechanism, option: LoadOption) -> Result<Load, JsValue> {
 
 /// `Mechanism.modes` (see there): the modes about q on the branch of `x_start`.
 pub fn modes(m: &Mechanism, q: &[f64], free_rotors: bool, x_start: Option<&[f64]>) -> Result<JsValue, JsValue> {
-    let mut ws = js(query::assembled(m, q, x_start))?;
-    let modes = js(elastic::modes(m, q, free_rotors, false, &mut ws))?;
+    let ws = js(query::assembled(m, q, x_start))?;
+    let modes = js(elastic::modes_about(m, &ws.x, free_rotors, false))?;
     Ok(Obj::new()
         .f64s("omega", &modes.omega())
         .f64s("omega2", &modes.omega2)
@@ -98,8 +98,8 @@ pub fn stiffness(
 ) -> Result<JsValue, JsValue> {
     let out = output(m, point)?;
     let load = load(m, from_js("load", load_option)?)?;
-    let mut ws = js(query::assembled(m, q, x_start))?;
-    let c = js(elastic::stiffness(m, q, out, &load, &mut ws))?;
+    let ws = js(query::assembled(m, q, x_start))?;
+    let c = js(elastic::stiffness_about(m, &ws.x, out, &load))?;
     let w = elastic::weakest_direction(&c, None);
     Ok(Obj::new()
         .set("weakest", w.stiffness)

@@ -109,3 +109,74 @@ fn a_rigid_model_or_a_preload_without_a_spring_is_refused_before_any_cell() {
     let err = elastic::map_rows(&one, &one.drawn_q(), &grid, &value).unwrap_err().to_string();
     assert!(err.contains("preload on actuator 1"), "{err}");
 }
+
+/// The compliant five-bar drawn on its other elbow: P reflected across the line C1 C2 (the
+/// lower intersection of the distal circles), the same dimensions, masses and springs.
+fn other_elbow() -> (Mechanism, [f64; 2]) {
+    let path = format!("{}/../../examples/models/five-bar.yaml", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).unwrap();
+    let (c1, c2, p) = (
+        [-0.25565456543517484, 0.2265769467591625],
+        [0.275, 0.21650635094610965],
+        [0.014002680494367873, 0.44970240410926887],
+    );
+    let (d, w) = ([c2[0] - c1[0], c2[1] - c1[1]], [p[0] - c1[0], p[1] - c1[1]]);
+    let s = (w[0] * d[0] + w[1] * d[1]) / (d[0] * d[0] + d[1] * d[1]);
+    let foot = [c1[0] + s * d[0], c1[1] + s * d[1]];
+    let mirrored = [2.0 * foot[0] - p[0], 2.0 * foot[1] - p[1]];
+    let line = text.lines().find(|l| l.trim_start().starts_with("P: [")).unwrap();
+    let text = text.replace(line, &format!("  P: [{:?}, {:?}]", mirrored[0], mirrored[1]));
+    let rigid = text.split("\ndrives:").next().unwrap();
+    let section =
+        "  drives:\n    - {actuator: theta1, stiffness: 2.0e3}\n    - {actuator: theta2, stiffness: 3.0e3}\n  \
+                   pairs:\n    - {pair: effector, stiffness: 5.0e5}\n";
+    (yaml(&format!("{rigid}\ncompliance:\n{section}")), mirrored)
+}
+
+#[test]
+fn the_per_pose_analyses_about_a_pose_keep_its_branch() {
+    // The app's Modes tab and loaded stiffness analyse the pose shown (`modes_about`,
+    // `stiffness_about`), which may be on another branch than the drawing's continuation. The
+    // same physical mechanism drawn on that branch gives the reference: frequencies and the
+    // weakest stiffness are independent of the body frames, so they must agree to round-off
+    // through two assemblies and two eigen- or factorisations (RTOL).
+    let mech = compliant_five_bar();
+    let (drawn_low, p_low) = other_elbow();
+    let q = mech.drawn_q();
+    assert!(q.iter().zip(drawn_low.drawn_q()).all(|(a, b)| (a - b).abs() < 1e-15), "the same motor angles");
+    // A start on the lower elbow: each distal link turned about its elbow so that P goes to P'.
+    let p = mech.point_id("P").unwrap();
+    let mut start = mech.x0.clone();
+    let at = |name: &str| {
+        let id = mech.point_id(name).unwrap();
+        planardyn::dynamics::query::point_positions(&mech, &mech.x0)[2 * id.0..2 * id.0 + 2].to_vec()
+    };
+    let (pp, c1, c2) = (at("P"), at("C1"), at("C2"));
+    for (body, c) in [(2, &c1), (3, &c2)] {
+        let turn = (p_low[1] - c[1]).atan2(p_low[0] - c[0]) - (pp[1] - c[1]).atan2(pp[0] - c[0]);
+        let (s, co) = turn.sin_cos();
+        let (rx, ry) = (start[3 * body] - c[0], start[3 * body + 1] - c[1]);
+        start[3 * body] = c[0] + co * rx - s * ry;
+        start[3 * body + 1] = c[1] + s * rx + co * ry;
+        start[3 * body + 2] += turn;
+    }
+    let x_low = planardyn::dynamics::query::assemble(&mech, &q, Some(&start)).unwrap();
+    let modes = elastic::modes_about(&mech, &x_low, false, false).unwrap().omega();
+    let want = elastic::modes(&drawn_low, &q, false, false, &mut Workspace::new(&drawn_low)).unwrap().omega();
+    let upper = elastic::modes(&mech, &q, false, false, &mut Workspace::new(&mech)).unwrap().omega();
+    for (g, w) in modes.iter().zip(&want) {
+        assert!((g - w).abs() <= RTOL * w, "omega {modes:?} vs {want:?}");
+    }
+    // The branch matters: the upper elbow's first frequency is another.
+    assert!((upper[0] - want[0]).abs() > 1e-3 * want[0], "{upper:?} vs {want:?}");
+    let out = Output { body: BodyId(2), point: Some(p) };
+    let out_low = Output { body: BodyId(2), point: drawn_low.point_id("P") };
+    let weakest = |c| elastic::weakest_direction(&c, None).stiffness;
+    let got = weakest(elastic::stiffness_about(&mech, &x_low, out, &Load::default()).unwrap());
+    let want = weakest(
+        elastic::stiffness(&drawn_low, &q, out_low, &Load::default(), &mut Workspace::new(&drawn_low)).unwrap(),
+    );
+    let upper = weakest(elastic::stiffness(&mech, &q, out, &Load::default(), &mut Workspace::new(&mech)).unwrap());
+    assert!((got - want).abs() <= RTOL * want, "weakest {got} vs {want} N/m");
+    assert!((upper - want).abs() > 1e-3 * want, "{upper} vs {want} N/m");
+}

@@ -22,5 +22,7 @@ pub use flexible::{simulate_flexible, FlexibleOde, FlexibleRun};
 pub use linearize::{linearize, linearize_compliant, StateSpace};
 pub use map_rows::{map_rows, MapValue};
 pub use model::Output;
-pub use modes::{equilibrium, modes, small_oscillations, Modes};
-pub use stiffness::{deflection, stiffness, weakest_direction, CartesianStiffness, Deflection, Load, Weakest};
+pub use modes::{equilibrium, modes, modes_about, small_oscillations, Modes};
+pub use stiffness::{
+    deflection, stiffness, stiffness_about, weakest_direction, CartesianStiffness, Deflection, Load, Weakest,
+};

@@ -11,7 +11,7 @@
 //! mass-normalised y_i (exact for damping proportional to K and M, first order otherwise).
 
 use super::model::ElasticModel;
-use super::stiffness::{elastic_at, loaded_stiffness, null_basis, Applied};
+use super::stiffness::{elastic_at, elastic_model, loaded_stiffness, null_basis, Applied};
 use crate::dynamics::{inverse, inverse_derivatives, mass_matrix};
 use crate::kinematics::assemble_into;
 use crate::model::{CoordinateKind, Mechanism};
@@ -115,6 +115,12 @@ pub fn modes(
     ws: &mut Workspace,
 ) -> Result<Modes, KinematicsError> {
     modes_of(&elastic_at(mech, q, free_rotors, ws)?, gravity)
+}
+
+/// [`modes`] about the assembled rigid pose x (3n body coordinates), not assembled again from
+/// the drawing: a view's pose on the branch it shows (a 5R with the other elbow).
+pub fn modes_about(mech: &Mechanism, x: &[f64], free_rotors: bool, gravity: bool) -> Result<Modes, KinematicsError> {
+    modes_of(&elastic_model(mech, x, free_rotors)?, gravity)
 }
 
 /// [`modes`] of the elastic model about its pose.

@@ -333,6 +333,17 @@ pub fn stiffness(
     stiffness_of(&elastic_at(mech, q, false, ws)?, out, load)
 }
 
+/// [`stiffness`] about the assembled rigid pose x (3n body coordinates), not assembled again
+/// from the drawing: a view's pose on the branch it shows.
+pub fn stiffness_about(
+    mech: &Mechanism,
+    x: &[f64],
+    out: Output,
+    load: &Load,
+) -> Result<CartesianStiffness, KinematicsError> {
+    stiffness_of(&elastic_model(mech, x, false)?, out, load)
+}
+
 /// [`stiffness`] of the elastic model about its pose.
 pub(crate) fn stiffness_of(
     model: &ElasticModel,
