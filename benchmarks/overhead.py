@@ -1,7 +1,8 @@
 """Python-call overhead: ``Mechanism.simulate`` from Python against the same run from Rust.
 
-The Rust side is ``benchmarks/rust-sim`` (``planardyn::simulate::simulate`` with the same
-settings, timed inside the process). Both sides take the best of 3 runs, alternated for
+The Rust side is ``benchmarks/rust-sim`` (``planardyn::simulate::simulate_prepared``, the model
+prepared once as a Python ``Mechanism`` does, with the same settings, timed inside the
+process). Both sides take the best of 3 runs, alternated for
 REPEATS rounds so that both see the same machine load; the medians are compared. Run by
 bench.py in a process of its own (only planardyn loaded); by hand::
 

@@ -16,7 +16,11 @@ run from Rust, and the serial share of a batch.
   batch at least 1 / (s + g + (1 - s - g) / 2) times as fast as one (Amdahl); the wall-time
   speed-up measured here is printed beside it and is only meaningful on an idle machine.
 
-    .venv/bin/python benchmarks/small_runs.py [--calls 10000] [--variants 4000]
+    .venv/bin/python benchmarks/small_runs.py [--calls 10000] [--variants 4000] [--icount]
+
+- With ``--icount``, the fixed cost also in instructions, which the machine's load does not
+  change: each side run under valgrind's callgrind for ICOUNT_CALLS[0] and ICOUNT_CALLS[1]
+  calls (after a first, untimed one), the difference of the two counts per call.
 
 Build ``benchmarks/rust-sim`` first for the Rust side (``benchmarks/run.sh`` does)::
 
@@ -27,9 +31,11 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import resource
 import statistics
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -47,6 +53,8 @@ T_SHORT, OUTPUT_DT, RTOL = 0.01, 1e-3, 1e-9
 T_BATCH = 1.0
 #: Rounds of the fixed-cost measurement, alternating Python and Rust.
 ROUNDS = 5
+#: Calls per process of the instruction count (two processes a side, see --icount).
+ICOUNT_CALLS = (10, 410)
 #: The targets of issue 25, item 4.
 FIXED_COST_TARGET_US, SERIAL_SHARE_TARGET = 10.0, 0.05
 
@@ -91,6 +99,31 @@ def fixed_cost(calls: int) -> dict[str, float]:
     return out
 
 
+def _instructions(command: list[str]) -> int:
+    """Instructions callgrind counts in a run of ``command`` (its ``Collected`` line)."""
+    out = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", *command],
+                         capture_output=True, text=True, check=True).stderr
+    return int(re.search(r"Collected : (\d+)", out).group(1))  # type: ignore[union-attr]
+
+
+def instructions_per_call() -> dict[str, float]:
+    """Instructions of one short run from Python and from Rust, and the difference: the
+    counts of processes making ICOUNT_CALLS[1] and ICOUNT_CALLS[0] calls, less each other."""
+    python = [sys.executable, __file__, "--calls-only"]
+    rust = [str(RUST_SIM), str(MODEL), "dop853", repr(RTOL), repr(RTOL), "-", repr(T_SHORT), repr(OUTPUT_DT)]
+    n0, n1 = ICOUNT_CALLS
+    per_call = {side: (_instructions(cmd + [str(n1 + 1)]) - _instructions(cmd + [str(n0 + 1)])) / (n1 - n0)
+                for side, cmd in (("python", python), ("rust", rust))}
+    return {**per_call, "fixed": per_call["python"] - per_call["rust"]}
+
+
+def calls_only(n: int) -> None:
+    """n short runs from Python and nothing else (the process callgrind counts)."""
+    mech = pd.load(MODEL)
+    for _ in range(n):
+        mech.simulate(T_SHORT, method="dop853", rtol=RTOL, atol=RTOL, output_dt=OUTPUT_DT)
+
+
 def serial_share(variants: int, threads: int = 2) -> dict[str, float]:
     """Main-thread CPU time over process CPU time of one batch call, and its wall time."""
     mech = pd.load(MODEL)
@@ -116,7 +149,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--calls", type=int, default=10_000)
     ap.add_argument("--variants", type=int, default=4000)
+    ap.add_argument("--icount", action="store_true", help="also count the instructions of a call (valgrind)")
+    ap.add_argument("--calls-only", type=int, help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.calls_only is not None:
+        calls_only(a.calls_only)
+        return
+    if a.icount:
+        i = instructions_per_call()
+        print(f"instructions a call (callgrind, {ICOUNT_CALLS[1]} less {ICOUNT_CALLS[0]} calls): Python "
+              f"{i['python']:.0f}, Rust {i['rust']:.0f}; fixed cost {i['fixed']:.0f}")
     f = fixed_cost(a.calls)
     print(f"one call, four-bar {T_SHORT} s ({a.calls} calls in {ROUNDS} rounds, medians): Python "
           f"{f['python_wall_us']:.1f} us wall, {f['python_cpu_us']:.1f} us thread CPU", end="")

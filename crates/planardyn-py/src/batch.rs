@@ -21,11 +21,12 @@ use crate::mechanism::PyMechanism;
 use crate::simulate::{motion_entries, MotionEntry, SIGNAL_INTERVAL};
 use planardyn::batch::task::{TaskError, TaskPath};
 use planardyn::batch::{map_many_until, Efforts, InverseVariant, Motion, Overrides, Variant};
+use planardyn::simulate::Prepared;
 use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc};
 
 /// Keys a variant's overrides dict may have (the keyword arguments of `Mechanism.simulate`
 /// that need no Python callback).
@@ -177,10 +178,12 @@ fn simulate_batch<'py>(
     threads: Option<usize>,
     finish: Option<Py<PyAny>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    // Each variant runs from its mechanism's prepared set-up, made once for all its runs.
     let make = |m: &Bound<'py, PyMechanism>, d: &Bound<'py, PyDict>| {
-        Ok(Variant { model: m.get().inner.clone(), overrides: overrides(&m.get().inner, d)? })
+        let (mech, prepared) = (m.get(), m.get().prepared(py).clone());
+        Ok((Variant { model: mech.inner.clone(), overrides: overrides(&mech.inner, d)? }, prepared))
     };
-    let solve = |v: &Variant, stop: &AtomicBool| v.simulate_until(stop);
+    let solve = |(v, prepared): &(Variant, Arc<Prepared>), stop: &AtomicBool| v.simulate_prepared(prepared, stop);
     run_batch(py, &variants, threads, finish, make, solve, |py, r, _| match r {
         // A batch's runs are cancelled only by Ctrl-C.
         Ok(traj) => {

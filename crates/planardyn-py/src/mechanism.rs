@@ -14,10 +14,11 @@ use crate::query::{Named, ToPython};
 use crate::rows::{self, MotionArgs};
 use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::dynamics::redundant::Distribution;
+use planardyn::simulate::Prepared;
 use planardyn::Mechanism;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 type ArrayArg<'py> = Floats<'py>;
 
@@ -25,6 +26,9 @@ type ArrayArg<'py> = Floats<'py>;
 #[pyclass(frozen, module = "planardyn._core", name = "Mechanism")]
 pub struct PyMechanism {
     pub inner: Arc<Mechanism>,
+    /// The set-up of its runs, made at the first and shared by every `simulate` and batch
+    /// run after (`planardyn::simulate::Prepared`).
+    prepared: OnceLock<Arc<Prepared>>,
 }
 
 /// Coordinates q and rates qd (m,), the efforts tau (m,) if given: where forward dynamics is asked.
@@ -32,7 +36,12 @@ type ForwardArgs = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
 
 impl PyMechanism {
     pub fn new(mech: Mechanism) -> Self {
-        PyMechanism { inner: Arc::new(mech) }
+        PyMechanism { inner: Arc::new(mech), prepared: OnceLock::new() }
+    }
+
+    /// The set-up of this mechanism's runs, made at the first call with the GIL released.
+    pub fn prepared(&self, py: Python<'_>) -> &Arc<Prepared> {
+        self.prepared.get_or_init(|| py.detach(|| Arc::new(Prepared::new(&self.inner))))
     }
 
     fn m(&self) -> usize {
@@ -576,6 +585,7 @@ impl PyMechanism {
         crate::simulate::simulate(
             py,
             &self.inner,
+            self.prepared(py),
             args,
             drives,
             motion.unwrap_or_default(),

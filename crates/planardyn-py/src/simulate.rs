@@ -11,7 +11,7 @@ use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, ToPyArray};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
 use planardyn::simulate::columns::{self, Column, Shape, COLUMNS};
-use planardyn::simulate::{Event, EventFn, Observe, Overrides, Trajectory};
+use planardyn::simulate::{simulate_prepared, Event, EventFn, Observe, Overrides, Prepared, Trajectory};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
@@ -177,11 +177,13 @@ pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) 
         .collect()
 }
 
-/// Run a simulation and return its trajectory as a dict (see `planardyn.SimulationResult`).
+/// Run a simulation from `mech`'s `prepared` set-up and return its trajectory as a dict (see
+/// `planardyn.SimulationResult`).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
     mech: &Mechanism,
+    prepared: &Prepared,
     args: Overrides,
     drives: Option<Py<PyAny>>,
     motion: Vec<(usize, MotionArg)>,
@@ -240,7 +242,7 @@ pub fn simulate<'py>(
             prescribed.set(*k, motion).map_err(|e| argument_error(Some("motion"), e))?;
         }
         let observe = Observe { events: core_events(&events, &event_fatal), dense_output };
-        Ok(planardyn::simulate::simulate_observed(mech, &s, d, &mut prescribed, observe, Some(&mut on_step))?)
+        Ok(simulate_prepared(mech, prepared, &s, d, &mut prescribed, observe, Some(&mut on_step))?)
     })?;
     let motion_fatal = motions.into_iter().find_map(|(_, e)| match e {
         MotionEntry::Function(f) => f.fatal,

@@ -20,7 +20,7 @@ use crate::dynamics::{self, ModelDrives};
 use crate::kinematics::{assemble_from, assemble_into, continue_to};
 use crate::simulate::charts::SWITCH_TO_PARTITION;
 pub use crate::simulate::Overrides;
-use crate::simulate::{simulate_prescribed, Trajectory};
+use crate::simulate::{simulate_prepared, Observe, Prepared, Trajectory};
 use crate::{Error, KinematicsError, Mechanism, Workspace};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -46,11 +46,18 @@ impl Variant {
     /// driven by them), stopping at the first step after `stop` is set (status
     /// `Cancelled`, the trajectory so far kept).
     pub fn simulate_until(&self, stop: &AtomicBool) -> Result<Trajectory, Error> {
+        self.simulate_prepared(&Prepared::new(&self.model), stop)
+    }
+
+    /// [`Variant::simulate_until`] with the set-up of its model's runs made once for them all
+    /// ([`Prepared::new`] of `self.model`; the trajectory is the same, to the bit).
+    pub fn simulate_prepared(&self, prepared: &Prepared, stop: &AtomicBool) -> Result<Trajectory, Error> {
         let mech = &*self.model;
         let settings = self.overrides.settings(mech)?;
         let mut motion = self.overrides.prescribed(mech)?;
         let mut go_on = |_t: f64| !stop.load(Ordering::Relaxed);
-        simulate_prescribed(mech, &settings, &mut ModelDrives(mech), &mut motion, Some(&mut go_on))
+        let (drives, observe) = (&mut ModelDrives(mech), Observe::default());
+        simulate_prepared(mech, prepared, &settings, drives, &mut motion, observe, Some(&mut go_on))
     }
 }
 

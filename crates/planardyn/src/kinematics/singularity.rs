@@ -38,7 +38,7 @@ pub(crate) fn scaled_phi_x(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
 /// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
 /// length (type II measure for `Inputs`; `group_sigma`). Cost linear in the bodies.
 pub fn sigma_min(mech: &Mechanism, chart: &Chart, x: &[f64]) -> f64 {
-    sigma_min_with(&mut System::new(mech), mech, chart, x)
+    sigma_min_with(&mut System::for_chart(mech, chart), mech, chart, x)
 }
 
 /// [`sigma_min`] with the blocks of a `sys` kept by the caller (analysed once per chart,

@@ -64,12 +64,18 @@ pub fn col_scales(mech: &Mechanism) -> Vec<f64> {
 }
 
 impl System {
+    /// J of the user's chart, its structure analysed.
     pub fn new(mech: &Mechanism) -> Self {
-        let lu = BlockLu::new(&jacobian_pattern(mech, &Chart::Inputs));
+        Self::for_chart(mech, &Chart::Inputs)
+    }
+
+    /// J of `chart`, its structure analysed (once: not the user's chart's first, then this one's).
+    pub fn for_chart(mech: &Mechanism, chart: &Chart) -> Self {
+        let lu = BlockLu::new(&jacobian_pattern(mech, chart));
         let u_support = u_support(mech, &lu);
         let (a_pairs, a_first, a_fill_in) = a_pattern(&u_support);
         System {
-            groups: GroupScales::new(mech, &Chart::Inputs, &lu),
+            groups: GroupScales::new(mech, chart, &lu),
             unit_reach: unit_reach(mech, &lu),
             u_support,
             a_pairs,
@@ -77,11 +83,11 @@ impl System {
             a_fill_in,
             supports_id: next_supports_id(),
             lu,
-            pattern_chart: Chart::Inputs,
+            pattern_chart: chart.clone(),
             row_scale: vec![1.0; mech.n_x()],
             col_scale: col_scales(mech),
             factored: false,
-            chart: Chart::Inputs,
+            chart: chart.clone(),
         }
     }
 

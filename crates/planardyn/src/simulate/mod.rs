@@ -10,6 +10,7 @@ pub mod events;
 mod jacobian;
 pub mod ode;
 mod overrides;
+mod prepared;
 mod run;
 mod start;
 mod stop;
@@ -18,6 +19,7 @@ pub mod trajectory;
 pub use dense::DenseOutput;
 pub use events::{Event, EventFn, EventRecords, EVENT_XTOL};
 pub use overrides::Overrides;
+pub use prepared::Prepared;
 pub use trajectory::{SimStats, Status, Trajectory};
 
 use std::ops::ControlFlow;
@@ -171,9 +173,26 @@ pub fn simulate_observed<'a>(
     observe: Observe,
     progress: Option<&mut dyn FnMut(f64) -> bool>,
 ) -> Result<Trajectory, Error> {
+    simulate_prepared(mech, &Prepared::new(mech), settings, drives, motion, observe, progress)
+}
+
+/// As [`simulate_observed`], the run's set-up from the model alone taken from `prepared`
+/// ([`Prepared::new`] of `mech`, made once for all its runs): the same trajectory, to the
+/// bit, without the Assur decomposition, J's structure analysis and the closed forms'
+/// construction of each run. A `prepared` of another mechanism is an error.
+pub fn simulate_prepared<'a>(
+    mech: &'a Mechanism,
+    prepared: &Prepared,
+    settings: &Settings,
+    drives: &'a mut dyn Drives,
+    motion: &'a mut Prescribed<'a>,
+    observe: Observe,
+    progress: Option<&mut dyn FnMut(f64) -> bool>,
+) -> Result<Trajectory, Error> {
+    prepared.check(mech)?;
     check(settings, mech)?;
     check_events(&observe, mech)?;
-    match Run::start(mech, settings, drives, motion, observe)? {
+    match Run::start(mech, prepared, settings, drives, motion, observe)? {
         ControlFlow::Continue(run) => Ok(run.run(progress)),
         ControlFlow::Break(stop) => Ok(stopped_at_start(mech, stop)),
     }

@@ -101,8 +101,20 @@ pub struct MechanismOde<'a> {
 impl<'a> MechanismOde<'a> {
     /// A system whose workspace `ws` holds a converged, analysed point of chart `ws.chart`.
     pub fn new(mech: &'a Mechanism, ws: Workspace, drives: &'a mut dyn Drives) -> Self {
+        Self::from_parts(mech, ws, drives, ClosedForm::new(mech), System::new(mech))
+    }
+
+    /// As [`MechanismOde::new`], given what it derives from the model alone: `closed`, the
+    /// model's `ClosedForm::new`, and `inputs_sys`, its `System::new` (copies of a
+    /// `simulate::Prepared`'s).
+    pub fn from_parts(
+        mech: &'a Mechanism,
+        ws: Workspace,
+        drives: &'a mut dyn Drives,
+        mut closed: Option<ClosedForm>,
+        inputs_sys: System,
+    ) -> Self {
         let m = mech.dof();
-        let mut closed = ClosedForm::new(mech);
         if let Some(c) = closed.as_mut() {
             c.set_reference(&ws.x);
         }
@@ -123,7 +135,7 @@ impl<'a> MechanismOde<'a> {
             max_move: f64::INFINITY,
             max_approach: f64::INFINITY,
             failed_evaluations: 0,
-            inputs_sys: System::new(mech),
+            inputs_sys,
             closed,
             base_closed: false,
             stale_j: false,

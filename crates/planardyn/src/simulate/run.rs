@@ -14,6 +14,7 @@ use super::crossing::{
 use super::dense::{self, DenseOutput};
 use super::events::Watch;
 use super::ode::MechanismOde;
+use super::prepared::Prepared;
 use super::start;
 use super::stop::{Near, Stop, PROGRESS_MARGIN};
 use super::trajectory::Trajectory;
@@ -76,12 +77,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// drive or the integrator failing at the start). Errors in the start itself return Err.
     pub fn start(
         mech: &'a Mechanism,
+        prepared: &Prepared,
         settings: &'s Settings,
         drives: &'a mut dyn Drives,
         motion: &'a mut Prescribed<'a>,
         observe: Observe<'e>,
     ) -> Result<ControlFlow<Stop, Self>, Error> {
-        let (mut ode, y) = match start::start(mech, settings, drives, motion) {
+        let (mut ode, y) = match start::start(mech, prepared, settings, drives, motion) {
             Ok(started) => started,
             // A drive that fails at once is a failed run, not bad input: say so in the status.
             Err(e @ Error::Drive { .. }) => return Ok(Break(Stop::StartDrive(e))),

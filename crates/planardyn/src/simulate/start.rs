@@ -3,17 +3,19 @@
 
 use super::charts::{chart_sigma, measure, next_chart, state_in, PASSIVE_SINGULAR};
 use super::ode::MechanismOde;
+use super::prepared::Prepared;
 use super::Settings;
 use crate::dynamics::{Drives, Prescribed};
 use crate::kinematics::{assemble_into, velocity_analogues, Chart};
 use crate::model::Mechanism;
-use crate::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
 
 /// The start: assembled at q0, in the user's chart unless it is near-singular there.
 /// Coordinates driven by motion start where their motion is at t0 (a `speed` counts from q0).
+/// The buffers and what the run derives from the model alone are copies of `prepared`'s.
 pub fn start<'a>(
     mech: &'a Mechanism,
+    prepared: &Prepared,
     s: &Settings,
     drives: &'a mut dyn Drives,
     motion: &'a mut Prescribed<'a>,
@@ -28,7 +30,7 @@ pub fn start<'a>(
             (q0[k], qd0[k]) = (motion.q[i], motion.qd[i]);
         }
     }
-    let mut ws = Workspace::new(mech);
+    let mut ws = prepared.workspace();
     assemble_into(mech, &q0, &mut ws)?;
     // Body velocities from qd0 need U in the user's chart, i.e. a regular start; at rest a
     // singular start is fine (xd = 0).
@@ -44,7 +46,8 @@ pub fn start<'a>(
     }
     ws.q.copy_from_slice(&q0);
     ws.qd.copy_from_slice(&qd0);
-    let mut ode = MechanismOde::new(mech, ws, drives).with_motion(motion);
+    let mut ode = MechanismOde::from_parts(mech, ws, drives, prepared.closed_form(), prepared.inputs_system())
+        .with_motion(motion);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
         return Err(

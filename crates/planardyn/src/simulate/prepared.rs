@@ -1,0 +1,73 @@
+//! A mechanism prepared for runs: the set-up a run derives from the immutable model alone,
+//! made once per model and copied into each run. The model (`Mechanism`), the prepared model
+//! and a run's own state stay separate, as Pinocchio's `Model` and `Data`: a run borrows the
+//! prepared model, starts from copies of its templates and changes only those.
+//!
+//! What it keeps, each as the constructor a run called before made it:
+//! - the evaluation buffers at the drawing in the user's chart ([`Workspace::new`]), with the
+//!   structure of J analysed there (`System::new`: the block pattern of `BlockLu`, the groups'
+//!   lengths and vectors of the type II estimate, the supports of U and of A);
+//! - the same analysis for the type II measure of the user's chart while a partition is
+//!   integrated (`MechanismOde::inputs_sys`);
+//! - the user's chart in closed form where every group has one ([`ClosedForm::new`], which
+//!   makes the Assur decomposition), its branches those of the drawing.
+//!
+//! A copy of a template is the value the constructor gives (none of them reads the clock, the
+//! state or anything but the model), so a run from a prepared model is the run without one, to
+//! the bit (`tests/prepared.rs`). The one difference is `System`'s analysis id, which the
+//! copies share: it only tells whether buffers were zeroed for the same supports, and copies
+//! of one analysis have the same supports.
+
+use crate::kinematics::{ClosedForm, System};
+use crate::model::Mechanism;
+use crate::{Error, Workspace};
+
+/// The set-up of every run of one mechanism ([`crate::simulate::simulate_prepared`]).
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The workspace a run starts from: buffers sized for the model, at its drawing, J's
+    /// structure analysed for the user's chart.
+    workspace: Workspace,
+    /// The user's chart in closed form (None where a group has none).
+    closed: Option<ClosedForm>,
+}
+
+impl Prepared {
+    /// The set-up of `mech`'s runs.
+    pub fn new(mech: &Mechanism) -> Self {
+        Prepared { workspace: Workspace::new(mech), closed: ClosedForm::new(mech) }
+    }
+
+    /// Err unless this was prepared from a mechanism of `mech`'s size and drawing: a run
+    /// given another model's set-up would index past its buffers or take its geometry.
+    pub fn check(&self, mech: &Mechanism) -> Result<(), Error> {
+        let ws = &self.workspace;
+        if ws.q.len() == mech.dof() && ws.x == mech.x0 {
+            return Ok(());
+        }
+        Err(Error::Options(format!(
+            "the prepared model ({} coordinates, {} body coordinates) was made from another mechanism than \
+             '{}' ({} coordinates, {} body coordinates): prepare it from the mechanism it runs",
+            ws.q.len(),
+            ws.x.len(),
+            mech.name,
+            mech.dof(),
+            mech.n_x()
+        )))
+    }
+
+    /// A run's workspace: a copy of the template.
+    pub fn workspace(&self) -> Workspace {
+        self.workspace.clone()
+    }
+
+    /// A run's analysis of J in the user's chart, for its type II measure in a partition.
+    pub fn inputs_system(&self) -> System {
+        self.workspace.frame.sys.clone()
+    }
+
+    /// A run's closed forms of the user's chart, if every group has one.
+    pub fn closed_form(&self) -> Option<ClosedForm> {
+        self.closed.clone()
+    }
+}
