@@ -94,14 +94,20 @@ impl Group {
     }
 
     #[inline]
-    fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+    fn position(
+        &mut self,
+        z: &[f64],
+        start: Start,
+        x: &mut [f64],
+        trig: &mut [[f64; 2]],
+    ) -> Result<(), KinematicsError> {
         match self {
             Group::Rrr(d, b, g) => d.position(b, g, x, trig)?,
             Group::Rrp(d, b, g) => d.position(b, g, x, trig)?,
             Group::Affine(g) => g.affine(x, trig)?,
             Group::Rpr(d, b) => d.position(b, x, trig)?,
             Group::Extended(d) => d.position(z, x, trig)?,
-            Group::Triad(t) => t.position(z, x, trig)?,
+            Group::Triad(t) => t.position(z, start == Start::Predicted, x, trig)?,
         }
         Ok(())
     }
@@ -129,6 +135,15 @@ impl Group {
             Group::Triad(t) => t.acceleration(v, a),
         }
     }
+}
+
+/// Where the iterative groups (the triad's Newton) start: from the reference configuration,
+/// or from the point in the buffer x (a prediction on the reference branches, which the
+/// caller's fold guard has checked: `MechanismOde`'s).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Start {
+    Reference,
+    Predicted,
 }
 
 #[derive(Debug, Clone)]
@@ -401,6 +416,11 @@ impl ClosedForm {
 
     /// Positions `ws.x` (and `ws.trig`) at the user's coordinates z on the reference branches.
     pub fn positions(&mut self, z: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
+        self.place(z, Start::Reference, ws)
+    }
+
+    /// [`ClosedForm::positions`], the triad's Newton from `start`.
+    fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         for c in &self.cranks {
             c.position(z, &mut ws.x, &mut ws.trig);
         }
@@ -408,7 +428,7 @@ impl ClosedForm {
             s.position(z, &mut ws.x, &mut ws.trig);
         }
         for d in &mut self.groups {
-            d.position(z, &mut ws.x, &mut ws.trig)?;
+            d.position(z, start, &mut ws.x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -467,7 +487,20 @@ impl ClosedForm {
     /// Positions, analogues and the convective term at (z, zd) in the user's chart, and the
     /// user's coordinates q = z, qd = zd: what `dynamics::kinematic_stages` computes there.
     pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
-        self.positions(z, ws)?;
+        self.stages_from(z, zd, Start::Reference, ws)
+    }
+
+    /// [`ClosedForm::kinematic_stages`] with the triad's Newton from the platform's pose in
+    /// `ws.x`, a prediction on the reference branches (the ODE's, whose side `keeps_branches`
+    /// has checked and whose distance from the solution the ODE bounds, as the Newton path's):
+    /// nearer than the reference configuration, so about two iterations fewer. The solution is
+    /// then the reference's to the Newton tolerance, not to the bit.
+    pub fn predicted_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
+        self.stages_from(z, zd, Start::Predicted, ws)
+    }
+
+    fn stages_from(&mut self, z: &[f64], zd: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
+        self.place(z, start, ws)?;
         self.velocity_analogues(ws);
         self.convective(zd, ws);
         ws.q.copy_from_slice(z);

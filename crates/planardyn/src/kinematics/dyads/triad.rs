@@ -175,11 +175,18 @@ impl Triad {
     }
 
     /// The bodies' poses (x and trig) on the reference branch, the links before them solved.
-    /// Newton stops as the general position solve does (`position`): at a scaled residual
+    /// Newton starts from the reference pose, or with `from_x` from the platform's pose in x
+    /// (a prediction on the reference branch, `ClosedForm::predicted_stages`). Newton stops as the general position solve does (`position`): at a scaled residual
     /// (each leg's length error / L) of POSITION_TOL relative to the pose's size, or at
     /// round-off once a step no longer halves it, with one more step above POLISH_BELOW.
     #[inline(never)]
-    pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
+    pub fn position(
+        &mut self,
+        z: &[f64],
+        from_x: bool,
+        x: &mut [f64],
+        trig: &mut [[f64; 2]],
+    ) -> Result<(), KinematicsError> {
         if self.extended.iter().any(Option::is_some) {
             self.set_arms(|a| a.ext.shift(z));
         }
@@ -188,7 +195,8 @@ impl Triad {
         for (i, j) in self.outer.iter().enumerate() {
             (a[i], g.known[i]) = j.place(x, trig);
         }
-        let mut pose = self.branch.pose;
+        let p = 3 * self.bodies[3];
+        let mut pose = if from_x { [x[p], x[p + 1], x[p + 2]] } else { self.branch.pose };
         let size = (pose[0].abs() * self.inv_scale).max(pose[1].abs() * self.inv_scale).max(pose[2].abs());
         let tol = POSITION_TOL * (1.0 + size);
         let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
