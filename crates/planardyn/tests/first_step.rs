@@ -3,25 +3,9 @@
 
 mod common;
 use common::*;
-use planardyn::integrate::{Method, OdeSystem, Options, Stepper};
+use planardyn::integrate::{Method, Options, Stepper};
 use planardyn::simulate::{grid, simulate, Settings, Trajectory};
 use planardyn::Mechanism;
-use std::convert::Infallible;
-
-/// y'' = -y.
-struct Oscillator;
-
-impl OdeSystem for Oscillator {
-    type Error = Infallible;
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Infallible> {
-        dy[0] = y[1];
-        dy[1] = -y[0];
-        Ok(())
-    }
-}
 
 /// The length of the first step of `method` from y = (1, 0) at rtol = atol = 1e-6, with the
 /// system's bound `h_max` on it (None: no bound), after a first reset that was bounded at 1e-9
