@@ -4,6 +4,8 @@
 //!
 //! Run with `--nocapture` to see the measured numbers.
 
+mod common;
+use common::Oscillator;
 use planardyn::integrate::*;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -45,20 +47,6 @@ fn allocations() -> usize {
 // Test problems with closed-form solutions.
 
 /// Harmonic oscillator y1' = y2, y2' = -y1; y(0) = (1, 0): y = (cos t, -sin t).
-struct Oscillator;
-
-impl OdeSystem for Oscillator {
-    type Error = Infallible;
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Infallible> {
-        dy[0] = y[1];
-        dy[1] = -y[0];
-        Ok(())
-    }
-}
-
 fn oscillator_exact(t: f64) -> [f64; 2] {
     [t.cos(), -t.sin()]
 }

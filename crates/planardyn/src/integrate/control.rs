@@ -82,6 +82,9 @@ pub(crate) struct Core {
     pub(crate) h_next: f64,
     /// Error norm of the last accepted step (the PI controller's memory; 1 after `reset`).
     pub(crate) err_prev: f64,
+    /// Largest automatic first step after `reset` (s): the system's own bound
+    /// ([`crate::integrate::Stepper::bound_first_step`]); infinite unless set.
+    pub(crate) first_step_max: f64,
     pub(crate) stats: Stats,
     pub(crate) started: bool,
 }
@@ -99,6 +102,7 @@ impl Core {
             f_prev: vec![0.0; n],
             h_next: 0.0,
             err_prev: 1.0,
+            first_step_max: f64::INFINITY,
             stats: Stats::default(),
             started: false,
         }
@@ -123,6 +127,7 @@ impl Core {
         self.f_prev.copy_from_slice(&self.f);
         self.h_next = 0.0;
         self.err_prev = 1.0;
+        self.first_step_max = f64::INFINITY;
         self.started = true;
         Ok(())
     }
@@ -270,8 +275,8 @@ fn scaled_norm(v: &[f64], y: &[f64], opts: &Options) -> f64 {
 }
 
 /// Hairer's automatic initial step (HNW I, II.4, p. 169; scipy `select_initial_step`)
-/// for a method whose error estimate is of order `order`, bounded by `t_stop - t`
-/// and `h_max`. Uses `y1`, `f1` as scratch and one `rhs` evaluation; if that
+/// for a method whose error estimate is of order `order`, bounded by `t_stop - t`,
+/// `h_max` and the system's own bound (`Core::first_step_max`). Uses `y1`, `f1` as scratch and one `rhs` evaluation; if that
 /// evaluation fails, the first guess `h0` is returned.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn initial_step<S: OdeSystem>(
@@ -283,14 +288,14 @@ pub(crate) fn initial_step<S: OdeSystem>(
     f1: &mut [f64],
 ) -> f64 {
     let (t, opts) = (core.t, &core.opts);
-    let interval = (t_stop - t).max(0.0);
+    let cap = (t_stop - t).max(0.0).min(opts.h_max).min(core.first_step_max);
     if core.n == 0 {
-        return interval.min(opts.h_max);
+        return cap;
     }
     let d0 = scaled_norm(&core.y, &core.y, opts);
     let d1 = scaled_norm(&core.f, &core.y, opts);
     let h0 = if d0 < START_NORM_FLOOR || d1 < START_NORM_FLOOR { START_H_FALLBACK } else { 0.01 * d0 / d1 };
-    let h0 = h0.min(interval).min(opts.h_max);
+    let h0 = h0.min(cap);
     for i in 0..core.n {
         y1[i] = core.y[i] + h0 * core.f[i];
     }
@@ -307,7 +312,7 @@ pub(crate) fn initial_step<S: OdeSystem>(
     } else {
         (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
     };
-    (100.0 * h0).min(h1).min(interval).min(opts.h_max)
+    (100.0 * h0).min(h1).min(cap)
 }
 
 /// Step factor after an accepted step with error norm `err <= 1`, from a PI controller

@@ -22,12 +22,9 @@
 //! degrades to the cubic Hermite polynomial (order 3). If one of the extra
 //! stages fails, that step's solution at a time inside it is a step of the method from
 //! the step's start to that time (12 more evaluations, and as accurate as the step), or,
-//! if one of those fails too, the cubic Hermite polynomial. So is a time inside the first
-//! step after a reset: its size is the starting guess's, not the controller's, and its
-//! degree-7 interpolant, one order below the step and not error-controlled, can then be far
-//! worse than the step's end (the five-bar at rtol 3.98e-8: a 47 ms first step after a chart
-//! switch, where the steps before were 8-13 ms; its outputs up to 3.3e-6 J off, its end
-//! 1.3e-7 J).
+//! if one of those fails too, the cubic Hermite polynomial. The first step after a reset is
+//! interpolated as any other: where its starting guess may be far too long (after a chart
+//! switch), the system bounds it (`Stepper::bound_first_step`).
 
 // The coefficients keep the 30 digits of the published table, so that they can be
 // compared with it digit by digit; the compiler rounds them to f64.
@@ -261,13 +258,9 @@ pub struct Dop853 {
     /// Whether `fd` holds the 7th-order coefficients of the last accepted step (else only
     /// its cubic Hermite rows, until the next `interpolate` evaluates the extra stages).
     dense_ready: bool,
-    /// Whether an extra stage of the last accepted step failed, or it was the first step after
-    /// a reset: `interpolate` then steps from its start instead ([`Dop853::substep`]).
+    /// Whether an extra stage of the last accepted step failed: `interpolate` then steps from
+    /// its start instead ([`Dop853::substep`]).
     substep: bool,
-    /// Whether the step being taken is the first since `reset` (its size the starting guess's,
-    /// not the controller's), and whether the last accepted step was.
-    first: bool,
-    first_accepted: bool,
 }
 
 impl Integrator for Dop853 {
@@ -290,8 +283,6 @@ impl Integrator for Dop853 {
             h: 0.0,
             dense_ready: true,
             substep: false,
-            first: true,
-            first_accepted: false,
         }
     }
 
@@ -327,7 +318,6 @@ impl Dop853 {
         self.fd.fill(0.0);
         self.dense_ready = true;
         self.substep = false;
-        self.first = true;
         self.core.reset(sys, t, y)
     }
 
@@ -350,7 +340,7 @@ impl Dop853 {
                 }
             }
         }
-        self.substep = self.core.opts.dense_output && (!extra_ok || self.first_accepted);
+        self.substep = self.core.opts.dense_output && !extra_ok;
         let Dop853 { k, fd, .. } = self;
         for i in 0..n {
             for r in 0..4 {
@@ -468,7 +458,6 @@ impl ExplicitPair for Dop853 {
         }
         self.dense_ready = false;
         self.substep = false;
-        self.first_accepted = std::mem::take(&mut self.first);
         self.core.accept(t_new, &mut self.y_new, &mut self.f_new);
     }
 }

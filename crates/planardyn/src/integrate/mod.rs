@@ -411,6 +411,15 @@ impl Stepper {
         dispatch!(self, s => s.reset(sys, t, y))
     }
 
+    /// Bound the automatic first step after the last `reset` by `h_max` (s), from what the
+    /// system knows of itself (a mechanism: how far its new chart's coordinates may move in
+    /// one step). The starting-step rule knows only f and its change along f, and its guess
+    /// after a chart switch was rejected twice or three times at most of the five-bar's
+    /// switches. A step size given in `Options::h0` is the caller's and is kept.
+    pub fn bound_first_step(&mut self, h_max: f64) {
+        dispatch!(self, s => s.core.first_step_max = h_max)
+    }
+
     /// Advance by one accepted step, never past t_stop (t_stop > t). Rejected tries are retried inside.
     ///
     /// The last step before `t_stop` ends exactly on it. With `t_stop <= t` nothing

@@ -6,7 +6,9 @@
 
 use std::ops::ControlFlow::{self, Break, Continue};
 
-use super::charts::{chart_sigma, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR};
+use super::charts::{
+    chart_sigma, first_step_bound, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR,
+};
 use super::crossing::{
     cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
     APPROACH_BELOW, APPROACH_FRACTION, CHANGE_POINT_RATIO, CROSS_START, WATCH_BELOW,
@@ -369,6 +371,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
                 return Break(Stop::ChartChange { t, error });
             }
             own = chart_sigma(&mut self.ode, meas.sigma);
+            self.stepper.bound_first_step(first_step_bound(&self.ode, own));
         }
         self.ode.limit_correction(own);
         // In the user's chart the passive measure is only bounded by sigma_II (it is
@@ -502,6 +505,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let meas = measure(ode);
         let own = chart_sigma(ode, meas.sigma);
         ode.limit_correction(own);
+        self.stepper.bound_first_step(first_step_bound(ode, own));
         let work_past = landing.y[landing.y.len() - 1];
         self.approach.clear();
         self.approach.keep(ode, landing.t, meas.passive);

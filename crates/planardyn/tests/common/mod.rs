@@ -1,7 +1,9 @@
 //! Models shared by the integration tests, written inline so that each test states its data.
 #![allow(dead_code)]
 
+use planardyn::integrate::OdeSystem;
 use planardyn::{loads, Format, Mechanism};
+use std::convert::Infallible;
 
 pub mod ode;
 
@@ -344,5 +346,20 @@ pub fn power_balance_along(
         let (p, p0) = (ws.tau[0] * qd, ws0.tau[0] * qd);
         assert!((p - p0 - ws.dissipated).abs() <= rtol * p.abs().max(floor), "t {t}: {p} {p0} {}", ws.dissipated);
         each(Swept { k, t, qd, qdd, p, p0, ws: &ws });
+    }
+}
+
+/// The harmonic oscillator y'' = -y as y = (y, y') (the integrators' tests).
+pub struct Oscillator;
+
+impl OdeSystem for Oscillator {
+    type Error = Infallible;
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Infallible> {
+        dy[0] = y[1];
+        dy[1] = -y[0];
+        Ok(())
     }
 }
