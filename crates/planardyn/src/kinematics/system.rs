@@ -52,8 +52,8 @@ pub struct System {
     supports_id: u64,
 }
 
-/// The next [`System::supports_id`].
-fn next_supports_id() -> u64 {
+/// The next [`System::supports_id`] (and the closed form's zero pattern of U, `column_reach`).
+pub(crate) fn next_supports_id() -> u64 {
     static NEXT: AtomicU64 = AtomicU64::new(1);
     NEXT.fetch_add(1, Ordering::Relaxed)
 }
