@@ -10,6 +10,11 @@
 - ``five_bars(n)``: n passive five-bars (the 5R of examples/models/five-bar-free-fall.yaml,
   hanging below the ground) side by side, 0.6 m apart, each started from its stable pose with
   rates (1, -0.5) rad/s: 2n coordinates, the same small oscillation in every copy.
+- ``ladder(n)``: a ladder of 2n - 1 five-bar loops, each sharing its rods with its neighbours:
+  2n rods of 0.2 m hanging from the ground at (0.3 i, 0), their tips joined in turn by RRR dyads
+  of two 0.25 m links (every link 1 kg per metre, uniform), started hanging with rates 1 and
+  -0.5 rad/s on alternate rods: 2n coordinates (one per rod), coupled (rod i moves the dyads on
+  both its sides, so A = U^T M U is tridiagonal, not block diagonal); n = 1 is a five-bar.
 - ``a02(n)``: IFToMM benchmark A02, the N-four-bar: n + 1 upright rods of 1 m hinged to the
   ground at (i, 0), n couplers joining their tops, every link a uniform 1 kg bar, gravity -y,
   B0 (the first rod's top) moving at +1 m/s in x. One coordinate; its mobility jumps to n + 1
@@ -142,4 +147,36 @@ def five_bars(n: int, gap: float = 0.6) -> dict[str, Any]:
     }
 
 
-FAMILIES = {"parallelograms": parallelograms, "five-bars": five_bars, "a02": a02}
+def ladder(n: int, gap: float = 0.3, rod: float = 0.2, link: float = 0.25) -> dict[str, Any]:
+    """2n hanging rods (m) `gap` apart, consecutive tips joined by a dyad of two `link` links."""
+    depth = math.sqrt(link**2 - (gap / 2) ** 2)
+    points: dict[str, list[float]] = {}
+    bodies: dict[str, Any] = {}
+    pairs: list[dict[str, Any]] = []
+    coordinates: list[dict[str, Any]] = []
+    for i in range(2 * n):
+        o, c = [gap * i, 0.0], [gap * i, -rod]
+        points.update({f"O{i}": o, f"C{i}": c})
+        bodies[f"rod{i}"] = {"points": [f"O{i}", f"C{i}"], **_bar(o, c, rod)}
+        pairs.append({"type": "revolute", "name": f"g_rod{i}", "at": f"O{i}", "bodies": ["ground", f"rod{i}"]})
+        coordinates.append({"name": f"theta{i}", "pair": f"g_rod{i}", "value": -math.pi / 2, "qd0": (1.0, -0.5)[i % 2]})
+    for i in range(2 * n - 1):
+        p = [gap * (i + 0.5), -rod - depth]
+        points[f"P{i}"] = p
+        for side, tip in (("l", i), ("r", i + 1)):
+            bodies[f"{side}{i}"] = {"points": [f"C{tip}", f"P{i}"], **_bar(points[f"C{tip}"], p, link)}
+            pairs.append({"type": "revolute", "at": f"C{tip}", "bodies": [f"rod{tip}", f"{side}{i}"]})
+        pairs.append({"type": "revolute", "at": f"P{i}", "bodies": [f"l{i}", f"r{i}"]})
+    return {
+        "name": f"ladder of {2 * n - 1} five-bar loops",
+        "units": "SI",
+        "gravity": [0.0, -G],
+        "points": points,
+        "ground": [f"O{i}" for i in range(2 * n)],
+        "bodies": bodies,
+        "pairs": pairs,
+        "coordinates": coordinates,
+    }
+
+
+FAMILIES = {"parallelograms": parallelograms, "five-bars": five_bars, "ladder": ladder, "a02": a02}

@@ -68,26 +68,34 @@ pub(crate) fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f
     pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
 }
 
-/// sum_i M_ii a_i b_i over the body coordinates, M = blockdiag(m, m, I) per body.
-/// a^T M b over the bodies `first..end` (a and b: 3n values each).
+/// a^T M b over the bodies `first..end` (a and b: 3n values each), M = blockdiag(m, m, I)
+/// per body.
 #[inline]
-pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
-    if first >= end {
+pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], range: (usize, usize)) -> f64 {
+    if range.0 >= range.1 {
         return 0.0;
+    }
+    m_dot_from(-0.0, mech, a, b, range)
+}
+
+/// `s` plus the terms of [`m_dot`], added one after the other (f64's `Sum` starts at -0.0).
+#[inline]
+fn m_dot_from(s: f64, mech: &Mechanism, a: &[f64], b: &[f64], (first, end): (usize, usize)) -> f64 {
+    if first >= end {
+        return s;
     }
     let (a, b) = (&a[3 * first..3 * end], &b[3 * first..3 * end]);
     mech.bodies[first..end]
         .iter()
         .zip(a.chunks_exact(3).zip(b.chunks_exact(3)))
-        .map(|(body, (a, b))| body.mass * (a[0] * b[0] + a[1] * b[1]) + body.inertia * a[2] * b[2])
-        .sum()
+        .fold(s, |s, (body, (a, b))| s + (body.mass * (a[0] * b[0] + a[1] * b[1]) + body.inertia * a[2] * b[2]))
 }
 
-/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`: the pairs of columns whose
-/// supports meet (`System::a_pairs`), over the bodies where both may be non-zero (the columns
-/// of independent parts of a mechanism, five-bars side by side, share none). The other
-/// entries keep the zeros of the last clearing, except where the Cholesky factor may have
-/// filled in (`System::a_fill_in`): cleared at each call.
+/// A = U^T M U (m x m, row-major) into `ws.a`, from `ws.u`: the pairs of columns that share a
+/// body (`System::a_pairs`), over the bodies they share (`System::a_runs`; the columns of
+/// independent parts of a mechanism, five-bars side by side, share none). The other entries
+/// keep the zeros of the last clearing, except where the Cholesky factor may have filled in
+/// (`System::a_fill_in`): cleared at each call.
 pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     let m = ws.b.len();
@@ -100,10 +108,10 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
             ws.a[k * m + j] = 0.0;
         }
     }
-    let support = ws.frame.sys.u_support();
-    for &(j, k) in ws.frame.sys.a_pairs() {
-        let ((fj, ej), (fk, ek)) = (support[j], support[k]);
-        let s = m_dot(mech, &ws.frame.u[j * n..(j + 1) * n], &ws.frame.u[k * n..(k + 1) * n], (fj.max(fk), ej.min(ek)));
+    for (p, &(j, k)) in ws.frame.sys.a_pairs().iter().enumerate() {
+        let (uj, uk) = (&ws.frame.u[j * n..(j + 1) * n], &ws.frame.u[k * n..(k + 1) * n]);
+        // One sum over the runs (as `m_dot` over one range: the same additions in order).
+        let s = ws.frame.sys.a_runs(p).iter().fold(-0.0, |s, &run| m_dot_from(s, mech, uj, uk, run));
         ws.a[j * m + k] = s;
         ws.a[k * m + j] = s;
     }

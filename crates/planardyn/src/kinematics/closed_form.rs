@@ -16,6 +16,7 @@
 //! prismatic ones, redundant pairs) take the general path (`position`, `analogues`).
 
 use super::analogues::body_rates;
+use super::column_reach::ColumnReach;
 use super::dyads::crank::Crank;
 use super::dyads::extended_rrr::ExtendedRrr;
 use super::dyads::extension::{Arm, Extension};
@@ -146,6 +147,10 @@ enum Start {
     Predicted,
 }
 
+/// The most coordinates for which U is solved over all the pieces per column (the few of a
+/// robot: no bookkeeping), beyond which over each coordinate's reach ([`ColumnReach`]).
+const REACH_FROM_M: usize = 4;
+
 #[derive(Debug, Clone)]
 pub struct ClosedForm {
     cranks: Vec<Crank>,
@@ -155,6 +160,9 @@ pub struct ClosedForm {
     /// measure (constant).
     inv_length: Vec<f64>,
     inputs_sigma: f64,
+    /// Beyond a few coordinates, the pieces each coordinate moves (`column_reach`): U is then
+    /// solved column by column over them only.
+    reach: Option<ColumnReach>,
 }
 
 /// The end of a revolute pair on `body` (its point there) and the other end.
@@ -383,7 +391,12 @@ impl ClosedForm {
         }
         groups.iter_mut().for_each(|d| d.set_reference(&mech.x0));
         let inv_length = groups.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
-        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma })
+        let reach = (mech.dof() > REACH_FROM_M).then(|| {
+            let (c, s): (Vec<_>, Vec<_>) =
+                (cranks.iter().map(|c| (c.body, c.k)).collect(), sliders.iter().map(|s| (s.body, s.k)).collect());
+            ColumnReach::new(mech, &c, &s, &decomposition.groups)
+        });
+        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma, reach })
     }
 
     /// Whether every group is placed without iteration (no class III triad, whose Newton
@@ -450,6 +463,9 @@ impl ClosedForm {
 
     /// The velocity analogues `ws.u` (column j the rates for zd = e_j).
     pub fn velocity_analogues(&self, ws: &mut Frame) {
+        if let Some(reach) = &self.reach {
+            return self.velocity_analogues_over(reach, ws);
+        }
         let (n, m) = (ws.x.len(), ws.q.len());
         // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
         let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
@@ -457,6 +473,28 @@ impl ClosedForm {
         for j in 0..m {
             unit[j] = 1.0;
             self.rates(&ws.trig, &unit[..m], &mut u[j * n..(j + 1) * n]);
+            unit[j] = 0.0;
+        }
+        (ws.u, ws.rhs) = (u, unit);
+    }
+
+    /// [`ClosedForm::velocity_analogues`] with each column over the pieces its coordinate moves
+    /// (`reach`): U is cleared whole when it held another zero pattern, then each column's
+    /// other entries keep those zeros.
+    fn velocity_analogues_over(&self, reach: &ColumnReach, ws: &mut Frame) {
+        let (n, m) = (ws.x.len(), ws.q.len());
+        if ws.u_zeros_for != reach.zeros_id {
+            ws.u.fill(0.0);
+            ws.u_zeros_for = reach.zeros_id;
+        }
+        let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
+        unit[..m].fill(0.0);
+        for j in 0..m {
+            unit[j] = 1.0;
+            let (zd, v) = (&unit[..m], &mut u[j * n..(j + 1) * n]);
+            reach.cranks[j].iter().for_each(|&i| self.cranks[i].velocity(&ws.trig, zd, v));
+            reach.sliders[j].iter().for_each(|&i| self.sliders[i].velocity(zd, v));
+            reach.groups[j].iter().for_each(|&i| self.groups[i].velocity(zd, v));
             unit[j] = 0.0;
         }
         (ws.u, ws.rhs) = (u, unit);

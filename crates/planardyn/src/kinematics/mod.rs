@@ -4,6 +4,7 @@
 
 pub mod analogues;
 pub mod closed_form;
+mod column_reach;
 pub mod constraints;
 pub mod dyads;
 pub mod effector;

@@ -80,36 +80,126 @@ pub fn scaled_constraint_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
 }
 
 /// Rank, singular values, independent rows and self-stresses of all pair-constraint rows at
-/// x, which must be finite (the SVD iteration need not end otherwise).
+/// x, which must be finite (the SVD iteration need not end otherwise). Rows that share no
+/// body coordinate, directly or through other rows, form independent blocks of Phi_x (the
+/// parts of a mechanism joined only through the ground, five-bars side by side): each is
+/// decomposed on its own, so that the cost is the sum of the parts' cubes, not the whole's.
+/// The rank threshold is the whole matrix's (its largest singular value is the parts').
 pub(crate) fn constraint_rank(mech: &Mechanism, x: &[f64]) -> Rank {
     let (rows, n) = (mech.n_pair_rows(), mech.n_x());
     if rows == 0 {
         return Rank { rank: 0, singular_values: vec![], independent_rows: vec![], self_stresses: vec![] };
     }
     let j = scaled_constraint_jacobian(mech, x);
-    // Zero columns up to a square matrix give the full U (rows x rows), so that the whole
-    // left null space is there also when there are more rows than body coordinates.
-    let width = n.max(rows);
-    let padded = DMatrix::from_fn(rows, width, |r, c| if c < n { j[r * n + c] } else { 0.0 });
-    let svd = padded.svd(true, false);
-    let tol = RANK_TOL * svd.singular_values.max().max(1.0);
-    let rank = svd.singular_values.iter().filter(|&&s| s > tol).count();
-    let mut singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
+    let parts: Vec<(Part, PartSvd)> = parts(&j, rows, n)
+        .into_iter()
+        .map(|p| {
+            let s = part_svd(&j, n, &p);
+            (p, s)
+        })
+        .collect();
+    let top = parts.iter().flat_map(|(_, s)| s.values.iter().copied()).fold(0.0, f64::max);
+    let tol = RANK_TOL * top.max(1.0);
+    let (mut rank, mut singular_values, mut independent_rows, mut null) =
+        (0, Vec::<f64>::new(), Vec::new(), Vec::new());
+    for (part, svd) in &parts {
+        let part_rank = svd.values.iter().filter(|&&s| s > tol).count();
+        rank += part_rank;
+        singular_values.extend(&svd.values);
+        for (i, _) in svd.values.iter().enumerate().filter(|(_, &s)| s <= tol) {
+            let mut v = vec![0.0; rows];
+            for (k, &r) in part.rows.iter().enumerate() {
+                v[r] = svd.u[(k, i)];
+            }
+            null.push(v);
+        }
+        // Phi_x^T of the part: its columns are the part's rows, ascending as in the whole.
+        let (pr, pn) = (part.rows.len(), part.cols.len());
+        let mut t = vec![0.0; pn * pr];
+        for (a, &r) in part.rows.iter().enumerate() {
+            for (c, &col) in part.cols.iter().enumerate() {
+                t[c * pr + a] = j[r * n + col];
+            }
+        }
+        independent_rows.extend(pivot_columns(&mut t, pn, pr, part_rank).into_iter().map(|a| part.rows[a]));
+    }
     singular_values.sort_by(|a, b| b.total_cmp(a));
     singular_values.truncate(rows.min(n));
     singular_values.reverse();
-    let u = svd.u.expect("requested");
-    let null: Vec<Vec<f64>> =
-        (0..rows).filter(|&i| svd.singular_values[i] <= tol).map(|i| u.column(i).iter().copied().collect()).collect();
-    let mut t = vec![0.0; n * rows];
-    for r in 0..rows {
-        for c in 0..n {
-            t[c * rows + r] = j[r * n + c];
-        }
-    }
-    let mut independent_rows = pivot_columns(&mut t, n, rows, rank);
     independent_rows.sort_unstable();
     Rank { rank, singular_values, independent_rows, self_stresses: self_stresses(mech, null) }
+}
+
+/// Rows of Phi_x and the body coordinates they touch, ascending; no other row touches these
+/// columns.
+struct Part {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+}
+
+/// A part's singular values (one per row: zero columns pad it to a square matrix, so that the
+/// full U (rows x rows) holds the whole left null space also where there are more rows than
+/// body coordinates) and U.
+struct PartSvd {
+    values: Vec<f64>,
+    u: DMatrix<f64>,
+}
+
+fn part_svd(j: &[f64], n: usize, part: &Part) -> PartSvd {
+    let (pr, pn) = (part.rows.len(), part.cols.len());
+    let width = pn.max(pr);
+    let padded = DMatrix::from_fn(pr, width, |r, c| if c < pn { j[part.rows[r] * n + part.cols[c]] } else { 0.0 });
+    let svd = padded.svd(true, false);
+    PartSvd { values: svd.singular_values.iter().copied().collect(), u: svd.u.expect("requested") }
+}
+
+/// The independent parts of the row-major `rows x n` matrix `j`: its rows joined when they
+/// share a non-zero column (union-find over the columns), in order of their first row.
+fn parts(j: &[f64], rows: usize, n: usize) -> Vec<Part> {
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut c: usize) -> usize {
+        while parent[c] != c {
+            parent[c] = parent[parent[c]];
+            c = parent[c];
+        }
+        c
+    }
+    let nonzero = |r: usize| (0..n).filter(move |&c| j[r * n + c] != 0.0);
+    for r in 0..rows {
+        let mut first = None;
+        for c in nonzero(r) {
+            let rc = root(&mut parent, c);
+            match first {
+                None => first = Some(rc),
+                Some(f) => parent[rc] = root(&mut parent, f),
+            }
+        }
+    }
+    // A part per root (a row of zeros is a part of its own, with no columns).
+    let (mut index, mut out): (Vec<Option<usize>>, Vec<Part>) = (vec![None; n], Vec::new());
+    for r in 0..rows {
+        let part = match nonzero(r).next() {
+            None => {
+                out.push(Part { rows: vec![], cols: vec![] });
+                out.len() - 1
+            }
+            Some(c) => {
+                let rc = root(&mut parent, c);
+                *index[rc].get_or_insert_with(|| {
+                    out.push(Part { rows: vec![], cols: vec![] });
+                    out.len() - 1
+                })
+            }
+        };
+        out[part].rows.push(r);
+    }
+    for c in 0..n {
+        let rc = root(&mut parent, c);
+        if let Some(p) = index[rc] {
+            out[p].cols.push(c);
+        }
+    }
+    out
 }
 
 /// Reduce a basis of the left null space (column echelon form: each vector gets a pivot row

@@ -40,11 +40,15 @@ pub struct System {
     /// Per column j of U, the bodies it may be non-zero on, [first, end): those of the blocks
     /// its coordinate's row reaches.
     u_support: Vec<(usize, usize)>,
-    /// The entries of A = U^T M U that may be non-zero: the pairs j <= k of columns whose
-    /// supports meet, and per row k the first such j (A's envelope, kept by its Cholesky factor);
-    /// the entries (k, j) of the envelope below the diagonal that are no such pair, where the
-    /// factor may fill in.
+    /// The entries of A = U^T M U that may be non-zero: the pairs j <= k of columns that share
+    /// a body (of the blocks their coordinates reach, not only of their supports' ranges: a
+    /// body order that interleaves the parts would make every range meet), and per row k the
+    /// first such j (A's envelope, kept by its Cholesky factor); the entries (k, j) of the
+    /// envelope below the diagonal that are no such pair, where the factor may fill in. The
+    /// bodies pair p shares: the runs `a_runs[a_runs_at[p]..a_runs_at[p + 1]]`, [first, end).
     a_pairs: Vec<(usize, usize)>,
+    a_runs_at: Vec<usize>,
+    a_runs: Vec<(usize, usize)>,
     a_first: Vec<usize>,
     a_fill_in: Vec<(usize, usize)>,
     /// Identifies the analysis the supports above come from (unique over all systems): buffers
@@ -52,8 +56,8 @@ pub struct System {
     supports_id: u64,
 }
 
-/// The next [`System::supports_id`].
-fn next_supports_id() -> u64 {
+/// The next [`System::supports_id`] (and the closed form's zero pattern of U, `column_reach`).
+pub(crate) fn next_supports_id() -> u64 {
     static NEXT: AtomicU64 = AtomicU64::new(1);
     NEXT.fetch_add(1, Ordering::Relaxed)
 }
@@ -72,13 +76,16 @@ impl System {
     /// J of `chart`, its structure analysed (once: not the user's chart's first, then this one's).
     pub fn for_chart(mech: &Mechanism, chart: &Chart) -> Self {
         let lu = BlockLu::new(&jacobian_pattern(mech, chart));
-        let u_support = u_support(mech, &lu);
-        let (a_pairs, a_first, a_fill_in) = a_pattern(&u_support);
+        let u_bodies = u_bodies(mech, &lu);
+        let APattern { pairs: a_pairs, runs_at: a_runs_at, runs: a_runs, first: a_first, fill_in: a_fill_in } =
+            a_pattern(&u_bodies, mech.n_bodies());
         System {
             groups: GroupScales::new(mech, chart, &lu),
             unit_reach: unit_reach(mech, &lu),
-            u_support,
+            u_support: u_bodies.iter().map(|b| support_range(b)).collect(),
             a_pairs,
+            a_runs_at,
+            a_runs,
             a_first,
             a_fill_in,
             supports_id: next_supports_id(),
@@ -106,8 +113,11 @@ impl System {
             self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
             self.groups = GroupScales::new(mech, chart, &self.lu);
             self.unit_reach = unit_reach(mech, &self.lu);
-            self.u_support = u_support(mech, &self.lu);
-            (self.a_pairs, self.a_first, self.a_fill_in) = a_pattern(&self.u_support);
+            let u_bodies = u_bodies(mech, &self.lu);
+            self.u_support = u_bodies.iter().map(|b| support_range(b)).collect();
+            let a = a_pattern(&u_bodies, mech.n_bodies());
+            (self.a_pairs, self.a_runs_at, self.a_runs, self.a_first, self.a_fill_in) =
+                (a.pairs, a.runs_at, a.runs, a.first, a.fill_in);
             self.supports_id = next_supports_id();
             self.pattern_chart.clone_from(chart);
         }
@@ -167,10 +177,15 @@ impl System {
         &self.u_support
     }
 
-    /// The pairs (j, k), j <= k, of columns of U whose supports meet: the entries of
-    /// A = U^T M U (and its mirror) that may be non-zero.
+    /// The pairs (j, k), j <= k, of columns of U that share a body: the entries of
+    /// A = U^T M U (and its mirror) that may be non-zero, by rows k, j ascending.
     pub fn a_pairs(&self) -> &[(usize, usize)] {
         &self.a_pairs
+    }
+
+    /// The bodies the p-th of [`System::a_pairs`] shares, as runs [first, end), ascending.
+    pub fn a_runs(&self, p: usize) -> &[(usize, usize)] {
+        &self.a_runs[self.a_runs_at[p]..self.a_runs_at[p + 1]]
     }
 
     /// Per row k of A, the first column j with (j, k) in [`System::a_pairs`]: A's envelope.
@@ -211,33 +226,87 @@ fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Option<Vec<Vec<usize>>> {
     reach.iter().any(|blocks| blocks.len() < lu.n_blocks()).then_some(reach)
 }
 
-/// The bodies each column of U may be non-zero on (see [`System::u_support`]).
-fn u_support(mech: &Mechanism, lu: &BlockLu) -> Vec<(usize, usize)> {
+/// The bodies (ascending) each column of U may be non-zero on: those of the blocks its
+/// coordinate's row reaches.
+fn u_bodies(mech: &Mechanism, lu: &BlockLu) -> Vec<Vec<usize>> {
     let (n, m) = (mech.n_x(), mech.dof());
     let cols = lu.position_cols();
     (n - m..n)
         .map(|row| {
-            let bodies = lu.reach(&[row]).into_iter().flat_map(|k| lu.span(k)).map(|p| cols[p] / 3);
-            bodies.fold((usize::MAX, 0), |(first, end), b| (first.min(b), end.max(b + 1)))
+            let mut bodies: Vec<usize> =
+                lu.reach(&[row]).into_iter().flat_map(|k| lu.span(k)).map(|p| cols[p] / 3).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            bodies
         })
-        .map(|(first, end)| (first.min(end), end))
         .collect()
 }
 
-/// The pairs of columns whose supports meet, A's envelope and its fill-in (see
-/// [`System::a_pairs`]). Once per chart: the m^2 / 2 comparisons are not made in a step.
-type APattern = (Vec<(usize, usize)>, Vec<usize>, Vec<(usize, usize)>);
-fn a_pattern(support: &[(usize, usize)]) -> APattern {
-    let meet = |(f1, e1): (usize, usize), (f2, e2): (usize, usize)| f1.max(f2) < e1.min(e2);
-    let (mut pairs, mut first, mut fill_in) = (Vec::new(), Vec::with_capacity(support.len()), Vec::new());
-    for (k, &sk) in support.iter().enumerate() {
-        let row: Vec<usize> = (0..k).filter(|&j| meet(support[j], sk)).collect();
-        let f = row.first().copied().unwrap_or(k);
-        fill_in.extend((f..k).filter(|j| !row.contains(j)).map(|j| (k, j)));
-        pairs.extend(row.into_iter().chain([k]).map(|j| (j, k)));
-        first.push(f);
+/// [first, end) of ascending `bodies` (see [`System::u_support`]); (0, 0) if none.
+fn support_range(bodies: &[usize]) -> (usize, usize) {
+    bodies.first().zip(bodies.last()).map_or((0, 0), |(&f, &l)| (f, l + 1))
+}
+
+/// A's pattern (see [`System::a_pairs`]).
+struct APattern {
+    pairs: Vec<(usize, usize)>,
+    runs_at: Vec<usize>,
+    runs: Vec<(usize, usize)>,
+    first: Vec<usize>,
+    fill_in: Vec<(usize, usize)>,
+}
+
+/// The pairs of columns that share a body, the bodies they share, A's envelope and its
+/// fill-in, from each column's bodies. Once per chart, through the columns on each body: the
+/// cost is the pairs' shared bodies, not m^2 comparisons.
+fn a_pattern(u_bodies: &[Vec<usize>], n_bodies: usize) -> APattern {
+    let mut on_body: Vec<Vec<usize>> = vec![Vec::new(); n_bodies];
+    for (j, bodies) in u_bodies.iter().enumerate() {
+        bodies.iter().for_each(|&b| on_body[b].push(j));
     }
-    (pairs, first, fill_in)
+    // (k, j, body) for j <= k on a common body, sorted: by row k, then j, then body.
+    let mut shared: Vec<(usize, usize, usize)> = Vec::new();
+    for (b, cols) in on_body.iter().enumerate() {
+        for (i, &k) in cols.iter().enumerate() {
+            shared.extend(cols[..=i].iter().map(|&j| (k, j, b)));
+        }
+    }
+    shared.sort_unstable();
+    let m = u_bodies.len();
+    let mut a = APattern {
+        pairs: Vec::new(),
+        runs_at: vec![0],
+        runs: Vec::new(),
+        first: (0..m).collect(),
+        fill_in: Vec::new(),
+    };
+    for (i, &(k, j, b)) in shared.iter().enumerate() {
+        let new_pair = i == 0 || (shared[i - 1].0, shared[i - 1].1) != (k, j);
+        if new_pair {
+            if i > 0 {
+                a.runs_at.push(a.runs.len());
+            }
+            a.pairs.push((j, k));
+            a.first[k] = a.first[k].min(j);
+        }
+        match a.runs.last_mut() {
+            Some(run) if !new_pair && run.1 == b => run.1 = b + 1,
+            _ => a.runs.push((b, b + 1)),
+        }
+    }
+    a.runs_at.push(a.runs.len());
+    let mut in_row = vec![false; m];
+    let mut p = 0;
+    for k in 0..m {
+        let start = p;
+        while p < a.pairs.len() && a.pairs[p].1 == k {
+            in_row[a.pairs[p].0] = true;
+            p += 1;
+        }
+        a.fill_in.extend((a.first[k]..k).filter(|&j| !in_row[j]).map(|j| (k, j)));
+        a.pairs[start..p].iter().for_each(|&(j, _)| in_row[j] = false);
+    }
+    a
 }
 
 /// Fill `j` (row-major, n x n) with the scaled Jacobian of a chart and `rs` with its row
