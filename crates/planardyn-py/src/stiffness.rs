@@ -2,7 +2,7 @@
 //! as dicts of numpy arrays; names (bodies, points, actuators) resolved to the core's ids.
 
 use crate::convert::{arr1, arr2, vector, Floats};
-use crate::errors::{run, Failure};
+use crate::errors::{kinematics_error, run, Failure};
 use crate::exceptions::argument_error;
 use crate::mechanism::PyMechanism;
 use planardyn::elastic::{self, CartesianStiffness, Load, Modes, Output};
@@ -46,27 +46,17 @@ fn output(mech: &Mechanism, body_name: &str, point: Option<&str>) -> PyResult<Ou
 }
 
 fn load(
+    py: Python<'_>,
     mech: &Mechanism,
     wrench: Option<ArrayArg<'_>>,
     preload: Option<HashMap<String, f64>>,
     gravity: bool,
 ) -> PyResult<Load> {
-    let wrench = match wrench {
+    let w = match wrench {
         Some(w) => vector("wrench", &w, 3, "[F_x, F_y, M] in N, N, N m")?,
         None => vec![0.0; 3],
     };
-    let names = mech.actuator_names();
-    let mut out = Load { wrench: [wrench[0], wrench[1], wrench[2]], preload: Vec::new(), gravity };
-    for (name, tau) in preload.unwrap_or_default() {
-        let k = names.iter().position(|n| *n == name).ok_or_else(|| {
-            argument_error(Some("preload"), format!("unknown actuator '{name}'; actuators are: {}", names.join(", ")))
-        })?;
-        if !tau.is_finite() {
-            return Err(argument_error(Some("preload"), format!("preload['{name}'] = {tau} is not a finite number")));
-        }
-        out.preload.push((k, tau));
-    }
-    Ok(out)
+    Load::named(mech, [w[0], w[1], w[2]], preload.unwrap_or_default(), gravity).map_err(|e| kinematics_error(py, &e))
 }
 
 fn cartesian<'py>(py: Python<'py>, s: &CartesianStiffness) -> PyResult<Bound<'py, PyDict>> {
@@ -102,7 +92,7 @@ pub fn stiffness<'py>(
     gravity: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &*mech.inner;
-    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(m, wrench, preload, gravity)?);
+    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(py, m, wrench, preload, gravity)?);
     let s = run(py, || Ok::<_, Failure>(elastic::stiffness(m, &q, out, &load, &mut Workspace::new(m))?))?;
     cartesian(py, &s)
 }
@@ -148,7 +138,7 @@ pub fn deflection<'py>(
     gravity: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &*mech.inner;
-    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(m, Some(wrench), preload, gravity)?);
+    let (q, out, load) = (coords(m, "q", &q)?, output(m, body, point)?, load(py, m, Some(wrench), preload, gravity)?);
     if !(1..=10_000).contains(&steps) {
         return Err(argument_error(Some("steps"), format!("steps must be 1 to 10000, got {steps}")));
     }

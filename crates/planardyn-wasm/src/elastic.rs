@@ -52,27 +52,9 @@ fn output(m: &Mechanism, point: &str) -> Result<Output, JsValue> {
     Ok(Output { body, point: Some(id) })
 }
 
-/// The core's load of a `LoadOption` (unknown actuators and non-finite values refused).
+/// The core's load of a `LoadOption` (`Load::named` checks it).
 fn load(m: &Mechanism, option: LoadOption) -> Result<Load, JsValue> {
-    let wrench = option.wrench.unwrap_or_default();
-    if wrench.iter().any(|v| !v.is_finite()) {
-        return Err(argument_error(
-            Some("wrench"),
-            format!("wrench {wrench:?} must be [F_x, F_y, M], finite (N, N, N m)"),
-        ));
-    }
-    let names = m.actuator_names();
-    let mut out = Load { wrench, preload: Vec::new(), gravity: option.gravity };
-    for (name, tau) in option.preload {
-        let k = names.iter().position(|n| *n == name).ok_or_else(|| {
-            argument_error(Some("preload"), format!("unknown actuator '{name}'; actuators are: {}", names.join(", ")))
-        })?;
-        if !tau.is_finite() {
-            return Err(argument_error(Some("preload"), format!("preload['{name}'] = {tau} is not a finite number")));
-        }
-        out.preload.push((k, tau));
-    }
-    Ok(out)
+    js(Load::named(m, option.wrench.unwrap_or_default(), option.preload, option.gravity))
 }
 
 /// `Mechanism.modes` (see there): the modes about q on the branch of `x_start`.

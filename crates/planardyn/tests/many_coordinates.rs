@@ -10,21 +10,32 @@ use planardyn::dynamics::query;
 use planardyn::kinematics::{ClosedForm, Frame};
 use planardyn::Mechanism;
 
+/// The ladder's rods' spacing, rods' and links' lengths (m).
+const GAP: f64 = 0.3;
+const ROD: f64 = 0.2;
+const LINK: f64 = 0.25;
+
+/// How far below the rods' tips a dyad's middle joint hangs (m).
+fn depth() -> f64 {
+    (LINK * LINK - (GAP / 2.0) * (GAP / 2.0)).sqrt()
+}
+
+/// A uniform bar from a to b of `mass` (kg) as a body's mass, inertia and centre of mass.
+fn bar(a: [f64; 2], b: [f64; 2], mass: f64) -> String {
+    let l2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2);
+    format!(
+        "mass: {mass}, inertia: {:?}, com: [{:?}, {:?}]",
+        mass * l2 / 12.0,
+        (a[0] + b[0]) / 2.0,
+        (a[1] + b[1]) / 2.0
+    )
+}
+
 /// `2n` rods hanging from the ground 0.3 m apart, consecutive tips joined by a dyad of two
 /// 0.25 m links (benchmarks/families.py `ladder`): 2n coordinates, each dyad coupling two.
 fn ladder(n: usize) -> Mechanism {
-    let (gap, rod, link) = (0.3, 0.2, 0.25);
-    let depth = (link * link - (gap / 2.0) * (gap / 2.0_f64)).sqrt();
+    let (gap, rod, depth) = (GAP, ROD, depth());
     let (mut points, mut bodies, mut pairs, mut coords) = (String::new(), String::new(), String::new(), String::new());
-    let bar = |a: [f64; 2], b: [f64; 2], mass: f64| {
-        let l2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2);
-        format!(
-            "mass: {mass}, inertia: {:?}, com: [{:?}, {:?}]",
-            mass * l2 / 12.0,
-            (a[0] + b[0]) / 2.0,
-            (a[1] + b[1]) / 2.0
-        )
-    };
     let mut at = std::collections::HashMap::new();
     for i in 0..2 * n {
         let (o, c) = ([gap * i as f64, 0.0], [gap * i as f64, -rod]);
@@ -38,7 +49,7 @@ fn ladder(n: usize) -> Mechanism {
         let p = [gap * (i as f64 + 0.5), -rod - depth];
         points += &format!("  P{i}: [{:?}, {:?}]\n", p[0], p[1]);
         for (side, tip) in [("l", i), ("r", i + 1)] {
-            bodies += &format!("  {side}{i}: {{points: [C{tip}, P{i}], {}}}\n", bar(at[&format!("C{tip}")], p, link));
+            bodies += &format!("  {side}{i}: {{points: [C{tip}, P{i}], {}}}\n", bar(at[&format!("C{tip}")], p, LINK));
             pairs += &format!("  - {{type: revolute, at: C{tip}, bodies: [rod{tip}, {side}{i}]}}\n");
         }
         pairs += &format!("  - {{type: revolute, at: P{i}, bodies: [l{i}, r{i}]}}\n");
@@ -144,17 +155,7 @@ fn separate_five_bars_have_the_mass_matrix_of_one_in_each_block() {
     // coordinates compute on the fixed-size path.
     let one = ladder(1);
     let text_one = |dx: f64, k: usize| {
-        let (gap, rod, link) = (0.3, 0.2, 0.25);
-        let depth = (link * link - (gap / 2.0) * (gap / 2.0_f64)).sqrt();
-        let bar = |a: [f64; 2], b: [f64; 2], mass: f64| {
-            let l2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2);
-            format!(
-                "mass: {mass}, inertia: {:?}, com: [{:?}, {:?}]",
-                mass * l2 / 12.0,
-                (a[0] + b[0]) / 2.0,
-                (a[1] + b[1]) / 2.0
-            )
-        };
+        let (gap, rod, depth) = (GAP, ROD, depth());
         let (o0, o1) = ([dx, 0.0], [dx + gap, 0.0]);
         let (c0, c1, p) = ([dx, -rod], [dx + gap, -rod], [dx + gap / 2.0, -rod - depth]);
         (
@@ -164,7 +165,7 @@ fn separate_five_bars_have_the_mass_matrix_of_one_in_each_block() {
             ),
             format!(
                 "  rod0_{k}: {{points: [O0_{k}, C0_{k}], {}}}\n  rod1_{k}: {{points: [O1_{k}, C1_{k}], {}}}\n  l_{k}: {{points: [C0_{k}, P_{k}], {}}}\n  r_{k}: {{points: [C1_{k}, P_{k}], {}}}\n",
-                bar(o0, c0, rod), bar(o1, c1, rod), bar(c0, p, link), bar(c1, p, link)
+                bar(o0, c0, rod), bar(o1, c1, rod), bar(c0, p, LINK), bar(c1, p, LINK)
             ),
             format!(
                 "  - {{type: revolute, name: g0_{k}, at: O0_{k}, bodies: [ground, rod0_{k}]}}\n  - {{type: revolute, name: g1_{k}, at: O1_{k}, bodies: [ground, rod1_{k}]}}\n  - {{type: revolute, at: C0_{k}, bodies: [rod0_{k}, l_{k}]}}\n  - {{type: revolute, at: C1_{k}, bodies: [rod1_{k}, r_{k}]}}\n  - {{type: revolute, at: P_{k}, bodies: [l_{k}, r_{k}]}}\n"

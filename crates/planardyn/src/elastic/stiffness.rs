@@ -54,6 +54,40 @@ pub struct Load {
     pub gravity: bool,
 }
 
+impl Load {
+    /// A load as a user writes it: the wrench [F_x, F_y, M] (N, N, N m; finite) and the
+    /// preloads by actuator name (N m or N; each a known actuator, finite). One check for
+    /// every binding.
+    pub fn named(
+        mech: &Mechanism,
+        wrench: [f64; 3],
+        preload: impl IntoIterator<Item = (String, f64)>,
+        gravity: bool,
+    ) -> Result<Load, KinematicsError> {
+        if wrench.iter().any(|v| !v.is_finite()) {
+            return Err(KinematicsError::bad_argument(
+                "wrench",
+                "[F_x, F_y, M], finite (N, N, N m)",
+                format!("{wrench:?}"),
+            ));
+        }
+        let names = mech.actuator_names();
+        let mut load = Load { wrench, preload: Vec::new(), gravity };
+        for (name, tau) in preload {
+            let Some(k) = names.iter().position(|n| *n == name) else {
+                let expected = format!("an actuator of the model ({})", names.join(", "));
+                return Err(KinematicsError::bad_argument("preload", expected, format!("unknown actuator '{name}'")));
+            };
+            if !tau.is_finite() {
+                let got = format!("preload['{name}'] = {tau}");
+                return Err(KinematicsError::bad_argument("preload", "finite preloads (N m or N)", got));
+            }
+            load.preload.push((k, tau));
+        }
+        Ok(load)
+    }
+}
+
 /// The applied loads of a load step: a wrench on an output (None: none) and the model's
 /// gravity times `gravity` (0 none, 1 all of it).
 #[derive(Debug, Clone, Copy)]
