@@ -211,7 +211,7 @@ impl WasmMechanism {
     }
 
     /// The natural modes of the compliant mechanism about coordinates q (its rigid pose, on the
-    /// branch of `xStart`; `planardyn::elastic::modes`), each elastic drive's rotor held
+    /// branch of `xStart`; `planardyn::elastic::modes_about`), each elastic drive's rotor held
     /// (`freeRotors` false) or free: `{omega (rad/s), omega2 (rad^2/s^2), dampingRatio, shapes
     /// (modes x 3n: mass-normalised body displacements [X, Y, phi]), x (3n: the pose)}`, by
     /// increasing frequency, about the pose without gravity's load (as the Python API's
@@ -223,7 +223,7 @@ impl WasmMechanism {
     }
 
     /// The stiffness of the point `point` (on the first body that carries it) at coordinates q
-    /// (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness`), in
+    /// (its rigid pose, on the branch of `xStart`; `planardyn::elastic::stiffness_about`), in
     /// equilibrium with `load` (`LoadOption`: `{wrench: [F_x, F_y, M] (N, N, N m) at the point,
     /// preload: {actuator name: effort (N m or N)} of elastic drives, gravity}`, each absent for
     /// none) with its geometric terms: `{weakest (N/m: the translational stiffness in its
