@@ -93,11 +93,15 @@ pub fn next_chart(ode: &MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
 
 /// The longest first step in the chart of the point held by `ode.ws`, whose own measure is
 /// `own` ([`chart_sigma`]): at its body rates xd (scaled), the step that moves x by
-/// [`FIRST_STEP_MOVE`] of the measure (s; infinite at rest).
+/// [`FIRST_STEP_MOVE`] of the measure (s; infinite at rest, where no step moves x).
 pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
     let ws = &ode.ws;
     let rate = ws.xd.iter().zip(ws.sys.group_col_scale()).fold(0.0_f64, |r, (v, s)| r.max(v.abs() / s));
-    FIRST_STEP_MOVE * own / rate
+    if rate > 0.0 {
+        FIRST_STEP_MOVE * own / rate
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// The state y = [z, zd, W] of `ode.ws`'s current point expressed in `chart`.

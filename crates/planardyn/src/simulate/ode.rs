@@ -599,3 +599,13 @@ impl OdeSystem for MechanismOde<'_> {
         exact.then(|| super::jacobian::exact_jacobian(self.mech, &self.ws, self.drives, t, y, jac))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// `MIN_RATE` is written as a literal (no const sqrt in stable Rust); it must be the square
+    /// root of the smallest normal f64 that its comment names.
+    #[test]
+    fn min_rate_is_the_square_root_of_the_smallest_normal() {
+        assert_eq!(super::MIN_RATE, f64::MIN_POSITIVE.sqrt());
+    }
+}
