@@ -10,7 +10,7 @@ extension (the same Rust through the Python API), measured in one run on this ma
   state's branch; native: a continuation loop in Python over Mechanism.kinematics, which also
   computes the analogues u and w: the Python API has no call for the map, so the native
   figure is the Python user's);
-- the compliant 5R's (elastic motors and end-effector pin, tests/test_app_browser.py's) 100 x 100
+- the compliant 5R's (the shipped five-bar-compliant: elastic motors and end-effector pin) 100 x 100
   map of its first natural frequency (web/src/map.js over planardyn::elastic::map_rows; the
   page's only: the Python API has no call for it);
 - the engine's size (wasm, the page, gzipped) and the page's load time to its first drawing.
@@ -135,16 +135,6 @@ PAGE_BENCH = """async ([four, rrr, compliant, frames, mapN, repeat, warm]) => {
   return { simFirst, sim, simBest, frameFirst, frame, frameBest, map, frequencyMap, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000 };
 }"""
 
-#: The five-bar with elastic motors and an elastic end-effector pin (tests/test_app_browser.py's).
-COMPLIANT = (ROOT / "examples/models/five-bar.yaml").read_text().split("\ndrives:")[0] + """
-compliance:
-  drives:
-    - {actuator: theta1, stiffness: 2.0e3}
-    - {actuator: theta2, stiffness: 3.0e3}
-  pairs:
-    - {pair: effector, stiffness: 5.0e5}
-"""
-
 
 def browser() -> dict[str, float]:
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -164,8 +154,8 @@ def browser() -> dict[str, float]:
         page = b.new_page()
         page.goto(page_file.as_uri())
         page.wait_for_selector("body[data-ready='1']", timeout=30_000)
-        texts = [pdy.models.path(n).read_text() for n in ("four-bar-gravity", "3-rrr")]
-        out = page.evaluate(PAGE_BENCH, [*texts, COMPLIANT, FRAMES, MAP_N, REPEAT, WARM])
+        texts = [pdy.models.path(n).read_text() for n in ("four-bar-gravity", "3-rrr", "five-bar-compliant")]
+        out = page.evaluate(PAGE_BENCH, [*texts, FRAMES, MAP_N, REPEAT, WARM])
         b.close()
     out["load"] = min(t["readyMs"] for t in loads) / 1000
     out["engine"] = min(t["engineMs"] for t in loads) / 1000
