@@ -264,15 +264,9 @@ def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
 
 # ------------------------------------------------------------------ stiffness and vibration
 
-#: The five-bar with elastic motors and an elastic end-effector pin (tests/test_stiffness.py's).
-COMPLIANT_FIVE_BAR = (ROOT / "examples/models/five-bar.yaml").read_text().split("\ndrives:")[0] + """
-compliance:
-  drives:
-    - {actuator: theta1, stiffness: 2.0e3}
-    - {actuator: theta2, stiffness: 3.0e3}
-  pairs:
-    - {pair: effector, stiffness: 5.0e5}
-"""
+#: The five-bar with elastic motors and an elastic end-effector pin (tests/test_stiffness.py's),
+#: shipped as five-bar-compliant.
+COMPLIANT_FIVE_BAR = pdy.models.path("five-bar-compliant").read_text()
 #: The modes in the page against Python's: the same Rust (SVD null space, symmetric eigen) in
 #: WebAssembly and natively, differing by the math library's rounding of the assembly's
 #: sin/cos (1 ulp), amplified by the eigenproblem's conditioning (frequencies 1e1..1e3 Hz apart

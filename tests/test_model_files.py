@@ -33,6 +33,7 @@ EXPECTED_COUNTS = {
     "andrews-squeezer.yaml": (7, 10, 1),
     "five-bar-free-fall.yaml": (4, 5, 2),
     "five-bar.yaml": (4, 5, 2),
+    "five-bar-compliant.yaml": (4, 5, 2),
     "five-bar-robot.yaml": (4, 5, 2),
     "slider-crank.yaml": (3, 4, 1),
     "hydraulic-boom.yaml": (3, 4, 1),

@@ -19,8 +19,8 @@ from planardyn import demo, models
 
 ROOT = Path(__file__).resolve().parents[1]
 
-SHIPPED = ["3-rrr", "andrews-squeezer", "five-bar", "five-bar-free-fall", "five-bar-robot", "four-bar-gravity",
-           "gear-train", "geared-five-bar", "hydraulic-boom", "scotch-yoke", "slider-crank"]
+SHIPPED = ["3-rrr", "andrews-squeezer", "five-bar", "five-bar-compliant", "five-bar-free-fall", "five-bar-robot",
+           "four-bar-gravity", "gear-train", "geared-five-bar", "hydraulic-boom", "scotch-yoke", "slider-crank"]
 LIBRARY = ["library/3-prr", "library/3-rpr", "library/3-rrr", "library/biglide", "library/double-parallelogram",
            "library/five-bar-5r", "library/four-bar", "library/slider-crank", "library/slider-crank-slider-driven",
            "library/stephenson-six-bar", "library/watt-six-bar"]

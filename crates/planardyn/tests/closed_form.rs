@@ -106,9 +106,10 @@ fn shipped_models_with_closed_forms() {
 /// with a gear or slot pair (1R1G, 1P1G, 1P1S), RRR and RRP dyads and 6R triads only, the RRR
 /// dyads' links and the triads' legs possibly cylinders (two bodies and a relative prismatic
 /// input: the hydraulic boom, the 3-RPR).
-const CLOSED: [&str; 21] = [
+const CLOSED: [&str; 22] = [
     "3-rrr",
     "andrews-squeezer",
+    "five-bar-compliant",
     "five-bar-free-fall",
     "five-bar-robot",
     "five-bar",
