@@ -29,6 +29,10 @@ LOSSY: dict[str, list[str]] = {
     "five-bar-robot": [*(f"Coulomb friction at pair {p!r} (mu = 0.1)" for p in ("elbow1", "effector", "elbow2")),
                        *(f"the {what} of actuator {c!r}" for c in ("theta1", "theta2")
                          for what in ("efficiency 0.8", "back-drive efficiency 0.75"))],
+    # the compliance section feeds the stiffness and vibration analyses only; no export carries it
+    "five-bar-compliant": ["the elastic drive of actuator 'theta1' (stiffness 2000.0)",
+                           "the elastic drive of actuator 'theta2' (stiffness 3000.0)",
+                           "the compliance of pair 'effector' (stiffness 500000.0)"],
 }
 
 

@@ -388,4 +388,10 @@ def not_carried(d: Drawing) -> list[str]:
         elif "table" in dr:
             lost.append(f"the effort table of coordinate {dr['coordinate']!r}: a control signal, set it at run time "
                         "(the export holds its value at t = 0)")
+    compliance = d.spec.get("compliance") or {}
+    lost += [f"the elastic drive of actuator {e['actuator']!r} (stiffness {e['stiffness']!r}): the exports' "
+             "transmissions are rigid" for e in compliance.get("drives", [])]
+    lost += [f"the compliance of pair {e['pair']!r} (stiffness {e['stiffness']!r}): the exports' joints are rigid"
+             for e in compliance.get("pairs", [])]
+    lost += [f"the elastic link {e['body']!r}: the exports' links are rigid" for e in compliance.get("links", [])]
     return lost
