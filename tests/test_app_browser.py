@@ -178,6 +178,23 @@ def test_a_run_in_the_page_agrees_with_python(page):
     np.testing.assert_allclose(np.reshape(got["q"], res.q.shape), res.q, atol=RUN_ATOL)
 
 
+def test_the_idle_warm_up_leaves_the_page_as_it_was(page):
+    """web/src/warm.js runs the model shown in idle time so that V8 optimises the engine before
+    a user's first run; it keeps no result: the pose, the mode and the run are as before, and a
+    run afterwards agrees with Python's as on a page just loaded (warming changes speed, not numbers)."""
+    before = page.evaluate("({q: Array.from(window.planardyn.q), mode: window.planardyn.mode})")
+    page.wait_for_selector("body[data-warm='1']", state="attached", timeout=20_000)
+    after = page.evaluate("({q: Array.from(window.planardyn.q), mode: window.planardyn.mode,"
+                          " run: window.planardyn.run, warmMs: window.planardyn.timings.warmMs})")
+    assert after["q"] == before["q"] and after["mode"] == before["mode"] == "design"
+    assert after["run"] is None
+    assert after["warmMs"] > 0
+    mech = five_bar()
+    res = mech.simulate(t_end=0.2, output_dt=0.01)
+    q = page.evaluate("Array.from(window.planardyn.mech.simulate({t_end: 0.2, output_dt: 0.01}).q)")
+    np.testing.assert_allclose(np.reshape(q, res.q.shape), res.q, atol=RUN_ATOL)
+
+
 def test_simulate_button_plays_and_charts(page):
     ARTEFACTS.mkdir(parents=True, exist_ok=True)
     page.fill("#t-end", "1")

@@ -9,7 +9,7 @@
 // sweep), run.js (runs here and Python's), model.js (the model from text, the editor),
 // map_tab.js (the map tab: singularity or first frequency), modes.js (natural modes, shown
 // animated), edit_drag.js (Shift + drag: a point of the model's drawing moved), files.js
-// (open, drop, export).
+// (open, drop, export), warm.js (the engine warmed in idle time).
 import { $, app, status } from "./state.js";
 import { engine } from "./engine.js";
 import { Charts } from "./charts.js";

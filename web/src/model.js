@@ -8,6 +8,7 @@ import { buildSliders, sweep } from "./design.js";
 import { buildRunModes } from "./run.js";
 import { startMap } from "./map_tab.js";
 import { listModes } from "./modes.js";
+import { warmEngine } from "./warm.js";
 
 /** Build the model from text; on an error, show it in place and keep the last model. The
  * model is shown at its initial state (q0, else as drawn), at the last state when only its
@@ -37,6 +38,7 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
   sweep();
   setMode("design");
   startMap();
+  warmEngine();
   status(`${app.info.name}: ${app.info.dof} coordinates, ${app.info.bodyNames.length} bodies; drag a point or a slider` +
     (app.info.warnings.length ? ` — ${app.info.warnings.join("; ")}` : ""));
   return true;
