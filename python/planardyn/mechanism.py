@@ -26,7 +26,7 @@ from .events import Crossing, Event, native_events
 from .guard import ALWAYS_FITS, available_memory, needed_bytes, rows_message
 from .models import UnknownModelError
 from .models import path as model_path
-from .result import PointMotion, SimulationInterrupted, SimulationResult
+from .result import PointMotion, RawRun, SimulationInterrupted, SimulationResult
 from .results_format import plain
 from .settings import check_settings
 
@@ -173,11 +173,15 @@ class Mechanism:
                                     defaults.get("output_dt"), defaults.get("t_end"))
         return self._facts
 
-    def _result(self, raw: dict[str, Any], settings: dict[str, Any]) -> SimulationResult:
+    def _result(self, raw: RawRun, settings: dict[str, Any]) -> SimulationResult:
         """The result of a run from the native dict, its metadata recording ``settings``."""
         f = self._run_facts()
+        # The metadata is made at its first read, from the settings as given (plain values now,
+        # so that an array the caller changes after the call is recorded as it was).
+        plain_settings = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
         return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
-                                         body_names=f.body_names, metadata=run_metadata({}, self, settings),
+                                         body_names=f.body_names,
+                                         metadata=lambda: run_metadata({}, self, plain_settings),
                                          tau_motor=self._result_motor_torques(raw))
 
     def __eq__(self, other: object) -> bool:
@@ -415,7 +419,7 @@ class Mechanism:
         effort itself."""
         return self._native.motor_torques(q, qd, qdd, tau, x, xd, allow_singular)
 
-    def _result_motor_torques(self, raw: Mapping[str, Any]) -> FloatArray | None:
+    def _result_motor_torques(self, raw: RawRun) -> FloatArray | None:
         """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
         tau, x, xd, each (N, ...)) when the model has an actuator, else None."""
         if not self._run_facts().has_actuators:
