@@ -62,9 +62,8 @@ class Energy:
 #: The output columns that are entries of :class:`Energy` (``result.energy.kinetic``, ...);
 #: every other column is the result's field of its name.
 ENERGY_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name in {f.name for f in dataclasses.fields(Energy)})
-#: The other columns, each a result's field of its name; and those every run has (not optional).
+#: The other columns, each a result's field of its name.
 FIELD_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name not in ENERGY_COLUMNS)
-RUN_COLUMNS = tuple(c.name for c in results_format.COLUMNS if not c.optional)
 
 
 def column_fields(values: Mapping[str, Any], body_names: list[str]) -> dict[str, Any]:
@@ -250,6 +249,8 @@ class SimulationResult:
             coordinate_kinds=list(coordinate_kinds),
             body_names=list(body_names),
             tau_motor=tau_motor,
+            # Not made later: a field with a default is a class attribute, found before __getattr__.
+            sol=raw.get("sol"),
             _pending=(raw, metadata),
         )
         return result
@@ -383,7 +384,7 @@ class SimulationResult:
 
 #: The fields of a result from a native run made at their first read (``from_raw``).
 LAZY_FIELDS = frozenset(FIELD_COLUMNS) - {"tau_motor"} | {
-    "energy", "poses", "stats", "change_points", "t_events", "q_events", "qd_events", "sol", "metadata"}
+    "energy", "poses", "stats", "change_points", "t_events", "q_events", "qd_events", "metadata"}
 
 
 def _lazy_field(result: SimulationResult, name: str, raw: RawRun,
@@ -402,7 +403,7 @@ def _lazy_field(result: SimulationResult, name: str, raw: RawRun,
         return list(raw.get(name, []))
     if name == "metadata":
         return dict((metadata() if callable(metadata) else metadata) or {})
-    return raw.get(name)  # an output column, or sol
+    return raw[name]  # an output column
 
 
 SimulationResult.__doc__ = f"{(SimulationResult.__doc__ or '').rstrip(' ')}{results_format.columns_doc('    ')}"
