@@ -173,15 +173,17 @@ class Mechanism:
                                     defaults.get("output_dt"), defaults.get("t_end"))
         return self._facts
 
-    def _result(self, raw: RawRun, settings: dict[str, Any]) -> SimulationResult:
-        """The result of a run from the native dict, its metadata recording ``settings``."""
+    def _result(self, raw: RawRun, settings: dict[str, Any] | Callable[[], dict[str, Any]]) -> SimulationResult:
+        """The result of a run from the native one, its metadata recording ``settings`` (or
+        what the callable makes: values the caller could change after the call copied)."""
         f = self._run_facts()
-        # The metadata is made at its first read, from the settings as given (plain values now,
-        # so that an array the caller changes after the call is recorded as it was).
-        plain_settings = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
+        if not callable(settings):  # plain values now: an array changed after the call is recorded as it was
+            given = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
+            settings = lambda: given  # noqa: E731
+        record = settings
+        # The metadata is made at its first read (issue 25 item 4).
         return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
-                                         body_names=f.body_names,
-                                         metadata=lambda: run_metadata({}, self, plain_settings),
+                                         body_names=f.body_names, metadata=lambda: run_metadata({}, self, record()),
                                          tau_motor=self._result_motor_torques(raw))
 
     def __eq__(self, other: object) -> bool:
@@ -768,15 +770,20 @@ class Mechanism:
             events=native_events(events, names),
             dense_output=bool(dense_output),
         )
-        # The result carries its model and settings, so it can be saved, re-plotted and rerun.
-        settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
-                        t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
-                        drives="callable" if callable(drives) else drives,
-                        motion=None if motion is None else
-                        {k: "callable" if callable(v) else v for k, v in motion.items()},
-                        **({} if events is None else {"events": [
-                            dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
+        # The result carries its model and settings, so it can be saved, re-plotted and rerun:
+        # made at the first read of its metadata, from copies of what the caller could change.
+        t_eval, q0, qd0 = plain(t_eval), plain(q0), plain(qd0)
+        drives_given = "callable" if callable(drives) else drives
+        motion_given = None if motion is None else {k: "callable" if callable(v) else v for k, v in motion.items()}
+        events_given = None if events is None else [dataclasses.asdict(e) if isinstance(e, Crossing) else "callable"
+                                                    for e in events]
+
+        def settings() -> dict[str, Any]:
+            return dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, t_eval=t_eval,
+                        q0=q0, qd0=qd0, max_steps=max_steps, drives=drives_given, motion=motion_given,
+                        **({} if events_given is None else {"events": events_given}),
                         **({"dense_output": True} if dense_output else {}))
+
         result = self._result(raw, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
