@@ -28,7 +28,7 @@ from .models import UnknownModelError
 from .models import path as model_path
 from .result import PointMotion, RawRun, SimulationInterrupted, SimulationResult
 from .results_format import plain
-from .settings import check_settings
+from .settings import check_settings, convert_settings
 
 
 class PlanardynWarning(UserWarning):
@@ -750,7 +750,9 @@ class Mechanism:
         ArgumentError
             An argument with the wrong shape or a non-finite value.
         """
-        checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
+        # The rules of the settings are the core's, which the run applies (checked once, issue 25
+        # item 4); here the numbers are converted, and checked only before their rows are counted.
+        checked = convert_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
         self._check_rows_fit(checked, t_eval)
         names = self._run_facts().coordinate_names
         raw = self._native.simulate(
@@ -803,6 +805,8 @@ class Mechanism:
             return
         if needed_bytes(rows, f.dof, f.n_bodies) <= ALWAYS_FITS:
             return
+        # A setting that breaks its rule (an infinite t_end...) is refused as such, not for its rows.
+        check_settings(**checked)
         refused = rows_message(rows, f.dof, f.n_bodies, available_memory())
         if refused:
             raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")
