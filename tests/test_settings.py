@@ -11,6 +11,7 @@ import pytest
 import yaml
 from conftest import MODELS, cli_run
 from planardyn import batch
+from planardyn import settings as settings_module
 from planardyn._core import check_setting
 from planardyn.settings import MAX_STEPS, MAX_THREADS, MIN_RTOL
 
@@ -83,6 +84,24 @@ def test_each_bad_setting_is_refused_alike_naming_it(name, value, error):
     option = "--" + name.replace("_", "-")
     code, err = cli_run("simulate", FIVE_BAR, "--t-end=0.01", f"{option}={value!r}")
     assert code == 2 and f"argument {option}: {message}" in err, err
+
+
+def test_simulate_checks_the_rules_once_in_the_run(monkeypatch):
+    """Mechanism.simulate leaves the rules of its numbers to the run (the core's one check, the
+    same errors as above: issue 25 item 4), but checks them before counting the rows of an
+    output grid too large to always fit, so that a bad setting is refused as such."""
+    mech = pd.load(FIVE_BAR)
+    calls = []
+    monkeypatch.setattr(settings_module, "check_setting", lambda *a: calls.append(a) or a[1])
+    assert mech.simulate(0.01, rtol=1e-9, atol=1e-9, output_dt=1e-3).success
+    assert calls == [], "no rule checked in Python on the way to the run"
+    monkeypatch.undo()
+    with pytest.raises(pd.SimulationError, match=r"rtol = -1 must be a finite number > 0"):
+        mech.simulate(0.01, rtol=-1.0)
+    # 1e9 rows of output would be refused for memory, but an infinite t_end is refused first.
+    with pytest.raises(pd.ArgumentError, match=r"t_end = inf must be a finite number > 0") as err:
+        mech.simulate(math.inf, output_dt=1e-9)
+    assert err.value.argument == "t_end"
 
 
 def test_the_rules_are_the_cores():

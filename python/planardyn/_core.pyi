@@ -29,6 +29,7 @@ __all__ = [
     "structure_of_model",
     "Effector",
     "DenseOutput",
+    "Run",
     "SINGULAR_TOL",
     "JUMP_TOL",
     "MIN_RTOL",
@@ -285,7 +286,13 @@ class Mechanism:
         motion: list[tuple[int, float | tuple[list[float], list[float]] | Callable[[float], Any]]] | None = None,
         events: list[tuple[Any, ...]] = ...,
         dense_output: bool = False,
-    ) -> dict[str, Any]: ...
+    ) -> Run: ...
+
+@final
+class Run:
+    def __getitem__(self, key: str, /) -> Any: ...
+    def get(self, key: str, default: Any = None) -> Any: ...
+    def __contains__(self, key: str, /) -> bool: ...
 
 @final
 class DenseOutput:

@@ -26,9 +26,9 @@ from .events import Crossing, Event, native_events
 from .guard import ALWAYS_FITS, available_memory, needed_bytes, rows_message
 from .models import UnknownModelError
 from .models import path as model_path
-from .result import PointMotion, SimulationInterrupted, SimulationResult
+from .result import PointMotion, RawRun, SimulationInterrupted, SimulationResult
 from .results_format import plain
-from .settings import check_settings
+from .settings import check_settings, convert_settings
 
 
 class PlanardynWarning(UserWarning):
@@ -173,11 +173,17 @@ class Mechanism:
                                     defaults.get("output_dt"), defaults.get("t_end"))
         return self._facts
 
-    def _result(self, raw: dict[str, Any], settings: dict[str, Any]) -> SimulationResult:
-        """The result of a run from the native dict, its metadata recording ``settings``."""
+    def _result(self, raw: RawRun, settings: dict[str, Any] | Callable[[], dict[str, Any]]) -> SimulationResult:
+        """The result of a run from the native one, its metadata recording ``settings`` (or
+        what the callable makes: values the caller could change after the call copied)."""
         f = self._run_facts()
+        if not callable(settings):  # plain values now: an array changed after the call is recorded as it was
+            given = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
+            settings = lambda: given  # noqa: E731
+        record = settings
+        # The metadata is made at its first read (issue 25 item 4).
         return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
-                                         body_names=f.body_names, metadata=run_metadata({}, self, settings),
+                                         body_names=f.body_names, metadata=lambda: run_metadata({}, self, record()),
                                          tau_motor=self._result_motor_torques(raw))
 
     def __eq__(self, other: object) -> bool:
@@ -415,7 +421,7 @@ class Mechanism:
         effort itself."""
         return self._native.motor_torques(q, qd, qdd, tau, x, xd, allow_singular)
 
-    def _result_motor_torques(self, raw: Mapping[str, Any]) -> FloatArray | None:
+    def _result_motor_torques(self, raw: RawRun) -> FloatArray | None:
         """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
         tau, x, xd, each (N, ...)) when the model has an actuator, else None."""
         if not self._run_facts().has_actuators:
@@ -744,7 +750,9 @@ class Mechanism:
         ArgumentError
             An argument with the wrong shape or a non-finite value.
         """
-        checked = check_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
+        # The rules of the settings are the core's, which the run applies (checked once, issue 25
+        # item 4); here the numbers are converted, and checked only before their rows are counted.
+        checked = convert_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
         self._check_rows_fit(checked, t_eval)
         names = self._run_facts().coordinate_names
         raw = self._native.simulate(
@@ -764,15 +772,20 @@ class Mechanism:
             events=native_events(events, names),
             dense_output=bool(dense_output),
         )
-        # The result carries its model and settings, so it can be saved, re-plotted and rerun.
-        settings = dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt,
-                        t_eval=t_eval, q0=q0, qd0=qd0, max_steps=max_steps,
-                        drives="callable" if callable(drives) else drives,
-                        motion=None if motion is None else
-                        {k: "callable" if callable(v) else v for k, v in motion.items()},
-                        **({} if events is None else {"events": [
-                            dataclasses.asdict(e) if isinstance(e, Crossing) else "callable" for e in events]}),
+        # The result carries its model and settings, so it can be saved, re-plotted and rerun:
+        # made at the first read of its metadata, from copies of what the caller could change.
+        t_eval, q0, qd0 = plain(t_eval), plain(q0), plain(qd0)
+        drives_given = "callable" if callable(drives) else drives
+        motion_given = None if motion is None else {k: "callable" if callable(v) else v for k, v in motion.items()}
+        events_given = None if events is None else [dataclasses.asdict(e) if isinstance(e, Crossing) else "callable"
+                                                    for e in events]
+
+        def settings() -> dict[str, Any]:
+            return dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, t_eval=t_eval,
+                        q0=q0, qd0=qd0, max_steps=max_steps, drives=drives_given, motion=motion_given,
+                        **({} if events_given is None else {"events": events_given}),
                         **({"dense_output": True} if dense_output else {}))
+
         result = self._result(raw, settings)
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
@@ -792,6 +805,8 @@ class Mechanism:
             return
         if needed_bytes(rows, f.dof, f.n_bodies) <= ALWAYS_FITS:
             return
+        # A setting that breaks its rule (an infinite t_end...) is refused as such, not for its rows.
+        check_settings(**checked)
         refused = rows_message(rows, f.dof, f.n_bodies, available_memory())
         if refused:
             raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")

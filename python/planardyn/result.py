@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -13,13 +13,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import extras, results_format
-from ._core import DenseOutput, __version__
+from ._core import DenseOutput, Run, __version__
 from .arguments import error
 
 if TYPE_CHECKING:
     import pandas
 
 FloatArray = NDArray[np.float64]
+#: What the native run returns: a ``_core.Run`` from ``simulate``, a dict from a batch.
+RawRun = Mapping[str, Any] | Run
 
 
 @dataclass(frozen=True, repr=False)
@@ -60,9 +62,8 @@ class Energy:
 #: The output columns that are entries of :class:`Energy` (``result.energy.kinetic``, ...);
 #: every other column is the result's field of its name.
 ENERGY_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name in {f.name for f in dataclasses.fields(Energy)})
-#: The other columns, each a result's field of its name; and those every run has (not optional).
+#: The other columns, each a result's field of its name.
 FIELD_COLUMNS = tuple(c.name for c in results_format.COLUMNS if c.name not in ENERGY_COLUMNS)
-RUN_COLUMNS = tuple(c.name for c in results_format.COLUMNS if not c.optional)
 
 
 def column_fields(values: Mapping[str, Any], body_names: list[str]) -> dict[str, Any]:
@@ -225,39 +226,47 @@ class SimulationResult:
     @classmethod
     def from_raw(
         cls,
-        raw: dict[str, Any],
+        raw: RawRun,
         *,
         coordinate_names: list[str],
         coordinate_kinds: list[str],
         body_names: list[str],
-        metadata: dict[str, Any] | None = None,
+        metadata: Mapping[str, Any] | Callable[[], Mapping[str, Any]] | None = None,
         tau_motor: FloatArray | None = None,
     ) -> SimulationResult:
-        """Wrap the dict returned by the native ``Mechanism.simulate``."""
-        columns = {name: raw[name] for name in RUN_COLUMNS}
-        columns["tau_motor"] = tau_motor
-        fields = dict(
-            **column_fields(columns, body_names),
+        """Wrap the native ``Mechanism.simulate``'s result (a ``_core.Run``, or the dict a
+        batch returns). Its arrays, counters, events and ``metadata`` (given, or made by a
+        callable) are made at their first read (:data:`LAZY_FIELDS`)."""
+        # Every other field at once: the frozen dataclass's __init__ sets them one by one
+        # through object.__setattr__, and making every array up front was most of a short run's
+        # fixed cost in Python (issue 25 item 4).
+        result = object.__new__(cls)
+        result.__dict__.update(
             success=raw["status"] in ("success", "event"),
             status=raw["status"],
             message=raw["message"],
-            stats=dict(raw["stats"]),
             coordinate_names=list(coordinate_names),
             coordinate_kinds=list(coordinate_kinds),
             body_names=list(body_names),
-            change_points=[ChangePoint.from_dict(c) for c in raw.get("change_points", [])],
-            metadata=dict(metadata or {}),
-            t_events=list(raw.get("t_events", [])),
-            q_events=list(raw.get("q_events", [])),
-            qd_events=list(raw.get("qd_events", [])),
+            tau_motor=tau_motor,
+            # Not made later: a field with a default is a class attribute, found before __getattr__.
             sol=raw.get("sol"),
+            _pending=(raw, metadata),
         )
-        # Every field is given: set them at once. The frozen dataclass's __init__ sets them one
-        # by one through object.__setattr__, about 5 us a result, a fifth of a short run's
-        # fixed cost in Python (issue 25 item 4).
-        result = object.__new__(cls)
-        result.__dict__.update(fields)
         return result
+
+    def __getattr__(self, name: str) -> Any:
+        # Only reached for an attribute not yet in __dict__: a field made at its first read.
+        pending = self.__dict__.get("_pending")
+        if pending is None or name not in LAZY_FIELDS:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        value = _lazy_field(self, name, *pending)
+        self.__dict__[name] = value
+        return value
+
+    def __getstate__(self) -> dict[str, Any]:
+        # Pickled and copied with every field made (the native run itself does not pickle).
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
     def change_points_frame(self) -> pandas.DataFrame:
         """The change points as a DataFrame: ``t``, ``rank_drop`` and the coordinates (needs
@@ -371,6 +380,30 @@ class SimulationResult:
             meta["events"] = {"t": [a.tolist() for a in self.t_events], "q": [a.tolist() for a in self.q_events],
                               "qd": [a.tolist() for a in self.qd_events]}
         return results_format.write(path, meta, groups, layout, ext)
+
+
+#: The fields of a result from a native run made at their first read (``from_raw``).
+LAZY_FIELDS = frozenset(FIELD_COLUMNS) - {"tau_motor"} | {
+    "energy", "poses", "stats", "change_points", "t_events", "q_events", "qd_events", "metadata"}
+
+
+def _lazy_field(result: SimulationResult, name: str, raw: RawRun,
+                metadata: Mapping[str, Any] | Callable[[], Mapping[str, Any]] | None) -> Any:
+    """Field ``name`` of ``result`` from its native run ``raw`` (see ``from_raw``)."""
+    if name == "energy":
+        return Energy.from_arrays(raw["kinetic"], raw["potential"], raw["work"])
+    if name == "poses":
+        x = result.x
+        return x.reshape(x.shape[0], len(result.body_names), 3)
+    if name == "stats":
+        return dict(raw["stats"])
+    if name == "change_points":
+        return [ChangePoint.from_dict(c) for c in raw.get("change_points", [])]
+    if name in ("t_events", "q_events", "qd_events"):
+        return list(raw.get(name, []))
+    if name == "metadata":
+        return dict((metadata() if callable(metadata) else metadata) or {})
+    return raw[name]  # an output column
 
 
 SimulationResult.__doc__ = f"{(SimulationResult.__doc__ or '').rstrip(' ')}{results_format.columns_doc('    ')}"

@@ -24,7 +24,7 @@ from typing import Any
 
 from ._core import MAX_STEPS, MIN_RTOL, check_setting
 
-__all__ = ["MAX_STEPS", "MAX_THREADS", "MIN_RTOL", "NUMBERS", "check_settings"]
+__all__ = ["MAX_STEPS", "MAX_THREADS", "MIN_RTOL", "NUMBERS", "check_settings", "convert_settings"]
 
 #: Settings that are numbers (s, or dimensionless for the tolerances).
 NUMBERS = ("t_end", "rtol", "atol", "dt", "output_dt")
@@ -58,12 +58,24 @@ def _integer(name: str, value: Any) -> int:
 def check_settings(**settings: Any) -> dict[str, Any]:
     """Check the given settings (None: not given, skipped) by their rules; returns them with
     numbers as float or int. Unnamed settings (``method``, ``t_eval``...) pass unchanged."""
+    out = convert_settings(**settings)
+    for name in NUMBERS:
+        if out.get(name) is not None:
+            out[name] = check_setting(name, out[name])
+    return out
+
+
+def convert_settings(**settings: Any) -> dict[str, Any]:
+    """:func:`check_settings` but for the rules of the numbers, left to the run, which applies
+    the same core check with the same errors (``Mechanism.simulate``: checked once); only a
+    number that is not one is a TypeError here. ``max_steps``'s range is checked here, since
+    a count out of it could not become the native integer."""
     out = dict(settings)
     for name, value in settings.items():
         if value is None:
             continue
         if name in NUMBERS:
-            out[name] = check_setting(name, _number(name, value))
+            out[name] = _number(name, value)
         elif name == "max_steps":
             n = _integer(name, value)
             check_setting(name, float(n))

@@ -186,9 +186,7 @@ fn simulate_batch<'py>(
     let solve = |(v, prepared): &(Variant, Arc<Prepared>), stop: &AtomicBool| v.simulate_prepared(prepared, stop);
     run_batch(py, &variants, threads, finish, make, solve, |py, r, _| match r {
         // A batch's runs are cancelled only by Ctrl-C.
-        Ok(traj) => {
-            Ok(crate::simulate::to_dict(py, traj, Some("interrupted (Ctrl-C)".to_string()))?.into_any().unbind())
-        }
+        Ok(traj) => Ok(crate::run::to_dict(py, traj, Some("interrupted (Ctrl-C)".to_string()))?.into_any().unbind()),
         Err(e) => error_pair(py, to_pyerr(py, &e), e.to_string()),
     })
 }

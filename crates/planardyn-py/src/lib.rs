@@ -18,6 +18,7 @@ mod mechanism;
 mod model;
 mod query;
 mod rows;
+mod run;
 mod settings;
 mod simulate;
 mod stiffness;
@@ -93,6 +94,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     structure::register(m)?;
     batch::register(m)?;
     simulate::register(m)?;
+    run::register(m)?;
     effector::register(m)?;
     stiffness::register(m)?;
     settings::register(m)?;

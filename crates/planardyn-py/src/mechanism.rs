@@ -554,7 +554,7 @@ impl PyMechanism {
         motion: Option<Vec<(usize, crate::simulate::MotionArg)>>,
         events: Vec<crate::simulate::EventArg>,
         dense_output: bool,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<crate::run::PyRun> {
         let t_eval = t_eval
             .map(|a| {
                 let v = Values::read(&a);

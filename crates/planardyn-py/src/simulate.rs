@@ -1,21 +1,20 @@
 //! `Mechanism.simulate`: settings from the model file's defaults and the caller's
 //! overrides, Python callables as drives, motions and progress callback, and the trajectory
-//! as a dict of time-major numpy arrays. The whole loop runs in Rust with the GIL released;
+//! as a `Run` (`run.rs`: time-major numpy arrays made at their first read). The whole loop runs in Rust with the GIL released;
 //! callbacks re-attach to the interpreter for the duration of each call.
 
-use crate::convert::{arr1, arr2, Values};
+use crate::convert::Values;
 use crate::errors::run;
-use crate::exceptions::{argument_error, PlanardynError};
-use numpy::ndarray::{ArrayView1, ArrayView2};
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, ToPyArray};
+use crate::exceptions::argument_error;
+use crate::run::PyRun;
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
-use planardyn::simulate::columns::{self, Column, Shape, COLUMNS};
-use planardyn::simulate::{simulate_prepared, Event, EventFn, Observe, Overrides, Prepared, Trajectory};
+use planardyn::simulate::columns::COLUMNS;
+use planardyn::simulate::{simulate_prepared, Event, EventFn, Observe, Overrides, Prepared};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -177,8 +176,8 @@ pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) 
         .collect()
 }
 
-/// Run a simulation from `mech`'s `prepared` set-up and return its trajectory as a dict (see
-/// `planardyn.SimulationResult`).
+/// Run a simulation from `mech`'s `prepared` set-up and return its result, read as a dict (see
+/// `planardyn.SimulationResult`), its values made at their first read.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -190,7 +189,7 @@ pub fn simulate<'py>(
     progress: Option<Py<PyAny>>,
     events: Vec<EventArg>,
     dense_output: bool,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyRun> {
     let event_fatal = Mutex::new(None);
     let m = mech.dof();
     let mut py_drives = drives.map(|f| PyDrives { f, m, fatal: None });
@@ -257,80 +256,14 @@ pub fn simulate<'py>(
             let at = traj.t.last().copied().unwrap_or(0.0);
             let reason = format!("interrupted (KeyboardInterrupt) at t = {at} s");
             // Whether it came in the progress check or inside a drive callable, it is a cancel.
-            let d = to_dict(py, traj, None)?;
-            d.set_item("status", planardyn::simulate::Status::Cancelled.name())?;
-            d.set_item("message", reason)?;
-            d.set_item("interrupt", e.value(py))?;
-            Ok(d)
+            let run = PyRun::new(py, traj, None)?;
+            run.set(py, "status", planardyn::simulate::Status::Cancelled.name())?;
+            run.set(py, "message", reason)?;
+            run.set(py, "interrupt", e.value(py))?;
+            Ok(run)
         }
         Some(e) => Err(e),
-        None => to_dict(py, traj, cancel_reason),
-    }
-}
-
-/// The trajectory as the dict `Mechanism.simulate` returns (arrays time-major); a
-/// cancellation's reason, if given, replaces the message.
-pub(crate) fn to_dict(py: Python<'_>, t: Trajectory, cancel_reason: Option<String>) -> PyResult<Bound<'_, PyDict>> {
-    let m = t.m;
-    let d = PyDict::new(py);
-    for c in COLUMNS {
-        d.set_item(c.name, column_array(py, c, &t)?)?;
-    }
-    let event_rows = |rows: Vec<Vec<f64>>| -> PyResult<Vec<Bound<'_, PyAny>>> {
-        rows.into_iter().map(|r| Ok(arr2(py, r.len() / m.max(1), m, r)?.into_any())).collect()
-    };
-    let ev = t.events;
-    d.set_item("t_events", ev.t.into_iter().map(|r| arr1(py, r)).collect::<Vec<_>>())?;
-    d.set_item("q_events", event_rows(ev.q)?)?;
-    d.set_item("qd_events", event_rows(ev.qd)?)?;
-    d.set_item("sol", t.dense.map(|inner| crate::dense::PyDenseOutput { inner }))?;
-    let points = PyList::empty(py);
-    for p in &t.change_points {
-        let c = PyDict::new(py);
-        c.set_item("t", p.t)?;
-        c.set_item("q", arr1(py, p.q.clone()))?;
-        c.set_item("x", arr1(py, p.x.clone()))?;
-        c.set_item("rank_drop", p.rank_drop)?;
-        points.append(c)?;
-    }
-    d.set_item("change_points", points)?;
-    d.set_item("status", t.status.name())?;
-    let message = match (t.status, cancel_reason) {
-        (planardyn::simulate::Status::Cancelled, Some(reason)) => reason,
-        _ => t.message,
-    };
-    d.set_item("message", message)?;
-    let st = &t.stats;
-    let stats = PyDict::new(py);
-    stats.set_item("nfev", st.integrator.nfev)?;
-    stats.set_item("naccept", st.integrator.naccept)?;
-    stats.set_item("nreject", st.integrator.nreject)?;
-    stats.set_item("njev", st.integrator.njev)?;
-    stats.set_item("nlu", st.integrator.nlu)?;
-    stats.set_item("chart_switches", st.chart_switches)?;
-    stats.set_item("partition_steps", st.partition_steps)?;
-    stats.set_item("max_residual", st.max_residual)?;
-    // A run that failed before measuring anything has no least measure: None, not inf.
-    stats.set_item("min_sigma", Some(st.min_sigma).filter(|s| s.is_finite()))?;
-    stats.set_item("min_passive_sigma", Some(st.min_passive_sigma).filter(|s| s.is_finite()))?;
-    stats.set_item("energy_drift", st.energy_drift)?;
-    stats.set_item("failed_evaluations", st.failed_evaluations)?;
-    d.set_item("stats", stats)?;
-    Ok(d)
-}
-
-/// Column `c` of `traj` as a numpy array (a copy): (N,) for a scalar, (N,) of bool for a flag,
-/// (N, width) for a row per output.
-fn column_array<'py>(py: Python<'py>, c: &Column, traj: &Trajectory) -> PyResult<Bound<'py, PyAny>> {
-    match ((c.values)(traj), c.shape) {
-        (columns::Values::Numbers(v), Shape::Coordinates | Shape::BodyPoses) => {
-            let shape = (traj.len(), c.shape.width(traj.m, traj.nx));
-            let rows = ArrayView2::from_shape(shape, v)
-                .map_err(|e| PlanardynError::new_err(format!("output column {}: {e}", c.name)))?;
-            Ok(rows.to_pyarray(py).into_any())
-        }
-        (columns::Values::Numbers(v), Shape::Scalar | Shape::Flag) => Ok(ArrayView1::from(v).to_pyarray(py).into_any()),
-        (columns::Values::Flags(v), _) => Ok(ArrayView1::from(v).to_pyarray(py).into_any()),
+        None => PyRun::new(py, traj, cancel_reason),
     }
 }
 
