@@ -7,10 +7,11 @@
 
 use super::forces::Drives;
 use super::workspace::Workspace;
+use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::{
     coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
 };
-use crate::kinematics::{add_u_times, convective, solve_position, velocity_analogues, Chart, Frame};
+use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame};
 use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
 use crate::model::{Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
@@ -263,6 +264,5 @@ fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
 /// one column of 3n a coordinate), each column over the bodies of its `support`
 /// (`System::u_support`), where it may be non-zero.
 pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
-    xdd.copy_from_slice(c);
-    add_u_times(u, support, |j| zdd[j], xdd);
+    u_times_from(u, support, |j| zdd[j], |i, _| c[i], xdd);
 }

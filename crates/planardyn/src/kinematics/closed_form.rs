@@ -467,15 +467,13 @@ impl ClosedForm {
             return self.velocity_analogues_over(reach, ws);
         }
         let (n, m) = (ws.x.len(), ws.q.len());
-        // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
-        let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
-        unit[..m].fill(0.0);
+        // Without `reach`, m <= REACH_FROM_M: the unit rates fit on the stack.
+        let mut unit = [0.0; REACH_FROM_M];
         for j in 0..m {
             unit[j] = 1.0;
-            self.rates(&ws.trig, &unit[..m], &mut u[j * n..(j + 1) * n]);
+            self.rates(&ws.trig, &unit[..m], &mut ws.u[j * n..(j + 1) * n]);
             unit[j] = 0.0;
         }
-        (ws.u, ws.rhs) = (u, unit);
     }
 
     /// [`ClosedForm::velocity_analogues`] with each column over the pieces its coordinate moves
