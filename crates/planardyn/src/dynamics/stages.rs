@@ -12,7 +12,7 @@ use crate::kinematics::constraints::{
     coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
 };
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame};
-use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
+use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope, copy_small};
 use crate::model::{Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
 
@@ -31,8 +31,8 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Frame)
 /// recomputed.
 fn user_coordinates(mech: &Mechanism, ws: &mut Frame, z: &[f64], zd: &[f64]) {
     if ws.chart == Chart::Inputs {
-        ws.q.copy_from_slice(z);
-        ws.qd.copy_from_slice(zd);
+        copy_small(&mut ws.q, z);
+        copy_small(&mut ws.qd, zd);
     } else {
         coordinates(mech, &ws.x, &mut ws.q);
         coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
@@ -251,7 +251,7 @@ pub(crate) fn accelerations(mech: &Mechanism, ws: &mut Workspace) {
 /// (as [`user_coordinates`]).
 fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
     if ws.chart == Chart::Inputs {
-        ws.qdd.copy_from_slice(&ws.zdd);
+        copy_small(&mut ws.qdd, &ws.zdd);
         return;
     }
     for (k, c) in mech.coordinates.iter().enumerate() {

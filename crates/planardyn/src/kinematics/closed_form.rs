@@ -31,6 +31,7 @@ use super::dyads::triad::Triad;
 use super::dyads::Joint;
 use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
+use crate::linalg::copy_small;
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::topology::assur::{self, AssurGroup};
 use crate::KinematicsError;
@@ -539,8 +540,8 @@ impl ClosedForm {
         self.place(z, start, ws)?;
         self.velocity_analogues(ws);
         self.convective(zd, ws);
-        ws.q.copy_from_slice(z);
-        ws.qd.copy_from_slice(zd);
+        copy_small(&mut ws.q, z);
+        copy_small(&mut ws.qd, zd);
         Ok(())
     }
 }

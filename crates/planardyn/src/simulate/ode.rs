@@ -4,10 +4,12 @@
 
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
+use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::gamma;
 use crate::kinematics::{
     add_u_times, scaled_distances, sigma_min, sigma_min_with, Chart, ClosedForm, System, MAX_CORRECTION,
 };
+use crate::linalg::copy_small;
 use crate::model::Mechanism;
 use crate::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
@@ -317,9 +319,8 @@ impl<'a> MechanismOde<'a> {
     /// x + U dz + 1/2 w(dz, dz) into `ws.x`, which holds the last evaluation's x.
     fn second_order(&mut self, z: &[f64]) {
         let ws = &mut self.ws;
-        ws.rhs.fill(0.0);
         let last = &self.last_y;
-        add_u_times(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], &mut ws.frame.rhs);
+        u_times_from(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], |_, _| 0.0, &mut ws.frame.rhs);
         // tmp = w(dz, dz) from the closed forms' accelerations where they gave the last
         // evaluation (their geometry is its), else -w(dz, dz) = J^-1 gamma(dz, dz) by J,
         // which Newton left factorised there.
@@ -356,7 +357,7 @@ impl<'a> MechanismOde<'a> {
     /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let mut z = std::mem::take(&mut self.eval_y);
-        z.copy_from_slice(y);
+        copy_small(&mut z, y);
         let outcome = self.evaluate_at(t, &mut z);
         if outcome.is_err() {
             self.failed_evaluations += 1;
@@ -365,7 +366,7 @@ impl<'a> MechanismOde<'a> {
         outcome?;
         self.base_valid = true;
         self.last_t = t;
-        self.last_y.copy_from_slice(y);
+        copy_small(&mut self.last_y, y);
         Ok(())
     }
 
@@ -555,8 +556,8 @@ impl MechanismOde<'_> {
     /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`).
     fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
-        dy[..m].copy_from_slice(&self.eval_y[m..2 * m]);
-        dy[m..2 * m].copy_from_slice(&self.ws.zdd);
+        copy_small(&mut dy[..m], &self.eval_y[m..2 * m]);
+        copy_small(&mut dy[m..2 * m], &self.ws.zdd);
         dy[2 * m] = self.ws.power;
     }
 }
