@@ -7,11 +7,12 @@
 
 use super::forces::Drives;
 use super::workspace::Workspace;
+use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::{
     coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
 };
-use crate::kinematics::{add_u_times, convective, solve_position, velocity_analogues, Chart, Frame};
-use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
+use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame};
+use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope, copy_small};
 use crate::model::{Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
 
@@ -30,8 +31,8 @@ pub fn kinematic_stages(mech: &Mechanism, z: &[f64], zd: &[f64], ws: &mut Frame)
 /// recomputed.
 fn user_coordinates(mech: &Mechanism, ws: &mut Frame, z: &[f64], zd: &[f64]) {
     if ws.chart == Chart::Inputs {
-        ws.q.copy_from_slice(z);
-        ws.qd.copy_from_slice(zd);
+        copy_small(&mut ws.q, z);
+        copy_small(&mut ws.qd, zd);
     } else {
         coordinates(mech, &ws.x, &mut ws.q);
         coordinate_rates(mech, &ws.x, &ws.xd, &mut ws.qd);
@@ -250,7 +251,7 @@ pub(crate) fn accelerations(mech: &Mechanism, ws: &mut Workspace) {
 /// (as [`user_coordinates`]).
 fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
     if ws.chart == Chart::Inputs {
-        ws.qdd.copy_from_slice(&ws.zdd);
+        copy_small(&mut ws.qdd, &ws.zdd);
         return;
     }
     for (k, c) in mech.coordinates.iter().enumerate() {
@@ -263,6 +264,5 @@ fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
 /// one column of 3n a coordinate), each column over the bodies of its `support`
 /// (`System::u_support`), where it may be non-zero.
 pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
-    xdd.copy_from_slice(c);
-    add_u_times(u, support, |j| zdd[j], xdd);
+    u_times_from(u, support, |j| zdd[j], |i, _| c[i], xdd);
 }

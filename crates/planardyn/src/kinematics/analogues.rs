@@ -29,14 +29,30 @@ pub fn velocity_analogues(ws: &mut Frame) -> Result<(), KinematicsError> {
 /// `System::u_support`: U is zero outside it), for U column-major (3n per column).
 #[inline]
 pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) -> f64, out: &mut [f64]) {
+    u_times_from(u, supports, dz, |_, v| v, out);
+}
+
+/// `out = start + sum_j dz(j) u_j`, `start(i, out_i)` the value entry i starts from (`out_i`
+/// itself for [`add_u_times`], zero or another vector's entry to write `out` whole): for a few
+/// columns in the one pass of [`add_columns`] (no clearing or copy of `out` before, which costs
+/// a library call a stage at this size), else over the supports.
+#[inline]
+pub(crate) fn u_times_from(
+    u: &[f64],
+    supports: &[(usize, usize)],
+    dz: impl Fn(usize) -> f64,
+    start: impl Fn(usize, f64) -> f64,
+    out: &mut [f64],
+) {
     let n = out.len();
     match supports.len() {
-        1 => return add_columns::<1>(u, std::array::from_fn(dz), out),
-        2 => return add_columns::<2>(u, std::array::from_fn(dz), out),
-        3 => return add_columns::<3>(u, std::array::from_fn(dz), out),
-        4 => return add_columns::<4>(u, std::array::from_fn(dz), out),
+        1 => return add_columns::<1>(u, std::array::from_fn(dz), start, out),
+        2 => return add_columns::<2>(u, std::array::from_fn(dz), start, out),
+        3 => return add_columns::<3>(u, std::array::from_fn(dz), start, out),
+        4 => return add_columns::<4>(u, std::array::from_fn(dz), start, out),
         _ => {}
     }
+    out.iter_mut().enumerate().for_each(|(i, v)| *v = start(i, *v));
     for (j, (u, &(first, end))) in u.chunks_exact(n).zip(supports).enumerate() {
         let r = dz(j);
         for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
@@ -45,25 +61,28 @@ pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) ->
     }
 }
 
-/// [`add_u_times`] for M (a few) columns, over every row in one pass with no supports'
+/// [`u_times_from`] for M (a few) columns, over every row in one pass with no supports'
 /// bookkeeping: U is zero outside its supports, and adding a zero term leaves a non-zero sum's
-/// bits as they are, so `out` is the same but for the sign of a zero `out` entry.
+/// bits as they are, so `out` is the same but for the sign of a zero `out` entry. Each entry's
+/// sum starts from `start` and adds the columns' terms in order, as a copy (or clearing) of
+/// `out` followed by the additions does: the same bits.
 #[inline(always)]
-fn add_columns<const M: usize>(u: &[f64], dz: [f64; M], out: &mut [f64]) {
+fn add_columns<const M: usize>(u: &[f64], dz: [f64; M], start: impl Fn(usize, f64) -> f64, out: &mut [f64]) {
     let n = out.len();
     let u: [&[f64]; M] = std::array::from_fn(|j| &u[j * n..(j + 1) * n]);
     for (i, v) in out.iter_mut().enumerate() {
+        let mut s = start(i, *v);
         for j in 0..M {
-            *v += u[j][i] * dz[j];
+            s += u[j][i] * dz[j];
         }
+        *v = s;
     }
 }
 
 /// Body velocities `ws.xd = U zd`, from `ws.u`.
 #[inline]
 pub(crate) fn body_rates(zd: &[f64], ws: &mut Frame) {
-    ws.xd.fill(0.0);
-    add_u_times(&ws.u, ws.sys.u_support(), |j| zd[j], &mut ws.xd);
+    u_times_from(&ws.u, ws.sys.u_support(), |j| zd[j], |_, _| 0.0, &mut ws.xd);
 }
 
 /// Body velocities `ws.xd = U zd` and the convective term `ws.c`, from `ws.u`.

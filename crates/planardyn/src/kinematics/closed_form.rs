@@ -31,6 +31,7 @@ use super::dyads::triad::Triad;
 use super::dyads::Joint;
 use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
+use crate::linalg::copy_small;
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::topology::assur::{self, AssurGroup};
 use crate::KinematicsError;
@@ -467,15 +468,13 @@ impl ClosedForm {
             return self.velocity_analogues_over(reach, ws);
         }
         let (n, m) = (ws.x.len(), ws.q.len());
-        // Each input body has 3 coordinates, so the 3n scratch holds the m unit rates.
-        let (mut u, mut unit) = (std::mem::take(&mut ws.u), std::mem::take(&mut ws.rhs));
-        unit[..m].fill(0.0);
+        // Without `reach`, m <= REACH_FROM_M: the unit rates fit on the stack.
+        let mut unit = [0.0; REACH_FROM_M];
         for j in 0..m {
             unit[j] = 1.0;
-            self.rates(&ws.trig, &unit[..m], &mut u[j * n..(j + 1) * n]);
+            self.rates(&ws.trig, &unit[..m], &mut ws.u[j * n..(j + 1) * n]);
             unit[j] = 0.0;
         }
-        (ws.u, ws.rhs) = (u, unit);
     }
 
     /// [`ClosedForm::velocity_analogues`] with each column over the pieces its coordinate moves
@@ -541,8 +540,8 @@ impl ClosedForm {
         self.place(z, start, ws)?;
         self.velocity_analogues(ws);
         self.convective(zd, ws);
-        ws.q.copy_from_slice(z);
-        ws.qd.copy_from_slice(zd);
+        copy_small(&mut ws.q, z);
+        copy_small(&mut ws.qd, zd);
         Ok(())
     }
 }

@@ -18,3 +18,26 @@ pub use cholesky::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesk
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
 pub use pivot::pivot_columns;
 pub use sink::{Dense, Sink};
+
+/// `dst.copy_from_slice(src)` for the few values of a state or its coordinates (m, 2m + 1) as
+/// moves: `copy_from_slice` of a length known only at run time is a call to the C library's
+/// `memcpy`, about 12 instructions for one value (issue 25's instruction counts, which make
+/// such copies several times an evaluation). Panics as `copy_from_slice` does if the lengths
+/// differ.
+#[inline(always)]
+pub fn copy_small(dst: &mut [f64], src: &[f64]) {
+    match src.len() {
+        1 => copy_fixed::<1>(dst, src),
+        2 => copy_fixed::<2>(dst, src),
+        3 => copy_fixed::<3>(dst, src),
+        4 => copy_fixed::<4>(dst, src),
+        5 => copy_fixed::<5>(dst, src),
+        _ => dst.copy_from_slice(src),
+    }
+}
+
+#[inline(always)]
+fn copy_fixed<const N: usize>(dst: &mut [f64], src: &[f64]) {
+    let dst: &mut [f64; N] = dst.try_into().expect("copy_small: destination and source lengths differ");
+    *dst = src.try_into().expect("copy_small: the source has N values");
+}

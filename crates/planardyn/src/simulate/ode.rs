@@ -4,10 +4,10 @@
 
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
+use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{
-    add_u_times, scaled_distances, sigma_min, sigma_min_with, Chart, ClosedForm, System, MAX_CORRECTION,
-};
+use crate::kinematics::{scaled_distances, sigma_min, sigma_min_with, Chart, ClosedForm, System, MAX_CORRECTION};
+use crate::linalg::copy_small;
 use crate::model::Mechanism;
 use crate::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
@@ -294,9 +294,8 @@ impl<'a> MechanismOde<'a> {
     fn predict(&mut self, z: &[f64], fold_guard_only: bool) -> Prediction {
         let ws = &mut self.ws;
         if !self.base_valid {
-            ws.x.copy_from_slice(&self.anchor_x);
-            let anchor = &self.anchor_z;
-            add_u_times(&self.anchor_u, ws.frame.sys.u_support(), |j| z[j] - anchor[j], &mut ws.frame.x);
+            let (anchor, x) = (&self.anchor_z, &self.anchor_x);
+            u_times_from(&self.anchor_u, ws.frame.sys.u_support(), |j| z[j] - anchor[j], |i, _| x[i], &mut ws.frame.x);
             return Prediction::Complete;
         }
         if let ([z], [z_last, zd, _]) = (z, self.last_y.as_slice()) {
@@ -304,8 +303,8 @@ impl<'a> MechanismOde<'a> {
                 let dz = z - z_last;
                 let r = dz / zd;
                 let half = 0.5 * r * r;
-                for ((x, u), c) in ws.frame.x.iter_mut().zip(&ws.frame.u).zip(&ws.frame.c) {
-                    *x += u * dz + half * c;
+                for (((x, b), u), c) in ws.frame.x.iter_mut().zip(&self.base).zip(&ws.frame.u).zip(&ws.frame.c) {
+                    *x = b + (u * dz + half * c);
                 }
                 return Prediction::FoldGuard;
             }
@@ -314,12 +313,11 @@ impl<'a> MechanismOde<'a> {
         Prediction::Complete
     }
 
-    /// x + U dz + 1/2 w(dz, dz) into `ws.x`, which holds the last evaluation's x.
+    /// x + U dz + 1/2 w(dz, dz) into `ws.x`, x the last evaluation's (in `base`).
     fn second_order(&mut self, z: &[f64]) {
         let ws = &mut self.ws;
-        ws.rhs.fill(0.0);
         let last = &self.last_y;
-        add_u_times(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], &mut ws.frame.rhs);
+        u_times_from(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], |_, _| 0.0, &mut ws.frame.rhs);
         // tmp = w(dz, dz) from the closed forms' accelerations where they gave the last
         // evaluation (their geometry is its), else -w(dz, dz) = J^-1 gamma(dz, dz) by J,
         // which Newton left factorised there.
@@ -332,7 +330,7 @@ impl<'a> MechanismOde<'a> {
                 gamma(
                     self.mech,
                     &ws.frame.chart,
-                    &ws.frame.x,
+                    &self.base,
                     &ws.frame.trig,
                     &ws.frame.rhs,
                     &ws.frame.rhs,
@@ -342,8 +340,8 @@ impl<'a> MechanismOde<'a> {
                 -0.5
             }
         };
-        for ((x, d), w) in ws.frame.x.iter_mut().zip(&ws.frame.rhs).zip(&ws.frame.tmp) {
-            *x += d + half * w;
+        for (((x, b), d), w) in ws.frame.x.iter_mut().zip(&self.base).zip(&ws.frame.rhs).zip(&ws.frame.tmp) {
+            *x = b + (d + half * w);
         }
     }
 
@@ -356,7 +354,7 @@ impl<'a> MechanismOde<'a> {
     /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         let mut z = std::mem::take(&mut self.eval_y);
-        z.copy_from_slice(y);
+        copy_small(&mut z, y);
         let outcome = self.evaluate_at(t, &mut z);
         if outcome.is_err() {
             self.failed_evaluations += 1;
@@ -365,7 +363,7 @@ impl<'a> MechanismOde<'a> {
         outcome?;
         self.base_valid = true;
         self.last_t = t;
-        self.last_y.copy_from_slice(y);
+        copy_small(&mut self.last_y, y);
         Ok(())
     }
 
@@ -380,7 +378,13 @@ impl<'a> MechanismOde<'a> {
             }
         }
         let (z, zd) = (&y[..m], &y[m..2 * m]);
-        self.base.copy_from_slice(if self.base_valid { &self.ws.x } else { &self.anchor_x });
+        // The point predicted from, into `base`: the last evaluation's x by a swap (the
+        // prediction then writes `ws.x` whole), else the anchor's by a copy.
+        if self.base_valid {
+            std::mem::swap(&mut self.base, &mut self.ws.frame.x);
+        } else {
+            self.base.copy_from_slice(&self.anchor_x);
+        }
         // A predictor past a dyad's fold means the motion leaves the closed forms' branch
         // there: Newton from the predictor follows it. The closed forms place the point from z
         // alone, so where they are in use the prediction is only this fold guard's (and the
@@ -389,7 +393,6 @@ impl<'a> MechanismOde<'a> {
         let prediction = self.predict(z, closed);
         let newton = !closed || !self.closed.as_ref().is_some_and(|c| c.keeps_branches(&self.ws.x));
         if newton && prediction == Prediction::FoldGuard {
-            self.ws.x.copy_from_slice(&self.base);
             self.second_order(z);
         }
         self.predicted.copy_from_slice(&self.ws.x);
@@ -555,8 +558,8 @@ impl MechanismOde<'_> {
     /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`).
     fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
-        dy[..m].copy_from_slice(&self.eval_y[m..2 * m]);
-        dy[m..2 * m].copy_from_slice(&self.ws.zdd);
+        copy_small(&mut dy[..m], &self.eval_y[m..2 * m]);
+        copy_small(&mut dy[m..2 * m], &self.ws.zdd);
         dy[2 * m] = self.ws.power;
     }
 }

@@ -5,7 +5,7 @@
 //! w1 E e1 - w2 E e2 = v_B - v_A (and its derivative) with e1 = P - A, e2 = P - B, whose
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
-use super::{put_acceleration, put_rate, rotation, Joint};
+use super::{put_acceleration, put_rate, rotation, round, Joint};
 use crate::kinematics::group_sigma::dyad_sigma;
 use crate::model::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
@@ -91,7 +91,7 @@ impl Rrr {
         let [b1, b2] = self.bodies;
         let psi = x[3 * b2 + 2] - x[3 * b1 + 2] + self.bend;
         // psi reduced to [-pi, pi] has the sign of sin(psi).
-        (psi - TAU * (psi / TAU).round()) * branch.side > 0.0
+        (psi - TAU * round(psi / TAU)) * branch.side > 0.0
     }
 
     /// The branch of the configuration x.
