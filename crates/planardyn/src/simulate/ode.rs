@@ -205,15 +205,22 @@ impl<'a> MechanismOde<'a> {
     /// is O(1)), and Newton from a predictor past half-way lands on it with a correction well
     /// under MAX_CORRECTION: the five-bar of the benchmarks, DOPRI5 at rtol 1e-4, jumped
     /// branch with a 0.047 correction at sigma ~ 0.06 and lost 6e-3 J, ending 4 rad off.
-    /// A quarter of the separation keeps the start inside its own basin. A step's solutions
-    /// stay within [`STEP_REACH`] times `sigma` of that point. Below
+    /// A quarter of the separation keeps the start inside its own basin. Below
     /// [`CLOSED_FORM_SIGMA`] the evaluations also leave the closed forms for Newton.
     pub fn limit_correction(&mut self, sigma: f64) {
         self.max_correction = MAX_CORRECTION.min(BASIN_FRACTION * sigma);
         self.own_sigma = sigma;
         self.clear_of_folds = sigma >= CLOSED_FORM_SIGMA;
         self.max_move = MOVE_FRACTION * sigma;
-        self.max_approach = STEP_REACH * sigma;
+        self.max_approach = f64::INFINITY;
+    }
+
+    /// Bound the move of a step's solutions from the last accepted point by [`STEP_REACH`]
+    /// times the chart's measure there (given to [`MechanismOde::limit_correction`]), for the
+    /// run's steps: a crossing's integration past its landing (`crossing::integrate_past`)
+    /// steps on from the landing without accepting, and keeps its own bounds.
+    pub fn limit_step_reach(&mut self) {
+        self.max_approach = self.max_approach.min(STEP_REACH * self.own_sigma);
     }
 
     /// Bound the move of a solution from the point it was predicted from by `max` as well
