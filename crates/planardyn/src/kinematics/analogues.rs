@@ -5,6 +5,7 @@
 
 use super::constraints::gamma;
 use super::frame::Frame;
+use super::u_support::USupport;
 use crate::model::Mechanism;
 use crate::KinematicsError;
 
@@ -25,10 +26,10 @@ pub fn velocity_analogues(ws: &mut Frame) -> Result<(), KinematicsError> {
     Ok(())
 }
 
-/// `out += sum_j dz(j) u_j` over each column's support (`supports`, from
-/// `System::u_support`: U is zero outside it), for U column-major (3n per column).
+/// `out += sum_j dz(j) u_j` over each column's runs of bodies (`supports`, from
+/// `System::u_support`: U is zero outside them), for U column-major (3n per column).
 #[inline]
-pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) -> f64, out: &mut [f64]) {
+pub fn add_u_times(u: &[f64], supports: &USupport, dz: impl Fn(usize) -> f64, out: &mut [f64]) {
     let n = out.len();
     match supports.len() {
         1 => return add_columns::<1>(u, std::array::from_fn(dz), out),
@@ -37,10 +38,12 @@ pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) ->
         4 => return add_columns::<4>(u, std::array::from_fn(dz), out),
         _ => {}
     }
-    for (j, (u, &(first, end))) in u.chunks_exact(n).zip(supports).enumerate() {
+    for (j, u) in u.chunks_exact(n).enumerate().take(supports.len()) {
         let r = dz(j);
-        for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
-            *v += u * r;
+        for rows in supports.rows(j) {
+            for (v, u) in out[rows.clone()].iter_mut().zip(&u[rows]) {
+                *v += u * r;
+            }
         }
     }
 }
