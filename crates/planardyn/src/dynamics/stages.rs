@@ -70,9 +70,14 @@ pub(crate) fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f
 
 /// a^T M b over the bodies of `runs` ([first, end), ascending; a and b: 3n values each),
 /// M = blockdiag(m, m, I) per body; the terms added in order from -0.0 (f64's `Sum`).
-#[inline]
+/// Inlined: called per entry of A and of b, a call's overhead is a five-bar's whole sum.
+#[inline(always)]
 pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], runs: &[(usize, usize)]) -> f64 {
-    runs.iter().fold(-0.0, |s, &run| m_dot_from(s, mech, a, b, run))
+    let mut s = -0.0;
+    for &run in runs {
+        s = m_dot_from(s, mech, a, b, run);
+    }
+    s
 }
 
 /// `s` plus the terms of [`m_dot`], added one after the other (f64's `Sum` starts at -0.0).

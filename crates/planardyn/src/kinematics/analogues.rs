@@ -40,8 +40,8 @@ pub fn add_u_times(u: &[f64], supports: &USupport, dz: impl Fn(usize) -> f64, ou
     }
     for (j, u) in u.chunks_exact(n).enumerate().take(supports.len()) {
         let r = dz(j);
-        for rows in supports.rows(j) {
-            for (v, u) in out[rows.clone()].iter_mut().zip(&u[rows]) {
+        for &(first, end) in supports.runs(j) {
+            for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
                 *v += u * r;
             }
         }
