@@ -6,7 +6,7 @@
 
 mod common;
 use common::*;
-use planardyn::dynamics::query;
+use planardyn::dynamics::query::{self, ForwardState};
 use planardyn::kinematics::{ClosedForm, Frame};
 use planardyn::Mechanism;
 
@@ -202,5 +202,69 @@ fn separate_five_bars_have_the_mass_matrix_of_one_in_each_block() {
                 assert_eq!(a3[j * 6 + k], 0.0, "A[{j}, {k}] off the blocks");
             }
         }
+    }
+}
+
+#[test]
+fn beyond_four_coordinates_u_is_zero_outside_each_columns_runs_of_bodies() {
+    // The products U zd, U^T f, U^T M c and U zdd run each column over its runs of bodies
+    // only (`System::u_support`): U must be exactly zero elsewhere, and the runs must be the
+    // ladder's few bodies per coordinate (rod j, and the two links of each dyad it carries:
+    // 5 bodies inside, 3 at the ends), not a range across the body order.
+    let mech = ladder(4);
+    let (m, q) = (mech.dof(), pose(&mech));
+    let ws =
+        query::forward_at(&mech, ForwardState { q: &q, qd: &vec![0.0; m], t: 0.0, tau: None, allow_singular: false })
+            .unwrap();
+    let (n, support) = (ws.x.len(), ws.frame.sys.u_support());
+    assert_eq!(support.len(), m);
+    for j in 0..m {
+        let bodies: usize = support.runs(j).iter().map(|(first, end)| end - first).sum();
+        assert_eq!(bodies, if j == 0 || j == m - 1 { 3 } else { 5 }, "column {j}: {:?}", support.runs(j));
+        let mut inside = vec![false; n];
+        support.rows(j).flatten().for_each(|i| inside[i] = true);
+        for i in (0..n).filter(|&i| !inside[i]) {
+            assert_eq!(ws.frame.u[j * n + i], 0.0, "U[{i}, {j}] outside the runs");
+        }
+    }
+}
+
+/// The ladder's accelerations against the dense formulas: a relative 1e-12 is round-off of
+/// sums over a few dozen bodies and of a Cholesky solve of a well-conditioned 8 x 8 A (its
+/// entries of order 0.01 kg m^2, qdd of order 100 rad/s^2), far below any missing term.
+const DENSE_TOL: f64 = 1e-12;
+
+#[test]
+fn ladder_accelerations_are_the_dense_solution_and_inverse_dynamics_gives_zero_effort() {
+    // qdd = (U^T M U)^-1 U^T (f - M c) with every sum over all bodies (nalgebra's LU), against
+    // the evaluation over the runs of U and A's envelope; then the passive ladder's inverse
+    // dynamics at that qdd is zero effort.
+    let mech = ladder(4);
+    let m = mech.dof();
+    let q = pose(&mech);
+    let qd: Vec<f64> = (0..m).map(|j| 0.7 * (j as f64 + 0.3).cos()).collect();
+    let ws =
+        query::forward_at(&mech, ForwardState { q: &q, qd: &qd, t: 0.0, tau: None, allow_singular: false }).unwrap();
+    let n = ws.x.len();
+    let (u, c, f) = (&ws.frame.u, &ws.frame.c, &ws.f);
+    let mass = |i: usize| if i % 3 == 2 { mech.bodies[i / 3].inertia } else { mech.bodies[i / 3].mass };
+    let a = nalgebra::DMatrix::<f64>::from_fn(m, m, |j, k| (0..n).map(|i| mass(i) * u[j * n + i] * u[k * n + i]).sum());
+    let b = nalgebra::DVector::<f64>::from_fn(m, |j, _| (0..n).map(|i| u[j * n + i] * (f[i] - mass(i) * c[i])).sum());
+    let dense: nalgebra::DVector<f64> = a.lu().solve(&b).unwrap();
+    let scale = dense.amax();
+    assert!(scale > 1.0, "a real acceleration: {scale}");
+    for j in 0..m {
+        assert!((ws.qdd[j] - dense[j]).abs() < DENSE_TOL * scale, "qdd[{j}] = {} vs dense {}", ws.qdd[j], dense[j]);
+    }
+    // xdd = U qdd + c over all rows.
+    for i in 0..n {
+        let want = c[i] + (0..m).map(|j| u[j * n + i] * ws.qdd[j]).sum::<f64>();
+        assert!((ws.xdd[i] - want).abs() < DENSE_TOL * scale, "xdd[{i}] = {} vs {want}", ws.xdd[i]);
+    }
+    // tau = U^T (M xdd - f): zero for the passive ladder, to the round-off of b (|f| ~ 1 N).
+    let tau = query::inverse_dynamics(&mech, &q, &qd, &ws.qdd, None).unwrap();
+    let b_scale = b.amax();
+    for (j, t) in tau.iter().enumerate() {
+        assert!(t.abs() < DENSE_TOL * b_scale.max(1.0), "tau[{j}] = {t}");
     }
 }

@@ -46,9 +46,8 @@ pub fn inverse_at_rates(
     let n = ws.x.len();
     for (j, tau) in ws.tau.iter_mut().enumerate() {
         let u = &ws.frame.u[j * n..(j + 1) * n];
-        let (first, end) = ws.frame.sys.u_support()[j];
-        let uf: f64 = u[3 * first..3 * end].iter().zip(&ws.f[3 * first..3 * end]).map(|(u, f)| u * f).sum();
-        *tau = m_dot(mech, u, &ws.xdd, (first, end)) - uf;
+        let support = ws.frame.sys.u_support();
+        *tau = m_dot(mech, u, &ws.xdd, support.runs(j)) - support.dot(j, u, &ws.f);
     }
     if mech.has_losses() {
         inverse_with_losses(mech, qdd, ws)?;

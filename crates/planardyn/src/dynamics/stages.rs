@@ -11,7 +11,7 @@ use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::{
     coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
 };
-use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame};
+use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame, USupport};
 use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope, copy_small};
 use crate::model::{Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
@@ -69,14 +69,16 @@ pub(crate) fn pair_grad(mech: &Mechanism, pair: PairId, x: &[f64], grad: &mut [f
     pair_coordinate_grad(&mech.pairs[pair.0], x, &mut Dense { j: grad, ncols: x.len() }, 0);
 }
 
-/// a^T M b over the bodies `first..end` (a and b: 3n values each), M = blockdiag(m, m, I)
-/// per body.
-#[inline]
-pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], range: (usize, usize)) -> f64 {
-    if range.0 >= range.1 {
-        return 0.0;
+/// a^T M b over the bodies of `runs` ([first, end), ascending; a and b: 3n values each),
+/// M = blockdiag(m, m, I) per body; the terms added in order from -0.0 (f64's `Sum`).
+/// Inlined: called per entry of A and of b, a call's overhead is a five-bar's whole sum.
+#[inline(always)]
+pub(crate) fn m_dot(mech: &Mechanism, a: &[f64], b: &[f64], runs: &[(usize, usize)]) -> f64 {
+    let mut s = -0.0;
+    for &run in runs {
+        s = m_dot_from(s, mech, a, b, run);
     }
-    m_dot_from(-0.0, mech, a, b, range)
+    s
 }
 
 /// `s` plus the terms of [`m_dot`], added one after the other (f64's `Sum` starts at -0.0).
@@ -111,21 +113,20 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     }
     for (p, &(j, k)) in ws.frame.sys.a_pairs().iter().enumerate() {
         let (uj, uk) = (&ws.frame.u[j * n..(j + 1) * n], &ws.frame.u[k * n..(k + 1) * n]);
-        // One sum over the runs (as `m_dot` over one range: the same additions in order).
-        let s = ws.frame.sys.a_runs(p).iter().fold(-0.0, |s, &run| m_dot_from(s, mech, uj, uk, run));
+        let s = m_dot(mech, uj, uk, ws.frame.sys.a_runs(p));
         ws.a[j * m + k] = s;
         ws.a[k * m + j] = s;
     }
 }
 
-/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`.
+/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`, each column
+/// over its runs of bodies (`System::u_support`).
 pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
+    let support = ws.frame.sys.u_support();
     for (j, bj) in ws.b.iter_mut().enumerate() {
         let uj = &ws.frame.u[j * n..(j + 1) * n];
-        let (first, end) = ws.frame.sys.u_support()[j];
-        let (u, f) = (&uj[3 * first..3 * end], &ws.f[3 * first..3 * end]);
-        *bj = u.iter().zip(f).map(|(u, f)| u * f).sum::<f64>() - m_dot(mech, uj, &ws.frame.c, (first, end));
+        *bj = support.dot(j, uj, &ws.f) - m_dot(mech, uj, &ws.frame.c, support.runs(j));
     }
 }
 
@@ -261,8 +262,8 @@ fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
 }
 
 /// xdd = U zdd + c: the body accelerations of chart accelerations zdd (U column-major,
-/// one column of 3n a coordinate), each column over the bodies of its `support`
+/// one column of 3n a coordinate), each column over its runs of bodies in `support`
 /// (`System::u_support`), where it may be non-zero.
-pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &[(usize, usize)], xdd: &mut [f64]) {
+pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &USupport, xdd: &mut [f64]) {
     u_times_from(u, support, |j| zdd[j], |i, _| c[i], xdd);
 }

@@ -5,6 +5,7 @@
 
 use super::constraints::gamma;
 use super::frame::Frame;
+use super::u_support::USupport;
 use crate::model::Mechanism;
 use crate::KinematicsError;
 
@@ -25,21 +26,16 @@ pub fn velocity_analogues(ws: &mut Frame) -> Result<(), KinematicsError> {
     Ok(())
 }
 
-/// `out += sum_j dz(j) u_j` over each column's support (`supports`, from
-/// `System::u_support`: U is zero outside it), for U column-major (3n per column).
-#[inline]
-pub fn add_u_times(u: &[f64], supports: &[(usize, usize)], dz: impl Fn(usize) -> f64, out: &mut [f64]) {
-    u_times_from(u, supports, dz, |_, v| v, out);
-}
-
-/// `out = start + sum_j dz(j) u_j`, `start(i, out_i)` the value entry i starts from (`out_i`
-/// itself for [`add_u_times`], zero or another vector's entry to write `out` whole): for a few
-/// columns in the one pass of [`add_columns`] (no clearing or copy of `out` before, which costs
-/// a library call a stage at this size), else over the supports.
+/// `out = start + sum_j dz(j) u_j` over each column's runs of bodies (`supports`, from
+/// `System::u_support`: U is zero outside them), for U column-major (3n per column);
+/// `start(i, out_i)` the value entry i starts from (`out_i` itself to add, zero or another
+/// vector's entry to write `out` whole): for a few columns in the one pass of [`add_columns`]
+/// (no clearing or copy of `out` before, which costs a library call a stage at this size),
+/// else over the runs.
 #[inline]
 pub(crate) fn u_times_from(
     u: &[f64],
-    supports: &[(usize, usize)],
+    supports: &USupport,
     dz: impl Fn(usize) -> f64,
     start: impl Fn(usize, f64) -> f64,
     out: &mut [f64],
@@ -53,10 +49,12 @@ pub(crate) fn u_times_from(
         _ => {}
     }
     out.iter_mut().enumerate().for_each(|(i, v)| *v = start(i, *v));
-    for (j, (u, &(first, end))) in u.chunks_exact(n).zip(supports).enumerate() {
+    for (j, u) in u.chunks_exact(n).enumerate().take(supports.len()) {
         let r = dz(j);
-        for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
-            *v += u * r;
+        for &(first, end) in supports.runs(j) {
+            for (v, u) in out[3 * first..3 * end].iter_mut().zip(&u[3 * first..3 * end]) {
+                *v += u * r;
+            }
         }
     }
 }

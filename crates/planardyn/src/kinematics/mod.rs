@@ -15,8 +15,9 @@ pub mod rank;
 pub mod singularity;
 pub mod system;
 pub mod third;
+pub mod u_support;
 
-pub use analogues::{acceleration_analogues, add_u_times, convective, velocity_analogues};
+pub use analogues::{acceleration_analogues, convective, velocity_analogues};
 pub use closed_form::ClosedForm;
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
@@ -27,3 +28,4 @@ pub use position::{
 };
 pub use singularity::{passive_sigma_min, select_partition, sigma_min, sigma_min_with};
 pub use system::System;
+pub use u_support::USupport;

@@ -10,6 +10,7 @@
 
 use super::constraints::{jacobian, jacobian_into, jacobian_pattern, set_row_scale, Chart};
 use super::group_sigma::GroupScales;
+use super::u_support::USupport;
 use crate::linalg::{BlockLu, MAX_COLUMNS};
 use crate::model::Mechanism;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -37,9 +38,9 @@ pub struct System {
     /// on (`BlockLu::reach`): a coordinate moves only the groups that depend on it. None when
     /// every sweep reaches every block (a single closed chain): the plain solve, no zeroing.
     unit_reach: Option<Vec<Vec<usize>>>,
-    /// Per column j of U, the bodies it may be non-zero on, [first, end): those of the blocks
-    /// its coordinate's row reaches.
-    u_support: Vec<(usize, usize)>,
+    /// Per column j of U, the bodies it may be non-zero on (those of the blocks its
+    /// coordinate's row reaches), as runs.
+    u_support: USupport,
     /// The entries of A = U^T M U that may be non-zero: the pairs j <= k of columns that share
     /// a body (of the blocks their coordinates reach, not only of their supports' ranges: a
     /// body order that interleaves the parts would make every range meet), and per row k the
@@ -82,7 +83,7 @@ impl System {
         System {
             groups: GroupScales::new(mech, chart, &lu),
             unit_reach: unit_reach(mech, &lu),
-            u_support: u_bodies.iter().map(|b| support_range(b)).collect(),
+            u_support: USupport::new(&u_bodies),
             a_pairs,
             a_runs_at,
             a_runs,
@@ -114,7 +115,7 @@ impl System {
             self.groups = GroupScales::new(mech, chart, &self.lu);
             self.unit_reach = unit_reach(mech, &self.lu);
             let u_bodies = u_bodies(mech, &self.lu);
-            self.u_support = u_bodies.iter().map(|b| support_range(b)).collect();
+            self.u_support = USupport::new(&u_bodies);
             let a = a_pattern(&u_bodies, mech.n_bodies());
             (self.a_pairs, self.a_runs_at, self.a_runs, self.a_first, self.a_fill_in) =
                 (a.pairs, a.runs_at, a.runs, a.first, a.fill_in);
@@ -171,9 +172,9 @@ impl System {
         self.lu.solve_unit_columns(u, first_row, &self.row_scale, &self.col_scale, self.unit_reach.as_deref());
     }
 
-    /// Per column j of U = dx/dz, the bodies it may be non-zero on, [first, end) (from the
-    /// blocks its coordinate reaches): the products of U's columns skip the others.
-    pub fn u_support(&self) -> &[(usize, usize)] {
+    /// Per column j of U = dx/dz, the bodies it may be non-zero on, as runs (from the blocks
+    /// its coordinate reaches): the products of U's columns skip the others.
+    pub fn u_support(&self) -> &USupport {
         &self.u_support
     }
 
@@ -240,11 +241,6 @@ fn u_bodies(mech: &Mechanism, lu: &BlockLu) -> Vec<Vec<usize>> {
             bodies
         })
         .collect()
-}
-
-/// [first, end) of ascending `bodies` (see [`System::u_support`]); (0, 0) if none.
-fn support_range(bodies: &[usize]) -> (usize, usize) {
-    bodies.first().zip(bodies.last()).map_or((0, 0), |(&f, &l)| (f, l + 1))
 }
 
 /// A's pattern (see [`System::a_pairs`]).
