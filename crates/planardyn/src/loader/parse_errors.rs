@@ -242,10 +242,18 @@ fn plain(message: &str) -> String {
         let end = out[i..].find(" elements").map_or(out.len(), |j| i + j + " elements".len());
         out.replace_range(i..end, "a mapping with the fields of its `type`");
     }
-    // Any other part of the model that serde names by its Rust type: a mapping.
-    while let Some(i) = out.find("struct ") {
+    // Any other part of the model that serde names by its Rust type (`struct ...Spec`): a
+    // mapping. Other text (a user's string holding "struct ") is left as written.
+    let mut from = 0;
+    while let Some(i) = out[from..].find("struct ").map(|i| from + i) {
         let name = out[i + "struct ".len()..].split(|c: char| !c.is_alphanumeric()).next().unwrap_or("");
-        out.replace_range(i..i + "struct ".len() + name.len(), "a mapping");
+        let end = i + "struct ".len() + name.len();
+        if name.ends_with("Spec") {
+            out.replace_range(i..end, "a mapping");
+            from = i + "a mapping".len();
+        } else {
+            from = end;
+        }
     }
     out
 }
