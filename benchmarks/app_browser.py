@@ -10,6 +10,9 @@ extension (the same Rust through the Python API), measured in one run on this ma
   state's branch; native: a continuation loop in Python over Mechanism.kinematics, which also
   computes the analogues u and w: the Python API has no call for the map, so the native
   figure is the Python user's);
+- the 3-RRR's 100 x 100 singularity map over its first two inputs, the third held (the same
+  page map: each cell placed on the current state's branch along its path from it,
+  planardyn::kinematics::BranchPath, the triad's Newton a step; native: the same Python loop);
 - the compliant 5R's (the shipped five-bar-compliant: elastic motors and end-effector pin) 100 x 100
   map of its first natural frequency (web/src/map.js over planardyn::elastic::map_rows; the
   page's only: the Python API has no call for it);
@@ -85,22 +88,25 @@ def native() -> dict[str, float]:
     out["frame"], out["frameBest"] = (t / FRAMES for t in steady(frames))
     five = pdy.load(pdy.models.path("five-bar"))
     out["map"] = once(lambda: python_map(five))
+    out["rrrMap"] = once(lambda: python_map(rrr))
     return out
 
 
 def python_map(mech: pdy.Mechanism) -> np.ndarray:
-    """The page's map (web/src/map.js) through the Python API: a serpentine over the grid,
-    each cell continued from the last."""
+    """The page's map (web/src/map.js) through the Python API: over the first two coordinates
+    (the others held), a serpentine over the grid, each cell continued from the last."""
     q0 = mech.q0
     lo, hi = q0 - np.pi, q0 + np.pi
     axis = [lo[k] + (hi[k] - lo[k]) * (np.arange(MAP_N) + 0.5) / MAP_N for k in range(2)]
     sigma = np.full((MAP_N, MAP_N), np.nan)
     x = row_start = mech.assemble(q0)
+    q = np.array(q0, dtype=float)
     for j in range(MAP_N):
         for i in range(MAP_N):
             ii = MAP_N - 1 - i if j % 2 else i
+            q[0], q[1] = axis[0][ii], axis[1][j]
             try:
-                k = mech.kinematics([axis[0][ii], axis[1][j]], x_start=x)
+                k = mech.kinematics(q, x_start=x)
                 x, sigma[j, ii] = k["x"], k["sigma_min"]
                 if i == 0:
                     row_start = x
@@ -132,8 +138,9 @@ PAGE_BENCH = """async ([four, rrr, compliant, frames, mapN, repeat, warm]) => {
     return once(() => mapper(rows(mech), mapRanges(info, info.q0), mapN, mech.assemble(info.q0), info.q0).step(Infinity));
   };
   const map = mapOf(five, sigmaRows);
+  const rrrMap = mapOf(m, sigmaRows);
   const frequencyMap = mapOf(pd.load(compliant, "yaml", "compliant.yaml"), frequencyRows);
-  return { simFirst, sim, simBest, frameFirst, frame, frameBest, map, frequencyMap, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000, warm: a.timings.warmMs / 1000 };
+  return { simFirst, sim, simBest, frameFirst, frame, frameBest, map, rrrMap, frequencyMap, load: a.timings.readyMs / 1000, engine: a.timings.engineMs / 1000, warm: a.timings.warmMs / 1000 };
 }"""
 
 
@@ -175,7 +182,8 @@ def main() -> None:
     print(f"{'':44s} {'browser':>10s} {'native':>10s} {'ratio':>7s} {'best':>15s} {'first':>10s}")
     rows = [("10 s passive four-bar run", "sim", 1e3, "ms"),
             ("3-RRR efforts + reactions, one frame", "frame", 1e6, "us"),
-            (f"5R singularity map {MAP_N} x {MAP_N}", "map", 1e3, "ms")]
+            (f"5R singularity map {MAP_N} x {MAP_N}", "map", 1e3, "ms"),
+            (f"3-RRR singularity map {MAP_N} x {MAP_N}", "rrrMap", 1e3, "ms")]
     for label, key, scale, unit in rows:
         timed = key + "First" in web
         first = f"{web[key + 'First'] * scale:10.3g}" if timed else f"{'-':>10s}"

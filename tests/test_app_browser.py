@@ -501,3 +501,31 @@ def test_loaded_stiffness_equals_the_python_api(page):
                      lambda q: st.stiffness(mech, q, body="distal_left", point="P", wrench=wrench,
                                             preload=preload).weakest_stiffness)
     page.wait_for_function(MAP_DONE, arg="the weakest stiffness of P (N/m, loaded)", timeout=120_000)
+
+
+def test_a_triads_map_is_on_the_current_branch(page):
+    # The 3-RRR (a triad solved by Newton) over th1, th2, th3 held: each present cell of a 12 x 12
+    # map made in the page is the configuration the Python API assembles from the drawing along
+    # the same straight path (assemble(q, x_start=)), sigma to STATE_RTOL (both reach it by
+    # continuation on its branch: crates/planardyn/tests/branch_path.rs finds them within
+    # 2e-13 in x); cells the path does not reach on the branch are NaN.
+    text = pdy.models.path("3-rrr").read_text()
+    mech = pdy.loads(text)
+    got = page.evaluate(
+        """(text) => {
+            const a = window.planardyn, { mapRanges, mapper, sigmaRows } = a.mapTools;
+            const m = a.pd.load(text, "yaml", "3-rrr.yaml"), info = m.info();
+            const ranges = mapRanges(info, info.q0), grid = mapper(sigmaRows(m), ranges, 12, m.assemble(info.q0), info.q0);
+            grid.step(Infinity);
+            return { ranges, sigma: Array.from(grid.sigma, (v) => (Number.isFinite(v) ? v : null)) };
+        }""",
+        text,
+    )
+    n, q0, x0 = 12, mech.q0, mech.assemble(mech.q0)
+    axes = [lo + (hi - lo) * (np.arange(n) + 0.5) / n for lo, hi in got["ranges"]]
+    present = [(j, i) for j in range(n) for i in range(n) if got["sigma"][j * n + i] is not None]
+    assert 0 < len(present) < n * n
+    for j, i in present:
+        q = np.array([axes[0][i], axes[1][j], q0[2]])
+        want = mech.kinematics(q, x_start=x0)["sigma_min"]
+        np.testing.assert_allclose(got["sigma"][j * n + i], want, rtol=STATE_RTOL, err_msg=f"cell ({j}, {i})")

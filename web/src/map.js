@@ -2,9 +2,10 @@
 // the type II measure sigma (the engine's `sigmaRows`) or, for a compliant model, the first
 // natural frequency or a point's weakest stiffness under a load (`elasticRows`), on the branch
 // of the current state (planardyn::dynamics::MapRows: where every group has a closed form
-// without iteration, each cell in the assembly modes of the current state; else by
-// continuation from it, each cell from its neighbour). Computed progressively, coarse grids
-// first, in slices that leave the page responsive; cells that do not assemble are grey.
+// without iteration, each cell in the assembly modes of the current state; with a triad, each
+// cell along the straight path from the current state in its modes; else by continuation from
+// it, each cell from its neighbour). Computed progressively, coarse grids first, in slices that
+// leave the page responsive; cells that do not assemble on that branch are grey.
 
 /** Grids of the progressive refinement; the last is the map's resolution. */
 export const LEVELS = [25, 50, 100];
@@ -25,9 +26,9 @@ export function mapRanges(info, q) {
   return [0, 1].map((k) => coordinateRange(info, k, q[k]));
 }
 
-/** The type II measure's rows (`Mechanism.sigmaRows`: one workspace, each row walked from
- * column i0 both ways, continuing from x): `{sigma (rows x n), x (where the next rows
- * continue)}`. */
+/** The type II measure's rows (`Mechanism.sigmaRows`: one workspace; each cell on its own on
+ * x's branch, or for a mechanism without closed forms each row walked from column i0 both
+ * ways, continuing from x): `{sigma (rows x n), x (where the next rows continue)}`. */
 export const sigmaRows = (mech) => (q, axes, i0, rows, x) => mech.sigmaRows(q, 0, 1, axes[0], axes[1], i0, rows, x);
 
 /** The rows of an elastic map (`Mechanism.elasticRows`, the same grid, rows and branch as

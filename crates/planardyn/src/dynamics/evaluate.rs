@@ -7,7 +7,7 @@
 
 use super::query::assembled;
 use super::{forward, inverse, kinetic_energy, motor_torques, potential_energy, reactions, FixedDrives, Workspace};
-use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, Chart, ClosedForm};
+use crate::kinematics::{assemble_from, passive_sigma_min, sigma_min, sigma_min_with, BranchPath, Chart, ClosedForm};
 use crate::model::Mechanism;
 use crate::{Error, KinematicsError};
 
@@ -88,7 +88,18 @@ pub fn evaluate(
 ///   edge of the cells that assemble), and it needs no walk: each cell is placed on its own,
 ///   in any order, and a cell is missing (NaN) exactly where no configuration exists at all
 ///   (the group cannot close on any branch: its circles do not meet).
-/// - otherwise (a group solved by Newton's method, or none with a closed form), by
+/// - where a class III triad is solved by Newton's method within the closed forms (a 3-RRR,
+///   a 3-RPR), the branch of `x_start` too, each cell again on its own: the configuration
+///   reached from `x_start` along the straight path in the coordinates (from those of
+///   `x_start` to the cell's) without leaving its assembly modes (the triad's side of its
+///   type II singularity, each dyad's elbow), in steps that cannot jump to another mode
+///   ([`crate::kinematics::BranchPath`]); a cell is missing where that path is blocked: no
+///   configuration on the way, or a fold of the branch (sigma -> 0) before the cell. A triad
+///   has up to six assembly modes, several on one side of its singularity, and Newton's method
+///   from a distant pose may converge to any of them: the path, not a test of the solution,
+///   is what keeps the branch. Such a map shows the part of the branch seen from `x_start`
+///   along straight lines (a region the branch reaches only around a bend is missing).
+/// - otherwise (no closed form for some group), by
 ///   continuation: each row in `rows` (in that order) starts at column `i0` from the previous
 ///   row's start (from `x_start` for the first), then walks right and left from there, each
 ///   cell from its neighbour; a cell that does not assemble is NaN and the walk goes on from
@@ -100,7 +111,8 @@ pub struct MapRows {
     /// NaN where the mechanism does not assemble on the branch shown or has no value there.
     pub values: Vec<f64>,
     /// Body coordinates (3n) where the next rows continue: the last row's start cell (by
-    /// continuation), or `x_start` itself (the branch's reference, by the closed forms).
+    /// continuation), or `x_start` itself (the branch's reference, by the closed forms and
+    /// the triad's path).
     pub x: Vec<f64>,
 }
 
@@ -184,13 +196,20 @@ pub fn map_rows(
     let mut ws = Workspace::new(mech);
     let mut q = q.to_vec();
     let mut values = vec![f64::NAN; rows.len() * n];
-    if let Some(mut closed) = ClosedForm::new(mech).filter(ClosedForm::is_explicit) {
+    if let Some(mut closed) = ClosedForm::new(mech) {
+        // Each cell on its own: by the closed forms in the reference's modes, or with a triad
+        // along the path from the reference (`BranchPath`).
+        let mut path = (!closed.is_explicit()).then(|| BranchPath::new(mech, &mut closed, x_start));
         closed.set_reference(x_start);
         for (&j, row) in rows.iter().zip(values.chunks_exact_mut(n)) {
             q[k[1]] = axes[1][j];
             for (i, cell) in row.iter_mut().enumerate() {
                 q[k[0]] = axes[0][i];
-                if closed.positions(&q, &mut ws.frame).is_ok() {
+                let placed = match &mut path {
+                    Some(path) => path.place(&mut closed, &q, &mut ws.frame),
+                    None => closed.positions(&q, &mut ws.frame),
+                };
+                if placed.is_ok() {
                     *cell = value(&q, &mut ws).unwrap_or(f64::NAN);
                 }
             }

@@ -433,6 +433,13 @@ impl ClosedForm {
         self.place(z, Start::Reference, ws)
     }
 
+    /// [`ClosedForm::positions`] with the triad's Newton from the platform's pose in `ws.x` (a
+    /// prediction on the reference branches, nearer than the reference configuration), the
+    /// positions alone: a step of a path on the reference branches (`branch_path`).
+    pub fn predicted_positions(&mut self, z: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
+        self.place(z, Start::Predicted, ws)
+    }
+
     /// [`ClosedForm::positions`], the triad's Newton from `start`.
     fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         for c in &self.cranks {

@@ -3,6 +3,7 @@
 //! One algorithm a file; all of them work on the body coordinates x (3n values).
 
 pub mod analogues;
+pub mod branch_path;
 pub mod closed_form;
 mod column_reach;
 pub mod constraints;
@@ -18,6 +19,7 @@ pub mod third;
 pub mod u_support;
 
 pub use analogues::{acceleration_analogues, convective, velocity_analogues};
+pub use branch_path::BranchPath;
 pub use closed_form::ClosedForm;
 pub use constraints::{coordinate_rates, coordinates, Chart};
 pub use effector::{Effector, EffectorError, EffectorState, SINGULAR_TOL};
