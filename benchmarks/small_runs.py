@@ -20,7 +20,8 @@ run from Rust, and the serial share of a batch.
 
 - With ``--icount``, the fixed cost also in instructions, which the machine's load does not
   change: each side run under valgrind's callgrind for ICOUNT_CALLS[0] and ICOUNT_CALLS[1]
-  calls (after a first, untimed one), the difference of the two counts per call.
+  calls (after a first, untimed one), the difference of the two counts per call (numpy's
+  BLAS on one thread: ``ICOUNT_ENV``).
 
 Build ``benchmarks/rust-sim`` first for the Rust side (``benchmarks/run.sh`` does)::
 
@@ -99,10 +100,17 @@ def fixed_cost(calls: int) -> dict[str, float]:
     return out
 
 
+#: The Python side's BLAS with one thread under callgrind: numpy's OpenBLAS worker threads spin
+#: while idle, and valgrind, running one thread at a time, counted 15-19k instructions a call of
+#: theirs that no call makes (no BLAS routine is on its path; the CPU time above is the calling
+#: thread's alone).
+ICOUNT_ENV = {"OPENBLAS_NUM_THREADS": "1"}
+
+
 def _instructions(command: list[str]) -> int:
     """Instructions callgrind counts in a run of ``command`` (its ``Collected`` line)."""
     out = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", *command],
-                         capture_output=True, text=True, check=True).stderr
+                         capture_output=True, text=True, check=True, env={**os.environ, **ICOUNT_ENV}).stderr
     return int(re.search(r"Collected : (\d+)", out).group(1))  # type: ignore[union-attr]
 
 

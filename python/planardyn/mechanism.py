@@ -28,7 +28,7 @@ from .models import UnknownModelError
 from .models import path as model_path
 from .result import PointMotion, RawRun, SimulationInterrupted, SimulationResult
 from .results_format import plain
-from .settings import check_settings, convert_settings
+from .settings import check_settings, convert_numbers
 
 
 class PlanardynWarning(UserWarning):
@@ -82,6 +82,8 @@ class _RunFacts(NamedTuple):
     #: The model file's ``simulate`` output_dt and t_end (s), None where not given.
     output_dt: float | None
     t_end: float | None
+    #: Most output rows that always fit (``guard.ALWAYS_FITS``): the memory is not read for them.
+    rows_always_fit: float
 
 
 class Mechanism:
@@ -170,13 +172,14 @@ class Mechanism:
             defaults = self.simulate_defaults
             self._facts = _RunFacts(self.to_dict(), self.source, self.coordinate_names, self.coordinate_kinds, self.body_names,
                                     any(a is not None for a in self.actuators), self.dof, self.n_bodies,
-                                    defaults.get("output_dt"), defaults.get("t_end"))
+                                    defaults.get("output_dt"), defaults.get("t_end"),
+                                    ALWAYS_FITS / needed_bytes(1, self.dof, self.n_bodies))
         return self._facts
 
     def _result(self, raw: RawRun, settings: dict[str, Any] | Callable[[], dict[str, Any]]) -> SimulationResult:
         """The result of a run from the native one, its metadata recording ``settings`` (or
         what the callable makes: values the caller could change after the call copied)."""
-        f = self._run_facts()
+        f = self._facts or self._run_facts()
         if not callable(settings):  # plain values now: an array changed after the call is recorded as it was
             given = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
             settings = lambda: given  # noqa: E731
@@ -184,7 +187,7 @@ class Mechanism:
         # The metadata is made at its first read (issue 25 item 4).
         return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
                                          body_names=f.body_names, metadata=lambda: run_metadata({}, self, record()),
-                                         tau_motor=self._result_motor_torques(raw))
+                                         tau_motor=self._result_motor_torques(raw) if f.has_actuators else None)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mechanism):
@@ -752,24 +755,26 @@ class Mechanism:
         """
         # The rules of the settings are the core's, which the run applies (checked once, issue 25
         # item 4); here the numbers are converted, and checked only before their rows are counted.
-        checked = convert_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
-        self._check_rows_fit(checked, t_eval)
-        names = self._run_facts().coordinate_names
+        f = self._facts or self._run_facts()
+        numbers = convert_numbers(t_end, rtol, atol, dt, output_dt, max_steps)
+        if t_eval is not None or numbers[4] is not None or f.output_dt is not None:
+            self._check_rows_fit(numbers, t_eval)
+        names = f.coordinate_names
         raw = self._native.simulate(
-            t_end=checked["t_end"],
+            t_end=numbers[0],
             method=method,
-            rtol=checked["rtol"],
-            atol=checked["atol"],
-            dt=checked["dt"],
+            rtol=numbers[1],
+            atol=numbers[2],
+            dt=numbers[3],
             t_eval=t_eval,
-            output_dt=checked["output_dt"],
+            output_dt=numbers[4],
             q0=q0,
             qd0=qd0,
             drives=drives,
             progress=progress,
-            max_steps=checked["max_steps"],
-            motion=native_motion(motion, names),
-            events=native_events(events, names),
+            max_steps=numbers[5],
+            motion=None if motion is None else native_motion(motion, names),
+            events=native_events(events, names) if events else [],
             dense_output=bool(dense_output),
         )
         # The result carries its model and settings, so it can be saved, re-plotted and rerun:
@@ -791,22 +796,23 @@ class Mechanism:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
 
-    def _check_rows_fit(self, checked: dict[str, Any], t_eval: ArrayLike | None) -> None:
+    def _check_rows_fit(self, numbers: tuple[Any, ...], t_eval: ArrayLike | None) -> None:
         """Refuse up front a run whose output rows cannot fit in the memory available (a run
-        that outputs every step has no count known up front). The memory is not read for a run
-        whose rows always fit (``guard.ALWAYS_FITS``)."""
+        that outputs every step has no count known up front); ``numbers`` are the converted
+        (t_end, rtol, atol, dt, output_dt, max_steps). The memory is not read for a run whose
+        rows always fit (``guard.ALWAYS_FITS``)."""
         f = self._run_facts()
-        output_dt = checked.get("output_dt") or f.output_dt
+        t_end, output_dt = numbers[0], numbers[4] or f.output_dt
         if t_eval is not None:
             rows = float(np.size(t_eval))
         elif output_dt is not None:
-            rows = (checked.get("t_end") or f.t_end or 1.0) / output_dt + 1
+            rows = (t_end or f.t_end or 1.0) / output_dt + 1
         else:
             return
-        if needed_bytes(rows, f.dof, f.n_bodies) <= ALWAYS_FITS:
+        if rows <= f.rows_always_fit:
             return
         # A setting that breaks its rule (an infinite t_end...) is refused as such, not for its rows.
-        check_settings(**checked)
+        check_settings(**dict(zip(("t_end", "rtol", "atol", "dt", "output_dt", "max_steps"), numbers)))
         refused = rows_message(rows, f.dof, f.n_bodies, available_memory())
         if refused:
             raise error("output_dt", f"{refused}: give a larger output_dt, fewer t_eval or a shorter t_end")

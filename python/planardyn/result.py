@@ -237,22 +237,19 @@ class SimulationResult:
         """Wrap the native ``Mechanism.simulate``'s result (a ``_core.Run``, or the dict a
         batch returns). Its arrays, counters, events and ``metadata`` (given, or made by a
         callable) are made at their first read (:data:`LAZY_FIELDS`)."""
-        # Every other field at once: the frozen dataclass's __init__ sets them one by one
-        # through object.__setattr__, and making every array up front was most of a short run's
-        # fixed cost in Python (issue 25 item 4).
+        # The frozen dataclass's __init__ sets every field one by one through
+        # object.__setattr__, and making every array up front was most of a short run's fixed
+        # cost in Python (issue 25 item 4): how the run ended is set now, the rest at its first read.
         result = object.__new__(cls)
-        result.__dict__.update(
-            success=raw["status"] in ("success", "event"),
-            status=raw["status"],
-            message=raw["message"],
-            coordinate_names=list(coordinate_names),
-            coordinate_kinds=list(coordinate_kinds),
-            body_names=list(body_names),
-            tau_motor=tau_motor,
-            # Not made later: a field with a default is a class attribute, found before __getattr__.
-            sol=raw.get("sol"),
-            _pending=(raw, metadata),
-        )
+        status = raw["status"]
+        values = result.__dict__
+        values.update(success=status in ("success", "event"), status=status, message=raw["message"],
+                      _pending=(raw, metadata, (coordinate_names, coordinate_kinds, body_names)))
+        # A field with a default is a class attribute, found before __getattr__: set when not the default.
+        if (sol := raw.get("sol")) is not None:
+            values["sol"] = sol
+        if tau_motor is not None:
+            values["tau_motor"] = tau_motor
         return result
 
     def __getattr__(self, name: str) -> Any:
@@ -384,12 +381,19 @@ class SimulationResult:
 
 #: The fields of a result from a native run made at their first read (``from_raw``).
 LAZY_FIELDS = frozenset(FIELD_COLUMNS) - {"tau_motor"} | {
-    "energy", "poses", "stats", "change_points", "t_events", "q_events", "qd_events", "metadata"}
+    "energy", "poses", "stats", "change_points", "t_events", "q_events", "qd_events", "metadata",
+    "coordinate_names", "coordinate_kinds", "body_names"}
+#: The mechanism's names a result holds, in ``from_raw``'s order.
+NAME_FIELDS = ("coordinate_names", "coordinate_kinds", "body_names")
 
 
 def _lazy_field(result: SimulationResult, name: str, raw: RawRun,
-                metadata: Mapping[str, Any] | Callable[[], Mapping[str, Any]] | None) -> Any:
-    """Field ``name`` of ``result`` from its native run ``raw`` (see ``from_raw``)."""
+                metadata: Mapping[str, Any] | Callable[[], Mapping[str, Any]] | None,
+                names: tuple[list[str], list[str], list[str]]) -> Any:
+    """Field ``name`` of ``result`` from its native run ``raw`` and the mechanism's ``names``
+    (coordinates, their kinds, bodies; see ``from_raw``)."""
+    if name in NAME_FIELDS:
+        return list(names[NAME_FIELDS.index(name)])  # the result's own copy
     if name == "energy":
         return Energy.from_arrays(raw["kinetic"], raw["potential"], raw["work"])
     if name == "poses":

@@ -24,13 +24,15 @@ from typing import Any
 
 from ._core import MAX_STEPS, MIN_RTOL, check_setting
 
-__all__ = ["MAX_STEPS", "MAX_THREADS", "MIN_RTOL", "NUMBERS", "check_settings", "convert_settings"]
+__all__ = ["MAX_STEPS", "MAX_THREADS", "MIN_RTOL", "NUMBERS", "check_settings", "convert_numbers", "convert_settings"]
 
 #: Settings that are numbers (s, or dimensionless for the tolerances).
 NUMBERS = ("t_end", "rtol", "atol", "dt", "output_dt")
 #: Most native threads of a batch: far more than any machine's cores, far fewer than
 #: would exhaust the system's thread table.
 MAX_THREADS = 256
+#: The types of a number setting that needs no conversion (a float, or None: not given).
+_AS_GIVEN = frozenset({float, type(None)})
 
 
 def _number(name: str, value: Any) -> float:
@@ -81,3 +83,15 @@ def convert_settings(**settings: Any) -> dict[str, Any]:
             check_setting(name, float(n))
             out[name] = n
     return out
+
+
+def convert_numbers(
+    t_end: Any, rtol: Any, atol: Any, dt: Any, output_dt: Any, max_steps: Any
+) -> tuple[float | None, float | None, float | None, float | None, float | None, int | None]:
+    """:func:`convert_settings` of ``Mechanism.simulate``'s numbers, in this order: floats and
+    None, the common case, pass as given after one set test (a short run's fixed cost, issue 25
+    item 4); anything else is converted, or refused, by :func:`convert_settings`."""
+    if max_steps is None and {type(t_end), type(rtol), type(atol), type(dt), type(output_dt)} <= _AS_GIVEN:
+        return t_end, rtol, atol, dt, output_dt, None
+    c = convert_settings(t_end=t_end, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, max_steps=max_steps)
+    return c["t_end"], c["rtol"], c["atol"], c["dt"], c["output_dt"], c["max_steps"]

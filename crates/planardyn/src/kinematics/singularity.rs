@@ -60,7 +60,18 @@ pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
     if mech.n_constraints == 0 {
         return f64::INFINITY;
     }
-    let inputs = sigma_min(mech, &Chart::Inputs, x);
+    passive_sigma_min_with(&mut System::new(mech), mech, x)
+}
+
+/// [`passive_sigma_min`] with the blocks of the user's chart kept by the caller (`inputs_sys`,
+/// a `System::new` analysed once, as [`sigma_min_with`] takes it): the same value without
+/// analysing that chart's structure again (a run's change-point check: about 40k of a short
+/// four-bar run's 384k instructions). Its factorisation is left invalid.
+pub fn passive_sigma_min_with(inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
+    if mech.n_constraints == 0 {
+        return f64::INFINITY;
+    }
+    let inputs = sigma_min_with(inputs_sys, mech, &Chart::Inputs, x);
     inputs.max(sigma_min(mech, &Chart::Partition(select_partition(mech, x)), x))
 }
 

@@ -3,7 +3,7 @@
 //! singularity, and back again once past it. Decisions are taken between accepted steps.
 
 use super::ode::MechanismOde;
-use crate::kinematics::{passive_sigma_min, select_partition, sigma_min_with, Chart};
+use crate::kinematics::{passive_sigma_min_with, select_partition, sigma_min_with, Chart};
 
 /// Below this scaled type II measure the integrator leaves the user's coordinates. The scaled
 /// J has O(1) entries; at 0.05 the position solve still loses under 2 digits, and a step of
@@ -59,7 +59,7 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
             Chart::Partition(_) => ode.ws.sys.sigma_min_estimate(),
             Chart::Inputs => None,
         };
-        own.map_or_else(|| passive_sigma_min(ode.mech, &ode.ws.x), |own| own.max(sigma))
+        own.map_or_else(|| passive_sigma_min_with(&mut ode.inputs_sys, ode.mech, &ode.ws.x), |own| own.max(sigma))
     };
     Measures { sigma, passive }
 }

@@ -23,7 +23,7 @@ use super::trajectory::Trajectory;
 use super::{Observe, Settings};
 use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
 use crate::integrate::{Options, Stats, Stepper};
-use crate::kinematics::{passive_sigma_min, Chart};
+use crate::kinematics::{passive_sigma_min, passive_sigma_min_with, Chart};
 use crate::model::Mechanism;
 use crate::Error;
 
@@ -405,9 +405,10 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if meas.passive < APPROACH_BELOW {
             return true;
         }
-        *self
-            .heading
-            .get_or_insert_with(|| passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CHANGE_POINT_RATIO * meas.passive)
+        *self.heading.get_or_insert_with(|| {
+            let ode = &mut self.ode;
+            passive_sigma_min_with(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CHANGE_POINT_RATIO * meas.passive
+        })
     }
 
     /// Whether the step just taken to t, not limited by the approach, went past the start of
