@@ -374,6 +374,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.bound_first_step(first_step_bound(&self.ode, own));
         }
         self.ode.limit_correction(own);
+        self.ode.limit_step_reach();
         // In the user's chart the passive measure is only bounded by sigma_II (it is
         // measured in a partition, which the integrator takes below 0.05).
         if meas.passive < WATCH_BELOW && self.ode.motion.is_none() && self.ode.ws.chart != Chart::Inputs {
