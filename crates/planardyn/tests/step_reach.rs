@@ -1,6 +1,8 @@
 //! A step accepted by the error test is as accurate as the tolerance asks, also where it
 //! passes near its chart's singularity (`simulate::ode::STEP_REACH`).
 
+mod common;
+use common::{yaml, PARALLELOGRAM};
 use planardyn::dynamics::ModelDrives;
 use planardyn::simulate::{grid, simulate, Settings};
 
@@ -36,4 +38,25 @@ fn five_bar_steps_near_singularities_keep_the_energy() {
     let at_steps = five_bar_drift(None);
     assert!(on_grid < DRIFT_TARGET, "drift on the 0.01 s grid {on_grid:.3e} J");
     assert!(at_steps < DRIFT_TARGET, "drift at the steps {at_steps:.3e} J");
+}
+
+/// tests/test_api.py's bound on the redundant triple crank's drift over 0.3 s (its default
+/// rtol 1e-9). The run ends 5 ms before its change point, inside the crossing, and its last
+/// row is the crossing's bridge; with the crossing started on the approach's grid it drifts
+/// 2.0e-11, 7.1e-11, 4.2e-9, 2.0e-9 J at the tolerances below. Main (f2d85fd), whose
+/// crossings started at the first point below CROSS_START: 6.5e-7, 2.5e-9, 4.6e-7, 5.5e-7 J;
+/// with the reach cutting the approach's steps (c7f959f): 4.5e-7, 4.9e-8, 1.4e-9, 5.0e-8 J.
+const CROSSING_DRIFT: f64 = 1e-8;
+
+#[test]
+fn triple_crank_crossing_starts_on_its_approach_grid_at_every_tolerance() {
+    let mech = yaml(PARALLELOGRAM);
+    for rtol in [5e-10, 1e-9, 1.1e-9, 2e-9] {
+        let mut s = Settings::for_model(&mech).unwrap();
+        (s.t_end, s.options.rtol) = (0.3, rtol);
+        let traj = simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap();
+        assert!(traj.success(), "rtol {rtol}: {}", traj.message);
+        let drift = traj.stats.energy_drift;
+        assert!(drift < CROSSING_DRIFT, "rtol {rtol}: drift {drift:.3e} J");
+    }
 }
