@@ -300,7 +300,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let falling = self.approach.last().is_some_and(|p| meas.passive < p.passive);
         let over = stepped_over(&self.ode, &self.approach, t, meas.passive);
         let watched = self.heading != Some(false) && self.ode.motion.is_none();
-        if over.is_none() && meas.passive < CROSS_START && falling && watched {
+        if over.is_none() && meas.passive < CROSS_START && falling && watched && !self.before_crossing_start(t, meas) {
             let work = self.y[self.y.len() - 1];
             return match self.cross_change_point((t, meas.sigma, meas.passive, work)) {
                 Ok(Crossed::Past) => Continue(true),
@@ -319,6 +319,19 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.approach.clear();
         }
         Continue(false)
+    }
+
+    /// Whether the point accepted at t is still before the crossing's start by more than a
+    /// quarter of the grid's spacing, as seen from it ([`Approach::grid`]): the next step then
+    /// ends there ([`Approach::step_limit`]), and the crossing starts on its grid, its gap
+    /// about twice the time from [`super::crossing::CROSS_BELOW`] to the point. Started at the
+    /// first point below [`CROSS_START`], the gap was up to 30 % longer wherever a step ended
+    /// short of the grid, and the rows inside it were the bridge's worst: the triple-crank
+    /// parallelogram (tests/test_api.py, 0.3 s) at rtol 5e-10, 1.1e-9, 2e-9 drifted 4.6e-7 ...
+    /// 6.5e-7 J at its last row, 5 ms before the point; with the crossing on its grid, at most
+    /// 4.2e-9 J over 14 tolerances 5e-10 ... 1e-6.
+    fn before_crossing_start(&self, t: f64, meas: &Measures) -> bool {
+        self.approach.grid(t, meas.passive).is_some_and(|g| t < g.t_star - g.tau - 0.25 * g.h)
     }
 
     /// Report a change point the run went through: in the trajectory's list, and in the least
@@ -356,8 +369,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         Break(Stop::Hopeless { t, attempts, mean, last, floor, t_end, max_steps })
     }
 
-    /// Change the chart if the measures ask for it, and bound the next step's moves by the
-    /// chart's distance to its singularities (and to a change point being approached).
+    /// Change the chart if the measures ask for it, and bound the next step's Newton moves by
+    /// the chart's distance to its singularities (and to a change point being approached).
     fn chart(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
         let m = self.ode.m();
         let mut own = chart_sigma(&mut self.ode, meas.sigma);
@@ -385,7 +398,15 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// With a change point ahead, the crossing's grid before it ([`Approach::grid`]) and where
     /// the next step should end at the latest ([`Approach::step_limit`]): below
     /// [`APPROACH_BELOW`] the next step ends there, above only if it would otherwise end past
-    /// the crossing's start ([`Run::retake`]).
+    /// the crossing's start ([`Run::retake`]). Elsewhere the step's reach is bounded by the
+    /// chart's measure (`MechanismOde::limit_step_reach`), which guards a chart's fold; below
+    /// [`APPROACH_BELOW`] with a change point ahead the measure is the change point's, which
+    /// every chart shares and the motion's branch passes smoothly (the triple-crank
+    /// parallelogram's mass matrix is constant through it), and the approach's grid bounds the
+    /// steps instead. The reach there (2 x 0.8 x the passive measure, a quarter of the way to
+    /// the point) cut the approach's steps off its grid, and the crossing started early
+    /// (tests/test_api.py's redundant triple crank at rtol 1e-9: at passive 0.0324, its row at
+    /// 0.3 s, 5 ms before the point, 4.9e-8 J off; 0.0256 and 2.5e-9 J without the reach).
     fn aim(&mut self, t: f64, meas: &Measures) {
         let grid = self.approach.grid(t, meas.passive).filter(|_| self.ode.motion.is_none());
         if grid.is_none() {
@@ -394,6 +415,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let ahead = grid.is_some() && self.change_point_ahead(meas);
         self.grid = grid.filter(|_| ahead);
         self.limit = self.approach.step_limit(t, meas.passive).filter(|_| ahead).map(|l| l.min(self.settings.t_end));
+        if self.limit.is_none() || meas.passive >= APPROACH_BELOW {
+            self.ode.limit_step_reach();
+        }
         self.t_stop = self.settings.t_end;
     }
 

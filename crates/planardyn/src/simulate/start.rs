@@ -61,5 +61,6 @@ pub fn start<'a>(
     ode.set_chart(chart, s.t0, &y)?;
     let own = chart_sigma(&mut ode, m0.sigma);
     ode.limit_correction(own);
+    ode.limit_step_reach();
     Ok((ode, y))
 }

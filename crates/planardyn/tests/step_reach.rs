@@ -1,0 +1,62 @@
+//! A step accepted by the error test is as accurate as the tolerance asks, also where it
+//! passes near its chart's singularity (`simulate::ode::STEP_REACH`).
+
+mod common;
+use common::{yaml, PARALLELOGRAM};
+use planardyn::dynamics::ModelDrives;
+use planardyn::simulate::{grid, simulate, Settings};
+
+/// The benchmarks' passive five-bar: total energy 1.874338473780 J (the model file's check).
+const FIVE_BAR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/models/five-bar-free-fall.yaml");
+
+/// The energy target of the five-bar benchmark (issue 25, drift 1e-4 J over 1 s). At this
+/// tolerance the run drifts 4.8e-5 J (grid) and 4.8e-5 J (every step); before the step's
+/// reach was bounded one step in the user's chart crossed the type II singularity and the run
+/// gained 0.89 J on the grid, 4.7e-2 J at the steps (both measured with DOP853 on main dde9f27).
+const DRIFT_TARGET: f64 = 1e-4;
+
+/// rtol = atol here: one of a sweep of 450 values 10^(-4 - k/150) where main lost most.
+const TOLERANCE: f64 = 3.860935e-5;
+
+fn five_bar_drift(t_eval: Option<Vec<f64>>) -> f64 {
+    let mech = planardyn::load(FIVE_BAR).unwrap();
+    let mut s = Settings::for_model(&mech).unwrap();
+    s.method = "dop853".parse().unwrap();
+    (s.t_end, s.options.rtol, s.options.atol) = (1.0, TOLERANCE, TOLERANCE);
+    s.t_eval = t_eval;
+    let traj = simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap();
+    assert!(traj.success(), "{}", traj.message);
+    traj.stats.energy_drift
+}
+
+#[test]
+fn five_bar_steps_near_singularities_keep_the_energy() {
+    let mut t = grid(0.0, 1.0, 0.01);
+    t.iter_mut().for_each(|v| *v = v.min(1.0));
+    t.dedup();
+    let on_grid = five_bar_drift(Some(t));
+    let at_steps = five_bar_drift(None);
+    assert!(on_grid < DRIFT_TARGET, "drift on the 0.01 s grid {on_grid:.3e} J");
+    assert!(at_steps < DRIFT_TARGET, "drift at the steps {at_steps:.3e} J");
+}
+
+/// tests/test_api.py's bound on the redundant triple crank's drift over 0.3 s (its default
+/// rtol 1e-9). The run ends 5 ms before its change point, inside the crossing, and its last
+/// row is the crossing's bridge; with the crossing started on the approach's grid it drifts
+/// 2.0e-11, 7.1e-11, 4.2e-9, 2.0e-9 J at the tolerances below. Main (f2d85fd), whose
+/// crossings started at the first point below CROSS_START: 6.5e-7, 2.5e-9, 4.6e-7, 5.5e-7 J;
+/// with the reach cutting the approach's steps (c7f959f): 4.5e-7, 4.9e-8, 1.4e-9, 5.0e-8 J.
+const CROSSING_DRIFT: f64 = 1e-8;
+
+#[test]
+fn triple_crank_crossing_starts_on_its_approach_grid_at_every_tolerance() {
+    let mech = yaml(PARALLELOGRAM);
+    for rtol in [5e-10, 1e-9, 1.1e-9, 2e-9] {
+        let mut s = Settings::for_model(&mech).unwrap();
+        (s.t_end, s.options.rtol) = (0.3, rtol);
+        let traj = simulate(&mech, &s, &mut ModelDrives(&mech), None).unwrap();
+        assert!(traj.success(), "rtol {rtol}: {}", traj.message);
+        let drift = traj.stats.energy_drift;
+        assert!(drift < CROSSING_DRIFT, "rtol {rtol}: drift {drift:.3e} J");
+    }
+}
