@@ -21,7 +21,7 @@
 //! row and 0 on the others (a column echelon basis, each as local as the left-out rows allow).
 
 use super::constraints::body_trig;
-use super::rank::{constraint_rank, RANK_TOL, SELF_STRESS_TOL};
+use super::rank::{constraint_rank, parts, Part, RANK_TOL, SELF_STRESS_TOL};
 use super::system::col_scales;
 use crate::linalg::{eliminate, gamma, gram_exceeds, Sink, SparseRow};
 use crate::model::pairs::{self, row_scales};
@@ -109,51 +109,6 @@ fn norm_bounds(phi: &[SparseRow], n: usize) -> (f64, f64) {
     (lo * (1.0 - 1e-12), (row_abs * col_max).sqrt() * (1.0 + 1e-12))
 }
 
-/// The rows of Phi_x joined when they share a column (union-find), as `rank`'s parts: each
-/// part's rows and columns ascending, the parts in order of their first row.
-fn parts(phi: &[SparseRow], n: usize) -> Vec<(Vec<usize>, Vec<usize>)> {
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut c: usize) -> usize {
-        while parent[c] != c {
-            parent[c] = parent[parent[c]];
-            c = parent[c];
-        }
-        c
-    }
-    for row in phi {
-        if let Some(&(f, _)) = row.first() {
-            for &(c, _) in &row[1..] {
-                let (rf, rc) = (root(&mut parent, f), root(&mut parent, c));
-                parent[rc] = rf;
-            }
-        }
-    }
-    let (mut index, mut out): (Vec<Option<usize>>, Vec<(Vec<usize>, Vec<usize>)>) = (vec![None; n], Vec::new());
-    for (r, row) in phi.iter().enumerate() {
-        let part = match row.first() {
-            None => {
-                out.push((vec![], vec![]));
-                out.len() - 1
-            }
-            Some(&(c, _)) => {
-                let rc = root(&mut parent, c);
-                *index[rc].get_or_insert_with(|| {
-                    out.push((vec![], vec![]));
-                    out.len() - 1
-                })
-            }
-        };
-        out[part].0.push(r);
-    }
-    for c in 0..n {
-        let rc = root(&mut parent, c);
-        if let Some(p) = index[rc] {
-            out[p].1.push(c);
-        }
-    }
-    out
-}
-
 /// The rank structure where the proofs settle it for every part; None where one does not.
 pub fn proven_rank(mech: &Mechanism, x: &[f64]) -> Option<IndependentRows> {
     let (rows, n) = (mech.n_pair_rows(), mech.n_x());
@@ -169,7 +124,7 @@ pub fn proven_rank(mech: &Mechanism, x: &[f64]) -> Option<IndependentRows> {
     let mut out = IndependentRows { rank: 0, rows: Vec::new(), stresses: Vec::new() };
     let mut local = vec![0; n];
     let mut lambda = vec![0.0; rows];
-    for (part_rows, cols) in parts(&phi, n) {
+    for Part { rows: part_rows, cols } in parts(&phi, n) {
         for (i, &c) in cols.iter().enumerate() {
             local[c] = i;
         }
