@@ -4,10 +4,9 @@
 //! specification (`spec`) and the checks of its parts (`build`, the load kinds in `loads`).
 
 use super::pairs;
-use super::spec::BodySpec;
 use super::{Attachment, BodyId, Link, Mechanism, PairId, PointId};
 use crate::ModelError;
-use indexmap::IndexMap;
+use indexmap::{IndexMap, IndexSet};
 
 /// The context of the checks of one specification (`build::context`).
 pub(crate) struct Ctx<'a> {
@@ -15,7 +14,7 @@ pub(crate) struct Ctx<'a> {
     pub source: &'a str,
     /// The points by name with their drawn coordinates (m), and the bodies' names, in file order.
     pub points: &'a IndexMap<String, [f64; 2]>,
-    pub bodies: &'a IndexMap<String, BodySpec>,
+    pub bodies: IndexSet<&'a str>,
     /// Whether each pair, in file order, was given a `name` (a made-up one may not be referred to).
     pub named_pairs: Vec<bool>,
 }
@@ -49,7 +48,7 @@ impl Ctx<'_> {
             return Ok(Link::Ground);
         }
         self.bodies.get_index_of(name).map(|i| Link::Body(BodyId(i))).ok_or_else(|| {
-            let known: Vec<&str> = self.bodies.keys().map(String::as_str).collect();
+            let known: Vec<&str> = self.bodies.iter().copied().collect();
             self.err(
                 path,
                 format!(
