@@ -7,6 +7,7 @@ of each cost against the number of bodies.
     .venv/bin/python benchmarks/scaling.py                      # parallelograms, five-bars, ladder
     .venv/bin/python benchmarks/scaling.py --family a02 --n 2 5 10 20 --t-end 0.5
     .venv/bin/python benchmarks/scaling.py --budget 60          # skip larger N once a run takes > 60 s
+    .venv/bin/python benchmarks/scaling.py --build-only --n 10 20 40 80   # the build alone, no runs
 
 The parallelogram chain has the same one-coordinate motion for every N (a simple pendulum of
 1 m, families.py): each run is checked against its closed-form period.
@@ -41,9 +42,11 @@ def build(spec: dict[str, Any], repeats: int) -> tuple[planardyn.Mechanism, floa
     return mech, best
 
 
-def run(family: str, n: int, t_end: float, rtol: float, atol: float, repeats: int) -> dict[str, Any]:
+def run(family: str, n: int, t_end: float, rtol: float, atol: float, repeats: int, build_only: bool) -> dict[str, Any]:
     spec = parallelograms(n, THETA0) if family == "parallelograms" else FAMILIES[family](n)
     mech, build_wall = build(spec, repeats)
+    if build_only:
+        return {"N": n, "bodies": len(spec["bodies"]), "build": build_wall}
     # Every step is an output (a stopped run's last row is where it stopped), except for the
     # parallelograms: the start, one closed-form period and the end.
     period = pendulum_period(THETA0)
@@ -86,7 +89,11 @@ def main() -> None:
     ap.add_argument("--atol", type=float, default=1e-12)
     ap.add_argument("--build-repeats", type=int, default=3, help="builds per N, the best is kept")
     ap.add_argument("--budget", type=float, default=120.0, help="skip larger N after a run longer than this (s)")
+    ap.add_argument("--build-only", action="store_true", help="time the build alone (no simulation)")
     args = ap.parse_args()
+    if args.build_only:
+        build_table(args)
+        return
     for family in args.family:
         print(f"\n{family}: t_end {args.t_end} s, rtol {args.rtol:g}, atol {args.atol:g}")
         head = "| N | bodies | status | t reached (s) | build (ms) | wall (s) | per eval (us) | per sim. s (ms) | nfev | steps | rejected | refused | switches | min sigma | period err (rad) |"
@@ -94,7 +101,7 @@ def main() -> None:
         print("|" + "---|" * (head.count("|") - 1))
         rows = []
         for n in sorted(args.n):
-            r = run(family, n, args.t_end, args.rtol, args.atol, args.build_repeats)
+            r = run(family, n, args.t_end, args.rtol, args.atol, args.build_repeats, False)
             r["per_eval"] = r["wall"] / max(r["nfev"], 1) * 1e6
             r["per_s"] = r["wall"] / max(r["t"], 1e-12) * 1e3
             rows.append(r)
@@ -114,6 +121,18 @@ def main() -> None:
             f"per simulated second {slope(b, [r['per_s'] for r in big]):.2f}, "
             f"build {slope(b, [r['build'] for r in big]):.2f}"
         )
+
+
+def build_table(args: argparse.Namespace) -> None:
+    """The build's wall time (best of ``--build-repeats``) per family and N, and its exponent."""
+    for family in args.family:
+        print(f"\n{family}: build only, best of {args.build_repeats}")
+        print("| N | bodies | build (ms) |\n|---|---|---|")
+        rows = [run(family, n, 0.0, 0.0, 0.0, args.build_repeats, True) for n in sorted(args.n)]
+        for r in rows:
+            print(f"| {r['N']} | {r['bodies']} | {r['build'] * 1e3:.3g} |", flush=True)
+        big = [r for r in rows if r["bodies"] >= 10] or rows
+        print(f"exponent (bodies >= 10): build {slope([r['bodies'] for r in big], [r['build'] for r in big]):.2f}")
 
 
 if __name__ == "__main__":

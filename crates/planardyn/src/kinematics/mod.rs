@@ -13,6 +13,7 @@ pub mod frame;
 pub mod group_sigma;
 pub mod position;
 pub mod rank;
+pub mod rank_proof;
 pub mod singularity;
 pub mod system;
 pub mod third;

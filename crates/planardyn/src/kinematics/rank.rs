@@ -3,7 +3,7 @@
 
 use super::constraints::{body_trig, constraint_jacobian};
 use super::system::col_scales;
-use crate::linalg::pivot_columns;
+use crate::linalg::{pivot_columns, SparseRow};
 use crate::model::pairs::row_scales;
 use crate::model::{Mechanism, PairId};
 use nalgebra::DMatrix;
@@ -91,7 +91,9 @@ pub(crate) fn constraint_rank(mech: &Mechanism, x: &[f64]) -> Rank {
         return Rank { rank: 0, singular_values: vec![], independent_rows: vec![], self_stresses: vec![] };
     }
     let j = scaled_constraint_jacobian(mech, x);
-    let parts: Vec<(Part, PartSvd)> = parts(&j, rows, n)
+    let sparse: Vec<SparseRow> =
+        (0..rows).map(|r| (0..n).filter(|&c| j[r * n + c] != 0.0).map(|c| (c, j[r * n + c])).collect()).collect();
+    let parts: Vec<(Part, PartSvd)> = parts(&sparse, n)
         .into_iter()
         .map(|p| {
             let s = part_svd(&j, n, &p);
@@ -132,9 +134,9 @@ pub(crate) fn constraint_rank(mech: &Mechanism, x: &[f64]) -> Rank {
 
 /// Rows of Phi_x and the body coordinates they touch, ascending; no other row touches these
 /// columns.
-struct Part {
-    rows: Vec<usize>,
-    cols: Vec<usize>,
+pub(super) struct Part {
+    pub rows: Vec<usize>,
+    pub cols: Vec<usize>,
 }
 
 /// A part's singular values (one per row: zero columns pad it to a square matrix, so that the
@@ -153,9 +155,10 @@ fn part_svd(j: &[f64], n: usize, part: &Part) -> PartSvd {
     PartSvd { values: svd.singular_values.iter().copied().collect(), u: svd.u.expect("requested") }
 }
 
-/// The independent parts of the row-major `rows x n` matrix `j`: its rows joined when they
-/// share a non-zero column (union-find over the columns), in order of their first row.
-fn parts(j: &[f64], rows: usize, n: usize) -> Vec<Part> {
+/// The rows of Phi_x (sparse rows, columns ascending) joined when they share a column
+/// (union-find over the columns): each part's rows and columns ascending, the parts in order of
+/// their first row (a row of zeros is a part of its own, with no columns).
+pub(super) fn parts(phi: &[SparseRow], n: usize) -> Vec<Part> {
     let mut parent: Vec<usize> = (0..n).collect();
     fn root(parent: &mut [usize], mut c: usize) -> usize {
         while parent[c] != c {
@@ -164,26 +167,22 @@ fn parts(j: &[f64], rows: usize, n: usize) -> Vec<Part> {
         }
         c
     }
-    let nonzero = |r: usize| (0..n).filter(move |&c| j[r * n + c] != 0.0);
-    for r in 0..rows {
-        let mut first = None;
-        for c in nonzero(r) {
-            let rc = root(&mut parent, c);
-            match first {
-                None => first = Some(rc),
-                Some(f) => parent[rc] = root(&mut parent, f),
+    for row in phi {
+        if let Some(&(f, _)) = row.first() {
+            for &(c, _) in &row[1..] {
+                let (rf, rc) = (root(&mut parent, f), root(&mut parent, c));
+                parent[rc] = rf;
             }
         }
     }
-    // A part per root (a row of zeros is a part of its own, with no columns).
     let (mut index, mut out): (Vec<Option<usize>>, Vec<Part>) = (vec![None; n], Vec::new());
-    for r in 0..rows {
-        let part = match nonzero(r).next() {
+    for (r, row) in phi.iter().enumerate() {
+        let part = match row.first() {
             None => {
                 out.push(Part { rows: vec![], cols: vec![] });
                 out.len() - 1
             }
-            Some(c) => {
+            Some(&(c, _)) => {
                 let rc = root(&mut parent, c);
                 *index[rc].get_or_insert_with(|| {
                     out.push(Part { rows: vec![], cols: vec![] });

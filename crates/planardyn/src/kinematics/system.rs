@@ -223,7 +223,7 @@ impl System {
 fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Option<Vec<Vec<usize>>> {
     let (n, m) = (mech.n_x(), mech.dof());
     let rows: Vec<usize> = (n - m..n).collect();
-    let reach: Vec<Vec<usize>> = rows.chunks(MAX_COLUMNS).map(|sweep| lu.reach(sweep)).collect();
+    let reach = lu.reaches(rows.chunks(MAX_COLUMNS));
     reach.iter().any(|blocks| blocks.len() < lu.n_blocks()).then_some(reach)
 }
 
@@ -232,10 +232,11 @@ fn unit_reach(mech: &Mechanism, lu: &BlockLu) -> Option<Vec<Vec<usize>>> {
 fn u_bodies(mech: &Mechanism, lu: &BlockLu) -> Vec<Vec<usize>> {
     let (n, m) = (mech.n_x(), mech.dof());
     let cols = lu.position_cols();
-    (n - m..n)
-        .map(|row| {
-            let mut bodies: Vec<usize> =
-                lu.reach(&[row]).into_iter().flat_map(|k| lu.span(k)).map(|p| cols[p] / 3).collect();
+    let rows: Vec<[usize; 1]> = (n - m..n).map(|row| [row]).collect();
+    lu.reaches(rows.iter().map(|r| &r[..]))
+        .into_iter()
+        .map(|blocks| {
+            let mut bodies: Vec<usize> = blocks.into_iter().flat_map(|k| lu.span(k)).map(|p| cols[p] / 3).collect();
             bodies.sort_unstable();
             bodies.dedup();
             bodies

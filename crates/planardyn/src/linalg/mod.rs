@@ -9,15 +9,19 @@
 
 mod block_lu;
 mod cholesky;
+mod gram;
 mod lu;
 mod pivot;
 mod sink;
+mod sparse_pivot;
 
 pub use block_lu::{BlockLu, BlockSink, MAX_COLUMNS};
 pub use cholesky::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
+pub use gram::{gamma, gram_exceeds};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
 pub use pivot::pivot_columns;
 pub use sink::{Dense, Sink};
+pub use sparse_pivot::{eliminate, Elimination, SparseRow};
 
 /// `dst.copy_from_slice(src)` for the few values of a state or its coordinates (m, 2m + 1) as
 /// moves: `copy_from_slice` of a length known only at run time is a call to the C library's

@@ -6,7 +6,7 @@
 use crate::error::Setting;
 use crate::integrate::Method;
 use crate::kinematics::assemble;
-use crate::kinematics::rank::constraint_rank;
+use crate::kinematics::rank_proof::independent_rows;
 use crate::model::build::context;
 use crate::model::checks::{Ctx, R};
 use crate::model::pairs;
@@ -58,7 +58,7 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
 /// in `warnings`.
 fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     let (n, rows, m) = (mech.n_bodies() as i64, mech.n_pair_rows(), mech.dof() as i64);
-    let cr = constraint_rank(mech, &mech.x0);
+    let cr = independent_rows(mech, &mech.x0);
     let (grubler, mobility) = (3 * n - rows as i64, 3 * n - cr.rank as i64);
     // The count written out: 2 rows for each revolute and prismatic pair, 1 for each gear or slot.
     let p1 = mech.pairs.iter().filter(|p| pairs::n_rows(&p.kind) == 1).count();
@@ -112,13 +112,13 @@ fn check_mobility(ctx: &Ctx, mech: &mut Mechanism) -> R<()> {
     }
     if cr.rank < rows {
         mech.row_slot = vec![None; rows];
-        for (slot, &row) in cr.independent_rows.iter().enumerate() {
+        for (slot, &row) in cr.rows.iter().enumerate() {
             mech.row_slot[row] = Some(slot);
         }
         mech.n_constraints = cr.rank;
         mech.pair_slots = mech.slots_by_pair(&mech.row_slot);
-        for stress in &cr.self_stresses {
-            let names: Vec<&str> = stress.pairs.iter().map(|&k| mech.pairs[k.0].name.as_str()).collect();
+        for stress in &cr.stresses {
+            let names: Vec<&str> = stress.iter().map(|&k| mech.pairs[k.0].name.as_str()).collect();
             mech.warnings.push(format!(
                 "redundant constraints among pairs {}: one of their constraint equations is implied by the others \
                  and left out (Chebyshev-Grubler counts {grubler} degree(s) of freedom, the rank shows {mobility}); \

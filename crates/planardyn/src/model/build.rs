@@ -83,9 +83,12 @@ pub(super) fn drawing(spec: MechanismSpec, source: &str) -> R<Mechanism> {
     };
     mech.x0 = mech.bodies.iter().flat_map(|b| [b.com0[0], b.com0[1], b.angle0]).collect();
     mech.scale = scale;
+    // The names so far, for the duplicate check (a scan of the pairs before each would be
+    // quadratic in their number).
+    let mut pair_names = std::collections::HashSet::new();
     for (k, p) in spec.pairs.iter().enumerate() {
         let pair = build_pair(&ctx, &mech, k, p)?;
-        if mech.pairs.iter().any(|q| q.name == pair.name) {
+        if !pair_names.insert(pair.name.clone()) {
             return Err(ctx.err(
                 format!("pairs[{k}].name"),
                 format!("duplicate pair name '{}'; rename one of the two", pair.name),
@@ -522,16 +525,19 @@ fn pair_name(p: &PairSpec) -> &Option<String> {
 }
 
 fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism, coordinates: &[CoordinateSpec]) -> R<()> {
+    // The names and pairs taken so far (scans of the coordinates before each would be
+    // quadratic in their number).
+    let (mut names, mut taken) = (std::collections::HashSet::new(), vec![false; mech.pairs.len()]);
     for (k, c) in coordinates.iter().enumerate() {
         let path = format!("coordinates[{k}]");
-        if mech.coordinates.iter().any(|d| d.name == c.name) || c.name.is_empty() {
+        if !names.insert(c.name.as_str()) || c.name.is_empty() {
             return Err(ctx.err(
                 format!("{path}.name"),
                 format!("coordinate name '{}' is empty or used twice; give each coordinate its own name", c.name),
             ));
         }
         let pair = pair_id(ctx, mech, &format!("{path}.pair"), &c.pair)?;
-        if mech.coordinates.iter().any(|d| d.pair == pair) {
+        if std::mem::replace(&mut taken[pair.0], true) {
             return Err(ctx.err(
                 format!("{path}.pair"),
                 format!("pair '{}' already has a coordinate; remove one of the two", c.pair),

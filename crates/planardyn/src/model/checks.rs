@@ -6,7 +6,7 @@
 use super::pairs;
 use super::{Attachment, BodyId, Link, Mechanism, PairId, PointId};
 use crate::ModelError;
-use indexmap::IndexMap;
+use indexmap::{IndexMap, IndexSet};
 
 /// The context of the checks of one specification (`build::context`).
 pub(crate) struct Ctx<'a> {
@@ -14,7 +14,7 @@ pub(crate) struct Ctx<'a> {
     pub source: &'a str,
     /// The points by name with their drawn coordinates (m), and the bodies' names, in file order.
     pub points: &'a IndexMap<String, [f64; 2]>,
-    pub bodies: Vec<&'a str>,
+    pub bodies: IndexSet<&'a str>,
     /// Whether each pair, in file order, was given a `name` (a made-up one may not be referred to).
     pub named_pairs: Vec<bool>,
 }
@@ -47,12 +47,13 @@ impl Ctx<'_> {
         if name == "ground" {
             return Ok(Link::Ground);
         }
-        self.bodies.iter().position(|b| *b == name).map(|i| Link::Body(BodyId(i))).ok_or_else(|| {
+        self.bodies.get_index_of(name).map(|i| Link::Body(BodyId(i))).ok_or_else(|| {
+            let known: Vec<&str> = self.bodies.iter().copied().collect();
             self.err(
                 path,
                 format!(
                     "unknown body '{name}'; bodies are: ground, {} (use one of them, or add it to `bodies`)",
-                    self.bodies.join(", ")
+                    known.join(", ")
                 ),
             )
         })
