@@ -72,11 +72,12 @@ fn add_revolute_effort(pair: &Pair, t: f64, xd: &[f64], f: &mut [f64]) -> f64 {
         Link::Body(b) => Some(3 * b.0 + 2),
     };
     let (a, b) = (angle(pair.a), angle(pair.b));
+    // f + t (-1) is f - t and f + t 1 is f + t, exactly.
     if let Some(k) = a {
-        f[k] += t * -1.0;
+        f[k] -= t;
     }
     if let Some(k) = b {
-        f[k] += t * 1.0;
+        f[k] += t;
     }
     let rate = |k: Option<usize>| k.map_or(0.0, |k| xd[k]);
     rate(b) - rate(a)
