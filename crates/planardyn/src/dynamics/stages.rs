@@ -158,12 +158,17 @@ const FIXED_M: usize = 4;
 /// zeros outside the envelope are there (`a_zeros_for`).
 fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
-    let u: [&[f64]; M] = std::array::from_fn(|j| &ws.frame.u[j * n..(j + 1) * n]);
+    // Each column's body by body: three values a step with no bounds check of their own.
+    let mut u: [std::slice::ChunksExact<f64>; M] =
+        std::array::from_fn(|j| ws.frame.u[j * n..(j + 1) * n].chunks_exact(3));
     // The sums of `m_dot` and `bias` start at -0.0 (f64's `Sum`).
     let (mut a, mut uf, mut umc) = ([[-0.0; M]; M], [-0.0; M], [-0.0; M]);
     let forces = ws.f.chunks_exact(3).zip(ws.frame.c.chunks_exact(3));
-    for (i, (body, (f, c))) in mech.bodies.iter().zip(forces).enumerate() {
-        let ui: [[f64; 3]; M] = std::array::from_fn(|j| [u[j][3 * i], u[j][3 * i + 1], u[j][3 * i + 2]]);
+    for (body, (f, c)) in mech.bodies.iter().zip(forces) {
+        let ui: [[f64; 3]; M] = std::array::from_fn(|j| {
+            let p = u[j].next().expect("a column of U has three values a body");
+            [p[0], p[1], p[2]]
+        });
         for (j, p) in ui.iter().enumerate() {
             for (k, q) in ui.iter().enumerate().skip(j) {
                 a[j][k] += body.mass * (p[0] * q[0] + p[1] * q[1]) + body.inertia * p[2] * q[2];

@@ -52,6 +52,31 @@ fn times(inv: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
     inv.map(|r| r[0] * b[0] + r[1] * b[1] + r[2] * b[2])
 }
 
+/// Largest turn (rad) of a body from the reference for the side test near it
+/// (`Triad::side_near_reference`): there [`near_sin_cos`] is within 2e-14 of sin and cos (its
+/// first left-out terms, 0.5^13 / 13! and 0.5^14 / 14!). The fold guard's predictions are
+/// within a step of the last accepted point; a body turned further takes the library's.
+const NEAR_TURN: f64 = 0.5;
+
+/// How far, relative to the product of the Jacobian's rows' sizes H (each row's entries at most
+/// |arm_i| (1 + |c_i|)), the determinant from the series must clear zero for its sign to be the
+/// library's. Rotations within eta = 3e-14 of the true ones (the series, the reference's
+/// sin and cos and the turn, each within 1 ulp but the series' 2e-14) move each entry of a row
+/// by at most 8 eta of its size and the determinant (six products of three entries) by at most
+/// about 150 eta H = 4.5e-12 H; the library's own rounding moves it by about 5e-14 H. Where the
+/// series' determinant is more than 1e-9 H from zero, 200 times both, the two have one sign.
+const SIDE_MARGIN: f64 = 1e-9;
+
+/// sin d and cos d by their Taylor series to d^11 and d^12, for |d| <= [`NEAR_TURN`].
+#[inline(always)]
+fn near_sin_cos(d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let k = |n: f64| d2 * (1.0 / n);
+    let s = d * (1.0 - k(6.0) * (1.0 - k(20.0) * (1.0 - k(42.0) * (1.0 - k(72.0) * (1.0 - k(110.0))))));
+    let c = 1.0 - k(2.0) * (1.0 - k(12.0) * (1.0 - k(30.0) * (1.0 - k(56.0) * (1.0 - k(90.0) * (1.0 - k(132.0))))));
+    (s, c)
+}
+
 #[derive(Debug, Clone)]
 pub struct Triad {
     /// The legs' bodies (the bases of two-body legs), then the platform's.
@@ -71,6 +96,9 @@ pub struct Triad {
     s_platform: [[f64; 2]; 3],
     /// 1 / L, the mechanism's length (Newton's scaled residual).
     inv_scale: f64,
+    /// The product over the legs of 1 + |c_i|: times that of the arms' lengths, it bounds the
+    /// product of the Jacobian's rows' entries (`SIDE_MARGIN`).
+    platform_sizes: f64,
     branch: Branch,
     geometry: Geometry,
 }
@@ -84,6 +112,10 @@ struct Branch {
     side: f64,
     legs: [f64; 3],
     directions: [[f64; 2]; 3],
+    /// The bodies' angles (legs, then the platform) and their [cos, sin], for the side test
+    /// near the reference (`Triad::side_near_reference`).
+    angles: [f64; 4],
+    trig: [[f64; 2]; 4],
 }
 
 /// The triad at its solved position: R s of A_i on their links and on the legs, e_i, the
@@ -123,6 +155,7 @@ impl Triad {
             inv_arm: [0.0; 3],
             s_platform,
             inv_scale: 1.0 / scale,
+            platform_sizes: s_platform.iter().map(|c| 1.0 + c[0].hypot(c[1])).product(),
             branch: Branch::default(),
             geometry: Geometry::default(),
         };
@@ -142,36 +175,69 @@ impl Triad {
         }
     }
 
-    /// The sign of the Jacobian's determinant with the bodies' angles in x (any x, not
-    /// necessarily assembled: the legs' directions and the platform's arms are those angles').
-    fn side(&self, x: &[f64]) -> f64 {
-        let (s, c) = x[3 * self.bodies[3] + 2].sin_cos();
-        let rows = [0, 1, 2].map(|i| {
-            let (sl, cl) = x[3 * self.bodies[i] + 2].sin_cos();
-            row(rot([cl, sl], self.arms[i]), rot([c, s], self.s_platform[i]))
-        });
+    /// The Jacobian's determinant with the bodies' rotations `cs` ([cos, sin] of the legs',
+    /// then the platform's angle): the legs' directions and the platform's arms are theirs.
+    #[inline]
+    fn det_at(&self, cs: [[f64; 2]; 4]) -> f64 {
+        let rows = [0, 1, 2].map(|i| row(rot(cs[i], self.arms[i]), rot(cs[3], self.s_platform[i])));
         let [a, b, d] = rows;
-        (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]))
-            .signum()
+        a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0])
+    }
+
+    /// The sign of the Jacobian's determinant with the bodies' angles in x (any x, not
+    /// necessarily assembled).
+    fn side(&self, x: &[f64]) -> f64 {
+        self.det_at(self.bodies.map(|b| {
+            let (s, c) = x[3 * b + 2].sin_cos();
+            [c, s]
+        }))
+        .signum()
+    }
+
+    /// [`Triad::side`] without the library's sin and cos where it can be told for certain:
+    /// each rotation from the reference's (`Branch::trig`) turned by the angle d from the
+    /// reference's, by the series of sin d and cos d ([`NEAR_TURN`]), and the sign of that
+    /// determinant where it clears zero by [`SIDE_MARGIN`]; None where it does not (near the
+    /// singularity, or a body turned further), and the caller then takes `side`.
+    fn side_near_reference(&self, x: &[f64]) -> Option<f64> {
+        let mut cs = [[0.0; 2]; 4];
+        for (i, &b) in self.bodies.iter().enumerate() {
+            // Exact where the angles are 1 rad or more (Sterbenz), within 1.1e-16 below.
+            let d = x[3 * b + 2] - self.branch.angles[i];
+            if !(d.abs() <= NEAR_TURN) {
+                return None;
+            }
+            let (s, c) = near_sin_cos(d);
+            let r = self.branch.trig[i];
+            cs[i] = [r[0] * c - r[1] * s, r[1] * c + r[0] * s];
+        }
+        let det = self.det_at(cs);
+        let rows = self.platform_sizes * (self.arms2[0] * self.arms2[1] * self.arms2[2]).sqrt();
+        (det.abs() > SIDE_MARGIN * rows).then(|| det.signum())
     }
 
     /// Take the branch of the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
         self.set_arms(|a| a.ext.shift_in(x));
         let p = 3 * self.bodies[3];
-        let legs = [0, 1, 2].map(|i| x[3 * self.bodies[i] + 2]);
-        let directions = [0, 1, 2].map(|i| {
-            let (s, c) = legs[i].sin_cos();
-            rot([c, s], self.arms[i])
+        let angles = self.bodies.map(|b| x[3 * b + 2]);
+        let trig = angles.map(|a| {
+            let (s, c) = a.sin_cos();
+            [c, s]
         });
-        self.branch = Branch { pose: [x[p], x[p + 1], x[p + 2]], side: self.side(x), legs, directions };
+        let directions = [0, 1, 2].map(|i| rot(trig[i], self.arms[i]));
+        let legs = [angles[0], angles[1], angles[2]];
+        let side = self.det_at(trig).signum();
+        self.branch = Branch { pose: [x[p], x[p + 1], x[p + 2]], side, legs, directions, angles, trig };
     }
 
     /// Whether the bodies' angles in x (a Newton predictor's) keep the reference's side of the
     /// triad's singularity; a predictor past it means the motion leaves the branch there,
-    /// which Newton from the reference pose would not follow.
+    /// which Newton from the reference pose would not follow. The fold guard asks it at every
+    /// evaluation: from the series near the reference, the library's sin and cos only where
+    /// the series cannot tell.
     pub fn keeps_side(&self, x: &[f64]) -> bool {
-        self.side(x) == self.branch.side
+        self.side_near_reference(x).unwrap_or_else(|| self.side(x)) == self.branch.side
     }
 
     /// The bodies' poses (x and trig) on the reference branch, the links before them solved.
@@ -351,5 +417,101 @@ impl Triad {
             }
         }
         block.sigma()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{near_sin_cos, Joint, Triad, NEAR_TURN};
+    use crate::model::Link;
+
+    /// A 3-RRR's triad: legs 0-2 hinged to the ground at A_i, the platform body 3 (m).
+    fn three_rrr() -> Triad {
+        let a = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.9]];
+        let outer = a.map(|s| Joint { link: Link::Ground, s });
+        let s_outer = [[-0.2, 0.0]; 3];
+        let s_inner = [[0.2, 0.0], [0.25, 0.0], [0.3, 0.0]];
+        let s_platform = [[-0.1, -0.05], [0.1, -0.05], [0.0, 0.1]];
+        Triad::new([0, 1, 2, 3], outer, [s_outer, s_inner, s_platform], [None, None, None], 1.0)
+    }
+
+    /// A few hundred thousand numbers in [0, 1) from a fixed seed (an LCG: the test repeats).
+    fn uniform(seed: &mut u64) -> f64 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The series are within 2e-14 of the library's sin and cos over |d| <= NEAR_TURN (the
+    /// bound `SIDE_MARGIN`'s argument takes: the first left-out term, 0.5^13 / 13! = 2.0e-14).
+    #[test]
+    fn near_sin_cos_is_within_its_bound() {
+        for k in -5000..=5000 {
+            let d = k as f64 * NEAR_TURN / 5000.0;
+            let (s, c) = near_sin_cos(d);
+            assert!((s - d.sin()).abs() <= 2e-14 && (c - d.cos()).abs() <= 2e-14, "d = {d}");
+        }
+    }
+
+    /// Wherever the side test from the series decides, it decides as the library's sin and cos
+    /// do: at 200000 random predictions up to 0.6 rad from references of up to 1000 rad, and at
+    /// 2000 points within 1e-13 ... 1e-3 rad of where the determinant changes sign (found by
+    /// bisection), where it must defer at the nearest. It decides almost everywhere else.
+    #[test]
+    fn side_near_reference_is_the_exact_side_where_it_decides() {
+        let mut t = three_rrr();
+        let mut seed = 7;
+        let (mut decided, mut asked) = (0, 0);
+        for case in 0..200 {
+            let mut x = [0.0; 12];
+            let span = if case % 2 == 0 { 6.0 } else { 2000.0 };
+            (0..4).for_each(|b| x[3 * b + 2] = span * (uniform(&mut seed) - 0.5));
+            t.set_reference(&x);
+            for _ in 0..1000 {
+                let mut y = x;
+                (0..4).for_each(|b| y[3 * b + 2] += 1.2 * (uniform(&mut seed) - 0.5));
+                asked += 1;
+                if let Some(s) = t.side_near_reference(&y) {
+                    decided += 1;
+                    assert_eq!(s, t.side(&y), "x = {x:?}, y = {y:?}");
+                }
+            }
+        }
+        // Each of the 4 turns is within 0.5 rad with probability 5/6: (5/6)^4 = 0.48.
+        assert!(decided as f64 > 0.45 * asked as f64, "decided {decided} of {asked}");
+        let (mut near, mut deferred) = (0, 0);
+        for _ in 0..2000 {
+            let mut x = [0.0; 12];
+            (0..4).for_each(|b| x[3 * b + 2] = 6.0 * (uniform(&mut seed) - 0.5));
+            t.set_reference(&x);
+            let step: [f64; 4] = std::array::from_fn(|_| 0.4 * (uniform(&mut seed) - 0.5));
+            let at = |h: f64| {
+                let mut y = x;
+                (0..4).for_each(|b| y[3 * b + 2] += h * step[b]);
+                y
+            };
+            if t.side(&at(1.0)) == t.side(&x) {
+                continue;
+            }
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..80 {
+                let mid = 0.5 * (lo + hi);
+                if t.side(&at(mid)) == t.side(&x) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            for e in [1e-13, 1e-11, 1e-9, 1e-7, 1e-5, 1e-3] {
+                for h in [lo - e, hi + e] {
+                    let y = at(h);
+                    if let Some(s) = t.side_near_reference(&y) {
+                        assert_eq!(s, t.side(&y), "x = {x:?}, y = {y:?}");
+                    }
+                }
+            }
+            near += 1;
+            deferred += usize::from(t.side_near_reference(&at(lo)).is_none());
+        }
+        assert!(near > 100 && deferred == near, "{deferred} of {near} crossings deferred");
     }
 }
