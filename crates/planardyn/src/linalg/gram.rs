@@ -12,7 +12,10 @@
 //!
 //! The rows are put in reverse Cuthill-McKee order (rows adjacent when they share a column),
 //! so that L stays within a narrow envelope, kept row by row (a skyline): O(rows w^2) for a
-//! chain or a ladder of loops, where a dense G would be O(rows^3).
+//! chain or a ladder of loops, where a dense G would be O(rows^3). Hand-written rather than a
+//! sparse crate added for this one check of the loader: nalgebra, the crate's linear algebra,
+//! has no sparse Cholesky, and the proof's shift needs the envelope's widest row w, which the
+//! skyline knows before it factorises.
 
 use super::sparse_pivot::SparseRow;
 

@@ -9,6 +9,11 @@
 //! does the dense one's arithmetic on the entries where the pivot row is non-zero (elsewhere
 //! the dense update subtracts l * 0, which changes no value), so the values and the pivots are
 //! the dense elimination's.
+//!
+//! Hand-written: a sparse LU from a library (faer's, sprs') picks its own pivots, for fill or
+//! threshold partial pivoting; the loader needs the dense complete pivoting's rows, ties
+//! included (the independent constraints it reports and keeps), and the rounding bound of
+//! `rank_proof` needs the factor's row lengths and norms, which those do not report.
 
 use std::collections::BTreeSet;
 
