@@ -179,7 +179,7 @@ class Mechanism:
     def _result(self, raw: RawRun, settings: dict[str, Any] | Callable[[], dict[str, Any]]) -> SimulationResult:
         """The result of a run from the native one, its metadata recording ``settings`` (or
         what the callable makes: values the caller could change after the call copied)."""
-        f = self._facts or self._run_facts()
+        f = self._run_facts()
         if not callable(settings):  # plain values now: an array changed after the call is recorded as it was
             given = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
             settings = lambda: given  # noqa: E731
@@ -755,7 +755,7 @@ class Mechanism:
         """
         # The rules of the settings are the core's, which the run applies (checked once, issue 25
         # item 4); here the numbers are converted, and checked only before their rows are counted.
-        f = self._facts or self._run_facts()
+        f = self._run_facts()
         numbers = convert_numbers(t_end, rtol, atol, dt, output_dt, max_steps)
         if t_eval is not None or numbers[4] is not None or f.output_dt is not None:
             self._check_rows_fit(numbers, t_eval)
