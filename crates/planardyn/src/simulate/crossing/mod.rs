@@ -141,9 +141,9 @@ impl Integration<'_> {
 /// Cross the change point ahead of the point accepted at `t` with passive measure `passive`
 /// and work `work` (held by `ode.ws`, evaluated), with the points before it in `approach`
 /// (see the module's steps). On return `ode` holds the landing, evaluated and anchored in its
-/// chart; `stats` counts the integrations past it. None, with `ode` as it was, if Phi_x keeps
-/// its rank on the Taylor step's path: the measure only dips (the five-bar's at its type II
-/// singularities). Err says why the motion cannot be continued.
+/// chart; `stats` counts the integrations past it. None, with `ode` as it was, if the measure
+/// is not heading to 0 or Phi_x keeps its rank on the Taylor step's path: the measure only
+/// dips (the five-bar's at its type II singularities). Err says why the motion cannot be continued.
 pub fn cross(
     ode: &mut MechanismOde,
     (t, passive, work): (f64, f64, f64),
@@ -151,9 +151,10 @@ pub fn cross(
     integration: &Integration,
     stats: &mut Stats,
 ) -> Result<Option<Landing>, String> {
-    let to_point = approach.time_to_point(t, passive).ok_or_else(|| {
-        format!("the time to the change point could not be estimated (passive measure {passive:.2e})")
-    })?;
+    // No root ahead of the measure's quadratic through its last points: it only dips (a
+    // five-bar's type II passage with its least passive measure at 0.030, between CROSS_BELOW
+    // and CROSS_START, stopped the run here as if at a change point).
+    let Some(to_point) = approach.time_to_point(t, passive) else { return Ok(None) };
     let start = Passed::of(ode, t, passive);
     let h = SPACING * to_point;
     let before: Vec<&Passed> = std::iter::once(&start).chain(approach.samples(t, h)).collect();
