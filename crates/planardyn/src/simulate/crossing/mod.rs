@@ -142,8 +142,9 @@ impl Integration<'_> {
 /// and work `work` (held by `ode.ws`, evaluated), with the points before it in `approach`
 /// (see the module's steps). On return `ode` holds the landing, evaluated and anchored in its
 /// chart; `stats` counts the integrations past it. None, with `ode` as it was, if the measure
-/// is not heading to 0 or Phi_x keeps its rank on the Taylor step's path: the measure only
-/// dips (the five-bar's at its type II singularities). Err says why the motion cannot be continued.
+/// is not heading to 0, Phi_x keeps its rank on the Taylor step's path or the step's first
+/// landing does not assemble: the measure only dips (the five-bar's at its type II
+/// singularities, or past a near miss of a change point). Err says why the motion cannot be continued.
 pub fn cross(
     ode: &mut MechanismOde,
     (t, passive, work): (f64, f64, f64),
@@ -163,9 +164,21 @@ pub fn cross(
         return Ok(None);
     }
     let mut why = String::new();
+    let before_landing = ode.save();
     for attempt in 0..ATTEMPTS {
         let t_land = t + 2.0 * to_point * f64::from(1u32 << attempt);
-        match land(ode, &predictor, t_land, passive)? {
+        let landed = match land(ode, &predictor, t_land, passive) {
+            // The motion turned away from a near miss (a dip of the measure near CROSS_BELOW,
+            // the dimensions near a change point's) while the Taylor step ran on into it: a
+            // five-bar with base 0.29991, proximal links 0.152 and distal 0.320 dips to 0.02
+            // at 0.863 s, and DOPRI5's prediction at rtol 1e-9 ... 1e-12 did not assemble.
+            Err(Unprojected::Unassembled(_)) if attempt == 0 => {
+                ode.restore(before_landing);
+                return Ok(None);
+            }
+            landed => landed.map_err(Unprojected::why)?,
+        };
+        match landed {
             (idx, y, past) if past >= 0.5 * passive => {
                 let times: Vec<f64> = (1..=NODES).map(|k| t_land + k as f64 * h).collect();
                 let landing = (t_land, idx.as_slice(), y, past);
@@ -225,7 +238,7 @@ fn land(
     path: &Bridge,
     t_land: f64,
     passive: f64,
-) -> Result<(Vec<usize>, Vec<f64>, f64), String> {
+) -> Result<(Vec<usize>, Vec<f64>, f64), Unprojected> {
     let n = path.coordinates();
     let (mut x, mut xd, mut xdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     path.at(t_land, &mut x, &mut xd, &mut xdd);
@@ -233,7 +246,8 @@ fn land(
     let past = project(ode, &idx, &x, &xd, passive)?;
     let y = partition_state(&idx, &ode.ws.x, &ode.ws.xd, path.work(t_land));
     if past >= 0.5 * passive {
-        ode.set_chart(Chart::Partition(idx.clone()), t_land, &y).map_err(|e| format!("past the change point: {e}"))?;
+        let set = ode.set_chart(Chart::Partition(idx.clone()), t_land, &y);
+        set.map_err(|e| Unprojected::Other(format!("past the change point: {e}")))?;
         let own = chart_sigma(ode, f64::INFINITY);
         ode.limit_correction(own);
     }
@@ -300,20 +314,37 @@ fn integrate_past(
     outcome.map(|()| out)
 }
 
+/// Why a predicted point past a change point is not on the motion's branch.
+enum Unprojected {
+    /// It does not assemble in its partition.
+    Unassembled(String),
+    /// It assembles, too far from the prediction or with another tangent.
+    Other(String),
+}
+
+impl Unprojected {
+    fn why(self) -> String {
+        match self {
+            Unprojected::Unassembled(why) | Unprojected::Other(why) => why,
+        }
+    }
+}
+
 /// Project the predicted (x, xd) onto the constraints and their tangent in the partition
 /// `idx`; the passive measure there, or why it is not the motion's branch.
-fn project(ode: &mut MechanismOde, idx: &[usize], x: &[f64], xd: &[f64], passive: f64) -> Result<f64, String> {
+fn project(ode: &mut MechanismOde, idx: &[usize], x: &[f64], xd: &[f64], passive: f64) -> Result<f64, Unprojected> {
     let mech = ode.mech;
     let ws = &mut ode.ws;
     ws.chart = Chart::Partition(idx.to_vec());
     ws.x.copy_from_slice(x);
     let z: Vec<f64> = idx.iter().map(|&i| x[i]).collect();
-    solve_position(mech, &z, ws).map_err(|e| format!("the predicted point does not assemble: {e}"))?;
+    solve_position(mech, &z, ws)
+        .map_err(|e| Unprojected::Unassembled(format!("the predicted point does not assemble: {e}")))?;
     let moved = scaled_distance(&ws.x, x, ws.sys.group_col_scale());
     if moved > PROJECTION_FRACTION * passive {
-        return Err(format!("the predicted point is {moved:.2e} from the nearest branch (scaled)"));
+        return Err(Unprojected::Other(format!("the predicted point is {moved:.2e} from the nearest branch (scaled)")));
     }
-    velocity_analogues(ws).map_err(|e| format!("no tangent past the point: {e}"))?;
+    velocity_analogues(ws).map_err(|e| Unprojected::Other(format!("no tangent past the point: {e}")))?;
     let n = x.len();
     ws.xd.fill(0.0);
     for (j, &i) in idx.iter().enumerate() {
@@ -325,7 +356,8 @@ fn project(ode: &mut MechanismOde, idx: &[usize], x: &[f64], xd: &[f64], passive
     let speed = xd.iter().zip(scale).fold(0.0, |s: f64, (v, l)| s.max((v / l).abs()));
     let mismatch = scaled_distance(&ws.xd, xd, scale);
     if mismatch > TANGENT_MISMATCH * speed {
-        return Err(format!("the branch's tangent differs from the motion's by {:.2e} of its speed", mismatch / speed));
+        let why = format!("the branch's tangent differs from the motion's by {:.2e} of its speed", mismatch / speed);
+        return Err(Unprojected::Other(why));
     }
     Ok(passive_sigma_min(mech, &ws.x))
 }
