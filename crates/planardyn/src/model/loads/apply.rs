@@ -76,6 +76,13 @@ pub(crate) fn revolute_rate(pair: &Pair, xd: &[f64]) -> f64 {
     angle_rate(pair.b, xd) - angle_rate(pair.a, xd)
 }
 
+/// A revolute pair's relative angle phi_b - phi_a less its drawn value: `coordinate`'s
+/// operations for that kind, inline (the generic call dispatches on the kind out of line).
+#[inline]
+pub(crate) fn revolute_angle(pair: &Pair, x: &[f64]) -> f64 {
+    angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0
+}
+
 /// Add `effort` acting on a revolute pair's relative angle phi_b - phi_a (the gradient's -1
 /// on a's angle, then +1 on b's): the operations of [`add_pair_effort`] for that kind, so the
 /// same bits, without the links' states (a pair spring's or a drive's evaluation cost a

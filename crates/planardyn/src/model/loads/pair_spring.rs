@@ -4,7 +4,7 @@
 //! 1/2 k (theta - rest)^2; its damper's power is -c theta'^2. A `friction` load's viscous
 //! part is one with k = 0 (`friction`).
 
-use super::apply::{add_pair_effort, add_revolute_effort, pair_effort_rate, revolute_rate};
+use super::apply::{add_pair_effort, add_revolute_effort, pair_effort_rate, revolute_angle, revolute_rate};
 use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
 use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_rate};
@@ -55,8 +55,12 @@ impl LoadType for PairSpring {
         let p = &mech.pairs[self.pair.0];
         // A revolute pair (a servo's spring on its motor pair) directly: the same operations.
         let revolute = p.kind == PairKind::Revolute;
-        let rate = if revolute { revolute_rate(p, xd) } else { coordinate_rate(p, x, xd) };
-        let effort = -self.stiffness * (coordinate(p, x) - self.rest) - self.damping * rate;
+        let (value, rate) = if revolute {
+            (revolute_angle(p, x), revolute_rate(p, xd))
+        } else {
+            (coordinate(p, x), coordinate_rate(p, x, xd))
+        };
+        let effort = -self.stiffness * (value - self.rest) - self.damping * rate;
         if revolute {
             add_revolute_effort(p, effort, f);
         } else {
