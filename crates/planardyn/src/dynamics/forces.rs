@@ -3,9 +3,10 @@
 //! dampers: each kind's own, `model::loads`), and the drive efforts mapped through the
 //! coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
-use crate::model::loads::{self, apply::add_pair_effort};
+use crate::model::loads;
+use crate::model::loads::apply::{add_pair_effort, add_revolute_effort, revolute_rate};
 use crate::model::pairs::coordinate_rate;
-use crate::model::{Link, Mechanism, Pair, PairKind};
+use crate::model::{Mechanism, PairKind};
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).
 pub trait Drives {
@@ -50,7 +51,8 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
         }
         let pair = &mech.pairs[c.pair.0];
         let rate = if pair.kind == PairKind::Revolute {
-            add_revolute_effort(pair, t, xd, f)
+            add_revolute_effort(pair, t, f);
+            revolute_rate(pair, xd)
         } else {
             add_pair_effort(mech, c.pair.0, t, x, f);
             coordinate_rate(pair, x, xd)
@@ -58,29 +60,6 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
         power += t * rate;
     }
     power
-}
-
-/// A revolute coordinate phi_b - phi_a's effort t added to `f` (the gradient's -1 on a's angle,
-/// then +1 on b's) and its rate phi_b' - phi_a', returned: the operations of `add_pair_effort`
-/// and `coordinate_rate` for that kind, so the same bits, without their link states (each of
-/// which takes the link's cos and sin, which neither needs here; a drive's evaluation cost a
-/// five-bar about 180 instructions a coordinate).
-#[inline]
-fn add_revolute_effort(pair: &Pair, t: f64, xd: &[f64], f: &mut [f64]) -> f64 {
-    let angle = |link: Link| match link {
-        Link::Ground => None,
-        Link::Body(b) => Some(3 * b.0 + 2),
-    };
-    let (a, b) = (angle(pair.a), angle(pair.b));
-    // f + t (-1) is f - t and f + t 1 is f + t, exactly.
-    if let Some(k) = a {
-        f[k] -= t;
-    }
-    if let Some(k) = b {
-        f[k] += t;
-    }
-    let rate = |k: Option<usize>| k.map_or(0.0, |k| xd[k]);
-    rate(b) - rate(a)
 }
 
 #[cfg(test)]

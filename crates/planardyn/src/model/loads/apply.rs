@@ -7,7 +7,7 @@
 use crate::linalg::{Dense, Sink};
 use crate::model::pairs::frames::{angle, link_state, perp, rotate};
 use crate::model::pairs::{coordinate_gamma, coordinate_grad, coordinate_pattern};
-use crate::model::{Attachment, Link, Mechanism};
+use crate::model::{Attachment, Link, Mechanism, Pair};
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -66,6 +66,36 @@ impl Sink for Effort<'_> {
 /// Add `effort` acting on a pair's relative coordinate (f += effort * grad).
 pub(crate) fn add_pair_effort(mech: &Mechanism, pair: usize, effort: f64, x: &[f64], f: &mut [f64]) {
     coordinate_grad(&mech.pairs[pair], x, &mut Effort { f, effort }, 0);
+}
+
+/// A revolute pair's relative angle phi_b - phi_a: its rate phi_b' - phi_a' at xd, as
+/// `coordinate_rate` gives it for that kind, without the links' states (each of which takes
+/// its link's cos and sin, which the rate does not need).
+#[inline]
+pub(crate) fn revolute_rate(pair: &Pair, xd: &[f64]) -> f64 {
+    angle_rate(pair.b, xd) - angle_rate(pair.a, xd)
+}
+
+/// A revolute pair's relative angle phi_b - phi_a less its drawn value: `coordinate`'s
+/// operations for that kind, inline (the generic call dispatches on the kind out of line).
+#[inline]
+pub(crate) fn revolute_angle(pair: &Pair, x: &[f64]) -> f64 {
+    angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0
+}
+
+/// Add `effort` acting on a revolute pair's relative angle phi_b - phi_a (the gradient's -1
+/// on a's angle, then +1 on b's): the operations of [`add_pair_effort`] for that kind, so the
+/// same bits, without the links' states (a pair spring's or a drive's evaluation cost a
+/// five-bar about 120 instructions a pair through the generic path).
+#[inline]
+pub(crate) fn add_revolute_effort(pair: &Pair, effort: f64, f: &mut [f64]) {
+    // f + effort (-1) is f - effort, and f + effort 1 is f + effort, exactly.
+    if let Link::Body(a) = pair.a {
+        f[3 * a.0 + 2] -= effort;
+    }
+    if let Link::Body(b) = pair.b {
+        f[3 * b.0 + 2] += effort;
+    }
 }
 
 /// Add the change of a force `force` (N) at a point of a link when x moves along t and the
