@@ -36,8 +36,12 @@ pub struct BlockLu {
     store: Vec<f64>,
     lu_at: Vec<usize>,
     off_base: usize,
-    /// Slot in `store` of entry (r, c) of the matrix at `r * n + c` (`NONE` outside the pattern).
-    dest: Vec<u32>,
+    /// Where the entries of each row go: row r's pattern entries are `dest[dest_at[r]..dest_at[r + 1]]`,
+    /// each (its column, its slot in `store`), in the order the pattern lists them. Per row, not
+    /// an n x n table: the pattern's O(entries) (a dense table was 8 MB and a fifth of the build
+    /// at the ladder's n = 1434), and a row has a few entries (a pair's row: its two bodies').
+    dest_at: Vec<usize>,
+    dest: Vec<(u32, u32)>,
     /// Row pivots of the last factorisation, per permuted position, local to its block.
     piv: Vec<usize>,
     /// The permuted position whose row the factor row at each position is (the block's row
@@ -64,14 +68,11 @@ type Scales<'a> = Option<(&'a [f64], &'a [f64])>;
 /// Right-hand sides solved in one sweep (the velocity analogues of a 3-DOF robot).
 pub const MAX_COLUMNS: usize = 3;
 
-/// `dest` of an entry outside the pattern.
-const NONE: u32 = u32::MAX;
-
 /// The entries of the matrix to factorise, scaled and written into the blocks as they come.
 pub struct BlockSink<'a> {
-    n: usize,
     store: &'a mut [f64],
-    dest: &'a [u32],
+    dest_at: &'a [usize],
+    dest: &'a [(u32, u32)],
     rs: &'a [f64],
     cs: &'a [f64],
 }
@@ -81,9 +82,10 @@ impl Sink for BlockSink<'_> {
     /// is a bug in the pattern: it panics in debug builds and is dropped in release ones.
     #[inline]
     fn add(&mut self, row: usize, col: usize, v: f64) {
-        let d = self.dest[row * self.n + col];
-        debug_assert!(d != NONE, "entry ({row}, {col}) is outside the pattern");
-        if d != NONE {
+        let entries = &self.dest[self.dest_at[row]..self.dest_at[row + 1]];
+        let slot = entries.iter().find(|&&(c, _)| c as usize == col);
+        debug_assert!(slot.is_some(), "entry ({row}, {col}) is outside the pattern");
+        if let Some(&(_, d)) = slot {
             self.store[d as usize] += v * self.rs[row] * self.cs[col];
         }
     }
@@ -96,7 +98,7 @@ impl BlockLu {
     pub fn new(pattern: &[Vec<usize>]) -> Self {
         let n = pattern.len();
         let blocks = blocks(pattern).unwrap_or_else(|| vec![((0..n).collect(), (0..n).collect())]);
-        let (mut row, mut col, mut start, mut lu_at) =
+        let (mut row, mut col, mut start, mut lu_at): (Vec<usize>, Vec<usize>, _, _) =
             (Vec::with_capacity(n), Vec::with_capacity(n), vec![0], Vec::new());
         let mut size = 0;
         for (rows, cols) in &blocks {
@@ -110,14 +112,19 @@ impl BlockLu {
         for (j, &c) in col.iter().enumerate() {
             position[c] = j;
         }
-        let mut dest = vec![NONE; n * n];
+        let mut dest_at = Vec::with_capacity(n + 1);
+        dest_at.push(0);
+        for r in pattern {
+            dest_at.push(dest_at.last().unwrap() + r.len());
+        }
+        let mut dest = vec![(0, 0); *dest_at.last().unwrap()];
         let (mut off_at, mut off_col) = (vec![0], Vec::new());
         for k in 0..blocks.len() {
             let (s0, s1) = (start[k], start[k + 1]);
             for (i, &r) in row[s0..s1].iter().enumerate() {
-                for &c in &pattern[r] {
+                for (&c, d) in pattern[r].iter().zip(&mut dest[dest_at[r]..dest_at[r + 1]]) {
                     let j = position[c];
-                    dest[r * n + c] = if j < s0 {
+                    let slot = if j < s0 {
                         off_col.push(j);
                         (size + off_col.len() - 1) as u32
                     } else if j < s1 {
@@ -125,6 +132,7 @@ impl BlockLu {
                     } else {
                         unreachable!("the block-triangular form has no entry right of a block")
                     };
+                    *d = (c as u32, slot);
                 }
                 off_at.push(off_col.len());
             }
@@ -135,6 +143,7 @@ impl BlockLu {
             store: vec![0.0; size + off_col.len()],
             lu_at,
             off_base: size,
+            dest_at,
             dest,
             piv: vec![0; n],
             src: (0..n).collect(),
@@ -205,7 +214,7 @@ impl BlockLu {
     /// and the sink scales the entries of A it is given. Then [`BlockLu::factor`].
     pub fn sink<'a>(&'a mut self, rs: &'a [f64], cs: &'a [f64]) -> BlockSink<'a> {
         self.store.fill(0.0);
-        BlockSink { n: self.n, store: &mut self.store, dest: &self.dest, rs, cs }
+        BlockSink { store: &mut self.store, dest_at: &self.dest_at, dest: &self.dest, rs, cs }
     }
 
     /// Factorise the filled matrix B block by block. A pivot of magnitude `<= tiny` (or not

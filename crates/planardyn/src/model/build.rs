@@ -511,7 +511,7 @@ pub(crate) fn context<'a>(source: &'a str, spec: &'a MechanismSpec) -> Ctx<'a> {
         source,
         points: &spec.points.0,
         bodies: spec.bodies.0.keys().map(String::as_str).collect(),
-        named_pairs: spec.pairs.iter().map(|p| pair_name(p).is_some()).collect(),
+        named_pairs: spec.pairs.iter().enumerate().filter_map(|(k, p)| Some((pair_name(p).as_deref()?, k))).collect(),
     }
 }
 

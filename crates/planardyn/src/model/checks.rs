@@ -7,6 +7,7 @@ use super::pairs;
 use super::{Attachment, BodyId, Link, Mechanism, PairId, PointId};
 use crate::ModelError;
 use indexmap::{IndexMap, IndexSet};
+use std::collections::HashMap;
 
 /// The context of the checks of one specification (`build::context`).
 pub(crate) struct Ctx<'a> {
@@ -15,8 +16,10 @@ pub(crate) struct Ctx<'a> {
     /// The points by name with their drawn coordinates (m), and the bodies' names, in file order.
     pub points: &'a IndexMap<String, [f64; 2]>,
     pub bodies: IndexSet<&'a str>,
-    /// Whether each pair, in file order, was given a `name` (a made-up one may not be referred to).
-    pub named_pairs: Vec<bool>,
+    /// The pairs given a `name`, by it: their index in file order (a made-up name, for an
+    /// unnamed pair, may not be referred to). A lookup per reference, not a scan of the pairs:
+    /// the coordinates alone refer to O(pairs) of them.
+    pub named_pairs: HashMap<&'a str, usize>,
 }
 
 pub(crate) type R<T> = Result<T, ModelError>;
@@ -82,23 +85,22 @@ impl Ctx<'_> {
 /// A pair referenced by the `name` it was given: the name made up for an unnamed pair
 /// (`a-b@at`) is for messages and results only, and changes when the file is edited.
 pub(crate) fn pair_id(ctx: &Ctx, mech: &Mechanism, path: &str, name: &str) -> R<PairId> {
-    let id = mech.pairs.iter().position(|p| p.name == name).map(PairId).ok_or_else(|| {
-        ctx.err(
-            path,
-            format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")),
-        )
-    })?;
-    if !ctx.named_pairs[id.0] {
-        return Err(ctx.err(
+    if let Some(&k) = ctx.named_pairs.get(name) {
+        return Ok(PairId(k));
+    }
+    Err(match mech.pairs.iter().position(|p| p.name == name) {
+        Some(k) => ctx.err(
             path,
             format!(
-                "'{name}' is the name made up for the unnamed pairs[{}], which a model may not refer to; \
-                 give that pair a `name:` and refer to it by that name",
-                id.0
+                "'{name}' is the name made up for the unnamed pairs[{k}], which a model may not refer to; \
+                 give that pair a `name:` and refer to it by that name"
             ),
-        ));
-    }
-    Ok(id)
+        ),
+        None => ctx.err(
+            path,
+            format!("unknown pair '{name}'; pairs are: {} (give the pair a `name`)", mech.pair_names().join(", ")),
+        ),
+    })
 }
 
 /// A pair with a relative motion of its own (for a pair spring or friction).

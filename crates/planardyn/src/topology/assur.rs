@@ -17,6 +17,8 @@ use crate::model::pairs::letter;
 use crate::model::{BodyId, Link, Mechanism, PairId};
 use petgraph::algo::tarjan_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// One Assur group: a set of links of zero mobility with the pairs joining them to each
 /// other and to the links solved before it.
@@ -82,12 +84,14 @@ fn body(link: Link) -> Option<BodyId> {
     }
 }
 
-/// Kuhn's augmenting path from row r over rows' columns; `col_row` the matching so far.
-fn augment(r: usize, rows: &[Vec<usize>], col_row: &mut [Option<usize>], seen: &mut [bool]) -> bool {
+/// Kuhn's augmenting path from row r over rows' columns; `col_row` the matching so far, `seen[c]
+/// == search` marks the columns this search has visited (one array for all the searches, each
+/// with its own mark: a fresh array per row cost O(rows x columns)).
+fn augment(r: usize, rows: &[Vec<usize>], col_row: &mut [Option<usize>], seen: &mut [usize], search: usize) -> bool {
     for &c in &rows[r] {
-        if !seen[c] {
-            seen[c] = true;
-            if col_row[c].is_none_or(|r2| augment(r2, rows, col_row, seen)) {
+        if seen[c] != search {
+            seen[c] = search;
+            if col_row[c].is_none_or(|r2| augment(r2, rows, col_row, seen, search)) {
                 col_row[c] = Some(r);
                 return true;
             }
@@ -124,8 +128,8 @@ pub(crate) fn assur(mech: &Mechanism) -> Assur {
             rows.extend(mech.pair_rows(PairId(k)).map(|_| columns(k)));
         }
     }
-    let mut col_row = vec![None; nx];
-    let kept: Vec<usize> = (0..rows.len()).filter(|&r| augment(r, &rows, &mut col_row, &mut vec![false; nx])).collect();
+    let (mut col_row, mut seen) = (vec![None; nx], vec![usize::MAX; nx]);
+    let kept: Vec<usize> = (0..rows.len()).filter(|&r| augment(r, &rows, &mut col_row, &mut seen, r)).collect();
     let mut row_col = vec![0; rows.len()];
     for (c, r) in col_row.iter().enumerate() {
         if let Some(r) = r {
@@ -136,8 +140,12 @@ pub(crate) fn assur(mech: &Mechanism) -> Assur {
     let mut under_col: Vec<bool> = col_row.iter().map(Option::is_none).collect();
     let mut under_row = vec![false; rows.len()];
     let mut todo: Vec<usize> = (0..nx).filter(|&c| under_col[c]).collect();
+    let mut kept_on: Vec<Vec<usize>> = vec![Vec::new(); nx];
+    for &r in &kept {
+        rows[r].iter().for_each(|&c| kept_on[c].push(r));
+    }
     while let Some(c) = todo.pop() {
-        for &r in kept.iter().filter(|&&r| rows[r].contains(&c)) {
+        for &r in &kept_on[c] {
             if !under_row[r] {
                 under_row[r] = true;
                 if !under_col[row_col[r]] {
@@ -195,10 +203,9 @@ pub(crate) fn assur(mech: &Mechanism) -> Assur {
             sets.union(scc[0].index(), v.index());
         }
     }
-    let set_of = |sets: &mut UnionFind, i: usize| sets.find(col_block[3 * i]);
+    let body_set: Vec<usize> = (0..n).map(|i| sets.find(col_block[3 * i])).collect();
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); under + 1];
-    for i in 0..n {
-        let s = set_of(&mut sets, i);
+    for (i, &s) in body_set.iter().enumerate() {
         members[s].push(i);
     }
     let ground = units.find(0);
@@ -231,26 +238,50 @@ pub(crate) fn assur(mech: &Mechanism) -> Assur {
         let links = links_of(units, &members[s]);
         (!base, s == under, links.len(), links.iter().map(|l| l[0].0).collect::<Vec<_>>())
     };
-    let mut order: Vec<usize> = Vec::new();
-    while order.len() < live.len() {
-        let ready = live.iter().copied().filter(|s| !order.contains(s) && preds[*s].iter().all(|t| order.contains(t)));
-        let next = ready.map(|s| (key(&mut units, s), s)).min().map(|(_, s)| s);
-        order.push(next.expect("with their cycles merged the sets form a DAG: one is always ready"));
+    // Kahn's order with the ready sets in a heap by key: each step takes the least ready set,
+    // as a scan of all the sets each step would (O(sets^2) and more).
+    let mut waiting: Vec<usize> = preds.iter().map(Vec::len).collect();
+    let mut succs: Vec<Vec<usize>> = vec![Vec::new(); under + 1];
+    for (s, ps) in preds.iter().enumerate() {
+        ps.iter().for_each(|&t| succs[t].push(s));
     }
+    let mut ready: BinaryHeap<Reverse<_>> =
+        live.iter().filter(|&&s| waiting[s] == 0).map(|&s| Reverse((key(&mut units, s), s))).collect();
+    let mut order: Vec<usize> = Vec::with_capacity(live.len());
+    while let Some(Reverse((_, s))) = ready.pop() {
+        order.push(s);
+        for &t in &succs[s] {
+            waiting[t] -= 1;
+            if waiting[t] == 0 {
+                ready.push(Reverse((key(&mut units, t), t)));
+            }
+        }
+    }
+    assert_eq!(order.len(), live.len(), "with their cycles merged the sets form a DAG: one is always ready");
 
+    // Each set's own pairs (not inputs, a body in the set), ascending: a set's inner and outer
+    // pairs are among them, found without a scan of all the pairs per set.
+    let mut touching: Vec<Vec<usize>> = vec![Vec::new(); under + 1];
+    for (k, p) in mech.pairs.iter().enumerate().filter(|(k, _)| !input[*k]) {
+        let [a, b] = [p.a, p.b].map(|l| body(l).map(|b| body_set[b.0]));
+        for s in [a, b.filter(|&b| Some(b) != a)].into_iter().flatten() {
+            touching[s].push(k);
+        }
+    }
     let mut placed = vec![false; n + 1];
     placed[0] = true;
     let (mut groups, mut left_over) = (Vec::new(), Vec::new());
     for s in order {
         let bodies = &members[s];
-        let in_set = |l: Link| body(l).is_some_and(|b| bodies.contains(&b.0));
+        let in_set = |l: Link| body(l).is_some_and(|b| body_set[b.0] == s);
         if bodies.iter().any(|&i| grounded(&mut units, i)) {
             let loose: Vec<usize> = bodies.iter().copied().filter(|&i| !grounded(&mut units, i)).collect();
             left_over.extend(links_of(&mut units, &loose));
         } else {
             let links = links_of(&mut units, bodies);
             let (mut inner, mut outer) = (Vec::new(), Vec::new());
-            for (k, p) in mech.pairs.iter().enumerate().filter(|(k, _)| !input[*k]) {
+            for &k in &touching[s] {
+                let p = &mech.pairs[k];
                 if in_set(p.a) && in_set(p.b) && units.find(node(p.a)) != units.find(node(p.b)) {
                     inner.push(PairId(k));
                 } else if (in_set(p.a) && placed[node(p.b)]) || (in_set(p.b) && placed[node(p.a)]) {
@@ -267,7 +298,9 @@ pub(crate) fn assur(mech: &Mechanism) -> Assur {
         bodies.iter().for_each(|&i| placed[i + 1] = true);
     }
     left_over.sort_by_key(|l| l[0].0);
-    let rest = |l: Link| body(l).is_some_and(|b| left_over.iter().flatten().any(|&c| c == b));
+    let mut in_rest = vec![false; n];
+    left_over.iter().flatten().for_each(|b: &BodyId| in_rest[b.0] = true);
+    let rest = |l: Link| body(l).is_some_and(|b| in_rest[b.0]);
     let constraints: usize = (0..mech.pairs.len())
         .filter(|&k| !input[k] && (rest(mech.pairs[k].a) || rest(mech.pairs[k].b)))
         .map(|k| mech.pair_rows(PairId(k)).len())
