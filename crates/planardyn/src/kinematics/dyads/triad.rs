@@ -13,12 +13,15 @@
 //! rod's relative velocity s_i, and the leg's equations gain s_i (rates) and its Coriolis
 //! term 2 w_i E s_i (accelerations).
 
+mod near;
+
 use super::extension::Arm;
 use super::{put_acceleration, put_rate, Joint};
 use crate::kinematics::group_sigma::{triad_sigma, Block};
 use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
 use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::{KinematicsError, SingularityKind};
+use near::{near_atan2, turned, EXACT_TURN};
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -53,7 +56,7 @@ fn times(inv: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// Largest turn (rad) of a body from the reference for the side test near it
-/// (`Triad::side_near_reference`): there [`near_sin_cos`] is within 2e-14 of sin and cos (its
+/// (`Triad::side_near_reference`): there [`near::near_sin_cos`] is within 2e-14 of sin and cos (its
 /// first left-out terms, 0.5^13 / 13! and 0.5^14 / 14!). The fold guard's predictions are
 /// within a step of the last accepted point; a body turned further takes the library's.
 const NEAR_TURN: f64 = 0.5;
@@ -66,16 +69,6 @@ const NEAR_TURN: f64 = 0.5;
 /// about 150 eta H = 4.5e-12 H; the library's own rounding moves it by about 5e-14 H. Where the
 /// series' determinant is more than 1e-9 H from zero, 200 times both, the two have one sign.
 const SIDE_MARGIN: f64 = 1e-9;
-
-/// sin d and cos d by their Taylor series to d^11 and d^12, for |d| <= [`NEAR_TURN`].
-#[inline(always)]
-fn near_sin_cos(d: f64) -> (f64, f64) {
-    let d2 = d * d;
-    let k = |n: f64| d2 * (1.0 / n);
-    let s = d * (1.0 - k(6.0) * (1.0 - k(20.0) * (1.0 - k(42.0) * (1.0 - k(72.0) * (1.0 - k(110.0))))));
-    let c = 1.0 - k(2.0) * (1.0 - k(12.0) * (1.0 - k(30.0) * (1.0 - k(56.0) * (1.0 - k(90.0) * (1.0 - k(132.0))))));
-    (s, c)
-}
 
 #[derive(Debug, Clone)]
 pub struct Triad {
@@ -207,13 +200,23 @@ impl Triad {
             if !(d.abs() <= NEAR_TURN) {
                 return None;
             }
-            let (s, c) = near_sin_cos(d);
-            let r = self.branch.trig[i];
-            cs[i] = [r[0] * c - r[1] * s, r[1] * c + r[0] * s];
+            cs[i] = turned(self.branch.trig[i], d);
         }
         let det = self.det_at(cs);
         let rows = self.platform_sizes * (self.arms2[0] * self.arms2[1] * self.arms2[2]).sqrt();
         (det.abs() > SIDE_MARGIN * rows).then(|| det.signum())
+    }
+
+    /// [cos, sin] of the platform's angle phi: the reference's rotation turned by the series
+    /// within [`EXACT_TURN`] of its angle (the library's to a few ulp), else the library's.
+    #[inline]
+    fn platform_trig(&self, phi: f64) -> [f64; 2] {
+        let d = phi - self.branch.angles[3];
+        if d.abs() <= EXACT_TURN {
+            return turned(self.branch.trig[3], d);
+        }
+        let (s, c) = phi.sin_cos();
+        [c, s]
     }
 
     /// Take the branch of the configuration x (a solution).
@@ -267,8 +270,7 @@ impl Triad {
         let tol = POSITION_TOL * (1.0 + size);
         let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
         for _ in 0..=MAX_NEWTON {
-            let (s, c) = pose[2].sin_cos();
-            let cs = [c, s];
+            let cs = self.platform_trig(pose[2]);
             let mut f = [0.0; 3];
             let mut norm: f64 = 0.0;
             for i in 0..3 {
@@ -316,7 +318,7 @@ impl Triad {
             let r = 1.0 / (self.arms2[i] * e2).sqrt();
             let leg_cs = [dot(arm, e) * r, cross(arm, e) * r];
             let d = self.branch.directions[i];
-            let turn = cross(d, e).atan2(dot(d, e));
+            let turn = near_atan2(cross(d, e), dot(d, e));
             let rs = rot(leg_cs, self.s_outer[i]);
             let c = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], e);
             x[3 * b] = c[0] - rs[0];
@@ -422,7 +424,7 @@ impl Triad {
 
 #[cfg(test)]
 mod tests {
-    use super::{near_sin_cos, Joint, Triad, NEAR_TURN};
+    use super::{Joint, Triad};
     use crate::model::Link;
 
     /// A 3-RRR's triad: legs 0-2 hinged to the ground at A_i, the platform body 3 (m).
@@ -439,17 +441,6 @@ mod tests {
     fn uniform(seed: &mut u64) -> f64 {
         *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (*seed >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// The series are within 2e-14 of the library's sin and cos over |d| <= NEAR_TURN (the
-    /// bound `SIDE_MARGIN`'s argument takes: the first left-out term, 0.5^13 / 13! = 2.0e-14).
-    #[test]
-    fn near_sin_cos_is_within_its_bound() {
-        for k in -5000..=5000 {
-            let d = k as f64 * NEAR_TURN / 5000.0;
-            let (s, c) = near_sin_cos(d);
-            assert!((s - d.sin()).abs() <= 2e-14 && (c - d.cos()).abs() <= 2e-14, "d = {d}");
-        }
     }
 
     /// Wherever the side test from the series decides, it decides as the library's sin and cos
