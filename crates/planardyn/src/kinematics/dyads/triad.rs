@@ -76,8 +76,9 @@ pub struct Triad {
     pub bodies: [usize; 4],
     /// Those and the followers of two-body legs: the group's bodies.
     pub members: Vec<usize>,
-    /// Per leg, its relative input if it is two bodies.
+    /// Per leg, its relative input if it is two bodies; whether any is.
     extended: [Option<Arm>; 3],
+    cylinders: bool,
     /// A_i on the links solved before, and the same points in the legs' frames.
     outer: [Joint; 3],
     s_outer: [[f64; 2]; 3],
@@ -111,8 +112,22 @@ struct Branch {
     trig: [[f64; 2]; 4],
 }
 
+impl Branch {
+    /// [cos, sin] of the platform's angle phi: the reference's rotation turned by the series
+    /// within [`EXACT_TURN`] of its angle (the library's to a few ulp), else the library's.
+    #[inline]
+    fn platform_trig(&self, phi: f64) -> [f64; 2] {
+        let d = phi - self.angles[3];
+        if d.abs() <= EXACT_TURN {
+            return turned(self.trig[3], d);
+        }
+        let (s, c) = phi.sin_cos();
+        [c, s]
+    }
+}
+
 /// The triad at its solved position: R s of A_i on their links and on the legs, e_i, the
-/// platform's arms R c_i, the inverse Jacobian and 1 / |e_i|^2.
+/// platform's arms R c_i, the inverse Jacobian, |e_i|^2 and 1 / |e_i|^2.
 #[derive(Debug, Clone, Copy, Default)]
 struct Geometry {
     known: [[f64; 2]; 3],
@@ -120,6 +135,7 @@ struct Geometry {
     e: [[f64; 2]; 3],
     lever: [[f64; 2]; 3],
     inv: [[f64; 3]; 3],
+    e2: [f64; 3],
     inv_e2: [f64; 3],
 }
 
@@ -137,10 +153,12 @@ impl Triad {
     ) -> Self {
         let arms = [0, 1, 2].map(|i| sub(s_inner[i], s_outer[i]));
         let members = bodies.iter().copied().chain(extended.iter().flatten().map(|a| a.ext.follower)).collect();
+        let cylinders = extended.iter().any(Option::is_some);
         let mut triad = Triad {
             bodies,
             members,
             extended,
+            cylinders,
             outer,
             s_outer,
             arms,
@@ -207,18 +225,6 @@ impl Triad {
         (det.abs() > SIDE_MARGIN * rows).then(|| det.signum())
     }
 
-    /// [cos, sin] of the platform's angle phi: the reference's rotation turned by the series
-    /// within [`EXACT_TURN`] of its angle (the library's to a few ulp), else the library's.
-    #[inline]
-    fn platform_trig(&self, phi: f64) -> [f64; 2] {
-        let d = phi - self.branch.angles[3];
-        if d.abs() <= EXACT_TURN {
-            return turned(self.branch.trig[3], d);
-        }
-        let (s, c) = phi.sin_cos();
-        [c, s]
-    }
-
     /// Take the branch of the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
         self.set_arms(|a| a.ext.shift_in(x));
@@ -256,10 +262,13 @@ impl Triad {
         x: &mut [f64],
         trig: &mut [[f64; 2]],
     ) -> Result<(), KinematicsError> {
-        if self.extended.iter().any(Option::is_some) {
+        if self.cylinders {
             self.set_arms(|a| a.ext.shift(z));
         }
-        let mut g = Geometry::default();
+        // The geometry is written in place (a 42-value copy an evaluation less): a failed
+        // solve leaves it partial, as it leaves x, and nothing reads it before the next
+        // successful one.
+        let g = &mut self.geometry;
         let mut a = [[0.0; 2]; 3];
         for (i, j) in self.outer.iter().enumerate() {
             (a[i], g.known[i]) = j.place(x, trig);
@@ -270,7 +279,7 @@ impl Triad {
         let tol = POSITION_TOL * (1.0 + size);
         let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
         for _ in 0..=MAX_NEWTON {
-            let cs = self.platform_trig(pose[2]);
+            let cs = self.branch.platform_trig(pose[2]);
             let mut f = [0.0; 3];
             let mut norm: f64 = 0.0;
             for i in 0..3 {
@@ -289,7 +298,7 @@ impl Triad {
             g.inv = inv;
             let done = polish || norm <= tol || (norm <= ROUND_OFF_FLOOR && norm > 0.5 * previous);
             if done && (polish || norm <= POLISH_BELOW) {
-                self.place(pose, cs, g, x, trig);
+                self.place(pose, cs, x, trig);
                 for a in self.extended.iter_mut().flatten() {
                     a.ext.place(z, x, trig);
                 }
@@ -304,9 +313,10 @@ impl Triad {
         Err(KinematicsError::AssemblyFailed { residual, iterations: MAX_NEWTON })
     }
 
-    /// Write the platform at `pose` and the legs from A_i and C_i, keeping the geometry.
+    /// Write the platform at `pose` and the legs from A_i and C_i, completing the geometry.
     #[inline]
-    fn place(&mut self, pose: [f64; 3], cs: [f64; 2], mut g: Geometry, x: &mut [f64], trig: &mut [[f64; 2]]) {
+    fn place(&mut self, pose: [f64; 3], cs: [f64; 2], x: &mut [f64], trig: &mut [[f64; 2]]) {
+        let g = &mut self.geometry;
         let p = self.bodies[3];
         x[3 * p..3 * p + 3].copy_from_slice(&pose);
         trig[p] = cs;
@@ -326,15 +336,16 @@ impl Triad {
             x[3 * b + 2] = self.branch.legs[i] + turn;
             trig[b] = leg_cs;
             g.own[i] = rs;
+            g.e2[i] = e2;
             g.inv_e2[i] = 1.0 / e2;
         }
-        self.geometry = g;
     }
 
-    /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg).
+    /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg); None where
+    /// every leg is one body (the 6R triad: every s_i is zero, and its terms are left out).
     #[inline]
-    fn slides(&self, d: impl Fn(&Arm) -> f64) -> [[f64; 2]; 3] {
-        self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a))))
+    fn slides(&self, d: impl Fn(&Arm) -> f64) -> Option<[[f64; 2]; 3]> {
+        self.cylinders.then(|| self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a)))))
     }
 
     /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
@@ -345,16 +356,23 @@ impl Triad {
         let g = &self.geometry;
         let s = self.slides(|a| a.ext.input_rate(zd));
         let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], v));
-        let [vx, vy, w] = times(&g.inv, [0, 1, 2].map(|i| dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]])));
+        let b = [0, 1, 2].map(|i| match s {
+            Some(s) => dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]]),
+            None => dot(g.e[i], va[i]),
+        });
+        let [vx, vy, w] = times(&g.inv, b);
         let p = self.bodies[3];
         v[3 * p..3 * p + 3].copy_from_slice(&[vx, vy, w]);
         for (i, &leg) in self.bodies[..3].iter().enumerate() {
-            let vc = [vx - w * g.lever[i][1] - s[i][0], vy + w * g.lever[i][0] - s[i][1]];
+            let mut vc = [vx - w * g.lever[i][1], vy + w * g.lever[i][0]];
+            if let Some(s) = s {
+                vc = sub(vc, s[i]);
+            }
             let wl = cross(g.e[i], sub(vc, va[i])) * g.inv_e2[i];
             put_rate(v, leg, va[i], g.own[i], wl);
         }
-        for a in self.extended.iter().flatten() {
-            a.ext.velocity(zd, v);
+        if s.is_some() {
+            self.extended.iter().flatten().for_each(|a| a.ext.velocity(zd, v));
         }
     }
 
@@ -365,27 +383,38 @@ impl Triad {
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         let g = &self.geometry;
         let s = self.slides(|x| x.ext.rate(v));
+        // The Coriolis acceleration of C_i on leg i, 2 w_i E s_i.
+        let coriolis = |s: [[f64; 2]; 3], i: usize, wl: f64| {
+            let c = perp(s[i]);
+            [2.0 * wl * c[0], 2.0 * wl * c[1]]
+        };
         let p = self.bodies[3];
         let w = v[3 * p + 2];
         let (mut aa, mut rhs) = ([[0.0; 2]; 3], [0.0; 3]);
         for (i, &b) in self.bodies[..3].iter().enumerate() {
             let (wl, l) = (v[3 * b + 2], g.lever[i]);
             // a_A_i plus the Coriolis acceleration of C_i on the leg.
-            let c = perp(s[i]);
             aa[i] = self.outer[i].acceleration(g.known[i], v, a);
-            let ac = [aa[i][0] + 2.0 * wl * c[0], aa[i][1] + 2.0 * wl * c[1]];
-            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * dot(g.e[i], g.e[i]);
+            let mut ac = aa[i];
+            if let Some(s) = s {
+                let k = coriolis(s, i, wl);
+                ac = [ac[0] + k[0], ac[1] + k[1]];
+            }
+            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * g.e2[i];
         }
         let [ax, ay, al] = times(&g.inv, rhs);
         a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
         for (i, &b) in self.bodies[..3].iter().enumerate() {
-            let (wl, l, c) = (v[3 * b + 2], g.lever[i], perp(s[i]));
+            let (wl, l) = (v[3 * b + 2], g.lever[i]);
             let ac = [ax - al * l[1] - w * w * l[0], ay + al * l[0] - w * w * l[1]];
-            let rel = [ac[0] - aa[i][0] - 2.0 * wl * c[0], ac[1] - aa[i][1] - 2.0 * wl * c[1]];
+            let mut rel = sub(ac, aa[i]);
+            if let Some(s) = s {
+                rel = sub(rel, coriolis(s, i, wl));
+            }
             put_acceleration(a, b, aa[i], g.own[i], wl, cross(g.e[i], rel) * g.inv_e2[i]);
         }
-        for x in self.extended.iter().flatten() {
-            x.ext.acceleration(v, a);
+        if s.is_some() {
+            self.extended.iter().flatten().for_each(|x| x.ext.acceleration(v, a));
         }
     }
 
