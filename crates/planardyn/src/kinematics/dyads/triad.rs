@@ -508,9 +508,10 @@ mod tests {
     }
 
     /// Wherever the side from the reference's determinant alone decides, it is the library's
-    /// side, at 200 references with predictions of turns up to 5e-4, 5e-3, 0.05 and 0.3 rad
-    /// (the bound is rigorous, so none differs); at the first (the integrator's steps near a
-    /// point) it decides most (measured: DECIDED_SMALL of 50000).
+    /// side, at 200 random references with 50000 predictions each of turns up to 5e-4, 5e-3,
+    /// 0.05 and 0.3 rad (the bound is rigorous, so none differs). Near a point, as the
+    /// integrator's steps are, it decides almost always (measured with this seed: 49705, 43835,
+    /// 6454 and 10 of 50000; asserted: at least 49000 and 40000 at the first two).
     #[test]
     fn side_from_reference_is_the_exact_side_where_it_decides() {
         let mut t = three_rrr();
@@ -531,8 +532,7 @@ mod tests {
                 }
             }
         }
-        eprintln!("decided {decided:?} of {asked:?}");
-        assert!(decided[0] > 0 && decided[3] < asked[3], "decided {decided:?} of {asked:?}");
+        assert!(decided[0] >= 49000 && decided[1] >= 40000, "decided {decided:?} of {asked:?}");
     }
 
     /// Wherever the side test from the series decides, it decides as the library's sin and cos
