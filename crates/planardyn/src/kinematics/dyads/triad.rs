@@ -13,12 +13,15 @@
 //! rod's relative velocity s_i, and the leg's equations gain s_i (rates) and its Coriolis
 //! term 2 w_i E s_i (accelerations).
 
+mod near;
+
 use super::extension::Arm;
 use super::{put_acceleration, put_rate, Joint};
 use crate::kinematics::group_sigma::{triad_sigma, Block};
 use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
 use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::{KinematicsError, SingularityKind};
+use near::{near_atan2, turned, EXACT_TURN};
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -53,7 +56,7 @@ fn times(inv: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// Largest turn (rad) of a body from the reference for the side test near it
-/// (`Triad::side_near_reference`): there [`near_sin_cos`] is within 2e-14 of sin and cos (its
+/// (`Triad::side_near_reference`): there [`near::near_sin_cos`] is within 2e-14 of sin and cos (its
 /// first left-out terms, 0.5^13 / 13! and 0.5^14 / 14!). The fold guard's predictions are
 /// within a step of the last accepted point; a body turned further takes the library's.
 const NEAR_TURN: f64 = 0.5;
@@ -67,24 +70,15 @@ const NEAR_TURN: f64 = 0.5;
 /// series' determinant is more than 1e-9 H from zero, 200 times both, the two have one sign.
 const SIDE_MARGIN: f64 = 1e-9;
 
-/// sin d and cos d by their Taylor series to d^11 and d^12, for |d| <= [`NEAR_TURN`].
-#[inline(always)]
-fn near_sin_cos(d: f64) -> (f64, f64) {
-    let d2 = d * d;
-    let k = |n: f64| d2 * (1.0 / n);
-    let s = d * (1.0 - k(6.0) * (1.0 - k(20.0) * (1.0 - k(42.0) * (1.0 - k(72.0) * (1.0 - k(110.0))))));
-    let c = 1.0 - k(2.0) * (1.0 - k(12.0) * (1.0 - k(30.0) * (1.0 - k(56.0) * (1.0 - k(90.0) * (1.0 - k(132.0))))));
-    (s, c)
-}
-
 #[derive(Debug, Clone)]
 pub struct Triad {
     /// The legs' bodies (the bases of two-body legs), then the platform's.
     pub bodies: [usize; 4],
     /// Those and the followers of two-body legs: the group's bodies.
     pub members: Vec<usize>,
-    /// Per leg, its relative input if it is two bodies.
+    /// Per leg, its relative input if it is two bodies; whether any is.
     extended: [Option<Arm>; 3],
+    cylinders: bool,
     /// A_i on the links solved before, and the same points in the legs' frames.
     outer: [Joint; 3],
     s_outer: [[f64; 2]; 3],
@@ -104,11 +98,12 @@ pub struct Triad {
 }
 
 /// What the triad keeps from the reference configuration: the platform's pose (Newton's start),
-/// the sign of its Jacobian's determinant, and each leg's angle with R(angle) arm_i (the new
+/// its Jacobian's determinant and the sign of it, and each leg's angle with R(angle) arm_i (the new
 /// angles are taken within pi of them).
 #[derive(Debug, Clone, Copy, Default)]
 struct Branch {
     pose: [f64; 3],
+    det: f64,
     side: f64,
     legs: [f64; 3],
     directions: [[f64; 2]; 3],
@@ -118,8 +113,22 @@ struct Branch {
     trig: [[f64; 2]; 4],
 }
 
+impl Branch {
+    /// [cos, sin] of the platform's angle phi: the reference's rotation turned by the series
+    /// within [`EXACT_TURN`] of its angle (the library's to a few ulp), else the library's.
+    #[inline]
+    fn platform_trig(&self, phi: f64) -> [f64; 2] {
+        let d = phi - self.angles[3];
+        if d.abs() <= EXACT_TURN {
+            return turned(self.trig[3], d);
+        }
+        let (s, c) = phi.sin_cos();
+        [c, s]
+    }
+}
+
 /// The triad at its solved position: R s of A_i on their links and on the legs, e_i, the
-/// platform's arms R c_i, the inverse Jacobian and 1 / |e_i|^2.
+/// platform's arms R c_i, the inverse Jacobian, |e_i|^2 and 1 / |e_i|^2.
 #[derive(Debug, Clone, Copy, Default)]
 struct Geometry {
     known: [[f64; 2]; 3],
@@ -127,6 +136,7 @@ struct Geometry {
     e: [[f64; 2]; 3],
     lever: [[f64; 2]; 3],
     inv: [[f64; 3]; 3],
+    e2: [f64; 3],
     inv_e2: [f64; 3],
 }
 
@@ -144,10 +154,12 @@ impl Triad {
     ) -> Self {
         let arms = [0, 1, 2].map(|i| sub(s_inner[i], s_outer[i]));
         let members = bodies.iter().copied().chain(extended.iter().flatten().map(|a| a.ext.follower)).collect();
+        let cylinders = extended.iter().any(Option::is_some);
         let mut triad = Triad {
             bodies,
             members,
             extended,
+            cylinders,
             outer,
             s_outer,
             arms,
@@ -194,26 +206,57 @@ impl Triad {
         .signum()
     }
 
+    /// The turns of the bodies (legs, then the platform) in x from the reference's angles.
+    #[inline]
+    fn turns(&self, x: &[f64]) -> [f64; 4] {
+        // Exact where the angles are 1 rad or more (Sterbenz), within 1.1e-16 below.
+        [0, 1, 2, 3].map(|i| x[3 * self.bodies[i] + 2] - self.branch.angles[i])
+    }
+
+    /// H = prod_i H_i, H_i = |arm_i| (1 + |c_i|) the bound of the Jacobian's row i.
+    #[inline]
+    fn row_sizes(&self) -> f64 {
+        self.platform_sizes * (self.arms2[0] * self.arms2[1] * self.arms2[2]).sqrt()
+    }
+
+    /// [`Triad::side`] from the reference's determinant alone where it is certain (6R triads,
+    /// whose arms are fixed), for the bodies' turns d from the reference: turning leg i by d_i
+    /// and the platform by d_p moves row i of the Jacobian (of size at most H_i) by at most
+    /// H_i (|d_i| + |d_p|) (the chord of e_i, and the change of the arm's cross product with
+    /// it), so the determinant (multilinear in the rows, each term bounded by Hadamard's
+    /// inequality) by at most H (prod_i (1 + |d_i| + |d_p|) - 1). Where the reference's
+    /// clears that by [`SIDE_MARGIN`] H (which covers its rounding and the library's), the
+    /// side is the reference's; else None.
+    #[inline]
+    fn side_from_reference(&self, d: [f64; 4]) -> Option<f64> {
+        if self.cylinders {
+            return None;
+        }
+        let moved = [0, 1, 2].map(|i| 1.0 + (d[i].abs() + d[3].abs()));
+        let bound = moved[0] * moved[1] * moved[2] - 1.0 + SIDE_MARGIN;
+        (self.branch.det.abs() > bound * self.row_sizes()).then_some(self.branch.side)
+    }
+
     /// [`Triad::side`] without the library's sin and cos where it can be told for certain:
-    /// each rotation from the reference's (`Branch::trig`) turned by the angle d from the
-    /// reference's, by the series of sin d and cos d ([`NEAR_TURN`]), and the sign of that
-    /// determinant where it clears zero by [`SIDE_MARGIN`]; None where it does not (near the
-    /// singularity, or a body turned further), and the caller then takes `side`.
+    /// [`Triad::side_from_reference`], else each rotation from the reference's
+    /// (`Branch::trig`) turned by the angle d from the reference's, by the series of sin d and
+    /// cos d ([`NEAR_TURN`]), and the sign of that determinant where it clears zero by
+    /// [`SIDE_MARGIN`] H; None where it does not (near the singularity, or a body turned
+    /// further), and the caller then takes `side`.
     fn side_near_reference(&self, x: &[f64]) -> Option<f64> {
+        let d = self.turns(x);
+        if let Some(side) = self.side_from_reference(d) {
+            return Some(side);
+        }
         let mut cs = [[0.0; 2]; 4];
-        for (i, &b) in self.bodies.iter().enumerate() {
-            // Exact where the angles are 1 rad or more (Sterbenz), within 1.1e-16 below.
-            let d = x[3 * b + 2] - self.branch.angles[i];
-            if !(d.abs() <= NEAR_TURN) {
+        for i in 0..4 {
+            if !(d[i].abs() <= NEAR_TURN) {
                 return None;
             }
-            let (s, c) = near_sin_cos(d);
-            let r = self.branch.trig[i];
-            cs[i] = [r[0] * c - r[1] * s, r[1] * c + r[0] * s];
+            cs[i] = turned(self.branch.trig[i], d[i]);
         }
         let det = self.det_at(cs);
-        let rows = self.platform_sizes * (self.arms2[0] * self.arms2[1] * self.arms2[2]).sqrt();
-        (det.abs() > SIDE_MARGIN * rows).then(|| det.signum())
+        (det.abs() > SIDE_MARGIN * self.row_sizes()).then(|| det.signum())
     }
 
     /// Take the branch of the configuration x (a solution).
@@ -227,8 +270,9 @@ impl Triad {
         });
         let directions = [0, 1, 2].map(|i| rot(trig[i], self.arms[i]));
         let legs = [angles[0], angles[1], angles[2]];
-        let side = self.det_at(trig).signum();
-        self.branch = Branch { pose: [x[p], x[p + 1], x[p + 2]], side, legs, directions, angles, trig };
+        let det = self.det_at(trig);
+        let side = det.signum();
+        self.branch = Branch { pose: [x[p], x[p + 1], x[p + 2]], det, side, legs, directions, angles, trig };
     }
 
     /// Whether the bodies' angles in x (a Newton predictor's) keep the reference's side of the
@@ -253,10 +297,13 @@ impl Triad {
         x: &mut [f64],
         trig: &mut [[f64; 2]],
     ) -> Result<(), KinematicsError> {
-        if self.extended.iter().any(Option::is_some) {
+        if self.cylinders {
             self.set_arms(|a| a.ext.shift(z));
         }
-        let mut g = Geometry::default();
+        // The geometry is written in place (a 42-value copy an evaluation less): a failed
+        // solve leaves it partial, as it leaves x, and nothing reads it before the next
+        // successful one.
+        let g = &mut self.geometry;
         let mut a = [[0.0; 2]; 3];
         for (i, j) in self.outer.iter().enumerate() {
             (a[i], g.known[i]) = j.place(x, trig);
@@ -267,8 +314,7 @@ impl Triad {
         let tol = POSITION_TOL * (1.0 + size);
         let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
         for _ in 0..=MAX_NEWTON {
-            let (s, c) = pose[2].sin_cos();
-            let cs = [c, s];
+            let cs = self.branch.platform_trig(pose[2]);
             let mut f = [0.0; 3];
             let mut norm: f64 = 0.0;
             for i in 0..3 {
@@ -287,7 +333,7 @@ impl Triad {
             g.inv = inv;
             let done = polish || norm <= tol || (norm <= ROUND_OFF_FLOOR && norm > 0.5 * previous);
             if done && (polish || norm <= POLISH_BELOW) {
-                self.place(pose, cs, g, x, trig);
+                self.place(pose, cs, x, trig);
                 for a in self.extended.iter_mut().flatten() {
                     a.ext.place(z, x, trig);
                 }
@@ -302,9 +348,10 @@ impl Triad {
         Err(KinematicsError::AssemblyFailed { residual, iterations: MAX_NEWTON })
     }
 
-    /// Write the platform at `pose` and the legs from A_i and C_i, keeping the geometry.
+    /// Write the platform at `pose` and the legs from A_i and C_i, completing the geometry.
     #[inline]
-    fn place(&mut self, pose: [f64; 3], cs: [f64; 2], mut g: Geometry, x: &mut [f64], trig: &mut [[f64; 2]]) {
+    fn place(&mut self, pose: [f64; 3], cs: [f64; 2], x: &mut [f64], trig: &mut [[f64; 2]]) {
+        let g = &mut self.geometry;
         let p = self.bodies[3];
         x[3 * p..3 * p + 3].copy_from_slice(&pose);
         trig[p] = cs;
@@ -316,7 +363,7 @@ impl Triad {
             let r = 1.0 / (self.arms2[i] * e2).sqrt();
             let leg_cs = [dot(arm, e) * r, cross(arm, e) * r];
             let d = self.branch.directions[i];
-            let turn = cross(d, e).atan2(dot(d, e));
+            let turn = near_atan2(cross(d, e), dot(d, e));
             let rs = rot(leg_cs, self.s_outer[i]);
             let c = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], e);
             x[3 * b] = c[0] - rs[0];
@@ -324,15 +371,16 @@ impl Triad {
             x[3 * b + 2] = self.branch.legs[i] + turn;
             trig[b] = leg_cs;
             g.own[i] = rs;
+            g.e2[i] = e2;
             g.inv_e2[i] = 1.0 / e2;
         }
-        self.geometry = g;
     }
 
-    /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg).
+    /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg); None where
+    /// every leg is one body (the 6R triad: every s_i is zero, and its terms are left out).
     #[inline]
-    fn slides(&self, d: impl Fn(&Arm) -> f64) -> [[f64; 2]; 3] {
-        self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a))))
+    fn slides(&self, d: impl Fn(&Arm) -> f64) -> Option<[[f64; 2]; 3]> {
+        self.cylinders.then(|| self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a)))))
     }
 
     /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
@@ -343,16 +391,23 @@ impl Triad {
         let g = &self.geometry;
         let s = self.slides(|a| a.ext.input_rate(zd));
         let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], v));
-        let [vx, vy, w] = times(&g.inv, [0, 1, 2].map(|i| dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]])));
+        let b = [0, 1, 2].map(|i| match s {
+            Some(s) => dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]]),
+            None => dot(g.e[i], va[i]),
+        });
+        let [vx, vy, w] = times(&g.inv, b);
         let p = self.bodies[3];
         v[3 * p..3 * p + 3].copy_from_slice(&[vx, vy, w]);
         for (i, &leg) in self.bodies[..3].iter().enumerate() {
-            let vc = [vx - w * g.lever[i][1] - s[i][0], vy + w * g.lever[i][0] - s[i][1]];
+            let mut vc = [vx - w * g.lever[i][1], vy + w * g.lever[i][0]];
+            if let Some(s) = s {
+                vc = sub(vc, s[i]);
+            }
             let wl = cross(g.e[i], sub(vc, va[i])) * g.inv_e2[i];
             put_rate(v, leg, va[i], g.own[i], wl);
         }
-        for a in self.extended.iter().flatten() {
-            a.ext.velocity(zd, v);
+        if s.is_some() {
+            self.extended.iter().flatten().for_each(|a| a.ext.velocity(zd, v));
         }
     }
 
@@ -363,27 +418,38 @@ impl Triad {
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
         let g = &self.geometry;
         let s = self.slides(|x| x.ext.rate(v));
+        // The Coriolis acceleration of C_i on leg i, 2 w_i E s_i.
+        let coriolis = |s: [[f64; 2]; 3], i: usize, wl: f64| {
+            let c = perp(s[i]);
+            [2.0 * wl * c[0], 2.0 * wl * c[1]]
+        };
         let p = self.bodies[3];
         let w = v[3 * p + 2];
         let (mut aa, mut rhs) = ([[0.0; 2]; 3], [0.0; 3]);
         for (i, &b) in self.bodies[..3].iter().enumerate() {
             let (wl, l) = (v[3 * b + 2], g.lever[i]);
             // a_A_i plus the Coriolis acceleration of C_i on the leg.
-            let c = perp(s[i]);
             aa[i] = self.outer[i].acceleration(g.known[i], v, a);
-            let ac = [aa[i][0] + 2.0 * wl * c[0], aa[i][1] + 2.0 * wl * c[1]];
-            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * dot(g.e[i], g.e[i]);
+            let mut ac = aa[i];
+            if let Some(s) = s {
+                let k = coriolis(s, i, wl);
+                ac = [ac[0] + k[0], ac[1] + k[1]];
+            }
+            rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * g.e2[i];
         }
         let [ax, ay, al] = times(&g.inv, rhs);
         a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
         for (i, &b) in self.bodies[..3].iter().enumerate() {
-            let (wl, l, c) = (v[3 * b + 2], g.lever[i], perp(s[i]));
+            let (wl, l) = (v[3 * b + 2], g.lever[i]);
             let ac = [ax - al * l[1] - w * w * l[0], ay + al * l[0] - w * w * l[1]];
-            let rel = [ac[0] - aa[i][0] - 2.0 * wl * c[0], ac[1] - aa[i][1] - 2.0 * wl * c[1]];
+            let mut rel = sub(ac, aa[i]);
+            if let Some(s) = s {
+                rel = sub(rel, coriolis(s, i, wl));
+            }
             put_acceleration(a, b, aa[i], g.own[i], wl, cross(g.e[i], rel) * g.inv_e2[i]);
         }
-        for x in self.extended.iter().flatten() {
-            x.ext.acceleration(v, a);
+        if s.is_some() {
+            self.extended.iter().flatten().for_each(|x| x.ext.acceleration(v, a));
         }
     }
 
@@ -422,7 +488,7 @@ impl Triad {
 
 #[cfg(test)]
 mod tests {
-    use super::{near_sin_cos, Joint, Triad, NEAR_TURN};
+    use super::{Joint, Triad};
     use crate::model::Link;
 
     /// A 3-RRR's triad: legs 0-2 hinged to the ground at A_i, the platform body 3 (m).
@@ -441,15 +507,32 @@ mod tests {
         (*seed >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    /// The series are within 2e-14 of the library's sin and cos over |d| <= NEAR_TURN (the
-    /// bound `SIDE_MARGIN`'s argument takes: the first left-out term, 0.5^13 / 13! = 2.0e-14).
+    /// Wherever the side from the reference's determinant alone decides, it is the library's
+    /// side, at 200 random references with 50000 predictions each of turns up to 5e-4, 5e-3,
+    /// 0.05 and 0.3 rad (the bound is rigorous, so none differs). Near a point, as the
+    /// integrator's steps are, it decides almost always (measured with this seed: 49705, 43835,
+    /// 6454 and 10 of 50000; asserted: at least 49000 and 40000 at the first two).
     #[test]
-    fn near_sin_cos_is_within_its_bound() {
-        for k in -5000..=5000 {
-            let d = k as f64 * NEAR_TURN / 5000.0;
-            let (s, c) = near_sin_cos(d);
-            assert!((s - d.sin()).abs() <= 2e-14 && (c - d.cos()).abs() <= 2e-14, "d = {d}");
+    fn side_from_reference_is_the_exact_side_where_it_decides() {
+        let mut t = three_rrr();
+        let mut seed = 11;
+        let (mut decided, mut asked) = ([0; 4], [0; 4]);
+        for _ in 0..200 {
+            let mut x = [0.0; 12];
+            (0..4).for_each(|b| x[3 * b + 2] = 6.0 * (uniform(&mut seed) - 0.5));
+            t.set_reference(&x);
+            for k in 0..1000 {
+                let spread = [1e-3, 1e-2, 0.1, 0.6][k % 4];
+                let mut y = x;
+                (0..4).for_each(|b| y[3 * b + 2] += spread * (uniform(&mut seed) - 0.5));
+                asked[k % 4] += 1;
+                if let Some(s) = t.side_from_reference(t.turns(&y)) {
+                    decided[k % 4] += 1;
+                    assert_eq!(s, t.side(&y), "x = {x:?}, y = {y:?}");
+                }
+            }
         }
+        assert!(decided[0] >= 49000 && decided[1] >= 40000, "decided {decided:?} of {asked:?}");
     }
 
     /// Wherever the side test from the series decides, it decides as the library's sin and cos
