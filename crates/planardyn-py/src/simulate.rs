@@ -256,14 +256,14 @@ pub fn simulate<'py>(
             let at = traj.t.last().copied().unwrap_or(0.0);
             let reason = format!("interrupted (KeyboardInterrupt) at t = {at} s");
             // Whether it came in the progress check or inside a drive callable, it is a cancel.
-            let run = PyRun::new(py, traj, None)?;
+            let run = PyRun::new(traj, None);
             run.set(py, "status", planardyn::simulate::Status::Cancelled.name())?;
             run.set(py, "message", reason)?;
             run.set(py, "interrupt", e.value(py))?;
             Ok(run)
         }
         Some(e) => Err(e),
-        None => PyRun::new(py, traj, cancel_reason),
+        None => Ok(PyRun::new(traj, cancel_reason)),
     }
 }
 
