@@ -12,6 +12,7 @@ import json
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from functools import partial
 from typing import Any, Generic, Literal, NamedTuple, TypeVar, overload
 
 import numpy as np
@@ -181,12 +182,11 @@ class Mechanism:
         what the callable makes: values the caller could change after the call copied)."""
         f = self._run_facts()
         if not callable(settings):  # plain values now: an array changed after the call is recorded as it was
-            given = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
-            settings = lambda: given  # noqa: E731
-        record = settings
-        # The metadata is made at its first read (issue 25 item 4).
+            settings = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
+        # The metadata is made at its first read (issue 25 item 4); a partial, not a closure, holds
+        # what it needs (a short run's fixed cost: no cells made and freed).
         return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
-                                         body_names=f.body_names, metadata=lambda: run_metadata({}, self, record()),
+                                         body_names=f.body_names, metadata=partial(_run_metadata, self, settings),
                                          tau_motor=self._result_motor_torques(raw) if f.has_actuators else None)
 
     def __eq__(self, other: object) -> bool:
@@ -760,38 +760,24 @@ class Mechanism:
         if t_eval is not None or numbers[4] is not None or f.output_dt is not None:
             self._check_rows_fit(numbers, t_eval)
         names = f.coordinate_names
-        raw = self._native.simulate(
-            t_end=numbers[0],
-            method=method,
-            rtol=numbers[1],
-            atol=numbers[2],
-            dt=numbers[3],
-            t_eval=t_eval,
-            output_dt=numbers[4],
-            q0=q0,
-            qd0=qd0,
-            drives=drives,
-            progress=progress,
-            max_steps=numbers[5],
-            motion=None if motion is None else native_motion(motion, names),
-            events=native_events(events, names) if events else [],
-            dense_output=bool(dense_output),
-        )
+        # Positionally, in the native signature's order (t_end, method, rtol, atol, dt, t_eval,
+        # output_dt, q0, qd0, drives, progress, max_steps, motion, events, dense_output):
+        # matching 15 keywords cost a short run ~8k instructions (issue 25 item 4).
+        raw = self._native.simulate(numbers[0], method, numbers[1], numbers[2], numbers[3], t_eval, numbers[4], q0, qd0,
+                                    drives, progress, numbers[5],
+                                    None if motion is None else native_motion(motion, names),
+                                    native_events(events, names) if events else [], bool(dense_output))
         # The result carries its model and settings, so it can be saved, re-plotted and rerun:
-        # made at the first read of its metadata, from copies of what the caller could change.
-        t_eval, q0, qd0 = plain(t_eval), plain(q0), plain(qd0)
-        drives_given = "callable" if callable(drives) else drives
-        motion_given = None if motion is None else {k: "callable" if callable(v) else v for k, v in motion.items()}
-        events_given = None if events is None else [dataclasses.asdict(e) if isinstance(e, Crossing) else "callable"
-                                                    for e in events]
-
-        def settings() -> dict[str, Any]:
-            return dict(t_end=t_end, method=method, rtol=rtol, atol=atol, dt=dt, output_dt=output_dt, t_eval=t_eval,
-                        q0=q0, qd0=qd0, max_steps=max_steps, drives=drives_given, motion=motion_given,
-                        **({} if events_given is None else {"events": events_given}),
-                        **({"dense_output": True} if dense_output else {}))
-
-        result = self._result(raw, settings)
+        # the settings as given (_SETTINGS' order), made into a dict at the first read of the
+        # metadata; what the caller could change after the call is copied now.
+        given = (t_end, method, rtol, atol, dt, output_dt, None if t_eval is None else plain(t_eval),
+                 None if q0 is None else plain(q0), None if qd0 is None else plain(qd0), max_steps,
+                 "callable" if callable(drives) else drives,
+                 None if motion is None else {k: "callable" if callable(v) else v for k, v in motion.items()},
+                 None if events is None else [dataclasses.asdict(e) if isinstance(e, Crossing) else "callable"
+                                              for e in events],
+                 dense_output)
+        result = self._result(raw, partial(_simulate_settings, given))
         if "interrupt" in raw:
             raise SimulationInterrupted(result) from raw["interrupt"]
         return result
@@ -846,6 +832,28 @@ def native_motion(
             raise TypeError(f"motion of {name!r}: give a speed (a number, rad/s or m/s), a table "
                             f"{{'t': ..., 'q': ...}} or a function f(t) -> (q, qd, qdd); got {type(m).__name__}")
     return out
+
+
+#: The settings a result of ``Mechanism.simulate`` records, in its metadata's order; then
+#: ``events`` (when given) and ``dense_output`` (when True).
+_SETTINGS = ("t_end", "method", "rtol", "atol", "dt", "output_dt", "t_eval", "q0", "qd0", "max_steps", "drives", "motion")
+
+
+def _simulate_settings(given: tuple[Any, ...]) -> dict[str, Any]:
+    """The settings record of a ``Mechanism.simulate`` call from the values it was given:
+    those of ``_SETTINGS`` in order, then events (None: not given) and dense_output."""
+    settings = dict(zip(_SETTINGS, given))
+    events, dense_output = given[len(_SETTINGS):]
+    if events is not None:
+        settings["events"] = events
+    if dense_output:
+        settings["dense_output"] = True
+    return settings
+
+
+def _run_metadata(mech: Mechanism, settings: dict[str, Any] | Callable[[], dict[str, Any]]) -> dict[str, Any]:
+    """The metadata of a run of ``mech`` with ``settings`` (or what the callable makes)."""
+    return run_metadata({}, mech, settings() if callable(settings) else settings)
 
 
 def load(path: str | os.PathLike[str]) -> Mechanism:

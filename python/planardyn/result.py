@@ -218,8 +218,9 @@ class SimulationResult:
     #: With ``simulate(dense_output=True)``: ``sol(t) -> (q, qd)`` at any time(s) t of the run
     #: ((m,) each for a number, (K, m) for (K,) times; a ValueError outside [sol.t_min,
     #: sol.t_max]), from each step's own interpolant. None otherwise, and when read from a file
-    #: (which keeps the events).
-    sol: DenseOutput | None = None
+    #: (which keeps the events). A default factory, not a default: a default is a class
+    #: attribute, found before ``__getattr__``, and a native run's ``sol`` is made at its first read.
+    sol: DenseOutput | None = field(default_factory=lambda: None)
     #: None for a model without actuators (the column ``tau_motor``, what identification reads).
     tau_motor: FloatArray | None = None
 
@@ -235,19 +236,16 @@ class SimulationResult:
         tau_motor: FloatArray | None = None,
     ) -> SimulationResult:
         """Wrap the native ``Mechanism.simulate``'s result (a ``_core.Run``, or the dict a
-        batch returns). Its arrays, counters, events and ``metadata`` (given, or made by a
-        callable) are made at their first read (:data:`LAZY_FIELDS`)."""
+        batch returns). Every field but ``tau_motor``, how the run ended too, is made at its
+        first read (:data:`LAZY_FIELDS`), ``metadata`` given or made by a callable."""
         # The frozen dataclass's __init__ sets every field one by one through
         # object.__setattr__, and making every array up front was most of a short run's fixed
-        # cost in Python (issue 25 item 4): how the run ended is set now, the rest at its first read.
+        # cost in Python (issue 25 item 4): nothing is read from the run now, every field at
+        # its first read, even how the run ended (each read of the native run costs as much).
         result = object.__new__(cls)
-        status = raw["status"]
         values = result.__dict__
-        values.update(success=status in ("success", "event"), status=status, message=raw["message"],
-                      _pending=(raw, metadata, (coordinate_names, coordinate_kinds, body_names)))
+        values["_pending"] = (raw, metadata, (coordinate_names, coordinate_kinds, body_names))
         # A field with a default is a class attribute, found before __getattr__: set when not the default.
-        if (sol := raw.get("sol")) is not None:
-            values["sol"] = sol
         if tau_motor is not None:
             values["tau_motor"] = tau_motor
         return result
@@ -381,8 +379,8 @@ class SimulationResult:
 
 #: The fields of a result from a native run made at their first read (``from_raw``).
 LAZY_FIELDS = frozenset(FIELD_COLUMNS) - {"tau_motor"} | {
-    "energy", "poses", "stats", "change_points", "t_events", "q_events", "qd_events", "metadata",
-    "coordinate_names", "coordinate_kinds", "body_names"}
+    "success", "status", "message", "energy", "poses", "stats", "change_points", "t_events", "q_events",
+    "qd_events", "sol", "metadata", "coordinate_names", "coordinate_kinds", "body_names"}
 #: The mechanism's names a result holds, in ``from_raw``'s order.
 NAME_FIELDS = ("coordinate_names", "coordinate_kinds", "body_names")
 
@@ -394,6 +392,10 @@ def _lazy_field(result: SimulationResult, name: str, raw: RawRun,
     (coordinates, their kinds, bodies; see ``from_raw``)."""
     if name in NAME_FIELDS:
         return list(names[NAME_FIELDS.index(name)])  # the result's own copy
+    if name == "success":
+        return result.status in ("success", "event")
+    if name == "sol":
+        return raw.get("sol")
     if name == "energy":
         return Energy.from_arrays(raw["kinetic"], raw["potential"], raw["work"])
     if name == "poses":
@@ -407,7 +409,7 @@ def _lazy_field(result: SimulationResult, name: str, raw: RawRun,
         return list(raw.get(name, []))
     if name == "metadata":
         return dict((metadata() if callable(metadata) else metadata) or {})
-    return raw[name]  # an output column
+    return raw[name]  # status, message or an output column
 
 
 SimulationResult.__doc__ = f"{(SimulationResult.__doc__ or '').rstrip(' ')}{results_format.columns_doc('    ')}"

@@ -29,6 +29,8 @@ pub struct PyMechanism {
     /// The set-up of its runs, made at the first and shared by every `simulate` and batch
     /// run after (`planardyn::simulate::Prepared`).
     prepared: OnceLock<Arc<Prepared>>,
+    /// The settings of its last `simulate`, for the next with the same arguments.
+    last_settings: crate::simulate::LastSettings,
 }
 
 /// Coordinates q and rates qd (m,), the efforts tau (m,) if given: where forward dynamics is asked.
@@ -36,7 +38,7 @@ type ForwardArgs = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
 
 impl PyMechanism {
     pub fn new(mech: Mechanism) -> Self {
-        PyMechanism { inner: Arc::new(mech), prepared: OnceLock::new() }
+        PyMechanism { inner: Arc::new(mech), prepared: OnceLock::new(), last_settings: Default::default() }
     }
 
     /// The set-up of this mechanism's runs, made at the first call with the GIL released.
@@ -586,6 +588,7 @@ impl PyMechanism {
             py,
             &self.inner,
             self.prepared(py),
+            &self.last_settings,
             args,
             drives,
             motion.unwrap_or_default(),

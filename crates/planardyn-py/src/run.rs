@@ -1,7 +1,8 @@
 //! `planardyn._core.Run`: a run's trajectory kept native, each entry (`t`, `q`, ..., `stats`)
 //! made into Python values at its first read and kept (issue 25 item 4: a short run's result
 //! is read in part or not at all, and building all 13 arrays and dicts up front cost more than
-//! the run). It reads as the dict `to_dict` makes for the batch.
+//! the run; a result read not at all makes not even its dict, nor its status). It reads as the
+//! dict `to_dict` makes for the batch.
 
 use crate::convert::{arr1, arr2};
 use crate::exceptions::PlanardynError;
@@ -11,11 +12,13 @@ use planardyn::simulate::columns::{self, Column, Shape, COLUMNS};
 use planardyn::simulate::{Status, Trajectory};
 use pyo3::exceptions::PyKeyError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyList, PyString};
 use std::sync::{Mutex, MutexGuard};
 
 /// The entries besides the output columns, in a dict's order.
-const OTHER_KEYS: [&str; 6] = ["t_events", "q_events", "qd_events", "sol", "change_points", "stats"];
+const OTHER_KEYS: [&str; 8] =
+    ["t_events", "q_events", "qd_events", "sol", "change_points", "stats", "status", "message"];
 
 /// A run's result: `run[key]` (`key` an output column, `t_events`, `q_events`, `qd_events`,
 /// `sol`, `change_points`, `status`, `message`, `stats`, and `interrupt` after a Ctrl-C), made
@@ -24,22 +27,25 @@ const OTHER_KEYS: [&str; 6] = ["t_events", "q_events", "qd_events", "sol", "chan
 pub struct PyRun {
     /// The trajectory; `sol` moves its dense output out at its first read.
     traj: Mutex<Trajectory>,
-    /// The entries read so far, and `status`, `message` (and `interrupt`) from the start.
-    values: Py<PyDict>,
+    /// A cancellation's reason, the message in place of the trajectory's.
+    cancel_reason: Option<String>,
+    /// The entries read (or set) so far, made at the first.
+    values: PyOnceLock<Py<PyDict>>,
 }
 
 impl PyRun {
     /// The run's result; a cancellation's reason, if given, replaces the message.
-    pub fn new(py: Python<'_>, traj: Trajectory, cancel_reason: Option<String>) -> PyResult<PyRun> {
-        let values = PyDict::new(py);
-        values.set_item("status", traj.status.name())?;
-        values.set_item("message", message(&traj, cancel_reason))?;
-        Ok(PyRun { traj: Mutex::new(traj), values: values.unbind() })
+    pub fn new(traj: Trajectory, cancel_reason: Option<String>) -> PyRun {
+        PyRun { traj: Mutex::new(traj), cancel_reason, values: PyOnceLock::new() }
     }
 
     /// Set an entry (the status, message and interrupt of a run stopped by Ctrl-C).
     pub fn set<'py>(&self, py: Python<'py>, key: &str, value: impl IntoPyObject<'py>) -> PyResult<()> {
-        self.values.bind(py).set_item(key, value)
+        self.values(py).set_item(key, value)
+    }
+
+    fn values<'py>(&self, py: Python<'py>) -> &Bound<'py, PyDict> {
+        self.values.get_or_init(py, || PyDict::new(py).unbind()).bind(py)
     }
 
     fn trajectory(&self) -> MutexGuard<'_, Trajectory> {
@@ -50,26 +56,35 @@ impl PyRun {
 
 #[pymethods]
 impl PyRun {
-    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
-        let values = self.values.bind(py);
+    // The key as the caller's string object, looked up as it is (its hash kept), made into
+    // a Rust string only for an entry not read before.
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &Bound<'py, PyString>) -> PyResult<Bound<'py, PyAny>> {
+        let values = self.values(py);
         if let Some(v) = values.get_item(key)? {
             return Ok(v);
         }
-        let v = entry(py, key, &mut self.trajectory())?.ok_or_else(|| PyKeyError::new_err(key.to_string()))?;
+        let made = entry(py, key.to_str()?, &mut self.trajectory(), self.cancel_reason.as_deref())?;
+        let v = made.ok_or_else(|| PyKeyError::new_err(key.clone().unbind()))?;
         values.set_item(key, &v)?;
         Ok(v)
     }
 
     #[pyo3(signature = (key, default=None))]
-    fn get<'py>(&self, py: Python<'py>, key: &str, default: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyAny>> {
+    fn get<'py>(
+        &self,
+        py: Python<'py>,
+        key: &Bound<'py, PyString>,
+        default: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         match self.__getitem__(py, key) {
             Err(e) if e.is_instance_of::<PyKeyError>(py) => Ok(default.unwrap_or_else(|| py.None().into_bound(py))),
             v => v,
         }
     }
 
-    fn __contains__(&self, py: Python<'_>, key: &str) -> PyResult<bool> {
-        Ok(self.values.bind(py).contains(key)? || is_entry(key))
+    fn __contains__<'py>(&self, py: Python<'py>, key: &Bound<'py, PyString>) -> PyResult<bool> {
+        let set = self.values.get(py).map(|v| v.bind(py).contains(key)).transpose()?;
+        Ok(set == Some(true) || is_entry(key.to_str()?))
     }
 
     fn __repr__(&self) -> String {
@@ -82,10 +97,10 @@ fn is_entry(key: &str) -> bool {
     COLUMNS.iter().any(|c| c.name == key) || OTHER_KEYS.contains(&key)
 }
 
-fn message(t: &Trajectory, cancel_reason: Option<String>) -> String {
+fn message<'a>(t: &'a Trajectory, cancel_reason: Option<&'a str>) -> &'a str {
     match (t.status, cancel_reason) {
         (Status::Cancelled, Some(reason)) => reason,
-        _ => t.message.clone(),
+        _ => &t.message,
     }
 }
 
@@ -94,15 +109,19 @@ fn message(t: &Trajectory, cancel_reason: Option<String>) -> String {
 pub(crate) fn to_dict(py: Python<'_>, mut t: Trajectory, cancel_reason: Option<String>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     for key in COLUMNS.iter().map(|c| c.name).chain(OTHER_KEYS) {
-        d.set_item(key, entry(py, key, &mut t)?)?;
+        d.set_item(key, entry(py, key, &mut t, cancel_reason.as_deref())?)?;
     }
-    d.set_item("status", t.status.name())?;
-    d.set_item("message", message(&t, cancel_reason))?;
     Ok(d)
 }
 
-/// Entry `key` of a run's result (None for no such entry; `sol` moves the dense output out).
-fn entry<'py>(py: Python<'py>, key: &str, t: &mut Trajectory) -> PyResult<Option<Bound<'py, PyAny>>> {
+/// Entry `key` of a run's result (None for no such entry; `sol` moves the dense output out), a
+/// cancellation's reason, if given, the message.
+fn entry<'py>(
+    py: Python<'py>,
+    key: &str,
+    t: &mut Trajectory,
+    cancel_reason: Option<&str>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
     if let Some(c) = COLUMNS.iter().find(|c| c.name == key) {
         return column_array(py, c, t).map(Some);
     }
@@ -119,6 +138,8 @@ fn entry<'py>(py: Python<'py>, key: &str, t: &mut Trajectory) -> PyResult<Option
         "sol" => t.dense.take().map(|inner| crate::dense::PyDenseOutput { inner }).into_pyobject(py)?.into_any(),
         "change_points" => change_points(py, t)?.into_any(),
         "stats" => stats(py, t)?.into_any(),
+        "status" => PyString::new(py, t.status.name()).into_any(),
+        "message" => PyString::new(py, message(t, cancel_reason)).into_any(),
         _ => return Ok(None),
     }))
 }

@@ -11,11 +11,11 @@ use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
 use planardyn::dynamics::{Drives, ModelDrives, Motion, MotionFunction, Prescribed};
 use planardyn::model::{MotionLaw, Spline};
 use planardyn::simulate::columns::COLUMNS;
-use planardyn::simulate::{simulate_prepared, Event, EventFn, Observe, Overrides, Prepared};
+use planardyn::simulate::{simulate_prepared, Event, EventFn, Observe, Overrides, Prepared, Settings};
 use planardyn::Mechanism;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The progress callback runs each time t has advanced by this fraction of the run: at most
@@ -176,6 +176,27 @@ pub(crate) fn motion_entries(mech: &Mechanism, motion: Vec<(usize, MotionArg)>) 
         .collect()
 }
 
+/// The settings of a mechanism's last run with the overrides they were made from: a loop of
+/// runs with the same arguments (an optimisation's) makes them once (issue 25 item 4: they
+/// were a tenth of a short run's fixed cost). The mechanism is immutable, so they stay right.
+#[derive(Default)]
+pub struct LastSettings(Mutex<Option<(Overrides, Arc<Settings>)>>);
+
+impl LastSettings {
+    /// The settings of a run of `mech` with `args` (`Overrides::settings`), the last run's
+    /// when its overrides were the same.
+    fn settings(&self, mech: &Mechanism, args: Overrides) -> Result<Arc<Settings>, planardyn::Error> {
+        // Nothing panics while holding it; a poisoned lock still holds whole settings.
+        let mut last = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some((_, s)) = last.as_ref().filter(|(given, _)| *given == args) {
+            return Ok(Arc::clone(s));
+        }
+        let s = Arc::new(args.settings(mech)?);
+        *last = Some((args, Arc::clone(&s)));
+        Ok(s)
+    }
+}
+
 /// Run a simulation from `mech`'s `prepared` set-up and return its result, read as a dict (see
 /// `planardyn.SimulationResult`), its values made at their first read.
 #[allow(clippy::too_many_arguments)]
@@ -183,6 +204,7 @@ pub fn simulate<'py>(
     py: Python<'py>,
     mech: &Mechanism,
     prepared: &Prepared,
+    last: &LastSettings,
     args: Overrides,
     drives: Option<Py<PyAny>>,
     motion: Vec<(usize, MotionArg)>,
@@ -197,7 +219,7 @@ pub fn simulate<'py>(
     let mut fatal: Option<PyErr> = None;
     let mut cancel_reason: Option<String> = None;
     let traj = run(py, || {
-        let s = args.settings(mech)?;
+        let s = last.settings(mech, args)?;
         let step = PROGRESS_FRACTION * (s.t_end - s.t0);
         let mut next = s.t0 + step;
         let mut last_check = Instant::now();
@@ -256,14 +278,14 @@ pub fn simulate<'py>(
             let at = traj.t.last().copied().unwrap_or(0.0);
             let reason = format!("interrupted (KeyboardInterrupt) at t = {at} s");
             // Whether it came in the progress check or inside a drive callable, it is a cancel.
-            let run = PyRun::new(py, traj, None)?;
+            let run = PyRun::new(traj, None);
             run.set(py, "status", planardyn::simulate::Status::Cancelled.name())?;
             run.set(py, "message", reason)?;
             run.set(py, "interrupt", e.value(py))?;
             Ok(run)
         }
         Some(e) => Err(e),
-        None => PyRun::new(py, traj, cancel_reason),
+        None => Ok(PyRun::new(traj, cancel_reason)),
     }
 }
 
