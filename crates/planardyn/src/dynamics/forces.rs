@@ -4,9 +4,8 @@
 //! coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
 use crate::model::loads;
-use crate::model::loads::apply::{add_pair_effort, add_revolute_effort, revolute_rate};
-use crate::model::pairs::coordinate_rate;
-use crate::model::{Mechanism, PairKind};
+use crate::model::loads::apply::{add_effort, pair_rate};
+use crate::model::Mechanism;
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).
 pub trait Drives {
@@ -49,15 +48,8 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
         if t == 0.0 {
             continue;
         }
-        let pair = &mech.pairs[c.pair.0];
-        let rate = if pair.kind == PairKind::Revolute {
-            add_revolute_effort(pair, t, f);
-            revolute_rate(pair, xd)
-        } else {
-            add_pair_effort(mech, c.pair.0, t, x, f);
-            coordinate_rate(pair, x, xd)
-        };
-        power += t * rate;
+        add_effort(mech, c.pair.0, t, x, f);
+        power += t * pair_rate(&mech.pairs[c.pair.0], x, xd);
     }
     power
 }

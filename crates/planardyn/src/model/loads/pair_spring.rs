@@ -4,11 +4,11 @@
 //! 1/2 k (theta - rest)^2; its damper's power is -c theta'^2. A `friction` load's viscous
 //! part is one with k = 0 (`friction`).
 
-use super::apply::{add_pair_effort, add_revolute_effort, pair_effort_rate, revolute_angle, revolute_rate};
+use super::apply::{add_effort, pair_effort_rate, pair_rate, pair_value};
 use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
 use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_rate};
-use crate::model::{Mechanism, PairId, PairKind};
+use crate::model::{Mechanism, PairId};
 use crate::units;
 use serde::{Deserialize, Serialize};
 
@@ -53,19 +53,10 @@ impl LoadType for PairSpring {
     #[inline]
     fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
         let p = &mech.pairs[self.pair.0];
-        // A revolute pair (a servo's spring on its motor pair) directly: the same operations.
-        let revolute = p.kind == PairKind::Revolute;
-        let (value, rate) = if revolute {
-            (revolute_angle(p, x), revolute_rate(p, xd))
-        } else {
-            (coordinate(p, x), coordinate_rate(p, x, xd))
-        };
-        let effort = -self.stiffness * (value - self.rest) - self.damping * rate;
-        if revolute {
-            add_revolute_effort(p, effort, f);
-        } else {
-            add_pair_effort(mech, self.pair.0, effort, x, f);
-        }
+        // A revolute pair (a servo's spring on its motor pair) takes the direct path: the same bits.
+        let rate = pair_rate(p, x, xd);
+        let effort = -self.stiffness * (pair_value(p, x) - self.rest) - self.damping * rate;
+        add_effort(mech, self.pair.0, effort, x, f);
         -(self.damping * rate * rate)
     }
 
@@ -94,7 +85,7 @@ mod tests {
     use super::super::{add_force, Load};
     use crate::model::pairs::{coordinate, coordinate_rate};
 
-    /// A spring on a revolute pair takes the direct path (`revolute_rate`, `add_revolute_effort`)
+    /// A spring on a revolute pair takes the direct path (`pair_rate`, `add_effort`)
     /// and gives the generic one's forces and power bit for bit: the five-bar's two servo
     /// springs on its motor pairs, at its drawing with rates 1.3 and the springs off their rest.
     #[test]
