@@ -33,6 +33,12 @@ const ITERATIONS: usize = 8;
 /// A warm-started estimate stops when an iteration changes 1/sigma^2 by less than this
 /// (relative): sigma to about 1e-3, far finer than the chart thresholds (0.05, 0.1) need.
 const RTOL: f64 = 2e-3;
+/// A group whose points lie within this fraction of the mechanism's length L of each other is
+/// a point (one body with its centre of mass at its one point): its length is then L. Its
+/// drawn points and centre of mass may differ by rounding (a slider's centre of mass given at
+/// its point, the mass times 1e12: 5.6e-17 m apart), and that difference taken for its length
+/// made every scaled distance of the run 1e16 times too large, so every evaluation failed.
+const POINT_GROUP: f64 = 1e-9;
 
 /// Per permuted position of a [`BlockLu`]: the factors taking the globally scaled J to each
 /// block's own length, and the inverse-iteration vectors of the estimate.
@@ -161,7 +167,7 @@ fn group_length(mech: &Mechanism, cols: &[usize]) -> f64 {
 }
 
 /// Length L_k of the group of `bodies`: the diameter of their drawn points and centres of mass
-/// (m); the mechanism's length if that is 0 (a group of one point).
+/// (m); the mechanism's length if that is 0 (a group of one point, to [`POINT_GROUP`]).
 pub(crate) fn bodies_length(mech: &Mechanism, bodies: &[usize]) -> f64 {
     let points: Vec<[f64; 2]> = bodies
         .iter()
@@ -171,7 +177,7 @@ pub(crate) fn bodies_length(mech: &Mechanism, bodies: &[usize]) -> f64 {
         })
         .collect();
     let l = diameter(&points);
-    if l > 0.0 {
+    if l > POINT_GROUP * mech.scale {
         l
     } else {
         mech.scale
