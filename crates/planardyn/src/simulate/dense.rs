@@ -6,6 +6,17 @@
 //! The nodes include both ends, so the solution is continuous from step to step and equals
 //! the accepted states at the step ends.
 
+/// Pieces a step integrated in a partition chart is stored in, each with its own nodes. There
+/// q(t) is not a polynomial but the assembly at the chart's interpolated values, whose
+/// derivatives grow near the user's chart's singularity (why the chart is in use): through
+/// the step's p + 1 points alone, qd was up to 85 times the run's tolerance off the mapped
+/// interpolant (the five-bar free fall, DOPRI5 at rtol 1e-5). Pieces divide that by about
+/// PIECES^(p + 1), at PIECES times the step's assemblies: with 3, below 0.3 of the tolerance
+/// on the five-bars at rtol 1e-5 ... 1e-10 with DOPRI5, DOP853 and Radau5
+/// (tests/test_dense_charts.py); at 1e-12 the assembly's round-off near the singularity is
+/// larger (2e-10 rad/s).
+pub const PARTITION_PIECES: usize = 3;
+
 /// The continuous solution of a run, step by step.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DenseOutput {

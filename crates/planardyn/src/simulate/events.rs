@@ -98,11 +98,11 @@ impl<'e> Watch<'e> {
         Ok(())
     }
 
-    /// Look for zeros in the last step of `dense`, record them, and return the time and index
-    /// of the first terminal one, if any (zeros after it are not recorded: the run ends there).
-    pub fn step(&mut self, dense: &DenseOutput) -> Result<Option<(f64, usize)>, String> {
-        let k = dense.steps() - 1;
-        let (t0, t1) = (dense.breaks[k], dense.breaks[k + 1]);
+    /// Look for zeros in the integrator's step from t0 to the end of `dense` (its last piece or
+    /// pieces), record them, and return the time and index of the first terminal one, if any
+    /// (zeros after it are not recorded: the run ends there).
+    pub fn step(&mut self, dense: &DenseOutput, t0: f64) -> Result<Option<(f64, usize)>, String> {
+        let t1 = dense.t_end;
         dense.eval(t1, &mut self.q, &mut self.qd)?;
         let mut found: Vec<(f64, usize)> = Vec::new();
         for (i, e) in self.events.iter_mut().enumerate() {

@@ -225,7 +225,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if let Err(error) = sample_step(&mut self.ode, &mut self.stepper, dense, &mut self.yi, &mut self.rows) {
             return Break(Stop::DenseOutput { t, error });
         }
-        match self.watch.step(dense) {
+        match self.watch.step(dense, self.stepper.t_prev()) {
             Ok(found) => Continue(found),
             Err(error) => Break(Stop::EventInStep { t, error }),
         }
@@ -605,8 +605,8 @@ fn evaluate_output(ode: &mut MechanismOde, stepper: &mut Stepper, t_out: f64, yi
 
 /// Append the step just taken to `dense`: the user's q and qd at its nodes, from the step's
 /// interpolant. In the user's chart that is the interpolant itself, the coordinates driven by
-/// motion following it; in a partition chart, the point assembled at the interpolated chart
-/// values (the interpolant of q through those points is then as accurate as the step's own).
+/// motion following it; in a partition chart, the points assembled at the interpolated chart
+/// values, over [`dense::PARTITION_PIECES`] pieces of the step (see there).
 fn sample_step(
     ode: &mut MechanismOde,
     stepper: &mut Stepper,
@@ -616,28 +616,33 @@ fn sample_step(
 ) -> Result<(), Error> {
     let m = ode.m();
     let (t0, t1) = (stepper.t_prev(), stepper.t());
-    rows.clear();
     ode.restart_from_anchor();
-    for j in 0..dense.nodes {
-        let t = t0 + dense::node(j, dense.nodes) * (t1 - t0);
-        if j + 1 == dense.nodes {
-            yi.copy_from_slice(stepper.y());
-        } else {
-            stepper.interpolate(ode, t, yi);
-        }
-        if ode.ws.chart == Chart::Inputs {
-            if let Some(motion) = ode.motion.as_deref_mut() {
-                motion.eval(t).map_err(|message| Error::Drive { t, message })?;
-                motion.overwrite(m, yi);
+    let pieces = if ode.ws.chart == Chart::Inputs { 1 } else { dense::PARTITION_PIECES };
+    for piece in 0..pieces {
+        let a = t0 + (t1 - t0) * piece as f64 / pieces as f64;
+        let b = if piece + 1 == pieces { t1 } else { t0 + (t1 - t0) * (piece + 1) as f64 / pieces as f64 };
+        rows.clear();
+        for j in 0..dense.nodes {
+            let t = a + dense::node(j, dense.nodes) * (b - a);
+            if piece + 1 == pieces && j + 1 == dense.nodes {
+                yi.copy_from_slice(stepper.y());
+            } else {
+                stepper.interpolate(ode, t, yi);
             }
-            rows.extend_from_slice(&yi[..2 * m]);
-        } else {
-            ode.evaluate_walking(t, yi)?;
-            rows.extend_from_slice(&ode.ws.q);
-            rows.extend_from_slice(&ode.ws.qd);
+            if ode.ws.chart == Chart::Inputs {
+                if let Some(motion) = ode.motion.as_deref_mut() {
+                    motion.eval(t).map_err(|message| Error::Drive { t, message })?;
+                    motion.overwrite(m, yi);
+                }
+                rows.extend_from_slice(&yi[..2 * m]);
+            } else {
+                ode.evaluate_walking(t, yi)?;
+                rows.extend_from_slice(&ode.ws.q);
+                rows.extend_from_slice(&ode.ws.qd);
+            }
         }
+        dense.push(a, b, rows);
     }
-    dense.push(t0, t1, rows);
     Ok(())
 }
 
