@@ -34,11 +34,12 @@ const PROGRESS_MIN_STEPS: usize = 10_000;
 /// The progress callback: called with t after each accepted step, false stops the run.
 pub type Progress<'p> = Option<&'p mut dyn FnMut(f64) -> bool>;
 
-/// What a crossing did: landed past the change point, reached t_end inside it, or found none
-/// (the passive measure only dipped).
+/// What a crossing did: landed past the change point, reached t_end inside it, met terminal
+/// event `index` at `t` inside it, or found none (the passive measure only dipped).
 enum Crossed {
     Past,
     AtEnd,
+    Event { t: f64, index: usize },
     NoPoint,
 }
 
@@ -211,6 +212,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         match self.cross_change_point((t, meas.sigma, meas.passive, y[2 * m])) {
             Ok(Crossed::Past) => Continue(()),
             Ok(Crossed::AtEnd) => Break(Stop::Reached { t_end: self.settings.t_end }),
+            Ok(Crossed::Event { t, index }) => Break(Stop::TerminalEvent { index, t }),
             Ok(Crossed::NoPoint) => {
                 let why = "Phi_x keeps its rank on the path ahead: no change point to cross".to_string();
                 Break(Stop::Step { error, crossing: Some(why) })
@@ -305,6 +307,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return match self.cross_change_point((t, meas.sigma, meas.passive, work)) {
                 Ok(Crossed::Past) => Continue(true),
                 Ok(Crossed::AtEnd) => Break(Stop::Reached { t_end: self.settings.t_end }),
+                Ok(Crossed::Event { t, index }) => Break(Stop::TerminalEvent { index, t }),
                 // A dip, not a change point: on with the step's other stages, unwatched.
                 Ok(Crossed::NoPoint) => {
                     self.heading = Some(false);
@@ -499,6 +502,31 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         Continue(())
     }
 
+    /// The crossing's gap [t0, t1] in the dense output, sampled from the path it followed
+    /// (as a partition chart's step: the path is in body coordinates), and the events in it;
+    /// the first terminal one's time and index. Without it the step after the landing was
+    /// stored over the gap, and sol was 0.33 rad off there (the double parallelogram swung
+    /// through its change point, DOP853 at rtol 1e-10). The point in `ode.ws` is kept.
+    fn observe_gap(&mut self, path: &Bridge, t0: f64, t1: f64) -> Result<Option<(f64, usize)>, String> {
+        let Some(dense) = self.dense.as_mut() else { return Ok(None) };
+        let ode = &mut self.ode;
+        ode.set_aside();
+        let (pieces, n, m) = (dense::PARTITION_PIECES, dense.nodes, ode.m());
+        for piece in 0..pieces {
+            let a = t0 + (t1 - t0) * piece as f64 / pieces as f64;
+            let b = if piece + 1 == pieces { t1 } else { t0 + (t1 - t0) * (piece + 1) as f64 / pieces as f64 };
+            self.rows.clear();
+            for j in 0..n {
+                path_state(ode, path, a + dense::node(j, n) * (b - a));
+                self.rows.extend_from_slice(&ode.ws.q[..m]);
+                self.rows.extend_from_slice(&ode.ws.qd[..m]);
+            }
+            dense.push(a, b, &self.rows);
+        }
+        ode.take_back();
+        self.watch.step(dense, t0).map_err(|e| format!("an event inside the crossing: {e}"))
+    }
+
     /// Cross the change point ahead of the point accepted at t (held by `ode.ws`, type II and
     /// passive measures `sigma`, `passive`, work `work`) and restart the stepper past it.
     /// Outputs inside the crossing come from the path it followed; without a grid the point
@@ -513,6 +541,19 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         self.passed_point(landing.point.clone());
         (self.t_stop, self.grid, self.heading) = (t_end, None, None);
         let inside = |s: f64, end: f64| s < end || s == t_end && end >= t_end;
+        if let Some((t_star, index)) = self.observe_gap(&landing.path, t, landing.t.min(t_end))? {
+            let rows: Vec<f64> = match self.t_eval {
+                Some(te) => te[self.next..].iter().copied().take_while(|&s| s < t_star).chain([t_star]).collect(),
+                None => vec![t_star],
+            };
+            for s in rows {
+                path_row(&mut self.ode, &mut self.traj, &landing.path, s, sigma);
+            }
+            if let Some(d) = self.dense.as_mut() {
+                d.truncate(t_star);
+            }
+            return Ok(Crossed::Event { t: t_star, index });
+        }
         if landing.t >= t_end {
             let rows: Vec<f64> = match self.t_eval {
                 Some(te) => te[self.next..].iter().copied().take_while(|&s| inside(s, t_end)).collect(),
@@ -648,8 +689,13 @@ fn sample_step(
 
 /// Record the row at time s inside a crossing, from the path it followed.
 fn path_row(ode: &mut MechanismOde, traj: &mut Trajectory, path: &Bridge, s: f64, sigma: f64) {
+    path_state(ode, path, s);
+    traj.record(ode, s, path.work(s), sigma);
+}
+
+/// The state at time s inside a crossing into `ode.ws`, from the path it followed.
+fn path_state(ode: &mut MechanismOde, path: &Bridge, s: f64) {
     let ws = &mut ode.ws;
     path.at(s, &mut ws.frame.x, &mut ws.frame.xd, &mut ws.xdd);
     user_state(ode);
-    traj.record(ode, s, path.work(s), sigma);
 }
