@@ -328,6 +328,11 @@ class Mechanism:
     ) -> FloatArray:
         """Generalized accelerations from A qdd = b (forward dynamics).
 
+        The position is assembled from q starting at the drawing, so on the drawing's branch:
+        at a row of a run that went through a type II singularity onto another branch this
+        gives the drawing branch's qdd, not the run's (``reactions(res)`` and
+        ``point_motion(res)`` follow the run's own branch).
+
         Parameters
         ----------
         q, qd : (m,) array_like
@@ -336,6 +341,9 @@ class Mechanism:
             Time (s), for the model's drive tables.
         tau : (m,) array_like, optional
             Drive efforts (N m on angles, N on displacements); default: the model's drives at t.
+            On a coordinate with an actuator this is its *motor torque* (docs/actuators.md), not
+            the joint-side effort :meth:`inverse_dynamics` returns: pass
+            ``motor_torques(q, qd, qdd, tau)`` of those to get qdd back.
 
         Returns
         -------
