@@ -115,3 +115,18 @@ def test_cli_stop_when(tmp_path):
     assert res.t_events[0].tolist() == [res.t[-1]] and res.q_events[0].shape == (1, 1)
     code, err = cli_run("simulate", model, "--stop-when", "theta~0")
     assert code == 2 and "NAME=VALUE" in err
+
+
+def test_one_event_alone_is_taken_as_solve_ivp_takes_it(pendulum):
+    # A lone Crossing or function used to fail inside the package ("'Crossing' object is not
+    # iterable"); solve_ivp takes one event without a list (s15-sweep).
+    def bottom(t, q, qd):
+        return q[0]
+
+    bottom.terminal = True
+    for event in (pd.Crossing("theta", 0.0, terminal=True), bottom):
+        res = released(pendulum, t_end=2.0, events=event)
+        assert res.status == "event" and res.t_events[0][0] == pytest.approx(QUARTER, abs=1e-9), res.message
+        assert len(res.metadata["settings"]["events"]) == 1
+    with pytest.raises(TypeError, match="events must be an event or a list of them"):
+        released(pendulum, t_end=2.0, events=3.0)
