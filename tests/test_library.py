@@ -8,6 +8,7 @@ constraint: Grubler says 0, the mechanism moves with 1).
 
 from __future__ import annotations
 
+import copy
 import math
 import warnings
 from pathlib import Path
@@ -185,3 +186,25 @@ def test_grashof():
 def test_docs_pictures_exist():
     for stem in STEMS:
         assert (ROOT / "docs" / "img" / f"library-{stem}.png").is_file(), stem
+
+
+def _masses_times(model, k):
+    model = copy.deepcopy(model)
+    for body in model["bodies"].values():
+        for part in [body, *body.get("parts", [])]:
+            for field in ("mass", "inertia"):
+                if field in part:
+                    part[field] *= k
+    return model
+
+
+def test_masses_scaled_together_leave_the_motion_unchanged():
+    # Under gravity alone, q(t) does not depend on the masses' common factor: the motion at
+    # k = 1e12 is the one at k = 1, to the integration's tolerance (rtol 1e-10 over 0.01 s).
+    # Before 6df075e (a slider's group length taken from an ulp's offset of its centre of
+    # mass) every evaluation failed from t = 0 for k = 1e11 .. 1e15 (s15-sweep's find).
+    model = lib.three_prr_model()
+    base = pd.from_dict(model).simulate(t_end=0.01, output_dt=0.001, rtol=1e-10)
+    heavy = pd.from_dict(_masses_times(model, 1e12)).simulate(t_end=0.01, output_dt=0.001, rtol=1e-10)
+    assert heavy.success, heavy.message
+    np.testing.assert_allclose(heavy.q, base.q, rtol=0, atol=1e-9)

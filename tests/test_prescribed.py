@@ -17,7 +17,7 @@ import sys
 import numpy as np
 import planardyn as pd
 import pytest
-from conftest import PENDULUM_I, PENDULUM_L, PENDULUM_M, G, pendulum_dict
+from conftest import PENDULUM_I, PENDULUM_L, PENDULUM_M, G, cli_run, pendulum_dict
 from planardyn.results_io import read_results
 
 I_O = PENDULUM_I + PENDULUM_M * PENDULUM_L**2
@@ -177,6 +177,15 @@ def test_cli_speed_option(tmp_path):
                       ("crank=1rpm", "give NAME=RATE with NAME one of theta")]:
         p = run_cli("simulate", model, "--speed", bad)
         assert p.returncode == 2 and f"--speed {bad}: " in p.stderr and said in p.stderr, p.stderr
+
+
+def test_cli_speed_given_twice_is_refused(tmp_path):
+    # It used to run with the last one silently (s15-sweep).
+    model = tmp_path / "pendulum.json"
+    model.write_text(json.dumps(pendulum_dict()))
+    code, err = cli_run("simulate", model, "--speed", "theta=1", "--speed", "theta=2", "-o", tmp_path / "run.npz")
+    assert code == 2 and "--speed theta=2: theta already has a speed: give each coordinate's --speed once" in err, err
+    assert not (tmp_path / "run.npz").exists()
 
 
 @pytest.mark.parametrize(("text", "kind", "si"), [

@@ -40,6 +40,20 @@ def test_loader_api_and_cli_refuse_the_same_values(name, value):
     assert code == 2 and f"argument --{name.replace('_', '-')}: {name} = " in err, err
 
 
+@pytest.mark.parametrize("simulate", [{"t_end": 1e31, "output_dt": 0.01}, {"t_end": 1e7, "output_dt": 1e-3},
+                                      {"output_dt": 1e-12}])
+def test_a_model_whose_output_grid_cannot_fit_is_refused_at_load(simulate):
+    """Before (s15-sweep): such a model loaded, and every simulate() of it, whatever t_end it
+    was given, aborted the process ("memory allocation of 4294967296 bytes failed" in
+    simulate::grid, building the file's grid of 1e33 times). The rule is the run's own output_dt
+    rule (planardyn::error::MAX_OUTPUTS, 1e8 outputs); without t_end the run lasts 1 s."""
+    with pytest.raises(pd.ModelError, match=r"<string>: simulate.output_dt: output_dt = .* output times, "
+                                            r"more than 1e8: use a larger output_dt or a shorter t_end"):
+        pd.loads(model_with(**simulate))
+    # At the limit the model loads (t_end 1e6 s, output_dt 0.01 s: 1e8 outputs).
+    assert pd.loads(model_with(t_end=1e6, output_dt=0.01)).name
+
+
 def test_positive_tolerances_are_taken():
     # The smallest values the rules allow run: atol just above 0, rtol at 100 epsilons.
     res = pd.load(FIVE_BAR).simulate(0.01, atol=1e-300, rtol=MIN_RTOL, max_steps=50)

@@ -505,6 +505,8 @@ def _speeds(given: list[str], mech: Mechanism) -> dict[str, float] | None:
         name, _, rate = text.partition("=")
         if name not in mech.coordinate_names:
             raise UsageError(f"--speed {text}: give NAME=RATE with NAME one of {', '.join(mech.coordinate_names)}")
+        if name in motion:
+            raise UsageError(f"--speed {text}: {name} already has a speed: give each coordinate's --speed once")
         try:
             motion[name] = parse_rate(rate, mech.coordinate_kinds[mech.coordinate_names.index(name)])
         except ValueError as e:

@@ -11,7 +11,7 @@ which the core evaluates without calling Python (an end stop, a crank angle reac
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -51,6 +51,19 @@ def parse_crossing(text: str) -> Crossing:
             break
     raise ValueError(f"--stop-when {text!r}: write NAME=VALUE, NAME>VALUE (rising) or NAME<VALUE (falling), "
                      "a coordinate's name and a finite number in rad or m, e.g. theta=1.5")
+
+
+def event_list(events: Event | Sequence[Event] | None) -> list[Event] | None:
+    """``Mechanism.simulate``'s ``events`` as a list: one event alone (a function or a
+    :class:`Crossing`) stands for the list of it, as in ``solve_ivp``."""
+    if events is None:
+        return None
+    if isinstance(events, Crossing) or callable(events):
+        return [events]
+    if isinstance(events, (str, bytes, Mapping)) or not isinstance(events, Iterable):
+        raise TypeError(f"events must be an event or a list of them (functions g(t, q, qd) -> float or "
+                        f"planardyn.Crossing), got {type(events).__name__}")
+    return list(events)
 
 
 def native_events(events: Sequence[Event | Mapping[str, Any]] | None, names: list[str]) -> list[tuple[Any, ...]]:

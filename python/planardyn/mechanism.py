@@ -23,7 +23,7 @@ from ._core import Mechanism as NativeMechanism
 from ._core import load as native_load
 from ._core import loads as native_loads
 from .arguments import array, error, index, number
-from .events import Crossing, Event, native_events
+from .events import Crossing, Event, event_list, native_events
 from .guard import ALWAYS_FITS, available_memory, needed_bytes, rows_message
 from .models import UnknownModelError
 from .models import path as model_path
@@ -328,6 +328,11 @@ class Mechanism:
     ) -> FloatArray:
         """Generalized accelerations from A qdd = b (forward dynamics).
 
+        The position is assembled from q starting at the drawing, so on the drawing's branch:
+        at a row of a run that went through a type II singularity onto another branch this
+        gives the drawing branch's qdd, not the run's (``reactions(res)`` and
+        ``point_motion(res)`` follow the run's own branch).
+
         Parameters
         ----------
         q, qd : (m,) array_like
@@ -336,6 +341,9 @@ class Mechanism:
             Time (s), for the model's drive tables.
         tau : (m,) array_like, optional
             Drive efforts (N m on angles, N on displacements); default: the model's drives at t.
+            On a coordinate with an actuator this is its *motor torque* (docs/actuators.md), not
+            the joint-side effort :meth:`inverse_dynamics` returns: pass
+            ``motor_torques(q, qd, qdd, tau)`` of those to get qdd back.
 
         Returns
         -------
@@ -673,7 +681,7 @@ class Mechanism:
         progress: ProgressFunction | None = None,
         max_steps: int | None = None,
         motion: Mapping[str, float | Mapping[str, ArrayLike] | MotionFunction] | None = None,
-        events: Sequence[Event] | None = None,
+        events: Event | Sequence[Event] | None = None,
         dense_output: bool = False,
     ) -> SimulationResult:
         """Integrate the equations of motion from t = 0 (forward dynamics in time).
@@ -723,7 +731,8 @@ class Mechanism:
             are not applied), their work is part of ``work``, and the other coordinates move
             freely under their drives.
         events : list, optional
-            Events as in scipy's ``solve_ivp`` (:mod:`planardyn.events`): functions
+            Events as in scipy's ``solve_ivp`` (:mod:`planardyn.events`; one alone need not be
+            in a list): functions
             ``g(t, q, qd) -> float`` with optional attributes ``terminal`` and ``direction``,
             or :class:`planardyn.Crossing` (a coordinate crossing a value). Zeros are found
             where g changes sign between accepted steps and located on the step's own
@@ -756,6 +765,7 @@ class Mechanism:
         # The rules of the settings are the core's, which the run applies (checked once, issue 25
         # item 4); here the numbers are converted, and checked only before their rows are counted.
         f = self._run_facts()
+        events = event_list(events)
         numbers = convert_numbers(t_end, rtol, atol, dt, output_dt, max_steps)
         if t_eval is not None or numbers[4] is not None or f.output_dt is not None:
             self._check_rows_fit(numbers, t_eval)

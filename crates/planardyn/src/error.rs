@@ -181,6 +181,10 @@ pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
 /// Most step attempts a run may be given: days of computing at a microsecond a step.
 pub const MAX_STEPS: f64 = 1e12;
 
+/// Most output times an `output_dt` may ask for over a run: a guard against output_dt = 1e-12
+/// or t_end = 1e30 s, whose grid would not fit in memory (8e8 bytes at this count).
+pub const MAX_OUTPUTS: f64 = 1e8;
+
 /// A setting of a simulation given as a number: the run's times and the integrator's options.
 /// Each has one rule ([`Setting::check`]), the same for every caller: `Overrides` (the Python
 /// API, the batch runner, the CLI through the glue), a Rust user's `Settings`, and the
@@ -263,6 +267,21 @@ impl Setting {
             return Ok(t_end);
         }
         Err(SettingError::new(Setting::TEnd, t_end, format!("must be a finite number > t0 = {t0} (the end time in s)")))
+    }
+
+    /// output_dt's rule over a run from t0 to t_end (s): its own ([`Setting::check`]), and at
+    /// most [`MAX_OUTPUTS`] output times.
+    pub fn check_outputs(t0: f64, t_end: f64, output_dt: f64) -> Result<f64, SettingError> {
+        let h = Setting::OutputDt.check(output_dt)?;
+        let count = (t_end - t0) / h;
+        if count > MAX_OUTPUTS {
+            let rule = format!(
+                "gives (t_end - t0) / output_dt = {count:.3e} output times, more than {MAX_OUTPUTS:e}: use a larger \
+                 output_dt or a shorter t_end"
+            );
+            return Err(SettingError::new(Setting::OutputDt, h, rule));
+        }
+        Ok(h)
     }
 
     /// The rule `value` breaks, if any.

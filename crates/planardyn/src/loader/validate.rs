@@ -41,13 +41,20 @@ fn build_simulate(ctx: &Ctx, s: Option<&SimulateSpec>) -> R<SimulateDefaults> {
     if let Some(m) = &s.method {
         m.parse::<Method>().map_err(|e| ctx.err("simulate.method", e))?;
     }
+    let t_end = checked(Setting::TEnd, s.t_end)?;
+    let output_dt = checked(Setting::OutputDt, s.output_dt)?;
+    // Every run starts from these defaults' output grid (from 0 s to t_end, 1 s without it).
+    if let Some(h) = output_dt {
+        Setting::check_outputs(0.0, t_end.unwrap_or(SimulateDefaults::T_END), h)
+            .map_err(|e| ctx.err("simulate.output_dt", e.to_string()))?;
+    }
     Ok(SimulateDefaults {
-        t_end: checked(Setting::TEnd, s.t_end)?,
+        t_end,
         method: s.method.clone(),
         rtol: checked(Setting::Rtol, s.rtol)?,
         atol: checked(Setting::Atol, s.atol)?,
         dt: checked(Setting::Dt, s.dt)?,
-        output_dt: checked(Setting::OutputDt, s.output_dt)?,
+        output_dt,
     })
 }
 

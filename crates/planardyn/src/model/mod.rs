@@ -181,6 +181,11 @@ pub struct SimulateDefaults {
     pub output_dt: Option<f64>,
 }
 
+impl SimulateDefaults {
+    /// The end time of a run when neither the model nor the caller gives one (s).
+    pub const T_END: f64 = 1.0;
+}
+
 /// An immutable, validated planar mechanism.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mechanism {
