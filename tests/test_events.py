@@ -130,20 +130,3 @@ def test_one_event_alone_is_taken_as_solve_ivp_takes_it(pendulum):
         assert len(res.metadata["settings"]["events"]) == 1
     with pytest.raises(TypeError, match="events must be an event or a list of them"):
         released(pendulum, t_end=2.0, events=3.0)
-
-
-@pytest.mark.xfail(strict=True, reason="s15-sweep: on steps integrated in another chart (partition_steps > 0) "
-                   "the output rows and a terminal event's last row are the chart's interpolant mapped to q, while "
-                   "sol(t) and q_events are a fit of the mapped q at the step's nodes: they differ by the "
-                   "interpolation error, not round-off (simulate/dense.rs, run.rs end_at_event); remove the mark "
-                   "when fixed")
-def test_sol_reproduces_the_outputs_on_steps_in_another_chart():
-    # The geared five-bar switches charts twice in 0.5 s (stats['partition_steps'] 14 at dopri5,
-    # rtol 1e-8); docs/api.md: sol is 'evaluated exactly, to round-off' and reproduces the
-    # outputs to 1e-12. Measured: 1.6e-10 in q, 8.6e-9 in qd.
-    mech = pd.load_example("geared-five-bar")
-    res = mech.simulate(t_end=0.5, method="dopri5", rtol=1e-8, atol=1e-11, dense_output=True)
-    assert res.stats["partition_steps"] > 0
-    q, qd = res.sol(res.t)
-    # Round-off of a degree-4 interpolant of values O(1): far below 1e-12.
-    assert np.abs(q - res.q).max() < 1e-12 and np.abs(qd - res.qd).max() < 1e-12
