@@ -3,13 +3,10 @@
 
 use super::{check, grid, Settings};
 use crate::dynamics::{Motion, Prescribed};
-use crate::error::{Setting, SettingError};
+use crate::error::Setting;
 use crate::integrate::Method;
 use crate::model::{Mechanism, MotionLaw};
 use crate::Error;
-
-/// Most output times an `output_dt` may ask for (a guard against output_dt = 1e-12).
-const MAX_OUTPUTS: f64 = 1e8;
 
 /// Changes to the model file's `simulate` defaults (`None`: the model's value). Times in s,
 /// coordinates in rad or m, rates in rad/s or m/s.
@@ -70,11 +67,7 @@ impl Overrides {
 
 /// Output times every h (s) from t0 to t_end, clamped to t_end without a duplicate end.
 fn output_grid(t0: f64, t_end: f64, h: f64) -> Result<Vec<f64>, Error> {
-    Setting::OutputDt.check(h)?;
-    if (t_end - t0) / h > MAX_OUTPUTS {
-        let rule = format!("gives more than {MAX_OUTPUTS:e} outputs over [{t0}, {t_end}] s: use a larger output_dt");
-        return Err(SettingError::new(Setting::OutputDt, h, rule).into());
-    }
+    Setting::check_outputs(t0, t_end, h)?;
     let mut t = grid(t0, t_end, h);
     t.iter_mut().for_each(|v| *v = v.min(t_end));
     t.dedup();
