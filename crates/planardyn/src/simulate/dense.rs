@@ -12,9 +12,9 @@
 /// the step's p + 1 points alone, qd was up to 85 times the run's tolerance off the mapped
 /// interpolant (the five-bar free fall, DOPRI5 at rtol 1e-5). Pieces divide that by about
 /// PIECES^(p + 1), at PIECES times the step's assemblies: with 3, below 0.3 of the tolerance
-/// on the five-bars at rtol 1e-5 ... 1e-10 with DOPRI5, DOP853 and Radau5
-/// (tests/test_dense_charts.py); at 1e-12 the assembly's round-off near the singularity is
-/// larger (2e-10 rad/s).
+/// on the five-bars at rtol 1e-5 ... 1e-9 with DOPRI5, DOP853 and Radau5
+/// (tests/test_dense_charts.py); from 1e-10 the assembly's round-off near the singularity,
+/// 1e-10 ... 3e-10 rad/s, is that large.
 pub const PARTITION_PIECES: usize = 3;
 
 /// The continuous solution of a run, step by step.
