@@ -4,7 +4,7 @@
 //! effort on the coordinate); and the rates of both along a direction t of x. The drives use
 //! the pair efforts too (`dynamics::forces`).
 
-use crate::linalg::{Dense, Sink};
+use crate::linalg::Dense;
 use crate::model::pairs::frames::{angle, link_state, perp, rotate};
 use crate::model::pairs::{coordinate_gamma, coordinate_grad, coordinate_pattern};
 use crate::model::{Attachment, Link, Mechanism};
@@ -48,27 +48,6 @@ impl Point {
         f[c + 2] += cross(self.arm, force);
         force[0] * self.v[0] + force[1] * self.v[1]
     }
-}
-
-/// f += effort * (a pair coordinate's gradient), as the gradient's entries are written.
-struct Effort<'a> {
-    f: &'a mut [f64],
-    effort: f64,
-}
-
-impl Sink for Effort<'_> {
-    #[inline]
-    fn add(&mut self, _row: usize, col: usize, v: f64) {
-        self.f[col] += self.effort * v;
-    }
-}
-
-/// Add `effort` acting on a pair's relative coordinate (f += effort * grad), as the kind
-/// writes its gradient (a revolute pair's -1 and +1 on its links' angles: f - effort and
-/// f + effort, exactly).
-#[inline]
-pub(crate) fn add_pair_effort(mech: &Mechanism, pair: usize, effort: f64, x: &[f64], f: &mut [f64]) {
-    coordinate_grad(&mech.pairs[pair], x, &mut Effort { f, effort }, 0);
 }
 
 /// Add the change of a force `force` (N) at a point of a link when x moves along t and the

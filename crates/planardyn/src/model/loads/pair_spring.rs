@@ -4,10 +4,10 @@
 //! 1/2 k (theta - rest)^2; its damper's power is -c theta'^2. A `friction` load's viscous
 //! part is one with k = 0 (`friction`).
 
-use super::apply::{add_pair_effort, pair_effort_rate};
+use super::apply::pair_effort_rate;
 use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
-use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_rate};
+use crate::model::pairs::{add_coordinate_effort, coordinate, coordinate_gamma, coordinate_rate};
 use crate::model::{Mechanism, PairId};
 use crate::units;
 use serde::{Deserialize, Serialize};
@@ -52,10 +52,8 @@ impl LoadSpecType for TorsionalSpringSpec {
 impl LoadType for PairSpring {
     #[inline]
     fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
-        let p = &mech.pairs[self.pair.0];
-        let rate = coordinate_rate(p, x, xd);
-        let effort = -self.stiffness * (coordinate(p, x) - self.rest) - self.damping * rate;
-        add_pair_effort(mech, self.pair.0, effort, x, f);
+        let effort = |value, rate| -self.stiffness * (value - self.rest) - self.damping * rate;
+        let (_, rate) = add_coordinate_effort(&mech.pairs[self.pair.0], x, xd, f, effort);
         -(self.damping * rate * rate)
     }
 

@@ -132,26 +132,28 @@ pub trait PairType {
 
 /// The relative-coordinate methods of [`PairType`] for a kind whose coordinate is the
 /// displacement of b's pair point along its `axis` field (fixed in a), measured from a's copy
-/// of the point (`Relative::Along`): the prismatic pair and the pin in a slot.
+/// of the point (`Relative::Along`): the prismatic pair and the pin in a slot. Out of line,
+/// so that the dispatch below stays small enough to inline where a revolute pair's is a
+/// subtraction (a drive's or a pair spring's effort and rate at every evaluation).
 macro_rules! along_coordinate {
     () => {
-        #[inline]
+        #[inline(never)]
         fn coordinate(&self, pair: &Pair, x: &[f64]) -> f64 {
             super::along(pair, self.axis, x).value()
         }
-        #[inline]
+        #[inline(never)]
         fn coordinate_grad<S: Sink>(&self, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
             super::along(pair, self.axis, x).grad(j, row, 1.0)
         }
-        #[inline]
+        #[inline(never)]
         fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
             super::along(pair, self.axis, x).gamma(u, v)
         }
-        #[inline]
+        #[inline(never)]
         fn coordinate_gamma3(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64 {
             super::along(pair, self.axis, x).gamma3(u, v, t)
         }
-        #[inline]
+        #[inline(never)]
         fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
             super::along(pair, self.axis, x).rate(xd)
         }
@@ -287,7 +289,7 @@ fn along(pair: &Pair, axis: [f64; 2], x: &[f64]) -> Projection {
 }
 
 /// Relative coordinate of a pair from the drawing: angle (rad) or displacement (m).
-#[inline]
+#[inline(always)]
 pub fn coordinate(pair: &Pair, x: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate(pair, x))
 }
@@ -326,7 +328,7 @@ pub fn slip_side(pair: &Pair, x: &[f64], reaction: [f64; 3], rate: f64) -> Side 
 }
 
 /// Gradient of [`coordinate`], added into row `row` of `j`.
-#[inline]
+#[inline(always)]
 pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
     dispatch!(&pair.kind, t => t.coordinate_grad(pair, x, j, row))
 }
@@ -343,8 +345,42 @@ pub fn coordinate_gamma3(pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]
     dispatch!(&pair.kind, k => k.coordinate_gamma3(pair, x, u, v, t))
 }
 
+/// f += effort * (a pair coordinate's gradient), as the kind writes the gradient's entries.
+struct Effort<'a> {
+    f: &'a mut [f64],
+    effort: f64,
+}
+
+impl Sink for Effort<'_> {
+    #[inline(always)]
+    fn add(&mut self, _row: usize, col: usize, v: f64) {
+        self.f[col] += self.effort * v;
+    }
+}
+
+/// A generalized effort on a pair's relative coordinate, `effort(value, rate)` of the
+/// coordinate's value and rate at (x, xd), added along its gradient into f (3n values; a
+/// revolute pair's -1 and +1 on its links' angles: f - effort and f + effort, exactly).
+/// One dispatch on the kind for the three (a pair spring's or a drive's, at every
+/// evaluation). Returns the effort and the rate.
+#[inline(always)]
+pub fn add_coordinate_effort(
+    pair: &Pair,
+    x: &[f64],
+    xd: &[f64],
+    f: &mut [f64],
+    effort: impl FnOnce(f64, f64) -> f64,
+) -> (f64, f64) {
+    dispatch!(&pair.kind, t => {
+        let rate = t.coordinate_rate(pair, x, xd);
+        let effort = effort(t.coordinate(pair, x), rate);
+        t.coordinate_grad(pair, x, &mut Effort { f, effort }, 0);
+        (effort, rate)
+    })
+}
+
 /// Rate of [`coordinate`]: its gradient times xd.
-#[inline]
+#[inline(always)]
 pub fn coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate_rate(pair, x, xd))
 }
