@@ -4,7 +4,7 @@
 //! coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
 use crate::model::loads;
-use crate::model::loads::apply::{add_effort, pair_rate};
+use crate::model::pairs::add_coordinate_effort;
 use crate::model::Mechanism;
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).
@@ -48,8 +48,8 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
         if t == 0.0 {
             continue;
         }
-        add_effort(mech, c.pair.0, t, x, f);
-        power += t * pair_rate(&mech.pairs[c.pair.0], x, xd);
+        let (_, rate) = add_coordinate_effort(&mech.pairs[c.pair.0], x, xd, f, |_, _| t);
+        power += t * rate;
     }
     power
 }
@@ -57,28 +57,33 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
 #[cfg(test)]
 mod tests {
     use super::{applied_forces, Drives, ModelDrives};
-    use crate::model::loads::apply::add_pair_effort;
-    use crate::model::pairs::coordinate_rate;
+    use crate::linalg::Dense;
+    use crate::model::pairs::coordinate_grad;
 
-    /// The revolute drives' path gives the generic one's forces and power bit for bit: the
+    /// The drives' efforts add tau times each coordinate's gradient (its row of D_x, written
+    /// into a dense row) and their power tau times the gradient along xd, bit for bit: the
     /// driven five-bar (two revolute inputs on the ground) and Andrews' squeezer at their
-    /// drawings with rates 1, against `add_pair_effort` and `coordinate_rate` per coordinate.
+    /// drawings with rates 1.
     #[test]
-    fn revolute_efforts_are_the_generic_ones() {
+    fn drive_efforts_are_tau_times_the_gradient() {
         for model in ["five-bar", "andrews-squeezer"] {
             let path = format!("{}/../../examples/models/{model}.yaml", env!("CARGO_MANIFEST_DIR"));
             let mech = crate::load(&path).unwrap();
             let (x, xd) = (mech.x0.clone(), vec![1.0; mech.x0.len()]);
+            let n = x.len();
             let mut tau = vec![0.0; mech.dof()];
             ModelDrives(&mech).efforts(0.3, &[], &[], &mut tau).unwrap();
             tau.iter_mut().for_each(|t| *t += 0.7);
-            let mut f = vec![0.0; x.len()];
+            let mut f = vec![0.0; n];
             let power = applied_forces(&mech, &x, &xd, &vec![0.0; mech.dof()], &mut f);
             let mut expected = f.clone();
             let mut expected_power = power;
             for (c, &t) in mech.coordinates.iter().zip(&tau) {
-                add_pair_effort(&mech, c.pair.0, t, &x, &mut expected);
-                expected_power += t * coordinate_rate(&mech.pairs[c.pair.0], &x, &xd);
+                let mut g = vec![0.0; n];
+                coordinate_grad(&mech.pairs[c.pair.0], &x, &mut Dense { j: &mut g, ncols: n }, 0);
+                let nonzero = || g.iter().enumerate().filter(|(_, g)| **g != 0.0);
+                nonzero().for_each(|(i, g)| expected[i] += t * g);
+                expected_power += t * nonzero().fold(-0.0, |s, (i, g)| s + g * xd[i]);
             }
             let power = applied_forces(&mech, &x, &xd, &tau, &mut f);
             assert_eq!(power.to_bits(), expected_power.to_bits(), "{model}");

@@ -456,7 +456,13 @@ impl<'a> MechanismOde<'a> {
         if newton && prediction == Prediction::FoldGuard {
             self.second_order(z);
         }
-        self.predicted.copy_from_slice(&self.ws.x);
+        // Kept for the correction's bound: moved by a swap where the closed forms then write
+        // every body's x without reading it (no triad, whose Newton starts from it).
+        if !newton && self.closed.as_ref().is_some_and(ClosedForm::is_explicit) {
+            std::mem::swap(&mut self.predicted, &mut self.ws.frame.x);
+        } else {
+            self.predicted.copy_from_slice(&self.ws.x);
+        }
         self.last_t = f64::NAN;
         self.base_valid = false;
         // The pairs' friction needs the reactions, solved with J at this point.

@@ -4,10 +4,10 @@
 //! effort on the coordinate); and the rates of both along a direction t of x. The drives use
 //! the pair efforts too (`dynamics::forces`).
 
-use crate::linalg::{Dense, Sink};
+use crate::linalg::Dense;
 use crate::model::pairs::frames::{angle, link_state, perp, rotate};
-use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_grad, coordinate_pattern, coordinate_rate};
-use crate::model::{Attachment, Link, Mechanism, Pair, PairKind};
+use crate::model::pairs::{coordinate_gamma, coordinate_grad, coordinate_pattern};
+use crate::model::{Attachment, Link, Mechanism};
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -47,66 +47,6 @@ impl Point {
         f[c + 1] += force[1];
         f[c + 2] += cross(self.arm, force);
         force[0] * self.v[0] + force[1] * self.v[1]
-    }
-}
-
-/// f += effort * (a pair coordinate's gradient), as the gradient's entries are written.
-struct Effort<'a> {
-    f: &'a mut [f64],
-    effort: f64,
-}
-
-impl Sink for Effort<'_> {
-    #[inline]
-    fn add(&mut self, _row: usize, col: usize, v: f64) {
-        self.f[col] += self.effort * v;
-    }
-}
-
-/// Add `effort` acting on a pair's relative coordinate (f += effort * grad).
-pub(crate) fn add_pair_effort(mech: &Mechanism, pair: usize, effort: f64, x: &[f64], f: &mut [f64]) {
-    coordinate_grad(&mech.pairs[pair], x, &mut Effort { f, effort }, 0);
-}
-
-/// A pair's relative coordinate less its drawn value, as `coordinate` gives it; a revolute
-/// pair's (phi_b - phi_a) inline, where the generic call dispatches on the kind out of line.
-#[inline]
-pub(crate) fn pair_value(pair: &Pair, x: &[f64]) -> f64 {
-    if pair.kind == PairKind::Revolute {
-        angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0
-    } else {
-        coordinate(pair, x)
-    }
-}
-
-/// A pair's relative coordinate's rate at xd, as `coordinate_rate` gives it; a revolute
-/// pair's (phi_b' - phi_a') without the links' states, each of which takes its link's cos
-/// and sin, which the rate does not need.
-#[inline]
-pub(crate) fn pair_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
-    if pair.kind == PairKind::Revolute {
-        angle_rate(pair.b, xd) - angle_rate(pair.a, xd)
-    } else {
-        coordinate_rate(pair, x, xd)
-    }
-}
-
-/// Add `effort` acting on a pair's relative coordinate, as [`add_pair_effort`] does; on a
-/// revolute pair's phi_b - phi_a directly (the gradient's -1 on a's angle, then +1 on b's: the
-/// same bits), without the links' states (a pair spring's or a drive's evaluation cost a
-/// five-bar about 120 instructions a pair through the generic path).
-#[inline]
-pub(crate) fn add_effort(mech: &Mechanism, pair: usize, effort: f64, x: &[f64], f: &mut [f64]) {
-    let p = &mech.pairs[pair];
-    if p.kind != PairKind::Revolute {
-        return add_pair_effort(mech, pair, effort, x, f);
-    }
-    // f + effort (-1) is f - effort, and f + effort 1 is f + effort, exactly.
-    if let Link::Body(a) = p.a {
-        f[3 * a.0 + 2] -= effort;
-    }
-    if let Link::Body(b) = p.b {
-        f[3 * b.0 + 2] += effort;
     }
 }
 

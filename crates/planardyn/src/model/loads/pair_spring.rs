@@ -4,10 +4,10 @@
 //! 1/2 k (theta - rest)^2; its damper's power is -c theta'^2. A `friction` load's viscous
 //! part is one with k = 0 (`friction`).
 
-use super::apply::{add_effort, pair_effort_rate, pair_rate, pair_value};
+use super::apply::pair_effort_rate;
 use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
-use crate::model::pairs::{coordinate, coordinate_gamma, coordinate_rate};
+use crate::model::pairs::{add_coordinate_effort, coordinate, coordinate_gamma, coordinate_rate};
 use crate::model::{Mechanism, PairId};
 use crate::units;
 use serde::{Deserialize, Serialize};
@@ -52,11 +52,8 @@ impl LoadSpecType for TorsionalSpringSpec {
 impl LoadType for PairSpring {
     #[inline]
     fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
-        let p = &mech.pairs[self.pair.0];
-        // A revolute pair (a servo's spring on its motor pair) takes the direct path: the same bits.
-        let rate = pair_rate(p, x, xd);
-        let effort = -self.stiffness * (pair_value(p, x) - self.rest) - self.damping * rate;
-        add_effort(mech, self.pair.0, effort, x, f);
+        let effort = |value, rate| -self.stiffness * (value - self.rest) - self.damping * rate;
+        let (_, rate) = add_coordinate_effort(&mech.pairs[self.pair.0], x, xd, f, effort);
         -(self.damping * rate * rate)
     }
 
@@ -81,31 +78,36 @@ impl LoadType for PairSpring {
 
 #[cfg(test)]
 mod tests {
-    use super::super::apply::add_pair_effort;
     use super::super::{add_force, Load};
-    use crate::model::pairs::{coordinate, coordinate_rate};
+    use crate::linalg::Dense;
+    use crate::model::pairs::{coordinate, coordinate_grad};
 
-    /// A spring on a revolute pair takes the direct path (`pair_rate`, `add_effort`)
-    /// and gives the generic one's forces and power bit for bit: the five-bar's two servo
-    /// springs on its motor pairs, at its drawing with rates 1.3 and the springs off their rest.
+    /// A pair spring adds its effort -k (theta - rest) - c theta' times the pair coordinate's
+    /// gradient (its row written into a dense row), theta' the gradient along xd, and returns
+    /// the damper's power -c theta'^2, bit for bit: the five-bar's two servo springs on its
+    /// motor pairs, at its drawing with rates 1.3 ... and the springs off their rest.
     #[test]
-    fn revolute_springs_are_the_generic_ones() {
+    fn a_spring_adds_its_effort_times_the_gradient() {
         let path = format!("{}/../../examples/models/five-bar.yaml", env!("CARGO_MANIFEST_DIR"));
         let mech = crate::load(&path).unwrap();
         let mut x = mech.x0.clone();
         x.iter_mut().enumerate().for_each(|(i, v)| *v += 0.01 * i as f64);
-        let xd: Vec<f64> = (0..x.len()).map(|i| 1.3 - 0.2 * i as f64).collect();
+        let n = x.len();
+        let xd: Vec<f64> = (0..n).map(|i| 1.3 - 0.2 * i as f64).collect();
         let springs: Vec<_> =
             mech.loads.iter().filter_map(|l| if let Load::PairSpring(s) = l { Some(s) } else { None }).collect();
         assert_eq!(springs.len(), 2);
         for s in springs {
             let p = &mech.pairs[s.pair.0];
-            let mut f: Vec<f64> = (0..x.len()).map(|i| 0.5 * i as f64 - 1.0).collect();
+            let mut f: Vec<f64> = (0..n).map(|i| 0.5 * i as f64 - 1.0).collect();
             let mut expected = f.clone();
             let power = add_force(&Load::PairSpring(*s), &mech, &x, &xd, &mut f);
-            let rate = coordinate_rate(p, &x, &xd);
+            let mut g = vec![0.0; n];
+            coordinate_grad(p, &x, &mut Dense { j: &mut g, ncols: n }, 0);
+            let nonzero = || g.iter().enumerate().filter(|(_, g)| **g != 0.0);
+            let rate = nonzero().fold(-0.0, |r, (i, g)| r + g * xd[i]);
             let effort = -s.stiffness * (coordinate(p, &x) - s.rest) - s.damping * rate;
-            add_pair_effort(&mech, s.pair.0, effort, &x, &mut expected);
+            nonzero().for_each(|(i, g)| expected[i] += effort * g);
             assert_ne!(effort, 0.0);
             assert_eq!(power.to_bits(), (-(s.damping * rate * rate)).to_bits());
             assert!(f.iter().zip(&expected).all(|(a, b)| a.to_bits() == b.to_bits()), "{f:?} {expected:?}");

@@ -237,4 +237,19 @@ impl PairType for Gear {
     fn slip_side(&self, x: &[f64], reaction: [f64; 3], rate: f64) -> Side {
         Gear::driver(self.tooth_force(x, reaction), rate)
     }
+
+    // No relative coordinate (`relative`): never asked for one (see `PairType`).
+    fn coordinate(&self, _pair: &Pair, _x: &[f64]) -> f64 {
+        0.0
+    }
+    fn coordinate_grad<S: Sink>(&self, _pair: &Pair, _x: &[f64], _j: &mut S, _row: usize) {}
+    fn coordinate_gamma(&self, _pair: &Pair, _x: &[f64], _u: &[f64], _v: &[f64]) -> f64 {
+        0.0
+    }
+    fn coordinate_gamma3(&self, _pair: &Pair, _x: &[f64], _u: &[f64], _v: &[f64], _t: &[f64]) -> f64 {
+        0.0
+    }
+    fn coordinate_rate(&self, _pair: &Pair, _x: &[f64], _xd: &[f64]) -> f64 {
+        0.0
+    }
 }

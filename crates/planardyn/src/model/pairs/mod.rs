@@ -19,7 +19,7 @@ pub mod slot;
 
 use crate::linalg::Sink;
 use crate::model::{CoordinateKind, JointFriction, Mechanism, Pair, PairKind};
-use frames::{add_grad, angle, link_columns, link_state, part, Projection};
+use frames::{link_columns, link_state, Projection};
 use gear::Side;
 
 /// Values of a pair's rows (the first `ROWS` entries).
@@ -118,32 +118,48 @@ pub trait PairType {
     /// gear mesh's driver, `Side::A` for a kind with one lever.
     fn slip_side(&self, x: &[f64], reaction: [f64; 3], rate: f64) -> Side;
 
-    // The relative coordinate's value, gradient, second derivative and rate, from
-    // `relative` (a constant of the kind, so each folds to one case).
-    #[inline]
-    fn coordinate(&self, pair: &Pair, x: &[f64]) -> f64 {
-        relative_value(self.relative(), pair, x)
-    }
-    #[inline]
-    fn coordinate_grad<S: Sink>(&self, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
-        relative_grad(self.relative(), pair, x, j, row)
-    }
-    #[inline]
-    fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
-        relative_gamma(self.relative(), pair, x, u, v)
-    }
-    #[inline]
-    fn coordinate_gamma3(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64 {
-        match self.relative() {
-            Some(Relative::Along { axis }) => along(pair, axis, x).gamma3(u, v, t),
-            Some(Relative::Angle) | None => 0.0,
-        }
-    }
-    #[inline]
-    fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
-        relative_rate(self.relative(), pair, x, xd)
-    }
+    // The relative coordinate (`relative`): its value less the drawn one, gradient (added into
+    // row `row` of `j`), second and third derivatives as multilinear forms, and rate at xd.
+    // Each kind writes its own: a revolute pair's from the two angles alone, a kind measured
+    // along a guide by [`along_coordinate!`]; a kind without one returns 0 (never reached:
+    // the model refuses a coordinate or a pair spring on it).
+    fn coordinate(&self, pair: &Pair, x: &[f64]) -> f64;
+    fn coordinate_grad<S: Sink>(&self, pair: &Pair, x: &[f64], j: &mut S, row: usize);
+    fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64;
+    fn coordinate_gamma3(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64;
+    fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64;
 }
+
+/// The relative-coordinate methods of [`PairType`] for a kind whose coordinate is the
+/// displacement of b's pair point along its `axis` field (fixed in a), measured from a's copy
+/// of the point (`Relative::Along`): the prismatic pair and the pin in a slot. Out of line,
+/// so that the dispatch below stays small enough to inline where a revolute pair's is a
+/// subtraction (a drive's or a pair spring's effort and rate at every evaluation).
+macro_rules! along_coordinate {
+    () => {
+        #[inline(never)]
+        fn coordinate(&self, pair: &Pair, x: &[f64]) -> f64 {
+            super::along(pair, self.axis, x).value()
+        }
+        #[inline(never)]
+        fn coordinate_grad<S: Sink>(&self, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
+            super::along(pair, self.axis, x).grad(j, row, 1.0)
+        }
+        #[inline(never)]
+        fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
+            super::along(pair, self.axis, x).gamma(u, v)
+        }
+        #[inline(never)]
+        fn coordinate_gamma3(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64 {
+            super::along(pair, self.axis, x).gamma3(u, v, t)
+        }
+        #[inline(never)]
+        fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
+            super::along(pair, self.axis, x).rate(xd)
+        }
+    };
+}
+pub(crate) use along_coordinate;
 
 /// Call `$body` with `$t` bound to the pair kind's [`PairType`] value.
 macro_rules! dispatch {
@@ -272,11 +288,8 @@ fn along(pair: &Pair, axis: [f64; 2], x: &[f64]) -> Projection {
     Projection::new(pair.sa, pair.sb, axis, link_state(pair.a, x), link_state(pair.b, x))
 }
 
-// A pair without a relative coordinate never reaches the functions below: the model
-// refuses a coordinate or a pair spring on it; they return 0 for it.
-
 /// Relative coordinate of a pair from the drawing: angle (rad) or displacement (m).
-#[inline]
+#[inline(always)]
 pub fn coordinate(pair: &Pair, x: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate(pair, x))
 }
@@ -315,7 +328,7 @@ pub fn slip_side(pair: &Pair, x: &[f64], reaction: [f64; 3], rate: f64) -> Side 
 }
 
 /// Gradient of [`coordinate`], added into row `row` of `j`.
-#[inline]
+#[inline(always)]
 pub fn coordinate_grad<S: Sink>(pair: &Pair, x: &[f64], j: &mut S, row: usize) {
     dispatch!(&pair.kind, t => t.coordinate_grad(pair, x, j, row))
 }
@@ -332,48 +345,44 @@ pub fn coordinate_gamma3(pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]
     dispatch!(&pair.kind, k => k.coordinate_gamma3(pair, x, u, v, t))
 }
 
+/// f += effort * (a pair coordinate's gradient), as the kind writes the gradient's entries.
+struct Effort<'a> {
+    f: &'a mut [f64],
+    effort: f64,
+}
+
+impl Sink for Effort<'_> {
+    #[inline(always)]
+    fn add(&mut self, _row: usize, col: usize, v: f64) {
+        self.f[col] += self.effort * v;
+    }
+}
+
+/// A generalized effort on a pair's relative coordinate, `effort(value, rate)` of the
+/// coordinate's value and rate at (x, xd), added along its gradient into f (3n values; a
+/// revolute pair's -1 and +1 on its links' angles: f - effort and f + effort, exactly).
+/// One dispatch on the kind for the three (a pair spring's or a drive's, at every
+/// evaluation). Returns the effort and the rate.
+#[inline(always)]
+pub fn add_coordinate_effort(
+    pair: &Pair,
+    x: &[f64],
+    xd: &[f64],
+    f: &mut [f64],
+    effort: impl FnOnce(f64, f64) -> f64,
+) -> (f64, f64) {
+    dispatch!(&pair.kind, t => {
+        let rate = t.coordinate_rate(pair, x, xd);
+        let effort = effort(t.coordinate(pair, x), rate);
+        t.coordinate_grad(pair, x, &mut Effort { f, effort }, 0);
+        (effort, rate)
+    })
+}
+
 /// Rate of [`coordinate`]: its gradient times xd.
-#[inline]
+#[inline(always)]
 pub fn coordinate_rate(pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
     dispatch!(&pair.kind, t => t.coordinate_rate(pair, x, xd))
-}
-
-#[inline(always)]
-fn relative_value(r: Option<Relative>, pair: &Pair, x: &[f64]) -> f64 {
-    match r {
-        Some(Relative::Angle) => angle(pair.b, x) - angle(pair.a, x) - pair.rel_angle0,
-        Some(Relative::Along { axis }) => along(pair, axis, x).value(),
-        None => 0.0,
-    }
-}
-
-#[inline(always)]
-fn relative_grad<S: Sink>(r: Option<Relative>, pair: &Pair, x: &[f64], j: &mut S, row: usize) {
-    match r {
-        Some(Relative::Angle) => {
-            add_grad(j, row, &link_state(pair.a, x), [0.0, 0.0, -1.0]);
-            add_grad(j, row, &link_state(pair.b, x), [0.0, 0.0, 1.0]);
-        }
-        Some(Relative::Along { axis }) => along(pair, axis, x).grad(j, row, 1.0),
-        None => {}
-    }
-}
-
-#[inline(always)]
-fn relative_gamma(r: Option<Relative>, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64 {
-    match r {
-        Some(Relative::Along { axis }) => along(pair, axis, x).gamma(u, v),
-        Some(Relative::Angle) | None => 0.0,
-    }
-}
-
-#[inline(always)]
-fn relative_rate(r: Option<Relative>, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
-    match r {
-        Some(Relative::Angle) => part(&link_state(pair.b, x), xd).1 - part(&link_state(pair.a, x), xd).1,
-        Some(Relative::Along { axis }) => along(pair, axis, x).rate(xd),
-        None => 0.0,
-    }
 }
 
 /// The block drawn on a guide of direction `axis` (in a's frame) through b's pair point:

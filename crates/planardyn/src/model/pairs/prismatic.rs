@@ -5,7 +5,9 @@
 use super::frames::{add_grad, angle, link_state, link_state_t, perp, Projection};
 use super::gear::Side;
 use super::revolute::both_links;
-use super::{coordinate_lever, guide, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
+use super::{
+    along_coordinate, coordinate_lever, guide, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows,
+};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -94,4 +96,6 @@ impl PairType for Prismatic {
     fn slip_side(&self, _x: &[f64], _reaction: [f64; 3], _rate: f64) -> Side {
         Side::A
     }
+
+    along_coordinate!();
 }

@@ -6,7 +6,9 @@
 use super::frames::{link_state, perp, Projection};
 use super::gear::Side;
 use super::revolute::both_links;
-use super::{coordinate_lever, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
+use super::{
+    along_coordinate, coordinate_lever, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows,
+};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Pair};
 
@@ -88,4 +90,6 @@ impl PairType for Slot {
     fn slip_side(&self, _x: &[f64], _reaction: [f64; 3], _rate: f64) -> Side {
         Side::A
     }
+
+    along_coordinate!();
 }
