@@ -31,6 +31,7 @@ use super::dyads::triad::Triad;
 use super::dyads::Joint;
 use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
+use super::u_support::USupport;
 use crate::linalg::copy_small;
 use crate::model::{BodyId, Link, Mechanism, PairId, PairKind};
 use crate::topology::assur::{self, AssurGroup};
@@ -420,6 +421,18 @@ impl ClosedForm {
     /// closed forms would leave the motion's branch there.
     pub fn keeps_branches(&self, x: &[f64]) -> bool {
         self.groups.iter().all(|d| d.keeps_side(x))
+    }
+
+    /// Where U is written by [`ClosedForm::velocity_analogues`] when its zero pattern is
+    /// `zeros_id` (`Frame::u_zeros_for`): each column's runs of bodies, beyond a few coordinates.
+    pub fn u_support_for(&self, zeros_id: u64) -> Option<&USupport> {
+        self.reach.as_ref().filter(|r| r.zeros_id == zeros_id).map(|r| &r.support)
+    }
+
+    /// Whether [`ClosedForm::velocity_analogues`] writes U's columns whole (up to a few
+    /// coordinates), leaving `Frame::u_zeros_for` as it was.
+    pub fn writes_u_whole(&self) -> bool {
+        self.reach.is_none()
     }
 
     /// The type II measure at the last positions (`group_sigma`'s: the smallest singular

@@ -8,6 +8,7 @@
 //! to and on a relative input inside it; found once per model, in the groups' solve order.
 
 use super::system::next_supports_id;
+use super::u_support::USupport;
 use crate::model::{Link, Mechanism};
 use crate::topology::assur::AssurGroup;
 
@@ -21,6 +22,8 @@ pub struct ColumnReach {
     /// Identifies this zero pattern of U among all supports (`Frame::u_zeros_for`): U is
     /// cleared whole once when it changes, then each column is written on its reach only.
     pub zeros_id: u64,
+    /// Per column, the bodies of its pieces as runs: where the closed form writes U.
+    pub support: USupport,
 }
 
 impl ColumnReach {
@@ -47,6 +50,7 @@ impl ColumnReach {
             sliders: vec![Vec::new(); m],
             groups: vec![Vec::new(); m],
             zeros_id: next_supports_id(),
+            support: USupport::default(),
         };
         for (i, &(_, k)) in cranks.iter().enumerate() {
             reach.cranks[k].push(i);
@@ -74,6 +78,15 @@ impl ColumnReach {
                 moved_by[b].clone_from(&deps);
             }
         }
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); m];
+        for (j, col) in columns.iter_mut().enumerate() {
+            col.extend(reach.cranks[j].iter().map(|&i| cranks[i].0));
+            col.extend(reach.sliders[j].iter().map(|&i| sliders[i].0));
+            col.extend(reach.groups[j].iter().flat_map(|&i| groups[i].links.iter().flatten().map(|b| b.0)));
+            col.sort_unstable();
+            col.dedup();
+        }
+        reach.support = USupport::new(&columns);
         reach
     }
 }

@@ -10,6 +10,7 @@ pub mod constraints;
 pub mod dyads;
 pub mod effector;
 pub mod frame;
+pub mod phi_pivots;
 pub mod group_sigma;
 pub mod position;
 pub mod rank;

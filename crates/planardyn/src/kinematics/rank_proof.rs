@@ -20,11 +20,9 @@
 //! `pivot_columns` on sparse rows); a self-stress is the null vector that is 1 on one left-out
 //! row and 0 on the others (a column echelon basis, each as local as the left-out rows allow).
 
-use super::constraints::body_trig;
+use super::phi_pivots::scaled_phi_rows;
 use super::rank::{constraint_rank, parts, Part, RANK_TOL, SELF_STRESS_TOL};
-use super::system::col_scales;
-use crate::linalg::{eliminate, gamma, gram_exceeds, Sink, SparseRow};
-use crate::model::pairs::{self, row_scales};
+use crate::linalg::{eliminate, gamma, gram_exceeds, SparseRow};
 use crate::model::{Mechanism, PairId};
 
 /// The SVD's backward error per row or column of Phi_x, in units of u ||Phi_x||_2 (its
@@ -53,42 +51,12 @@ pub fn independent_rows(mech: &Mechanism, x: &[f64]) -> IndependentRows {
     })
 }
 
-/// The sparse rows of the scaled Phi_x: [`rank::scaled_constraint_jacobian`](super::rank)'s
+/// The sparse rows of the scaled Phi_x, all pair rows: [`rank::scaled_constraint_jacobian`](super::rank)'s
 /// non-zeros, the same values bit for bit (summed and scaled in the same order).
-struct Rows(Vec<SparseRow>);
-
-impl Sink for Rows {
-    fn add(&mut self, row: usize, col: usize, v: f64) {
-        let r = &mut self.0[row];
-        match r.iter_mut().find(|e| e.0 == col) {
-            Some(e) => e.1 += v,
-            None => r.push((col, 0.0 + v)),
-        }
-    }
-}
-
 fn sparse_scaled_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<SparseRow> {
     let rows = mech.n_pair_rows();
-    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
-    body_trig(x, &mut trig);
-    let mut phi = Rows(vec![Vec::new(); rows]);
     let all: Vec<Option<usize>> = (0..rows).map(Some).collect();
-    for (pair, slots) in mech.pairs.iter().zip(&mech.slots_by_pair(&all)) {
-        pairs::jacobian(pair, x, &trig, &mut phi, *slots);
-    }
-    let cs = col_scales(mech);
-    for (k, pair) in mech.pairs.iter().enumerate() {
-        for (r, s) in mech.pair_rows(PairId(k)).zip(row_scales(pair, 1.0 / mech.scale)) {
-            for e in &mut phi.0[r] {
-                e.1 *= s * cs[e.0];
-            }
-        }
-    }
-    for row in &mut phi.0 {
-        row.retain(|e| e.1 != 0.0);
-        row.sort_unstable_by_key(|e| e.0);
-    }
-    phi.0
+    scaled_phi_rows(mech, x, &mech.slots_by_pair(&all), rows)
 }
 
 /// Bounds on ||Phi_x||_2: below, its largest row or column norm; above, sqrt(||.||_1 ||.||_inf).

@@ -15,25 +15,9 @@
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
 use super::constraints::{body_trig, Chart};
-use super::system::{col_scales, scaled_jacobian, System};
-use crate::linalg::pivot_columns;
+use super::system::System;
+use super::phi_pivots::phi_x_pivots;
 use crate::model::Mechanism;
-
-fn scaled(mech: &Mechanism, chart: &Chart, x: &[f64]) -> Vec<f64> {
-    let n = x.len();
-    let mut j = vec![0.0; n * n];
-    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
-    body_trig(x, &mut trig);
-    scaled_jacobian(mech, chart, x, &trig, &mut vec![1.0; n], &col_scales(mech), &mut j);
-    j
-}
-
-/// The scaled Phi_x at x (its independent rows x 3n, row-major).
-pub(crate) fn scaled_phi_x(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
-    let mut a = scaled(mech, &Chart::Inputs, x);
-    a.truncate(mech.n_constraints * x.len());
-    a
-}
 
 /// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
 /// length (type II measure for `Inputs`; `group_sigma`). Cost linear in the bodies.
@@ -78,10 +62,9 @@ pub fn passive_sigma_min_with(inputs_sys: &mut System, mech: &Mechanism, x: &[f6
 /// The m best independent components of x at x: the columns of the scaled Phi_x (its
 /// independent rows) left without a pivot by complete-pivoting elimination. Ascending.
 pub fn select_partition(mech: &Mechanism, x: &[f64]) -> Vec<usize> {
-    let (n, rows) = (x.len(), mech.n_constraints);
-    let mut a = scaled_phi_x(mech, x);
-    let pivots = pivot_columns(&mut a, rows, n, rows);
-    let mut free: Vec<usize> = (0..n).filter(|c| !pivots.contains(c)).collect();
+    let mut free = vec![true; x.len()];
+    phi_x_pivots(mech, x).iter().for_each(|&(c, _)| free[c] = false);
+    let mut free: Vec<usize> = (0..x.len()).filter(|&c| free[c]).collect();
     free.truncate(mech.dof());
     free
 }

@@ -58,6 +58,18 @@ impl USupport {
         self.runs(j).iter().map(|&(first, end)| 3 * first..3 * end)
     }
 
+    /// Copy U's columns (column-major, `n` rows each) from `src` to `dst` over their runs only:
+    /// where both hold zeros outside them, `dst` is then `src` whole, at the cost of the
+    /// supports instead of n x m.
+    pub fn copy_columns(&self, n: usize, src: &[f64], dst: &mut [f64]) {
+        for j in 0..self.len() {
+            for rows in self.rows(j) {
+                let rows = j * n + rows.start..j * n + rows.end;
+                dst[rows.clone()].copy_from_slice(&src[rows]);
+            }
+        }
+    }
+
     /// u_j . f over column j's rows (`u`: the column, 3n values), the terms added in order
     /// from -0.0 (as f64's `Sum` over all rows: the skipped terms are zero). Inlined: called
     /// per entry of b, a call's overhead is a five-bar's whole sum.
@@ -90,5 +102,14 @@ mod tests {
         assert_eq!(s.runs(3), &[(7, 9)]);
         assert_eq!(s.runs(4), &[(1, 5)]);
         assert_eq!(s.rows(0).collect::<Vec<_>>(), vec![0..9, 21..24]);
+        // A copy over the runs of columns 0 and 2 (n = 27 rows) takes their runs' rows only.
+        let s = USupport::new(&[vec![0, 1, 2, 7], vec![4]]);
+        let src: Vec<f64> = (1..=54).map(f64::from).collect();
+        let mut dst = vec![0.0; 54];
+        s.copy_columns(27, &src, &mut dst);
+        let copied: Vec<usize> = (0..54).filter(|&i| dst[i] != 0.0).collect();
+        assert!(copied.iter().all(|&i| dst[i] == src[i]));
+        let want: Vec<usize> = (0..9).chain(21..24).chain(27 + 12..27 + 15).collect();
+        assert_eq!(copied, want);
     }
 }

@@ -93,6 +93,8 @@ pub struct MechanismOde<'a> {
     anchor_x: Vec<f64>,
     anchor_u: Vec<f64>,
     anchor_z: Vec<f64>,
+    /// The zero pattern of U (`Frame::u_zeros_for`) whose copy `anchor_u` holds (0: none).
+    anchor_u_zeros: u64,
     /// The (t, y) of the evaluation whose results `ws` holds, to reuse it at acceptance.
     last_t: f64,
     last_y: Vec<f64>,
@@ -158,6 +160,7 @@ impl<'a> MechanismOde<'a> {
             eval_y: vec![0.0; 2 * m + 1],
             anchor_x: ws.x.clone(),
             anchor_u: ws.u.clone(),
+            anchor_u_zeros: 0,
             anchor_z: vec![0.0; m],
             last_t: f64::NAN,
             last_y: vec![f64::NAN; 2 * m + 1],
@@ -203,7 +206,7 @@ impl<'a> MechanismOde<'a> {
             self.evaluate(t, y)?;
         }
         self.anchor_x.copy_from_slice(&self.ws.x);
-        self.anchor_u.copy_from_slice(&self.ws.u);
+        self.copy_anchor_u();
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
         // The spare evaluates the outputs of the next step, from this point's branches.
@@ -211,6 +214,30 @@ impl<'a> MechanismOde<'a> {
             c.set_reference(&self.ws.x);
         }
         Ok(())
+    }
+
+    /// `anchor_u` = U of the point in `ws`. Both are zero outside the supports of the zero
+    /// pattern they were last cleared for (`Frame::u_zeros_for`, the position solve's or the
+    /// closed form's): with the same pattern, only its supports are copied, at the cost of the
+    /// reaches instead of 3n x m (1.8 MB a step on the ladder of 80 five-bar loops). Closed
+    /// forms that write U whole (a few coordinates) keep no pattern: U is copied whole.
+    fn copy_anchor_u(&mut self) {
+        let (id, n) = (self.ws.u_zeros_for, self.ws.x.len());
+        let whole = self.closed.as_ref().is_some_and(ClosedForm::writes_u_whole);
+        let support = if whole || id == 0 || id != self.anchor_u_zeros {
+            None
+        } else if id == self.ws.sys.supports_id() {
+            Some(self.ws.sys.u_support())
+        } else {
+            self.closed.as_ref().and_then(|c| c.u_support_for(id))
+        };
+        match support {
+            Some(s) => s.copy_columns(n, &self.ws.u, &mut self.anchor_u),
+            None => {
+                self.anchor_u.copy_from_slice(&self.ws.u);
+                self.anchor_u_zeros = id;
+            }
+        }
     }
 
     /// Bound the Newton correction by the chart's smallest scaled singular value `sigma` at

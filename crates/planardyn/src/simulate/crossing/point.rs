@@ -5,8 +5,7 @@ use super::approach::{Approach, Passed};
 use super::bridge::{Path, Quintic};
 use super::WATCH_BELOW;
 use crate::kinematics::coordinates;
-use crate::kinematics::singularity::scaled_phi_x;
-use crate::linalg::pivot_columns;
+use crate::kinematics::phi_pivots::phi_x_pivots;
 use crate::model::Mechanism;
 use crate::simulate::charts::Measures;
 use crate::simulate::ode::MechanismOde;
@@ -89,10 +88,7 @@ fn strictly_inside(point: &ChangePoint, t0: f64, t: f64) -> bool {
 /// The scaled pivots of complete pivoting on Phi_x at x, in pivot order (fewer than its
 /// rows where one is exactly 0).
 fn pivots(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
-    let (n, rows) = (x.len(), mech.n_constraints);
-    let mut a = scaled_phi_x(mech, x);
-    let columns = pivot_columns(&mut a, rows, n, rows);
-    columns.iter().enumerate().map(|(k, &c)| a[k * n + c].abs()).collect()
+    phi_x_pivots(mech, x).into_iter().map(|(_, p)| p).collect()
 }
 
 /// Rank Phi_x has lost at x against a regular point (3n - m).
