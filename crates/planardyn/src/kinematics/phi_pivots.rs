@@ -27,7 +27,12 @@ impl Sink for Rows {
 /// The scaled Phi_x's rows placed by `slots` (per pair, as `Mechanism::pair_slots`) among
 /// `rows`: the non-zeros of the dense scaled Jacobian (`system::scaled_jacobian`, rows in metres
 /// over L, translation columns times L), the same values bit for bit, each row by column.
-pub(crate) fn scaled_phi_rows(mech: &Mechanism, x: &[f64], slots: &[[Option<usize>; 2]], rows: usize) -> Vec<SparseRow> {
+pub(crate) fn scaled_phi_rows(
+    mech: &Mechanism,
+    x: &[f64],
+    slots: &[[Option<usize>; 2]],
+    rows: usize,
+) -> Vec<SparseRow> {
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
     let mut phi = Rows(vec![Vec::new(); rows]);
@@ -113,7 +118,7 @@ coordinates:
         // where Phi_x loses rank 2 (two pivots at rounding level).
         let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/models/");
         for file in ["five-bar-free-fall", "3-rrr", "andrews-squeezer", "slider-crank"] {
-            let mech = crate::load(&format!("{root}{file}.yaml")).expect(file);
+            let mech = crate::load(format!("{root}{file}.yaml")).expect(file);
             let mut x = mech.x0.clone();
             assert_eq!(phi_x_pivots(&mech, &x), dense_pivots(&mech, &x), "{file} drawn");
             for (i, v) in x.iter_mut().enumerate() {
