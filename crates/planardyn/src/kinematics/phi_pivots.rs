@@ -27,7 +27,12 @@ impl Sink for Rows {
 /// The scaled Phi_x's rows placed by `slots` (per pair, as `Mechanism::pair_slots`) among
 /// `rows`: the non-zeros of the dense scaled Jacobian (`system::scaled_jacobian`, rows in metres
 /// over L, translation columns times L), the same values bit for bit, each row by column.
-pub(crate) fn scaled_phi_rows(mech: &Mechanism, x: &[f64], slots: &[[Option<usize>; 2]], rows: usize) -> Vec<SparseRow> {
+pub(crate) fn scaled_phi_rows(
+    mech: &Mechanism,
+    x: &[f64],
+    slots: &[[Option<usize>; 2]],
+    rows: usize,
+) -> Vec<SparseRow> {
     let mut trig = vec![[0.0; 2]; mech.n_bodies()];
     body_trig(x, &mut trig);
     let mut phi = Rows(vec![Vec::new(); rows]);

@@ -15,8 +15,8 @@
 //! partitioning): the columns left without a pivot are the best-conditioned independent set.
 
 use super::constraints::{body_trig, Chart};
-use super::system::System;
 use super::phi_pivots::phi_x_pivots;
+use super::system::System;
 use crate::model::Mechanism;
 
 /// Smallest singular value of the blocks of the scaled J of a chart at x, each at its own
