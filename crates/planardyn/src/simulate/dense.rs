@@ -32,6 +32,12 @@ pub struct DenseOutput {
     pub samples: Vec<f64>,
 }
 
+/// Piece k of `pieces` equal pieces of [t0, t1], its end t1 exactly for the last.
+pub fn piece(t0: f64, t1: f64, k: usize, pieces: usize) -> (f64, f64) {
+    let at = |j: usize| if j == pieces { t1 } else { t0 + (t1 - t0) * j as f64 / pieces as f64 };
+    (at(k), at(k + 1))
+}
+
 /// Fraction theta in [0, 1] of the step at which node j of `nodes` lies.
 pub fn node(j: usize, nodes: usize) -> f64 {
     if j == 0 {

@@ -529,8 +529,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         ode.set_aside();
         let (pieces, n, m) = (dense::PARTITION_PIECES, dense.nodes, ode.m());
         for piece in 0..pieces {
-            let a = t0 + (t1 - t0) * piece as f64 / pieces as f64;
-            let b = if piece + 1 == pieces { t1 } else { t0 + (t1 - t0) * (piece + 1) as f64 / pieces as f64 };
+            let (a, b) = dense::piece(t0, t1, piece, pieces);
             self.rows.clear();
             for j in 0..n {
                 path_state(ode, path, a + dense::node(j, n) * (b - a));
@@ -676,8 +675,7 @@ fn sample_step(
     ode.restart_from_anchor();
     let pieces = if ode.ws.chart == Chart::Inputs { 1 } else { dense::PARTITION_PIECES };
     for piece in 0..pieces {
-        let a = t0 + (t1 - t0) * piece as f64 / pieces as f64;
-        let b = if piece + 1 == pieces { t1 } else { t0 + (t1 - t0) * (piece + 1) as f64 / pieces as f64 };
+        let (a, b) = dense::piece(t0, t1, piece, pieces);
         rows.clear();
         for j in 0..dense.nodes {
             let t = a + dense::node(j, dense.nodes) * (b - a);
