@@ -233,12 +233,9 @@ fn build_body(ctx: &Ctx, name: &str, b: &BodySpec, scale: f64) -> R<Body> {
     if !(mass >= MIN_MASS) {
         return Err(ctx.err(format!("{path}.mass"), format!("mass must be > 0 kg (at least {MIN_MASS:e}), got {mass}")));
     }
-    // The mean of the parts' centres about the first's: exactly that point where they all are
-    // there (m c / m is not c to the bit).
-    let c0 = parts[0].2;
     let com = [
-        c0[0] + parts.iter().map(|p| p.0 * (p.2[0] - c0[0])).sum::<f64>() / mass,
-        c0[1] + parts.iter().map(|p| p.0 * (p.2[1] - c0[1])).sum::<f64>() / mass,
+        parts.iter().map(|p| p.0 * p.2[0]).sum::<f64>() / mass,
+        parts.iter().map(|p| p.0 * p.2[1]).sum::<f64>() / mass,
     ];
     let inertia: f64 = parts.iter().map(|(m, i, c)| i + m * ((c[0] - com[0]).powi(2) + (c[1] - com[1]).powi(2))).sum();
     if !(inertia >= MIN_MASS) {
