@@ -319,7 +319,7 @@ impl ClosedForm {
             // A crank's rows split in J's block-triangular form: the coordinate's on its angle
             // (+-1) and the pivot's on its centre (I), each of measure 1.
             inputs_sigma = inputs_sigma.min(1.0);
-            cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value });
+            cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value, rs: [0.0; 2] });
         }
         let mut groups = Vec::new();
         let mut pairs_used = mech.coordinates.len();
@@ -457,7 +457,7 @@ impl ClosedForm {
 
     /// [`ClosedForm::positions`], the triad's Newton from `start`.
     fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
-        for c in &self.cranks {
+        for c in &mut self.cranks {
             c.position(z, &mut ws.x, &mut ws.trig);
         }
         for s in &self.sliders {
@@ -472,9 +472,9 @@ impl ClosedForm {
     }
 
     /// Body rates for coordinate rates zd into v (3n), at the positions in `ws`.
-    fn rates(&self, trig: &[[f64; 2]], zd: &[f64], v: &mut [f64]) {
+    fn rates(&self, zd: &[f64], v: &mut [f64]) {
         for c in &self.cranks {
-            c.velocity(trig, zd, v);
+            c.velocity(zd, v);
         }
         for s in &self.sliders {
             s.velocity(zd, v);
@@ -492,13 +492,13 @@ impl ClosedForm {
         let (n, m) = (ws.x.len(), ws.q.len());
         if m == 1 {
             // One column, the rates for zd = 1: no loop over the unit rates.
-            return self.rates(&ws.trig, &[1.0], &mut ws.u[..n]);
+            return self.rates(&[1.0], &mut ws.u[..n]);
         }
         // Without `reach`, m <= REACH_FROM_M: the unit rates fit on the stack.
         let mut unit = [0.0; REACH_FROM_M];
         for j in 0..m {
             unit[j] = 1.0;
-            self.rates(&ws.trig, &unit[..m], &mut ws.u[j * n..(j + 1) * n]);
+            self.rates(&unit[..m], &mut ws.u[j * n..(j + 1) * n]);
             unit[j] = 0.0;
         }
     }
@@ -517,7 +517,7 @@ impl ClosedForm {
         for j in 0..m {
             unit[j] = 1.0;
             let (zd, v) = (&unit[..m], &mut u[j * n..(j + 1) * n]);
-            reach.cranks[j].iter().for_each(|&i| self.cranks[i].velocity(&ws.trig, zd, v));
+            reach.cranks[j].iter().for_each(|&i| self.cranks[i].velocity(zd, v));
             reach.sliders[j].iter().for_each(|&i| self.sliders[i].velocity(zd, v));
             reach.groups[j].iter().for_each(|&i| self.groups[i].velocity(zd, v));
             unit[j] = 0.0;
@@ -535,15 +535,14 @@ impl ClosedForm {
         } else {
             body_rates(zd, ws);
         }
-        self.accelerations(&ws.trig, &ws.xd, &mut ws.c);
+        self.accelerations(&ws.xd, &mut ws.c);
     }
 
     /// Body accelerations `a` at zero coordinate accelerations for body rates v (3n, a velocity
-    /// of the mechanism), at the last positions (`trig` theirs): the convective term for v,
-    /// -J^-1 gamma(v, v).
-    pub fn accelerations(&self, trig: &[[f64; 2]], v: &[f64], a: &mut [f64]) {
+    /// of the mechanism), at the last positions: the convective term for v, -J^-1 gamma(v, v).
+    pub fn accelerations(&self, v: &[f64], a: &mut [f64]) {
         for k in &self.cranks {
-            k.acceleration(trig, v, a);
+            k.acceleration(v, a);
         }
         for s in &self.sliders {
             s.acceleration(a);

@@ -373,7 +373,7 @@ impl<'a> MechanismOde<'a> {
         // which Newton left factorised there.
         let half = match self.closed.as_ref().filter(|_| self.base_closed) {
             Some(c) => {
-                c.accelerations(&ws.frame.trig, &ws.frame.rhs, &mut ws.frame.tmp);
+                c.accelerations(&ws.frame.rhs, &mut ws.frame.tmp);
                 0.5
             }
             None => {

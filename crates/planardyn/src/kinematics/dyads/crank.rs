@@ -15,29 +15,34 @@ pub struct Crank {
     pub k: usize,
     pub sign: f64,
     pub offset: f64,
+    /// R s at the last positions, for the rates and accelerations (as an RRR dyad's
+    /// `Geometry`: no rotation of s again per column of U and per pass).
+    pub rs: [f64; 2],
 }
 
 impl Crank {
     /// Pose at coordinates z: x and trig of the body.
     #[inline]
-    pub fn position(&self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
+    pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let phi = self.sign * (z[self.k] + self.offset);
         let (sn, cs) = phi.sin_cos();
         let rs = rot([cs, sn], self.s);
         let b = 3 * self.body;
         x[b..b + 3].copy_from_slice(&[self.pivot[0] - rs[0], self.pivot[1] - rs[1], phi]);
         trig[self.body] = [cs, sn];
+        self.rs = rs;
     }
 
-    /// The body's rates for the coordinate rates zd.
+    /// The body's rates for the coordinate rates zd, at the last positions.
     #[inline]
-    pub fn velocity(&self, trig: &[[f64; 2]], zd: &[f64], v: &mut [f64]) {
-        put_rate(v, self.body, [0.0; 2], rot(trig[self.body], self.s), self.sign * zd[self.k]);
+    pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
+        put_rate(v, self.body, [0.0; 2], self.rs, self.sign * zd[self.k]);
     }
 
-    /// The body's accelerations for zero coordinate accelerations, from the rates v.
+    /// The body's accelerations for zero coordinate accelerations, from the rates v, at the
+    /// last positions.
     #[inline]
-    pub fn acceleration(&self, trig: &[[f64; 2]], v: &[f64], a: &mut [f64]) {
-        put_acceleration(a, self.body, [0.0; 2], rot(trig[self.body], self.s), v[3 * self.body + 2], 0.0);
+    pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
+        put_acceleration(a, self.body, [0.0; 2], self.rs, v[3 * self.body + 2], 0.0);
     }
 }
