@@ -167,6 +167,8 @@ pub struct ClosedForm {
     /// Beyond a few coordinates, the pieces each coordinate moves (`column_reach`): U is then
     /// solved column by column over them only.
     reach: Option<ColumnReach>,
+    /// Whether no group iterates ([`ClosedForm::is_explicit`]; asked at every ODE evaluation).
+    explicit: bool,
 }
 
 /// The end of a revolute pair on `body` (its point there) and the other end.
@@ -400,14 +402,15 @@ impl ClosedForm {
                 (cranks.iter().map(|c| (c.body, c.k)).collect(), sliders.iter().map(|s| (s.body, s.k)).collect());
             ColumnReach::new(mech, &c, &s, &decomposition.groups)
         });
-        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma, reach })
+        let explicit = !groups.iter().any(|g| matches!(g, Group::Triad(_)));
+        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma, reach, explicit })
     }
 
     /// Whether every group is placed without iteration (no class III triad, whose Newton
     /// solve can fail on one branch where a configuration exists): `positions` then fails
     /// only where no configuration exists at those coordinates.
     pub fn is_explicit(&self) -> bool {
-        !self.groups.iter().any(|g| matches!(g, Group::Triad(_)))
+        self.explicit
     }
 
     /// Take the assembly branches from the configuration x (a solution).

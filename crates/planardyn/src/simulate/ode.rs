@@ -611,7 +611,9 @@ impl MechanismOde<'_> {
         Err(error)
     }
 
-    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`).
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`). Inlined: its
+    /// call cost a tenth of the copies' instructions.
+    #[inline(always)]
     fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
         copy_small(&mut dy[..m], &self.eval_y[m..2 * m]);
