@@ -611,9 +611,7 @@ impl MechanismOde<'_> {
         Err(error)
     }
 
-    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`). Inlined into
-    /// `rhs`, once an evaluation: a call's own code was about 20 of its 55 instructions.
-    #[inline(always)]
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`).
     fn derivative(&self, dy: &mut [f64]) {
         let m = self.m();
         copy_small(&mut dy[..m], &self.eval_y[m..2 * m]);
