@@ -2,13 +2,20 @@
 //! partition a chart switch chooses and a change point's pivots. The dense elimination of the
 //! (3n - m) x 3n matrix was O(n^2) in memory and time at each call (the change point's location
 //! calls it about 80 times a crossing: 1.4e8 instructions of a 1.1e9 run of ten five-bars);
-//! [`eliminate`] takes the same pivots bit for bit at a cost that follows the non-zeros.
+//! [`eliminate`] takes the same pivots bit for bit at a cost that follows the non-zeros. A small
+//! mechanism's is still the dense one, which has no sets or row vectors to build: the five-bar's
+//! (10 x 12) took 29.7 k instructions sparse, 11 k dense, and a crossing's location calls it 43 times.
 
 use super::constraints::body_trig;
 use super::system::col_scales;
-use crate::linalg::{eliminate, Sink, SparseRow};
+use crate::linalg::{eliminate, pivot_columns, Dense, Sink, SparseRow};
 use crate::model::pairs::{self, row_scales};
 use crate::model::Mechanism;
+
+/// Body coordinates up to which [`phi_x_pivots`] eliminates densely: the dense matrix is
+/// (3n - m) x 3n, cleared and scanned whole each step, which the sparse elimination's set and
+/// per-row vectors cost more than up to a few tens of coordinates (ten bodies).
+const DENSE_PIVOTS_MAX: usize = 30;
 
 /// Sparse rows as a [`Sink`]: each entry summed in the order the pair functions add it, as the
 /// dense [`Dense`](crate::linalg::Dense) sums it from zero.
@@ -58,8 +65,17 @@ pub(crate) fn scaled_phi_rows(
 
 /// Complete pivoting on the scaled Phi_x (its independent rows) at x: each step's pivot column
 /// and |pivot|, in pivot order (fewer than its rows where one is exactly 0). The pivots of
-/// `linalg::pivot_columns` on the dense matrix, bit for bit.
+/// `linalg::pivot_columns` on the dense matrix, bit for bit, whichever elimination takes them.
 pub fn phi_x_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
+    if x.len() <= DENSE_PIVOTS_MAX {
+        dense_pivots(mech, x)
+    } else {
+        sparse_pivots(mech, x)
+    }
+}
+
+/// [`phi_x_pivots`] by [`eliminate`] on [`scaled_phi_rows`].
+fn sparse_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
     let rows = mech.n_constraints;
     let e = eliminate(scaled_phi_rows(mech, x, &mech.pair_slots, rows), x.len(), 0.0, rows);
     e.pivots
@@ -68,18 +84,41 @@ pub fn phi_x_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
         .collect()
 }
 
+/// [`phi_x_pivots`] by `pivot_columns` on the dense scaled Phi_x, its entries summed and scaled
+/// as [`scaled_phi_rows`] makes them, the pivots read back from the eliminated matrix.
+fn dense_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
+    let (n, rows) = (x.len(), mech.n_constraints);
+    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+    body_trig(x, &mut trig);
+    let mut j = vec![0.0; rows * n];
+    for (pair, s) in mech.pairs.iter().zip(&mech.pair_slots) {
+        pairs::jacobian(pair, x, &trig, &mut Dense { j: &mut j, ncols: n }, *s);
+    }
+    let cs = col_scales(mech);
+    for (pair, s) in mech.pairs.iter().zip(&mech.pair_slots) {
+        for (slot, scale) in s.iter().zip(row_scales(pair, 1.0 / mech.scale)) {
+            if let Some(r) = *slot {
+                for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(&cs) {
+                    *v *= scale * c;
+                }
+            }
+        }
+    }
+    let columns = pivot_columns(&mut j, rows, n, rows);
+    columns.iter().enumerate().map(|(k, &c)| (c, j[k * n + c].abs())).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::kinematics::constraints::Chart;
     use crate::kinematics::system::scaled_jacobian;
-    use crate::linalg::pivot_columns;
     use crate::Format;
     use std::f64::consts::FRAC_PI_2;
 
-    /// The dense elimination the module replaces: the scaled J of the user's chart, its first
-    /// n_constraints rows, `pivot_columns`, and the pivots read back from the eliminated matrix.
-    fn dense_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
+    /// The dense elimination the sparse one replaces, on the user chart's scaled J (its first
+    /// n_constraints rows): `pivot_columns`, the pivots read back from the eliminated matrix.
+    fn reference_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
         let (n, rows) = (x.len(), mech.n_constraints);
         let mut j = vec![0.0; n * n];
         let mut trig = vec![[0.0; 2]; mech.n_bodies()];
@@ -88,6 +127,14 @@ mod tests {
         j.truncate(rows * n);
         let columns = pivot_columns(&mut j, rows, n, rows);
         columns.iter().enumerate().map(|(k, &c)| (c, j[k * n + c].abs())).collect()
+    }
+
+    /// Both eliminations against the reference, bit for bit.
+    fn assert_pivots(mech: &Mechanism, x: &[f64], what: &str) -> Vec<(usize, f64)> {
+        let reference = reference_pivots(mech, x);
+        assert_eq!(sparse_pivots(mech, x), reference, "{what}: sparse");
+        assert_eq!(dense_pivots(mech, x), reference, "{what}: dense");
+        reference
     }
 
     /// Two parallelogram windows (IFToMM A02 with N = 2, drawn upright).
@@ -120,11 +167,11 @@ coordinates:
         for file in ["five-bar-free-fall", "3-rrr", "andrews-squeezer", "slider-crank"] {
             let mech = crate::load(format!("{root}{file}.yaml")).expect(file);
             let mut x = mech.x0.clone();
-            assert_eq!(phi_x_pivots(&mech, &x), dense_pivots(&mech, &x), "{file} drawn");
+            assert_pivots(&mech, &x, &format!("{file} drawn"));
             for (i, v) in x.iter_mut().enumerate() {
                 *v += 1e-3 * ((i * 7 % 5) as f64 - 2.0);
             }
-            assert_eq!(phi_x_pivots(&mech, &x), dense_pivots(&mech, &x), "{file} moved");
+            assert_pivots(&mech, &x, &format!("{file} moved"));
         }
         let mech = crate::loads(A02, Format::Yaml, "A02").unwrap();
         // The rods turned to +x about their pivots, the couplers moved with their tops.
@@ -135,8 +182,7 @@ coordinates:
             x[3 * b + 1] += dy;
             x[3 * b + 2] += dphi;
         }
-        let pivots = phi_x_pivots(&mech, &x);
-        assert_eq!(pivots, dense_pivots(&mech, &x));
+        let pivots = assert_pivots(&mech, &x, "A02 folded");
         // Rank 2 lost: two pivots at rounding level (2.7e-17), the others 0.45 and up.
         assert_eq!(pivots.iter().filter(|p| p.1 < 1e-12).count(), 2, "{pivots:?}");
     }

@@ -48,15 +48,17 @@ pub fn passive_sigma_min(mech: &Mechanism, x: &[f64]) -> f64 {
 }
 
 /// [`passive_sigma_min`] with the blocks of the user's chart kept by the caller (`inputs_sys`,
-/// a `System::new` analysed once, as [`sigma_min_with`] takes it): the same value without
-/// analysing that chart's structure again (a run's change-point check: about 40k of a short
+/// a `System::new` analysed once, as [`sigma_min_with`] takes it), and those of the partition
+/// kept with it (`System::other_chart`): the same value without analysing either chart's
+/// structure again while the partition stays (a run's change-point check: about 40k of a short
 /// four-bar run's 384k instructions). Its factorisation is left invalid.
 pub fn passive_sigma_min_with(inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
     if mech.n_constraints == 0 {
         return f64::INFINITY;
     }
     let inputs = sigma_min_with(inputs_sys, mech, &Chart::Inputs, x);
-    inputs.max(sigma_min(mech, &Chart::Partition(select_partition(mech, x)), x))
+    let partition = Chart::Partition(select_partition(mech, x));
+    inputs.max(sigma_min_with(inputs_sys.other_chart(mech, &partition), mech, &partition, x))
 }
 
 /// The m best independent components of x at x: the columns of the scaled Phi_x (its
