@@ -301,6 +301,7 @@ impl PyMechanism {
     }
 
     /// Accelerations qdd (m,) at (q, qd), time t (s), efforts tau (m,) or the model's drives.
+    #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false, x_start=None))]
     fn forward_dynamics<'py>(
         &self,
@@ -321,6 +322,7 @@ impl PyMechanism {
     /// Exact first derivatives of forward dynamics at (q, qd), time t (s), with efforts tau
     /// (m,) or the model's drives held fixed: a dict of `qdd` (m,) and `dq`, `dqd`, `dtau`
     /// (m, m), entry [i, k] = d qdd_i / d (q, qd, tau)_k.
+    #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false, x_start=None))]
     fn forward_dynamics_derivatives<'py>(
         &self,
@@ -356,6 +358,7 @@ impl PyMechanism {
     }
 
     /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
+    #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false, x_start=None))]
     fn reactions<'py>(
         &self,
