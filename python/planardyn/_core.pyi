@@ -210,7 +210,9 @@ class Mechanism:
     def pair_geometry(self, x: ArrayLike) -> list[dict[str, Any]]: ...
     def point_positions(self, x: ArrayLike) -> NDArray[np.float64]: ...
     def kinematics(self, q: ArrayLike, qd: ArrayLike | None = None, x_start: ArrayLike | None = None) -> dict[str, Any]: ...
-    def mass_matrix(self, q: ArrayLike, allow_singular: bool = False) -> NDArray[np.float64]: ...
+    def mass_matrix(
+        self, q: ArrayLike, allow_singular: bool = False, x_start: ArrayLike | None = None
+    ) -> NDArray[np.float64]: ...
     def forward_dynamics(
         self,
         q: ArrayLike,
@@ -218,6 +220,7 @@ class Mechanism:
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
+        x_start: ArrayLike | None = None,
     ) -> NDArray[np.float64]: ...
     def forward_dynamics_derivatives(
         self,
@@ -226,6 +229,7 @@ class Mechanism:
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
+        x_start: ArrayLike | None = None,
     ) -> dict[str, NDArray[np.float64]]: ...
     def inverse_dynamics_derivatives(
         self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, allow_singular: bool = False
@@ -246,6 +250,7 @@ class Mechanism:
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
+        x_start: ArrayLike | None = None,
     ) -> NDArray[np.float64]: ...
     def regressor(
         self,

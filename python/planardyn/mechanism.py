@@ -294,13 +294,16 @@ class Mechanism:
 
     # ------------------------------------------------------------------ dynamics
 
-    def mass_matrix(self, q: ArrayLike, allow_singular: bool = False) -> FloatArray:
+    def mass_matrix(self, q: ArrayLike, allow_singular: bool = False, x_start: ArrayLike | None = None) -> FloatArray:
         """Generalized mass matrix A = U^T M U at q.
 
         Parameters
         ----------
         q : (m,) array_like
             Generalized coordinates (rad or m).
+        x_start : (3n,) array_like, optional
+            Body coordinates near the wanted assembly (a result's ``res.x[k]``): the position is
+            assembled from them and keeps their branch; default: the drawing's branch.
 
         Returns
         -------
@@ -316,7 +319,7 @@ class Mechanism:
             reliable digit (attributes ``kind`` 'type_ii', ``sigma_min``). With
             ``allow_singular=True`` the value is computed anyway.
         """
-        return self._native.mass_matrix(q, allow_singular)
+        return self._native.mass_matrix(q, allow_singular, x_start)
 
     def forward_dynamics(
         self,
@@ -325,13 +328,14 @@ class Mechanism:
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
+        x_start: ArrayLike | None = None,
     ) -> FloatArray:
         """Generalized accelerations from A qdd = b (forward dynamics).
 
-        The position is assembled from q starting at the drawing, so on the drawing's branch:
-        at a row of a run that went through a type II singularity onto another branch this
-        gives the drawing branch's qdd, not the run's (``reactions(res)`` and
-        ``point_motion(res)`` follow the run's own branch).
+        The position is assembled from q starting at ``x_start``, else at the drawing: at a
+        row k of a run that went through a type II singularity onto another branch, pass
+        ``x_start=res.x[k]`` for the run's qdd; without it this gives the drawing branch's
+        (``reactions(res)`` and ``point_motion(res)`` follow the run's own branch).
 
         Parameters
         ----------
@@ -344,6 +348,8 @@ class Mechanism:
             On a coordinate with an actuator this is its *motor torque* (docs/actuators.md), not
             the joint-side effort :meth:`inverse_dynamics` returns: pass
             ``motor_torques(q, qd, qdd, tau)`` of those to get qdd back.
+        x_start : (3n,) array_like, optional
+            The branch, as for :meth:`mass_matrix`.
 
         Returns
         -------
@@ -359,7 +365,7 @@ class Mechanism:
             Finite arguments whose result overflows (attribute ``quantity``): try smaller
             efforts or rates.
         """
-        return self._native.forward_dynamics(q, qd, number("t", t, "s"), tau, allow_singular)
+        return self._native.forward_dynamics(q, qd, number("t", t, "s"), tau, allow_singular, x_start)
 
     def inverse_dynamics(
         self,
@@ -503,12 +509,13 @@ class Mechanism:
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
+        x_start: ArrayLike | None = None,
     ) -> dict[str, FloatArray]:
         """Exact first derivatives of forward dynamics (docs/formulation.md, *Derivatives*).
 
         Parameters
         ----------
-        q, qd, t, tau
+        q, qd, t, tau, x_start
             As for :meth:`forward_dynamics`; the efforts are held fixed (a drive that depends
             on q or qd is differentiated as its value at this state).
 
@@ -524,7 +531,7 @@ class Mechanism:
         SingularityError
             As for :meth:`mass_matrix`.
         """
-        return self._native.forward_dynamics_derivatives(q, qd, t, tau, allow_singular)
+        return self._native.forward_dynamics_derivatives(q, qd, t, tau, allow_singular, x_start)
 
     def inverse_dynamics_derivatives(
         self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, allow_singular: bool = False
@@ -557,13 +564,14 @@ class Mechanism:
         t: float = 0.0,
         tau: ArrayLike | None = None,
         allow_singular: bool = False,
+        x_start: ArrayLike | None = None,
     ) -> FloatArray:
         """Pair reactions during the motion from (q, qd) under drives tau, or along a whole
         trajectory: ``mech.reactions(res)``.
 
         Parameters
         ----------
-        q, qd, t, tau, allow_singular
+        q, qd, t, tau, allow_singular, x_start
             As for :meth:`forward_dynamics`.
         q : SimulationResult
             A run of this mechanism (qd, t, tau not given): every row on its own branch
@@ -583,12 +591,12 @@ class Mechanism:
             ``t`` of the row.
         """
         if isinstance(q, SimulationResult):
-            if qd is not None or tau is not None:
+            if qd is not None or tau is not None or x_start is not None:
                 raise TypeError("reactions(res) takes the result alone: its rows carry q, qd and tau")
             return self._along(q, allow_singular)["reactions"]
         if qd is None:
             raise TypeError("reactions(q, qd, ...) needs qd (or give a SimulationResult alone)")
-        return self._native.reactions(q, qd, number("t", t, "s"), tau, allow_singular)
+        return self._native.reactions(q, qd, number("t", t, "s"), tau, allow_singular, x_start)
 
     def point_motion(self, res: SimulationResult, allow_singular: bool = False) -> PointMotion:
         """Positions, velocities and accelerations of the named points (those a body or the

@@ -286,16 +286,23 @@ impl PyMechanism {
         self.query(py, |mech| query::kinematics(mech, &q, qd.as_deref(), x_start.as_deref()))
     }
 
-    /// Mass matrix A = U^T M U (m, m) at q.
-    #[pyo3(signature = (q, allow_singular=false))]
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayArg<'py>, allow_singular: bool) -> PyResult<Bound<'py, PyAny>> {
-        let q = self.q_arg("q", &q)?;
-        let a = run(py, || Ok(query::mass_matrix(&self.inner, &q, allow_singular)?))?;
+    /// Mass matrix A = U^T M U (m, m) at q, on the branch of x_start (else the drawn one).
+    #[pyo3(signature = (q, allow_singular=false, x_start=None))]
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayArg<'py>,
+        allow_singular: bool,
+        x_start: Option<ArrayArg<'py>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, x_start) = (self.q_arg("q", &q)?, self.x_start(x_start)?);
+        let a = run(py, || Ok(query::mass_matrix(&self.inner, &q, x_start.as_deref(), allow_singular)?))?;
         arr2(py, self.m(), self.m(), a)
     }
 
     /// Accelerations qdd (m,) at (q, qd), time t (s), efforts tau (m,) or the model's drives.
-    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false, x_start=None))]
     fn forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -304,16 +311,19 @@ impl PyMechanism {
         t: f64,
         tau: Option<ArrayArg<'py>>,
         allow_singular: bool,
+        x_start: Option<ArrayArg<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd, tau) = self.forward_args(&q, &qd, t, tau.as_ref())?;
-        let at = ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular };
+        let x_start = self.x_start(x_start)?;
+        let at = ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular, x_start: x_start.as_deref() };
         self.query(py, |mech| query::forward_dynamics(mech, at))
     }
 
     /// Exact first derivatives of forward dynamics at (q, qd), time t (s), with efforts tau
     /// (m,) or the model's drives held fixed: a dict of `qdd` (m,) and `dq`, `dqd`, `dtau`
     /// (m, m), entry [i, k] = d qdd_i / d (q, qd, tau)_k.
-    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false, x_start=None))]
     fn forward_dynamics_derivatives<'py>(
         &self,
         py: Python<'py>,
@@ -322,9 +332,11 @@ impl PyMechanism {
         t: f64,
         tau: Option<ArrayArg<'py>>,
         allow_singular: bool,
+        x_start: Option<ArrayArg<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd, tau) = self.forward_args(&q, &qd, t, tau.as_ref())?;
-        let at = ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular };
+        let x_start = self.x_start(x_start)?;
+        let at = ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular, x_start: x_start.as_deref() };
         self.query(py, |mech| query::forward_derivatives(mech, at).map(|d| Named(d, ["qdd", "dtau"])))
     }
 
@@ -346,7 +358,8 @@ impl PyMechanism {
     }
 
     /// Pair reactions (p, 3): [F_x, F_y, M] that body a exerts on body b (N, N m).
-    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false))]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (q, qd, t=0.0, tau=None, allow_singular=false, x_start=None))]
     fn reactions<'py>(
         &self,
         py: Python<'py>,
@@ -355,9 +368,11 @@ impl PyMechanism {
         t: f64,
         tau: Option<ArrayArg<'py>>,
         allow_singular: bool,
+        x_start: Option<ArrayArg<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd, tau) = self.forward_args(&q, &qd, t, tau.as_ref())?;
-        let at = ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular };
+        let x_start = self.x_start(x_start)?;
+        let at = ForwardState { q: &q, qd: &qd, t, tau: tau.as_deref(), allow_singular, x_start: x_start.as_deref() };
         self.query(py, |mech| query::reactions(mech, at))
     }
 

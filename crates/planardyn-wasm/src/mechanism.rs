@@ -288,15 +288,21 @@ impl WasmMechanism {
     #[wasm_bindgen(js_name = forwardDynamics)]
     pub fn forward_dynamics(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Vec<f64>, JsValue> {
         self.forward_args(q, qd, t, tau.as_deref())?;
-        js(query::forward_dynamics(&self.inner, ForwardState { q, qd, t, tau: tau.as_deref(), allow_singular: false }))
+        js(query::forward_dynamics(
+            &self.inner,
+            ForwardState { q, qd, t, tau: tau.as_deref(), allow_singular: false, x_start: None },
+        ))
     }
 
     /// Pair reactions (p x 3: F_x, F_y, M that body a exerts on b; N, N m) at (q, qd), time t
     /// (s), under efforts `tau` (m), else the model's drives.
     pub fn reactions(&self, q: &[f64], qd: &[f64], t: f64, tau: Option<Vec<f64>>) -> Result<Vec<f64>, JsValue> {
         self.forward_args(q, qd, t, tau.as_deref())?;
-        Ok(js(query::reactions(&self.inner, ForwardState { q, qd, t, tau: tau.as_deref(), allow_singular: false }))?
-            .concat())
+        Ok(js(query::reactions(
+            &self.inner,
+            ForwardState { q, qd, t, tau: tau.as_deref(), allow_singular: false, x_start: None },
+        ))?
+        .concat())
     }
 
     /// Body accelerations and pair reactions along rows of a run (t (N), x and xd (N x 3n),

@@ -158,7 +158,7 @@ pub enum Error {
     #[error("invalid option: {0}")]
     Options(String),
     /// A user-supplied drive function failed (its message is kept).
-    #[error("drive function failed at t = {t}: {message}")]
+    #[error("drive function failed at t = {}: {message}", Time(*.t))]
     Drive { t: f64, message: String },
     /// Rows of a motion given by q alone pass so near a type II singularity that the branch
     /// after it cannot be told from q: the motion may have changed assembly mode there.
@@ -169,7 +169,7 @@ pub enum Error {
     )]
     BranchUndecided { row: usize, sigma_min: f64, tol: f64 },
     /// A computation along the rows of a trajectory failed at one row.
-    #[error("row {row} (t = {t} s): {source}")]
+    #[error("row {row} (t = {} s): {source}", Time(*.t))]
     Row { row: usize, t: f64, source: Box<Error> },
 }
 
@@ -266,7 +266,11 @@ impl Setting {
         if t0.is_finite() && t_end.is_finite() && t_end > t0 {
             return Ok(t_end);
         }
-        Err(SettingError::new(Setting::TEnd, t_end, format!("must be a finite number > t0 = {t0} (the end time in s)")))
+        Err(SettingError::new(
+            Setting::TEnd,
+            t_end,
+            format!("must be a finite number > t0 = {} (the end time in s)", Time(t0)),
+        ))
     }
 
     /// output_dt's rule over a run from t0 to t_end (s): its own ([`Setting::check`]), and at
@@ -282,6 +286,22 @@ impl Setting {
             return Err(SettingError::new(Setting::OutputDt, h, rule));
         }
         Ok(h)
+    }
+
+    /// dt's rule with the run's step budget: a fixed step dt (s) that needs more than
+    /// `max_steps` steps from t0 to t_end cannot finish, which is known before the first step.
+    pub fn check_fixed_steps(t0: f64, t_end: f64, dt: f64, max_steps: usize) -> Result<f64, SettingError> {
+        let count = (t_end - t0) / dt;
+        // usize to f64 is exact up to 2^53, far above MAX_STEPS.
+        if count > max_steps as f64 {
+            let rule = format!(
+                "is a fixed step: (t_end - t0) / dt = {count:.3e} steps to t_end = {} s, more than max_steps = \
+                 {max_steps}: use a larger dt, a shorter t_end, or raise max_steps (at most {MAX_STEPS:e})",
+                Time(t_end)
+            );
+            return Err(SettingError::new(Setting::Dt, dt, rule));
+        }
+        Ok(dt)
     }
 
     /// The rule `value` breaks, if any.
@@ -305,6 +325,23 @@ impl Setting {
             Setting::H0 => (!positive).then_some("must be a finite number > 0, or None for automatic"),
             Setting::HMax => (v.is_nan() || v <= 0.0).then_some("must be > 0 (use infinity for no limit)"),
             Setting::HMin => (!(v.is_finite() && v >= 0.0)).then_some("must be finite and >= 0 (default 1e-14)"),
+        }
+    }
+}
+
+/// A time (s) in a message, as short as it reads back exactly: the shortest decimal that
+/// parses to the same f64, in scientific notation outside 1e-5 <= |t| < 1e16 (where f64's
+/// Display would write 1e300 in 301 digits and 1e-300 with 300 zeros), as Python prints it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Time(pub f64);
+
+impl std::fmt::Display for Time {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-5..1e16).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
         }
     }
 }

@@ -122,7 +122,7 @@ fn beyond_four_coordinates_each_column_of_u_is_the_derivative_of_the_positions()
 fn beyond_four_coordinates_the_mass_matrix_is_the_dense_product() {
     let mech = ladder(3);
     let (m, q) = (mech.dof(), pose(&mech));
-    let a = query::mass_matrix(&mech, &q, false).unwrap();
+    let a = query::mass_matrix(&mech, &q, None, false).unwrap();
     let report = query::kinematics(&mech, &q, None, None).unwrap();
     let mut zero_pairs = 0;
     for j in 0..m {
@@ -191,9 +191,9 @@ fn separate_five_bars_have_the_mass_matrix_of_one_in_each_block() {
         cat(|p| &p.3, "")
     ));
     let q1 = pose(&one);
-    let a1 = query::mass_matrix(&one, &q1, false).unwrap();
+    let a1 = query::mass_matrix(&one, &q1, None, false).unwrap();
     let q3: Vec<f64> = (0..3).flat_map(|_| q1.clone()).collect();
-    let a3 = query::mass_matrix(&three, &q3, false).unwrap();
+    let a3 = query::mass_matrix(&three, &q3, None, false).unwrap();
     for j in 0..6 {
         for k in 0..6 {
             let want = if j / 2 == k / 2 { a1[(j % 2) * 2 + k % 2] } else { 0.0 };
@@ -213,9 +213,11 @@ fn beyond_four_coordinates_u_is_zero_outside_each_columns_runs_of_bodies() {
     // 5 bodies inside, 3 at the ends), not a range across the body order.
     let mech = ladder(4);
     let (m, q) = (mech.dof(), pose(&mech));
-    let ws =
-        query::forward_at(&mech, ForwardState { q: &q, qd: &vec![0.0; m], t: 0.0, tau: None, allow_singular: false })
-            .unwrap();
+    let ws = query::forward_at(
+        &mech,
+        ForwardState { q: &q, qd: &vec![0.0; m], t: 0.0, tau: None, allow_singular: false, x_start: None },
+    )
+    .unwrap();
     let (n, support) = (ws.x.len(), ws.frame.sys.u_support());
     assert_eq!(support.len(), m);
     for j in 0..m {
@@ -243,8 +245,11 @@ fn ladder_accelerations_are_the_dense_solution_and_inverse_dynamics_gives_zero_e
     let m = mech.dof();
     let q = pose(&mech);
     let qd: Vec<f64> = (0..m).map(|j| 0.7 * (j as f64 + 0.3).cos()).collect();
-    let ws =
-        query::forward_at(&mech, ForwardState { q: &q, qd: &qd, t: 0.0, tau: None, allow_singular: false }).unwrap();
+    let ws = query::forward_at(
+        &mech,
+        ForwardState { q: &q, qd: &qd, t: 0.0, tau: None, allow_singular: false, x_start: None },
+    )
+    .unwrap();
     let n = ws.x.len();
     let (u, c, f) = (&ws.frame.u, &ws.frame.c, &ws.f);
     let mass = |i: usize| if i % 3 == 2 { mech.bodies[i / 3].inertia } else { mech.bodies[i / 3].mass };

@@ -38,7 +38,7 @@ fn close(got: &[f64], want: &[f64], tol: f64, what: &str) {
 
 /// The pendulum at (Q, QD), t = 0, under `tau` (or its drives, none).
 fn at(tau: Option<&[f64]>) -> query::ForwardState<'_> {
-    query::ForwardState { q: &[Q], qd: &[QD], t: 0.0, tau, allow_singular: false }
+    query::ForwardState { q: &[Q], qd: &[QD], t: 0.0, tau, allow_singular: false, x_start: None }
 }
 
 /// The gravity torque about O (N m) at angle q.
@@ -70,7 +70,7 @@ fn the_pendulums_kinematics_report_is_its_closed_form() {
 #[test]
 fn the_pendulums_dynamics_are_its_closed_form() {
     let mech = yaml(PENDULUM);
-    close(&query::mass_matrix(&mech, &[Q], false).unwrap(), &[I_O], TOL, "A");
+    close(&query::mass_matrix(&mech, &[Q], None, false).unwrap(), &[I_O], TOL, "A");
     // I_O qdd = tau - m g (l/2) cos q.
     let qdd = (TAU - gravity_torque(Q)) / I_O;
     close(&query::forward_dynamics(&mech, at(Some(&[TAU]))).unwrap(), &[qdd], TOL, "qdd");

@@ -2,6 +2,7 @@
 //! set [`Prescribed`] evaluates q_p, qd_p, qdd_p of the driven coordinates at a time; the
 //! efforts they need come from `dynamics::prescribed`.
 
+use crate::error::Time;
 use crate::model::{Mechanism, MotionLaw};
 
 /// A motion given by the caller as a function of time (a Python callable, a closed form).
@@ -101,9 +102,13 @@ impl<'a> Prescribed<'a> {
                 let (a, b) = s.span();
                 if t0 < a || t_end > b {
                     return Err(format!(
-                        "the motion table of '{}' covers t = {a} to {b} s but the run goes from {t0} to {t_end} s: \
+                        "the motion table of '{}' covers t = {} to {} s but the run goes from {} to {} s: \
                          extend the table or shorten t_end",
-                        self.names[k]
+                        self.names[k],
+                        Time(a),
+                        Time(b),
+                        Time(t0),
+                        Time(t_end)
                     ));
                 }
             }
@@ -122,8 +127,10 @@ impl<'a> Prescribed<'a> {
             if let Some(d) = v.iter().position(|v| !v.is_finite()) {
                 let what = ["position", "rate", "acceleration"][d];
                 return Err(format!(
-                    "the motion of '{}' gives a non-finite {what} {} at t = {t} s",
-                    self.names[self.p[i]], v[d]
+                    "the motion of '{}' gives a non-finite {what} {} at t = {} s",
+                    self.names[self.p[i]],
+                    v[d],
+                    Time(t)
                 ));
             }
             [self.q[i], self.qd[i], self.qdd[i]] = v;

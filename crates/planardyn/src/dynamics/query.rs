@@ -141,10 +141,15 @@ pub fn point_positions(mech: &Mechanism, x: &[f64]) -> Vec<f64> {
     per_point(&carriers(mech), |a| world_point(a.link, a.s, x))
 }
 
-/// The mass matrix A = U^T M U (m x m; kg, kg m, kg m^2) at q, on the drawn branch; refused
-/// near a type II singularity unless `allow_singular`.
-pub fn mass_matrix(mech: &Mechanism, q: &[f64], allow_singular: bool) -> Result<Vec<f64>, KinematicsError> {
-    let mut ws = assembled(mech, q, None)?;
+/// The mass matrix A = U^T M U (m x m; kg, kg m, kg m^2) at q, on the branch of `x_start`
+/// (else the drawn one); refused near a type II singularity unless `allow_singular`.
+pub fn mass_matrix(
+    mech: &Mechanism,
+    q: &[f64],
+    x_start: Option<&[f64]>,
+    allow_singular: bool,
+) -> Result<Vec<f64>, KinematicsError> {
+    let mut ws = assembled(mech, q, x_start)?;
     velocity_analogues(&mut ws)?;
     type_ii_measure(mech, &mut ws, allow_singular)?;
     super::mass_matrix(mech, &mut ws);
@@ -161,8 +166,8 @@ fn with_drives<R>(mech: &Mechanism, tau: Option<&[f64]>, f: impl FnOnce(&mut dyn
 
 /// Where forward dynamics is asked: coordinates q and rates qd (m each), time t (s), and the
 /// efforts (m; N m or N, motor torques where a motor is) `tau`, or the model's drives if None.
-/// The positions are those of the drawn branch; a state near a type II singularity is
-/// refused (`Singular`) unless `allow_singular`.
+/// The positions are those of the branch of `x_start` (3n; else the drawn one); a state near
+/// a type II singularity is refused (`Singular`) unless `allow_singular`.
 #[derive(Debug, Clone, Copy)]
 pub struct ForwardState<'a> {
     pub q: &'a [f64],
@@ -170,13 +175,14 @@ pub struct ForwardState<'a> {
     pub t: f64,
     pub tau: Option<&'a [f64]>,
     pub allow_singular: bool,
+    pub x_start: Option<&'a [f64]>,
 }
 
 /// A forward evaluation at `at`: every buffer of the returned workspace filled. Refused also
 /// where the accelerations are not finite.
 pub fn forward_at(mech: &Mechanism, at: ForwardState<'_>) -> Result<Workspace, Error> {
-    let ForwardState { q, qd, t, tau, allow_singular } = at;
-    let mut ws = assembled(mech, q, None)?;
+    let ForwardState { q, qd, t, tau, allow_singular, x_start } = at;
+    let mut ws = assembled(mech, q, x_start)?;
     with_drives(mech, tau, |drives| forward(mech, t, q, qd, drives, &mut ws))?;
     type_ii_measure(mech, &mut ws, allow_singular)?;
     finite("accelerations qdd", &ws.qdd)?;
@@ -224,8 +230,8 @@ pub struct Derivatives {
 /// Exact first derivatives of forward dynamics at `at`, with its efforts held fixed
 /// ([`derivatives::forward_derivatives`]).
 pub fn forward_derivatives(mech: &Mechanism, at: ForwardState<'_>) -> Result<Derivatives, Error> {
-    let ForwardState { q, qd, t, tau, allow_singular } = at;
-    let mut ws = assembled(mech, q, None)?;
+    let ForwardState { q, qd, t, tau, allow_singular, x_start } = at;
+    let mut ws = assembled(mech, q, x_start)?;
     let mut efforts = vec![0.0; q.len()];
     with_drives(mech, tau, |drives| drives.efforts(t, q, qd, &mut efforts))
         .map_err(|message| Error::Drive { t, message })?;

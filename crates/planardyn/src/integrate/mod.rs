@@ -53,7 +53,7 @@ pub mod dopri5;
 pub mod radau5;
 pub mod rk4;
 
-use crate::error::{Setting, SettingError};
+use crate::error::{Setting, SettingError, Time};
 use std::fmt;
 use std::str::FromStr;
 
@@ -346,19 +346,21 @@ impl<E: fmt::Debug> fmt::Display for StepError<E> {
         match self {
             StepError::StepSizeUnderflow { t, h } => write!(
                 f,
-                "step size underflow at t = {t} s (h = {h:e} s): the problem may be stiff \
-                 (try radau5) or singular there, or loosen rtol/atol"
+                "step size underflow at t = {} s (h = {h:e} s): the problem may be stiff \
+                 (try radau5) or singular there, or loosen rtol/atol",
+                Time(*t)
             ),
             StepError::Rhs { t, error } => {
-                write!(f, "right-hand side failed at t = {t} s even for the smallest step: {error:?}")
+                write!(f, "right-hand side failed at t = {} s even for the smallest step: {error:?}", Time(*t))
             }
             StepError::NonFinite { t } => {
-                write!(f, "NaN or infinity in the solution near t = {t} s")
+                write!(f, "NaN or infinity in the solution near t = {} s", Time(*t))
             }
             StepError::TooManySteps { t, steps } => write!(
                 f,
-                "{steps} steps used before t_stop (stopped at t = {t} s): raise max_steps, \
-                 loosen the tolerances, or try radau5 if the problem is stiff"
+                "{steps} steps used before t_stop (stopped at t = {} s): raise max_steps, \
+                 loosen the tolerances, or try radau5 if the problem is stiff",
+                Time(*t)
             ),
         }
     }

@@ -6,6 +6,8 @@
 //! The nodes include both ends, so the solution is continuous from step to step and equals
 //! the accepted states at the step ends.
 
+use crate::error::Time;
+
 /// Pieces a step integrated in a partition chart is stored in, each with its own nodes. There
 /// q(t) is not a polynomial but the assembly at the chart's interpolated values, whose
 /// derivatives grow near the user's chart's singularity (why the chart is in use): through
@@ -118,7 +120,10 @@ impl DenseOutput {
         };
         if !(t >= a && t <= b) {
             return Err(format!(
-                "t = {t} s is outside the run [{a}, {b}] s: the dense output only covers the times integrated"
+                "t = {} s is outside the run [{}, {}] s: the dense output only covers the times integrated",
+                Time(t),
+                Time(a),
+                Time(b)
             ));
         }
         // The step whose span holds t (the earlier one at a shared boundary: both agree there).

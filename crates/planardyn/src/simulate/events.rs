@@ -4,6 +4,7 @@
 //! output, [`super::dense`]) by the Illinois variant of regula falsi, to [`EVENT_XTOL`].
 
 use super::dense::DenseOutput;
+use crate::error::Time;
 
 /// An event's time is located to within `EVENT_XTOL * max(|t|, h)` (h the step holding it):
 /// a few units in the last place of t, the accuracy to which the interpolant is a function
@@ -48,7 +49,7 @@ impl Event<'_> {
         if g.is_finite() {
             Ok(g)
         } else {
-            Err(format!("the event function returned {g} at t = {t} s: it must return a finite number"))
+            Err(format!("the event function returned {g} at t = {} s: it must return a finite number", Time(t)))
         }
     }
 

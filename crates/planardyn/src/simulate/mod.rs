@@ -25,9 +25,9 @@ pub use trajectory::{SimStats, Status, Trajectory};
 use std::ops::ControlFlow;
 
 use crate::dynamics::{Drives, Prescribed};
-use crate::error::Setting;
+use crate::error::{Setting, Time};
 use crate::integrate::{Method, Options};
-use crate::model::Mechanism;
+use crate::model::{Mechanism, SimulateDefaults};
 use crate::Error;
 use run::{stopped_at_start, Run};
 
@@ -59,6 +59,16 @@ impl Settings {
     /// Defaults for a mechanism: its file's `simulate` section, else DOP853 with
     /// rtol 1e-9, atol 1e-12 over 1 s.
     pub fn for_model(mech: &Mechanism) -> Result<Settings, Error> {
+        let mut s = Settings::without_outputs(mech)?;
+        if let Some(h) = mech.simulate.output_dt {
+            s.t_eval = Some(overrides::output_grid(s.t0, s.t_end, h)?);
+        }
+        Ok(s)
+    }
+
+    /// [`Settings::for_model`] without the file's output grid, which [`Overrides::settings`]
+    /// builds from the run's own t_end (a file's 1e8 output times are not made for a 0.05 s run).
+    fn without_outputs(mech: &Mechanism) -> Result<Settings, Error> {
         let d = &mech.simulate;
         let method = match &d.method {
             Some(name) => name.parse().map_err(Error::Options)?,
@@ -70,9 +80,8 @@ impl Settings {
             dt: d.dt,
             ..Options::default()
         };
-        let t_end = d.t_end.unwrap_or(1.0);
-        let t_eval = d.output_dt.map(|h| grid(0.0, t_end, h));
-        Ok(Settings { t0: 0.0, t_end, method, options, t_eval, q0: None, qd0: None })
+        let t_end = d.t_end.unwrap_or(SimulateDefaults::T_END);
+        Ok(Settings { t0: 0.0, t_end, method, options, t_eval: None, q0: None, qd0: None })
     }
 }
 
@@ -90,6 +99,9 @@ fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
     let bad = |m: String| Err(Error::Options(m));
     Setting::check_end(settings.t0, settings.t_end)?;
     settings.options.validate(settings.method)?;
+    if let Some(dt) = settings.options.dt {
+        Setting::check_fixed_steps(settings.t0, settings.t_end, dt, settings.options.max_steps)?;
+    }
     for (name, v) in [("q0", &settings.q0), ("qd0", &settings.qd0)] {
         if let Some(v) = v {
             if v.len() != mech.dof() || v.iter().any(|x| !x.is_finite()) {
@@ -108,7 +120,8 @@ fn check(settings: &Settings, mech: &Mechanism) -> Result<(), Error> {
         {
             return bad(format!(
                 "t_eval must increase strictly within [t0, t_end] = [{}, {}]",
-                settings.t0, settings.t_end
+                Time(settings.t0),
+                Time(settings.t_end)
             ));
         }
     }

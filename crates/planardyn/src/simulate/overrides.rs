@@ -32,7 +32,7 @@ impl Overrides {
     /// The settings of a run: the model's defaults ([`Settings::for_model`]) with these
     /// changes, as `Mechanism.simulate` in Python makes them.
     pub fn settings(&self, mech: &Mechanism) -> Result<Settings, Error> {
-        let mut s = Settings::for_model(mech)?;
+        let mut s = Settings::without_outputs(mech)?;
         s.t_end = self.t_end.unwrap_or(s.t_end);
         if let Some(name) = &self.method {
             s.method = name.parse::<Method>().map_err(Error::Options)?;
@@ -66,7 +66,7 @@ impl Overrides {
 }
 
 /// Output times every h (s) from t0 to t_end, clamped to t_end without a duplicate end.
-fn output_grid(t0: f64, t_end: f64, h: f64) -> Result<Vec<f64>, Error> {
+pub(super) fn output_grid(t0: f64, t_end: f64, h: f64) -> Result<Vec<f64>, Error> {
     Setting::check_outputs(t0, t_end, h)?;
     let mut t = grid(t0, t_end, h);
     t.iter_mut().for_each(|v| *v = v.min(t_end));

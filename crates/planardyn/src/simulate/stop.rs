@@ -4,6 +4,7 @@
 
 use super::charts::NEAR_PASSIVE_SINGULAR;
 use super::trajectory::Status;
+use crate::error::Time;
 use crate::integrate::StepError;
 use crate::Error;
 
@@ -95,7 +96,7 @@ impl Stop {
     /// Status and message, before the diagnosis of [`Stop::describe`].
     fn status_message(self) -> (Status, String) {
         match self {
-            Stop::Reached { t_end } => (Status::Success, format!("reached t_end = {t_end} s")),
+            Stop::Reached { t_end } => (Status::Success, format!("reached t_end = {} s", Time(t_end))),
             Stop::StartDrive(e) => (Status::DriveFailed, e.to_string()),
             Stop::Step { error, crossing } => {
                 let (status, message) = step_failure(&error);
@@ -104,45 +105,53 @@ impl Stop {
                     None => (status, message),
                 }
             }
-            Stop::EventAtStart { t, error } => (Status::EventFailed, format!("at t = {t} s: {error}")),
+            Stop::EventAtStart { t, error } => (Status::EventFailed, format!("at t = {} s: {error}", Time(t))),
             Stop::DenseOutput { t, error } => {
                 let kind =
                     if matches!(error, Error::Drive { .. }) { Status::DriveFailed } else { Status::AssemblyFailed };
-                (kind, format!("dense output of the step to t = {t} s: {error}"))
+                (kind, format!("dense output of the step to t = {} s: {error}", Time(t)))
             }
-            Stop::EventInStep { t, error } => (Status::EventFailed, format!("in the step to t = {t} s: {error}")),
-            Stop::Output { t, error } => (Status::AssemblyFailed, format!("output at t = {t}: {error}")),
-            Stop::TerminalEvent { index, t } => (Status::Event, format!("terminal event {index} at t = {t} s")),
+            Stop::EventInStep { t, error } => {
+                (Status::EventFailed, format!("in the step to t = {} s: {error}", Time(t)))
+            }
+            Stop::Output { t, error } => (Status::AssemblyFailed, format!("output at t = {}: {error}", Time(t))),
+            Stop::TerminalEvent { index, t } => (Status::Event, format!("terminal event {index} at t = {} s", Time(t))),
             Stop::EventState { index, t, error } => {
-                (Status::AssemblyFailed, format!("the state at terminal event {index}, t = {t} s: {error}"))
+                (Status::AssemblyFailed, format!("the state at terminal event {index}, t = {} s: {error}", Time(t)))
             }
-            Stop::Accept { t, error } => (Status::AssemblyFailed, format!("at t = {t}: {error}")),
+            Stop::Accept { t, error } => (Status::AssemblyFailed, format!("at t = {}: {error}", Time(t))),
             Stop::NoCrossing { t, passive, why } => (
                 Status::PassiveSingularity,
-                format!("the passive mechanism is singular at t = {t} s (scaled measure {passive:.2e}) and {why}"),
+                format!(
+                    "the passive mechanism is singular at t = {} s (scaled measure {passive:.2e}) and {why}",
+                    Time(t)
+                ),
             ),
             Stop::PassiveSingular { t, passive } => (
                 Status::PassiveSingularity,
                 format!(
-                    "the passive mechanism is singular at t = {t} s (scaled measure {passive:.2e}): its pair \
-                     constraints lose rank and the motion is not determined beyond"
+                    "the passive mechanism is singular at t = {} s (scaled measure {passive:.2e}): its pair \
+                     constraints lose rank and the motion is not determined beyond",
+                    Time(t)
                 ),
             ),
             Stop::Hopeless { t, attempts, mean, last, floor, t_end, max_steps } => (
                 Status::StepSizeTooSmall,
                 format!(
-                    "step size too small at t = {t:e} s: after {attempts} steps the mean step is {mean:.2e} s \
+                    "step size too small at t = {} s: after {attempts} steps the mean step is {mean:.2e} s \
                      (last {last:.2e} s), below (t_end - t0) / ({PROGRESS_MARGIN} max_steps) = {floor:.2e} s, so \
-                     the run cannot make progress to t_end = {t_end} s within max_steps = {max_steps}. The efforts \
+                     the run cannot make progress to t_end = {} s within max_steps = {max_steps}. The efforts \
                      are too large for the model or the tolerances too tight: lower the efforts, loosen rtol/atol, \
-                     shorten t_end, or raise max_steps"
+                     shorten t_end, or raise max_steps",
+                    Time(t),
+                    Time(t_end)
                 ),
             ),
             Stop::ChartChange { t, error } => {
-                (Status::AssemblyFailed, format!("changing coordinates at t = {t} s: {error}"))
+                (Status::AssemblyFailed, format!("changing coordinates at t = {} s: {error}", Time(t)))
             }
             Stop::Cancelled { t } => {
-                (Status::Cancelled, format!("cancelled at t = {t} s: the progress callback asked to stop"))
+                (Status::Cancelled, format!("cancelled at t = {} s: the progress callback asked to stop", Time(t)))
             }
         }
     }
@@ -162,7 +171,7 @@ fn step_failure(e: &StepError<Error>) -> (Status, String) {
         StepError::Rhs { .. } => Status::AssemblyFailed,
     };
     let message = match e {
-        StepError::Rhs { t, error } => format!("at t = {t} s, even with the smallest step: {error}"),
+        StepError::Rhs { t, error } => format!("at t = {} s, even with the smallest step: {error}", Time(*t)),
         other => other.to_string(),
     };
     (status, message)
