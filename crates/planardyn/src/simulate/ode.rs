@@ -47,7 +47,7 @@ const STEP_REACH: f64 = MOVE_FRACTION;
 /// benchmark's search), with the predictive step bound of `Run::aim` and this bound applied
 /// before change points too, by this fraction: 0.5: five-bar 780 evaluations, 3-RRR 62,
 /// Andrews 470; 0.7: 756, 62, 353; 0.85: 756, 122, 326; 1: 718, 127, 891; without the bound:
-/// 767, 74, 522. Kept away from change points (`Run::aim`), 0.7: 750, 72, 411. The stages move
+/// 767, 74, 522. Kept away from change points' grids (`Run::aim`), 0.7: 750, 72, 411 (s15). The stages move
 /// x faster than the start's rates where the motion accelerates towards the singularity, and a
 /// longer bound lets more of them fail.
 const REACH_STEP_FRACTION: f64 = 0.7;
