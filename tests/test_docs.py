@@ -65,11 +65,17 @@ def page_blocks(markdown: str) -> list[tuple[list[tuple[str, str]], str | None]]
     """The code blocks that run, in page order, each as its code (snippets' python blocks
     and planardyn commands) and the ```text block right after it (None without one). A bash
     block of `python examples/...` lines runs them only when its output is shown."""
+    return [(code, None if shown is None else shown.group(2)) for code, shown in page_block_matches(markdown)]
+
+
+def page_block_matches(markdown: str) -> list[tuple[list[tuple[str, str]], re.Match[str] | None]]:
+    """page_blocks with each shown ```text block as its FENCE match (where it is on the page:
+    tools/update_docs_outputs.py rewrites it there)."""
     found = list(FENCE.finditer(markdown))
     out = []
     for i, m in enumerate(found):
         nxt = found[i + 1] if i + 1 < len(found) else None
-        shown = (nxt.group(2) if nxt is not None and nxt.group(1) in ("text", "")
+        shown = (nxt if nxt is not None and nxt.group(1) in ("text", "")
                  and not markdown[m.end():nxt.start()].strip() else None)
         code = snippets(m.group(0))
         if not code and m.group(1) == "bash" and shown is not None:
@@ -96,6 +102,18 @@ def checked_script(page) -> tuple[str, int]:
     return "\n".join(parts), len(blocks)
 
 
+def run_page(page, folder) -> dict[int, str]:
+    """Runs checked_script in ``folder`` (empty, but for a link to examples/): {k: what
+    running block k printed}."""
+    script, n = checked_script(page)
+    (folder / "examples").symlink_to(ROOT / "examples")
+    (folder / "page.py").write_text(script)
+    p = subprocess.run([sys.executable, "page.py"], cwd=folder, capture_output=True, text=True, timeout=600,
+                       env={**__import__("os").environ, "MPLBACKEND": "Agg"})
+    assert p.returncode == 0, f"{page.name}:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}"
+    return dict(zip(range(n), re.split(r"\x1e--- block \d+ ---\n", p.stdout)[1:]))
+
+
 def matches(got: str, want: str) -> bool:
     """Line by line, trailing spaces aside; a line "..." in ``want`` stands for any lines."""
     pattern = "\n".join(".*?" if line.strip() == "..." else re.escape(line.rstrip()) for line in want.strip("\n").splitlines())
@@ -105,15 +123,9 @@ def matches(got: str, want: str) -> bool:
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
 def test_page_code_runs(page, tmp_path):
-    script, n = checked_script(page)
-    if n == 0:
+    if checked_script(page)[1] == 0:
         pytest.skip(f"{page.name} has no Python block or planardyn command")
-    (tmp_path / "examples").symlink_to(ROOT / "examples")
-    (tmp_path / "page.py").write_text(script)
-    p = subprocess.run([sys.executable, "page.py"], cwd=tmp_path, capture_output=True, text=True, timeout=600,
-                       env={**__import__("os").environ, "MPLBACKEND": "Agg"})
-    assert p.returncode == 0, f"{page.name}:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}"
-    printed = dict(zip(range(n), re.split(r"\x1e--- block \d+ ---\n", p.stdout)[1:]))
+    printed = run_page(page, tmp_path)
     wrong = [f"block {k}: the page shows\n{want}\nthe code prints\n{printed.get(k, '')}"
              for k, want in expected_outputs(page.read_text()).items() if not matches(printed.get(k, ""), want)]
     assert not wrong, f"{page.name}: " + "\n".join(wrong)

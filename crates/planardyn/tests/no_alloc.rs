@@ -197,6 +197,7 @@ fn flexible_joint_evaluation_does_not_allocate() {
 /// Once its queues are full their oldest buffers are reused.
 #[test]
 fn approach_bookkeeping_does_not_allocate() {
+    use planardyn::simulate::charts::Measures;
     use planardyn::simulate::crossing::Approach;
     let mech = yaml(FOUR_BAR);
     let (q, qd) = test_state(&mech);
@@ -209,8 +210,9 @@ fn approach_bookkeeping_does_not_allocate() {
     let step = |approach: &mut Approach, k: usize| {
         let t = 1e-2 * k as f64;
         approach.fill(&ode, t - 5e-3);
-        approach.keep(&ode, t, 0.1 * (1.0 - t));
-        approach.step_limit(t, 0.1 * (1.0 - t))
+        let meas = Measures { sigma: 0.1 * (1.0 - t), passive: 0.1 * (1.0 - t) };
+        approach.keep(&ode, t, &meas);
+        approach.step_limit(t, &meas)
     };
     // Past the queues' length (a few dozen): from here on each point reuses the oldest's buffers.
     for k in 0..64 {

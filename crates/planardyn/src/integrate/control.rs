@@ -82,6 +82,11 @@ pub(crate) struct Core {
     pub(crate) h_next: f64,
     /// Error norm of the last accepted step (the PI controller's memory; 1 after `reset`).
     pub(crate) err_prev: f64,
+    /// (h, error norm) of the last two accepted steps of an explicit pair since `reset`, the
+    /// newer first, and that pair's error order: the error's trend that
+    /// [`Core::predict_next_step`] extrapolates.
+    pub(crate) accepted: [Option<(f64, f64)>; 2],
+    pub(crate) error_order: usize,
     /// Largest automatic first step after `reset` (s): the system's own bound
     /// ([`crate::integrate::Stepper::bound_first_step`]); infinite unless set.
     pub(crate) first_step_max: f64,
@@ -102,6 +107,8 @@ impl Core {
             f_prev: vec![0.0; n],
             h_next: 0.0,
             err_prev: 1.0,
+            accepted: [None; 2],
+            error_order: 0,
             first_step_max: f64::INFINITY,
             stats: Stats::default(),
             started: false,
@@ -127,9 +134,36 @@ impl Core {
         self.f_prev.copy_from_slice(&self.f);
         self.h_next = 0.0;
         self.err_prev = 1.0;
+        self.accepted = [None; 2];
         self.first_step_max = f64::INFINITY;
         self.started = true;
         Ok(())
+    }
+
+    /// Bound the next trial step by `h_max` (see `Stepper::bound_next_step`).
+    pub(crate) fn bound_next_step(&mut self, h_max: f64) {
+        if self.opts.dt.is_some() {
+            return;
+        }
+        if self.h_next > 0.0 {
+            self.h_next = self.h_next.min(h_max);
+        } else {
+            self.first_step_max = self.first_step_max.min(h_max);
+        }
+    }
+
+    /// Bound the next trial step by the error's trend over the last two accepted steps
+    /// (see `Stepper::predict_next_step`): Gustafsson's predictive controller, as Hairer's
+    /// RADAU5 takes it, the smaller of its step and the controller's.
+    pub(crate) fn predict_next_step(&mut self) {
+        let [Some((h1, e1)), Some((h0, e0))] = self.accepted else { return };
+        if self.opts.dt.is_some() || self.h_next <= 0.0 {
+            return;
+        }
+        let k = self.error_order as f64 + 1.0;
+        let (e1, e0) = (e1.max(ERR_FLOOR), e0.max(ERR_FLOOR));
+        let factor = (SAFETY * (h1 / h0) * (e0 / (e1 * e1)).powf(1.0 / k)).clamp(MIN_FACTOR, MAX_FACTOR);
+        self.h_next = self.h_next.min(h1 * factor);
     }
 
     /// Evaluate `rhs`, counting it, and map an error to a [`Failure`].
@@ -397,6 +431,8 @@ pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
                     None => {
                         let factor = factor_accept(err, core.err_prev, P::ERROR_ORDER, rejected);
                         core.err_prev = err;
+                        core.accepted = [Some((h_try, err)), core.accepted[0]];
+                        core.error_order = P::ERROR_ORDER;
                         core.propose(h_try, factor, h, t_stop)
                     }
                 };

@@ -422,6 +422,23 @@ impl Stepper {
         dispatch!(self, s => s.core.first_step_max = h_max)
     }
 
+    /// Bound the next trial step by `h_max` (s), from what the system knows of itself (a
+    /// mechanism: how far its solutions may move from the last accepted point, see
+    /// `MechanismOde::reach_step_bound`). The controller's proposal is kept where shorter;
+    /// right after a `reset` the bound caps the automatic first step as
+    /// [`Stepper::bound_first_step`] does. Fixed steps (`Options::dt`) are left alone.
+    pub fn bound_next_step(&mut self, h_max: f64) {
+        dispatch!(self, s => s.core.bound_next_step(h_max))
+    }
+
+    /// Bound the next trial step by the trend of the error estimates over the last two
+    /// accepted steps (Gustafsson's predictive controller), where the system expects its error
+    /// constant to keep growing (a mechanism approaching its chart's singularity). No-op
+    /// without two accepted steps since the last `reset`, or for fixed steps.
+    pub fn predict_next_step(&mut self) {
+        dispatch!(self, s => s.core.predict_next_step())
+    }
+
     /// Advance by one accepted step, never past t_stop (t_stop > t). Rejected tries are retried inside.
     ///
     /// The last step before `t_stop` ends exactly on it. With `t_stop <= t` nothing

@@ -95,8 +95,7 @@ pub fn next_chart(ode: &MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
 /// `own` ([`chart_sigma`]): at its body rates xd (scaled), the step that moves x by
 /// [`FIRST_STEP_MOVE`] of the measure (s; infinite at rest, where no step moves x).
 pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
-    let ws = &ode.ws;
-    let rate = ws.xd.iter().zip(ws.sys.group_col_scale()).fold(0.0_f64, |r, (v, s)| r.max(v.abs() / s));
+    let rate = ode.scaled_body_rate();
     if rate > 0.0 {
         FIRST_STEP_MOVE * own / rate
     } else {

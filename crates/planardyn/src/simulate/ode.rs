@@ -38,6 +38,20 @@ const MOVE_FRACTION: f64 = 2.0;
 /// reach of 3 let the 0.76 J step through.
 const STEP_REACH: f64 = MOVE_FRACTION;
 
+/// The longest step after an accepted point, as a fraction of the step at which its body
+/// rates there would carry x to the step's reach ([`STEP_REACH`]; `Run::aim`). A stage past
+/// the reach fails the step, which is taken again 4 times shorter (`FAIL_FACTOR`): the 3-RRR
+/// of the benchmarks (DOPRI5, rtol 0.195) had 4 of its 14 steps refused so, the five-bar's
+/// fall (rtol 7.59e-7) 2 of 140, Andrews' squeezer (rtol 1e-6) 2 of 89. Cheapest DOPRI5
+/// setting passing each benchmark's drift target (every step; rtol = 10^(-k/100), the
+/// benchmark's search), with the predictive step bound of `Run::aim` and this bound applied
+/// before change points too, by this fraction: 0.5: five-bar 780 evaluations, 3-RRR 62,
+/// Andrews 470; 0.7: 756, 62, 353; 0.85: 756, 122, 326; 1: 718, 127, 891; without the bound:
+/// 767, 74, 522. Kept away from change points' grids (`Run::aim`), 0.7: 750, 72, 411 (s15). The stages move
+/// x faster than the start's rates where the motion accelerates towards the singularity, and a
+/// longer bound lets more of them fail.
+const REACH_STEP_FRACTION: f64 = 0.7;
+
 /// Below this type II measure at the last accepted point the user's chart takes the Newton
 /// path even where closed forms exist. A dyad's branch changes where the passive motion goes
 /// through its fold (the five-bar's type II singularities, A02's change points, where the
@@ -251,6 +265,30 @@ impl<'a> MechanismOde<'a> {
     /// steps on from the landing without accepting, and keeps its own bounds.
     pub fn limit_step_reach(&mut self) {
         self.max_approach = self.max_approach.min(STEP_REACH * self.own_sigma);
+    }
+
+    /// The longest next step whose solutions stay within the step's reach
+    /// (`limit_step_reach`) at the body rates of the point in `ws` (the last accepted one),
+    /// by [`REACH_STEP_FRACTION`] (s; infinite at rest or without a reach).
+    pub fn reach_step_bound(&self) -> f64 {
+        let rate = self.scaled_body_rate();
+        if rate > 0.0 {
+            REACH_STEP_FRACTION * self.max_approach / rate
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The chart's own measure at the last accepted point (given to `limit_correction`).
+    pub fn chart_measure(&self) -> f64 {
+        self.own_sigma
+    }
+
+    /// The largest body rate of the point in `ws`, each scaled by its group's length (1/s),
+    /// as the Newton bounds' distances are (`limit_correction`).
+    pub fn scaled_body_rate(&self) -> f64 {
+        let ws = &self.ws;
+        ws.xd.iter().zip(ws.sys.group_col_scale()).fold(0.0_f64, |r, (v, s)| r.max(v.abs() / s))
     }
 
     /// Bound the move of a solution from the point it was predicted from by `max` as well

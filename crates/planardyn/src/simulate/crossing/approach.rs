@@ -4,31 +4,49 @@
 
 use std::collections::VecDeque;
 
-use super::{APPROACH_CAP, CROSS_BELOW, CROSS_START, NODES, SPACING};
+use super::{APPROACH_CAP, CHANGE_POINT_RATIO, CROSS_BELOW, CROSS_DISTANCE, CROSS_START, NODES, SPACING};
+use crate::model::Mechanism;
+use crate::simulate::charts::Measures;
 use crate::simulate::ode::MechanismOde;
 
 /// Accepted points kept: the crossing's [`NODES`] before the point are chosen among them (at
 /// the tightest tolerances the integrator takes up to a few dozen steps over their span).
 const KEPT: usize = 48;
+/// Nodes of a crossing at least after the first point kept (see [`Approach::grid`]). Over
+/// benchmarks/change_point_sweep.py's double parallelograms (40 drawings x 6 runs, seeds 1 and
+/// 2), 3 left 19 and 29 runs failing, 5: 15 and 24 (the others a first crossing soon after a
+/// start at rest, or a slow one where the motion turns).
+const FIRST_NODES: f64 = 5.0;
 
-/// An accepted point on the way: time (s), passive measure, body coordinates x, rates xd and
-/// accelerations xdd (3n each), and the power of the non-conservative forces (W).
+/// An accepted point on the way: time (s), passive and type II measures (the type II one NaN
+/// but at the points kept), body coordinates x, rates xd and accelerations xdd (3n each), the
+/// power of the non-conservative forces (W), and the scaled speed ([`scaled_speed`], 1/s).
 #[derive(Debug, Clone)]
 pub struct Passed {
     pub t: f64,
     pub passive: f64,
+    pub sigma: f64,
     pub x: Vec<f64>,
     pub xd: Vec<f64>,
     pub xdd: Vec<f64>,
     pub power: f64,
+    pub speed: f64,
 }
 
 impl Passed {
     /// The point evaluated in `ode.ws`, at time t with passive measure `passive`.
     pub fn of(ode: &MechanismOde, t: f64, passive: f64) -> Self {
         let ws = &ode.ws;
-        Passed { t, passive, x: ws.x.clone(), xd: ws.xd.clone(), xdd: ws.xdd.clone(), power: ws.power }
+        let speed = scaled_speed(ode.mech, &ws.xd);
+        let (x, xd, xdd) = (ws.x.clone(), ws.xd.clone(), ws.xdd.clone());
+        Passed { t, passive, sigma: f64::NAN, x, xd, xdd, power: ws.power, speed }
     }
+}
+
+/// The largest rate of the body coordinates xd, translations per the characteristic length L
+/// (the units of `kinematics::scaled_distance` with `col_scales`).
+fn scaled_speed(mech: &Mechanism, xd: &[f64]) -> f64 {
+    xd.chunks_exact(3).fold(0.0, |s: f64, v| s.max(v[0].abs().max(v[1].abs()) / mech.scale).max(v[2].abs()))
 }
 
 /// The last [`KEPT`] accepted points, newest last (since the last change point crossed), and
@@ -37,6 +55,8 @@ impl Passed {
 pub struct Approach {
     passed: VecDeque<Passed>,
     filled: VecDeque<Passed>,
+    /// The time of the first point kept (the run's start, or the last landing).
+    since: f64,
 }
 
 /// Where a change point ahead is expected: at `t_star` (s); the crossing starts `tau` (s)
@@ -57,15 +77,18 @@ impl Grid {
 }
 
 impl Approach {
-    /// Remember the point held by `ode.ws`, accepted at t with passive measure `passive`.
-    pub fn keep(&mut self, ode: &MechanismOde, t: f64, passive: f64) {
-        push(&mut self.passed, ode, t, passive);
+    /// Remember the point held by `ode.ws`, accepted at t with measures `meas`.
+    pub fn keep(&mut self, ode: &MechanismOde, t: f64, meas: &Measures) {
+        if self.passed.is_empty() {
+            self.since = t;
+        }
+        push(&mut self.passed, ode, t, meas);
     }
 
     /// Add the point held by `ode.ws`, evaluated at t inside the step just accepted (before
     /// the point kept next; its passive measure is not asked for).
     pub fn fill(&mut self, ode: &MechanismOde, t: f64) {
-        push(&mut self.filled, ode, t, f64::NAN);
+        push(&mut self.filled, ode, t, &Measures { sigma: f64::NAN, passive: f64::NAN });
     }
 
     /// Forget the way (after a crossing: the points before it are on the other side).
@@ -96,22 +119,41 @@ impl Approach {
     }
 
     /// The time from the point accepted at `t` (passive measure `passive`) to the change
-    /// point ahead: where the parabola through t and the two points kept before it reaches 0
-    /// (the line through the one before, if only one is kept). Near the point the measure falls
+    /// point ahead: where the parabola through t and the two points kept before it reaches 0.
+    /// With one point kept before, the line through it, or the parabola flat there if the
+    /// motion started at rest there (a run started near the point: the line through its start
+    /// put a drawing 0.084 rad from it 16.8 s away, and the crossing's prediction 9.1e3 from
+    /// any branch). Near the point the measure falls
     /// linearly (a transversal crossing); farther it is curved (A02's rises to a maximum at the
     /// upright pose and falls again: the secant through one point over that maximum made the
     /// time left 2.6 times too long). None unless it is falling towards 0: a parabola whose
     /// least value is above [`CROSS_START`] passes a singularity of the user's coordinates
     /// (the five-bar's), not a change point.
-    pub fn time_to_point(&self, t: f64, passive: f64) -> Option<f64> {
-        let mut before = self.passed.iter().rev().filter(|p| p.t < t);
+    pub fn time_to_point(&self, t: f64, meas: &Measures) -> Option<f64> {
+        // The type II measure where the passive one is about it (both heading to 0, as at a
+        // change point): it is smooth, where the passive one is the better of the partition
+        // in use and it, and the partition changes from step to step near the point (the
+        // double parallelogram's three equal cranks: 0.0325, 0.0312, 0.0276, 0.0303, 0.0268 at
+        // five accepted points while the type II measure fell as 0.0294, 0.0282, 0.0276,
+        // 0.0274, 0.0268;
+        // the parabola through such points put the point 1-4 ms ahead instead of 30 ms).
+        let of_sigma = meas.passive <= CHANGE_POINT_RATIO * meas.sigma;
+        let level = |passive: f64, sigma: f64| if of_sigma { sigma } else { passive };
+        let passive = level(meas.passive, meas.sigma);
+        let mut before =
+            self.passed.iter().rev().filter(|p| p.t < t).map(|p| (p.t, level(p.passive, p.sigma), p.speed));
         let p1 = before.next()?;
-        let secant = (passive - p1.passive) / (t - p1.t);
+        let secant = (passive - p1.1) / (t - p1.0);
         // passive + slope s + curvature s^2 for s = time ahead.
         let (slope, curvature) = match before.next() {
             Some(p2) => {
-                let curvature = (secant - (p1.passive - p2.passive) / (p1.t - p2.t)) / (t - p2.t);
-                (secant + curvature * (t - p1.t), curvature)
+                let curvature = (secant - (p1.1 - p2.1) / (p1.0 - p2.0)) / (t - p2.0);
+                (secant + curvature * (t - p1.0), curvature)
+            }
+            // From rest: p1's level + curvature (s + t - p1.t)^2.
+            None if p1.2 == 0.0 => {
+                let curvature = secant / (t - p1.0);
+                (2.0 * curvature * (t - p1.0), curvature)
             }
             None => (secant, 0.0),
         };
@@ -124,11 +166,18 @@ impl Approach {
         to_point.is_finite().then_some(to_point)
     }
 
-    /// The change point ahead of the point accepted at `t` (passive measure `passive`, kept
-    /// last) and the crossing's grid before it, if the measure is falling towards 0.
-    pub fn grid(&self, t: f64, passive: f64) -> Option<Grid> {
-        let to_point = self.time_to_point(t, passive)?;
-        let tau = to_point * CROSS_BELOW / passive;
+    /// The change point ahead of the point accepted at `t` (measures `meas`) and the
+    /// crossing's grid before it, if the measure is falling towards 0: the crossing starts
+    /// where the passive measure is [`CROSS_BELOW`] or, nearer, at [`CROSS_DISTANCE`] from the
+    /// point at the speed of the newest point kept, and late enough for [`FIRST_NODES`] of its
+    /// nodes to follow the first point kept (a run started at rest 0.03 rad from a change
+    /// point crossed at its first step, from the start's acceleration alone: 6.0e-2 off the
+    /// branch's tangent).
+    pub fn grid(&self, t: f64, meas: &Measures) -> Option<Grid> {
+        let to_point = self.time_to_point(t, meas)?;
+        let speed = self.passed.back().map_or(0.0, |p| p.speed);
+        let history = (t + to_point - self.since) / (1.0 + FIRST_NODES * SPACING);
+        let tau = (to_point * CROSS_BELOW / meas.passive).min(CROSS_DISTANCE / speed).min(history);
         Some(Grid { t_star: t + to_point, tau, h: SPACING * tau })
     }
 
@@ -137,8 +186,8 @@ impl Approach {
     /// within it (the last step ends at the crossing's start, t* - tau), a third of the way to
     /// the point before. The integrator's stages then stay where the evaluations are accurate;
     /// grid times it stepped over are filled from its interpolant ([`Approach::fill`]).
-    pub fn step_limit(&self, t: f64, passive: f64) -> Option<f64> {
-        let Grid { t_star, tau, h } = self.grid(t, passive)?;
+    pub fn step_limit(&self, t: f64, meas: &Measures) -> Option<f64> {
+        let Grid { t_star, tau, h } = self.grid(t, meas)?;
         let to_point = t_star - t;
         // How many spacings from the crossing's start t* - tau.
         let away = (to_point - tau) / h;
@@ -152,17 +201,19 @@ impl Approach {
 
 /// Append the point held by `ode.ws` (at t, passive measure `passive`) to `points`, the
 /// oldest's buffers reused once [`KEPT`] are held (no allocation then).
-fn push(points: &mut VecDeque<Passed>, ode: &MechanismOde, t: f64, passive: f64) {
+fn push(points: &mut VecDeque<Passed>, ode: &MechanismOde, t: f64, meas: &Measures) {
     let ws = &ode.ws;
     let recycled = if points.len() >= KEPT { points.pop_front() } else { None };
-    match recycled {
+    let mut p = match recycled {
         Some(mut p) => {
-            (p.t, p.passive, p.power) = (t, passive, ws.power);
+            (p.t, p.passive, p.power, p.speed) = (t, meas.passive, ws.power, scaled_speed(ode.mech, &ws.xd));
             p.x.copy_from_slice(&ws.x);
             p.xd.copy_from_slice(&ws.xd);
             p.xdd.copy_from_slice(&ws.xdd);
-            points.push_back(p);
+            p
         }
-        None => points.push_back(Passed::of(ode, t, passive)),
-    }
+        None => Passed::of(ode, t, meas.passive),
+    };
+    p.sigma = meas.sigma;
+    points.push_back(p);
 }

@@ -27,7 +27,7 @@ pub use approach::{Approach, Grid, Passed};
 pub use bridge::{Bridge, Path};
 pub use point::{inside_step, stepped_over, ChangePoint};
 
-use super::charts::chart_sigma;
+use super::charts::{chart_sigma, first_step_bound, Measures};
 use super::ode::MechanismOde;
 use crate::integrate::{Method, Options, Stats, StepError, Stepper};
 use crate::kinematics::constraints::{body_trig, pair_coordinate_gamma, pair_coordinate_rate};
@@ -53,6 +53,15 @@ pub const SPACING: f64 = 0.6;
 /// The passive measure below which a falling one starts the crossing: the approach's last
 /// step ends at about [`CROSS_BELOW`], the one before at 1 + [`SPACING`] times it.
 pub const CROSS_START: f64 = (1.0 + 0.5 * SPACING) * CROSS_BELOW;
+/// The scaled distance from the change point (the largest of the angles in rad and the
+/// translations per L, at the present speed) nearer which a crossing starts, if its measure
+/// there is still above [`CROSS_BELOW`]: the bridge spans the motion, not the measure, and
+/// where the measure grows slowly from the point it spanned too much of it. A02's measure is
+/// CROSS_BELOW 0.092 rad before its points (N = 2 and 40), so it crosses as before; a double
+/// parallelogram (crank 0.306 m, spacing 0.771 m) had 0.026 at 0.33 rad: its gap of 0.1 s
+/// (0.65 rad of the cranks) left the prediction 2.4e-2 off the branch's tangent, and its nodes
+/// past the landing, 0.24 s of it, ran its partition into a fold.
+pub const CROSS_DISTANCE: f64 = 0.1;
 /// Nodes on either side of a crossing (besides its start and its landing) whose accelerations
 /// its bridge goes through, [`SPACING`] tau apart. Through the exact accelerations of A02 at
 /// N = 2 (its reduction), the landing's rate is off by 1.2e-13 rad/s at tau = 0.02 s, 5.5e-12
@@ -82,7 +91,9 @@ pub const WATCH_BELOW: f64 = 0.02;
 /// See [`WATCH_BELOW`].
 pub const APPROACH_FRACTION: f64 = 0.5;
 /// Largest projection from the prediction, as a fraction of the passive measure before the
-/// point (the other branches are about that far, scaled).
+/// point or of the prediction's scaled distance from the point, the larger (the other branches
+/// are about that far: they meet the motion's there; where the measure grows slowly from the
+/// point, as the double parallelogram's, farther than the measure says).
 const PROJECTION_FRACTION: f64 = 0.25;
 /// Largest change of the predicted velocity by its projection, relative to it: the branch
 /// the motion follows has its tangent to the prediction's accuracy, another branch one at an
@@ -147,7 +158,7 @@ impl Integration<'_> {
 /// singularities, or past a near miss of a change point). Err says why the motion cannot be continued.
 pub fn cross(
     ode: &mut MechanismOde,
-    (t, passive, work): (f64, f64, f64),
+    (t, meas, work): (f64, &Measures, f64),
     approach: &Approach,
     integration: &Integration,
     stats: &mut Stats,
@@ -155,19 +166,21 @@ pub fn cross(
     // No root ahead of the measure's quadratic through its last points: it only dips (a
     // five-bar's type II passage with its least passive measure at 0.030, between CROSS_BELOW
     // and CROSS_START, stopped the run here as if at a change point).
-    let Some(to_point) = approach.time_to_point(t, passive) else { return Ok(None) };
+    let Some(to_point) = approach.time_to_point(t, meas) else { return Ok(None) };
+    let passive = meas.passive;
     let start = Passed::of(ode, t, passive);
     let h = SPACING * to_point;
     let before: Vec<&Passed> = std::iter::once(&start).chain(approach.samples(t, h)).collect();
     let predictor = Bridge::new(&before, work, to_point);
-    if located(ode.mech, &predictor, t, t + 2.0 * to_point).rank_drop == 0 {
+    let ahead = located(ode.mech, &predictor, t, t + 2.0 * to_point);
+    if ahead.rank_drop == 0 {
         return Ok(None);
     }
     let mut why = String::new();
     let before_landing = ode.save();
     for attempt in 0..ATTEMPTS {
         let t_land = t + 2.0 * to_point * f64::from(1u32 << attempt);
-        let landed = match land(ode, &predictor, t_land, passive) {
+        let landed = match land(ode, &predictor, t_land, (passive, &ahead.x)) {
             // The motion turned away from a near miss (a dip of the measure near CROSS_BELOW,
             // the dimensions near a change point's) while the Taylor step ran on into it: a
             // five-bar with base 0.29991, proximal links 0.152 and distal 0.320 dips to 0.02
@@ -237,13 +250,13 @@ fn land(
     ode: &mut MechanismOde,
     path: &Bridge,
     t_land: f64,
-    passive: f64,
+    (passive, point): (f64, &[f64]),
 ) -> Result<(Vec<usize>, Vec<f64>, f64), Unprojected> {
     let n = path.coordinates();
     let (mut x, mut xd, mut xdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     path.at(t_land, &mut x, &mut xd, &mut xdd);
     let idx = partition_at(ode, &x);
-    let past = project(ode, &idx, &x, &xd, passive)?;
+    let past = project(ode, &idx, (&x, &xd), (passive, point))?;
     let y = partition_state(&idx, &ode.ws.x, &ode.ws.xd, path.work(t_land));
     if past >= 0.5 * passive {
         let set = ode.set_chart(Chart::Partition(idx.clone()), t_land, &y);
@@ -285,7 +298,11 @@ fn return_to(ode: &mut MechanismOde, landing: &Passed, idx: &[usize], y: &[f64])
 
 /// The points at `times` past the landing at `t_land` (state `y` in the chart of `ode`, which
 /// holds it), integrated from it with the run's method and tolerances; the integration's
-/// counters are added to `stats`.
+/// counters are added to `stats`. Each step's end is accepted as the run's are, and bounds the
+/// next step's Newton moves by the chart's measure there: the measure grows away from the
+/// point, and the landing's bounds (2 sigma from the last accepted point) kept for all of it
+/// refused every evaluation past them (a double parallelogram at 12 rad/s, landing at
+/// measure 7e-3: 2 ms past it, "even for the smallest step").
 fn integrate_past(
     ode: &mut MechanismOde,
     (t_land, y): (f64, &[f64]),
@@ -296,12 +313,19 @@ fn integrate_past(
     let mut stepper = Stepper::new(integration.method, integration.options, y.len())?;
     let past = |e: StepError<Error>| format!("integrating past the landing: {e}");
     let mut outcome = stepper.reset(ode, t_land, y).map_err(past);
+    let own = chart_sigma(ode, f64::INFINITY);
+    stepper.bound_first_step(first_step_bound(ode, own));
+    let accepted = |ode: &mut MechanismOde, stepper: &Stepper, t: f64| {
+        ode.accept(t, stepper.y()).map_err(|e| format!("past the landing: {e}"))?;
+        let own = chart_sigma(ode, f64::INFINITY);
+        ode.limit_correction(own);
+        Ok(())
+    };
     let mut out = Vec::with_capacity(times.len());
     for &time in times {
         while outcome.is_ok() && stepper.t() < time {
-            outcome = stepper.step(ode, time).map_err(past);
+            outcome = stepper.step(ode, time).map_err(past).and_then(|()| accepted(ode, &stepper, stepper.t()));
         }
-        outcome = outcome.and_then(|()| ode.accept(time, stepper.y()).map_err(|e| format!("past the landing: {e}")));
         if outcome.is_err() {
             break;
         }
@@ -332,7 +356,12 @@ impl Unprojected {
 
 /// Project the predicted (x, xd) onto the constraints and their tangent in the partition
 /// `idx`; the passive measure there, or why it is not the motion's branch.
-fn project(ode: &mut MechanismOde, idx: &[usize], x: &[f64], xd: &[f64], passive: f64) -> Result<f64, Unprojected> {
+fn project(
+    ode: &mut MechanismOde,
+    idx: &[usize],
+    (x, xd): (&[f64], &[f64]),
+    (passive, point): (f64, &[f64]),
+) -> Result<f64, Unprojected> {
     let mech = ode.mech;
     let ws = &mut ode.ws;
     ws.chart = Chart::Partition(idx.to_vec());
@@ -341,7 +370,8 @@ fn project(ode: &mut MechanismOde, idx: &[usize], x: &[f64], xd: &[f64], passive
     solve_position(mech, &z, ws)
         .map_err(|e| Unprojected::Unassembled(format!("the predicted point does not assemble: {e}")))?;
     let moved = scaled_distance(&ws.x, x, ws.sys.group_col_scale());
-    if moved > PROJECTION_FRACTION * passive {
+    let apart = passive.max(scaled_distance(x, point, ws.sys.group_col_scale()));
+    if moved > PROJECTION_FRACTION * apart {
         return Err(Unprojected::Other(format!("the predicted point is {moved:.2e} from the nearest branch (scaled)")));
     }
     velocity_analogues(ws).map_err(|e| Unprojected::Other(format!("no tangent past the point: {e}")))?;

@@ -7,6 +7,7 @@ use super::WATCH_BELOW;
 use crate::kinematics::coordinates;
 use crate::kinematics::phi_pivots::phi_x_pivots;
 use crate::model::Mechanism;
+use crate::simulate::charts::Measures;
 use crate::simulate::ode::MechanismOde;
 
 /// A scaled pivot of Phi_x below this at the change point counts as a lost rank.
@@ -51,7 +52,7 @@ pub fn stepped_over(ode: &MechanismOde, approach: &Approach, t: f64, passive: f6
     let last = approach.last().filter(|p| p.t < t)?;
     let near = last.passive < WATCH_BELOW;
     if near {
-        let to_point = approach.time_to_point(last.t, last.passive)?;
+        let to_point = approach.time_to_point(last.t, &Measures { sigma: last.sigma, passive: last.passive })?;
         let t_star = last.t + to_point;
         let expected = last.passive / to_point * (t - t_star);
         if !(t_star < t && passive > 0.5 * expected && passive < 2.0 * expected) {
