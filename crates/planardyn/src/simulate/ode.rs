@@ -47,7 +47,9 @@ const STEP_REACH: f64 = MOVE_FRACTION;
 /// benchmark's search), with the predictive step bound of `Run::aim` and this bound applied
 /// before change points too, by this fraction: 0.5: five-bar 780 evaluations, 3-RRR 62,
 /// Andrews 470; 0.7: 756, 62, 353; 0.85: 756, 122, 326; 1: 718, 127, 891; without the bound:
-/// 767, 74, 522. Kept away from change points' grids (`Run::aim`), 0.7: 750, 72, 411 (s15). The stages move
+/// 767, 74, 522. Kept away from change points' grids, 0.7: 750, 72, 411 (measured in s15 with
+/// the bound off in the whole approach; `Run::aim` now keeps it above APPROACH_BELOW too, and
+/// these figures were not measured again). The stages move
 /// x faster than the start's rates where the motion accelerates towards the singularity, and a
 /// longer bound lets more of them fail.
 const REACH_STEP_FRACTION: f64 = 0.7;
@@ -61,8 +63,9 @@ const REACH_STEP_FRACTION: f64 = 0.7;
 /// (`ClosedForm::keeps_branches`); this threshold keeps the closed forms away from the
 /// partition threshold (0.05), below which the chart changes. At 0.07 (was 0.1) the five-bar
 /// free fall (DOPRI5 rtol 7.59e-7, 1 s) took 401 -> 313 position solves (27.4 -> 24.9 M
-/// instructions), its counters unchanged and its drift within 3e-7 of itself; at 0.05, A02's N = 40 crossings at rtol 1e-12 were 1.05e-8 rad off (0.06: 3.5e-9,
-/// 0.07: 2.3e-9, 0.1: 2.7e-9; tests/change_points.rs bounds 1e-8).
+/// instructions), its counters unchanged and its drift within 3e-7 of itself; at 0.05, A02's
+/// N = 40 crossings at rtol 1e-12 were 1.05e-8 rad off (0.06: 3.5e-9, 0.07: 2.3e-9, 0.1:
+/// 2.7e-9; tests/change_points.rs bounds 1e-8).
 const CLOSED_FORM_SIGMA: f64 = 0.07;
 
 /// Smallest own measure of the chart at a dense-output stage, as a fraction of the measure at
