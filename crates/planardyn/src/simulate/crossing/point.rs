@@ -12,8 +12,19 @@ use crate::simulate::ode::MechanismOde;
 
 /// A scaled pivot of Phi_x below this at the change point counts as a lost rank.
 const LOST_PIVOT: f64 = 1e-4;
-/// Golden-section steps locating the point within a crossing (0.618^40 of its length).
-const LOCATE_ITERATIONS: usize = 40;
+/// The bracket within which the point is located, as a fraction of the crossing's (or step's)
+/// length: 0.618^40, that of the 40 golden-section steps the location took before (42
+/// evaluations of Phi_x's pivots a location; Brent's take 8-15 on the five-bar's steps).
+const LOCATE_BRACKET: f64 = 4.37e-9;
+/// At most this many evaluations a location: Brent's method falls back to golden-section steps
+/// where the parabolas do not shrink the bracket, which 40 of reach [`LOCATE_BRACKET`]; a
+/// bound, never reached in the tests.
+const LOCATE_EVALUATIONS: usize = 100;
+/// Within this fraction of the interval from one of its ends, the search asks whether the
+/// least is at that end (2 evaluations instead of about 30 golden-section steps to it).
+const END_NEAR: f64 = 1.0 / 16.0;
+/// Rounding of a scaled pivot of Phi_x (entries O(1), a few eliminations' sums): 16 ulps of 1.
+const PIVOT_ROUNDING: f64 = 16.0 * f64::EPSILON;
 
 /// One crossing of a change point, as the result reports it.
 #[derive(Debug, Clone, PartialEq)]
@@ -81,7 +92,7 @@ fn located_in_step(ode: &MechanismOde, last: &Passed, t: f64) -> ChangePoint {
 
 /// Whether `point`, located in the step from t0 to t, lost rank strictly inside it.
 fn strictly_inside(point: &ChangePoint, t0: f64, t: f64) -> bool {
-    // Golden section ends within 0.618^40 of an end where the pivot only falls.
+    // The location ends within LOCATE_BRACKET / 2 of an end where the pivot only falls.
     point.rank_drop > 0 && point.t < t - 1e-6 * (t - t0)
 }
 
@@ -98,8 +109,12 @@ fn rank_drop(mech: &Mechanism, x: &[f64]) -> usize {
 }
 
 /// The time in [a, b] where `path` passes the change point: where the smallest of Phi_x's
-/// regular pivots (0 at the point, growing as |t - t*| on either side) is least, by golden
-/// section. The passive measure's own V is not symmetric enough (the partition chosen on
+/// regular pivots (0 at the point, growing as |t - t*| on either side) is least, by Brent's
+/// minimisation (golden section and parabolic steps) of its square, which is smooth across the
+/// point as the pivot is not, so that the parabolas fit it there. The time returned is within
+/// half of [`LOCATE_BRACKET`] of the interval's length from the least pivot (the final
+/// bracket's guarantee), as the 40 golden-section steps this replaces left their bracket's
+/// midpoint. The passive measure's own V is not symmetric enough (the partition chosen on
 /// either side differs): located from it, A02's point was 3e-6 rad off.
 fn locate(mech: &Mechanism, path: &dyn Path, mut a: f64, mut b: f64) -> f64 {
     let n = mech.n_x();
@@ -111,22 +126,106 @@ fn locate(mech: &Mechanism, path: &dyn Path, mut a: f64, mut b: f64) -> f64 {
         if p.len() < regular {
             0.0
         } else {
-            p.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v))
+            let least = p.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v));
+            least * least
         }
     };
-    let r = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..LOCATE_ITERATIONS {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - r * (b - a);
-            fc = f(c);
+    // Brent (1973), `localmin`, with an absolute tolerance: it ends when the bracket [a, b]
+    // lies within tol2 of the best point t (a golden-section step where a parabola's would
+    // not shrink the bracket fast enough).
+    let golden = (3.0 - 5f64.sqrt()) / 2.0;
+    let (bracket, widest) = (LOCATE_BRACKET * (b - a) / 4.0, f64::EPSILON.sqrt() * (b - a));
+    let mut t = a + golden * (b - a);
+    let (mut w, mut v) = (t, t);
+    let mut ft = f(t);
+    let (mut fw, mut fv) = (ft, ft);
+    let (mut d, mut e) = (0.0_f64, 0.0_f64);
+    let (a0, b0, end) = (a, b, LOCATE_BRACKET * (b - a));
+    let mut ends_asked = [false; 2];
+    for _ in 0..LOCATE_EVALUATIONS {
+        // Near an end the search still has (the pivot only falling towards it), whether the
+        // least is within `end` of it: rising from it over that distance, it is (the pivot has
+        // one minimum in [a, b], as the search assumes), and the midpoint is the located time,
+        // as the golden-section steps ended within that bracket of it. Else the search goes on.
+        for (k, (edge, inward)) in [(a0, end), (b0, -end)].into_iter().enumerate() {
+            let open = if k == 0 { a == a0 } else { b == b0 };
+            if open && !ends_asked[k] && (t - edge).abs() < END_NEAR * (b0 - a0) {
+                ends_asked[k] = true;
+                if f(edge + inward) > f(edge) {
+                    return edge + 0.5 * inward;
+                }
+            }
+        }
+        let mid = 0.5 * (a + b);
+        let tol1 = bracket.max(resolution([(t, ft), (w, fw), (v, fv)]).min(widest));
+        let tol2 = 2.0 * tol1;
+        if (t - mid).abs() <= tol2 - 0.5 * (b - a) {
+            break;
+        }
+        let mut parabolic = false;
+        if e.abs() > tol1 {
+            // The parabola through (t, w, v): its vertex at t + p / q.
+            let r = (t - w) * (ft - fv);
+            let s = (t - v) * (ft - fw);
+            let (mut p, mut q) = ((t - v) * s - (t - w) * r, 2.0 * (s - r));
+            if q > 0.0 {
+                p = -p;
+            } else {
+                q = -q;
+            }
+            let last = e;
+            e = d;
+            if p.abs() < (0.5 * q * last).abs() && p > q * (a - t) && p < q * (b - t) {
+                d = p / q;
+                let u = t + d;
+                if u - a < tol2 || b - u < tol2 {
+                    d = tol1.copysign(mid - t);
+                }
+                parabolic = true;
+            }
+        }
+        if !parabolic {
+            e = if t >= mid { a - t } else { b - t };
+            d = golden * e;
+        }
+        let u = if d.abs() >= tol1 { t + d } else { t + tol1.copysign(d) };
+        let fu = f(u);
+        if fu <= ft {
+            if u >= t {
+                a = t;
+            } else {
+                b = t;
+            }
+            (v, fv, w, fw, t, ft) = (w, fw, t, ft, u, fu);
         } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + r * (b - a);
-            fd = f(d);
+            if u < t {
+                a = u;
+            } else {
+                b = u;
+            }
+            if fu <= fw || w == t {
+                (v, fv, w, fw) = (w, fw, u, fu);
+            } else if fu <= fv || v == t || v == w {
+                (v, fv) = (u, fu);
+            }
         }
     }
-    (a + b) / 2.0
+    t
+}
+
+/// How close to the least of a smooth positive minimum the squared pivot can tell, through the
+/// parabola of its three best points (the best first): where it rises from its vertex by less
+/// than its rounding ([`PIVOT_ROUNDING`] in the pivot), the comparisons of the search are
+/// rounding, not the pivot's shape. 0 where the points do not give a convex parabola. At a
+/// change point the pivot's square falls to rounding level, and so does this resolution.
+fn resolution([(t, ft), (w, fw), (v, fv)]: [(f64, f64); 3]) -> f64 {
+    if t == w || t == v || w == v {
+        return 0.0;
+    }
+    let curvature = ((fw - ft) / (w - t) - (fv - ft) / (v - t)) / (w - v);
+    if curvature > 0.0 {
+        (2.0 * ft.sqrt() * PIVOT_ROUNDING / curvature).sqrt()
+    } else {
+        0.0
+    }
 }
