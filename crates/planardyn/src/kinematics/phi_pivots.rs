@@ -109,7 +109,7 @@ fn dense_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::kinematics::constraints::Chart;
     use crate::kinematics::system::scaled_jacobian;
@@ -158,6 +158,20 @@ coordinates:
   - {name: theta, pair: g0, value: 1.5707963267948966}
 ";
 
+    /// A02 and its body coordinates at its change point: the rods turned to +x about their
+    /// pivots, the couplers moved with their tops.
+    pub(crate) fn a02_folded() -> (Mechanism, Vec<f64>) {
+        let mech = crate::loads(A02, Format::Yaml, "A02").unwrap();
+        let mut x = mech.x0.clone();
+        for (b, body) in mech.bodies.iter().enumerate() {
+            let (dx, dy, dphi) = if body.name.starts_with("rod") { (0.5, -0.5, -FRAC_PI_2) } else { (1.0, -1.0, 0.0) };
+            x[3 * b] += dx;
+            x[3 * b + 1] += dy;
+            x[3 * b + 2] += dphi;
+        }
+        (mech, x)
+    }
+
     #[test]
     fn the_dense_eliminations_pivots_bit_for_bit() {
         // Revolute, prismatic and multi-loop mechanisms at their drawn pose (ties: small
@@ -173,15 +187,7 @@ coordinates:
             }
             assert_pivots(&mech, &x, &format!("{file} moved"));
         }
-        let mech = crate::loads(A02, Format::Yaml, "A02").unwrap();
-        // The rods turned to +x about their pivots, the couplers moved with their tops.
-        let mut x = mech.x0.clone();
-        for (b, body) in mech.bodies.iter().enumerate() {
-            let (dx, dy, dphi) = if body.name.starts_with("rod") { (0.5, -0.5, -FRAC_PI_2) } else { (1.0, -1.0, 0.0) };
-            x[3 * b] += dx;
-            x[3 * b + 1] += dy;
-            x[3 * b + 2] += dphi;
-        }
+        let (mech, x) = a02_folded();
         let pivots = assert_pivots(&mech, &x, "A02 folded");
         // Rank 2 lost: two pivots at rounding level (2.7e-17), the others 0.45 and up.
         assert_eq!(pivots.iter().filter(|p| p.1 < 1e-12).count(), 2, "{pivots:?}");

@@ -229,3 +229,44 @@ fn resolution([(t, ft), (w, fw), (v, fv)]: [(f64, f64); 3]) -> f64 {
         0.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::phi_pivots::tests::a02_folded;
+
+    /// A straight line in x through A02's change point at `T_STAR` (from its drawn pose).
+    struct Line {
+        fold: Vec<f64>,
+        dx: Vec<f64>,
+    }
+
+    const T_STAR: f64 = 0.37;
+
+    impl Path for Line {
+        fn at(&self, t: f64, x: &mut [f64], xd: &mut [f64], xdd: &mut [f64]) {
+            for (i, (f, d)) in self.fold.iter().zip(&self.dx).enumerate() {
+                (x[i], xd[i], xdd[i]) = (f + (t - T_STAR) * d, *d, 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn a_change_point_is_located_within_its_bracket() {
+        // Phi_x loses rank 2 at T_STAR only; its least regular pivot grows as |t - T_STAR|
+        // on either side. Located within LOCATE_BRACKET / 2 of each interval's length from
+        // it (the stated tolerance), or from the interval's end nearer to it when outside.
+        let (mech, fold) = a02_folded();
+        let dx: Vec<f64> = fold.iter().zip(&mech.x0).map(|(f, x0)| f - x0).collect();
+        let line = Line { fold, dx };
+        for (a, b) in [(0.07, 0.47), (0.32, 0.57), (0.3699, 0.5), (0.38, 0.6), (0.1, 0.36)] {
+            let point = located(&mech, &line, a, b);
+            let expected = T_STAR.clamp(a, b);
+            // At an end the located time is the end bracket's midpoint, exactly that far
+            // from it: a few ulps of t for the rounding of the bracket's ends.
+            let tolerance = 0.5 * LOCATE_BRACKET * (b - a) + 4.0 * f64::EPSILON * b;
+            assert!((point.t - expected).abs() <= tolerance, "[{a}, {b}]: {} vs {expected}", point.t);
+            assert_eq!(point.rank_drop, if expected == T_STAR { 2 } else { 0 }, "[{a}, {b}]");
+        }
+    }
+}
