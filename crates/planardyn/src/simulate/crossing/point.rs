@@ -132,8 +132,10 @@ fn locate(mech: &Mechanism, path: &dyn Path, mut a: f64, mut b: f64) -> f64 {
         }
     };
     // Brent (1973), `localmin`, with an absolute tolerance: it ends when the bracket [a, b]
-    // lies within tol2 of the best point t (a golden-section step where a parabola's would
-    // not shrink the bracket fast enough).
+    // lies within tol2 of the best point t. Written here rather than taken from argmin's
+    // BrentOpt: the end test and the stop at the pivot's rounding (`resolution`) are this
+    // search's own, and the core would take on an optimisation framework for 60 lines. A
+    // golden-section step is taken where a parabola's would not shrink the bracket fast enough.
     let golden = (3.0 - 5f64.sqrt()) / 2.0;
     let (bracket, widest) = (LOCATE_BRACKET * (b - a) / 4.0, f64::EPSILON.sqrt() * (b - a));
     let mut t = a + golden * (b - a);
