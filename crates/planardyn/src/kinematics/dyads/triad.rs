@@ -358,9 +358,9 @@ impl Triad {
             self.set_arms(|a| a.ext.shift(z));
         }
         self.holds(x);
-        // The geometry is written in place (a 42-value copy an evaluation less): a failed
-        // solve leaves it partial, as it leaves x, and nothing reads it before the next
-        // successful one.
+        // The geometry is written in place (a 42-value copy an evaluation less), the Newton
+        // iterates' levers, e and inverse once they have converged: a failed solve leaves it
+        // partial, as it leaves x, and nothing reads it before the next successful one.
         let g = &mut self.geometry;
         let mut a = [[0.0; 2]; 3];
         for (i, j) in self.outer.iter().enumerate() {
@@ -380,12 +380,12 @@ impl Triad {
         let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
         for _ in 0..=MAX_NEWTON {
             let cs = self.branch.platform_trig(pose[2]);
-            let mut f = [0.0; 3];
+            let (mut f, mut lever, mut e) = ([0.0; 3], [[0.0; 2]; 3], [[0.0; 2]; 3]);
             let mut norm: f64 = 0.0;
             for i in 0..3 {
-                g.lever[i] = rot(cs, self.s_platform[i]);
-                g.e[i] = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], a[i]);
-                f[i] = 0.5 * (dot(g.e[i], g.e[i]) - self.arms2[i]);
+                lever[i] = rot(cs, self.s_platform[i]);
+                e[i] = sub([pose[0] + lever[i][0], pose[1] + lever[i][1]], a[i]);
+                f[i] = 0.5 * (dot(e[i], e[i]) - self.arms2[i]);
                 norm = norm.max(f[i].abs() * self.inv_arm[i]);
             }
             norm *= self.inv_scale;
@@ -393,11 +393,11 @@ impl Triad {
                 break;
             }
             first = first.min(norm);
-            let jac = [0, 1, 2].map(|i| row(g.e[i], g.lever[i]));
+            let jac = [0, 1, 2].map(|i| row(e[i], lever[i]));
             let Some((inv, _)) = inverse(&jac) else { return Err(KinematicsError::singular(SingularityKind::TypeII)) };
-            g.inv = inv;
             let done = polish || norm <= tol || (norm <= ROUND_OFF_FLOOR && norm > 0.5 * previous);
             if done && (polish || norm <= POLISH_BELOW) {
+                (g.lever, g.e, g.inv) = (lever, e, inv);
                 self.place(pose, cs, x, trig);
                 for a in self.extended.iter_mut().flatten() {
                     a.ext.place(z, x, trig);
@@ -406,7 +406,7 @@ impl Triad {
             }
             polish = done;
             previous = norm;
-            let d = times(&g.inv, f);
+            let d = times(&inv, f);
             pose = [pose[0] - d[0], pose[1] - d[1], pose[2] - d[2]];
         }
         let residual = if first.is_finite() { first } else { f64::INFINITY };
