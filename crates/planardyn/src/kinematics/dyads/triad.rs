@@ -267,7 +267,9 @@ impl Triad {
     #[inline]
     fn turns(&self, x: &[f64]) -> [f64; 4] {
         // Exact where the angles are 1 rad or more (Sterbenz), within 1.1e-16 below.
-        [0, 1, 2, 3].map(|i| x[3 * self.bodies[i] + 2] - self.branch.angles[i])
+        self.holds(x);
+        // SAFETY: `holds(x)`.
+        [0, 1, 2, 3].map(|i| unsafe { three(x, self.at[i]) }[2] - self.branch.angles[i])
     }
 
     /// H = prod_i H_i, H_i = |arm_i| (1 + |c_i|) the bound of the Jacobian's row i.
