@@ -495,7 +495,8 @@ impl Triad {
             let c = perp(s[i]);
             [2.0 * wl * c[0], 2.0 * wl * c[1]]
         };
-        (self.holds(v), self.holds(a));
+        self.holds(v);
+        self.holds(a);
         // SAFETY (each `three` and `three_mut` below): `holds(v)` and `holds(a)`.
         let w = unsafe { three(v, self.at[3]) }[2];
         let wl = [0, 1, 2].map(|i| unsafe { three(v, self.at[i]) }[2]);
