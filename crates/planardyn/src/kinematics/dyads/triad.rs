@@ -20,6 +20,7 @@ use super::{put_acceleration, put_rate, Joint};
 use crate::kinematics::group_sigma::{triad_sigma, Block};
 use crate::kinematics::position::{MAX_NEWTON, POLISH_BELOW, POSITION_TOL, ROUND_OFF_FLOOR};
 use crate::model::pairs::frames::{dot, perp, rot, sub};
+use crate::model::{BodyId, Link};
 use crate::{KinematicsError, SingularityKind};
 use near::{near_atan2, turned, EXACT_TURN};
 
@@ -55,6 +56,41 @@ fn times(inv: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
     inv.map(|r| r[0] * b[0] + r[1] * b[1] + r[2] * b[2])
 }
 
+/// A body's three entries (x, y, angle) of x, v or a from `at`, one of the triad's offsets
+/// (`Triad::at`, `Triad::outer_at`), unchecked: a checked slice costs 5-7 instructions and a
+/// panic branch an access, 57 of them an evaluation of the 3-RRR; with one length check a call
+/// instead (`Triad::holds`) the evaluation took 7375 instructions, not 7655 (7649 with an
+/// assert an access, 7734 with `&v[at..][..3]`: benchmarks/icount).
+///
+/// # Safety
+/// `Triad::holds(v)` has passed (every offset plus 3 is at most `span`, at most v's length).
+#[inline(always)]
+unsafe fn three(v: &[f64], at: usize) -> &[f64] {
+    debug_assert!(at + 3 <= v.len());
+    // SAFETY: at + 3 <= span <= v.len() (the caller's `holds`).
+    unsafe { v.get_unchecked(at..at + 3) }
+}
+
+/// [`three`] to write.
+///
+/// # Safety
+/// As `three`.
+#[inline(always)]
+unsafe fn three_mut(v: &mut [f64], at: usize) -> &mut [f64] {
+    debug_assert!(at + 3 <= v.len());
+    // SAFETY: as `three`.
+    unsafe { v.get_unchecked_mut(at..at + 3) }
+}
+
+/// The link as the first body of its own entries (`three`), the ground as itself: the outer
+/// joints' `Joint` methods then read no other index.
+fn local(link: Link) -> Link {
+    match link {
+        Link::Ground => Link::Ground,
+        Link::Body(_) => Link::Body(BodyId(0)),
+    }
+}
+
 /// Largest turn (rad) of a body from the reference for the side test near it
 /// (`Triad::side_near_reference`): there [`near::near_sin_cos`] is within 2e-14 of sin and cos (its
 /// first left-out terms, 0.5^13 / 13! and 0.5^14 / 14!). The fold guard's predictions are
@@ -76,10 +112,17 @@ pub struct Triad {
     pub bodies: [usize; 4],
     /// Those and the followers of two-body legs: the group's bodies.
     pub members: Vec<usize>,
+    /// Where the bodies' entries start in x, v and a (3 b), and the outer joints' links' (their
+    /// indices in trig, the ground's 0 and not read); all entries lie below `span`.
+    at: [usize; 4],
+    outer_at: [usize; 3],
+    outer_trig: [usize; 3],
+    span: usize,
     /// Per leg, its relative input if it is two bodies; whether any is.
     extended: [Option<Arm>; 3],
     cylinders: bool,
-    /// A_i on the links solved before, and the same points in the legs' frames.
+    /// A_i on the links solved before, each as the joint on its link's own entries (`local`),
+    /// and the same points in the legs' frames.
     outer: [Joint; 3],
     s_outer: [[f64; 2]; 3],
     /// C_i - A_i in leg i's frame, its squared length and 1 / length.
@@ -155,9 +198,18 @@ impl Triad {
         let arms = [0, 1, 2].map(|i| sub(s_inner[i], s_outer[i]));
         let members = bodies.iter().copied().chain(extended.iter().flatten().map(|a| a.ext.follower)).collect();
         let cylinders = extended.iter().any(Option::is_some);
+        let outer_trig = outer.map(|j| match j.link {
+            Link::Ground => 0,
+            Link::Body(b) => b.0,
+        });
+        let outer = outer.map(|j| Joint { link: local(j.link), s: j.s });
         let mut triad = Triad {
             bodies,
             members,
+            at: bodies.map(|b| 3 * b),
+            outer_at: outer_trig.map(|b| 3 * b),
+            outer_trig,
+            span: 3 * (bodies.iter().chain(&outer_trig).max().unwrap() + 1),
             extended,
             cylinders,
             outer,
@@ -173,6 +225,13 @@ impl Triad {
         };
         triad.set_arms(|_| 0.0);
         triad
+    }
+
+    /// That x, v or a holds every entry of the triad's bodies and outer links (`span`), which
+    /// makes `three` and `three_mut` at their offsets safe: checked once a call.
+    #[inline(always)]
+    fn holds(&self, v: &[f64]) {
+        assert!(v.len() >= self.span, "{} entries, the triad's bodies need {}", v.len(), self.span);
     }
 
     /// The legs' arms at the extensions d(leg) of the two-body ones.
@@ -210,7 +269,9 @@ impl Triad {
     #[inline]
     fn turns(&self, x: &[f64]) -> [f64; 4] {
         // Exact where the angles are 1 rad or more (Sterbenz), within 1.1e-16 below.
-        [0, 1, 2, 3].map(|i| x[3 * self.bodies[i] + 2] - self.branch.angles[i])
+        self.holds(x);
+        // SAFETY: `holds(x)`.
+        [0, 1, 2, 3].map(|i| unsafe { three(x, self.at[i]) }[2] - self.branch.angles[i])
     }
 
     /// H = prod_i H_i, H_i = |arm_i| (1 + |c_i|) the bound of the Jacobian's row i.
@@ -300,27 +361,35 @@ impl Triad {
         if self.cylinders {
             self.set_arms(|a| a.ext.shift(z));
         }
-        // The geometry is written in place (a 42-value copy an evaluation less): a failed
-        // solve leaves it partial, as it leaves x, and nothing reads it before the next
-        // successful one.
+        self.holds(x);
+        // The geometry is written in place (a 42-value copy an evaluation less), the Newton
+        // iterates' levers, e and inverse once they have converged: a failed solve leaves it
+        // partial, as it leaves x, and nothing reads it before the next successful one.
         let g = &mut self.geometry;
         let mut a = [[0.0; 2]; 3];
         for (i, j) in self.outer.iter().enumerate() {
-            (a[i], g.known[i]) = j.place(x, trig);
+            let at = self.outer_at[i];
+            // SAFETY: `holds(x)` above.
+            (a[i], g.known[i]) = j.place(unsafe { three(x, at) }, &trig[self.outer_trig[i]..]);
         }
-        let p = 3 * self.bodies[3];
-        let mut pose = if from_x { [x[p], x[p + 1], x[p + 2]] } else { self.branch.pose };
+        let mut pose = if from_x {
+            // SAFETY: `holds(x)` above.
+            let p = unsafe { three(x, self.at[3]) };
+            [p[0], p[1], p[2]]
+        } else {
+            self.branch.pose
+        };
         let size = (pose[0].abs() * self.inv_scale).max(pose[1].abs() * self.inv_scale).max(pose[2].abs());
         let tol = POSITION_TOL * (1.0 + size);
         let (mut first, mut previous, mut polish) = (f64::INFINITY, f64::INFINITY, false);
         for _ in 0..=MAX_NEWTON {
             let cs = self.branch.platform_trig(pose[2]);
-            let mut f = [0.0; 3];
+            let (mut f, mut lever, mut e) = ([0.0; 3], [[0.0; 2]; 3], [[0.0; 2]; 3]);
             let mut norm: f64 = 0.0;
             for i in 0..3 {
-                g.lever[i] = rot(cs, self.s_platform[i]);
-                g.e[i] = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], a[i]);
-                f[i] = 0.5 * (dot(g.e[i], g.e[i]) - self.arms2[i]);
+                lever[i] = rot(cs, self.s_platform[i]);
+                e[i] = sub([pose[0] + lever[i][0], pose[1] + lever[i][1]], a[i]);
+                f[i] = 0.5 * (dot(e[i], e[i]) - self.arms2[i]);
                 norm = norm.max(f[i].abs() * self.inv_arm[i]);
             }
             norm *= self.inv_scale;
@@ -328,11 +397,11 @@ impl Triad {
                 break;
             }
             first = first.min(norm);
-            let jac = [0, 1, 2].map(|i| row(g.e[i], g.lever[i]));
+            let jac = [0, 1, 2].map(|i| row(e[i], lever[i]));
             let Some((inv, _)) = inverse(&jac) else { return Err(KinematicsError::singular(SingularityKind::TypeII)) };
-            g.inv = inv;
             let done = polish || norm <= tol || (norm <= ROUND_OFF_FLOOR && norm > 0.5 * previous);
             if done && (polish || norm <= POLISH_BELOW) {
+                (g.lever, g.e, g.inv) = (lever, e, inv);
                 self.place(pose, cs, x, trig);
                 for a in self.extended.iter_mut().flatten() {
                     a.ext.place(z, x, trig);
@@ -341,20 +410,21 @@ impl Triad {
             }
             polish = done;
             previous = norm;
-            let d = times(&g.inv, f);
+            let d = times(&inv, f);
             pose = [pose[0] - d[0], pose[1] - d[1], pose[2] - d[2]];
         }
         let residual = if first.is_finite() { first } else { f64::INFINITY };
         Err(KinematicsError::AssemblyFailed { residual, iterations: MAX_NEWTON })
     }
 
-    /// Write the platform at `pose` and the legs from A_i and C_i, completing the geometry.
+    /// Write the platform at `pose` and the legs from A_i and C_i, completing the geometry
+    /// (`position`'s, after its `holds(x)`).
     #[inline]
     fn place(&mut self, pose: [f64; 3], cs: [f64; 2], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let g = &mut self.geometry;
-        let p = self.bodies[3];
-        x[3 * p..3 * p + 3].copy_from_slice(&pose);
-        trig[p] = cs;
+        // SAFETY: `holds(x)` in `position`, the only caller.
+        unsafe { three_mut(x, self.at[3]) }.copy_from_slice(&pose);
+        trig[self.bodies[3]] = cs;
         for i in 0..3 {
             let (arm, e, b) = (self.arms[i], g.e[i], self.bodies[i]);
             let e2 = dot(e, e);
@@ -366,9 +436,12 @@ impl Triad {
             let turn = near_atan2(cross(d, e), dot(d, e));
             let rs = rot(leg_cs, self.s_outer[i]);
             let c = sub([pose[0] + g.lever[i][0], pose[1] + g.lever[i][1]], e);
-            x[3 * b] = c[0] - rs[0];
-            x[3 * b + 1] = c[1] - rs[1];
-            x[3 * b + 2] = self.branch.legs[i] + turn;
+            // SAFETY: as the platform's.
+            unsafe { three_mut(x, self.at[i]) }.copy_from_slice(&[
+                c[0] - rs[0],
+                c[1] - rs[1],
+                self.branch.legs[i] + turn,
+            ]);
             trig[b] = leg_cs;
             g.own[i] = rs;
             g.e2[i] = e2;
@@ -390,21 +463,22 @@ impl Triad {
     pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
         let g = &self.geometry;
         let s = self.slides(|a| a.ext.input_rate(zd));
-        let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], v));
+        self.holds(v);
+        // SAFETY (each `three` and `three_mut` below): `holds(v)`.
+        let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], unsafe { three(v, self.outer_at[i]) }));
         let b = [0, 1, 2].map(|i| match s {
             Some(s) => dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]]),
             None => dot(g.e[i], va[i]),
         });
         let [vx, vy, w] = times(&g.inv, b);
-        let p = self.bodies[3];
-        v[3 * p..3 * p + 3].copy_from_slice(&[vx, vy, w]);
-        for (i, &leg) in self.bodies[..3].iter().enumerate() {
+        unsafe { three_mut(v, self.at[3]) }.copy_from_slice(&[vx, vy, w]);
+        for i in 0..3 {
             let mut vc = [vx - w * g.lever[i][1], vy + w * g.lever[i][0]];
             if let Some(s) = s {
                 vc = sub(vc, s[i]);
             }
             let wl = cross(g.e[i], sub(vc, va[i])) * g.inv_e2[i];
-            put_rate(v, leg, va[i], g.own[i], wl);
+            put_rate(unsafe { three_mut(v, self.at[i]) }, 0, va[i], g.own[i], wl);
         }
         if s.is_some() {
             self.extended.iter().flatten().for_each(|a| a.ext.velocity(zd, v));
@@ -423,13 +497,16 @@ impl Triad {
             let c = perp(s[i]);
             [2.0 * wl * c[0], 2.0 * wl * c[1]]
         };
-        let p = self.bodies[3];
-        let w = v[3 * p + 2];
+        self.holds(v);
+        self.holds(a);
+        // SAFETY (each `three` and `three_mut` below): `holds(v)` and `holds(a)`.
+        let w = unsafe { three(v, self.at[3]) }[2];
+        let wl = [0, 1, 2].map(|i| unsafe { three(v, self.at[i]) }[2]);
         let (mut aa, mut rhs) = ([[0.0; 2]; 3], [0.0; 3]);
-        for (i, &b) in self.bodies[..3].iter().enumerate() {
-            let (wl, l) = (v[3 * b + 2], g.lever[i]);
+        for i in 0..3 {
+            let (wl, l, at) = (wl[i], g.lever[i], self.outer_at[i]);
             // a_A_i plus the Coriolis acceleration of C_i on the leg.
-            aa[i] = self.outer[i].acceleration(g.known[i], v, a);
+            aa[i] = self.outer[i].acceleration(g.known[i], unsafe { three(v, at) }, unsafe { three(a, at) });
             let mut ac = aa[i];
             if let Some(s) = s {
                 let k = coriolis(s, i, wl);
@@ -438,15 +515,16 @@ impl Triad {
             rhs[i] = dot(g.e[i], [ac[0] + w * w * l[0], ac[1] + w * w * l[1]]) - wl * wl * g.e2[i];
         }
         let [ax, ay, al] = times(&g.inv, rhs);
-        a[3 * p..3 * p + 3].copy_from_slice(&[ax, ay, al]);
-        for (i, &b) in self.bodies[..3].iter().enumerate() {
-            let (wl, l) = (v[3 * b + 2], g.lever[i]);
+        unsafe { three_mut(a, self.at[3]) }.copy_from_slice(&[ax, ay, al]);
+        for i in 0..3 {
+            let (wl, l) = (wl[i], g.lever[i]);
             let ac = [ax - al * l[1] - w * w * l[0], ay + al * l[0] - w * w * l[1]];
             let mut rel = sub(ac, aa[i]);
             if let Some(s) = s {
                 rel = sub(rel, coriolis(s, i, wl));
             }
-            put_acceleration(a, b, aa[i], g.own[i], wl, cross(g.e[i], rel) * g.inv_e2[i]);
+            let al_leg = cross(g.e[i], rel) * g.inv_e2[i];
+            put_acceleration(unsafe { three_mut(a, self.at[i]) }, 0, aa[i], g.own[i], wl, al_leg);
         }
         if s.is_some() {
             self.extended.iter().flatten().for_each(|x| x.ext.acceleration(v, a));
