@@ -28,7 +28,7 @@ use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
 use super::dyads::triad::Triad;
-use super::dyads::Joint;
+use super::dyads::{Joint, Pass};
 use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use super::u_support::USupport;
@@ -138,6 +138,21 @@ impl Group {
             Group::Rpr(d, _) => d.acceleration(v, a),
             Group::Extended(d) => d.acceleration(v, a),
             Group::Triad(t) => t.acceleration(v, a),
+        }
+    }
+
+    /// The group's rows of U, xd and c in one pass ([`Pass::piece`]).
+    #[inline(always)]
+    fn pass<const M: usize>(&self, p: &mut Pass<M>) {
+        match self {
+            Group::Rrr(d, _, g) => {
+                p.piece(&d.bodies, |_, v| d.velocity(g, [[0.0; 2]; 2], v), |v, a| d.acceleration(g, [[0.0; 2]; 2], v, a))
+            }
+            Group::Rrp(d, _, g) => p.piece(&d.bodies, |_, v| d.velocity(g, v), |v, a| d.acceleration(g, v, a)),
+            Group::Affine(g) => p.piece(g.bodies(), |_, v| g.velocity(v), |v, a| g.acceleration(v, a)),
+            Group::Rpr(d, _) => p.piece(d.bodies(), |_, v| d.velocity(v), |v, a| d.acceleration(v, a)),
+            Group::Extended(d) => p.piece(&d.members, |zd, v| d.velocity(zd, v), |v, a| d.acceleration(v, a)),
+            Group::Triad(t) => p.piece(&t.members, |zd, v| t.velocity(zd, v), |v, a| t.acceleration(v, a)),
         }
     }
 }
@@ -555,6 +570,25 @@ impl ClosedForm {
         }
     }
 
+    /// U (whole columns: no `reach`), xd and c at the positions in `ws` in one pass over the
+    /// pieces ([`Pass`]): what [`ClosedForm::velocity_analogues`] then
+    /// [`ClosedForm::convective`] write, to the bit.
+    #[inline(always)]
+    fn pass<const M: usize>(&self, zd: &[f64], ws: &mut Frame) {
+        let n = ws.x.len();
+        let zd: [f64; M] = zd.try_into().expect("M coordinates");
+        let mut p = Pass { zd, n, u: &mut ws.u[..M * n], xd: &mut ws.xd, c: &mut ws.c };
+        for c in &self.cranks {
+            p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
+        }
+        for s in &self.sliders {
+            p.piece(&[s.body], |zd, v| s.velocity(zd, v), |_, a| s.acceleration(a));
+        }
+        for d in &self.groups {
+            d.pass(&mut p);
+        }
+    }
+
     /// Positions, analogues and the convective term at (z, zd) in the user's chart, and the
     /// user's coordinates q = z, qd = zd: what `dynamics::kinematic_stages` computes there.
     pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
@@ -572,8 +606,16 @@ impl ClosedForm {
 
     fn stages_from(&mut self, z: &[f64], zd: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         self.place(z, start, ws)?;
-        self.velocity_analogues(ws);
-        self.convective(zd, ws);
+        match (&self.reach, zd.len()) {
+            (None, 1) => self.pass::<1>(zd, ws),
+            (None, 2) => self.pass::<2>(zd, ws),
+            (None, 3) => self.pass::<3>(zd, ws),
+            (None, 4) => self.pass::<4>(zd, ws),
+            _ => {
+                self.velocity_analogues(ws);
+                self.convective(zd, ws);
+            }
+        }
         copy_small(&mut ws.q, z);
         copy_small(&mut ws.qd, zd);
         Ok(())
