@@ -575,9 +575,8 @@ impl ClosedForm {
     /// [`ClosedForm::convective`] write, to the bit.
     #[inline(always)]
     fn pass<const M: usize>(&self, zd: &[f64], ws: &mut Frame) {
-        let n = ws.x.len();
         let zd: [f64; M] = zd.try_into().expect("M coordinates");
-        let mut p = Pass { zd, n, u: &mut ws.u[..M * n], xd: &mut ws.xd, c: &mut ws.c };
+        let mut p = Pass::new(zd, &mut ws.u, &mut ws.xd, &mut ws.c);
         for c in &self.cranks {
             p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
         }

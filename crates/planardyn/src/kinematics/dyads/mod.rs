@@ -151,16 +151,27 @@ pub(crate) fn put_acceleration(a: &mut [f64], b: usize, ap: [f64; 2], rs: [f64; 
 /// piece, in the decomposition's order, writes its bodies' rows of every column of U, then
 /// their rates, then their accelerations ([`Pass::piece`]): what it reads of the pieces before
 /// it is written by then, so one pass per piece replaces a pass over the pieces per column,
-/// one for xd and one for c, with the same operations on the same numbers.
+/// one for xd and one for c, with the same operations on the same numbers. The vectors are
+/// held as body rows ([`Pass::new`]): the pieces' [`body`] of the flat vectors handed to them
+/// then needs no division of their length by 3 an access (it folds with the multiplication).
 pub(crate) struct Pass<'a, const M: usize> {
-    pub zd: [f64; M],
-    pub n: usize,
-    pub u: &'a mut [f64],
-    pub xd: &'a mut [f64],
-    pub c: &'a mut [f64],
+    zd: [f64; M],
+    /// The bodies, U's columns (`bodies` rows each), xd and c.
+    bodies: usize,
+    u: &'a mut [[f64; 3]],
+    xd: &'a mut [[f64; 3]],
+    c: &'a mut [[f64; 3]],
 }
 
-impl<const M: usize> Pass<'_, M> {
+impl<'a, const M: usize> Pass<'a, M> {
+    /// U's first M columns (3 per body of xd each), xd and c for the rates zd.
+    #[inline(always)]
+    pub fn new(zd: [f64; M], u: &'a mut [f64], xd: &'a mut [f64], c: &'a mut [f64]) -> Self {
+        let bodies = xd.len() / 3;
+        let u = &mut u.as_chunks_mut().0[..M * bodies];
+        Pass { zd, bodies, u, xd: xd.as_chunks_mut().0, c: c.as_chunks_mut().0 }
+    }
+
     /// A piece of `bodies` by its rates for coordinate rates zd (`velocity(zd, v)`, the links
     /// before it in v) and its accelerations for rates v (`acceleration(v, a)`): its rows of
     /// U's column j by `velocity` at the unit rates e_j, of xd from them, of c from xd.
@@ -171,15 +182,15 @@ impl<const M: usize> Pass<'_, M> {
         velocity: impl Fn(&[f64], &mut [f64]),
         acceleration: impl Fn(&[f64], &mut [f64]),
     ) {
-        let n = self.n;
+        let n = self.bodies;
         for j in 0..M {
             let unit: [f64; M] = std::array::from_fn(|i| if i == j { 1.0 } else { 0.0 });
-            velocity(&unit, &mut self.u[j * n..(j + 1) * n]);
+            velocity(&unit, self.u[j * n..(j + 1) * n].as_flattened_mut());
         }
         for &b in bodies {
             self.rates(b);
         }
-        acceleration(self.xd, self.c);
+        acceleration(self.xd.as_flattened(), self.c.as_flattened_mut());
     }
 
     /// Body b's rates xd = U zd, each 0 + u_0 zd_0 + u_1 zd_1 + ... in that order (as
@@ -188,11 +199,10 @@ impl<const M: usize> Pass<'_, M> {
     fn rates(&mut self, b: usize) {
         let mut s = [0.0; 3];
         for (j, zd) in self.zd.iter().enumerate() {
-            // Column j's body b: U is column-major, n = 3 x (bodies) rows a column.
-            let u = body(self.u, j * (self.n / 3) + b);
+            let u = self.u[j * self.bodies + b];
             s = [s[0] + u[0] * zd, s[1] + u[1] * zd, s[2] + u[2] * zd];
         }
-        *body_mut(self.xd, b) = s;
+        self.xd[b] = s;
     }
 }
 
