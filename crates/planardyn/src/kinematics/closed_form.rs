@@ -145,9 +145,11 @@ impl Group {
     #[inline(always)]
     fn pass<const M: usize>(&self, p: &mut Pass<M>) {
         match self {
-            Group::Rrr(d, _, g) => {
-                p.piece(&d.bodies, |_, v| d.velocity(g, [[0.0; 2]; 2], v), |v, a| d.acceleration(g, [[0.0; 2]; 2], v, a))
-            }
+            Group::Rrr(d, _, g) => p.piece(
+                &d.bodies,
+                |_, v| d.velocity(g, [[0.0; 2]; 2], v),
+                |v, a| d.acceleration(g, [[0.0; 2]; 2], v, a),
+            ),
             Group::Rrp(d, _, g) => p.piece(&d.bodies, |_, v| d.velocity(g, v), |v, a| d.acceleration(g, v, a)),
             Group::Affine(g) => p.piece(g.bodies(), |_, v| g.velocity(v), |v, a| g.acceleration(v, a)),
             Group::Rpr(d, _) => p.piece(d.bodies(), |_, v| d.velocity(v), |v, a| d.acceleration(v, a)),

@@ -26,7 +26,8 @@ impl Slider {
     pub fn position(&self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let d = z[self.k] - self.value;
         let rs = rot(self.cs, self.s);
-        *body_mut(x, self.body) = [self.origin[0] + d * self.axis[0] - rs[0], self.origin[1] + d * self.axis[1] - rs[1], self.phi];
+        *body_mut(x, self.body) =
+            [self.origin[0] + d * self.axis[0] - rs[0], self.origin[1] + d * self.axis[1] - rs[1], self.phi];
         trig[self.body] = self.cs;
     }
 
