@@ -82,6 +82,20 @@ pub(crate) fn body_mut(v: &mut [f64], b: usize) -> &mut [f64; 3] {
     &mut v.as_chunks_mut::<3>().0[b]
 }
 
+/// A vector of 3 per body as whole body rows flattened again (the same entries): the pieces'
+/// [`body`] of it then needs no division of its length by 3 an access (it folds with the
+/// multiplication), a loop's worth of them for a pass over the pieces.
+#[inline(always)]
+pub(crate) fn rows(v: &[f64]) -> &[f64] {
+    v.as_chunks::<3>().0.as_flattened()
+}
+
+/// [`rows`], to write.
+#[inline(always)]
+pub(crate) fn rows_mut(v: &mut [f64]) -> &mut [f64] {
+    v.as_chunks_mut::<3>().0.as_flattened_mut()
+}
+
 /// Pose (centre, [cos, sin]) of a link in x and trig; the ground's is the identity.
 #[inline(always)]
 pub(crate) fn pose(link: Link, x: &[f64], trig: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
