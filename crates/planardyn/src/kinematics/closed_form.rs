@@ -634,8 +634,8 @@ mod tests {
     /// c to the bit as the passes by stage do ([`ClosedForm::velocity_analogues`], a pass over
     /// the pieces per column of U, then [`ClosedForm::convective`]: xd = U zd by
     /// `u_times_from` and an accelerations pass), for every shipped model with closed forms
-    /// (1, 2 and 3 coordinates among them), at its drawing and at a point 0.05 away in each
-    /// coordinate with rates of both signs.
+    /// (1, 2 and 3 coordinates among them), at its drawing and, where they assemble there, at a
+    /// point 0.05 away in each coordinate, with rates of both signs.
     #[test]
     fn one_pass_writes_what_the_stages_do_to_the_bit() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/models");
@@ -656,8 +656,13 @@ mod tests {
                 let z: Vec<f64> = q0.iter().map(|q| q + shift).collect();
                 let zd: Vec<f64> = (0..m).map(|j| [0.7, -1.3, 0.4, -0.9][j] * (1.0 + shift)).collect();
                 let (mut one, mut staged) = (Workspace::new(&mech), Workspace::new(&mech));
-                closed.kinematic_stages(&z, &zd, &mut one).unwrap();
-                closed.positions(&z, &mut staged).unwrap();
+                let placed = closed.kinematic_stages(&z, &zd, &mut one).is_ok();
+                assert_eq!(closed.positions(&z, &mut staged).is_ok(), placed, "{}", path.display());
+                if !placed {
+                    // Off the drawing a triad's Newton from its reference may not converge.
+                    assert!(shift > 0.0, "{} at its drawing", path.display());
+                    continue;
+                }
                 closed.velocity_analogues(&mut staged);
                 closed.convective(&zd, &mut staged);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
