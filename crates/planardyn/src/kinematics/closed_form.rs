@@ -28,7 +28,7 @@ use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
 use super::dyads::triad::Triad;
-use super::dyads::Joint;
+use super::dyads::{Joint, Pass};
 use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use super::u_support::USupport;
@@ -138,6 +138,23 @@ impl Group {
             Group::Rpr(d, _) => d.acceleration(v, a),
             Group::Extended(d) => d.acceleration(v, a),
             Group::Triad(t) => t.acceleration(v, a),
+        }
+    }
+
+    /// The group's rows of U, xd and c in one pass ([`Pass::piece`]).
+    #[inline(always)]
+    fn pass<const M: usize>(&self, p: &mut Pass<M>) {
+        match self {
+            Group::Rrr(d, _, g) => p.piece(
+                &d.bodies,
+                |_, v| d.velocity(g, [[0.0; 2]; 2], v),
+                |v, a| d.acceleration(g, [[0.0; 2]; 2], v, a),
+            ),
+            Group::Rrp(d, _, g) => p.piece(&d.bodies, |_, v| d.velocity(g, v), |v, a| d.acceleration(g, v, a)),
+            Group::Affine(g) => p.piece(g.bodies(), |_, v| g.velocity(v), |v, a| g.acceleration(v, a)),
+            Group::Rpr(d, _) => p.piece(d.bodies(), |_, v| d.velocity(v), |v, a| d.acceleration(v, a)),
+            Group::Extended(d) => p.piece(&d.members, |zd, v| d.velocity(zd, v), |v, a| d.acceleration(v, a)),
+            Group::Triad(t) => p.piece(&t.members, |zd, v| t.velocity(zd, v), |v, a| t.acceleration(v, a)),
         }
     }
 }
@@ -555,6 +572,25 @@ impl ClosedForm {
         }
     }
 
+    /// U (whole columns: no `reach`), xd and c at the positions in `ws` in one pass over the
+    /// pieces ([`Pass`]): what [`ClosedForm::velocity_analogues`] then
+    /// [`ClosedForm::convective`] write, to the bit.
+    #[inline(always)]
+    fn pass<const M: usize>(&self, zd: &[f64], ws: &mut Frame) {
+        let n = ws.x.len();
+        let zd: [f64; M] = zd.try_into().expect("M coordinates");
+        let mut p = Pass { zd, n, u: &mut ws.u[..M * n], xd: &mut ws.xd, c: &mut ws.c };
+        for c in &self.cranks {
+            p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
+        }
+        for s in &self.sliders {
+            p.piece(&[s.body], |zd, v| s.velocity(zd, v), |_, a| s.acceleration(a));
+        }
+        for d in &self.groups {
+            d.pass(&mut p);
+        }
+    }
+
     /// Positions, analogues and the convective term at (z, zd) in the user's chart, and the
     /// user's coordinates q = z, qd = zd: what `dynamics::kinematic_stages` computes there.
     pub fn kinematic_stages(&mut self, z: &[f64], zd: &[f64], ws: &mut Frame) -> Result<(), KinematicsError> {
@@ -572,10 +608,70 @@ impl ClosedForm {
 
     fn stages_from(&mut self, z: &[f64], zd: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         self.place(z, start, ws)?;
-        self.velocity_analogues(ws);
-        self.convective(zd, ws);
+        match (&self.reach, zd.len()) {
+            (None, 1) => self.pass::<1>(zd, ws),
+            (None, 2) => self.pass::<2>(zd, ws),
+            (None, 3) => self.pass::<3>(zd, ws),
+            (None, 4) => self.pass::<4>(zd, ws),
+            _ => {
+                self.velocity_analogues(ws);
+                self.convective(zd, ws);
+            }
+        }
         copy_small(&mut ws.q, z);
         copy_small(&mut ws.qd, zd);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Workspace;
+
+    /// The one pass over the pieces (`ClosedForm::pass`, up to 4 coordinates) writes U, xd and
+    /// c to the bit as the passes by stage do ([`ClosedForm::velocity_analogues`], a pass over
+    /// the pieces per column of U, then [`ClosedForm::convective`]: xd = U zd by
+    /// `u_times_from` and an accelerations pass), for every shipped model with closed forms
+    /// (1, 2 and 3 coordinates among them), at its drawing and, where they assemble there, at a
+    /// point 0.05 away in each coordinate, with rates of both signs.
+    #[test]
+    fn one_pass_writes_what_the_stages_do_to_the_bit() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/models");
+        let mut files: Vec<_> = [root.clone(), root.join("library")]
+            .iter()
+            .flat_map(|d| std::fs::read_dir(d).unwrap().map(|e| e.unwrap().path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "yaml"))
+            .collect();
+        files.sort();
+        let mut coordinates = Vec::new();
+        for path in &files {
+            let mech = crate::load(path.to_str().unwrap()).unwrap();
+            let Some(mut closed) = ClosedForm::new(&mech).filter(|c| c.writes_u_whole()) else { continue };
+            let (q0, _) = mech.initial_state();
+            let m = q0.len();
+            coordinates.push(m);
+            for shift in [0.0, 0.05] {
+                let z: Vec<f64> = q0.iter().map(|q| q + shift).collect();
+                let zd: Vec<f64> = (0..m).map(|j| [0.7, -1.3, 0.4, -0.9][j] * (1.0 + shift)).collect();
+                let (mut one, mut staged) = (Workspace::new(&mech), Workspace::new(&mech));
+                let placed = closed.kinematic_stages(&z, &zd, &mut one).is_ok();
+                assert_eq!(closed.positions(&z, &mut staged).is_ok(), placed, "{}", path.display());
+                if !placed {
+                    // Off the drawing a triad's Newton from its reference may not converge.
+                    assert!(shift > 0.0, "{} at its drawing", path.display());
+                    continue;
+                }
+                closed.velocity_analogues(&mut staged);
+                closed.convective(&zd, &mut staged);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                for (what, a, b) in [("U", &one.u, &staged.u), ("xd", &one.xd, &staged.xd), ("c", &one.c, &staged.c)] {
+                    assert_eq!(bits(a), bits(b), "{what} of {} at shift {shift}", path.display());
+                }
+            }
+        }
+        coordinates.sort();
+        coordinates.dedup();
+        assert_eq!(coordinates, [1, 2, 3]);
     }
 }

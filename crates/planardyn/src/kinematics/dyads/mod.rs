@@ -138,6 +138,55 @@ pub(crate) fn put_acceleration(a: &mut [f64], body: usize, ap: [f64; 2], rs: [f6
     ]);
 }
 
+/// Where one pass over the pieces (`ClosedForm::stages_from`) writes, at the positions just
+/// solved: U's M columns (n rows each), the rates xd = U zd and the convective term c. Each
+/// piece, in the decomposition's order, writes its bodies' rows of every column of U, then
+/// their rates, then their accelerations ([`Pass::piece`]): what it reads of the pieces before
+/// it is written by then, so one pass per piece replaces a pass over the pieces per column,
+/// one for xd and one for c, with the same operations on the same numbers.
+pub(crate) struct Pass<'a, const M: usize> {
+    pub zd: [f64; M],
+    pub n: usize,
+    pub u: &'a mut [f64],
+    pub xd: &'a mut [f64],
+    pub c: &'a mut [f64],
+}
+
+impl<const M: usize> Pass<'_, M> {
+    /// A piece of `bodies` by its rates for coordinate rates zd (`velocity(zd, v)`, the links
+    /// before it in v) and its accelerations for rates v (`acceleration(v, a)`): its rows of
+    /// U's column j by `velocity` at the unit rates e_j, of xd from them, of c from xd.
+    #[inline(always)]
+    pub fn piece(
+        &mut self,
+        bodies: &[usize],
+        velocity: impl Fn(&[f64], &mut [f64]),
+        acceleration: impl Fn(&[f64], &mut [f64]),
+    ) {
+        let n = self.n;
+        for j in 0..M {
+            let unit: [f64; M] = std::array::from_fn(|i| if i == j { 1.0 } else { 0.0 });
+            velocity(&unit, &mut self.u[j * n..(j + 1) * n]);
+        }
+        for &b in bodies {
+            self.rates(b);
+        }
+        acceleration(self.xd, self.c);
+    }
+
+    /// Body b's rates xd = U zd, each 0 + u_0 zd_0 + u_1 zd_1 + ... in that order (as
+    /// `analogues::u_times_from` sums them).
+    #[inline(always)]
+    fn rates(&mut self, b: usize) {
+        let mut s = [0.0; 3];
+        for (j, zd) in self.zd.iter().enumerate() {
+            let u: &[f64; 3] = self.u[j * self.n + 3 * b..][..3].try_into().expect("3 rows a body");
+            s = [s[0] + u[0] * zd, s[1] + u[1] * zd, s[2] + u[2] * zd];
+        }
+        self.xd[3 * b..3 * b + 3].copy_from_slice(&s);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     /// [`super::round`] is `f64::round` to the bit: halves either side of zero, the largest
