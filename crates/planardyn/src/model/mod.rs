@@ -122,6 +122,9 @@ pub struct Coordinate {
     pub q0: f64,
     /// Initial rate (rad/s or m/s).
     pub qd0: f64,
+    /// The pair's relative coordinate as a difference of two entries of x, where it is one
+    /// (`pairs::linear_coordinate`): a drive's effort through it at every evaluation.
+    pub linear: Option<pairs::LinearCoordinate>,
 }
 
 /// Largest move one continuation of the position analysis may make (rad, or lengths L for

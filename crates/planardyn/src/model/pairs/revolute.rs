@@ -3,7 +3,7 @@
 
 use super::frames::{add_grad, angle, link_columns, link_state, link_state_t, part, perp};
 use super::gear::Side;
-use super::{coordinate_lever, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
+use super::{coordinate_lever, reaction_force, FrictionField, LinearCoordinate, PairGeometry, PairType, Relative, Rows};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Link, Pair};
 
@@ -122,6 +122,13 @@ impl PairType for Revolute {
     #[inline]
     fn coordinate_rate(&self, pair: &Pair, _x: &[f64], xd: &[f64]) -> f64 {
         angle(pair.b, xd) - angle(pair.a, xd)
+    }
+    fn linear_coordinate(&self, pair: &Pair) -> Option<LinearCoordinate> {
+        let column = |link| match link {
+            Link::Ground => None,
+            Link::Body(b) => Some(3 * b.0 + 2),
+        };
+        Some(LinearCoordinate { minus: column(pair.a), plus: column(pair.b), offset: pair.rel_angle0 })
     }
 }
 
