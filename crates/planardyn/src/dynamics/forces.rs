@@ -48,7 +48,7 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
         if t == 0.0 {
             continue;
         }
-        let (_, rate) = add_effort(c.linear.as_ref(), &mech.pairs[c.pair.0], x, xd, f, |_, _| t);
+        let (_, rate) = add_effort(c.linear.as_ref(), &mech.pairs, c.pair, x, xd, f, |_, _| t);
         power += t * rate;
     }
     power

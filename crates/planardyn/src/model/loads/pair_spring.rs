@@ -58,7 +58,7 @@ impl LoadType for PairSpring {
     #[inline]
     fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
         let effort = |value, rate| -self.stiffness * (value - self.rest) - self.damping * rate;
-        let (_, rate) = add_effort(self.linear.as_ref(), &mech.pairs[self.pair.0], x, xd, f, effort);
+        let (_, rate) = add_effort(self.linear.as_ref(), &mech.pairs, self.pair, x, xd, f, effort);
         -(self.damping * rate * rate)
     }
 

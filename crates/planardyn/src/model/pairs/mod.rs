@@ -18,7 +18,7 @@ pub mod revolute;
 pub mod slot;
 
 use crate::linalg::Sink;
-use crate::model::{CoordinateKind, JointFriction, Mechanism, Pair, PairKind};
+use crate::model::{CoordinateKind, JointFriction, Mechanism, Pair, PairId, PairKind};
 use frames::{link_columns, link_state, Projection};
 use gear::Side;
 
@@ -404,16 +404,24 @@ impl LinearCoordinate {
     /// -1 and +1 times the effort), so the same numbers.
     #[inline(always)]
     pub fn add_effort(&self, x: &[f64], xd: &[f64], f: &mut [f64], effort: impl FnOnce(f64, f64) -> f64) -> (f64, f64) {
-        let at = |v: &[f64], c: Option<usize>| c.map_or(0.0, |c| v[c]);
-        let rate = at(xd, self.plus) - at(xd, self.minus);
-        let effort = effort(at(x, self.plus) - at(x, self.minus) - self.offset, rate);
-        if let Some(c) = self.minus {
-            f[c] += effort * -1.0;
+        let add = |minus: Option<usize>, plus: Option<usize>| {
+            let at = |v: &[f64], c: Option<usize>| c.map_or(0.0, |c| v[c]);
+            let rate = at(xd, plus) - at(xd, minus);
+            let effort = effort(at(x, plus) - at(x, minus) - self.offset, rate);
+            if let Some(c) = minus {
+                f[c] += effort * -1.0;
+            }
+            if let Some(c) = plus {
+                f[c] += effort * 1.0;
+            }
+            (effort, rate)
+        };
+        // One test of which links are the ground, each case's code without any.
+        match (self.minus, self.plus) {
+            (Some(a), Some(b)) => add(Some(a), Some(b)),
+            (None, Some(b)) => add(None, Some(b)),
+            (a, None) => add(a, None),
         }
-        if let Some(c) = self.plus {
-            f[c] += effort * 1.0;
-        }
-        (effort, rate)
     }
 }
 
@@ -422,12 +430,13 @@ pub fn linear_coordinate(pair: &Pair) -> Option<LinearCoordinate> {
     dispatch!(&pair.kind, t => t.linear_coordinate(pair))
 }
 
-/// [`add_coordinate_effort`], through `linear` where the coordinate is one (the pair's own
-/// [`linear_coordinate`]).
+/// [`add_coordinate_effort`] of pair `pair` of `pairs`, through `linear` where the coordinate
+/// is one (the pair's own [`linear_coordinate`]).
 #[inline(always)]
 pub fn add_effort(
     linear: Option<&LinearCoordinate>,
-    pair: &Pair,
+    pairs: &[Pair],
+    pair: PairId,
     x: &[f64],
     xd: &[f64],
     f: &mut [f64],
@@ -435,7 +444,7 @@ pub fn add_effort(
 ) -> (f64, f64) {
     match linear {
         Some(l) => l.add_effort(x, xd, f, effort),
-        None => add_coordinate_effort(pair, x, xd, f, effort),
+        None => add_coordinate_effort(&pairs[pair.0], x, xd, f, effort),
     }
 }
 
