@@ -178,4 +178,35 @@ mod tests {
             assert_eq!(coordinate_gamma(p, &x, &xd, &xd), 0.0);
         }
     }
+
+    /// An effort through the relative angle's columns found at build (`LinearCoordinate`) is
+    /// the generic pair code's to the bit: f, the effort and the rate, with an effort of both
+    /// the angle and its rate, at every revolute pair of Andrews' squeezer (ground-body and
+    /// body-body pairs) off the drawing; and a prismatic pair has none.
+    #[test]
+    fn the_linear_coordinate_gives_the_generic_effort_bit_for_bit() {
+        use crate::model::pairs::{add_coordinate_effort, linear_coordinate};
+        let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
+        let mech = crate::load(&path).unwrap();
+        let n = mech.x0.len();
+        let x: Vec<f64> = mech.x0.iter().enumerate().map(|(i, v)| v + 0.013 * i as f64).collect();
+        let xd: Vec<f64> = (0..n).map(|i| 1.3 - 0.21 * i as f64).collect();
+        let effort = |value: f64, rate: f64| -7.0 * (value - 0.1) - 0.3 * rate;
+        let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        let mut grounded = 0;
+        for p in mech.pairs.iter().filter(|p| p.kind == PairKind::Revolute) {
+            let linear = linear_coordinate(p).expect("a revolute pair's angle is linear");
+            grounded += usize::from(linear.minus.is_none() || linear.plus.is_none());
+            let start: Vec<f64> = (0..n).map(|i| 0.5 * i as f64 - 1.0).collect();
+            let (mut f, mut expected) = (start.clone(), start);
+            let (e, r) = linear.add_effort(&x, &xd, &mut f, effort);
+            let (e0, r0) = add_coordinate_effort(p, &x, &xd, &mut expected, effort);
+            assert_eq!((e.to_bits(), r.to_bits()), (e0.to_bits(), r0.to_bits()), "{}", p.name);
+            assert_eq!(bits(&f), bits(&expected), "{}", p.name);
+            assert_ne!(f, (0..n).map(|i| 0.5 * i as f64 - 1.0).collect::<Vec<_>>());
+        }
+        assert!(grounded >= 3, "{grounded}");
+        let prismatic = crate::model::Pair { kind: PairKind::Prismatic { axis: [1.0, 0.0] }, ..mech.pairs[0].clone() };
+        assert_eq!(linear_coordinate(&prismatic), None);
+    }
 }
