@@ -7,7 +7,9 @@
 use super::apply::pair_effort_rate;
 use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
-use crate::model::pairs::{add_effort, coordinate, coordinate_gamma, coordinate_rate, linear_coordinate, LinearCoordinate};
+use crate::model::pairs::{
+    add_effort, coordinate, coordinate_gamma, coordinate_rate, linear_coordinate, LinearCoordinate,
+};
 use crate::model::{Mechanism, PairId};
 use crate::units;
 use serde::{Deserialize, Serialize};

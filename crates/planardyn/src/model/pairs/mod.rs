@@ -408,11 +408,12 @@ impl LinearCoordinate {
             let at = |v: &[f64], c: Option<usize>| c.map_or(0.0, |c| v[c]);
             let rate = at(xd, plus) - at(xd, minus);
             let effort = effort(at(x, plus) - at(x, minus) - self.offset, rate);
+            // f + effort * -1 and f + effort * 1 of the generic code: f - effort and f + effort.
             if let Some(c) = minus {
-                f[c] += effort * -1.0;
+                f[c] -= effort;
             }
             if let Some(c) = plus {
-                f[c] += effort * 1.0;
+                f[c] += effort;
             }
             (effort, rate)
         };

@@ -3,7 +3,9 @@
 
 use super::frames::{add_grad, angle, link_columns, link_state, link_state_t, part, perp};
 use super::gear::Side;
-use super::{coordinate_lever, reaction_force, FrictionField, LinearCoordinate, PairGeometry, PairType, Relative, Rows};
+use super::{
+    coordinate_lever, reaction_force, FrictionField, LinearCoordinate, PairGeometry, PairType, Relative, Rows,
+};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Link, Pair};
 
