@@ -152,17 +152,24 @@ mod tests {
     const H: f64 = 1e-6;
     const FD_TOL: f64 = 1e-8;
 
+    /// Andrews' squeezer (revolute pairs ground-body and body-body, either order), x off its
+    /// drawing and rates xd.
+    fn andrews_off_drawing() -> (crate::model::Mechanism, Vec<f64>, Vec<f64>) {
+        let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
+        let mech = crate::load(&path).unwrap();
+        let x: Vec<f64> = mech.x0.iter().enumerate().map(|(i, v)| v + 0.013 * i as f64).collect();
+        let xd: Vec<f64> = (0..x.len()).map(|i| 1.3 - 0.21 * i as f64).collect();
+        (mech, x, xd)
+    }
+
     /// A revolute pair's relative angle from its own module (no cos or sin of the links):
     /// the gradient is the angle's (central differences along every column of x), the rate
     /// the gradient times xd, the second derivative zero. Every revolute pair of Andrews'
     /// squeezer (ground-body and body-body pairs, either order) at a point off the drawing.
     #[test]
     fn the_relative_angle_its_gradient_and_rate() {
-        let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
-        let mech = crate::load(&path).unwrap();
-        let n = mech.x0.len();
-        let x: Vec<f64> = mech.x0.iter().enumerate().map(|(i, v)| v + 0.013 * i as f64).collect();
-        let xd: Vec<f64> = (0..n).map(|i| 1.3 - 0.21 * i as f64).collect();
+        let (mech, x, xd) = andrews_off_drawing();
+        let n = x.len();
         let pairs: Vec<_> = mech.pairs.iter().filter(|p| p.kind == PairKind::Revolute).collect();
         assert!(pairs.len() >= 7, "{}", pairs.len());
         for p in pairs {
@@ -188,11 +195,8 @@ mod tests {
     #[test]
     fn the_linear_coordinate_gives_the_generic_effort_bit_for_bit() {
         use crate::model::pairs::{add_coordinate_effort, linear_coordinate};
-        let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
-        let mech = crate::load(&path).unwrap();
-        let n = mech.x0.len();
-        let x: Vec<f64> = mech.x0.iter().enumerate().map(|(i, v)| v + 0.013 * i as f64).collect();
-        let xd: Vec<f64> = (0..n).map(|i| 1.3 - 0.21 * i as f64).collect();
+        let (mech, x, xd) = andrews_off_drawing();
+        let n = x.len();
         let effort = |value: f64, rate: f64| -7.0 * (value - 0.1) - 0.3 * rate;
         let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         let mut grounded = 0;
