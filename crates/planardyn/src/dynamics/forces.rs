@@ -4,7 +4,7 @@
 //! coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
 use crate::model::loads;
-use crate::model::pairs::add_coordinate_effort;
+use crate::model::pairs::add_effort;
 use crate::model::Mechanism;
 
 /// Drive efforts on the generalized coordinates (N m on angles, N on displacements).
@@ -48,7 +48,7 @@ pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &
         if t == 0.0 {
             continue;
         }
-        let (_, rate) = add_coordinate_effort(&mech.pairs[c.pair.0], x, xd, f, |_, _| t);
+        let (_, rate) = add_effort(c.linear.as_ref(), &mech.pairs, c.pair, x, xd, f, |_, _| t);
         power += t * rate;
     }
     power

@@ -254,12 +254,19 @@ pub(crate) fn accelerations(mech: &Mechanism, ws: &mut Workspace) {
 }
 
 /// The user's accelerations from x, xd and xdd; in the input chart the chart's own zdd
-/// (as [`user_coordinates`]).
+/// (as [`user_coordinates`]). Inlined, that copy: the other charts' pass out of line.
+#[inline(always)]
 fn user_accelerations(mech: &Mechanism, ws: &mut Workspace) {
     if ws.chart == Chart::Inputs {
         copy_small(&mut ws.qdd, &ws.zdd);
-        return;
+    } else {
+        user_accelerations_from_x(mech, ws);
     }
+}
+
+/// The user's accelerations from x, xd and xdd (outside the input chart).
+#[inline(never)]
+fn user_accelerations_from_x(mech: &Mechanism, ws: &mut Workspace) {
     for (k, c) in mech.coordinates.iter().enumerate() {
         let p = &mech.pairs[c.pair.0];
         ws.qdd[k] = pair_coordinate_rate(p, &ws.x, &ws.xdd) + pair_coordinate_gamma(p, &ws.x, &ws.xd, &ws.xd);

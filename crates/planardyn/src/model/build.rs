@@ -560,7 +560,8 @@ fn build_coordinates(ctx: &Ctx, mech: &mut Mechanism, coordinates: &[CoordinateS
             return Err(ctx.err(format!("{path}.q0"), format!("q0 = {q0} is more than {MAX_CONTINUATION_DISTANCE:e} (rad, or lengths of the drawing) from the drawn value {value}: the assembly follows the drawing there step by step; draw the mechanism nearer its start")));
         }
         let qd0 = ctx.finite(&format!("{path}.qd0"), c.qd0)?;
-        mech.coordinates.push(Coordinate { name: c.name.clone(), pair, kind, value, q0, qd0 });
+        let linear = pairs::linear_coordinate(&mech.pairs[pair.0]);
+        mech.coordinates.push(Coordinate { name: c.name.clone(), pair, kind, value, q0, qd0, linear });
     }
     Ok(())
 }

@@ -122,6 +122,9 @@ pub struct Coordinate {
     pub q0: f64,
     /// Initial rate (rad/s or m/s).
     pub qd0: f64,
+    /// The pair's relative coordinate as a difference of two entries of x, where it is one
+    /// (`pairs::linear_coordinate`): a drive's effort through it at every evaluation.
+    pub linear: Option<pairs::LinearCoordinate>,
 }
 
 /// Largest move one continuation of the position analysis may make (rad, or lengths L for
@@ -143,24 +146,29 @@ pub enum DriveLaw {
 }
 
 impl DriveLaw {
-    /// The effort at time `t` (s).
+    /// The effort at time `t` (s). Inlined, a constant; a table's lookup out of line.
+    #[inline]
     pub fn effort(&self, t: f64) -> f64 {
         match self {
             DriveLaw::Constant(value) => *value,
-            DriveLaw::Table { t: times, effort } => {
-                let last = times.len() - 1;
-                if t <= times[0] {
-                    return effort[0];
-                }
-                if t >= times[last] {
-                    return effort[last];
-                }
-                let k = times.partition_point(|&ti| ti <= t).min(last);
-                let s = (t - times[k - 1]) / (times[k] - times[k - 1]);
-                effort[k - 1] + s * (effort[k] - effort[k - 1])
-            }
+            DriveLaw::Table { t: times, effort } => table_effort(times, effort, t),
         }
     }
+}
+
+/// The effort at time `t` (s) of a table (`DriveLaw::Table`).
+#[inline(never)]
+fn table_effort(times: &[f64], effort: &[f64], t: f64) -> f64 {
+    let last = times.len() - 1;
+    if t <= times[0] {
+        return effort[0];
+    }
+    if t >= times[last] {
+        return effort[last];
+    }
+    let k = times.partition_point(|&ti| ti <= t).min(last);
+    let s = (t - times[k - 1]) / (times[k] - times[k - 1]);
+    effort[k - 1] + s * (effort[k] - effort[k - 1])
 }
 
 /// A point of a link: the link and the point's coordinates in the link frame (m).

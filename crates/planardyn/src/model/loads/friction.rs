@@ -65,11 +65,13 @@ impl LoadSpecType for FrictionSpec {
         if self.viscous.is_none() && pair_id(ctx, mech, "", &self.pair).is_ok_and(mesh) {
             return Ok(None);
         }
+        let pair = relative_pair(ctx, mech, &format!("{path}.pair"), &self.pair)?;
         Ok(Some(Load::PairSpring(PairSpring {
-            pair: relative_pair(ctx, mech, &format!("{path}.pair"), &self.pair)?,
+            pair,
             stiffness: 0.0,
             damping: ctx.non_negative(&format!("{path}.viscous"), self.viscous.unwrap_or(0.0))?,
             rest: 0.0,
+            linear: pairs::linear_coordinate(&mech.pairs[pair.0]),
         })))
     }
 

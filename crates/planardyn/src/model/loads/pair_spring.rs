@@ -7,7 +7,9 @@
 use super::apply::pair_effort_rate;
 use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
-use crate::model::pairs::{add_coordinate_effort, coordinate, coordinate_gamma, coordinate_rate};
+use crate::model::pairs::{
+    add_effort, coordinate, coordinate_gamma, coordinate_rate, linear_coordinate, LinearCoordinate,
+};
 use crate::model::{Mechanism, PairId};
 use crate::units;
 use serde::{Deserialize, Serialize};
@@ -36,15 +38,20 @@ pub struct PairSpring {
     pub stiffness: f64,
     pub damping: f64,
     pub rest: f64,
+    /// The pair's relative coordinate where it is a difference of two entries of x
+    /// (`pairs::linear_coordinate`): the effort through it at every evaluation.
+    pub linear: Option<LinearCoordinate>,
 }
 
 impl LoadSpecType for TorsionalSpringSpec {
     fn build(&self, ctx: &Ctx, mech: &Mechanism, path: &str) -> R<Option<Load>> {
+        let pair = relative_pair(ctx, mech, &format!("{path}.pair"), &self.pair)?;
         Ok(Some(Load::PairSpring(PairSpring {
-            pair: relative_pair(ctx, mech, &format!("{path}.pair"), &self.pair)?,
+            pair,
             stiffness: ctx.non_negative(&format!("{path}.stiffness"), self.stiffness)?,
             damping: ctx.non_negative(&format!("{path}.damping"), self.damping)?,
             rest: ctx.finite(&format!("{path}.rest"), self.rest)?,
+            linear: linear_coordinate(&mech.pairs[pair.0]),
         })))
     }
 }
@@ -53,7 +60,7 @@ impl LoadType for PairSpring {
     #[inline]
     fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
         let effort = |value, rate| -self.stiffness * (value - self.rest) - self.damping * rate;
-        let (_, rate) = add_coordinate_effort(&mech.pairs[self.pair.0], x, xd, f, effort);
+        let (_, rate) = add_effort(self.linear.as_ref(), &mech.pairs, self.pair, x, xd, f, effort);
         -(self.damping * rate * rate)
     }
 

@@ -252,4 +252,7 @@ impl PairType for Gear {
     fn coordinate_rate(&self, _pair: &Pair, _x: &[f64], _xd: &[f64]) -> f64 {
         0.0
     }
+    fn linear_coordinate(&self, _pair: &Pair) -> Option<super::LinearCoordinate> {
+        None
+    }
 }

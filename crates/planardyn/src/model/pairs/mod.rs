@@ -18,7 +18,7 @@ pub mod revolute;
 pub mod slot;
 
 use crate::linalg::Sink;
-use crate::model::{CoordinateKind, JointFriction, Mechanism, Pair, PairKind};
+use crate::model::{CoordinateKind, JointFriction, Mechanism, Pair, PairId, PairKind};
 use frames::{link_columns, link_state, Projection};
 use gear::Side;
 
@@ -128,6 +128,9 @@ pub trait PairType {
     fn coordinate_gamma(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64]) -> f64;
     fn coordinate_gamma3(&self, pair: &Pair, x: &[f64], u: &[f64], v: &[f64], t: &[f64]) -> f64;
     fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64;
+    /// The relative coordinate as a [`LinearCoordinate`] where it is one (a revolute pair's
+    /// angle), else None.
+    fn linear_coordinate(&self, pair: &Pair) -> Option<LinearCoordinate>;
 }
 
 /// The relative-coordinate methods of [`PairType`] for a kind whose coordinate is the
@@ -156,6 +159,10 @@ macro_rules! along_coordinate {
         #[inline(never)]
         fn coordinate_rate(&self, pair: &Pair, x: &[f64], xd: &[f64]) -> f64 {
             super::along(pair, self.axis, x).rate(xd)
+        }
+        // The displacement along a turning guide is not linear in x.
+        fn linear_coordinate(&self, _pair: &Pair) -> Option<super::LinearCoordinate> {
+            None
         }
     };
 }
@@ -377,6 +384,69 @@ pub fn add_coordinate_effort(
         t.coordinate_grad(pair, x, &mut Effort { f, effort }, 0);
         (effort, rate)
     })
+}
+
+/// A relative coordinate that is a difference of two entries of x, less its drawn value: a
+/// revolute pair's angle x[plus] - x[minus] - offset (the ground's angle 0: no column), its
+/// gradient +1 at `plus` and -1 at `minus`, its rate the same difference along xd. Its columns
+/// are found once, where the model is built (`PairType::linear_coordinate`), for the efforts
+/// of [`LinearCoordinate::add_effort`] at every evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearCoordinate {
+    pub minus: Option<usize>,
+    pub plus: Option<usize>,
+    pub offset: f64,
+}
+
+impl LinearCoordinate {
+    /// [`add_coordinate_effort`] of the pair whose coordinate this is: the same operations
+    /// (rate, value, then f - effort at `minus` and f + effort at `plus`, as the gradient's
+    /// -1 and +1 times the effort), so the same numbers.
+    #[inline(always)]
+    pub fn add_effort(&self, x: &[f64], xd: &[f64], f: &mut [f64], effort: impl FnOnce(f64, f64) -> f64) -> (f64, f64) {
+        let add = |minus: Option<usize>, plus: Option<usize>| {
+            let at = |v: &[f64], c: Option<usize>| c.map_or(0.0, |c| v[c]);
+            let rate = at(xd, plus) - at(xd, minus);
+            let effort = effort(at(x, plus) - at(x, minus) - self.offset, rate);
+            // f + effort * -1 and f + effort * 1 of the generic code: f - effort and f + effort.
+            if let Some(c) = minus {
+                f[c] -= effort;
+            }
+            if let Some(c) = plus {
+                f[c] += effort;
+            }
+            (effort, rate)
+        };
+        // One test of which links are the ground, each case's code without any.
+        match (self.minus, self.plus) {
+            (Some(a), Some(b)) => add(Some(a), Some(b)),
+            (None, Some(b)) => add(None, Some(b)),
+            (a, None) => add(a, None),
+        }
+    }
+}
+
+/// A pair's relative coordinate as a [`LinearCoordinate`], where it is one.
+pub fn linear_coordinate(pair: &Pair) -> Option<LinearCoordinate> {
+    dispatch!(&pair.kind, t => t.linear_coordinate(pair))
+}
+
+/// [`add_coordinate_effort`] of pair `pair` of `pairs`, through `linear` where the coordinate
+/// is one (the pair's own [`linear_coordinate`]).
+#[inline(always)]
+pub fn add_effort(
+    linear: Option<&LinearCoordinate>,
+    pairs: &[Pair],
+    pair: PairId,
+    x: &[f64],
+    xd: &[f64],
+    f: &mut [f64],
+    effort: impl FnOnce(f64, f64) -> f64,
+) -> (f64, f64) {
+    match linear {
+        Some(l) => l.add_effort(x, xd, f, effort),
+        None => add_coordinate_effort(&pairs[pair.0], x, xd, f, effort),
+    }
 }
 
 /// Rate of [`coordinate`]: its gradient times xd.

@@ -3,7 +3,9 @@
 
 use super::frames::{add_grad, angle, link_columns, link_state, link_state_t, part, perp};
 use super::gear::Side;
-use super::{coordinate_lever, reaction_force, FrictionField, PairGeometry, PairType, Relative, Rows};
+use super::{
+    coordinate_lever, reaction_force, FrictionField, LinearCoordinate, PairGeometry, PairType, Relative, Rows,
+};
 use crate::linalg::Sink;
 use crate::model::{JointFriction, Link, Pair};
 
@@ -123,6 +125,13 @@ impl PairType for Revolute {
     fn coordinate_rate(&self, pair: &Pair, _x: &[f64], xd: &[f64]) -> f64 {
         angle(pair.b, xd) - angle(pair.a, xd)
     }
+    fn linear_coordinate(&self, pair: &Pair) -> Option<LinearCoordinate> {
+        let column = |link| match link {
+            Link::Ground => None,
+            Link::Body(b) => Some(3 * b.0 + 2),
+        };
+        Some(LinearCoordinate { minus: column(pair.a), plus: column(pair.b), offset: pair.rel_angle0 })
+    }
 }
 
 /// All three columns of both links of a pair, ascending.
@@ -143,17 +152,24 @@ mod tests {
     const H: f64 = 1e-6;
     const FD_TOL: f64 = 1e-8;
 
+    /// Andrews' squeezer (revolute pairs ground-body and body-body, either order), x off its
+    /// drawing and rates xd.
+    fn andrews_off_drawing() -> (crate::model::Mechanism, Vec<f64>, Vec<f64>) {
+        let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
+        let mech = crate::load(&path).unwrap();
+        let x: Vec<f64> = mech.x0.iter().enumerate().map(|(i, v)| v + 0.013 * i as f64).collect();
+        let xd: Vec<f64> = (0..x.len()).map(|i| 1.3 - 0.21 * i as f64).collect();
+        (mech, x, xd)
+    }
+
     /// A revolute pair's relative angle from its own module (no cos or sin of the links):
     /// the gradient is the angle's (central differences along every column of x), the rate
     /// the gradient times xd, the second derivative zero. Every revolute pair of Andrews'
     /// squeezer (ground-body and body-body pairs, either order) at a point off the drawing.
     #[test]
     fn the_relative_angle_its_gradient_and_rate() {
-        let path = format!("{}/../../examples/models/andrews-squeezer.yaml", env!("CARGO_MANIFEST_DIR"));
-        let mech = crate::load(&path).unwrap();
-        let n = mech.x0.len();
-        let x: Vec<f64> = mech.x0.iter().enumerate().map(|(i, v)| v + 0.013 * i as f64).collect();
-        let xd: Vec<f64> = (0..n).map(|i| 1.3 - 0.21 * i as f64).collect();
+        let (mech, x, xd) = andrews_off_drawing();
+        let n = x.len();
         let pairs: Vec<_> = mech.pairs.iter().filter(|p| p.kind == PairKind::Revolute).collect();
         assert!(pairs.len() >= 7, "{}", pairs.len());
         for p in pairs {
@@ -170,5 +186,33 @@ mod tests {
             assert!((coordinate_rate(p, &x, &xd) - along).abs() <= 1e-15 * along.abs(), "{along}");
             assert_eq!(coordinate_gamma(p, &x, &xd, &xd), 0.0);
         }
+    }
+
+    /// An effort through the relative angle's columns found at build (`LinearCoordinate`) is
+    /// the generic pair code's to the bit: f, the effort and the rate, with an effort of both
+    /// the angle and its rate, at every revolute pair of Andrews' squeezer (ground-body and
+    /// body-body pairs) off the drawing; and a prismatic pair has none.
+    #[test]
+    fn the_linear_coordinate_gives_the_generic_effort_bit_for_bit() {
+        use crate::model::pairs::{add_coordinate_effort, linear_coordinate};
+        let (mech, x, xd) = andrews_off_drawing();
+        let n = x.len();
+        let effort = |value: f64, rate: f64| -7.0 * (value - 0.1) - 0.3 * rate;
+        let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        let mut grounded = 0;
+        for p in mech.pairs.iter().filter(|p| p.kind == PairKind::Revolute) {
+            let linear = linear_coordinate(p).expect("a revolute pair's angle is linear");
+            grounded += usize::from(linear.minus.is_none() || linear.plus.is_none());
+            let start: Vec<f64> = (0..n).map(|i| 0.5 * i as f64 - 1.0).collect();
+            let (mut f, mut expected) = (start.clone(), start);
+            let (e, r) = linear.add_effort(&x, &xd, &mut f, effort);
+            let (e0, r0) = add_coordinate_effort(p, &x, &xd, &mut expected, effort);
+            assert_eq!((e.to_bits(), r.to_bits()), (e0.to_bits(), r0.to_bits()), "{}", p.name);
+            assert_eq!(bits(&f), bits(&expected), "{}", p.name);
+            assert_ne!(f, (0..n).map(|i| 0.5 * i as f64 - 1.0).collect::<Vec<_>>());
+        }
+        assert!(grounded >= 3, "{grounded}");
+        let prismatic = crate::model::Pair { kind: PairKind::Prismatic { axis: [1.0, 0.0] }, ..mech.pairs[0].clone() };
+        assert_eq!(linear_coordinate(&prismatic), None);
     }
 }
