@@ -28,7 +28,7 @@ use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
 use super::dyads::slider::Slider;
 use super::dyads::triad::Triad;
-use super::dyads::{Joint, Pass};
+use super::dyads::{rows, rows_mut, Joint, Pass};
 use super::frame::Frame;
 use super::group_sigma::{bodies_length, input_link_sigma};
 use super::u_support::USupport;
@@ -477,14 +477,15 @@ impl ClosedForm {
 
     /// [`ClosedForm::positions`], the triad's Newton from `start`.
     fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
+        let x = rows_mut(&mut ws.x);
         for c in &mut self.cranks {
-            c.position(z, &mut ws.x, &mut ws.trig);
+            c.position(z, x, &mut ws.trig);
         }
         for s in &self.sliders {
-            s.position(z, &mut ws.x, &mut ws.trig);
+            s.position(z, x, &mut ws.trig);
         }
         for d in &mut self.groups {
-            d.position(z, start, &mut ws.x, &mut ws.trig)?;
+            d.position(z, start, x, &mut ws.trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -561,6 +562,7 @@ impl ClosedForm {
     /// Body accelerations `a` at zero coordinate accelerations for body rates v (3n, a velocity
     /// of the mechanism), at the last positions: the convective term for v, -J^-1 gamma(v, v).
     pub fn accelerations(&self, v: &[f64], a: &mut [f64]) {
+        let (v, a) = (rows(v), rows_mut(a));
         for k in &self.cranks {
             k.acceleration(v, a);
         }
@@ -577,9 +579,8 @@ impl ClosedForm {
     /// [`ClosedForm::convective`] write, to the bit.
     #[inline(always)]
     fn pass<const M: usize>(&self, zd: &[f64], ws: &mut Frame) {
-        let n = ws.x.len();
         let zd: [f64; M] = zd.try_into().expect("M coordinates");
-        let mut p = Pass { zd, n, u: &mut ws.u[..M * n], xd: &mut ws.xd, c: &mut ws.c };
+        let mut p = Pass::new(zd, &mut ws.u, &mut ws.xd, &mut ws.c);
         for c in &self.cranks {
             p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
         }

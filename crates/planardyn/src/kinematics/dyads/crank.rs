@@ -2,7 +2,7 @@
 //! q_k = phi_b - phi_a - (drawn relative angle) + (drawn value), the body's angle is
 //! sign (q_k + offset), sign +1 when the body is the pair's b.
 
-use super::{put_acceleration, put_rate};
+use super::{body, body_mut, put_acceleration, put_rate};
 use crate::model::pairs::frames::rot;
 
 #[derive(Debug, Clone)]
@@ -27,8 +27,7 @@ impl Crank {
         let phi = self.sign * (z[self.k] + self.offset);
         let (sn, cs) = phi.sin_cos();
         let rs = rot([cs, sn], self.s);
-        let b = 3 * self.body;
-        x[b..b + 3].copy_from_slice(&[self.pivot[0] - rs[0], self.pivot[1] - rs[1], phi]);
+        *body_mut(x, self.body) = [self.pivot[0] - rs[0], self.pivot[1] - rs[1], phi];
         trig[self.body] = [cs, sn];
         self.rs = rs;
     }
@@ -43,6 +42,6 @@ impl Crank {
     /// last positions.
     #[inline]
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
-        put_acceleration(a, self.body, [0.0; 2], self.rs, v[3 * self.body + 2], 0.0);
+        put_acceleration(a, self.body, [0.0; 2], self.rs, body(v, self.body)[2], 0.0);
     }
 }

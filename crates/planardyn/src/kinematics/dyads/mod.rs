@@ -69,13 +69,40 @@ pub struct Joint {
     pub s: [f64; 2],
 }
 
+/// Body b's three entries (centre x, y and angle, or their rates) of a vector of 3 per body:
+/// one bounds check, where a slice 3b..3b + 3 costs about six instructions an access.
+#[inline(always)]
+pub(crate) fn body(v: &[f64], b: usize) -> &[f64; 3] {
+    &v.as_chunks::<3>().0[b]
+}
+
+/// [`body`], to write.
+#[inline(always)]
+pub(crate) fn body_mut(v: &mut [f64], b: usize) -> &mut [f64; 3] {
+    &mut v.as_chunks_mut::<3>().0[b]
+}
+
+/// A vector of 3 per body as whole body rows flattened again (the same entries): the pieces'
+/// [`body`] of it then needs no division of its length by 3 an access (it folds with the
+/// multiplication), a loop's worth of them for a pass over the pieces.
+#[inline(always)]
+pub(crate) fn rows(v: &[f64]) -> &[f64] {
+    v.as_chunks::<3>().0.as_flattened()
+}
+
+/// [`rows`], to write.
+#[inline(always)]
+pub(crate) fn rows_mut(v: &mut [f64]) -> &mut [f64] {
+    v.as_chunks_mut::<3>().0.as_flattened_mut()
+}
+
 /// Pose (centre, [cos, sin]) of a link in x and trig; the ground's is the identity.
 #[inline(always)]
 pub(crate) fn pose(link: Link, x: &[f64], trig: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
     match link {
         Link::Ground => ([0.0; 2], [1.0, 0.0]),
         Link::Body(b) => {
-            let r = &x[3 * b.0..3 * b.0 + 2];
+            let r = body(x, b.0);
             ([r[0], r[1]], trig[b.0])
         }
     }
@@ -87,8 +114,7 @@ pub(crate) fn rate(link: Link, v: &[f64]) -> ([f64; 2], f64) {
     match link {
         Link::Ground => ([0.0; 2], 0.0),
         Link::Body(b) => {
-            // One bounds check for the three.
-            let r = &v[3 * b.0..3 * b.0 + 3];
+            let r = body(v, b.0);
             ([r[0], r[1]], r[2])
         }
     }
@@ -123,19 +149,15 @@ impl Joint {
 /// Write a body's rates (centre velocity r' = v_p - w E R s from a point p = r + R s of
 /// velocity v_p, and w) into v.
 #[inline(always)]
-pub(crate) fn put_rate(v: &mut [f64], body: usize, vp: [f64; 2], rs: [f64; 2], w: f64) {
-    v[3 * body..3 * body + 3].copy_from_slice(&[vp[0] + w * rs[1], vp[1] - w * rs[0], w]);
+pub(crate) fn put_rate(v: &mut [f64], b: usize, vp: [f64; 2], rs: [f64; 2], w: f64) {
+    *body_mut(v, b) = [vp[0] + w * rs[1], vp[1] - w * rs[0], w];
 }
 
 /// Write a body's accelerations (r'' = a_p - al E R s + w^2 R s from a point p = r + R s of
 /// acceleration a_p, and al) into a.
 #[inline(always)]
-pub(crate) fn put_acceleration(a: &mut [f64], body: usize, ap: [f64; 2], rs: [f64; 2], w: f64, al: f64) {
-    a[3 * body..3 * body + 3].copy_from_slice(&[
-        ap[0] + al * rs[1] + w * w * rs[0],
-        ap[1] - al * rs[0] + w * w * rs[1],
-        al,
-    ]);
+pub(crate) fn put_acceleration(a: &mut [f64], b: usize, ap: [f64; 2], rs: [f64; 2], w: f64, al: f64) {
+    *body_mut(a, b) = [ap[0] + al * rs[1] + w * w * rs[0], ap[1] - al * rs[0] + w * w * rs[1], al];
 }
 
 /// Where one pass over the pieces (`ClosedForm::stages_from`) writes, at the positions just
@@ -143,16 +165,27 @@ pub(crate) fn put_acceleration(a: &mut [f64], body: usize, ap: [f64; 2], rs: [f6
 /// piece, in the decomposition's order, writes its bodies' rows of every column of U, then
 /// their rates, then their accelerations ([`Pass::piece`]): what it reads of the pieces before
 /// it is written by then, so one pass per piece replaces a pass over the pieces per column,
-/// one for xd and one for c, with the same operations on the same numbers.
+/// one for xd and one for c, with the same operations on the same numbers. The vectors are
+/// held as body rows ([`Pass::new`]): the pieces' [`body`] of the flat vectors handed to them
+/// then needs no division of their length by 3 an access (it folds with the multiplication).
 pub(crate) struct Pass<'a, const M: usize> {
-    pub zd: [f64; M],
-    pub n: usize,
-    pub u: &'a mut [f64],
-    pub xd: &'a mut [f64],
-    pub c: &'a mut [f64],
+    zd: [f64; M],
+    /// The bodies, U's columns (`bodies` rows each), xd and c.
+    bodies: usize,
+    u: &'a mut [[f64; 3]],
+    xd: &'a mut [[f64; 3]],
+    c: &'a mut [[f64; 3]],
 }
 
-impl<const M: usize> Pass<'_, M> {
+impl<'a, const M: usize> Pass<'a, M> {
+    /// U's first M columns (3 per body of xd each), xd and c for the rates zd.
+    #[inline(always)]
+    pub fn new(zd: [f64; M], u: &'a mut [f64], xd: &'a mut [f64], c: &'a mut [f64]) -> Self {
+        let bodies = xd.len() / 3;
+        let u = &mut u.as_chunks_mut().0[..M * bodies];
+        Pass { zd, bodies, u, xd: xd.as_chunks_mut().0, c: c.as_chunks_mut().0 }
+    }
+
     /// A piece of `bodies` by its rates for coordinate rates zd (`velocity(zd, v)`, the links
     /// before it in v) and its accelerations for rates v (`acceleration(v, a)`): its rows of
     /// U's column j by `velocity` at the unit rates e_j, of xd from them, of c from xd.
@@ -163,15 +196,15 @@ impl<const M: usize> Pass<'_, M> {
         velocity: impl Fn(&[f64], &mut [f64]),
         acceleration: impl Fn(&[f64], &mut [f64]),
     ) {
-        let n = self.n;
+        let n = self.bodies;
         for j in 0..M {
             let unit: [f64; M] = std::array::from_fn(|i| if i == j { 1.0 } else { 0.0 });
-            velocity(&unit, &mut self.u[j * n..(j + 1) * n]);
+            velocity(&unit, self.u[j * n..(j + 1) * n].as_flattened_mut());
         }
         for &b in bodies {
             self.rates(b);
         }
-        acceleration(self.xd, self.c);
+        acceleration(self.xd.as_flattened(), self.c.as_flattened_mut());
     }
 
     /// Body b's rates xd = U zd, each 0 + u_0 zd_0 + u_1 zd_1 + ... in that order (as
@@ -180,10 +213,10 @@ impl<const M: usize> Pass<'_, M> {
     fn rates(&mut self, b: usize) {
         let mut s = [0.0; 3];
         for (j, zd) in self.zd.iter().enumerate() {
-            let u: &[f64; 3] = self.u[j * self.n + 3 * b..][..3].try_into().expect("3 rows a body");
+            let u = self.u[j * self.bodies + b];
             s = [s[0] + u[0] * zd, s[1] + u[1] * zd, s[2] + u[2] * zd];
         }
-        self.xd[3 * b..3 * b + 3].copy_from_slice(&s);
+        self.xd[b] = s;
     }
 }
 

@@ -6,7 +6,7 @@
 //! the reference configuration. Body 1's rates and accelerations solve one scalar equation
 //! whose coefficient n . E e (e = P - A) vanishes where the rod stands normal to the guide.
 
-use super::{pose, put_acceleration, put_rate, rate, rotation, Joint};
+use super::{body, body_mut, pose, put_acceleration, put_rate, rate, rotation, Joint};
 use crate::kinematics::group_sigma::rrp_sigma;
 use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
@@ -202,11 +202,11 @@ impl Rrp {
         let (cs, turn) = rotation(c, s, branch.rest);
         let own = rot(cs, self.s_hinge);
         let [b1, b2] = self.bodies;
-        x[3 * b1..3 * b1 + 3].copy_from_slice(&[a[0] - own[0], a[1] - own[1], branch.turns + branch.rest + turn]);
+        *body_mut(x, b1) = [a[0] - own[0], a[1] - own[1], branch.turns + branch.rest + turn];
         trig[b1] = cs;
         // Body 2: g's angle, P at its point s_P.
         let rp = rot(c2, self.s_p);
-        x[3 * b2..3 * b2 + 3].copy_from_slice(&[p[0] - rp[0], p[1] - rp[1], phi_g + self.turn]);
+        *body_mut(x, b2) = [p[0] - rp[0], p[1] - rp[1], phi_g + self.turn];
         trig[b2] = c2;
         let inv_det = 1.0 / dot(n, perp(e));
         *out = Geometry { known: [ra, rk], own, e, n, rw, rp, d: sub(sub(p, k), rw), inv_det };
@@ -237,7 +237,7 @@ impl Rrp {
         let vk = self.slide.velocity(g.known[1], v);
         let (_, wg) = rate(self.slide.link, v);
         let (_, ag) = rate(self.slide.link, a);
-        let w1 = v[3 * self.bodies[0] + 2];
+        let w1 = body(v, self.bodies[0])[2];
         let vp = add(va, scaled(w1, perp(g.e)));
         // The second derivative of n . D: n'' . D + 2 n' . D' + n . D'' = 0.
         let nd = scaled(wg, perp(g.n));

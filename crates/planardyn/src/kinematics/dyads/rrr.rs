@@ -5,7 +5,7 @@
 //! w1 E e1 - w2 E e2 = v_B - v_A (and its derivative) with e1 = P - A, e2 = P - B, whose
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
-use super::{put_acceleration, put_rate, rotation, round, Joint};
+use super::{body, body_mut, put_acceleration, put_rate, rotation, round, Joint};
 use crate::kinematics::group_sigma::dyad_sigma;
 use crate::model::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
@@ -139,8 +139,7 @@ impl Rrr {
             let (c, s) = (dot(arm, e), cross(arm, e));
             let (cs, turn) = rotation(c, s, branch.rest[i]);
             let rs = rot(cs, self.s_outer[i]);
-            let k = 3 * self.bodies[i];
-            x[k..k + 3].copy_from_slice(&[q[0] - rs[0], q[1] - rs[1], branch.turns[i] + branch.rest[i] + turn]);
+            *body_mut(x, self.bodies[i]) = [q[0] - rs[0], q[1] - rs[1], branch.turns[i] + branch.rest[i] + turn];
             trig[self.bodies[i]] = cs;
             g.own[i] = rs;
             g.e[i] = e;
@@ -167,7 +166,7 @@ impl Rrr {
     pub fn acceleration(&self, g: &Geometry, slide: [[f64; 2]; 2], v: &[f64], a: &mut [f64]) {
         let aa = self.outer[0].acceleration(g.known[0], v, a);
         let ab = self.outer[1].acceleration(g.known[1], v, a);
-        let (w1, w2) = (v[3 * self.bodies[0] + 2], v[3 * self.bodies[1] + 2]);
+        let (w1, w2) = (body(v, self.bodies[0])[2], body(v, self.bodies[1])[2]);
         let (k1, k2, [e1, e2]) = (w1 * w1, w2 * w2, g.e);
         let (c1, c2) = (perp(slide[0]), perp(slide[1]));
         let (t1, t2) = (2.0 * w1, 2.0 * w2);

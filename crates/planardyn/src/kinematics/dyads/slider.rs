@@ -2,7 +2,7 @@
 //! pair. The body keeps the pair's drawn angle and its pair point lies at G + (q_k - value) u,
 //! G the pair point on the ground and u the guide's direction.
 
-use super::put_rate;
+use super::{body_mut, put_rate};
 use crate::model::pairs::frames::rot;
 
 #[derive(Debug, Clone)]
@@ -26,10 +26,8 @@ impl Slider {
     pub fn position(&self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let d = z[self.k] - self.value;
         let rs = rot(self.cs, self.s);
-        let b = 3 * self.body;
-        x[b] = self.origin[0] + d * self.axis[0] - rs[0];
-        x[b + 1] = self.origin[1] + d * self.axis[1] - rs[1];
-        x[b + 2] = self.phi;
+        *body_mut(x, self.body) =
+            [self.origin[0] + d * self.axis[0] - rs[0], self.origin[1] + d * self.axis[1] - rs[1], self.phi];
         trig[self.body] = self.cs;
     }
 
@@ -42,6 +40,6 @@ impl Slider {
     /// The body's accelerations for zero coordinate accelerations: none (it does not turn).
     #[inline]
     pub fn acceleration(&self, a: &mut [f64]) {
-        a[3 * self.body..3 * self.body + 3].fill(0.0);
+        *body_mut(a, self.body) = [0.0; 3];
     }
 }
