@@ -64,7 +64,7 @@ pub fn finite(name: &str, v: &[f64]) -> Result<(), JsValue> {
 
 /// Check rows of `len` values each (N x len, row after row).
 pub fn rows(name: &str, v: &[f64], len: usize, what: &str) -> Result<usize, JsValue> {
-    if len == 0 || v.len() % len != 0 {
+    if len == 0 || !v.len().is_multiple_of(len) {
         return Err(argument_error(
             Some(name),
             format!("{name} needs rows of {len} values ({what}), got {} values", v.len()),

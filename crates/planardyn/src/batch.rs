@@ -257,7 +257,7 @@ fn walk_rows(
     mut each: impl FnMut(&mut Workspace, std::ops::Range<usize>, Option<&[f64]>) -> Result<(), Error>,
 ) -> Result<(), Error> {
     let (m, nx) = (mech.dof(), mech.n_x());
-    if m == 0 || q.len() % m != 0 || qd.len() != q.len() || qdd.len() != q.len() {
+    if m == 0 || !q.len().is_multiple_of(m) || qd.len() != q.len() || qdd.len() != q.len() {
         return Err(KinematicsError::bad_argument(
             "q, qd, qdd",
             format!("the same number of rows of {m} values each"),

@@ -656,7 +656,7 @@ fn dop853_dense_output_costs_three_evaluations_where_used() {
     while st.t() < 2.0 * PI {
         st.step(&mut Kepler, 2.0 * PI).unwrap();
         // Every other step, twice (the second call is free).
-        if st.stats().naccept % 2 == 0 {
+        if st.stats().naccept.is_multiple_of(2) {
             st.interpolate(&mut Kepler, st.t_prev(), &mut out);
             st.interpolate(&mut Kepler, st.t(), &mut out);
             interpolated += 1;
