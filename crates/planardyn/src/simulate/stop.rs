@@ -69,12 +69,29 @@ impl Stop {
     /// The trajectory's status and message. A failure that usually means a change point (steps
     /// that shrink to nothing, a position that does not assemble) asks `near` for the measures
     /// at the last accepted point and says when one of them is near-singular.
+    /// A run that ran out of steps or progress (`stalled`) gets the driven coordinates'
+    /// diagnosis only: its passive measure does not explain small steps.
     pub fn describe(self, near: impl FnOnce() -> Near) -> (Status, String) {
+        let stalled = self.stalled_at();
         let (status, message) = self.status_message();
-        if !matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
+        let failed = matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite);
+        if !failed && stalled.is_none() {
             return (status, message);
         }
         let Near { passive, driven } = near();
+        if let Some(t) = stalled {
+            if driven >= NEAR_PASSIVE_SINGULAR {
+                return (status, message);
+            }
+            let message = format!(
+                "{message}. The prescribed motion runs into a singularity of its driven coordinates at t = {} s \
+                 (scaled measure {driven:.2e}): there they stop determining the mechanism, its steps shrink \
+                 towards that time, and past it the mechanism may not assemble at the prescribed coordinates. \
+                 Change the motion, or its range (t_end), so that it stops short of this configuration",
+                Time(t)
+            );
+            return (status, message);
+        }
         if passive < NEAR_PASSIVE_SINGULAR {
             let message = format!(
                 "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
@@ -90,6 +107,14 @@ impl Stop {
             (status, message)
         } else {
             (status, message)
+        }
+    }
+
+    /// Where a run stopped that ran out of steps or of progress.
+    fn stalled_at(&self) -> Option<f64> {
+        match self {
+            Stop::Step { error: StepError::TooManySteps { t, .. }, .. } | Stop::Hopeless { t, .. } => Some(*t),
+            _ => None,
         }
     }
 
