@@ -39,6 +39,9 @@ pub enum Stop {
     /// The run cannot reach t_end at its rate of progress (see `Run::progress_rate`): at t,
     /// after `attempts` steps of mean `mean` (last `last`), below `floor`.
     Hopeless { t: f64, attempts: usize, mean: f64, last: f64, floor: f64, t_end: f64, max_steps: usize },
+    /// The prescribed motion runs into a fold of its driven coordinates: at t their measure is
+    /// `driven`, and its square, linear in t, reaches 0 at `t_star` (see `run::FoldWatch`).
+    Fold { t: f64, t_star: f64, driven: f64 },
     /// Changing the chart at t failed.
     ChartChange { t: f64, error: String },
     /// The progress callback asked to stop at t.
@@ -62,6 +65,7 @@ impl Stop {
                 | Stop::DenseOutput { .. }
                 | Stop::EventInStep { .. }
                 | Stop::Hopeless { .. }
+                | Stop::Fold { .. }
                 | Stop::Cancelled { .. }
         )
     }
@@ -87,7 +91,7 @@ impl Stop {
                 "{message}. The prescribed motion runs into a singularity of its driven coordinates at t = {} s \
                  (scaled measure {driven:.2e}): there they stop determining the mechanism, its steps shrink \
                  towards that time, and past it the mechanism may not assemble at the prescribed coordinates. \
-                 Change the motion, or its range (t_end), so that it stops short of this configuration",
+                 {CHANGE_THE_MOTION}",
                 Time(t)
             );
             return (status, message);
@@ -172,6 +176,17 @@ impl Stop {
                     Time(t_end)
                 ),
             ),
+            Stop::Fold { t, t_star, driven } => (
+                Status::StepSizeTooSmall,
+                format!(
+                    "step size too small at t = {} s: the prescribed motion runs into a fold of its driven \
+                     coordinates at t ≈ {} s. Their scaled measure ({driven:.2e} at t) falls like the square root \
+                     of the time left to it, the steps shrink towards that time without passing it, and past it \
+                     the mechanism does not assemble at the prescribed coordinates. {CHANGE_THE_MOTION}",
+                    Time(t),
+                    Time(t_star)
+                ),
+            ),
             Stop::ChartChange { t, error } => {
                 (Status::AssemblyFailed, format!("changing coordinates at t = {} s: {error}", Time(t)))
             }
@@ -185,6 +200,9 @@ impl Stop {
 /// A run whose mean step so far would need this many times its step budget to reach t_end
 /// is stopped: it cannot finish, and waiting for the budget costs this many times more work.
 pub const PROGRESS_MARGIN: f64 = 10.0;
+
+/// What a prescribed motion that runs into its driven coordinates' singularity should change.
+const CHANGE_THE_MOTION: &str = "Change the motion, or its range (t_end), so that it stops short of this configuration";
 
 /// Status and message for a failed step.
 fn step_failure(e: &StepError<Error>) -> (Status, String) {
