@@ -19,6 +19,7 @@ MODES = (1, -1, -1)
 AMPLITUDE = np.array([0.10060306745483943, 0.10650916317844883, 0.10119159596920518])  # rad
 OMEGA = np.array([7.860931860681065, 6.074515709845619, 5.84141748947288])  # rad/s
 T_FOLD = 0.1107510025  # s
+CHANGE = "Change the motion so that it avoids this configuration, or end the run before it (t_end)"
 
 
 def cranks(t: float, q0):
@@ -48,7 +49,7 @@ def test_running_out_of_steps_at_the_fold_names_the_driven_singularity():
     assert res.status == "too_many_steps"
     assert abs(res.t[-1] - T_FOLD) < 1e-6, res.t[-1]
     assert "runs into a singularity of its driven coordinates at t = 0.1107" in res.message, res.message
-    assert "Change the motion, or its range (t_end)" in res.message, res.message
+    assert CHANGE in res.message, res.message
 
 
 def test_a_motion_into_the_fold_stops_there_and_predicts_it():
@@ -60,8 +61,9 @@ def test_a_motion_into_the_fold_stops_there_and_predicts_it():
     steps = res.stats["naccept"] + res.stats["nreject"]
     assert steps < 500, res.stats
     assert abs(res.t[-1] - T_FOLD) < 1e-6, res.t[-1]
-    assert "runs into a fold of its driven coordinates at t ≈ 0.1107510" in res.message, res.message
-    assert "Change the motion, or its range (t_end)" in res.message, res.message
+    assert "near a singularity of their own" in res.message, res.message
+    assert "a fold that the prescribed motion runs into at t ≈ 0.1107510" in res.message, res.message
+    assert CHANGE in res.message, res.message
 
 
 @pytest.mark.parametrize("delta", [1e-4, 1e-6])

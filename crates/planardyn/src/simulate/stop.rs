@@ -179,10 +179,11 @@ impl Stop {
             Stop::Fold { t, t_star, driven } => (
                 Status::StepSizeTooSmall,
                 format!(
-                    "step size too small at t = {} s: the prescribed motion runs into a fold of its driven \
-                     coordinates at t ≈ {} s. Their scaled measure ({driven:.2e} at t) falls like the square root \
-                     of the time left to it, the steps shrink towards that time without passing it, and past it \
-                     the mechanism does not assemble at the prescribed coordinates. {CHANGE_THE_MOTION}",
+                    "step size too small at t = {} s: the coordinates driven by motion are near a singularity of \
+                     their own (scaled measure {driven:.2e}), a fold that the prescribed motion runs into at \
+                     t ≈ {} s. Their measure falls like the square root of the time left to it, the steps shrink \
+                     towards that time without passing it, and past it the mechanism does not assemble at the \
+                     prescribed coordinates. {CHANGE_THE_MOTION}",
                     Time(t),
                     Time(t_star)
                 ),
@@ -202,7 +203,8 @@ impl Stop {
 pub const PROGRESS_MARGIN: f64 = 10.0;
 
 /// What a prescribed motion that runs into its driven coordinates' singularity should change.
-const CHANGE_THE_MOTION: &str = "Change the motion, or its range (t_end), so that it stops short of this configuration";
+const CHANGE_THE_MOTION: &str =
+    "Change the motion so that it avoids this configuration, or end the run before it (t_end)";
 
 /// Status and message for a failed step.
 fn step_failure(e: &StepError<Error>) -> (Status, String) {
