@@ -8,6 +8,7 @@ use std::ops::ControlFlow::{self, Break, Continue};
 
 use super::charts::{
     chart_sigma, first_step_bound, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR,
+    SWITCH_TO_PARTITION,
 };
 use super::crossing::{
     cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
@@ -83,6 +84,8 @@ pub struct Run<'a, 's, 'e> {
     keep_dense: bool,
     /// The chart's own measure at the last accepted point, while in the same chart.
     last_own: Option<f64>,
+    /// The driven coordinates' measure at the last accepted points, near their singularity.
+    fold: FoldWatch,
 }
 
 impl<'a, 's, 'e> Run<'a, 's, 'e> {
@@ -134,6 +137,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             watch: Watch::new(observe.events, m),
             keep_dense,
             last_own: None,
+            fold: FoldWatch::default(),
         };
         // The start counts in the least measures, so that a run of no step reports its start's.
         let first = measure(&mut run.ode);
@@ -193,6 +197,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         self.approach.keep(&self.ode, t, &meas);
         self.passive(t, &meas)?;
         self.progress_rate()?;
+        self.fold(t, &meas)?;
         self.chart(t, &meas)?;
         self.aim(t, &meas);
         self.report(t, progress)
@@ -381,6 +386,23 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         }
         let last = t - self.stepper.t_prev();
         Break(Stop::Hopeless { t, attempts, mean, last, floor, t_end, max_steps })
+    }
+
+    /// Stop a prescribed motion that runs into a fold of its driven coordinates, where their
+    /// measure falls like sqrt(t* - t) and the steps shrink towards t* without passing it
+    /// ([`FoldWatch`]). Measured only where the user's type II measure is below
+    /// [`SWITCH_TO_PARTITION`]: the driven coordinates are some of the user's, so their measure
+    /// is small only near a singularity of the user's chart.
+    fn fold(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
+        let ode = &self.ode;
+        let driven = match &ode.motion {
+            Some(p) if meas.sigma < SWITCH_TO_PARTITION => prescribed_sigma_min(ode.mech, &p.p, ode.anchor_x()),
+            _ => f64::INFINITY,
+        };
+        match self.fold.zeno(t, driven, t - self.stepper.t_prev()) {
+            Some(t_star) => Break(Stop::Fold { t, t_star, driven }),
+            None => Continue(()),
+        }
     }
 
     /// Change the chart if the measures ask for it, and bound the next step's Newton moves by
@@ -638,6 +660,57 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
         });
         traj
+    }
+}
+
+/// Accepted points in the fold's fit: two secants of [`FOLD_SPAN`] steps each.
+const FOLD_SPAN: usize = 4;
+
+/// The fold's prediction may move by this fraction of the time the run advanced. Near a fold
+/// the measure's square is k (t* - t), and t* stays put (the repro of tests/test_prescribed_fold.py:
+/// |dt*/dt| < 0.04 over its last 2 ms). A motion that passes close to it and turns back has
+/// sigma^2 ~ k (d + c (t - t_m)^2), whose secants predict a t* that moves at least half as fast
+/// as t (measured: 0.53 ... 0.85 at d = 1e-4 and 1e-6 s before its minimum, more after).
+const FOLD_DRIFT: f64 = 0.25;
+
+/// A step shorter than this fraction of the predicted time left to the fold no longer
+/// advances towards it: the steps close in geometrically while the integrator resolves the
+/// approach (about 0.2 of the time left each step, in the repro), and stall at the
+/// tolerance's resolution of the fold (4e-4 there, 2e-13 s steps 5e-10 s before t*, for
+/// thousands of steps).
+const FOLD_ADVANCE: f64 = 0.01;
+
+/// The driven coordinates' measure (their scaled smallest singular value, `sigma`) at the
+/// last accepted points, while it is below [`NEAR_PASSIVE_SINGULAR`], the threshold of their
+/// diagnosis. Near a fold of the driven coordinates sigma^2 falls linearly in t to 0 at t*.
+#[derive(Default)]
+struct FoldWatch {
+    /// (t, sigma^2), the oldest first; at most 2 FOLD_SPAN + 1.
+    points: std::collections::VecDeque<(f64, f64)>,
+}
+
+impl FoldWatch {
+    /// Keep the point accepted at t (measure `sigma`, after a step of h); the fold's time when
+    /// the run steps towards it without reaching it: two successive secants of sigma^2 over
+    /// t both fall and predict the same t* (within [`FOLD_DRIFT`] of the time between them),
+    /// and the step h is below [`FOLD_ADVANCE`] of the time left to it.
+    fn zeno(&mut self, t: f64, sigma: f64, h: f64) -> Option<f64> {
+        if sigma >= NEAR_PASSIVE_SINGULAR {
+            self.points.clear();
+            return None;
+        }
+        if self.points.len() > 2 * FOLD_SPAN {
+            self.points.pop_front();
+        }
+        self.points.push_back((t, sigma * sigma));
+        if self.points.len() <= 2 * FOLD_SPAN {
+            return None;
+        }
+        let root = |(t0, s0): (f64, f64), (t1, s1): (f64, f64)| (s1 < s0).then(|| t1 + s1 * (t1 - t0) / (s0 - s1));
+        let (first, mid, last) = (self.points[0], self.points[FOLD_SPAN], self.points[2 * FOLD_SPAN]);
+        let (before, now) = (root(first, mid)?, root(mid, last)?);
+        let fixed = (now - before).abs() < FOLD_DRIFT * (last.0 - mid.0);
+        (fixed && h < FOLD_ADVANCE * (now - t)).then_some(now)
     }
 }
 

@@ -39,6 +39,9 @@ pub enum Stop {
     /// The run cannot reach t_end at its rate of progress (see `Run::progress_rate`): at t,
     /// after `attempts` steps of mean `mean` (last `last`), below `floor`.
     Hopeless { t: f64, attempts: usize, mean: f64, last: f64, floor: f64, t_end: f64, max_steps: usize },
+    /// The prescribed motion runs into a fold of its driven coordinates: at t their measure is
+    /// `driven`, and its square, linear in t, reaches 0 at `t_star` (see `run::FoldWatch`).
+    Fold { t: f64, t_star: f64, driven: f64 },
     /// Changing the chart at t failed.
     ChartChange { t: f64, error: String },
     /// The progress callback asked to stop at t.
@@ -62,6 +65,7 @@ impl Stop {
                 | Stop::DenseOutput { .. }
                 | Stop::EventInStep { .. }
                 | Stop::Hopeless { .. }
+                | Stop::Fold { .. }
                 | Stop::Cancelled { .. }
         )
     }
@@ -69,12 +73,29 @@ impl Stop {
     /// The trajectory's status and message. A failure that usually means a change point (steps
     /// that shrink to nothing, a position that does not assemble) asks `near` for the measures
     /// at the last accepted point and says when one of them is near-singular.
+    /// A run that ran out of steps or progress (`stalled`) gets the driven coordinates'
+    /// diagnosis only: its passive measure does not explain small steps.
     pub fn describe(self, near: impl FnOnce() -> Near) -> (Status, String) {
+        let stalled = self.stalled_at();
         let (status, message) = self.status_message();
-        if !matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite) {
+        let failed = matches!(status, Status::StepSizeUnderflow | Status::AssemblyFailed | Status::NonFinite);
+        if !failed && stalled.is_none() {
             return (status, message);
         }
         let Near { passive, driven } = near();
+        if let Some(t) = stalled {
+            if driven >= NEAR_PASSIVE_SINGULAR {
+                return (status, message);
+            }
+            let message = format!(
+                "{message}. The prescribed motion runs into a singularity of its driven coordinates at t = {} s \
+                 (scaled measure {driven:.2e}): there they stop determining the mechanism, its steps shrink \
+                 towards that time, and past it the mechanism may not assemble at the prescribed coordinates. \
+                 {CHANGE_THE_MOTION}",
+                Time(t)
+            );
+            return (status, message);
+        }
         if passive < NEAR_PASSIVE_SINGULAR {
             let message = format!(
                 "{message}; the passive mechanism is near-singular there (scaled measure {passive:.2e}): \
@@ -90,6 +111,14 @@ impl Stop {
             (status, message)
         } else {
             (status, message)
+        }
+    }
+
+    /// Where a run stopped that ran out of steps or of progress.
+    fn stalled_at(&self) -> Option<f64> {
+        match self {
+            Stop::Step { error: StepError::TooManySteps { t, .. }, .. } | Stop::Hopeless { t, .. } => Some(*t),
+            _ => None,
         }
     }
 
@@ -147,6 +176,18 @@ impl Stop {
                     Time(t_end)
                 ),
             ),
+            Stop::Fold { t, t_star, driven } => (
+                Status::StepSizeTooSmall,
+                format!(
+                    "step size too small at t = {} s: the coordinates driven by motion are near a singularity of \
+                     their own (scaled measure {driven:.2e}), a fold that the prescribed motion runs into at \
+                     t ≈ {} s. Their measure falls like the square root of the time left to it, the steps shrink \
+                     towards that time without passing it, and past it the mechanism does not assemble at the \
+                     prescribed coordinates. {CHANGE_THE_MOTION}",
+                    Time(t),
+                    Time(t_star)
+                ),
+            ),
             Stop::ChartChange { t, error } => {
                 (Status::AssemblyFailed, format!("changing coordinates at t = {} s: {error}", Time(t)))
             }
@@ -160,6 +201,10 @@ impl Stop {
 /// A run whose mean step so far would need this many times its step budget to reach t_end
 /// is stopped: it cannot finish, and waiting for the budget costs this many times more work.
 pub const PROGRESS_MARGIN: f64 = 10.0;
+
+/// What a prescribed motion that runs into its driven coordinates' singularity should change.
+const CHANGE_THE_MOTION: &str =
+    "Change the motion so that it avoids this configuration, or end the run before it (t_end)";
 
 /// Status and message for a failed step.
 fn step_failure(e: &StepError<Error>) -> (Status, String) {

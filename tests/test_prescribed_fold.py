@@ -1,0 +1,85 @@
+"""A fully prescribed motion that runs into a fold of its driven coordinates.
+
+Every crank of a 3-RRR (s15-sweep's case: library.three_rrr, pose and modes below) is driven by
+q0 + a sin(w t). The driven coordinates' measure (the platform's type II one) falls like
+sqrt(T_FOLD - t): the measure's square extrapolated linearly in t over main's accepted steps
+gives T_FOLD to 1e-9 s, and past it the mechanism does not assemble at the prescribed
+coordinates (s17-fivebar, diag2.py). The run cannot reach t_end; what is checked is how it
+stops and what it says.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from planardyn import library
+
+POSE = (0.045493311996761016, -0.010013650569952362, 0.14315413293871293)
+MODES = (1, -1, -1)
+AMPLITUDE = np.array([0.10060306745483943, 0.10650916317844883, 0.10119159596920518])  # rad
+OMEGA = np.array([7.860931860681065, 6.074515709845619, 5.84141748947288])  # rad/s
+T_FOLD = 0.1107510025  # s
+CHANGE = "Change the motion so that it avoids this configuration, or end the run before it (t_end)"
+
+
+def cranks(t: float, q0):
+    """The cranks' motion: position, speed, acceleration."""
+    s, c = np.sin(OMEGA * t), np.cos(OMEGA * t)
+    return q0 + AMPLITUDE * s, AMPLITUDE * OMEGA * c, -AMPLITUDE * OMEGA**2 * s
+
+
+def run(law, t_end: float, **options):
+    """The 3-RRR with every crank driven by law(t, q0) = (q, qd, qdd), DOP853 at rtol 1e-9."""
+    mech = library.three_rrr(pose=POSE, modes=MODES)
+    q0 = mech.q0.copy()
+    motion = {
+        name: (lambda t, k=k: tuple(float(v[k]) for v in law(t, q0))) for k, name in enumerate(mech.coordinate_names)
+    }
+    return mech.simulate(t_end=t_end, motion=motion, rtol=1e-9, atol=1e-12, **options), q0
+
+
+def fold_run(max_steps: int):
+    return run(cranks, 0.5, output_dt=0.01, max_steps=max_steps)[0]
+
+
+def test_running_out_of_steps_at_the_fold_names_the_driven_singularity():
+    # 150 attempts take the run to 8e-8 s before the fold (type II measure 3e-5, below the
+    # diagnosis' 1e-3); on main the message only said to raise max_steps.
+    res = fold_run(150)
+    assert res.status == "too_many_steps"
+    assert abs(res.t[-1] - T_FOLD) < 1e-6, res.t[-1]
+    assert "runs into a singularity of its driven coordinates at t = 0.1107" in res.message, res.message
+    assert CHANGE in res.message, res.message
+
+
+def test_a_motion_into_the_fold_stops_there_and_predicts_it():
+    # On main the run took the 20 000 steps of s15's repro to get 5e-10 s closer (max_steps
+    # 1e7 by default: minutes); here it stops once its steps no longer advance towards the
+    # predicted fold, at 213 attempts (109 accepted), 6e-10 s before T_FOLD.
+    res = fold_run(10_000_000)
+    assert res.status == "step_size_too_small"
+    steps = res.stats["naccept"] + res.stats["nreject"]
+    assert steps < 500, res.stats
+    assert abs(res.t[-1] - T_FOLD) < 1e-6, res.t[-1]
+    assert "near a singularity of their own" in res.message, res.message
+    assert "a fold that the prescribed motion runs into at t ≈ 0.1107510" in res.message, res.message
+    assert CHANGE in res.message, res.message
+
+
+@pytest.mark.parametrize("delta", [1e-4, 1e-6])
+def test_a_motion_that_turns_back_before_the_fold_completes(delta):
+    # The cranks' law at u(t) = (T_FOLD - delta) sin(pi t / 0.4): up to delta s of the fold and
+    # back (driven measure down to 1.1e-3 and 1.1e-4). The fold's prediction moves on with t
+    # here, so the run completes; its results are main's bit for bit (s17-fold-bitcheck.py).
+    umax, w = T_FOLD - delta, np.pi / 0.4
+
+    def passing(t, q0):
+        u, ud, udd = umax * np.sin(w * t), umax * w * np.cos(w * t), -umax * w * w * np.sin(w * t)
+        q, qd, qdd = cranks(u, q0)
+        return q, qd * ud, qdd * ud * ud + qd * udd
+
+    res, q0 = run(passing, 0.4, output_dt=0.01)
+    assert res.status == "success", res.message
+    follows = np.max(np.abs(res.q - np.array([passing(t, q0)[0] for t in res.t])))
+    # Measured 6.8e-12 and 1.2e-11 rad (the partition chart's position solve).
+    assert follows < 1e-10, follows
