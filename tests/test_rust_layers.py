@@ -60,6 +60,21 @@ def test_downward_references_comments_and_unit_tests_are_not_violations(tmp_path
     assert run(tmp_path, files) == ([], [])
 
 
+def test_a_unit_test_module_shared_with_other_tests_is_still_a_test(tmp_path: Path) -> None:
+    # `pub(crate) mod tests` shares a fixture with another module's tests (s17: A02's folded
+    # pose); its loader use is a test's. The same text outside a test module is an upward edge.
+    shared = """\
+        pub struct Mechanism;
+        #[cfg(test)]
+        pub(crate) mod tests {
+            use crate::loader::load;
+        }
+        """
+    assert run(tmp_path, {"kinematics.rs": "", "model.rs": shared}) == ([], [])
+    upward = "pub struct Mechanism;\nuse crate::loader::load;\n"
+    assert run(tmp_path / "b", {"kinematics.rs": "", "model.rs": upward})[0]
+
+
 def test_a_path_through_a_reexport_lands_in_the_file_that_defines_it(tmp_path: Path) -> None:
     # `crate::Workspace` is lib.rs's re-export of kinematics/ws.rs: the model may not use it.
     files = {

@@ -29,7 +29,8 @@ need). An edge goes from a file to the file that defines what a path names:
   module taking the object);
 - references to an ancestor module's own file are left out (a child uses its parent's
   types; the parent declares its children), as are comments and a unit-test module
-  ``#[cfg(test)] mod tests`` at the end of a file (tests may reach anything).
+  ``#[cfg(test)] mod tests`` at the end of a file, of any visibility (``pub(crate) mod tests``
+  shares fixtures with other modules' tests; tests may reach anything).
 
 Usage: ``python tools/rust_layers.py [CONFIG]`` (default ``crates/layers.toml``); prints each
 finding and a summary line per crate.
@@ -51,7 +52,7 @@ ROOT = Path(__file__).resolve().parents[1]
 Module = tuple[str, ...]
 
 _COMMENT = re.compile(r"//[^\n]*|/\*.*?\*/", re.S)
-_TESTS = re.compile(r"#\[cfg\(test\)\]\s*mod\s+tests\s*\{.*", re.S)
+_TESTS = re.compile(r"#\[cfg\(test\)\]\s*(?:pub(?:\([^)]*\))?\s+)?mod\s+tests\s*\{.*", re.S)
 _USE = re.compile(r"^[ \t]*(pub(?:\([^)]*\))?\s+)?use\s+([^;]*);", re.S | re.M)
 _PATH = re.compile(r"(?<![\w:$])((?:crate|super|self)(?:\s*::\s*\w+)+)")
 _IMPL = re.compile(r"^[ \t]*impl\b\s*(?:<[^{>]*>)?\s*([\w:]+)[^{;]*\{", re.M)
