@@ -55,6 +55,26 @@ def test_a_run_is_in_the_page_in_the_replay_format(tmp_path):
     assert len(run["P"]) == 5 and {c["key"] for c in run["channels"]} >= {"kinetic", "potential"}
 
 
+def test_a_passive_run_opens_on_its_energies_not_its_zero_efforts(five_bar):
+    # The four-bar under gravity has no drive: its effort channel is all zero, so its run is
+    # charted first by its coordinate and energies; a driven run by its coordinates and efforts.
+    mech = pdy.load(pdy.models.path("four-bar-gravity"))
+    res = mech.simulate(t_end=0.2, output_dt=0.05)
+    assert not np.any(res.tau)
+    on = [c["key"] for c in run_data(mech, res)["channels"] if c["on"]]
+    assert on == ["theta1", "kinetic", "potential", "total"]
+    driven, res = five_bar
+    on = [c["key"] for c in run_data(driven, res)["channels"] if c["on"]]
+    assert on == ["theta1", "theta2", "tau_theta1", "tau_theta2"]
+
+
+def test_the_page_holds_the_shipped_models_to_start_from(tmp_path):
+    out = write_app(tmp_path / "a.html", pdy.models.path("five-bar"))
+    shipped = page_data(out.read_text())["shipped"]
+    assert set(shipped) == {n for n in pdy.models.names() if "/" not in n} >= {"3-rrr", "four-bar-gravity"}
+    assert shipped["3-rrr"] == pdy.models.path("3-rrr").read_text()
+
+
 def test_the_command_writes_the_page_and_refuses_other_outputs(tmp_path, capsys):
     assert main(["app", "slider-crank", "-o", str(tmp_path / "a.html")]) == 0
     assert page_data((tmp_path / "a.html").read_text())["model"]["source"] == "slider-crank.yaml"

@@ -11,8 +11,10 @@ must be built (./dev setup builds it): a missing page fails.
 
 from __future__ import annotations
 
+import csv
 import json
 import shutil
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -206,6 +208,108 @@ def test_simulate_button_plays_and_charts(page):
     assert units and all(units)
     page.screenshot(path=str(ARTEFACTS / "app-five-bar.png"))
     assert (ARTEFACTS / "app-five-bar.png").stat().st_size > 10_000
+
+
+#: The charts' y axes, read from uPlot: per chart its unit, the scale's least value, the ticks'
+#: values (`_splits`, uPlot's own) and the plot's height (CSS px).
+CHART_AXES = """() => window.planardyn.charts.plots.map((p) => ({unit: p.root.dataset.unit, min: p.scales.y.min,
+    ticks: p.axes[1]._splits, labels: p.axes[1]._values, height: p.bbox.height / devicePixelRatio}))"""
+#: At least this many ticks on every y axis (the old layout left 55 px plots with one tick, 0).
+MIN_TICKS = 3
+
+
+def check_nice_ticks(axes) -> None:
+    """Every chart's y ticks: at least MIN_TICKS, evenly spaced by 1, 2, 2.5 or 5 times a power
+    of ten, each a whole multiple of that step (ticks at 2.15, 1.84 are not), labelled in short."""
+    for ax in axes:
+        ticks = np.asarray(ax["ticks"], dtype=float)
+        assert len(ticks) >= MIN_TICKS, ax
+        steps = np.diff(ticks)
+        step = steps[0]
+        np.testing.assert_allclose(steps, step, rtol=1e-9)
+        mantissa = step / 10 ** np.floor(np.log10(step))
+        assert min(abs(mantissa - m) for m in (1, 2, 2.5, 5, 10)) < 1e-9, ax
+        np.testing.assert_allclose(ticks / step, np.round(ticks / step), rtol=0, atol=1e-6)
+        assert all(len(label) <= 6 for label in ax["labels"]), ax
+
+
+def test_a_passive_run_is_charted_with_nice_ticks_on_its_energies(page):
+    # The four-bar under gravity, started from the shipped models' menu: at rest its holding
+    # torque is charted (gravity makes it non-zero), but its run has no drive, so the run opens on
+    # its coordinate and energies, not on the all-zero torque the sweep's choice named. Every
+    # chart's ticks are nice numbers, and the |F| axes do not go below zero.
+    page.select_option("#shipped", "four-bar-gravity")
+    name = pdy.load(pdy.models.path("four-bar-gravity")).name
+    assert page.text_content("#status").startswith(f"{name}: 1 coordinate, 3 bodies;")
+    assert page.evaluate("[...window.planardyn.charts.on]") == ["theta1", "tau_theta1"]
+    check_nice_ticks(page.evaluate(CHART_AXES))
+    page.fill("#t-end", "2")
+    page.click("#simulate")
+    assert page.evaluate("window.planardyn.mode") == "run"
+    assert sorted(page.evaluate("[...window.planardyn.charts.on]")) == ["kinetic", "potential", "theta1", "total"]
+    check_nice_ticks(page.evaluate(CHART_AXES))
+    page.click("summary:has-text('pair reactions')")
+    page.check("#channels input[data-key='F_ground_rocker']")
+    axes = page.evaluate(CHART_AXES)
+    check_nice_ticks(axes)
+    force = next(ax for ax in axes if ax["unit"] == "N")
+    assert force["min"] >= 0
+    # The user's choice is kept for the next run.
+    page.click("#simulate")
+    assert "F_ground_rocker" in page.evaluate("[...window.planardyn.charts.on]")
+
+
+def test_a_shipped_model_is_chosen_in_the_page(page):
+    # The 3-RRR from the menu: the page's state is the Python API's at q0 (1e-9); at rest
+    # without gravity its efforts and potential are all zero, so its singularity measure is
+    # charted beside its coordinates.
+    mech = pdy.load(pdy.models.path("3-rrr"))
+    page.select_option("#shipped", "3-rrr")
+    got = page.evaluate("({q: Array.from(window.planardyn.q), names: window.planardyn.info.points,"
+                        " points: Array.from(window.planardyn.ev.points), source: window.planardyn.source})")
+    assert got["source"] == "3-rrr.yaml"
+    np.testing.assert_allclose(got["q"], mech.q0, rtol=0, atol=1e-12)
+    carried = [mech.point_names.index(n) for n in got["names"]]
+    np.testing.assert_allclose(np.reshape(got["points"], (-1, 2)), mech.kinematics(mech.q0)["points"][carried],
+                               rtol=STATE_RTOL, atol=STATE_RTOL * mech.scale)
+    assert page.evaluate("[...window.planardyn.charts.on]") == ["th1", "th2", "th3", "sigma"]
+    check_nice_ticks(page.evaluate(CHART_AXES))
+    assert page.text_content("#status").startswith(f"{mech.name}: 3 coordinates, ")
+
+
+def download(page, button: str) -> tuple[str, bytes]:
+    """Click an export button; the file's suggested name and its bytes."""
+    with page.expect_download() as d:
+        page.click(button)
+    return d.value.suggested_filename, Path(d.value.path()).read_bytes()
+
+
+def test_exports_are_the_model_the_run_and_the_drawing(page):
+    # After a 0.5 s run of the five-bar: the model file is the editor's text (it loads as the
+    # same mechanism), the CSV holds the run's times and every channel with its unit (the
+    # coordinates are the page's run's, 17 significant digits written), the PNG and SVG are
+    # the drawing at the canvas's size.
+    page.fill("#t-end", "0.5")
+    page.click("#simulate")
+    page.click("#play")  # paused: the frame no longer moves
+    name, model = download(page, "#export-model")
+    assert name.endswith(".yaml")
+    assert pdy.loads(model.decode()) == five_bar()
+    name, table_text = download(page, "#export-csv")
+    rows = table_text.decode().splitlines()
+    head = next(csv.reader([rows[0]]))
+    assert head[0] == "t (s)" and "theta1 (rad)" in head and "tau_theta2 (N m)" in head and "|F| effector (N)" in head
+    table = np.array([[float(v) if v else np.nan for v in r.split(",")] for r in rows[1:]])
+    run = page.evaluate("({t: Array.from(window.planardyn.run.t), q: Array.from(window.planardyn.run.q)})")
+    np.testing.assert_array_equal(table[:, 0], run["t"])
+    np.testing.assert_array_equal(table[:, head.index("theta2 (rad)")], np.reshape(run["q"], (-1, 2))[:, 1])
+    name, png = download(page, "#export-png")
+    assert name.endswith(".png") and png[:8] == b"\x89PNG\r\n\x1a\n"
+    size = page.evaluate("(() => { const c = document.getElementById('drawing'); return [c.width, c.height]; })()")
+    assert [int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")] == size
+    name, svg = download(page, "#export-svg")
+    root = ET.fromstring(svg)
+    assert root.tag.endswith("svg") and len(root.findall("{http://www.w3.org/2000/svg}circle")) >= 5
 
 
 # ------------------------------------------------------------------ the app in a notebook

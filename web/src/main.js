@@ -22,7 +22,7 @@ import { backToDesign, showReplay, simulate } from "./run.js";
 import { installEditor, setModel } from "./model.js";
 import { startMap } from "./map_tab.js";
 import { listModes, showMode } from "./modes.js";
-import { installFiles } from "./files.js";
+import { installFiles, installShipped } from "./files.js";
 
 window.planardyn = app;
 
@@ -53,7 +53,8 @@ function start() {
   const data = JSON.parse($("planardyn-data").textContent);
   if (data.model) setModel(data.model.text, data.model.format, data.model.source);
   if (data.run) showReplay(data.run);
-  if (!data.model && !data.run) status("open or drop a model file (.yaml, .json)");
+  if (data.shipped) installShipped(data.shipped);
+  if (!data.model && !data.run) status(`open or drop a model file (.yaml, .json)${data.shipped ? ", or choose a shipped model" : ""}`);
   app.timings.readyMs = performance.now();
   document.body.dataset.ready = "1";
 }

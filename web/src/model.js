@@ -39,10 +39,13 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
   setMode("design");
   startMap();
   warmEngine();
-  status(`${app.info.name}: ${app.info.dof} coordinates, ${app.info.bodyNames.length} bodies; drag a point or a slider` +
+  status(`${app.info.name}: ${count(app.info.dof, "coordinate")}, ${count(app.info.bodyNames.length, "body", "bodies")}; drag a point or a slider` +
     (app.info.warnings.length ? ` — ${app.info.warnings.join("; ")}` : ""));
   return true;
 }
+
+/** "1 coordinate", "3 coordinates". */
+const count = (n, one, many = `${one}s`) => `${n} ${n === 1 ? one : many}`;
 
 /** The loader's error under the editor, with its line selected on a click. */
 function showModelError(err, text) {
