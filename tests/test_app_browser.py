@@ -248,6 +248,8 @@ def test_a_passive_run_is_charted_with_nice_ticks_on_its_energies(page):
     assert page.evaluate("window.planardyn.mode") == "run"
     assert sorted(page.evaluate("[...window.planardyn.charts.on]")) == ["kinetic", "potential", "theta1", "total"]
     check_nice_ticks(page.evaluate(CHART_AXES))
+    # The two charts fill the charts' area at 1400 x 900 px, their legends in view.
+    assert page.evaluate("(() => { const c = document.getElementById('charts'); return c.scrollHeight <= c.clientHeight; })()")
     page.click("summary:has-text('pair reactions')")
     page.check("#channels input[data-key='F_ground_rocker']")
     axes = page.evaluate(CHART_AXES)
@@ -310,6 +312,14 @@ def test_exports_are_the_model_the_run_and_the_drawing(page):
     name, svg = download(page, "#export-svg")
     root = ET.fromstring(svg)
     assert root.tag.endswith("svg") and len(root.findall("{http://www.w3.org/2000/svg}circle")) >= 5
+    # The drawing's scale bar: a nice length (1, 2 or 5 times a power of ten) with its unit.
+    texts = [t.text for t in root.iter("{http://www.w3.org/2000/svg}text")]
+    assert texts == ["0.2 m"]
+    # Scrubbing shows the frame chosen: the values table is the run's state at its time.
+    page.fill("#scrub", "40")
+    assert page.evaluate("window.planardyn.frame") == 40
+    t40 = page.evaluate("window.planardyn.run.t[40]")
+    assert page.text_content("#values th") == f"t = {t40:.4g} s"
 
 
 # ------------------------------------------------------------------ the app in a notebook

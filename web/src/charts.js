@@ -6,11 +6,11 @@ import { GROUPS } from "./channels.js";
 
 const COLORS = ["#1f6fb2", "#d9730d", "#2e8540", "#8e44ad", "#b3261e", "#0f7c80", "#7a5c00", "#c2185b"];
 /** Height of one chart (px, its plot and x axis): the charts share the area, scrolling below
- * MIN_HEIGHT, whose plot (less the axis) still holds four ticks at Y_TICK_SPACE apart. */
-const MIN_HEIGHT = 150;
+ * MIN_HEIGHT, whose plot (100 px, less the axis) still holds four ticks Y_TICK_SPACE apart. */
+const MIN_HEIGHT = 130;
 const MAX_HEIGHT = 320;
-/** The legend's line under each chart (px). */
-const LEGEND_HEIGHT = 22;
+/** The legend's line under each chart (px, as chromium lays it out, with its 2 px margin). */
+const LEGEND_HEIGHT = 27;
 /** The x axis's tick labels (px), and its label's line under the last chart. */
 const X_AXIS_SIZE = 30;
 const X_LABEL_SIZE = 20;
