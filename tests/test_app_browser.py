@@ -617,6 +617,19 @@ def test_loaded_stiffness_equals_the_python_api(page):
     page.wait_for_function(MAP_DONE, arg="the weakest stiffness of P (N/m, loaded)", timeout=120_000)
 
 
+def test_the_map_tab_maps_a_3rrr_over_two_inputs(page):
+    # The 3-RRR chosen in the page, its Map tab open: the type II map over th1 x th2, th3 held
+    # at q0's, drawn to 100 x 100; its cells are the map tools' (checked against Python below).
+    mech = pdy.load(pdy.models.path("3-rrr"))
+    page.select_option("#shipped", "3-rrr")
+    page.click("nav button[data-tab='map']")
+    page.wait_for_function(MAP_DONE, arg="σ (type II)", timeout=120_000)
+    assert f"th3 = {mech.q0[2]:.4g} held" in page.text_content("#map-note")
+    sigma = np.array(page.evaluate("Array.from(window.planardyn.mapGrid.sigma, (v) => (Number.isFinite(v) ? v : null))"),
+                     dtype=float)
+    assert sigma.size == 100 * 100 and 0 < np.isfinite(sigma).sum() < sigma.size
+
+
 def test_a_triads_map_is_on_the_current_branch(page):
     # The 3-RRR (a triad solved by Newton) over th1, th2, th3 held: each present cell of a 12 x 12
     # map made in the page is the configuration the Python API assembles from the drawing along
