@@ -241,6 +241,10 @@ def test_a_passive_run_is_charted_with_nice_ticks_on_its_energies(page):
     page.select_option("#shipped", "four-bar-gravity")
     name = pdy.load(pdy.models.path("four-bar-gravity")).name
     assert page.text_content("#status").startswith(f"{name}: 1 coordinate, 3 bodies;")
+    # Its Map tab says why it has no map, with no empty frame for one.
+    page.click("nav button[data-tab='map']")
+    assert page.text_content("#map-note") == "The maps are over two coordinates: this model has one."
+    assert not page.is_visible("#map")
     assert page.evaluate("[...window.planardyn.charts.on]") == ["theta1", "tau_theta1"]
     check_nice_ticks(page.evaluate(CHART_AXES))
     page.fill("#t-end", "2")

@@ -80,7 +80,9 @@ export function startMap() {
   const stiffness = app.info && app.info.compliant && $("map-kind").value === "stiffness";
   $("map-point").hidden = !stiffness;
   $("map-load").hidden = !stiffness;
-  if (!app.info || app.info.dof < 2) {
+  // No empty frame where there is no map (a model of one coordinate).
+  $("map").hidden = !app.info || app.info.dof < 2;
+  if ($("map").hidden) {
     note.textContent = "The maps are over two coordinates: this model has one.";
     return;
   }
