@@ -628,7 +628,11 @@ def test_the_map_tab_maps_a_3rrr_over_two_inputs(page):
     page.select_option("#shipped", "3-rrr")
     page.click("nav button[data-tab='map']")
     page.wait_for_function(MAP_DONE, arg="σ (type II)", timeout=120_000)
-    assert f"th3 = {mech.q0[2]:.4g} held" in page.text_content("#map-note")
+    note = page.text_content("#map-note")
+    assert f"th3 = {mech.q0[2]:.4g} held" in note
+    # Its axes: th1 across and th2 up, each over q0's +-pi rad.
+    lo, hi = mech.q0[:2] - np.pi, mech.q0[:2] + np.pi
+    assert f"th1 across from {lo[0]:.4g} to {hi[0]:.4g} rad, th2 up from {lo[1]:.4g} to {hi[1]:.4g} rad" in note
     sigma = np.array(page.evaluate("Array.from(window.planardyn.mapGrid.sigma, (v) => (Number.isFinite(v) ? v : null))"),
                      dtype=float)
     assert sigma.size == 100 * 100 and 0 < np.isfinite(sigma).sum() < sigma.size

@@ -1,6 +1,7 @@
 // The side panel's map tab (the maps themselves: map.js): the singularity map, or for a
 // compliant model the first natural frequency's or a chosen point's weakest stiffness.
 import { $, app, fmt } from "./state.js";
+import { unitOf } from "./channels.js";
 import { LEVELS, frequencyRows, mapRanges, mapper, paintMap, sigmaRows, sigmaScale, spanScale, stiffnessRows } from "./map.js";
 
 /** The maps: each its rows, its colour scale and legend; all on the same grids (`LEVELS`). */
@@ -99,6 +100,8 @@ export function startMap() {
   const names = app.info.coordinateNames;
   // The coordinates past the first two are held where they are (a 3-RRR's third input).
   const held = names.slice(2).map((n, k) => `${n} = ${fmt(q[k + 2])}`).join(", ");
+  const axis = (k, way) => `${names[k]} ${way} from ${fmt(ranges[k][0])} to ${fmt(ranges[k][1])} ${unitOf(app.info, k, "q")}`;
+  const axes = `${axis(0, "across")}, ${axis(1, "up")}`;
   const work = () => {
     let done;
     try {
@@ -111,7 +114,7 @@ export function startMap() {
     if (done && level + 1 < LEVELS.length) grid = mapper(rows, ranges, LEVELS[++level], x0, q, grid);
     else if (done) {
       note.textContent = `${kind.what()} over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms` +
-        ` (${held ? `${held} held; ` : ""}${kind.legend(grid)}; grey: does not assemble on this branch)`;
+        ` (${axes}${held ? `; ${held} held` : ""}; ${kind.legend(grid)}; grey: does not assemble on this branch)`;
       app.mapGrid = grid;
       return;
     }
