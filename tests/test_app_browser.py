@@ -166,6 +166,29 @@ def test_an_edit_that_breaks_the_model_shows_the_located_error(page):
     page.wait_for_selector("#model-error[hidden]", state="attached", timeout=5_000)
 
 
+def test_an_edit_of_a_mass_is_recomputed_as_typed(page):
+    # The first body's mass doubled in the editor: once rebuilt (the pose kept), the holding
+    # torques and reactions shown are the Python API's for the edited text at that pose (1e-9).
+    page.click("nav button[data-tab='model']")
+    text = page.input_value("#editor")
+    mass = next(line for line in text.splitlines() if line.strip().startswith("mass:"))
+    value = float(mass.split(":")[1].split("#")[0])
+    edited = text.replace(mass, mass.replace(mass.split(":")[1].split("#")[0].strip(), repr(2 * value), 1), 1)
+    before = page.evaluate("Array.from(window.planardyn.ev.tau)")
+    page.fill("#editor", edited)
+    page.wait_for_function("(t) => window.planardyn.text === t", arg=edited, timeout=5_000)
+    mech = pdy.loads(edited)
+    got = page.evaluate("({q: Array.from(window.planardyn.q), tau: Array.from(window.planardyn.ev.tau),"
+                        " reactions: Array.from(window.planardyn.ev.reactions)})")
+    zero = np.zeros(mech.dof)
+    tau = mech.inverse_dynamics(got["q"], zero, zero)
+    np.testing.assert_allclose(got["tau"], tau, rtol=STATE_RTOL, atol=STATE_RTOL * np.abs(tau).max())
+    reactions = mech.reactions(got["q"], zero, tau=tau)
+    np.testing.assert_allclose(got["reactions"], np.ravel(reactions), rtol=STATE_RTOL,
+                               atol=STATE_RTOL * np.abs(reactions).max())
+    assert np.max(np.abs(np.subtract(got["tau"], before))) > 1e-3
+
+
 def test_a_run_in_the_page_agrees_with_python(page):
     mech = five_bar()
     res = mech.simulate(t_end=1.0, output_dt=0.01)
