@@ -203,6 +203,25 @@ def test_a_run_in_the_page_agrees_with_python(page):
     np.testing.assert_allclose(np.reshape(got["q"], res.q.shape), res.q, atol=RUN_ATOL)
 
 
+def test_a_driven_run_from_the_controls_agrees_with_python(page):
+    # theta1 driven at 2 rad/s from the pose shown, for 0.5 s, chosen with the run controls: theta1
+    # is q0 + 2 t (the motion's law), and the run (600 outputs, from rest) is Python's with the
+    # same motion within RUN_ATOL.
+    page.select_option("#run-mode", "0")
+    page.fill("#speed", "2")
+    page.fill("#t-end", "0.5")
+    page.click("#simulate")
+    got = page.evaluate("({t: Array.from(window.planardyn.run.t), q: Array.from(window.planardyn.run.q),"
+                        " status: window.planardyn.run.status})")
+    mech = five_bar()
+    q = np.reshape(got["q"], (-1, 2))
+    res = mech.simulate(t_end=0.5, output_dt=0.5 / 600, q0=q[0], qd0=np.zeros(2), motion={"theta1": 2.0})
+    assert got["status"] == res.status == "success"
+    np.testing.assert_allclose(q[:, 0], q[0, 0] + 2.0 * np.asarray(got["t"]), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got["t"], res.t, atol=1e-12)
+    np.testing.assert_allclose(q, res.q, atol=RUN_ATOL)
+
+
 def test_the_idle_warm_up_leaves_the_page_as_it_was(page):
     """web/src/warm.js runs the model shown in idle time so that V8 optimises the engine before
     a user's first run; it keeps no result: the pose, the mode and the run are as before, and a
