@@ -61,8 +61,9 @@ def test_a_passive_run_opens_on_its_energies_not_its_zero_efforts(five_bar):
     mech = pdy.load(pdy.models.path("four-bar-gravity"))
     res = mech.simulate(t_end=0.2, output_dt=0.05)
     assert not np.any(res.tau)
-    on = [c["key"] for c in run_data(mech, res)["channels"] if c["on"]]
-    assert on == ["theta1", "kinetic", "potential", "total"]
+    data = run_data(mech, res)
+    assert [c["key"] for c in data["channels"] if c["on"]] == ["theta1", "kinetic", "potential", "total"]
+    assert "; 1 coordinate (theta1), 3 bodies;" in data["info"]
     driven, res = five_bar
     on = [c["key"] for c in run_data(driven, res)["channels"] if c["on"]]
     assert on == ["theta1", "theta2", "tau_theta1", "tau_theta2"]

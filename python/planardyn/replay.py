@@ -186,7 +186,8 @@ def run_data(
     st = result.stats
     info = (
         f"{result.status}: {n} outputs, t = {result.t[0]:.4g}..{result.t[-1]:.4g} s; "
-        f"{mech.dof} coordinates ({', '.join(mech.coordinate_names)}), {mech.n_bodies} bodies; "
+        f"{mech.dof} coordinate{'s' if mech.dof != 1 else ''} ({', '.join(mech.coordinate_names)}), "
+        f"{mech.n_bodies} bod{'ies' if mech.n_bodies != 1 else 'y'}; "
         f"energy drift {result.energy.drift:.3g} J; min sigma {st.get('min_sigma', float(np.min(result.sigma))):.3g}"
     )
     t = result.t[keep]
