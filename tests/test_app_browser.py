@@ -325,6 +325,29 @@ def test_a_shipped_model_is_chosen_in_the_page(page):
     assert page.text_content("#status").startswith(f"{mech.name}: 3 coordinates, ")
 
 
+def test_opening_a_model_file_and_a_python_run(page, tmp_path):
+    # Open... with a model file: the page shows that model at its q0 (Python's, 1e-12). Then a
+    # run of it made in Python (planardyn.replay.run_data as JSON): played, its frame 10's
+    # points the run's, rounded to DIGITS significant digits of L (half a unit of the last).
+    from planardyn.replay import DIGITS, run_data
+
+    model = pdy.models.path("four-bar-gravity")
+    mech = pdy.load(model)
+    page.set_input_files("#open", str(model))
+    page.wait_for_function("window.planardyn.source === 'four-bar-gravity.yaml'", timeout=5_000)
+    np.testing.assert_allclose(page.evaluate("Array.from(window.planardyn.q)"), mech.q0, rtol=0, atol=1e-12)
+    res = mech.simulate(t_end=0.5, output_dt=0.05)
+    run = tmp_path / "run.json"
+    run.write_text(json.dumps(run_data(mech, res)))
+    page.set_input_files("#open", str(run))
+    page.wait_for_function("window.planardyn.mode === 'replay'", timeout=5_000)
+    shown = page.evaluate("""() => { const a = window.planardyn; a.setFrame(10);
+        return Array.from(a.replay.data.P[a.frame]); }""")
+    rounding = 0.5 * 10.0 ** (np.floor(np.log10(mech.scale)) - DIGITS + 1)
+    np.testing.assert_allclose(np.reshape(shown, (-1, 2)), mech.point_positions(res.x[10]), rtol=0,
+                               atol=rounding * (1 + 1e-9))
+
+
 def download(page, button: str) -> tuple[str, bytes]:
     """Click an export button; the file's suggested name and its bytes."""
     with page.expect_download() as d:
