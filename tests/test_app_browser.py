@@ -302,9 +302,11 @@ def test_a_passive_run_is_charted_with_nice_ticks_on_its_energies(page):
     check_nice_ticks(axes)
     force = next(ax for ax in axes if ax["unit"] == "N")
     assert force["min"] >= 0
-    # The user's choice is kept for the next run.
+    # The user's choice is kept for the next run, not for another model (the same one opened anew).
     page.click("#simulate")
     assert "F_ground_rocker" in page.evaluate("[...window.planardyn.charts.on]")
+    page.select_option("#shipped", "four-bar-gravity")
+    assert page.evaluate("[...window.planardyn.charts.on]") == ["theta1", "tau_theta1"]
 
 
 def test_a_shipped_model_is_chosen_in_the_page(page):
