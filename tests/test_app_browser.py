@@ -344,10 +344,12 @@ def test_opening_a_model_file_and_a_python_run(page, tmp_path):
     page.set_input_files("#open", str(run))
     page.wait_for_function("window.planardyn.mode === 'replay'", timeout=5_000)
     shown = page.evaluate("""() => { const a = window.planardyn; a.setFrame(10);
-        return Array.from(a.replay.data.P[a.frame]); }""")
+        return {P: Array.from(a.replay.data.P[a.frame]), q: document.getElementById('q-out-0').textContent}; }""")
     rounding = 0.5 * 10.0 ** (np.floor(np.log10(mech.scale)) - DIGITS + 1)
-    np.testing.assert_allclose(np.reshape(shown, (-1, 2)), mech.point_positions(res.x[10]), rtol=0,
+    np.testing.assert_allclose(np.reshape(shown["P"], (-1, 2)), mech.point_positions(res.x[10]), rtol=0,
                                atol=rounding * (1 + 1e-9))
+    # The slider's reading is the frame's theta1 (4 digits shown), not the pose before the run.
+    assert float(shown["q"]) == pytest.approx(res.q[10, 0], rel=1e-3)
 
 
 def download(page, button: str) -> tuple[str, bytes]:

@@ -80,15 +80,24 @@ export function drawingSvg() {
   return pen.svg(w, h);
 }
 
+/** The coordinates shown by the sliders: the state's, or while a Python run plays, its frame's
+ * (its coordinate channels, by the model's coordinate names). */
+function shownQ() {
+  if (app.mode !== "replay") return app.q;
+  const chans = app.replay.chans;
+  return app.info.coordinateNames.map((n, k) => chans.find((c) => c.group === "q" && c.key === n)?.values[app.frame] ?? app.q[k]);
+}
+
 export function showState() {
   redraw();
   renderValues();
   const k = app.active;
   if (app.mode === "design") app.charts.mark(app.q[k]);
   else app.charts.mark(app.mode === "run" ? app.run.t[app.frame] : app.replay.t[app.frame]);
+  const q = shownQ();
   document.querySelectorAll("#sliders input").forEach((s, j) => {
-    s.value = app.q[j];
-    $(`q-out-${j}`).textContent = fmt(app.q[j]);
+    s.value = q[j];
+    $(`q-out-${j}`).textContent = fmt(q[j]);
   });
   document.body.dataset.q = Array.from(app.q ?? []).join(",");
 }
