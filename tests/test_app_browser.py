@@ -416,6 +416,13 @@ for (const html of outputs) {
 </script></body></html>"""
 
 
+#: What an app in a notebook shows: its charts' count and their area's heights (scrolled and
+#: shown), the drawing's height, the page's heights (px).
+FITS = """() => { const c = document.getElementById('charts'), e = document.scrollingElement;
+    return {charts: c.querySelectorAll('.uplot').length, chartsScroll: c.scrollHeight, chartsHeight: c.clientHeight,
+            drawing: document.getElementById('drawing').clientHeight, pageScroll: e.scrollHeight, pageHeight: e.clientHeight}; }"""
+
+
 def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
     # A mechanism and a result displayed in a notebook, as Jupyter renders them: the engine is
     # in the first output only, and both become apps: the mechanism's state is the Python API's
@@ -442,6 +449,13 @@ def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
         f.wait_for_selector("body[data-ready='1']", timeout=20_000)
     by_mode = {f.evaluate("window.planardyn.mode"): f for f in frames}
     assert set(by_mode) == {"design", "replay"}
+    # Each app shows its drawing and its default charts (two units each here) whole, with no
+    # inner scroll (notebook.APP_HEIGHT; at 640 px the second chart scrolled), and its charts'
+    # plots are at least charts.js's MIN_HEIGHT less the x axis, so that they hold four ticks.
+    for mode, f in by_mode.items():
+        fit = f.evaluate(FITS)
+        assert fit["charts"] >= 2 and fit["chartsScroll"] <= fit["chartsHeight"], (mode, fit)
+        assert fit["drawing"] >= 300 and fit["pageScroll"] <= fit["pageHeight"], (mode, fit)
     # The summaries' drawings gave way to the apps; their tables stay.
     assert pg.evaluate("document.querySelectorAll('.planardyn-summary svg').length") == 0
     assert pg.evaluate("document.querySelectorAll('.planardyn-summary table').length") == 2

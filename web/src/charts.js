@@ -16,6 +16,12 @@ const X_AXIS_SIZE = 30;
 const X_LABEL_SIZE = 20;
 /** Least distance between y ticks (px; uPlot's default, 30, left charts of 150 px one tick). */
 const Y_TICK_SPACE = 22;
+/** The charts' area's padding (px, top and bottom: app.css's 4 px each). */
+const AREA_PAD = 8;
+/** Charts the area holds whole at least (a model's default channels span at most two units):
+ * the page gives the area their height and its 1 px top border (app.css's --charts-min) before
+ * the drawing its share. */
+const CHARTS_SHOWN = 2;
 
 /** uPlot's range with a margin, never below zero for a channel that never is (|F|, speeds). */
 function range(u, min, max) {
@@ -37,6 +43,7 @@ export class Charts {
     this.marker = null;
     /** Whether the user has chosen channels (then kept across series). */
     this.chosen = false;
+    document.documentElement.style.setProperty("--charts-min", `${CHARTS_SHOWN * (MIN_HEIGHT + LEGEND_HEIGHT) + X_LABEL_SIZE + AREA_PAD + 1}px`);
   }
 
   /** Show channels `chans` over `x` (label with unit), keeping the channels the user chose
@@ -86,7 +93,7 @@ export class Charts {
     const chosen = this.chans.filter((c) => this.on.has(c.key));
     const units = [...new Set(chosen.map((c) => c.unit))];
     const width = Math.max(200, this.area.clientWidth - 12);
-    const height = Math.min(MAX_HEIGHT, Math.max(MIN_HEIGHT, (this.area.clientHeight - 8 - X_LABEL_SIZE) / Math.max(1, units.length) - LEGEND_HEIGHT));
+    const height = Math.min(MAX_HEIGHT, Math.max(MIN_HEIGHT, (this.area.clientHeight - AREA_PAD - X_LABEL_SIZE) / Math.max(1, units.length) - LEGEND_HEIGHT));
     const sync = uPlot.sync("planardyn");
     units.forEach((unit, u) => {
       const members = chosen.filter((c) => c.unit === unit);
