@@ -149,6 +149,76 @@ def test_dragging_a_point_moves_the_mechanism(page):
     np.testing.assert_allclose(page.evaluate("Array.from(window.planardyn.x)"), x, atol=1e-12)
 
 
+#: The reaction arrows' tips (m) at every state of the run shown, or of the sweep behind the
+#: drawing when none: an arrow is ARROW_FRACTION (0.3) of L long at the force app.arrowRef, at
+#: most twice that (web/src/draw.js), from the pair's first pin (else block); with the view's
+#: bounds [xmin, xmax, ymin, ymax] and the mechanism's points.
+ARROW_TIPS = """() => {
+    const a = window.planardyn, p = a.info.pairs.length, nx = a.info.x0.length, L = a.info.scale;
+    const [xs, rs, pts] = a.mode === 'run' ? [a.run.x, a.run.reactions, a.run.points]
+        : [a.sweepStates.flatMap((s) => Array.from(s.ev.x)), a.sweepStates.flatMap((s) => Array.from(s.ev.reactions)),
+           a.sweepStates.flatMap((s) => Array.from(s.ev.points))];
+    const tips = [];
+    for (let i = 0; i < xs.length / nx; i++) {
+        a.mech.pairGeometry(xs.slice(i * nx, (i + 1) * nx)).forEach((g, j) => {
+            const at = g.pins.length ? g.pins : g.blocks, [fx, fy] = [rs[3 * (i * p + j)], rs[3 * (i * p + j) + 1]];
+            const n = Math.hypot(fx, fy), len = Math.min(n / a.arrowRef, 2) * 0.3 * L;
+            if (n > 0) tips.push(at[0] + fx / n * len, at[1] + fy / n * len);
+        });
+    }
+    return {tips, bounds: a.bounds, points: Array.from(pts)};
+}"""
+
+
+def inside(xy, bounds) -> bool:
+    """Whether every (x, y) of the flat list xy is within bounds [xmin, xmax, ymin, ymax] (m)."""
+    p = np.reshape(xy, (-1, 2))
+    p = p[np.all(np.isfinite(p), axis=1)]
+    return bool(np.all((p[:, 0] >= bounds[0]) & (p[:, 0] <= bounds[1]) & (p[:, 1] >= bounds[2]) & (p[:, 1] <= bounds[3])))
+
+
+def test_the_view_keeps_its_scale_through_a_drag_and_holds_the_arrows(page):
+    # The 3-RRR's platform point P dragged 30 px and released: the view (its bounds, so its
+    # scale and place) is the one it had before, P stays under the pointer (before: the sweep
+    # after the release refitted the view, P moved ~11 px on the screen); the Fit button refits.
+    # The reaction arrows of every state of the sweep, and of a run, are inside the view (before:
+    # the run's view was fitted to its points only, an arrow left it at the top).
+    page.select_option("#shipped", "3-rrr")
+    shown = page.evaluate(ARROW_TIPS)
+    assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
+    before = shown["bounds"]
+    where = page.evaluate(SCREEN_OF_P)
+    page.mouse.move(where["x"], where["y"])
+    page.mouse.down()
+    for i in range(1, 7):
+        page.mouse.move(where["x"] + 5 * i, where["y"])
+    page.mouse.up()
+    assert page.evaluate("document.body.dataset.grabbed") == "P"
+    assert page.evaluate("window.planardyn.bounds") == before
+    after = page.evaluate(SCREEN_OF_P)
+    assert np.hypot(after["x"] - where["x"] - 30, after["y"] - where["y"]) < 1.0
+    shown = page.evaluate(ARROW_TIPS)
+    assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
+    page.click("#fit")
+    fitted = page.evaluate("window.planardyn.bounds")
+    assert fitted != before and inside(page.evaluate(ARROW_TIPS)["tips"], fitted)
+    page.fill("#t-end", "2")
+    page.click("#simulate")
+    shown = page.evaluate(ARROW_TIPS)
+    assert len(shown["tips"]) > 0
+    assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
+
+
+#: Where the page draws point P (client px), through the view's transform (draw.js's).
+SCREEN_OF_P = """() => {
+    const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
+    const k = a.info.points.indexOf('P'), b = a.bounds, w = r.width, h = r.height;
+    const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
+    const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
+    return {x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1]};
+}"""
+
+
 def test_an_edit_that_breaks_the_model_shows_the_located_error(page):
     page.click("nav button[data-tab='model']")
     text = page.input_value("#editor")

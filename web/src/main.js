@@ -14,7 +14,7 @@ import { $, app, status } from "./state.js";
 import { engine } from "./engine.js";
 import { Charts } from "./charts.js";
 import { frequencyRows, mapRanges, mapper, sigmaRows, stiffnessRows } from "./map.js";
-import { drawingSvg, moveTo, showState } from "./view.js";
+import { drawingSvg, fitView, moveTo, showState } from "./view.js";
 import { play, setFrame } from "./timeline.js";
 import { installDrag, sweep } from "./design.js";
 import { installEditDrag } from "./edit_drag.js";
@@ -47,6 +47,7 @@ function start() {
   $("simulate").onclick = simulate;
   $("play").onclick = () => play(!app.playing);
   $("design").onclick = backToDesign;
+  $("fit").onclick = fitView;
   $("scrub").addEventListener("input", () => { play(false); setFrame(+$("scrub").value); });
   window.addEventListener("resize", () => { if (app.info || app.replay) { app.charts.render(); showState(); } });
   Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper, sigmaRows, frequencyRows, stiffnessRows }, listModes, showMode });

@@ -25,8 +25,11 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
   const keep = app.info && app.info.dof === mech.info().dof && fromEditor;
   if (app.mech) app.mech.free();
   Object.assign(app, { mech, info: mech.info(), text, format, source, x: null, run: null, replay: null, mode: "design" });
-  // Another model (not an edit of this one) opens on its own default channels.
-  if (!fromEditor && !drawn) app.charts.chosen = false;
+  // Another model (not an edit of this one) opens on its own default channels and view.
+  if (!fromEditor && !drawn) {
+    app.charts.chosen = false;
+    app.bounds = null;
+  }
   if (!fromEditor) $("editor").value = text;
   $("title").textContent = app.info.name;
   const starts = drawn ? [app.info.drawnQ] : keep ? [app.q, app.info.q0, app.info.drawnQ] : [app.info.q0, app.info.drawnQ];
