@@ -209,6 +209,20 @@ def test_the_view_keeps_its_scale_through_a_drag_and_holds_the_arrows(page):
     assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
 
 
+def test_the_drawing_is_drawn_at_its_boxs_size(browser, app_file):
+    # At 1184 x 798 px (a notebook's width) the status line set after the first drawing wraps
+    # the title, the header grows and the drawing's box shrinks: the drawing is drawn again at
+    # its box's size (before: a 328 px bitmap stretched into a 316 px box, as was every box
+    # change other than the window's).
+    pg = browser.new_page(viewport={"width": 1184, "height": 798})
+    pg.goto(app_file.as_uri())
+    pg.wait_for_selector("body[data-ready='1']", timeout=20_000)
+    pg.wait_for_timeout(100)  # the observers' callbacks run after layout, before the next paint
+    fit = pg.evaluate(FITS)
+    assert fit["bitmap"] == fit["drawing"] and fit["chartsScroll"] <= fit["chartsHeight"], fit
+    pg.close()
+
+
 #: Where the page draws point P (client px), through the view's transform (draw.js's).
 SCREEN_OF_P = """() => {
     const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
@@ -487,10 +501,11 @@ for (const html of outputs) {
 
 
 #: What an app in a notebook shows: its charts' count and their area's heights (scrolled and
-#: shown), the drawing's height, the page's heights (px).
-FITS = """() => { const c = document.getElementById('charts'), e = document.scrollingElement;
+#: shown), the drawing's height and its bitmap's (CSS px), the page's heights (px).
+FITS = """() => { const c = document.getElementById('charts'), e = document.scrollingElement, d = document.getElementById('drawing');
     return {charts: c.querySelectorAll('.uplot').length, chartsScroll: c.scrollHeight, chartsHeight: c.clientHeight,
-            drawing: document.getElementById('drawing').clientHeight, pageScroll: e.scrollHeight, pageHeight: e.clientHeight}; }"""
+            drawing: d.clientHeight, bitmap: d.height / (window.devicePixelRatio || 1),
+            pageScroll: e.scrollHeight, pageHeight: e.clientHeight}; }"""
 
 
 def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
@@ -526,6 +541,9 @@ def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
         fit = f.evaluate(FITS)
         assert fit["charts"] >= 2 and fit["chartsScroll"] <= fit["chartsHeight"], (mode, fit)
         assert fit["drawing"] >= 300 and fit["pageScroll"] <= fit["pageHeight"], (mode, fit)
+        # The drawing was drawn at its box's size (it was stretched where the header wrapped
+        # after the first drawing: a 328 px bitmap in a 316 px box).
+        assert fit["bitmap"] == fit["drawing"], (mode, fit)
     # The summaries' drawings gave way to the apps; their tables stay.
     assert pg.evaluate("document.querySelectorAll('.planardyn-summary svg').length") == 0
     assert pg.evaluate("document.querySelectorAll('.planardyn-summary table').length") == 2

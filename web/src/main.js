@@ -49,7 +49,10 @@ function start() {
   $("design").onclick = backToDesign;
   $("fit").onclick = fitView;
   $("scrub").addEventListener("input", () => { play(false); setFrame(+$("scrub").value); });
-  window.addEventListener("resize", () => { if (app.info || app.replay) { app.charts.render(); showState(); } });
+  // The drawing and the charts follow their boxes: the window's size, and the header's (a status
+  // line may wrap the title after the first drawing).
+  const observer = new ResizeObserver(() => { if (app.info || app.replay) { app.charts.render(); showState(); } });
+  for (const id of ["drawing", "charts"]) observer.observe($(id));
   Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper, sigmaRows, frequencyRows, stiffnessRows }, listModes, showMode });
   const data = JSON.parse($("planardyn-data").textContent);
   if (data.model) setModel(data.model.text, data.model.format, data.model.source);
