@@ -85,6 +85,44 @@ def test_the_command_writes_the_page_and_refuses_other_outputs(tmp_path, capsys)
     assert main(["app", "no-such-model", "-o", str(tmp_path / "b.html")]) == 2
 
 
+def broken_four_bar(tmp_path, old: str, new: str) -> tuple[str, int, int]:
+    """The four-bar under gravity with `old` written `new` once, as a file: its path, and the
+    line and column (1-based) where `new` is written."""
+    text = (MODELS / "four-bar-gravity.yaml").read_text()
+    assert old in text
+    lines = text.replace(old, new, 1).splitlines()
+    line = next(i for i, row in enumerate(lines, 1) if new in row)
+    path = tmp_path / "broken.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    return str(path), line, lines[line - 1].index(new) + 1
+
+
+def refusal(capsys, *argv: str) -> str:
+    """The message of a command that refuses (exit 2)."""
+    assert main(list(argv)) == 2
+    return capsys.readouterr().err
+
+
+def test_the_command_refuses_a_model_that_does_not_parse_with_its_file_line_and_field(tmp_path, capsys):
+    # The loader's located error, as `planardyn check` gives it (one path: the loader's message).
+    path, line, column = broken_four_bar(tmp_path, "mass: 0.5", "mass: [0.5")
+    err = refusal(capsys, "app", path, "-o", str(tmp_path / "b.html"))
+    assert err.startswith(f"planardyn: {path}: bodies.crank.mass: invalid type: list, ")
+    assert f"(line {line} column {column + len('mass: ')})" in err
+    assert refusal(capsys, "check", path) == err
+
+
+@pytest.mark.xfail(strict=True, reason="the loader locates a validation error by its field path only (the core's "
+                   "loader/io.rs with_line adds a line to points.* construction errors alone): a core change")
+def test_the_command_refuses_an_invalid_model_with_its_file_line_and_field(tmp_path, capsys):
+    # A value that parses but is refused (a negative mass): the same location as a parse error's.
+    path, line, column = broken_four_bar(tmp_path, "mass: 0.5", "mass: -0.5")
+    err = refusal(capsys, "app", path, "-o", str(tmp_path / "b.html"))
+    assert err.startswith(f"planardyn: {path}: bodies.crank.mass: mass must be > 0 kg, got -0.5")
+    assert f"(line {line} column {column + len('mass: ')})" in err
+    assert refusal(capsys, "check", path) == err
+
+
 @pytest.fixture(scope="module")
 def five_bar():
     mech = pdy.load(MODELS / "five-bar.yaml")
