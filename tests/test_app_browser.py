@@ -115,28 +115,35 @@ def test_state_equals_the_python_api(page):
     close([got["kinetic"], got["potential"]], [kinetic, potential])
 
 
+#: Where the page draws point P (client px), through the view's transform (draw.js's): its
+#: index, the scale s (px/m) and its position p (m) too.
+SCREEN_OF_P = """() => {
+    const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
+    const k = a.info.points.indexOf('P'), b = a.bounds, w = r.width, h = r.height;
+    const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
+    const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
+    return {k, x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1], s,
+            p: [a.ev.points[2 * k], a.ev.points[2 * k + 1]]};
+}"""
+
+
+def drag_right(page, where, moves: int) -> None:
+    """Press at `where` (client px), move right 5 px `moves` times, release."""
+    page.mouse.move(where["x"], where["y"])
+    page.mouse.down()
+    for i in range(1, moves + 1):
+        page.mouse.move(where["x"] + 5 * i, where["y"])
+    page.mouse.up()
+
+
 def test_dragging_a_point_moves_the_mechanism(page):
     # Grab the end effector P where the page draws it and drag it 40 px right in steps of 5 px:
     # the coordinates change and P follows the pointer. A 5R's P moves freely in the plane
     # (two coordinates), so damped least squares bring it to the pointer: within 1 px (four
     # iterations a move, each cutting the error by far more than the 5 px a move adds).
     before = page.evaluate("Array.from(window.planardyn.q)")
-    where = page.evaluate(
-        """() => {
-            const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
-            const k = a.info.points.indexOf('P');
-            const b = a.bounds, w = r.width, h = r.height;
-            const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
-            const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
-            return {k, x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1], s,
-                    p: [a.ev.points[2 * k], a.ev.points[2 * k + 1]]};
-        }"""
-    )
-    page.mouse.move(where["x"], where["y"])
-    page.mouse.down()
-    for i in range(1, 9):
-        page.mouse.move(where["x"] + 5 * i, where["y"])
-    page.mouse.up()
+    where = page.evaluate(SCREEN_OF_P)
+    drag_right(page, where, 8)
     assert page.evaluate("document.body.dataset.grabbed") == "P"
     after = page.evaluate("Array.from(window.planardyn.q)")
     assert np.max(np.abs(np.subtract(after, before))) > 1e-3
@@ -188,11 +195,7 @@ def test_the_view_keeps_its_scale_through_a_drag_and_holds_the_arrows(page):
     assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
     before = shown["bounds"]
     where = page.evaluate(SCREEN_OF_P)
-    page.mouse.move(where["x"], where["y"])
-    page.mouse.down()
-    for i in range(1, 7):
-        page.mouse.move(where["x"] + 5 * i, where["y"])
-    page.mouse.up()
+    drag_right(page, where, 6)
     assert page.evaluate("document.body.dataset.grabbed") == "P"
     assert page.evaluate("window.planardyn.bounds") == before
     after = page.evaluate(SCREEN_OF_P)
@@ -221,16 +224,6 @@ def test_the_drawing_is_drawn_at_its_boxs_size(browser, app_file):
     fit = pg.evaluate(FITS)
     assert fit["bitmap"] == fit["drawing"] and fit["chartsScroll"] <= fit["chartsHeight"], fit
     pg.close()
-
-
-#: Where the page draws point P (client px), through the view's transform (draw.js's).
-SCREEN_OF_P = """() => {
-    const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
-    const k = a.info.points.indexOf('P'), b = a.bounds, w = r.width, h = r.height;
-    const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
-    const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
-    return {x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1]};
-}"""
 
 
 def test_an_edit_that_breaks_the_model_shows_the_located_error(page):
