@@ -11,8 +11,10 @@ must be built (./dev setup builds it): a missing page fails.
 
 from __future__ import annotations
 
+import csv
 import json
 import shutil
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -113,28 +115,35 @@ def test_state_equals_the_python_api(page):
     close([got["kinetic"], got["potential"]], [kinetic, potential])
 
 
+#: Where the page draws point P (client px), through the view's transform (draw.js's): its
+#: index, the scale s (px/m) and its position p (m) too.
+SCREEN_OF_P = """() => {
+    const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
+    const k = a.info.points.indexOf('P'), b = a.bounds, w = r.width, h = r.height;
+    const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
+    const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
+    return {k, x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1], s,
+            p: [a.ev.points[2 * k], a.ev.points[2 * k + 1]]};
+}"""
+
+
+def drag_right(page, where, moves: int) -> None:
+    """Press at `where` (client px), move right 5 px `moves` times, release."""
+    page.mouse.move(where["x"], where["y"])
+    page.mouse.down()
+    for i in range(1, moves + 1):
+        page.mouse.move(where["x"] + 5 * i, where["y"])
+    page.mouse.up()
+
+
 def test_dragging_a_point_moves_the_mechanism(page):
     # Grab the end effector P where the page draws it and drag it 40 px right in steps of 5 px:
     # the coordinates change and P follows the pointer. A 5R's P moves freely in the plane
     # (two coordinates), so damped least squares bring it to the pointer: within 1 px (four
     # iterations a move, each cutting the error by far more than the 5 px a move adds).
     before = page.evaluate("Array.from(window.planardyn.q)")
-    where = page.evaluate(
-        """() => {
-            const a = window.planardyn, c = document.getElementById('drawing'), r = c.getBoundingClientRect();
-            const k = a.info.points.indexOf('P');
-            const b = a.bounds, w = r.width, h = r.height;
-            const s = Math.min(w / (b[1] - b[0]), h / (b[3] - b[2]));
-            const cx = (w - s * (b[1] - b[0])) / 2 - s * b[0], cy = (h + s * (b[3] - b[2])) / 2 + s * b[2];
-            return {k, x: r.left + cx + s * a.ev.points[2 * k], y: r.top + cy - s * a.ev.points[2 * k + 1], s,
-                    p: [a.ev.points[2 * k], a.ev.points[2 * k + 1]]};
-        }"""
-    )
-    page.mouse.move(where["x"], where["y"])
-    page.mouse.down()
-    for i in range(1, 9):
-        page.mouse.move(where["x"] + 5 * i, where["y"])
-    page.mouse.up()
+    where = page.evaluate(SCREEN_OF_P)
+    drag_right(page, where, 8)
     assert page.evaluate("document.body.dataset.grabbed") == "P"
     after = page.evaluate("Array.from(window.planardyn.q)")
     assert np.max(np.abs(np.subtract(after, before))) > 1e-3
@@ -145,6 +154,76 @@ def test_dragging_a_point_moves_the_mechanism(page):
     # The page's state is the engine's at the new coordinates (the drawing is of it).
     x = five_bar().assemble(after, x_start=page.evaluate("Array.from(window.planardyn.x)"))
     np.testing.assert_allclose(page.evaluate("Array.from(window.planardyn.x)"), x, atol=1e-12)
+
+
+#: The reaction arrows' tips (m) at every state of the run shown, or of the sweep behind the
+#: drawing when none: an arrow is ARROW_FRACTION (0.3) of L long at the force app.arrowRef, at
+#: most twice that (web/src/draw.js), from the pair's first pin (else block); with the view's
+#: bounds [xmin, xmax, ymin, ymax] and the mechanism's points.
+ARROW_TIPS = """() => {
+    const a = window.planardyn, p = a.info.pairs.length, nx = a.info.x0.length, L = a.info.scale;
+    const [xs, rs, pts] = a.mode === 'run' ? [a.run.x, a.run.reactions, a.run.points]
+        : [a.sweepStates.flatMap((s) => Array.from(s.ev.x)), a.sweepStates.flatMap((s) => Array.from(s.ev.reactions)),
+           a.sweepStates.flatMap((s) => Array.from(s.ev.points))];
+    const tips = [];
+    for (let i = 0; i < xs.length / nx; i++) {
+        a.mech.pairGeometry(xs.slice(i * nx, (i + 1) * nx)).forEach((g, j) => {
+            const at = g.pins.length ? g.pins : g.blocks, [fx, fy] = [rs[3 * (i * p + j)], rs[3 * (i * p + j) + 1]];
+            const n = Math.hypot(fx, fy), len = Math.min(n / a.arrowRef, 2) * 0.3 * L;
+            if (n > 0) tips.push(at[0] + fx / n * len, at[1] + fy / n * len);
+        });
+    }
+    return {tips, bounds: a.bounds, points: Array.from(pts)};
+}"""
+
+
+def inside(xy, bounds) -> bool:
+    """Whether every (x, y) of the flat list xy is within bounds [xmin, xmax, ymin, ymax] (m)."""
+    p = np.reshape(xy, (-1, 2))
+    p = p[np.all(np.isfinite(p), axis=1)]
+    return bool(np.all((p[:, 0] >= bounds[0]) & (p[:, 0] <= bounds[1]) & (p[:, 1] >= bounds[2]) & (p[:, 1] <= bounds[3])))
+
+
+def test_the_view_keeps_its_scale_through_a_drag_and_holds_the_arrows(page):
+    # The 3-RRR's platform point P dragged 30 px and released: the view (its bounds, so its
+    # scale and place) is the one it had before, P stays under the pointer (before: the sweep
+    # after the release refitted the view, P moved ~11 px on the screen); the Fit button refits.
+    # The reaction arrows of every state of the sweep, and of a run, are inside the view (before:
+    # the run's view was fitted to its points only, an arrow left it at the top).
+    page.select_option("#shipped", "3-rrr")
+    shown = page.evaluate(ARROW_TIPS)
+    assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
+    before = shown["bounds"]
+    where = page.evaluate(SCREEN_OF_P)
+    drag_right(page, where, 6)
+    assert page.evaluate("document.body.dataset.grabbed") == "P"
+    assert page.evaluate("window.planardyn.bounds") == before
+    after = page.evaluate(SCREEN_OF_P)
+    assert np.hypot(after["x"] - where["x"] - 30, after["y"] - where["y"]) < 1.0
+    shown = page.evaluate(ARROW_TIPS)
+    assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
+    page.click("#fit")
+    fitted = page.evaluate("window.planardyn.bounds")
+    assert fitted != before and inside(page.evaluate(ARROW_TIPS)["tips"], fitted)
+    page.fill("#t-end", "2")
+    page.click("#simulate")
+    shown = page.evaluate(ARROW_TIPS)
+    assert len(shown["tips"]) > 0
+    assert inside(shown["tips"], shown["bounds"]) and inside(shown["points"], shown["bounds"])
+
+
+def test_the_drawing_is_drawn_at_its_boxs_size(browser, app_file):
+    # At 1184 x 798 px (a notebook's width) the status line set after the first drawing wraps
+    # the title, the header grows and the drawing's box shrinks: the drawing is drawn again at
+    # its box's size (before: a 328 px bitmap stretched into a 316 px box, as was every box
+    # change other than the window's).
+    pg = browser.new_page(viewport={"width": 1184, "height": 798})
+    pg.goto(app_file.as_uri())
+    pg.wait_for_selector("body[data-ready='1']", timeout=20_000)
+    pg.wait_for_timeout(100)  # the observers' callbacks run after layout, before the next paint
+    fit = pg.evaluate(FITS)
+    assert fit["bitmap"] == fit["drawing"] and fit["chartsScroll"] <= fit["chartsHeight"], fit
+    pg.close()
 
 
 def test_an_edit_that_breaks_the_model_shows_the_located_error(page):
@@ -164,6 +243,29 @@ def test_an_edit_that_breaks_the_model_shows_the_located_error(page):
     page.wait_for_selector("#model-error[hidden]", state="attached", timeout=5_000)
 
 
+def test_an_edit_of_a_mass_is_recomputed_as_typed(page):
+    # The first body's mass doubled in the editor: once rebuilt (the pose kept), the holding
+    # torques and reactions shown are the Python API's for the edited text at that pose (1e-9).
+    page.click("nav button[data-tab='model']")
+    text = page.input_value("#editor")
+    mass = next(line for line in text.splitlines() if line.strip().startswith("mass:"))
+    value = float(mass.split(":")[1].split("#")[0])
+    edited = text.replace(mass, mass.replace(mass.split(":")[1].split("#")[0].strip(), repr(2 * value), 1), 1)
+    before = page.evaluate("Array.from(window.planardyn.ev.tau)")
+    page.fill("#editor", edited)
+    page.wait_for_function("(t) => window.planardyn.text === t", arg=edited, timeout=5_000)
+    mech = pdy.loads(edited)
+    got = page.evaluate("({q: Array.from(window.planardyn.q), tau: Array.from(window.planardyn.ev.tau),"
+                        " reactions: Array.from(window.planardyn.ev.reactions)})")
+    zero = np.zeros(mech.dof)
+    tau = mech.inverse_dynamics(got["q"], zero, zero)
+    np.testing.assert_allclose(got["tau"], tau, rtol=STATE_RTOL, atol=STATE_RTOL * np.abs(tau).max())
+    reactions = mech.reactions(got["q"], zero, tau=tau)
+    np.testing.assert_allclose(got["reactions"], np.ravel(reactions), rtol=STATE_RTOL,
+                               atol=STATE_RTOL * np.abs(reactions).max())
+    assert np.max(np.abs(np.subtract(got["tau"], before))) > 1e-3
+
+
 def test_a_run_in_the_page_agrees_with_python(page):
     mech = five_bar()
     res = mech.simulate(t_end=1.0, output_dt=0.01)
@@ -176,6 +278,25 @@ def test_a_run_in_the_page_agrees_with_python(page):
     assert got["status"] == res.status == "success"
     np.testing.assert_allclose(got["t"], res.t, atol=1e-12)
     np.testing.assert_allclose(np.reshape(got["q"], res.q.shape), res.q, atol=RUN_ATOL)
+
+
+def test_a_driven_run_from_the_controls_agrees_with_python(page):
+    # theta1 driven at 2 rad/s from the pose shown, for 0.5 s, chosen with the run controls: theta1
+    # is q0 + 2 t (the motion's law), and the run (600 outputs, from rest) is Python's with the
+    # same motion within RUN_ATOL.
+    page.select_option("#run-mode", "0")
+    page.fill("#speed", "2")
+    page.fill("#t-end", "0.5")
+    page.click("#simulate")
+    got = page.evaluate("({t: Array.from(window.planardyn.run.t), q: Array.from(window.planardyn.run.q),"
+                        " status: window.planardyn.run.status})")
+    mech = five_bar()
+    q = np.reshape(got["q"], (-1, 2))
+    res = mech.simulate(t_end=0.5, output_dt=0.5 / 600, q0=q[0], qd0=np.zeros(2), motion={"theta1": 2.0})
+    assert got["status"] == res.status == "success"
+    np.testing.assert_allclose(q[:, 0], q[0, 0] + 2.0 * np.asarray(got["t"]), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got["t"], res.t, atol=1e-12)
+    np.testing.assert_allclose(q, res.q, atol=RUN_ATOL)
 
 
 def test_the_idle_warm_up_leaves_the_page_as_it_was(page):
@@ -208,6 +329,149 @@ def test_simulate_button_plays_and_charts(page):
     assert (ARTEFACTS / "app-five-bar.png").stat().st_size > 10_000
 
 
+#: The charts' y axes, read from uPlot: per chart its unit, the scale's least value, the ticks'
+#: values (`_splits`, uPlot's own) and the plot's height (CSS px).
+CHART_AXES = """() => window.planardyn.charts.plots.map((p) => ({unit: p.root.dataset.unit, min: p.scales.y.min,
+    ticks: p.axes[1]._splits, labels: p.axes[1]._values, height: p.bbox.height / devicePixelRatio}))"""
+#: At least this many ticks on every y axis (the old layout left 55 px plots with one tick, 0).
+MIN_TICKS = 3
+
+
+def check_nice_ticks(axes) -> None:
+    """Every chart's y ticks: at least MIN_TICKS, evenly spaced by 1, 2, 2.5 or 5 times a power
+    of ten, each a whole multiple of that step (ticks at 2.15, 1.84 are not), labelled in short."""
+    for ax in axes:
+        ticks = np.asarray(ax["ticks"], dtype=float)
+        assert len(ticks) >= MIN_TICKS, ax
+        steps = np.diff(ticks)
+        step = steps[0]
+        np.testing.assert_allclose(steps, step, rtol=1e-9)
+        mantissa = step / 10 ** np.floor(np.log10(step))
+        assert min(abs(mantissa - m) for m in (1, 2, 2.5, 5, 10)) < 1e-9, ax
+        np.testing.assert_allclose(ticks / step, np.round(ticks / step), rtol=0, atol=1e-6)
+        assert all(len(label) <= 6 for label in ax["labels"]), ax
+
+
+def test_a_passive_run_is_charted_with_nice_ticks_on_its_energies(page):
+    # The four-bar under gravity, started from the shipped models' menu: at rest its holding
+    # torque is charted (gravity makes it non-zero), but its run has no drive, so the run opens on
+    # its coordinate and energies, not on the all-zero torque the sweep's choice named. Every
+    # chart's ticks are nice numbers, and the |F| axes do not go below zero.
+    page.select_option("#shipped", "four-bar-gravity")
+    name = pdy.load(pdy.models.path("four-bar-gravity")).name
+    assert page.text_content("#status").startswith(f"{name}: 1 coordinate, 3 bodies;")
+    # Its Map tab says why it has no map, with no empty frame for one.
+    page.click("nav button[data-tab='map']")
+    assert page.text_content("#map-note") == "The maps are over two coordinates: this model has one."
+    assert not page.is_visible("#map")
+    assert page.evaluate("[...window.planardyn.charts.on]") == ["theta1", "tau_theta1"]
+    check_nice_ticks(page.evaluate(CHART_AXES))
+    page.fill("#t-end", "2")
+    page.click("#simulate")
+    assert page.evaluate("window.planardyn.mode") == "run"
+    assert sorted(page.evaluate("[...window.planardyn.charts.on]")) == ["kinetic", "potential", "theta1", "total"]
+    check_nice_ticks(page.evaluate(CHART_AXES))
+    # The two charts fill the charts' area at 1400 x 900 px, their legends in view.
+    assert page.evaluate("(() => { const c = document.getElementById('charts'); return c.scrollHeight <= c.clientHeight; })()")
+    page.click("summary:has-text('pair reactions')")
+    page.check("#channels input[data-key='F_ground_rocker']")
+    axes = page.evaluate(CHART_AXES)
+    check_nice_ticks(axes)
+    force = next(ax for ax in axes if ax["unit"] == "N")
+    assert force["min"] >= 0
+    # The user's choice is kept for the next run, not for another model (the same one opened anew).
+    page.click("#simulate")
+    assert "F_ground_rocker" in page.evaluate("[...window.planardyn.charts.on]")
+    page.select_option("#shipped", "four-bar-gravity")
+    assert page.evaluate("[...window.planardyn.charts.on]") == ["theta1", "tau_theta1"]
+
+
+def test_a_shipped_model_is_chosen_in_the_page(page):
+    # The 3-RRR from the menu: the page's state is the Python API's at q0 (1e-9); at rest
+    # without gravity its efforts and potential are all zero, so its singularity measure is
+    # charted beside its coordinates.
+    mech = pdy.load(pdy.models.path("3-rrr"))
+    page.select_option("#shipped", "3-rrr")
+    got = page.evaluate("({q: Array.from(window.planardyn.q), names: window.planardyn.info.points,"
+                        " points: Array.from(window.planardyn.ev.points), source: window.planardyn.source})")
+    assert got["source"] == "3-rrr.yaml"
+    np.testing.assert_allclose(got["q"], mech.q0, rtol=0, atol=1e-12)
+    carried = [mech.point_names.index(n) for n in got["names"]]
+    np.testing.assert_allclose(np.reshape(got["points"], (-1, 2)), mech.kinematics(mech.q0)["points"][carried],
+                               rtol=STATE_RTOL, atol=STATE_RTOL * mech.scale)
+    assert page.evaluate("[...window.planardyn.charts.on]") == ["th1", "th2", "th3", "sigma"]
+    check_nice_ticks(page.evaluate(CHART_AXES))
+    assert page.text_content("#status").startswith(f"{mech.name}: 3 coordinates, ")
+
+
+def test_opening_a_model_file_and_a_python_run(page, tmp_path):
+    # Open... with a model file: the page shows that model at its q0 (Python's, 1e-12). Then a
+    # run of it made in Python (planardyn.replay.run_data as JSON): played, its frame 10's
+    # points the run's, rounded to DIGITS significant digits of L (half a unit of the last).
+    from planardyn.replay import DIGITS, run_data
+
+    model = pdy.models.path("four-bar-gravity")
+    mech = pdy.load(model)
+    page.set_input_files("#open", str(model))
+    page.wait_for_function("window.planardyn.source === 'four-bar-gravity.yaml'", timeout=5_000)
+    np.testing.assert_allclose(page.evaluate("Array.from(window.planardyn.q)"), mech.q0, rtol=0, atol=1e-12)
+    res = mech.simulate(t_end=0.5, output_dt=0.05)
+    run = tmp_path / "run.json"
+    run.write_text(json.dumps(run_data(mech, res)))
+    page.set_input_files("#open", str(run))
+    page.wait_for_function("window.planardyn.mode === 'replay'", timeout=5_000)
+    shown = page.evaluate("""() => { const a = window.planardyn; a.setFrame(10);
+        return {P: Array.from(a.replay.data.P[a.frame]), q: document.getElementById('q-out-0').textContent}; }""")
+    rounding = 0.5 * 10.0 ** (np.floor(np.log10(mech.scale)) - DIGITS + 1)
+    np.testing.assert_allclose(np.reshape(shown["P"], (-1, 2)), mech.point_positions(res.x[10]), rtol=0,
+                               atol=rounding * (1 + 1e-9))
+    # The slider's reading is the frame's theta1 (4 digits shown), not the pose before the run.
+    assert float(shown["q"]) == pytest.approx(res.q[10, 0], rel=1e-3)
+
+
+def download(page, button: str) -> tuple[str, bytes]:
+    """Click an export button; the file's suggested name and its bytes."""
+    with page.expect_download() as d:
+        page.click(button)
+    return d.value.suggested_filename, Path(d.value.path()).read_bytes()
+
+
+def test_exports_are_the_model_the_run_and_the_drawing(page):
+    # After a 0.5 s run of the five-bar: the model file is the editor's text (it loads as the
+    # same mechanism), the CSV holds the run's times and every channel with its unit (the
+    # coordinates are the page's run's, 17 significant digits written), the PNG and SVG are
+    # the drawing at the canvas's size.
+    page.fill("#t-end", "0.5")
+    page.click("#simulate")
+    page.click("#play")  # paused: the frame no longer moves
+    name, model = download(page, "#export-model")
+    assert name.endswith(".yaml")
+    assert pdy.loads(model.decode()) == five_bar()
+    name, table_text = download(page, "#export-csv")
+    rows = table_text.decode().splitlines()
+    head = next(csv.reader([rows[0]]))
+    assert head[0] == "t (s)" and "theta1 (rad)" in head and "tau_theta2 (N m)" in head and "|F| effector (N)" in head
+    table = np.array([[float(v) if v else np.nan for v in r.split(",")] for r in rows[1:]])
+    run = page.evaluate("({t: Array.from(window.planardyn.run.t), q: Array.from(window.planardyn.run.q)})")
+    np.testing.assert_array_equal(table[:, 0], run["t"])
+    np.testing.assert_array_equal(table[:, head.index("theta2 (rad)")], np.reshape(run["q"], (-1, 2))[:, 1])
+    name, png = download(page, "#export-png")
+    assert name.endswith(".png") and png[:8] == b"\x89PNG\r\n\x1a\n"
+    size = page.evaluate("(() => { const c = document.getElementById('drawing'); return [c.width, c.height]; })()")
+    assert [int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")] == size
+    name, svg = download(page, "#export-svg")
+    root = ET.fromstring(svg)
+    assert root.tag.endswith("svg") and len(root.findall("{http://www.w3.org/2000/svg}circle")) >= 5
+    # The drawing's scale bar: a nice length (1, 2 or 5 times a power of ten) with its unit.
+    texts = [t.text for t in root.iter("{http://www.w3.org/2000/svg}text")]
+    assert texts == ["0.2 m"]
+    # Scrubbing shows the frame chosen: the values table is the run's state at its time.
+    page.fill("#scrub", "40")
+    assert page.evaluate("window.planardyn.frame") == 40
+    t40 = page.evaluate("window.planardyn.run.t[40]")
+    assert page.text_content("#values th") == f"t = {t40:.4g} s"
+
+
 # ------------------------------------------------------------------ the app in a notebook
 
 #: How Jupyter shows an HTML output (JupyterLab's renderer, classic Notebook, VS Code): the
@@ -227,6 +491,14 @@ for (const html of outputs) {
   }
 }
 </script></body></html>"""
+
+
+#: What an app in a notebook shows: its charts' count and their area's heights (scrolled and
+#: shown), the drawing's height and its bitmap's (CSS px), the page's heights (px).
+FITS = """() => { const c = document.getElementById('charts'), e = document.scrollingElement, d = document.getElementById('drawing');
+    return {charts: c.querySelectorAll('.uplot').length, chartsScroll: c.scrollHeight, chartsHeight: c.clientHeight,
+            drawing: d.clientHeight, bitmap: d.height / (window.devicePixelRatio || 1),
+            pageScroll: e.scrollHeight, pageHeight: e.clientHeight}; }"""
 
 
 def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
@@ -255,6 +527,16 @@ def test_notebook_displays_are_live_apps(browser, tmp_path, monkeypatch):
         f.wait_for_selector("body[data-ready='1']", timeout=20_000)
     by_mode = {f.evaluate("window.planardyn.mode"): f for f in frames}
     assert set(by_mode) == {"design", "replay"}
+    # Each app shows its drawing and its default charts (two units each here) whole, with no
+    # inner scroll (notebook.APP_HEIGHT; at 640 px the second chart scrolled), and its charts'
+    # plots are at least charts.js's MIN_HEIGHT less the x axis, so that they hold four ticks.
+    for mode, f in by_mode.items():
+        fit = f.evaluate(FITS)
+        assert fit["charts"] >= 2 and fit["chartsScroll"] <= fit["chartsHeight"], (mode, fit)
+        assert fit["drawing"] >= 300 and fit["pageScroll"] <= fit["pageHeight"], (mode, fit)
+        # The drawing was drawn at its box's size (it was stretched where the header wrapped
+        # after the first drawing: a 328 px bitmap in a 316 px box).
+        assert fit["bitmap"] == fit["drawing"], (mode, fit)
     # The summaries' drawings gave way to the apps; their tables stay.
     assert pg.evaluate("document.querySelectorAll('.planardyn-summary svg').length") == 0
     assert pg.evaluate("document.querySelectorAll('.planardyn-summary table').length") == 2
@@ -501,6 +783,23 @@ def test_loaded_stiffness_equals_the_python_api(page):
                      lambda q: st.stiffness(mech, q, body="distal_left", point="P", wrench=wrench,
                                             preload=preload).weakest_stiffness)
     page.wait_for_function(MAP_DONE, arg="the weakest stiffness of P (N/m, loaded)", timeout=120_000)
+
+
+def test_the_map_tab_maps_a_3rrr_over_two_inputs(page):
+    # The 3-RRR chosen in the page, its Map tab open: the type II map over th1 x th2, th3 held
+    # at q0's, drawn to 100 x 100; its cells are the map tools' (checked against Python below).
+    mech = pdy.load(pdy.models.path("3-rrr"))
+    page.select_option("#shipped", "3-rrr")
+    page.click("nav button[data-tab='map']")
+    page.wait_for_function(MAP_DONE, arg="σ (type II)", timeout=120_000)
+    note = page.text_content("#map-note")
+    assert f"th3 = {mech.q0[2]:.4g} held" in note
+    # Its axes: th1 across and th2 up, each over q0's +-pi rad.
+    lo, hi = mech.q0[:2] - np.pi, mech.q0[:2] + np.pi
+    assert f"th1 across from {lo[0]:.4g} to {hi[0]:.4g} rad, th2 up from {lo[1]:.4g} to {hi[1]:.4g} rad" in note
+    sigma = np.array(page.evaluate("Array.from(window.planardyn.mapGrid.sigma, (v) => (Number.isFinite(v) ? v : null))"),
+                     dtype=float)
+    assert sigma.size == 100 * 100 and 0 < np.isfinite(sigma).sum() < sigma.size
 
 
 def test_a_triads_map_is_on_the_current_branch(page):

@@ -21,6 +21,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from . import models
 from .mechanism import Mechanism, load
 from .model_text import model_text
 from .replay import run_data
@@ -71,21 +72,32 @@ def mechanism_payload(mech: Mechanism) -> dict[str, str]:
     return {"text": model_text(mech.to_dict(), header), "format": "yaml", "source": Path(mech.source).name}
 
 
-def page_data(model: dict[str, str] | None = None, run: dict[str, Any] | None = None) -> str:
-    """The JSON of the page's data element: ``model`` (:func:`model_payload`) and ``run``
-    (:func:`planardyn.replay.run_data`), every ``<`` escaped (``\\u003c``, the same string
-    once parsed) so that nothing in it can end the element."""
+def shipped_models() -> dict[str, str]:
+    """The text of every shipped model by name (:func:`planardyn.models.names`, the library's
+    files left out; about 30 kB), for the page's menu of models to start from."""
+    return {name: models.path(name).read_text(encoding="utf-8") for name in models.names() if "/" not in name}
+
+
+def page_data(
+    model: dict[str, str] | None = None, run: dict[str, Any] | None = None, shipped: dict[str, str] | None = None
+) -> str:
+    """The JSON of the page's data element: ``model`` (:func:`model_payload`), ``run``
+    (:func:`planardyn.replay.run_data`) and ``shipped`` (:func:`shipped_models`), every ``<``
+    escaped (``\\u003c``, the same string once parsed) so that nothing in it can end the element."""
     data: dict[str, Any] = {}
     if model is not None:
         data["model"] = model
     if run is not None:
         data["run"] = run
+    if shipped is not None:
+        data["shipped"] = shipped
     return json.dumps(data, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c")
 
 
 def app_html(model: dict[str, str] | None = None, run: dict[str, Any] | None = None) -> str:
-    """The page with ``model`` and ``run`` inline (:func:`page_data`)."""
-    return app_template().replace(DATA_ELEMENT, DATA_ELEMENT.replace("{}", page_data(model, run)), 1)
+    """The page with ``model``, ``run`` and the shipped models inline (:func:`page_data`)."""
+    data = page_data(model, run, shipped_models())
+    return app_template().replace(DATA_ELEMENT, DATA_ELEMENT.replace("{}", data), 1)
 
 
 def payloads(

@@ -243,8 +243,12 @@ def point_motion_html(motion: PointMotion) -> str:
     return f"<div><b>PointMotion</b>{_table(rows)}</div>"
 
 
-#: The app's height in a notebook (px): the drawing, its sliders and the charts in one view.
-APP_HEIGHT = 640
+#: The app's height in a notebook (px): the drawing, its sliders and the charts in one view,
+#: with no inner scroll: the header (43 px), two charts whole (342 px: web/src/charts.js's
+#: --charts-min; at 640 px the second chart scrolled), the sliders and run or play controls
+#: (85 to 100 px for two coordinates) and a drawing of at least 300 px (tests/test_app_browser.py's
+#: notebook test).
+APP_HEIGHT = 800
 #: Whether this session's notebook page holds the engine (the first app shown defines it).
 _engine_shown = False
 #: Defines ``window.planardynApp`` in the notebook's page: a promise of the app's page, which

@@ -25,6 +25,9 @@ if TYPE_CHECKING:
 
 #: Frames kept in the page at most (longer results are subsampled uniformly).
 MAX_FRAMES = 1500
+#: An effort channel whose largest magnitude is below this (N m or N) is all zero, a passive
+#: model's: not charted first (web/src/channels.js's ZERO_EFFORT).
+ZERO_CHANNEL = 1e-12
 #: Significant digits kept for positions (relative to the mechanism's size) and channels.
 DIGITS = 6
 #: Smallest time scale (s) the rounding of output times is relative to: a run near t = 0
@@ -111,7 +114,10 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
     chans.append({"key": "sigma", "label": "sigma", "group": "sigma", "values": result.sigma[keep], "unit": "1"})
     groups += extra[0]
     chans += extra[1]
-    default = {c["key"] for c in chans if c["group"] in ("q", "tau")}
+    # The coordinates, with the efforts that are not all zero, else the energies (a passive
+    # model's efforts are all zero: web/src/channels.js's defaultChannels, as the app's own runs).
+    efforts = {c["key"] for c in chans if c["group"] == "tau" and np.any(np.abs(c["values"]) > ZERO_CHANNEL)}
+    default = {c["key"] for c in chans if c["group"] == "q"} | (efforts or {"kinetic", "potential", "total"})
     chosen = default if selected is None else set(selected)
     unknown = chosen - {c["key"] for c in chans}
     if unknown:
@@ -180,7 +186,8 @@ def run_data(
     st = result.stats
     info = (
         f"{result.status}: {n} outputs, t = {result.t[0]:.4g}..{result.t[-1]:.4g} s; "
-        f"{mech.dof} coordinates ({', '.join(mech.coordinate_names)}), {mech.n_bodies} bodies; "
+        f"{mech.dof} coordinate{'s' if mech.dof != 1 else ''} ({', '.join(mech.coordinate_names)}), "
+        f"{mech.n_bodies} bod{'ies' if mech.n_bodies != 1 else 'y'}; "
         f"energy drift {result.energy.drift:.3g} J; min sigma {st.get('min_sigma', float(np.min(result.sigma))):.3g}"
     )
     t = result.t[keep]

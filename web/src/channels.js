@@ -9,8 +9,8 @@ export const GROUPS = [
   ["positions", "point positions"], ["speeds", "point speeds"], ["point_accelerations", "point accelerations"],
 ];
 
-/** An effort channel whose largest magnitude is below this (N m or N) is all zero: a passive
- * model's, not shown first. */
+/** An effort or energy channel whose largest magnitude is below this (N m, N or J) is all
+ * zero: a passive model's efforts, a model's potential without gravity; not shown first. */
 const ZERO_EFFORT = 1e-12;
 
 const UNITS = {
@@ -71,12 +71,17 @@ export function seriesChannels(info, s) {
   return chans;
 }
 
-/** The channels shown first: the coordinates with the efforts where an effort is not all
- * zero, else with the energies (a passive model's efforts are all zero). */
+/** Whether a channel is not all zero (within ZERO_EFFORT). */
+const nonZero = (c) => c.values.some((v) => Math.abs(v) > ZERO_EFFORT);
+
+/** The channels shown first: the coordinates with the efforts that are not all zero, else
+ * with the energies that are not (a passive model's efforts are all zero), else with the
+ * singularity measure (at rest without gravity, efforts and energies are all zero). */
 export function defaultChannels(chans) {
-  const efforts = chans.filter((c) => c.group === "tau" && c.values.some((v) => Math.abs(v) > ZERO_EFFORT));
   const q = chans.filter((c) => c.group === "q");
-  const second = efforts.length ? efforts : chans.filter((c) => c.key === "total" || c.key === "kinetic" || c.key === "potential");
+  const efforts = chans.filter((c) => c.group === "tau" && nonZero(c));
+  const energies = chans.filter((c) => ["total", "kinetic", "potential"].includes(c.key) && nonZero(c));
+  const second = efforts.length ? efforts : energies.length ? energies : chans.filter((c) => c.group === "sigma");
   return new Set([...q, ...second].map((c) => c.key));
 }
 

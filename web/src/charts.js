@@ -5,11 +5,23 @@ import uPlot from "uplot";
 import { GROUPS } from "./channels.js";
 
 const COLORS = ["#1f6fb2", "#d9730d", "#2e8540", "#8e44ad", "#b3261e", "#0f7c80", "#7a5c00", "#c2185b"];
-/** Height of one chart (px): the charts share the area, scrolling below this. */
-const MIN_HEIGHT = 150;
+/** Height of one chart (px, its plot and x axis): the charts share the area, scrolling below
+ * MIN_HEIGHT, whose plot (100 px, less the axis) still holds four ticks Y_TICK_SPACE apart. */
+const MIN_HEIGHT = 130;
 const MAX_HEIGHT = 320;
-/** The legend's line under each chart (px). */
-const LEGEND_HEIGHT = 26;
+/** The legend's line under each chart (px, as chromium lays it out, with its 2 px margin). */
+const LEGEND_HEIGHT = 27;
+/** The x axis's tick labels (px), and its label's line under the last chart. */
+const X_AXIS_SIZE = 30;
+const X_LABEL_SIZE = 20;
+/** Least distance between y ticks (px; uPlot's default, 30, left charts of 150 px one tick). */
+const Y_TICK_SPACE = 22;
+/** The charts' area's padding (px, top and bottom: app.css's 4 px each). */
+const AREA_PAD = 8;
+/** Charts the area holds whole at least (a model's default channels span at most two units):
+ * the page gives the area their height and its 1 px top border (app.css's --charts-min) before
+ * the drawing its share. */
+const CHARTS_SHOWN = 2;
 
 /** uPlot's range with a margin, never below zero for a channel that never is (|F|, speeds). */
 function range(u, min, max) {
@@ -29,13 +41,17 @@ export class Charts {
     this.x = new Float64Array(0);
     this.xLabel = "";
     this.marker = null;
+    /** Whether the user has chosen channels (then kept across series). */
+    this.chosen = false;
+    document.documentElement.style.setProperty("--charts-min", `${CHARTS_SHOWN * (MIN_HEIGHT + LEGEND_HEIGHT) + X_LABEL_SIZE + AREA_PAD + 1}px`);
   }
 
-  /** Show channels `chans` over `x` (label with unit), keeping the user's choice where
-   * it still names channels, else `defaults`. */
+  /** Show channels `chans` over `x` (label with unit), keeping the channels the user chose
+   * where they still name channels, else `defaults` (the defaults of the series shown before
+   * are not kept: a sweep's holding efforts are a passive model's zero efforts in its run). */
   set(x, xLabel, chans, defaults) {
     const keys = new Set(chans.map((c) => c.key));
-    const kept = [...this.on].filter((k) => keys.has(k));
+    const kept = this.chosen ? [...this.on].filter((k) => keys.has(k)) : [];
     this.on = kept.length ? new Set(kept) : defaults;
     Object.assign(this, { x, xLabel, chans });
     this.renderChooser();
@@ -59,6 +75,7 @@ export class Charts {
         input.checked = this.on.has(c.key);
         input.dataset.key = c.key;
         input.addEventListener("change", () => {
+          this.chosen = true;
           input.checked ? this.on.add(c.key) : this.on.delete(c.key);
           this.render();
         });
@@ -76,14 +93,17 @@ export class Charts {
     const chosen = this.chans.filter((c) => this.on.has(c.key));
     const units = [...new Set(chosen.map((c) => c.unit))];
     const width = Math.max(200, this.area.clientWidth - 12);
-    const height = Math.min(MAX_HEIGHT, Math.max(MIN_HEIGHT, (this.area.clientHeight - 8) / Math.max(1, units.length) - LEGEND_HEIGHT));
+    const height = Math.min(MAX_HEIGHT, Math.max(MIN_HEIGHT, (this.area.clientHeight - AREA_PAD - X_LABEL_SIZE) / Math.max(1, units.length) - LEGEND_HEIGHT));
     const sync = uPlot.sync("planardyn");
     units.forEach((unit, u) => {
       const members = chosen.filter((c) => c.unit === unit);
+      // The x axis's label under the last chart only (uPlot keeps a label's room even when empty).
+      const last = u === units.length - 1;
       const opts = {
-        width, height,
+        width, height: height + (last ? X_LABEL_SIZE : 0),
         scales: { x: { time: false }, y: { range } },
-        axes: [{ label: u === units.length - 1 ? this.xLabel : "" }, { label: unit, size: 60 }],
+        axes: [{ size: X_AXIS_SIZE, ...(last ? { label: this.xLabel, labelSize: X_LABEL_SIZE } : {}) },
+          { label: unit, size: 60, labelSize: X_LABEL_SIZE, space: Y_TICK_SPACE }],
         series: [{ label: this.xLabel }, ...members.map((c, i) => ({ label: c.label, stroke: COLORS[i % COLORS.length], width: 1.5 }))],
         cursor: { sync: { key: sync.key } },
         legend: { live: true },

@@ -2,10 +2,10 @@
 // coordinate behind the quasi-static charts and the points' paths.
 import { $, app, fmt, status, zeros } from "./state.js";
 import { defaultChannels, seriesChannels, unitOf } from "./channels.js";
-import { fitBounds, transform } from "./draw.js";
+import { transform } from "./draw.js";
 import { dragTowards } from "./drag.js";
 import { coordinateRange } from "./map.js";
-import { groundIndices, moveTo, showState } from "./view.js";
+import { arrowTips, groundIndices, holdView, moveTo, showState } from "./view.js";
 import { setMode } from "./timeline.js";
 import { listModes } from "./modes.js";
 
@@ -77,8 +77,10 @@ export function sweep() {
     states.forEach((s, r) => { path[2 * r] = s.ev.points[2 * i]; path[2 * r + 1] = s.ev.points[2 * i + 1]; });
     return path;
   });
+  app.sweepStates = states;
   app.arrowRef = arrowScale(series.reactions, app.info.pairs.length);
-  app.bounds = fitBounds([app.ev.points, ...app.paths], app.info.scale);
+  app.viewContent = [app.ev.points, ...app.paths, arrowTips(series.reactions, cat((s) => s.ev.x))];
+  holdView(app.viewContent);
   const chans = seriesChannels(app.info, series);
   const name = app.info.coordinateNames[k];
   app.sweepX = series.q.filter((_, i) => i % app.info.dof === k);

@@ -36,6 +36,17 @@ export function fitBounds(arrays, scale) {
   return [x0 - pad, x1 + pad, y0 - pad, y1 + pad];
 }
 
+/** Whether `bounds` [xmin, xmax, ymin, ymax] hold every finite point of `arrays` (x, y, ...). */
+export function holds(bounds, arrays) {
+  const [x0, x1, y0, y1] = bounds;
+  return arrays.every((a) => {
+    for (let i = 0; i + 1 < a.length; i += 2) {
+      if (Number.isFinite(a[i]) && Number.isFinite(a[i + 1]) && (a[i] < x0 || a[i] > x1 || a[i + 1] < y0 || a[i + 1] > y1)) return false;
+    }
+    return true;
+  });
+}
+
 /** The map from world (m, y up) to pixels (y down) showing `bounds` whole, centred. */
 export function transform(bounds, width, height) {
   const [x0, x1, y0, y1] = bounds;
@@ -143,22 +154,23 @@ export function drawScene(pen, scene, tr, w, h) {
   scaleBar(pen, tr, w, h);
 }
 
-/** Reaction arrows: `arrows.items` [{x, y, fx, fy}] scaled so that `arrows.ref` (N) is
- * ARROW_FRACTION of L long. */
+/** The tip (m) of the reaction arrow of `item` {x, y, fx, fy}: the force `ref` (N) is drawn
+ * ARROW_FRACTION of L long, a force beyond twice the reference (near a singularity) at twice
+ * that length. The view holds every tip (view.js). */
+export function arrowTip({ x, y, fx, fy }, ref, scale) {
+  const len = (ARROW_FRACTION * scale * Math.min(Math.hypot(fx, fy) / ref, 2)) / (Math.hypot(fx, fy) || 1);
+  return [x + fx * len, y + fy * len];
+}
+
+/** Reaction arrows: `arrows.items` [{x, y, fx, fy}] to their tips (arrowTip with `arrows.ref`). */
 function drawArrows(pen, arrows, tr, scale) {
   if (!arrows || !(arrows.ref > 0)) return;
-  const len = (ARROW_FRACTION * scale * tr.k) / arrows.ref;
-  for (const { x, y, fx, fy } of arrows.items) {
-    const [x0, y0] = [tr.px(x), tr.py(y)];
-    let [dx, dy] = [fx * len, -fy * len];
-    let n = Math.hypot(dx, dy);
+  for (const item of arrows.items) {
+    const [tx, ty] = arrowTip(item, arrows.ref, scale);
+    const [x0, y0, x1, y1] = [tr.px(item.x), tr.py(item.y), tr.px(tx), tr.py(ty)];
+    const n = Math.hypot(x1 - x0, y1 - y0);
     if (!(n > 2)) continue;
-    // Beyond twice the reference (near a singularity) an arrow is drawn at twice its length.
-    const cap = 2 * ARROW_FRACTION * scale * tr.k;
-    const shrink = n > cap ? cap / n : 1;
-    [dx, dy, n] = [dx * shrink, dy * shrink, n * shrink];
-    const [ux, uy] = [dx / n, dy / n];
-    const [x1, y1] = [x0 + dx, y0 + dy];
+    const [ux, uy] = [(x1 - x0) / n, (y1 - y0) / n];
     const style = { stroke: "#b3261e", width: 2 };
     pen.path([x0, y0, x1, y1], style);
     pen.path([x1 - 8 * ux + 4 * uy, y1 - 8 * uy - 4 * ux, x1, y1, x1 - 8 * ux - 4 * uy, y1 - 8 * uy + 4 * ux], style);

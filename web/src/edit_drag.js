@@ -94,8 +94,7 @@ export function installEditDrag() {
       status(`point ${edit.name} is not written as ${where} in the model text, so it cannot be dragged; edit it in the Model tab`, true);
       return;
     }
-    const bounds = app.bounds;
-    if (setModel(text, app.format, app.source, { drawn: true })) app.bounds = bounds;  // the view stays put under the pointer
+    setModel(text, app.format, app.source, { drawn: true });  // the view stays put while it holds the mechanism
     app.showState();
   };
   c.addEventListener("pointerdown", (e) => {

@@ -1,5 +1,6 @@
-// Files: opening or dropping a model (.yaml, .json) or a Python run's data (.json), and the
-// exports (the model's text, the charts' CSV, the drawing as PNG or SVG).
+// Files: opening or dropping a model (.yaml, .json) or a Python run's data (.json), starting
+// from a shipped model, and the exports (the model's text, the charts' CSV, the drawing as PNG
+// or SVG).
 import { $, app } from "./state.js";
 import { toCsv } from "./channels.js";
 import { isRun } from "./replay.js";
@@ -43,4 +44,16 @@ export function installFiles() {
   };
   $("export-png").onclick = () => $("drawing").toBlob((b) => download(`${base()}.png`, b));
   $("export-svg").onclick = () => download(`${base()}.svg`, new Blob([drawingSvg()], { type: "image/svg+xml" }));
+}
+
+/** The menu of the shipped models (`planardyn app` puts their text in the page): one chosen
+ * is loaded as a file opened. */
+export function installShipped(models) {
+  const sel = $("shipped");
+  for (const name of Object.keys(models)) sel.append(new Option(name, name));
+  sel.hidden = false;
+  sel.addEventListener("change", () => {
+    if (sel.value) setModel(models[sel.value], "yaml", `${sel.value}.yaml`);
+    sel.value = "";
+  });
 }

@@ -14,7 +14,7 @@ import { $, app, status } from "./state.js";
 import { engine } from "./engine.js";
 import { Charts } from "./charts.js";
 import { frequencyRows, mapRanges, mapper, sigmaRows, stiffnessRows } from "./map.js";
-import { drawingSvg, moveTo, showState } from "./view.js";
+import { drawingSvg, fitView, moveTo, showState } from "./view.js";
 import { play, setFrame } from "./timeline.js";
 import { installDrag, sweep } from "./design.js";
 import { installEditDrag } from "./edit_drag.js";
@@ -22,7 +22,7 @@ import { backToDesign, showReplay, simulate } from "./run.js";
 import { installEditor, setModel } from "./model.js";
 import { startMap } from "./map_tab.js";
 import { listModes, showMode } from "./modes.js";
-import { installFiles } from "./files.js";
+import { installFiles, installShipped } from "./files.js";
 
 window.planardyn = app;
 
@@ -47,13 +47,18 @@ function start() {
   $("simulate").onclick = simulate;
   $("play").onclick = () => play(!app.playing);
   $("design").onclick = backToDesign;
+  $("fit").onclick = fitView;
   $("scrub").addEventListener("input", () => { play(false); setFrame(+$("scrub").value); });
-  window.addEventListener("resize", () => { if (app.info || app.replay) { app.charts.render(); showState(); } });
+  // The drawing and the charts follow their boxes: the window's size, and the header's (a status
+  // line may wrap the title after the first drawing).
+  const observer = new ResizeObserver(() => { if (app.info || app.replay) { app.charts.render(); showState(); } });
+  for (const id of ["drawing", "charts"]) observer.observe($(id));
   Object.assign(app, { setModel, simulate, setFrame, moveTo, showState, drawingSvg, startMap, sweep, mapTools: { mapRanges, mapper, sigmaRows, frequencyRows, stiffnessRows }, listModes, showMode });
   const data = JSON.parse($("planardyn-data").textContent);
   if (data.model) setModel(data.model.text, data.model.format, data.model.source);
   if (data.run) showReplay(data.run);
-  if (!data.model && !data.run) status("open or drop a model file (.yaml, .json)");
+  if (data.shipped) installShipped(data.shipped);
+  if (!data.model && !data.run) status(`open or drop a model file (.yaml, .json)${data.shipped ? ", or choose a shipped model" : ""}`);
   app.timings.readyMs = performance.now();
   document.body.dataset.ready = "1";
 }

@@ -1,6 +1,7 @@
 // The side panel's map tab (the maps themselves: map.js): the singularity map, or for a
 // compliant model the first natural frequency's or a chosen point's weakest stiffness.
 import { $, app, fmt } from "./state.js";
+import { unitOf } from "./channels.js";
 import { LEVELS, frequencyRows, mapRanges, mapper, paintMap, sigmaRows, sigmaScale, spanScale, stiffnessRows } from "./map.js";
 
 /** The maps: each its rows, its colour scale and legend; all on the same grids (`LEVELS`). */
@@ -70,8 +71,8 @@ function listPoints() {
   if ([...sel.options].map((o) => o.value).join() !== names.join()) sel.replaceChildren(...names.map((p) => new Option(p, p)));
 }
 
-/** The map of a two-coordinate model, refined level by level while the page stays responsive
- * (only while its tab is open). */
+/** The map of a model over its first two coordinates (any others held), refined level by
+ * level while the page stays responsive (only while its tab is open). */
 export function startMap() {
   const note = $("map-note");
   if (app.mapJob) cancelAnimationFrame(app.mapJob);
@@ -80,8 +81,10 @@ export function startMap() {
   const stiffness = app.info && app.info.compliant && $("map-kind").value === "stiffness";
   $("map-point").hidden = !stiffness;
   $("map-load").hidden = !stiffness;
-  if (!app.info || app.info.dof !== 2) {
-    note.textContent = "The maps are drawn for mechanisms of two coordinates (a 5R, a two-input robot).";
+  // No empty frame where there is no map (a model of one coordinate).
+  $("map").hidden = !app.info || app.info.dof < 2;
+  if ($("map").hidden) {
+    note.textContent = "The maps are over two coordinates: this model has one.";
     return;
   }
   if (!$("tab-map").classList.contains("on")) return;
@@ -95,6 +98,10 @@ export function startMap() {
   const t0 = performance.now();
   note.textContent = `computing ${grid.n} × ${grid.n}…`;  // not the last map's note meanwhile
   const names = app.info.coordinateNames;
+  // The coordinates past the first two are held where they are (a 3-RRR's third input).
+  const held = names.slice(2).map((n, k) => `${n} = ${fmt(q[k + 2])}`).join(", ");
+  const axis = (k, way) => `${names[k]} ${way} from ${fmt(ranges[k][0])} to ${fmt(ranges[k][1])} ${unitOf(app.info, k, "q")}`;
+  const axes = `${axis(0, "across")}, ${axis(1, "up")}`;
   const work = () => {
     let done;
     try {
@@ -106,7 +113,8 @@ export function startMap() {
     paintMap($("map"), grid, ranges, q, kind.scale(grid));
     if (done && level + 1 < LEVELS.length) grid = mapper(rows, ranges, LEVELS[++level], x0, q, grid);
     else if (done) {
-      note.textContent = `${kind.what()} over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms (${kind.legend(grid)}; grey: does not assemble on this branch)`;
+      note.textContent = `${kind.what()} over ${names[0]} × ${names[1]}, ${grid.n} × ${grid.n}, in ${(performance.now() - t0).toFixed(0)} ms` +
+        ` (${axes}${held ? `; ${held} held` : ""}; ${kind.legend(grid)}; grey: does not assemble on this branch)`;
       app.mapGrid = grid;
       return;
     }

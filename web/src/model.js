@@ -25,6 +25,11 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
   const keep = app.info && app.info.dof === mech.info().dof && fromEditor;
   if (app.mech) app.mech.free();
   Object.assign(app, { mech, info: mech.info(), text, format, source, x: null, run: null, replay: null, mode: "design" });
+  // Another model (not an edit of this one) opens on its own default channels and view.
+  if (!fromEditor && !drawn) {
+    app.charts.chosen = false;
+    app.bounds = null;
+  }
   if (!fromEditor) $("editor").value = text;
   $("title").textContent = app.info.name;
   const starts = drawn ? [app.info.drawnQ] : keep ? [app.q, app.info.q0, app.info.drawnQ] : [app.info.q0, app.info.drawnQ];
@@ -39,10 +44,13 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
   setMode("design");
   startMap();
   warmEngine();
-  status(`${app.info.name}: ${app.info.dof} coordinates, ${app.info.bodyNames.length} bodies; drag a point or a slider` +
+  status(`${app.info.name}: ${count(app.info.dof, "coordinate")}, ${count(app.info.bodyNames.length, "body", "bodies")}; drag a point or a slider` +
     (app.info.warnings.length ? ` — ${app.info.warnings.join("; ")}` : ""));
   return true;
 }
+
+/** "1 coordinate", "3 coordinates". */
+const count = (n, one, many = `${one}s`) => `${n} ${n === 1 ? one : many}`;
 
 /** The loader's error under the editor, with its line selected on a click. */
 function showModelError(err, text) {

@@ -3,9 +3,8 @@
 import { $, app, fmt, status, zeros } from "./state.js";
 import { describe } from "./engine.js";
 import { defaultChannels, seriesChannels, unitOf } from "./channels.js";
-import { fitBounds } from "./draw.js";
 import { replaySeries } from "./replay.js";
-import { moveTo } from "./view.js";
+import { arrowTips, holdView, moveTo } from "./view.js";
 import { play, setMode } from "./timeline.js";
 import { arrowScale, sweep } from "./design.js";
 
@@ -50,7 +49,8 @@ export function simulate() {
   app.run = run;
   app.frame = 0;
   app.arrowRef = run.reactions ? arrowScale(run.reactions, app.info.pairs.length) : 0;
-  app.bounds = fitBounds([run.points], app.info.scale);
+  app.viewContent = [run.points, arrowTips(run.reactions, run.x)];
+  holdView(app.viewContent);
   const chans = seriesChannels(app.info, run);
   app.charts.set(run.t, "t (s)", chans, defaultChannels(chans));
   setMode("run");

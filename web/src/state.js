@@ -5,7 +5,7 @@ export const $ = (id) => document.getElementById(id);
 
 export const app = {
   pd: null, mech: null, info: null, text: "", format: "yaml", source: "",
-  q: null, x: null, ev: null, bounds: null, paths: [], arrowRef: 0,
+  q: null, x: null, ev: null, bounds: null, viewContent: [], sweepStates: [], paths: [], arrowRef: 0,
   mode: "design", active: 0, run: null, frame: 0, playing: false, replay: null,
   charts: null, map: null, errors: [],
 };

@@ -2,7 +2,7 @@
 // Python run (replay); drawn on the canvas (or as SVG) and listed in the values table.
 import { $, app, fmt, status, zeros } from "./state.js";
 import { describe } from "./engine.js";
-import { canvasPen, drawScene, svgPen, transform } from "./draw.js";
+import { arrowTip, canvasPen, drawScene, fitBounds, holds, svgPen, transform } from "./draw.js";
 import { unitOf } from "./channels.js";
 import { replayScene } from "./replay.js";
 
@@ -36,6 +36,34 @@ function arrowsOf(reactions, x) {
     return { x: at[0], y: at[1], fx: reactions[3 * j], fy: reactions[3 * j + 1] };
   }).filter((a) => Number.isFinite(a.x));
   return { ref: app.arrowRef, items };
+}
+
+/** The tips (m: x, y, ...) of the reaction arrows of states: `reactions` (3 per pair a state)
+ * at body coordinates `xs` (the model's x0 length a state), drawn at the reference app.arrowRef. */
+export function arrowTips(reactions, xs) {
+  const nx = app.info.x0.length, p3 = 3 * app.info.pairs.length, tips = [];
+  if (!reactions || !(app.arrowRef > 0)) return tips;
+  for (let i = 0; (i + 1) * nx <= xs.length; i++) {
+    for (const a of arrowsOf(reactions.slice(i * p3, (i + 1) * p3), xs.slice(i * nx, (i + 1) * nx)).items) tips.push(...arrowTip(a, app.arrowRef, app.info.scale));
+  }
+  return tips;
+}
+
+/** Hold `content` (arrays of x, y, ... in m: points, paths, arrow tips) in the view: the view
+ * (app.bounds) stays as it is while it holds them, so that its scale is fixed while the user
+ * works on one model; where they leave it (or with no view yet) it widens to hold them too. */
+export function holdView(content) {
+  if (app.bounds && holds(app.bounds, content)) return;
+  const [f, b] = [fitBounds(content, app.info.scale), app.bounds];
+  app.bounds = b ? [Math.min(b[0], f[0]), Math.max(b[1], f[1]), Math.min(b[2], f[2]), Math.max(b[3], f[3])] : f;
+}
+
+/** The Fit button: the view fitted to what is shown (the sweep's or the run's points, paths
+ * and arrows: app.viewContent; a Python run's own bounds). */
+export function fitView() {
+  if (!app.info && !app.replay) return;
+  app.bounds = app.mode === "replay" ? app.replay.data.bounds : fitBounds(app.viewContent, app.info.scale);
+  showState();
 }
 
 /** Stop showing a natural mode (modes.js): the drawing is the state's again. */
@@ -80,15 +108,26 @@ export function drawingSvg() {
   return pen.svg(w, h);
 }
 
+/** The coordinates shown by the sliders: the state's, or while a Python run plays, its frame's
+ * (its coordinate channels, by the model's coordinate names). */
+function shownQ() {
+  if (app.mode !== "replay") return app.q;
+  const chans = app.replay.chans;
+  return app.info.coordinateNames.map((n, k) => chans.find((c) => c.group === "q" && c.key === n)?.values[app.frame] ?? app.q[k]);
+}
+
 export function showState() {
+  // A drag or a slider may take the mechanism, or its arrows, out of the view.
+  if (app.mode === "design") holdView([app.ev.points, arrowTips(app.ev.reactions, app.ev.x)]);
   redraw();
   renderValues();
   const k = app.active;
   if (app.mode === "design") app.charts.mark(app.q[k]);
   else app.charts.mark(app.mode === "run" ? app.run.t[app.frame] : app.replay.t[app.frame]);
+  const q = shownQ();
   document.querySelectorAll("#sliders input").forEach((s, j) => {
-    s.value = app.q[j];
-    $(`q-out-${j}`).textContent = fmt(app.q[j]);
+    s.value = q[j];
+    $(`q-out-${j}`).textContent = fmt(q[j]);
   });
   document.body.dataset.q = Array.from(app.q ?? []).join(",");
 }
