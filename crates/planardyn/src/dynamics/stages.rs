@@ -251,12 +251,14 @@ fn not_positive_definite(ws: &Workspace) -> KinematicsError {
     KinematicsError::singular(SingularityKind::MassMatrix { type_ii })
 }
 
-/// The stages after [`mass_matrix_and_bias`] for one coordinate (m = 1) in one pass and no
-/// bookkeeping of A's pattern: A's factor sqrt(A) into `ws.a` (as [`factor_mass_matrix`] leaves
-/// it), zdd = (b / sqrt(A)) / sqrt(A), xdd = c + u zdd and the user's qdd; the operations of
-/// [`factor_mass_matrix`], [`solve_mass_matrix`] and [`accelerations`], so the same numbers (xdd
-/// but for the sign of a zero entry).
-pub(crate) fn one_coordinate_accelerations(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+/// The stages after the forces for one coordinate (m = 1) in one function and no bookkeeping
+/// of A's pattern: A and b as [`mass_matrix_and_bias`] sums them, A's factor sqrt(A) into
+/// `ws.a` (as [`factor_mass_matrix`] leaves it), zdd = (b / sqrt(A)) / sqrt(A), xdd = c + u zdd
+/// and the user's qdd; the operations of [`mass_matrix_and_bias`], [`factor_mass_matrix`],
+/// [`solve_mass_matrix`] and [`accelerations`], so the same numbers (xdd but for the sign of a
+/// zero entry), without the dispatch on m and a call between A, b and the rest.
+pub(crate) fn one_coordinate_dynamics(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+    fixed_mass_matrix_and_bias::<1>(mech, ws);
     let a = ws.a[0];
     if !(a > 0.0) {
         return Err(not_positive_definite(ws));
