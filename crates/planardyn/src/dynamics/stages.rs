@@ -325,3 +325,39 @@ fn user_accelerations_from_x(mech: &Mechanism, ws: &mut Workspace) {
 pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &USupport, xdd: &mut [f64]) {
     u_times_from(u, support, |j| zdd[j], |i, _| c[i], xdd);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::forces::applied_forces;
+
+    /// A and b with fixed-size sums body by body (`mass_matrix_and_bias` up to `FIXED_M`
+    /// coordinates; from `SPLIT_FROM_M` on, A's sums and b's in a pass over the bodies each)
+    /// equal those over U's supports (`mass_matrix`, `bias`) to the bit, but for the sign of an
+    /// entry of zero terms only: the four-bar (m = 1), five-bar (2) and 3-RRR (3) at their
+    /// drawings, with rates of both signs and a drive effort on every coordinate.
+    #[test]
+    fn fixed_sums_are_the_supports_sums_to_the_bit() {
+        for (model, m) in [("four-bar-gravity", 1), ("five-bar", 2), ("3-rrr", 3)] {
+            let path = format!("{}/../../examples/models/{model}.yaml", env!("CARGO_MANIFEST_DIR"));
+            let mech = crate::load(&path).unwrap();
+            let (z, _) = mech.initial_state();
+            assert_eq!(z.len(), m, "{model}");
+            let zd = &[0.7, -1.3, 0.4][..m];
+            let (mut fixed, mut supports) = (Workspace::new(&mech), Workspace::new(&mech));
+            for ws in [&mut fixed, &mut supports] {
+                kinematic_stages(&mech, &z, zd, ws).unwrap();
+                ws.tau.fill(0.3);
+                applied_forces(&mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
+            }
+            mass_matrix_and_bias(&mech, &mut fixed);
+            mass_matrix(&mech, &mut supports);
+            bias(&mech, &mut supports);
+            for (what, x, y) in [("A", &fixed.a, &supports.a), ("b", &fixed.b, &supports.b)] {
+                let same = x.iter().zip(y.iter()).all(|(p, q)| p.to_bits() == q.to_bits() || (*p == 0.0 && *q == 0.0));
+                assert!(same && x.len() == y.len(), "{what} of {model}: {x:?} against {y:?}");
+                assert!(x.iter().any(|v| *v != 0.0), "{what} of {model} is zero");
+            }
+        }
+    }
+}
