@@ -329,13 +329,12 @@ pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &US
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::forces::applied_forces;
 
     /// A and b with fixed-size sums body by body (`mass_matrix_and_bias` up to `FIXED_M`
     /// coordinates; from `SPLIT_FROM_M` on, A's sums and b's in a pass over the bodies each)
     /// equal those over U's supports (`mass_matrix`, `bias`) to the bit, but for the sign of an
     /// entry of zero terms only: the four-bar (m = 1), five-bar (2) and 3-RRR (3) at their
-    /// drawings, with rates of both signs and a drive effort on every coordinate.
+    /// drawings, with rates of both signs and forces of every component on every body.
     #[test]
     fn fixed_sums_are_the_supports_sums_to_the_bit() {
         for (model, m) in [("four-bar-gravity", 1), ("five-bar", 2), ("3-rrr", 3)] {
@@ -347,8 +346,8 @@ mod tests {
             let (mut fixed, mut supports) = (Workspace::new(&mech), Workspace::new(&mech));
             for ws in [&mut fixed, &mut supports] {
                 kinematic_stages(&mech, &z, zd, ws).unwrap();
-                ws.tau.fill(0.3);
-                applied_forces(&mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
+                // Forces with all three components on every body (gravity alone has one).
+                ws.f.iter_mut().enumerate().for_each(|(i, f)| *f = 2.0 * (0.37 * i as f64).sin() + 0.1);
             }
             mass_matrix_and_bias(&mech, &mut fixed);
             mass_matrix(&mech, &mut supports);
