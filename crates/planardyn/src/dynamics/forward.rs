@@ -7,7 +7,7 @@ use super::forces::{applied_forces, Drives};
 use super::losses::forward_with_losses;
 use super::stages::{
     accelerations, apply_pair_efforts, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix_and_bias,
-    one_coordinate_accelerations, solve_mass_matrix,
+    one_coordinate_dynamics, solve_mass_matrix,
 };
 use super::workspace::Workspace;
 use crate::model::Mechanism;
@@ -36,12 +36,12 @@ pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mu
     ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
     ws.power = applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     ws.power += apply_pair_efforts(mech, ws);
+    if ws.b.len() == 1 && !mech.has_losses() {
+        return Ok(one_coordinate_dynamics(mech, ws)?);
+    }
     mass_matrix_and_bias(mech, ws);
     if mech.has_losses() {
         return Ok(forward_with_losses(mech, ws)?);
-    }
-    if ws.b.len() == 1 {
-        return Ok(one_coordinate_accelerations(mech, ws)?);
     }
     factor_mass_matrix(ws)?;
     solve_mass_matrix(ws);

@@ -13,7 +13,7 @@ use crate::kinematics::constraints::{
 };
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame, USupport};
 use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope, copy_small};
-use crate::model::{Mechanism, PairId};
+use crate::model::{Body, Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
 
 /// Positions, analogues and the convective term at chart coordinates z, zd (`ws.x` is the
@@ -155,26 +155,39 @@ const FIXED_M: usize = 4;
 /// summed body by body over all bodies. U is zero outside its supports and a zero term leaves a
 /// non-zero sum's bits as they are, so the entries are [`mass_matrix`]'s and [`bias`]'s to the
 /// bit (an entry of zero terms only may differ in its zero's sign). A is written whole: its
-/// zeros outside the envelope are there (`a_zeros_for`).
+/// zeros outside the envelope are there (`a_zeros_for`). From [`SPLIT_FROM_M`] coordinates A's
+/// sums and b's take a pass over the bodies each: the same terms added in the same order, with
+/// half the running sums of one pass (which then no longer fit the registers).
 fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     // Each column's body by body: three values a step with no bounds check of their own.
-    let mut u: [std::slice::ChunksExact<f64>; M] =
-        std::array::from_fn(|j| ws.frame.u[j * n..(j + 1) * n].chunks_exact(3));
+    let columns = || -> [std::slice::ChunksExact<f64>; M] {
+        std::array::from_fn(|j| ws.frame.u[j * n..(j + 1) * n].chunks_exact(3))
+    };
+    let rows = |u: &mut [std::slice::ChunksExact<f64>; M]| -> [[f64; 3]; M] {
+        std::array::from_fn(|j| {
+            let p = u[j].next().expect("a column of U has three values a body");
+            [p[0], p[1], p[2]]
+        })
+    };
     // The sums of `m_dot` and `bias` start at -0.0 (f64's `Sum`).
     let (mut a, mut uf, mut umc) = ([[-0.0; M]; M], [-0.0; M], [-0.0; M]);
     let forces = ws.f.chunks_exact(3).zip(ws.frame.c.chunks_exact(3));
-    for (body, (f, c)) in mech.bodies.iter().zip(forces) {
-        let ui: [[f64; 3]; M] = std::array::from_fn(|j| {
-            let p = u[j].next().expect("a column of U has three values a body");
-            [p[0], p[1], p[2]]
-        });
-        for (j, p) in ui.iter().enumerate() {
-            for (k, q) in ui.iter().enumerate().skip(j) {
-                a[j][k] += body.mass * (p[0] * q[0] + p[1] * q[1]) + body.inertia * p[2] * q[2];
-            }
-            uf[j] = uf[j] + p[0] * f[0] + p[1] * f[1] + p[2] * f[2];
-            umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
+    if M >= SPLIT_FROM_M {
+        let mut u = columns();
+        for body in &mech.bodies {
+            add_mass_terms(&mut a, body, &rows(&mut u));
+        }
+        let mut u = columns();
+        for (body, (f, c)) in mech.bodies.iter().zip(forces) {
+            add_bias_terms(&mut uf, &mut umc, body, &rows(&mut u), f, c);
+        }
+    } else {
+        let mut u = columns();
+        for (body, (f, c)) in mech.bodies.iter().zip(forces) {
+            let ui = rows(&mut u);
+            add_mass_terms(&mut a, body, &ui);
+            add_bias_terms(&mut uf, &mut umc, body, &ui, f, c);
         }
     }
     for (j, row) in a.iter().enumerate() {
@@ -184,6 +197,37 @@ fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspa
         ws.b[j] = uf[j] - umc[j];
     }
     ws.a_zeros_for = ws.frame.sys.supports_id();
+}
+
+/// From how many coordinates [`fixed_mass_matrix_and_bias`] sums A and b in a pass each (the
+/// 3-RRR's 12 running sums in one pass spill to the stack).
+const SPLIT_FROM_M: usize = 3;
+
+/// One body's terms of A's upper triangle (`ui` its rows of U's columns), as `m_dot` adds them.
+#[inline(always)]
+fn add_mass_terms<const M: usize>(a: &mut [[f64; M]; M], body: &Body, ui: &[[f64; 3]; M]) {
+    for (j, p) in ui.iter().enumerate() {
+        for (k, q) in ui.iter().enumerate().skip(j) {
+            a[j][k] += body.mass * (p[0] * q[0] + p[1] * q[1]) + body.inertia * p[2] * q[2];
+        }
+    }
+}
+
+/// One body's terms of U^T f (`uf`, as `USupport::dot` adds them) and of U^T M c (`umc`, as
+/// `m_dot`), f and c its forces and convective accelerations.
+#[inline(always)]
+fn add_bias_terms<const M: usize>(
+    uf: &mut [f64; M],
+    umc: &mut [f64; M],
+    body: &Body,
+    ui: &[[f64; 3]; M],
+    f: &[f64],
+    c: &[f64],
+) {
+    for (j, p) in ui.iter().enumerate() {
+        uf[j] = uf[j] + p[0] * f[0] + p[1] * f[1] + p[2] * f[2];
+        umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
+    }
 }
 
 /// `ws.a` into its Cholesky factor, or the singularity that keeps A from being positive definite.
@@ -207,12 +251,14 @@ fn not_positive_definite(ws: &Workspace) -> KinematicsError {
     KinematicsError::singular(SingularityKind::MassMatrix { type_ii })
 }
 
-/// The stages after [`mass_matrix_and_bias`] for one coordinate (m = 1) in one pass and no
-/// bookkeeping of A's pattern: A's factor sqrt(A) into `ws.a` (as [`factor_mass_matrix`] leaves
-/// it), zdd = (b / sqrt(A)) / sqrt(A), xdd = c + u zdd and the user's qdd; the operations of
-/// [`factor_mass_matrix`], [`solve_mass_matrix`] and [`accelerations`], so the same numbers (xdd
-/// but for the sign of a zero entry).
-pub(crate) fn one_coordinate_accelerations(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+/// The stages after the forces for one coordinate (m = 1) in one function and no bookkeeping
+/// of A's pattern: A and b as [`mass_matrix_and_bias`] sums them, A's factor sqrt(A) into
+/// `ws.a` (as [`factor_mass_matrix`] leaves it), zdd = (b / sqrt(A)) / sqrt(A), xdd = c + u zdd
+/// and the user's qdd; the operations of [`mass_matrix_and_bias`], [`factor_mass_matrix`],
+/// [`solve_mass_matrix`] and [`accelerations`], so the same numbers (xdd but for the sign of a
+/// zero entry), without the dispatch on m and a call between A, b and the rest.
+pub(crate) fn one_coordinate_dynamics(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+    fixed_mass_matrix_and_bias::<1>(mech, ws);
     let a = ws.a[0];
     if !(a > 0.0) {
         return Err(not_positive_definite(ws));
@@ -278,4 +324,39 @@ fn user_accelerations_from_x(mech: &Mechanism, ws: &mut Workspace) {
 /// (`System::u_support`), where it may be non-zero.
 pub(crate) fn body_accelerations(u: &[f64], c: &[f64], zdd: &[f64], support: &USupport, xdd: &mut [f64]) {
     u_times_from(u, support, |j| zdd[j], |i, _| c[i], xdd);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A and b with fixed-size sums body by body (`mass_matrix_and_bias` up to `FIXED_M`
+    /// coordinates; from `SPLIT_FROM_M` on, A's sums and b's in a pass over the bodies each)
+    /// equal those over U's supports (`mass_matrix`, `bias`) to the bit, but for the sign of an
+    /// entry of zero terms only: the four-bar (m = 1), five-bar (2) and 3-RRR (3) at their
+    /// drawings, with rates of both signs and forces of every component on every body.
+    #[test]
+    fn fixed_sums_are_the_supports_sums_to_the_bit() {
+        for (model, m) in [("four-bar-gravity", 1), ("five-bar", 2), ("3-rrr", 3)] {
+            let path = format!("{}/../../examples/models/{model}.yaml", env!("CARGO_MANIFEST_DIR"));
+            let mech = crate::load(&path).unwrap();
+            let (z, _) = mech.initial_state();
+            assert_eq!(z.len(), m, "{model}");
+            let zd = &[0.7, -1.3, 0.4][..m];
+            let (mut fixed, mut supports) = (Workspace::new(&mech), Workspace::new(&mech));
+            for ws in [&mut fixed, &mut supports] {
+                kinematic_stages(&mech, &z, zd, ws).unwrap();
+                // Forces with all three components on every body (gravity alone has one).
+                ws.f.iter_mut().enumerate().for_each(|(i, f)| *f = 2.0 * (0.37 * i as f64).sin() + 0.1);
+            }
+            mass_matrix_and_bias(&mech, &mut fixed);
+            mass_matrix(&mech, &mut supports);
+            bias(&mech, &mut supports);
+            for (what, x, y) in [("A", &fixed.a, &supports.a), ("b", &fixed.b, &supports.b)] {
+                let same = x.iter().zip(y.iter()).all(|(p, q)| p.to_bits() == q.to_bits() || (*p == 0.0 && *q == 0.0));
+                assert!(same && x.len() == y.len(), "{what} of {model}: {x:?} against {y:?}");
+                assert!(x.iter().any(|v| *v != 0.0), "{what} of {model} is zero");
+            }
+        }
+    }
 }
