@@ -120,7 +120,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             settings,
             ode,
             stepper,
-            traj: Trajectory::new(m, mech.n_x()),
+            traj: Trajectory::with_rows(m, mech.n_x(), settings.t_eval.as_ref().map_or(0, Vec::len)),
             t_eval: settings.t_eval.as_deref(),
             next: 0,
             approach: Approach::default(),
