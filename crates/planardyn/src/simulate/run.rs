@@ -356,7 +356,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// Report a change point the run went through: in the trajectory's list, and in the least
     /// passive measure seen (the path passes through it, the accepted points do not).
     fn passed_point(&mut self, point: ChangePoint) {
-        let passive = passive_sigma_min(self.ode.mech, &point.x);
+        let ode = &mut self.ode;
+        let passive = passive_sigma_min_with(&mut ode.inputs_sys, ode.mech, &point.x);
         let stats = &mut self.traj.stats;
         stats.min_passive_sigma = stats.min_passive_sigma.min(passive);
         self.traj.change_points.push(point);
@@ -497,7 +498,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let Some(last) = self.approach.last() else { return false };
         let saved = self.ode.save();
         let near = self.ode.evaluate(t, self.stepper.y()).map(|()| {
-            passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CROSS_START || inside_step(&self.ode, last, t)
+            let ode = &mut self.ode;
+            passive_sigma_min_with(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CROSS_START || inside_step(ode, last, t)
         });
         self.ode.restore(saved);
         near.unwrap_or(true)
