@@ -147,6 +147,16 @@ impl System {
         self.other.get_or_insert_with(|| Box::new(System::for_chart(mech, chart)))
     }
 
+    /// The system kept for another chart's measures ([`System::other_chart`]), if any.
+    pub fn other(&self) -> Option<&System> {
+        self.other.as_deref()
+    }
+
+    /// Keep `make()` as the system for another chart's measures, unless one is kept already.
+    pub fn keep_other(&mut self, make: impl FnOnce() -> System) {
+        self.other.get_or_insert_with(|| Box::new(make()));
+    }
+
     /// Whether J is factorised (the last [`System::factor`] succeeded).
     pub fn is_factored(&self) -> bool {
         self.factored
