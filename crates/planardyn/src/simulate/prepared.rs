@@ -35,7 +35,7 @@ pub struct Prepared {
     closed: Option<ClosedForm>,
     /// The first run's analysis of the partition of its first passive measure (a `System`
     /// analysed for it), empty until a run asks for that measure: a run that never does pays
-    /// nothing, and the later runs do not analyse it again (127 k of the 3-RRR benchmark run's
+    /// nothing, and the later runs do not analyse it again (88 k of the 3-RRR benchmark run's
     /// 1.57 M instructions). A run whose partition is another re-analyses it (`System::fill`).
     partition: OnceLock<System>,
 }
