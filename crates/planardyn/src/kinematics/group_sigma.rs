@@ -432,16 +432,19 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
         phi[3][i] = phi[i][3];
         phi[3][3] += dot(l[i], l[i]);
     }
-    // M(lambda) and M'(lambda).
+    // M(lambda) and M'(lambda), symmetric as phi and G_r are to the bit (their (j, k) and
+    // (k, j) entries are the same products summed in the same order): the upper triangles,
+    // mirrored.
     let m = |lambda: f64| {
         let f = poles.map(|k| 1.0 / (k - lambda));
         let mut m = [[0.0; 4]; 4];
         let mut d = [[0.0; 4]; 4];
         for j in 0..4 {
-            for k in 0..4 {
+            for k in j..4 {
                 let eye = if j == k { 1.0 } else { 0.0 };
                 m[j][k] = phi[j][k] - eye * lambda - (0..3).map(|r| g[r][j][k] * f[r]).sum::<f64>();
                 d[j][k] = -eye - (0..3).map(|r| g[r][j][k] * f[r] * f[r]).sum::<f64>();
+                (m[k][j], d[k][j]) = (m[j][k], d[j][k]);
             }
         }
         (m, d)

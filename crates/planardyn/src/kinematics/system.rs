@@ -55,6 +55,9 @@ pub struct System {
     /// Identifies the analysis the supports above come from (unique over all systems): buffers
     /// that keep zeros outside the supports are cleared once when it changes.
     supports_id: u64,
+    /// Whether the supports above are analysed (not in a system for measures only,
+    /// [`System::other_chart`]'s).
+    supports: bool,
     /// A system kept for the measures of another chart ([`System::other_chart`]).
     other: Option<Box<System>>,
 }
@@ -78,19 +81,28 @@ impl System {
 
     /// J of `chart`, its structure analysed (once: not the user's chart's first, then this one's).
     pub fn for_chart(mech: &Mechanism, chart: &Chart) -> Self {
+        Self::analysed(mech, chart, true)
+    }
+
+    /// J of `chart` for its type II measure only ([`System::group_sigma_exact`]): its blocks and
+    /// their scales, without the supports of U and A that the solves and A = U^T M U use (20 k
+    /// of the five-bar's 57 k instructions an analysis).
+    fn for_measures(mech: &Mechanism, chart: &Chart) -> Self {
+        Self::analysed(mech, chart, false)
+    }
+
+    fn analysed(mech: &Mechanism, chart: &Chart, supports: bool) -> Self {
         let lu = BlockLu::new(&jacobian_pattern(mech, chart));
-        let u_bodies = u_bodies(mech, &lu);
-        let APattern { pairs: a_pairs, runs_at: a_runs_at, runs: a_runs, first: a_first, fill_in: a_fill_in } =
-            a_pattern(&u_bodies, mech.n_bodies());
-        System {
+        let mut sys = System {
             groups: GroupScales::new(mech, chart, &lu),
-            unit_reach: unit_reach(mech, &lu),
-            u_support: USupport::new(&u_bodies),
-            a_pairs,
-            a_runs_at,
-            a_runs,
-            a_first,
-            a_fill_in,
+            unit_reach: None,
+            u_support: USupport::default(),
+            a_pairs: Vec::new(),
+            a_runs_at: Vec::new(),
+            a_runs: Vec::new(),
+            a_first: Vec::new(),
+            a_fill_in: Vec::new(),
+            supports,
             supports_id: next_supports_id(),
             other: None,
             lu,
@@ -99,7 +111,21 @@ impl System {
             col_scale: col_scales(mech),
             factored: false,
             chart: chart.clone(),
+        };
+        if supports {
+            sys.analyse_supports(mech);
         }
+        sys
+    }
+
+    /// The supports of U and A from the analysed blocks.
+    fn analyse_supports(&mut self, mech: &Mechanism) {
+        self.unit_reach = unit_reach(mech, &self.lu);
+        let u_bodies = u_bodies(mech, &self.lu);
+        self.u_support = USupport::new(&u_bodies);
+        let a = a_pattern(&u_bodies, mech.n_bodies());
+        (self.a_pairs, self.a_runs_at, self.a_runs, self.a_first, self.a_fill_in) =
+            (a.pairs, a.runs_at, a.runs, a.first, a.fill_in);
     }
 
     /// Evaluate and factorise J(x). Err carries the column (body coordinate) that had no
@@ -116,12 +142,9 @@ impl System {
         if self.pattern_chart != *chart {
             self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
             self.groups = GroupScales::new(mech, chart, &self.lu);
-            self.unit_reach = unit_reach(mech, &self.lu);
-            let u_bodies = u_bodies(mech, &self.lu);
-            self.u_support = USupport::new(&u_bodies);
-            let a = a_pattern(&u_bodies, mech.n_bodies());
-            (self.a_pairs, self.a_runs_at, self.a_runs, self.a_first, self.a_fill_in) =
-                (a.pairs, a.runs_at, a.runs, a.first, a.fill_in);
+            if self.supports {
+                self.analyse_supports(mech);
+            }
             self.supports_id = next_supports_id();
             self.pattern_chart.clone_from(chart);
         }
@@ -142,9 +165,20 @@ impl System {
     /// A system kept with this one for the measures of `chart`, another chart than this one's
     /// (the passive measure's partition, which changes only where the pivots do): its pattern is
     /// analysed when the chart changes, not at each measure (the five-bar's analysis cost 74 k
-    /// instructions, its measure 35 k). Its factorisation is not this system's.
+    /// instructions, its measure 35 k). It serves the measures only (no supports of U and A);
+    /// its factorisation is not this system's.
     pub fn other_chart(&mut self, mech: &Mechanism, chart: &Chart) -> &mut System {
-        self.other.get_or_insert_with(|| Box::new(System::for_chart(mech, chart)))
+        self.other.get_or_insert_with(|| Box::new(System::for_measures(mech, chart)))
+    }
+
+    /// The system kept for another chart's measures ([`System::other_chart`]), if any.
+    pub fn other(&self) -> Option<&System> {
+        self.other.as_deref()
+    }
+
+    /// Keep `make()` as the system for another chart's measures, unless one is kept already.
+    pub fn keep_other(&mut self, make: impl FnOnce() -> System) {
+        self.other.get_or_insert_with(|| Box::new(make()));
     }
 
     /// Whether J is factorised (the last [`System::factor`] succeeded).

@@ -24,7 +24,7 @@ use super::trajectory::Trajectory;
 use super::{Observe, Settings};
 use crate::dynamics::{prescribed_sigma_min, Drives, Prescribed};
 use crate::integrate::{Options, Stats, Stepper};
-use crate::kinematics::{passive_sigma_min, passive_sigma_min_with, Chart};
+use crate::kinematics::{passive_sigma_min, Chart};
 use crate::model::Mechanism;
 use crate::Error;
 
@@ -56,6 +56,7 @@ enum Crossed {
 /// the stages keep between steps.
 pub struct Run<'a, 's, 'e> {
     settings: &'s Settings,
+    prepared: &'s Prepared,
     ode: MechanismOde<'a>,
     stepper: Stepper,
     traj: Trajectory,
@@ -93,7 +94,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// drive or the integrator failing at the start). Errors in the start itself return Err.
     pub fn start(
         mech: &'a Mechanism,
-        prepared: &Prepared,
+        prepared: &'s Prepared,
         settings: &'s Settings,
         drives: &'a mut dyn Drives,
         motion: &'a mut Prescribed<'a>,
@@ -118,9 +119,10 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         }
         let mut run = Run {
             settings,
+            prepared,
             ode,
             stepper,
-            traj: Trajectory::new(m, mech.n_x()),
+            traj: Trajectory::with_rows(m, mech.n_x(), settings.t_eval.as_ref().map_or(0, Vec::len)),
             t_eval: settings.t_eval.as_deref(),
             next: 0,
             approach: Approach::default(),
@@ -356,7 +358,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// Report a change point the run went through: in the trajectory's list, and in the least
     /// passive measure seen (the path passes through it, the accepted points do not).
     fn passed_point(&mut self, point: ChangePoint) {
-        let passive = passive_sigma_min(self.ode.mech, &point.x);
+        let (ode, prepared) = (&mut self.ode, self.prepared);
+        let passive = prepared.passive_measure(&mut ode.inputs_sys, ode.mech, &point.x);
         let stats = &mut self.traj.stats;
         stats.min_passive_sigma = stats.min_passive_sigma.min(passive);
         self.traj.change_points.push(point);
@@ -479,8 +482,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return true;
         }
         *self.heading.get_or_insert_with(|| {
-            let ode = &mut self.ode;
-            passive_sigma_min_with(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CHANGE_POINT_RATIO * meas.passive
+            let (ode, prepared) = (&mut self.ode, self.prepared);
+            prepared.passive_measure(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CHANGE_POINT_RATIO * meas.passive
         })
     }
 
@@ -497,7 +500,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let Some(last) = self.approach.last() else { return false };
         let saved = self.ode.save();
         let near = self.ode.evaluate(t, self.stepper.y()).map(|()| {
-            passive_sigma_min(self.ode.mech, &self.ode.ws.x) < CROSS_START || inside_step(&self.ode, last, t)
+            let (ode, prepared) = (&mut self.ode, self.prepared);
+            prepared.passive_measure(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CROSS_START
+                || inside_step(ode, last, t)
         });
         self.ode.restore(saved);
         near.unwrap_or(true)
