@@ -220,12 +220,14 @@ impl System {
     /// Per column j of U = dx/dz, the bodies it may be non-zero on, as runs (from the blocks
     /// its coordinate reaches): the products of U's columns skip the others.
     pub fn u_support(&self) -> &USupport {
+        debug_assert!(self.supports, "a system for measures only has no supports");
         &self.u_support
     }
 
     /// The pairs (j, k), j <= k, of columns of U that share a body: the entries of
     /// A = U^T M U (and its mirror) that may be non-zero, by rows k, j ascending.
     pub fn a_pairs(&self) -> &[(usize, usize)] {
+        debug_assert!(self.supports, "a system for measures only has no supports");
         &self.a_pairs
     }
 
