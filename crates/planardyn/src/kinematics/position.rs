@@ -288,3 +288,35 @@ pub fn assemble_into(mech: &Mechanism, q: &[f64], ws: &mut Frame) -> Result<(), 
     solve_position(mech, &drawn, ws)?;
     continue_to(mech, &drawn, q, ws)
 }
+
+#[cfg(test)]
+mod tests {
+    /// `scaled_distances` (two lanes, then their maximum) gives each distance the bits of the
+    /// entry-by-entry maximum `|a_i - b_i| / s_i` (a NaN entry passed over, as `f64::max`
+    /// does), at odd and even lengths, for one to three distances.
+    #[test]
+    fn scaled_distances_are_the_entrywise_maximum_to_the_bit() {
+        let entrywise = |a: &[f64], b: &[f64], s: &[f64]| {
+            a.iter().zip(b).zip(s).fold(0.0_f64, |d, ((x, y), s)| d.max((x - y).abs() / s))
+        };
+        // A deterministic spread of values, signs and scales (no random source needed).
+        let value = |k: usize| ((k * 7919 % 1013) as f64 - 506.0) * 1.37e-3 * (1.0 + (k % 5) as f64);
+        for n in 0..12 {
+            let a: Vec<f64> = (0..n).map(value).collect();
+            let mut b: Vec<f64> = (0..n).map(|i| value(i + 101)).collect();
+            let c: Vec<f64> = (0..n).map(|i| value(i + 211)).collect();
+            let s: Vec<f64> = (0..n).map(|i| 0.5 + (i % 3) as f64).collect();
+            if n > 4 {
+                b[n / 2] = f64::NAN;
+            }
+            let [d1] = super::scaled_distances(&a, [&b], &s);
+            let [d2, d3] = super::scaled_distances(&a, [&c, &b], &s);
+            let [e1, e2, e3] = super::scaled_distances(&a, [&b, &c, &a], &s);
+            assert_eq!(d1.to_bits(), entrywise(&a, &b, &s).to_bits(), "n = {n}");
+            assert_eq!(d2.to_bits(), entrywise(&a, &c, &s).to_bits(), "n = {n}");
+            assert_eq!((d3.to_bits(), e1.to_bits(), e2.to_bits()), (d1.to_bits(), d1.to_bits(), d2.to_bits()));
+            assert_eq!(e3, 0.0, "n = {n}");
+            assert!(n == 0 || d2 > 0.0, "n = {n}");
+        }
+    }
+}
