@@ -214,3 +214,39 @@ def test_double_parallelograms_cross_their_change_points_at_the_tolerance(double
     # five-bar's above): measured up to 6.5e-10.
     if rtol == 1e-11:
         assert abs(res.energy.drift) / res.energy.kinetic.max() < 1e-8
+
+
+#: A double parallelogram of benchmarks/change_point_sweep.py (seed 1, drawing 24) whose small
+#: cranks swing through their change points every 0.1-0.15 s, turning just past some of them:
+#: at 47791d6 every one of these 6 runs stopped at its crossing at 0.339 s ("integrating past
+#: the landing: right-hand side failed ... even for the smallest step"), the nodes past the
+#: landing run into the next change point, 0.118 s later.
+TURNING_PARALLELOGRAM = dict(crank=0.11739491614261098, spacing=0.6220292531623017, theta=3.0359579660097866)
+#: Its error against the reference where the crossings' nodes past the landing are squeezed
+#: before the next point: measured 5.0e-9 rad (DOPRI5 at rtol 1e-11; 4.7 ... 5.7 rtol at 1e-9).
+SQUEEZED_NODES = 1e-8
+
+
+@pytest.fixture(scope="module")
+def turning_parallelogram():
+    from planardyn import library as lib
+
+    mech = pd.from_dict(lib.double_parallelogram_model(**TURNING_PARALLELOGRAM))
+    t = np.linspace(0.0, 1.0, 101)
+    ref = mech.simulate(t_end=1.0, t_eval=t, method="dop853", rtol=1e-13, atol=1e-15)
+    assert ref.status == "success", ref.message
+    return mech, t, ref
+
+
+@pytest.mark.parametrize("method", ["dop853", "dopri5"])
+@pytest.mark.parametrize("rtol", [1e-6, 1e-9, 1e-11])
+def test_a_crossing_ends_its_nodes_before_the_next_change_point(turning_parallelogram, method, rtol):
+    mech, t, ref = turning_parallelogram
+    res = mech.simulate(t_end=1.0, t_eval=t, method=method, rtol=rtol, atol=1e-2 * rtol)
+    assert res.status == "success", res.message
+    assert len(res.change_points) == len(ref.change_points) == 7
+    assert np.abs(res.q - ref.q).max() < max(20 * rtol, SQUEEZED_NODES)
+    if rtol == 1e-11:
+        # The sweep's balance (its runs without an output grid): measured 5.5e-9 (DOP853).
+        run = mech.simulate(t_end=1.0, method=method, rtol=rtol, atol=1e-2 * rtol)
+        assert abs(run.energy.drift) / run.energy.kinetic.max() < 1e-8
