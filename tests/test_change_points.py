@@ -189,28 +189,68 @@ DOUBLE_PARALLELOGRAMS = [
 ]
 
 
-@pytest.fixture(scope="module", params=range(len(DOUBLE_PARALLELOGRAMS)))
-def double_parallelogram(request):
+def _with_reference(dims):
+    """A double parallelogram, its 101 output times over 1 s and its DOP853 rtol 1e-13 run."""
     from planardyn import library as lib
 
-    mech = pd.from_dict(lib.double_parallelogram_model(**DOUBLE_PARALLELOGRAMS[request.param]))
+    mech = pd.from_dict(lib.double_parallelogram_model(**dims))
     t = np.linspace(0.0, 1.0, 101)
     ref = mech.simulate(t_end=1.0, t_eval=t, method="dop853", rtol=1e-13, atol=1e-15)
     assert ref.status == "success", ref.message
     return mech, t, ref
 
 
+def _as_the_reference(with_reference, method, rtol, error):
+    """The run at rtol (atol 1e-2 rtol) on the reference's output times: it succeeds, crosses
+    as many change points as the reference and its q is within `error` of the reference's."""
+    mech, t, ref = with_reference
+    res = mech.simulate(t_end=1.0, t_eval=t, method=method, rtol=rtol, atol=1e-2 * rtol)
+    assert res.status == "success", res.message
+    assert len(res.change_points) == len(ref.change_points)
+    assert np.abs(res.q - ref.q).max() < error
+    return res
+
+
+@pytest.fixture(scope="module", params=range(len(DOUBLE_PARALLELOGRAMS)))
+def double_parallelogram(request):
+    return _with_reference(DOUBLE_PARALLELOGRAMS[request.param])
+
+
 @pytest.mark.parametrize("method", ["dop853", "dopri5"])
 @pytest.mark.parametrize("rtol", [1e-6, 1e-9, 1e-11])
 def test_double_parallelograms_cross_their_change_points_at_the_tolerance(double_parallelogram, method, rtol):
-    mech, t, ref = double_parallelogram
-    res = mech.simulate(t_end=1.0, t_eval=t, method=method, rtol=rtol, atol=1e-2 * rtol)
-    assert res.status == "success", res.message
-    assert len(res.change_points) == len(ref.change_points) >= 2
     # Against DOP853 at rtol 1e-13 (its own drift below 4e-12 of the peak kinetic energy):
     # measured up to 11.7 rtol (DOPRI5 at 1e-11), 20 rtol.
-    assert np.abs(res.q - ref.q).max() < 20 * rtol
+    res = _as_the_reference(double_parallelogram, method, rtol, 20 * rtol)
+    assert len(res.change_points) >= 2
     # The random sweep's energy balance at rtol 1e-11 (drift per peak kinetic energy, as the
     # five-bar's above): measured up to 6.5e-10.
     if rtol == 1e-11:
         assert abs(res.energy.drift) / res.energy.kinetic.max() < 1e-8
+
+
+#: A double parallelogram of benchmarks/change_point_sweep.py (seed 1, drawing 24) whose small
+#: cranks swing through their change points every 0.1-0.15 s, turning just past some of them:
+#: at 47791d6 every one of these 6 runs stopped at its crossing at 0.339 s ("integrating past
+#: the landing: right-hand side failed ... even for the smallest step"), the nodes past the
+#: landing run into the next change point, 0.118 s later.
+TURNING_PARALLELOGRAM = dict(crank=0.11739491614261098, spacing=0.6220292531623017, theta=3.0359579660097866)
+#: Its error against the reference where the crossings' nodes past the landing are squeezed
+#: before the next point: measured 5.0e-9 rad (DOPRI5 at rtol 1e-11; 4.7 ... 5.7 rtol at 1e-9).
+SQUEEZED_NODES = 1e-8
+
+
+@pytest.fixture(scope="module")
+def turning_parallelogram():
+    return _with_reference(TURNING_PARALLELOGRAM)
+
+
+@pytest.mark.parametrize("method", ["dop853", "dopri5"])
+@pytest.mark.parametrize("rtol", [1e-6, 1e-9, 1e-11])
+def test_a_crossing_ends_its_nodes_before_the_next_change_point(turning_parallelogram, method, rtol):
+    res = _as_the_reference(turning_parallelogram, method, rtol, max(20 * rtol, SQUEEZED_NODES))
+    assert len(res.change_points) == 7
+    if rtol == 1e-11:
+        # The sweep's balance (its runs without an output grid): measured 5.9e-9 (DOP853), 1.1e-9.
+        run = turning_parallelogram[0].simulate(t_end=1.0, method=method, rtol=rtol, atol=1e-2 * rtol)
+        assert abs(run.energy.drift) / run.energy.kinetic.max() < 1e-8

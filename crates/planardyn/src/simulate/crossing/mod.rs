@@ -103,6 +103,15 @@ const PROJECTION_FRACTION: f64 = 0.25;
 const TANGENT_MISMATCH: f64 = 1e-2;
 /// Lengthenings of the gap tried when the point past it is still too near the singularity.
 const ATTEMPTS: usize = 4;
+/// A point past the landing whose chart measure is below this fraction of the landing's ends
+/// the points integrated past it (`integrate_past`): the motion is heading into another
+/// singularity, where the evaluations lose accuracy and then fail. Double parallelograms of
+/// benchmarks/change_point_sweep.py whose motion turns near a change point (crank 0.117 m,
+/// spacing 0.622 m, theta 3.036: crossed at 0.339 s, the next point 0.118 s later) ran their
+/// nodes past the landing, 4.8 times the time to the point, into the next one ("even for the
+/// smallest step"). Half: the landing's measure is about [`CROSS_BELOW`], and the run's own
+/// crossings start as low as a fifth of it.
+const NEXT_SINGULARITY: f64 = 0.5;
 /// Corrections of a landing at most. Each changes it by about the last one's change times
 /// the contraction (gap |df/dy|: 1e-4 on A02), and the correction ends when that product is
 /// below the tolerance ([`CORRECTED`]): usually after 2, each an integration over
@@ -180,7 +189,7 @@ pub fn cross(
     let before_landing = ode.save();
     for attempt in 0..ATTEMPTS {
         let t_land = t + 2.0 * to_point * f64::from(1u32 << attempt);
-        let landed = match land(ode, &predictor, t_land, (passive, &ahead.x)) {
+        let landed = match land(ode, &predictor, t_land, (passive, &ahead.x, start.speed)) {
             // The motion turned away from a near miss (a dip of the measure near CROSS_BELOW,
             // the dimensions near a change point's) while the Taylor step ran on into it: a
             // five-bar with base 0.29991, proximal links 0.152 and distal 0.320 dips to 0.02
@@ -219,9 +228,19 @@ fn correct(
 ) -> Result<(Vec<f64>, Bridge), String> {
     let mut change = f64::INFINITY;
     let mut landing = Passed::of(ode, t_land, past);
+    let mut times = times.to_vec();
     for k in 1..=MAX_CORRECTIONS {
-        let after = integrate_past(ode, (t_land, &y), times, integration, stats)?;
+        let (mut after, clear) = integrate_past(ode, (t_land, &y), &times, integration, stats)?;
         return_to(ode, &landing, idx, &y)?;
+        // Another singularity ahead: the nodes again, spaced over the part clear of it (with
+        // the first nodes only, a double parallelogram drifted 3e-7 of its peak kinetic energy
+        // at rtol 1e-11, against 1e-8 for the sweep's balance).
+        if after.len() < times.len() && clear > t_land {
+            let h = (clear - t_land) / times.len() as f64;
+            times = (1..=times.len()).map(|j| t_land + j as f64 * h).collect();
+            after = integrate_past(ode, (t_land, &y), &times, integration, stats)?.0;
+            return_to(ode, &landing, idx, &y)?;
+        }
         landing = Passed::of(ode, t_land, past);
         let nodes: Vec<&Passed> = before.iter().copied().chain([&landing]).chain(&after).collect();
         let path = Bridge::new(&nodes, work, scale);
@@ -244,19 +263,20 @@ fn correct(
 
 /// Land the Taylor step `path` at `t_land`: its (x, xd) projected onto the branch (in the
 /// partition of [`partition_at`]), evaluated and anchored there; the partition, the state
-/// y = [z, zd, W] and the passive measure there. Err when the branch does not continue the
-/// motion.
+/// y = [z, zd, W] and the passive measure there. `passive`, `point` and `arrival`: the
+/// passive measure and scaled speed at the crossing's start, the change point. Err when the
+/// branch does not continue the motion.
 fn land(
     ode: &mut MechanismOde,
     path: &Bridge,
     t_land: f64,
-    (passive, point): (f64, &[f64]),
+    (passive, point, arrival): (f64, &[f64], f64),
 ) -> Result<(Vec<usize>, Vec<f64>, f64), Unprojected> {
     let n = path.coordinates();
     let (mut x, mut xd, mut xdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     path.at(t_land, &mut x, &mut xd, &mut xdd);
     let idx = partition_at(ode, &x);
-    let past = project(ode, &idx, (&x, &xd), (passive, point))?;
+    let past = project(ode, &idx, (&x, &xd), (passive, point, arrival))?;
     let y = partition_state(&idx, &ode.ws.x, &ode.ws.xd, path.work(t_land));
     if past >= 0.5 * passive {
         let set = ode.set_chart(Chart::Partition(idx.clone()), t_land, &y);
@@ -302,31 +322,41 @@ fn return_to(ode: &mut MechanismOde, landing: &Passed, idx: &[usize], y: &[f64])
 /// next step's Newton moves by the chart's measure there: the measure grows away from the
 /// point, and the landing's bounds (2 sigma from the last accepted point) kept for all of it
 /// refused every evaluation past them (a double parallelogram at 12 rad/s, landing at
-/// measure 7e-3: 2 ms past it, "even for the smallest step").
+/// measure 7e-3: 2 ms past it, "even for the smallest step"). The points end early, before a
+/// step whose chart measure is below [`NEXT_SINGULARITY`] of the landing's: the motion is
+/// heading into another singularity (the next change point, or the point again where the
+/// motion turns past it); with them, the last time accepted before that step.
 fn integrate_past(
     ode: &mut MechanismOde,
     (t_land, y): (f64, &[f64]),
     times: &[f64],
     integration: &Integration,
     stats: &mut Stats,
-) -> Result<Vec<Passed>, String> {
+) -> Result<(Vec<Passed>, f64), String> {
     let mut stepper = Stepper::new(integration.method, integration.options, y.len())?;
     let past = |e: StepError<Error>| format!("integrating past the landing: {e}");
     let mut outcome = stepper.reset(ode, t_land, y).map_err(past);
-    let own = chart_sigma(ode, f64::INFINITY);
-    stepper.bound_first_step(first_step_bound(ode, own));
+    let landing = chart_sigma(ode, f64::INFINITY);
+    stepper.bound_first_step(first_step_bound(ode, landing));
     let accepted = |ode: &mut MechanismOde, stepper: &Stepper, t: f64| {
         ode.accept(t, stepper.y()).map_err(|e| format!("past the landing: {e}"))?;
         let own = chart_sigma(ode, f64::INFINITY);
         ode.limit_correction(own);
-        Ok(())
+        Ok(own)
     };
     let mut out = Vec::with_capacity(times.len());
+    let (mut heading, mut clear) = (false, t_land);
     for &time in times {
-        while outcome.is_ok() && stepper.t() < time {
-            outcome = stepper.step(ode, time).map_err(past).and_then(|()| accepted(ode, &stepper, stepper.t()));
+        while outcome.is_ok() && !heading && stepper.t() < time {
+            let step = stepper.step(ode, time).map_err(past);
+            outcome = step.and_then(|()| accepted(ode, &stepper, stepper.t())).map(|own| {
+                heading = own < NEXT_SINGULARITY * landing;
+            });
+            if outcome.is_ok() && !heading {
+                clear = stepper.t();
+            }
         }
-        if outcome.is_err() {
+        if outcome.is_err() || heading {
             break;
         }
         out.push(Passed::of(ode, time, 0.0));
@@ -335,7 +365,7 @@ fn integrate_past(
     stats.nfev += local.nfev;
     stats.naccept += local.naccept;
     stats.nreject += local.nreject;
-    outcome.map(|()| out)
+    outcome.map(|()| (out, clear))
 }
 
 /// Why a predicted point past a change point is not on the motion's branch.
@@ -355,12 +385,13 @@ impl Unprojected {
 }
 
 /// Project the predicted (x, xd) onto the constraints and their tangent in the partition
-/// `idx`; the passive measure there, or why it is not the motion's branch.
+/// `idx` (`passive`, `point`, `arrival`: see [`land`]); the passive measure there, or why it
+/// is not the motion's branch.
 fn project(
     ode: &mut MechanismOde,
     idx: &[usize],
     (x, xd): (&[f64], &[f64]),
-    (passive, point): (f64, &[f64]),
+    (passive, point, arrival): (f64, &[f64], f64),
 ) -> Result<f64, Unprojected> {
     let mech = ode.mech;
     let ws = &mut ode.ws;
@@ -383,7 +414,13 @@ fn project(
         }
     }
     let scale = ws.sys.group_col_scale();
-    let speed = xd.iter().zip(scale).fold(0.0, |s: f64, (v, l)| s.max((v / l).abs()));
+    // The prediction's error is of the motion's speed over the gap, not of its speed at the
+    // landing: where the motion turns in the gap, the latter is a fraction of it (a double
+    // parallelogram turning 0.03 rad past its point: 0.20 at the landing against 2.7 arriving,
+    // 1.7e-2 off the tangent). A branch at an O(1) angle is then still told by the position
+    // (PROJECTION_FRACTION).
+    let landing = xd.iter().zip(scale).fold(0.0, |s: f64, (v, l)| s.max((v / l).abs()));
+    let speed = landing.max(arrival);
     let mismatch = scaled_distance(&ws.xd, xd, scale);
     if mismatch > TANGENT_MISMATCH * speed {
         let why = format!("the branch's tangent differs from the motion's by {:.2e} of its speed", mismatch / speed);
