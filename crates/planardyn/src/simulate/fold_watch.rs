@@ -25,10 +25,9 @@ const FOLD_DRIFT: f64 = 0.25;
 /// thousands of steps).
 const FOLD_ADVANCE: f64 = 0.01;
 
-/// A failed step's fold must lie within this many steps of the last accepted point: the steps
-/// that fail at a fold are those that try to pass it. A fixed step (rk4, or `dt`) can also
-/// end an accepted step past it, where the position solve then fails (the repro at rk4 dt
-/// 1e-3: its last measures are taken 0.8 and 1.8 steps before t*).
+/// A failed step's fold must lie within this many steps of the last accepted point, and the
+/// secant that predicts it end as near before it: the steps that fail at a fold are those that
+/// try to pass it, or (fixed steps: rk4, or `dt`) the ones after the step that passed it.
 const FOLD_REACH: f64 = 2.0;
 
 /// The driven coordinates' measure (their scaled smallest singular value, `sigma`) at the
@@ -40,8 +39,10 @@ pub struct FoldWatch {
     points: VecDeque<(f64, f64)>,
     /// When the measure last fell below [`NEAR_PASSIVE_SINGULAR`] (the first of `points`).
     entered: f64,
-    /// (t, sigma^2) at the last two accepted points where the measure was taken (at any value).
-    last: [Option<(f64, f64)>; 2],
+    /// (t, sigma^2) at the last accepted point where the measure was taken (at any value), and
+    /// the last two such successive points where it fell.
+    last: Option<(f64, f64)>,
+    fell: Option<[(f64, f64); 2]>,
 }
 
 impl FoldWatch {
@@ -55,7 +56,13 @@ impl FoldWatch {
     /// 3-RRR's fold, rounding in its 4e-11 s steps made the secants agree on a fold 0.0104 s
     /// ahead after 23 000 steps, 2.8e-3 s after the measure fell below the threshold.
     pub fn zeno(&mut self, t: f64, sigma: f64, h: f64) -> Option<f64> {
-        self.last = if sigma.is_finite() { [self.last[1], Some((t, sigma * sigma))] } else { [None, None] };
+        let point = (t, sigma * sigma);
+        match self.last.filter(|_| sigma.is_finite()) {
+            Some(before) if point.1 < before.1 => self.fell = Some([before, point]),
+            Some(_) => {}
+            None => self.fell = None,
+        }
+        self.last = sigma.is_finite().then_some(point);
         if sigma >= NEAR_PASSIVE_SINGULAR {
             self.points.clear();
             return None;
@@ -76,12 +83,13 @@ impl FoldWatch {
         (fixed && h < FOLD_ADVANCE * (now - t) && now - t < t - self.entered).then_some(now)
     }
 
-    /// The fold a run that failed after a step of h was running into: the secant of sigma^2
-    /// through the last two measured points falls and reaches 0 within [`FOLD_REACH`] steps
-    /// of h after the last (or before it: a step without error control may pass the fold).
-    pub fn ahead(&self, h: f64) -> Option<f64> {
-        let [Some(before), Some(last)] = self.last else { return None };
-        root(before, last).filter(|&t_star| t_star < last.0 + FOLD_REACH * h)
+    /// The fold a run that failed at t, after a step of h, was running into: the last secant
+    /// of sigma^2 that fell, ending within [`FOLD_REACH`] steps of h before t, reaches 0
+    /// within as many after t. A fixed step (no error control) can pass the fold: the
+    /// measures of the points it accepts past it rise again, or are not taken.
+    pub fn ahead(&self, t: f64, h: f64) -> Option<f64> {
+        let [before, last] = self.fell.filter(|[_, last]| t - last.0 <= FOLD_REACH * h)?;
+        root(before, last).filter(|&t_star| t_star < t + FOLD_REACH * h)
     }
 }
 

@@ -656,7 +656,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // Events alone need the dense output only while the run lasts.
         traj.dense = self.dense.filter(|_| self.keep_dense);
         let (mech, ode) = (self.ode.mech, &self.ode);
-        let fold = self.fold.ahead(self.stepper.t() - self.stepper.t_prev());
+        let fold = self.fold.ahead(self.stepper.t(), self.stepper.t() - self.stepper.t_prev());
         (traj.status, traj.message) = stop.describe(|| Near {
             passive: passive_sigma_min(mech, ode.anchor_x()),
             driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
