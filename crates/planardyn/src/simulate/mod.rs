@@ -7,6 +7,7 @@ pub mod columns;
 pub mod crossing;
 pub mod dense;
 pub mod events;
+mod fold_watch;
 mod jacobian;
 pub mod ode;
 mod overrides;

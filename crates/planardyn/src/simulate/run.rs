@@ -16,6 +16,7 @@ use super::crossing::{
 };
 use super::dense::{self, DenseOutput};
 use super::events::Watch;
+use super::fold_watch::FoldWatch;
 use super::ode::MechanismOde;
 use super::prepared::Prepared;
 use super::start;
@@ -660,69 +661,20 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // Events alone need the dense output only while the run lasts.
         traj.dense = self.dense.filter(|_| self.keep_dense);
         let (mech, ode) = (self.ode.mech, &self.ode);
+        let fold = self.fold.ahead(self.stepper.t(), self.stepper.t() - self.stepper.t_prev());
         (traj.status, traj.message) = stop.describe(|| Near {
             passive: passive_sigma_min(mech, ode.anchor_x()),
             driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
+            fold,
         });
         traj
-    }
-}
-
-/// Accepted points in the fold's fit: two secants of [`FOLD_SPAN`] steps each.
-const FOLD_SPAN: usize = 4;
-
-/// The fold's prediction may move by this fraction of the time the run advanced. Near a fold
-/// the measure's square is k (t* - t), and t* stays put (the repro of tests/test_prescribed_fold.py:
-/// |dt*/dt| < 0.04 over its last 2 ms). A motion that passes close to it and turns back has
-/// sigma^2 ~ k (d + c (t - t_m)^2), whose secants predict a t* that moves at least half as fast
-/// as t (measured: 0.53 ... 0.85 at d = 1e-4 and 1e-6 s before its minimum, more after).
-const FOLD_DRIFT: f64 = 0.25;
-
-/// A step shorter than this fraction of the predicted time left to the fold no longer
-/// advances towards it: the steps close in geometrically while the integrator resolves the
-/// approach (about 0.2 of the time left each step, in the repro), and stall at the
-/// tolerance's resolution of the fold (4e-4 there, 2e-13 s steps 5e-10 s before t*, for
-/// thousands of steps).
-const FOLD_ADVANCE: f64 = 0.01;
-
-/// The driven coordinates' measure (their scaled smallest singular value, `sigma`) at the
-/// last accepted points, while it is below [`NEAR_PASSIVE_SINGULAR`], the threshold of their
-/// diagnosis. Near a fold of the driven coordinates sigma^2 falls linearly in t to 0 at t*.
-#[derive(Default)]
-struct FoldWatch {
-    /// (t, sigma^2), the oldest first; at most 2 FOLD_SPAN + 1.
-    points: std::collections::VecDeque<(f64, f64)>,
-}
-
-impl FoldWatch {
-    /// Keep the point accepted at t (measure `sigma`, after a step of h); the fold's time when
-    /// the run steps towards it without reaching it: two successive secants of sigma^2 over
-    /// t both fall and predict the same t* (within [`FOLD_DRIFT`] of the time between them),
-    /// and the step h is below [`FOLD_ADVANCE`] of the time left to it.
-    fn zeno(&mut self, t: f64, sigma: f64, h: f64) -> Option<f64> {
-        if sigma >= NEAR_PASSIVE_SINGULAR {
-            self.points.clear();
-            return None;
-        }
-        if self.points.len() > 2 * FOLD_SPAN {
-            self.points.pop_front();
-        }
-        self.points.push_back((t, sigma * sigma));
-        if self.points.len() <= 2 * FOLD_SPAN {
-            return None;
-        }
-        let root = |(t0, s0): (f64, f64), (t1, s1): (f64, f64)| (s1 < s0).then(|| t1 + s1 * (t1 - t0) / (s0 - s1));
-        let (first, mid, last) = (self.points[0], self.points[FOLD_SPAN], self.points[2 * FOLD_SPAN]);
-        let (before, now) = (root(first, mid)?, root(mid, last)?);
-        let fixed = (now - before).abs() < FOLD_DRIFT * (last.0 - mid.0);
-        (fixed && h < FOLD_ADVANCE * (now - t)).then_some(now)
     }
 }
 
 /// The trajectory of a run that stopped before its first step: no row, its status.
 pub fn stopped_at_start(mech: &Mechanism, stop: Stop) -> Trajectory {
     let mut traj = Trajectory::new(mech.dof(), mech.n_x());
-    (traj.status, traj.message) = stop.describe(|| Near { passive: f64::INFINITY, driven: f64::INFINITY });
+    (traj.status, traj.message) = stop.describe(|| Near { passive: f64::INFINITY, driven: f64::INFINITY, fold: None });
     traj
 }
 

@@ -53,6 +53,9 @@ pub enum Stop {
 pub struct Near {
     pub passive: f64,
     pub driven: f64,
+    /// The fold of the driven coordinates the run was running into, if their measure fell
+    /// towards one within its last steps (`FoldWatch::ahead`).
+    pub fold: Option<f64>,
 }
 
 impl Stop {
@@ -82,7 +85,7 @@ impl Stop {
         if !failed && stalled.is_none() {
             return (status, message);
         }
-        let Near { passive, driven } = near();
+        let Near { passive, driven, fold } = near();
         if let Some(t) = stalled {
             if driven >= NEAR_PASSIVE_SINGULAR {
                 return (status, message);
@@ -107,6 +110,15 @@ impl Stop {
                 "{message}; the coordinates driven by motion are near a singularity of their own there (scaled \
                  measure {driven:.2e}): they stop determining their part of the mechanism, and the efforts their \
                  motion needs grow without bound. Change the motion so that it avoids this configuration"
+            );
+            (status, message)
+        } else if let Some(t_star) = fold {
+            let message = format!(
+                "{message}; the prescribed motion runs into a fold of its driven coordinates at t ≈ {} s: their \
+                 scaled measure ({driven:.2e} at the last accepted point) falls like the square root of the time \
+                 left to it, and past it the mechanism does not assemble at the prescribed coordinates. \
+                 {CHANGE_THE_MOTION}",
+                Time(t_star)
             );
             (status, message)
         } else {

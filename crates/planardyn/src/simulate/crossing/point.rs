@@ -272,4 +272,28 @@ mod tests {
             assert_eq!(point.rank_drop, if expected == T_STAR { 2 } else { 0 }, "[{a}, {b}]");
         }
     }
+
+    #[test]
+    fn a_change_point_at_either_end_is_located_within_its_bracket() {
+        // T_STAR inside [a, b], `at` end brackets (LOCATE_BRACKET (b - a)) from a or from b:
+        // on the end itself, inside the end's bracket (the end check answers), just past it
+        // and 2 brackets in (the search goes on). Each within the stated tolerance of T_STAR.
+        let (mech, fold) = a02_folded();
+        let dx: Vec<f64> = fold.iter().zip(&mech.x0).map(|(f, x0)| f - x0).collect();
+        let line = Line { fold, dx };
+        for len in [0.2, 0.013] {
+            let end = LOCATE_BRACKET * len;
+            for at in [0.0, 0.3, 0.5, 0.99, 1.01, 2.0] {
+                let from_a = T_STAR - at * end;
+                let from_b = T_STAR + at * end;
+                for (a, b) in [(from_a, from_a + len), (from_b - len, from_b)] {
+                    let point = located(&mech, &line, a, b);
+                    let tolerance = 0.5 * end + 4.0 * f64::EPSILON * b;
+                    let miss = (point.t - T_STAR).abs();
+                    assert!(miss <= tolerance, "[{a}, {b}] at {at}: {} off by {miss:e} > {tolerance:e}", point.t);
+                    assert_eq!(point.rank_drop, 2, "[{a}, {b}] at {at}");
+                }
+            }
+        }
+    }
 }

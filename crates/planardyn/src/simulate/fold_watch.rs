@@ -1,0 +1,150 @@
+//! A prescribed motion that runs into a fold of its driven coordinates: their measure falls
+//! like sqrt(t* - t), the steps shrink towards t* without passing it, and past it the mechanism
+//! does not assemble at the prescribed coordinates. [`FoldWatch`] predicts t* from the
+//! measure's square, linear in t near it, to stop such a run (`Stop::Fold`) and to say why a
+//! run failed at it (`Near::fold`).
+
+use std::collections::VecDeque;
+
+use super::charts::NEAR_PASSIVE_SINGULAR;
+
+/// Accepted points in the fold's fit: two secants of [`FOLD_SPAN`] steps each.
+const FOLD_SPAN: usize = 4;
+
+/// The fold's prediction may move by this fraction of the time the run advanced. Near a fold
+/// the measure's square is k (t* - t), and t* stays put (the repro of tests/test_prescribed_fold.py:
+/// |dt*/dt| < 0.04 over its last 2 ms). A motion that passes close to it and turns back has
+/// sigma^2 ~ k (d + c (t - t_m)^2), whose secants predict a t* that moves at least half as fast
+/// as t (measured: 0.53 ... 0.85 at d = 1e-4 and 1e-6 s before its minimum, more after).
+const FOLD_DRIFT: f64 = 0.25;
+
+/// A step shorter than this fraction of the predicted time left to the fold no longer
+/// advances towards it: the steps close in geometrically while the integrator resolves the
+/// approach (about 0.2 of the time left each step, in the repro), and stall at the
+/// tolerance's resolution of the fold (4e-4 there, 2e-13 s steps 5e-10 s before t*, for
+/// thousands of steps).
+const FOLD_ADVANCE: f64 = 0.01;
+
+/// A failed step's fold must lie within this many steps of the last accepted point, and the
+/// secant that predicts it end as near before it: the steps that fail at a fold are those that
+/// try to pass it, or (fixed steps: rk4, or `dt`) the ones after the step that passed it.
+const FOLD_REACH: f64 = 2.0;
+
+/// The driven coordinates' measure (their scaled smallest singular value, `sigma`) at the
+/// last accepted points, while it is below [`NEAR_PASSIVE_SINGULAR`], the threshold of their
+/// diagnosis. Near a fold of the driven coordinates sigma^2 falls linearly in t to 0 at t*.
+#[derive(Default)]
+pub struct FoldWatch {
+    /// (t, sigma^2), the oldest first; at most 2 FOLD_SPAN + 1.
+    points: VecDeque<(f64, f64)>,
+    /// When the measure last fell below [`NEAR_PASSIVE_SINGULAR`] (the first of `points`).
+    entered: f64,
+    /// (t, sigma^2) at the last accepted point where the measure was taken (at any value), and
+    /// the last two such successive points where it fell.
+    last: Option<(f64, f64)>,
+    fell: Option<[(f64, f64); 2]>,
+}
+
+impl FoldWatch {
+    /// Keep the point accepted at t (measure `sigma`, after a step of h); the fold's time when
+    /// the run steps towards it without reaching it: two successive secants of sigma^2 over
+    /// t both fall and predict the same t* (within [`FOLD_DRIFT`] of the time between them),
+    /// and the step h is below [`FOLD_ADVANCE`] of the time left to it, which is shorter than
+    /// the time the measure has been below [`NEAR_PASSIVE_SINGULAR`]. On sigma^2 = k (t* - t)
+    /// the latter holds once sigma is below 1/sqrt(2) of that threshold. A pass-by near its
+    /// closest approach (a flat sigma^2) has a far t*: at DOP853 rtol 1e-12, 1e-7 s from the
+    /// 3-RRR's fold, rounding in its 4e-11 s steps made the secants agree on a fold 0.0104 s
+    /// ahead after 23 000 steps, 2.8e-3 s after the measure fell below the threshold.
+    pub fn zeno(&mut self, t: f64, sigma: f64, h: f64) -> Option<f64> {
+        let point = (t, sigma * sigma);
+        match self.last.filter(|_| sigma.is_finite()) {
+            Some(before) if point.1 < before.1 => self.fell = Some([before, point]),
+            Some(_) => {}
+            None => self.fell = None,
+        }
+        self.last = sigma.is_finite().then_some(point);
+        if sigma >= NEAR_PASSIVE_SINGULAR {
+            self.points.clear();
+            return None;
+        }
+        if self.points.is_empty() {
+            self.entered = t;
+        }
+        if self.points.len() > 2 * FOLD_SPAN {
+            self.points.pop_front();
+        }
+        self.points.push_back((t, sigma * sigma));
+        if self.points.len() <= 2 * FOLD_SPAN {
+            return None;
+        }
+        let (first, mid, last) = (self.points[0], self.points[FOLD_SPAN], self.points[2 * FOLD_SPAN]);
+        let (before, now) = (root(first, mid)?, root(mid, last)?);
+        let fixed = (now - before).abs() < FOLD_DRIFT * (last.0 - mid.0);
+        (fixed && h < FOLD_ADVANCE * (now - t) && now - t < t - self.entered).then_some(now)
+    }
+
+    /// The fold a run that failed at t, after a step of h, was running into: the last secant
+    /// of sigma^2 that fell, ending within [`FOLD_REACH`] steps of h before t, reaches 0
+    /// within as many after t. A fixed step (no error control) can pass the fold: the
+    /// measures of the points it accepts past it rise again, or are not taken.
+    pub fn ahead(&self, t: f64, h: f64) -> Option<f64> {
+        let [before, last] = self.fell.filter(|[_, last]| t - last.0 <= FOLD_REACH * h)?;
+        root(before, last).filter(|&t_star| t_star < t + FOLD_REACH * h)
+    }
+}
+
+/// Where the line through two points (t, sigma^2) reaches 0, if it falls.
+fn root((t0, s0): (f64, f64), (t1, s1): (f64, f64)) -> Option<f64> {
+    (s1 < s0).then(|| t1 + s1 * (t1 - t0) / (s0 - s1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 3-RRR's fold (tests/test_prescribed_fold.py): sigma^2 = K (T_STAR - t).
+    const K: f64 = 0.0112;
+    const T_STAR: f64 = 0.1107510027;
+
+    #[test]
+    fn a_run_that_stalls_before_the_fold_is_stopped_there() {
+        // Steps of 0.2 of the time left from where the measure falls below the threshold,
+        // then steps of 2e-13 s 5e-10 s before T_STAR (the repro's stall).
+        let mut watch = FoldWatch::default();
+        let mut t = T_STAR - 0.99 * NEAR_PASSIVE_SINGULAR.powi(2) / K;
+        let mut stop = None;
+        for k in 0..200 {
+            let h = if T_STAR - t > 5e-10 { 0.2 * (T_STAR - t) } else { 2e-13 };
+            t += h;
+            stop = watch.zeno(t, (K * (T_STAR - t)).sqrt(), h);
+            if stop.is_some() {
+                assert!(k > 10, "stopped after {k} steps at {t}");
+                break;
+            }
+        }
+        let t_star = stop.expect("a stop at the fold");
+        assert!((t_star - T_STAR).abs() < 1e-12, "{t_star}");
+    }
+
+    #[test]
+    fn a_pass_by_ground_to_tiny_steps_is_not_a_fold() {
+        // A pass-by 1e-7 s from the fold, K (1e-7 + C (t - tm)^2) (C from the motion's turn),
+        // below the threshold from 2.8e-3 s before its closest approach at tm; then steps of
+        // 4e-11 s at 4.3e-7 s before tm (DOP853 at rtol 1e-12 on it). Over a few steps the
+        // measure's square is linear to rounding: its secants agree on a t* 0.0104 s ahead.
+        const C: f64 = 11.1;
+        let (d, tm) = (1e-7, T_STAR);
+        let sigma = |t: f64| (K * (d + C * (t - tm) * (t - tm))).sqrt();
+        let mut watch = FoldWatch::default();
+        let t_in = tm - 2.8e-3;
+        assert!(sigma(t_in) < NEAR_PASSIVE_SINGULAR);
+        assert_eq!(watch.zeno(t_in, sigma(t_in), 1e-4), None);
+        let (t0, h) = (tm - 4.3e-7, 4e-11);
+        let slope = 2.0 * K * C * (t0 - tm);
+        for k in 0..20 {
+            let t = t0 + k as f64 * h;
+            let s2 = sigma(t0).powi(2) + slope * (t - t0);
+            assert_eq!(watch.zeno(t, s2.sqrt(), h), None, "step {k} at {t}");
+        }
+    }
+}
