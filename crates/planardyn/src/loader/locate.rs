@@ -158,7 +158,8 @@ impl Reader {
             let rest = &line[indent..];
             let marker = indent == 0
                 && (rest.first() == Some(&'%')
-                    || ([['-'; 3], ['.'; 3]].iter().any(|m| rest.starts_with(m)) && rest.get(3).is_none_or(|&c| c == ' ')));
+                    || ([['-'; 3], ['.'; 3]].iter().any(|m| rest.starts_with(m))
+                        && rest.get(3).is_none_or(|&c| c == ' ')));
             let blank = rest.iter().all(|c| c.is_whitespace()) || rest.first() == Some(&'#');
             if !(blank || marker) {
                 self.col = indent;
