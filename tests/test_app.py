@@ -105,10 +105,8 @@ def refusal(capsys, *argv: str) -> str:
 
 @pytest.mark.parametrize("written, message", [
     ("mass: [0.5", "invalid type: list, "),
-    # A value that parses but is refused: the field is named, not its line.
-    pytest.param("mass: -0.5", "mass must be > 0 kg, got -0.5", marks=pytest.mark.xfail(
-        strict=True, reason="the loader locates a validation error by its field path only (the core's "
-        "loader/io.rs with_line adds a line to points.* construction errors alone): a core change")),
+    # A value that parses but is refused: located as a parse error is (loader/locate.rs).
+    ("mass: -0.5", "mass must be > 0 kg, got -0.5"),
 ])
 def test_the_command_refuses_a_broken_model_with_its_file_field_line_and_column(tmp_path, capsys, written, message):
     # The loader's located error, as `planardyn check` gives it (one path: the loader's message).

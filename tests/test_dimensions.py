@@ -224,7 +224,7 @@ def test_errors_name_the_field_and_the_fix(page):
         pdy.loads(text.replace('[O4, "125 mm"]', '[O4, "20 mm"]'), source="hoeken.yaml")
     assert str(e.value).startswith("hoeken.yaml: points.B: the circles of radius 0.125 m about A and 0.02 m about O4 "
                                    "do not meet: their centres are 0.15 m apart, more than the sum of the radii 0.145 "
-                                   "by 5.000000e-3 m (line 7); change a radius by at least that, or move a centre")
+                                   "by 5.000000e-3 m (line 7 column 6); change a radius by at least that, or move a centre")
 
 
 def test_check_prints_the_derived_dimensions(page, capsys):

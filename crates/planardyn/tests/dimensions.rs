@@ -133,7 +133,7 @@ fn circles_that_do_not_meet_name_the_point_and_the_gap() {
         msg,
         format!(
             "m.yaml: points.B: the circles of radius 0.5 m about A and 0.3 m about D do not meet: their centres are \
-             0.866025403784 m apart, more than the sum of the radii 0.8 by {:.6e} m (line 8); change a radius by at least that, \
+             0.866025403784 m apart, more than the sum of the radii 0.8 by {:.6e} m (line 8 column 6); change a radius by at least that, \
              or move a centre",
             d - 0.8
         )
@@ -143,18 +143,21 @@ fn circles_that_do_not_meet_name_the_point_and_the_gap() {
         Format::Yaml,
     );
     assert!(msg.contains("one lies inside the other"), "{msg}");
-    // In JSON too, the line of the point's key.
+    // In JSON too, the line of the point's key and the column of its value.
     let json = "{\n  \"name\": \"x\",\n  \"points\": {\n    \"A\": [0, 0],\n    \"D\": [1, 0],\n    \
                 \"B\": {\"circles\": [[\"A\", 0.2], [\"D\", 0.3]], \"side\": \"left\"}\n  },\n  \
                 \"bodies\": {}, \"pairs\": [], \"coordinates\": []\n}";
     let msg = refused(json, Format::Json);
-    assert!(msg.starts_with("m.yaml: points.B: the circles") && msg.contains("by 5.000000e-1 m (line 6); "), "{msg}");
+    assert!(
+        msg.starts_with("m.yaml: points.B: the circles") && msg.contains("by 5.000000e-1 m (line 6 column 10); "),
+        "{msg}"
+    );
 }
 
 #[test]
 fn constructions_refer_to_points_that_exist_and_do_not_go_round() {
     let msg = refused(&four_bar_by_dimensions().replace("from: O,", "from: Q,"), Format::Yaml);
-    assert!(msg.starts_with("m.yaml: points.A: unknown point 'Q' (line 7); points are: O, D, A, B"), "{msg}");
+    assert!(msg.starts_with("m.yaml: points.A: unknown point 'Q' (line 7 column 6); points are: O, D, A, B"), "{msg}");
     let msg = refused(&four_bar_by_dimensions().replace("from: O,", "from: B,"), Format::Yaml);
     assert!(msg.contains("points.A: 'A' is constructed from B, which cannot be placed before it"), "{msg}");
     // A construction missing its side says so.
@@ -170,7 +173,7 @@ fn a_value_in_a_unit_of_the_wrong_motion_is_refused() {
     let msg = refused(&four_bar_by_dimensions().replace("{angle: [O, A]}", "\"60 mm\""), Format::Yaml);
     assert_eq!(
         msg,
-        "m.yaml: coordinates[0].value: the pair 'O' turns, so its value is an angle; give it in rad or deg"
+        "m.yaml: coordinates[0].value: the pair 'O' turns, so its value is an angle (line 20 column 36); give it in rad or deg"
     );
     let m = load(&four_bar_by_dimensions().replace("{angle: [O, A]}", "\"60 deg\""));
     assert!((m.spec.coordinates[0].value - PI / 3.0).abs() < CONSTRUCTED_TOL);

@@ -137,21 +137,29 @@ const TRIANGLE: &str = "name: s\npoints: {O: [0, 0], A: [1, 0], B: [0, 1]}\ngrou
 
 #[test]
 fn a_structure_is_told_it_cannot_move_whatever_its_coordinates() {
-    let expected = "m.yaml: coordinates: the drawing is a structure (mobility 0): its 6 pair constraints have rank 6 = 3n \
-        in the drawing (Chebyshev-Grubler: 3n - 2p = 3*2 - 2*3 = 0), so nothing can move, and planardyn moves mechanisms \
-        only; remove a pair or a body (or add a body) until the mobility is at least 1, or check the drawing, then give \
-        one coordinate per degree of freedom";
-    for coordinates in ["coordinates: []\n", "coordinates:\n  - {name: q, pair: O, value: 1.5707963267948966}\n"] {
+    // Located at the list's value on its key's line, or at the key above a block list.
+    for (coordinates, at) in [
+        ("coordinates: []\n", "line 11 column 14"),
+        ("coordinates:\n  - {name: q, pair: O, value: 1.5707963267948966}\n", "line 11 column 1"),
+    ] {
         let (msg, path) = refused(&format!("{TRIANGLE}{coordinates}"), Format::Yaml);
         assert_eq!(path, "coordinates");
-        assert_eq!(msg, expected);
+        assert_eq!(
+            msg,
+            format!(
+                "m.yaml: coordinates: the drawing is a structure (mobility 0): its 6 pair constraints have rank 6 = 3n \
+                 in the drawing (Chebyshev-Grubler: 3n - 2p = 3*2 - 2*3 = 0), so nothing can move, and planardyn moves \
+                 mechanisms only ({at}); remove a pair or a body (or add a body) until the mobility is at least 1, or \
+                 check the drawing, then give one coordinate per degree of freedom"
+            )
+        );
     }
     // A mechanism with no coordinate is told how many to give.
     let (msg, _) =
         refused(&FOUR_BAR.replace("  - {name: theta1, pair: O, value: 1.0471975511965976}\n", ""), Format::Yaml);
     assert_eq!(
         msg,
-        "m.yaml: coordinates: no generalized coordinates, but the mechanism has mobility 3n - rank = 1; \
+        "m.yaml: coordinates: no generalized coordinates, but the mechanism has mobility 3n - rank = 1 (line 19 column 1); \
          name 1 input pair(s) under `coordinates`"
     );
 }
@@ -187,7 +195,8 @@ fn a_centre_of_mass_far_outside_the_drawing_is_named() {
     assert_eq!(
         msg,
         "m.yaml: bodies.crank.com: the centre of mass [1000000000, 0.2] is 1.000e9 m from the nearest point of body \
-         'crank', more than 1e6 times the size of the drawing (1.6351920284924188 m): it is far outside the drawing; \
+         'crank', more than 1e6 times the size of the drawing (1.6351920284924188 m): it is far outside the drawing \
+         (line 11 column 74); \
          check its coordinates and units (SI: metres), and give it in the same frame as `points`"
     );
     // A part's centre of mass is named as the part's.
@@ -207,7 +216,7 @@ fn an_unnamed_pair_is_not_referenced_by_its_made_up_name() {
     assert_eq!(
         msg,
         "m.yaml: coordinates[0].pair: 'crank-coupler@A' is the name made up for the unnamed pairs[1], which a model \
-         may not refer to; give that pair a `name:` and refer to it by that name"
+         may not refer to (line 20 column 26); give that pair a `name:` and refer to it by that name"
     );
 }
 
@@ -225,4 +234,67 @@ fn a_yaml_tag_is_refused_where_it_is() {
     assert!(msg.starts_with("m.yaml: line 1 column 1: the YAML tag `!model` is not part"), "{msg}");
     // The core tags are YAML's own types, and `!` inside a plain string is text.
     yaml(&FOUR_BAR.replace("mass: 0.5,", "mass: !!float 0.5,").replace("under gravity", "under gravity !x"));
+}
+
+/// A drive whose table's times go back (its third), for the drive's refused value.
+const DRIVE: &str = "drives:\n  - coordinate: theta1\n    table:\n      t: [0, 2, 1]\n      effort: [1, 2, 3]\n";
+
+/// A value the loader's checks refuse (a body's mass, a pair's point in the list of pairs, a
+/// point, a drive's time) is located as a parse error is, `(line L column C)` of the value
+/// before the fix, in YAML block style (the shipped four-bar), flow style (`FOUR_BAR`'s
+/// bodies, pairs and coordinates) and JSON (`FOUR_BAR` with a drive, pretty-printed).
+#[test]
+fn a_refused_value_is_located_in_yaml_block_and_flow_and_json() {
+    let shipped = format!("{}/../../examples/models/four-bar-gravity.yaml", env!("CARGO_MANIFEST_DIR"));
+    let block = std::fs::read_to_string(shipped).unwrap();
+    let json = serde_json::to_string_pretty(&yaml(&format!("{FOUR_BAR}{}", DRIVE.replace("1]", "7]"))).spec).unwrap();
+    let mass = "bodies.rocker.mass: mass must be > 0 kg, got -1";
+    let pair = ("pairs[2].at: unknown point 'Q'", "; points are: O, D, A, B (use one of them, or add it to `points`)");
+    let point = "points.B: 1e31 is beyond the largest magnitude accepted, 1e30: check the units (SI)";
+    let drive = "drives[0].table.t[2]: times must increase strictly";
+    let drive_block = format!("{DRIVE}simulate:");
+    let drive_flow = format!("{DRIVE}coordinates:");
+    let cases = [
+        (block.as_str(), Format::Yaml, "    mass: 1.0\n", "    mass: -1.0\n", mass, "(line 36 column 11)", ""),
+        (block.as_str(), Format::Yaml, "at: B,", "at: Q,", pair.0, "(line 43 column 48)", pair.1),
+        (block.as_str(), Format::Yaml, "B: [1.336926485022576,", "B: [1e31,", point, "(line 20 column 6)", ""),
+        (block.as_str(), Format::Yaml, "simulate:", &drive_block, drive, "(line 60 column 17)", ""),
+        (FOUR_BAR, Format::Yaml, "mass: 1.0,", "mass: -1.0,", mass, "(line 13 column 34)", ""),
+        (FOUR_BAR, Format::Yaml, "at: B,", "at: Q,", pair.0, "(line 17 column 26)", pair.1),
+        (FOUR_BAR, Format::Yaml, "B: [1.336926485022576,", "B: [1e31,", point, "(line 8 column 6)", ""),
+        (FOUR_BAR, Format::Yaml, "coordinates:", &drive_flow, drive, "(line 22 column 17)", ""),
+        (json.as_str(), Format::Json, "\"mass\": 1.0", "\"mass\": -1.0", mass, "(line 59 column 15)", ""),
+        (json.as_str(), Format::Json, "\"at\": \"B\"", "\"at\": \"Q\"", pair.0, "(line 87 column 13)", pair.1),
+        (json.as_str(), Format::Json, "1.336926485022576", "1e31", point, "(line 20 column 10)", ""),
+        (json.as_str(), Format::Json, "7.0", "1.0", drive, "(line 117 column 11)", ""),
+    ];
+    for (text, format, old, new, what, at, fix) in cases {
+        assert!(text.contains(old), "{old}");
+        let (msg, _) = refused(&text.replacen(old, new, 1), format);
+        assert_eq!(msg, format!("m.yaml: {what} {at}{fix}"));
+    }
+}
+
+/// A field the text does not give is located at its parent: a body's missing `inertia` at the
+/// body (its key above a block, its mapping's `{` in flow style and JSON).
+#[test]
+fn a_missing_fields_error_is_located_at_its_parent() {
+    let shipped = format!("{}/../../examples/models/four-bar-gravity.yaml", env!("CARGO_MANIFEST_DIR"));
+    let block = std::fs::read_to_string(shipped).unwrap();
+    let json = serde_json::to_string_pretty(&yaml(FOUR_BAR).spec).unwrap();
+    let cases = [
+        (block.as_str(), Format::Yaml, "    inertia: 0.08333333333333333\n", "(line 34 column 3)"),
+        (FOUR_BAR, Format::Yaml, " inertia: 0.08333333333333333,", "(line 13 column 11)"),
+        (json.as_str(), Format::Json, "\n      \"inertia\": 0.08333333333333333,", "(line 54 column 15)"),
+    ];
+    for (text, format, written, at) in cases {
+        assert!(text.contains(written), "{written}");
+        let (msg, _) = refused(&text.replacen(written, "", 1), format);
+        assert_eq!(
+            msg,
+            format!(
+                "m.yaml: bodies.rocker.inertia: missing: add the moment of inertia about the centre of mass (kg m^2) {at}"
+            )
+        );
+    }
 }

@@ -3,7 +3,7 @@
 //! put in plain words by [`super::parse_errors`].
 
 use super::parse_errors::Input;
-use super::{nesting, tags, Format};
+use super::{locate, nesting, tags, Format};
 use crate::model::construct;
 use crate::model::spec::{PointSpec, ValueSpec};
 use crate::model::{Mechanism, MechanismSpec};
@@ -36,7 +36,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<Mechanism, ModelError> {
 /// Parse model text; `source` names it in error messages.
 pub fn loads(text: &str, format: Format, source: &str) -> Result<Mechanism, ModelError> {
     let spec = parse_spec(text, format, source)?;
-    super::build(spec, source)
+    super::build(spec, source).map_err(|e| with_line(e, text, format))
 }
 
 /// Parse model text into its specification without validating it: quantities with units
@@ -60,31 +60,17 @@ pub fn parse_spec_constructed(
     Ok((spec, constructed))
 }
 
-/// A construction's error with the line of its point in the text: `points.B: ... (line 8); fix`.
+/// A check's error with where its field is written, as a parse error's:
+/// `bodies.crank.mass: mass must be > 0 kg, got -1 (line 26 column 11)`, before the fix
+/// where the message gives one (`...; fix`).
 fn with_line(e: ModelError, text: &str, format: Format) -> ModelError {
     let ModelError::Invalid { source_name, path, message } = e else { return e };
-    let line = path.strip_prefix("points.").and_then(|name| point_line(text, format, name));
-    let message = match (line, message.split_once("; ")) {
-        (Some(line), Some((what, fix))) => format!("{what} (line {line}); {fix}"),
-        (Some(line), None) => format!("{message} (line {line})"),
+    let message = match (locate::field_line(text, format, &path), message.split_once("; ")) {
+        (Some((line, column)), Some((what, fix))) => format!("{what} (line {line} column {column}); {fix}"),
+        (Some((line, column)), None) => format!("{message} (line {line} column {column})"),
         (None, _) => message,
     };
     ModelError::Invalid { source_name, path, message }
-}
-
-/// The 1-based line where the point `name` is given: its key, the first after the `points`
-/// key (an entry `B: {...}` in YAML, `"B": {...}` in JSON, where several may share a line).
-fn point_line(text: &str, format: Format, name: &str) -> Option<usize> {
-    let lines: Vec<&str> = text.lines().collect();
-    let is_key = |line: &str, key: &str| {
-        let l = line.trim_start().trim_start_matches(['{', ',', ' ']);
-        [format!("{key}:"), format!("\"{key}\":"), format!("'{key}':")].iter().any(|k| l.starts_with(k.as_str()))
-    };
-    let start = lines.iter().position(|l| is_key(l, "points") || is_key(l, "points_at_t0"))?;
-    let json_key = format!("\"{name}\":");
-    let found =
-        lines[start..].iter().position(|l| is_key(l, name) || (format == Format::Json && l.contains(&json_key)))?;
-    Some(start + found + 1)
 }
 
 /// The model text as written: points and coordinate values also by construction.

@@ -5,6 +5,7 @@
 //! names) after the model's own.
 
 mod io;
+mod locate;
 mod nesting;
 mod parse_errors;
 mod tags;

@@ -19,6 +19,16 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::marker::PhantomData;
 
+/// The other names a file may give a field by (the `alias`es below): (field, alias), for
+/// locating a field's error in the text (`loader::locate`).
+pub const FIELD_ALIASES: &[(&str, &str)] = &[
+    ("points", "points_at_t0"),
+    ("ground", "fixed_points"),
+    ("inertia", "inertia_about_com"),
+    ("about", "role"),
+    ("point_mass", "point_mass_at"),
+];
+
 /// A whole mechanism: its points coordinates [x, y] (m) and its coordinates' drawn values
 /// numbers (rad or m). `MechanismSpec<PointSpec, ValueSpec>` is a model file as written,
 /// points and values also by construction, which the loader resolves into this.
