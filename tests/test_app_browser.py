@@ -229,12 +229,15 @@ def test_the_drawing_is_drawn_at_its_boxs_size(browser, app_file):
 def test_an_edit_that_breaks_the_model_shows_the_located_error(page):
     page.click("nav button[data-tab='model']")
     text = page.input_value("#editor")
-    broken = text.replace("mass:", "mass: -", 1)
-    assert broken != text
+    # The last body's mass refused: its line, not the first "mass:" line's (the core locates
+    # the field by its whole path, loader/locate.rs).
+    head, _, tail = text.rpartition("mass:")
+    broken = head + "mass: -" + tail
+    assert text.count("mass:") > 1
     page.fill("#editor", broken)
     page.wait_for_selector("#model-error:not([hidden])", timeout=5_000)
     message = page.text_content("#model-error")
-    line = next(i for i, l in enumerate(broken.splitlines(), 1) if "mass: -" in l)
+    line = next(i for i, l in reversed(list(enumerate(broken.splitlines(), 1))) if "mass: -" in l)
     assert "mass" in message
     assert message.startswith(f"line {line}:")
     # The last good model stays: the drawing and the engine still work.

@@ -18,7 +18,7 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
   try {
     mech = app.pd.load(text, format, source);
   } catch (err) {
-    showModelError(err, text);
+    showModelError(err);
     return false;
   }
   showModelError(null);
@@ -53,24 +53,16 @@ export function setModel(text, format, source, { fromEditor = false, drawn = fal
 const count = (n, one, many = `${one}s`) => `${n} ${n === 1 ? one : many}`;
 
 /** The loader's error under the editor, with its line selected on a click. */
-function showModelError(err, text) {
+function showModelError(err) {
   const box = $("model-error");
   $("editor").classList.toggle("bad", !!err);
   box.hidden = !err;
   if (!err) return;
-  const line = err.line ?? lineOfField(text, err.field);
+  // The core locates every refused field (loader/locate.rs): its line is in the error.
+  const line = err.line;
   box.dataset.line = line ?? "";
   box.textContent = (line ? `line ${line}: ` : "") + describe(err);
   status(`the model has an error (${err.field || err.name})`, true);
-}
-
-/** The line where the last key of a field path (`bodies.crank.mass`) is written, if found. */
-function lineOfField(text, field) {
-  const key = (field || "").split(/[.[\]]/).filter((s) => s && !/^\d+$/.test(s)).pop();
-  if (!key) return null;
-  const re = new RegExp(`^\\s*(- )?"?${key.replace(/[^\w]/g, "\\$&")}"?\\s*:`);
-  const i = text.split("\n").findIndex((l) => re.test(l));
-  return i >= 0 ? i + 1 : null;
 }
 
 /** The side panel: the editor (the model rebuilt as it is typed, its error's line selected
