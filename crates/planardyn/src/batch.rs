@@ -112,7 +112,7 @@ pub enum Branch<'a> {
     /// A run's own rows (a simulation's x and xd): as `Rows` with the rates, which are not
     /// checked against qd. They are the run's state; where it prescribes coordinates its qd are
     /// the motion's, and J xd meets them only within the integrator's error, magnified near a
-    /// fold of the driven coordinates (five-bar-robot, theta1 at 1 rad/s: 1.5e-7 relative
+    /// fold of the driven coordinates (five-bar-robot, theta1 at 1 rad/s: 1.1e-7 relative
     /// 0.03 s before its fold, 1.2e-6 at 5.5e-5 s, rtol 1e-9), past [`RATES_TOL`].
     Run(&'a [f64], &'a [f64]),
 }
