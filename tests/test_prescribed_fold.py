@@ -13,11 +13,10 @@ from __future__ import annotations
 import re
 
 import numpy as np
-import pytest
 import planardyn as pdy
-from planardyn import library
-
+import pytest
 from conftest import MODELS
+from planardyn import library
 
 POSE = (0.045493311996761016, -0.010013650569952362, 0.14315413293871293)
 MODES = (1, -1, -1)
