@@ -178,6 +178,7 @@ class Mechanism:
         x: ArrayLike | None = None,
         xd: ArrayLike | None = None,
         allow_singular: bool = False,
+        recorded: bool = False,
     ) -> NDArray[np.float64]: ...
     @property
     def actuator_names(self) -> list[str]: ...

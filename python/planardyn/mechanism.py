@@ -440,14 +440,16 @@ class Mechanism:
 
     def _result_motor_torques(self, raw: RawRun) -> FloatArray | None:
         """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
-        tau, x, xd, each (N, ...)) when the model has an actuator, else None."""
+        tau, x, xd, each (N, ...)) when the model has an actuator, else None. The rates xd are
+        the run's state, not checked against qd (``recorded``): near a fold of prescribed
+        coordinates the two agree only within the integrator's error, magnified there."""
         if not self._run_facts().has_actuators:
             return None
         tau = np.asarray(raw["tau"], dtype=np.float64)
         if len(tau) == 0:
             return tau.copy()
-        return np.asarray(self.motor_torques(raw["q"], raw["qd"], raw["qdd"], tau, x=raw["x"], xd=raw["xd"],
-                                             allow_singular=True), dtype=np.float64).reshape(np.shape(tau))
+        return np.asarray(self._native.motor_torques(raw["q"], raw["qd"], raw["qdd"], tau, raw["x"], raw["xd"], True, True),
+                          dtype=np.float64).reshape(np.shape(tau))
 
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."

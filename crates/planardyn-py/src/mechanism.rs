@@ -471,8 +471,10 @@ impl PyMechanism {
     /// Motor torques (N m, motor side) along (q, qd, qdd), each (m,) or (N, m), on the branch
     /// of x (and with the rates xd) as `inverse_dynamics`: of the joint-side efforts `tau`,
     /// (m,) / (N, m) or every actuator's (n_a,) / (N, n_a), or of the motion's own inverse
-    /// dynamics without `tau`; on an actuator without a motor, the effort itself.
-    #[pyo3(signature = (q, qd, qdd, tau=None, x=None, xd=None, allow_singular=false))]
+    /// dynamics without `tau`; on an actuator without a motor, the effort itself. `recorded`:
+    /// x and xd are a run's own rows (a result's), its state: the rates are not checked
+    /// against qd (`Branch::Run`).
+    #[pyo3(signature = (q, qd, qdd, tau=None, x=None, xd=None, allow_singular=false, recorded=false))]
     #[allow(clippy::too_many_arguments)]
     fn motor_torques<'py>(
         &self,
@@ -484,9 +486,10 @@ impl PyMechanism {
         x: Option<ArrayArg<'py>>,
         xd: Option<ArrayArg<'py>>,
         allow_singular: bool,
+        recorded: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let motion = MotionArgs { q: &q, qd: &qd, qdd: &qdd, x: x.as_ref(), xd: xd.as_ref() };
-        rows::motor_torques(py, &self.inner, motion, tau.as_ref(), allow_singular)
+        rows::motor_torques(py, &self.inner, motion, tau.as_ref(), allow_singular, recorded)
     }
 
     /// The regressor form along rows of a motion, on the branch of x (and with the body rates

@@ -131,13 +131,15 @@ pub fn dissipated_power<'py>(
     Ok(arr1(py, p))
 }
 
-/// `Mechanism.motor_torques` (the method's doc there).
+/// `Mechanism.motor_torques` (the method's doc there); `recorded`: x and xd are a run's own
+/// rows ([`Branch::recorded`]).
 pub fn motor_torques<'py>(
     py: Python<'py>,
     mech: &Mechanism,
     motion: MotionArgs<'_, 'py>,
     tau: Option<&ArrayArg<'py>>,
     allow_singular: bool,
+    recorded: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let motion = motion.checked(mech)?;
     let q = &motion.q;
@@ -166,6 +168,7 @@ pub fn motor_torques<'py>(
     }
     let t_m = motion.run(py, |branch, q, qd, qdd| {
         let given = tau.as_ref().map(|(t, w)| (&t.data[..], *w));
+        let branch = if recorded { branch.recorded() } else { branch };
         dynamics::finite("motor torques", motor_torque_rows(mech, branch, q, qd, qdd, given, allow_singular)?)
             .map_err(Error::from)
     })?;

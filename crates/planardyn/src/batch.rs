@@ -109,6 +109,22 @@ pub enum Branch<'a> {
     /// (one rounding unit of qd moves the rates J xd = [0; qd] gives by eps/sigma). Rows whose
     /// xd and qd disagree by more than [`RATES_TOL`] are refused.
     Rows(&'a [f64], Option<&'a [f64]>),
+    /// A run's own rows (a simulation's x and xd): as `Rows` with the rates, which are not
+    /// checked against qd. They are the run's state; where it prescribes coordinates its qd are
+    /// the motion's, and J xd meets them only within the integrator's error, magnified near a
+    /// fold of the driven coordinates (five-bar-robot, theta1 at 1 rad/s: 1.1e-7 relative
+    /// 0.03 s before its fold, 1.2e-6 at 5.5e-5 s, rtol 1e-9), past [`RATES_TOL`].
+    Run(&'a [f64], &'a [f64]),
+}
+
+impl Branch<'_> {
+    /// `Rows` with rates as a run's own rows ([`Branch::Run`]); any other branch as it is.
+    pub fn recorded(self) -> Self {
+        match self {
+            Branch::Rows(x, Some(xd)) => Branch::Run(x, xd),
+            other => other,
+        }
+    }
 }
 
 /// A motion given by q alone whose continuation passes below this type II measure is
@@ -266,7 +282,13 @@ fn walk_rows(
         .into());
     }
     let n = q.len() / m;
-    if let Branch::Rows(x, xd) = branch {
+    // The rows' own body coordinates and rates, and whether the rates are checked against qd.
+    let (rows, check_rates) = match branch {
+        Branch::Rows(x, xd) => (Some((x, xd)), true),
+        Branch::Run(x, xd) => (Some((x, Some(xd))), false),
+        Branch::From(_) | Branch::Drawing => (None, false),
+    };
+    if let Some((x, xd)) = rows {
         for (name, v) in [("x", Some(x)), ("xd", xd)] {
             let Some(v) = v else { continue };
             if v.len() != n * nx {
@@ -284,17 +306,17 @@ fn walk_rows(
     for k in 0..n {
         let row = k * m..(k + 1) * m;
         let mut xd_row = None;
-        match (branch, k) {
-            (Branch::Rows(x, xd), _) => {
+        match (branch, rows, k) {
+            (_, Some((x, xd)), _) => {
                 assemble_from(mech, &x[k * nx..(k + 1) * nx], &q[row.clone()], &mut ws)?;
                 xd_row = xd.map(|xd| &xd[k * nx..(k + 1) * nx]);
             }
-            (Branch::From(x), 0) => assemble_from(mech, x, &q[row.clone()], &mut ws)?,
-            (Branch::Drawing, 0) => assemble_into(mech, &q[row.clone()], &mut ws)?,
+            (Branch::From(x), _, 0) => assemble_from(mech, x, &q[row.clone()], &mut ws)?,
+            (Branch::Drawing, _, 0) => assemble_into(mech, &q[row.clone()], &mut ws)?,
             _ => continue_to(mech, &q[row.start - m..row.start], &q[row.clone()], &mut ws)?,
         }
         each(&mut ws, row.clone(), xd_row)?;
-        if let Some(xd) = xd_row {
+        if let Some(xd) = xd_row.filter(|_| check_rates) {
             jac.resize(nx * nx, 0.0);
             let mismatch = dynamics::rates_mismatch(mech, &ws, &qd[row], xd, &mut jac);
             if mismatch > RATES_TOL {
@@ -306,7 +328,7 @@ fn walk_rows(
         }
         let sigma_min = dynamics::type_ii_measure(mech, &mut ws, allow_singular)?;
         // Only the rows after a near-singular one are in doubt.
-        if !matches!(branch, Branch::Rows(..)) && k + 1 < n && sigma_min < BRANCH_SIGMA {
+        if rows.is_none() && k + 1 < n && sigma_min < BRANCH_SIGMA {
             return Err(Error::BranchUndecided { row: k, sigma_min, tol: BRANCH_SIGMA });
         }
     }

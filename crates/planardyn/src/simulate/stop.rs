@@ -113,11 +113,13 @@ impl Stop {
             );
             (status, message)
         } else if let Some(t_star) = fold {
+            // The fold first: the failure (a position that does not assemble, friction efforts
+            // that do not settle under a near-singular J) is its symptom.
             let message = format!(
-                "{message}; the prescribed motion runs into a fold of its driven coordinates at t ≈ {} s: their \
-                 scaled measure ({driven:.2e} at the last accepted point) falls like the square root of the time \
-                 left to it, and past it the mechanism does not assemble at the prescribed coordinates. \
-                 {CHANGE_THE_MOTION}",
+                "the prescribed motion runs into a fold of its driven coordinates at t ≈ {} s: their scaled \
+                 measure ({driven:.2e} at the last accepted point) falls like the square root of the time left to \
+                 it, and past it the mechanism does not assemble at the prescribed coordinates. \
+                 {CHANGE_THE_MOTION}. Near it the step failed, a symptom of the fold: {message}",
                 Time(t_star)
             );
             (status, message)
