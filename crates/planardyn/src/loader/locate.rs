@@ -3,6 +3,11 @@
 //! parsed model (the parsers locate their own errors). The text has parsed, so this reads
 //! its structure leniently, as much as a path needs: YAML block style by indentation, flow
 //! style (`{...}`, `[...]`) and JSON; scalars are skipped, not read.
+//!
+//! Written here because no parser at hand keeps positions for a field path: serde_yaml drops
+//! them after deserialisation, serde_path_to_error gives them for parse errors only, and a
+//! YAML parser with markers (yaml-rust2, saphyr) would be a second YAML parser that does not
+//! read JSON.
 
 use super::Format;
 use crate::model::spec::FIELD_ALIASES;
