@@ -27,7 +27,7 @@ fn unknown_names_are_named_with_the_known_ones() {
         "bodies: [crank, coupler]",
         "bodies: [crank, couple]",
         "pairs[1].bodies[1]",
-        "unknown body 'couple'; bodies are: ground, crank, coupler, rocker",
+        "unknown body 'couple' (line 16 column 45); bodies are: ground, crank, coupler, rocker",
     );
     expect("at: A, bodies", "at: Q, bodies", "pairs[1].at", "unknown point 'Q'");
     expect("pair: O, value", "pair: X, value", "coordinates[0].pair", "unknown pair 'X'");
