@@ -273,3 +273,41 @@ fn ladder_accelerations_are_the_dense_solution_and_inverse_dynamics_gives_zero_e
         assert!(t.abs() < DENSE_TOL * b_scale.max(1.0), "tau[{j}] = {t}");
     }
 }
+
+/// qdd of the ODE's closed-form evaluation against the general path's (Newton, J's factor),
+/// relative to the largest entry: as tests/closed_form.rs's REL_TOL (measured worst there
+/// 1.4e-11, where b is a difference of terms 10 times larger than itself).
+const ODE_REL_TOL: f64 = 1e-10;
+
+#[test]
+fn the_odes_derivative_is_the_rates_the_accelerations_and_the_power_for_two_to_eight_coordinates() {
+    // `MechanismOde::derivative` copies with m a constant up to 4 coordinates and through
+    // `derivative_of` beyond: ladders of 2, 4, 6 and 8 coordinates take both. dy = [zd, qdd, P]:
+    // zd the state's rates to the bit, qdd the general path's at the same state, P the power of
+    // the non-conservative forces (none in the ladder: zero).
+    use planardyn::dynamics::{forward, ModelDrives};
+    use planardyn::integrate::OdeSystem;
+    use planardyn::kinematics::assemble_into;
+    use planardyn::Workspace;
+    for n in 1..=4 {
+        let mech = ladder(n);
+        let m = mech.dof();
+        let mut drives = ModelDrives(&mech);
+        let (mut ode, mut y) = common::ode::at_drawing(&mech, &mut drives);
+        y[..m].iter_mut().enumerate().for_each(|(j, v)| *v += 1e-3 * (j as f64 + 1.0));
+        y[m..2 * m].iter_mut().enumerate().for_each(|(j, v)| *v = 0.5 - 0.2 * j as f64);
+        let mut dy = vec![f64::NAN; 2 * m + 1];
+        ode.rhs(0.0, &y, &mut dy).unwrap_or_else(|e| panic!("m = {m}: {e}"));
+        assert_eq!(dy[..m], y[m..2 * m], "m = {m}: the rates");
+        let mut general = Workspace::new(&mech);
+        assemble_into(&mech, &y[..m], &mut general).unwrap();
+        forward(&mech, 0.0, &y[..m], &y[m..2 * m], &mut ModelDrives(&mech), &mut general).unwrap();
+        let scale = general.qdd.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        assert!(scale > 1.0, "m = {m}: a real acceleration ({scale})");
+        for j in 0..m {
+            let d = (dy[m + j] - general.qdd[j]).abs();
+            assert!(d < ODE_REL_TOL * scale, "m = {m}: qdd[{j}] {} vs {}", dy[m + j], general.qdd[j]);
+        }
+        assert_eq!(dy[2 * m], 0.0, "m = {m}: the power of a passive ladder without losses");
+    }
+}
