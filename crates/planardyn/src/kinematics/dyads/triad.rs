@@ -458,9 +458,12 @@ impl Triad {
 
     /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg); None where
     /// every leg is one body (the 6R triad: every s_i is zero, and its terms are left out).
-    #[inline]
-    fn slides(&self, d: impl Fn(&Arm) -> f64) -> Option<[[f64; 2]; 3]> {
-        self.cylinders.then(|| self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a)))))
+    /// `CYLINDERS` is `self.cylinders`, a constant in each of `velocity` and `acceleration`'s
+    /// two compilations (`velocity_with`, `acceleration_with`), so that the 6R triad's carries
+    /// no test of it.
+    #[inline(always)]
+    fn slides<const CYLINDERS: bool>(&self, d: impl Fn(&Arm) -> f64) -> Option<[[f64; 2]; 3]> {
+        CYLINDERS.then(|| self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a)))))
     }
 
     /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
@@ -468,8 +471,18 @@ impl Triad {
     /// v_C_i - v_A_i - s_i = w E e_i.
     #[inline(never)]
     pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
+        if self.cylinders {
+            self.velocity_with::<true>(zd, v);
+        } else {
+            self.velocity_with::<false>(zd, v);
+        }
+    }
+
+    /// [`Triad::velocity`] with `CYLINDERS` = `self.cylinders` (`slides`).
+    #[inline(always)]
+    fn velocity_with<const CYLINDERS: bool>(&self, zd: &[f64], v: &mut [f64]) {
         let g = &self.geometry;
-        let s = self.slides(|a| a.ext.input_rate(zd));
+        let s = self.slides::<CYLINDERS>(|a| a.ext.input_rate(zd));
         self.holds(v);
         // SAFETY (each `three` and `three_mut` below): `holds(v)`.
         let va = [0, 1, 2].map(|i| self.outer(i).velocity(g.known[i], unsafe { three(v, self.outer_at[i]) }));
@@ -497,8 +510,18 @@ impl Triad {
     /// e_i . (a_C_i - a_A_i) = -w_i^2 |e_i|^2 + 2 w_i s_i x e_i.
     #[inline(never)]
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
+        if self.cylinders {
+            self.acceleration_with::<true>(v, a);
+        } else {
+            self.acceleration_with::<false>(v, a);
+        }
+    }
+
+    /// [`Triad::acceleration`] with `CYLINDERS` = `self.cylinders` (`slides`).
+    #[inline(always)]
+    fn acceleration_with<const CYLINDERS: bool>(&self, v: &[f64], a: &mut [f64]) {
         let g = &self.geometry;
-        let s = self.slides(|x| x.ext.rate(v));
+        let s = self.slides::<CYLINDERS>(|x| x.ext.rate(v));
         // The Coriolis acceleration of C_i on leg i, 2 w_i E s_i.
         let coriolis = |s: [[f64; 2]; 3], i: usize, wl: f64| {
             let c = perp(s[i]);
