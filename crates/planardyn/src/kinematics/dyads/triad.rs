@@ -82,13 +82,13 @@ unsafe fn three_mut(v: &mut [f64], at: usize) -> &mut [f64] {
     unsafe { v.get_unchecked_mut(at..at + 3) }
 }
 
-/// The link as the first body of its own entries (`three`), the ground as itself: the outer
-/// joints' `Joint` methods then read no other index.
-fn local(link: Link) -> Link {
-    match link {
-        Link::Ground => Link::Ground,
-        Link::Body(_) => Link::Body(BodyId(0)),
-    }
+/// A point of a link as the joint on the link's own entries (`three`): the body as the first
+/// of them, a constant the joint's reads then check at compile time (a body index kept in the
+/// triad was loaded and checked against 0 at every read, 3 instructions a leg in each of
+/// `position`, `velocity` and `acceleration`); the ground as itself.
+#[inline(always)]
+fn local(on_body: bool, s: [f64; 2]) -> Joint {
+    Joint { link: if on_body { Link::Body(BodyId(0)) } else { Link::Ground }, s }
 }
 
 /// Largest turn (rad) of a body from the reference for the side test near it
@@ -121,9 +121,10 @@ pub struct Triad {
     /// Per leg, its relative input if it is two bodies; whether any is.
     extended: [Option<Arm>; 3],
     cylinders: bool,
-    /// A_i on the links solved before, each as the joint on its link's own entries (`local`),
-    /// and the same points in the legs' frames.
-    outer: [Joint; 3],
+    /// A_i on the links solved before (whether each link is a body, the point in its frame:
+    /// `local` makes the joint), and the same points in the legs' frames.
+    outer_on_body: [bool; 3],
+    outer_s: [[f64; 2]; 3],
     s_outer: [[f64; 2]; 3],
     /// C_i - A_i in leg i's frame, its squared length and 1 / length.
     arms: [[f64; 2]; 3],
@@ -202,7 +203,6 @@ impl Triad {
             Link::Ground => 0,
             Link::Body(b) => b.0,
         });
-        let outer = outer.map(|j| Joint { link: local(j.link), s: j.s });
         let mut triad = Triad {
             bodies,
             members,
@@ -212,7 +212,8 @@ impl Triad {
             span: 3 * (bodies.iter().chain(&outer_trig).max().unwrap() + 1),
             extended,
             cylinders,
-            outer,
+            outer_on_body: outer.map(|j| matches!(j.link, Link::Body(_))),
+            outer_s: outer.map(|j| j.s),
             s_outer,
             arms,
             arms2: [0.0; 3],
@@ -225,6 +226,12 @@ impl Triad {
         };
         triad.set_arms(|_| 0.0);
         triad
+    }
+
+    /// A_i as the joint on its link's own entries (`local`).
+    #[inline(always)]
+    fn outer(&self, i: usize) -> Joint {
+        local(self.outer_on_body[i], self.outer_s[i])
     }
 
     /// That x, v or a holds every entry of the triad's bodies and outer links (`span`), which
@@ -367,8 +374,8 @@ impl Triad {
         // partial, as it leaves x, and nothing reads it before the next successful one.
         let g = &mut self.geometry;
         let mut a = [[0.0; 2]; 3];
-        for (i, j) in self.outer.iter().enumerate() {
-            let at = self.outer_at[i];
+        for i in 0..3 {
+            let (j, at) = (local(self.outer_on_body[i], self.outer_s[i]), self.outer_at[i]);
             // SAFETY: `holds(x)` above.
             (a[i], g.known[i]) = j.place(unsafe { three(x, at) }, &trig[self.outer_trig[i]..]);
         }
@@ -451,9 +458,12 @@ impl Triad {
 
     /// C_i's velocity relative to leg i (s_i), for the extensions' rates d'(leg); None where
     /// every leg is one body (the 6R triad: every s_i is zero, and its terms are left out).
-    #[inline]
-    fn slides(&self, d: impl Fn(&Arm) -> f64) -> Option<[[f64; 2]; 3]> {
-        self.cylinders.then(|| self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a)))))
+    /// `CYLINDERS` is `self.cylinders`, a constant in each of `velocity` and `acceleration`'s
+    /// two compilations (`velocity_with`, `acceleration_with`), so that the 6R triad's carries
+    /// no test of it.
+    #[inline(always)]
+    fn slides<const CYLINDERS: bool>(&self, d: impl Fn(&Arm) -> f64) -> Option<[[f64; 2]; 3]> {
+        CYLINDERS.then(|| self.extended.each_ref().map(|a| a.as_ref().map_or([0.0; 2], |a| a.slide(d(a)))))
     }
 
     /// The bodies' rates for the coordinate rates zd, those of the links before them in v:
@@ -461,11 +471,21 @@ impl Triad {
     /// v_C_i - v_A_i - s_i = w E e_i.
     #[inline(never)]
     pub fn velocity(&self, zd: &[f64], v: &mut [f64]) {
+        if self.cylinders {
+            self.velocity_with::<true>(zd, v);
+        } else {
+            self.velocity_with::<false>(zd, v);
+        }
+    }
+
+    /// [`Triad::velocity`] with `CYLINDERS` = `self.cylinders` (`slides`).
+    #[inline(always)]
+    fn velocity_with<const CYLINDERS: bool>(&self, zd: &[f64], v: &mut [f64]) {
         let g = &self.geometry;
-        let s = self.slides(|a| a.ext.input_rate(zd));
+        let s = self.slides::<CYLINDERS>(|a| a.ext.input_rate(zd));
         self.holds(v);
         // SAFETY (each `three` and `three_mut` below): `holds(v)`.
-        let va = [0, 1, 2].map(|i| self.outer[i].velocity(g.known[i], unsafe { three(v, self.outer_at[i]) }));
+        let va = [0, 1, 2].map(|i| self.outer(i).velocity(g.known[i], unsafe { three(v, self.outer_at[i]) }));
         let b = [0, 1, 2].map(|i| match s {
             Some(s) => dot(g.e[i], [va[i][0] + s[i][0], va[i][1] + s[i][1]]),
             None => dot(g.e[i], va[i]),
@@ -490,8 +510,18 @@ impl Triad {
     /// e_i . (a_C_i - a_A_i) = -w_i^2 |e_i|^2 + 2 w_i s_i x e_i.
     #[inline(never)]
     pub fn acceleration(&self, v: &[f64], a: &mut [f64]) {
+        if self.cylinders {
+            self.acceleration_with::<true>(v, a);
+        } else {
+            self.acceleration_with::<false>(v, a);
+        }
+    }
+
+    /// [`Triad::acceleration`] with `CYLINDERS` = `self.cylinders` (`slides`).
+    #[inline(always)]
+    fn acceleration_with<const CYLINDERS: bool>(&self, v: &[f64], a: &mut [f64]) {
         let g = &self.geometry;
-        let s = self.slides(|x| x.ext.rate(v));
+        let s = self.slides::<CYLINDERS>(|x| x.ext.rate(v));
         // The Coriolis acceleration of C_i on leg i, 2 w_i E s_i.
         let coriolis = |s: [[f64; 2]; 3], i: usize, wl: f64| {
             let c = perp(s[i]);
@@ -506,7 +536,7 @@ impl Triad {
         for i in 0..3 {
             let (wl, l, at) = (wl[i], g.lever[i], self.outer_at[i]);
             // a_A_i plus the Coriolis acceleration of C_i on the leg.
-            aa[i] = self.outer[i].acceleration(g.known[i], unsafe { three(v, at) }, unsafe { three(a, at) });
+            aa[i] = self.outer(i).acceleration(g.known[i], unsafe { three(v, at) }, unsafe { three(a, at) });
             let mut ac = aa[i];
             if let Some(s) = s {
                 let k = coriolis(s, i, wl);
