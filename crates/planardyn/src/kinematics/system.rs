@@ -425,3 +425,43 @@ pub fn scaled_jacobian(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::constraints::body_trig;
+    use crate::kinematics::select_partition;
+
+    /// A chart switch back to a chart analysed before copies the kept analysis (the list of
+    /// analyses does not grow, and a copy of the system shares it), and the copy factorises,
+    /// solves and measures as a fresh analysis does, to the bit.
+    #[test]
+    fn a_chart_analysed_before_is_copied_and_gives_a_fresh_analysis_bits() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/models");
+        let mech = crate::load(root.join("five-bar-free-fall.yaml").to_str().unwrap()).unwrap();
+        let x = mech.x0.clone();
+        let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+        body_trig(&x, &mut trig);
+        let partition = Chart::Partition(select_partition(&mech, &x));
+        let kept = |sys: &System| sys.analyses.0.lock().unwrap().len();
+        // J's factors through a solve, and the type II estimate of the factors.
+        let figures = |sys: &mut System, chart: &Chart| {
+            sys.factor(&mech, chart, &x, &trig).unwrap();
+            let mut b: Vec<f64> = (0..x.len()).map(|i| 1.0 + 0.1 * i as f64).collect();
+            sys.solve(&mut b);
+            let sigma = sys.sigma_min_estimate().unwrap();
+            (b.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), sigma.to_bits())
+        };
+        let mut sys = System::new(&mech);
+        let first = figures(&mut sys, &Chart::Inputs);
+        let mut copy = sys.clone();
+        let in_partition = figures(&mut copy, &partition);
+        assert_eq!(kept(&sys), 2, "the copy's analysis of the partition is shared");
+        assert_eq!(figures(&mut System::for_chart(&mech, &partition), &partition), in_partition);
+        let id = copy.supports_id();
+        assert_eq!(figures(&mut copy, &Chart::Inputs), first, "back in the user's chart: a fresh analysis's bits");
+        assert_ne!(copy.supports_id(), id, "a new analysis id for the buffers");
+        assert_eq!(figures(&mut sys, &partition), in_partition);
+        assert_eq!(kept(&sys), 2, "no chart analysed twice");
+    }
+}
