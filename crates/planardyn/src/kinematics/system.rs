@@ -14,6 +14,7 @@ use super::u_support::USupport;
 use crate::linalg::{BlockLu, MAX_COLUMNS};
 use crate::model::Mechanism;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// A scaled pivot below this counts as singular. Scaled entries are O(1), so 1e-12 is about
 /// 1e4 times the rounding error of an O(1) elimination.
@@ -60,6 +61,51 @@ pub struct System {
     supports: bool,
     /// A system kept for the measures of another chart ([`System::other_chart`]).
     other: Option<Box<System>>,
+    /// The analyses this system and its copies made, shared by them ([`Analyses`]).
+    analyses: Analyses,
+}
+
+/// Fresh analyses (as [`System::analysed`] leaves them, before any factorisation) by chart,
+/// shared by a system and its copies (a run's saved states, the prepared model's templates):
+/// a chart switch back to a chart analysed before copies its analysis instead of analysing
+/// it again (the five-bar free fall's run switched 12 times, each analysis 57 k instructions).
+/// A copy is the analysis itself, so the results are those of a fresh one to the bit.
+#[derive(Debug, Clone, Default)]
+struct Analyses(Arc<Mutex<Vec<System>>>);
+
+/// At most this many analyses are kept per [`Analyses`]: a mechanism's partitions are few in a
+/// run (the five-bar's 5), and a bound keeps a long run through many charts from growing it.
+const MAX_ANALYSES: usize = 16;
+
+impl Analyses {
+    /// Copy the analysis of `chart` (and of `supports`) kept here into `sys`; false if none is.
+    fn copy_into(&self, sys: &mut System, chart: &Chart) -> bool {
+        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(a) = kept.iter().find(|a| a.pattern_chart == *chart && a.supports == sys.supports) else {
+            return false;
+        };
+        sys.lu.clone_from(&a.lu);
+        sys.groups.clone_from(&a.groups);
+        sys.unit_reach.clone_from(&a.unit_reach);
+        sys.u_support.clone_from(&a.u_support);
+        sys.a_pairs.clone_from(&a.a_pairs);
+        sys.a_runs_at.clone_from(&a.a_runs_at);
+        sys.a_runs.clone_from(&a.a_runs);
+        sys.a_first.clone_from(&a.a_first);
+        sys.a_fill_in.clone_from(&a.a_fill_in);
+        true
+    }
+
+    /// Keep a copy of `sys`'s fresh analysis (of its `pattern_chart`).
+    fn keep(&self, sys: &mut System) {
+        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.len() < MAX_ANALYSES {
+            // Not the system kept for another chart, nor the shared list (no cycle of Arcs).
+            let other = sys.other.take();
+            kept.push(System { analyses: Analyses::default(), ..sys.clone() });
+            sys.other = other;
+        }
+    }
 }
 
 /// The next [`System::supports_id`] (and the closed form's zero pattern of U, `column_reach`).
@@ -105,6 +151,7 @@ impl System {
             supports,
             supports_id: next_supports_id(),
             other: None,
+            analyses: Analyses::default(),
             lu,
             pattern_chart: chart.clone(),
             row_scale: vec![1.0; mech.n_x()],
@@ -115,6 +162,7 @@ impl System {
         if supports {
             sys.analyse_supports(mech);
         }
+        sys.analyses.clone().keep(&mut sys);
         sys
     }
 
@@ -140,10 +188,14 @@ impl System {
     /// Evaluate J(x) into the blocks without factorising it.
     fn fill(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]]) {
         if self.pattern_chart != *chart {
-            self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
-            self.groups = GroupScales::new(mech, chart, &self.lu);
-            if self.supports {
-                self.analyse_supports(mech);
+            if !self.analyses.clone().copy_into(self, chart) {
+                self.lu = BlockLu::new(&jacobian_pattern(mech, chart));
+                self.groups = GroupScales::new(mech, chart, &self.lu);
+                if self.supports {
+                    self.analyse_supports(mech);
+                }
+                self.pattern_chart.clone_from(chart);
+                self.analyses.clone().keep(self);
             }
             self.supports_id = next_supports_id();
             self.pattern_chart.clone_from(chart);
@@ -371,5 +423,45 @@ pub fn scaled_jacobian(
         for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(cs) {
             *v *= rs[r] * c;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::constraints::body_trig;
+    use crate::kinematics::select_partition;
+
+    /// A chart switch back to a chart analysed before copies the kept analysis (the list of
+    /// analyses does not grow, and a copy of the system shares it), and the copy factorises,
+    /// solves and measures as a fresh analysis does, to the bit.
+    #[test]
+    fn a_chart_analysed_before_is_copied_and_gives_a_fresh_analysis_bits() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/models");
+        let mech = crate::load(root.join("five-bar-free-fall.yaml").to_str().unwrap()).unwrap();
+        let x = mech.x0.clone();
+        let mut trig = vec![[0.0; 2]; mech.n_bodies()];
+        body_trig(&x, &mut trig);
+        let partition = Chart::Partition(select_partition(&mech, &x));
+        let kept = |sys: &System| sys.analyses.0.lock().unwrap().len();
+        // J's factors through a solve, and the type II estimate of the factors.
+        let figures = |sys: &mut System, chart: &Chart| {
+            sys.factor(&mech, chart, &x, &trig).unwrap();
+            let mut b: Vec<f64> = (0..x.len()).map(|i| 1.0 + 0.1 * i as f64).collect();
+            sys.solve(&mut b);
+            let sigma = sys.sigma_min_estimate().unwrap();
+            (b.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), sigma.to_bits())
+        };
+        let mut sys = System::new(&mech);
+        let first = figures(&mut sys, &Chart::Inputs);
+        let mut copy = sys.clone();
+        let in_partition = figures(&mut copy, &partition);
+        assert_eq!(kept(&sys), 2, "the copy's analysis of the partition is shared");
+        assert_eq!(figures(&mut System::for_chart(&mech, &partition), &partition), in_partition);
+        let id = copy.supports_id();
+        assert_eq!(figures(&mut copy, &Chart::Inputs), first, "back in the user's chart: a fresh analysis's bits");
+        assert_ne!(copy.supports_id(), id, "a new analysis id for the buffers");
+        assert_eq!(figures(&mut sys, &partition), in_partition);
+        assert_eq!(kept(&sys), 2, "no chart analysed twice");
     }
 }
