@@ -61,7 +61,7 @@ const TINY_TAN: f64 = 7.450580596923828e-9;
 /// atan2(y, x): for x > 0 and |y| < [`EXACT_TAN`] x, atan(y / x) by fdlibm's kernel (its odd
 /// and even halves as s_atan.c sums them), else the library's.
 #[inline(always)]
-pub(super) fn near_atan2(y: f64, x: f64) -> f64 {
+pub(in crate::kinematics::dyads) fn near_atan2(y: f64, x: f64) -> f64 {
     if !(x > 0.0 && y.abs() < EXACT_TAN * x) {
         return y.atan2(x);
     }
