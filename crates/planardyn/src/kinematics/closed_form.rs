@@ -338,7 +338,16 @@ impl ClosedForm {
             // A crank's rows split in J's block-triangular form: the coordinate's on its angle
             // (+-1) and the pivot's on its centre (I), each of measure 1.
             inputs_sigma = inputs_sigma.min(1.0);
-            cranks.push(Crank { body, pivot, s, k, sign, offset: p.rel_angle0 - c.value, rs: [0.0; 2] });
+            cranks.push(Crank {
+                body,
+                pivot,
+                s,
+                k,
+                sign,
+                offset: p.rel_angle0 - c.value,
+                rs: [0.0; 2],
+                reference: (f64::NAN, [0.0; 2]),
+            });
         }
         let mut groups = Vec::new();
         let mut pairs_used = mech.coordinates.len();
@@ -412,6 +421,7 @@ impl ClosedForm {
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
             return None;
         }
+        cranks.iter_mut().for_each(|c| c.set_reference(&mech.x0));
         groups.iter_mut().for_each(|d| d.set_reference(&mech.x0));
         let inv_length = groups.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
         let reach = (mech.dof() > REACH_FROM_M).then(|| {
@@ -432,6 +442,7 @@ impl ClosedForm {
 
     /// Take the assembly branches from the configuration x (a solution).
     pub fn set_reference(&mut self, x: &[f64]) {
+        self.cranks.iter_mut().for_each(|c| c.set_reference(x));
         self.groups.iter_mut().for_each(|d| d.set_reference(x));
     }
 

@@ -8,11 +8,10 @@
 //! and the measure come from the group's block of J (`Local`).
 
 use super::local::Local;
-use super::{rotation, Joint};
+use super::{Angle, Joint};
 use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{Mechanism, Pair, PairId, PairKind};
 use crate::{KinematicsError, SingularityKind};
-use std::f64::consts::TAU;
 
 #[derive(Debug, Clone)]
 pub struct Rpr {
@@ -31,13 +30,11 @@ pub struct Rpr {
 }
 
 /// What the dyad keeps from the reference configuration: the side of A's foot on the guide
-/// that B is on (+1 ahead along the axis) and body o's angle as whole turns plus a remainder
-/// in (-pi, pi].
+/// that B is on (+1 ahead along the axis) and body o's angle.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Branch {
     pub side: f64,
-    pub turns: f64,
-    pub rest: f64,
+    pub angle: Angle,
 }
 
 impl Rpr {
@@ -99,8 +96,7 @@ impl Rpr {
     pub fn branch(&self, x: &[f64]) -> Branch {
         let (u, ab) = self.guide_and_ab(x);
         let phi = x[3 * self.local.bodies()[0] + 2];
-        let turns = TAU * (phi / TAU).round();
-        Branch { side: if dot(u, ab) >= 0.0 { 1.0 } else { -1.0 }, turns, rest: phi - turns }
+        Branch { side: if dot(u, ab) >= 0.0 { 1.0 } else { -1.0 }, angle: Angle::of(phi) }
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved.
@@ -124,8 +120,7 @@ impl Rpr {
         let t = branch.side * m2.sqrt();
         let v = [self.w[0] + (t - along) * self.axis[0], self.w[1] + (t - along) * self.axis[1]];
         let (c, s) = (dot(v, ab), v[0] * ab[1] - v[1] * ab[0]);
-        let (cs, turn) = rotation(c, s, branch.rest);
-        let phi = branch.turns + branch.rest + turn;
+        let (cs, phi) = branch.angle.rotation(c, s);
         let cf = rot(cs, self.turn_cs);
         let (ro, rf) = (rot(cs, self.s_hinges[0]), rot(cf, self.s_hinges[1]));
         self.local.load(x, trig);

@@ -6,12 +6,11 @@
 //! the reference configuration. Body 1's rates and accelerations solve one scalar equation
 //! whose coefficient n . E e (e = P - A) vanishes where the rod stands normal to the guide.
 
-use super::{body, body_mut, pose, put_acceleration, put_rate, rate, rotation, Joint};
+use super::{body, body_mut, pose, put_acceleration, put_rate, rate, Angle, Joint};
 use crate::kinematics::group_sigma::rrp_sigma;
 use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
 use crate::{KinematicsError, SingularityKind};
-use std::f64::consts::TAU;
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -53,13 +52,11 @@ pub struct Rrp {
 }
 
 /// What the dyad keeps from the reference configuration: the side of A along the guide that
-/// P is on (+1 ahead along the axis) and body 1's angle as whole turns plus a remainder in
-/// (-pi, pi].
+/// P is on (+1 ahead along the axis) and body 1's angle.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Branch {
     pub side: f64,
-    pub turns: f64,
-    pub rest: f64,
+    pub angle: Angle,
 }
 
 /// The dyad at its solved position: R s of A on its link and on body 1, of K on g, e = P - A,
@@ -159,8 +156,7 @@ impl Rrp {
     pub fn branch(&self, x: &[f64]) -> Branch {
         let phi = x[3 * self.bodies[0] + 2];
         let psi = phi - self.guide_angle(x) + self.bend;
-        let turns = TAU * (phi / TAU).round();
-        Branch { side: if psi.cos() >= 0.0 { 1.0 } else { -1.0 }, turns, rest: phi - turns }
+        Branch { side: if psi.cos() >= 0.0 { 1.0 } else { -1.0 }, angle: Angle::of(phi) }
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved, and the
@@ -199,10 +195,10 @@ impl Rrp {
         let p = add(a, e);
         // Body 1: the rotation taking its arm to e.
         let (c, s) = (dot(self.arm, e), cross(self.arm, e));
-        let (cs, turn) = rotation(c, s, branch.rest);
+        let (cs, phi) = branch.angle.rotation(c, s);
         let own = rot(cs, self.s_hinge);
         let [b1, b2] = self.bodies;
-        *body_mut(x, b1) = [a[0] - own[0], a[1] - own[1], branch.turns + branch.rest + turn];
+        *body_mut(x, b1) = [a[0] - own[0], a[1] - own[1], phi];
         trig[b1] = cs;
         // Body 2: g's angle, P at its point s_P.
         let rp = rot(c2, self.s_p);

@@ -5,7 +5,7 @@
 //! w1 E e1 - w2 E e2 = v_B - v_A (and its derivative) with e1 = P - A, e2 = P - B, whose
 //! determinant e1 x e2 = l1 l2 sin(mu) vanishes with the transmission angle mu.
 
-use super::{body, body_mut, put_acceleration, put_rate, rotation, round, Joint};
+use super::{body, body_mut, put_acceleration, put_rate, round, Angle, Joint};
 use crate::kinematics::group_sigma::dyad_sigma;
 use crate::model::pairs::frames::{dot, link_state, perp, rot, sub};
 use crate::model::{BodyId, Link};
@@ -32,13 +32,11 @@ pub struct Rrr {
 }
 
 /// What the dyad keeps from the reference configuration: the side of AB that P is on (+1 to
-/// the left of A -> B) and the bodies' angles, each as a whole number of turns plus a
-/// remainder in (-pi, pi] (the new angles are taken within pi of them).
+/// the left of A -> B) and the bodies' angles (the new angles are taken within pi of them).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Branch {
     pub side: f64,
-    pub turns: [f64; 2],
-    pub rest: [f64; 2],
+    pub angles: [Angle; 2],
 }
 
 /// The dyad at its solved position, for the rates and accelerations: R s of A and B on their
@@ -99,9 +97,8 @@ impl Rrr {
         let [a, b] = self.outer.map(|j| link_state(j.link, x).point(j.s));
         let s_p = [self.s_outer[0][0] + self.arms[0][0], self.s_outer[0][1] + self.arms[0][1]];
         let p = link_state(Link::Body(BodyId(self.bodies[0])), x).point(s_p);
-        let phi = self.bodies.map(|i| x[3 * i + 2]);
-        let turns = phi.map(|f| TAU * (f / TAU).round());
-        Branch { side: cross(sub(b, a), sub(p, a)).signum(), turns, rest: [phi[0] - turns[0], phi[1] - turns[1]] }
+        let angles = self.bodies.map(|i| Angle::of(x[3 * i + 2]));
+        Branch { side: cross(sub(b, a), sub(p, a)).signum(), angles }
     }
 
     /// The bodies' poses (x and trig) on `branch`, the links before them solved, and their
@@ -137,9 +134,9 @@ impl Rrr {
             // The rotation taking the arm in the body's frame to e = P - q in the world.
             let (arm, e) = (self.arms[i], sub(p, q));
             let (c, s) = (dot(arm, e), cross(arm, e));
-            let (cs, turn) = rotation(c, s, branch.rest[i]);
+            let (cs, phi) = branch.angles[i].rotation(c, s);
             let rs = rot(cs, self.s_outer[i]);
-            *body_mut(x, self.bodies[i]) = [q[0] - rs[0], q[1] - rs[1], branch.turns[i] + branch.rest[i] + turn];
+            *body_mut(x, self.bodies[i]) = [q[0] - rs[0], q[1] - rs[1], phi];
             trig[self.bodies[i]] = cs;
             g.own[i] = rs;
             g.e[i] = e;

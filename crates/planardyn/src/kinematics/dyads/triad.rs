@@ -13,7 +13,7 @@
 //! rod's relative velocity s_i, and the leg's equations gain s_i (rates) and its Coriolis
 //! term 2 w_i E s_i (accelerations).
 
-mod near;
+pub(super) mod near;
 
 use super::extension::Arm;
 use super::{put_acceleration, put_rate, Joint};

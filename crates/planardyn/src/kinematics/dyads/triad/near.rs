@@ -11,7 +11,7 @@
 /// Largest turn (rad) from the reference whose [`near_sin_cos`] is the library's sin and cos to
 /// rounding: its first left-out terms are 0.25^13 / 13! = 2.4e-18 (sin) and 0.25^14 / 14! =
 /// 4.3e-20 (cos), below a tenth of an ulp of sin d near 0.25 (5.6e-17 / 2).
-pub(super) const EXACT_TURN: f64 = 0.25;
+pub(in crate::kinematics::dyads) const EXACT_TURN: f64 = 0.25;
 
 /// Largest |tan| of a turn taken by [`near_atan`]: 7/16, the end of fdlibm's first interval
 /// of atan (where its kernel needs no reduction; error below one ulp there, fdlibm's
@@ -33,7 +33,7 @@ pub(super) fn near_sin_cos(d: f64) -> (f64, f64) {
 /// The rotation r ([cos, sin] of an angle) turned by d, as [cos, sin], d's sin and cos by
 /// [`near_sin_cos`].
 #[inline(always)]
-pub(super) fn turned(r: [f64; 2], d: f64) -> [f64; 2] {
+pub(in crate::kinematics::dyads) fn turned(r: [f64; 2], d: f64) -> [f64; 2] {
     let (s, c) = near_sin_cos(d);
     [r[0] * c - r[1] * s, r[1] * c + r[0] * s]
 }
@@ -61,7 +61,7 @@ const TINY_TAN: f64 = 7.450580596923828e-9;
 /// atan2(y, x): for x > 0 and |y| < [`EXACT_TAN`] x, atan(y / x) by fdlibm's kernel (its odd
 /// and even halves as s_atan.c sums them), else the library's.
 #[inline(always)]
-pub(super) fn near_atan2(y: f64, x: f64) -> f64 {
+pub(in crate::kinematics::dyads) fn near_atan2(y: f64, x: f64) -> f64 {
     if !(x > 0.0 && y.abs() < EXACT_TAN * x) {
         return y.atan2(x);
     }
