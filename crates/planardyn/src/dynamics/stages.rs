@@ -122,27 +122,15 @@ pub fn mass_matrix(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
-/// b = U^T (f - M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`: g = f - M c body by body (into
-/// `ws.tmp`), then U^T g, each column over its runs of bodies (`System::u_support`).
+/// b = U^T (f - M c) = U^T f - (U^T M c) into `ws.b`, from `ws.u`, `ws.f`, `ws.c`, each column
+/// over its runs of bodies (`System::u_support`).
 pub(crate) fn bias(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
-    let g = &mut ws.frame.tmp[..n];
-    for ((g, body), (f, c)) in
-        g.chunks_exact_mut(3).zip(&mech.bodies).zip(ws.f.chunks_exact(3).zip(ws.frame.c.chunks_exact(3)))
-    {
-        g.copy_from_slice(&body_bias_force(body, f, c));
-    }
     let support = ws.frame.sys.u_support();
     for (j, bj) in ws.b.iter_mut().enumerate() {
-        *bj = support.dot(j, &ws.frame.u[j * n..(j + 1) * n], &ws.frame.tmp[..n]);
+        let uj = &ws.frame.u[j * n..(j + 1) * n];
+        *bj = support.dot(j, uj, &ws.f) - m_dot(mech, uj, &ws.frame.c, support.runs(j));
     }
-}
-
-/// A body's f - M c, f its forces and c its convective accelerations: the force that b = U^T
-/// (f - M c) takes from it.
-#[inline(always)]
-fn body_bias_force(body: &Body, f: &[f64], c: &[f64]) -> [f64; 3] {
-    [f[0] - body.mass * c[0], f[1] - body.mass * c[1], f[2] - body.inertia * c[2]]
 }
 
 /// A = U^T M U and b = U^T (f - M c) into `ws.a` and `ws.b`, as [`mass_matrix`] and [`bias`]
@@ -194,7 +182,7 @@ fn fixed_sums<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
         })
     };
     // The sums of `m_dot` and `bias` start at -0.0 (f64's `Sum`).
-    let (mut a, mut b) = ([[-0.0; M]; M], [-0.0; M]);
+    let (mut a, mut uf, mut umc) = ([[-0.0; M]; M], [-0.0; M], [-0.0; M]);
     let forces = ws.f.chunks_exact(3).zip(ws.frame.c.chunks_exact(3));
     if M >= SPLIT_FROM_M {
         let mut u = columns();
@@ -203,21 +191,21 @@ fn fixed_sums<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
         }
         let mut u = columns();
         for (body, (f, c)) in mech.bodies.iter().zip(forces) {
-            add_bias_terms(&mut b, body, &rows(&mut u), f, c);
+            add_bias_terms(&mut uf, &mut umc, body, &rows(&mut u), f, c);
         }
     } else {
         let mut u = columns();
         for (body, (f, c)) in mech.bodies.iter().zip(forces) {
             let ui = rows(&mut u);
             add_mass_terms(&mut a, body, &ui);
-            add_bias_terms(&mut b, body, &ui, f, c);
+            add_bias_terms(&mut uf, &mut umc, body, &ui, f, c);
         }
     }
     for (j, row) in a.iter().enumerate() {
         for (k, &v) in row.iter().enumerate().skip(j) {
             (ws.a[j * M + k], ws.a[k * M + j]) = (v, v);
         }
-        ws.b[j] = b[j];
+        ws.b[j] = uf[j] - umc[j];
     }
     ws.a_zeros_for = ws.frame.sys.supports_id();
 }
@@ -236,13 +224,20 @@ fn add_mass_terms<const M: usize>(a: &mut [[f64; M]; M], body: &Body, ui: &[[f64
     }
 }
 
-/// One body's terms of b = U^T (f - M c) (as [`bias`] adds them), f its forces and c its
-/// convective accelerations.
+/// One body's terms of U^T f (`uf`, as `USupport::dot` adds them) and of U^T M c (`umc`, as
+/// `m_dot`), f and c its forces and convective accelerations.
 #[inline(always)]
-fn add_bias_terms<const M: usize>(b: &mut [f64; M], body: &Body, ui: &[[f64; 3]; M], f: &[f64], c: &[f64]) {
-    let g = body_bias_force(body, f, c);
-    for (b, p) in b.iter_mut().zip(ui) {
-        *b = *b + p[0] * g[0] + p[1] * g[1] + p[2] * g[2];
+fn add_bias_terms<const M: usize>(
+    uf: &mut [f64; M],
+    umc: &mut [f64; M],
+    body: &Body,
+    ui: &[[f64; 3]; M],
+    f: &[f64],
+    c: &[f64],
+) {
+    for (j, p) in ui.iter().enumerate() {
+        uf[j] = uf[j] + p[0] * f[0] + p[1] * f[1] + p[2] * f[2];
+        umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
     }
 }
 
