@@ -6,8 +6,8 @@
 use super::forces::{applied_forces, Drives};
 use super::losses::forward_with_losses;
 use super::stages::{
-    accelerations, apply_pair_efforts, drive_efforts, factor_mass_matrix, kinematic_stages, mass_matrix_and_bias,
-    one_coordinate_dynamics, solve_mass_matrix,
+    accelerations, apply_pair_efforts, drive_efforts, factor_mass_matrix, fixed_dynamics, kinematic_stages,
+    mass_matrix_and_bias, solve_mass_matrix, FIXED_M,
 };
 use super::workspace::Workspace;
 use crate::model::Mechanism;
@@ -36,8 +36,14 @@ pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mu
     ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
     ws.power = applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     ws.power += apply_pair_efforts(mech, ws);
-    if ws.b.len() == 1 && !mech.has_losses() {
-        return Ok(one_coordinate_dynamics(mech, ws)?);
+    if !mech.has_losses() {
+        match ws.b.len() {
+            1 => return Ok(fixed_dynamics::<1>(mech, ws)?),
+            2 => return Ok(fixed_dynamics::<2>(mech, ws)?),
+            3 => return Ok(fixed_dynamics::<3>(mech, ws)?),
+            FIXED_M => return Ok(fixed_dynamics::<FIXED_M>(mech, ws)?),
+            _ => {}
+        }
     }
     mass_matrix_and_bias(mech, ws);
     if mech.has_losses() {

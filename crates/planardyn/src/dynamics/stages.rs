@@ -12,7 +12,10 @@ use crate::kinematics::constraints::{
     coordinate_rates, coordinates, pair_coordinate_gamma, pair_coordinate_grad, pair_coordinate_rate, Dense,
 };
 use crate::kinematics::{convective, solve_position, velocity_analogues, Chart, Frame, USupport};
-use crate::linalg::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope, copy_small};
+use crate::linalg::{
+    cholesky_envelope, cholesky_envelope_fixed, cholesky_in_place, cholesky_solve, cholesky_solve_envelope,
+    cholesky_solve_envelope_fixed, copy_small,
+};
 use crate::model::{Body, Mechanism, PairId};
 use crate::{Error, KinematicsError, SingularityKind};
 
@@ -149,7 +152,7 @@ pub(crate) fn mass_matrix_and_bias(mech: &Mechanism, ws: &mut Workspace) {
 /// The most coordinates the stages take with fixed-size loops (`mass_matrix_and_bias`, the
 /// Cholesky factor and solve): past a few, U's supports (which the fixed-size loops do not
 /// use) save more than the loops' bookkeeping costs.
-const FIXED_M: usize = 4;
+pub(crate) const FIXED_M: usize = 4;
 
 /// [`mass_matrix_and_bias`] for M coordinates: every entry of A's upper triangle and of b
 /// summed body by body over all bodies. U is zero outside its supports and a zero term leaves a
@@ -158,7 +161,15 @@ const FIXED_M: usize = 4;
 /// zeros outside the envelope are there (`a_zeros_for`). From [`SPLIT_FROM_M`] coordinates A's
 /// sums and b's take a pass over the bodies each: the same terms added in the same order, with
 /// half the running sums of one pass (which then no longer fit the registers).
+#[inline(never)]
 fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
+    fixed_sums::<M>(mech, ws);
+}
+
+/// [`fixed_mass_matrix_and_bias`]'s sums, inlined where one coordinate's (a few instructions a
+/// body) are worth no call.
+#[inline(always)]
+fn fixed_sums<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     // Each column's body by body: three values a step with no bounds check of their own.
     let columns = || -> [std::slice::ChunksExact<f64>; M] {
@@ -251,23 +262,36 @@ fn not_positive_definite(ws: &Workspace) -> KinematicsError {
     KinematicsError::singular(SingularityKind::MassMatrix { type_ii })
 }
 
-/// The stages after the forces for one coordinate (m = 1) in one function and no bookkeeping
-/// of A's pattern: A and b as [`mass_matrix_and_bias`] sums them, A's factor sqrt(A) into
-/// `ws.a` (as [`factor_mass_matrix`] leaves it), zdd = (b / sqrt(A)) / sqrt(A), xdd = c + u zdd
-/// and the user's qdd; the operations of [`mass_matrix_and_bias`], [`factor_mass_matrix`],
-/// [`solve_mass_matrix`] and [`accelerations`], so the same numbers (xdd but for the sign of a
-/// zero entry), without the dispatch on m and a call between A, b and the rest.
-pub(crate) fn one_coordinate_dynamics(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
-    fixed_mass_matrix_and_bias::<1>(mech, ws);
-    let a = ws.a[0];
-    if !(a > 0.0) {
+/// The stages after the forces for M coordinates (up to [`FIXED_M`]) in one function and no
+/// bookkeeping of A's pattern: A and b as [`mass_matrix_and_bias`] sums them, A's factor into
+/// `ws.a` (as [`factor_mass_matrix`] leaves it), zdd = A^-1 b, xdd = U zdd + c and the user's
+/// qdd; the operations of [`mass_matrix_and_bias`], [`factor_mass_matrix`],
+/// [`solve_mass_matrix`] and [`accelerations`] (with its few columns' one pass), so the same
+/// numbers, without the dispatch on m and the calls between the stages.
+pub(crate) fn fixed_dynamics<const M: usize>(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
+    // Inlined at M = 1 (the five m = 1 models -3 to -13 instructions an evaluation); at M = 2
+    // and 3 the call keeps the caller's code as it compiles best (s18: 3-RRR +149 inlined).
+    if M == 1 {
+        fixed_sums::<M>(mech, ws);
+    } else {
+        fixed_mass_matrix_and_bias::<M>(mech, ws);
+    }
+    let first = ws.frame.sys.a_first();
+    if !cholesky_envelope_fixed::<M>(&mut ws.a, first) {
         return Err(not_positive_definite(ws));
     }
-    let l = a.sqrt();
-    let zdd = ws.b[0] / l / l;
-    (ws.a[0], ws.zdd[0]) = (l, zdd);
-    for ((x, c), u) in ws.xdd.iter_mut().zip(&ws.frame.c).zip(&ws.frame.u) {
-        *x = c + u * zdd;
+    let mut zdd: [f64; M] = std::array::from_fn(|j| ws.b[j]);
+    cholesky_solve_envelope_fixed::<M>(&ws.a, first, &mut zdd);
+    ws.zdd.copy_from_slice(&zdd);
+    // xdd = c + U zdd, each entry's terms added column by column (as `body_accelerations`).
+    let n = ws.xdd.len();
+    let u: [&[f64]; M] = std::array::from_fn(|j| &ws.frame.u[j * n..][..n]);
+    for (i, (x, c)) in ws.xdd.iter_mut().zip(&ws.frame.c[..n]).enumerate() {
+        let mut s = *c;
+        for (uj, zj) in u.iter().zip(&zdd) {
+            s += uj[i] * zj;
+        }
+        *x = s;
     }
     user_accelerations(mech, ws);
     Ok(())

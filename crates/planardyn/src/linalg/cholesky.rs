@@ -12,20 +12,28 @@ pub fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
 /// As [`cholesky_in_place`] with the envelope given: `first[i]`, the first column of row i that
 /// may be non-zero (from the supports of U), so that no row is scanned for it.
 pub fn cholesky_envelope(a: &mut [f64], m: usize, first: &[usize]) -> bool {
-    // m as a constant up to 4, so that the loops of `factor` (inlined) unroll: the mass matrix
-    // of a mechanism of a few coordinates, where their bookkeeping would cost more than the
-    // arithmetic.
-    // At m = 3 and 4 a full envelope (every row from column 0: the columns of U share bodies,
-    // as a 3-RRR's do) with its bounds constant too, so that the loops unroll whole: the same
-    // operations (3-RRR -49 instructions an evaluation; at m = 2 it saved nothing).
+    // m as a constant up to 4 (`cholesky_envelope_fixed`).
     match m {
-        1 => factor(a, 1, |_, i| first[i]),
-        2 => factor(a, 2, |_, i| first[i]),
-        3 if first == [0; 3] => factor(a, 3, |_, _| 0),
-        4 if first == [0; 4] => factor(a, 4, |_, _| 0),
-        3 => factor(a, 3, |_, i| first[i]),
-        4 => factor(a, 4, |_, i| first[i]),
+        1 => cholesky_envelope_fixed::<1>(a, first),
+        2 => cholesky_envelope_fixed::<2>(a, first),
+        3 => cholesky_envelope_fixed::<3>(a, first),
+        4 => cholesky_envelope_fixed::<4>(a, first),
         _ => factor(a, m, |_, i| first[i]),
+    }
+}
+
+/// [`cholesky_envelope`] for M known when compiled (a few), inlined: the loops of `factor`
+/// unroll, for the mass matrix of a mechanism of a few coordinates, where their bookkeeping
+/// would cost more than the arithmetic. From M = 3 a full envelope (every row from column 0:
+/// the columns of U share bodies, as a 3-RRR's do) has its bounds constant too, so that the
+/// loops unroll whole: the same operations (3-RRR -49 instructions an evaluation; at M = 2 it
+/// saved nothing).
+#[inline(always)]
+pub fn cholesky_envelope_fixed<const M: usize>(a: &mut [f64], first: &[usize]) -> bool {
+    if M >= 3 && first == [0; M] {
+        factor(a, M, |_, _| 0)
+    } else {
+        factor(a, M, |_, i| first[i])
     }
 }
 
@@ -65,15 +73,22 @@ pub fn cholesky_solve(l: &[f64], m: usize, b: &mut [f64]) {
 /// envelope's size, not m^2.
 pub fn cholesky_solve_envelope(l: &[f64], m: usize, first: &[usize], b: &mut [f64]) {
     // m as a constant up to 4 (as in `cholesky_envelope`).
-    // A full envelope's bounds constant at m = 3 and 4 (as in `cholesky_envelope`).
     match m {
-        1 => solve(l, 1, b, |i| first[i]),
-        2 => solve(l, 2, b, |i| first[i]),
-        3 if first == [0; 3] => solve(l, 3, b, |_| 0),
-        4 if first == [0; 4] => solve(l, 4, b, |_| 0),
-        3 => solve(l, 3, b, |i| first[i]),
-        4 => solve(l, 4, b, |i| first[i]),
+        1 => cholesky_solve_envelope_fixed::<1>(l, first, b),
+        2 => cholesky_solve_envelope_fixed::<2>(l, first, b),
+        3 => cholesky_solve_envelope_fixed::<3>(l, first, b),
+        4 => cholesky_solve_envelope_fixed::<4>(l, first, b),
         _ => solve(l, m, b, |i| first[i]),
+    }
+}
+
+/// [`cholesky_solve_envelope`] for M known when compiled, inlined (as [`cholesky_envelope_fixed`]).
+#[inline(always)]
+pub fn cholesky_solve_envelope_fixed<const M: usize>(l: &[f64], first: &[usize], b: &mut [f64]) {
+    if M >= 3 && first == [0; M] {
+        solve(l, M, b, |_| 0)
+    } else {
+        solve(l, M, b, |i| first[i])
     }
 }
 

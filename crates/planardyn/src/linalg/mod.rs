@@ -16,7 +16,10 @@ mod sink;
 mod sparse_pivot;
 
 pub use block_lu::{BlockLu, BlockSink, MAX_COLUMNS};
-pub use cholesky::{cholesky_envelope, cholesky_in_place, cholesky_solve, cholesky_solve_envelope};
+pub use cholesky::{
+    cholesky_envelope, cholesky_envelope_fixed, cholesky_in_place, cholesky_solve, cholesky_solve_envelope,
+    cholesky_solve_envelope_fixed,
+};
 pub use gram::{gamma, gram_exceeds};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
 pub use pivot::pivot_columns;
