@@ -231,7 +231,7 @@ mod tests {
         let sigma = |t: f64| (K * (d + C * (t - tm) * (t - tm))).sqrt();
         let mut watch = FoldWatch::default();
         let (mut t, h) = (tm - 0.11, 1e-5);
-        let mut step = |watch: &mut FoldWatch, t: &mut f64, h: f64| {
+        let step = |watch: &mut FoldWatch, t: &mut f64, h: f64| {
             *t += h;
             watch.zeno(*t, sigma(*t), h);
         };
