@@ -55,18 +55,19 @@ def test_a_run_is_in_the_page_in_the_replay_format(tmp_path):
     assert len(run["P"]) == 5 and {c["key"] for c in run["channels"]} >= {"kinetic", "potential"}
 
 
-def test_a_passive_run_opens_on_its_energies_not_its_zero_efforts(five_bar):
-    # The four-bar under gravity has no drive: its effort channel is all zero, so its run is
-    # charted first by its coordinate and energies; a driven run by its coordinates and efforts.
+def test_a_runs_first_channels_are_the_pages_choice_unless_named(five_bar):
+    # Without channels named, run_data marks none: the page opens the run on the channels it
+    # opens its own runs on (web/src/channels.js's defaultChannels; tests/test_app_browser.py
+    # checks the page's choice). Named channels are marked on, the others off.
     mech = pdy.load(pdy.models.path("four-bar-gravity"))
     res = mech.simulate(t_end=0.2, output_dt=0.05)
-    assert not np.any(res.tau)
     data = run_data(mech, res)
-    assert [c["key"] for c in data["channels"] if c["on"]] == ["theta1", "kinetic", "potential", "total"]
+    assert not any("on" in c for c in data["channels"])
     assert "; 1 coordinate (theta1), 3 bodies;" in data["info"]
     driven, res = five_bar
-    on = [c["key"] for c in run_data(driven, res)["channels"] if c["on"]]
-    assert on == ["theta1", "theta2", "tau_theta1", "tau_theta2"]
+    chans = run_data(driven, res, channels=["theta1", "tau_theta2"])["channels"]
+    assert [c["key"] for c in chans if c["on"]] == ["theta1", "tau_theta2"]
+    assert all("on" in c for c in chans)
 
 
 def test_the_page_holds_the_shipped_models_to_start_from(tmp_path):

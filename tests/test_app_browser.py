@@ -432,6 +432,31 @@ def test_opening_a_model_file_and_a_python_run(page, tmp_path):
     assert float(shown["q"]) == pytest.approx(res.q[10, 0], rel=1e-3)
 
 
+def test_a_python_run_opens_on_the_pages_default_channels(page, tmp_path):
+    # The page chooses a played run's first channels with its own rule (web/src/channels.js's
+    # defaultChannels), as for its own runs: the four-bar without gravity, at rest, has all-zero
+    # efforts and energies, so its run written by Python opens on its coordinate and singularity
+    # measure; under gravity (passive: zero efforts) on its coordinate and energies. Channels
+    # named in Python (run_data's channels) are the ones opened.
+    from planardyn.replay import run_data
+
+    spec = pdy.load(pdy.models.path("four-bar-gravity")).to_dict()
+    falling = pdy.from_dict(spec)
+    spec["gravity"] = [0, 0]
+    resting = pdy.from_dict(spec)
+    res = resting.simulate(t_end=0.2, output_dt=0.05)
+    assert not np.any(res.tau) and not np.any(res.energy.total)
+    cases = [(resting, res, None, ["sigma", "theta1"]),
+             (falling, falling.simulate(t_end=0.2, output_dt=0.05), None, ["kinetic", "potential", "theta1", "total"]),
+             (resting, res, ["theta1", "kinetic"], ["kinetic", "theta1"])]
+    for k, (mech, res, channels, opened) in enumerate(cases):
+        run = tmp_path / f"run{k}.json"  # a file of its own: the same file again is no change
+        run.write_text(json.dumps(run_data(mech, res, channels=channels, title=f"run {k}")))
+        page.set_input_files("#open", str(run))
+        page.wait_for_function(f"document.getElementById('title').textContent === 'run {k}'", timeout=5_000)
+        assert sorted(page.evaluate("[...window.planardyn.charts.on]")) == opened, k
+
+
 def download(page, button: str) -> tuple[str, bytes]:
     """Click an export button; the file's suggested name and its bytes."""
     with page.expect_download() as d:

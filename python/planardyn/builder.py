@@ -106,7 +106,7 @@ class Builder:
         if self._placed is None:
             skeleton = {"name": self._d["name"], "points": self._d["points"], "bodies": {}, "pairs": [],
                         "coordinates": []}
-            text, _ = resolve_model(json.dumps(skeleton), "json", f"<Builder {self._d['name']!r}>")
+            text, _ = resolve_model(json.dumps(skeleton), "data", f"<Builder {self._d['name']!r}>")
             self._placed = {k: (v[0], v[1]) for k, v in json.loads(text)["points"].items()}
         return self._placed[name]
 

@@ -929,11 +929,12 @@ def _json_default(value: Any) -> Any:
 def from_dict(model: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
     """Build a mechanism from a dict in the model-file schema (as ``yaml.safe_load`` gives).
 
-    numpy numbers and arrays are accepted as values.
+    numpy numbers and arrays are accepted as values. A :class:`ModelError` names the field
+    by its path in the dict (``bodies.crank.mass``, ``pairs[2].at``), with no line.
     """
     if not isinstance(model, Mapping):
         raise TypeError(f"from_dict needs a mapping, got {type(model).__name__}")
-    return loads(json.dumps(model, default=_json_default, allow_nan=True), "json", source)
+    return Mechanism(native_loads(json.dumps(model, default=_json_default, allow_nan=True), "data", source))
 
 
 def from_result(result: SimulationResult) -> Mechanism:

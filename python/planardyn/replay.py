@@ -25,9 +25,6 @@ if TYPE_CHECKING:
 
 #: Frames kept in the page at most (longer results are subsampled uniformly).
 MAX_FRAMES = 1500
-#: An effort channel whose largest magnitude is below this (N m or N) is all zero, a passive
-#: model's: not charted first (web/src/channels.js's ZERO_EFFORT).
-ZERO_CHANNEL = 1e-12
 #: Significant digits kept for positions (relative to the mechanism's size) and channels.
 DIGITS = 6
 #: Smallest time scale (s) the rounding of output times is relative to: a run near t = 0
@@ -86,8 +83,9 @@ def _along_channels(mech: Mechanism, result: SimulationResult, keep: np.ndarray,
 
 def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | None,
               extra: tuple[list, list] = ([], [])) -> tuple[list, list]:
-    """(groups, channels): each channel a dict key, label, group, values, on; ``extra``
-    groups and channels appended (computed along the trajectory)."""
+    """(groups, channels): each channel a dict key, label, group, values, and ``on`` where
+    ``selected`` names the channels opened (else the page chooses); ``extra`` groups and
+    channels appended (computed along the trajectory)."""
     names, kinds = result.coordinate_names, result.coordinate_kinds
     # Per coordinate group: key, values, channel names, label, unit (on an angle, on a displacement).
     per_coordinate = [
@@ -114,11 +112,9 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
     chans.append({"key": "sigma", "label": "sigma", "group": "sigma", "values": result.sigma[keep], "unit": "1"})
     groups += extra[0]
     chans += extra[1]
-    # The coordinates, with the efforts that are not all zero, else the energies (a passive
-    # model's efforts are all zero: web/src/channels.js's defaultChannels, as the app's own runs).
-    efforts = {c["key"] for c in chans if c["group"] == "tau" and np.any(np.abs(c["values"]) > ZERO_CHANNEL)}
-    default = {c["key"] for c in chans if c["group"] == "q"} | (efforts or {"kinetic", "potential", "total"})
-    chosen = default if selected is None else set(selected)
+    # Without a choice the page opens the run on the channels it opens its own runs on
+    # (web/src/channels.js's defaultChannels).
+    chosen = set(selected or ())
     unknown = chosen - {c["key"] for c in chans}
     if unknown:
         raise error(
@@ -126,7 +122,8 @@ def _channels(result: SimulationResult, keep: np.ndarray, selected: list[str] | 
             f"{', '.join(c['key'] for c in chans)}"
         )
     for c in chans:
-        c["on"] = c["key"] in chosen
+        if selected is not None:
+            c["on"] = c["key"] in chosen
         v = np.asarray(c["values"], dtype=float)
         finite = v[np.isfinite(v)]
         c["values"] = _round(v, float(np.max(np.abs(finite))) if finite.size else 1.0)
@@ -153,8 +150,11 @@ def run_data(
     channels : list of str, optional
         Channels plotted at first (the page has a checkbox for every one): coordinate names,
         ``qd_<name>``, ``qdd_<name>``, ``tau_<name>``, ``kinetic``, ``potential``, ``total``,
-        ``work``, ``balance``, ``sigma``, ``F_<pair>``, ``v_<point>``, ``a_<point>``. Default:
-        the coordinates and the drive efforts.
+        ``work``, ``balance``, ``sigma``, ``F_<pair>``, ``v_<point>``, ``a_<point>``; each
+        channel's ``on`` says whether it is one of them. Default: no ``on`` in the data, and
+        the page opens the run on the channels it opens its own runs on (the coordinates with
+        the drive efforts that are not all zero, else with the energies that are not, else with
+        the singularity measure: web/src/channels.js's ``defaultChannels``).
     traces : list of str, optional
         Points whose paths are drawn (default :func:`planardyn.plot.default_trace_points`).
     max_frames : int

@@ -2,6 +2,8 @@
 // point positions per frame P, bodies and ground as point indices, each pair's drawing per
 // frame, channels with their units), played without the engine.
 
+import { defaultChannels } from "./channels.js";
+
 /** Whether parsed JSON is a viewer's data. */
 export const isRun = (d) => d && Array.isArray(d.P) && Array.isArray(d.t) && Array.isArray(d.channels);
 
@@ -11,6 +13,13 @@ const f64 = (a) => Float64Array.from(a, (v) => (v === null ? NaN : v));
 export function replaySeries(data) {
   const chans = data.channels.map((c) => ({ key: c.key, label: c.label, group: c.group, unit: c.unit, values: f64(c.values), on: c.on }));
   return { data, t: f64(data.t), chans };
+}
+
+/** The channels a run opens on: those its data marks `on` (channels chosen in Python), else
+ * the ones the page opens its own runs on. */
+export function replayDefaults(chans) {
+  const marked = chans.filter((c) => c.on !== undefined);
+  return marked.length ? new Set(marked.filter((c) => c.on).map((c) => c.key)) : defaultChannels(chans);
 }
 
 /** The scene of frame i, traced points' paths up to it. */

@@ -3,7 +3,7 @@
 import { $, app, fmt, status, zeros } from "./state.js";
 import { describe } from "./engine.js";
 import { defaultChannels, seriesChannels, unitOf } from "./channels.js";
-import { replaySeries } from "./replay.js";
+import { replayDefaults, replaySeries } from "./replay.js";
 import { arrowTips, holdView, moveTo } from "./view.js";
 import { play, setMode } from "./timeline.js";
 import { arrowScale, sweep } from "./design.js";
@@ -73,7 +73,7 @@ export function backToDesign() {
 export function showReplay(data) {
   app.replay = replaySeries(data);
   app.bounds = data.bounds;
-  app.charts.set(app.replay.t, "t (s)", app.replay.chans, new Set(app.replay.chans.filter((c) => c.on).map((c) => c.key)));
+  app.charts.set(app.replay.t, "t (s)", app.replay.chans, replayDefaults(app.replay.chans));
   $("title").textContent = data.title;
   setMode("replay");
   status(data.info);

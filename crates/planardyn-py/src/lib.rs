@@ -78,6 +78,8 @@ fn format_arg(format: &str) -> PyResult<Format> {
     match format.to_ascii_lowercase().as_str() {
         "yaml" | "yml" => Ok(Format::Yaml),
         "json" => Ok(Format::Json),
+        // A model given as a dict, as JSON: errors by field path, no line (from_dict).
+        "data" => Ok(Format::Data),
         other => Err(argument_error(Some("format"), format!("format must be 'yaml' or 'json', got {other:?}"))),
     }
 }

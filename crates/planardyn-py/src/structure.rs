@@ -4,7 +4,7 @@
 use crate::convert::{arr1, arr2, vector, Floats};
 use crate::errors::{kinematics_error, model_error};
 use crate::mechanism::PyMechanism;
-use planardyn::loader::{analyse_spec, parse_spec};
+use planardyn::loader::analyse_spec;
 use planardyn::model::Link;
 use planardyn::structure::{analyse, pair_constraint_jacobian, scaled_constraint_jacobian, Structure};
 use planardyn::Format;
@@ -45,14 +45,12 @@ pub fn structure<'py>(py: Python<'py>, mech: &PyMechanism, x: Option<ArrayArg<'p
     to_dict(py, &s)
 }
 
-/// The structural analysis of a model (JSON text) at its drawing, also of a model whose
-/// mobility differs from its coordinates (`planardyn::loader::analyse_spec`).
+/// The structural analysis of a model dict (as JSON text) at its drawing, also of a model
+/// whose mobility differs from its coordinates (`planardyn::loader::analyse_spec`).
 #[pyfunction]
 #[pyo3(signature = (text, source="<dict>"))]
 pub fn structure_of_model<'py>(py: Python<'py>, text: &str, source: &str) -> PyResult<Bound<'py, PyDict>> {
-    let s = parse_spec(text, Format::Json, source)
-        .and_then(|spec| analyse_spec(spec, source))
-        .map_err(|e| model_error(py, &e))?;
+    let s = analyse_spec(text, Format::Data, source).map_err(|e| model_error(py, &e))?;
     to_dict(py, &s)
 }
 

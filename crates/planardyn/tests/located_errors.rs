@@ -298,3 +298,50 @@ fn a_missing_fields_error_is_located_at_its_parent() {
         );
     }
 }
+
+/// A model given as data (a Python dict, serialised as JSON text its user never wrote): its
+/// errors name the field path alone, the checks' as the parsers', with no line of that text.
+#[test]
+fn a_model_given_as_data_is_located_by_its_field_path_alone() {
+    let json = serde_json::to_string(&yaml(FOUR_BAR).spec).unwrap();
+    let cases = [
+        ("\"mass\":1.0", "\"mass\":-1.0", "bodies.rocker.mass: mass must be > 0 kg, got -1".to_string()),
+        (
+            "\"mass\":1.0",
+            "\"mass\":\"heavy\"",
+            "bodies.rocker.mass: \"heavy\" is not a number with a unit; this field takes a mass (kg, g, lb, or a \
+             number alone in kg); write e.g. \"30 g\""
+                .to_string(),
+        ),
+        (
+            "\"mass\":1.0",
+            "\"mass\":NaN",
+            "bodies.rocker.mass: not a finite number; give a finite number (NaN and infinities are not model values)"
+                .to_string(),
+        ),
+        (
+            "\"at\":\"B\"",
+            "\"at\":\"Q\"",
+            "pairs[2].at: unknown point 'Q'; points are: O, D, A, B (use one of them, or add it to `points`)"
+                .to_string(),
+        ),
+    ];
+    for (old, new, expected) in cases {
+        assert!(json.contains(old), "{old}");
+        let text = json.replacen(old, new, 1);
+        assert_eq!(loads(&text, Format::Data, "<dict>").unwrap_err().to_string(), format!("<dict>: {expected}"));
+        // As JSON text, the same error with its line.
+        let located = loads(&text, Format::Json, "<dict>").unwrap_err().to_string();
+        assert!(located.contains(" (line 1 column "), "{located}");
+    }
+}
+
+/// The structural analysis reads a model the loader refuses for its mobility; every other
+/// error is the loader's, located as [`loads`] locates it.
+#[test]
+fn the_structural_analysis_locates_the_loaders_errors() {
+    let text = FOUR_BAR.replace("mass: 1.0,", "mass: -1.0,");
+    let err = planardyn::analyse_spec(&text, Format::Yaml, "m.yaml").unwrap_err().to_string();
+    assert_eq!(err, "m.yaml: bodies.rocker.mass: mass must be > 0 kg, got -1 (line 13 column 34)");
+    assert_eq!(err, loads(&text, Format::Yaml, "m.yaml").unwrap_err().to_string());
+}

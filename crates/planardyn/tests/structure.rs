@@ -4,7 +4,7 @@
 
 mod common;
 use common::*;
-use planardyn::loader::{analyse_spec, parse_spec};
+use planardyn::loader::analyse_spec;
 use planardyn::model::{BodyId, PairId};
 use planardyn::structure::{analyse, scaled_constraint_jacobian, Structure};
 use planardyn::{Format, KinematicsError, Mechanism};
@@ -215,8 +215,7 @@ fn a_model_the_loader_refuses_is_analysed_from_its_drawing() {
         .replace("coordinates:\n", "coordinates:\n  - {name: extra, pair: B, value: 0.0}\n");
     let err = planardyn::loads(&text, Format::Yaml, "<test>").unwrap_err();
     assert!(err.to_string().contains("coordinates"), "{err}");
-    let spec = parse_spec(&text, Format::Yaml, "<test>").unwrap();
-    let s = analyse_spec(spec, "<test>").unwrap();
+    let s = analyse_spec(&text, Format::Yaml, "<test>").unwrap();
     assert_eq!(counts(&s), (1, 1, 8, 1));
     assert_eq!((s.redundant, s.actuation, s.fully_actuated()), (0, 2, false));
     assert_eq!(names(&s, &s.input_links), ["crank"]);
@@ -230,8 +229,7 @@ fn links_a_missing_coordinate_leaves_free_are_left_over() {
     // The 3-RRR with two coordinates: the third proximal link, the distal links and the
     // platform are free to move with the pairs that touch them: 3*5 - 2*7 = 1.
     let text = RRR3.replace("  - {name: th3, pair: R3, value: 1.7769252074235635}\n", "");
-    let spec = parse_spec(&text, Format::Yaml, "<test>").unwrap();
-    let s = analyse_spec(spec, "<test>").unwrap();
+    let s = analyse_spec(&text, Format::Yaml, "<test>").unwrap();
     assert_eq!(counts(&s), (3, 3, 18, 2));
     assert_eq!(names(&s, &s.input_links), ["prox1", "prox2"]);
     assert!(s.groups.is_empty());

@@ -62,8 +62,8 @@ pub fn parse_spec_constructed(
 
 /// A check's error with where its field is written, as a parse error's:
 /// `bodies.crank.mass: mass must be > 0 kg, got -1 (line 26 column 11)`, before the fix
-/// where the message gives one (`...; fix`).
-fn with_line(e: ModelError, text: &str, format: Format) -> ModelError {
+/// where the message gives one (`...; fix`). Data (`Format::Data`) has no lines: its field path only.
+pub(super) fn with_line(e: ModelError, text: &str, format: Format) -> ModelError {
     let ModelError::Invalid { source_name, path, message } = e else { return e };
     let message = match (locate::field_line(text, format, &path), message.split_once("; ")) {
         (Some((line, column)), Some((what, fix))) => format!("{what} (line {line} column {column}); {fix}"),
@@ -77,10 +77,11 @@ fn with_line(e: ModelError, text: &str, format: Format) -> ModelError {
 fn parse_file(text: &str, format: Format, source: &str) -> Result<FileSpec, ModelError> {
     let input = Input { text, format, source };
     match format {
-        Format::Json => {
+        Format::Json | Format::Data => {
             let de = &mut serde_json::Deserializer::from_str(text);
             serde_path_to_error::deserialize(de).map_err(|e| {
-                let at = (e.inner().line() > 0).then(|| (e.inner().line(), e.inner().column()));
+                let located = format == Format::Json && e.inner().line() > 0;
+                let at = located.then(|| (e.inner().line(), e.inner().column()));
                 input.error(e.path(), &e.inner().to_string(), at)
             })
         }

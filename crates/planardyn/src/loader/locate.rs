@@ -22,8 +22,12 @@ const MAX_DEPTH: usize = 200;
 /// The line and column of the field at `path` in `text`: of its value where the value starts
 /// on its key's line (or its list dash's), of the key otherwise; that of the deepest
 /// component of the path found where the rest is not written (a field left to its default,
-/// `bodies.crank` for `bodies.crank.inertia`); `None` where not even the first is.
+/// `bodies.crank` for `bodies.crank.inertia`); `None` where not even the first is, and in
+/// data (`Format::Data`: no text its user wrote).
 pub(super) fn field_line(text: &str, format: Format, path: &str) -> Option<At> {
+    if format == Format::Data {
+        return None;
+    }
     let root = Reader::new(text, format).document()?;
     let (mut node, mut rest, mut found) = (&root, path, None);
     while let Some((entry, after)) = node.child(rest) {

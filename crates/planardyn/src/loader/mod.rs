@@ -11,10 +11,10 @@ mod parse_errors;
 mod tags;
 mod validate;
 
+use io::with_line;
 pub use io::{load, loads, parse_spec, parse_spec_constructed};
 pub use validate::build;
 
-use crate::model::MechanismSpec;
 use crate::structure::{structure, Structure};
 use crate::ModelError;
 use std::path::Path;
@@ -24,6 +24,9 @@ use std::path::Path;
 pub enum Format {
     Yaml,
     Json,
+    /// JSON serialised from a model given as data (a Python dict): read as JSON, its errors
+    /// located by their field path alone, not by a line of a text its user never wrote.
+    Data,
 }
 
 impl Format {
@@ -36,11 +39,11 @@ impl Format {
     }
 }
 
-/// The structural analysis of a model at its drawing, also when it does not build because
+/// The structural analysis of model text at its drawing, also when it does not build because
 /// its mobility differs from its number of coordinates or it does not assemble at `q0`
 /// (what a structural analysis is for). Every other check of the loader applies; its errors
-/// are returned as they are.
-pub fn analyse_spec(spec: MechanismSpec, source: &str) -> Result<Structure, ModelError> {
-    let mech = validate::drawing(spec, source)?;
+/// are located as [`loads`]'s.
+pub fn analyse_spec(text: &str, format: Format, source: &str) -> Result<Structure, ModelError> {
+    let mech = validate::drawing(parse_spec(text, format, source)?, source).map_err(|e| with_line(e, text, format))?;
     Ok(structure(&mech, &mech.x0))
 }

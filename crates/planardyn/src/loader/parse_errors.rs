@@ -43,6 +43,7 @@ impl Input<'_> {
         let mut field = field_path(path);
         let (message, fix) = self.explain(message, &mut field);
         let (path, message) = match (field.is_empty(), at) {
+            (true, _) if self.format == Format::Data => ("the model".into(), message),
             (true, _) => (self.line_column(&message, at), message),
             (false, Some((line, column))) => (field, format!("{message} (line {line} column {column})")),
             (false, None) => (field, message),
@@ -100,6 +101,8 @@ impl Input<'_> {
         let syntax = match self.format {
             Format::Yaml => "the text is not valid YAML: check the indentation, brackets, quotes and colons there",
             Format::Json => "the text is not valid JSON: check the brackets, quotes, commas and colons there (JSON has no NaN or Infinity)",
+            // Data serialised as JSON is valid but for the NaN and infinities it writes as such.
+            Format::Data => return ("not a finite number".into(), "give a finite number (NaN and infinities are not model values)".into()),
         };
         let fix = match message {
             "unknown anchor" => {

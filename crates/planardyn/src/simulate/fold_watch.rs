@@ -25,6 +25,13 @@ const FOLD_DRIFT: f64 = 0.25;
 /// thousands of steps).
 const FOLD_ADVANCE: f64 = 0.01;
 
+/// A failed run stalled before a fold when its last step was below this fraction of the time
+/// left to it: five-bar-robot's steps shrank to 2.4e-7 of it (4e-12 s, 1.7e-5 s before its fold).
+/// The ordinary small steps of a 3-RRR pass-by, where sigma^2 is nearly linear and its secant
+/// reaches 0 far ahead (RADAU5 at rtol 1e-12, rk4 at dt 1e-4), come to 2.3e-3 of it and more
+/// (s19-review's sweep, /work/notes/s19-review.md); [`FOLD_ADVANCE`] let those count as stalls.
+const FOLD_STALL: f64 = 1e-4;
+
 /// A failed step's fold must lie within this many steps of the last accepted point, and the
 /// secant that predicts it end as near before it: the steps that fail at a fold are those that
 /// try to pass it, or (fixed steps: rk4, or `dt`) the ones after the step that passed it.
@@ -45,6 +52,10 @@ pub struct FoldWatch {
     fell: Option<[(f64, f64); 2]>,
     /// Since when the measure has fallen at every accepted point, up to the last one.
     falling_since: Option<f64>,
+    /// (t, t*): the fold the secants predicted at two points of that fall, the older first, the
+    /// newer taken at least half the time left after the older (a fold's t* stays put, a
+    /// pass-by's moves on with t: [`FOLD_DRIFT`]).
+    predicted: Option<[(f64, f64); 2]>,
 }
 
 impl FoldWatch {
@@ -62,10 +73,13 @@ impl FoldWatch {
         match self.last.filter(|_| sigma.is_finite()) {
             Some(before) if point.1 < before.1 => {
                 self.fell = Some([before, point]);
-                self.falling_since = self.falling_since.or(Some(before.0));
+                if self.falling_since.is_none() {
+                    (self.falling_since, self.predicted) = (Some(before.0), None);
+                }
+                self.predict(t, root(before, point));
             }
-            Some(_) => self.falling_since = None,
-            None => (self.fell, self.falling_since) = (None, None),
+            Some(_) => (self.falling_since, self.predicted) = (None, None),
+            None => (self.fell, self.falling_since, self.predicted) = (None, None, None),
         }
         self.last = sigma.is_finite().then_some(point);
         if sigma >= NEAR_PASSIVE_SINGULAR {
@@ -91,10 +105,11 @@ impl FoldWatch {
     /// The fold a run that failed at t, after a step of h, was running into: the last secant
     /// of sigma^2 that fell, ending within [`FOLD_REACH`] steps of h before t, reaches 0
     /// within as many after t. A fixed step (no error control) can pass the fold: the
-    /// measures of the points it accepts past it rise again, or are not taken. Or, as
-    /// [`FoldWatch::zeno`] would stop it, the steps stalled before it: the measure fell at
-    /// every point up to t, h is below [`FOLD_ADVANCE`] of the time left, and that is shorter
-    /// than the time it has been falling. A step that fails for another reason near the fold
+    /// measures of the points it accepts past it rise again, or are not taken. Or the steps
+    /// stalled before it: the measure fell at every point up to t, h is below [`FOLD_STALL`] of
+    /// the time left, that is shorter than the time it has been falling, and the fold predicted
+    /// earlier in the fall is the same (within [`FOLD_DRIFT`] of the time since): a pass-by's
+    /// secants reach 0 ahead of its closest approach too, at a t* that moves on with t. A step that fails for another reason near the fold
     /// (the friction efforts' fixed point, which J's near-singularity makes stiff) shrinks the
     /// steps to nothing there: five-bar-robot, cranks at +1 / -1 rad/s, failed 1.7e-5 s before
     /// its fold after steps of 4e-12 s, at a measure of 1.5e-3.
@@ -102,10 +117,22 @@ impl FoldWatch {
         let [before, last] = self.fell?;
         let t_star = root(before, last)?;
         let reach = t - last.0 <= FOLD_REACH * h && t_star < t + FOLD_REACH * h;
+        let fixed = self.predicted.is_some_and(|[(t0, t0_star), _]| (t_star - t0_star).abs() < FOLD_DRIFT * (t - t0));
         let stalled = self
             .falling_since
-            .is_some_and(|since| last.0 == t && h < FOLD_ADVANCE * (t_star - t) && t_star - t < t - since);
+            .is_some_and(|since| last.0 == t && h < FOLD_STALL * (t_star - t) && t_star - t < t - since && fixed);
         (reach || stalled).then_some(t_star)
+    }
+
+    /// Keep the fold `t_star` predicted at t (falling): the newer prediction once half the
+    /// time left has passed since it, the one it replaces the older.
+    fn predict(&mut self, t: f64, t_star: Option<f64>) {
+        let Some(t_star) = t_star else { return };
+        self.predicted = match self.predicted {
+            None => Some([(t, t_star); 2]),
+            Some([_, newer]) if t - newer.0 >= 0.5 * (t_star - t) => Some([newer, (t, t_star)]),
+            kept => kept,
+        };
     }
 }
 
@@ -188,5 +215,37 @@ mod tests {
             let s2 = sigma(t0).powi(2) + slope * (t - t0);
             assert_eq!(watch.zeno(t, s2.sqrt(), h), None, "step {k} at {t}");
         }
+    }
+
+    #[test]
+    fn a_pass_by_that_stalls_before_its_closest_approach_is_not_named_a_fold() {
+        // A pass-by 1e-4 s from the fold, K (1e-4 + C (t - tm)^2), falling from tm - 0.11 s (the
+        // sweep's law from t = 0): its measure stays above the threshold (1.06e-3 at tm), where
+        // a failed run's fold is named, and its secants reach 0 ahead of tm. On main a step
+        // failing on it named a fold: after ordinary steps of 1e-5 s 1.5e-3 s before tm (2.7e-3
+        // of the time left to the secant's root; DOPRI5 at rtol 1e-12 in s19-review's sweep),
+        // and after steps stalled to 4e-12 s 5e-5 s before tm (its root 0.09 s ahead; RADAU5 at
+        // rtol 1e-12 stalled to 4.6e-5 of the time left).
+        const C: f64 = 11.1;
+        let (d, tm) = (1e-4, T_STAR);
+        let sigma = |t: f64| (K * (d + C * (t - tm) * (t - tm))).sqrt();
+        let mut watch = FoldWatch::default();
+        let (mut t, h) = (tm - 0.11, 1e-5);
+        let step = |watch: &mut FoldWatch, t: &mut f64, h: f64| {
+            *t += h;
+            watch.zeno(*t, sigma(*t), h);
+        };
+        while t < tm - 1.5e-3 {
+            step(&mut watch, &mut t, h);
+        }
+        assert_eq!(watch.ahead(t, h), None, "ordinary steps at {t}");
+        while t < tm - 5e-5 {
+            step(&mut watch, &mut t, h);
+        }
+        for _ in 0..3 {
+            step(&mut watch, &mut t, 4e-12);
+        }
+        assert!(sigma(t) > NEAR_PASSIVE_SINGULAR);
+        assert_eq!(watch.ahead(t, 4e-12), None, "stalled steps at {t}");
     }
 }
