@@ -160,6 +160,11 @@ def test_csv_written_before_the_metadata_file_is_read(tmp_path):
     old = ROOT / "tests" / "data" / "four-bar-v3-comment-metadata.csv"
     res = read_results(old)
     assert res.success and len(res.t) == 6 and res.metadata["model"]["name"] == "four-bar under gravity (passive)"
+    # Every number as the file's text gives it, to the bit.
+    header, *rows = [line.split(",") for line in old.read_text().splitlines() if not line.startswith("#")]
+    for name, read in [("theta1", res.q[:, 0]), ("qd_theta1", res.qd[:, 0])]:
+        column = header.index(name)
+        np.testing.assert_array_equal(read, [float(row[column]) for row in rows])
     again = pd.from_result(res).simulate(**res.metadata["settings"])
     # The same run by the same integrator (DOP853 at its default rtol 1e-9): the file's
     # numbers to round-off. Not to the bit: s19 evaluates the angles by their turn from the
