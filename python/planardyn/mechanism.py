@@ -451,24 +451,27 @@ class Mechanism:
         tau = np.asarray(raw["tau"], dtype=np.float64)
         if len(tau) == 0:
             return tau.copy()
-        rows = (raw["q"], raw["qd"], raw["qdd"], tau, raw["x"], raw["xd"])
         try:
-            t_m = self._native.motor_torques(*rows, True, True)
+            return self._rows_motor_torques(raw, tau, slice(None))
         except ArgumentError:
             raise
         except PlanardynError:
-            t_m = [self._row_motor_torques(rows, k) for k in range(len(tau))]
-        return np.asarray(t_m, dtype=np.float64).reshape(np.shape(tau))
+            return np.stack([self._row_motor_torques(raw, tau, k) for k in range(len(tau))])
 
-    def _row_motor_torques(self, rows: tuple[Any, ...], k: int) -> FloatArray:
-        """Row k's motor torques of a result's ``rows`` (q, qd, qdd, tau, x, xd), NaN where they
-        cannot be found (:meth:`_result_motor_torques`)."""
+    def _rows_motor_torques(self, raw: RawRun, tau: FloatArray, rows: slice) -> FloatArray:
+        """The motor torques of a result's ``rows`` (:meth:`_result_motor_torques`)."""
+        t_m = self._native.motor_torques(raw["q"][rows], raw["qd"][rows], raw["qdd"][rows], tau[rows], raw["x"][rows],
+                                         raw["xd"][rows], True, True)
+        return np.asarray(t_m, dtype=np.float64).reshape(np.shape(tau[rows]))
+
+    def _row_motor_torques(self, raw: RawRun, tau: FloatArray, k: int) -> FloatArray:
+        """Row k's motor torques, NaN where they cannot be found (:meth:`_result_motor_torques`)."""
         try:
-            return np.asarray(self._native.motor_torques(*(np.asarray(r)[k:k + 1] for r in rows), True, True))[0]
+            return self._rows_motor_torques(raw, tau, slice(k, k + 1))[0]
         except ArgumentError:
             raise
         except PlanardynError:
-            return np.full(np.shape(rows[3])[1], np.nan)
+            return np.full(np.shape(tau)[1], np.nan)
 
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
