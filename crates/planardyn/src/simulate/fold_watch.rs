@@ -113,8 +113,8 @@ impl FoldWatch {
     /// The fold a run that failed at t, after a step of h, was running into: the last secant
     /// of sigma^2 that fell, ending within [`FOLD_REACH`] steps of h before t, reaches 0
     /// within as many after t, or within [`FOLD_AHEAD`] of h where it ends at t. A fixed step
-    /// (no error control) can pass the fold: the
-    /// measures of the points it accepts past it rise again, or are not taken. Or the steps
+    /// (no error control) can pass the fold: the measures of the points it accepts past it rise
+    /// again, or are not taken. Or the steps
     /// stalled before it: the measure fell at every point up to t, h is below [`FOLD_STALL`] of
     /// the time left, that is shorter than the time it has been falling, and the fold predicted
     /// earlier in the fall is the same (within [`FOLD_DRIFT`] of the time since): a pass-by's
