@@ -7,8 +7,10 @@ or from another entry point of the same library (consistency: forward then inver
 from __future__ import annotations
 
 import copy
+import json
 import math
 import os
+import re
 import signal
 import threading
 
@@ -191,6 +193,18 @@ def test_wrong_type_names_the_field():
 def test_missing_file_is_a_model_error(tmp_path):
     with pytest.raises(pd.ModelError, match="nothere.yaml"):
         pd.load(tmp_path / "nothere.yaml")
+
+
+def test_a_refused_format_names_every_format_accepted():
+    # The refusal listed 'yaml' and 'json' while "data" (from_dict's JSON) was accepted too; each
+    # format it names now loads the four-bar's JSON (YAML reads JSON), and nothing else is named.
+    with pytest.raises(pd.ArgumentError) as refused:
+        pd.loads("{}", format="toml")
+    named = re.findall(r"'(\w+)'", str(refused.value).split(", got")[0])
+    assert named == ["yaml", "json", "data"], str(refused.value)
+    text = json.dumps(four_bar_dict())
+    for fmt in named:
+        assert pd.loads(text, format=fmt).dof == 1, fmt
 
 
 def test_bad_format_and_bad_dict():

@@ -80,7 +80,10 @@ fn format_arg(format: &str) -> PyResult<Format> {
         "json" => Ok(Format::Json),
         // A model given as a dict, as JSON: errors by field path, no line (from_dict).
         "data" => Ok(Format::Data),
-        other => Err(argument_error(Some("format"), format!("format must be 'yaml' or 'json', got {other:?}"))),
+        other => Err(argument_error(
+            Some("format"),
+            format!("format must be 'yaml', 'json' or 'data' (JSON of a model given as a dict), got {other:?}"),
+        )),
     }
 }
 

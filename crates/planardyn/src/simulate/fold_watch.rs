@@ -37,6 +37,14 @@ const FOLD_STALL: f64 = 1e-4;
 /// try to pass it, or (fixed steps: rk4, or `dt`) the ones after the step that passed it.
 const FOLD_REACH: f64 = 2.0;
 
+/// Where the measure still fell at the last accepted point, its fold must lie within this
+/// fraction of the last step after it: a run fails at a fold only once its steps, shrunk or
+/// refined as far as they go, can no longer approach it, so the fold is then closer than the
+/// step that failed (measured up to 0.20 of it: rk4 at dt 5e-4 into the 3-RRR's fold, refined to
+/// 3e-14 s steps). A pass-by's secant at ordinary steps reaches 0 about a step ahead (0.8 to 1.9
+/// of it in s20-review's sweep, /work/notes/s20-review.md), where FOLD_REACH named a fold.
+const FOLD_AHEAD: f64 = 0.5;
+
 /// The driven coordinates' measure (their scaled smallest singular value, `sigma`) at the
 /// last accepted points, while it is below [`NEAR_PASSIVE_SINGULAR`], the threshold of their
 /// diagnosis. Near a fold of the driven coordinates sigma^2 falls linearly in t to 0 at t*.
@@ -104,8 +112,9 @@ impl FoldWatch {
 
     /// The fold a run that failed at t, after a step of h, was running into: the last secant
     /// of sigma^2 that fell, ending within [`FOLD_REACH`] steps of h before t, reaches 0
-    /// within as many after t. A fixed step (no error control) can pass the fold: the
-    /// measures of the points it accepts past it rise again, or are not taken. Or the steps
+    /// within as many after t, or within [`FOLD_AHEAD`] of h where it ends at t. A fixed step
+    /// (no error control) can pass the fold: the measures of the points it accepts past it rise
+    /// again, or are not taken. Or the steps
     /// stalled before it: the measure fell at every point up to t, h is below [`FOLD_STALL`] of
     /// the time left, that is shorter than the time it has been falling, and the fold predicted
     /// earlier in the fall is the same (within [`FOLD_DRIFT`] of the time since): a pass-by's
@@ -116,7 +125,8 @@ impl FoldWatch {
     pub fn ahead(&self, t: f64, h: f64) -> Option<f64> {
         let [before, last] = self.fell?;
         let t_star = root(before, last)?;
-        let reach = t - last.0 <= FOLD_REACH * h && t_star < t + FOLD_REACH * h;
+        let ahead = if last.0 < t { FOLD_REACH } else { FOLD_AHEAD };
+        let reach = t - last.0 <= FOLD_REACH * h && t_star < t + ahead * h;
         let fixed = self.predicted.is_some_and(|[(t0, t0_star), _]| (t_star - t0_star).abs() < FOLD_DRIFT * (t - t0));
         let stalled = self
             .falling_since
@@ -144,6 +154,7 @@ fn root((t0, s0): (f64, f64), (t1, s1): (f64, f64)) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simulate::charts::SWITCH_TO_PARTITION;
 
     /// The 3-RRR's fold (tests/test_prescribed_fold.py): sigma^2 = K (T_STAR - t).
     const K: f64 = 0.0112;
@@ -193,6 +204,42 @@ mod tests {
         // Not when the measure stopped falling (a pass-by's closest approach).
         watch.zeno(t + h, (KR * (TR - t)).sqrt(), h);
         assert_eq!(watch.ahead(t + h, h), None);
+    }
+
+    #[test]
+    fn a_pass_by_at_ordinary_steps_is_not_a_fold() {
+        // A pass-by 1e-4 s from the fold, K (1e-4 + C (t - tm)^2), at steps of 0.02 s (DOP853 at
+        // rtol 1e-5 on the 3-RRR's takes such steps, s20-review's sweep): the secant from
+        // tm - 0.076 to tm - 0.056 s reaches 0 1.2 steps ahead. On main a step failing there
+        // named that a fold (FOLD_REACH alone).
+        const C: f64 = 11.1;
+        let (d, tm, h) = (1e-4, T_STAR, 0.02);
+        let sigma = |t: f64| (K * (d + C * (t - tm) * (t - tm))).sqrt();
+        let mut watch = FoldWatch::default();
+        let mut t = tm - 0.096;
+        for _ in 0..3 {
+            assert!(sigma(t) < SWITCH_TO_PARTITION && sigma(t) > NEAR_PASSIVE_SINGULAR, "{t}");
+            assert_eq!(watch.zeno(t, sigma(t), h), None);
+            t += h;
+        }
+        let t = t - h;
+        let t_star = root((t - h, sigma(t - h).powi(2)), (t, sigma(t).powi(2))).unwrap();
+        assert!(t_star - t > FOLD_AHEAD * h && t_star - t < FOLD_REACH * h, "{}", (t_star - t) / h);
+        assert_eq!(watch.ahead(t, h), None);
+    }
+
+    #[test]
+    fn a_fixed_step_that_fails_just_before_the_fold_names_it() {
+        // Steps of 1e-3 s on K (T_STAR - t) up to 2e-4 s before it (0.2 of a step: the largest
+        // measured, rk4 at dt 5e-4 into the 3-RRR's fold), where the next step fails.
+        let h = 1e-3;
+        let mut watch = FoldWatch::default();
+        for k in (0..6).rev() {
+            let t = T_STAR - 2e-4 - k as f64 * h;
+            watch.zeno(t, (K * (T_STAR - t)).sqrt(), h);
+        }
+        let t_star = watch.ahead(T_STAR - 2e-4, h).expect("the fold named");
+        assert!((t_star - T_STAR).abs() < 1e-12, "{t_star}");
     }
 
     #[test]
