@@ -92,8 +92,9 @@ pub struct MechanismOde<'a> {
     pub drives: &'a mut dyn Drives,
     /// The coordinates driven by motion, if any ([`MechanismOde::with_motion`]).
     pub motion: Option<&'a mut Prescribed<'a>>,
-    /// (2m + 1) The state evaluated last: y with, in the user's chart, the prescribed
-    /// coordinates and rates replaced by their motion's.
+    /// (2m + 1) With a prescribed motion, the state evaluated last: y with, in the user's
+    /// chart, the prescribed coordinates and rates replaced by their motion's (without one,
+    /// `last_y`: [`MechanismOde::evaluated_y`]).
     eval_y: Vec<f64>,
     /// The last accepted point: body coordinates, analogues U (3n x m) and chart values z.
     anchor_x: Vec<f64>,
@@ -452,13 +453,11 @@ impl<'a> MechanismOde<'a> {
     /// motion may leave that branch): the integrator then shortens it, and the monitor moves
     /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
-        let mut z = std::mem::take(&mut self.eval_y);
-        copy_small(&mut z, y);
-        let outcome = self.evaluate_at(t, &mut z);
+        // Without a prescribed motion the state evaluated is y itself, `last_y` once it succeeds.
+        let outcome = if self.motion.is_some() { self.evaluate_prescribed(t, y) } else { self.evaluate_at(t, y) };
         if outcome.is_err() {
             self.failed_evaluations += 1;
         }
-        self.eval_y = z;
         outcome?;
         self.base_valid = true;
         self.last_t = t;
@@ -466,16 +465,32 @@ impl<'a> MechanismOde<'a> {
         Ok(())
     }
 
-    /// The body of [`MechanismOde::evaluate`] at state `y`, whose prescribed coordinates it
-    /// replaces by their motion's in the user's chart.
-    fn evaluate_at(&mut self, t: f64, y: &mut [f64]) -> Result<(), Error> {
-        let m = self.m();
-        if let Some(motion) = self.motion.as_deref_mut() {
+    /// [`MechanismOde::evaluate_at`] with the prescribed motion at t: the state evaluated,
+    /// `eval_y`, is y with (in the user's chart) the prescribed coordinates and rates replaced
+    /// by their motion's.
+    #[inline(never)]
+    fn evaluate_prescribed(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let mut z = std::mem::take(&mut self.eval_y);
+        copy_small(&mut z, y);
+        let (m, inputs) = (self.m(), self.ws.chart == Chart::Inputs);
+        let outcome = self.motion.as_deref_mut().map_or(Ok(()), |motion| {
             motion.eval(t).map_err(|message| Error::Drive { t, message })?;
-            if self.ws.chart == Chart::Inputs {
-                motion.overwrite(m, y);
+            if inputs {
+                motion.overwrite(m, &mut z);
             }
-        }
+            Ok(())
+        });
+        let outcome = outcome.and_then(|()| self.evaluate_at(t, &z));
+        self.eval_y = z;
+        outcome
+    }
+
+    /// The body of [`MechanismOde::evaluate`] at state `y` (prescribed coordinates replaced).
+    /// Inlined into both callers: a call of its own cost the four-bar 11 instructions an
+    /// evaluation.
+    #[inline(always)]
+    fn evaluate_at(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let m = self.m();
         let (z, zd) = (&y[..m], &y[m..2 * m]);
         // The point predicted from, into `base`: the last evaluation's x by a swap (the
         // prediction then writes `ws.x` whole), else the anchor's by a copy.
@@ -672,7 +687,16 @@ impl MechanismOde<'_> {
         Err(error)
     }
 
-    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`). For a few
+    /// The state of the evaluation held in `ws` (a successful one).
+    fn evaluated_y(&self) -> &[f64] {
+        if self.motion.is_some() {
+            &self.eval_y
+        } else {
+            &self.last_y
+        }
+    }
+
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` ([`Self::evaluated_y`]). For a few
     /// coordinates each arm's m is a constant, so the copies are moves of a known size: no
     /// dispatch on the size per copy, and no library call whose registers the function would
     /// save (four-bar: 55 -> 34 instructions an evaluation); more take [`Self::derivative_of`]'s
@@ -695,7 +719,7 @@ impl MechanismOde<'_> {
     #[inline(always)]
     fn copy_derivative(&self, m: usize, dy: &mut [f64]) {
         let dy = &mut dy[..2 * m + 1];
-        copy_small(&mut dy[..m], &self.eval_y[m..2 * m]);
+        copy_small(&mut dy[..m], &self.evaluated_y()[m..2 * m]);
         copy_small(&mut dy[m..2 * m], &self.ws.zdd);
         dy[2 * m] = self.ws.power;
     }
