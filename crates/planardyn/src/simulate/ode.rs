@@ -702,24 +702,25 @@ impl MechanismOde<'_> {
     /// save (four-bar: 55 -> 34 instructions an evaluation); more take [`Self::derivative_of`]'s
     /// own call.
     fn derivative(&self, dy: &mut [f64]) {
+        let y = self.evaluated_y();
         match self.m() {
-            1 => self.copy_derivative(1, dy),
-            2 => self.copy_derivative(2, dy),
-            3 => self.copy_derivative(3, dy),
-            4 => self.copy_derivative(4, dy),
-            m => self.derivative_of(m, dy),
+            1 => self.copy_derivative(1, y, dy),
+            2 => self.copy_derivative(2, y, dy),
+            3 => self.copy_derivative(3, y, dy),
+            4 => self.copy_derivative(4, y, dy),
+            m => self.derivative_of(m, y, dy),
         }
     }
 
     #[inline(never)]
-    fn derivative_of(&self, m: usize, dy: &mut [f64]) {
-        self.copy_derivative(m, dy);
+    fn derivative_of(&self, m: usize, y: &[f64], dy: &mut [f64]) {
+        self.copy_derivative(m, y, dy);
     }
 
     #[inline(always)]
-    fn copy_derivative(&self, m: usize, dy: &mut [f64]) {
+    fn copy_derivative(&self, m: usize, y: &[f64], dy: &mut [f64]) {
         let dy = &mut dy[..2 * m + 1];
-        copy_small(&mut dy[..m], &self.evaluated_y()[m..2 * m]);
+        copy_small(&mut dy[..m], &y[m..2 * m]);
         copy_small(&mut dy[m..2 * m], &self.ws.zdd);
         dy[2 * m] = self.ws.power;
     }
