@@ -417,7 +417,11 @@ impl<'a> MechanismOde<'a> {
     fn second_order(&mut self, z: &[f64]) {
         let ws = &mut self.ws;
         let last = &self.last_y;
-        u_times_from(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], |_, _| 0.0, &mut ws.frame.rhs);
+        let dz = |j: usize| z[j] - last[j];
+        match z.len() {
+            2 => rates_by_pairs::<2>(&ws.frame.u, std::array::from_fn(dz), &mut ws.frame.rhs),
+            _ => u_times_from(&ws.frame.u, ws.frame.sys.u_support(), dz, |_, _| 0.0, &mut ws.frame.rhs),
+        }
         // tmp = w(dz, dz) from the closed forms' accelerations where they gave the last
         // evaluation (their geometry is its), else -w(dz, dz) = J^-1 gamma(dz, dz) by J,
         // which Newton left factorised there.
@@ -559,6 +563,24 @@ impl<'a> MechanismOde<'a> {
 fn fold_guard_prediction(x: &mut [f64], b: &[f64], (u, dz): (&[f64], f64), (c, h): (&[f64], f64)) {
     for (((x, b), u), c) in x.iter_mut().zip(b).zip(u).zip(c) {
         *x = b + (u * dz + h * c);
+    }
+}
+
+/// v = U dz for M (a few) columns of U, as `u_times_from` makes it for a few columns (every
+/// row, each entry's terms added in order from 0: the same bits), by pairs of entries: one
+/// packed multiply and add a column and pair, with no scalar remainder loop of the vectorised
+/// form (five-bar: 12 entries, 2 columns).
+#[inline(always)]
+fn rates_by_pairs<const M: usize>(u: &[f64], dz: [f64; M], v: &mut [f64]) {
+    let n = v.len();
+    let columns: [&[f64]; M] = std::array::from_fn(|j| &u[j * n..(j + 1) * n]);
+    let pairs = columns.map(|c| c.as_chunks::<2>().0);
+    let (v_pairs, v_last) = v.as_chunks_mut::<2>();
+    for (k, p) in v_pairs.iter_mut().enumerate() {
+        *p = pairs.iter().zip(dz).fold([0.0; 2], |s, (c, r)| [s[0] + c[k][0] * r, s[1] + c[k][1] * r]);
+    }
+    if let [l] = v_last {
+        *l = columns.iter().zip(dz).fold(0.0, |s, (c, r)| s + c[n - 1] * r);
     }
 }
 
