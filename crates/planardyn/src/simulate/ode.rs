@@ -92,8 +92,9 @@ pub struct MechanismOde<'a> {
     pub drives: &'a mut dyn Drives,
     /// The coordinates driven by motion, if any ([`MechanismOde::with_motion`]).
     pub motion: Option<&'a mut Prescribed<'a>>,
-    /// (2m + 1) The state evaluated last: y with, in the user's chart, the prescribed
-    /// coordinates and rates replaced by their motion's.
+    /// (2m + 1) With a prescribed motion, the state evaluated last: y with, in the user's
+    /// chart, the prescribed coordinates and rates replaced by their motion's (without one,
+    /// `last_y`: [`MechanismOde::evaluated_y`]).
     eval_y: Vec<f64>,
     /// The last accepted point: body coordinates, analogues U (3n x m) and chart values z.
     anchor_x: Vec<f64>,
@@ -393,11 +394,14 @@ impl<'a> MechanismOde<'a> {
     /// 26 decisions differed: 14 corrections within their bound that the exact prediction puts
     /// over it, and 12 side tests kept where the exact prediction has crossed a fold (the
     /// anchor's w, a step away, misses the curvature that grows towards the fold).
+    ///
+    /// Inlined into `evaluate`, the other predictions in calls of their own: the one-coordinate
+    /// fold guard's is then a call from `evaluate` (four-bar: 16 fewer instructions an evaluation).
+    #[inline(always)]
     fn predict(&mut self, z: &[f64], fold_guard_only: bool) -> Prediction {
         let ws = &mut self.ws;
         if !self.base_valid {
-            let (anchor, x) = (&self.anchor_z, &self.anchor_x);
-            u_times_from(&self.anchor_u, ws.frame.sys.u_support(), |j| z[j] - anchor[j], |i, _| x[i], &mut ws.frame.x);
+            self.first_order(z);
             return Prediction::Complete;
         }
         if let ([z], [z_last, zd, _]) = (z, self.last_y.as_slice()) {
@@ -412,11 +416,24 @@ impl<'a> MechanismOde<'a> {
         Prediction::Complete
     }
 
+    /// x + U dz into `ws.x` from the last accepted point.
+    #[inline(never)]
+    fn first_order(&mut self, z: &[f64]) {
+        let (anchor, x) = (&self.anchor_z, &self.anchor_x);
+        let ws = &mut self.ws.frame;
+        u_times_from(&self.anchor_u, ws.sys.u_support(), |j| z[j] - anchor[j], |i, _| x[i], &mut ws.x);
+    }
+
     /// x + U dz + 1/2 w(dz, dz) into `ws.x`, x the last evaluation's (in `base`).
+    #[inline(never)]
     fn second_order(&mut self, z: &[f64]) {
         let ws = &mut self.ws;
         let last = &self.last_y;
-        u_times_from(&ws.frame.u, ws.frame.sys.u_support(), |j| z[j] - last[j], |_, _| 0.0, &mut ws.frame.rhs);
+        let dz = |j: usize| z[j] - last[j];
+        match z.len() {
+            2 => rates_by_pairs::<2>(&ws.frame.u, std::array::from_fn(dz), &mut ws.frame.rhs),
+            _ => u_times_from(&ws.frame.u, ws.frame.sys.u_support(), dz, |_, _| 0.0, &mut ws.frame.rhs),
+        }
         // tmp = w(dz, dz) from the closed forms' accelerations where they gave the last
         // evaluation (their geometry is its), else -w(dz, dz) = J^-1 gamma(dz, dz) by J,
         // which Newton left factorised there.
@@ -452,13 +469,11 @@ impl<'a> MechanismOde<'a> {
     /// motion may leave that branch): the integrator then shortens it, and the monitor moves
     /// to a partition once an accepted point is close enough.
     pub fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
-        let mut z = std::mem::take(&mut self.eval_y);
-        copy_small(&mut z, y);
-        let outcome = self.evaluate_at(t, &mut z);
+        // Without a prescribed motion the state evaluated is y itself, `last_y` once it succeeds.
+        let outcome = if self.motion.is_some() { self.evaluate_prescribed(t, y) } else { self.evaluate_at(t, y) };
         if outcome.is_err() {
             self.failed_evaluations += 1;
         }
-        self.eval_y = z;
         outcome?;
         self.base_valid = true;
         self.last_t = t;
@@ -466,16 +481,32 @@ impl<'a> MechanismOde<'a> {
         Ok(())
     }
 
-    /// The body of [`MechanismOde::evaluate`] at state `y`, whose prescribed coordinates it
-    /// replaces by their motion's in the user's chart.
-    fn evaluate_at(&mut self, t: f64, y: &mut [f64]) -> Result<(), Error> {
-        let m = self.m();
-        if let Some(motion) = self.motion.as_deref_mut() {
+    /// [`MechanismOde::evaluate_at`] with the prescribed motion at t: the state evaluated,
+    /// `eval_y`, is y with (in the user's chart) the prescribed coordinates and rates replaced
+    /// by their motion's.
+    #[inline(never)]
+    fn evaluate_prescribed(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let mut z = std::mem::take(&mut self.eval_y);
+        copy_small(&mut z, y);
+        let (m, inputs) = (self.m(), self.ws.chart == Chart::Inputs);
+        let outcome = self.motion.as_deref_mut().map_or(Ok(()), |motion| {
             motion.eval(t).map_err(|message| Error::Drive { t, message })?;
-            if self.ws.chart == Chart::Inputs {
-                motion.overwrite(m, y);
+            if inputs {
+                motion.overwrite(m, &mut z);
             }
-        }
+            Ok(())
+        });
+        let outcome = outcome.and_then(|()| self.evaluate_at(t, &z));
+        self.eval_y = z;
+        outcome
+    }
+
+    /// The body of [`MechanismOde::evaluate`] at state `y` (prescribed coordinates replaced).
+    /// Inlined into both callers: a call of its own cost the four-bar 11 instructions an
+    /// evaluation.
+    #[inline(always)]
+    fn evaluate_at(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        let m = self.m();
         let (z, zd) = (&y[..m], &y[m..2 * m]);
         // The point predicted from, into `base`: the last evaluation's x by a swap (the
         // prediction then writes `ws.x` whole), else the anchor's by a copy.
@@ -544,6 +575,24 @@ impl<'a> MechanismOde<'a> {
 fn fold_guard_prediction(x: &mut [f64], b: &[f64], (u, dz): (&[f64], f64), (c, h): (&[f64], f64)) {
     for (((x, b), u), c) in x.iter_mut().zip(b).zip(u).zip(c) {
         *x = b + (u * dz + h * c);
+    }
+}
+
+/// v = U dz for M (a few) columns of U, as `u_times_from` makes it for a few columns (every
+/// row, each entry's terms added in order from 0: the same bits), by pairs of entries: one
+/// packed multiply and add a column and pair, with no scalar remainder loop of the vectorised
+/// form (five-bar: 12 entries, 2 columns).
+#[inline(always)]
+fn rates_by_pairs<const M: usize>(u: &[f64], dz: [f64; M], v: &mut [f64]) {
+    let n = v.len();
+    let columns: [&[f64]; M] = std::array::from_fn(|j| &u[j * n..(j + 1) * n]);
+    let pairs = columns.map(|c| c.as_chunks::<2>().0);
+    let (v_pairs, v_last) = v.as_chunks_mut::<2>();
+    for (k, p) in v_pairs.iter_mut().enumerate() {
+        *p = pairs.iter().zip(dz).fold([0.0; 2], |s, (c, r)| [s[0] + c[k][0] * r, s[1] + c[k][1] * r]);
+    }
+    if let [l] = v_last {
+        *l = columns.iter().zip(dz).fold(0.0, |s, (c, r)| s + c[n - 1] * r);
     }
 }
 
@@ -672,30 +721,40 @@ impl MechanismOde<'_> {
         Err(error)
     }
 
-    /// dy = [zd, zdd, P] from the evaluation held in `ws` (of state `eval_y`). For a few
+    /// The state of the evaluation held in `ws` (a successful one).
+    fn evaluated_y(&self) -> &[f64] {
+        if self.motion.is_some() {
+            &self.eval_y
+        } else {
+            &self.last_y
+        }
+    }
+
+    /// dy = [zd, zdd, P] from the evaluation held in `ws` ([`Self::evaluated_y`]). For a few
     /// coordinates each arm's m is a constant, so the copies are moves of a known size: no
     /// dispatch on the size per copy, and no library call whose registers the function would
     /// save (four-bar: 55 -> 34 instructions an evaluation); more take [`Self::derivative_of`]'s
     /// own call.
     fn derivative(&self, dy: &mut [f64]) {
+        let y = self.evaluated_y();
         match self.m() {
-            1 => self.copy_derivative(1, dy),
-            2 => self.copy_derivative(2, dy),
-            3 => self.copy_derivative(3, dy),
-            4 => self.copy_derivative(4, dy),
-            m => self.derivative_of(m, dy),
+            1 => self.copy_derivative(1, y, dy),
+            2 => self.copy_derivative(2, y, dy),
+            3 => self.copy_derivative(3, y, dy),
+            4 => self.copy_derivative(4, y, dy),
+            m => self.derivative_of(m, y, dy),
         }
     }
 
     #[inline(never)]
-    fn derivative_of(&self, m: usize, dy: &mut [f64]) {
-        self.copy_derivative(m, dy);
+    fn derivative_of(&self, m: usize, y: &[f64], dy: &mut [f64]) {
+        self.copy_derivative(m, y, dy);
     }
 
     #[inline(always)]
-    fn copy_derivative(&self, m: usize, dy: &mut [f64]) {
+    fn copy_derivative(&self, m: usize, y: &[f64], dy: &mut [f64]) {
         let dy = &mut dy[..2 * m + 1];
-        copy_small(&mut dy[..m], &self.eval_y[m..2 * m]);
+        copy_small(&mut dy[..m], &y[m..2 * m]);
         copy_small(&mut dy[m..2 * m], &self.ws.zdd);
         dy[2 * m] = self.ws.power;
     }
