@@ -489,14 +489,16 @@ impl ClosedForm {
     /// [`ClosedForm::positions`], the triad's Newton from `start`.
     fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         let x = rows_mut(&mut ws.x);
+        // trig as long as x's body rows: a body's check on one then holds for the other.
+        let trig = &mut ws.trig[..x.len() / 3];
         for c in &mut self.cranks {
-            c.position(z, x, &mut ws.trig);
+            c.position(z, x, trig);
         }
         for s in &self.sliders {
-            s.position(z, x, &mut ws.trig);
+            s.position(z, x, trig);
         }
         for d in &mut self.groups {
-            d.position(z, start, x, &mut ws.trig)?;
+            d.position(z, start, x, trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
