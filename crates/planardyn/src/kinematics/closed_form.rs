@@ -346,7 +346,7 @@ impl ClosedForm {
                 sign,
                 offset: p.rel_angle0 - c.value,
                 rs: [0.0; 2],
-                reference: Default::default(),
+                reference: (f64::NAN, [0.0; 2]),
             });
         }
         let mut groups = Vec::new();

@@ -3,7 +3,7 @@
 //! sign (q_k + offset), sign +1 when the body is the pair's b.
 
 use super::triad::near::{turned, EXACT_TURN};
-use super::{body, body_mut, put_acceleration, put_rate, Angle};
+use super::{body, body_mut, put_acceleration, put_rate};
 use crate::model::pairs::frames::rot;
 
 #[derive(Debug, Clone)]
@@ -19,14 +19,17 @@ pub struct Crank {
     /// R s at the last positions, for the rates and accelerations (as an RRR dyad's
     /// `Geometry`: no rotation of s again per column of U and per pass).
     pub rs: [f64; 2],
-    /// The body's angle in the reference configuration (the last accepted point).
-    pub reference: Angle,
+    /// The body's angle in the reference configuration (the last accepted point; NaN before
+    /// one) and its [cos, sin].
+    pub reference: (f64, [f64; 2]),
 }
 
 impl Crank {
     /// Take the reference angle from the configuration x.
     pub fn set_reference(&mut self, x: &[f64]) {
-        self.reference = Angle::of(body(x, self.body)[2]);
+        let phi = body(x, self.body)[2];
+        let (sn, cs) = phi.sin_cos();
+        self.reference = (phi, [cs, sn]);
     }
 
     /// Pose at coordinates z: x and trig of the body. Its [cos, sin] is the reference's turned
@@ -36,9 +39,9 @@ impl Crank {
     #[inline]
     pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let phi = self.sign * (z[self.k] + self.offset);
-        let turn = phi - self.reference.phi;
+        let turn = phi - self.reference.0;
         let cs = if turn.abs() <= EXACT_TURN {
-            turned(self.reference.cs, turn)
+            turned(self.reference.1, turn)
         } else {
             let (sn, cs) = phi.sin_cos();
             [cs, sn]
@@ -65,13 +68,14 @@ impl Crank {
 
 #[cfg(test)]
 mod tests {
-    use super::{Angle, Crank};
+    use super::Crank;
 
     /// The crank's [cos, sin] from its reference turned by the series is the library's sin_cos
     /// of its angle within 4 ulp of 1 (the series' 2 and the turned products', as
     /// `near::tests::turned_is_the_library_rotation_to_rounding`) plus half an ulp of the angle
     /// (the turn phi - reference is rounded), at references up to 100 rad and turns across
-    /// EXACT_TURN's edge (the library's beyond, to the bit).
+    /// EXACT_TURN's edge (the library's beyond, to the bit), and before any reference (the
+    /// library's).
     #[test]
     fn position_is_the_library_rotation_to_rounding() {
         let mut c = Crank {
@@ -82,17 +86,19 @@ mod tests {
             sign: 1.0,
             offset: 0.0,
             rs: [0.0; 2],
-            reference: Angle::default(),
+            reference: (f64::NAN, [0.0; 2]),
         };
         let (mut x, mut trig) = ([0.0; 3], [[0.0; 2]]);
         let mut near = 0;
         for k in 0..20000 {
             let reference = 100.0 * (k as f64 * 0.7548776662466927).sin();
-            c.set_reference(&[0.0, 0.0, reference]);
+            if k > 0 {
+                c.set_reference(&[0.0, 0.0, reference]);
+            }
             let phi = reference + 0.3 * (k as f64 * 0.5698402909980532).sin();
             c.position(&[phi], &mut x, &mut trig);
             let (s, cs) = phi.sin_cos();
-            if (phi - reference).abs() > super::EXACT_TURN {
+            if k == 0 || (phi - reference).abs() > super::EXACT_TURN {
                 assert_eq!(trig[0].map(f64::to_bits), [cs, s].map(f64::to_bits), "phi {phi}");
             } else {
                 near += 1;

@@ -25,43 +25,40 @@ pub mod triad;
 
 use crate::model::pairs::frames::rot;
 use crate::model::Link;
+use std::f64::consts::TAU;
 use triad::near::near_atan2;
 
-/// A body's angle in the reference configuration (the last accepted point) and its
-/// [cos, sin]: a new angle is taken within pi of it, as its turn from the reference (the dyads'
-/// bodies, [`Angle::rotation`]; the crank's, [`crank::Crank::position`]).
-#[derive(Debug, Clone, Copy)]
+/// A body's angle in the reference configuration (the last accepted point), as whole turns,
+/// a remainder in (-pi, pi] and the remainder's [cos, sin]: a new angle is taken within pi of
+/// it, as its turn from the reference.
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Angle {
-    pub(crate) phi: f64,
-    pub(crate) cs: [f64; 2],
-}
-
-impl Default for Angle {
-    /// The angle 0 (a group's branch before its first reference).
-    fn default() -> Self {
-        Angle { phi: 0.0, cs: [1.0, 0.0] }
-    }
+    turns: f64,
+    rest: f64,
+    rest_cs: [f64; 2],
 }
 
 impl Angle {
     /// The reference angle phi.
     pub fn of(phi: f64) -> Self {
-        let (s, c) = phi.sin_cos();
-        Angle { phi, cs: [c, s] }
+        let turns = TAU * (phi / TAU).round();
+        let rest = phi - turns;
+        let (s, c) = rest.sin_cos();
+        Angle { turns, rest, rest_cs: [c, s] }
     }
 
     /// The rotation whose cosine and sine are proportional to (c, s), as [cos, sin], and its
-    /// angle, the one within pi of the reference: the reference + the turn from it, the angle
-    /// of (c, s) turned back by the reference (in [-pi, pi]). The turns a body makes between
-    /// evaluations are small, so the turn's atan2 is mostly the kernel alone ([`near_atan2`]:
-    /// no reduction), where the angle of (c, s) less the reference would need the library's
-    /// full atan2 (12 % of the four-bar's evaluation, 18 % of Andrews').
+    /// angle, the one within pi of the reference: the reference's whole turns + rest + the turn
+    /// from the reference, the angle of (c, s) turned back by rest (in [-pi, pi]). The turns a
+    /// body makes between evaluations are small, so the turn's atan2 is mostly the kernel
+    /// alone ([`near_atan2`]: no reduction), where the angle of (c, s) less rest would need the
+    /// library's full atan2 (12 % of the four-bar's evaluation, 18 % of Andrews').
     #[inline(always)]
     pub(crate) fn rotation(&self, c: f64, s: f64) -> ([f64; 2], f64) {
         let r = (c * c + s * s).sqrt();
-        let [rc, rs] = self.cs;
+        let [rc, rs] = self.rest_cs;
         let turn = near_atan2(s * rc - c * rs, c * rc + s * rs);
-        ([c / r, s / r], self.phi + turn)
+        ([c / r, s / r], self.turns + self.rest + turn)
     }
 }
 
@@ -248,27 +245,34 @@ impl<'a, const M: usize> Pass<'a, M> {
 mod tests {
     use std::f64::consts::PI;
 
-    /// [`super::Angle::rotation`] is the angle reference + turn of the direction (c, s) it is
-    /// given (the float sum, as x holds it) to rounding: within 2 ulp of the turn (the kernel's
-    /// 1 and the turned-back products'), half an ulp of the angle's sum and 4 ulp of 1 (the
-    /// reference's and the direction's sin and cos), at references up to 100 rad either side
-    /// and turns across the whole circle (the kernel's and the library's parts); and its
-    /// [cos, sin] is the direction of (c, s) to the bit. (A reference kept as whole turns of the
-    /// rounded 2 pi and a remainder, as before, is k 2.4e-16 rad off after k turns: up to 3.9e-15
-    /// here, beyond the bound.)
+    /// [`super::Angle::rotation`] is the angle the library's atan2 gives (the angle of (c, s)
+    /// less the reference's remainder, taken in [-pi, pi], plus the reference's turns and
+    /// remainder) to rounding: within 2 ulp of the turn (the kernel's 1 and the turned-back
+    /// products') and half an ulp of the angle's sum, at references up to 100 rad either side
+    /// and turns across the whole circle (the kernel's and the library's parts), and its
+    /// [cos, sin] is the direction of (c, s) to the bit.
     #[test]
-    fn rotation_is_the_angle_to_rounding() {
+    fn rotation_is_the_library_angle_to_rounding() {
         for k in 0..40000 {
             let reference = 100.0 * (k as f64 * 0.7548776662466927).sin();
             let turn = PI * (k as f64 * 0.5698402909980532).sin() * if k % 2 == 0 { 0.1 } else { 1.0 };
             let angle = super::Angle::of(reference);
             let r = 0.01 + (k % 7) as f64;
-            let exact = reference + turn;
-            let (s, c) = exact.sin_cos();
+            let (s, c) = (reference + turn).sin_cos();
             let (c, s) = (r * c, r * s);
             let (cs, phi) = angle.rotation(c, s);
-            let tol = 2.0 * f64::EPSILON * turn.abs() + 0.5 * exact.abs() * f64::EPSILON + 4.0 * f64::EPSILON;
-            assert!((phi - exact).abs() <= tol, "reference {reference}, turn {turn}: {phi} vs {exact}");
+            let turns = super::TAU * (reference / super::TAU).round();
+            let rest = reference - turns;
+            let mut library = s.atan2(c) - rest;
+            if library > PI {
+                library -= super::TAU;
+            } else if library < -PI {
+                library += super::TAU;
+            }
+            let old = turns + rest + library;
+            let tol =
+                2.0 * f64::EPSILON * library.abs() + 4.0 * f64::EPSILON * rest.abs() + 0.5 * old.abs() * f64::EPSILON;
+            assert!((phi - old).abs() <= tol, "reference {reference}, turn {turn}: {phi} vs {old}");
             let h = (c * c + s * s).sqrt();
             assert_eq!(cs.map(f64::to_bits), [c / h, s / h].map(f64::to_bits));
         }
