@@ -489,14 +489,16 @@ impl ClosedForm {
     /// [`ClosedForm::positions`], the triad's Newton from `start`.
     fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         let x = rows_mut(&mut ws.x);
+        // trig as long as x's body rows: a body's check on one then holds for the other.
+        let trig = &mut ws.trig[..x.len() / 3];
         for c in &mut self.cranks {
-            c.position(z, x, &mut ws.trig);
+            c.position(z, x, trig);
         }
         for s in &self.sliders {
-            s.position(z, x, &mut ws.trig);
+            s.position(z, x, trig);
         }
         for d in &mut self.groups {
-            d.position(z, start, x, &mut ws.trig)?;
+            d.position(z, start, x, trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
@@ -587,10 +589,15 @@ impl ClosedForm {
 
     /// U (whole columns: no `reach`), xd and c at the positions in `ws` in one pass over the
     /// pieces ([`Pass`]): what [`ClosedForm::velocity_analogues`] then
-    /// [`ClosedForm::convective`] write, to the bit.
+    /// [`ClosedForm::convective`] write, to the bit; and q = z, qd = zd.
     #[inline(always)]
-    fn pass<const M: usize>(&self, zd: &[f64], ws: &mut Frame) {
+    fn pass<const M: usize>(&self, z: &[f64], zd: &[f64], ws: &mut Frame) {
         let zd: [f64; M] = zd.try_into().expect("M coordinates");
+        // q = z and qd = zd as M values (no dispatch on the length as `copy_small`'s).
+        let q: &mut [f64; M] = ws.q.as_mut_slice().try_into().expect("M coordinates");
+        *q = z.try_into().expect("M coordinates");
+        let qd: &mut [f64; M] = ws.qd.as_mut_slice().try_into().expect("M coordinates");
+        *qd = zd;
         let mut p = Pass::new(zd, &mut ws.u, &mut ws.xd, &mut ws.c);
         for c in &self.cranks {
             p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
@@ -621,17 +628,17 @@ impl ClosedForm {
     fn stages_from(&mut self, z: &[f64], zd: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         self.place(z, start, ws)?;
         match (&self.reach, zd.len()) {
-            (None, 1) => self.pass::<1>(zd, ws),
-            (None, 2) => self.pass::<2>(zd, ws),
-            (None, 3) => self.pass::<3>(zd, ws),
-            (None, 4) => self.pass::<4>(zd, ws),
+            (None, 1) => self.pass::<1>(z, zd, ws),
+            (None, 2) => self.pass::<2>(z, zd, ws),
+            (None, 3) => self.pass::<3>(z, zd, ws),
+            (None, 4) => self.pass::<4>(z, zd, ws),
             _ => {
                 self.velocity_analogues(ws);
                 self.convective(zd, ws);
+                copy_small(&mut ws.q, z);
+                copy_small(&mut ws.qd, zd);
             }
         }
-        copy_small(&mut ws.q, z);
-        copy_small(&mut ws.qd, zd);
         Ok(())
     }
 }

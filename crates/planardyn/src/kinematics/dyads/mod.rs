@@ -202,8 +202,9 @@ impl<'a, const M: usize> Pass<'a, M> {
     #[inline(always)]
     pub fn new(zd: [f64; M], u: &'a mut [f64], xd: &'a mut [f64], c: &'a mut [f64]) -> Self {
         let bodies = xd.len() / 3;
+        // U's columns and c as long as xd's rows: a body's check on one then holds for all.
         let u = &mut u.as_chunks_mut().0[..M * bodies];
-        Pass { zd, bodies, u, xd: xd.as_chunks_mut().0, c: c.as_chunks_mut().0 }
+        Pass { zd, bodies, u, xd: xd.as_chunks_mut().0, c: &mut c.as_chunks_mut().0[..bodies] }
     }
 
     /// A piece of `bodies` by its rates for coordinate rates zd (`velocity(zd, v)`, the links
