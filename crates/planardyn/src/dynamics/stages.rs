@@ -167,7 +167,7 @@ fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspa
 }
 
 /// [`fixed_mass_matrix_and_bias`] with b = U^T g summed as eq. 31 writes it, g = f - M c a
-/// body's net force ([`add_net_bias_terms`]): one product a term of U instead of two (3-RRR
+/// body's net force ([`add_bias_terms`] with `NET`): one product a term of U instead of two (3-RRR
 /// -255 instructions an evaluation, five-bar -50). The same A; b to round-off (the same sum
 /// re-associated). For the lossless forward evaluation at 2 to [`FIXED_M`] coordinates only:
 /// at m = 1 it cost 5 to 27 instructions, and the losses' and prescribed paths keep
@@ -203,14 +203,14 @@ fn fixed_sums<const M: usize, const NET: bool>(mech: &Mechanism, ws: &mut Worksp
         }
         let mut u = columns();
         for (body, (f, c)) in mech.bodies.iter().zip(forces) {
-            bias_terms::<M, NET>(&mut uf, &mut umc, body, &rows(&mut u), f, c);
+            add_bias_terms::<M, NET>(&mut uf, &mut umc, body, &rows(&mut u), f, c);
         }
     } else {
         let mut u = columns();
         for (body, (f, c)) in mech.bodies.iter().zip(forces) {
             let ui = rows(&mut u);
             add_mass_terms(&mut a, body, &ui);
-            bias_terms::<M, NET>(&mut uf, &mut umc, body, &ui, f, c);
+            add_bias_terms::<M, NET>(&mut uf, &mut umc, body, &ui, f, c);
         }
     }
     for (j, row) in a.iter().enumerate() {
@@ -236,10 +236,11 @@ fn add_mass_terms<const M: usize>(a: &mut [[f64; M]; M], body: &Body, ui: &[[f64
     }
 }
 
-/// One body's terms of b: [`add_net_bias_terms`] into `uf` with `NET`, else
-/// [`add_bias_terms`].
+/// One body's terms of U^T f (`uf`, as `USupport::dot` adds them) and of U^T M c (`umc`, as
+/// `m_dot`), f and c its forces and convective accelerations; with `NET`, of b = U^T g into
+/// `uf`, g = f - M c the body's net force (as `USupport::dot` adds U^T g's).
 #[inline(always)]
-fn bias_terms<const M: usize, const NET: bool>(
+fn add_bias_terms<const M: usize, const NET: bool>(
     uf: &mut [f64; M],
     umc: &mut [f64; M],
     body: &Body,
@@ -248,33 +249,12 @@ fn bias_terms<const M: usize, const NET: bool>(
     c: &[f64],
 ) {
     if NET {
-        add_net_bias_terms(uf, body, ui, f, c);
-    } else {
-        add_bias_terms(uf, umc, body, ui, f, c);
+        let g = [f[0] - body.mass * c[0], f[1] - body.mass * c[1], f[2] - body.inertia * c[2]];
+        for (b, p) in uf.iter_mut().zip(ui) {
+            *b = *b + p[0] * g[0] + p[1] * g[1] + p[2] * g[2];
+        }
+        return;
     }
-}
-
-/// One body's terms of b = U^T g, g = f - M c its net force (f its forces, c its convective
-/// accelerations), as `USupport::dot` adds U^T g's.
-#[inline(always)]
-fn add_net_bias_terms<const M: usize>(b: &mut [f64; M], body: &Body, ui: &[[f64; 3]; M], f: &[f64], c: &[f64]) {
-    let g = [f[0] - body.mass * c[0], f[1] - body.mass * c[1], f[2] - body.inertia * c[2]];
-    for (b, p) in b.iter_mut().zip(ui) {
-        *b = *b + p[0] * g[0] + p[1] * g[1] + p[2] * g[2];
-    }
-}
-
-/// One body's terms of U^T f (`uf`, as `USupport::dot` adds them) and of U^T M c (`umc`, as
-/// `m_dot`), f and c its forces and convective accelerations.
-#[inline(always)]
-fn add_bias_terms<const M: usize>(
-    uf: &mut [f64; M],
-    umc: &mut [f64; M],
-    body: &Body,
-    ui: &[[f64; 3]; M],
-    f: &[f64],
-    c: &[f64],
-) {
     for (j, p) in ui.iter().enumerate() {
         uf[j] = uf[j] + p[0] * f[0] + p[1] * f[1] + p[2] * f[2];
         umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
