@@ -163,13 +163,25 @@ pub(crate) const FIXED_M: usize = 4;
 /// half the running sums of one pass (which then no longer fit the registers).
 #[inline(never)]
 fn fixed_mass_matrix_and_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
-    fixed_sums::<M>(mech, ws);
+    fixed_sums::<M, false>(mech, ws);
 }
 
-/// [`fixed_mass_matrix_and_bias`]'s sums, inlined where one coordinate's (a few instructions a
-/// body) are worth no call.
+/// [`fixed_mass_matrix_and_bias`] with b = U^T g summed as eq. 31 writes it, g = f - M c a
+/// body's net force ([`add_bias_terms`] with `NET`): one product a term of U instead of two (3-RRR
+/// -255 instructions an evaluation, five-bar -50). The same A; b to round-off (the same sum
+/// re-associated). For the lossless forward evaluation at 2 to [`FIXED_M`] coordinates only:
+/// at m = 1 it cost 5 to 27 instructions, and the losses' and prescribed paths keep
+/// [`bias`]'s bits (tests/test_prescribed_fold.py locates a self-locking fold's time to 1e-7 s
+/// through friction, which the round-off moved by 3e-7 s).
+#[inline(never)]
+fn fixed_mass_matrix_and_net_bias<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
+    fixed_sums::<M, true>(mech, ws);
+}
+
+/// [`fixed_mass_matrix_and_bias`]'s sums (with `NET`, [`fixed_mass_matrix_and_net_bias`]'s),
+/// inlined where one coordinate's (a few instructions a body) are worth no call.
 #[inline(always)]
-fn fixed_sums<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
+fn fixed_sums<const M: usize, const NET: bool>(mech: &Mechanism, ws: &mut Workspace) {
     let n = ws.x.len();
     // Each column's body by body: three values a step with no bounds check of their own.
     let columns = || -> [std::slice::ChunksExact<f64>; M] {
@@ -181,7 +193,7 @@ fn fixed_sums<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
             [p[0], p[1], p[2]]
         })
     };
-    // The sums of `m_dot` and `bias` start at -0.0 (f64's `Sum`).
+    // The sums of `m_dot` and `bias` start at -0.0 (f64's `Sum`); with `NET`, `uf` is b.
     let (mut a, mut uf, mut umc) = ([[-0.0; M]; M], [-0.0; M], [-0.0; M]);
     let forces = ws.f.chunks_exact(3).zip(ws.frame.c.chunks_exact(3));
     if M >= SPLIT_FROM_M {
@@ -191,21 +203,21 @@ fn fixed_sums<const M: usize>(mech: &Mechanism, ws: &mut Workspace) {
         }
         let mut u = columns();
         for (body, (f, c)) in mech.bodies.iter().zip(forces) {
-            add_bias_terms(&mut uf, &mut umc, body, &rows(&mut u), f, c);
+            add_bias_terms::<M, NET>(&mut uf, &mut umc, body, &rows(&mut u), f, c);
         }
     } else {
         let mut u = columns();
         for (body, (f, c)) in mech.bodies.iter().zip(forces) {
             let ui = rows(&mut u);
             add_mass_terms(&mut a, body, &ui);
-            add_bias_terms(&mut uf, &mut umc, body, &ui, f, c);
+            add_bias_terms::<M, NET>(&mut uf, &mut umc, body, &ui, f, c);
         }
     }
     for (j, row) in a.iter().enumerate() {
         for (k, &v) in row.iter().enumerate().skip(j) {
             (ws.a[j * M + k], ws.a[k * M + j]) = (v, v);
         }
-        ws.b[j] = uf[j] - umc[j];
+        ws.b[j] = if NET { uf[j] } else { uf[j] - umc[j] };
     }
     ws.a_zeros_for = ws.frame.sys.supports_id();
 }
@@ -225,9 +237,10 @@ fn add_mass_terms<const M: usize>(a: &mut [[f64; M]; M], body: &Body, ui: &[[f64
 }
 
 /// One body's terms of U^T f (`uf`, as `USupport::dot` adds them) and of U^T M c (`umc`, as
-/// `m_dot`), f and c its forces and convective accelerations.
+/// `m_dot`), f and c its forces and convective accelerations; with `NET`, of b = U^T g into
+/// `uf`, g = f - M c the body's net force (as `USupport::dot` adds U^T g's).
 #[inline(always)]
-fn add_bias_terms<const M: usize>(
+fn add_bias_terms<const M: usize, const NET: bool>(
     uf: &mut [f64; M],
     umc: &mut [f64; M],
     body: &Body,
@@ -235,6 +248,13 @@ fn add_bias_terms<const M: usize>(
     f: &[f64],
     c: &[f64],
 ) {
+    if NET {
+        let g = [f[0] - body.mass * c[0], f[1] - body.mass * c[1], f[2] - body.inertia * c[2]];
+        for (b, p) in uf.iter_mut().zip(ui) {
+            *b = *b + p[0] * g[0] + p[1] * g[1] + p[2] * g[2];
+        }
+        return;
+    }
     for (j, p) in ui.iter().enumerate() {
         uf[j] = uf[j] + p[0] * f[0] + p[1] * f[1] + p[2] * f[2];
         umc[j] += body.mass * (p[0] * c[0] + p[1] * c[1]) + body.inertia * p[2] * c[2];
@@ -263,18 +283,19 @@ fn not_positive_definite(ws: &Workspace) -> KinematicsError {
 }
 
 /// The stages after the forces for M coordinates (up to [`FIXED_M`]) in one function and no
-/// bookkeeping of A's pattern: A and b as [`mass_matrix_and_bias`] sums them, A's factor into
+/// bookkeeping of A's pattern: A and b as [`mass_matrix_and_bias`] sums them (from 2
+/// coordinates b as [`fixed_mass_matrix_and_net_bias`] does, to round-off), A's factor into
 /// `ws.a` (as [`factor_mass_matrix`] leaves it), zdd = A^-1 b, xdd = U zdd + c and the user's
 /// qdd; the operations of [`mass_matrix_and_bias`], [`factor_mass_matrix`],
-/// [`solve_mass_matrix`] and [`accelerations`] (with its few columns' one pass), so the same
-/// numbers, without the dispatch on m and the calls between the stages.
+/// [`solve_mass_matrix`] and [`accelerations`] (with its few columns' one pass), without the
+/// dispatch on m and the calls between the stages.
 pub(crate) fn fixed_dynamics<const M: usize>(mech: &Mechanism, ws: &mut Workspace) -> Result<(), KinematicsError> {
     // Inlined at M = 1 (the five m = 1 models -3 to -13 instructions an evaluation); at M = 2
     // and 3 the call keeps the caller's code as it compiles best (s18: 3-RRR +149 inlined).
     if M == 1 {
-        fixed_sums::<M>(mech, ws);
+        fixed_sums::<M, false>(mech, ws);
     } else {
-        fixed_mass_matrix_and_bias::<M>(mech, ws);
+        fixed_mass_matrix_and_net_bias::<M>(mech, ws);
     }
     let first = ws.frame.sys.a_first();
     if !cholesky_envelope_fixed::<M>(&mut ws.a, first) {
@@ -380,6 +401,64 @@ mod tests {
                 let same = x.iter().zip(y.iter()).all(|(p, q)| p.to_bits() == q.to_bits() || (*p == 0.0 && *q == 0.0));
                 assert!(same && x.len() == y.len(), "{what} of {model}: {x:?} against {y:?}");
                 assert!(x.iter().any(|v| *v != 0.0), "{what} of {model} is zero");
+            }
+        }
+    }
+
+    /// The lossless path's b = U^T g (g = f - M c body by body) equals U^T g summed over U's
+    /// supports (`USupport::dot`, g formed apart) to the bit, and A is `mass_matrix`'s; and b
+    /// agrees with U^T f - U^T M c (`bias`) to round-off (the sums re-associated). Five-bar (m = 2) and 3-RRR (3) at their
+    /// drawings, rates of both signs, forces of every component on every body.
+    #[test]
+    fn net_bias_is_u_transpose_of_f_less_m_c() {
+        for (model, m) in [("five-bar", 2), ("3-rrr", 3)] {
+            let path = format!("{}/../../examples/models/{model}.yaml", env!("CARGO_MANIFEST_DIR"));
+            let mech = crate::load(&path).unwrap();
+            let (z, _) = mech.initial_state();
+            let zd = &[0.7, -1.3, 0.4][..m];
+            let mut ws = Workspace::new(&mech);
+            kinematic_stages(&mech, &z, zd, &mut ws).unwrap();
+            ws.f.iter_mut().enumerate().for_each(|(i, f)| *f = 2.0 * (0.37 * i as f64).sin() + 0.1);
+            match m {
+                2 => fixed_mass_matrix_and_net_bias::<2>(&mech, &mut ws),
+                _ => fixed_mass_matrix_and_net_bias::<3>(&mech, &mut ws),
+            }
+            let (a, b) = (ws.a.clone(), ws.b.clone());
+            let g: Vec<f64> = (mech.bodies.iter().zip(ws.f.chunks_exact(3)).zip(ws.frame.c.chunks_exact(3)))
+                .flat_map(|((body, f), c)| {
+                    [f[0] - body.mass * c[0], f[1] - body.mass * c[1], f[2] - body.inertia * c[2]]
+                })
+                .collect();
+            let n = ws.x.len();
+            let support = ws.frame.sys.u_support();
+            let by_supports: Vec<f64> = (0..m).map(|j| support.dot(j, &ws.frame.u[j * n..(j + 1) * n], &g)).collect();
+            assert!(
+                b.iter().zip(&by_supports).all(|(p, q)| p.to_bits() == q.to_bits()),
+                "{model}: {b:?} against {by_supports:?}"
+            );
+            // The sums' scale: U^T (|f| + |M c|) with |U|, whose n eps (n < 30 terms) bounds
+            // the round-off of either association.
+            let abs_u: Vec<f64> = ws.frame.u.iter().map(|v| v.abs()).collect();
+            let abs_g: Vec<f64> = (mech.bodies.iter().zip(ws.f.chunks_exact(3)).zip(ws.frame.c.chunks_exact(3)))
+                .flat_map(|((body, f), c)| {
+                    [
+                        f[0].abs() + (body.mass * c[0]).abs(),
+                        f[1].abs() + (body.mass * c[1]).abs(),
+                        f[2].abs() + (body.inertia * c[2]).abs(),
+                    ]
+                })
+                .collect();
+            let scale: Vec<f64> = (0..m).map(|j| support.dot(j, &abs_u[j * n..(j + 1) * n], &abs_g)).collect();
+            mass_matrix(&mech, &mut ws);
+            bias(&mech, &mut ws);
+            let same = a.iter().zip(&ws.a).all(|(p, q)| p.to_bits() == q.to_bits() || (*p == 0.0 && *q == 0.0));
+            assert!(same, "A of {model}: {a:?} against {:?}", ws.a);
+            for j in 0..m {
+                assert!(
+                    (b[j] - ws.b[j]).abs() <= 30.0 * f64::EPSILON * scale[j],
+                    "b of {model}: {b:?} against {:?}",
+                    ws.b
+                );
             }
         }
     }

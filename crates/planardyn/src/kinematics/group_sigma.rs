@@ -383,6 +383,14 @@ impl Block {
 /// Iterations of [`triad_sigma`]'s safeguarded Newton; it converges in about 6.
 const TRIAD_ITERATIONS: usize = 60;
 
+/// The relative width of [`triad_sigma`]'s bracket [lo, lambda] (M positive definite at lo, not
+/// at lambda) within which lambda is taken as the root: 64 ulps of lambda, 32 of sigma, the
+/// round-off of M's entries. At the root M is singular to round-off, and a Newton step there
+/// (the 3-RRR's: 50 ulps, onto lambda, which fails the factor) used to start bisections that
+/// chased the last bits (11 iterations of ~560 instructions for the 7 to this lambda, the same
+/// value there).
+const TRIAD_BRACKET: f64 = 64.0 * f64::EPSILON;
+
 /// The measure of a 6R triad's 12 x 12 block in closed form, from its lever arms at its own
 /// length: per leg i, `a[i]` A_i and `p[i]` C_i on the leg (R s / L_k), `l[i]` C_i on the
 /// platform. As in [`dyad_sigma`], the block is [T, Phi] (translations | angles), with T^T T =
@@ -455,6 +463,9 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
         let Some(inv) = spd_inverse(&mm) else {
             if it == 0 {
                 return 0.0; // M(0) singular: so is the block
+            }
+            if lambda - lo <= TRIAD_BRACKET * lambda {
+                return lambda.sqrt(); // the root is in [lo, lambda], within round-off of lambda
             }
             hi = lambda;
             lambda = 0.5 * (lo + hi);

@@ -24,7 +24,7 @@
 //! copies share: it only tells whether buffers were zeroed for the same supports, and copies
 //! of one analysis have the same supports.
 
-use crate::kinematics::{passive_sigma_min_with, ClosedForm, System};
+use crate::kinematics::{passive_sigma_min_with, select_partition, sigma_min_with, Chart, ClosedForm, System};
 use crate::model::Mechanism;
 use crate::{Error, Workspace};
 use std::sync::OnceLock;
@@ -83,15 +83,33 @@ impl Prepared {
     /// kept here for the later ones. The same value as without (the analysis is that of
     /// `System::for_chart`, and a partition that differs is analysed again).
     pub fn passive_measure(&self, inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
+        self.with_partition(inputs_sys, |sys| passive_sigma_min_with(sys, mech, x))
+    }
+
+    /// The partition's half of [`Prepared::passive_measure`]: the type II measure of the
+    /// partition [`select_partition`] chooses at x (infinite without constraints), not the
+    /// user's chart's. Where the caller has the user's chart's measure already, the passive
+    /// measure is the larger of the two.
+    pub fn partition_measure(&self, inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
+        if mech.n_constraints == 0 {
+            return f64::INFINITY;
+        }
+        let partition = Chart::Partition(select_partition(mech, x));
+        self.with_partition(inputs_sys, |sys| sigma_min_with(sys.other_chart(mech, &partition), mech, &partition, x))
+    }
+
+    /// `measure(inputs_sys)` with the partition's analysis lent from here when the run has none
+    /// yet, and the first run's kept here for the later ones.
+    fn with_partition(&self, inputs_sys: &mut System, measure: impl FnOnce(&mut System) -> f64) -> f64 {
         if let Some(kept) = self.partition.get() {
             inputs_sys.keep_other(|| kept.clone());
         }
-        let passive = passive_sigma_min_with(inputs_sys, mech, x);
+        let value = measure(inputs_sys);
         if let (None, Some(other)) = (self.partition.get(), inputs_sys.other()) {
             // Another thread's run may have kept its own meanwhile: either serves.
             let _ = self.partition.set(other.clone());
         }
-        passive
+        value
     }
 
     /// A run's closed forms of the user's chart, if every group has one.
