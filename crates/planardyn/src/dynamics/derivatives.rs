@@ -13,7 +13,9 @@
 use super::force_rates::{applied_forces_dx, applied_forces_dxd, load_power_dx, load_power_dxd, RateScratch};
 use super::forces::applied_forces;
 use super::inverse::inverse;
-use super::stages::{bias, body_accelerations, factor_mass_matrix, kinematic_stages, mass_matrix};
+use super::stages::{
+    body_accelerations, factor_mass_matrix, kinematic_stages, lossless_mass_matrix_and_bias, mass_matrix,
+};
 use super::workspace::Workspace;
 use crate::kinematics::third::convective_derivative;
 use crate::kinematics::{acceleration_analogues, Chart};
@@ -195,8 +197,8 @@ fn accelerations_and_jacobians(
     kinematic_stages(mech, q, qd, ws)?;
     ws.tau.fill(0.0);
     applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
-    mass_matrix(mech, ws);
-    bias(mech, ws);
+    // A and b summed as the forward evaluation sums them: qdd is `forward`'s to the bit.
+    lossless_mass_matrix_and_bias(mech, ws);
     let a = ws.a.clone();
     factor_mass_matrix(ws)?;
     let m = q.len();

@@ -149,6 +149,19 @@ pub(crate) fn mass_matrix_and_bias(mech: &Mechanism, ws: &mut Workspace) {
     }
 }
 
+/// A and b as the lossless forward evaluation ([`fixed_dynamics`]) sums them, to the bit: from 2
+/// to [`FIXED_M`] coordinates b as [`fixed_mass_matrix_and_net_bias`] does, else as
+/// [`mass_matrix_and_bias`]. For the other lossless callers whose accelerations are the
+/// forward evaluation's (the derivatives' qdd is `forward_dynamics`' to the bit).
+pub(crate) fn lossless_mass_matrix_and_bias(mech: &Mechanism, ws: &mut Workspace) {
+    match ws.b.len() {
+        2 => fixed_mass_matrix_and_net_bias::<2>(mech, ws),
+        3 => fixed_mass_matrix_and_net_bias::<3>(mech, ws),
+        FIXED_M => fixed_mass_matrix_and_net_bias::<FIXED_M>(mech, ws),
+        _ => mass_matrix_and_bias(mech, ws),
+    }
+}
+
 /// The most coordinates the stages take with fixed-size loops (`mass_matrix_and_bias`, the
 /// Cholesky factor and solve): past a few, U's supports (which the fixed-size loops do not
 /// use) save more than the loops' bookkeeping costs.
