@@ -171,7 +171,8 @@ pub fn forward_derivatives(
 
 /// [`forward_derivatives`] and the derivatives of the power of the non-conservative forces
 /// P = tau . qd + P_loads(x, xd): what the equations of motion with their work need. One
-/// position solve: qdd = A^-1 (tau + b) with b of the forces without drives (input chart).
+/// position solve: qdd = A^-1 b, b of the forces with the drives' efforts (input chart), as the
+/// forward evaluation makes it.
 pub fn motion_derivatives(
     mech: &Mechanism,
     q: &[f64],
@@ -195,18 +196,20 @@ fn accelerations_and_jacobians(
     lossless(mech)?;
     ws.chart = Chart::Inputs;
     kinematic_stages(mech, q, qd, ws)?;
-    ws.tau.fill(0.0);
+    // qdd as the forward evaluation makes it, to the bit (`forward_dynamics`' own): the drives'
+    // efforts among the forces, A and b summed by its function.
+    ws.tau.copy_from_slice(tau);
     applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
-    // A and b summed as the forward evaluation sums them: qdd is `forward`'s to the bit.
     lossless_mass_matrix_and_bias(mech, ws);
     let a = ws.a.clone();
     factor_mass_matrix(ws)?;
     let m = q.len();
-    let mut qdd: Vec<f64> = tau.iter().zip(&ws.b).map(|(t, b)| t + b).collect();
+    let mut qdd = ws.b.clone();
     cholesky_solve(&ws.a, m, &mut qdd);
     super::finite("accelerations qdd", &qdd)?;
     let factor = std::mem::replace(&mut ws.a, a);
-    ws.tau.copy_from_slice(tau);
+    // The efforts' Jacobians take f without the drives (r = M xdd - f).
+    applied_forces(mech, &ws.frame.x, &ws.frame.xd, &vec![0.0; m], &mut ws.f);
     ws.qdd.copy_from_slice(&qdd);
     let w = acceleration_analogues(mech, ws);
     let mut rs = RateScratch::at(mech, &ws.x);
