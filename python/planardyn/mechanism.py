@@ -19,7 +19,7 @@ from typing import Any, Generic, Literal, NamedTuple, TypeVar, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._core import ArgumentError, PlanardynError, __version__
+from ._core import ArgumentError, __version__
 from ._core import Mechanism as NativeMechanism
 from ._core import load as native_load
 from ._core import loads as native_loads
