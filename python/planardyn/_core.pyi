@@ -180,6 +180,15 @@ class Mechanism:
         allow_singular: bool = False,
         recorded: bool = False,
     ) -> NDArray[np.float64]: ...
+    def run_motor_torques(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        tau: ArrayLike,
+        x: ArrayLike,
+        xd: ArrayLike,
+    ) -> tuple[NDArray[np.float64], list[tuple[int, int, str]]]: ...
     @property
     def actuator_names(self) -> list[str]: ...
     @property

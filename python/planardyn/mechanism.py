@@ -8,6 +8,7 @@ an angle, m for a displacement), n mobile bodies, ``x`` the 3n body coordinates
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import os
 import warnings
@@ -18,7 +19,7 @@ from typing import Any, Generic, Literal, NamedTuple, TypeVar, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._core import ArgumentError, PlanardynError, __version__
+from ._core import ArgumentError, __version__
 from ._core import Mechanism as NativeMechanism
 from ._core import load as native_load
 from ._core import loads as native_loads
@@ -185,9 +186,10 @@ class Mechanism:
             settings = {k: v if v is None else plain(v) for k, v in settings.items()}  # most are None
         # The metadata is made at its first read (issue 25 item 4); a partial, not a closure, holds
         # what it needs (a short run's fixed cost: no cells made and freed).
+        tau_motor, note = self._result_motor_torques(raw) if f.has_actuators else (None, "")
         return SimulationResult.from_raw(raw, coordinate_names=f.coordinate_names, coordinate_kinds=f.coordinate_kinds,
                                          body_names=f.body_names, metadata=partial(_run_metadata, self, settings),
-                                         tau_motor=self._result_motor_torques(raw) if f.has_actuators else None)
+                                         tau_motor=tau_motor, message_note=note)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mechanism):
@@ -438,50 +440,19 @@ class Mechanism:
         effort itself."""
         return self._native.motor_torques(q, qd, qdd, tau, x, xd, allow_singular)
 
-    def _result_motor_torques(self, raw: RawRun) -> FloatArray | None:
-        """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: q, qd, qdd,
-        tau, x, xd, each (N, ...)) when the model has an actuator, else None. The rates xd are
-        the run's state, not checked against qd (``recorded``): near a fold of prescribed
+    def _result_motor_torques(self, raw: RawRun) -> tuple[FloatArray | None, str]:
+        """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: t, q, qd, qdd,
+        tau, x, xd, each (N, ...)) when the model has an actuator, else None; and what the
+        result's message adds about rows without them ("" when every row has them). The rates
+        xd are the run's state, not checked against qd (``recorded``): near a fold of prescribed
         coordinates the two agree only within the integrator's error, magnified there. A row
-        whose motor torques cannot be found is NaN, the run kept: the friction efforts of a
-        run failing at a fold may not settle again at its last rows (five-bar-robot at rk4 dt
-        1e-4, 4 of its 10318 rows); each row's are those of the rows together, to the bit."""
+        whose friction efforts do not settle (or whose gears jam) is NaN, the run kept: a run
+        failing at a fold may not settle again at its last rows (five-bar-robot at rk4 dt 1e-4,
+        4 of its 10318 rows); the others' are each row's own call's, to the bit."""
         if not self._run_facts().has_actuators:
-            return None
-        tau = np.asarray(raw["tau"], dtype=np.float64)
-        if len(tau) == 0:
-            return tau.copy()
-        try:
-            return self._rows_motor_torques(raw, tau, slice(None))
-        except ArgumentError:
-            raise
-        except PlanardynError:
-            return np.concatenate([self._chunk_motor_torques(raw, tau, k, min(k + _TORQUE_CHUNK, len(tau)))
-                                   for k in range(0, len(tau), _TORQUE_CHUNK)])
-
-    def _chunk_motor_torques(self, raw: RawRun, tau: FloatArray, start: int, stop: int) -> FloatArray:
-        """Rows start..stop's motor torques, row by row where they cannot all be found."""
-        try:
-            return self._rows_motor_torques(raw, tau, slice(start, stop))
-        except ArgumentError:
-            raise
-        except PlanardynError:
-            return np.stack([self._row_motor_torques(raw, tau, k) for k in range(start, stop)])
-
-    def _rows_motor_torques(self, raw: RawRun, tau: FloatArray, rows: slice) -> FloatArray:
-        """The motor torques of a result's ``rows`` (:meth:`_result_motor_torques`)."""
-        t_m = self._native.motor_torques(raw["q"][rows], raw["qd"][rows], raw["qdd"][rows], tau[rows], raw["x"][rows],
-                                         raw["xd"][rows], True, True)
-        return np.asarray(t_m, dtype=np.float64).reshape(np.shape(tau[rows]))
-
-    def _row_motor_torques(self, raw: RawRun, tau: FloatArray, k: int) -> FloatArray:
-        """Row k's motor torques, NaN where they cannot be found (:meth:`_result_motor_torques`)."""
-        try:
-            return self._rows_motor_torques(raw, tau, slice(k, k + 1))[0]
-        except ArgumentError:
-            raise
-        except PlanardynError:
-            return np.full(np.shape(tau)[1], np.nan)
+            return None, ""
+        t_m, unsolved = self._native.run_motor_torques(raw["q"], raw["qd"], raw["qdd"], raw["tau"], raw["x"], raw["xd"])
+        return np.asarray(t_m, dtype=np.float64), _unsolved_note(raw["t"], unsolved)
 
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
@@ -958,9 +929,22 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not a model value (use numbers, strings, lists and dicts)")
 
 
-#: Rows per call when a result's motor torques are found in pieces (a row of them cannot be
-#: found): a run of 10^5 rows then makes about 400 calls, not 10^5.
-_TORQUE_CHUNK = 256
+def _unsolved_note(t: FloatArray, unsolved: list[tuple[int, int, str]]) -> str:
+    """What a result's message adds about its rows without motor torques, from the core's
+    spans (first, stop, why) of them: "; no motor torques at rows 10314-10317 (t = 3.0912-3.0915
+    s): the friction efforts did not settle", spans of one reason together (at most
+    :data:`_NAMED_SPANS` named), "" when every row has them."""
+    notes = []
+    for why, group in itertools.groupby(unsolved, key=lambda span: span[2]):
+        spans = [f"row {a} (t = {t[a]:.10g} s)" if b == a + 1 else f"rows {a}-{b - 1} (t = {t[a]:.10g}-{t[b - 1]:.10g} s)"
+                 for a, b, _ in group]
+        more = f" and {len(spans) - _NAMED_SPANS} more spans of rows" if len(spans) > _NAMED_SPANS else ""
+        notes.append(f"; no motor torques at {', '.join(spans[:_NAMED_SPANS])}{more}: {why}")
+    return "".join(notes)
+
+
+#: The most spans of rows without motor torques a result's message names, for one reason.
+_NAMED_SPANS = 8
 
 
 def from_dict(model: Mapping[str, Any], source: str = "<dict>") -> Mechanism:

@@ -234,10 +234,12 @@ class SimulationResult:
         body_names: list[str],
         metadata: Mapping[str, Any] | Callable[[], Mapping[str, Any]] | None = None,
         tau_motor: FloatArray | None = None,
+        message_note: str = "",
     ) -> SimulationResult:
         """Wrap the native ``Mechanism.simulate``'s result (a ``_core.Run``, or the dict a
         batch returns). Every field but ``tau_motor``, how the run ended too, is made at its
-        first read (:data:`LAZY_FIELDS`), ``metadata`` given or made by a callable."""
+        first read (:data:`LAZY_FIELDS`), ``metadata`` given or made by a callable;
+        ``message_note`` is added to the run's message (rows without motor torques)."""
         # The frozen dataclass's __init__ sets every field one by one through
         # object.__setattr__, and making every array up front was most of a short run's fixed
         # cost in Python (issue 25 item 4): nothing is read from the run now, every field at
@@ -248,6 +250,8 @@ class SimulationResult:
         # A field with a default is a class attribute, found before __getattr__: set when not the default.
         if tau_motor is not None:
             values["tau_motor"] = tau_motor
+        if message_note:
+            values["message"] = raw["message"] + message_note
         return result
 
     def __getattr__(self, name: str) -> Any:

@@ -316,10 +316,11 @@ def inverse_result(
     work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
     columns: dict[str, Any] = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": tau, "x": x, "xd": xd}
     columns |= {"kinetic": kinetic, "potential": potential, "work": work, "sigma": sigma, "residual": residual,
-                "partitioned": np.zeros(n_t, dtype=bool), "tau_motor": mech._result_motor_torques(columns)}
+                "partitioned": np.zeros(n_t, dtype=bool)}
+    columns["tau_motor"], note = mech._result_motor_torques(columns)
     res = SimulationResult(
         **column_fields(columns, mech.body_names),
-        success=True, status="success", message="inverse dynamics of a prescribed motion",
+        success=True, status="success", message="inverse dynamics of a prescribed motion" + note,
         stats={"rows": n_t, "max_residual": float(residual.max()), "min_sigma": float(sigma.min()),
                "max_abs_tau": [float(v) for v in np.abs(tau).max(axis=0)]},
         coordinate_names=list(mech.coordinate_names),

@@ -5,9 +5,11 @@
 //! methods of these names: they check the rows' shapes, call the core and shape its result.
 
 use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, Floats, Values};
-use crate::errors::run;
+use crate::errors::{run, to_pyerr};
 use crate::exceptions::argument_error;
-use planardyn::batch::{dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch};
+use planardyn::batch::{
+    dissipation_rows, inverse_rows_checked, motor_torque_rows, regressor_rows, Branch, MotorTorqueRows,
+};
 use planardyn::dynamics::{self, query, Rows};
 use planardyn::Error;
 use planardyn::Mechanism;
@@ -132,7 +134,7 @@ pub fn dissipated_power<'py>(
 }
 
 /// `Mechanism.motor_torques` (the method's doc there); `recorded`: x and xd are a run's own
-/// rows ([`Branch::recorded`]).
+/// rows ([`Branch::recorded`]). A row without motor torques fails the call with its error.
 pub fn motor_torques<'py>(
     py: Python<'py>,
     mech: &Mechanism,
@@ -141,6 +143,33 @@ pub fn motor_torques<'py>(
     allow_singular: bool,
     recorded: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let (shape, t_m) = motor_torque_query(py, mech, motion, tau, allow_singular, recorded)?;
+    arr_dyn(py, &shape, t_m.into_values().map_err(|e| to_pyerr(py, &e))?)
+}
+
+/// `Mechanism.run_motor_torques` (the method's doc there): a run's rows' motor torques, NaN
+/// on the rows without, and those rows as (first, stop, why) spans.
+#[allow(clippy::type_complexity)]
+pub fn run_motor_torques<'py>(
+    py: Python<'py>,
+    mech: &Mechanism,
+    motion: MotionArgs<'_, 'py>,
+    tau: &ArrayArg<'py>,
+) -> PyResult<(Bound<'py, PyAny>, Vec<(usize, usize, String)>)> {
+    let (shape, t_m) = motor_torque_query(py, mech, motion, Some(tau), true, true)?;
+    let unsolved = t_m.unsolved.into_iter().map(|u| (u.rows.start, u.rows.end, u.reason)).collect();
+    Ok((arr_dyn(py, &shape, t_m.values)?, unsolved))
+}
+
+/// The core's motor torques of `motion` ([`motor_torques`]' arguments) and their shape.
+fn motor_torque_query<'py>(
+    py: Python<'py>,
+    mech: &Mechanism,
+    motion: MotionArgs<'_, 'py>,
+    tau: Option<&ArrayArg<'py>>,
+    allow_singular: bool,
+    recorded: bool,
+) -> PyResult<(Vec<usize>, MotorTorqueRows)> {
     let motion = motion.checked(mech)?;
     let q = &motion.q;
     let n_a = mech.n_actuators();
@@ -169,10 +198,9 @@ pub fn motor_torques<'py>(
     let t_m = motion.run(py, |branch, q, qd, qdd| {
         let given = tau.as_ref().map(|(t, w)| (&t.data[..], *w));
         let branch = if recorded { branch.recorded() } else { branch };
-        dynamics::finite("motor torques", motor_torque_rows(mech, branch, q, qd, qdd, given, allow_singular)?)
-            .map_err(Error::from)
+        motor_torque_rows(mech, branch, q, qd, qdd, given, allow_singular)
     })?;
-    arr_dyn(py, &shape, t_m)
+    Ok((shape, t_m))
 }
 
 /// `Mechanism.regressor` (the method's doc there).

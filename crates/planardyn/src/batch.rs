@@ -180,6 +180,10 @@ pub fn inverse_rows_checked(
 /// efforts, the coordinates' then the pair actuators', e.g. a run's tau or shared efforts),
 /// or of the motion's own inverse dynamics (w = m) when `tau` is `None`; at each row's rates
 /// and accelerations (`dynamics::motor_torques`: a rotor takes its own torque before its gear).
+/// Each row's outcome: a row whose losses fail ([`row_failure`]: its friction efforts do not
+/// settle, its gears jam) has none, the others are kept
+/// ([`MotorTorqueRows::into_values`] for all or the first failure). Motor torques that overflow,
+/// and the failures of the walk itself (arguments, assembly, branch), fail the whole call.
 #[allow(clippy::too_many_arguments)]
 pub fn motor_torque_rows(
     mech: &Mechanism,
@@ -189,16 +193,98 @@ pub fn motor_torque_rows(
     qdd: &[f64],
     tau: Option<(&[f64], usize)>,
     allow_singular: bool,
-) -> Result<Vec<f64>, Error> {
+) -> Result<MotorTorqueRows, Error> {
     let w = tau.map_or(mech.dof(), |(_, w)| w);
-    let mut out = Vec::with_capacity(q.len() / mech.dof().max(1) * w);
+    let m = mech.dof().max(1);
+    let mut out = MotorTorqueRows { values: Vec::with_capacity(q.len() / m * w), unsolved: Vec::new() };
     let mut row = vec![0.0; w];
-    inverse_walk(mech, branch, q, qd, qdd, allow_singular, |ws| {
-        let given = tau.map_or(&ws.tau[..], |(tau, w)| &tau[out.len()..out.len() + w]);
-        dynamics::motor_torques(mech, ws, given, &mut row);
-        out.extend_from_slice(&row);
+    walk_rows(mech, branch, q, qd, qdd, allow_singular, |ws, rows, xd| {
+        let k = rows.start / m;
+        let (q, qd, qdd) = (&q[rows.clone()], &qd[rows.clone()], &qdd[rows]);
+        match dynamics::inverse_at_rates(mech, q, qd, qdd, xd, ws) {
+            Ok(()) => {
+                let given = tau.map_or(&ws.tau[..], |(tau, w)| &tau[k * w..(k + 1) * w]);
+                dynamics::motor_torques(mech, ws, given, &mut row);
+                out.values.extend_from_slice(dynamics::finite("motor torques", &row)?);
+            }
+            Err(e) => {
+                let Some(reason) = row_failure(&e) else { return Err(e.into()) };
+                out.values.extend(std::iter::repeat_n(f64::NAN, w));
+                out.unsolved_row(k, reason, e);
+            }
+        }
+        Ok(())
     })?;
     Ok(out)
+}
+
+/// Why a row has no motor torques when its inverse dynamics failing with `e` fails that row
+/// alone: its losses (the friction efforts that do not settle, the gears that jam there), which
+/// leave the next rows' evaluations as they are. `None` for the failures of the query: its
+/// arguments (`BadArgument`, `Overflow`), a row's kinematics (`AssemblyFailed`, `Singular`,
+/// which the walk's measure then reads), and `EffortSharing`, which no row's inverse dynamics
+/// raises.
+fn row_failure(e: &KinematicsError) -> Option<String> {
+    match e {
+        // Not the iterations, which a diverging row's cut short: its span's next rows' may differ.
+        KinematicsError::FrictionUnsettled { .. } => Some("the friction efforts did not settle".into()),
+        KinematicsError::GearsJammed { actuators } => {
+            Some(format!("the gears of {actuators} admit no consistent motion"))
+        }
+        KinematicsError::AssemblyFailed { .. }
+        | KinematicsError::Singular { .. }
+        | KinematicsError::EffortSharing { .. }
+        | KinematicsError::Overflow { .. }
+        | KinematicsError::BadArgument { .. } => None,
+    }
+}
+
+/// [`motor_torque_rows`]' result: every row's motor torques, and the rows without.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotorTorqueRows {
+    /// N x w motor torques (N m), NaN on the rows in `unsolved`.
+    pub values: Vec<f64>,
+    /// The rows whose losses failed, in order: each span consecutive rows failing for the same
+    /// reason, so that their number stays that of the failures' runs.
+    pub unsolved: Vec<UnsolvedRows>,
+}
+
+impl MotorTorqueRows {
+    /// The values when every row has them, else the first unsolved row's failure.
+    pub fn into_values(self) -> Result<Vec<f64>, Error> {
+        match self.unsolved.into_iter().next() {
+            Some(span) => Err(span.error.into()),
+            None => Ok(self.values),
+        }
+    }
+
+    /// Row k failed with `error` for `reason`: its span's, when the row before failed for the
+    /// same reason, else a new span.
+    fn unsolved_row(&mut self, k: usize, reason: String, error: KinematicsError) {
+        match self.unsolved.last_mut() {
+            Some(span) if span.rows.end == k && span.reason == reason => span.rows.end = k + 1,
+            _ => self.unsolved.push(UnsolvedRows { rows: k..k + 1, reason, error }),
+        }
+    }
+}
+
+/// Consecutive rows without motor torques: their indices, why ("the friction efforts did not
+/// settle"), and the first one's error (with the iterations and the last change).
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnsolvedRows {
+    pub rows: std::ops::Range<usize>,
+    pub reason: String,
+    pub error: KinematicsError,
+}
+
+impl std::fmt::Display for UnsolvedRows {
+    /// "rows 10314-10317: the friction efforts did not settle" ("row 7: ...").
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.rows.len() {
+            1 => write!(f, "row {}: {}", self.rows.start, self.reason),
+            _ => write!(f, "rows {}-{}: {}", self.rows.start, self.rows.end - 1, self.reason),
+        }
+    }
 }
 
 /// Inverse dynamics at every row of a motion on `branch` (as [`inverse_rows_checked`]),

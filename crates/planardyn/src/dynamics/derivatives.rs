@@ -208,8 +208,11 @@ fn accelerations_and_jacobians(
     cholesky_solve(&ws.a, m, &mut qdd);
     super::finite("accelerations qdd", &qdd)?;
     let factor = std::mem::replace(&mut ws.a, a);
-    // The efforts' Jacobians take f without the drives (r = M xdd - f).
-    applied_forces(mech, &ws.frame.x, &ws.frame.xd, &vec![0.0; m], &mut ws.f);
+    // The efforts' Jacobians take f without the drives (r = M xdd - f): ws.tau zeroed for it,
+    // then the drives' efforts again (as the forward evaluation leaves them).
+    ws.tau.fill(0.0);
+    applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
+    ws.tau.copy_from_slice(tau);
     ws.qdd.copy_from_slice(&qdd);
     let w = acceleration_analogues(mech, ws);
     let mut rs = RateScratch::at(mech, &ws.x);

@@ -30,6 +30,8 @@ pub use position::{
     assemble, assemble_from, assemble_into, continue_to, scaled_distance, scaled_distances, solve_position,
     MAX_CORRECTION, POSITION_TOL,
 };
-pub use singularity::{passive_sigma_min, passive_sigma_min_with, select_partition, sigma_min, sigma_min_with};
+pub use singularity::{
+    partition_sigma_min_with, passive_sigma_min, passive_sigma_min_with, select_partition, sigma_min, sigma_min_with,
+};
 pub use system::System;
 pub use u_support::USupport;

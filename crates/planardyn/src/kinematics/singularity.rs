@@ -57,8 +57,18 @@ pub fn passive_sigma_min_with(inputs_sys: &mut System, mech: &Mechanism, x: &[f6
         return f64::INFINITY;
     }
     let inputs = sigma_min_with(inputs_sys, mech, &Chart::Inputs, x);
+    inputs.max(partition_sigma_min_with(inputs_sys, mech, x))
+}
+
+/// The partition's half of [`passive_sigma_min_with`]: the type II measure of the partition
+/// [`select_partition`] chooses at x (infinite without constraints), not the user's chart's,
+/// with its blocks kept in `inputs_sys` (`System::other_chart`).
+pub fn partition_sigma_min_with(inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
+    if mech.n_constraints == 0 {
+        return f64::INFINITY;
+    }
     let partition = Chart::Partition(select_partition(mech, x));
-    inputs.max(sigma_min_with(inputs_sys.other_chart(mech, &partition), mech, &partition, x))
+    sigma_min_with(inputs_sys.other_chart(mech, &partition), mech, &partition, x)
 }
 
 /// The m best independent components of x at x: the columns of the scaled Phi_x (its

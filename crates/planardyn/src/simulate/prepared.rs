@@ -24,7 +24,7 @@
 //! copies share: it only tells whether buffers were zeroed for the same supports, and copies
 //! of one analysis have the same supports.
 
-use crate::kinematics::{passive_sigma_min_with, select_partition, sigma_min_with, Chart, ClosedForm, System};
+use crate::kinematics::{partition_sigma_min_with, passive_sigma_min_with, ClosedForm, System};
 use crate::model::Mechanism;
 use crate::{Error, Workspace};
 use std::sync::OnceLock;
@@ -86,16 +86,12 @@ impl Prepared {
         self.with_partition(inputs_sys, |sys| passive_sigma_min_with(sys, mech, x))
     }
 
-    /// The partition's half of [`Prepared::passive_measure`]: the type II measure of the
-    /// partition [`select_partition`] chooses at x (infinite without constraints), not the
-    /// user's chart's. Where the caller has the user's chart's measure already, the passive
-    /// measure is the larger of the two.
+    /// The partition's half of [`Prepared::passive_measure`] ([`partition_sigma_min_with`]): the
+    /// type II measure of the partition `select_partition` chooses at x (infinite without
+    /// constraints), not the user's chart's. Where the caller has the user's chart's measure
+    /// already, the passive measure is the larger of the two.
     pub fn partition_measure(&self, inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
-        if mech.n_constraints == 0 {
-            return f64::INFINITY;
-        }
-        let partition = Chart::Partition(select_partition(mech, x));
-        self.with_partition(inputs_sys, |sys| sigma_min_with(sys.other_chart(mech, &partition), mech, &partition, x))
+        self.with_partition(inputs_sys, |sys| partition_sigma_min_with(sys, mech, x))
     }
 
     /// `measure(inputs_sys)` with the partition's analysis lent from here when the run has none
