@@ -435,7 +435,14 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
     // triangles, mirrored (w_j . w_k is w_k . w_j to the bit).
     let mut g = [[[0.0; 4]; 4]; 3];
     for (r, v) in vectors.iter().enumerate() {
-        let w: [[f64; 2]; 4] = [0, 1, 2, 3].map(|j| (0..4).fold([0.0; 2], |s, n| add(s, c[n][j], v[n])));
+        // Leg column j of C holds rows j and 3 only: the other products are zeros, which add exactly.
+        let w: [[f64; 2]; 4] = [0, 1, 2, 3].map(|j| {
+            if j < 3 {
+                add(add([0.0; 2], c[j][j], v[j]), c[3][j], v[3])
+            } else {
+                (0..4).fold([0.0; 2], |s, n| add(s, c[n][j], v[n]))
+            }
+        });
         for j in 0..4 {
             for k in j..4 {
                 g[r.saturating_sub(1)][j][k] += dot(w[j], w[k]);
