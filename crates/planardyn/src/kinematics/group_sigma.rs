@@ -380,27 +380,36 @@ impl Block {
     }
 }
 
-/// Iterations of [`triad_sigma`]'s safeguarded Newton; it converges in about 6.
+/// Iterations of [`triad_sigma`]'s safeguarded Laguerre iteration; it converges in about 5 (up to
+/// ~45 at a double root, where it is linear: three-fold symmetric triads).
 const TRIAD_ITERATIONS: usize = 60;
 
-/// The relative width of [`triad_sigma`]'s bracket [lo, lambda] (M positive definite at lo, not
-/// at lambda) within which lambda is taken as the root: 64 ulps of lambda, 32 of sigma, the
-/// round-off of M's entries. At the root M is singular to round-off, and a Newton step there
-/// (the 3-RRR's: 50 ulps, onto lambda, which fails the factor) used to start bisections that
-/// chased the last bits (11 iterations of ~560 instructions for the 7 to this lambda, the same
-/// value there).
+/// The relative width of [`triad_sigma`]'s bracket [lo, hi] (M positive definite at lo, not at
+/// hi) within which hi is taken as the root: 64 ulps of lambda, 32 of sigma, the round-off of
+/// M's entries. At the root M is singular to round-off, and the step that converges lands on it
+/// or a few ulps past it (the factor fails there): the iteration then tries [`TRIAD_BRACKET`] / 2
+/// below, which closes the bracket (bisecting from lo instead halved a 1e-6 bracket 30 times on
+/// the 3-RRR's run).
 const TRIAD_BRACKET: f64 = 64.0 * f64::EPSILON;
 
 /// The measure of a 6R triad's 12 x 12 block in closed form, from its lever arms at its own
 /// length: per leg i, `a[i]` A_i and `p[i]` C_i on the leg (R s / L_k), `l[i]` C_i on the
-/// platform. As in [`dyad_sigma`], the block is [T, Phi] (translations | angles), with T^T T =
+/// platform. As in [`dyad_sigma`], the block is B = [T, Phi] (translations | angles), with T^T T =
 /// K (x) I constant, K = [[2, 0, 0, -1], [0, 2, 0, -1], [0, 0, 2, -1], [-1, -1, -1, 3]]
 /// (the legs, then the platform; eigenvalues 2, 2 and (5 +- 13^(1/2)) / 2). Its smallest
 /// squared singular value lambda is the smallest root of det M(lambda) = 0,
 /// M(lambda) = Phi^T Phi - lambda - C^T (K (x) I - lambda)^-1 C (4 x 4, C = T^T Phi), in
 /// [0, k_min] (a unit translation along K's eigenvector of k_min has |B v|^2 = k_min). M is
 /// positive definite exactly below the root (it decreases with lambda), which brackets the
-/// Newton steps on det M, 1 / tr(M^-1 M') each; a step out of the bracket bisects it.
+/// steps. det(B^T B - lambda) = det(K (x) I - lambda) det M(lambda) (M the Schur complement) is
+/// a polynomial of degree 12 with real roots only, on which Laguerre's iteration from 0 goes up
+/// to the smallest root without passing it, cubically near it (5.5 iterations a call in the
+/// 3-RRR's benchmark run, where Newton's on det M took 13, 8.5 with this bracket's back-off, each
+/// ~250 instructions fewer): from
+/// g = (ln det)' = tr(M^-1 M') - sum_r n_r / (k_r - lambda) and
+/// h = -(ln det)'' = tr((M^-1 M')^2) - tr(M^-1 M'') + sum_r n_r / (k_r - lambda)^2
+/// (n_r the multiplicity of K's eigenvalue k_r, doubled by (x) I), the step is
+/// 12 / (-g + ((12 - 1) (12 h - g^2))^(1/2)). A step out of the bracket bisects it.
 pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) -> f64 {
     let dot = |u: [f64; 2], v: [f64; 2]| u[0] * v[0] + u[1] * v[1];
     let add = |u: [f64; 2], v: [f64; 2], s: f64| [u[0] + s * v[0], u[1] + s * v[1]];
@@ -422,17 +431,32 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
     };
     let (r2, r6) = (0.5_f64.sqrt(), (1.0_f64 / 6.0).sqrt());
     let vectors = [[r2, -r2, 0.0, 0.0], [r6, r6, -2.0 * r6, 0.0], symmetric(k_plus), symmetric(k_minus)];
-    // G_r = W_r^T W_r, W_r = (v_r (x) I)^T C; the two of eigenvalue 2 summed.
+    // G_r = W_r^T W_r, W_r = (v_r (x) I)^T C; the two of eigenvalue 2 summed. The upper
+    // triangles, mirrored (w_j . w_k is w_k . w_j to the bit).
     let mut g = [[[0.0; 4]; 4]; 3];
     for (r, v) in vectors.iter().enumerate() {
-        let w: [[f64; 2]; 4] = [0, 1, 2, 3].map(|j| (0..4).fold([0.0; 2], |s, n| add(s, c[n][j], v[n])));
+        // Leg column j of C holds rows j and 3 only: the other products are zeros, which add exactly.
+        let w: [[f64; 2]; 4] = [0, 1, 2, 3].map(|j| {
+            if j < 3 {
+                add(add([0.0; 2], c[j][j], v[j]), c[3][j], v[3])
+            } else {
+                (0..4).fold([0.0; 2], |s, n| add(s, c[n][j], v[n]))
+            }
+        });
         for j in 0..4 {
-            for k in 0..4 {
+            for k in j..4 {
                 g[r.saturating_sub(1)][j][k] += dot(w[j], w[k]);
             }
         }
     }
-    let poles = [2.0, k_plus, k_minus];
+    for g in &mut g {
+        for (j, k) in [(1, 0), (2, 0), (2, 1), (3, 0), (3, 1), (3, 2)] {
+            g[j][k] = g[k][j];
+        }
+    }
+    // K's eigenvalues and their multiplicities in K (x) I (12 in all with M's 4 columns).
+    let (poles, multiplicity) = ([2.0, k_plus, k_minus], [4.0, 2.0, 2.0]);
+    const DEGREE: f64 = 12.0;
     let mut phi = [[0.0; 4]; 4];
     for i in 0..3 {
         phi[i][i] = dot(a[i], a[i]) + dot(p[i], p[i]);
@@ -440,27 +464,23 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
         phi[3][i] = phi[i][3];
         phi[3][3] += dot(l[i], l[i]);
     }
-    // M(lambda) and M'(lambda), symmetric as phi and G_r are to the bit (their (j, k) and
-    // (k, j) entries are the same products summed in the same order): the upper triangles,
-    // mirrored.
-    let m = |lambda: f64| {
-        let f = poles.map(|k| 1.0 / (k - lambda));
+    // M(lambda), symmetric as phi and G_r are to the bit (its (j, k) and (k, j) entries are the
+    // same products summed in the same order): the upper triangle, mirrored.
+    let m = |f: [f64; 3], lambda: f64| {
         let mut m = [[0.0; 4]; 4];
-        let mut d = [[0.0; 4]; 4];
         for j in 0..4 {
             for k in j..4 {
                 let eye = if j == k { 1.0 } else { 0.0 };
                 m[j][k] = phi[j][k] - eye * lambda - (0..3).map(|r| g[r][j][k] * f[r]).sum::<f64>();
-                d[j][k] = -eye - (0..3).map(|r| g[r][j][k] * f[r] * f[r]).sum::<f64>();
-                (m[k][j], d[k][j]) = (m[j][k], d[j][k]);
+                m[k][j] = m[j][k];
             }
         }
-        (m, d)
+        m
     };
-    let (mut lo, mut hi, mut lambda) = (0.0, k_minus, 0.0);
+    let (mut lo, mut hi, mut lambda, mut backed_off) = (0.0, k_minus, 0.0, false);
     for it in 0..TRIAD_ITERATIONS {
-        let (mm, d) = m(lambda);
-        let Some(inv) = spd_inverse(&mm) else {
+        let f = poles.map(|k| 1.0 / (k - lambda));
+        let Some(factor) = cholesky(&m(f, lambda)) else {
             if it == 0 {
                 return 0.0; // M(0) singular: so is the block
             }
@@ -468,12 +488,38 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
                 return lambda.sqrt(); // the root is in [lo, lambda], within round-off of lambda
             }
             hi = lambda;
-            lambda = 0.5 * (lo + hi);
+            // Once just below (the step's landing past the root by round-off), else bisect.
+            lambda = if backed_off { 0.5 * (lo + hi) } else { hi - 0.5 * TRIAD_BRACKET * hi };
+            backed_off = true;
             continue;
         };
         lo = lambda;
-        let trace: f64 = (0..4).map(|j| (0..4).map(|k| inv[j][k] * d[k][j]).sum::<f64>()).sum();
-        let mut next = lambda - 1.0 / trace;
+        if hi - lo <= TRIAD_BRACKET * hi {
+            return hi.sqrt();
+        }
+        let inv = inverse(&factor);
+        // M' = -I - sum_r G_r f_r^2 (symmetric), x = M^-1 M'; tr(M^-1 M'') from
+        // M'' = -2 sum_r G_r f_r^3 as the products <M^-1, G_r> (both symmetric).
+        let mut d = [[0.0; 4]; 4];
+        let mut inner = [0.0; 3];
+        for j in 0..4 {
+            for k in j..4 {
+                let eye = if j == k { 1.0 } else { 0.0 };
+                d[j][k] = -eye - (0..3).map(|r| g[r][j][k] * (f[r] * f[r])).sum::<f64>();
+                d[k][j] = d[j][k];
+                let twice = if j == k { 1.0 } else { 2.0 };
+                (0..3).for_each(|r| inner[r] += twice * inv[j][k] * g[r][j][k]);
+            }
+        }
+        let x: [[f64; 4]; 4] = inv.map(|row| [0, 1, 2, 3].map(|n| (0..4).map(|k| row[k] * d[k][n]).sum::<f64>()));
+        let inv_m2 = -2.0 * (0..3).map(|r| inner[r] * (f[r] * f[r] * f[r])).sum::<f64>();
+        let trace: f64 = (0..4).map(|j| x[j][j]).sum();
+        let square: f64 = (0..4).map(|j| (0..4).map(|k| x[j][k] * x[k][j]).sum::<f64>()).sum();
+        let poles_g: f64 = (0..3).map(|r| multiplicity[r] * f[r]).sum();
+        let poles_h: f64 = (0..3).map(|r| multiplicity[r] * f[r] * f[r]).sum();
+        let (gl, hl) = (trace - poles_g, square - inv_m2 + poles_h);
+        let root = ((DEGREE - 1.0) * (DEGREE * hl - gl * gl)).max(0.0).sqrt();
+        let mut next = lambda + DEGREE / (root - gl);
         if !(next < hi) {
             next = 0.5 * (lambda + hi);
         }
@@ -485,8 +531,8 @@ pub(crate) fn triad_sigma(a: [[f64; 2]; 3], p: [[f64; 2]; 3], l: [[f64; 2]; 3]) 
     lambda.max(0.0).sqrt()
 }
 
-/// The inverse of a symmetric 4 x 4 matrix by Cholesky, None unless positive definite.
-fn spd_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
+/// The Cholesky factor L (M = L L^T) of a symmetric 4 x 4 matrix, None unless positive definite.
+fn cholesky(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
     let mut l = [[0.0; 4]; 4];
     for j in 0..4 {
         let d = m[j][j] - (0..j).map(|k| l[j][k] * l[j][k]).sum::<f64>();
@@ -498,8 +544,13 @@ fn spd_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
             l[i][j] = (m[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>()) / l[j][j];
         }
     }
-    // M^-1 = L^-T L^-1, column by column (each also a row: it is symmetric).
-    Some([0, 1, 2, 3].map(|c| {
+    Some(l)
+}
+
+/// M^-1 = L^-T L^-1 from M's Cholesky factor L, column by column (each also a row: it is
+/// symmetric).
+fn inverse(l: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
+    [0, 1, 2, 3].map(|c| {
         let mut y = [0.0; 4];
         for i in 0..4 {
             let e = if i == c { 1.0 } else { 0.0 };
@@ -509,12 +560,57 @@ fn spd_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
             y[i] = (y[i] - (i + 1..4).map(|k| l[k][i] * y[k]).sum::<f64>()) / l[i][i];
         }
         y
-    }))
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`triad_sigma`]'s squared measure is the smallest squared singular value of the triad's
+    /// 12 x 12 block (its SVD, `Block::sigma`, the path of triads with cylinder legs) within
+    /// 64 eps |B|_F^2: the SVD's sigma is exact for B + E with |E| a few eps |B| (so its square
+    /// within a few eps |B|^2), and triad_sigma's lambda is a root of det M to M's round-off.
+    /// Random triads (arms in [-0.5, 0.5]^2) and three-fold symmetric ones, whose two smallest
+    /// singular values are equal (a double root, where Laguerre's iteration is only linear).
+    #[test]
+    fn triad_sigma_is_the_svd_of_its_block() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let turn = |v: [f64; 2], i: usize| {
+            let (s, c) = (2.0 * std::f64::consts::PI * i as f64 / 3.0).sin_cos();
+            [c * v[0] - s * v[1], s * v[0] + c * v[1]]
+        };
+        for case in 0..400 {
+            let mut arms = [[[0.0; 2]; 3]; 3];
+            for arm in arms.iter_mut() {
+                let first = [next(), next()];
+                for (i, leg) in arm.iter_mut().enumerate() {
+                    *leg = if case % 2 == 0 {
+                        turn(first, i)
+                    } else if i == 0 {
+                        first
+                    } else {
+                        [next(), next()]
+                    };
+                }
+            }
+            let [a, p, l] = arms;
+            let mut block = Block::new(4, 1.0);
+            let mut frobenius = 0.0;
+            for i in 0..3 {
+                block.point_rows(&[(i, 1.0, a[i])]);
+                block.point_rows(&[(i, 1.0, p[i]), (3, -1.0, l[i])]);
+                frobenius += 6.0 + a[i].iter().chain(&p[i]).chain(&l[i]).map(|v| v * v).sum::<f64>();
+            }
+            let (sigma, svd) = (triad_sigma(a, p, l), block.sigma());
+            let tol = 64.0 * f64::EPSILON * frobenius;
+            assert!((sigma * sigma - svd * svd).abs() <= tol, "case {case}: {sigma} against the SVD's {svd}");
+        }
+    }
 
     /// `exact`'s fixed-size SVDs give the dynamic one's smallest singular value bit for bit
     /// (random blocks of each fixed size, some near singular: a row the sum of two plus 1e-9).
