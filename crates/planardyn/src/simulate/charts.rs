@@ -30,6 +30,12 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 /// of 21 settings (as 0.13 J at 8.9e-5 before), 0.25 left rows 2.03x the steps at 3.98e-8.
 const FIRST_STEP_MOVE: f64 = 0.3;
 
+/// Smallest ratio of the type II measure at a step's end to its start that a step in the
+/// user's chart may aim for (`fall_step_bound`). The chart's equations of motion vary like
+/// 1/sigma^2, so the error constant of a step that takes the measure from sigma to a sigma
+/// grows by 1/a^2 inside it while the embedded estimate sees mostly its start.
+const USER_FALL: f64 = 0.5;
+
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]
 pub struct Measures {
@@ -98,6 +104,19 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
     let rate = ode.scaled_body_rate();
     if rate > 0.0 {
         FIRST_STEP_MOVE * own / rate
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The longest next step in the user's chart from its measure `now` = (t, sigma) at the last
+/// accepted point and `last` at the one before: with sigma^2 linear in t (a generic passage by
+/// a type II singularity), the step at whose end the measure is [`USER_FALL`] times sigma (s;
+/// infinite where the measure does not fall).
+pub fn fall_step_bound(last: (f64, f64), now: (f64, f64)) -> f64 {
+    let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
+    if now.0 > last.0 && fall_rate > 0.0 {
+        now.1 * now.1 * (1.0 - USER_FALL * USER_FALL) / fall_rate
     } else {
         f64::INFINITY
     }
