@@ -34,7 +34,7 @@ const FIRST_STEP_MOVE: f64 = 0.3;
 /// user's chart may aim for (`fall_step_bound`). The chart's equations of motion vary like
 /// 1/sigma^2, so the error constant of a step that takes the measure from sigma to a sigma
 /// grows by 1/a^2 inside it while the embedded estimate sees mostly its start.
-const USER_FALL: f64 = 0.5;
+const USER_FALL: f64 = 0.35;
 
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]
@@ -115,8 +115,9 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
 /// infinite where the measure does not fall).
 pub fn fall_step_bound(last: (f64, f64), now: (f64, f64)) -> f64 {
     let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
+    let end = (USER_FALL * now.1).min(SWITCH_TO_PARTITION);
     if now.0 > last.0 && fall_rate > 0.0 {
-        now.1 * now.1 * (1.0 - USER_FALL * USER_FALL) / fall_rate
+        (now.1 * now.1 - end * end).max(0.0) / fall_rate
     } else {
         f64::INFINITY
     }

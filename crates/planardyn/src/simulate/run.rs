@@ -7,8 +7,8 @@
 use std::ops::ControlFlow::{self, Break, Continue};
 
 use super::charts::{
-    chart_sigma, fall_step_bound, first_step_bound, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR,
-    SWITCH_TO_PARTITION,
+    chart_sigma, fall_step_bound, first_step_bound, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR,
+    PASSIVE_SINGULAR, SWITCH_TO_PARTITION,
 };
 use super::crossing::{
     cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
