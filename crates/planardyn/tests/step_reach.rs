@@ -48,8 +48,8 @@ fn five_bar_steps_near_singularities_keep_the_energy() {
 /// took one step in the user's chart from a type II measure of 0.066-0.076 to a quarter of it
 /// (t = 0.155 s; the step's reach, 2 x the measure, let it through) and drifted 6.5e-4 to
 /// 9.2e-4 J at the steps, 7.1e-4 to 9.4e-4 J on a 1 ms grid. With the measure's fall in one
-/// step bounded (`simulate::charts::fall_step_bound`) the largest fall is 1.74x and the
-/// drift 4.4e-6 to 6.5e-6 J (steps), 1.4e-5 to 1.7e-5 J (1 ms grid).
+/// step bounded (`simulate::charts::fall_step_bound`) the largest fall is 2.03x and the
+/// drift 7.4e-6 to 9.0e-6 J (steps), 1.8e-5 to 2.7e-5 J (1 ms grid).
 const FAST_APPROACH_LEVELS: std::ops::RangeInclusive<i32> = 0..=13;
 
 #[test]

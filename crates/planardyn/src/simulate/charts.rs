@@ -31,9 +31,15 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 const FIRST_STEP_MOVE: f64 = 0.3;
 
 /// Smallest ratio of the type II measure at a step's end to its start that a step in the
-/// user's chart may aim for (`fall_step_bound`). The chart's equations of motion vary like
-/// 1/sigma^2, so the error constant of a step that takes the measure from sigma to a sigma
-/// grows by 1/a^2 inside it while the embedded estimate sees mostly its start.
+/// user's chart may aim for, where it would end below [`SWITCH_TO_PARTITION`]
+/// (`fall_step_bound`). The chart's equations of motion vary like 1/sigma^2: the error
+/// constant of a step that takes the measure from sigma to a sigma grows 1/a^2-fold inside it,
+/// and the embedded estimate does not see it. Main 2e54c44 (five-bar fall, DOP853, rtol = atol
+/// 1e-4 ... 3.7e-5) took steps from 0.07 to 0.017 and drifted up to 9.2e-4 J; over 751 rtols
+/// 10^(-k/150), k = 600 ... 1350, runs over 1e-4 J: DOP853 66 -> 0 (steps), 74 -> 0 (1 ms grid),
+/// DOPRI5 302 -> 300; evaluations -0.6 % / +0.3 %. Aiming at half the measure (0.5, not
+/// limited to below the threshold): also 0 for DOP853, but the five-bar benchmark's DOPRI5
+/// setting (7.59e-7) drifted 1.2e-4 J (tests/step_reach.rs).
 const USER_FALL: f64 = 0.35;
 
 /// What the monitor found at an accepted point.
@@ -111,8 +117,8 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
 
 /// The longest next step in the user's chart from its measure `now` = (t, sigma) at the last
 /// accepted point and `last` at the one before: with sigma^2 linear in t (a generic passage by
-/// a type II singularity), the step at whose end the measure is [`USER_FALL`] times sigma (s;
-/// infinite where the measure does not fall).
+/// a type II singularity), the step at whose end the measure is [`USER_FALL`] times sigma, or
+/// [`SWITCH_TO_PARTITION`] if higher (s; infinite where the measure does not fall).
 pub fn fall_step_bound(last: (f64, f64), now: (f64, f64)) -> f64 {
     let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
     let end = (USER_FALL * now.1).min(SWITCH_TO_PARTITION);

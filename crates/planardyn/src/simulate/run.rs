@@ -474,6 +474,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.predict_next_step();
         }
         self.last_own = Some(own);
+        // A step in the user's chart may not rush into type II (`fall_step_bound`).
         let user = self.ode.ws.chart == Chart::Inputs;
         if let Some(last) = self.last_user.filter(|_| user && own < PREDICT_BELOW) {
             self.stepper.bound_next_step(fall_step_bound(last, (t, own)));
