@@ -117,8 +117,8 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
 
 /// The longest next step in the user's chart from its measure `now` = (t, sigma) at the last
 /// accepted point and `last` at the one before: with sigma^2 linear in t (a generic passage by
-/// a type II singularity), the step at whose end the measure is [`USER_FALL`] times sigma, or
-/// [`SWITCH_TO_PARTITION`] if higher (s; infinite where the measure does not fall).
+/// a type II singularity), the step at whose end the measure is the lower of [`USER_FALL`]
+/// times sigma and [`SWITCH_TO_PARTITION`] (s; infinite where the measure does not fall).
 pub fn fall_step_bound(last: (f64, f64), now: (f64, f64)) -> f64 {
     let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
     let end = (USER_FALL * now.1).min(SWITCH_TO_PARTITION);
