@@ -30,6 +30,18 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 /// of 21 settings (as 0.13 J at 8.9e-5 before), 0.25 left rows 2.03x the steps at 3.98e-8.
 const FIRST_STEP_MOVE: f64 = 0.3;
 
+/// Smallest ratio of the type II measure at a step's end to its start that a step in the
+/// user's chart may aim for, where it would end below [`SWITCH_TO_PARTITION`]
+/// (`fall_step_bound`). The chart's equations of motion vary like 1/sigma^2: the error
+/// constant of a step that takes the measure from sigma to a sigma grows 1/a^2-fold inside it,
+/// and the embedded estimate does not see it. Main 2e54c44 (five-bar fall, DOP853, rtol = atol
+/// 1e-4 ... 3.7e-5) took steps from 0.07 to 0.017 and drifted up to 9.2e-4 J; over 751 rtols
+/// 10^(-k/150), k = 600 ... 1350, runs over 1e-4 J: DOP853 66 -> 0 (steps), 74 -> 0 (1 ms grid),
+/// DOPRI5 302 -> 300; evaluations -0.6 % / +0.3 %. Aiming at half the measure (0.5, not
+/// limited to below the threshold): also 0 for DOP853, but the five-bar benchmark's DOPRI5
+/// setting (7.59e-7) drifted 1.2e-4 J (tests/step_reach.rs).
+const USER_FALL: f64 = 0.35;
+
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]
 pub struct Measures {
@@ -98,6 +110,20 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
     let rate = ode.scaled_body_rate();
     if rate > 0.0 {
         FIRST_STEP_MOVE * own / rate
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The longest next step in the user's chart from its measure `now` = (t, sigma) at the last
+/// accepted point and `last` at the one before: with sigma^2 linear in t (a generic passage by
+/// a type II singularity), the step at whose end the measure is the lower of [`USER_FALL`]
+/// times sigma and [`SWITCH_TO_PARTITION`] (s; infinite where the measure does not fall).
+pub fn fall_step_bound(last: (f64, f64), now: (f64, f64)) -> f64 {
+    let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
+    let end = (USER_FALL * now.1).min(SWITCH_TO_PARTITION);
+    if now.0 > last.0 && fall_rate > 0.0 {
+        (now.1 * now.1 - end * end).max(0.0) / fall_rate
     } else {
         f64::INFINITY
     }

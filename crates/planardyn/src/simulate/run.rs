@@ -7,8 +7,8 @@
 use std::ops::ControlFlow::{self, Break, Continue};
 
 use super::charts::{
-    chart_sigma, first_step_bound, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR,
-    SWITCH_TO_PARTITION,
+    chart_sigma, fall_step_bound, first_step_bound, measure, next_chart, state_in, Measures, NEAR_PASSIVE_SINGULAR,
+    PASSIVE_SINGULAR, SWITCH_TO_PARTITION,
 };
 use super::crossing::{
     cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
@@ -86,6 +86,8 @@ pub struct Run<'a, 's, 'e> {
     keep_dense: bool,
     /// The chart's own measure at the last accepted point, while in the same chart.
     last_own: Option<f64>,
+    /// The user's chart's time and type II measure at the last accepted point, if in that chart.
+    last_user: Option<(f64, f64)>,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
     fold: FoldWatch,
 }
@@ -140,6 +142,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             watch: Watch::new(observe.events, m),
             keep_dense,
             last_own: None,
+            last_user: None,
             fold: FoldWatch::default(),
         };
         // The start counts in the least measures, so that a run of no step reports its start's.
@@ -471,6 +474,12 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.predict_next_step();
         }
         self.last_own = Some(own);
+        // A step in the user's chart may not rush into type II (`fall_step_bound`).
+        let user = self.ode.ws.chart == Chart::Inputs;
+        if let Some(last) = self.last_user.filter(|_| user && own < PREDICT_BELOW) {
+            self.stepper.bound_next_step(fall_step_bound(last, (t, own)));
+        }
+        self.last_user = user.then_some((t, own));
         self.t_stop = self.settings.t_end;
     }
 
