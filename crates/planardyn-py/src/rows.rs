@@ -157,7 +157,7 @@ pub fn run_motor_torques<'py>(
     tau: &ArrayArg<'py>,
 ) -> PyResult<(Bound<'py, PyAny>, Vec<(usize, usize, String)>)> {
     let (shape, t_m) = motor_torque_query(py, mech, motion, Some(tau), true, true)?;
-    let unsolved = t_m.unsolved.into_iter().map(|u| (u.rows.start, u.rows.end, u.reason)).collect();
+    let unsolved = t_m.unsolved.into_iter().map(|u| (u.rows.start, u.rows.end, u.reason())).collect();
     Ok((arr_dyn(py, &shape, t_m.values)?, unsolved))
 }
 

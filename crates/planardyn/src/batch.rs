@@ -210,7 +210,7 @@ pub fn motor_torque_rows(
             Err(e) => {
                 let Some(reason) = row_failure(&e) else { return Err(e.into()) };
                 out.values.extend(std::iter::repeat_n(f64::NAN, w));
-                out.unsolved_row(k, reason, e);
+                out.unsolved_row(k, &reason, e);
             }
         }
         Ok(())
@@ -260,29 +260,35 @@ impl MotorTorqueRows {
 
     /// Row k failed with `error` for `reason`: its span's, when the row before failed for the
     /// same reason, else a new span.
-    fn unsolved_row(&mut self, k: usize, reason: String, error: KinematicsError) {
+    fn unsolved_row(&mut self, k: usize, reason: &str, error: KinematicsError) {
         match self.unsolved.last_mut() {
-            Some(span) if span.rows.end == k && span.reason == reason => span.rows.end = k + 1,
-            _ => self.unsolved.push(UnsolvedRows { rows: k..k + 1, reason, error }),
+            Some(span) if span.rows.end == k && span.reason() == reason => span.rows.end = k + 1,
+            _ => self.unsolved.push(UnsolvedRows { rows: k..k + 1, error }),
         }
     }
 }
 
-/// Consecutive rows without motor torques: their indices, why ("the friction efforts did not
-/// settle"), and the first one's error (with the iterations and the last change).
+/// Consecutive rows without motor torques: their indices and the first one's error (with the
+/// iterations and the last change), which says why ([`UnsolvedRows::reason`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct UnsolvedRows {
     pub rows: std::ops::Range<usize>,
-    pub reason: String,
     pub error: KinematicsError,
+}
+
+impl UnsolvedRows {
+    /// Why the rows have no motor torques ("the friction efforts did not settle"), from the error.
+    pub fn reason(&self) -> String {
+        row_failure(&self.error).unwrap_or_else(|| self.error.to_string())
+    }
 }
 
 impl std::fmt::Display for UnsolvedRows {
     /// "rows 10314-10317: the friction efforts did not settle" ("row 7: ...").
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.rows.len() {
-            1 => write!(f, "row {}: {}", self.rows.start, self.reason),
-            _ => write!(f, "rows {}-{}: {}", self.rows.start, self.rows.end - 1, self.reason),
+            1 => write!(f, "row {}: {}", self.rows.start, self.reason()),
+            _ => write!(f, "rows {}-{}: {}", self.rows.start, self.rows.end - 1, self.reason()),
         }
     }
 }

@@ -58,7 +58,7 @@ fn rows_that_do_not_settle_have_no_motor_torques_and_the_others_their_own() {
             Some(span) => {
                 assert!(rows.values[k].is_nan(), "row {k}: {}", rows.values[k]);
                 assert_eq!(own.unsolved.len(), 1, "row {k}");
-                assert_eq!(own.unsolved[0].reason, span.reason);
+                assert_eq!(own.unsolved[0].reason(), span.reason());
                 if span.rows.start == k {
                     assert_eq!(own.unsolved[0].error, span.error);
                 }
@@ -70,7 +70,7 @@ fn rows_that_do_not_settle_have_no_motor_torques_and_the_others_their_own() {
         }
     }
     for span in &rows.unsolved {
-        assert_eq!(span.reason, "the friction efforts did not settle");
+        assert_eq!(span.reason(), "the friction efforts did not settle");
         assert!(matches!(span.error, KinematicsError::FrictionUnsettled { .. }), "{:?}", span.error);
     }
     assert_eq!(rows.unsolved[0].to_string(), "rows 2-3: the friction efforts did not settle");
