@@ -51,6 +51,27 @@ def usage(mech, plan, f=FRACTIONS):
     where braking into it back-drives the gear (t_m = tau eta / n) up to the last instant."""
     i = np.repeat(np.arange(len(plan.sdd)), len(f))
     s = plan.s[i] + np.tile(f, len(plan.sdd)) * np.diff(plan.s)[i]
+    use, speed = usage_at(mech, plan, i, s)
+    use = use.reshape(len(plan.sdd), len(f))
+    use[-1, -1] = 0.0
+    return use, speed.reshape(use.shape)
+
+
+def knot_usage(mech, plan):
+    """The largest |t_m| / available torque (I,) at the path's knots inside each grid interval
+    (0 where none): the efforts have a kink there (the spline's third derivative jumps), a
+    maximum the fractions may miss."""
+    knots = plan.path.ss_waypoints
+    i = np.searchsorted(plan.s, knots, side="right") - 1
+    keep = (i >= 0) & (i < len(plan.sdd)) & (knots > plan.s[np.clip(i, 0, len(plan.sdd) - 1)])
+    out = np.zeros(len(plan.sdd))
+    np.maximum.at(out, i[keep], usage_at(mech, plan, i[keep], knots[keep])[0])
+    return out
+
+
+def usage_at(mech, plan, i, s):
+    """|t_m| / available torque and the motors' speeds, the largest over the motors, at the
+    points s of the grid intervals i."""
     x = np.maximum(plan.sd[i] ** 2 + 2 * (s - plan.s[i]) * plan.sdd[i], 0.0)  # round-off below 0 at rest
     p1, p2 = plan.path(s, 1), plan.path(s, 2)
     qd = p1 * np.sqrt(x)[:, None]
@@ -58,9 +79,7 @@ def usage(mech, plan, f=FRACTIONS):
     qdd = p1 * plan.sdd[i][:, None] + p2 * x[:, None]
     t_m = np.asarray(mech.motor_torques(plan.path(s), qd, qdd, tau, x=plan.x[i]))
     avail = np.column_stack([mech.available_torque(k, RATIO * qd[:, k]) for k in range(mech.dof)])
-    use = (np.abs(t_m) / avail).max(axis=1).reshape(len(plan.sdd), len(f))
-    use[-1, -1] = 0.0
-    return use, (RATIO * np.abs(qd).max(axis=1)).reshape(use.shape)
+    return (np.abs(t_m) / avail).max(axis=1), RATIO * np.abs(qd).max(axis=1)
 
 
 def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> None:
@@ -71,7 +90,8 @@ def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> N
     plan = time_optimal(mech, path, "actuators", n_grid=200)
     use, speed = usage(mech, plan)
     assert use.max() <= 1 + 1e-9  # at both ends of every interval and inside
-    active = use.max(axis=1) > 1 - 1e-6
+    # Interval 265's largest is at a knot (0.99999997 at 0.811 of it): the check's cut there.
+    active = np.maximum(use.max(axis=1), knot_usage(mech, plan)) > 1 - 1e-6
     assert np.count_nonzero(~active) <= 1  # the switch from accelerating to braking
     on_droop = ((speed > 100.0) & (use > 1 - 1e-6)).any(axis=1)
     assert on_droop.sum() > 200

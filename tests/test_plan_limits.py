@@ -17,7 +17,7 @@ import planardyn
 import pytest
 from conftest import MODELS
 from planardyn import robot as rb
-from planardyn.plan import collocate, time_optimal
+from planardyn.plan import collocate, task_waypoints, time_optimal
 from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 
@@ -132,6 +132,26 @@ def test_the_conservative_timing_converges_at_first_order(optimum) -> None:
     assert np.all(excess > 0)
     slope = np.polyfit(np.log(n), np.log(excess), 1)[0]
     assert slope == pytest.approx(-1.0, abs=0.05), (slope, excess)
+
+
+def test_the_timing_holds_its_limits_at_the_paths_knots() -> None:
+    # The 5R from (0.06, 0.26) to (-0.06, 0.38) m, |tau| <= [1, 5] N m: the waypoints' C2
+    # spline has a jump of its third derivative at each knot, so the efforts have a kink there,
+    # which the check's parabola through its samples does not reach. At 5816799 theta1's
+    # effort reached 1.0000083 N m at the knot s = 0.62505, inside the grid interval
+    # (0.62374, 0.62626), with limit_ratio 0.99999997 (s22-check). Checked at 200 points per
+    # interval; tolerance the cuts' 1e-10 of the limit with the parabola's third-order error
+    # (1e-9, as above).
+    robot = planardyn.load(MODELS / "library" / "five-bar-5r.yaml")
+    ee = rb.EndEffector(robot, "P")
+    limit = np.array([1.0, 5.0])
+    plan = time_optimal(robot, task_waypoints(ee, [[0.06, 0.26], [-0.06, 0.38]], spacing=0.01), effort=limit,
+                        n_grid=100)
+    f = np.linspace(0.0, 1.0, 200, endpoint=False)
+    t = np.append((plan.t[:-1, None] + np.diff(plan.t)[:, None] * f).ravel(), plan.t[-1])
+    used = (np.abs(plan.efforts(t)) / limit).max()
+    assert used <= 1 + 1e-9
+    assert used - 1e-9 <= plan.limit_ratio <= 1 + 1e-9
 
 
 def test_collocation_keeps_its_speed_limits_between_nodes() -> None:

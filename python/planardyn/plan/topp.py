@@ -364,7 +364,7 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
         if not np.isfinite(t_new):
             raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}, but at rest "
                                  "somewhere along it): raise the limits or move the path")
-        found = check(mech, path, s, x, sd, sdd, limits, exact)
+        found = check(mech, path, s, x, sd, sdd, limits, path.ss_waypoints, exact)
         settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
         if found.ratio <= 1 + RATIO_TOL and settled:
             break
