@@ -128,19 +128,20 @@ class Limit(Protocol):
 class EffortLimit:
     """lo <= tau <= hi, with (lo, hi) (P, m) = ``bounds(q)`` (N m or N); the ratio is
     |tau - mid| / half (mid and half the middle and half-width of [lo, hi]: |tau| / limit
-    for symmetric limits)."""
+    for symmetric limits). Halves are taken before the sums (hi / 2 - lo / 2, as exact): hi - lo
+    overflows for limits near 1e308."""
 
     bounds: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
 
     def rows(self, pts: PathPoints, x0: FloatArray) -> Rows:
         lo, hi = self.bounds(pts.q)
-        half = np.hstack([(hi - lo) / 2, (hi - lo) / 2])
+        half = np.hstack([hi / 2 - lo / 2, hi / 2 - lo / 2])
         return (np.hstack([pts.a, -pts.a]) / half, np.hstack([pts.b, -pts.b]) / half,
                 np.hstack([pts.c - hi, lo - pts.c]) / half + ROW_MARGIN)
 
     def ratio(self, pts: PathPoints, u: FloatArray, x: FloatArray) -> FloatArray:
         lo, hi = self.bounds(pts.q)
-        return np.asarray(np.max(np.abs(pts.efforts(u, x) - (lo + hi) / 2) / ((hi - lo) / 2), axis=1))
+        return np.asarray(np.max(np.abs(pts.efforts(u, x) - (lo / 2 + hi / 2)) / (hi / 2 - lo / 2), axis=1))
 
 
 @dataclass
