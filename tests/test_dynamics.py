@@ -68,6 +68,18 @@ def test_huge_efforts_are_an_overflow_error():
     assert err.value.quantity == "accelerations qdd"
 
 
+@pytest.mark.parametrize("run", [{"qd0": [1e308]}, {"qd0": [1e154]}, {"motion": {"theta1": 1e308}},
+                                 {"drives": lambda t, q, qd: [1e308]}])
+def test_a_run_that_overflows_says_what_to_make_smaller(run):
+    # At 5816799 these stopped with status non_finite and only "NaN or infinity in the
+    # solution near t = 0 s", naming no argument (s22-check); forward_dynamics names them.
+    res = pd.load_example("four-bar-gravity").simulate(0.1, **run)
+    assert res.status == "non_finite" and not res.success
+    assert "NaN or infinity in the solution near t = 0 s" in res.message
+    assert "try smaller start rates (qd0), efforts or motion speeds" in res.message
+    assert np.all(np.isfinite(res.q)) and np.all(np.isfinite(res.qd))
+
+
 @pytest.mark.parametrize(
     ("call", "quantity"),
     [

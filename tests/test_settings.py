@@ -70,6 +70,9 @@ BAD_SETTINGS = [
     ("t_end", math.nan, pd.ArgumentError),
     ("rtol", -1e-9, pd.SimulationError),
     ("rtol", MIN_RTOL / 2, pd.SimulationError),
+    # At 5816799 rtol = 2 (or 1e308) ran: an error test that lets a step's error exceed the
+    # state itself (s22-check).
+    ("rtol", 2.0, pd.SimulationError),
     ("atol", 0.0, pd.SimulationError),
     ("dt", math.inf, pd.SimulationError),
     ("output_dt", -1.0, pd.SimulationError),

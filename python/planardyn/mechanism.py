@@ -711,7 +711,7 @@ class Mechanism:
             ``'rk4'`` (fixed step, needs ``dt``).
         rtol, atol : float
             Relative and absolute tolerances of the adaptive methods (defaults 1e-9, 1e-12),
-            each finite and > 0 (the rules of :mod:`planardyn.settings`).
+            each finite and > 0, rtol at most 1 (the rules of :mod:`planardyn.settings`).
         dt : float
             Fixed step (s): required by rk4; for an adaptive method it turns error control off.
         t_eval : (K,) array_like

@@ -6,7 +6,8 @@ ones a run applies whoever made its settings: times and tolerances (``t_end``, `
 error scale is ``atol + rtol * |y_i|``: a state component that passes through 0 (an angle, a
 rate at rest) would have a zero scale, the step size would collapse and the run end in "NaN or
 infinity" instead of an answer. ``rtol`` is also at least :data:`MIN_RTOL` (below it the error
-test asks for more than double precision holds). ``max_steps`` is an integer in
+test asks for more than double precision holds) and at most 1 (above it a step's error may
+exceed the state itself). ``max_steps`` is an integer in
 1..=:data:`MAX_STEPS`.
 
 A value that breaks its rule raises what ``Mechanism.simulate`` raises for it:

@@ -178,6 +178,9 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// Smallest relative tolerance: 100 machine epsilons (below it the error test asks for more
 /// than double precision holds).
 pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+/// Largest relative tolerance: above it the error test accepts a step whose error exceeds
+/// the state itself (rtol = 1, the loosest meaningful, is the benchmarks' cheapest scan point).
+pub const MAX_RTOL: f64 = 1.0;
 /// Most step attempts a run may be given: days of computing at a microsecond a step.
 pub const MAX_STEPS: f64 = 1e12;
 
@@ -249,7 +252,7 @@ impl Setting {
     /// `value` if it keeps this setting's rule, else the error naming the setting and the fix.
     /// The times and tolerances are finite numbers > 0 (t_end after the start at 0 s): with
     /// atol = 0 a state component passing through 0 has no error scale and the step
-    /// collapses; rtol is at least [`MIN_RTOL`]; max_steps an integer in 1..=[`MAX_STEPS`].
+    /// collapses; rtol is in [[`MIN_RTOL`], [`MAX_RTOL`]]; max_steps an integer in 1..=[`MAX_STEPS`].
     pub fn check(self, value: f64) -> Result<f64, SettingError> {
         match self.broken(value) {
             Some(rule) => Err(SettingError::new(self, value, rule)),
@@ -310,6 +313,9 @@ impl Setting {
         match self {
             Setting::TEnd => (!positive).then_some("must be a finite number > 0 (the end time in s)"),
             Setting::Rtol if !positive => Some("must be a finite number > 0 (try 1e-8)"),
+            Setting::Rtol if v > MAX_RTOL => {
+                Some("must be at most 1: above it a step's error may exceed the state itself (try 1e-6)")
+            }
             Setting::Rtol => {
                 (v < MIN_RTOL).then_some("is below 100 machine epsilons and cannot be met: use rtol >= 2.3e-14")
             }

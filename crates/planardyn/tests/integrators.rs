@@ -621,14 +621,19 @@ fn options_follow_the_loaders_rule() {
     for atol in [0.0, -0.0, -1e-10, f64::NAN, f64::INFINITY] {
         refused(Options::tol(1e-8, atol), "atol");
     }
-    for rtol in [0.0, 99.0 * eps, f64::NAN, f64::INFINITY] {
+    // rtol > 1 (MAX_RTOL) ran at 5816799 (s22-check).
+    for rtol in [0.0, 99.0 * eps, 1.0 + eps, 2.0, 1e308, f64::NAN, f64::INFINITY] {
         refused(Options::tol(rtol, 1e-10), "rtol");
     }
     for dt in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
         refused(Options::fixed(dt), "dt");
     }
     refused(Options { max_steps: 0, ..Options::default() }, "max_steps");
-    for opts in [Options::tol(100.0 * eps, f64::MIN_POSITIVE), Options { max_steps: 1, ..Options::fixed(1e-300) }] {
+    for opts in [
+        Options::tol(100.0 * eps, f64::MIN_POSITIVE),
+        Options::tol(1.0, 1e-10),
+        Options { max_steps: 1, ..Options::fixed(1e-300) },
+    ] {
         assert!(opts.validate(Method::Dopri5).is_ok(), "{opts:?}");
     }
 }

@@ -353,9 +353,12 @@ impl<E: fmt::Debug> fmt::Display for StepError<E> {
             StepError::Rhs { t, error } => {
                 write!(f, "right-hand side failed at t = {} s even for the smallest step: {error:?}", Time(*t))
             }
-            StepError::NonFinite { t } => {
-                write!(f, "NaN or infinity in the solution near t = {} s", Time(*t))
-            }
+            StepError::NonFinite { t } => write!(
+                f,
+                "NaN or infinity in the solution near t = {} s: the rates or efforts overflow there; \
+                 try smaller start rates (qd0), efforts or motion speeds, or tighter rtol/atol",
+                Time(*t)
+            ),
             StepError::TooManySteps { t, steps } => write!(
                 f,
                 "{steps} steps used before t_stop (stopped at t = {} s): raise max_steps, \
