@@ -14,13 +14,13 @@ The limits hold between the grid points too, not only at them: each stage's line
 takes the limits at both ends of its interval (toppra's interpolation scheme), and the timing
 is then checked at ten times the grid's density and at the path's knots
 (planardyn.plan.dense_check); an interval where a limit is still exceeded gets the limit at
-its worst point as one more row, and toppra is solved again, until no limit is exceeded by more than :data:`RATIO_TOL` of itself. A
-timing that keeps every limit everywhere is a feasible timing of the path, so the duration is
-never shorter than the optimum. It is longer by O(grid spacing) (first order: a constant s''
-per interval must meet the limits at the interval's worst point, where the optimum's s''
-varies across it); with ``rtol`` the grid is doubled until the duration changes by less
-than rtol of itself, and that change, the first-order estimate of the remaining excess, is
-reported (``TimedPath.time_error``).
+its worst point as one more row, and toppra is solved again, until no limit is exceeded by
+more than :data:`RATIO_TOL` of itself. A timing that keeps every limit everywhere is a
+feasible timing of the path, so the duration is never shorter than the optimum. It is longer
+by O(grid spacing) (first order: a constant s'' per interval must meet the limits at the
+interval's worst point, where the optimum's s'' varies across it); with ``rtol`` the grid is
+doubled until the duration changes by less than rtol of itself, and that change, the
+first-order estimate of the remaining excess, is reported (``TimedPath.time_error``).
 
 The model planned is the user's with its drive laws replaced by the planned efforts: its
 drives and its drives' servos are left out (``TimedPath.ignored`` lists them), a damper that
