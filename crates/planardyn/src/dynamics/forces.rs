@@ -3,7 +3,7 @@
 //! dampers: each kind's own, `model::loads`), and the drive efforts mapped through the
 //! coordinates' gradients (f += D_x^T tau, the virtual work of tau on q).
 
-use crate::model::loads::{self, Trig};
+use crate::model::loads;
 use crate::model::pairs::add_effort;
 use crate::model::Mechanism;
 
@@ -36,19 +36,13 @@ impl Drives for ModelDrives<'_> {
 /// Fill `f` (3n) with every applied force at (x, xd) and drive efforts `tau`. Returns the power of the non-conservative forces (drives, dampers, point
 /// forces and torques) in W; gravity and spring stiffness are counted in the potential.
 pub fn applied_forces(mech: &Mechanism, x: &[f64], xd: &[f64], tau: &[f64], f: &mut [f64]) -> f64 {
-    applied_forces_at(mech, x, None, xd, tau, f)
-}
-
-/// [`applied_forces`] with every body's [cos, sin] of its angle in x where the caller holds
-/// them (`trig`, as the closed forms place x): the point loads then take no sin_cos.
-pub fn applied_forces_at(mech: &Mechanism, x: &[f64], trig: Trig<'_>, xd: &[f64], tau: &[f64], f: &mut [f64]) -> f64 {
     let g = mech.gravity;
     for (f, body) in f.chunks_exact_mut(3).zip(&mech.bodies) {
         f.copy_from_slice(&[body.mass * g[0], body.mass * g[1], 0.0]);
     }
     let mut power = 0.0;
     for load in &mech.loads {
-        power += loads::add_force(load, mech, x, trig, xd, f);
+        power += loads::add_force(load, mech, x, xd, f);
     }
     for (c, &t) in mech.coordinates.iter().zip(tau) {
         if t == 0.0 {

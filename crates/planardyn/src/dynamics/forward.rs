@@ -3,7 +3,7 @@
 //!   b = U^T (f - M c) -> zdd = A^-1 b -> xdd = U zdd + c, qdd
 //! as a list of the stages of `dynamics::stages`.
 
-use super::forces::{applied_forces_at, Drives};
+use super::forces::{applied_forces, Drives};
 use super::losses::forward_with_losses;
 use super::stages::{
     accelerations, apply_pair_efforts, drive_efforts, factor_mass_matrix, fixed_dynamics, kinematic_stages,
@@ -26,23 +26,15 @@ pub fn forward(
     ws: &mut Workspace,
 ) -> Result<(), Error> {
     kinematic_stages(mech, z, zd, ws)?;
-    dynamic_stages(mech, t, drives, ws, false)
+    dynamic_stages(mech, t, drives, ws)
 }
 
 /// The stages of [`forward`] after the kinematic ones (whose results `ws` holds): forces,
-/// A, b, zdd, xdd and the user's accelerations. `placed`: the closed forms placed x, so that
-/// `ws.frame.trig` is its bodies' [cos, sin] (Newton's last update leaves them a step behind).
-pub fn dynamic_stages(
-    mech: &Mechanism,
-    t: f64,
-    drives: &mut dyn Drives,
-    ws: &mut Workspace,
-    placed: bool,
-) -> Result<(), Error> {
+/// A, b, zdd, xdd and the user's accelerations.
+pub fn dynamic_stages(mech: &Mechanism, t: f64, drives: &mut dyn Drives, ws: &mut Workspace) -> Result<(), Error> {
     drive_efforts(t, drives, ws)?;
     ws.losses.take_motor_torques(&mut ws.tau, &ws.pair_tau);
-    let trig = placed.then_some(&ws.frame.trig[..]);
-    ws.power = applied_forces_at(mech, &ws.frame.x, trig, &ws.frame.xd, &ws.tau, &mut ws.f);
+    ws.power = applied_forces(mech, &ws.frame.x, &ws.frame.xd, &ws.tau, &mut ws.f);
     ws.power += apply_pair_efforts(mech, ws);
     if !mech.has_losses() {
         match ws.b.len() {

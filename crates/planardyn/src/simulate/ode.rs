@@ -546,7 +546,7 @@ impl<'a> MechanismOde<'a> {
                 if reactions {
                     let _singular = ws.frame.sys.factor(self.mech, &ws.frame.chart, &ws.frame.x, &ws.frame.trig);
                 }
-                dynamic_stages(self.mech, t, self.drives, ws, true)
+                dynamic_stages(self.mech, t, self.drives, ws)
             }),
             (_, None) => forward(self.mech, t, z, zd, self.drives, &mut self.ws),
             (_, Some(motion)) => forward_prescribed(self.mech, t, z, zd, self.drives, motion, &mut self.ws),

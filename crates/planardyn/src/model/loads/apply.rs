@@ -5,9 +5,8 @@
 //! the pair efforts too (`dynamics::forces`).
 
 use crate::linalg::Dense;
-use crate::model::pairs::frames::{angle, link_state, link_state_t, perp, rotate};
+use crate::model::pairs::frames::{angle, link_state, perp, rotate};
 use crate::model::pairs::{coordinate_gamma, coordinate_grad, coordinate_pattern};
-use super::Trig;
 use crate::model::{Attachment, Link, Mechanism};
 
 #[inline]
@@ -23,9 +22,8 @@ fn angle_rate(link: Link, v: &[f64]) -> f64 {
     }
 }
 
-/// A point of a link at (x, xd), with the link's [cos, sin] given or one sin_cos of its angle:
-/// its position, R s (from the centre) and velocity, and the link's first column in x (None
-/// for the ground).
+/// A point of a link at (x, xd), with one sin_cos of its angle: its position, R s (from the
+/// centre) and velocity, and the link's first column in x (None for the ground).
 pub(super) struct Point {
     pub p: [f64; 2],
     arm: [f64; 2],
@@ -34,12 +32,8 @@ pub(super) struct Point {
 }
 
 impl Point {
-    /// `trig`: every body's [cos, sin] of its angle in x, where known (`Trig`).
-    pub fn at(at: &Attachment, x: &[f64], trig: Trig<'_>, xd: &[f64]) -> Self {
-        let l = match trig {
-            Some(trig) => link_state_t(at.link, x, trig),
-            None => link_state(at.link, x),
-        };
+    pub fn at(at: &Attachment, x: &[f64], xd: &[f64]) -> Self {
+        let l = link_state(at.link, x);
         let arm = l.rot(at.s);
         let (rd, w) = l.col.map_or(([0.0; 2], 0.0), |c| ([xd[c], xd[c + 1]], xd[c + 2]));
         let t = perp(arm);

@@ -2,7 +2,7 @@
 //! power is F . v of the point; it stores no energy.
 
 use super::apply::{add_point_force_rate, point_velocity_rate, Point};
-use super::{mobile_body, Load, LoadSpecType, LoadType, Trig};
+use super::{mobile_body, Load, LoadSpecType, LoadType};
 use crate::model::checks::{body_point, Ctx, R};
 use crate::model::{Attachment, Mechanism};
 use crate::units;
@@ -40,8 +40,8 @@ impl LoadSpecType for ForceSpec {
 
 impl LoadType for Force {
     #[inline]
-    fn add_force(&self, _mech: &Mechanism, x: &[f64], trig: Trig<'_>, xd: &[f64], f: &mut [f64]) -> f64 {
-        Point::at(&self.at, x, trig, xd).add_force(self.value, f)
+    fn add_force(&self, _mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
+        Point::at(&self.at, x, xd).add_force(self.value, f)
     }
 
     fn add_force_dx(&self, _: &Mechanism, x: &[f64], _xd: &[f64], t: &[f64], df: &mut [f64], _: &mut [f64]) {

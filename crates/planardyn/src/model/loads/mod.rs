@@ -60,15 +60,11 @@ pub(crate) trait LoadSpecType {
     }
 }
 
-/// Every body's [cos, sin] of its angle in x where the caller holds them (the closed forms'
-/// placement writes them with x, to round-off of the angle's sin_cos); None: from the angles.
-pub type Trig<'a> = Option<&'a [[f64; 2]]>;
-
 /// What a load does at body coordinates x (3n) and body rates xd (3n).
 pub trait LoadType {
     /// Add its forces and moments at the centres of mass into `f` (3n); return its power (W)
     /// but for the part counted in the potential energy (a spring's stiffness).
-    fn add_force(&self, mech: &Mechanism, x: &[f64], trig: Trig<'_>, xd: &[f64], f: &mut [f64]) -> f64;
+    fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64;
     /// Add d/dx . t of its forces at fixed xd into `df` (3n); `scratch` (3n) is free to use.
     fn add_force_dx(&self, mech: &Mechanism, x: &[f64], xd: &[f64], t: &[f64], df: &mut [f64], scratch: &mut [f64]);
     /// d/dx . t at fixed xd of the power `add_force` returns.
@@ -104,8 +100,8 @@ macro_rules! dispatch_spec {
 
 /// Add a load's forces into `f` (3n) at (x, xd); returns its power (W), see [`LoadType::add_force`].
 #[inline]
-pub fn add_force(load: &Load, mech: &Mechanism, x: &[f64], trig: Trig<'_>, xd: &[f64], f: &mut [f64]) -> f64 {
-    dispatch!(load, t => t.add_force(mech, x, trig, xd, f))
+pub fn add_force(load: &Load, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
+    dispatch!(load, t => t.add_force(mech, x, xd, f))
 }
 
 /// Add d/dx . t of a load's forces into `df` (3n); `scratch` has length 3n.

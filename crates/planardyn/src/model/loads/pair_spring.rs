@@ -5,7 +5,7 @@
 //! part is one with k = 0 (`friction`).
 
 use super::apply::pair_effort_rate;
-use super::{Load, LoadSpecType, LoadType, Trig};
+use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{relative_pair, Ctx, R};
 use crate::model::pairs::{
     add_effort, coordinate, coordinate_gamma, coordinate_rate, linear_coordinate, LinearCoordinate,
@@ -58,7 +58,7 @@ impl LoadSpecType for TorsionalSpringSpec {
 
 impl LoadType for PairSpring {
     #[inline]
-    fn add_force(&self, mech: &Mechanism, x: &[f64], _trig: Trig<'_>, xd: &[f64], f: &mut [f64]) -> f64 {
+    fn add_force(&self, mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
         let effort = |value, rate| -self.stiffness * (value - self.rest) - self.damping * rate;
         let (_, rate) = add_effort(self.linear.as_ref(), &mech.pairs, self.pair, x, xd, f, effort);
         -(self.damping * rate * rate)

@@ -4,7 +4,7 @@
 //! is -c (dL/dt)^2.
 
 use super::apply::{add_point_force_rate, point_velocity_rate, Point};
-use super::{Load, LoadSpecType, LoadType, Trig};
+use super::{Load, LoadSpecType, LoadType};
 use crate::model::checks::{body_point, Ctx, R};
 use crate::model::pairs::frames::{point_velocity, world_point};
 use crate::model::{Attachment, Mechanism};
@@ -97,8 +97,8 @@ impl Spring {
 
 impl LoadType for Spring {
     #[inline]
-    fn add_force(&self, _mech: &Mechanism, x: &[f64], trig: Trig<'_>, xd: &[f64], f: &mut [f64]) -> f64 {
-        let (p0, p1) = (Point::at(&self.ends[0], x, trig, xd), Point::at(&self.ends[1], x, trig, xd));
+    fn add_force(&self, _mech: &Mechanism, x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
+        let (p0, p1) = (Point::at(&self.ends[0], x, xd), Point::at(&self.ends[1], x, xd));
         let d = [p1.p[0] - p0.p[0], p1.p[1] - p0.p[1]];
         let len = length(d);
         if len == 0.0 {

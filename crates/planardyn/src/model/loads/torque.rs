@@ -1,7 +1,7 @@
 //! A constant torque on a body: `type: torque`, value (N m). Its power is the torque times
 //! the body's angular rate; it stores no energy and does not depend on x.
 
-use super::{mobile_body, Load, LoadSpecType, LoadType, Trig};
+use super::{mobile_body, Load, LoadSpecType, LoadType};
 use crate::model::checks::{Ctx, R};
 use crate::model::{BodyId, Mechanism};
 use crate::units;
@@ -33,7 +33,7 @@ impl LoadSpecType for TorqueSpec {
 
 impl LoadType for Torque {
     #[inline]
-    fn add_force(&self, _mech: &Mechanism, _x: &[f64], _trig: Trig<'_>, xd: &[f64], f: &mut [f64]) -> f64 {
+    fn add_force(&self, _mech: &Mechanism, _x: &[f64], xd: &[f64], f: &mut [f64]) -> f64 {
         f[3 * self.body.0 + 2] += self.value;
         self.value * xd[3 * self.body.0 + 2]
     }
