@@ -182,13 +182,14 @@ class Mechanism:
     ) -> NDArray[np.float64]: ...
     def run_motor_torques(
         self,
+        t: ArrayLike,
         q: ArrayLike,
         qd: ArrayLike,
         qdd: ArrayLike,
         tau: ArrayLike,
         x: ArrayLike,
         xd: ArrayLike,
-    ) -> tuple[NDArray[np.float64], list[tuple[int, int, str]]]: ...
+    ) -> tuple[NDArray[np.float64], str | None]: ...
     @property
     def actuator_names(self) -> list[str]: ...
     @property

@@ -8,7 +8,6 @@ an angle, m for a displacement), n mobile bodies, ``x`` the 3n body coordinates
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
 import os
 import warnings
@@ -443,16 +442,18 @@ class Mechanism:
     def _result_motor_torques(self, raw: RawRun) -> tuple[FloatArray | None, str]:
         """A result's ``tau_motor``: :meth:`motor_torques` of its rows (``raw``: t, q, qd, qdd,
         tau, x, xd, each (N, ...)) when the model has an actuator, else None; and what the
-        result's message adds about rows without them ("" when every row has them). The rates
-        xd are the run's state, not checked against qd (``recorded``): near a fold of prescribed
-        coordinates the two agree only within the integrator's error, magnified there. A row
-        whose friction efforts do not settle (or whose gears jam) is NaN, the run kept: a run
-        failing at a fold may not settle again at its last rows (five-bar-robot at rk4 dt 1e-4,
-        4 of its 10318 rows); the others' are each row's own call's, to the bit."""
+        result's message adds about rows without them, the core's note ("" when every row has
+        them). The rates xd are the run's state, not checked against qd (``recorded``): near a
+        fold of prescribed coordinates the two agree only within the integrator's error,
+        magnified there. A row whose friction efforts do not settle (or whose gears jam) is NaN,
+        the run kept: a run failing at a fold may not settle again at its last rows
+        (five-bar-robot at rk4 dt 1e-4, 4 of its 10318 rows); the others' are each row's own
+        call's, to the bit."""
         if not self._run_facts().has_actuators:
             return None, ""
-        t_m, unsolved = self._native.run_motor_torques(raw["q"], raw["qd"], raw["qdd"], raw["tau"], raw["x"], raw["xd"])
-        return np.asarray(t_m, dtype=np.float64), _unsolved_note(raw["t"], unsolved)
+        t_m, note = self._native.run_motor_torques(raw["t"], raw["q"], raw["qd"], raw["qdd"], raw["tau"], raw["x"],
+                                                   raw["xd"])
+        return np.asarray(t_m, dtype=np.float64), "" if note is None else f"; {note}"
 
     actuator_names: _Native[list[str]] = _Native(
         "The actuators: the coordinates, then the redundant actuators on other pairs (docs/actuators.md)."
@@ -927,24 +928,6 @@ def _json_default(value: Any) -> Any:
     if isinstance(value, (tuple, set)):
         return list(value)
     raise TypeError(f"{type(value).__name__} is not a model value (use numbers, strings, lists and dicts)")
-
-
-def _unsolved_note(t: FloatArray, unsolved: list[tuple[int, int, str]]) -> str:
-    """What a result's message adds about its rows without motor torques, from the core's
-    spans (first, stop, why) of them: "; no motor torques at rows 10314-10317 (t = 3.0912-3.0915
-    s): the friction efforts did not settle", spans of one reason together (at most
-    :data:`_NAMED_SPANS` named), "" when every row has them."""
-    notes = []
-    for why, group in itertools.groupby(unsolved, key=lambda span: span[2]):
-        spans = [f"row {a} (t = {t[a]:.10g} s)" if b == a + 1 else f"rows {a}-{b - 1} (t = {t[a]:.10g}-{t[b - 1]:.10g} s)"
-                 for a, b, _ in group]
-        more = f" and {len(spans) - _NAMED_SPANS} more spans of rows" if len(spans) > _NAMED_SPANS else ""
-        notes.append(f"; no motor torques at {', '.join(spans[:_NAMED_SPANS])}{more}: {why}")
-    return "".join(notes)
-
-
-#: The most spans of rows without motor torques a result's message names, for one reason.
-_NAMED_SPANS = 8
 
 
 def from_dict(model: Mapping[str, Any], source: str = "<dict>") -> Mechanism:

@@ -492,23 +492,24 @@ impl PyMechanism {
         rows::motor_torques(py, &self.inner, motion, tau.as_ref(), allow_singular, recorded)
     }
 
-    /// A run's motor torques (N m) along its rows (q, qd, qdd, tau (N, m), x, xd (N, 3n): a
-    /// result's, `recorded` and singular rows allowed, as `motor_torques`), each row's outcome
+    /// A run's motor torques (N m) along its rows (t (N,), q, qd, qdd, tau (N, m), x, xd (N, 3n):
+    /// a result's, `recorded` and singular rows allowed, as `motor_torques`), each row's outcome
     /// kept: NaN on a row whose losses fail (its friction efforts do not settle, its gears
-    /// jam), and those rows as (first, stop, why) spans of consecutive rows failing alike.
-    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    /// jam), and what the run's message says of those rows (the core's note, None without).
+    #[allow(clippy::too_many_arguments)]
     fn run_motor_torques<'py>(
         &self,
         py: Python<'py>,
+        t: ArrayArg<'py>,
         q: ArrayArg<'py>,
         qd: ArrayArg<'py>,
         qdd: ArrayArg<'py>,
         tau: ArrayArg<'py>,
         x: ArrayArg<'py>,
         xd: ArrayArg<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, Vec<(usize, usize, String)>)> {
+    ) -> PyResult<(Bound<'py, PyAny>, Option<String>)> {
         let motion = MotionArgs { q: &q, qd: &qd, qdd: &qdd, x: Some(&x), xd: Some(&xd) };
-        rows::run_motor_torques(py, &self.inner, motion, &tau)
+        rows::run_motor_torques(py, &self.inner, &t, motion, &tau)
     }
 
     /// The regressor form along rows of a motion, on the branch of x (and with the body rates

@@ -4,7 +4,7 @@
 //! (`planardyn::dynamics::along`); the named points' motion. The bodies of `Mechanism`'s
 //! methods of these names: they check the rows' shapes, call the core and shape its result.
 
-use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, Floats, Values};
+use crate::convert::{arr1, arr2, arr3, arr_dyn, rows, vector, Floats, Values};
 use crate::errors::{run, to_pyerr};
 use crate::exceptions::argument_error;
 use planardyn::batch::{
@@ -148,17 +148,18 @@ pub fn motor_torques<'py>(
 }
 
 /// `Mechanism.run_motor_torques` (the method's doc there): a run's rows' motor torques, NaN
-/// on the rows without, and those rows as (first, stop, why) spans.
-#[allow(clippy::type_complexity)]
+/// on the rows without, and the core's note of those rows at their times `t`.
 pub fn run_motor_torques<'py>(
     py: Python<'py>,
     mech: &Mechanism,
+    t: &ArrayArg<'py>,
     motion: MotionArgs<'_, 'py>,
     tau: &ArrayArg<'py>,
-) -> PyResult<(Bound<'py, PyAny>, Vec<(usize, usize, String)>)> {
+) -> PyResult<(Bound<'py, PyAny>, Option<String>)> {
     let (shape, t_m) = motor_torque_query(py, mech, motion, Some(tau), true, true)?;
-    let unsolved = t_m.unsolved.into_iter().map(|u| (u.rows.start, u.rows.end, u.reason())).collect();
-    Ok((arr_dyn(py, &shape, t_m.values)?, unsolved))
+    let t = vector("t", t, shape[..shape.len() - 1].iter().product(), "one time (s) per row")?;
+    let note = t_m.note(&t);
+    Ok((arr_dyn(py, &shape, t_m.values)?, note))
 }
 
 /// The core's motor torques of `motion` ([`motor_torques`]' arguments) and their shape.

@@ -258,6 +258,21 @@ impl MotorTorqueRows {
         }
     }
 
+    /// What a run's message says of its rows without motor torques, `t` the rows' times (s,
+    /// one per row): "no motor torques at rows 10314-10317 (t = 3.0912-3.0915 s): the friction
+    /// efforts did not settle", consecutive spans of one reason together, the reasons' notes
+    /// joined by "; "; `None` when every row has them.
+    pub fn note(&self, t: &[f64]) -> Option<String> {
+        let mut note = String::new();
+        for spans in self.unsolved.chunk_by(|a, b| a.reason() == b.reason()) {
+            if !note.is_empty() {
+                note.push_str("; ");
+            }
+            write_note(&mut note, spans, Some(t)).expect("a String takes any text");
+        }
+        (!note.is_empty()).then_some(note)
+    }
+
     /// Row k failed with `error` for `reason`: its span's, when the row before failed for the
     /// same reason, else a new span.
     fn unsolved_row(&mut self, k: usize, reason: &str, error: KinematicsError) {
@@ -284,11 +299,62 @@ impl UnsolvedRows {
 }
 
 impl std::fmt::Display for UnsolvedRows {
-    /// "rows 10314-10317: the friction efforts did not settle" ("row 7: ...").
+    /// "no motor torques at rows 10314-10317: the friction efforts did not settle" ("... at
+    /// row 7: ..."), a run's note ([`MotorTorqueRows::note`]) of these rows alone, without times.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.rows.len() {
-            1 => write!(f, "row {}: {}", self.rows.start, self.reason()),
-            _ => write!(f, "rows {}-{}: {}", self.rows.start, self.rows.end - 1, self.reason()),
+        write_note(f, std::slice::from_ref(self), None)
+    }
+}
+
+/// The most spans of rows failing for one reason that a run's note names.
+const NAMED_SPANS: usize = 8;
+
+/// The note of `spans`, consecutive and failing for one reason, with the rows' times `t` when
+/// given: "no motor torques at rows 2-3 (t = 0.2-0.3 s), row 5 (t = 0.5 s): why", the first
+/// [`NAMED_SPANS`] named, then "and 3 more spans of rows".
+fn write_note(f: &mut impl std::fmt::Write, spans: &[UnsolvedRows], t: Option<&[f64]>) -> std::fmt::Result {
+    f.write_str("no motor torques at ")?;
+    for (i, span) in spans.iter().take(NAMED_SPANS).enumerate() {
+        let (a, b) = (span.rows.start, span.rows.end - 1);
+        let sep = if i == 0 { "" } else { ", " };
+        match t {
+            None if a == b => write!(f, "{sep}row {a}")?,
+            None => write!(f, "{sep}rows {a}-{b}")?,
+            Some(t) if a == b => write!(f, "{sep}row {a} (t = {} s)", Digits10(t[a]))?,
+            Some(t) => write!(f, "{sep}rows {a}-{b} (t = {}-{} s)", Digits10(t[a]), Digits10(t[b]))?,
+        }
+    }
+    if spans.len() > NAMED_SPANS {
+        write!(f, " and {} more spans of rows", spans.len() - NAMED_SPANS)?;
+    }
+    write!(f, ": {}", spans[0].reason())
+}
+
+/// A time to 10 significant digits, as C's and Python's `%.10g` print it: trailing zeros
+/// dropped, in exponent form ("1.5e-05") below 1e-4 and from 1e10 (the text Python's results
+/// showed before the core wrote it). A run's last steps into a fold are down to 6e-12 s: the
+/// row numbers tell such rows apart, the times say where they are.
+struct Digits10(f64);
+
+impl std::fmt::Display for Digits10 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        const P: i32 = 10;
+        let v = self.0;
+        let e = format!("{v:.*e}", (P - 1) as usize);
+        let Some((mantissa, exp)) = e.split_once('e') else { return write!(f, "{v}") }; // NaN, inf
+        let exp: i32 = exp.parse().expect("Rust's exponent is an integer");
+        let trim = |s: &str| {
+            if s.contains('.') {
+                s.trim_end_matches('0').trim_end_matches('.').to_owned()
+            } else {
+                s.to_owned()
+            }
+        };
+        if (-4..P).contains(&exp) {
+            // The same digits: the exponent is the rounded value's.
+            write!(f, "{}", trim(&format!("{v:.*}", (P - 1 - exp) as usize)))
+        } else {
+            write!(f, "{}e{}{:02}", trim(mantissa), if exp < 0 { '-' } else { '+' }, exp.abs())
         }
     }
 }
@@ -475,4 +541,38 @@ pub fn inverse_many(
     threads: Option<usize>,
 ) -> Result<Vec<Result<Efforts, TaskError>>, Error> {
     map_many(variants, threads, InverseVariant::solve)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Digits10;
+
+    #[test]
+    fn times_print_as_pythons_10g() {
+        // Each value's `'%.10g' % v` in Python 3.11: its rounding at the tenth digit (up and down,
+        // into the next power of ten, a binary tie to even), the forms' bounds, signs and zeros.
+        let cases = [
+            (0.0, "0"),
+            (-0.0, "-0"),
+            (1.0, "1"),
+            (0.1 + 0.2, "0.3"),
+            (1.0295874723456, "1.029587472"),
+            (3.0912345678912, "3.091234568"),
+            (1e-4, "0.0001"),
+            (9.99999999995e-5, "0.0001"),
+            (1.5e-5, "1.5e-05"),
+            (6e-12, "6e-12"),
+            (123456789.987, "123456790"),
+            (1234567890.5, "1234567890"),
+            (9999999999.5, "1e+10"),
+            (1e10, "1e+10"),
+            (12345678912.0, "1.234567891e+10"),
+            (-2.5e-7, "-2.5e-07"),
+            (9.9999999995, "9.999999999"),
+            (0.00012345678915, "0.0001234567891"),
+        ];
+        for (v, want) in cases {
+            assert_eq!(Digits10(v).to_string(), want, "{v:e}");
+        }
+    }
 }

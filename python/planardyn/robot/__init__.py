@@ -17,7 +17,7 @@ from .cli import size_cli
 from .effector import EffectorState, EndEffector
 from .maps import TaskGrid, Workspace, flood, singularity_map, workspace
 from .modes import Mode, assembly_modes, working_modes
-from .motion import TaskMotion, singularity_message, solve_motion
+from .motion import TaskMotion, solve_motion
 from .paths import TaskPath, circle, from_functions, line, point_to_point, table, time_law
 from .plots import plot_capability, plot_modes, plot_motion, plot_singularity_map, plot_sizing, plot_workspace
 from .sampling import SamplingError, SizingError
@@ -35,7 +35,6 @@ __all__ = [
     "envelope",
     "flood",
     "singularity_map",
-    "singularity_message",
     "size",
     "size_cli",
     "with_payload",

@@ -40,13 +40,6 @@ MAX_SAMPLES = 10**7
 # far below the 1e-6 m to which the efforts are required to reproduce the path.
 CHECK_RTOL, CHECK_ATOL = 1e-10, 1e-12
 
-KIND_TEXT = {
-    "I": "type I (serial) singularity: the end effector cannot move in some direction there "
-         "(a leg stretched out or folded back), the input rates would be infinite",
-    "II": "type II (parallel) singularity: the mechanism gains an uncontrolled motion there and "
-          "no drive effort holds it, the efforts would be infinite",
-}
-
 
 @dataclass
 class TaskMotion(Summarized):
@@ -131,20 +124,6 @@ def _sample_times(duration: float, n: int | None, dt: float | None) -> FloatArra
         raise error("dt", f"dt = {step:g} s cuts the {duration:g} s motion into more than {MAX_SAMPLES} samples: "
                           "give a larger dt")
     return np.linspace(0.0, duration, max(int(np.ceil(duration / step)) + 1, 2))
-
-
-def _where(ee: EndEffector, X: FloatArray) -> str:
-    pos = f"({X[0]:.4f}, {X[1]:.4f}) m"
-    return pos if ee.dim == 2 else f"{pos}, psi = {X[2]:.4f} rad"
-
-
-def singularity_message(ee: EndEffector, kind: str, t: float, X: FloatArray, q: FloatArray,
-                        sigma: float, tol: float) -> str:
-    """The message of a refused motion: which kind, where (end effector, inputs) and when."""
-    return (f"the prescribed motion reaches a {KIND_TEXT[kind]}; at t = {t:.4f} s, end effector "
-            f"{ee.point} at {_where(ee, X)}, q = {np.array2string(q, precision=4)}: sigma_{kind} = "
-            f"{sigma:.2e} < {tol:g}. Keep the path away from it (robot.singularity_map shows where "
-            f"they are); the motion up to there is the error's .partial")
 
 
 def solve_motion(
