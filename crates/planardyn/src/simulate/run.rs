@@ -339,7 +339,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn change_points(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop, bool> {
         let falling = self.approach.last().is_some_and(|p| meas.passive < p.passive);
         let over = stepped_over(&self.ode, &self.approach, t, meas.passive);
-        if over.is_none() && meas.passive < CROSS_START && falling && self.watched() && !self.before_crossing_start(t, meas)
+        if over.is_none()
+            && meas.passive < CROSS_START
+            && falling
+            && self.watched()
+            && !self.before_crossing_start(t, meas)
         {
             let work = self.y[self.y.len() - 1];
             return match self.cross_change_point((t, meas.sigma, meas.passive, work)) {
@@ -534,7 +538,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn settle(&mut self) {
         let Heading::Deferred { passive } = self.heading else { return };
         let (ode, prepared) = (&mut self.ode, self.prepared);
-        let ahead = prepared.partition_measure(&mut ode.inputs_sys, ode.mech, &self.heading_x) < CHANGE_POINT_RATIO * passive;
+        let ahead =
+            prepared.partition_measure(&mut ode.inputs_sys, ode.mech, &self.heading_x) < CHANGE_POINT_RATIO * passive;
         self.heading = Heading::Known(ahead);
         if self.on_heading && !ahead {
             (self.grid, self.limit) = (None, None);
