@@ -74,6 +74,34 @@ impl Group {
         }
     }
 
+    /// Take the reference of `from`, the same group in another copy of the closed forms.
+    fn copy_reference(&mut self, from: &Group) {
+        const SAME: &str = "the same group in both copies of the closed forms";
+        match self {
+            Group::Rrr(_, b, _) => {
+                let Group::Rrr(_, f, _) = from else { unreachable!("{SAME}") };
+                *b = *f;
+            }
+            Group::Rrp(_, b, _) => {
+                let Group::Rrp(_, f, _) = from else { unreachable!("{SAME}") };
+                *b = *f;
+            }
+            Group::Affine(_) => {}
+            Group::Rpr(_, b) => {
+                let Group::Rpr(_, f) = from else { unreachable!("{SAME}") };
+                *b = *f;
+            }
+            Group::Extended(d) => {
+                let Group::Extended(f) = from else { unreachable!("{SAME}") };
+                d.copy_reference(f);
+            }
+            Group::Triad(t) => {
+                let Group::Triad(f) = from else { unreachable!("{SAME}") };
+                t.copy_reference(f);
+            }
+        }
+    }
+
     fn keeps_side(&self, x: &[f64]) -> bool {
         match self {
             Group::Rrr(d, b, _) => d.keeps_side(b, x),
@@ -444,6 +472,13 @@ impl ClosedForm {
     pub fn set_reference(&mut self, x: &[f64]) {
         self.cranks.iter_mut().for_each(|c| c.set_reference(x));
         self.groups.iter_mut().for_each(|d| d.set_reference(x));
+    }
+
+    /// Take the assembly branches of `from`, a copy of these closed forms whose reference was
+    /// set last ([`ClosedForm::set_reference`]): the same values, without the sines and cosines.
+    pub fn copy_reference(&mut self, from: &ClosedForm) {
+        self.cranks.iter_mut().zip(&from.cranks).for_each(|(c, f)| c.copy_reference(f));
+        self.groups.iter_mut().zip(&from.groups).for_each(|(d, f)| d.copy_reference(f));
     }
 
     /// Whether every group's side in the body coordinates x (a predicted point) is that of its

@@ -218,9 +218,13 @@ impl<'a> MechanismOde<'a> {
         self.copy_anchor_u();
         let m = self.m();
         self.anchor_z.copy_from_slice(&y[..m]);
-        // The spare evaluates the outputs of the next step, from this point's branches.
-        for c in [self.closed.as_mut(), self.spare.closed.as_mut()].into_iter().flatten() {
+        // The spare evaluates the outputs of the next step, from this point's branches (a copy
+        // of the same closed forms: their references copied, not taken from x again).
+        if let Some(c) = self.closed.as_mut() {
             c.set_reference(&self.ws.x);
+        }
+        if let (Some(spare), Some(c)) = (self.spare.closed.as_mut(), self.closed.as_ref()) {
+            spare.copy_reference(c);
         }
         Ok(())
     }

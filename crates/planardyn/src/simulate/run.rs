@@ -53,6 +53,16 @@ enum Crossed {
     NoPoint,
 }
 
+/// Whether the measure heading to 0 above [`APPROACH_BELOW`] is the passive one
+/// ([`Run::change_point_ahead`]): not asked in this approach, put off with the passive measure
+/// of the point it is asked at, or known.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Heading {
+    Unasked,
+    Deferred { passive: f64 },
+    Known(bool),
+}
+
 /// A run: the mechanism in its chart, the integrator, the trajectory written so far, and what
 /// the stages keep between steps.
 pub struct Run<'a, 's, 'e> {
@@ -70,8 +80,12 @@ pub struct Run<'a, 's, 'e> {
     t_stop: f64,
     grid: Option<Grid>,
     limit: Option<f64>,
-    /// Whether the measure now heading to 0 is the passive one (asked once an approach).
-    heading: Option<bool>,
+    /// Whether the measure now heading to 0 is the passive one (asked once an approach, where
+    /// first needed: [`Heading`]), the point it is asked at (x), and whether `grid` and `limit`
+    /// hold only if it is (set by an aim that put the question off).
+    heading: Heading,
+    heading_x: Vec<f64>,
+    on_heading: bool,
     /// The integrator's options without dense output (for a crossing's integration past its
     /// landing), and the counters of those integrations.
     options: Options,
@@ -132,7 +146,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             t_stop: settings.t_end,
             grid: None,
             limit: None,
-            heading: None,
+            heading: Heading::Unasked,
+            heading_x: Vec::new(),
+            on_heading: false,
             options: Options { dense_output: false, ..settings.options.clone() },
             crossing_stats: Stats::default(),
             y,
@@ -323,8 +339,12 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn change_points(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop, bool> {
         let falling = self.approach.last().is_some_and(|p| meas.passive < p.passive);
         let over = stepped_over(&self.ode, &self.approach, t, meas.passive);
-        let watched = self.heading != Some(false) && self.ode.motion.is_none();
-        if over.is_none() && meas.passive < CROSS_START && falling && watched && !self.before_crossing_start(t, meas) {
+        if over.is_none()
+            && meas.passive < CROSS_START
+            && falling
+            && self.watched()
+            && !self.before_crossing_start(t, meas)
+        {
             let work = self.y[self.y.len() - 1];
             return match self.cross_change_point((t, meas.sigma, meas.passive, work)) {
                 Ok(Crossed::Past) => Continue(true),
@@ -332,7 +352,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
                 Ok(Crossed::Event { t, index }) => Break(Stop::TerminalEvent { index, t }),
                 // A dip, not a change point: on with the step's other stages, unwatched.
                 Ok(Crossed::NoPoint) => {
-                    self.heading = Some(false);
+                    self.heading = Heading::Known(false);
                     Continue(false)
                 }
                 Err(why) => Break(Stop::NoCrossing { t, passive: meas.passive, why }),
@@ -453,9 +473,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn aim(&mut self, t: f64, meas: &Measures) {
         let grid = self.approach.grid(t, meas).filter(|_| self.ode.motion.is_none());
         if grid.is_none() {
-            self.heading = None;
+            self.heading = Heading::Unasked;
         }
-        let ahead = grid.is_some() && self.change_point_ahead(meas);
+        let ahead = if grid.is_some() { self.change_point_ahead(meas) } else { Some(false) };
+        self.on_heading = ahead.is_none();
+        let ahead = ahead != Some(false);
         self.grid = grid.filter(|_| ahead);
         self.limit = self.approach.step_limit(t, meas).filter(|_| ahead).map(|l| l.min(self.settings.t_end));
         if self.limit.is_none() || meas.passive >= APPROACH_BELOW {
@@ -492,15 +514,50 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// least that measure to round-off (it is that measure, from the closed forms or exact, or
     /// an inverse-iteration estimate of it, which bounds it from above, or the larger of it and
     /// another), so the partition's decides alone and the user's chart's SVD is not taken
-    /// again (the 3-RRR benchmark run's 55 k instructions).
-    fn change_point_ahead(&mut self, meas: &Measures) -> bool {
+    /// again (the 3-RRR benchmark run's 55 k instructions). None: not known yet, asked where
+    /// first needed ([`Run::settle`]), which the 3-RRR's dip never is (73 k a run, 99 k more in
+    /// the first: the partition's analysis).
+    fn change_point_ahead(&mut self, meas: &Measures) -> Option<bool> {
         if meas.passive < APPROACH_BELOW {
-            return true;
+            return Some(true);
         }
-        *self.heading.get_or_insert_with(|| {
-            let (ode, prepared) = (&mut self.ode, self.prepared);
-            prepared.partition_measure(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CHANGE_POINT_RATIO * meas.passive
-        })
+        match self.heading {
+            Heading::Known(ahead) => Some(ahead),
+            Heading::Deferred { .. } => None,
+            Heading::Unasked => {
+                self.heading_x.clone_from(&self.ode.ws.x);
+                self.heading = Heading::Deferred { passive: meas.passive };
+                None
+            }
+        }
+    }
+
+    /// Ask the question [`Run::change_point_ahead`] put off, at the point it was put off at
+    /// (the same answer as asked there); without a change point ahead, the grid and the limit
+    /// the last aim set on it are dropped.
+    fn settle(&mut self) {
+        let Heading::Deferred { passive } = self.heading else { return };
+        let (ode, prepared) = (&mut self.ode, self.prepared);
+        let ahead =
+            prepared.partition_measure(&mut ode.inputs_sys, ode.mech, &self.heading_x) < CHANGE_POINT_RATIO * passive;
+        self.heading = Heading::Known(ahead);
+        if self.on_heading && !ahead {
+            (self.grid, self.limit) = (None, None);
+        }
+        self.on_heading = false;
+    }
+
+    /// The crossing's grid of the change point ahead, the heading asked if it was put off.
+    fn settled_grid(&mut self) -> Option<Grid> {
+        self.settle();
+        self.grid
+    }
+
+    /// Whether a change point is watched for: not after a dip of the passive measure, nor
+    /// where the measure heading to 0 is not the passive one, nor in a prescribed motion.
+    fn watched(&mut self) -> bool {
+        self.settle();
+        self.heading != Heading::Known(false) && self.ode.motion.is_none()
     }
 
     /// Whether the step just taken to t, not limited by the approach, went past the start of
@@ -510,7 +567,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// passive measure there; Phi_x's rank along the quintic through its ends).
     fn overshot(&mut self, t: f64) -> bool {
         let unlimited = self.t_stop == self.settings.t_end;
-        if !(unlimited && self.grid.is_some_and(|g| t > g.t_star - g.tau)) {
+        if !(unlimited && self.grid.is_some_and(|g| t > g.t_star - g.tau)) || self.settled_grid().is_none() {
             return false;
         }
         let Some(last) = self.approach.last() else { return false };
@@ -545,7 +602,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let Some(grid) = self.grid else { return Continue(()) };
         let t_prev = self.stepper.t_prev();
         let inside = |s: &f64| *s > t_prev + grid.h / 4.0 && *s < t - grid.h / 4.0;
-        if !grid.nodes().any(|s| inside(&s)) {
+        // Not asked for a crossing that would start after t_end (the 3-RRR's dip at 0.69 s
+        // of 0.8, its point predicted at 0.92 s): its nodes are left to the points kept.
+        let after_end = grid.t_star - grid.tau >= self.settings.t_end;
+        let unasked = matches!(self.heading, Heading::Deferred { .. });
+        if !grid.nodes().any(|s| inside(&s)) || unasked && after_end || self.settled_grid().is_none() {
             return Continue(());
         }
         // The step's end is set aside (`MechanismOde::set_aside`): these evaluations leave it.
@@ -605,7 +666,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return Ok(Crossed::NoPoint);
         };
         self.passed_point(landing.point.clone());
-        (self.t_stop, self.grid, self.heading) = (t_end, None, None);
+        (self.t_stop, self.grid, self.heading) = (t_end, None, Heading::Unasked);
         let inside = |s: f64, end: f64| s < end || s == t_end && end >= t_end;
         if let Some((t_star, index)) = self.observe_gap(&landing.path, t, landing.t.min(t_end))? {
             let rows: Vec<f64> = match self.t_eval {

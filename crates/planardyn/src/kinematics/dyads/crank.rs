@@ -32,6 +32,11 @@ impl Crank {
         self.reference = (phi, [cs, sn]);
     }
 
+    /// Take the reference of `from`, the same crank in another copy of the closed forms.
+    pub fn copy_reference(&mut self, from: &Crank) {
+        self.reference = from.reference;
+    }
+
     /// Pose at coordinates z: x and trig of the body. Its [cos, sin] is the reference's turned
     /// by the turn from it where that is within [`EXACT_TURN`] (the series, to rounding: the
     /// library's sin_cos costs about 120 instructions, most of it its argument's reduction),

@@ -43,6 +43,13 @@ impl ExtendedRrr {
         self.branch = self.rrr.branch(x);
     }
 
+    /// Take the branch and arms of `from`, the same dyad in another copy of the closed forms
+    /// (the arms are the dyad's only state that `set_reference` moves besides the branch).
+    pub fn copy_reference(&mut self, from: &ExtendedRrr) {
+        (self.rrr.arms, self.rrr.arms2, self.rrr.bend) = (from.rrr.arms, from.rrr.arms2, from.rrr.bend);
+        self.branch = from.branch;
+    }
+
     /// [`Rrr::keeps_side`] with the arms of the last positions: a guide off the arm's line
     /// turns the arm in its frame as the input moves, which shifts the guard's threshold by
     /// that turn over one step (nothing when the guide is along the arm, as in the shipped

@@ -343,6 +343,13 @@ impl Triad {
         self.branch = Branch { pose: [x[p], x[p + 1], x[p + 2]], det, side, legs, directions, angles, trig };
     }
 
+    /// Take the branch and arms of `from`, the same triad in another copy of the closed forms:
+    /// what `set_reference` sets, without its sines and cosines.
+    pub fn copy_reference(&mut self, from: &Triad) {
+        (self.arms, self.arms2, self.inv_arm) = (from.arms, from.arms2, from.inv_arm);
+        self.branch = from.branch;
+    }
+
     /// Whether the bodies' angles in x (a Newton predictor's) keep the reference's side of the
     /// triad's singularity; a predictor past it means the motion leaves the branch there,
     /// which Newton from the reference pose would not follow. The fold guard asks it at every
