@@ -103,7 +103,8 @@ pub fn next_chart(ode: &mut MechanismOde, m: &Measures, own: f64) -> Option<Char
         Chart::Inputs if m.sigma < CLOSED_FORM_SIGMA => clear_alt_chart(ode),
         Chart::Inputs => None,
         Chart::Partition(_) | Chart::Pairs(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
-        Chart::Partition(_) | Chart::Pairs(_) if own >= SWITCH_TO_PARTITION => None,
+        Chart::Partition(_) if own >= SWITCH_TO_PARTITION => None,
+        Chart::Pairs(_) if own >= ALT_CLEAR => None,
         Chart::Partition(_) | Chart::Pairs(_) => {
             let best = other_chart(ode);
             (best != ode.ws.chart).then_some(best)
