@@ -83,7 +83,8 @@ impl AltCharts {
     /// The sets of m revolute pairs other than the user's coordinates' whose chart has closed forms.
     pub fn new(mech: &Mechanism) -> Self {
         let user: Vec<usize> = mech.coordinates.iter().map(|c| c.pair.0).collect();
-        let revolute: Vec<usize> = (0..mech.pairs.len()).filter(|&i| mech.pairs[i].kind == PairKind::Revolute).collect();
+        let revolute: Vec<usize> =
+            (0..mech.pairs.len()).filter(|&i| mech.pairs[i].kind == PairKind::Revolute).collect();
         let candidates = subsets(revolute.len(), mech.dof(), MAX_CANDIDATES)
             .into_iter()
             .map(|s| s.iter().map(|&i| revolute[i]).collect::<Vec<_>>())
@@ -127,6 +128,39 @@ impl AltCharts {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kinematics::constraints::pair_coordinate;
+    use crate::kinematics::{convective, solve_position, velocity_analogues, Frame};
+
+    /// The five-bar's alternative charts are the angles at one ground pivot and its elbow
+    /// (pairs 0 and 1: a crank, a crank on it, an RRR dyad; pairs 3 and 4 the other side's), and
+    /// their closed forms give the Newton path's positions, U and convective term to 1e-12 at a
+    /// point 0.05 rad from the drawing in each angle, with rates (1.3, -0.7) rad/s (the Newton
+    /// path's own tolerance, POSITION_TOL, is 1e-12 scaled; U and c then follow to round-off).
+    #[test]
+    fn five_bar_alternative_charts_are_newtons_to_round_off() {
+        let path = format!("{}/../../examples/models/five-bar-free-fall.yaml", env!("CARGO_MANIFEST_DIR"));
+        let mech = crate::load(&path).unwrap();
+        let alt = AltCharts::new(&mech);
+        let sets: Vec<_> = alt.candidates.iter().map(|c| c.pairs.clone()).collect();
+        assert_eq!(sets, vec![vec![0, 1], vec![3, 4]]);
+        for pairs in sets {
+            let z: Vec<f64> = pairs.iter().map(|&i| pair_coordinate(&mech.pairs[i], &mech.x0) + 0.05).collect();
+            let zd = [1.3, -0.7];
+            let mut newton = Frame::new(&mech);
+            newton.chart = Chart::Pairs(pairs.clone());
+            solve_position(&mech, &z, &mut newton).unwrap();
+            velocity_analogues(&mut newton).unwrap();
+            convective(&mech, &zd, &mut newton);
+            let mut closed = Frame::new(&mech);
+            let mut form = alt.closed_form(&pairs).unwrap().clone();
+            form.kinematic_stages(&z, &zd, &mut closed).unwrap();
+            for (name, a, b) in [("x", &newton.x, &closed.x), ("U", &newton.u, &closed.u), ("c", &newton.c, &closed.c)]
+            {
+                let worst = a.iter().zip(b.iter()).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+                assert!(worst < 1e-12, "pairs {pairs:?}: {name} {worst:e} from Newton's");
+            }
+        }
+    }
 
     #[test]
     fn subsets_are_every_choice_in_order() {

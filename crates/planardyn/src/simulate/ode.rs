@@ -4,19 +4,19 @@
 
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
+use crate::kinematics::alt_charts::AltCharts;
 use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::alt_charts::AltCharts;
 use crate::kinematics::Frame;
 use crate::kinematics::{
     coordinate_rates, coordinates, scaled_distances, sigma_min, sigma_min_with, Chart, ClosedForm, System,
     MAX_CORRECTION,
 };
-use std::sync::{Arc, OnceLock};
 use crate::linalg::copy_small;
 use crate::model::Mechanism;
 use crate::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
+use std::sync::{Arc, OnceLock};
 
 /// Largest Newton correction as a fraction of the chart's type II measure (see
 /// `MechanismOde::limit_correction`); both in each group's own length (`group_sigma`).

@@ -46,8 +46,15 @@ pub fn start<'a>(
     }
     ws.q.copy_from_slice(&q0);
     ws.qd.copy_from_slice(&qd0);
-    let mut ode = MechanismOde::from_parts(mech, ws, drives, prepared.closed_form(), prepared.inputs_system(), prepared.alt_charts())
-        .with_motion(motion);
+    let mut ode = MechanismOde::from_parts(
+        mech,
+        ws,
+        drives,
+        prepared.closed_form(),
+        prepared.inputs_system(),
+        prepared.alt_charts(),
+    )
+    .with_motion(motion);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
         return Err(
