@@ -26,7 +26,7 @@
 
 use crate::kinematics::alt_charts::AltCharts;
 use crate::kinematics::{
-    partition_sigma_min_with, passive_sigma_min_with, select_partition, sigma_min_with, Chart, ClosedForm, System,
+    partition_sigma_min_with, passive_sigma_min_with, ClosedForm, System,
 };
 use crate::model::Mechanism;
 use crate::{Error, Workspace};
