@@ -185,8 +185,10 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return self.retake();
         }
         self.y.copy_from_slice(self.stepper.y());
-        if self.ode.ws.chart != Chart::Inputs {
-            self.traj.stats.partition_steps += 1;
+        match self.ode.ws.chart {
+            Chart::Inputs => {}
+            Chart::Partition(_) => self.traj.stats.partition_steps += 1,
+            Chart::Pairs(_) => self.traj.stats.alt_steps += 1,
         }
         // The step's end as the stepper evaluated it, kept from its outputs until `accept`.
         self.ode.set_aside();
@@ -417,7 +419,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn chart(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
         let m = self.ode.m();
         let mut own = chart_sigma(&mut self.ode, meas.sigma);
-        if let Some(chart) = next_chart(&self.ode, meas, own) {
+        if let Some(chart) = next_chart(&mut self.ode, meas, own) {
             state_in(&self.ode, &chart, self.y[2 * m], &mut self.y);
             self.traj.stats.chart_switches += 1;
             let switched = self.ode.set_chart(chart, t, &self.y).map_err(|e| e.to_string());
