@@ -88,6 +88,8 @@ pub struct Run<'a, 's, 'e> {
     last_own: Option<f64>,
     /// The user's chart's time and type II measure at the last accepted point, if in that chart.
     last_user: Option<(f64, f64)>,
+    /// Steps accepted since the last chart switch.
+    chart_steps: usize,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
     fold: FoldWatch,
 }
@@ -143,6 +145,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             keep_dense,
             last_own: None,
             last_user: None,
+            chart_steps: 0,
             fold: FoldWatch::default(),
         };
         // The start counts in the least measures, so that a run of no step reports its start's.
@@ -185,6 +188,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return self.retake();
         }
         self.y.copy_from_slice(self.stepper.y());
+        self.chart_steps += 1;
         match self.ode.ws.chart {
             Chart::Inputs => {}
             Chart::Partition(_) => self.traj.stats.partition_steps += 1,
@@ -430,6 +434,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             }
             own = chart_sigma(&mut self.ode, meas.sigma);
             self.stepper.bound_first_step(first_step_bound(&self.ode, own));
+            self.chart_steps = 0;
         }
         self.ode.limit_correction(own);
         // In the user's chart the passive measure is only bounded by sigma_II (it is
@@ -482,6 +487,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.bound_next_step(fall_step_bound(last, (t, own)));
         }
         self.last_user = user.then_some((t, own));
+        // The controller's proposal after a switch's first step, which `first_step_bound` kept
+        // short, is long: in an alternative chart it is bounded as that first step was.
+        if self.chart_steps == 1 && matches!(self.ode.ws.chart, Chart::Pairs(_)) {
+            self.stepper.bound_next_step(first_step_bound(&self.ode, own));
+        }
         self.t_stop = self.settings.t_end;
     }
 
