@@ -139,8 +139,8 @@ pub struct MechanismOde<'a> {
     closed: Option<ClosedForm>,
     base_closed: bool,
     stale_j: bool,
-    /// The user's chart's closed forms (`closed` holds the current chart's: the user's, or an
-    /// alternative chart's), and the alternative charts, analysed by the first run that asks
+    /// The user's chart's closed forms while `closed` holds an alternative chart's (moved, not
+    /// copied, at a switch), and the alternative charts, analysed by the first run that asks
     /// (shared with its `Prepared`) and copied into this one then.
     user_closed: Option<ClosedForm>,
     alt_shared: Arc<OnceLock<AltCharts>>,
@@ -199,7 +199,7 @@ impl<'a> MechanismOde<'a> {
             max_approach: f64::INFINITY,
             failed_evaluations: 0,
             inputs_sys,
-            user_closed: closed.clone(),
+            user_closed: None,
             alt_shared,
             alt: None,
             user_frame: None,
@@ -404,10 +404,14 @@ impl<'a> MechanismOde<'a> {
     /// Change to `chart`, in which the point held by `ws` has state `y`; then evaluates
     /// there and anchors the predictor to it.
     pub fn set_chart(&mut self, chart: Chart, t: f64, y: &[f64]) -> Result<(), Error> {
-        self.closed = match &chart {
-            Chart::Pairs(idx) => self.alt.as_ref().and_then(|a| a.closed_form(idx)).cloned(),
-            _ => self.user_closed.clone(),
-        };
+        let user = if matches!(self.ws.chart, Chart::Pairs(_)) { self.user_closed.take() } else { self.closed.take() };
+        match &chart {
+            Chart::Pairs(idx) => {
+                self.closed = self.alt.as_ref().and_then(|a| a.closed_form(idx)).cloned();
+                self.user_closed = user;
+            }
+            Chart::Inputs | Chart::Partition(_) => self.closed = user,
+        }
         self.ws.chart = chart;
         // The first point of a chart takes the Newton path, which analyses the chart's
         // structure (the supports of U that the closed forms' dynamic stages use).
