@@ -25,9 +25,7 @@
 //! of one analysis have the same supports.
 
 use crate::kinematics::alt_charts::AltCharts;
-use crate::kinematics::{
-    partition_sigma_min_with, passive_sigma_min_with, ClosedForm, System,
-};
+use crate::kinematics::{partition_sigma_min_with, passive_sigma_min_with, ClosedForm, System};
 use crate::model::Mechanism;
 use crate::{Error, Workspace};
 use std::sync::{Arc, OnceLock};
