@@ -195,7 +195,8 @@ class SimulationResult:
     #: run's last row is its last accepted state, on the output grid or not.
     status: str
     message: str
-    #: Counters: nfev, naccept, nreject, njev, nlu, chart_switches, partition_steps,
+    #: Counters: nfev, naccept, nreject, njev, nlu, chart_switches, partition_steps, alt_steps
+    #: (steps in another set of joint angles near a type II singularity), failed_evaluations,
     #: max_residual, min_sigma, min_passive_sigma, energy_drift (J).
     stats: dict[str, Any] = field(default_factory=dict)
     coordinate_names: list[str] = field(default_factory=list)

@@ -167,6 +167,7 @@ fn stats<'py>(py: Python<'py>, t: &Trajectory) -> PyResult<Bound<'py, PyDict>> {
     stats.set_item("nlu", st.integrator.nlu)?;
     stats.set_item("chart_switches", st.chart_switches)?;
     stats.set_item("partition_steps", st.partition_steps)?;
+    stats.set_item("alt_steps", st.alt_steps)?;
     stats.set_item("max_residual", st.max_residual)?;
     // A run that failed before measuring anything has no least measure: None, not inf.
     stats.set_item("min_sigma", Some(st.min_sigma).filter(|s| s.is_finite()))?;

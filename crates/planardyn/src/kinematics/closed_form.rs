@@ -23,6 +23,7 @@ use super::dyads::extension::{Arm, Extension};
 use super::dyads::local::Local;
 use super::dyads::one_link::one_link;
 use super::dyads::prp::prp;
+use super::dyads::relative_crank::RelativeCrank;
 use super::dyads::rpr::{self, Rpr};
 use super::dyads::rrp::{self, Rrp};
 use super::dyads::rrr::{self, Rrr};
@@ -203,6 +204,8 @@ const REACH_FROM_M: usize = 4;
 #[derive(Debug, Clone)]
 pub struct ClosedForm {
     cranks: Vec<Crank>,
+    /// Bodies turned by relative revolute inputs, each after the link it turns on.
+    relative: Vec<RelativeCrank>,
     sliders: Vec<Slider>,
     groups: Vec<Group>,
     /// Per dyad 1 / L_k (its group's length, `group_sigma`), and the smallest input link
@@ -329,6 +332,44 @@ fn triad(mech: &Mechanism, g: &AssurGroup) -> Option<Triad> {
     Some(Triad::new(bodies, outer, s, extended, mech.scale))
 }
 
+/// The relative revolute inputs `pending` (indices of coordinates) as cranks on links placed
+/// before them: the cranks' bodies, then each other's, in an order where each one's pivot link
+/// is placed; None if some input turns a body on a link no input places.
+fn relative_cranks(mech: &Mechanism, cranks: &[Crank], mut pending: Vec<usize>) -> Option<Vec<RelativeCrank>> {
+    let mut placed: Vec<usize> = cranks.iter().map(|c| c.body).collect();
+    let mut relative = Vec::new();
+    while !pending.is_empty() {
+        let before = pending.len();
+        pending.retain(|&k| {
+            let c = &mech.coordinates[k];
+            let p = &mech.pairs[c.pair.0];
+            let (Link::Body(a), Link::Body(b)) = (p.a, p.b) else { return true };
+            let (body, sign) = match (placed.contains(&a.0), placed.contains(&b.0)) {
+                (true, false) => (b.0, 1.0),
+                (false, true) => (a.0, -1.0),
+                _ => return true,
+            };
+            let (s, pivot) = ends(mech, c.pair, body);
+            relative.push(RelativeCrank {
+                body,
+                pivot,
+                s,
+                k,
+                sign,
+                offset: p.rel_angle0 - c.value,
+                rs: [0.0; 2],
+                pivot_rs: [0.0; 2],
+            });
+            placed.push(body);
+            false
+        });
+        if pending.len() == before {
+            return None;
+        }
+    }
+    Some(relative)
+}
+
 impl ClosedForm {
     /// The closed forms of `mech`'s groups, if every group has one (see the module's doc); the
     /// branches are those of the drawing until [`ClosedForm::set_reference`].
@@ -338,7 +379,7 @@ impl ClosedForm {
             return None;
         }
         let revolute = |k: PairId| mech.pairs[k.0].kind == PairKind::Revolute;
-        let (mut cranks, mut sliders) = (Vec::new(), Vec::new());
+        let (mut cranks, mut sliders, mut pending) = (Vec::new(), Vec::new(), Vec::new());
         let mut inputs_sigma = f64::INFINITY;
         for (k, c) in mech.coordinates.iter().enumerate() {
             let p = &mech.pairs[c.pair.0];
@@ -346,6 +387,11 @@ impl ClosedForm {
                 (Link::Ground, Link::Body(b)) | (Link::Body(b), Link::Ground) => b.0,
                 // A relative prismatic input: its group solves it (`Extension`).
                 (Link::Body(_), Link::Body(_)) if matches!(p.kind, PairKind::Prismatic { .. }) => continue,
+                // A relative revolute input: a crank on a link placed before it (below).
+                (Link::Body(_), Link::Body(_)) if p.kind == PairKind::Revolute => {
+                    pending.push(k);
+                    continue;
+                }
                 _ => return None,
             };
             let (s, ground) = ends(mech, c.pair, body);
@@ -377,6 +423,8 @@ impl ClosedForm {
                 reference: (f64::NAN, [0.0; 2]),
             });
         }
+        let relative = relative_cranks(mech, &cranks, pending)?;
+        inputs_sigma = inputs_sigma.min(if relative.is_empty() { f64::INFINITY } else { 1.0 });
         let mut groups = Vec::new();
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
@@ -444,6 +492,7 @@ impl ClosedForm {
             .iter()
             .map(|c| c.body)
             .chain(sliders.iter().map(|s| s.body))
+            .chain(relative.iter().map(|c| c.body))
             .chain(groups.iter().flat_map(|d| d.bodies().iter().copied()))
             .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
@@ -452,13 +501,16 @@ impl ClosedForm {
         cranks.iter_mut().for_each(|c| c.set_reference(&mech.x0));
         groups.iter_mut().for_each(|d| d.set_reference(&mech.x0));
         let inv_length = groups.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
+        if mech.dof() > REACH_FROM_M && !relative.is_empty() {
+            return None;
+        }
         let reach = (mech.dof() > REACH_FROM_M).then(|| {
             let (c, s): (Vec<_>, Vec<_>) =
                 (cranks.iter().map(|c| (c.body, c.k)).collect(), sliders.iter().map(|s| (s.body, s.k)).collect());
             ColumnReach::new(mech, &c, &s, &decomposition.groups)
         });
         let explicit = !groups.iter().any(|g| matches!(g, Group::Triad(_)));
-        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma, reach, explicit })
+        Some(ClosedForm { cranks, relative, sliders, groups, inv_length, inputs_sigma, reach, explicit })
     }
 
     /// Whether every group is placed without iteration (no class III triad, whose Newton
@@ -532,6 +584,9 @@ impl ClosedForm {
         for s in &self.sliders {
             s.position(z, x, trig);
         }
+        for c in &mut self.relative {
+            c.position(z, x, trig);
+        }
         for d in &mut self.groups {
             d.position(z, start, x, trig)?;
         }
@@ -547,6 +602,9 @@ impl ClosedForm {
         }
         for s in &self.sliders {
             s.velocity(zd, v);
+        }
+        for c in &self.relative {
+            c.velocity(zd, v);
         }
         for d in &self.groups {
             d.velocity(zd, v);
@@ -617,6 +675,9 @@ impl ClosedForm {
         for s in &self.sliders {
             s.acceleration(a);
         }
+        for c in &self.relative {
+            c.acceleration(v, a);
+        }
         for d in &self.groups {
             d.acceleration(v, a);
         }
@@ -639,6 +700,9 @@ impl ClosedForm {
         }
         for s in &self.sliders {
             p.piece(&[s.body], |zd, v| s.velocity(zd, v), |_, a| s.acceleration(a));
+        }
+        for c in &self.relative {
+            p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
         }
         for d in &self.groups {
             d.pass(&mut p);

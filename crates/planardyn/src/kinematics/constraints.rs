@@ -15,7 +15,7 @@ pub use crate::model::pairs::{
     coordinate as pair_coordinate, coordinate_gamma as pair_coordinate_gamma, coordinate_grad as pair_coordinate_grad,
     coordinate_rate as pair_coordinate_rate,
 };
-use crate::model::{CoordinateKind, Mechanism};
+use crate::model::{CoordinateKind, Mechanism, PairKind};
 use crate::SingularityKind;
 
 /// Which m functions of x are the independent coordinates.
@@ -26,6 +26,10 @@ pub enum Chart {
     /// Components of x (indices into the 3n body coordinates), chosen near a singularity
     /// of the actuated mechanism.
     Partition(Vec<usize>),
+    /// The relative coordinates of m other pairs (indices into `Mechanism::pairs`; their raw
+    /// `pairs::coordinate`, no drawn value added): another set of coordinates of the same
+    /// mechanism, in closed form where the user's is singular (`kinematics::alt_charts`).
+    Pairs(Vec<usize>),
 }
 
 impl Chart {
@@ -35,6 +39,7 @@ impl Chart {
         match self {
             Chart::Inputs => SingularityKind::TypeII,
             Chart::Partition(_) => SingularityKind::Passive,
+            Chart::Pairs(_) => SingularityKind::TypeII,
         }
     }
 }
@@ -46,12 +51,15 @@ impl Clone for Chart {
         match self {
             Chart::Inputs => Chart::Inputs,
             Chart::Partition(idx) => Chart::Partition(idx.clone()),
+            Chart::Pairs(idx) => Chart::Pairs(idx.clone()),
         }
     }
 
     fn clone_from(&mut self, source: &Self) {
         match (self, source) {
-            (Chart::Partition(idx), Chart::Partition(from)) => idx.clone_from(from),
+            (Chart::Partition(idx), Chart::Partition(from)) | (Chart::Pairs(idx), Chart::Pairs(from)) => {
+                idx.clone_from(from)
+            }
             (this, _) => *this = source.clone(),
         }
     }
@@ -103,6 +111,11 @@ pub fn residual(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], z
                 *o = x[i];
             }
         }
+        Chart::Pairs(idx) => {
+            for (o, &i) in out[nc..].iter_mut().zip(idx) {
+                *o = pair_coordinate(&mech.pairs[i], x);
+            }
+        }
     }
     for (o, zk) in out[nc..].iter_mut().zip(z) {
         *o -= zk;
@@ -130,6 +143,11 @@ pub fn jacobian_into<S: Sink>(mech: &Mechanism, chart: &Chart, x: &[f64], trig: 
         Chart::Partition(idx) => {
             for (k, &i) in idx.iter().enumerate() {
                 sink.add(nc + k, i, 1.0);
+            }
+        }
+        Chart::Pairs(idx) => {
+            for (k, &i) in idx.iter().enumerate() {
+                pair_coordinate_grad(&mech.pairs[i], x, sink, nc + k);
             }
         }
     }
@@ -162,6 +180,7 @@ pub fn jacobian_pattern(mech: &Mechanism, chart: &Chart) -> Vec<Vec<usize>> {
         *row = match chart {
             Chart::Inputs => pairs::coordinate_pattern(&mech.pairs[mech.coordinates[k].pair.0]),
             Chart::Partition(idx) => vec![idx[k]],
+            Chart::Pairs(idx) => pairs::coordinate_pattern(&mech.pairs[idx[k]]),
         };
     }
     pattern
@@ -177,6 +196,7 @@ pub fn gamma(mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], u: &
         *o = match chart {
             Chart::Inputs => pair_coordinate_gamma(&mech.pairs[mech.coordinates[k].pair.0], x, u, v),
             Chart::Partition(_) => 0.0,
+            Chart::Pairs(idx) => pair_coordinate_gamma(&mech.pairs[idx[k]], x, u, v),
         };
     }
 }
@@ -200,6 +220,7 @@ pub fn fill_row_scale(mech: &Mechanism, chart: &Chart, inv: f64, rs: &mut [f64])
         let angle = match chart {
             Chart::Inputs => mech.coordinates[k].kind == CoordinateKind::Angle,
             Chart::Partition(idx) => idx[k] % 3 == 2,
+            Chart::Pairs(idx) => mech.pairs[idx[k]].kind == PairKind::Revolute,
         };
         *r = if angle { 1.0 } else { inv };
     }

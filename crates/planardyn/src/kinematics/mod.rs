@@ -2,6 +2,7 @@
 //! the end effector and its inverse kinematics.
 //! One algorithm a file; all of them work on the body coordinates x (3n values).
 
+pub mod alt_charts;
 pub mod analogues;
 pub mod branch_path;
 pub mod closed_form;

@@ -37,6 +37,7 @@ pub fn gamma3(
         *o = match chart {
             Chart::Inputs => pairs::coordinate_gamma3(&mech.pairs[mech.coordinates[k].pair.0], x, u, v, t),
             Chart::Partition(_) => 0.0,
+            Chart::Pairs(idx) => pairs::coordinate_gamma3(&mech.pairs[idx[k]], x, u, v, t),
         };
     }
 }

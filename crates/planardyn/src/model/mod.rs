@@ -264,6 +264,34 @@ impl Mechanism {
             || self.actuators.iter().any(Option::is_some)
             || self.pair_actuators.iter().any(|a| a.drive.is_some())
     }
+    /// The same mechanism with the raw relative coordinates of `pairs` (indices into `pairs`,
+    /// revolute) as its coordinates, value 0 (`pairs::coordinate`), at rest, without drives,
+    /// motions, actuators or friction: the kinematics of another chart of it
+    /// (`kinematics::alt_charts`), not a model to simulate.
+    pub fn with_pair_coordinates(&self, pairs: &[usize]) -> Mechanism {
+        let coordinates = pairs
+            .iter()
+            .map(|&i| Coordinate {
+                name: self.pairs[i].name.clone(),
+                pair: PairId(i),
+                kind: CoordinateKind::Angle,
+                value: 0.0,
+                q0: 0.0,
+                qd0: 0.0,
+                linear: pairs::linear_coordinate(&self.pairs[i]),
+            })
+            .collect();
+        let m = pairs.len();
+        Mechanism {
+            coordinates,
+            drives: vec![None; m],
+            motions: vec![None; m],
+            actuators: vec![None; m],
+            pair_actuators: Vec::new(),
+            friction: Vec::new(),
+            ..self.clone()
+        }
+    }
     /// Number of actuators n_a: the coordinates, then the pair actuators.
     pub fn n_actuators(&self) -> usize {
         self.dof() + self.pair_actuators.len()

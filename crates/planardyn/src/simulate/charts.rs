@@ -2,7 +2,8 @@
 //! mechanism well, m components of x (generalized coordinate partitioning) near a type II
 //! singularity, and back again once past it. Decisions are taken between accepted steps.
 
-use super::ode::MechanismOde;
+use super::ode::{MechanismOde, CLOSED_FORM_SIGMA};
+use crate::kinematics::constraints::{pair_coordinate, pair_coordinate_rate};
 use crate::kinematics::{passive_sigma_min_with, select_partition, sigma_min_with, Chart};
 
 /// Below this scaled type II measure the integrator leaves the user's coordinates. The scaled
@@ -11,6 +12,10 @@ use crate::kinematics::{passive_sigma_min_with, select_partition, sigma_min_with
 pub const SWITCH_TO_PARTITION: f64 = 0.05;
 /// Above this it returns to them (hysteresis, so that it does not switch back and forth).
 pub const SWITCH_TO_INPUTS: f64 = 0.1;
+/// The smallest own measure of an alternative chart (`kinematics::alt_charts`) to take it
+/// instead of a partition: as clear of its singularity as the user's chart must be to return
+/// to it, so that its closed forms are in use (above `CLOSED_FORM_SIGMA`, 0.07).
+pub const ALT_CLEAR: f64 = SWITCH_TO_INPUTS;
 /// Below this scaled measure the passive mechanism is singular: the simulation stops.
 pub const PASSIVE_SINGULAR: f64 = 1e-8;
 /// A failed step this close to a passive singularity is reported as one.
@@ -61,6 +66,7 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
     let sigma = match ode.ws.chart {
         Chart::Inputs => ode.own_sigma(),
         Chart::Partition(_) => sigma_min_with(&mut ode.inputs_sys, ode.mech, &Chart::Inputs, &ode.ws.x),
+        Chart::Pairs(_) => ode.user_sigma(),
     };
     // Passive: the better of the user's chart and the partition in use (its factorisation is
     // in the workspace), else the partition complete pivoting would choose.
@@ -69,6 +75,8 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
     } else {
         let own = match ode.ws.chart {
             Chart::Partition(_) => ode.ws.sys.sigma_min_estimate(),
+            // Where another chart's J is regular, so are the pair constraints.
+            Chart::Pairs(_) => Some(ode.own_sigma()),
             Chart::Inputs => None,
         };
         own.map_or_else(|| passive_sigma_min_with(&mut ode.inputs_sys, ode.mech, &ode.ws.x), |own| own.max(sigma))
@@ -82,25 +90,44 @@ pub fn measure(ode: &mut MechanismOde) -> Measures {
 pub fn chart_sigma(ode: &mut MechanismOde, sigma: f64) -> f64 {
     match &ode.ws.chart {
         Chart::Inputs => sigma,
-        Chart::Partition(_) => ode.own_sigma(),
+        Chart::Partition(_) | Chart::Pairs(_) => ode.own_sigma(),
     }
 }
 
 /// The chart to integrate in next, if it should change, from the measures at the current
-/// point and the current chart's own measure `own` ([`chart_sigma`]): partition when q is
-/// near-singular, back to q when clear of it, and a fresh partition when the current one
-/// degrades.
-pub fn next_chart(ode: &MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
+/// point and the current chart's own measure `own` ([`chart_sigma`]): another chart when q is
+/// near-singular, back to q when clear of it, and a fresh one when the current one degrades.
+pub fn next_chart(ode: &mut MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
     match &ode.ws.chart {
-        Chart::Inputs if m.sigma < SWITCH_TO_PARTITION => Some(Chart::Partition(select_partition(ode.mech, &ode.ws.x))),
+        Chart::Inputs if m.sigma < SWITCH_TO_PARTITION => Some(other_chart(ode)),
+        Chart::Inputs if m.sigma < CLOSED_FORM_SIGMA => clear_alt_chart(ode),
         Chart::Inputs => None,
-        Chart::Partition(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
+        Chart::Partition(_) | Chart::Pairs(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
         Chart::Partition(_) if own >= SWITCH_TO_PARTITION => None,
-        Chart::Partition(idx) => {
-            let best = select_partition(ode.mech, &ode.ws.x);
-            (&best != idx).then_some(Chart::Partition(best))
+        Chart::Pairs(_) if own >= ALT_CLEAR => None,
+        Chart::Partition(_) | Chart::Pairs(_) => {
+            let best = other_chart(ode);
+            (best != ode.ws.chart).then_some(best)
         }
     }
+}
+
+/// The chart to leave the user's for at the point in `ode.ws`: the alternative chart of largest
+/// own measure where that is clear of its singularity ([`ALT_CLEAR`]; none with a prescribed
+/// motion, whose coordinates are the user's), else the partition complete pivoting chooses.
+fn other_chart(ode: &mut MechanismOde) -> Chart {
+    clear_alt_chart(ode).unwrap_or_else(|| Chart::Partition(select_partition(ode.mech, &ode.ws.x)))
+}
+
+/// The alternative chart of largest own measure at the point in `ode.ws` where that is clear
+/// of its singularity ([`ALT_CLEAR`]; none with a prescribed motion). Taken from the user's
+/// chart below `CLOSED_FORM_SIGMA` already, where the user's chart leaves its closed forms for
+/// Newton: the alternative chart's are in use there.
+fn clear_alt_chart(ode: &mut MechanismOde) -> Option<Chart> {
+    if ode.motion.is_some() {
+        return None;
+    }
+    ode.best_alt_chart().filter(|(_, sigma)| *sigma >= ALT_CLEAR).map(|(chart, _)| chart)
 }
 
 /// The longest first step in the chart of the point held by `ode.ws`, whose own measure is
@@ -141,6 +168,13 @@ pub fn state_in(ode: &MechanismOde, chart: &Chart, work: f64, y: &mut [f64]) {
             for (k, &i) in idx.iter().enumerate() {
                 y[k] = ode.ws.x[i];
                 y[m + k] = ode.ws.xd[i];
+            }
+        }
+        Chart::Pairs(idx) => {
+            for (k, &i) in idx.iter().enumerate() {
+                let pair = &ode.mech.pairs[i];
+                y[k] = pair_coordinate(pair, &ode.ws.x);
+                y[m + k] = pair_coordinate_rate(pair, &ode.ws.x, &ode.ws.xd);
             }
         }
     }

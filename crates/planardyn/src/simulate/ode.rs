@@ -4,13 +4,19 @@
 
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
+use crate::kinematics::alt_charts::AltCharts;
 use crate::kinematics::analogues::u_times_from;
 use crate::kinematics::constraints::gamma;
-use crate::kinematics::{scaled_distances, sigma_min, sigma_min_with, Chart, ClosedForm, System, MAX_CORRECTION};
+use crate::kinematics::Frame;
+use crate::kinematics::{
+    coordinate_rates, coordinates, scaled_distances, sigma_min, sigma_min_with, Chart, ClosedForm, System,
+    MAX_CORRECTION,
+};
 use crate::linalg::copy_small;
 use crate::model::Mechanism;
 use crate::Workspace;
 use crate::{Error, KinematicsError, SingularityKind};
+use std::sync::{Arc, OnceLock};
 
 /// Largest Newton correction as a fraction of the chart's type II measure (see
 /// `MechanismOde::limit_correction`); both in each group's own length (`group_sigma`).
@@ -66,7 +72,7 @@ const REACH_STEP_FRACTION: f64 = 0.7;
 /// instructions), its counters unchanged and its drift within 3e-7 of itself; at 0.05, A02's
 /// N = 40 crossings at rtol 1e-12 were 1.05e-8 rad off (0.06: 3.5e-9, 0.07: 2.3e-9, 0.1:
 /// 2.7e-9; tests/change_points.rs bounds 1e-8).
-const CLOSED_FORM_SIGMA: f64 = 0.07;
+pub(super) const CLOSED_FORM_SIGMA: f64 = 0.07;
 
 /// Smallest own measure of the chart at a dense-output stage, as a fraction of the measure at
 /// the step's start. In a chart the equations of motion are ill-conditioned like 1/sigma^2
@@ -133,6 +139,16 @@ pub struct MechanismOde<'a> {
     closed: Option<ClosedForm>,
     base_closed: bool,
     stale_j: bool,
+    /// The user's chart's closed forms while `closed` holds an alternative chart's (moved, not
+    /// copied, at a switch), and the alternative charts, analysed by the first run that asks
+    /// (shared with its `Prepared`) and copied into this one then.
+    user_closed: Option<ClosedForm>,
+    alt_shared: Arc<OnceLock<AltCharts>>,
+    alt: Option<AltCharts>,
+    /// Where the user's closed forms place the point of an alternative chart for its type II
+    /// measure ([`MechanismOde::user_sigma`]): a copy of the workspace's frame, made at the
+    /// first such measure.
+    user_frame: Option<Frame>,
     /// Whether the last accepted point is clear of folds ([`CLOSED_FORM_SIGMA`]).
     clear_of_folds: bool,
     /// The chart's own measure at the last accepted point (`limit_correction`), which the
@@ -146,7 +162,7 @@ pub struct MechanismOde<'a> {
 impl<'a> MechanismOde<'a> {
     /// A system whose workspace `ws` holds a converged, analysed point of chart `ws.chart`.
     pub fn new(mech: &'a Mechanism, ws: Workspace, drives: &'a mut dyn Drives) -> Self {
-        Self::from_parts(mech, ws, drives, ClosedForm::new(mech), System::new(mech))
+        Self::from_parts(mech, ws, drives, ClosedForm::new(mech), System::new(mech), Default::default())
     }
 
     /// As [`MechanismOde::new`], given what it derives from the model alone: `closed`, the
@@ -158,6 +174,7 @@ impl<'a> MechanismOde<'a> {
         drives: &'a mut dyn Drives,
         mut closed: Option<ClosedForm>,
         inputs_sys: System,
+        alt_shared: Arc<OnceLock<AltCharts>>,
     ) -> Self {
         let m = mech.dof();
         if let Some(c) = closed.as_mut() {
@@ -182,6 +199,10 @@ impl<'a> MechanismOde<'a> {
             max_approach: f64::INFINITY,
             failed_evaluations: 0,
             inputs_sys,
+            user_closed: None,
+            alt_shared,
+            alt: None,
+            user_frame: None,
             closed,
             base_closed: false,
             stale_j: false,
@@ -316,7 +337,10 @@ impl<'a> MechanismOde<'a> {
     /// Whether evaluations take the closed forms: there are some, in the user's chart, clear
     /// of folds, with no coordinate driven by a prescribed motion.
     fn closed_form_in_use(&self) -> bool {
-        self.closed.is_some() && self.ws.chart == Chart::Inputs && self.clear_of_folds && self.motion.is_none()
+        self.closed.is_some()
+            && !matches!(self.ws.chart, Chart::Partition(_))
+            && self.clear_of_folds
+            && self.motion.is_none()
     }
 
     /// Factorise J at the point in `ws` if a closed-form evaluation left it behind (for the
@@ -333,7 +357,8 @@ impl<'a> MechanismOde<'a> {
     /// The type II measure of the point in `ws` from the closed forms, if it was evaluated with
     /// them (J is then not factorised there).
     fn closed_form_sigma(&self) -> Option<f64> {
-        self.closed.as_ref().filter(|_| self.stale_j && self.ws.chart == Chart::Inputs).map(ClosedForm::sigma)
+        let own_chart = !matches!(self.ws.chart, Chart::Partition(_));
+        self.closed.as_ref().filter(|_| self.stale_j && own_chart).map(ClosedForm::sigma)
     }
 
     /// The current chart's own measure at the point in `ws` (in the user's chart its type II
@@ -347,8 +372,31 @@ impl<'a> MechanismOde<'a> {
         });
         estimate.unwrap_or_else(|| match self.ws.chart {
             Chart::Inputs => sigma_min_with(&mut self.inputs_sys, self.mech, &Chart::Inputs, &self.ws.x),
-            Chart::Partition(_) => sigma_min(self.mech, &self.ws.chart, &self.ws.x),
+            Chart::Partition(_) | Chart::Pairs(_) => sigma_min(self.mech, &self.ws.chart, &self.ws.x),
         })
+    }
+
+    /// The alternative chart of largest own measure at the point in `ws`, and that measure
+    /// (`AltCharts::best`); the charts are analysed at the first call of any run of the model.
+    pub fn best_alt_chart(&mut self) -> Option<(Chart, f64)> {
+        let mech = self.mech;
+        let alt = self.alt.get_or_insert_with(|| self.alt_shared.get_or_init(|| AltCharts::new(mech)).clone());
+        alt.best(mech, &self.ws.x)
+    }
+
+    /// The user's chart's type II measure at the point in `ws` (held in another chart): from its
+    /// closed forms, which place the point at its q on its own branches (the same blocks'
+    /// smallest singular values as the exact measure's SVDs, to round-off, at a few hundred
+    /// instructions for an SVD's tens of thousands), else exact.
+    pub fn user_sigma(&mut self) -> f64 {
+        if let Some(c) = self.user_closed.as_mut() {
+            let frame = self.user_frame.get_or_insert_with(|| self.ws.frame.clone());
+            c.set_reference(&self.ws.x);
+            if c.positions(&self.ws.q, frame).is_ok() {
+                return c.sigma();
+            }
+        }
+        sigma_min_with(&mut self.inputs_sys, self.mech, &Chart::Inputs, &self.ws.x)
     }
 
     /// Predict the next evaluation from the last accepted point, not the last evaluation.
@@ -360,6 +408,14 @@ impl<'a> MechanismOde<'a> {
     /// Change to `chart`, in which the point held by `ws` has state `y`; then evaluates
     /// there and anchors the predictor to it.
     pub fn set_chart(&mut self, chart: Chart, t: f64, y: &[f64]) -> Result<(), Error> {
+        let user = if matches!(self.ws.chart, Chart::Pairs(_)) { self.user_closed.take() } else { self.closed.take() };
+        match &chart {
+            Chart::Pairs(idx) => {
+                self.closed = self.alt.as_ref().and_then(|a| a.closed_form(idx)).cloned();
+                self.user_closed = user;
+            }
+            Chart::Inputs | Chart::Partition(_) => self.closed = user,
+        }
         self.ws.chart = chart;
         // The first point of a chart takes the Newton path, which analyses the chart's
         // structure (the supports of U that the closed forms' dynamic stages use).
@@ -547,6 +603,12 @@ impl<'a> MechanismOde<'a> {
         let mut outcome = match (self.closed.as_mut().filter(|_| !newton), self.motion.as_deref_mut()) {
             (Some(c), _) => c.predicted_stages(z, zd, &mut self.ws).map_err(Error::from).and_then(|()| {
                 let ws = &mut self.ws;
+                if matches!(ws.frame.chart, Chart::Pairs(_)) {
+                    // The closed forms give q = z: in another chart, the user's from x.
+                    let f = &mut ws.frame;
+                    coordinates(self.mech, &f.x, &mut f.q);
+                    coordinate_rates(self.mech, &f.x, &f.xd, &mut f.qd);
+                }
                 if reactions {
                     let _singular = ws.frame.sys.factor(self.mech, &ws.frame.chart, &ws.frame.x, &ws.frame.trig);
                 }

@@ -24,10 +24,11 @@
 //! copies share: it only tells whether buffers were zeroed for the same supports, and copies
 //! of one analysis have the same supports.
 
+use crate::kinematics::alt_charts::AltCharts;
 use crate::kinematics::{partition_sigma_min_with, passive_sigma_min_with, ClosedForm, System};
 use crate::model::Mechanism;
 use crate::{Error, Workspace};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// The set-up of every run of one mechanism ([`crate::simulate::simulate_prepared`]).
 #[derive(Debug, Clone)]
@@ -42,12 +43,20 @@ pub struct Prepared {
     /// nothing, and the later runs do not analyse it again (88 k of the 3-RRR benchmark run's
     /// 1.57 M instructions). A run whose partition is another re-analyses it (`System::fill`).
     partition: OnceLock<System>,
+    /// The alternative charts (`kinematics::alt_charts`), analysed by the first run that leaves
+    /// the user's chart and shared with the later ones.
+    alt: Arc<OnceLock<AltCharts>>,
 }
 
 impl Prepared {
     /// The set-up of `mech`'s runs.
     pub fn new(mech: &Mechanism) -> Self {
-        Prepared { workspace: Workspace::new(mech), closed: ClosedForm::new(mech), partition: OnceLock::new() }
+        Prepared {
+            workspace: Workspace::new(mech),
+            closed: ClosedForm::new(mech),
+            partition: OnceLock::new(),
+            alt: Default::default(),
+        }
     }
 
     /// Err unless this was prepared from a mechanism of `mech`'s size and drawing: a run
@@ -106,6 +115,11 @@ impl Prepared {
             let _ = self.partition.set(other.clone());
         }
         value
+    }
+
+    /// The alternative charts, shared by the runs (analysed by the first that needs them).
+    pub fn alt_charts(&self) -> Arc<OnceLock<AltCharts>> {
+        self.alt.clone()
     }
 
     /// A run's closed forms of the user's chart, if every group has one.

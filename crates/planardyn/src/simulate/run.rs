@@ -102,6 +102,8 @@ pub struct Run<'a, 's, 'e> {
     last_own: Option<f64>,
     /// The user's chart's time and type II measure at the last accepted point, if in that chart.
     last_user: Option<(f64, f64)>,
+    /// Steps accepted since the last chart switch.
+    chart_steps: usize,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
     fold: FoldWatch,
 }
@@ -159,6 +161,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             keep_dense,
             last_own: None,
             last_user: None,
+            chart_steps: 0,
             fold: FoldWatch::default(),
         };
         // The start counts in the least measures, so that a run of no step reports its start's.
@@ -201,8 +204,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             return self.retake();
         }
         self.y.copy_from_slice(self.stepper.y());
-        if self.ode.ws.chart != Chart::Inputs {
-            self.traj.stats.partition_steps += 1;
+        self.chart_steps += 1;
+        match self.ode.ws.chart {
+            Chart::Inputs => {}
+            Chart::Partition(_) => self.traj.stats.partition_steps += 1,
+            Chart::Pairs(_) => self.traj.stats.alt_steps += 1,
         }
         // The step's end as the stepper evaluated it, kept from its outputs until `accept`.
         self.ode.set_aside();
@@ -437,7 +443,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn chart(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
         let m = self.ode.m();
         let mut own = chart_sigma(&mut self.ode, meas.sigma);
-        if let Some(chart) = next_chart(&self.ode, meas, own) {
+        if let Some(chart) = next_chart(&mut self.ode, meas, own) {
             state_in(&self.ode, &chart, self.y[2 * m], &mut self.y);
             self.traj.stats.chart_switches += 1;
             let switched = self.ode.set_chart(chart, t, &self.y).map_err(|e| e.to_string());
@@ -448,6 +454,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             }
             own = chart_sigma(&mut self.ode, meas.sigma);
             self.stepper.bound_first_step(first_step_bound(&self.ode, own));
+            self.chart_steps = 0;
         }
         self.ode.limit_correction(own);
         // In the user's chart the passive measure is only bounded by sigma_II (it is
@@ -502,6 +509,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.bound_next_step(fall_step_bound(last, (t, own)));
         }
         self.last_user = user.then_some((t, own));
+        // The controller's proposal after a switch's first step, which `first_step_bound` kept
+        // short, is long: in an alternative chart it is bounded as that first step was.
+        if self.chart_steps == 1 && matches!(self.ode.ws.chart, Chart::Pairs(_)) {
+            self.stepper.bound_next_step(first_step_bound(&self.ode, own));
+        }
         self.t_stop = self.settings.t_end;
     }
 

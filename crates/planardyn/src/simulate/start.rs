@@ -46,15 +46,22 @@ pub fn start<'a>(
     }
     ws.q.copy_from_slice(&q0);
     ws.qd.copy_from_slice(&qd0);
-    let mut ode = MechanismOde::from_parts(mech, ws, drives, prepared.closed_form(), prepared.inputs_system())
-        .with_motion(motion);
+    let mut ode = MechanismOde::from_parts(
+        mech,
+        ws,
+        drives,
+        prepared.closed_form(),
+        prepared.inputs_system(),
+        prepared.alt_charts(),
+    )
+    .with_motion(motion);
     let m0 = measure(&mut ode);
     if m0.passive < PASSIVE_SINGULAR {
         return Err(
             KinematicsError::Singular { kind: SingularityKind::PassiveAtStart, sigma_min: Some(m0.passive) }.into()
         );
     }
-    let chart = next_chart(&ode, &m0, m0.sigma).unwrap_or(Chart::Inputs);
+    let chart = next_chart(&mut ode, &m0, m0.sigma).unwrap_or(Chart::Inputs);
     let m = mech.dof();
     let mut y = vec![0.0; 2 * m + 1];
     state_in(&ode, &chart, 0.0, &mut y);

@@ -66,6 +66,8 @@ pub struct SimStats {
     pub chart_switches: usize,
     /// Steps integrated in a partition chart (near type II singularities).
     pub partition_steps: usize,
+    /// Steps integrated in an alternative chart of pair coordinates (`kinematics::alt_charts`).
+    pub alt_steps: usize,
     /// Right-hand-side evaluations refused (Newton failed or would have changed branch); each
     /// made the integrator retry a shorter step.
     pub failed_evaluations: usize,

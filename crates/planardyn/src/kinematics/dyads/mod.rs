@@ -17,6 +17,7 @@ pub mod extension;
 pub mod local;
 pub mod one_link;
 pub mod prp;
+pub mod relative_crank;
 pub mod rpr;
 pub mod rrp;
 pub mod rrr;

@@ -1,0 +1,170 @@
+//! Alternative charts: other sets of m pair coordinates of the same mechanism whose structure
+//! decomposes into closed-form groups (`closed_form`), to integrate in near a type II
+//! singularity of the user's coordinates instead of a body-coordinate partition. A five-bar's
+//! two crank angles leave the triangle of its distal links, singular where that is flat; the
+//! angles at one ground pivot and its elbow leave the other side's triangle (an RRR dyad on a
+//! crank on a crank), singular elsewhere: some choice is well conditioned where the user's is not.
+//!
+//! Where no candidate applies (no closed form, more pair sets than [`MAX_CANDIDATES`], a
+//! prismatic coordinate), the partition stays the fallback (`simulate::charts`).
+
+use super::closed_form::ClosedForm;
+use super::constraints::Chart;
+use super::singularity::sigma_min_with;
+use super::system::System;
+use crate::model::{Link, Mechanism, PairKind};
+
+/// The most pair sets tried: each costs an Assur decomposition once per prepared model.
+const MAX_CANDIDATES: usize = 64;
+
+/// One alternative chart: its pairs, its closed forms and its J's analysis (for its measure).
+#[derive(Debug, Clone)]
+struct Candidate {
+    pairs: Vec<usize>,
+    closed: ClosedForm,
+    sys: System,
+}
+
+/// The alternative charts of a mechanism, analysed once.
+#[derive(Debug, Clone, Default)]
+pub struct AltCharts {
+    candidates: Vec<Candidate>,
+}
+
+/// Every set of m indices out of 0..n, in lexicographic order (empty past `max` sets).
+fn subsets(n: usize, m: usize, max: usize) -> Vec<Vec<usize>> {
+    let (mut out, mut pick) = (Vec::new(), (0..m).collect::<Vec<_>>());
+    if m == 0 || m > n {
+        return out;
+    }
+    loop {
+        if out.len() == max {
+            return Vec::new();
+        }
+        out.push(pick.clone());
+        let Some(i) = (0..m).rev().find(|&i| pick[i] < n - m + i) else { return out };
+        pick[i] += 1;
+        for j in i + 1..m {
+            pick[j] = pick[j - 1] + 1;
+        }
+    }
+}
+
+/// Whether the pairs turn their bodies one after the other from the ground (each joins a
+/// body turned before, or the ground, to a new one), as the closed forms' cranks and cranks on
+/// cranks need: a check before the Assur decomposition of the sets that cannot pass it.
+fn chained(mech: &Mechanism, pairs: &[usize]) -> bool {
+    let mut placed = vec![false; mech.n_bodies()];
+    let is_placed = |placed: &[bool], l: Link| match l {
+        Link::Ground => true,
+        Link::Body(b) => placed[b.0],
+    };
+    let mut left: Vec<usize> = pairs.to_vec();
+    while !left.is_empty() {
+        let before = left.len();
+        left.retain(|&i| {
+            let p = &mech.pairs[i];
+            match (is_placed(&placed, p.a), is_placed(&placed, p.b), p.a, p.b) {
+                (true, false, _, Link::Body(b)) | (false, true, Link::Body(b), _) => {
+                    placed[b.0] = true;
+                    false
+                }
+                _ => true,
+            }
+        });
+        if left.len() == before {
+            return false;
+        }
+    }
+    true
+}
+
+impl AltCharts {
+    /// The sets of m revolute pairs other than the user's coordinates' whose chart has closed forms.
+    pub fn new(mech: &Mechanism) -> Self {
+        let user: Vec<usize> = mech.coordinates.iter().map(|c| c.pair.0).collect();
+        let revolute: Vec<usize> =
+            (0..mech.pairs.len()).filter(|&i| mech.pairs[i].kind == PairKind::Revolute).collect();
+        let candidates = subsets(revolute.len(), mech.dof(), MAX_CANDIDATES)
+            .into_iter()
+            .map(|s| s.iter().map(|&i| revolute[i]).collect::<Vec<_>>())
+            .filter(|pairs| {
+                let mut sorted = user.clone();
+                sorted.sort_unstable();
+                *pairs != sorted && chained(mech, pairs)
+            })
+            .filter_map(|pairs| {
+                let closed = ClosedForm::new(&mech.with_pair_coordinates(&pairs))?;
+                let sys = System::for_chart(mech, &Chart::Pairs(pairs.clone()));
+                Some(Candidate { pairs, closed, sys })
+            })
+            .collect();
+        AltCharts { candidates }
+    }
+
+    /// Whether there is any.
+    pub fn is_empty(&self) -> bool {
+        self.candidates.is_empty()
+    }
+
+    /// The candidate whose own measure (`group_sigma`, exact) is largest at x, and that measure.
+    pub fn best(&mut self, mech: &Mechanism, x: &[f64]) -> Option<(Chart, f64)> {
+        self.candidates
+            .iter_mut()
+            .map(|c| {
+                let chart = Chart::Pairs(c.pairs.clone());
+                let sigma = sigma_min_with(&mut c.sys, mech, &chart, x);
+                (chart, sigma)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// The closed forms of the chart of `pairs`, if it is one of these.
+    pub fn closed_form(&self, pairs: &[usize]) -> Option<&ClosedForm> {
+        self.candidates.iter().find(|c| c.pairs == pairs).map(|c| &c.closed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::constraints::pair_coordinate;
+    use crate::kinematics::{convective, solve_position, velocity_analogues, Frame};
+
+    /// The five-bar's alternative charts are the angles at one ground pivot and its elbow
+    /// (pairs 0 and 1: a crank, a crank on it, an RRR dyad; pairs 3 and 4 the other side's), and
+    /// their closed forms give the Newton path's positions, U and convective term to 1e-12 at a
+    /// point 0.05 rad from the drawing in each angle, with rates (1.3, -0.7) rad/s (the Newton
+    /// path's own tolerance, POSITION_TOL, is 1e-12 scaled; U and c then follow to round-off).
+    #[test]
+    fn five_bar_alternative_charts_are_newtons_to_round_off() {
+        let path = format!("{}/../../examples/models/five-bar-free-fall.yaml", env!("CARGO_MANIFEST_DIR"));
+        let mech = crate::load(&path).unwrap();
+        let alt = AltCharts::new(&mech);
+        let sets: Vec<_> = alt.candidates.iter().map(|c| c.pairs.clone()).collect();
+        assert_eq!(sets, vec![vec![0, 1], vec![3, 4]]);
+        for pairs in sets {
+            let z: Vec<f64> = pairs.iter().map(|&i| pair_coordinate(&mech.pairs[i], &mech.x0) + 0.05).collect();
+            let zd = [1.3, -0.7];
+            let mut newton = Frame::new(&mech);
+            newton.chart = Chart::Pairs(pairs.clone());
+            solve_position(&mech, &z, &mut newton).unwrap();
+            velocity_analogues(&mut newton).unwrap();
+            convective(&mech, &zd, &mut newton);
+            let mut closed = Frame::new(&mech);
+            let mut form = alt.closed_form(&pairs).unwrap().clone();
+            form.kinematic_stages(&z, &zd, &mut closed).unwrap();
+            for (name, a, b) in [("x", &newton.x, &closed.x), ("U", &newton.u, &closed.u), ("c", &newton.c, &closed.c)]
+            {
+                let worst = a.iter().zip(b.iter()).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+                assert!(worst < 1e-12, "pairs {pairs:?}: {name} {worst:e} from Newton's");
+            }
+        }
+    }
+
+    #[test]
+    fn subsets_are_every_choice_in_order() {
+        assert_eq!(subsets(4, 2, 64), vec![vec![0, 1], vec![0, 2], vec![0, 3], vec![1, 2], vec![1, 3], vec![2, 3]]);
+        assert!(subsets(40, 3, 64).is_empty());
+    }
+}
