@@ -429,6 +429,9 @@ impl<'a> MechanismOde<'a> {
         self.anchor_z.copy_from_slice(&y[..m]);
         self.last_t = f64::NAN;
         self.base_valid = false;
+        // The spare's closed forms are still the old chart's (another alternative chart's may have
+        // other groups): `accept` must not copy references into them; `save` renews the spare.
+        self.spare.closed = None;
         self.accept(t, y)?;
         // The spare's chart and its structure (`System`'s analysis, which the predictor from
         // the anchor uses before Newton renews it) are the new chart's: a copy, once a switch.
