@@ -13,14 +13,15 @@ use super::constraints::Chart;
 use super::singularity::sigma_min_with;
 use super::system::System;
 use crate::model::{Link, Mechanism, PairKind};
+use itertools::Itertools;
 
 /// The most pair sets tried: each costs an Assur decomposition once per prepared model.
 const MAX_CANDIDATES: usize = 64;
 
-/// One alternative chart: its pairs, its closed forms and its J's analysis (for its measure).
+/// One alternative chart (`Chart::Pairs`), its closed forms and its J's analysis (for its measure).
 #[derive(Debug, Clone)]
 struct Candidate {
-    pairs: Vec<usize>,
+    chart: Chart,
     closed: ClosedForm,
     sys: System,
 }
@@ -31,23 +32,13 @@ pub struct AltCharts {
     candidates: Vec<Candidate>,
 }
 
-/// Every set of m indices out of 0..n, in lexicographic order (empty past `max` sets).
+/// Every set of m indices out of 0..n, in lexicographic order (none past `max` sets).
 fn subsets(n: usize, m: usize, max: usize) -> Vec<Vec<usize>> {
-    let (mut out, mut pick) = (Vec::new(), (0..m).collect::<Vec<_>>());
-    if m == 0 || m > n {
-        return out;
+    let sets: Vec<_> = (0..n).combinations(m).take(max + 1).collect();
+    if m == 0 || sets.len() > max {
+        return Vec::new();
     }
-    loop {
-        if out.len() == max {
-            return Vec::new();
-        }
-        out.push(pick.clone());
-        let Some(i) = (0..m).rev().find(|&i| pick[i] < n - m + i) else { return out };
-        pick[i] += 1;
-        for j in i + 1..m {
-            pick[j] = pick[j - 1] + 1;
-        }
-    }
+    sets
 }
 
 /// Whether the pairs turn their bodies one after the other from the ground (each joins a
@@ -95,8 +86,9 @@ impl AltCharts {
             })
             .filter_map(|pairs| {
                 let closed = ClosedForm::new(&mech.with_pair_coordinates(&pairs))?;
-                let sys = System::for_chart(mech, &Chart::Pairs(pairs.clone()));
-                Some(Candidate { pairs, closed, sys })
+                let chart = Chart::Pairs(pairs);
+                let sys = System::for_chart(mech, &chart);
+                Some(Candidate { chart, closed, sys })
             })
             .collect();
         AltCharts { candidates }
@@ -109,19 +101,17 @@ impl AltCharts {
 
     /// The candidate whose own measure (`group_sigma`, exact) is largest at x, and that measure.
     pub fn best(&mut self, mech: &Mechanism, x: &[f64]) -> Option<(Chart, f64)> {
+        // The winner's chart alone is cloned: no allocation per candidate.
         self.candidates
             .iter_mut()
-            .map(|c| {
-                let chart = Chart::Pairs(c.pairs.clone());
-                let sigma = sigma_min_with(&mut c.sys, mech, &chart, x);
-                (chart, sigma)
-            })
-            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|c| (sigma_min_with(&mut c.sys, mech, &c.chart, x), &c.chart))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(sigma, chart)| (chart.clone(), sigma))
     }
 
     /// The closed forms of the chart of `pairs`, if it is one of these.
     pub fn closed_form(&self, pairs: &[usize]) -> Option<&ClosedForm> {
-        self.candidates.iter().find(|c| c.pairs == pairs).map(|c| &c.closed)
+        self.candidates.iter().find(|c| matches!(&c.chart, Chart::Pairs(p) if p == pairs)).map(|c| &c.closed)
     }
 }
 
@@ -141,7 +131,14 @@ mod tests {
         let path = format!("{}/../../examples/models/five-bar-free-fall.yaml", env!("CARGO_MANIFEST_DIR"));
         let mech = crate::load(&path).unwrap();
         let alt = AltCharts::new(&mech);
-        let sets: Vec<_> = alt.candidates.iter().map(|c| c.pairs.clone()).collect();
+        let sets: Vec<_> = alt
+            .candidates
+            .iter()
+            .map(|c| match &c.chart {
+                Chart::Pairs(p) => p.clone(),
+                other => panic!("an alternative chart is Chart::Pairs, not {other:?}"),
+            })
+            .collect();
         assert_eq!(sets, vec![vec![0, 1], vec![3, 4]]);
         for pairs in sets {
             let z: Vec<f64> = pairs.iter().map(|&i| pair_coordinate(&mech.pairs[i], &mech.x0) + 0.05).collect();
