@@ -584,8 +584,8 @@ impl ClosedForm {
         for s in &self.sliders {
             s.position(z, x, trig);
         }
-        for c in &mut self.relative {
-            c.position(z, x, trig);
+        if !self.relative.is_empty() {
+            self.place_relative(z, x, trig);
         }
         for d in &mut self.groups {
             d.position(z, start, x, trig)?;
@@ -593,6 +593,16 @@ impl ClosedForm {
         ws.residual = 0.0;
         ws.iterations = 0;
         Ok(())
+    }
+
+    /// The relative cranks' bodies (alternative charts only). Not inlined: in [`ClosedForm::place`]
+    /// the loop kept `place` from being inlined into the stages (the four-bar's evaluation 2059
+    /// -> 2033 instructions without it; its run has no relative crank).
+    #[inline(never)]
+    fn place_relative(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
+        for c in &mut self.relative {
+            c.position(z, x, trig);
+        }
     }
 
     /// Body rates for coordinate rates zd into v (3n), at the positions in `ws`.

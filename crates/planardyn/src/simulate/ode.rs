@@ -607,10 +607,7 @@ impl<'a> MechanismOde<'a> {
             (Some(c), _) => c.predicted_stages(z, zd, &mut self.ws).map_err(Error::from).and_then(|()| {
                 let ws = &mut self.ws;
                 if matches!(ws.frame.chart, Chart::Pairs(_)) {
-                    // The closed forms give q = z: in another chart, the user's from x.
-                    let f = &mut ws.frame;
-                    coordinates(self.mech, &f.x, &mut f.q);
-                    coordinate_rates(self.mech, &f.x, &f.xd, &mut f.qd);
+                    users_coordinates(self.mech, &mut ws.frame);
                 }
                 if reactions {
                     let _singular = ws.frame.sys.factor(self.mech, &ws.frame.chart, &ws.frame.x, &ws.frame.trig);
@@ -706,6 +703,16 @@ impl Evaluation {
             stale_j: false,
         }
     }
+}
+
+/// The user's q, qd of the point in `f` from its x, xd: in an alternative chart the closed forms
+/// give q = z, the chart's own coordinates. Not inlined: in the closed-form branch of
+/// [`MechanismOde::evaluate_at`] it made that branch a function of its own (+62 k instructions
+/// on the four-bar's run, which never takes it).
+#[inline(never)]
+fn users_coordinates(mech: &Mechanism, f: &mut Frame) {
+    coordinates(mech, &f.x, &mut f.q);
+    coordinate_rates(mech, &f.x, &f.xd, &mut f.qd);
 }
 
 impl MechanismOde<'_> {
