@@ -125,7 +125,8 @@ impl Group {
         }
     }
 
-    #[inline]
+    /// Inlined into [`ClosedForm::place`], as `place` is into the stages (see there).
+    #[inline(always)]
     fn position(
         &mut self,
         z: &[f64],
@@ -573,7 +574,12 @@ impl ClosedForm {
         self.place(z, Start::Predicted, ws)
     }
 
-    /// [`ClosedForm::positions`], the triad's Newton from `start`.
+    /// [`ClosedForm::positions`], the triad's Newton from `start`. Inlined, with the crank's,
+    /// the group's and the affine group's positions: left to the compiler, since the relative
+    /// cranks came, one of them became a call of its own (icount four-bar 2033 -> 2003,
+    /// 3-RRR 6188 -> 6140, gear-train 9301 -> 9279 with all four inlined; `place` alone
+    /// inlined left the groups' positions out: four-bar 2094).
+    #[inline(always)]
     fn place(&mut self, z: &[f64], start: Start, ws: &mut Frame) -> Result<(), KinematicsError> {
         let x = rows_mut(&mut ws.x);
         // trig as long as x's body rows: a body's check on one then holds for the other.

@@ -40,8 +40,8 @@ impl Crank {
     /// Pose at coordinates z: x and trig of the body. Its [cos, sin] is the reference's turned
     /// by the turn from it where that is within [`EXACT_TURN`] (the series, to rounding: the
     /// library's sin_cos costs about 120 instructions, most of it its argument's reduction),
-    /// the library's beyond.
-    #[inline]
+    /// the library's beyond. Inlined into `ClosedForm::place` (see there).
+    #[inline(always)]
     pub fn position(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
         let phi = self.sign * (z[self.k] + self.offset);
         let turn = phi - self.reference.0;

@@ -209,7 +209,9 @@ impl Local {
     }
 
     /// The group's bodies' poses (x and trig) for an affine group, the links before it solved.
-    #[inline]
+    /// Inlined into `ClosedForm::place` (see there): a call of its own cost the gear train 49
+    /// instructions an evaluation (icount 9279 -> 9328) and the scotch yoke 14.
+    #[inline(always)]
     pub fn affine(&mut self, x: &mut [f64], trig: &mut [[f64; 2]]) -> Result<(), KinematicsError> {
         self.load(x, trig);
         let nb = self.n_bodies;
