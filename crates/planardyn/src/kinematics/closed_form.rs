@@ -41,7 +41,10 @@ use crate::KinematicsError;
 /// A group of a kind with a closed form: a class II dyad with the branch of its reference
 /// configuration (and for RRR and RRP its geometry at the last positions, for the rates and
 /// accelerations), a group placed in one affine step (a class I group or a PRP dyad: no
-/// branch), or the class III triad (which keeps its own).
+/// branch), or the class III triad (which keeps its own); or a body turned by a relative
+/// revolute input on a link placed before it (alternative charts only, before every other
+/// group: a group, not a loop of its own in each stage, which cost the user's charts' stages
+/// 5..34 instructions an evaluation though they have none).
 #[derive(Debug, Clone)]
 enum Group {
     Rrr(Rrr, rrr::Branch, rrr::Geometry),
@@ -50,6 +53,7 @@ enum Group {
     Rpr(Box<Rpr>, rpr::Branch),
     Extended(Box<ExtendedRrr>),
     Triad(Box<Triad>),
+    Relative(RelativeCrank),
 }
 
 impl Group {
@@ -61,6 +65,7 @@ impl Group {
             Group::Rpr(d, _) => d.bodies(),
             Group::Extended(d) => &d.members,
             Group::Triad(t) => &t.members,
+            Group::Relative(c) => std::slice::from_ref(&c.body),
         }
     }
 
@@ -72,6 +77,7 @@ impl Group {
             Group::Rpr(d, b) => *b = d.branch(x),
             Group::Extended(d) => d.set_reference(x),
             Group::Triad(t) => t.set_reference(x),
+            Group::Relative(_) => {}
         }
     }
 
@@ -100,6 +106,7 @@ impl Group {
                 let Group::Triad(f) = from else { unreachable!("{SAME}") };
                 t.copy_reference(f);
             }
+            Group::Relative(_) => {}
         }
     }
 
@@ -111,6 +118,7 @@ impl Group {
             Group::Rpr(d, b) => d.keeps_side(b, x),
             Group::Extended(d) => d.keeps_side(x),
             Group::Triad(t) => t.keeps_side(x),
+            Group::Relative(_) => true,
         }
     }
 
@@ -122,6 +130,8 @@ impl Group {
             Group::Rpr(d, _) => d.sigma(inv_length),
             Group::Extended(d) => d.sigma(inv_length),
             Group::Triad(t) => t.sigma(inv_length),
+            // Its input's measure is in `inputs_sigma`.
+            Group::Relative(_) => f64::INFINITY,
         }
     }
 
@@ -141,6 +151,7 @@ impl Group {
             Group::Rpr(d, b) => d.position(b, x, trig)?,
             Group::Extended(d) => d.position(z, x, trig)?,
             Group::Triad(t) => t.position(z, start == Start::Predicted, x, trig)?,
+            Group::Relative(c) => c.position(z, x, trig),
         }
         Ok(())
     }
@@ -156,6 +167,7 @@ impl Group {
             Group::Rpr(d, _) => d.velocity(v),
             Group::Extended(d) => d.velocity(zd, v),
             Group::Triad(t) => t.velocity(zd, v),
+            Group::Relative(c) => c.velocity(zd, v),
         }
     }
 
@@ -168,6 +180,7 @@ impl Group {
             Group::Rpr(d, _) => d.acceleration(v, a),
             Group::Extended(d) => d.acceleration(v, a),
             Group::Triad(t) => t.acceleration(v, a),
+            Group::Relative(c) => c.acceleration(v, a),
         }
     }
 
@@ -185,6 +198,7 @@ impl Group {
             Group::Rpr(d, _) => p.piece(d.bodies(), |_, v| d.velocity(v), |v, a| d.acceleration(v, a)),
             Group::Extended(d) => p.piece(&d.members, |zd, v| d.velocity(zd, v), |v, a| d.acceleration(v, a)),
             Group::Triad(t) => p.piece(&t.members, |zd, v| t.velocity(zd, v), |v, a| t.acceleration(v, a)),
+            Group::Relative(c) => p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a)),
         }
     }
 }
@@ -205,9 +219,9 @@ const REACH_FROM_M: usize = 4;
 #[derive(Debug, Clone)]
 pub struct ClosedForm {
     cranks: Vec<Crank>,
-    /// Bodies turned by relative revolute inputs, each after the link it turns on.
-    relative: Vec<RelativeCrank>,
     sliders: Vec<Slider>,
+    /// In order of placement: the relative cranks, each after the link it turns on, then the
+    /// Assur groups.
     groups: Vec<Group>,
     /// Per dyad 1 / L_k (its group's length, `group_sigma`), and the smallest input link
     /// measure (constant).
@@ -425,8 +439,9 @@ impl ClosedForm {
             });
         }
         let relative = relative_cranks(mech, &cranks, pending)?;
-        inputs_sigma = inputs_sigma.min(if relative.is_empty() { f64::INFINITY } else { 1.0 });
-        let mut groups = Vec::new();
+        let has_relative = !relative.is_empty();
+        inputs_sigma = inputs_sigma.min(if has_relative { 1.0 } else { f64::INFINITY });
+        let mut groups: Vec<_> = relative.into_iter().map(Group::Relative).collect();
         let mut pairs_used = mech.coordinates.len();
         for g in &decomposition.groups {
             if let ([link], [o1, o2]) = (g.links.as_slice(), g.outer_pairs.as_slice()) {
@@ -493,7 +508,6 @@ impl ClosedForm {
             .iter()
             .map(|c| c.body)
             .chain(sliders.iter().map(|s| s.body))
-            .chain(relative.iter().map(|c| c.body))
             .chain(groups.iter().flat_map(|d| d.bodies().iter().copied()))
             .for_each(|b| solved[b] += 1);
         if pairs_used != mech.pairs.len() || solved.iter().any(|&k| k != 1) {
@@ -502,7 +516,7 @@ impl ClosedForm {
         cranks.iter_mut().for_each(|c| c.set_reference(&mech.x0));
         groups.iter_mut().for_each(|d| d.set_reference(&mech.x0));
         let inv_length = groups.iter().map(|d| 1.0 / bodies_length(mech, d.bodies())).collect();
-        if mech.dof() > REACH_FROM_M && !relative.is_empty() {
+        if mech.dof() > REACH_FROM_M && has_relative {
             return None;
         }
         let reach = (mech.dof() > REACH_FROM_M).then(|| {
@@ -511,7 +525,7 @@ impl ClosedForm {
             ColumnReach::new(mech, &c, &s, &decomposition.groups)
         });
         let explicit = !groups.iter().any(|g| matches!(g, Group::Triad(_)));
-        Some(ClosedForm { cranks, relative, sliders, groups, inv_length, inputs_sigma, reach, explicit })
+        Some(ClosedForm { cranks, sliders, groups, inv_length, inputs_sigma, reach, explicit })
     }
 
     /// Whether every group is placed without iteration (no class III triad, whose Newton
@@ -590,25 +604,12 @@ impl ClosedForm {
         for s in &self.sliders {
             s.position(z, x, trig);
         }
-        if !self.relative.is_empty() {
-            self.place_relative(z, x, trig);
-        }
         for d in &mut self.groups {
             d.position(z, start, x, trig)?;
         }
         ws.residual = 0.0;
         ws.iterations = 0;
         Ok(())
-    }
-
-    /// The relative cranks' bodies (alternative charts only). Not inlined: in [`ClosedForm::place`]
-    /// the loop kept `place` from being inlined into the stages (the four-bar's evaluation 2059
-    /// -> 2033 instructions without it; its run has no relative crank).
-    #[inline(never)]
-    fn place_relative(&mut self, z: &[f64], x: &mut [f64], trig: &mut [[f64; 2]]) {
-        for c in &mut self.relative {
-            c.position(z, x, trig);
-        }
     }
 
     /// Body rates for coordinate rates zd into v (3n), at the positions in `ws`.
@@ -618,9 +619,6 @@ impl ClosedForm {
         }
         for s in &self.sliders {
             s.velocity(zd, v);
-        }
-        for c in &self.relative {
-            c.velocity(zd, v);
         }
         for d in &self.groups {
             d.velocity(zd, v);
@@ -691,9 +689,6 @@ impl ClosedForm {
         for s in &self.sliders {
             s.acceleration(a);
         }
-        for c in &self.relative {
-            c.acceleration(v, a);
-        }
         for d in &self.groups {
             d.acceleration(v, a);
         }
@@ -716,9 +711,6 @@ impl ClosedForm {
         }
         for s in &self.sliders {
             p.piece(&[s.body], |zd, v| s.velocity(zd, v), |_, a| s.acceleration(a));
-        }
-        for c in &self.relative {
-            p.piece(&[c.body], |zd, v| c.velocity(zd, v), |v, a| c.acceleration(v, a));
         }
         for d in &self.groups {
             d.pass(&mut p);
