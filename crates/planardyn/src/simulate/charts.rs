@@ -96,38 +96,45 @@ pub fn chart_sigma(ode: &mut MechanismOde, sigma: f64) -> f64 {
 
 /// The chart to integrate in next, if it should change, from the measures at the current
 /// point and the current chart's own measure `own` ([`chart_sigma`]): another chart when q is
-/// near-singular, back to q when clear of it, and a fresh one when the current one degrades.
-pub fn next_chart(ode: &mut MechanismOde, m: &Measures, own: f64) -> Option<Chart> {
+/// near-singular, back to q when clear of it, and a fresh one when the current one degrades;
+/// with its own measure at this point where that is known already (the user's chart's, and
+/// an alternative chart's from its choice, exact to round-off: `AltCharts::best`), so that
+/// the switch need not estimate it from the new chart's first factorisation ([`chart_sigma`]).
+pub fn next_chart(ode: &mut MechanismOde, m: &Measures, own: f64) -> Option<(Chart, Option<f64>)> {
     match &ode.ws.chart {
         Chart::Inputs if m.sigma < SWITCH_TO_PARTITION => Some(other_chart(ode)),
-        Chart::Inputs if m.sigma < CLOSED_FORM_SIGMA => clear_alt_chart(ode),
+        Chart::Inputs if m.sigma < CLOSED_FORM_SIGMA => clear_alt_chart(ode).map(|(c, s)| (c, Some(s))),
         Chart::Inputs => None,
-        Chart::Partition(_) | Chart::Pairs(_) if m.sigma > SWITCH_TO_INPUTS => Some(Chart::Inputs),
+        Chart::Partition(_) | Chart::Pairs(_) if m.sigma > SWITCH_TO_INPUTS => Some((Chart::Inputs, Some(m.sigma))),
         Chart::Partition(_) if own >= SWITCH_TO_PARTITION => None,
         Chart::Pairs(_) if own >= ALT_CLEAR => None,
         Chart::Partition(_) | Chart::Pairs(_) => {
             let best = other_chart(ode);
-            (best != ode.ws.chart).then_some(best)
+            (best.0 != ode.ws.chart).then_some(best)
         }
     }
 }
 
-/// The chart to leave the user's for at the point in `ode.ws`: the alternative chart of largest
-/// own measure where that is clear of its singularity ([`ALT_CLEAR`]; none with a prescribed
-/// motion, whose coordinates are the user's), else the partition complete pivoting chooses.
-fn other_chart(ode: &mut MechanismOde) -> Chart {
-    clear_alt_chart(ode).unwrap_or_else(|| Chart::Partition(select_partition(ode.mech, &ode.ws.x)))
+/// The chart to leave the user's for at the point in `ode.ws`, with its measure there if known:
+/// the alternative chart of largest own measure where that is clear of its singularity
+/// ([`ALT_CLEAR`]; none with a prescribed motion, whose coordinates are the user's), else the
+/// partition complete pivoting chooses.
+fn other_chart(ode: &mut MechanismOde) -> (Chart, Option<f64>) {
+    match clear_alt_chart(ode) {
+        Some((chart, sigma)) => (chart, Some(sigma)),
+        None => (Chart::Partition(select_partition(ode.mech, &ode.ws.x)), None),
+    }
 }
 
 /// The alternative chart of largest own measure at the point in `ode.ws` where that is clear
-/// of its singularity ([`ALT_CLEAR`]; none with a prescribed motion). Taken from the user's
-/// chart below `CLOSED_FORM_SIGMA` already, where the user's chart leaves its closed forms for
-/// Newton: the alternative chart's are in use there.
-fn clear_alt_chart(ode: &mut MechanismOde) -> Option<Chart> {
+/// of its singularity ([`ALT_CLEAR`]; none with a prescribed motion), and that measure. Taken
+/// from the user's chart below `CLOSED_FORM_SIGMA` already, where the user's chart leaves its
+/// closed forms for Newton: the alternative chart's are in use there.
+fn clear_alt_chart(ode: &mut MechanismOde) -> Option<(Chart, f64)> {
     if ode.motion.is_some() {
         return None;
     }
-    ode.best_alt_chart().filter(|(_, sigma)| *sigma >= ALT_CLEAR).map(|(chart, _)| chart)
+    ode.best_alt_chart().filter(|(_, sigma)| *sigma >= ALT_CLEAR)
 }
 
 /// The longest first step in the chart of the point held by `ode.ws`, whose own measure is

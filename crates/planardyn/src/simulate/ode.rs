@@ -146,8 +146,9 @@ pub struct MechanismOde<'a> {
     alt_shared: Arc<OnceLock<AltCharts>>,
     alt: Option<AltCharts>,
     /// Where the user's closed forms place the point of an alternative chart for its type II
-    /// measure ([`MechanismOde::user_sigma`]): a copy of the workspace's frame, made at the
-    /// first such measure.
+    /// measure ([`MechanismOde::user_sigma`]), and the alternative charts' closed forms the
+    /// point in `ws` for theirs (`AltCharts::best`): a copy of the workspace's frame, made at
+    /// the first such measure.
     user_frame: Option<Frame>,
     /// Whether the last accepted point is clear of folds ([`CLOSED_FORM_SIGMA`]).
     clear_of_folds: bool,
@@ -381,7 +382,8 @@ impl<'a> MechanismOde<'a> {
     pub fn best_alt_chart(&mut self) -> Option<(Chart, f64)> {
         let mech = self.mech;
         let alt = self.alt.get_or_insert_with(|| self.alt_shared.get_or_init(|| AltCharts::new(mech)).clone());
-        alt.best(mech, &self.ws.x)
+        let frame = self.user_frame.get_or_insert_with(|| self.ws.frame.clone());
+        alt.best(mech, &self.ws.x, frame)
     }
 
     /// The user's chart's type II measure at the point in `ws` (held in another chart): from its

@@ -443,7 +443,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn chart(&mut self, t: f64, meas: &Measures) -> ControlFlow<Stop> {
         let m = self.ode.m();
         let mut own = chart_sigma(&mut self.ode, meas.sigma);
-        if let Some(chart) = next_chart(&mut self.ode, meas, own) {
+        if let Some((chart, known)) = next_chart(&mut self.ode, meas, own) {
             state_in(&self.ode, &chart, self.y[2 * m], &mut self.y);
             self.traj.stats.chart_switches += 1;
             let switched = self.ode.set_chart(chart, t, &self.y).map_err(|e| e.to_string());
@@ -452,7 +452,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             {
                 return Break(Stop::ChartChange { t, error });
             }
-            own = chart_sigma(&mut self.ode, meas.sigma);
+            own = known.unwrap_or_else(|| chart_sigma(&mut self.ode, meas.sigma));
             self.stepper.bound_first_step(first_step_bound(&self.ode, own));
             self.chart_steps = 0;
         }

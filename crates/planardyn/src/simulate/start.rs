@@ -61,12 +61,12 @@ pub fn start<'a>(
             KinematicsError::Singular { kind: SingularityKind::PassiveAtStart, sigma_min: Some(m0.passive) }.into()
         );
     }
-    let chart = next_chart(&mut ode, &m0, m0.sigma).unwrap_or(Chart::Inputs);
+    let (chart, known) = next_chart(&mut ode, &m0, m0.sigma).unwrap_or((Chart::Inputs, Some(m0.sigma)));
     let m = mech.dof();
     let mut y = vec![0.0; 2 * m + 1];
     state_in(&ode, &chart, 0.0, &mut y);
     ode.set_chart(chart, s.t0, &y)?;
-    let own = chart_sigma(&mut ode, m0.sigma);
+    let own = known.unwrap_or_else(|| chart_sigma(&mut ode, m0.sigma));
     ode.limit_correction(own);
     ode.limit_step_reach();
     Ok((ode, y))
