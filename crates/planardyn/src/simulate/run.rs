@@ -54,12 +54,13 @@ enum Crossed {
 }
 
 /// Whether the measure heading to 0 above [`APPROACH_BELOW`] is the passive one
-/// ([`Run::change_point_ahead`]): not asked in this approach, put off with the passive measure
-/// of the point it is asked at, or known.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// ([`Run::change_point_ahead`]): not asked in this approach, put off, or known. Put off, it
+/// keeps the point it is to be asked at (passive measure and body coordinates x), and whether
+/// the last aim's grid and limit hold only if it is (`on`: that aim could not answer it).
+#[derive(Debug, Clone, PartialEq)]
 enum Heading {
     Unasked,
-    Deferred { passive: f64 },
+    Deferred { passive: f64, x: Vec<f64>, on: bool },
     Known(bool),
 }
 
@@ -81,11 +82,8 @@ pub struct Run<'a, 's, 'e> {
     grid: Option<Grid>,
     limit: Option<f64>,
     /// Whether the measure now heading to 0 is the passive one (asked once an approach, where
-    /// first needed: [`Heading`]), the point it is asked at (x), and whether `grid` and `limit`
-    /// hold only if it is (set by an aim that put the question off).
+    /// first needed: [`Heading`]).
     heading: Heading,
-    heading_x: Vec<f64>,
-    on_heading: bool,
     /// The integrator's options without dense output (for a crossing's integration past its
     /// landing), and the counters of those integrations.
     options: Options,
@@ -149,8 +147,6 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             grid: None,
             limit: None,
             heading: Heading::Unasked,
-            heading_x: Vec::new(),
-            on_heading: false,
             options: Options { dense_output: false, ..settings.options.clone() },
             crossing_stats: Stats::default(),
             y,
@@ -483,7 +479,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.heading = Heading::Unasked;
         }
         let ahead = if grid.is_some() { self.change_point_ahead(meas) } else { Some(false) };
-        self.on_heading = ahead.is_none();
+        if let Heading::Deferred { on, .. } = &mut self.heading {
+            *on = ahead.is_none();
+        }
         let ahead = ahead != Some(false);
         self.grid = grid.filter(|_| ahead);
         self.limit = self.approach.step_limit(t, meas).filter(|_| ahead).map(|l| l.min(self.settings.t_end));
@@ -537,8 +535,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             Heading::Known(ahead) => Some(ahead),
             Heading::Deferred { .. } => None,
             Heading::Unasked => {
-                self.heading_x.clone_from(&self.ode.ws.x);
-                self.heading = Heading::Deferred { passive: meas.passive };
+                // Once an approach (the question's point), not once a step.
+                self.heading = Heading::Deferred { passive: meas.passive, x: self.ode.ws.x.clone(), on: true };
                 None
             }
         }
@@ -548,15 +546,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// (the same answer as asked there); without a change point ahead, the grid and the limit
     /// the last aim set on it are dropped.
     fn settle(&mut self) {
-        let Heading::Deferred { passive } = self.heading else { return };
-        let (ode, prepared) = (&mut self.ode, self.prepared);
-        let ahead =
-            prepared.partition_measure(&mut ode.inputs_sys, ode.mech, &self.heading_x) < CHANGE_POINT_RATIO * passive;
-        self.heading = Heading::Known(ahead);
-        if self.on_heading && !ahead {
+        let Heading::Deferred { passive, x, on } = &self.heading else { return };
+        let ode = &mut self.ode;
+        let ahead = self.prepared.partition_measure(&mut ode.inputs_sys, ode.mech, x) < CHANGE_POINT_RATIO * passive;
+        if *on && !ahead {
             (self.grid, self.limit) = (None, None);
         }
-        self.on_heading = false;
+        self.heading = Heading::Known(ahead);
     }
 
     /// The crossing's grid of the change point ahead, the heading asked if it was put off.
