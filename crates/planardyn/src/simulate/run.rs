@@ -11,7 +11,7 @@ use super::charts::{
     PASSIVE_SINGULAR, SWITCH_TO_PARTITION,
 };
 use super::crossing::{
-    cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
+    cross, inside_step, scaled_speed, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
     APPROACH_BELOW, APPROACH_FRACTION, CHANGE_POINT_RATIO, CROSS_START, WATCH_BELOW,
 };
 use super::dense::{self, DenseOutput};
@@ -744,11 +744,17 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         traj.events = self.watch.records;
         // Events alone need the dense output only while the run lasts.
         traj.dense = self.dense.filter(|_| self.keep_dense);
-        let (mech, ode) = (self.ode.mech, &self.ode);
-        let fold = self.fold.ahead(self.stepper.t(), self.stepper.t() - self.stepper.t_prev());
+        let (mech, ode, t) = (self.ode.mech, &self.ode, self.stepper.t());
+        let fold = self.fold.ahead(t, t - self.stepper.t_prev());
+        let h_min = self.settings.options.h_min * t.abs().max(1.0);
+        // The last row is the last accepted state (`keeps_last`) for the failures diagnosed.
+        let speed = traj.xd.rchunks_exact(traj.nx).next().map_or(0.0, |xd| scaled_speed(mech, xd));
         (traj.status, traj.message) = stop.describe(|| Near {
             passive: passive_sigma_min(mech, ode.anchor_x()),
             driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
+            reach: speed * h_min,
+            h_min,
+            start: t - self.settings.t0 < h_min,
             fold,
         });
         traj
@@ -758,7 +764,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
 /// The trajectory of a run that stopped before its first step: no row, its status.
 pub fn stopped_at_start(mech: &Mechanism, stop: Stop) -> Trajectory {
     let mut traj = Trajectory::new(mech.dof(), mech.n_x());
-    (traj.status, traj.message) = stop.describe(|| Near { passive: f64::INFINITY, driven: f64::INFINITY, fold: None });
+    let near = Near { passive: f64::INFINITY, driven: f64::INFINITY, reach: 0.0, h_min: 0.0, start: true, fold: None };
+    (traj.status, traj.message) = stop.describe(|| near);
     traj
 }
 
