@@ -617,3 +617,10 @@ def test_unexpected_error_is_one_line_exit_1(monkeypatch):
     monkeypatch.setitem(cli.COMMANDS, "check", broken)
     code, err = cli_run("check", FIVE_BAR)
     assert (code, err) == (1, "planardyn: unexpected RuntimeError: boom (please report this)\n")
+
+
+def test_the_summary_of_a_run_without_outputs_says_so():
+    # It read "non_finite: 0 outputs to t = - s, 0 steps (...), energy drift 0 J, min sigma -".
+    res = pd.load_example("four-bar-gravity").simulate(0.1, qd0=[1e300])
+    assert len(res.t) == 0 and res.status == "non_finite"
+    assert cli.summary(res) == "non_finite: no outputs, the run stopped at its start before its first row"
