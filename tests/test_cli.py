@@ -139,7 +139,7 @@ def test_hopeless_model_stops_early_exit_1(tmp_path):
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert p.stdout.startswith("step_size_too_small:")
     res = read_results(out)
-    assert res.status == "step_size_too_small" and "efforts are too large" in res.message
+    assert res.status == "step_size_too_small" and "efforts or rates are too large" in res.message
     assert len(res.t) == 2 and res.t[-1] > 0 and np.isfinite(res.energy.balance[-1])
 
 
