@@ -92,21 +92,6 @@ impl Stop {
             return (status, message);
         }
         let Near { passive, driven, reach, h_min, start, fold } = near();
-        if stalled.is_none() && reach > MAX_REACH {
-            // The rates, not the positions or the tolerances: the failure is their symptom
-            // (the advice of a failed position analysis is for positions).
-            let (what, fix) = if start {
-                ("the start rates qd0 are", "give smaller start rates (qd0)")
-            } else {
-                ("the rates are", "lower the efforts or start rates (qd0) that drive them there")
-            };
-            let message = format!(
-                "{what} too large to integrate: the mechanism moves {reach:.2e} rad (or lengths per L) in the \
-                 integrator's smallest step ({h_min:.0e} s), more than its position analysis follows in a step \
-                 ({MAX_REACH}); {fix}. The step failed with: {message}"
-            );
-            return (status, message);
-        }
         if let Some(t) = stalled {
             if driven >= NEAR_PASSIVE_SINGULAR {
                 return (status, message);
@@ -142,6 +127,21 @@ impl Stop {
                  it, and past it the mechanism does not assemble at the prescribed coordinates. \
                  {CHANGE_THE_MOTION}. Near it the step failed, a symptom of the fold: {message}",
                 Time(t_star)
+            );
+            (status, message)
+        } else if reach > MAX_REACH {
+            // The rates, not the positions or the tolerances: the failure is their symptom
+            // (the advice of a failed position analysis is for positions). After the
+            // singularities' diagnoses: near a fold the rates grow too, as its symptom.
+            let (what, fix) = if start {
+                ("the start rates qd0 are", "give smaller start rates (qd0)")
+            } else {
+                ("the rates are", "lower the efforts or start rates (qd0) that drive them there")
+            };
+            let message = format!(
+                "{what} too large to integrate: the mechanism moves {reach:.2e} rad (or lengths per L) in the \
+                 integrator's smallest step ({h_min:.0e} s), more than its position analysis follows in a step \
+                 ({MAX_REACH}); {fix}. The step failed with: {message}"
             );
             (status, message)
         } else {
