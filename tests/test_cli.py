@@ -139,7 +139,7 @@ def test_hopeless_model_stops_early_exit_1(tmp_path):
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert p.stdout.startswith("step_size_too_small:")
     res = read_results(out)
-    assert res.status == "step_size_too_small" and "efforts are too large" in res.message
+    assert res.status == "step_size_too_small" and "efforts or rates are too large" in res.message
     assert len(res.t) == 2 and res.t[-1] > 0 and np.isfinite(res.energy.balance[-1])
 
 
@@ -617,3 +617,10 @@ def test_unexpected_error_is_one_line_exit_1(monkeypatch):
     monkeypatch.setitem(cli.COMMANDS, "check", broken)
     code, err = cli_run("check", FIVE_BAR)
     assert (code, err) == (1, "planardyn: unexpected RuntimeError: boom (please report this)\n")
+
+
+def test_the_summary_of_a_run_without_outputs_says_so():
+    # It read "non_finite: 0 outputs to t = - s, 0 steps (...), energy drift 0 J, min sigma -".
+    res = pd.load_example("four-bar-gravity").simulate(0.1, qd0=[1e300])
+    assert len(res.t) == 0 and res.status == "non_finite"
+    assert cli.summary(res) == "non_finite: no outputs, the run stopped at its start before its first row"

@@ -80,6 +80,19 @@ def test_a_run_that_overflows_says_what_to_make_smaller(run):
     assert np.all(np.isfinite(res.q)) and np.all(np.isfinite(res.qd))
 
 
+@pytest.mark.parametrize("example", ["four-bar-gravity", "five-bar-free-fall", "slider-crank"])
+def test_start_rates_too_large_to_integrate_are_named(example):
+    # qd0 1e20 rad/s moves the mechanism 1e6 rad in the smallest step (h_min 1e-14 s): the
+    # step failed with a failed position analysis's advice, "try values closer to the drawing"
+    # (the four-bar, the five-bar), or "try radau5" (the slider-crank's underflow), naming no
+    # argument (s22-check N1).
+    mech = pd.load_example(example)
+    res = mech.simulate(0.1, qd0=[1e20] * mech.dof)
+    assert not res.success and res.status in ("assembly_failed", "step_size_underflow")
+    assert res.message.startswith("the start rates qd0 are too large to integrate: the mechanism moves ")
+    assert "give smaller start rates (qd0). The step failed with: " in res.message
+
+
 @pytest.mark.parametrize(
     ("call", "quantity"),
     [

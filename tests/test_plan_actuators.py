@@ -184,3 +184,18 @@ def test_cli_plans_within_the_motors(tmp_path, path) -> None:
     assert np.all(np.abs(t_m) <= avail * (1 + 1e-9))
     assert table["t"][-1] == pytest.approx(time_optimal(geared(CURVE), path, "actuators").duration, rel=1e-9)
     assert main(["plan", str(file), *line, "--collocate", "time"]) == 2
+
+
+def test_timing_that_alternates_between_two_rounds_says_so():
+    # The five-bar robot's motors on this line at n_grid 10 (refined to 145 points): from round
+    # 8 the tangents taken at 0.0679969 s (limits used to 0.99999997) give 0.0679794 s (to
+    # 1.000003) and back. The message named the last two times as if the time still changed
+    # ("did not settle in 60 rounds (0.0679969417 s, then 0.0679793638 s, ...)").
+    mech = planardyn.load_example("five-bar-robot")
+    q = task_waypoints(rb.EndEffector(mech, "P"), [[-0.04, 0.45], [0.06, 0.5]], 0.01)
+    with pytest.raises(PlanError) as err:
+        time_optimal(mech, q, "actuators", n_grid=10)
+    message = str(err.value)
+    assert message.startswith("the timing did not settle in 60 rounds on a grid of 145 points: its time alternates "
+                              "between 0.06799694")
+    assert "and 0.06797936" in message and message.endswith("try another n_grid")

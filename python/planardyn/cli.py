@@ -137,11 +137,13 @@ def _crossing(text: str) -> Crossing:
 def summary(res: SimulationResult) -> str:
     """One line: status, outputs, steps, energy balance drift, smallest singularity measure."""
     st = res.stats
-    t_last = f"{res.t[-1]:.6g}" if len(res.t) else "-"
+    if not len(res.t):
+        # Nothing ran: no time, balance or measure to report (the message says why).
+        return f"{res.status}: no outputs, the run stopped at its start before its first row"
     min_sigma = st.get("min_sigma")
     sigma_text = "-" if min_sigma is None else f"{min_sigma:.3g}"
     return (
-        f"{res.status}: {len(res.t)} outputs to t = {t_last} s, {st.get('naccept', 0)} steps "
+        f"{res.status}: {len(res.t)} outputs to t = {res.t[-1]:.6g} s, {st.get('naccept', 0)} steps "
         f"({st.get('nreject', 0)} rejected, {st.get('nfev', 0)} evaluations), "
         f"energy drift {res.energy.drift:.3g} J, min sigma {sigma_text}"
         + "".join(f"; change point at t = {c.t:.6g} s (rank -{c.rank_drop})" for c in res.change_points)

@@ -209,6 +209,25 @@ fn a_centre_of_mass_far_outside_the_drawing_is_named() {
 }
 
 #[test]
+fn a_bar_of_length_zero_is_named_as_the_bar() {
+    // The body's inertia is then 0: it was reported as `bodies.crank.inertia`, a field not given.
+    let crank = "crank: {points: [O, A], mass: 0.5, inertia: 0.010416666666666666, com: [0.125, 0.21650635094610965]}";
+    let (msg, path) =
+        refused(&FOUR_BAR.replace(crank, "crank: {points: [O, A], mass: 0.5, uniform_bar: [A, A]}"), Format::Yaml);
+    assert_eq!(path, "bodies.crank.uniform_bar");
+    assert_eq!(
+        msg,
+        "m.yaml: bodies.crank.uniform_bar: the bar's ends A and A are at the same place, a bar of length 0 with no \
+         moment of inertia (line 11 column 51); name the bar's two ends, or give a point mass (`point_mass: A`) or \
+         `com` with `inertia`"
+    );
+    // A part's bar is named as the part's (the body's other part gives it inertia).
+    let parts = "crank: {points: [O, A], parts: [{mass: 0.5, uniform_bar: [O, A]}, {mass: 0.1, uniform_bar: [A, A]}]}";
+    let (_, path) = refused(&FOUR_BAR.replace(crank, parts), Format::Yaml);
+    assert_eq!(path, "bodies.crank.parts[1].uniform_bar");
+}
+
+#[test]
 fn an_unnamed_pair_is_not_referenced_by_its_made_up_name() {
     let text = FOUR_BAR.replace("{name: theta1, pair: O,", "{name: theta1, pair: crank-coupler@A,");
     let (msg, path) = refused(&text, Format::Yaml);

@@ -354,6 +354,7 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
     x0 = _first_speeds(limits, pts)
     u0 = np.zeros_like(x0)
     duration, rounds = np.inf, 0
+    history: list[tuple[float, float]] = []  # (time s, limits used) of each round
     while True:
         rounds += 1
         rows = stage_rows(stage, d, rows_at(limits, variants(model, pts, u0, x0) if model.has_coulomb else [(pts, None)],
@@ -368,9 +369,9 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
         settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
         if found.ratio <= 1 + RATIO_TOL and settled:
             break
+        history.append((t_new, found.ratio))
         if rounds == MAX_ROUNDS:
-            raise PlanError(f"the timing did not settle in {rounds} rounds ({duration:.9g} s, then {t_new:.9g} s, "
-                            f"limits used to {found.ratio:.9g}); use a finer n_grid")
+            raise PlanError(_unsettled(history, n))
         bad = np.flatnonzero(found.worst > 1 + RATIO_TOL)
         if len(bad):
             cut = path_points(model.bare or mech, path, found.at[bad], x[bad], exact=exact)
@@ -388,6 +389,26 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
                      q=grid.q, qd=grid.p1 * sd[:, None], qdd=grid.p1 * u[:, None] + grid.p2 * sd2[:, None],
                      tau=grid.efforts(u, sd2), limit_ratio=found.ratio, lo=grid.a * np.nan, hi=grid.a * np.nan,
                      speed=np.full(mech.dof, np.inf), time_error=None, status=status, ignored=[])
+
+
+def _unsettled(history: list[tuple[float, float]], n: int) -> str:
+    """Why the rounds on a grid of n points did not end, from each round's time (s) and limits
+    used: the time still changing, alternating between two timings (the motor envelopes'
+    tangents taken at one give the other: the five-bar robot's --actuators line at n_grid 10,
+    refined to 145 points, from round 8 on), or settled with a limit still exceeded."""
+    (t_2, _), (t_1, r_1), (t, r) = history[-3:]
+
+    def same(a: float, b: float) -> bool:
+        return abs(a - b) <= ACTUATOR_TOL * b
+
+    if same(t, t_2) and not same(t, t_1):
+        what = (f"alternates between {t_1:.9g} s (limits used to {r_1:.9g}) and {t:.9g} s (limits used to {r:.9g}) "
+                "from round to round: the motor envelopes' tangents taken at either timing give the other")
+    elif same(t, t_1):
+        what = f"settled at {t:.9g} s, but the dense check still finds the limits used to {r:.9g}"
+    else:
+        what = f"still changes ({t_1:.9g} s, then {t:.9g} s, limits used to {r:.9g})"
+    return f"the timing did not settle in {len(history)} rounds on a grid of {n} points: its time {what}; try another n_grid"
 
 
 def _first_speeds(limits: list[Limit], pts: PathPoints) -> FloatArray:

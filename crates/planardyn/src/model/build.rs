@@ -169,6 +169,16 @@ fn part_inertia(ctx: &Ctx, path: &str, p: &PartSpec) -> R<(f64, f64, [f64; 2])> 
         }
         let (pa, pb) = (ctx.xy(&format!("{path}.uniform_bar[0]"), a)?, ctx.xy(&format!("{path}.uniform_bar[1]"), b)?);
         let l2 = (pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2);
+        // Named here: the body's inertia check would report an `inertia` the user never gave.
+        if l2 == 0.0 {
+            return Err(ctx.err(
+                format!("{path}.uniform_bar"),
+                format!(
+                    "the bar's ends {a} and {b} are at the same place, a bar of length 0 with no moment of inertia; \
+                     name the bar's two ends, or give a point mass (`point_mass: {a}`) or `com` with `inertia`"
+                ),
+            ));
+        }
         return Ok((mass, mass * l2 / 12.0, [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0]));
     }
     if let Some(pt) = &p.point_mass {

@@ -11,7 +11,7 @@ use super::charts::{
     PASSIVE_SINGULAR, SWITCH_TO_PARTITION,
 };
 use super::crossing::{
-    cross, inside_step, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
+    cross, inside_step, scaled_speed, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
     APPROACH_BELOW, APPROACH_FRACTION, CHANGE_POINT_RATIO, CROSS_START, WATCH_BELOW,
 };
 use super::dense::{self, DenseOutput};
@@ -54,12 +54,13 @@ enum Crossed {
 }
 
 /// Whether the measure heading to 0 above [`APPROACH_BELOW`] is the passive one
-/// ([`Run::change_point_ahead`]): not asked in this approach, put off with the passive measure
-/// of the point it is asked at, or known.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// ([`Run::change_point_ahead`]): not asked in this approach, put off, or known. Put off, it
+/// keeps the point it is to be asked at (passive measure and body coordinates x), and whether
+/// the last aim's grid and limit hold only if it is (`on`: that aim could not answer it).
+#[derive(Debug, Clone, PartialEq)]
 enum Heading {
     Unasked,
-    Deferred { passive: f64 },
+    Deferred { passive: f64, x: Vec<f64>, on: bool },
     Known(bool),
 }
 
@@ -81,11 +82,8 @@ pub struct Run<'a, 's, 'e> {
     grid: Option<Grid>,
     limit: Option<f64>,
     /// Whether the measure now heading to 0 is the passive one (asked once an approach, where
-    /// first needed: [`Heading`]), the point it is asked at (x), and whether `grid` and `limit`
-    /// hold only if it is (set by an aim that put the question off).
+    /// first needed: [`Heading`]).
     heading: Heading,
-    heading_x: Vec<f64>,
-    on_heading: bool,
     /// The integrator's options without dense output (for a crossing's integration past its
     /// landing), and the counters of those integrations.
     options: Options,
@@ -149,8 +147,6 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             grid: None,
             limit: None,
             heading: Heading::Unasked,
-            heading_x: Vec::new(),
-            on_heading: false,
             options: Options { dense_output: false, ..settings.options.clone() },
             crossing_stats: Stats::default(),
             y,
@@ -483,7 +479,9 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.heading = Heading::Unasked;
         }
         let ahead = if grid.is_some() { self.change_point_ahead(meas) } else { Some(false) };
-        self.on_heading = ahead.is_none();
+        if let Heading::Deferred { on, .. } = &mut self.heading {
+            *on = ahead.is_none();
+        }
         let ahead = ahead != Some(false);
         self.grid = grid.filter(|_| ahead);
         self.limit = self.approach.step_limit(t, meas).filter(|_| ahead).map(|l| l.min(self.settings.t_end));
@@ -537,8 +535,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             Heading::Known(ahead) => Some(ahead),
             Heading::Deferred { .. } => None,
             Heading::Unasked => {
-                self.heading_x.clone_from(&self.ode.ws.x);
-                self.heading = Heading::Deferred { passive: meas.passive };
+                // Once an approach (the question's point), not once a step.
+                self.heading = Heading::Deferred { passive: meas.passive, x: self.ode.ws.x.clone(), on: true };
                 None
             }
         }
@@ -548,15 +546,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// (the same answer as asked there); without a change point ahead, the grid and the limit
     /// the last aim set on it are dropped.
     fn settle(&mut self) {
-        let Heading::Deferred { passive } = self.heading else { return };
-        let (ode, prepared) = (&mut self.ode, self.prepared);
-        let ahead =
-            prepared.partition_measure(&mut ode.inputs_sys, ode.mech, &self.heading_x) < CHANGE_POINT_RATIO * passive;
-        self.heading = Heading::Known(ahead);
-        if self.on_heading && !ahead {
+        let Heading::Deferred { passive, x, on } = &self.heading else { return };
+        let ode = &mut self.ode;
+        let ahead = self.prepared.partition_measure(&mut ode.inputs_sys, ode.mech, x) < CHANGE_POINT_RATIO * passive;
+        if *on && !ahead {
             (self.grid, self.limit) = (None, None);
         }
-        self.on_heading = false;
+        self.heading = Heading::Known(ahead);
     }
 
     /// The crossing's grid of the change point ahead, the heading asked if it was put off.
@@ -748,11 +744,17 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         traj.events = self.watch.records;
         // Events alone need the dense output only while the run lasts.
         traj.dense = self.dense.filter(|_| self.keep_dense);
-        let (mech, ode) = (self.ode.mech, &self.ode);
-        let fold = self.fold.ahead(self.stepper.t(), self.stepper.t() - self.stepper.t_prev());
+        let (mech, ode, t) = (self.ode.mech, &self.ode, self.stepper.t());
+        let fold = self.fold.ahead(t, t - self.stepper.t_prev());
+        let h_min = self.settings.options.h_min * t.abs().max(1.0);
+        // The last row is the last accepted state (`keeps_last`) for the failures diagnosed.
+        let speed = traj.xd.rchunks_exact(traj.nx).next().map_or(0.0, |xd| scaled_speed(mech, xd));
         (traj.status, traj.message) = stop.describe(|| Near {
             passive: passive_sigma_min(mech, ode.anchor_x()),
             driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
+            reach: speed * h_min,
+            h_min,
+            start: t - self.settings.t0 < h_min,
             fold,
         });
         traj
@@ -762,7 +764,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
 /// The trajectory of a run that stopped before its first step: no row, its status.
 pub fn stopped_at_start(mech: &Mechanism, stop: Stop) -> Trajectory {
     let mut traj = Trajectory::new(mech.dof(), mech.n_x());
-    (traj.status, traj.message) = stop.describe(|| Near { passive: f64::INFINITY, driven: f64::INFINITY, fold: None });
+    let near = Near { passive: f64::INFINITY, driven: f64::INFINITY, reach: 0.0, h_min: 0.0, start: true, fold: None };
+    (traj.status, traj.message) = stop.describe(|| near);
     traj
 }
 

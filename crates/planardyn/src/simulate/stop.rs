@@ -53,6 +53,12 @@ pub enum Stop {
 pub struct Near {
     pub passive: f64,
     pub driven: f64,
+    /// How far the mechanism moves at its rates there (body rates, translations per the
+    /// characteristic length L: [`super::crossing::scaled_speed`]) in the integrator's smallest
+    /// step (`Options::h_min`), and that step (s); `start`: no step was accepted.
+    pub reach: f64,
+    pub h_min: f64,
+    pub start: bool,
     /// The fold of the driven coordinates the run was running into, if their measure fell
     /// towards one within its last steps (`FoldWatch::ahead`).
     pub fold: Option<f64>,
@@ -85,7 +91,7 @@ impl Stop {
         if !failed && stalled.is_none() {
             return (status, message);
         }
-        let Near { passive, driven, fold } = near();
+        let Near { passive, driven, reach, h_min, start, fold } = near();
         if let Some(t) = stalled {
             if driven >= NEAR_PASSIVE_SINGULAR {
                 return (status, message);
@@ -121,6 +127,21 @@ impl Stop {
                  it, and past it the mechanism does not assemble at the prescribed coordinates. \
                  {CHANGE_THE_MOTION}. Near it the step failed, a symptom of the fold: {message}",
                 Time(t_star)
+            );
+            (status, message)
+        } else if reach > MAX_REACH {
+            // The rates, not the positions or the tolerances: the failure is their symptom
+            // (the advice of a failed position analysis is for positions). After the
+            // singularities' diagnoses: near a fold the rates grow too, as its symptom.
+            let (what, fix) = if start {
+                ("the start rates qd0 are", "give smaller start rates (qd0)")
+            } else {
+                ("the rates are", "lower the efforts or start rates (qd0) that drive them there")
+            };
+            let message = format!(
+                "{what} too large to integrate: the mechanism moves {reach:.2e} rad (or lengths per L) in the \
+                 integrator's smallest step ({h_min:.0e} s), more than its position analysis follows in a step \
+                 ({MAX_REACH}); {fix}. The step failed with: {message}"
             );
             (status, message)
         } else {
@@ -184,8 +205,8 @@ impl Stop {
                     "step size too small at t = {} s: after {attempts} steps the mean step is {mean:.2e} s \
                      (last {last:.2e} s), below (t_end - t0) / ({PROGRESS_MARGIN} max_steps) = {floor:.2e} s, so \
                      the run cannot make progress to t_end = {} s within max_steps = {max_steps}. The efforts \
-                     are too large for the model or the tolerances too tight: lower the efforts, loosen rtol/atol, \
-                     shorten t_end, or raise max_steps",
+                     or rates are too large for the model or the tolerances too tight: lower the efforts or the \
+                     start rates (qd0), loosen rtol/atol, shorten t_end, or raise max_steps",
                     Time(t),
                     Time(t_end)
                 ),
@@ -211,6 +232,13 @@ impl Stop {
         }
     }
 }
+
+/// The most the mechanism may move (rad, or lengths per L) in the integrator's smallest step
+/// for a failed step to be blamed on anything but its rates: the core's continuation step
+/// (`kinematics::effector::IK_CONTINUATION_STEP`), the farthest its position analysis is taken
+/// at once. Past it, the start rates 1e20 rad/s of the four-bar's and the five-bar's runs failed
+/// their position analysis, with advice for positions.
+const MAX_REACH: f64 = 0.02;
 
 /// A run whose mean step so far would need this many times its step budget to reach t_end
 /// is stopped: it cannot finish, and waiting for the budget costs this many times more work.

@@ -45,7 +45,7 @@ impl Passed {
 
 /// The largest rate of the body coordinates xd, translations per the characteristic length L
 /// (the units of `kinematics::scaled_distance` with `col_scales`).
-fn scaled_speed(mech: &Mechanism, xd: &[f64]) -> f64 {
+pub fn scaled_speed(mech: &Mechanism, xd: &[f64]) -> f64 {
     xd.chunks_exact(3).fold(0.0, |s: f64, v| s.max(v[0].abs().max(v[1].abs()) / mech.scale).max(v[2].abs()))
 }
 

@@ -23,7 +23,7 @@ mod approach;
 mod bridge;
 mod point;
 
-pub use approach::{Approach, Grid, Passed};
+pub use approach::{scaled_speed, Approach, Grid, Passed};
 pub use bridge::{Bridge, Path};
 pub use point::{inside_step, stepped_over, ChangePoint};
 
