@@ -145,11 +145,11 @@ pub struct MechanismOde<'a> {
     user_closed: Option<ClosedForm>,
     alt_shared: Arc<OnceLock<AltCharts>>,
     alt: Option<AltCharts>,
-    /// Where the user's closed forms place the point of an alternative chart for its type II
-    /// measure ([`MechanismOde::user_sigma`]), and the alternative charts' closed forms the
-    /// point in `ws` for theirs (`AltCharts::best`): a copy of the workspace's frame, made at
-    /// the first such measure.
-    user_frame: Option<Frame>,
+    /// The scratch frame of the measures taken by other charts' closed forms: where the user's
+    /// place the point of an alternative chart for its type II measure
+    /// ([`MechanismOde::user_sigma`]), and the alternative charts' the point in `ws` for theirs
+    /// (`AltCharts::best`); a copy of the workspace's frame, made at the first such measure.
+    measure_frame: Option<Frame>,
     /// Whether the last accepted point is clear of folds ([`CLOSED_FORM_SIGMA`]).
     clear_of_folds: bool,
     /// The chart's own measure at the last accepted point (`limit_correction`), which the
@@ -203,7 +203,7 @@ impl<'a> MechanismOde<'a> {
             user_closed: None,
             alt_shared,
             alt: None,
-            user_frame: None,
+            measure_frame: None,
             closed,
             base_closed: false,
             stale_j: false,
@@ -382,7 +382,7 @@ impl<'a> MechanismOde<'a> {
     pub fn best_alt_chart(&mut self) -> Option<(Chart, f64)> {
         let mech = self.mech;
         let alt = self.alt.get_or_insert_with(|| self.alt_shared.get_or_init(|| AltCharts::new(mech)).clone());
-        let frame = self.user_frame.get_or_insert_with(|| self.ws.frame.clone());
+        let frame = self.measure_frame.get_or_insert_with(|| self.ws.frame.clone());
         alt.best(mech, &self.ws.x, frame)
     }
 
@@ -392,7 +392,7 @@ impl<'a> MechanismOde<'a> {
     /// instructions for an SVD's tens of thousands), else exact.
     pub fn user_sigma(&mut self) -> f64 {
         if let Some(c) = self.user_closed.as_mut() {
-            let frame = self.user_frame.get_or_insert_with(|| self.ws.frame.clone());
+            let frame = self.measure_frame.get_or_insert_with(|| self.ws.frame.clone());
             c.set_reference(&self.ws.x);
             if c.positions(&self.ws.q, frame).is_ok() {
                 return c.sigma();

@@ -6,6 +6,7 @@ use super::charts::NEAR_PASSIVE_SINGULAR;
 use super::trajectory::Status;
 use crate::error::Time;
 use crate::integrate::StepError;
+use crate::kinematics::effector::IK_CONTINUATION_STEP;
 use crate::Error;
 
 /// Why a run stopped. Times in s.
@@ -234,11 +235,11 @@ impl Stop {
 }
 
 /// The most the mechanism may move (rad, or lengths per L) in the integrator's smallest step
-/// for a failed step to be blamed on anything but its rates: the core's continuation step
-/// (`kinematics::effector::IK_CONTINUATION_STEP`), the farthest its position analysis is taken
-/// at once. Past it, the start rates 1e20 rad/s of the four-bar's and the five-bar's runs failed
-/// their position analysis, with advice for positions.
-const MAX_REACH: f64 = 0.02;
+/// for a failed step to be blamed on anything but its rates: the core's continuation step,
+/// the farthest its position analysis is taken at once. Past it, the start rates 1e20 rad/s
+/// of the four-bar's and the five-bar's runs failed their position analysis, with advice for
+/// positions.
+const MAX_REACH: f64 = IK_CONTINUATION_STEP;
 
 /// A run whose mean step so far would need this many times its step budget to reach t_end
 /// is stopped: it cannot finish, and waiting for the budget costs this many times more work.
