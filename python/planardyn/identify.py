@@ -280,6 +280,7 @@ def identify(
     r = base.rank
     _check_identifiable(base, Wb.reshape(-1, r), n, m)
     beta, _ = _least_squares(Wb.reshape(-1, r), rhs.reshape(-1))
+    _refuse_overflow(tau, beta, Wb @ beta)  # the second pass's weights come from these residuals
     # Second pass: each coordinate's rows weighted by the inverse of its residual's size.
     floor = RESIDUAL_FLOOR * max(float(np.sqrt(np.mean(rhs**2))), np.finfo(float).tiny)
     sigma = np.maximum(np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0)), floor)  # per coordinate
@@ -287,13 +288,19 @@ def identify(
     beta, variance = _least_squares(Ww, rw)
     s2 = float(np.sum((rw - Ww @ beta) ** 2) / (n * m - r))
     std = np.sqrt(s2 * variance)
-    if not (np.isfinite(beta).all() and np.isfinite(std).all()):
-        raise error("tau", f"tau: the efforts (largest {np.abs(tau).max():.3g}) overflow the least-squares sums: "
-                           "give them in N m or N")
+    _refuse_overflow(tau, beta, std)
     prior_pi = np.array(list(mech.regressor_parameters.values()))
     resid = np.sqrt(np.mean((rhs - Wb @ beta) ** 2, axis=0))
     pi = _consistent(base, beta, prior_pi, mech.n_bodies)
     return Identification(base, beta, std, base.of(prior_pi), dict(zip(base.parameters, pi)), resid, n)
+
+
+def _refuse_overflow(tau: FloatArray, *values: FloatArray) -> None:
+    """Refuse efforts so large that a least-squares pass's values overflow (1e308 in one row:
+    a NaN residual, on which the second pass's SVD fails)."""
+    if not all(np.isfinite(v).all() for v in values):
+        raise error("tau", f"tau: the efforts (largest {np.abs(tau).max():.3g}) overflow the least-squares sums: "
+                           "give them in N m or N")
 
 
 def _base_of(mech: Mechanism, base: BaseParameters | None) -> BaseParameters:
