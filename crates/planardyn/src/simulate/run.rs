@@ -747,12 +747,13 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let (mech, ode, t) = (self.ode.mech, &self.ode, self.stepper.t());
         let fold = self.fold.ahead(t, t - self.stepper.t_prev());
         let h_min = self.settings.options.h_min * t.abs().max(1.0);
-        // The last row is the last accepted state (`keeps_last`) for the failures diagnosed.
-        let speed = traj.xd.rchunks_exact(traj.nx).next().map_or(0.0, |xd| scaled_speed(mech, xd));
+        // The last row is the last accepted state (`keeps_last`) for the failures diagnosed;
+        // its speed is read only for a failed run's message (`describe` calls `near` then).
+        let (xd, nx) = (&traj.xd, traj.nx);
         (traj.status, traj.message) = stop.describe(|| Near {
             passive: passive_sigma_min(mech, ode.anchor_x()),
             driven: ode.motion.as_ref().map_or(f64::INFINITY, |p| prescribed_sigma_min(mech, &p.p, ode.anchor_x())),
-            reach: speed * h_min,
+            reach: xd.rchunks_exact(nx).next().map_or(0.0, |xd| scaled_speed(mech, xd)) * h_min,
             h_min,
             start: t - self.settings.t0 < h_min,
             fold,
