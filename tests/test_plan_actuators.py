@@ -78,8 +78,9 @@ def usage_at(mech, plan, i, s):
     tau = mech.inverse_dynamics(plan.path(s), qd, p1 * plan.sdd[i][:, None] + p2 * x[:, None], x=plan.x[i])
     qdd = p1 * plan.sdd[i][:, None] + p2 * x[:, None]
     t_m = np.asarray(mech.motor_torques(plan.path(s), qd, qdd, tau, x=plan.x[i]))
-    avail = np.column_stack([mech.available_torque(k, RATIO * qd[:, k]) for k in range(mech.dof)])
-    return (np.abs(t_m) / avail).max(axis=1), RATIO * np.abs(qd).max(axis=1)
+    ratio = np.array([a["gear_ratio"] for a in mech.actuators])
+    avail = np.column_stack([mech.available_torque(k, ratio[k] * qd[:, k]) for k in range(mech.dof)])
+    return (np.abs(t_m) / avail).max(axis=1), np.abs(ratio * qd).max(axis=1)
 
 
 def test_motor_torques_stay_within_the_drooping_envelope_and_it_binds(path) -> None:
@@ -186,16 +187,20 @@ def test_cli_plans_within_the_motors(tmp_path, path) -> None:
     assert main(["plan", str(file), *line, "--collocate", "time"]) == 2
 
 
-def test_timing_that_alternates_between_two_rounds_says_so():
-    # The five-bar robot's motors on this line at n_grid 10 (refined to 145 points): from round
-    # 8 the tangents taken at 0.0679969 s (limits used to 0.99999997) give 0.0679794 s (to
-    # 1.000003) and back. The message named the last two times as if the time still changed
-    # ("did not settle in 60 rounds (0.0679969417 s, then 0.0679793638 s, ...)").
+def test_timing_that_alternates_between_two_rounds_takes_the_one_within_the_limits():
+    # The five-bar robot's motors on this line at n_grid 10 (refined to 145 points): from a round
+    # on the tangents taken at 0.0679969 s (limits used to 0.99999997) give 0.0679794 s (to
+    # 1.000003) and back, so the rounds never settled and the plan failed after 60. The dense
+    # check holds the first within the limits: it is the plan, and its status says why.
     mech = planardyn.load_example("five-bar-robot")
     q = task_waypoints(rb.EndEffector(mech, "P"), [[-0.04, 0.45], [0.06, 0.5]], 0.01)
-    with pytest.raises(PlanError) as err:
-        time_optimal(mech, q, "actuators", n_grid=10)
-    message = str(err.value)
-    assert message.startswith("the timing did not settle in 60 rounds on a grid of 145 points: its time alternates "
-                              "between 0.06799694")
-    assert "and 0.06797936" in message and message.endswith("try another n_grid")
+    plan = time_optimal(mech, q, "actuators", n_grid=10)
+    assert plan.duration == pytest.approx(0.0679969417, rel=1e-9)
+    assert plan.limit_ratio <= 1 + 1e-10
+    assert "alternating between 0.0679969417 s (taken: limits used to 0.99999997" in plan.status
+    assert "and 0.0679793638 s (limits used to 1.00000298)" in plan.status
+    # Checked apart from the plan's own check: the motor torques of the model the plan ran on
+    # (its servos left out) at 11 points of every interval (the path's end, at rest, left out
+    # as in usage()) within the envelope to round-off.
+    use, _ = usage(plan.mech, plan)
+    assert len(plan.s) == 145 and use.max() <= 1 + 1e-9

@@ -366,8 +366,11 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
             raise InfeasiblePlan(f"no timing follows this path within the limits (toppra: {status}, but at rest "
                                  "somewhere along it): raise the limits or move the path")
         found = check(mech, path, s, x, sd, sdd, limits, path.ss_waypoints, exact)
-        settled = not tangents or abs(duration - t_new) <= ACTUATOR_TOL * t_new
-        if found.ratio <= 1 + RATIO_TOL and settled:
+        settled = not tangents or _same(duration, t_new)
+        # Rounds that alternate between two timings never settle; the dense check holds this
+        # one within the limits, so it is a plan (the other, not: see _unsettled).
+        alternates = len(history) >= 2 and _same(history[-2][0], t_new) and not _same(duration, t_new)
+        if found.ratio <= 1 + RATIO_TOL and (settled or alternates):
             break
         history.append((t_new, found.ratio))
         if rounds == MAX_ROUNDS:
@@ -382,6 +385,9 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
         u0 = np.append(sdd, 0.0)[stage]
         x0 = sd[stage] ** 2 + 2 * d * u0
     status = f"{status}; {rounds} rounds" + (" of tangents" if tangents else "")
+    if tangents and not settled:
+        status += (f", alternating between {t_new:.9g} s (taken: limits used to {found.ratio:.9g}) and "
+                   f"{duration:.9g} s (limits used to {history[-1][1]:.9g})")
     sd2 = sd**2
     dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
     u = np.append(sdd, sdd[-1])
@@ -391,20 +397,21 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
                      speed=np.full(mech.dof, np.inf), time_error=None, status=status, ignored=[])
 
 
+def _same(a: float, b: float) -> bool:
+    """Two rounds' times (s) the same to ACTUATOR_TOL."""
+    return abs(a - b) <= ACTUATOR_TOL * b
+
+
 def _unsettled(history: list[tuple[float, float]], n: int) -> str:
     """Why the rounds on a grid of n points did not end, from each round's time (s) and limits
-    used: the time still changing, alternating between two timings (the motor envelopes'
-    tangents taken at one give the other: the five-bar robot's --actuators line at n_grid 10,
-    refined to 145 points, from round 8 on), or settled with a limit still exceeded."""
+    used: the time still changing, alternating between two timings that both exceed a limit
+    (the motor envelopes' tangents taken at one give the other; where one of the two is within
+    the limits, it is taken), or settled with a limit still exceeded."""
     (t_2, _), (t_1, r_1), (t, r) = history[-3:]
-
-    def same(a: float, b: float) -> bool:
-        return abs(a - b) <= ACTUATOR_TOL * b
-
-    if same(t, t_2) and not same(t, t_1):
+    if _same(t, t_2) and not _same(t, t_1):
         what = (f"alternates between {t_1:.9g} s (limits used to {r_1:.9g}) and {t:.9g} s (limits used to {r:.9g}) "
                 "from round to round: the motor envelopes' tangents taken at either timing give the other")
-    elif same(t, t_1):
+    elif _same(t, t_1):
         what = f"settled at {t:.9g} s, but the dense check still finds the limits used to {r:.9g}"
     else:
         what = f"still changes ({t_1:.9g} s, then {t:.9g} s, limits used to {r:.9g})"
