@@ -40,6 +40,9 @@ const RTOL: f64 = 2e-3;
 /// made every scaled distance of the run 1e16 times too large, so every evaluation failed.
 const POINT_GROUP: f64 = 1e-9;
 
+/// Largest block whose scratch [`GroupScales::below`] keeps on the stack.
+const SMALL_BLOCK: usize = 8;
+
 /// Per permuted position of a [`BlockLu`]: the factors taking the globally scaled J to each
 /// block's own length, and the inverse-iteration vectors of the estimate.
 #[derive(Debug, Clone, Default)]
@@ -56,7 +59,7 @@ pub struct GroupScales {
     v: Vec<f64>,
     w: Vec<f64>,
     warm: Vec<bool>,
-    /// Scratch of [`GroupScales::below`]: a block and its Gram matrix.
+    /// Scratch of [`GroupScales::below`]: a block and its Gram matrix (over [`SMALL_BLOCK`]).
     gram: Vec<f64>,
 }
 
@@ -177,8 +180,16 @@ impl GroupScales {
             if b.iter().any(|v| !v.is_finite()) {
                 return true;
             }
-            self.gram.resize(2 * s * s, 0.0);
-            let (rows, gram) = self.gram.split_at_mut(s * s);
+            // On the stack up to 8 x 8 (the five-bar's dyad block): `gram` grew once for
+            // each new analysis of the chart's blocks otherwise (16 k of the free fall's run).
+            let mut stack = [0.0; 2 * SMALL_BLOCK * SMALL_BLOCK];
+            let scratch = if s <= SMALL_BLOCK {
+                &mut stack[..2 * s * s]
+            } else {
+                self.gram.resize(2 * s * s, 0.0);
+                &mut self.gram[..]
+            };
+            let (rows, gram) = scratch.split_at_mut(s * s);
             for (i, row) in rows.chunks_exact_mut(s).enumerate() {
                 for (j, v) in row.iter_mut().enumerate() {
                     *v = b[i * s + j] * fr[i] * fc[j];
