@@ -21,7 +21,7 @@
 //! takes the SVD of each block (s^3), never of the whole J.
 
 use super::constraints::{fill_row_scale, Chart};
-use crate::linalg::BlockLu;
+use crate::linalg::{cholesky_in_place, gamma, BlockLu};
 use crate::model::diameter::diameter;
 use crate::model::pairs::frames::perp;
 use crate::model::Mechanism;
@@ -40,6 +40,9 @@ const RTOL: f64 = 2e-3;
 /// made every scaled distance of the run 1e16 times too large, so every evaluation failed.
 const POINT_GROUP: f64 = 1e-9;
 
+/// Largest block whose scratch [`GroupScales::below`] keeps on the stack.
+const SMALL_BLOCK: usize = 8;
+
 /// Per permuted position of a [`BlockLu`]: the factors taking the globally scaled J to each
 /// block's own length, and the inverse-iteration vectors of the estimate.
 #[derive(Debug, Clone, Default)]
@@ -56,6 +59,8 @@ pub struct GroupScales {
     v: Vec<f64>,
     w: Vec<f64>,
     warm: Vec<bool>,
+    /// Scratch of [`GroupScales::below`]: a block and its Gram matrix (over [`SMALL_BLOCK`]).
+    gram: Vec<f64>,
 }
 
 impl GroupScales {
@@ -80,7 +85,15 @@ impl GroupScales {
                 }
             }
         }
-        GroupScales { row, col, col_scale, v: vec![0.0; n], w: vec![0.0; n], warm: vec![false; lu.n_blocks()] }
+        GroupScales {
+            row,
+            col,
+            col_scale,
+            v: vec![0.0; n],
+            w: vec![0.0; n],
+            warm: vec![false; lu.n_blocks()],
+            gram: Vec::new(),
+        }
     }
 
     /// Forget the singular vectors (the next estimate starts cold).
@@ -142,27 +155,100 @@ impl GroupScales {
     pub fn exact(&self, lu: &BlockLu) -> f64 {
         let mut best = f64::INFINITY;
         for k in 0..lu.n_blocks() {
-            let span = lu.span(k);
-            let s = span.len();
-            let (fr, fc) = (&self.row[span.clone()], &self.col[span]);
-            let b = lu.block(k);
             // The SVD iteration need not end on non-finite entries: such a block is singular.
-            if b.iter().any(|v| !v.is_finite()) {
-                return 0.0;
-            }
-            let entry = |i: usize, j: usize| b[i * s + j] * fr[i] * fc[j];
-            // nalgebra's SVD runs the same steps whatever the matrix's storage, except its own
-            // 2 x 2 and 3 x 3 paths (which differ in the last bits): a fixed 1 x 1 or 6 x 6 only
-            // spares the heap (the five-bar's 176 input-link and 79 dyad blocks of a run's 431).
-            let sigma = match s {
-                1 => SMatrix::<f64, 1, 1>::from_fn(entry).singular_values().min(),
-                6 => SMatrix::<f64, 6, 6>::from_fn(entry).singular_values().min(),
-                _ => DMatrix::from_fn(s, s, entry).singular_values().min(),
-            };
+            let Some(sigma) = self.block_sigma(lu, k) else { return 0.0 };
             best = best.min(sigma);
         }
         best
     }
+
+    /// Whether [`GroupScales::exact`] of the filled `lu` is below `t` (> 0), the same answer
+    /// without the SVDs wherever rounding cannot change it: block B (scaled, s x s) has its
+    /// smallest singular value at or above t exactly where G = B B^T - t^2 I is positive
+    /// semidefinite, which a Cholesky factorisation of G shifted by what its rounding can hide
+    /// decides both ways (Rump's argument, as `linalg::gram`'s: a factorisation that completes
+    /// proves sigma > t; one that fails at the opposite shift proves sigma < t, by Demmel's
+    /// condition for its success, Higham 2nd ed. ch. 10). Only a block within that shift of t, about
+    /// 1e-12 t for the five-bar's 8 x 8 dyad block, takes its SVD. 2 s^3 / 3 flops a block
+    /// where the SVD takes tens of s^3.
+    pub fn below(&mut self, lu: &BlockLu, t: f64) -> bool {
+        for k in 0..lu.n_blocks() {
+            let s = lu.span(k).len();
+            let (fr, fc) = (&self.row[lu.span(k)], &self.col[lu.span(k)]);
+            let b = lu.block(k);
+            // As `exact`: a block with a non-finite entry is singular.
+            if b.iter().any(|v| !v.is_finite()) {
+                return true;
+            }
+            // On the stack up to 8 x 8 (the five-bar's dyad block): `gram` grew once for
+            // each new analysis of the chart's blocks otherwise (16 k of the free fall's run).
+            let mut stack = [0.0; 2 * SMALL_BLOCK * SMALL_BLOCK];
+            let scratch = if s <= SMALL_BLOCK {
+                &mut stack[..2 * s * s]
+            } else {
+                self.gram.resize(2 * s * s, 0.0);
+                &mut self.gram[..]
+            };
+            let (rows, gram) = scratch.split_at_mut(s * s);
+            for (i, row) in rows.chunks_exact_mut(s).enumerate() {
+                for (j, v) in row.iter_mut().enumerate() {
+                    *v = b[i * s + j] * fr[i] * fc[j];
+                }
+            }
+            // The lower triangle of B B^T, and its trace (= ||B||_F^2, which bounds every rounding).
+            let mut trace = 0.0;
+            for i in 0..s {
+                for j in 0..=i {
+                    gram[i * s + j] =
+                        rows[i * s..(i + 1) * s].iter().zip(&rows[j * s..(j + 1) * s]).map(|(a, b)| a * b).sum();
+                }
+                trace += gram[i * s + i];
+            }
+            let g = gamma(s + 1);
+            let hidden = 2.0 * (s as f64 * g / (1.0 - s as f64 * g) + 2.0 * gamma(s) + f64::EPSILON) * trace;
+            let t2 = t * t;
+            if shifted_factorises(gram, rows, s, t2 * (1.0 + 2.0 * f64::EPSILON) + hidden) {
+                continue;
+            }
+            if !shifted_factorises(gram, rows, s, t2 * (1.0 - 2.0 * f64::EPSILON) - hidden)
+                || self.block_sigma(lu, k).is_none_or(|sigma| sigma < t)
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The smallest singular value of block k of the filled `lu` at its own length (None where
+    /// an entry is not finite).
+    fn block_sigma(&self, lu: &BlockLu, k: usize) -> Option<f64> {
+        let span = lu.span(k);
+        let s = span.len();
+        let (fr, fc) = (&self.row[span.clone()], &self.col[span]);
+        let b = lu.block(k);
+        if b.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let entry = |i: usize, j: usize| b[i * s + j] * fr[i] * fc[j];
+        // nalgebra's SVD runs the same steps whatever the matrix's storage, except its own
+        // 2 x 2 and 3 x 3 paths (which differ in the last bits): a fixed 1 x 1 or 6 x 6 only
+        // spares the heap (the five-bar's 176 input-link and 79 dyad blocks of a run's 431).
+        Some(match s {
+            1 => SMatrix::<f64, 1, 1>::from_fn(entry).singular_values().min(),
+            6 => SMatrix::<f64, 6, 6>::from_fn(entry).singular_values().min(),
+            _ => DMatrix::from_fn(s, s, entry).singular_values().min(),
+        })
+    }
+}
+
+/// Whether the Cholesky factorisation of `gram` (s x s, its lower triangle) less `shift` on its
+/// diagonal runs to completion, in `work` (s x s).
+fn shifted_factorises(gram: &[f64], work: &mut [f64], s: usize, shift: f64) -> bool {
+    work.copy_from_slice(gram);
+    for i in 0..s {
+        work[i * s + i] -= shift;
+    }
+    cholesky_in_place(work, s)
 }
 
 /// Length of the group whose block has the columns `cols` (body coordinates): see

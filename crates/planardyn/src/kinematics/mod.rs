@@ -32,7 +32,8 @@ pub use position::{
     MAX_CORRECTION, POSITION_TOL,
 };
 pub use singularity::{
-    partition_sigma_min_with, passive_sigma_min, passive_sigma_min_with, select_partition, sigma_min, sigma_min_with,
+    partition_sigma_below_with, passive_sigma_below_with, passive_sigma_min, passive_sigma_min_with, select_partition,
+    sigma_min, sigma_min_with,
 };
 pub use system::System;
 pub use u_support::USupport;

@@ -214,6 +214,14 @@ impl System {
         self.groups.exact(&self.lu)
     }
 
+    /// Whether [`System::group_sigma_exact`] would be below `t` (> 0): the same answer, taking
+    /// a block's SVD only where rounding could change it (`GroupScales::below`).
+    pub fn group_sigma_below(&mut self, mech: &Mechanism, chart: &Chart, x: &[f64], trig: &[[f64; 2]], t: f64) -> bool {
+        self.fill(mech, chart, x, trig);
+        self.groups.reset();
+        self.groups.below(&self.lu, t)
+    }
+
     /// A system kept with this one for the measures of `chart`, another chart than this one's
     /// (the passive measure's partition, which changes only where the pivots do): its pattern is
     /// analysed when the chart changes, not at each measure (the five-bar's analysis cost 74 k

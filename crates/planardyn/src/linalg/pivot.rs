@@ -20,12 +20,28 @@ fn row_max(row: &[f64], free: &[usize]) -> (f64, usize) {
     (best, col)
 }
 
+/// `row -= l pivot_row` over the `free` columns, and then [`row_max`] of it, in one pass: the
+/// same entries and the same first largest (a pass fewer over the row: the five-bar's 10 x 12
+/// Phi_x, 33 eliminations of the free fall's run: 48 k instructions fewer of 6.81 M).
+#[inline(always)]
+fn update_row_max(row: &mut [f64], pivot_row: &[f64], l: f64, free: &[usize]) -> (f64, usize) {
+    let (mut best, mut col) = (0.0, usize::MAX);
+    for &c in free {
+        row[c] -= l * pivot_row[c];
+        let v = row[c].abs();
+        if v > best {
+            (best, col) = (v, c);
+        }
+    }
+    (best, col)
+}
+
 /// Eliminate the row-major `rows x cols` matrix `a` (destroyed) with complete pivoting;
 /// returns the first `count` pivot columns in pivot order (fewer if a pivot is exactly 0).
 pub fn pivot_columns(a: &mut [f64], rows: usize, cols: usize, count: usize) -> Vec<usize> {
     let mut free: Vec<usize> = (0..cols).collect();
     let mut best_of: Vec<(f64, usize)> = (0..rows).map(|r| row_max(&a[r * cols..(r + 1) * cols], &free)).collect();
-    let mut pivots = Vec::new();
+    let mut pivots = Vec::with_capacity(rows.min(count));
     for k in 0..rows.min(count) {
         let (mut pr, mut best) = (k, 0.0);
         for (r, &(v, _)) in best_of.iter().enumerate().skip(k) {
@@ -49,11 +65,8 @@ pub fn pivot_columns(a: &mut [f64], rows: usize, cols: usize, count: usize) -> V
         for (r, row) in rest.chunks_exact_mut(cols).enumerate() {
             let l = row[col] / pivot_row[col];
             if l != 0.0 {
-                for &j in &free {
-                    row[j] -= l * pivot_row[j];
-                }
-            }
-            if l != 0.0 || best_of[k + 1 + r].1 == col {
+                best_of[k + 1 + r] = update_row_max(row, pivot_row, l, &free);
+            } else if best_of[k + 1 + r].1 == col {
                 best_of[k + 1 + r] = row_max(row, &free);
             }
         }

@@ -25,7 +25,9 @@
 //! of one analysis have the same supports.
 
 use crate::kinematics::alt_charts::AltCharts;
-use crate::kinematics::{partition_sigma_min_with, passive_sigma_min_with, ClosedForm, System};
+use crate::kinematics::{
+    partition_sigma_below_with, passive_sigma_below_with, passive_sigma_min_with, ClosedForm, System,
+};
 use crate::model::Mechanism;
 use crate::{Error, Workspace};
 use std::sync::{Arc, OnceLock};
@@ -95,17 +97,23 @@ impl Prepared {
         self.with_partition(inputs_sys, |sys| passive_sigma_min_with(sys, mech, x))
     }
 
-    /// The partition's half of [`Prepared::passive_measure`] ([`partition_sigma_min_with`]): the
-    /// type II measure of the partition `select_partition` chooses at x (infinite without
-    /// constraints), not the user's chart's. Where the caller has the user's chart's measure
-    /// already, the passive measure is the larger of the two.
-    pub fn partition_measure(&self, inputs_sys: &mut System, mech: &Mechanism, x: &[f64]) -> f64 {
-        self.with_partition(inputs_sys, |sys| partition_sigma_min_with(sys, mech, x))
+    /// Whether [`Prepared::passive_measure`] at x is below `t` (> 0), the same answer without the
+    /// blocks' SVDs where rounding cannot change it ([`passive_sigma_below_with`]).
+    pub fn passive_below(&self, inputs_sys: &mut System, mech: &Mechanism, x: &[f64], t: f64) -> bool {
+        self.with_partition(inputs_sys, |sys| passive_sigma_below_with(sys, mech, x, t))
+    }
+
+    /// Whether the partition's half of [`Prepared::passive_measure`] is below `t` (> 0)
+    /// ([`partition_sigma_below_with`]): the type II measure of the partition `select_partition`
+    /// chooses at x (infinite without constraints), not the user's chart's. Where the caller has
+    /// the user's chart's measure already, the passive measure is the larger of the two.
+    pub fn partition_below(&self, inputs_sys: &mut System, mech: &Mechanism, x: &[f64], t: f64) -> bool {
+        self.with_partition(inputs_sys, |sys| partition_sigma_below_with(sys, mech, x, t))
     }
 
     /// `measure(inputs_sys)` with the partition's analysis lent from here when the run has none
     /// yet, and the first run's kept here for the later ones.
-    fn with_partition(&self, inputs_sys: &mut System, measure: impl FnOnce(&mut System) -> f64) -> f64 {
+    fn with_partition<T>(&self, inputs_sys: &mut System, measure: impl FnOnce(&mut System) -> T) -> T {
         if let Some(kept) = self.partition.get() {
             inputs_sys.keep_other(|| kept.clone());
         }

@@ -548,7 +548,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     fn settle(&mut self) {
         let Heading::Deferred { passive, x, on } = &self.heading else { return };
         let ode = &mut self.ode;
-        let ahead = self.prepared.partition_measure(&mut ode.inputs_sys, ode.mech, x) < CHANGE_POINT_RATIO * passive;
+        let ahead = self.prepared.partition_below(&mut ode.inputs_sys, ode.mech, x, CHANGE_POINT_RATIO * passive);
         if *on && !ahead {
             (self.grid, self.limit) = (None, None);
         }
@@ -582,8 +582,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let saved = self.ode.save();
         let near = self.ode.evaluate(t, self.stepper.y()).map(|()| {
             let (ode, prepared) = (&mut self.ode, self.prepared);
-            prepared.passive_measure(&mut ode.inputs_sys, ode.mech, &ode.ws.x) < CROSS_START
-                || inside_step(ode, last, t)
+            prepared.passive_below(&mut ode.inputs_sys, ode.mech, &ode.ws.x, CROSS_START) || inside_step(ode, last, t)
         });
         self.ode.restore(saved);
         near.unwrap_or(true)
