@@ -104,6 +104,9 @@ pub struct Run<'a, 's, 'e> {
     /// The accelerations' growth against 1 / sigma into that point (`acceleration_growth`;
     /// NaN where not known).
     user_growth: f64,
+    /// The user's chart's singularity was found in the solution (`acceleration_growth` rose
+    /// below PREDICT_BELOW) while its measure has been falling since.
+    fall_singular: bool,
     /// Steps accepted since the last chart switch.
     chart_steps: usize,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
@@ -162,6 +165,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             last_own: None,
             last_user: None,
             user_growth: f64::NAN,
+            fall_singular: false,
             chart_steps: 0,
             fold: FoldWatch::default(),
         };
@@ -516,7 +520,14 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         let m = self.ode.m();
         let now = (t, own, self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt());
         let growth = self.last_user.filter(|_| user).map_or(f64::NAN, |last| acceleration_growth(last, now));
-        let singular = growth > 0.0 && growth >= self.user_growth;
+        let rising = growth > 0.0 && growth >= self.user_growth;
+        // Latched for the rest of the fall once it rose below PREDICT_BELOW: the growth from
+        // point to point is noisy where the steps are long (five-bar fall, DOPRI5 rtol
+        // 9.5e-5: 27.1 then 25.7 at sigma 0.106 and 0.085, and the next step, unbounded by
+        // T/2, took 0.085 to 0.050 and gained 1.0e-3 J).
+        let falling = self.last_user.filter(|_| user).is_some_and(|last| own < last.1);
+        self.fall_singular = falling && (self.fall_singular || (rising && own < PREDICT_BELOW));
+        let singular = rising || self.fall_singular;
         if let Some(last) = self.last_user.filter(|_| user && (own < PREDICT_BELOW || singular)) {
             self.stepper.bound_next_step(fall_step_bound(last, now, singular));
         }
