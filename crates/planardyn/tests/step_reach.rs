@@ -10,7 +10,7 @@ use planardyn::simulate::{grid, simulate, Settings};
 const FIVE_BAR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/models/five-bar-free-fall.yaml");
 
 /// The energy target of the five-bar benchmark (issue 25, drift 1e-4 J over 1 s). At this
-/// tolerance the run drifts 6.0e-6 J (grid) and 6.0e-6 J (every step; main f9f5f7e 3.6e-5 and
+/// tolerance the run drifts 3.6e-5 J (grid) and 2.3e-5 J (every step; main d231ebd 3.6e-5 and
 /// 2.6e-5 J); before the step's reach was bounded one step in the user's chart crossed the
 /// type II singularity and the run gained 0.89 J on the grid, 4.7e-2 J at the steps (both
 /// measured with DOP853 on main dde9f27).
@@ -54,8 +54,9 @@ fn five_bar_steps_near_singularities_keep_the_energy() {
 /// (t = 0.155 s; the step's reach, 2 x the measure, let it through) and drifted 6.5e-4 to
 /// 9.2e-4 J at the steps, 7.1e-4 to 9.4e-4 J on a 1 ms grid. With the measure's fall in one
 /// step bounded (`simulate::charts::fall_step_bound`) the largest fall is 2.03x and the
-/// drift 7.4e-6 to 9.0e-6 J (steps), 1.8e-5 to 2.7e-5 J (1 ms grid); with a step at most
-/// half the time to the singularity (s23-spike) 3.0e-6 to 5.1e-6 J and 6.5e-6 to 8.4e-6 J.
+/// drift 7.4e-6 to 9.0e-6 J (steps), 1.8e-5 to 2.7e-5 J (1 ms grid) (main d231ebd: 6.5e-6
+/// to 8.9e-6 J, 1.0e-5 to 1.6e-5 J); with a step at most half the time to the singularity
+/// where it is in the solution 5.8e-6 to 8.0e-6 J and 6.1e-6 to 1.0e-5 J.
 const FAST_APPROACH_LEVELS: std::ops::RangeInclusive<i32> = 0..=13;
 
 #[test]
