@@ -81,19 +81,30 @@ fn body_motion(mech: &Mechanism, qd: &[f64], qdd: &[f64], given: Option<&[f64]>,
 }
 
 /// How far body rates xd are from being the rates of user rates qd at the positions in `ws`
-/// (`ws.x`, `ws.trig`): the largest row of |J xd - [0; qd]| relative to that row's own size,
-/// sum |J_ki xd_i| + |[0; qd]_k|. A product and a subtraction, so independent of J's
-/// conditioning: round-off gives a few eps, rates of another state O(1). `j` is a 3n x 3n
-/// scratch buffer.
+/// (`ws.x`, `ws.trig`): the largest row of |J xd - [0; qd]| relative to that row's size at the
+/// rates' own scale, sum_i |J_ki| s_i + |[0; qd]_k|, with s_i the largest translational or
+/// angular rate of xd (the kind of component i). A product and a subtraction, so independent
+/// of J's conditioning: round-off gives a few eps, rates of another state O(1). Not each term's
+/// own |J_ki xd_i|: a rate that is 0 in exact arithmetic carries the round-off of the others
+/// (the slider-crank through its dead centre, DOP853 rtol 1e-10: its slider's vertical rate
+/// -9.0e-16 m/s, which alone made its guide's row 1.0 "relative" and refused the run's own xd).
+/// `j` is a 3n x 3n scratch buffer.
 pub fn rates_mismatch(mech: &Mechanism, ws: &Workspace, qd: &[f64], xd: &[f64], j: &mut [f64]) -> f64 {
     let (n, nc) = (xd.len(), mech.n_constraints);
     jacobian(mech, &Chart::Inputs, &ws.x, &ws.trig, j);
+    // Body coordinates are (x, y, angle) per body.
+    let scale = |angular: bool| {
+        xd.iter().enumerate().filter(|(i, _)| (i % 3 == 2) == angular).map(|(_, v)| v.abs()).fold(0.0, f64::max)
+    };
+    let (linear, angular) = (scale(false), scale(true));
     (0..n)
         .map(|k| {
             let rhs = if k >= nc { qd[k - nc] } else { 0.0 };
             let row = &j[k * n..(k + 1) * n];
             let jxd: f64 = row.iter().zip(xd).map(|(a, v)| a * v).sum();
-            let size: f64 = row.iter().zip(xd).map(|(a, v)| (a * v).abs()).sum::<f64>() + rhs.abs();
+            let size: f64 =
+                row.iter().enumerate().map(|(i, a)| a.abs() * if i % 3 == 2 { angular } else { linear }).sum::<f64>()
+                    + rhs.abs();
             if size > 0.0 {
                 (jxd - rhs).abs() / size
             } else {
