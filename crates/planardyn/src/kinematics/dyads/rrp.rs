@@ -11,6 +11,20 @@ use crate::kinematics::group_sigma::rrp_sigma;
 use crate::model::pairs::frames::{dot, perp, rot, sub};
 use crate::model::{BodyId, Link, Pair, PairKind};
 use crate::{KinematicsError, SingularityKind};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Whether cos(psi) has the sign of `side` (a branch's, +-1): `psi.cos() * side > 0`. Within
+/// [-pi, pi], cos(psi) > 0 where |psi| <= FRAC_PI_2, the f64 below pi/2 (cos 6.1e-17, the next
+/// f64's -1.6e-16: the library's cosine, within an ulp, has these signs), and no f64 is a zero
+/// of it: the fold guard's test at every evaluation without the library call.
+#[inline(always)]
+fn on_side(psi: f64, side: f64) -> bool {
+    if psi.abs() <= PI {
+        let sign = if psi.abs() <= FRAC_PI_2 { 1.0 } else { -1.0 };
+        return sign * side > 0.0;
+    }
+    psi.cos() * side > 0.0
+}
 
 #[inline]
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -149,7 +163,7 @@ impl Rrp {
     #[inline]
     pub fn keeps_side(&self, branch: &Branch, x: &[f64]) -> bool {
         let psi = x[3 * self.bodies[0] + 2] - self.guide_angle(x) + self.bend;
-        psi.cos() * branch.side > 0.0
+        on_side(psi, branch.side)
     }
 
     /// The branch of the configuration x.
@@ -244,5 +258,28 @@ impl Rrp {
         let ap = add(aa, sub(scaled(al1, perp(g.e)), scaled(w1 * w1, g.e)));
         put_acceleration(a, self.bodies[0], aa, g.own, w1, al1);
         put_acceleration(a, self.bodies[1], ap, g.rp, wg, ag);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// `on_side`'s shortcut within [-pi, pi] decides as the library cosine's sign does, at its
+    /// edges (pi/2 and pi, each side of them), at 0 of both signs, across whole turns and at
+    /// NaN, for both sides (and a side of 0 or NaN, which no branch has).
+    #[test]
+    fn on_side_is_the_cosines_sign() {
+        let mut angles = vec![0.0, -0.0, f64::NAN, f64::INFINITY, 1e-300, 3.0 * PI, -7.0 * PI, 1e6, -1e6];
+        for edge in [FRAC_PI_2, -FRAC_PI_2, PI, -PI, 3.0 * FRAC_PI_2] {
+            angles.extend([edge, edge.next_up(), edge.next_down(), edge.next_up().next_up()]);
+        }
+        angles.extend((-4000..=4000).map(|k| k as f64 * 1.37e-3 * PI));
+        for psi in angles {
+            for side in [1.0, -1.0, 0.0, f64::NAN] {
+                assert_eq!(super::on_side(psi, side), psi.cos() * side > 0.0, "psi = {psi:e}, side {side}");
+            }
+        }
+        assert!(super::on_side(FRAC_PI_2, 1.0) && !super::on_side(FRAC_PI_2.next_up(), 1.0));
     }
 }
