@@ -3,8 +3,8 @@
 //! step that reaches beyond the solution's radius of convergence (`integrate::dop853::REACH_E3`).
 //!
 //! The cases are the worst such outliers of a sweep of rtol = atol = 10^(-k/20), k = 20..200,
-//! 1 s, DOP853 (/work/notes/s23-spike/sweep.py; outliers.py: drift over 10x the geometric mean
-//! of the runs at k - 1 and k + 1), on main d231ebd, drift in J at k - 1, k, k + 1:
+//! 1 s, DOP853 (benchmarks/drift_outliers.py: drift over 10x the geometric mean of the runs at
+//! k - 1 and k + 1), before the bound (d231ebd), drift in J at k - 1, k, k + 1:
 //! - Scotch yoke k = 119 (1.122e-6): 4.06e-5, **6.19e-3**, 1.64e-5 (240x);
 //! - four-bar with gravity k = 83 (7.08e-5): 1.24e-4, **1.19e-2**, 5.65e-5 (142x), one step of
 //!   0.097 s (0.192 -> 0.288 s) gains 1.19e-2 J;
@@ -17,7 +17,7 @@ use planardyn::dynamics::ModelDrives;
 use planardyn::simulate::{simulate, Overrides};
 
 /// The outlier test of the sweep: a drift over this many times the geometric mean of its two
-/// neighbours' is an outlier (outliers.py's default).
+/// neighbours' is an outlier (benchmarks/drift_outliers.py's default).
 const OUTLIER: f64 = 10.0;
 
 fn drift(model: &str, k: i32) -> f64 {

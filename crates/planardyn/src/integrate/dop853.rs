@@ -255,12 +255,13 @@ const D: [[f64; N_EXT]; 4] = [
 /// estimate `e5^2 / sqrt(e5^2 + 0.01 e3^2)` is no longer an error bound: e5 can be small by
 /// accident and a huge e3 deflates it further (the Scotch yoke's crank whipping through
 /// theta = 0 mod pi, complex singularities 3 ms away: steps of 15-17 ms with e5 = 22, e3 = 6500
-/// tolerances, estimate 0.77, true error 143 tolerances; s23-spike). Over rtol = atol =
-/// 10^(-k/20), k = 20..200, 1 s, the tolerances whose energy drift is over 10x the geometric
-/// mean of their neighbours' go from 17 to 0 on the yoke (over 5x: 26 -> 1), at +20 %
-/// evaluations; 76 -> 54 over 11 models (+7.7 %; the five-bar robot, whose friction and gear
-/// efficiency switch, 17 -> 24). In a replica (scipy's DOP853 on the yoke's equations written
-/// out, without the gate) 0.03 leaves 2 over 10x, 0.003 none, for +33 % evaluations at k >= 60.
+/// tolerances, estimate 0.77, true error 143 tolerances). Over rtol = atol = 10^(-k/20),
+/// k = 20..200, 1 s (benchmarks/drift_outliers.py), the tolerances whose energy drift is over
+/// 10x the geometric mean of their neighbours' go from 17 to 0 on the yoke (over 5x: 26 -> 1),
+/// at +20 % evaluations; 76 -> 54 over 11 models (+7.7 %; the five-bar robot, whose friction
+/// and gear efficiency switch, 17 -> 24). In a replica (scipy's DOP853 on the yoke's
+/// equations written out, without the gate) 0.03 leaves 2 over 10x, 0.003 none, for +33 %
+/// evaluations at k >= 60.
 const REACH_E3: f64 = 0.01;
 
 /// The error norm that keeps a step within [`REACH_E3`]: `(eta / REACH_E3)^(8/3)` with

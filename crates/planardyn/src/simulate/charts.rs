@@ -47,14 +47,14 @@ const FIRST_STEP_MOVE: f64 = 0.3;
 /// 5.7e-4 J in that step, the steps around it 1e-8 to 6e-5 J (tolerances 1.096e-6 and
 /// 1.063e-6 on either side: 6.5e-4 and 7.7e-5 J). The same bound, h < T / 2 with T the time to
 /// the nearest complex singularity, removed every outlier of DOP853 on the Scotch yoke's
-/// equations written out (scipy, rtol = 10^(-k/20), k = 20 ... 200; /work/notes/s23-spike.md).
+/// equations written out (scipy, rtol = 10^(-k/20), k = 20 ... 200).
 const USER_FALL: f64 = 0.5;
 
 /// Smallest ratio of the type II measure at a step's end to its start that a step in the
 /// user's chart may aim for, below [`SWITCH_TO_PARTITION`], where the measure falls but the
 /// accelerations do not grow like 1 / sigma (`fall_step_bound`): a change point on a branch
 /// the motion passes analytically (A02), whose equations are singular only as 0 / 0. The
-/// bound main had everywhere (2e54c44); [`USER_FALL`] there took A02 (N = 40, rtol 1e-12)
+/// bound applied everywhere before [`USER_FALL`] (2e54c44); [`USER_FALL`] there took A02 (N = 40, rtol 1e-12)
 /// from 2.4e-9 to 1.03e-8 rad off the reduction (tests/change_points.rs: 1e-8).
 const SMOOTH_FALL: f64 = 0.35;
 
