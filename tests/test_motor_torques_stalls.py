@@ -1,6 +1,6 @@
 """The motor-torque and losses queries on rows around the five-bar-robot's cranks' stalls
 (qd_k = 0, where its gears change branch and its pins' friction changes direction): what the
-methods' docstrings promise holds there too (s21-mend's dense re-check, /work/notes/s21-mend.md)."""
+methods' docstrings promise holds there too (a dense re-check of them)."""
 
 from __future__ import annotations
 

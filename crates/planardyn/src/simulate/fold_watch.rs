@@ -29,7 +29,7 @@ const FOLD_ADVANCE: f64 = 0.01;
 /// left to it: five-bar-robot's steps shrank to 2.4e-7 of it (4e-12 s, 1.7e-5 s before its fold).
 /// The ordinary small steps of a 3-RRR pass-by, where sigma^2 is nearly linear and its secant
 /// reaches 0 far ahead (RADAU5 at rtol 1e-12, rk4 at dt 1e-4), come to 2.3e-3 of it and more
-/// (s19-review's sweep, /work/notes/s19-review.md); [`FOLD_ADVANCE`] let those count as stalls.
+/// (a sweep of the shipped models' failed runs); [`FOLD_ADVANCE`] let those count as stalls.
 const FOLD_STALL: f64 = 1e-4;
 
 /// A failed step's fold must lie within this many steps of the last accepted point, and the
@@ -42,7 +42,7 @@ const FOLD_REACH: f64 = 2.0;
 /// refined as far as they go, can no longer approach it, so the fold is then closer than the
 /// step that failed (measured up to 0.20 of it: rk4 at dt 5e-4 into the 3-RRR's fold, refined to
 /// 3e-14 s steps). A pass-by's secant at ordinary steps reaches 0 about a step ahead (0.8 to 1.9
-/// of it in s20-review's sweep, /work/notes/s20-review.md), where FOLD_REACH named a fold.
+/// of it over a sweep of the shipped models' runs), where FOLD_REACH named a fold.
 const FOLD_AHEAD: f64 = 0.5;
 
 /// The driven coordinates' measure (their scaled smallest singular value, `sigma`) at the
