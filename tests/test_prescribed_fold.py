@@ -23,8 +23,8 @@ MODES = (1, -1, -1)
 AMPLITUDE = np.array([0.10060306745483943, 0.10650916317844883, 0.10119159596920518])  # rad
 OMEGA = np.array([7.860931860681065, 6.074515709845619, 5.84141748947288])  # rad/s
 # The fold (s): the analytic one, Newton on the three distal lengths |C_i(pose) - B_i(t)| and
-# det d(lengths)/d(pose) = 0 in (pose, t), a regular root, to 1e-15 s. Bisection on whether the model assembles ends 2.5e-10 s later: the position
-# solve's tolerance assembles just past a fold.
+# det d(lengths)/d(pose) = 0 in (pose, t), a regular root, to 1e-15 s. Bisection on whether the
+# model assembles ends 2.5e-10 s later: the position solve's tolerance assembles just past a fold.
 T_FOLD = 0.11075100275396015
 CHANGE = "Change the motion so that it avoids this configuration, or end the run before it (t_end)"
 
