@@ -397,7 +397,8 @@ class Mechanism:
             solved from qd: near a type II singularity (measure sigma) one rounding unit of
             qd moves those by eps/sigma, and the efforts with them (2.5e-8 N m at sigma
             8.6e-4 on the free-falling five-bar). Rows whose xd are not the rates of their qd
-            (J xd = [0; qd] within ``planardyn::batch::RATES_TOL``, 1e-10 relative) raise
+            (J xd = [0; qd] within ``planardyn::batch::RATES_TOL``, 1e-10 of the largest body
+            rate) raise
             ``ArgumentError`` naming the row.
 
         Returns

@@ -133,10 +133,12 @@ impl Branch<'_> {
 /// threshold for leaving the input chart (`simulate::charts::SWITCH_TO_PARTITION`).
 pub const BRANCH_SIGMA: f64 = SWITCH_TO_PARTITION;
 
-/// The largest relative mismatch of given body rates xd with a row's qd,
-/// [`dynamics::rates_mismatch`], accepted: round-off leaves a few eps, whatever J's
-/// conditioning; rates of another state are off by O(1) (one body's rate 1e-6 rad/s off,
-/// about 1e-7 relative, is refused in tests/test_dynamics.py).
+/// The largest mismatch of given body rates xd with a row's qd, relative to the rates' own scale
+/// (the largest translational and angular body rate: [`dynamics::rates_mismatch`]), accepted:
+/// round-off leaves a few eps, whatever J's conditioning; the rates of another state are off by
+/// more than this fraction of that scale (one body's rate 1e-6 rad/s off, about 1e-7 of it, is
+/// refused in tests/test_dynamics.py, 1e-12 rad/s accepted). Rates accepted this way give the
+/// same efforts to about this fraction of the velocity terms' size.
 pub const RATES_TOL: f64 = 1e-10;
 
 /// Drive efforts (N x m, N m or N) along rows of q, qd, qdd (N x m each) on the drawn branch;
