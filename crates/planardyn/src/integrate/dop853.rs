@@ -276,7 +276,8 @@ fn reach_error(e3: f64, dy: f64) -> f64 {
     } else if dy == 0.0 {
         e3
     } else {
-        (e3 / (REACH_E3 * dy)).powf(8.0 / 3.0)
+        // Capped: a step that barely moves (dy below ~1e-113 tolerances) would overflow.
+        (e3 / (REACH_E3 * dy)).powf(8.0 / 3.0).min(f64::MAX)
     }
 }
 
