@@ -42,7 +42,8 @@ const FIRST_STEP_MOVE: f64 = 0.3;
 /// An embedded error estimate is the difference of two truncations of it, and it bounds the
 /// error of the solution propagated only while each term is below half the one before, h < T / 2
 /// (at h = rho T it sees (1 - rho) of the lower order's error, the propagated one being rho of
-/// it). Was: the end's measure no lower than 0.35 sigma (h up to 0.88 T): the five-bar fall
+/// it). Where the singularity is in the solution this replaces [`SMOOTH_FALL`] (the end's
+/// measure no lower than 0.35 sigma, h up to 0.88 T), under which the five-bar fall
 /// (DOPRI5, rtol = atol 1.0965e-6, 1 s) stepped from 0.0746 to 0.0458 (h = 0.62 T) and gained
 /// 5.7e-4 J in that step, the steps around it 1e-8 to 6e-5 J (tolerances 1.096e-6 and
 /// 1.063e-6 on either side: 6.5e-4 and 7.7e-5 J). The same bound, h < T / 2 with T the time to
