@@ -355,6 +355,8 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
     u0 = np.zeros_like(x0)
     duration, rounds = np.inf, 0
     history: list[tuple[float, float]] = []  # (time s, limits used) of each round
+    previous: tuple[Any, ...] = ()  # the last round's timing: sdd, sd, status, dense check
+    alternation = ""
     while True:
         rounds += 1
         rows = stage_rows(stage, d, rows_at(limits, variants(model, pts, u0, x0) if model.has_coulomb else [(pts, None)],
@@ -367,12 +369,22 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
                                  "somewhere along it): raise the limits or move the path")
         found = check(mech, path, s, x, sd, sdd, limits, path.ss_waypoints, exact)
         settled = not tangents or _same(duration, t_new)
-        # Rounds that alternate between two timings never settle; the dense check holds this
-        # one within the limits, so it is a plan (the other, not: see _unsettled).
-        alternates = len(history) >= 2 and _same(history[-2][0], t_new) and not _same(duration, t_new)
-        if found.ratio <= 1 + RATIO_TOL and (settled or alternates):
+        # Rounds that alternate between two timings never settle: the shorter of the two that
+        # the dense check holds within the limits is the plan (where neither is: _unsettled).
+        if len(history) >= 2 and _same(history[-2][0], t_new) and not settled:
+            pair = [(t_new, found.ratio, (sdd, sd, status, found)), (duration, history[-1][1], previous)]
+            within = [p for p in pair if p[1] <= 1 + RATIO_TOL]
+            if within:
+                taken = min(within, key=lambda p: p[0])
+                other = pair[1] if taken is pair[0] else pair[0]
+                sdd, sd, status, found = taken[2]
+                alternation = (f", alternating between {taken[0]:.9g} s (taken: limits used to {taken[1]:.9g}) and "
+                               f"{other[0]:.9g} s (limits used to {other[1]:.9g})")
+                break
+        if found.ratio <= 1 + RATIO_TOL and settled:
             break
         history.append((t_new, found.ratio))
+        previous = (sdd, sd, status, found)
         if rounds == MAX_ROUNDS:
             raise PlanError(_unsettled(history, n))
         bad = np.flatnonzero(found.worst > 1 + RATIO_TOL)
@@ -384,10 +396,7 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
         duration = t_new
         u0 = np.append(sdd, 0.0)[stage]
         x0 = sd[stage] ** 2 + 2 * d * u0
-    status = f"{status}; {rounds} rounds" + (" of tangents" if tangents else "")
-    if tangents and not settled:
-        status += (f", alternating between {t_new:.9g} s (taken: limits used to {found.ratio:.9g}) and "
-                   f"{duration:.9g} s (limits used to {history[-1][1]:.9g})")
+    status = f"{status}; {rounds} rounds" + (" of tangents" if tangents else "") + alternation
     sd2 = sd**2
     dt = 2 * np.diff(s) / (sd[:-1] + sd[1:])
     u = np.append(sdd, sdd[-1])
