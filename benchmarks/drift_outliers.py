@@ -73,10 +73,12 @@ def main(argv: list[str] | None = None) -> int:
             rows = kept[f"{name}/{method}"] = sweep(name, method, ks, args.per_decade)
             found = outliers(rows, args.factor)
             drifts = np.array([row[2] for row in rows])
-            worst = int(np.nanargmax(drifts))
             failed = int(np.isnan(drifts).sum())
-            line = (f"{name} {method}: {len(found)} over {args.factor:g}x, worst drift {drifts[worst]:.3g} J at "
-                    f"rtol {rows[worst][1]:.3g}, {sum(row[3] for row in rows)} evaluations")
+            line = f"{name} {method}: {len(found)} over {args.factor:g}x, "
+            if failed < len(rows):
+                worst = int(np.nanargmax(drifts))
+                line += f"worst drift {drifts[worst]:.3g} J at rtol {rows[worst][1]:.3g}, "
+            line += f"{sum(row[3] for row in rows)} evaluations"
             if args.over is not None:
                 line += f", {int((drifts > args.over).sum())} of {len(rows)} over {args.over:g} J"
             print(line + (f", {failed} failed" if failed else "") + f" ({time.perf_counter() - start:.0f} s)",
