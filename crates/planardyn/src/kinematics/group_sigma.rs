@@ -21,7 +21,7 @@
 //! takes the SVD of each block (s^3), never of the whole J.
 
 use super::constraints::{fill_row_scale, Chart};
-use crate::linalg::{cholesky_in_place, gamma, BlockLu};
+use crate::linalg::{cholesky_in_place, gamma, rounding_shift, BlockLu};
 use crate::model::diameter::diameter;
 use crate::model::pairs::frames::perp;
 use crate::model::Mechanism;
@@ -205,7 +205,7 @@ impl GroupScales {
                 trace += gram[i * s + i];
             }
             let g = gamma(s + 1);
-            let hidden = 2.0 * (s as f64 * g / (1.0 - s as f64 * g) + 2.0 * gamma(s) + f64::EPSILON) * trace;
+            let hidden = rounding_shift(s as f64 * g / (1.0 - s as f64 * g), s, trace);
             let t2 = t * t;
             if shifted_factorises(gram, rows, s, t2 * (1.0 + 2.0 * f64::EPSILON) + hidden) {
                 continue;

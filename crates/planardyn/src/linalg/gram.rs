@@ -29,6 +29,14 @@ pub fn gamma(n: usize) -> f64 {
     nu / (1.0 - nu)
 }
 
+/// What the rounding of a Gram matrix G (entries sums of at most `d` products, trace `trace`) and
+/// of a Cholesky factorisation of it can hide of its eigenvalues, twice over (see the module):
+/// `factor` bounds ||dA||_2 / trace for the factorisation, gamma_{w+1} / (1 - gamma_{w+1}) for
+/// an envelope of width w.
+pub fn rounding_shift(factor: f64, d: usize, trace: f64) -> f64 {
+    2.0 * (factor + 2.0 * gamma(d) + U) * trace
+}
+
 /// Whether lambda_min(R R^T) > `bound` is proven, `rows` the rows of R (`ncols` columns).
 /// False means not proven (G near singular, or not positive definite at all).
 pub fn gram_exceeds(rows: &[SparseRow], ncols: usize, bound: f64) -> bool {
@@ -69,7 +77,7 @@ pub fn gram_exceeds(rows: &[SparseRow], ncols: usize, bound: f64) -> bool {
     let d = rows.iter().map(Vec::len).max().unwrap_or(1);
     let trace: f64 = rows.iter().flat_map(|row| row.iter().map(|&(_, v)| v * v)).sum();
     let g_w = gamma(w + 1);
-    let shift = bound * (1.0 + 2.0 * U) + 2.0 * (g_w / (1.0 - g_w) + 2.0 * gamma(d) + U) * trace;
+    let shift = bound * (1.0 + 2.0 * U) + rounding_shift(g_w / (1.0 - g_w), d, trace);
     let mut l = vec![0.0; start[k]];
     let mut dense = vec![0.0; ncols];
     for p in 0..k {

@@ -20,7 +20,7 @@ pub use cholesky::{
     cholesky_envelope, cholesky_envelope_fixed, cholesky_in_place, cholesky_solve, cholesky_solve_envelope,
     cholesky_solve_envelope_fixed,
 };
-pub use gram::{gamma, gram_exceeds};
+pub use gram::{gamma, gram_exceeds, rounding_shift};
 pub use lu::{lu_factor, lu_solve, lu_solve_transpose, Lu, LuError, Scalar};
 pub use pivot::pivot_columns;
 pub use sink::{Dense, Sink};
