@@ -168,10 +168,15 @@ impl GroupScales {
     /// semidefinite, which a Cholesky factorisation of G shifted by what its rounding can hide
     /// decides both ways (Rump's argument, as `linalg::gram`'s: a factorisation that completes
     /// proves sigma > t; one that fails at the opposite shift proves sigma < t, by Demmel's
-    /// condition for its success, Higham 2nd ed. ch. 10). Only a block within that shift of t, about
-    /// 1e-12 t for the five-bar's 8 x 8 dyad block, takes its SVD. 2 s^3 / 3 flops a block
-    /// where the SVD takes tens of s^3.
+    /// condition for its success, Higham 2nd ed. ch. 10). Only a block whose measure is within
+    /// hidden / (2 t) of t takes its SVD (hidden: that shift, ~s^2 eps ||B||_F^2), so the band
+    /// widens like 1 / t^2 relative to t: ~1e-12 for the five-bar's 8 x 8 dyad block at t ~ 0.3,
+    /// ~1e-6 at t ~ 1e-4. 2 s^3 / 3 flops a block where the SVD takes tens of s^3. A threshold
+    /// that is not positive (or NaN) is never above a measure, as `exact(..) < t` says.
     pub fn below(&mut self, lu: &BlockLu, t: f64) -> bool {
+        if !(t > 0.0) {
+            return false;
+        }
         for k in 0..lu.n_blocks() {
             let s = lu.span(k).len();
             let (fr, fc) = (&self.row[lu.span(k)], &self.col[lu.span(k)]);
