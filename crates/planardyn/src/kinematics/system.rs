@@ -137,7 +137,16 @@ pub(crate) fn next_supports_id() -> u64 {
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
 pub fn col_scales(mech: &Mechanism) -> Vec<f64> {
-    (0..mech.n_x()).map(|i| if i % 3 == 2 { 1.0 } else { mech.scale }).collect()
+    (0..mech.n_x()).map(|i| col_scale(mech, i)).collect()
+}
+
+/// The column scale of body coordinate i ([`col_scales`]).
+pub fn col_scale(mech: &Mechanism, i: usize) -> f64 {
+    if i % 3 == 2 {
+        1.0
+    } else {
+        mech.scale
+    }
 }
 
 impl System {
