@@ -20,6 +20,25 @@
 // `!(x > 0.0)` is how the validators reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+/// `impl Clone` for a struct of buffers, field by field, with a `clone_from` that copies each
+/// field into the target's own (a derived `clone_from` is `*self = source.clone()`: it allocates
+/// every buffer anew and frees the old ones). Copying a saved evaluation or a kept analysis into
+/// one of the same sizes then allocates nothing. The struct literal in `clone` names every
+/// field, so a field left out of the list does not compile.
+macro_rules! clone_reusing {
+    ($t:ty { $($f:ident),+ $(,)? }) => {
+        impl Clone for $t {
+            fn clone(&self) -> Self {
+                Self { $($f: self.$f.clone()),+ }
+            }
+
+            fn clone_from(&mut self, source: &Self) {
+                $(self.$f.clone_from(&source.$f);)+
+            }
+        }
+    };
+}
+
 pub mod batch;
 pub mod dynamics;
 pub mod elastic;

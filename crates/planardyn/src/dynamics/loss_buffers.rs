@@ -10,7 +10,7 @@ use crate::model::Mechanism;
 /// losses). A lever is a pair's relative coordinate seen from the bodies: its gradient (3n)
 /// and that gradient times U (m); the friction entries' come first, then one per actuator
 /// (the coordinates', then the pair actuators').
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub struct LossBuffers {
     /// (3n) the applied forces, and (m) b or the efforts, before the friction.
     pub(super) f0: Vec<f64>,
@@ -33,6 +33,8 @@ pub struct LossBuffers {
     pub(super) lambda: Vec<f64>,
     pub(super) reactions: Vec<[f64; 3]>,
 }
+
+clone_reusing!(LossBuffers { f0, b0, grad, gu, rates, e, sides, actuator_rates, gears, rhs, y0, lambda, reactions });
 
 impl LossBuffers {
     /// Buffers for `mech` (none when it has no losses).

@@ -16,7 +16,7 @@ use super::loss_buffers::LossBuffers;
 use crate::kinematics::Frame;
 use crate::model::Mechanism;
 
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Workspace {
     /// The kinematic stages' buffers (positions, analogues, convective term).
     pub frame: Frame,
@@ -47,6 +47,8 @@ pub struct Workspace {
     /// The transmissions' and the pair friction's buffers (forward and inverse with losses).
     pub losses: LossBuffers,
 }
+
+clone_reusing!(Workspace { frame, a_zeros_for, tau, pair_tau, f, power, dissipated, a, b, zdd, qdd, xdd, losses });
 
 impl Workspace {
     /// Buffers for `mech`, starting at its drawing in the input chart.

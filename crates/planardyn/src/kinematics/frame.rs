@@ -10,7 +10,7 @@
 use super::{Chart, System};
 use crate::model::Mechanism;
 
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Frame {
     /// The chart whose coordinates z the position stage solves for.
     pub chart: Chart,
@@ -44,6 +44,8 @@ pub struct Frame {
     /// (3n) scratch for residuals and second derivatives.
     pub tmp: Vec<f64>,
 }
+
+clone_reusing!(Frame { chart, x, trig, sys, residual, iterations, u, u_zeros_for, xd, c, q, qd, rhs, tmp });
 
 impl Frame {
     /// Buffers for `mech`, starting at its drawing in the input chart.

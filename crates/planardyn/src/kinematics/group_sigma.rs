@@ -45,7 +45,7 @@ const SMALL_BLOCK: usize = 8;
 
 /// Per permuted position of a [`BlockLu`]: the factors taking the globally scaled J to each
 /// block's own length, and the inverse-iteration vectors of the estimate.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub struct GroupScales {
     /// Row factor (L / L_k on rows in metres, 1 on rows in radians) and column factor (L_k / L
     /// on translations, 1 on angles), per permuted position.
@@ -62,6 +62,8 @@ pub struct GroupScales {
     /// Scratch of [`GroupScales::below`]: a block and its Gram matrix (over [`SMALL_BLOCK`]).
     gram: Vec<f64>,
 }
+
+clone_reusing!(GroupScales { row, col, col_scale, v, w, warm, gram });
 
 impl GroupScales {
     /// The factors of `lu`'s blocks, J being that of `chart`.

@@ -7,7 +7,7 @@
 //! (10 x 12) took 29.7 k instructions sparse, 11 k dense, and a crossing's location calls it 43 times.
 
 use super::constraints::body_trig;
-use super::system::col_scales;
+use super::system::{col_scale, col_scales};
 use crate::linalg::{eliminate, pivot_columns, Dense, Sink, SparseRow};
 use crate::model::pairs::{self, row_scales};
 use crate::model::Mechanism;
@@ -85,20 +85,27 @@ fn sparse_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
 }
 
 /// [`phi_x_pivots`] by `pivot_columns` on the dense scaled Phi_x, its entries summed and scaled
-/// as [`scaled_phi_rows`] makes them, the pivots read back from the eliminated matrix.
+/// as [`scaled_phi_rows`] makes them, the pivots read back from the eliminated matrix. Its
+/// trig and scales are on the stack (n <= [`DENSE_PIVOTS_MAX`]); the matrix is not: a stack
+/// array of the largest size, zeroed whole, cost the five-bar free fall 0.2 M instructions more.
 fn dense_pivots(mech: &Mechanism, x: &[f64]) -> Vec<(usize, f64)> {
     let (n, rows) = (x.len(), mech.n_constraints);
-    let mut trig = vec![[0.0; 2]; mech.n_bodies()];
-    body_trig(x, &mut trig);
+    let mut trig = [[0.0; 2]; DENSE_PIVOTS_MAX / 3];
+    let trig = &mut trig[..mech.n_bodies()];
+    body_trig(x, trig);
     let mut j = vec![0.0; rows * n];
     for (pair, s) in mech.pairs.iter().zip(&mech.pair_slots) {
-        pairs::jacobian(pair, x, &trig, &mut Dense { j: &mut j, ncols: n }, *s);
+        pairs::jacobian(pair, x, trig, &mut Dense { j: &mut j, ncols: n }, *s);
     }
-    let cs = col_scales(mech);
+    let mut cs = [0.0; DENSE_PIVOTS_MAX];
+    let cs = &mut cs[..n];
+    for (i, c) in cs.iter_mut().enumerate() {
+        *c = col_scale(mech, i);
+    }
     for (pair, s) in mech.pairs.iter().zip(&mech.pair_slots) {
         for (slot, scale) in s.iter().zip(row_scales(pair, 1.0 / mech.scale)) {
             if let Some(r) = *slot {
-                for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(&cs) {
+                for (v, c) in j[r * n..(r + 1) * n].iter_mut().zip(cs.iter()) {
                     *v *= scale * c;
                 }
             }

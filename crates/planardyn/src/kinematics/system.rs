@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 /// 1e4 times the rounding error of an O(1) elimination.
 pub const SINGULAR_PIVOT: f64 = 1e-12;
 /// J(x) for one chart, scaled and LU-factorised.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct System {
     lu: BlockLu,
     /// The chart whose pattern `lu` was analysed for.
@@ -64,6 +64,27 @@ pub struct System {
     /// The analyses this system and its copies made, shared by them ([`Analyses`]).
     analyses: Analyses,
 }
+
+clone_reusing!(System {
+    lu,
+    pattern_chart,
+    row_scale,
+    col_scale,
+    factored,
+    chart,
+    groups,
+    unit_reach,
+    u_support,
+    a_pairs,
+    a_runs_at,
+    a_runs,
+    a_first,
+    a_fill_in,
+    supports_id,
+    supports,
+    other,
+    analyses
+});
 
 /// Fresh analyses (as [`System::analysed`] leaves them, before any factorisation) by chart,
 /// shared by a system and its copies (a run's saved states, the prepared model's templates):
@@ -116,7 +137,16 @@ pub(crate) fn next_supports_id() -> u64 {
 
 /// Column scales of the body coordinates: L for X and Y, 1 for phi.
 pub fn col_scales(mech: &Mechanism) -> Vec<f64> {
-    (0..mech.n_x()).map(|i| if i % 3 == 2 { 1.0 } else { mech.scale }).collect()
+    (0..mech.n_x()).map(|i| col_scale(mech, i)).collect()
+}
+
+/// The column scale of body coordinate i ([`col_scales`]).
+pub fn col_scale(mech: &Mechanism, i: usize) -> f64 {
+    if i % 3 == 2 {
+        1.0
+    } else {
+        mech.scale
+    }
 }
 
 impl System {

@@ -13,12 +13,14 @@
 const MERGE_GAP: usize = 4;
 
 /// Per column of U, its bodies as ascending runs (see the module doc).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct USupport {
     /// Column j's runs: `runs[runs_at[j]..runs_at[j + 1]]`.
     runs_at: Vec<usize>,
     runs: Vec<(usize, usize)>,
 }
+
+clone_reusing!(USupport { runs_at, runs });
 
 impl USupport {
     /// From each column's bodies (ascending, no repeats); gaps below [`MERGE_GAP`] bodies joined.

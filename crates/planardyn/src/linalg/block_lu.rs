@@ -21,7 +21,7 @@ use petgraph::algo::{maximum_matching, tarjan_scc};
 use petgraph::graph::{DiGraph, NodeIndex, UnGraph};
 
 /// The block-triangular factors of an n x n matrix, in buffers sized once per pattern.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct BlockLu {
     n: usize,
     /// Permuted position -> original row, and -> original column.
@@ -61,6 +61,25 @@ pub struct BlockLu {
     /// unsolved blocks' values as 0), so a sequence of them costs their blocks only.
     work_clean: bool,
 }
+
+clone_reusing!(BlockLu {
+    n,
+    row,
+    col,
+    start,
+    store,
+    lu_at,
+    off_base,
+    dest_at,
+    dest,
+    piv,
+    src,
+    off_at,
+    off_col,
+    inv_diag,
+    work,
+    work_clean
+});
 
 /// Row and column scales applied on the way in and out of a solve (see [`BlockLu::sink`]).
 type Scales<'a> = Option<(&'a [f64], &'a [f64])>;

@@ -437,7 +437,7 @@ impl<'a> MechanismOde<'a> {
         self.accept(t, y)?;
         // The spare's chart and its structure (`System`'s analysis, which the predictor from
         // the anchor uses before Newton renews it) are the new chart's: a copy, once a switch.
-        self.spare = self.save();
+        self.save_to_spare();
         Ok(())
     }
 
@@ -761,6 +761,18 @@ impl MechanismOde<'_> {
             base_closed: self.base_closed,
             stale_j: self.stale_j,
         }
+    }
+
+    /// [`MechanismOde::save`] into the spare's buffers (`clone_from`: the old spare's
+    /// allocations reused, 0.18 M instructions of the five-bar free fall's 11 switches).
+    fn save_to_spare(&mut self) {
+        let e = &mut self.spare;
+        e.ws.clone_from(&self.ws);
+        e.eval_y.clone_from(&self.eval_y);
+        e.last_y.clone_from(&self.last_y);
+        e.closed.clone_from(&self.closed);
+        (e.last_t, e.base_valid, e.base_closed, e.stale_j) =
+            (self.last_t, self.base_valid, self.base_closed, self.stale_j);
     }
 
     /// Put back an evaluation saved by [`MechanismOde::save`].

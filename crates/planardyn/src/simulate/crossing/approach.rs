@@ -19,16 +19,16 @@ const KEPT: usize = 48;
 const FIRST_NODES: f64 = 5.0;
 
 /// An accepted point on the way: time (s), passive and type II measures (the type II one NaN
-/// but at the points kept), body coordinates x, rates xd and accelerations xdd (3n each), the
-/// power of the non-conservative forces (W), and the scaled speed ([`scaled_speed`], 1/s).
+/// but at the points kept), body coordinates x, rates xd and accelerations xdd (3n each, in one
+/// buffer: a point kept is one allocation, not three), the power of the non-conservative forces
+/// (W), and the scaled speed ([`scaled_speed`], 1/s).
 #[derive(Debug, Clone)]
 pub struct Passed {
     pub t: f64,
     pub passive: f64,
     pub sigma: f64,
-    pub x: Vec<f64>,
-    pub xd: Vec<f64>,
-    pub xdd: Vec<f64>,
+    /// [x, xd, xdd].
+    state: Vec<f64>,
     pub power: f64,
     pub speed: f64,
 }
@@ -37,9 +37,37 @@ impl Passed {
     /// The point evaluated in `ode.ws`, at time t with passive measure `passive`.
     pub fn of(ode: &MechanismOde, t: f64, passive: f64) -> Self {
         let ws = &ode.ws;
-        let speed = scaled_speed(ode.mech, &ws.xd);
-        let (x, xd, xdd) = (ws.x.clone(), ws.xd.clone(), ws.xdd.clone());
-        Passed { t, passive, sigma: f64::NAN, x, xd, xdd, power: ws.power, speed }
+        let mut state = Vec::with_capacity(3 * ws.x.len());
+        for part in [&ws.x, &ws.xd, &ws.xdd] {
+            state.extend_from_slice(part);
+        }
+        Passed { t, passive, sigma: f64::NAN, state, power: ws.power, speed: scaled_speed(ode.mech, &ws.xd) }
+    }
+
+    /// Body coordinates x (3n).
+    pub fn x(&self) -> &[f64] {
+        &self.state[..self.state.len() / 3]
+    }
+
+    /// Body rates xd (3n).
+    pub fn xd(&self) -> &[f64] {
+        let n = self.state.len() / 3;
+        &self.state[n..2 * n]
+    }
+
+    /// Body accelerations xdd (3n).
+    pub fn xdd(&self) -> &[f64] {
+        &self.state[2 * self.state.len() / 3..]
+    }
+
+    /// Take the point evaluated in `ode.ws` into this one's buffer (of its size).
+    fn renew(&mut self, ode: &MechanismOde, t: f64, passive: f64) {
+        let ws = &ode.ws;
+        (self.t, self.passive, self.sigma, self.power, self.speed) =
+            (t, passive, f64::NAN, ws.power, scaled_speed(ode.mech, &ws.xd));
+        for (dest, part) in self.state.chunks_exact_mut(ws.x.len()).zip([&ws.x, &ws.xd, &ws.xdd]) {
+            dest.copy_from_slice(part);
+        }
     }
 }
 
@@ -202,18 +230,18 @@ impl Approach {
 /// Append the point held by `ode.ws` (at t, passive measure `passive`) to `points`, the
 /// oldest's buffers reused once [`KEPT`] are held (no allocation then).
 fn push(points: &mut VecDeque<Passed>, ode: &MechanismOde, t: f64, meas: &Measures) {
-    let ws = &ode.ws;
     let recycled = if points.len() >= KEPT { points.pop_front() } else { None };
     let mut p = match recycled {
         Some(mut p) => {
-            (p.t, p.passive, p.power, p.speed) = (t, meas.passive, ws.power, scaled_speed(ode.mech, &ws.xd));
-            p.x.copy_from_slice(&ws.x);
-            p.xd.copy_from_slice(&ws.xd);
-            p.xdd.copy_from_slice(&ws.xdd);
+            p.renew(ode, t, meas.passive);
             p
         }
         None => Passed::of(ode, t, meas.passive),
     };
     p.sigma = meas.sigma;
+    if points.capacity() == 0 {
+        // At most KEPT, never grown (and copied) on the way there.
+        points.reserve_exact(KEPT);
+    }
     points.push_back(p);
 }

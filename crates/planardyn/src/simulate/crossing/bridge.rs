@@ -38,20 +38,20 @@ impl Bridge {
     /// `nodes` (distinct times); `scale` about the time the step spans (s).
     pub fn new(nodes: &[&Passed], work: f64, scale: f64) -> Self {
         let start = nodes[0];
-        let (k, n) = (nodes.len(), start.x.len());
+        let (k, n) = (nodes.len(), start.x().len());
         let u: Vec<f64> = nodes.iter().map(|p| (p.t - start.t) / scale).collect();
         // xdd = sum_j j (j - 1) c_j u^(j-2) / scale^2, j = col + 2.
         let v = nalgebra::DMatrix::from_fn(k, k, |i, col| {
             let j = (col + 2) as f64;
             j * (j - 1.0) * u[i].powi(col as i32) / (scale * scale)
         });
-        let rhs = nalgebra::DMatrix::from_fn(k, n, |i, c| nodes[i].xdd[c]);
+        let rhs = nalgebra::DMatrix::from_fn(k, n, |i, c| nodes[i].xdd()[c]);
         let c = v.lu().solve(&rhs).unwrap_or_else(|| nalgebra::DMatrix::zeros(k, n));
         let c = (0..k).map(|j| c.row(j).iter().copied().collect()).collect();
         let pv = nalgebra::DMatrix::from_fn(k, k, |i, j| u[i].powi(j as i32));
         let powers = nalgebra::DVector::from_iterator(k, nodes.iter().map(|p| p.power));
         let beta = pv.lu().solve(&powers).map_or_else(|| vec![0.0; k], |b| b.iter().copied().collect());
-        Bridge { t0: start.t, x: start.x.clone(), xd: start.xd.clone(), c, work, beta, scale }
+        Bridge { t0: start.t, x: start.x().to_vec(), xd: start.xd().to_vec(), c, work, beta, scale }
     }
 
     /// The number of body coordinates (3n).
@@ -103,10 +103,11 @@ pub struct Quintic {
 impl Quintic {
     pub fn new(a: &Passed, b: (&[f64], &[f64], &[f64]), tb: f64) -> Self {
         let span = tb - a.t;
-        let n = a.x.len();
+        let n = a.x().len();
+        let (ax, axd, axdd) = (a.x(), a.xd(), a.xdd());
         let mut c: [Vec<f64>; 6] = std::array::from_fn(|_| vec![0.0; n]);
         for i in 0..n {
-            let (c0, c1, c2) = (a.x[i], a.xd[i] * span, a.xdd[i] * span * span / 2.0);
+            let (c0, c1, c2) = (ax[i], axd[i] * span, axdd[i] * span * span / 2.0);
             let p = b.0[i] - (c0 + c1 + c2);
             let v = b.1[i] * span - (c1 + 2.0 * c2);
             let w = b.2[i] * span * span - 2.0 * c2;

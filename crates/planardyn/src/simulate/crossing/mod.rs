@@ -308,7 +308,7 @@ fn partition_at(ode: &MechanismOde, x: &[f64]) -> Vec<usize> {
 /// Back to the landing `landing` (partition `idx`, state `y`) from the points past it:
 /// evaluated and anchored there, Newton's moves bounded by its chart's measure.
 fn return_to(ode: &mut MechanismOde, landing: &Passed, idx: &[usize], y: &[f64]) -> Result<(), String> {
-    ode.ws.x.copy_from_slice(&landing.x);
+    ode.ws.x.copy_from_slice(landing.x());
     let chart = Chart::Partition(idx.to_vec());
     ode.set_chart(chart, landing.t, y).map_err(|e| format!("the landing past it: {e}"))?;
     let own = chart_sigma(ode, f64::INFINITY);
