@@ -211,9 +211,11 @@ def test_slider_crank_through_its_dead_centre(v0):
     assert res.success and res.partitioned.any()
     # With the run's body rates, as test_free_fall_efforts_are_zero_from_the_result: from q, qd
     # and qdd the efforts near the dead centre are ill-conditioned (at a row at sigma 7.4e-5 one
-    # rounding unit of qd moves them 4.2e-7 N, of qdd 1.0e-7 N, of q 4.5 N; from x alone the rows
-    # at 32 of 122 rtols within 10^+-0.3 of this one were 1e-6 to 0.8 N off, growing as the row
-    # nearest the dead centre comes closer). With xd, qdd's rounding is left, about 1/sigma^2.
+    # rounding unit of qd moves them 4.2e-7 N, of qdd 1.0e-7 N, of q 4.5 N; from x alone the
+    # rows before the half-time step bound (d231ebd) at 32 of 122 rtols within 10^+-0.3 of this one were 1e-6 to 0.8 N off,
+    # growing as the row nearest the dead centre comes closer). With xd, qdd's rounding is
+    # left, about 1/sigma^2: 3 of 58 of those rtols (v0 = 3) have a row at sigma 2e-6 to 9e-6,
+    # 2.5e-6 to 1.2e-4 N off; this run's nearest row is at 7.4e-5.
     tau = mech.inverse_dynamics(res.q, res.qd, res.qdd, x=res.x, xd=res.xd)
     # 1e-6 N is ~1e2 times the measured 2.3e-8 N (at a row at sigma 7.4e-5) and 1e-6 of the
     # gravity loads.
