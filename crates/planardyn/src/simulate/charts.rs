@@ -175,9 +175,9 @@ pub fn acceleration_growth(last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
 /// The longest next step in the user's chart from (t, sigma) at the last accepted point
 /// (`now`) and at the one before (`last`), with sigma^2 linear in t (a generic passage by a
 /// type II singularity): where the chart's singularity is in the solution (`singular`: the
-/// accelerations' growth against 1 / sigma does not fall, [`acceleration_growth`], or did not
-/// once on this fall below `run::PREDICT_BELOW`), the step
-/// covers at most [`USER_FALL`] of the time to it; elsewhere it ends no lower than
+/// accelerations' growth against 1 / sigma, [`acceleration_growth`], rises, or was not seen to
+/// fall at a point of this fall below `run::PREDICT_BELOW`), the step covers at most
+/// [`USER_FALL`] of the time to it; elsewhere it ends no lower than
 /// [`SMOOTH_FALL`] times the measure or [`SWITCH_TO_PARTITION`] (s; infinite where the measure
 /// does not fall).
 pub fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) -> f64 {

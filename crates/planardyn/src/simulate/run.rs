@@ -104,8 +104,8 @@ pub struct Run<'a, 's, 'e> {
     /// The accelerations' growth against 1 / sigma into that point (`acceleration_growth`;
     /// NaN where not known).
     user_growth: f64,
-    /// The user's chart's singularity was found in the solution (`acceleration_growth` rose
-    /// below PREDICT_BELOW) while its measure has been falling since.
+    /// The user's chart's singularity was taken to be in the solution (below PREDICT_BELOW,
+    /// `acceleration_growth` not seen to fall) while its measure has been falling since.
     fall_singular: bool,
     /// Steps accepted since the last chart switch.
     chart_steps: usize,
@@ -511,24 +511,35 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         }
         self.last_own = Some(own);
         // A step in the user's chart may not rush into type II (`fall_step_bound`), wherever
-        // the measure falls: above PREDICT_BELOW too, where the five-bar fall (DOP853, rtol =
-        // atol 3.55e-4) stepped from 0.255 to 0.093 in 25 ms, 0.87 of the time to the
-        // singularity, and lost 2.8e-4 J in it (the runs on either side 2.6e-5 and 3.5e-5 J).
-        // Where the accelerations' growth against 1 / sigma falls (a change point passed
-        // analytically), only below PREDICT_BELOW, as before the five-bar's bound.
+        // the measure falls: above PREDICT_BELOW too where the accelerations' growth against
+        // 1 / sigma rises (the five-bar fall with DOP853 at rtol = atol 3.55e-4, before its
+        // estimate saw the step's reach, stepped from 0.255 to 0.093 in 25 ms, 0.87 of the time
+        // to the singularity, and lost 2.8e-4 J in it; the runs on either side 2.6e-5 and
+        // 3.5e-5 J).
         let user = self.ode.ws.chart == Chart::Inputs;
         let m = self.ode.m();
         let now = (t, own, self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt());
-        let growth = self.last_user.filter(|_| user).map_or(f64::NAN, |last| acceleration_growth(last, now));
+        let last = self.last_user.filter(|_| user);
+        let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
         let rising = growth > 0.0 && growth >= self.user_growth;
-        // Latched for the rest of the fall once it rose below PREDICT_BELOW: the growth from
-        // point to point is noisy where the steps are long (five-bar fall, DOPRI5 rtol
-        // 9.5e-5: 27.1 then 25.7 at sigma 0.106 and 0.085, and the next step, unbounded by
-        // T/2, took 0.085 to 0.050 and gained 1.0e-3 J).
-        let falling = self.last_user.filter(|_| user).is_some_and(|last| own < last.1);
-        self.fall_singular = falling && (self.fall_singular || (rising && own < PREDICT_BELOW));
-        let singular = rising || self.fall_singular;
-        if let Some(last) = self.last_user.filter(|_| user && (own < PREDICT_BELOW || singular)) {
+        // Below PREDICT_BELOW the singularity is in the solution unless the growth is seen to
+        // fall towards a finite limit, positive and below the last (A02, N = 40, rtol 1e-12: at
+        // every point of a fall from sigma 0.39 down, 7.8 ... 1.75 ... 0.055): waiting for it
+        // to rise missed a fall's first steps, where the accelerations' regular part falls
+        // (five-bar fall, DOP853 at 1e-6 with the bound: growth -183 then -55 at sigma 0.29 and
+        // 0.23, and the next step, to 0.14, covered 0.82 of the time to the singularity, its
+        // dense output 5.8e-7 J off mid-step). Latched for the rest of the fall: the growth from
+        // point to point is noisy where the steps are long (five-bar fall, DOPRI5 rtol 9.5e-5:
+        // 27.1 then 25.7 at sigma 0.106 and 0.085, and the next step, unbounded by T/2, took
+        // 0.085 to 0.050 and gained 1.0e-3 J). Not for a method that sees the step's reach
+        // itself (DOP853: with the bound, 0 of 751 rtols from 1e-4 to 1e-9 over 1e-4 J either
+        // way, the worst 1.4e-5 -> 1.5e-5 J, for +6 % evaluations).
+        let analytic = growth > 0.0 && growth < self.user_growth;
+        let falling = last.is_some_and(|last| own < last.1);
+        let bounds_fall = !self.settings.method.sees_reach();
+        self.fall_singular = bounds_fall && falling && (self.fall_singular || (own < PREDICT_BELOW && !analytic));
+        let singular = bounds_fall && (rising || self.fall_singular);
+        if let Some(last) = last.filter(|_| own < PREDICT_BELOW || singular) {
             self.stepper.bound_next_step(fall_step_bound(last, now, singular));
         }
         self.last_user = user.then_some(now);
