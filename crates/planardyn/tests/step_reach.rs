@@ -10,10 +10,10 @@ use planardyn::simulate::{grid, simulate, Settings};
 const FIVE_BAR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/models/five-bar-free-fall.yaml");
 
 /// The energy target of the five-bar benchmark (issue 25, drift 1e-4 J over 1 s). At this
-/// tolerance the run drifts 3.6e-5 J (grid) and 2.3e-5 J (every step; main d231ebd 3.6e-5 and
-/// 2.6e-5 J); before the step's reach was bounded one step in the user's chart crossed the
-/// type II singularity and the run gained 0.89 J on the grid, 4.7e-2 J at the steps (both
-/// measured with DOP853 on main dde9f27).
+/// tolerance the run drifts 5.9e-6 J (grid) and 5.7e-6 J (every step; 4.8e-5 J both before
+/// DOP853's estimate saw the step's reach, `integrate::dop853`); before the step's reach was
+/// bounded one step in the user's chart crossed the type II singularity and the run gained
+/// 0.89 J on the grid, 4.7e-2 J at the steps (both measured with DOP853 on main dde9f27).
 const DRIFT_TARGET: f64 = 1e-4;
 
 /// rtol = atol here: one of a sweep of 450 values 10^(-4 - k/150) where main lost most.
@@ -54,9 +54,8 @@ fn five_bar_steps_near_singularities_keep_the_energy() {
 /// (t = 0.155 s; the step's reach, 2 x the measure, let it through) and drifted 6.5e-4 to
 /// 9.2e-4 J at the steps, 7.1e-4 to 9.4e-4 J on a 1 ms grid. With the measure's fall in one
 /// step bounded (`simulate::charts::fall_step_bound`) the largest fall is 2.03x and the
-/// drift 7.4e-6 to 9.0e-6 J (steps), 1.8e-5 to 2.7e-5 J (1 ms grid) (main d231ebd: 6.5e-6
-/// to 8.9e-6 J, 1.0e-5 to 1.6e-5 J); with a step at most half the time to the singularity
-/// where it is in the solution 5.8e-6 to 8.0e-6 J and 6.1e-6 to 1.0e-5 J.
+/// drift 7.4e-6 to 9.0e-6 J (steps), 1.8e-5 to 2.7e-5 J (1 ms grid); with DOP853's estimate
+/// seeing the step's reach too (d0abcad) 3.4e-6 to 3.8e-6 J and 7.0e-6 to 1.0e-5 J.
 const FAST_APPROACH_LEVELS: std::ops::RangeInclusive<i32> = 0..=13;
 
 #[test]
