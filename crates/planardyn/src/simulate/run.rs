@@ -517,8 +517,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // to the singularity, and lost 2.8e-4 J in it; the runs on either side 2.6e-5 and
         // 3.5e-5 J).
         let user = self.ode.ws.chart == Chart::Inputs;
+        let bounds_fall = !self.settings.method.sees_reach();
         let m = self.ode.m();
-        let now = (t, own, self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt());
+        let qdd =
+            if bounds_fall { self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt() } else { f64::NAN };
+        let now = (t, own, qdd);
         let last = self.last_user.filter(|_| user);
         let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
         let rising = growth > 0.0 && growth >= self.user_growth;
@@ -536,7 +539,6 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // way, the worst 1.4e-5 -> 1.5e-5 J, for +6 % evaluations).
         let analytic = growth > 0.0 && growth < self.user_growth;
         let falling = last.is_some_and(|last| own < last.1);
-        let bounds_fall = !self.settings.method.sees_reach();
         self.fall_singular = bounds_fall && falling && (self.fall_singular || (own < PREDICT_BELOW && !analytic));
         let singular = bounds_fall && (rising || self.fall_singular);
         if let Some(last) = last.filter(|_| own < PREDICT_BELOW || singular) {
