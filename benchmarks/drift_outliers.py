@@ -9,8 +9,8 @@ evaluations of the sweep (its cost).
     .venv/bin/python benchmarks/drift_outliers.py --model five-bar-free-fall --method dopri5 \\
         --per-decade 150 --k 600 1350 --over 1e-4                          # the five-bar's band
 
-The figures in the comments of `integrate/dop853.rs` (REACH_E3) and tests/estimate_reach.rs
-come from it (--json keeps every run).
+The figures in the comments of `integrate/dop853.rs` (REACH_E3), `simulate/run.rs` (the type II
+fall's decision) and tests/estimate_reach.rs come from it (--json keeps every run).
 """
 
 from __future__ import annotations

@@ -309,6 +309,8 @@ impl Integrator for Dop853 {
     const DENSE_ORDER: usize = 7;
     const ADAPTIVE: bool = true;
     const IMPLICIT: bool = false;
+    /// Its reach term ([`REACH_E3`]).
+    const SEES_REACH: bool = true;
 
     fn new(opts: &Options, n: usize) -> Self {
         Dop853 {

@@ -79,6 +79,7 @@ impl Integrator for Dopri5 {
     const DENSE_ORDER: usize = 4;
     const ADAPTIVE: bool = true;
     const IMPLICIT: bool = false;
+    const SEES_REACH: bool = false;
 
     fn new(opts: &Options, n: usize) -> Self {
         Dopri5 {

@@ -95,6 +95,10 @@ pub trait Integrator: Sized {
     const ADAPTIVE: bool;
     /// Implicit (stiffly accurate).
     const IMPLICIT: bool;
+    /// Whose error estimate also bounds a step's reach towards the solution's nearest
+    /// singularity (DOP853's third-order estimate against the step's increment), so that the
+    /// run need not bound the steps into a type II singularity itself.
+    const SEES_REACH: bool;
     /// A stepper for systems of dimension `dim`, all buffers allocated here.
     fn new(opts: &Options, dim: usize) -> Self;
     /// The solution at t in [t_prev, t] of the last accepted step into `out`; `sys` for a
@@ -198,6 +202,12 @@ impl Method {
     /// True for the implicit (stiffly accurate) methods.
     pub fn is_implicit(self) -> bool {
         registry!(self, T => T::IMPLICIT)
+    }
+
+    /// True for the methods whose error estimate also bounds a step's reach towards the
+    /// solution's nearest singularity (DOP853).
+    pub fn sees_reach(self) -> bool {
+        registry!(self, T => T::SEES_REACH)
     }
 
     /// The canonical lower-case name, as accepted by `FromStr`.

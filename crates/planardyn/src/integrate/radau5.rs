@@ -148,6 +148,7 @@ impl Integrator for Radau5 {
     const DENSE_ORDER: usize = 3;
     const ADAPTIVE: bool = true;
     const IMPLICIT: bool = true;
+    const SEES_REACH: bool = false;
 
     fn new(opts: &Options, n: usize) -> Self {
         let eps = f64::EPSILON;

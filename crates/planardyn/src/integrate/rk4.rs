@@ -45,6 +45,7 @@ impl Integrator for Rk4 {
     const DENSE_ORDER: usize = 3;
     const ADAPTIVE: bool = false;
     const IMPLICIT: bool = false;
+    const SEES_REACH: bool = false;
 
     fn new(opts: &Options, n: usize) -> Self {
         Rk4 {

@@ -35,17 +35,29 @@ pub const NEAR_PASSIVE_SINGULAR: f64 = 1e-3;
 /// of 21 settings (as 0.13 J at 8.9e-5 before), 0.25 left rows 2.03x the steps at 3.98e-8.
 const FIRST_STEP_MOVE: f64 = 0.3;
 
+/// Largest step in the user's chart while its type II measure falls, as a fraction of the time
+/// the measure takes to reach 0 (`fall_step_bound`). The chart's equations of motion vary like
+/// 1/sigma^2, singular where sigma^2, about linear in t, reaches 0: the solution's Taylor series
+/// about a step's start converges only out to that time T, its terms falling like (h / T)^p.
+/// An embedded error estimate is the difference of two truncations of it, and it bounds the
+/// error of the solution propagated only while each term is below half the one before, h < T / 2
+/// (at h = rho T it sees (1 - rho) of the lower order's error, the propagated one being rho of
+/// it). Where the singularity is in the solution this replaces [`SMOOTH_FALL`] (the end's
+/// measure no lower than 0.35 sigma, h up to 0.88 T), under which the five-bar fall
+/// (DOPRI5, rtol = atol 1.0965e-6, 1 s) stepped from 0.0746 to 0.0458 (h = 0.62 T) and gained
+/// 5.7e-4 J in that step, the steps around it 1e-8 to 6e-5 J (tolerances 1.096e-6 and
+/// 1.063e-6 on either side: 6.5e-4 and 7.7e-5 J). The same bound, h < T / 2 with T the time to
+/// the nearest complex singularity, removed every outlier of DOP853 on the Scotch yoke's
+/// equations written out (scipy, rtol = 10^(-k/20), k = 20 ... 200).
+const USER_FALL: f64 = 0.5;
+
 /// Smallest ratio of the type II measure at a step's end to its start that a step in the
-/// user's chart may aim for, where it would end below [`SWITCH_TO_PARTITION`]
-/// (`fall_step_bound`). The chart's equations of motion vary like 1/sigma^2: the error
-/// constant of a step that takes the measure from sigma to a sigma grows 1/a^2-fold inside it,
-/// and the embedded estimate does not see it. Main 2e54c44 (five-bar fall, DOP853, rtol = atol
-/// 1e-4 ... 3.7e-5) took steps from 0.07 to 0.017 and drifted up to 9.2e-4 J; over 751 rtols
-/// 10^(-k/150), k = 600 ... 1350, runs over 1e-4 J: DOP853 66 -> 0 (steps), 74 -> 0 (1 ms grid),
-/// DOPRI5 302 -> 300; evaluations -0.6 % / +0.3 %. Aiming at half the measure (0.5, not
-/// limited to below the threshold): also 0 for DOP853, but the five-bar benchmark's DOPRI5
-/// setting (7.59e-7) drifted 1.2e-4 J (tests/step_reach.rs).
-const USER_FALL: f64 = 0.35;
+/// user's chart may aim for, below [`SWITCH_TO_PARTITION`], where the measure falls but the
+/// accelerations do not grow like 1 / sigma (`fall_step_bound`): a change point on a branch
+/// the motion passes analytically (A02), whose equations are singular only as 0 / 0. The
+/// bound applied everywhere before [`USER_FALL`] (2e54c44); [`USER_FALL`] there took A02 (N = 40, rtol 1e-12)
+/// from 2.4e-9 to 1.03e-8 rad off the reduction (tests/change_points.rs: 1e-8).
+const SMOOTH_FALL: f64 = 0.35;
 
 /// What the monitor found at an accepted point.
 #[derive(Debug, Clone, Copy)]
@@ -149,17 +161,35 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
     }
 }
 
-/// The longest next step in the user's chart from its measure `now` = (t, sigma) at the last
-/// accepted point and `last` at the one before: with sigma^2 linear in t (a generic passage by
-/// a type II singularity), the step at whose end the measure is the lower of [`USER_FALL`]
-/// times sigma and [`SWITCH_TO_PARTITION`] (s; infinite where the measure does not fall).
-pub fn fall_step_bound(last: (f64, f64), now: (f64, f64)) -> f64 {
+/// How fast the accelerations grow against 1 / sigma from `last` to `now` (t, sigma, |qdd|):
+/// d|qdd| / d(1 / sigma). Where the user's chart's singularity is in the solution, the
+/// accelerations have a part like 1 / sigma^k, k >= 1, and this growth does not die out as
+/// sigma falls; where the motion passes the point analytically (a change point on the branch
+/// it follows, A02's), |qdd| tends to a finite limit and the growth falls towards 0 (measured:
+/// five-bar fall, DOPRI5 at 1.0965e-6, sigma 0.21 -> 0.10: 14, 26, 28 (s^-2); A02, N = 40,
+/// DOP853 at 1e-12, sigma 0.24 -> 0.055: 1.75, 1.26, 0.82, 0.46, 0.20, 0.055).
+pub fn acceleration_growth(last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
+    (now.2 - last.2) / (1.0 / now.1 - 1.0 / last.1)
+}
+
+/// The longest next step in the user's chart from (t, sigma) at the last accepted point
+/// (`now`) and at the one before (`last`), with sigma^2 linear in t (a generic passage by a
+/// type II singularity): where the chart's singularity is in the solution (`singular`: the
+/// accelerations' growth against 1 / sigma, [`acceleration_growth`], rises, or was not seen to
+/// fall at a point of this fall below `run::PREDICT_BELOW`), the step covers at most
+/// [`USER_FALL`] of the time to it; elsewhere it ends no lower than
+/// [`SMOOTH_FALL`] times the measure or [`SWITCH_TO_PARTITION`] (s; infinite where the measure
+/// does not fall).
+pub fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) -> f64 {
     let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
-    let end = (USER_FALL * now.1).min(SWITCH_TO_PARTITION);
-    if now.0 > last.0 && fall_rate > 0.0 {
-        (now.1 * now.1 - end * end).max(0.0) / fall_rate
+    if !(now.0 > last.0 && fall_rate > 0.0) {
+        return f64::INFINITY;
+    }
+    if singular {
+        USER_FALL * now.1 * now.1 / fall_rate
     } else {
-        f64::INFINITY
+        let end = (SMOOTH_FALL * now.1).min(SWITCH_TO_PARTITION);
+        (now.1 * now.1 - end * end).max(0.0) / fall_rate
     }
 }
 
