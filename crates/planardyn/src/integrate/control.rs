@@ -306,8 +306,10 @@ pub(crate) fn weighted_sum(out: &mut [f64], w: &[f64], k: &[f64]) {
         7 => weighted_sum_fixed::<7>(out, w, k),
         n => {
             out.fill(-0.0);
-            for (wj, kj) in w.iter().zip(k.chunks_exact(n)).filter(|(wj, _)| **wj != 0.0) {
-                out.iter_mut().zip(kj).for_each(|(o, x)| *o += wj * x);
+            for (&wj, kj) in w.iter().zip(k.chunks_exact(n)) {
+                if wj != 0.0 {
+                    out.iter_mut().zip(kj).for_each(|(o, x)| *o += wj * x);
+                }
             }
         }
     }
@@ -316,9 +318,9 @@ pub(crate) fn weighted_sum(out: &mut [f64], w: &[f64], k: &[f64]) {
 /// [`weighted_sum`] for `out.len() == N`.
 fn weighted_sum_fixed<const N: usize>(out: &mut [f64], w: &[f64], k: &[f64]) {
     let mut acc = [-0.0; N];
-    for (wj, kj) in w.iter().zip(k.as_chunks::<N>().0).filter(|(wj, _)| **wj != 0.0) {
-        for i in 0..N {
-            acc[i] += wj * kj[i];
+    for (&wj, kj) in w.iter().zip(k.as_chunks::<N>().0) {
+        if wj != 0.0 {
+            acc.iter_mut().zip(kj).for_each(|(a, x)| *a += wj * x);
         }
     }
     out.copy_from_slice(&acc);
