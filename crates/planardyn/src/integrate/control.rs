@@ -293,11 +293,10 @@ pub(crate) fn all_finite(v: &[f64]) -> bool {
 /// whose weight is not zero, added in j's order from -0.0 as `Iterator::sum` does: the tableau
 /// row's sum as written, bit for bit (a zero weight adds nothing, and the stages are finite), at
 /// the cost of its nonzero weights only (DOP853's rows are a quarter zeros). Each weight scales
-/// a whole row, with no bounds checks; a mechanism's state of 3, 5 or 7 coordinates (1 to 3 degrees
-/// of freedom: `2 m + 1`, the last its work) gets a fixed-size path, unrolled, whose sums stay
-/// in registers. Hand-written: a BLAS `gemv` would
-/// neither keep the order of the sum nor skip the zeros, and its call costs more than the
-/// whole sum for so small a state.
+/// a whole row, with no bounds checks; a mechanism's state of 3, 5 or 7 coordinates (`2 m + 1`
+/// for 1 to 3 degrees of freedom, the last its work) gets a fixed-size path, unrolled, whose
+/// sums stay in registers. Hand-written: a BLAS `gemv` would neither keep the order of the sum
+/// nor skip the zeros, and its call costs more than the whole sum for so small a state.
 pub(crate) fn weighted_sum(out: &mut [f64], w: &[f64], k: &[f64]) {
     match out.len() {
         0 => {}
