@@ -32,7 +32,7 @@
 // compared with it digit by digit; the compiler rounds them to f64.
 #![allow(clippy::excessive_precision)]
 
-use super::control::{all_finite, explicit_step, Core, ExplicitPair, Failure};
+use super::control::{all_finite, combine, explicit_step, weighted_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
 
 /// Stages of the step (the FSAL stage excluded).
@@ -289,6 +289,8 @@ pub struct Dop853 {
     /// Dense output coefficients `F_0..F_6` of the last accepted step (`7 x n`).
     fd: Vec<f64>,
     ytmp: Vec<f64>,
+    /// The 3rd-order error estimate of the last attempt (`ytmp` holds the 5th-order one).
+    e3: Vec<f64>,
     y_new: Vec<f64>,
     f_new: Vec<f64>,
     /// Step size of the last attempt (s).
@@ -318,6 +320,7 @@ impl Integrator for Dop853 {
             k: vec![0.0; N_EXT * n],
             fd: vec![0.0; 7 * n],
             ytmp: vec![0.0; n],
+            e3: vec![0.0; n],
             y_new: vec![0.0; n],
             f_new: vec![0.0; n],
             h: 0.0,
@@ -340,15 +343,11 @@ impl Integrator for Dop853 {
         if self.substep && s > 0.0 && s < 1.0 && self.substep(sys, s * h, out).is_ok() {
             return;
         }
-        let c = &self.core;
-        let n = c.n;
-        for i in 0..n {
-            let mut acc = 0.0;
-            for r in (0..7).rev() {
-                acc += self.fd[r * n + i];
-                acc *= if (6 - r) % 2 == 0 { s } else { 1.0 - s };
-            }
-            out[i] = c.y_prev[i] + acc;
+        let (c, n, s1) = (&self.core, self.core.n, 1.0 - s);
+        let f = |r: usize| &self.fd[r * n..(r + 1) * n];
+        let rows = f(0).iter().zip(f(1)).zip(f(2)).zip(f(3)).zip(f(4)).zip(f(5)).zip(f(6));
+        for ((((((((f0, f1), f2), f3), f4), f5), f6), y), o) in rows.zip(&c.y_prev).zip(out.iter_mut()) {
+            *o = y + (f0 + (f1 + (f2 + (f3 + (f4 + (f5 + f6 * s) * s1) * s) * s1) * s) * s1) * s;
         }
     }
 }
@@ -382,10 +381,12 @@ impl Dop853 {
         }
         self.substep = self.core.opts.dense_output && !extra_ok;
         let Dop853 { k, fd, .. } = self;
-        for i in 0..n {
-            for r in 0..4 {
-                fd[(3 + r) * n + i] =
-                    if extra_ok { h * (0..N_EXT).map(|j| D[r][j] * k[j * n + i]).sum::<f64>() } else { 0.0 };
+        for (r, row) in fd[3 * n..].chunks_exact_mut(n.max(1)).enumerate() {
+            if extra_ok {
+                weighted_sum(row, &D[r], k);
+                row.iter_mut().for_each(|x| *x *= h);
+            } else {
+                row.fill(0.0);
             }
         }
     }
@@ -402,11 +403,7 @@ impl Dop853 {
             self.stage(sys, s, hs, true)?;
         }
         let Dop853 { core, k, .. } = self;
-        let n = core.n;
-        for i in 0..n {
-            let incr: f64 = (0..N_STAGES).map(|j| B[j] * k[j * n + i]).sum();
-            out[i] = core.y_prev[i] + hs * incr;
-        }
+        combine(out, &core.y_prev, hs, &B, &k[..N_STAGES * core.n]);
         if all_finite(out) {
             Ok(())
         } else {
@@ -420,10 +417,7 @@ impl Dop853 {
         let Dop853 { core, k, ytmp, .. } = self;
         let n = core.n;
         let (t0, y0) = if accepted { (core.t_prev, &core.y_prev) } else { (core.t, &core.y) };
-        for i in 0..n {
-            let incr: f64 = (0..s).map(|j| A[s][j] * k[j * n + i]).sum();
-            ytmp[i] = y0[i] + h * incr;
-        }
+        combine(ytmp, y0, h, &A[s][..s], &k[..s * n]);
         let ks = &mut k[s * n..(s + 1) * n];
         if accepted {
             Core::eval_dense(&mut core.stats, sys, t0 + C[s] * h, ytmp, ks)
@@ -457,11 +451,8 @@ impl ExplicitPair for Dop853 {
         for s in 1..N_STAGES {
             self.stage(sys, s, h, false)?;
         }
-        let Dop853 { core, k, y_new, f_new, .. } = self;
-        for i in 0..n {
-            let incr: f64 = (0..N_STAGES).map(|j| B[j] * k[j * n + i]).sum();
-            y_new[i] = core.y[i] + h * incr;
-        }
+        let Dop853 { core, k, ytmp, e3, y_new, f_new, .. } = self;
+        combine(y_new, &core.y, h, &B, &k[..N_STAGES * n]);
         if !all_finite(y_new) {
             return Err(Failure::NonFinite);
         }
@@ -469,17 +460,15 @@ impl ExplicitPair for Dop853 {
         k[N_STAGES * n..(N_STAGES + 1) * n].copy_from_slice(f_new);
         // Hairer's combined estimator, in scaled RMS form, and the step's increment in the same
         // scale (for `reach_error`).
+        let e5 = ytmp;
+        weighted_sum(e5, &E5, k);
+        weighted_sum(e3, &E3, k);
         let (mut e5sq, mut e3sq, mut dysq) = (0.0, 0.0, 0.0);
-        for i in 0..n {
-            let sc = core.opts.atol + core.opts.rtol * core.y[i].abs().max(y_new[i].abs());
-            let (mut e5, mut e3) = (0.0, 0.0);
-            for j in 0..=N_STAGES {
-                e5 += E5[j] * k[j * n + i];
-                e3 += E3[j] * k[j * n + i];
-            }
+        for (((e5, e3), y), y_new) in e5.iter().zip(e3.iter()).zip(&core.y).zip(y_new.iter()) {
+            let sc = core.opts.atol + core.opts.rtol * y.abs().max(y_new.abs());
             e5sq += (e5 / sc).powi(2);
             e3sq += (e3 / sc).powi(2);
-            dysq += ((y_new[i] - core.y[i]) / sc).powi(2);
+            dysq += ((y_new - y) / sc).powi(2);
         }
         if e5sq == 0.0 && e3sq == 0.0 {
             return Ok(0.0);

@@ -25,7 +25,7 @@
 //! Dense output: `y(t_prev + s h) = y_prev + h sum_j (K_j^T P)_j s^j`, `j = 1..4`,
 //! computed at each accepted step (`4 x n` values, no `rhs` call).
 
-use super::control::{all_finite, error_norm, explicit_step, Core, ExplicitPair, Failure};
+use super::control::{all_finite, combine, error_norm, explicit_step, weighted_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
 
 const C: [f64; 6] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0];
@@ -55,6 +55,21 @@ const P: [[f64; 4]; 7] = [
     [0.0, -282668133.0 / 205662961.0, 2019193451.0 / 616988883.0, -1453857185.0 / 822651844.0],
     [0.0, 40617522.0 / 29380423.0, -110615467.0 / 29380423.0, 69997945.0 / 29380423.0],
 ];
+
+/// [`P`] transposed: row = power of `s`, column = stage (the weights of one power's sum).
+const P_T: [[f64; 7]; 4] = {
+    let mut t = [[0.0; 7]; 4];
+    let mut j = 0;
+    while j < 7 {
+        let mut p = 0;
+        while p < 4 {
+            t[p][j] = P[j][p];
+            p += 1;
+        }
+        j += 1;
+    }
+    t
+};
 
 /// Dormand-Prince 5(4) stepper. All buffers allocated in `new`.
 pub struct Dopri5 {
@@ -100,13 +115,10 @@ impl Integrator for Dopri5 {
         let n = c.n;
         let h = c.t - c.t_prev;
         let s = if h == 0.0 { 0.0 } else { (t - c.t_prev) / h };
-        for i in 0..n {
+        let q = |p: usize| &self.q[p * n..(p + 1) * n];
+        for ((((q1, q2), q3), q4), (y, o)) in q(0).iter().zip(q(1)).zip(q(2)).zip(q(3)).zip(c.y_prev.iter().zip(out)) {
             // Horner in s: s (q1 + s (q2 + s (q3 + s q4))).
-            let mut acc = 0.0;
-            for j in (0..4).rev() {
-                acc = acc * s + self.q[j * n + i];
-            }
-            out[i] = c.y_prev[i] + acc * s;
+            *o = y + (q1 + (q2 + (q3 + q4 * s) * s) * s) * s;
         }
     }
 }
@@ -139,35 +151,26 @@ impl ExplicitPair for Dopri5 {
         let (t, n) = (core.t, core.n);
         k[..n].copy_from_slice(&core.f);
         for s in 1..6 {
-            for i in 0..n {
-                let incr: f64 = (0..s).map(|j| A[s][j] * k[j * n + i]).sum();
-                ytmp[i] = core.y[i] + h * incr;
-            }
+            combine(ytmp, &core.y, h, &A[s][..s], &k[..s * n]);
             let ks = &mut k[s * n..(s + 1) * n];
             Core::eval(&mut core.stats, sys, t + C[s] * h, ytmp, ks)?;
         }
-        for i in 0..n {
-            let incr: f64 = (0..6).map(|j| B[j] * k[j * n + i]).sum();
-            y_new[i] = core.y[i] + h * incr;
-        }
+        combine(y_new, &core.y, h, &B, &k[..6 * n]);
         if !all_finite(y_new) {
             return Err(Failure::NonFinite);
         }
         Core::eval(&mut core.stats, sys, t + h, y_new, f_new)?;
         k[6 * n..].copy_from_slice(f_new);
-        for i in 0..n {
-            err[i] = h * (0..7).map(|j| E[j] * k[j * n + i]).sum::<f64>();
-        }
+        weighted_sum(err, &E, k);
+        err.iter_mut().for_each(|e| *e *= h);
         Ok(error_norm(err, &core.y, y_new, &core.opts))
     }
 
     fn accept<S: OdeSystem>(&mut self, _sys: &mut S, t_new: f64) {
-        let n = self.core.n;
-        let h = self.h;
-        for p in 0..4 {
-            for i in 0..n {
-                self.q[p * n + i] = h * (0..7).map(|j| P[j][p] * self.k[j * n + i]).sum::<f64>();
-            }
+        let (n, h) = (self.core.n, self.h);
+        for (p, row) in self.q.chunks_exact_mut(n.max(1)).enumerate() {
+            weighted_sum(row, &P_T[p], &self.k);
+            row.iter_mut().for_each(|x| *x *= h);
         }
         self.core.accept(t_new, &mut self.y_new, &mut self.f_new);
     }
