@@ -84,6 +84,29 @@ def test_results_are_finished_in_the_native_threads(five_bar):
     assert {k: kind for k, _, kind in seen} == {0: "dict", 1: "dict", 2: "tuple", 3: "dict"}
 
 
+def test_each_native_thread_keeps_one_python_state_for_the_whole_batch(five_bar):
+    """A worker's Python thread state lives from its first variant to its last: a
+    ``threading.local`` set while finishing one variant is there at the next on the same
+    thread. Each variant made and freed a state of its own before (its frame stack mapped and
+    unmapped each time), which took a batch of 1 s four-bar runs from 1.94x to 1.7x on two
+    cores (docs/benchmarks.md, *Small and many runs*); a second batch starts afresh."""
+    from planardyn._core import simulate_batch
+
+    native = [(five_bar._native, {"q0": list(five_bar.q0 + [0.002 * k, 0.0]), "t_end": 0.01}) for k in range(40)]
+    for _ in range(2):
+        local = threading.local()
+        counts: dict[int, int] = {}
+
+        def finish(k, raw, local=local, counts=counts):
+            local.n = getattr(local, "n", 0) + 1
+            counts[threading.get_ident()] = local.n
+            return k
+
+        assert simulate_batch(native, 2, finish) == list(range(40))
+        # Every variant finished on a thread whose state counted all its earlier ones.
+        assert sum(counts.values()) == 40 and len(counts) <= 2
+
+
 def test_a_failing_variant_is_reported_in_its_place(five_bar, variants):
     bad_model = five_bar.to_dict()
     bad_model["bodies"]["proximal_left"]["mass"] = -1.0

@@ -23,8 +23,10 @@ use planardyn::batch::task::{TaskError, TaskPath};
 use planardyn::batch::{map_many_until, Efforts, InverseVariant, Motion, Overrides, Variant};
 use planardyn::simulate::Prepared;
 use planardyn::Mechanism;
+use pyo3::ffi;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
 
@@ -147,8 +149,9 @@ fn run_batch<'py, V: Sync, R>(
             None => out(py, r, v),
         })
     };
-    let (done, interrupt) =
-        run_until_interrupt(py, |stop| map_many_until(&items, threads, stop, one).map_err(Failure::from))?;
+    let (done, interrupt) = run_until_interrupt(py, |stop| {
+        map_many_until(&items, threads, stop, one, (keep_thread_state, drop_thread_state)).map_err(Failure::from)
+    })?;
     let results = done
         .into_iter()
         .map(|r| match r {
@@ -162,6 +165,46 @@ fn run_batch<'py, V: Sync, R>(
             Err(e)
         }
         None => Ok(results),
+    }
+}
+
+std::thread_local! {
+    /// The interpreter state a batch thread keeps from [`keep_thread_state`] to
+    /// [`drop_thread_state`], with its GIL-state token.
+    static KEPT: Cell<Option<(*mut ffi::PyThreadState, ffi::PyGILState_STATE)>> = const { Cell::new(None) };
+}
+
+/// Give this batch thread an interpreter state for the whole batch, detached (the GIL not
+/// held). Without one each variant's `Python::attach` made a state and freed it again
+/// (`PyGILState_Ensure` / `Release` on a thread Python does not know), with its 16 KB frame
+/// stack mapped and unmapped each time: an unmap in a process with two threads running flushes
+/// the other core's TLB, and a batch of 20000 four-bar runs of 0.1 s spent a tenth of its time
+/// there (perf), two threads only 1.16x as fast as one. With a kept state an attach only takes
+/// the GIL. Made with `PyGILState_Ensure`, the state the GIL-state calls of `Python::attach`
+/// find and reuse (one made otherwise they would not know), then detached by
+/// `PyEval_SaveThread`; as pants' executor keeps its threads' (pantsbuild/pants #23489).
+fn keep_thread_state() {
+    // SAFETY: a pool thread starts a batch with no Python state (the last batch's
+    // `drop_thread_state` released it) and without the GIL; `PyGILState_Ensure` makes its
+    // state and takes the GIL, `PyEval_SaveThread` releases it, and both stay valid until the
+    // paired calls in `drop_thread_state` on this same thread.
+    unsafe {
+        let gil = ffi::PyGILState_Ensure();
+        KEPT.set(Some((ffi::PyEval_SaveThread(), gil)));
+    }
+}
+
+/// Release the state [`keep_thread_state`] gave this thread: attached again, the last
+/// GIL-state reference released, which has Python clear and free it.
+fn drop_thread_state() {
+    if let Some((state, gil)) = KEPT.take() {
+        // SAFETY: `state` and `gil` come from `keep_thread_state` on this thread, which is
+        // detached here (every variant's attach was released); the calling thread waits in the
+        // batch call, so the interpreter is alive.
+        unsafe {
+            ffi::PyEval_RestoreThread(state);
+            ffi::PyGILState_Release(gil);
+        }
     }
 }
 

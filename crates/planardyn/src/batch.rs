@@ -519,15 +519,22 @@ pub fn map_many<T: Sync, R: Send>(
 
 /// [`map_many`] that another thread can stop (on Ctrl-C, a closed window...) by setting
 /// `stop`: the items not started by then are `None`; `f` gets the flag too, so a long item
-/// can stop early ([`Variant::simulate_until`]).
+/// can stop early ([`Variant::simulate_until`]). `enter` runs on every thread of the pool
+/// before its first item and `leave` after the last (a caller's per-thread context, made once
+/// a batch rather than once an item: the Python binding's interpreter state of each thread).
 pub fn map_many_until<T: Sync, R: Send>(
     items: &[T],
     threads: Option<usize>,
     stop: &AtomicBool,
     f: impl Fn(&T, &AtomicBool) -> R + Sync + Send,
+    (enter, leave): (impl Fn() + Sync, impl Fn() + Sync),
 ) -> Result<Vec<Option<R>>, Error> {
     let one = |item: &T| (!stop.load(Ordering::Relaxed)).then(|| f(item, stop));
-    Ok(pool(threads)?.install(|| items.par_iter().with_max_len(1).map(one).collect()))
+    let pool = pool(threads)?;
+    pool.broadcast(|_| enter());
+    let out = pool.install(|| items.par_iter().with_max_len(1).map(one).collect());
+    pool.broadcast(|_| leave());
+    Ok(out)
 }
 
 /// Simulate every variant in parallel on `threads` threads (`None`: all cores). The outer
