@@ -764,15 +764,15 @@ impl MechanismOde<'_> {
     }
 
     /// [`MechanismOde::save`] into the spare's buffers (`clone_from`: the old spare's
-    /// allocations reused, 0.18 M instructions of the five-bar free fall's 11 switches).
+    /// allocations reused, 0.18 M instructions of the five-bar free fall's 11 switches). The
+    /// pattern names every field, so one added to [`Evaluation`] but not here does not compile.
     fn save_to_spare(&mut self) {
-        let e = &mut self.spare;
-        e.ws.clone_from(&self.ws);
-        e.eval_y.clone_from(&self.eval_y);
-        e.last_y.clone_from(&self.last_y);
-        e.closed.clone_from(&self.closed);
-        (e.last_t, e.base_valid, e.base_closed, e.stale_j) =
-            (self.last_t, self.base_valid, self.base_closed, self.stale_j);
+        let Evaluation { ws, eval_y, last_t, last_y, base_valid, closed, base_closed, stale_j } = &mut self.spare;
+        ws.clone_from(&self.ws);
+        eval_y.clone_from(&self.eval_y);
+        last_y.clone_from(&self.last_y);
+        closed.clone_from(&self.closed);
+        (*last_t, *base_valid, *base_closed, *stale_j) = (self.last_t, self.base_valid, self.base_closed, self.stale_j);
     }
 
     /// Put back an evaluation saved by [`MechanismOde::save`].
