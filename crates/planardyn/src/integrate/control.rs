@@ -325,6 +325,12 @@ fn weighted_sum_fixed<const N: usize>(out: &mut [f64], w: &[f64], k: &[f64]) {
     out.copy_from_slice(&acc);
 }
 
+/// `out_i = h sum_j w_j K_ji`, the sum as [`weighted_sum`]'s.
+pub(crate) fn scaled_sum(out: &mut [f64], h: f64, w: &[f64], k: &[f64]) {
+    weighted_sum(out, w, k);
+    out.iter_mut().for_each(|o| *o *= h);
+}
+
 /// `out_i = y_i + h sum_j w_j K_ji`, the sum as [`weighted_sum`]'s.
 pub(crate) fn combine(out: &mut [f64], y: &[f64], h: f64, w: &[f64], k: &[f64]) {
     weighted_sum(out, w, k);

@@ -32,7 +32,7 @@
 // compared with it digit by digit; the compiler rounds them to f64.
 #![allow(clippy::excessive_precision)]
 
-use super::control::{all_finite, combine, explicit_step, weighted_sum, Core, ExplicitPair, Failure};
+use super::control::{all_finite, combine, explicit_step, scaled_sum, weighted_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
 
 /// Stages of the step (the FSAL stage excluded).
@@ -383,8 +383,7 @@ impl Dop853 {
         let Dop853 { k, fd, .. } = self;
         for (r, row) in fd[3 * n..].chunks_exact_mut(n.max(1)).enumerate() {
             if extra_ok {
-                weighted_sum(row, &D[r], k);
-                row.iter_mut().for_each(|x| *x *= h);
+                scaled_sum(row, h, &D[r], k);
             } else {
                 row.fill(0.0);
             }

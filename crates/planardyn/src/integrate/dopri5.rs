@@ -25,7 +25,7 @@
 //! Dense output: `y(t_prev + s h) = y_prev + h sum_j (K_j^T P)_j s^j`, `j = 1..4`,
 //! computed at each accepted step (`4 x n` values, no `rhs` call).
 
-use super::control::{all_finite, combine, error_norm, explicit_step, weighted_sum, Core, ExplicitPair, Failure};
+use super::control::{all_finite, combine, error_norm, explicit_step, scaled_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
 
 const C: [f64; 6] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0];
@@ -161,16 +161,14 @@ impl ExplicitPair for Dopri5 {
         }
         Core::eval(&mut core.stats, sys, t + h, y_new, f_new)?;
         k[6 * n..].copy_from_slice(f_new);
-        weighted_sum(err, &E, k);
-        err.iter_mut().for_each(|e| *e *= h);
+        scaled_sum(err, h, &E, k);
         Ok(error_norm(err, &core.y, y_new, &core.opts))
     }
 
     fn accept<S: OdeSystem>(&mut self, _sys: &mut S, t_new: f64) {
         let (n, h) = (self.core.n, self.h);
         for (p, row) in self.q.chunks_exact_mut(n.max(1)).enumerate() {
-            weighted_sum(row, &P_T[p], &self.k);
-            row.iter_mut().for_each(|x| *x *= h);
+            scaled_sum(row, h, &P_T[p], &self.k);
         }
         self.core.accept(t_new, &mut self.y_new, &mut self.f_new);
     }
