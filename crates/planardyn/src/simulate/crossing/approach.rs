@@ -36,12 +36,10 @@ pub struct Passed {
 impl Passed {
     /// The point evaluated in `ode.ws`, at time t with passive measure `passive`.
     pub fn of(ode: &MechanismOde, t: f64, passive: f64) -> Self {
-        let ws = &ode.ws;
-        let mut state = Vec::with_capacity(3 * ws.x.len());
-        for part in [&ws.x, &ws.xd, &ws.xdd] {
-            state.extend_from_slice(part);
-        }
-        Passed { t, passive, sigma: f64::NAN, state, power: ws.power, speed: scaled_speed(ode.mech, &ws.xd) }
+        let state = vec![0.0; 3 * ode.ws.x.len()];
+        let mut p = Passed { t, passive, sigma: f64::NAN, state, power: 0.0, speed: 0.0 };
+        p.renew(ode, t, passive);
+        p
     }
 
     /// Body coordinates x (3n).
@@ -65,7 +63,7 @@ impl Passed {
         let ws = &ode.ws;
         (self.t, self.passive, self.sigma, self.power, self.speed) =
             (t, passive, f64::NAN, ws.power, scaled_speed(ode.mech, &ws.xd));
-        for (dest, part) in self.state.chunks_exact_mut(ws.x.len()).zip([&ws.x, &ws.xd, &ws.xdd]) {
+        for (dest, part) in self.state.chunks_exact_mut(ws.x.len().max(1)).zip([&ws.x, &ws.xd, &ws.xdd]) {
             dest.copy_from_slice(part);
         }
     }
