@@ -3,6 +3,7 @@
 //! singularity, and back again once past it. Decisions are taken between accepted steps.
 
 use super::ode::{MechanismOde, CLOSED_FORM_SIGMA};
+use crate::integrate::Method;
 use crate::kinematics::constraints::{pair_coordinate, pair_coordinate_rate};
 use crate::kinematics::{passive_sigma_min_with, select_partition, sigma_min_with, Chart};
 
@@ -168,7 +169,7 @@ pub fn first_step_bound(ode: &MechanismOde, own: f64) -> f64 {
 /// it follows, A02's), |qdd| tends to a finite limit and the growth falls towards 0 (measured:
 /// five-bar fall, DOPRI5 at 1.0965e-6, sigma 0.21 -> 0.10: 14, 26, 28 (s^-2); A02, N = 40,
 /// DOP853 at 1e-12, sigma 0.24 -> 0.055: 1.75, 1.26, 0.82, 0.46, 0.20, 0.055).
-pub fn acceleration_growth(last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
+fn acceleration_growth(last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
     (now.2 - last.2) / (1.0 / now.1 - 1.0 / last.1)
 }
 
@@ -176,11 +177,11 @@ pub fn acceleration_growth(last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
 /// (`now`) and at the one before (`last`), with sigma^2 linear in t (a generic passage by a
 /// type II singularity): where the chart's singularity is in the solution (`singular`: the
 /// accelerations' growth against 1 / sigma, [`acceleration_growth`], rises, or was not seen to
-/// fall at a point of this fall below `run::PREDICT_BELOW`), the step covers at most
+/// fall at a point of this fall below the run's PREDICT_BELOW), the step covers at most
 /// [`USER_FALL`] of the time to it; elsewhere it ends no lower than
 /// [`SMOOTH_FALL`] times the measure or [`SWITCH_TO_PARTITION`] (s; infinite where the measure
 /// does not fall).
-pub fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) -> f64 {
+fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) -> f64 {
     let fall_rate = (last.1 * last.1 - now.1 * now.1) / (now.0 - last.0);
     if !(now.0 > last.0 && fall_rate > 0.0) {
         return f64::INFINITY;
@@ -190,6 +191,62 @@ pub fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bo
     } else {
         let end = (SMOOTH_FALL * now.1).min(SWITCH_TO_PARTITION);
         (now.1 * now.1 - end * end).max(0.0) / fall_rate
+    }
+}
+
+/// The user's chart's type II falls, accepted point by accepted point: what [`fall_step_bound`]
+/// needs of the points before, and whether the fall under way is singular in the solution.
+#[derive(Debug, Clone)]
+pub struct FallWatch {
+    /// Whether the run bounds a fall by [`USER_FALL`] at all: not for a method whose estimate
+    /// sees the step's reach itself (DOP853: with the bound, 0 of 751 rtols from 1e-4 to 1e-9
+    /// over 1e-4 J either way, the worst 1.4e-5 -> 1.5e-5 J, for +6 % evaluations).
+    bounds: bool,
+    /// (t, sigma, |qdd|) at the last accepted point, if in the user's chart.
+    last: Option<(f64, f64, f64)>,
+    /// The accelerations' growth into that point ([`acceleration_growth`]; NaN where unknown).
+    growth: f64,
+    /// This fall was taken to be singular in the solution, latched while the measure falls.
+    singular: bool,
+}
+
+impl FallWatch {
+    /// Before the run's first point, for a run by `method`.
+    pub fn new(method: Method) -> Self {
+        FallWatch { bounds: !method.sees_reach(), last: None, growth: f64::NAN, singular: false }
+    }
+
+    /// Whether [`FallWatch::next_step_bound`] reads |qdd| (only where falls are bounded).
+    pub fn wants_accelerations(&self) -> bool {
+        self.bounds
+    }
+
+    /// Take the accepted point `now` = (t, sigma, |qdd|) (`user`: in the user's chart; `low`:
+    /// sigma below the run's PREDICT_BELOW) and return the bound on the next step, if any.
+    ///
+    /// Wherever the measure falls, above PREDICT_BELOW too where the accelerations' growth
+    /// against 1 / sigma rises (the five-bar fall with DOP853 at rtol = atol 3.55e-4, before its
+    /// estimate saw the step's reach, stepped from 0.255 to 0.093 in 25 ms, 0.87 of the time to
+    /// the singularity, and lost 2.8e-4 J in it; the runs on either side 2.6e-5 and 3.5e-5 J).
+    /// Below PREDICT_BELOW the singularity is in the solution unless the growth is seen to fall
+    /// towards a finite limit, positive and below the last (A02, N = 40, rtol 1e-12: at every
+    /// point of a fall from sigma 0.39 down, 7.8 ... 1.75 ... 0.055): waiting for it to rise
+    /// missed a fall's first steps, where the accelerations' regular part falls (five-bar fall,
+    /// DOP853 at 1e-6 with the bound: growth -183 then -55 at sigma 0.29 and 0.23, and the next
+    /// step, to 0.14, covered 0.82 of the time to the singularity, its dense output 5.8e-7 J off
+    /// mid-step). Latched for the rest of the fall: the growth from point to point is noisy
+    /// where the steps are long (five-bar fall, DOPRI5 rtol 9.5e-5: 27.1 then 25.7 at sigma
+    /// 0.106 and 0.085, and the next step, unbounded by T/2, took 0.085 to 0.050 and gained
+    /// 1.0e-3 J).
+    pub fn next_step_bound(&mut self, user: bool, low: bool, now: (f64, f64, f64)) -> Option<f64> {
+        let last = self.last.filter(|_| user);
+        let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
+        let (rising, analytic) = (growth > 0.0 && growth >= self.growth, growth > 0.0 && growth < self.growth);
+        let falling = last.is_some_and(|last| now.1 < last.1);
+        self.singular = self.bounds && falling && (self.singular || (low && !analytic));
+        let singular = self.bounds && (rising || self.singular);
+        (self.last, self.growth) = (user.then_some(now), growth);
+        last.filter(|_| low || singular).map(|last| fall_step_bound(last, now, singular))
     }
 }
 

@@ -7,8 +7,8 @@
 use std::ops::ControlFlow::{self, Break, Continue};
 
 use super::charts::{
-    acceleration_growth, chart_sigma, fall_step_bound, first_step_bound, measure, next_chart, state_in, Measures,
-    NEAR_PASSIVE_SINGULAR, PASSIVE_SINGULAR, SWITCH_TO_PARTITION,
+    chart_sigma, first_step_bound, measure, next_chart, state_in, FallWatch, Measures, NEAR_PASSIVE_SINGULAR,
+    PASSIVE_SINGULAR, SWITCH_TO_PARTITION,
 };
 use super::crossing::{
     cross, inside_step, scaled_speed, stepped_over, user_state, Approach, Bridge, ChangePoint, Grid, Integration, Path,
@@ -98,15 +98,8 @@ pub struct Run<'a, 's, 'e> {
     keep_dense: bool,
     /// The chart's own measure at the last accepted point, while in the same chart.
     last_own: Option<f64>,
-    /// The user's chart's time, type II measure and size of qdd at the last accepted point, if in
-    /// that chart.
-    last_user: Option<(f64, f64, f64)>,
-    /// The accelerations' growth against 1 / sigma into that point (`acceleration_growth`;
-    /// NaN where not known).
-    user_growth: f64,
-    /// The user's chart's singularity was taken to be in the solution (below PREDICT_BELOW,
-    /// `acceleration_growth` not seen to fall) while its measure has been falling since.
-    fall_singular: bool,
+    /// The user's chart's type II falls, for the bound on the steps into them.
+    fall: FallWatch,
     /// Steps accepted since the last chart switch.
     chart_steps: usize,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
@@ -163,9 +156,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             watch: Watch::new(observe.events, m),
             keep_dense,
             last_own: None,
-            last_user: None,
-            user_growth: f64::NAN,
-            fall_singular: false,
+            fall: FallWatch::new(settings.method),
             chart_steps: 0,
             fold: FoldWatch::default(),
         };
@@ -510,42 +501,17 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.predict_next_step();
         }
         self.last_own = Some(own);
-        // A step in the user's chart may not rush into type II (`fall_step_bound`), wherever
-        // the measure falls: above PREDICT_BELOW too where the accelerations' growth against
-        // 1 / sigma rises (the five-bar fall with DOP853 at rtol = atol 3.55e-4, before its
-        // estimate saw the step's reach, stepped from 0.255 to 0.093 in 25 ms, 0.87 of the time
-        // to the singularity, and lost 2.8e-4 J in it; the runs on either side 2.6e-5 and
-        // 3.5e-5 J).
+        // A step in the user's chart may not rush into type II (`FallWatch`).
         let user = self.ode.ws.chart == Chart::Inputs;
-        let bounds_fall = !self.settings.method.sees_reach();
         let m = self.ode.m();
-        let qdd =
-            if bounds_fall { self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt() } else { f64::NAN };
-        let now = (t, own, qdd);
-        let last = self.last_user.filter(|_| user);
-        let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
-        let rising = growth > 0.0 && growth >= self.user_growth;
-        // Below PREDICT_BELOW the singularity is in the solution unless the growth is seen to
-        // fall towards a finite limit, positive and below the last (A02, N = 40, rtol 1e-12: at
-        // every point of a fall from sigma 0.39 down, 7.8 ... 1.75 ... 0.055): waiting for it
-        // to rise missed a fall's first steps, where the accelerations' regular part falls
-        // (five-bar fall, DOP853 at 1e-6 with the bound: growth -183 then -55 at sigma 0.29 and
-        // 0.23, and the next step, to 0.14, covered 0.82 of the time to the singularity, its
-        // dense output 5.8e-7 J off mid-step). Latched for the rest of the fall: the growth from
-        // point to point is noisy where the steps are long (five-bar fall, DOPRI5 rtol 9.5e-5:
-        // 27.1 then 25.7 at sigma 0.106 and 0.085, and the next step, unbounded by T/2, took
-        // 0.085 to 0.050 and gained 1.0e-3 J). Not for a method that sees the step's reach
-        // itself (DOP853: with the bound, 0 of 751 rtols from 1e-4 to 1e-9 over 1e-4 J either
-        // way, the worst 1.4e-5 -> 1.5e-5 J, for +6 % evaluations).
-        let analytic = growth > 0.0 && growth < self.user_growth;
-        let falling = last.is_some_and(|last| own < last.1);
-        self.fall_singular = bounds_fall && falling && (self.fall_singular || (own < PREDICT_BELOW && !analytic));
-        let singular = bounds_fall && (rising || self.fall_singular);
-        if let Some(last) = last.filter(|_| own < PREDICT_BELOW || singular) {
-            self.stepper.bound_next_step(fall_step_bound(last, now, singular));
+        let qdd = if self.fall.wants_accelerations() {
+            self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt()
+        } else {
+            f64::NAN
+        };
+        if let Some(h) = self.fall.next_step_bound(user, own < PREDICT_BELOW, (t, own, qdd)) {
+            self.stepper.bound_next_step(h);
         }
-        self.last_user = user.then_some(now);
-        self.user_growth = growth;
         // The controller's proposal after a switch's first step, which `first_step_bound` kept
         // short, is long: in an alternative chart it is bounded as that first step was.
         if self.chart_steps == 1 && matches!(self.ode.ws.chart, Chart::Pairs(_)) {
