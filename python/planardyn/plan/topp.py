@@ -354,8 +354,8 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
     x0 = _first_speeds(limits, pts)
     u0 = np.zeros_like(x0)
     duration, rounds = np.inf, 0
-    history: list[tuple[float, float]] = []  # (time s, limits used) of each round
-    previous: tuple[Any, ...] = ()  # the last round's timing: sdd, sd, status, dense check
+    # (time s, limits used, (sdd, sd, status, dense check)) of each round
+    history: list[tuple[float, float, tuple[Any, ...]]] = []
     alternation = ""
     while True:
         rounds += 1
@@ -372,7 +372,7 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
         # Rounds that alternate between two timings never settle: the shorter of the two that
         # the dense check holds within the limits is the plan (where neither is: _unsettled).
         if len(history) >= 2 and _same(history[-2][0], t_new) and not settled:
-            pair = [(t_new, found.ratio, (sdd, sd, status, found)), (duration, history[-1][1], previous)]
+            pair = [(t_new, found.ratio, (sdd, sd, status, found)), history[-1]]
             within = [p for p in pair if p[1] <= 1 + RATIO_TOL]
             if within:
                 taken = min(within, key=lambda p: p[0])
@@ -383,8 +383,7 @@ def _time_on_grid(model: PlanningModel, path: Any, s: FloatArray, limits: list[L
                 break
         if found.ratio <= 1 + RATIO_TOL and settled:
             break
-        history.append((t_new, found.ratio))
-        previous = (sdd, sd, status, found)
+        history.append((t_new, found.ratio, (sdd, sd, status, found)))
         if rounds == MAX_ROUNDS:
             raise PlanError(_unsettled(history, n))
         bad = np.flatnonzero(found.worst > 1 + RATIO_TOL)
@@ -411,12 +410,12 @@ def _same(a: float, b: float) -> bool:
     return abs(a - b) <= ACTUATOR_TOL * b
 
 
-def _unsettled(history: list[tuple[float, float]], n: int) -> str:
+def _unsettled(history: list[tuple[float, float, Any]], n: int) -> str:
     """Why the rounds on a grid of n points did not end, from each round's time (s) and limits
     used: the time still changing, alternating between two timings that both exceed a limit
     (the motor envelopes' tangents taken at one give the other; where one of the two is within
     the limits, it is taken), or settled with a limit still exceeded."""
-    (t_2, _), (t_1, r_1), (t, r) = history[-3:]
+    (t_2, _, _), (t_1, r_1, _), (t, r, _) = history[-3:]
     if _same(t, t_2) and not _same(t, t_1):
         what = (f"alternates between {t_1:.9g} s (limits used to {r_1:.9g}) and {t:.9g} s (limits used to {r:.9g}) "
                 "from round to round: the motor envelopes' tangents taken at either timing give the other")
