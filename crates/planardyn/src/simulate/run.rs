@@ -215,6 +215,10 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         }
         self.fill_approach(t)?;
         let meas = self.accept(t)?;
+        if std::env::var_os("S26DBG").is_some() {
+            let own = self.ode.chart_measure();
+            eprintln!("DBG step {:?} {:.6} -> {:.6} h {:.3e} sigma {:.4} own {:.4}", self.ode.ws.chart, self.stepper.t_prev(), t, t - self.stepper.t_prev(), meas.sigma, own);
+        }
         if self.change_points(t, &meas)? {
             return Continue(());
         }
@@ -501,15 +505,16 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             self.stepper.predict_next_step();
         }
         self.last_own = Some(own);
-        // A step in the user's chart may not rush into type II (`FallWatch`).
-        let user = self.ode.ws.chart == Chart::Inputs;
+        // A step in the user's chart may not rush into type II, nor one in an alternative
+        // chart into its own singularity (`FallWatch`).
+        let watched = matches!(self.ode.ws.chart, Chart::Inputs | Chart::Pairs(_));
         let m = self.ode.m();
         let qdd = if self.fall.wants_accelerations() {
             self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt()
         } else {
             f64::NAN
         };
-        if let Some(h) = self.fall.next_step_bound(user, own < PREDICT_BELOW, (t, own, qdd)) {
+        if let Some(h) = self.fall.next_step_bound(watched, self.chart_steps > 0, own < PREDICT_BELOW, (t, own, qdd)) {
             self.stepper.bound_next_step(h);
         }
         // The controller's proposal after a switch's first step, which `first_step_bound` kept
