@@ -215,10 +215,6 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         }
         self.fill_approach(t)?;
         let meas = self.accept(t)?;
-        if std::env::var_os("S26DBG").is_some() {
-            let own = self.ode.chart_measure();
-            eprintln!("DBG step {:?} {:.6} -> {:.6} h {:.3e} sigma {:.4} own {:.4}", self.ode.ws.chart, self.stepper.t_prev(), t, t - self.stepper.t_prev(), meas.sigma, own);
-        }
         if self.change_points(t, &meas)? {
             return Continue(());
         }
