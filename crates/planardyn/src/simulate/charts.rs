@@ -221,10 +221,11 @@ impl FallWatch {
         self.bounds
     }
 
-    /// Take the accepted point `now` = (t, sigma, |qdd|) (`watched`: in a chart whose falls are
-    /// watched, the user's or an alternative one, sigma and qdd that chart's own; `continued`:
-    /// the point before was in the same chart; `low`: sigma below the run's PREDICT_BELOW) and
-    /// return the bound on the next step, if any.
+    /// Take the accepted point `now` = (t, sigma, |qdd|), sigma and qdd the chart's own (`user`:
+    /// in the user's chart; `alt`: in an alternative chart, watched only where falls are
+    /// bounded, so that DOP853's steps there keep no smooth-fall bound they did not have;
+    /// `continued`: the point before was in the same chart; `low`: sigma below the run's
+    /// PREDICT_BELOW) and return the bound on the next step, if any.
     ///
     /// An alternative chart's equations are singular as the user's are where its own measure
     /// reaches 0, and its steps fall into it alike: the five-bar fall, DOPRI5 at rtol = atol
@@ -246,7 +247,15 @@ impl FallWatch {
     /// where the steps are long (five-bar fall, DOPRI5 rtol 9.5e-5: 27.1 then 25.7 at sigma
     /// 0.106 and 0.085, and the next step, unbounded by T/2, took 0.085 to 0.050 and gained
     /// 1.0e-3 J).
-    pub fn next_step_bound(&mut self, watched: bool, continued: bool, low: bool, now: (f64, f64, f64)) -> Option<f64> {
+    pub fn next_step_bound(
+        &mut self,
+        user: bool,
+        alt: bool,
+        continued: bool,
+        low: bool,
+        now: (f64, f64, f64),
+    ) -> Option<f64> {
+        let watched = user || alt && self.bounds;
         let last = self.last.filter(|_| watched && continued);
         let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
         let (rising, analytic) = (growth > 0.0 && growth >= self.growth, growth > 0.0 && growth < self.growth);
