@@ -194,6 +194,21 @@ fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) 
     }
 }
 
+/// The time from `now` to where sigma^2, the parabola in t through the last three accepted
+/// points' (`before`, `last`, `now`: (t, sigma)), reaches 0, where it is concave (s; infinite
+/// elsewhere): a fall that starts at a peak of the measure, which the two points' slope does
+/// not see.
+fn curved_fall_time(before: (f64, f64), last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
+    let (a, b, c) = (before.1 * before.1, last.1 * last.1, now.1 * now.1);
+    let (d1, d2) = ((b - a) / (last.0 - before.0), (c - b) / (now.0 - last.0));
+    let dd = (d2 - d1) / (now.0 - before.0);
+    if dd.is_nan() || dd >= 0.0 {
+        return f64::INFINITY;
+    }
+    let g = d2 + dd * (now.0 - last.0);
+    (g + (g * g - 4.0 * dd * c).sqrt()) / (-2.0 * dd)
+}
+
 /// The user's chart's type II falls, accepted point by accepted point: what [`fall_step_bound`]
 /// needs of the points before, and whether the fall under way is singular in the solution.
 #[derive(Debug, Clone)]
@@ -204,6 +219,8 @@ pub struct FallWatch {
     bounds: bool,
     /// (t, sigma, |qdd|) at the last accepted point, if in a watched chart.
     last: Option<(f64, f64, f64)>,
+    /// (t, sigma) at the accepted point before `last`, in the same chart.
+    before: Option<(f64, f64)>,
     /// The accelerations' growth into that point ([`acceleration_growth`]; NaN where unknown).
     growth: f64,
     /// This fall was taken to be singular in the solution, latched while the measure falls.
@@ -213,7 +230,7 @@ pub struct FallWatch {
 impl FallWatch {
     /// Before the run's first point, for a run by `method`.
     pub fn new(method: Method) -> Self {
-        FallWatch { bounds: !method.sees_reach(), last: None, growth: f64::NAN, singular: false }
+        FallWatch { bounds: !method.sees_reach(), last: None, before: None, growth: f64::NAN, singular: false }
     }
 
     /// Whether [`FallWatch::next_step_bound`] reads |qdd| (only where falls are bounded).
@@ -262,8 +279,16 @@ impl FallWatch {
         let falling = last.is_some_and(|last| now.1 < last.1);
         self.singular = self.bounds && falling && (self.singular || (low && !analytic));
         let singular = self.bounds && (rising || self.singular);
+        let before = self.before.filter(|_| self.bounds && last.is_some());
+        let curved =
+            before.zip(last).map_or(f64::INFINITY, |(before, last)| USER_FALL * curved_fall_time(before, last, now));
+        self.before = last.map(|last| (last.0, last.1));
         (self.last, self.growth) = (watched.then_some(now), growth);
-        last.filter(|_| low || singular).map(|last| fall_step_bound(last, now, singular))
+        let bound = last.filter(|_| low || singular).map(|last| fall_step_bound(last, now, singular));
+        match bound {
+            Some(h) => Some(h.min(curved)),
+            None => curved.is_finite().then_some(curved),
+        }
     }
 }
 
