@@ -198,7 +198,7 @@ fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) 
 /// points' (`before`, `last`, `now`: (t, sigma)), reaches 0, where it is concave (s; infinite
 /// elsewhere): a fall that starts at a peak of the measure, which the two points' slope does
 /// not see (five-bar fall, DOPRI5 at rtol = atol 0.0501: from sigma 0.3005, 0.3009 a step of
-/// 28 ms fell to 0.126, 2.1 times this time, and gained 0.50 J; bounded to half of it, the
+/// 28 ms fell to 0.126 and gained 0.50 J; bounded to half of it, the
 /// sweep rtol = 10^(-k/20), k = 20 ... 200, has its worst 0.508 -> 0.126 J for +1.6 %
 /// evaluations).
 fn curved_fall_time(before: (f64, f64), last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
