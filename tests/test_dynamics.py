@@ -181,8 +181,9 @@ def test_free_fall_steps_from_a_peak_stay_within_half_the_time_to_the_curved_fal
     # reaches 0 (simulate/charts.rs, curved_fall_time and USER_FALL), to rounding of T from the
     # rows. Before it (3b0e891) 10 of these 13 runs had a step over it, up to 2.77 of that time
     # (k = 20); at k = 20 and 26 one step from sigma 0.28 - 0.30 fell to 0.11 - 0.13 in 27 - 28 ms
-    # and gained 0.33 - 0.50 J (the drift at k = 20 ... 27 was 0.36 - 0.51 J; now 0.0056 - 0.126 J). The watch takes its first point at the end of the run's first step
-    # (not the start), so its first parabola is at the third step's end (row 3).
+    # and gained 0.33 - 0.50 J (the drift at k = 20 ... 27 was 0.36 - 0.51 J; now 0.0056 - 0.126 J).
+    # The watch takes its first point at the end of the run's first step (not the start), so its
+    # first parabola is at the third step's end (row 3).
     mech = pd.load_example("five-bar-free-fall")
     r = 10 ** (-k / 20)
     res = mech.simulate(t_end=1.0, method="DOPRI5", rtol=r, atol=r)
