@@ -194,6 +194,24 @@ fn fall_step_bound(last: (f64, f64, f64), now: (f64, f64, f64), singular: bool) 
     }
 }
 
+/// The time from `now` to where sigma^2, the parabola in t through the last three accepted
+/// points' (`before`, `last`, `now`: (t, sigma)), reaches 0, where it is concave (s; infinite
+/// elsewhere): a fall that starts at a peak of the measure, which the two points' slope does
+/// not see (five-bar fall, DOPRI5 at rtol = atol 0.0501: from sigma 0.3005, 0.3009 a step of
+/// 28 ms fell to 0.126 and gained 0.50 J; bounded to half of it, the
+/// sweep rtol = 10^(-k/20), k = 20 ... 200, has its worst 0.508 -> 0.126 J for +1.6 %
+/// evaluations).
+fn curved_fall_time(before: (f64, f64), last: (f64, f64, f64), now: (f64, f64, f64)) -> f64 {
+    let (a, b, c) = (before.1 * before.1, last.1 * last.1, now.1 * now.1);
+    let (d1, d2) = ((b - a) / (last.0 - before.0), (c - b) / (now.0 - last.0));
+    let dd = (d2 - d1) / (now.0 - before.0);
+    if dd.is_nan() || dd >= 0.0 {
+        return f64::INFINITY;
+    }
+    let g = d2 + dd * (now.0 - last.0);
+    (g + (g * g - 4.0 * dd * c).sqrt()) / (-2.0 * dd)
+}
+
 /// The user's chart's type II falls, accepted point by accepted point: what [`fall_step_bound`]
 /// needs of the points before, and whether the fall under way is singular in the solution.
 #[derive(Debug, Clone)]
@@ -202,8 +220,10 @@ pub struct FallWatch {
     /// sees the step's reach itself (DOP853: with the bound, 0 of 751 rtols from 1e-4 to 1e-9
     /// over 1e-4 J either way, the worst 1.4e-5 -> 1.5e-5 J, for +6 % evaluations).
     bounds: bool,
-    /// (t, sigma, |qdd|) at the last accepted point, if in the user's chart.
+    /// (t, sigma, |qdd|) at the last accepted point, if in a watched chart.
     last: Option<(f64, f64, f64)>,
+    /// (t, sigma) at the accepted point before `last`, in the same chart.
+    before: Option<(f64, f64)>,
     /// The accelerations' growth into that point ([`acceleration_growth`]; NaN where unknown).
     growth: f64,
     /// This fall was taken to be singular in the solution, latched while the measure falls.
@@ -213,7 +233,7 @@ pub struct FallWatch {
 impl FallWatch {
     /// Before the run's first point, for a run by `method`.
     pub fn new(method: Method) -> Self {
-        FallWatch { bounds: !method.sees_reach(), last: None, growth: f64::NAN, singular: false }
+        FallWatch { bounds: !method.sees_reach(), last: None, before: None, growth: f64::NAN, singular: false }
     }
 
     /// Whether [`FallWatch::next_step_bound`] reads |qdd| (only where falls are bounded).
@@ -221,8 +241,17 @@ impl FallWatch {
         self.bounds
     }
 
-    /// Take the accepted point `now` = (t, sigma, |qdd|) (`user`: in the user's chart; `low`:
-    /// sigma below the run's PREDICT_BELOW) and return the bound on the next step, if any.
+    /// Take the accepted point `now` = (t, sigma, |qdd|), sigma and qdd the chart's own (`user`:
+    /// in the user's chart; `alt`: in an alternative chart, watched only where falls are
+    /// bounded, so that DOP853's steps there keep no smooth-fall bound they did not have;
+    /// `continued`: the point before was in the same chart; `low`: sigma below the run's
+    /// PREDICT_BELOW) and return the bound on the next step, if any.
+    ///
+    /// An alternative chart's equations are singular as the user's are where its own measure
+    /// reaches 0, and its steps fall into it alike: the five-bar fall, DOPRI5 at rtol = atol
+    /// 4.47e-4, stepped in the pairs' chart from own measure 0.103 to 0.080 in 5.9 ms (more
+    /// than the time to its singularity, sigma^2 extrapolated) and gained 5.7e-3 J in that
+    /// step, the runs on either side 4.1e-4 and 5.3e-4 J in all.
     ///
     /// Wherever the measure falls, above PREDICT_BELOW too where the accelerations' growth
     /// against 1 / sigma rises (the five-bar fall with DOP853 at rtol = atol 3.55e-4, before its
@@ -238,15 +267,31 @@ impl FallWatch {
     /// where the steps are long (five-bar fall, DOPRI5 rtol 9.5e-5: 27.1 then 25.7 at sigma
     /// 0.106 and 0.085, and the next step, unbounded by T/2, took 0.085 to 0.050 and gained
     /// 1.0e-3 J).
-    pub fn next_step_bound(&mut self, user: bool, low: bool, now: (f64, f64, f64)) -> Option<f64> {
-        let last = self.last.filter(|_| user);
+    pub fn next_step_bound(
+        &mut self,
+        user: bool,
+        alt: bool,
+        continued: bool,
+        low: bool,
+        now: (f64, f64, f64),
+    ) -> Option<f64> {
+        let watched = user || alt && self.bounds;
+        let last = self.last.filter(|_| watched && continued);
         let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
         let (rising, analytic) = (growth > 0.0 && growth >= self.growth, growth > 0.0 && growth < self.growth);
         let falling = last.is_some_and(|last| now.1 < last.1);
         self.singular = self.bounds && falling && (self.singular || (low && !analytic));
         let singular = self.bounds && (rising || self.singular);
-        (self.last, self.growth) = (user.then_some(now), growth);
-        last.filter(|_| low || singular).map(|last| fall_step_bound(last, now, singular))
+        let before = self.before.filter(|_| self.bounds && last.is_some());
+        let curved =
+            before.zip(last).map_or(f64::INFINITY, |(before, last)| USER_FALL * curved_fall_time(before, last, now));
+        self.before = last.map(|last| (last.0, last.1));
+        (self.last, self.growth) = (watched.then_some(now), growth);
+        let bound = last.filter(|_| low || singular).map(|last| fall_step_bound(last, now, singular));
+        match bound {
+            Some(h) => Some(h.min(curved)),
+            None => curved.is_finite().then_some(curved),
+        }
     }
 }
 
