@@ -3,6 +3,7 @@
 //! forces and P its power, so that T + V - W is constant along any exact trajectory.
 
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
+use crate::dynamics::transmission::Band;
 use crate::integrate::OdeSystem;
 use crate::kinematics::alt_charts::AltCharts;
 use crate::kinematics::analogues::u_times_from;
@@ -728,6 +729,13 @@ impl MechanismOde<'_> {
     pub fn set_aside(&mut self) {
         self.swap_spare();
         self.restart_from_anchor();
+    }
+
+    /// Hold motor i's side of its at-rest band (`simulate::gear_sides`) in both evaluations'
+    /// buffers: the outputs, evaluated in the spare, follow the law the steps do.
+    pub fn hold_gear(&mut self, i: usize, band: Option<Band>) {
+        self.ws.losses.gears_mut().hold(i, band);
+        self.spare.ws.losses.gears_mut().hold(i, band);
     }
 
     /// Take back the evaluation set aside by [`MechanismOde::set_aside`].
