@@ -80,12 +80,13 @@ impl Band {
         }
     }
 
-    /// A moving gear's switching function n s qd - v_m: positive until qd enters the at-rest
-    /// band (`None` at rest).
-    pub fn entry(self, a: &Actuator, qd: f64) -> Option<f64> {
+    /// The switching function of this side at qd, positive while the gear keeps to it:
+    /// moving, n s qd - v_m (qd entering the band); at rest, (1 + `exit`) v_m - |n qd| (qd
+    /// leaving the band `exit` (a fraction) past its edge: a hysteresis against chattering).
+    pub fn switching(self, a: &Actuator, qd: f64, exit: f64) -> f64 {
         match self {
-            Band::AtRest => None,
-            Band::Moving(s) => Some(s * a.ratio * qd - a.stiction_speed),
+            Band::AtRest => (1.0 + exit) * a.stiction_speed - (a.ratio * qd).abs(),
+            Band::Moving(s) => s * a.ratio * qd - a.stiction_speed,
         }
     }
 }

@@ -6,20 +6,24 @@
 //! robot's rows jumped inside steps (its efforts -2.38 -> -3.87 N m and back at t = 0.745 s,
 //! DOP853 rtol 4.47e-6) and its drift over 1 s stood out 35000x from its neighbours'.
 //!
-//! Held, each band's law is smooth in the state (`dynamics::gears`: the modes within it meet
-//! continuously, motoring and back-driven at tau = 0, sticking and slipping at zero slip). A
-//! moving gear's entry n s qd - v_m ([`Band::entry`]) is a switching function: where it
-//! changes sign inside a step, the crossing is located on the step's interpolant
-//! ([`locate_zero`], to [`super::events::EVENT_XTOL`]), the step is taken again to end there,
-//! the gear is held at rest and the integrator restarted. Leaving the band needs no restart:
-//! a gear leaves it slipping outwards, where the at-rest law and the moving one are the same
-//! equations (motoring or back-driven along qd), so it is switched at the accepted point.
+//! Held, each side's law is smooth in the state (`dynamics::gears`: the modes within it meet
+//! continuously, motoring and back-driven at tau = 0, sticking and slipping at zero slip).
+//! Each side's switching function ([`Band::switching`]) is watched: where one changes sign
+//! inside a step, its zero is located on the step's interpolant ([`locate_zero`], to
+//! [`super::events::EVENT_XTOL`]), the step is taken again to end there, and the gear is
+//! switched. Past its edge a side's law is no motion's (the at-rest one decides the branch by
+//! qdd + qd / T, which a decelerating gear far outside the band gets wrong), so the interpolant
+//! of a step that went far past it is off there too: the step taken again is checked as any
+//! other, and only an end within [`END_WINDOW`] of the edge counts as the switch. Entering the
+//! band the law jumps (the gear may stick): the integrator restarts. Leaving it the gear slips
+//! outwards, where both sides' laws are the same equations (motoring or back-driven along qd):
+//! no restart.
 //!
-//! **Chattering.** A gear is switched back out of the band only once its motor turns
-//! [`EXIT_MARGIN`] faster than its stiction speed: entered at the located crossing, its state
-//! lies on the edge to the run's tolerance, on either side, and a gear sliding along the edge
-//! (held at its stuck band's boundary, the sliding mode `transmission::STUCK_DECAY` describes)
-//! stays on the at-rest side, whose law covers that motion smoothly.
+//! **Chattering.** A gear leaves the band only [`EXIT_MARGIN`] past its edge, so a gear that
+//! entered at the located edge (to [`END_WINDOW`]) is not switched back by the tolerance-sized
+//! offset of its state, and one sliding along the edge (held at its stuck band's boundary, the
+//! sliding mode `transmission::STUCK_DECAY` describes) stays at rest, whose law covers that
+//! motion smoothly.
 
 use super::events::locate_zero;
 use super::ode::MechanismOde;
@@ -28,17 +32,22 @@ use crate::integrate::Stepper;
 use crate::kinematics::Chart;
 use crate::Error;
 
-/// A gear held at rest is switched to moving once its motor's speed |n qd| exceeds its
-/// stiction speed v_m by this fraction: a hysteresis far above the tolerance to which an entry
-/// is located, and small beside the band (the motor's Coulomb torque, tanh(n qd / v_m), is
-/// 0.77 of its full value at the edge, 0.77 at 1.01 v_m too).
+/// A gear at rest leaves its band once its motor turns this fraction faster than its stiction
+/// speed v_m: a hysteresis far above the tolerance to which a switch is located, and small
+/// beside the band (the motor's Coulomb torque, T_c tanh(n qd / v_m), is 0.762 T_c at the
+/// edge, 0.766 T_c at 1.01 v_m).
 pub const EXIT_MARGIN: f64 = 1e-2;
 
-/// The entry located inside the last step taken: its time, the retaken step's end, and the
-/// motor that enters its band there.
+/// A step taken again to end at a located switch makes it when its end's switching function
+/// lies within this fraction of v_m of 0 (half the hysteresis: the other side's function then
+/// starts at least as far from its own zero).
+pub const END_WINDOW: f64 = 0.5 * EXIT_MARGIN;
+
+/// The switch located inside the last step taken: its time (the retaken step's end) and the
+/// motor that switches there.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct GearSides {
-    entry: Option<(f64, usize)>,
+    switch: Option<(f64, usize)>,
 }
 
 impl GearSides {
@@ -50,11 +59,10 @@ impl GearSides {
         }
     }
 
-    /// The earliest entry of a moving gear into its at-rest band inside the step the stepper
-    /// just took from (`t0`, `y0`), located on its interpolant (`yi` its scratch); `None`
-    /// without one, and in the step taken again to end at an entry located before: that
-    /// step's crossing is that entry, at its end.
-    pub fn entry_in_step(
+    /// The earliest switch of a gear's side inside the step the stepper just took from
+    /// (`t0`, `y0`), located on its interpolant (`yi` its scratch), for the step to be taken
+    /// again to end there; `None` without one, or when the step (taken again) ends on it.
+    pub fn switch_in_step(
         &mut self,
         ode: &mut MechanismOde,
         stepper: &mut Stepper,
@@ -62,7 +70,8 @@ impl GearSides {
         yi: &mut [f64],
     ) -> Result<Option<f64>, Error> {
         let (t0, t1) = (stepper.t_prev(), stepper.t());
-        if !ode.ws.losses.gears().has_motors() || self.entry.is_some_and(|(t, _)| t1 >= t) {
+        let retaken = self.switch.take().filter(|&(ts, _)| t1 == ts);
+        if !ode.ws.losses.gears().has_motors() {
             return Ok(None);
         }
         let m = ode.m();
@@ -74,78 +83,66 @@ impl GearSides {
         yi.copy_from_slice(stepper.y());
         let mut first: Option<(f64, usize)> = None;
         for i in 0..n {
-            let end = entry(ode, i, t1, yi)?;
-            if !end.is_some_and(|g| g <= 0.0) {
+            let (g1, window) = switching(ode, i, t1, yi)?;
+            if retaken.is_some_and(|(_, j)| j == i) && g1.abs() <= window {
+                first = Some((t1, i));
                 continue;
             }
-            let start = entry(ode, i, t0, y0)?.filter(|&g| g > 0.0);
-            let (Some(g0), Some(g1)) = (start, end) else { continue };
-            let t = locate_zero(
-                |s| {
-                    stepper.interpolate(ode, s, yi);
-                    entry(ode, i, s, yi).map(|g| g.unwrap_or(1.0))
-                },
-                (t0, t1),
-                (g0, g1),
-            )?;
+            if g1 > 0.0 {
+                continue;
+            }
+            let (g0, _) = switching(ode, i, t0, y0)?;
+            if g0 <= 0.0 {
+                // Past its edge from the step's start (no zero to locate): switched at its end
+                // rather than held on a side it has left.
+                first.get_or_insert((t1, i));
+                continue;
+            }
+            let locate = |s| {
+                stepper.interpolate(ode, s, yi);
+                switching(ode, i, s, yi).map(|(g, _)| g)
+            };
+            let t = locate_zero(locate, (t0, t1), (g0, g1))?;
             if first.is_none_or(|(tf, _)| t < tf) {
                 first = Some((t, i));
             }
         }
-        match first {
-            Some(found) => {
-                self.entry = Some(found);
-                Ok(Some(found.0))
-            }
-            None => {
-                // No entry: the step's evaluations stand, to the bit.
-                if let Some(saved) = saved {
-                    ode.restore(saved);
-                }
-                Ok(None)
-            }
+        self.switch = first;
+        if let Some((t, _)) = first.filter(|&(t, _)| t < t1) {
+            return Ok(Some(t));
         }
+        // No switch inside the step (or one at its end): its evaluations stand, to the bit.
+        if let Some(saved) = saved {
+            ode.restore(saved);
+        }
+        Ok(None)
     }
 
-    /// At the point accepted at `t` (evaluated in `ode.ws`): the gear whose entry the step
-    /// ended at held at rest, and gears at rest that turn [`EXIT_MARGIN`] past their band held
-    /// moving. True when the law changed discontinuously there: restart the integrator.
+    /// At the point accepted at `t` (evaluated in `ode.ws`): switch the gear whose switch the
+    /// step ended at. True when it entered its band, where the law jumps: restart the
+    /// integrator.
     pub fn switch(&mut self, ode: &mut MechanismOde, t: f64) -> bool {
-        // The retaken step ends on the entry exactly; a crossing of a change point that
-        // restarted the run past it drops it.
-        let entered = self.entry.filter(|&(te, _)| t == te).map(|(_, i)| i);
-        if self.entry.is_some_and(|(te, _)| t >= te) {
-            self.entry = None;
-        }
-        let sides: Vec<(Band, f64)> = ode
-            .ws
-            .losses
-            .gears()
-            .sides(ode.mech)
-            .map(|(_, band, a, qd)| (band, a.ratio * qd / a.stiction_speed))
-            .collect();
-        for (i, (band, speed)) in sides.into_iter().enumerate() {
-            if Some(i) == entered {
-                ode.hold_gear(i, Some(Band::AtRest));
-            } else if band == Band::AtRest && speed.abs() > 1.0 + EXIT_MARGIN {
-                ode.hold_gear(i, Some(Band::Moving(speed.signum())));
-            }
-        }
-        entered.is_some()
+        let Some((_, i)) = self.switch.take().filter(|&(ts, _)| t == ts) else { return false };
+        let (_, band, _, qd) = ode.ws.losses.gears().sides(ode.mech).nth(i).expect("motor i exists");
+        let next = match band {
+            Band::AtRest => Band::Moving(qd.signum()),
+            Band::Moving(_) => Band::AtRest,
+        };
+        ode.hold_gear(i, Some(next));
+        next == Band::AtRest
     }
 }
 
-/// Motor i's entry function ([`Band::entry`]) at state y (`None` at rest): qd read from y in the
-/// user's chart for a coordinate's motor, else from an evaluation there.
-fn entry(ode: &mut MechanismOde, i: usize, t: f64, y: &[f64]) -> Result<Option<f64>, Error> {
+/// Motor i's switching function ([`Band::switching`]) at state y and its [`END_WINDOW`]: qd
+/// read from y in the user's chart for a coordinate's motor, else from an evaluation there.
+fn switching(ode: &mut MechanismOde, i: usize, t: f64, y: &[f64]) -> Result<(f64, f64), Error> {
     let m = ode.m();
     let (k, band, a, _) = ode.ws.losses.gears().sides(ode.mech).nth(i).expect("motor i exists");
-    let direct = k < m && ode.ws.chart == Chart::Inputs && ode.motion.is_none();
-    let qd = if direct {
+    let qd = if k < m && ode.ws.chart == Chart::Inputs && ode.motion.is_none() {
         y[m + k]
     } else {
         ode.evaluate_walking(t, y)?;
         ode.ws.losses.gears().sides(ode.mech).nth(i).expect("motor i exists").3
     };
-    Ok(band.entry(a, qd))
+    Ok((band.switching(a, qd, EXIT_MARGIN), END_WINDOW * a.stiction_speed))
 }

@@ -105,7 +105,7 @@ pub struct Run<'a, 's, 'e> {
     chart_steps: usize,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
     fold: FoldWatch,
-    /// The gears' entries into their at-rest bands, located inside steps.
+    /// The gears' switches of side of their at-rest bands, located inside steps.
     gear_sides: GearSides,
 }
 
@@ -204,8 +204,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if self.overshot(t) {
             return self.retake();
         }
-        match self.gear_sides.entry_in_step(&mut self.ode, &mut self.stepper, &self.y, &mut self.yi) {
-            Ok(Some(t_entry)) => return self.retake_to(t_entry),
+        match self.gear_sides.switch_in_step(&mut self.ode, &mut self.stepper, &self.y, &mut self.yi) {
+            Ok(Some(t_switch)) => return self.retake_to(t_switch),
             Ok(None) => {}
             Err(error) => return Break(Stop::Output { t, error }),
         }
