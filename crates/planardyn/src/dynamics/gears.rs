@@ -40,7 +40,7 @@
 //! consistent (Painleve's paradox of friction), the evaluation is refused
 //! ([`KinematicsError::GearsJammed`]) rather than guessed.
 
-use super::transmission::{at_rest, direction, housing, motor_friction, motors, STUCK_DECAY};
+use super::transmission::{housing, motor_friction, motors, Band, STUCK_DECAY};
 use crate::linalg::{lu_factor, lu_solve};
 use crate::model::{Actuator, Mechanism};
 use crate::KinematicsError;
@@ -115,6 +115,9 @@ pub(crate) struct Gears {
     modes: Vec<&'static [Mode]>,
     first: Vec<usize>,
     digits: Vec<usize>,
+    /// (N) each motor's side of its at-rest band as a run holds it (`None`: chosen from qd at
+    /// each evaluation, as outside a run).
+    held: Vec<Option<Band>>,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -143,6 +146,7 @@ impl Gears {
             modes: vec![MOVING; n],
             first: vec![0; n],
             digits: vec![0; n],
+            held: vec![None; n],
             slots,
         }
     }
@@ -212,15 +216,43 @@ impl Gears {
             r.net = if prescribed { 0.0 } else { r.torque - motor_friction(a, r.rate) };
             (self.modes[i], self.first[i]) = if prescribed {
                 (PRESCRIBED, 0)
-            } else if at_rest(a, r.rate) {
-                (AT_REST, 2)
             } else {
-                (MOVING, usize::from(r.net * r.rate < 0.0))
+                match self.held[i].unwrap_or_else(|| Band::of(a, r.rate)) {
+                    Band::AtRest => (AT_REST, 2),
+                    Band::Moving(s) => (MOVING, usize::from(r.net * s < 0.0)),
+                }
             };
             self.ag[i * m..(i + 1) * m].copy_from_slice(&gu[k * m..(k + 1) * m]);
             let e = &self.e[i * m..(i + 1) * m];
             self.ae[i * m..(i + 1) * m].copy_from_slice(e);
         }
+    }
+
+    /// Motor i's side of its at-rest band: the held one, else qd's.
+    fn side(&self, mech: &Mechanism, i: usize) -> Band {
+        self.held[i].unwrap_or_else(|| Band::of(self.actuator(mech, i), self.rotors[self.slots[i]].rate))
+    }
+
+    /// Whether any actuator has a motor (and so a side to hold).
+    pub(crate) fn has_motors(&self) -> bool {
+        !self.slots.is_empty()
+    }
+
+    /// Each motor's actuator index, side of its at-rest band (held or qd's), actuator and
+    /// rate qd at the last evaluation.
+    pub(crate) fn sides<'g, 'm: 'g>(
+        &'g self,
+        mech: &'m Mechanism,
+    ) -> impl Iterator<Item = (usize, Band, &'m Actuator, f64)> + 'g {
+        (0..self.slots.len()).map(move |i| {
+            let k = self.slots[i];
+            (k, self.side(mech, i), self.actuator(mech, i), self.rotors[k].rate)
+        })
+    }
+
+    /// Hold motor i's side (`None`: choose it from qd at each evaluation).
+    pub(crate) fn hold(&mut self, i: usize, side: Option<Band>) {
+        self.held[i] = side;
     }
 
     /// The columns to solve with A (homogeneous: prescribed coordinates held), in place:
@@ -364,7 +396,7 @@ impl Gears {
             let (qdd, size) = terms.fold((self.gy[i] + r.h, self.gy[i].abs() + r.h.abs()), |(s, z), (p, q)| {
                 (s + p + q, z + p.abs() + q.abs())
             });
-            let direction = direction(a, r.rate, qdd);
+            let direction = self.side(mech, i).direction(r.rate, qdd);
             let direction =
                 if direction.abs() > MODE_TOL * (size + (r.rate / STUCK_DECAY).abs()) { direction } else { 0.0 };
             let slack = MODE_TOL * (tau.abs() + a.ratio * (t.abs() + r.net.abs()));

@@ -78,6 +78,11 @@ impl LossBuffers {
         &self.gears
     }
 
+    /// The motors' gears, to hold their sides of the at-rest band through a run's steps.
+    pub(crate) fn gears_mut(&mut self) -> &mut Gears {
+        &mut self.gears
+    }
+
     /// The motors' torques t_m of the drives in `tau` and `pair_tau` move to the gears.
     pub(crate) fn take_motor_torques(&mut self, tau: &mut [f64], pair_tau: &[f64]) {
         self.gears.take_torques(tau, pair_tau);

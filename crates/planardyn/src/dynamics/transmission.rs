@@ -46,10 +46,48 @@ pub(crate) fn at_rest(a: &Actuator, qd: f64) -> bool {
 /// ([`at_rest`]) the way it slips from sticking, qdd - (-qd / T) ([`STUCK_DECAY`]): qdd at
 /// qd = 0, and positive, zero or negative as the gear slips forward, sticks or slips back.
 pub(crate) fn direction(a: &Actuator, qd: f64, qdd: f64) -> f64 {
-    if at_rest(a, qd) {
-        qdd + qd / STUCK_DECAY
-    } else {
-        qd
+    Band::of(a, qd).direction(qd, qdd)
+}
+
+/// The side of its at-rest band ([`at_rest`]) whose law a gear follows. Chosen afresh from qd
+/// at every evaluation, the law jumps where qd enters the band and the gear sticks there
+/// (qdd from the moving solution to -qd / T), inside an integrator's step; a run holds each
+/// gear's side through its steps (`dynamics::gears`, `simulate::gear_sides`), and the law of
+/// a side extends past its edge smoothly: moving, the direction's sign is held (so qd may pass
+/// 0 under it), at rest the band's law applies at any qd.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Band {
+    AtRest,
+    /// Moving with qd of this sign (+1 or -1).
+    Moving(f64),
+}
+
+impl Band {
+    /// The side qd is on.
+    pub fn of(a: &Actuator, qd: f64) -> Band {
+        if at_rest(a, qd) {
+            Band::AtRest
+        } else {
+            Band::Moving(if qd > 0.0 { 1.0 } else { -1.0 })
+        }
+    }
+
+    /// [`direction`] on this side: qd (its sign held) moving, qdd + qd / T at rest.
+    pub fn direction(self, qd: f64, qdd: f64) -> f64 {
+        match self {
+            Band::AtRest => qdd + qd / STUCK_DECAY,
+            Band::Moving(s) => s * qd.abs(),
+        }
+    }
+
+    /// The switching function of this side at qd, positive while the gear keeps to it:
+    /// moving, n s qd - v_m (qd entering the band); at rest, (1 + `exit`) v_m - |n qd| (qd
+    /// leaving the band `exit` (a fraction) past its edge: a hysteresis against chattering).
+    pub fn switching(self, a: &Actuator, qd: f64, exit: f64) -> f64 {
+        match self {
+            Band::AtRest => (1.0 + exit) * a.stiction_speed - (a.ratio * qd).abs(),
+            Band::Moving(s) => s * a.ratio * qd - a.stiction_speed,
+        }
     }
 }
 

@@ -126,11 +126,29 @@ impl<'e> Watch<'e> {
 }
 
 /// The zero of `e` in [a, b] on the dense output, g(a) = ga != 0 and g(b) = gb of the other
-/// sign or 0: Illinois (regula falsi halving the weight of an end kept twice). Returns the
-/// bracket's later end, where g has crossed.
-fn locate(e: &mut Event, dense: &DenseOutput, mut a: f64, mut b: f64, mut ga: f64, mut gb: f64) -> Result<f64, String> {
-    let (m, h) = (dense.m, b - a);
+/// sign or 0 ([`locate_zero`]).
+fn locate(e: &mut Event, dense: &DenseOutput, a: f64, b: f64, ga: f64, gb: f64) -> Result<f64, String> {
+    let m = dense.m;
     let (mut q, mut qd) = (vec![0.0; m], vec![0.0; m]);
+    locate_zero(
+        |c| {
+            dense.eval(c, &mut q, &mut qd)?;
+            e.value(c, &q, &qd)
+        },
+        (a, b),
+        (ga, gb),
+    )
+}
+
+/// The zero of g in [a, b], g(a) = ga != 0 and g(b) = gb of the other sign or 0, to
+/// [`EVENT_XTOL`]: Illinois (regula falsi halving the weight of an end kept twice). Returns the
+/// bracket's later end, where g has crossed.
+pub(super) fn locate_zero<E>(
+    mut g: impl FnMut(f64) -> Result<f64, E>,
+    (mut a, mut b): (f64, f64),
+    (mut ga, mut gb): (f64, f64),
+) -> Result<f64, E> {
+    let h = b - a;
     let mut side = 0;
     for _ in 0..MAX_ITERATIONS {
         if gb == 0.0 || (b - a) <= EVENT_XTOL * b.abs().max(a.abs()).max(h) {
@@ -139,8 +157,7 @@ fn locate(e: &mut Event, dense: &DenseOutput, mut a: f64, mut b: f64, mut ga: f6
         let c = ((a * gb - b * ga) / (gb - ga)).clamp(a, b);
         // A secant point at an end (round-off) would not shrink the bracket: bisect.
         let c = if c <= a || c >= b { 0.5 * (a + b) } else { c };
-        dense.eval(c, &mut q, &mut qd)?;
-        let gc = e.value(c, &q, &qd)?;
+        let gc = g(c)?;
         if gc == 0.0 || (gc < 0.0) != (ga < 0.0) {
             (b, gb) = (c, gc);
             if side == -1 {

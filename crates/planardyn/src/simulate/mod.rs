@@ -8,6 +8,7 @@ pub mod crossing;
 pub mod dense;
 pub mod events;
 mod fold_watch;
+mod gear_sides;
 mod jacobian;
 pub mod ode;
 mod overrides;

@@ -2,6 +2,7 @@
 //! y = [z, zd, W] with y' = [zd, zdd, P], where W is the work done by the non-conservative
 //! forces and P its power, so that T + V - W is constant along any exact trajectory.
 
+use crate::dynamics::transmission::Band;
 use crate::dynamics::{dynamic_stages, forward, forward_prescribed, Drives, Prescribed};
 use crate::integrate::OdeSystem;
 use crate::kinematics::alt_charts::AltCharts;
@@ -728,6 +729,13 @@ impl MechanismOde<'_> {
     pub fn set_aside(&mut self) {
         self.swap_spare();
         self.restart_from_anchor();
+    }
+
+    /// Hold motor i's side of its at-rest band (`simulate::gear_sides`) in both evaluations'
+    /// buffers: the outputs, evaluated in the spare, follow the law the steps do.
+    pub fn hold_gear(&mut self, i: usize, band: Option<Band>) {
+        self.ws.losses.gears_mut().hold(i, band);
+        self.spare.ws.losses.gears_mut().hold(i, band);
     }
 
     /// Take back the evaluation set aside by [`MechanismOde::set_aside`].

@@ -17,6 +17,7 @@ use super::crossing::{
 use super::dense::{self, DenseOutput};
 use super::events::Watch;
 use super::fold_watch::FoldWatch;
+use super::gear_sides::GearSides;
 use super::ode::MechanismOde;
 use super::prepared::Prepared;
 use super::start;
@@ -104,6 +105,8 @@ pub struct Run<'a, 's, 'e> {
     chart_steps: usize,
     /// The driven coordinates' measure at the last accepted points, near their singularity.
     fold: FoldWatch,
+    /// The gears' switches of side of their at-rest bands, located inside steps.
+    gear_sides: GearSides,
 }
 
 impl<'a, 's, 'e> Run<'a, 's, 'e> {
@@ -131,6 +134,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         // nodes): a step without pays nothing.
         let options = Options { dense_output: true, ..settings.options.clone() };
         let mut stepper = Stepper::new(settings.method, &options, 2 * m + 1).map_err(Error::Options)?;
+        GearSides::hold_all(&mut ode);
         if let Err(error) = stepper.reset(&mut ode, settings.t0, &y) {
             return Ok(Break(Stop::Step { error, crossing: None }));
         }
@@ -159,6 +163,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
             fall: FallWatch::new(settings.method),
             chart_steps: 0,
             fold: FoldWatch::default(),
+            gear_sides: GearSides::default(),
         };
         // The start counts in the least measures, so that a run of no step reports its start's.
         let first = measure(&mut run.ode);
@@ -199,6 +204,11 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         if self.overshot(t) {
             return self.retake();
         }
+        match self.gear_sides.switch_in_step(&mut self.ode, &mut self.stepper, &self.y, &mut self.yi) {
+            Ok(Some(t_switch)) => return self.retake_to(t_switch),
+            Ok(None) => {}
+            Err(error) => return Break(Stop::Output { t, error }),
+        }
         self.y.copy_from_slice(self.stepper.y());
         self.chart_steps += 1;
         match self.ode.ws.chart {
@@ -223,6 +233,7 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         self.progress_rate()?;
         self.fold(t, &meas)?;
         self.chart(t, &meas)?;
+        self.gears(t)?;
         self.aim(t, &meas);
         self.report(t, progress)
     }
@@ -600,12 +611,29 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
     /// rtol 1e-8 stepped from 0.06 to past it in the user's chart) would leave the crossing no
     /// nodes before it. `self.y` still holds the step's start.
     fn retake(&mut self) -> ControlFlow<Stop> {
+        self.retake_to(self.limit.unwrap_or(self.settings.t_end))
+    }
+
+    /// Take the step just taken again from its start, ending at `t_stop` at the latest.
+    fn retake_to(&mut self, t_stop: f64) -> ControlFlow<Stop> {
         let t_prev = self.stepper.t_prev();
         self.ode.restart_from_anchor();
         if let Err(error) = self.stepper.reset(&mut self.ode, t_prev, &self.y) {
             return Break(Stop::Step { error, crossing: None });
         }
-        self.t_stop = self.limit.unwrap_or(self.settings.t_end);
+        self.t_stop = t_stop;
+        Continue(())
+    }
+
+    /// Switch the gears' held sides at the point accepted at t ([`GearSides::switch`]),
+    /// restarting the integrator where the law jumped.
+    fn gears(&mut self, t: f64) -> ControlFlow<Stop> {
+        if self.gear_sides.switch(&mut self.ode, t) {
+            self.ode.restart_from_anchor();
+            if let Err(error) = self.stepper.reset(&mut self.ode, t, &self.y) {
+                return Break(Stop::Step { error, crossing: None });
+            }
+        }
         Continue(())
     }
 
