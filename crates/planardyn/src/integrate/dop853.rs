@@ -34,6 +34,7 @@
 
 use super::control::{all_finite, combine, explicit_step, scaled_sum, weighted_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
+use crate::linalg::copy_small;
 
 /// Stages of the step (the FSAL stage excluded).
 const N_STAGES: usize = 12;
@@ -446,7 +447,7 @@ impl ExplicitPair for Dop853 {
             self.dense_ready = true;
         }
         self.h = h;
-        self.k[..n].copy_from_slice(&self.core.f);
+        copy_small(&mut self.k[..n], &self.core.f);
         for s in 1..N_STAGES {
             self.stage(sys, s, h, false)?;
         }
@@ -456,7 +457,7 @@ impl ExplicitPair for Dop853 {
             return Err(Failure::NonFinite);
         }
         Core::eval(&mut core.stats, sys, core.t + h, y_new, f_new)?;
-        k[N_STAGES * n..(N_STAGES + 1) * n].copy_from_slice(f_new);
+        copy_small(&mut k[N_STAGES * n..(N_STAGES + 1) * n], f_new);
         // Hairer's combined estimator, in scaled RMS form, and the step's increment in the same
         // scale (for `reach_error`).
         let e5 = ytmp;
