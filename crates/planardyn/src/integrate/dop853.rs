@@ -413,6 +413,10 @@ impl Dop853 {
 
     /// Evaluate stage `s` from the stages before it: `K_s = f(t + C_s h, y + h sum_j A_sj K_j)`,
     /// from the current point, or (`accepted`) from the start of the last accepted step.
+    /// Inlined: as a call of its own each of a step's 11 stages saved and restored its
+    /// registers and checked its slices' bounds again (four-bar 10 s, 4634 stages: 12.57 M ->
+    /// 12.40 M instructions a run).
+    #[inline(always)]
     fn stage<S: OdeSystem>(&mut self, sys: &mut S, s: usize, h: f64, accepted: bool) -> Result<(), Failure<S::Error>> {
         let Dop853 { core, k, ytmp, .. } = self;
         let n = core.n;
