@@ -312,6 +312,10 @@ fn all_finite_fixed<const N: usize>(v: &[f64]) -> bool {
 /// for 1 to 3 degrees of freedom, the last its work) gets a fixed-size path, unrolled, whose
 /// sums stay in registers. Hand-written: a BLAS `gemv` would neither keep the order of the sum
 /// nor skip the zeros, and its call costs more than the whole sum for so small a state.
+/// Inlined, with [`combine`]: where the weights are a constant row (DOP853's stages,
+/// `Dop853::stage_at`) the zero ones are dropped at compile time. `k` holds at least `w.len()`
+/// rows.
+#[inline(always)]
 pub(crate) fn weighted_sum(out: &mut [f64], w: &[f64], k: &[f64]) {
     match out.len() {
         0 => {}
@@ -329,10 +333,13 @@ pub(crate) fn weighted_sum(out: &mut [f64], w: &[f64], k: &[f64]) {
     }
 }
 
-/// [`weighted_sum`] for `out.len() == N`.
+/// [`weighted_sum`] for `out.len() == N`. The rows taken are `w.len()`, a constant where the
+/// weights are: the loop is then unrolled (zipped with all of `k`'s rows, its length was not
+/// known and it was not).
+#[inline(always)]
 fn weighted_sum_fixed<const N: usize>(out: &mut [f64], w: &[f64], k: &[f64]) {
     let mut acc = [-0.0; N];
-    for (&wj, kj) in w.iter().zip(k.as_chunks::<N>().0) {
+    for (&wj, kj) in w.iter().zip(&k.as_chunks::<N>().0[..w.len()]) {
         if wj != 0.0 {
             acc.iter_mut().zip(kj).for_each(|(a, x)| *a += wj * x);
         }
@@ -347,6 +354,7 @@ pub(crate) fn scaled_sum(out: &mut [f64], h: f64, w: &[f64], k: &[f64]) {
 }
 
 /// `out_i = y_i + h sum_j w_j K_ji`, the sum as [`weighted_sum`]'s.
+#[inline(always)]
 pub(crate) fn combine(out: &mut [f64], y: &[f64], h: f64, w: &[f64], k: &[f64]) {
     weighted_sum(out, w, k);
     out.iter_mut().zip(y).for_each(|(o, yi)| *o = yi + h * *o);

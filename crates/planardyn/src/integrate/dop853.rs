@@ -429,6 +429,16 @@ impl Dop853 {
             Core::eval(&mut core.stats, sys, t0 + C[s] * h, ytmp, ks)
         }
     }
+
+    /// Stage `I` of an attempt ([`Dop853::stage`] from the current point). With `I` a constant
+    /// the row `A[I]` is known where its sum is inlined (`combine`), so the compiler drops its
+    /// zero weights and unrolls the rest: the four-bar's 10 s run (4634 stages) 12.40 M ->
+    /// 12.07 M instructions, where a loop over the stages, even unrolled, kept a test and a
+    /// branch for each weight (12.29 M).
+    #[inline(always)]
+    fn stage_at<const I: usize, S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<(), Failure<S::Error>> {
+        self.stage(sys, I, h, false)
+    }
 }
 
 impl ExplicitPair for Dop853 {
@@ -452,9 +462,13 @@ impl ExplicitPair for Dop853 {
         }
         self.h = h;
         copy_small(&mut self.k[..n], &self.core.f);
-        for s in 1..N_STAGES {
-            self.stage(sys, s, h, false)?;
+        // Stage by stage with the index a constant: each stage's sum is then of its tableau
+        // row's nonzero weights only, unrolled, with no test of a weight (see `stage_at`).
+        macro_rules! stages {
+            ($($s:literal)*) => { $(self.stage_at::<$s, S>(sys, h)?;)* };
         }
+        const { assert!(N_STAGES == 12, "the stages listed are 1..N_STAGES") };
+        stages!(1 2 3 4 5 6 7 8 9 10 11);
         let Dop853 { core, k, ytmp, e3, y_new, f_new, .. } = self;
         combine(y_new, &core.y, h, &B, &k[..N_STAGES * n]);
         if !all_finite(y_new) {
