@@ -528,3 +528,28 @@ pub(crate) fn explicit_step<P: ExplicitPair, S: OdeSystem>(
         p.core().stats.nreject += 1;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::all_finite;
+
+    /// The fixed-size test (3, 5, 7 entries) and the general one (any other length) refuse a
+    /// NaN or an infinity of either sign at every position, and accept finite values at the
+    /// ends of the range (the largest, a subnormal, both zeros), where `x - x` must stay 0.
+    #[test]
+    fn all_finite_refuses_each_non_finite_entry_at_every_length() {
+        let finite = [f64::MAX, -f64::MAX, 5e-324, -0.0, 0.0, 1.0, -3.5, f64::MIN_POSITIVE];
+        for n in 1..=8 {
+            let v: Vec<f64> = finite[..n].to_vec();
+            assert!(all_finite(&v), "n = {n}: {v:?}");
+            for i in 0..n {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut w = v.clone();
+                    w[i] = bad;
+                    assert!(!all_finite(&w), "n = {n}, {bad} at {i}");
+                }
+            }
+        }
+        assert!(all_finite(&[]));
+    }
+}
