@@ -298,10 +298,10 @@ pub(crate) fn all_finite(v: &[f64]) -> bool {
     }
 }
 
-/// [`all_finite`] for `v.len() == N`: `x - x` is 0 for a finite x and NaN for an infinite or
-/// NaN one, and their sum is 0 exactly when every term is.
+/// [`all_finite`] for `v.len() == N`: `0 x` is a zero for a finite x and NaN for an infinite
+/// or NaN one, and their sum is a zero exactly when every term is.
 fn all_finite_fixed<const N: usize>(v: &[f64]) -> bool {
-    v.as_chunks::<N>().0[0].iter().fold(0.0, |s, x| s + (x - x)) == 0.0
+    v.as_chunks::<N>().0[0].iter().fold(0.0, |s, x| s + 0.0 * x) == 0.0
 }
 
 /// `out_i = sum_j w_j K_ji` over the stages `K_j` (the rows of `k`, each `out.len()` long)
@@ -535,7 +535,7 @@ mod tests {
 
     /// The fixed-size test (3, 5, 7 entries) and the general one (any other length) refuse a
     /// NaN or an infinity of either sign at every position, and accept finite values at the
-    /// ends of the range (the largest, a subnormal, both zeros), where `x - x` must stay 0.
+    /// ends of the range (the largest, a subnormal, both zeros), where `0 x` must stay a zero.
     #[test]
     fn all_finite_refuses_each_non_finite_entry_at_every_length() {
         let finite = [f64::MAX, -f64::MAX, 5e-324, -0.0, 0.0, 1.0, -3.5, f64::MIN_POSITIVE];
