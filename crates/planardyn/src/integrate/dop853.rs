@@ -34,6 +34,7 @@
 
 use super::control::{all_finite, combine, explicit_step, scaled_sum, weighted_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
+use crate::linalg::copy_small;
 
 /// Stages of the step (the FSAL stage excluded).
 const N_STAGES: usize = 12;
@@ -412,6 +413,10 @@ impl Dop853 {
 
     /// Evaluate stage `s` from the stages before it: `K_s = f(t + C_s h, y + h sum_j A_sj K_j)`,
     /// from the current point, or (`accepted`) from the start of the last accepted step.
+    /// Inlined: as a call of its own each of a step's 11 stages saved and restored its
+    /// registers and checked its slices' bounds again (four-bar 10 s, 4634 stages: 12.57 M ->
+    /// 12.40 M instructions a run).
+    #[inline(always)]
     fn stage<S: OdeSystem>(&mut self, sys: &mut S, s: usize, h: f64, accepted: bool) -> Result<(), Failure<S::Error>> {
         let Dop853 { core, k, ytmp, .. } = self;
         let n = core.n;
@@ -423,6 +428,16 @@ impl Dop853 {
         } else {
             Core::eval(&mut core.stats, sys, t0 + C[s] * h, ytmp, ks)
         }
+    }
+
+    /// Stage `I` of an attempt ([`Dop853::stage`] from the current point). With `I` a constant
+    /// the row `A[I]` is known where its sum is inlined (`combine`), so the compiler drops its
+    /// zero weights and unrolls the rest: the four-bar's 10 s run (4634 stages) 12.40 M ->
+    /// 12.07 M instructions, where a loop over the stages, even unrolled, kept a test and a
+    /// branch for each weight (12.29 M).
+    #[inline(always)]
+    fn stage_at<const I: usize, S: OdeSystem>(&mut self, sys: &mut S, h: f64) -> Result<(), Failure<S::Error>> {
+        self.stage(sys, I, h, false)
     }
 }
 
@@ -446,17 +461,21 @@ impl ExplicitPair for Dop853 {
             self.dense_ready = true;
         }
         self.h = h;
-        self.k[..n].copy_from_slice(&self.core.f);
-        for s in 1..N_STAGES {
-            self.stage(sys, s, h, false)?;
+        copy_small(&mut self.k[..n], &self.core.f);
+        // Stage by stage with the index a constant: each stage's sum is then of its tableau
+        // row's nonzero weights only, unrolled, with no test of a weight (see `stage_at`).
+        macro_rules! stages {
+            ($($s:literal)*) => { $(self.stage_at::<$s, S>(sys, h)?;)* };
         }
+        const { assert!(N_STAGES == 12, "the stages listed are 1..N_STAGES") };
+        stages!(1 2 3 4 5 6 7 8 9 10 11);
         let Dop853 { core, k, ytmp, e3, y_new, f_new, .. } = self;
         combine(y_new, &core.y, h, &B, &k[..N_STAGES * n]);
         if !all_finite(y_new) {
             return Err(Failure::NonFinite);
         }
         Core::eval(&mut core.stats, sys, core.t + h, y_new, f_new)?;
-        k[N_STAGES * n..(N_STAGES + 1) * n].copy_from_slice(f_new);
+        copy_small(&mut k[N_STAGES * n..(N_STAGES + 1) * n], f_new);
         // Hairer's combined estimator, in scaled RMS form, and the step's increment in the same
         // scale (for `reach_error`).
         let e5 = ytmp;

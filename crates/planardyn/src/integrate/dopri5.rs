@@ -27,6 +27,7 @@
 
 use super::control::{all_finite, combine, error_norm, explicit_step, scaled_sum, Core, ExplicitPair, Failure};
 use super::{Integrator, OdeSystem, Options, StepError};
+use crate::linalg::copy_small;
 
 const C: [f64; 6] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0];
 
@@ -149,18 +150,22 @@ impl ExplicitPair for Dopri5 {
         self.h = h;
         let Dopri5 { core, k, ytmp, y_new, f_new, err, .. } = self;
         let (t, n) = (core.t, core.n);
-        k[..n].copy_from_slice(&core.f);
-        for s in 1..6 {
-            combine(ytmp, &core.y, h, &A[s][..s], &k[..s * n]);
-            let ks = &mut k[s * n..(s + 1) * n];
-            Core::eval(&mut core.stats, sys, t + C[s] * h, ytmp, ks)?;
+        copy_small(&mut k[..n], &core.f);
+        // Stage by stage with the index a constant, as DOP853's (`Dop853::stage_at`): each
+        // row's sum is unrolled over its nonzero weights only.
+        macro_rules! stages {
+            ($($s:literal)*) => { $(
+                combine(ytmp, &core.y, h, &A[$s][..$s], &k[..$s * n]);
+                Core::eval(&mut core.stats, sys, t + C[$s] * h, ytmp, &mut k[$s * n..($s + 1) * n])?;
+            )* };
         }
+        stages!(1 2 3 4 5);
         combine(y_new, &core.y, h, &B, &k[..6 * n]);
         if !all_finite(y_new) {
             return Err(Failure::NonFinite);
         }
         Core::eval(&mut core.stats, sys, t + h, y_new, f_new)?;
-        k[6 * n..].copy_from_slice(f_new);
+        copy_small(&mut k[6 * n..], f_new);
         scaled_sum(err, h, &E, k);
         Ok(error_norm(err, &core.y, y_new, &core.opts))
     }
