@@ -233,9 +233,10 @@ impl Gears {
         self.held[i].unwrap_or_else(|| Band::of(self.actuator(mech, i), self.rotors[self.slots[i]].rate))
     }
 
-    /// Whether any actuator has a motor (and so a side to hold).
-    pub(crate) fn has_motors(&self) -> bool {
-        !self.slots.is_empty()
+    /// Whether motor i's law has a side to hold: its coordinate was not following a prescribed
+    /// motion at the last evaluation (a prescribed one's gear only reacts on its housing).
+    pub(crate) fn free(&self, i: usize) -> bool {
+        self.modes[i] != PRESCRIBED
     }
 
     /// Each motor's actuator index, side of its at-rest band (held or qd's), actuator and

@@ -71,11 +71,13 @@ impl GearSides {
     ) -> Result<Option<f64>, Error> {
         let (t0, t1) = (stepper.t_prev(), stepper.t());
         let retaken = self.switch.take().filter(|&(ts, _)| t1 == ts);
-        if !ode.ws.losses.gears().has_motors() {
+        let n = ode.ws.losses.gears().sides(ode.mech).count();
+        // A prescribed coordinate's gear has no side (its switching function would only cost
+        // evaluations, and one failing there would end the run).
+        if !(0..n).any(|i| ode.ws.losses.gears().free(i)) {
             return Ok(None);
         }
         let m = ode.m();
-        let n = ode.ws.losses.gears().sides(ode.mech).count();
         let direct = ode.ws.chart == Chart::Inputs && ode.motion.is_none();
         let direct = direct && ode.ws.losses.gears().sides(ode.mech).all(|(k, ..)| k < m);
         // Read from the states, unless a motor's rate needs an evaluation (put back after).
@@ -83,6 +85,9 @@ impl GearSides {
         yi.copy_from_slice(stepper.y());
         let mut first: Option<(f64, usize)> = None;
         for i in 0..n {
+            if !ode.ws.losses.gears().free(i) {
+                continue;
+            }
             let (g1, window) = switching(ode, i, t1, yi)?;
             if retaken.is_some_and(|(_, j)| j == i) && g1.abs() <= window {
                 first = Some((t1, i));
