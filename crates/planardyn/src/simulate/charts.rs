@@ -241,11 +241,11 @@ impl FallWatch {
         self.bounds
     }
 
-    /// Take the accepted point `now` = (t, sigma, |qdd|), sigma and qdd the chart's own (`user`:
-    /// in the user's chart; `alt`: in an alternative chart, watched only where falls are
-    /// bounded, so that DOP853's steps there keep no smooth-fall bound they did not have;
-    /// `continued`: the point before was in the same chart; `low`: sigma below the run's
-    /// PREDICT_BELOW) and return the bound on the next step, if any.
+    /// Take the accepted point `now` = (t, sigma, |qdd|) in `chart`, sigma and qdd the chart's
+    /// own (`continued`: the point before was in the same chart; `low`: sigma below the run's
+    /// PREDICT_BELOW) and return the bound on the next step, if any. The user's chart is
+    /// watched; an alternative (pairs') chart only where falls are bounded, so that DOP853's
+    /// steps there keep no smooth-fall bound they did not have; a partition is not watched.
     ///
     /// An alternative chart's equations are singular as the user's are where its own measure
     /// reaches 0, and its steps fall into it alike: the five-bar fall, DOPRI5 at rtol = atol
@@ -267,15 +267,12 @@ impl FallWatch {
     /// where the steps are long (five-bar fall, DOPRI5 rtol 9.5e-5: 27.1 then 25.7 at sigma
     /// 0.106 and 0.085, and the next step, unbounded by T/2, took 0.085 to 0.050 and gained
     /// 1.0e-3 J).
-    pub fn next_step_bound(
-        &mut self,
-        user: bool,
-        alt: bool,
-        continued: bool,
-        low: bool,
-        now: (f64, f64, f64),
-    ) -> Option<f64> {
-        let watched = user || alt && self.bounds;
+    pub fn next_step_bound(&mut self, chart: &Chart, continued: bool, low: bool, now: (f64, f64, f64)) -> Option<f64> {
+        let watched = match chart {
+            Chart::Inputs => true,
+            Chart::Pairs(_) => self.bounds,
+            Chart::Partition(_) => false,
+        };
         let last = self.last.filter(|_| watched && continued);
         let growth = last.map_or(f64::NAN, |last| acceleration_growth(last, now));
         let (rising, analytic) = (growth > 0.0 && growth >= self.growth, growth > 0.0 && growth < self.growth);

@@ -514,14 +514,14 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         self.last_own = Some(own);
         // A step in the user's chart may not rush into type II, nor one in an alternative
         // chart into its own singularity (`FallWatch`).
-        let (user, alt) = (self.ode.ws.chart == Chart::Inputs, matches!(self.ode.ws.chart, Chart::Pairs(_)));
         let m = self.ode.m();
         let qdd = if self.fall.wants_accelerations() {
             self.stepper.dy()[m..2 * m].iter().map(|a| a * a).sum::<f64>().sqrt()
         } else {
             f64::NAN
         };
-        if let Some(h) = self.fall.next_step_bound(user, alt, self.chart_steps > 0, own < PREDICT_BELOW, (t, own, qdd))
+        if let Some(h) =
+            self.fall.next_step_bound(&self.ode.ws.chart, self.chart_steps > 0, own < PREDICT_BELOW, (t, own, qdd))
         {
             self.stepper.bound_next_step(h);
         }
