@@ -77,10 +77,8 @@ impl GearSides {
         if !(0..n).any(|i| ode.ws.losses.gears().free(i)) {
             return Ok(None);
         }
-        let m = ode.m();
-        let direct = ode.ws.chart == Chart::Inputs && ode.motion.is_none();
-        let direct = direct && ode.ws.losses.gears().sides(ode.mech).all(|(k, ..)| k < m);
         // Read from the states, unless a motor's rate needs an evaluation (put back after).
+        let direct = ode.ws.losses.gears().sides(ode.mech).all(|(k, ..)| rate_in_state(ode, k));
         let saved = (!direct).then(|| ode.save());
         yi.copy_from_slice(stepper.y());
         let mut first: Option<(f64, usize)> = None;
@@ -141,13 +139,18 @@ impl GearSides {
 /// Motor i's switching function ([`Band::switching`]) at state y and its [`END_WINDOW`]: qd
 /// read from y in the user's chart for a coordinate's motor, else from an evaluation there.
 fn switching(ode: &mut MechanismOde, i: usize, t: f64, y: &[f64]) -> Result<(f64, f64), Error> {
-    let m = ode.m();
     let (k, band, a, _) = ode.ws.losses.gears().sides(ode.mech).nth(i).expect("motor i exists");
-    let qd = if k < m && ode.ws.chart == Chart::Inputs && ode.motion.is_none() {
-        y[m + k]
+    let qd = if rate_in_state(ode, k) {
+        y[ode.m() + k]
     } else {
         ode.evaluate_walking(t, y)?;
         ode.ws.losses.gears().sides(ode.mech).nth(i).expect("motor i exists").3
     };
     Ok((band.switching(a, qd, EXIT_MARGIN), END_WINDOW * a.stiction_speed))
+}
+
+/// Whether actuator k's rate is read from the state itself: a coordinate's, in the user's chart,
+/// with no prescribed motion (which replaces the state's rates in the evaluation).
+fn rate_in_state(ode: &MechanismOde, k: usize) -> bool {
+    k < ode.m() && ode.ws.chart == Chart::Inputs && ode.motion.is_none()
 }
