@@ -207,7 +207,8 @@ impl<'a, 's, 'e> Run<'a, 's, 'e> {
         match self.gear_sides.switch_in_step(&mut self.ode, &mut self.stepper, &self.y, &mut self.yi) {
             Ok(Some(t_switch)) => return self.retake_to(t_switch),
             Ok(None) => {}
-            Err(error) => return Break(Stop::Output { t, error }),
+            // Read on the step's interpolant: its failure is the dense output's.
+            Err(error) => return Break(Stop::DenseOutput { t, error }),
         }
         self.y.copy_from_slice(self.stepper.y());
         self.chart_steps += 1;
