@@ -63,6 +63,7 @@ impl Passed {
         let ws = &ode.ws;
         (self.t, self.passive, self.sigma, self.power, self.speed) =
             (t, passive, f64::NAN, ws.power, scaled_speed(ode.mech, &ws.xd));
+        // `max(1)`: chunks of 0 panic, and a state of no bodies has none to copy.
         for (dest, part) in self.state.chunks_exact_mut(ws.x.len().max(1)).zip([&ws.x, &ws.xd, &ws.xdd]) {
             dest.copy_from_slice(part);
         }
